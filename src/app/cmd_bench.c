@@ -1,0 +1,135 @@
+// cmd_bench.c: `cranesim bench`: real-time factors as JSON lines.
+//
+// Each configuration is run `--repeat` times and the median wall time is
+// reported: this machine is shared and noisy, so medians and ratios are the
+// honest figures. Benchmarks measure; tests never time anything.
+#include "app.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static void bench_help(FILE* f) {
+    fprintf(f,
+            "usage: cranesim bench [--scenario S] [--duration T] [--repeat N] [--config NAME] [--model M]\n"
+            "\n"
+            "Prints one JSON object per line and configuration: scenario, mechanics, variant,\n"
+            "solver, step or tolerances, simulated time [s], median wall time [s], real-time\n"
+            "factor (simulated/wall), steps, f evaluations, LU factorisations, ns per step.\n"
+            "\n"
+            "configurations (default: all lagrange ones):\n"
+            "  krus-0.1ms   Krus, h = 0.1 ms, block-diagonal J every 10 steps (the paper's setting)\n"
+            "  krus-dense   Krus, h = 0.1 ms, dense J every 10 steps\n"
+            "  ros2-0.1ms   ROS2, h = 0.1 ms, block J\n"
+            "  krus-1ms     Krus, h = 1 ms\n"
+            "  ros34pw2     adaptive ROS34PW2, rtol 1e-3\n"
+            "  rodas3       adaptive RODAS3, rtol 1e-3\n"
+            "\n"
+            "options:\n"
+            "  --scenario S   default ramp\n"
+            "  --duration T   simulated seconds per run (default: the scenario's)\n"
+            "  --repeat N     runs per configuration, median reported (default 3)\n"
+            "  --config NAME  only this configuration (repeatable)\n");
+}
+
+typedef struct bench_cfg {
+    const char* name;
+    hyd_method solver;
+    double h;
+    bool dense;
+    double rtol;
+} bench_cfg;
+
+static const bench_cfg configs[] = {
+    {"krus-0.1ms", HYD_KRUS, 1e-4, false, 0},
+    {"krus-dense", HYD_KRUS, 1e-4, true, 0},
+    {"ros2-0.1ms", HYD_ROS2, 1e-4, false, 0},
+    {"krus-1ms", HYD_KRUS, 1e-3, false, 0},
+    {"ros34pw2", HYD_ROS34PW2, 0, false, 1e-3},
+    {"rodas3", HYD_RODAS3, 0, false, 1e-3},
+};
+
+static int cmp_d(const void* a, const void* b) {
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+int cmd_bench(int argc, char** argv) {
+    app_common c = {.sim = sim_default_opts()};
+    int repeat = 3;
+    const char* only[16];
+    int nonly = 0;
+    for (int i = 0; i < argc; ++i) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            bench_help(stdout);
+            return 0;
+        }
+        int rc = app_parse_common(&c, argc, argv, &i);
+        if (rc < 0) return EXIT_USAGE;
+        if (rc > 0) continue;
+        if (!strcmp(argv[i], "--repeat") && i + 1 < argc) {
+            double d;
+            if (app_parse_double(argv[++i], &d) || d < 1 || d > 100) {
+                fprintf(stderr, "cranesim bench: --repeat: expected 1..100, got '%s'\n", argv[i]);
+                return EXIT_USAGE;
+            }
+            repeat = (int)d;
+            continue;
+        }
+        if (!strcmp(argv[i], "--config") && i + 1 < argc && nonly < 16) {
+            only[nonly++] = argv[++i];
+            continue;
+        }
+        fprintf(stderr, "cranesim bench: unknown option '%s' (see cranesim bench --help)\n", argv[i]);
+        return EXIT_USAGE;
+    }
+    for (int j = 0; j < nonly; ++j) {
+        bool found = false;
+        for (size_t k = 0; k < sizeof configs / sizeof configs[0]; ++k) found |= !strcmp(only[j], configs[k].name);
+        if (!found) {
+            fprintf(stderr, "cranesim bench: unknown configuration '%s' (see --help)\n", only[j]);
+            return EXIT_USAGE;
+        }
+    }
+    model* m;
+    scenario sc;
+    int rc = app_load(&c, &m, &sc);
+    if (rc) return rc;
+    int code = 0;
+    for (size_t k = 0; k < sizeof configs / sizeof configs[0]; ++k) {
+        const bench_cfg* b = &configs[k];
+        bool want = nonly == 0;
+        for (int j = 0; j < nonly; ++j) want |= !strcmp(only[j], b->name);
+        if (!want) continue;
+        sim_opts o = c.sim;
+        o.solver = b->solver;
+        o.dense_jac = b->dense;
+        if (b->h > 0) o.h = b->h;
+        if (b->rtol > 0) o.rtol = b->rtol;
+        double walls[100];
+        sim_result r;
+        for (int i = 0; i < repeat; ++i) {
+            sim_run(m, &sc, &o, NULL, NULL, NULL, NULL, NULL, &r);
+            walls[i] = r.wall;
+            if (r.status) break;
+        }
+        if (r.status) {
+            printf("{\"config\":\"%s\",\"error\":\"%s\"}\n", b->name, r.message);
+            code = EXIT_RUNTIME;
+            continue;
+        }
+        qsort(walls, (size_t)repeat, sizeof walls[0], cmp_d);
+        double wall = walls[repeat / 2];
+        printf("{\"config\":\"%s\",\"scenario\":\"%s\",\"mechanics\":\"lagrange\",\"variant\":\"%s\","
+               "\"solver\":\"%s\",\"h_s\":%g,\"rtol\":%g,\"jacobian\":\"%s\",\"sim_time_s\":%.6g,"
+               "\"wall_s_median\":%.6g,\"repeat\":%d,\"rt_factor\":%.1f,\"steps\":%ld,\"rejected\":%ld,"
+               "\"fevals\":%ld,\"jevals\":%ld,\"lus\":%ld,\"ns_per_step\":%.1f}\n",
+               b->name, sc.name, lagrange_variant_name(o.variant), hyd_method_name(o.solver),
+               hyd_method_is_adaptive(o.solver) ? 0.0 : o.h, hyd_method_is_adaptive(o.solver) ? o.rtol : 0.0,
+               hyd_method_is_adaptive(o.solver) ? "dense" : (o.dense_jac ? "dense" : "blocks"), r.t_end, wall,
+               repeat, r.t_end / wall, r.stats.steps, r.stats.rejected, r.stats.fevals, r.stats.jevals,
+               r.stats.lus, 1e9 * wall / (double)(r.stats.steps ? r.stats.steps : 1));
+        fflush(stdout);
+    }
+    model_free(m);
+    return code;
+}

@@ -1,0 +1,218 @@
+// cmd_compare.c: `cranesim compare`: one scenario run two ways, difference
+// metrics, overlay plots, and a pass/fail against given tolerances.
+#include "app.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static void compare_help(FILE* f) {
+    fprintf(f,
+            "usage: cranesim compare [--scenario S] [--backends A,B] [--solvers A,B] [--variants A,B]\n"
+            "                        [--dts H1,H2] [--tol-stroke MM] [--tol-pressure PCT] [--plot FILE.png]\n"
+            "\n"
+            "Runs the scenario twice, differing in what the pair options say (the rest is\n"
+            "shared), and prints RMS and maximum differences of strokes [mm], chamber\n"
+            "pressures [MPa and %% of peak], joint angles [deg] and tip position [mm].\n"
+            "Default: --backends lagrange,ode (lagrange full vs the ode validation world).\n"
+            "\n"
+            "options:\n"
+            "  --backends A,B      lagrange | ode\n"
+            "  --solvers A,B       krus | ros2 | rk4 | ros34pw2 | rodas3\n"
+            "  --variants A,B      full | paper | paper-typo\n"
+            "  --dts H1,H2         fixed steps [s]\n"
+            "  --tol-stroke MM     fail (exit 1) if the stroke RMS difference exceeds MM millimetres\n"
+            "  --tol-pressure PCT  fail (exit 1) if the pressure RMS difference exceeds PCT %% of peak\n"
+            "  --plot FILE.png     overlay plot (solid: A, dashed: B)\n");
+    app_common_help(f, true);
+}
+
+static int split_pair(const char* opt, const char* v, char a[64], char b[64]) {
+    const char* comma = strchr(v, ',');
+    if (!comma || comma == v || !comma[1] || (size_t)(comma - v) >= 64 || strlen(comma + 1) >= 64) {
+        fprintf(stderr, "cranesim compare: %s: expected two values A,B, got '%s'\n", opt, v);
+        return -1;
+    }
+    memcpy(a, v, (size_t)(comma - v));
+    a[comma - v] = 0;
+    snprintf(b, 64, "%s", comma + 1);
+    return 0;
+}
+
+typedef struct diff {
+    double rms, max;
+} diff;
+
+static diff column_diff(const sim_trace* a, const sim_trace* b, int col, double scale) {
+    int n = a->nrow < b->nrow ? a->nrow : b->nrow;
+    double s2 = 0, mx = 0;
+    for (int i = 0; i < n; ++i) {
+        double d = (a->v[(size_t)i * SIM_NCOL + col] - b->v[(size_t)i * SIM_NCOL + col]) * scale;
+        s2 += d * d;
+        if (fabs(d) > mx) mx = fabs(d);
+    }
+    diff r = {n ? sqrt(s2 / n) : 0, mx};
+    return r;
+}
+
+int cmd_compare(int argc, char** argv) {
+    app_common c = {.sim = sim_default_opts()};
+    sim_opts side[2];
+    char label[2][96] = {"lagrange", "ode"};
+    bool backends_given = false, any_pair = false;
+    double tol_stroke = -1, tol_pressure = -1;
+    const char* plot = NULL;
+    char pa[64], pb[64];
+    const char* pairs[4] = {NULL, NULL, NULL, NULL}; // backends, solvers, variants, dts
+    for (int i = 0; i < argc; ++i) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            compare_help(stdout);
+            return 0;
+        }
+        int rc = app_parse_common(&c, argc, argv, &i);
+        if (rc < 0) return EXIT_USAGE;
+        if (rc > 0) continue;
+        static const char* const popt[] = {"--backends", "--solvers", "--variants", "--dts"};
+        bool used = false;
+        for (int k = 0; k < 4; ++k)
+            if (!strcmp(argv[i], popt[k]) && i + 1 < argc) {
+                pairs[k] = argv[++i];
+                used = true;
+            }
+        if (used) continue;
+        if ((!strcmp(argv[i], "--tol-stroke") || !strcmp(argv[i], "--tol-pressure")) && i + 1 < argc) {
+            double d;
+            if (app_parse_double(argv[i + 1], &d) || d < 0) {
+                fprintf(stderr, "cranesim compare: %s: expected a number >= 0, got '%s'\n", argv[i], argv[i + 1]);
+                return EXIT_USAGE;
+            }
+            if (argv[i][6] == 's') tol_stroke = d;
+            else tol_pressure = d;
+            ++i;
+            continue;
+        }
+        if (!strcmp(argv[i], "--plot") && i + 1 < argc) {
+            plot = argv[++i];
+            continue;
+        }
+        fprintf(stderr, "cranesim compare: unknown option '%s' (see cranesim compare --help)\n", argv[i]);
+        return EXIT_USAGE;
+    }
+    side[0] = side[1] = c.sim;
+    label[0][0] = label[1][0] = 0;
+    for (int k = 0; k < 4; ++k) {
+        if (!pairs[k]) continue;
+        static const char* const popt[] = {"--backends", "--solvers", "--variants", "--dts"};
+        if (split_pair(popt[k], pairs[k], pa, pb)) return EXIT_USAGE;
+        any_pair = true;
+        const char* v[2] = {pa, pb};
+        for (int s = 0; s < 2; ++s) {
+            if (k == 0) {
+                backends_given = true;
+                if (!strcmp(v[s], "lagrange")) side[s].mechanics = SIM_LAGRANGE;
+                else if (!strcmp(v[s], "ode")) side[s].mechanics = SIM_ODE;
+                else {
+                    fprintf(stderr, "cranesim compare: --backends: expected lagrange or ode, got '%s'\n", v[s]);
+                    return EXIT_USAGE;
+                }
+            } else if (k == 1) {
+                int m = hyd_method_parse(v[s]);
+                if (m < 0) {
+                    fprintf(stderr, "cranesim compare: --solvers: unknown solver '%s'\n", v[s]);
+                    return EXIT_USAGE;
+                }
+                side[s].solver = (hyd_method)m;
+            } else if (k == 2) {
+                int m = lagrange_variant_parse(v[s]);
+                if (m < 0) {
+                    fprintf(stderr, "cranesim compare: --variants: unknown variant '%s'\n", v[s]);
+                    return EXIT_USAGE;
+                }
+                side[s].variant = (lagrange_variant)m;
+            } else if (app_parse_double(v[s], &side[s].h) || !(side[s].h > 0)) {
+                fprintf(stderr, "cranesim compare: --dts: expected positive steps [s], got '%s'\n", v[s]);
+                return EXIT_USAGE;
+            }
+            size_t L = strlen(label[s]);
+            snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? "/" : "", v[s]);
+        }
+    }
+    (void)backends_given;
+    if (!any_pair) { // the default comparison: lagrange full vs the ode validation world
+        side[0].mechanics = SIM_LAGRANGE;
+        side[1].mechanics = SIM_ODE;
+        snprintf(label[0], sizeof label[0], "lagrange");
+        snprintf(label[1], sizeof label[1], "ode");
+    }
+    model* m;
+    scenario sc;
+    int rc = app_load(&c, &m, &sc);
+    if (rc) return rc;
+    sim_trace tr[2] = {{0}, {0}};
+    sim_result res[2];
+    for (int s = 0; s < 2; ++s) {
+        if (!c.quiet && isatty(2)) fprintf(stderr, "run %s:\n", label[s]);
+        sim_run(m, &sc, &side[s], NULL, NULL, &tr[s], c.quiet ? NULL : app_progress, NULL, &res[s]);
+        if (!c.quiet) app_progress_done();
+        if (res[s].status) {
+            fprintf(stderr, "cranesim compare: %s: %s\n", label[s], res[s].message);
+            sim_trace_free(&tr[0]);
+            sim_trace_free(&tr[1]);
+            model_free(m);
+            return res[s].status == 1 ? EXIT_RUNTIME : EXIT_USAGE;
+        }
+    }
+    double ppeak = 0;
+    for (int i = 0; i < tr[0].nrow; ++i)
+        for (int k = 0; k < 4; ++k) ppeak = fmax(ppeak, tr[0].v[(size_t)i * SIM_NCOL + COL_P1A + k]);
+    printf("cranesim compare: %s, A = %s, B = %s, %d rows\n", sc.name, label[0], label[1],
+           tr[0].nrow < tr[1].nrow ? tr[0].nrow : tr[1].nrow);
+    printf("  %-8s %12s %12s\n", "column", "RMS diff", "max diff");
+    struct {
+        int col;
+        double scale;
+        const char* unit;
+    } rows[] = {{COL_X1, 1e3, "mm"},  {COL_X2, 1e3, "mm"},         {COL_P1A, 1e-6, "MPa"},
+                {COL_P1B, 1e-6, "MPa"}, {COL_P2A, 1e-6, "MPa"},    {COL_P2B, 1e-6, "MPa"},
+                {COL_Q1, 180 / M_PI, "deg"}, {COL_Q2, 180 / M_PI, "deg"}, {COL_TIP_X, 1e3, "mm"},
+                {COL_TIP_Z, 1e3, "mm"}};
+    double stroke_rms = 0, press_rms = 0;
+    for (size_t k = 0; k < sizeof rows / sizeof rows[0]; ++k) {
+        diff d = column_diff(&tr[0], &tr[1], rows[k].col, rows[k].scale);
+        printf("  %-8s %9.4g %-3s %9.4g %-3s\n", sim_col_name[rows[k].col], d.rms, rows[k].unit, d.max,
+               rows[k].unit);
+        if (rows[k].col == COL_X1 || rows[k].col == COL_X2) stroke_rms = fmax(stroke_rms, d.rms);
+        if (rows[k].col >= COL_P1A && rows[k].col <= COL_P2B) press_rms = fmax(press_rms, d.rms);
+    }
+    double press_pct = ppeak > 0 ? 100.0 * press_rms / (ppeak * 1e-6) : 0;
+    printf("  worst stroke RMS %.4g mm; worst pressure RMS %.4g MPa = %.3g %% of peak %.2f MPa\n", stroke_rms,
+           press_rms, press_pct, ppeak * 1e-6);
+    int code = 0;
+    if (tol_stroke >= 0 && stroke_rms > tol_stroke) {
+        printf("  FAIL: stroke RMS %.4g mm > tolerance %.4g mm\n", stroke_rms, tol_stroke);
+        code = EXIT_RUNTIME;
+    }
+    if (tol_pressure >= 0 && press_pct > tol_pressure) {
+        printf("  FAIL: pressure RMS %.3g %% > tolerance %.3g %%\n", press_pct, tol_pressure);
+        code = EXIT_RUNTIME;
+    }
+    if (plot) {
+        char err[256], title[200];
+        snprintf(title, sizeof title, "%s: %s vs %s", sc.name, label[0], label[1]);
+        if (app_plot_compare(&tr[0], label[0], &tr[1], label[1], title, plot, err, sizeof err)) {
+            fprintf(stderr, "cranesim compare: plot: %s\n", err);
+            code = EXIT_RUNTIME;
+        } else {
+            printf("  plot -> %s\n", plot);
+        }
+    }
+    sim_trace_free(&tr[0]);
+    sim_trace_free(&tr[1]);
+    model_free(m);
+    return code;
+}

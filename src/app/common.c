@@ -1,0 +1,169 @@
+// common.c: option parsing and loading shared by the subcommands.
+#include "app.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+int app_parse_double(const char* s, double* v) {
+    char* end;
+    errno = 0;
+    double x = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(x)) return -1;
+    *v = x;
+    return 0;
+}
+
+static int need_value(int argc, char** argv, int i) {
+    if (i + 1 >= argc) {
+        fprintf(stderr, "cranesim: option %s needs a value (see --help)\n", argv[i]);
+        return -1;
+    }
+    return 0;
+}
+
+static int positive(const char* opt, const char* s, double* v) {
+    if (app_parse_double(s, v) || !(*v > 0)) {
+        fprintf(stderr, "cranesim: %s: expected a positive number, got '%s'\n", opt, s);
+        return -1;
+    }
+    return 0;
+}
+
+int app_parse_common(app_common* c, int argc, char** argv, int* i) {
+    const char* a = argv[*i];
+    if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+        c->quiet = true;
+        return 1;
+    }
+    if (!strcmp(a, "--dense-jac")) {
+        c->sim.dense_jac = true;
+        return 1;
+    }
+    static const char* const with_value[] = {"--model", "--scenario", "--mechanics", "--variant", "--solver",
+                                             "--dt", "--rtol", "--atol", "--duration", "--every",
+                                             "--set", "--jac-every", NULL};
+    int k = -1;
+    for (int j = 0; with_value[j]; ++j)
+        if (!strcmp(a, with_value[j])) k = j;
+    if (k < 0) return 0;
+    if (need_value(argc, argv, *i)) return -1;
+    const char* v = argv[++*i];
+    double d;
+    switch (k) {
+    case 0: c->model_path = v; break;
+    case 1: c->scenario_path = v; break;
+    case 2:
+        if (!strcmp(v, "lagrange")) c->sim.mechanics = SIM_LAGRANGE;
+        else if (!strcmp(v, "ode")) c->sim.mechanics = SIM_ODE;
+        else {
+            fprintf(stderr, "cranesim: --mechanics: expected lagrange or ode, got '%s'\n", v);
+            return -1;
+        }
+        break;
+    case 3: {
+        int var = lagrange_variant_parse(v);
+        if (var < 0) {
+            fprintf(stderr, "cranesim: --variant: expected full, paper or paper-typo, got '%s'\n", v);
+            return -1;
+        }
+        c->sim.variant = (lagrange_variant)var;
+        break;
+    }
+    case 4: {
+        int m = hyd_method_parse(v);
+        if (m < 0) {
+            fprintf(stderr, "cranesim: --solver: expected krus, ros2, rk4, ros34pw2 or rodas3, got '%s'\n", v);
+            return -1;
+        }
+        c->sim.solver = (hyd_method)m;
+        break;
+    }
+    case 5: if (positive(a, v, &c->sim.h)) return -1; break;
+    case 6: if (positive(a, v, &c->sim.rtol)) return -1; break;
+    case 7: if (positive(a, v, &c->sim.atol)) return -1; break;
+    case 8: if (positive(a, v, &c->sim.duration)) return -1; break;
+    case 9: if (positive(a, v, &c->sim.dt_out)) return -1; break;
+    case 10:
+        if (c->nset == APP_MAX_SET) {
+            fprintf(stderr, "cranesim: at most %d --set options\n", APP_MAX_SET);
+            return -1;
+        }
+        if (!strchr(v, '=')) {
+            fprintf(stderr, "cranesim: --set: expected path=value, got '%s'\n", v);
+            return -1;
+        }
+        c->sets[c->nset++] = v;
+        break;
+    case 11:
+        if (app_parse_double(v, &d) || d < 1 || d != floor(d)) {
+            fprintf(stderr, "cranesim: --jac-every: expected a whole number >= 1, got '%s'\n", v);
+            return -1;
+        }
+        c->sim.jac_every = (int)d;
+        break;
+    }
+    return 1;
+}
+
+void app_common_help(FILE* f, bool with_solver) {
+    fprintf(f,
+            "  --model FILE         crane model JSON (default: assets/models/hiab031.json)\n"
+            "  --scenario S         scenario JSON file, or a name in assets/scenarios (e.g. ramp)\n"
+            "  --set PATH=VALUE     override any model value, e.g. --set mechanics.load_mass=800\n"
+            "                       or --set hydraulics.components.lift_cyl.bore=0.11 (repeatable)\n"
+            "  --mechanics M        lagrange (analytic 2-DOF, default) or ode\n"
+            "  --variant V          lagrange equations: full (default), paper, paper-typo\n");
+    if (with_solver)
+        fprintf(f,
+                "  --solver S           krus (default), ros2, rk4, ros34pw2, rodas3\n"
+                "  --dt H               fixed step [s] (default 1e-4)\n"
+                "  --rtol R, --atol A   adaptive tolerances (default 1e-3, 1e-6)\n"
+                "  --jac-every N        fixed-step: new Jacobian every N steps (default 10)\n"
+                "  --dense-jac          fixed-step: dense Jacobian instead of the block pattern\n"
+                "  --duration T         simulated time [s] (default: the scenario's)\n"
+                "  --every DT           output period [s] (default 1e-3, i.e. 1 kHz)\n");
+    fprintf(f, "  --quiet              no progress bar or summary\n");
+}
+
+const char* app_scenario_path(const char* arg, char* buf, size_t n) {
+    if (access(arg, R_OK) == 0 || strchr(arg, '/') || strstr(arg, ".json")) return arg;
+    snprintf(buf, n, "%s/scenarios/%s.json", model_assets_dir(), arg);
+    return buf;
+}
+
+int app_load(const app_common* c, model** m, scenario* sc) {
+    char err[512];
+    *m = model_load(c->model_path, c->sets, c->nset, err, sizeof err);
+    if (!*m) {
+        fprintf(stderr, "cranesim: %s\n", err);
+        return EXIT_USAGE;
+    }
+    char buf[512];
+    const char* sp = app_scenario_path(c->scenario_path ? c->scenario_path : "ramp", buf, sizeof buf);
+    if (scenario_load(sp, sc, err, sizeof err)) {
+        fprintf(stderr, "cranesim: %s\n", err);
+        model_free(*m);
+        *m = NULL;
+        return EXIT_USAGE;
+    }
+    return 0;
+}
+
+void app_progress(void* user, double t, double t_end) {
+    (void)user;
+    if (!isatty(2)) return;
+    const int width = 40;
+    double f = t_end > 0 ? t / t_end : 1.0;
+    if (f > 1) f = 1;
+    int n = (int)(f * width + 0.5);
+    fprintf(stderr, "\r  [%.*s%*s] %5.1f %%  t = %.2f / %.2f s", n,
+            "########################################", width - n, "", 100.0 * f, t, t_end);
+    fflush(stderr);
+}
+
+void app_progress_done(void) {
+    if (isatty(2)) fprintf(stderr, "\r%*s\r", 78, "");
+}

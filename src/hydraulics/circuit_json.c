@@ -1,0 +1,350 @@
+// circuit_json.c: the JSON face of the circuit (cJSON). Built as its own
+// library so the core stays libm-only.
+//
+// The loader walks the document, turning every field into the same definition
+// structs the C API uses (via the parameter and port tables in circuit.c),
+// then compiles. Value and cross-field rules live once, in the compiler;
+// errors it reports (element index + field) are mapped back to JSON paths
+// here. Unknown keys are rejected so a typo never silently falls back to a
+// default. Keys starting with '_' are comments and are ignored.
+#include "hyd_internal.h"
+
+#include <cjson/cJSON.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct jctx {
+    const char* file;
+    const char* prefix; ///< "" or "hydraulics" (no trailing dot)
+    char* err;
+    size_t errsz;
+} jctx;
+
+// "<file>: <prefix>.<path>: <msg>" (the prefix and its dot are left out when empty).
+static void jerr(const jctx* c, const char* path, const char* fmt, ...) {
+    if (!c->err || !c->errsz)
+        return;
+    char msg[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    const int pre = c->prefix && c->prefix[0];
+    const int has = path && path[0];
+    snprintf(c->err, c->errsz, "%s: %s%s%s%s%s", c->file ? c->file : "<json>",
+             pre ? c->prefix : "", pre && has ? "." : "", has ? path : "",
+             (pre || has) ? ": " : "", msg);
+}
+
+static const char* jtype(const cJSON* j) {
+    if (cJSON_IsNumber(j)) return "number";
+    if (cJSON_IsString(j)) return "string";
+    if (cJSON_IsBool(j)) return "boolean";
+    if (cJSON_IsNull(j)) return "null";
+    if (cJSON_IsArray(j)) return "array";
+    if (cJSON_IsObject(j)) return "object";
+    return "invalid";
+}
+
+// Set the numeric fields of a def struct from object o; report unknown keys.
+// allowed_extra: keys handled by the caller (name, type, ports).
+static int read_params(const jctx* c, const cJSON* o, const char* path, void* def,
+                       const hyd_param_info* p, int np, const hyd_port_info* ports, int nports,
+                       const char** port_out, int is_elem, const char* type_name) {
+    for (const cJSON* it = o->child; it; it = it->next) {
+        const char* key = it->string;
+        char fpath[200];
+        snprintf(fpath, sizeof fpath, "%s.%s", path, key);
+        if (key[0] == '_')
+            continue;
+        if (is_elem && (!strcmp(key, "name") || !strcmp(key, "type")))
+            continue;
+        int found = 0;
+        for (int k = 0; k < nports && !found; ++k)
+            if (!strcmp(key, ports[k].name)) {
+                found = 1;
+                if (!cJSON_IsString(it) || !it->valuestring[0]) {
+                    jerr(c, fpath, "must be a node name (non-empty string), got %s", jtype(it));
+                    return -1;
+                }
+                port_out[k] = it->valuestring;
+            }
+        for (int k = 0; k < np && !found; ++k)
+            if (!strcmp(key, p[k].name)) {
+                found = 1;
+                if (!cJSON_IsNumber(it)) {
+                    jerr(c, fpath, "must be a number, got %s", jtype(it));
+                    return -1;
+                }
+                *(double*)((char*)def + p[k].off) = it->valuedouble;
+            }
+        if (!found) {
+            char known[400] = "";
+            size_t len = 0;
+            for (int k = 0; k < nports + np; ++k) {
+                const char* nm = k < nports ? ports[k].name : p[k - nports].name;
+                len += (size_t)snprintf(known + len, len < sizeof known ? sizeof known - len : 0,
+                                        "%s%s", k ? ", " : "", nm);
+            }
+            jerr(c, fpath, "unknown field for %s (known: %s%s)", type_name,
+                 is_elem ? "name, type, " : "", known);
+            return -1;
+        }
+    }
+    for (int k = 0; k < np; ++k)
+        if (p[k].required && !cJSON_GetObjectItemCaseSensitive(o, p[k].name)) {
+            char fpath[200];
+            snprintf(fpath, sizeof fpath, "%s.%s", path, p[k].name);
+            jerr(c, fpath, "missing required field [%s]", p[k].unit);
+            return -1;
+        }
+    for (int k = 0; k < nports; ++k)
+        if (!port_out[k]) {
+            char fpath[200];
+            snprintf(fpath, sizeof fpath, "%s.%s", path, ports[k].name);
+            jerr(c, fpath, "missing required port (a node name)");
+            return -1;
+        }
+    return 0;
+}
+
+// Default def of a type, as raw bytes in the element union.
+static void default_def(hyd_type t, hyd_elem* e) {
+    switch (t) {
+    case HYD_TANK: e->def.tank = hyd_default_tank_def(); break;
+    case HYD_VOLUME: e->def.volume = hyd_default_volume_def(); break;
+    case HYD_PUMP: e->def.pump = hyd_default_pump_def(); break;
+    case HYD_RELIEF: e->def.relief = hyd_default_relief_def(); break;
+    case HYD_CHECK: e->def.check = hyd_default_check_def(); break;
+    case HYD_ORIFICE: e->def.orifice = hyd_default_orifice_def(); break;
+    case HYD_HOSE: e->def.hose = hyd_default_hose_def(); break;
+    case HYD_VALVE: e->def.valve = hyd_default_valve_def(); break;
+    case HYD_CYLINDER: e->def.cylinder = hyd_default_cylinder_def(); break;
+    default: break;
+    }
+}
+
+static int add_elem(hyd_builder* b, hyd_elem* e) {
+    switch (e->type) {
+    case HYD_TANK: return hyd_add_tank(b, &e->def.tank);
+    case HYD_VOLUME: return hyd_add_volume(b, &e->def.volume);
+    case HYD_PUMP: return hyd_add_pump(b, &e->def.pump);
+    case HYD_RELIEF: return hyd_add_relief(b, &e->def.relief);
+    case HYD_CHECK: return hyd_add_check(b, &e->def.check);
+    case HYD_ORIFICE: return hyd_add_orifice(b, &e->def.orifice);
+    case HYD_HOSE: return hyd_add_hose(b, &e->def.hose);
+    case HYD_VALVE: return hyd_add_valve(b, &e->def.valve);
+    case HYD_CYLINDER: return hyd_add_cylinder(b, &e->def.cylinder);
+    default: return -1;
+    }
+}
+
+// One entry of "nodes" (nodes = 1) or "components" (nodes = 0).
+static int read_elem(const jctx* c, hyd_builder* b, const cJSON* o, const char* list, int i,
+                     int nodes) {
+    char path[96];
+    snprintf(path, sizeof path, "%s[%d]", list, i);
+    if (!cJSON_IsObject(o)) {
+        jerr(c, path, "must be an object, got %s", jtype(o));
+        return -1;
+    }
+    const cJSON* jn = cJSON_GetObjectItemCaseSensitive(o, "name");
+    const cJSON* jt = cJSON_GetObjectItemCaseSensitive(o, "type");
+    char fpath[128];
+    snprintf(fpath, sizeof fpath, "%s.name", path);
+    if (!jn) {
+        jerr(c, fpath, "missing required field (a unique name)");
+        return -1;
+    }
+    if (!cJSON_IsString(jn)) {
+        jerr(c, fpath, "must be a string, got %s", jtype(jn));
+        return -1;
+    }
+    snprintf(fpath, sizeof fpath, "%s.type", path);
+    if (!jt) {
+        jerr(c, fpath, "missing required field");
+        return -1;
+    }
+    if (!cJSON_IsString(jt)) {
+        jerr(c, fpath, "must be a string, got %s", jtype(jt));
+        return -1;
+    }
+    const int t = hyd_type_parse(jt->valuestring);
+    const int is_node_type = t == HYD_TANK || t == HYD_VOLUME;
+    if (t < 0 || is_node_type != nodes) {
+        jerr(c, fpath, "unknown %s type '%s' (known: %s)", nodes ? "node" : "component",
+             jt->valuestring,
+             nodes ? "tank, volume" : "pump, relief, check, orifice, hose, valve, cylinder");
+        return -1;
+    }
+    hyd_elem e;
+    memset(&e, 0, sizeof e);
+    e.type = (hyd_type)t;
+    default_def(e.type, &e);
+    int np, nports;
+    const hyd_param_info* p = hyd_params_of(e.type, &np);
+    const hyd_port_info* ports = hyd_ports_of(e.type, &nports);
+    const char* port_names[HYD_MAXPORT] = {0};
+    if (read_params(c, o, path, &e.def, p, np, ports, nports, port_names, 1, jt->valuestring))
+        return -1;
+    char* base = (char*)&e.def;
+    *(const char**)base = jn->valuestring;
+    for (int k = 0; k < nports; ++k)
+        *(const char**)(base + ports[k].off) = port_names[k];
+    if (add_elem(b, &e) < 0) {
+        jerr(c, path, "out of memory");
+        return -1;
+    }
+    return 0;
+}
+
+static int read_list(const jctx* c, hyd_builder* b, const cJSON* root, const char* key,
+                     int nodes) {
+    const cJSON* a = cJSON_GetObjectItemCaseSensitive(root, key);
+    if (!a) {
+        jerr(c, key, "missing required array");
+        return -1;
+    }
+    if (!cJSON_IsArray(a)) {
+        jerr(c, key, "must be an array, got %s", jtype(a));
+        return -1;
+    }
+    int i = 0;
+    for (const cJSON* it = a->child; it; it = it->next, ++i)
+        if (read_elem(c, b, it, key, i, nodes))
+            return -1;
+    return 0;
+}
+
+hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const char* prefix,
+                               char* err, size_t errsz) {
+    jctx c = {file, prefix ? prefix : "", err, errsz};
+    if (!cJSON_IsObject(circuit)) {
+        jerr(&c, "", "circuit must be an object, got %s", circuit ? jtype(circuit) : "nothing");
+        return NULL;
+    }
+    for (const cJSON* it = circuit->child; it; it = it->next)
+        if (it->string[0] != '_' && strcmp(it->string, "fluid") && strcmp(it->string, "nodes") &&
+            strcmp(it->string, "components")) {
+            jerr(&c, it->string, "unknown field (known: fluid, nodes, components)");
+            return NULL;
+        }
+    hyd_builder* b = hyd_builder_create();
+    if (!b) {
+        jerr(&c, "", "out of memory");
+        return NULL;
+    }
+    hyd_model* m = NULL;
+    const cJSON* jf = cJSON_GetObjectItemCaseSensitive(circuit, "fluid");
+    if (jf) {
+        if (!cJSON_IsObject(jf)) {
+            jerr(&c, "fluid", "must be an object, got %s", jtype(jf));
+            goto done;
+        }
+        hyd_fluid_def f = hyd_default_fluid_def();
+        int np;
+        const hyd_param_info* p = hyd_fluid_params(&np);
+        if (read_params(&c, jf, "fluid", &f, p, np, NULL, 0, NULL, 0, "fluid"))
+            goto done;
+        hyd_builder_set_fluid(b, &f);
+    }
+    if (read_list(&c, b, circuit, "nodes", 1) || read_list(&c, b, circuit, "components", 0))
+        goto done;
+    hyd_build_error e;
+    m = hyd_compile_ex(b, &e);
+    if (!m) {
+        char path[160];
+        if (e.where == 0)
+            snprintf(path, sizeof path, "fluid.%s", e.field);
+        else if (e.where == 1 || e.where == 2)
+            snprintf(path, sizeof path, "%s[%d].%s", e.where == 1 ? "nodes" : "components",
+                     e.index, e.field);
+        else
+            path[0] = 0;
+        jerr(&c, path, "%s", e.msg);
+    }
+done:
+    hyd_builder_free(b);
+    return m;
+}
+
+hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz) {
+    jctx c = {path, "", err, errsz};
+    FILE* fp = fopen(path, "rb");
+    if (!fp) {
+        jerr(&c, "", "cannot open file");
+        return NULL;
+    }
+    char* text = NULL;
+    long n = -1;
+    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0) {
+        text = malloc((size_t)n + 1);
+        if (text && fread(text, 1, (size_t)n, fp) != (size_t)n) {
+            free(text);
+            text = NULL;
+        }
+    }
+    fclose(fp);
+    if (!text) {
+        jerr(&c, "", "cannot read file");
+        return NULL;
+    }
+    text[n] = 0;
+    const char* end = NULL;
+    cJSON* root = cJSON_ParseWithOpts(text, &end, 1);
+    if (!root) {
+        // Report the line of the syntax error.
+        int line = 1;
+        for (const char* q = text; end && q < end && *q; ++q)
+            line += *q == '\n';
+        jerr(&c, "", "JSON syntax error near line %d", line);
+        free(text);
+        return NULL;
+    }
+    free(text);
+    const cJSON* h = cJSON_GetObjectItemCaseSensitive(root, "hydraulics");
+    hyd_model* m = h ? hyd_model_from_json(h, path, "hydraulics", err, errsz)
+                     : hyd_model_from_json(root, path, "", err, errsz);
+    cJSON_Delete(root);
+    return m;
+}
+
+// Export: every numeric parameter (defaults included) so the saved file is
+// complete and self-describing.
+static cJSON* elem_to_json(const hyd_elem* e) {
+    cJSON* o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddStringToObject(o, "name", e->name);
+    cJSON_AddStringToObject(o, "type", hyd_type_name(e->type));
+    int np, nports;
+    const hyd_param_info* p = hyd_params_of(e->type, &np);
+    const hyd_port_info* ports = hyd_ports_of(e->type, &nports);
+    for (int k = 0; k < nports; ++k)
+        cJSON_AddStringToObject(o, ports[k].name, e->port[k]);
+    for (int k = 0; k < np; ++k)
+        cJSON_AddNumberToObject(o, p[k].name, *(const double*)((const char*)&e->def + p[k].off));
+    return o;
+}
+
+cJSON* hyd_model_to_json(const hyd_model* m) {
+    cJSON* root = cJSON_CreateObject();
+    cJSON* fl = cJSON_AddObjectToObject(root, "fluid");
+    cJSON* nodes = cJSON_AddArrayToObject(root, "nodes");
+    cJSON* comps = cJSON_AddArrayToObject(root, "components");
+    if (!root || !fl || !nodes || !comps) {
+        cJSON_Delete(root);
+        return NULL;
+    }
+    int np;
+    const hyd_param_info* p = hyd_fluid_params(&np);
+    for (int k = 0; k < np; ++k)
+        cJSON_AddNumberToObject(fl, p[k].name, *(const double*)((const char*)&m->fluid + p[k].off));
+    for (int i = 0; i < m->nunode; ++i)
+        cJSON_AddItemToArray(nodes, elem_to_json(&m->unode[i]));
+    for (int i = 0; i < m->ncomp; ++i)
+        cJSON_AddItemToArray(comps, elem_to_json(&m->comp[i]));
+    return root;
+}

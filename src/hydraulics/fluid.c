@@ -1,0 +1,75 @@
+// fluid.c: fluid properties and the effective bulk modulus Be(p).
+//
+// Be(p) follows the entrained-air law of SPEC 3.2, written in absolute
+// pressure P = p_a + p_gauge:
+//   r(P)  = (p_a / P)^(1/n)                  (free-air volume per unit air at p_a)
+//   Be(P) = Be_l (1 + alpha r) / (1 + alpha Be_l r / (n P))
+// It tends to n P as P -> 0, so a node cannot be pushed through absolute zero
+// by a finite flow. Below P_LO the law is continued by an exponential that
+// matches value and slope, so an integrator that overshoots into P <= 0 still
+// gets a positive, C1 modulus instead of pow() of a negative number (NaN).
+#include "hyd_internal.h"
+
+#include <math.h>
+
+/// Below this absolute pressure [Pa] Be is continued exponentially (see above).
+#define HYD_BE_P_LO 100.0
+
+hyd_fluid_def hyd_default_fluid_def(void) {
+    hyd_fluid_def f;
+    f.density = 870.0;
+    f.viscosity = 32e-6;
+    f.bulk_modulus = 1.2e9;
+    f.air_fraction = 0.005;
+    f.polytropic_index = 1.4;
+    f.p_atm = 101325.0;
+    f.re_transition = 100.0;
+    return f;
+}
+
+// The law itself at P >= P_LO; alpha = 0 reduces it to Be_l exactly, which is
+// the constant-bulk-modulus option (and skips the pow()). Written with two
+// divisions (1/P, 1/D): this runs once per node per evaluation.
+//   q = (alpha Be_l / n) r / P,  D = 1 + q,  N = 1 + alpha r
+//   dN/dP = -alpha r / (n P),    dD/dP = -(1 + 1/n) q / P
+static double be_law(double alpha, double inv_n, double pa, double bel, double P, double* dbe) {
+    if (alpha == 0.0) {
+        *dbe = 0.0;
+        return bel;
+    }
+    const double iP = 1.0 / P;
+    const double r = exp(-inv_n * log(P / pa)); // (p_a/P)^(1/n); exp(log) is cheaper than pow
+    const double ar = alpha * r;
+    const double q = bel * inv_n * ar * iP;
+    const double iD = 1.0 / (1.0 + q);
+    const double be = bel * (1.0 + ar) * iD;
+    const double dN = -inv_n * ar * iP;
+    const double dD = -(1.0 + inv_n) * q * iP;
+    *dbe = (bel * dN - be * dD) * iD;
+    return be;
+}
+
+static double be_eval(double alpha, double inv_n, double pa, double bel, double P, double* dbe) {
+    double d;
+    if (P >= HYD_BE_P_LO) {
+        double be = be_law(alpha, inv_n, pa, bel, P, &d);
+        if (dbe)
+            *dbe = d;
+        return be;
+    }
+    // C1 exponential continuation below P_LO: Be = Be_lo exp(k (P - P_LO)).
+    const double be_lo = be_law(alpha, inv_n, pa, bel, HYD_BE_P_LO, &d);
+    const double k = d / be_lo;
+    const double be = be_lo * exp(k * (P - HYD_BE_P_LO));
+    if (dbe)
+        *dbe = k * be;
+    return be;
+}
+
+double hyd_bulk_modulus(const hyd_fluid_def* f, double be_liquid, double p, double* dbe) {
+    return be_eval(f->air_fraction, 1.0 / f->polytropic_index, f->p_atm, be_liquid, p, dbe);
+}
+
+double hyd_be(const hyd_model* m, double bel, double p, double* dbe) {
+    return be_eval(m->be_alpha, m->be_inv_n, m->fluid.p_atm, bel, p, dbe);
+}

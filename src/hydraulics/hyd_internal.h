@@ -1,0 +1,238 @@
+// hyd_internal.h: module-private layout of the compiled circuit (hyd_model) and
+// the per-type evaluation kernels. Not installed; include only from
+// src/hydraulics/*.c.
+#ifndef HYD_INTERNAL_H
+#define HYD_INTERNAL_H
+
+#include "hydraulics.h"
+
+#include <stddef.h>
+#include <stdio.h>
+
+#define HYD_MAXPORT 4
+/// pi (M_PI is not part of strict C11).
+#define HYD_PI 3.14159265358979323846
+/// Chamber volumes never fall below this fraction of their dead volume, so a
+/// piston driven far into a stop cannot make V <= 0 (cylinder.c).
+#define HYD_VMIN_FRAC 0.05
+
+/// A node or component as the user defined it (names owned by the holder).
+/// Kept in the model so live parameter changes and JSON export see the same
+/// values that the derived arrays were computed from.
+typedef struct hyd_elem {
+    hyd_type type;
+    char* name;
+    char* port[HYD_MAXPORT]; ///< port node names, by the type's port table order
+    union {
+        hyd_tank_def tank;
+        hyd_volume_def volume;
+        hyd_pump_def pump;
+        hyd_relief_def relief;
+        hyd_check_def check;
+        hyd_orifice_def orifice;
+        hyd_hose_def hose;
+        hyd_valve_def valve;
+        hyd_cylinder_def cylinder;
+    } def;
+} hyd_elem;
+
+/// Parameter checking rules.
+enum { HYD_R_POS = 0, HYD_R_NONNEG, HYD_R_ANY, HYD_R_UNIT, HYD_R_FRAC };
+
+/// A port of a component type: its name and the offset of its const char*
+/// field inside the type's def struct.
+typedef struct hyd_port_info {
+    const char* name;
+    size_t off;
+} hyd_port_info;
+
+typedef struct hyd_param_info {
+    const char* name;
+    const char* unit;
+    size_t off;   ///< byte offset of the double inside the type's def struct
+    int rule;     ///< HYD_R_*
+    int required; ///< must be given in JSON (C defaults leave it 0, which fails the rule)
+} hyd_param_info;
+
+/// Parameter and port tables of a type (circuit.c).
+const hyd_param_info* hyd_params_of(hyd_type t, int* count);
+const hyd_port_info* hyd_ports_of(hyd_type t, int* count);
+/// Pointer to an element's def struct (the active union member).
+void* hyd_elem_def(hyd_elem* e);
+const void* hyd_elem_cdef(const hyd_elem* e);
+/// Check one value against a rule; returns 0 or writes a message and returns -1.
+int hyd_param_check(const hyd_param_info* p, double v, char* msg, size_t msgsz);
+/// Fluid parameter table (name, unit, offset into hyd_fluid_def).
+const hyd_param_info* hyd_fluid_params(int* count);
+
+// ---------------------------------------------------------------------------
+// Compiled per-type records. Each holds node indices (into hyd_data node_*)
+// and derived constants, so the kernels read one small struct per component.
+// ---------------------------------------------------------------------------
+
+typedef struct hyd_pump_c {
+    int in, out, comp;
+    double qmax, pset, inv_band;
+} hyd_pump_c;
+
+/// Relief and check valves share this record: q = q_rated * ramp(dp - p_crack, w).
+typedef struct hyd_ramp_c {
+    int in, out, comp;
+    double pcr, inv_w, qr;
+} hyd_ramp_c;
+
+/// Orifice constants: K = k A, p_tr = P0 / A, laminar conductance G = kl A^1.5.
+typedef struct hyd_orif_k {
+    double k;     ///< cd sqrt(2/rho) [m^1.5/kg^0.5]
+    double P0;    ///< p_tr * A [Pa m^2]
+    double invP0; ///< 1 / P0
+    double kl;    ///< 5 k / (4 sqrt(P0))
+} hyd_orif_k;
+
+typedef struct hyd_orifice_c {
+    int in, out, comp;
+    double A;
+    hyd_orif_k ok;
+} hyd_orifice_c;
+
+typedef struct hyd_hose_c {
+    int node, to, comp;
+    double G; ///< laminar conductance [m^3/(s Pa)]
+} hyd_hose_c;
+
+typedef struct hyd_valve_c {
+    int P, T, A, B, adr, comp;
+    double Amax, inv_tau;
+    hyd_orif_k ok;
+} hyd_valve_c;
+
+typedef struct hyd_cyl_c {
+    int nA, nB, sA, sB, comp; ///< chamber nodes and their state indices
+    double AA, AB, s, VA0, VB0, CL, bv, ks, cs, ws;
+} hyd_cyl_c;
+
+struct hyd_model {
+    hyd_fluid_def fluid;
+    int nstate, nnode, ncomp, nunode; ///< nunode: user-declared nodes (first in node order)
+
+    hyd_elem* unode; ///< (nunode) user node definitions
+    hyd_elem* comp;  ///< (ncomp) component definitions
+
+    // Nodes: user nodes first, then owned nodes (hoses, cylinder chambers).
+    char** node_name;  ///< (nnode)
+    int* node_state;   ///< (nnode) state index, or -1 for a tank
+    int* node_sidx;    ///< (nnode) state index, or nstate for a tank (dummy row/col)
+    double* node_V0;   ///< (nnode) fixed volume [m^3] (0 for chambers: the cylinder sets V)
+    double* node_bel;  ///< (nnode) liquid bulk modulus [Pa]
+    double* node_pfix; ///< (nnode) tank pressure [Pa abs] (0 for volume nodes)
+    double* node_p0;   ///< (nnode) initial pressure [Pa abs]
+
+    int nvol, ntank;
+    int* vol_node;  ///< (nvol) state-carrying nodes, in state order of appearance
+    int* tank_node; ///< (ntank)
+
+    int npump, nrelief, ncheck, norifice, nhose, nvalve, ncyl;
+    hyd_pump_c* pump;
+    hyd_ramp_c* relief;
+    hyd_ramp_c* check;
+    hyd_orifice_c* orifice;
+    hyd_hose_c* hose;
+    hyd_valve_c* valve;
+    hyd_cyl_c* cyl;
+    int* comp_sub; ///< (ncomp) index within its type's array
+    /// Incidence, CSR over volume nodes in vol_node order: node vol_node[k]
+    /// receives flow slots vol_flow[vol_ptr[k] .. vol_ptr[k+1]-1] (indices into
+    /// hyd_data flow_, 4 per component: port order pump/relief/check/orifice
+    /// [inlet, outlet], hose [own node, to], valve [P, T, A, B], cylinder [A, B]).
+    int* vol_ptr;  ///< (nvol + 1)
+    int* vol_flow; ///< (vol_ptr[nvol])
+
+    // Fluid constants used by the bulk-modulus law for every node.
+    double be_inv_n, be_alpha;
+
+    char** state_name; ///< (nstate)
+    double* y0;        ///< (nstate) initial state
+};
+
+/// Recompute every derived array from the definitions (after compile or a
+/// parameter change). Returns 0, or -1 with e filled if a value is invalid.
+int hyd_model_derive(hyd_model* m, hyd_build_error* e);
+
+// Component derivations (each in its own file).
+void hyd_pump_derive(const hyd_pump_def* d, hyd_pump_c* c);
+void hyd_relief_derive(const hyd_relief_def* d, hyd_ramp_c* c);
+void hyd_check_derive(const hyd_check_def* d, hyd_ramp_c* c);
+hyd_orif_k hyd_orifice_constants(const hyd_fluid_def* f, double cd);
+void hyd_hose_derive(const hyd_fluid_def* f, const hyd_hose_def* d, hyd_hose_c* c);
+double hyd_hose_volume(const hyd_hose_def* d);
+void hyd_valve_derive(const hyd_fluid_def* f, const hyd_valve_def* d, hyd_valve_c* c);
+void hyd_cylinder_derive(const hyd_cylinder_def* d, hyd_cyl_c* c);
+/// Cross-field checks a table cannot express; return 0 or fill field/msg.
+int hyd_cylinder_validate(const hyd_cylinder_def* d, char* field, size_t fsz, char* msg,
+                          size_t msz);
+
+/// Orifice law on precomputed constants: Q [m^3/s], *g = dQ/ddp, *gA = dQ/dA.
+double hyd_orifice_q(const hyd_orif_k* k, double A, double dp, double* g, double* gA);
+
+// ---------------------------------------------------------------------------
+// Kernels: each loops over all components of its type, adds flows into
+// d->node_q and, when G is non-NULL, flow partials into G, an (n+1) x (n+1)
+// row-major matrix indexed by state (tank nodes map to the dummy index n),
+// so a kernel needs no branch on node kind.
+// ---------------------------------------------------------------------------
+
+void hyd_cylinders_eval(const hyd_model* m, hyd_data* d, double* G);
+void hyd_pumps_eval(const hyd_model* m, hyd_data* d, double* G);
+void hyd_reliefs_eval(const hyd_model* m, hyd_data* d, double* G);
+void hyd_checks_eval(const hyd_model* m, hyd_data* d, double* G);
+/// Relief and check kernel on an array of ramp records (relief.c).
+void hyd_ramps_eval(const hyd_model* m, hyd_data* d, double* G, const hyd_ramp_c* v, int nv);
+void hyd_orifices_eval(const hyd_model* m, hyd_data* d, double* G);
+void hyd_hoses_eval(const hyd_model* m, hyd_data* d, double* G);
+void hyd_valves_eval(const hyd_model* m, hyd_data* d, const double* y, double* ydot, double* G);
+/// Pressure derivative of every volume node; with J non-NULL also the node
+/// rows of the Jacobian (see volume.c).
+void hyd_volumes_eval(const hyd_model* m, hyd_data* d, double* ydot, const double* G, double* J,
+                      int ldj);
+
+/// Bulk modulus on the model's precomputed fluid constants.
+double hyd_be(const hyd_model* m, double bel, double p, double* dbe);
+
+/// Flow partials of a flow from node a to node b: ga = dq/dp_a, gb = dq/dp_b.
+static inline void hyd_jac_flow(const hyd_model* m, double* G, int a, int b, double ga, double gb) {
+    const int ld = m->nstate + 1;
+    const int sa = m->node_sidx[a], sb = m->node_sidx[b];
+    G[sa * ld + sa] -= ga;
+    G[sa * ld + sb] -= gb;
+    G[sb * ld + sa] += ga;
+    G[sb * ld + sb] += gb;
+}
+
+/// A flow q from port 0 (node a) to port 1 (node b) of component c: written
+/// as "flow into the node at port k" slots, which volume.c gathers per node
+/// (a gather keeps each node's sum in a register instead of a chain of
+/// read-modify-writes through memory, e.g. on the tank). With G non-NULL the
+/// partials ga = dq/dp_a, gb = dq/dp_b are added too.
+static inline void hyd_flow2(const hyd_model* m, hyd_data* d, double* G, int c, int a, int b,
+                             double q, double ga, double gb) {
+    d->flow_[4 * c] = -q;
+    d->flow_[4 * c + 1] = q;
+    if (G)
+        hyd_jac_flow(m, G, a, b, ga, gb);
+}
+
+/// C1 smoothstep s(t) = 3t^2 - 2t^3 on [0,1], 0 below, 1 above; *ds = ds/dt.
+static inline double hyd_smoothstep(double t, double* ds) {
+    if (t <= 0.0) {
+        *ds = 0.0;
+        return 0.0;
+    }
+    if (t >= 1.0) {
+        *ds = 0.0;
+        return 1.0;
+    }
+    *ds = 6.0 * t * (1.0 - t);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+#endif

@@ -1,0 +1,155 @@
+// hyd_solver.h: generic ODE integrators for y' = f(t, y).
+//
+// Works on any problem, not only hydraulic circuits: n states, a right-hand
+// side, an optional analytic Jacobian. Methods:
+//   HYD_KRUS      2-stage linearly implicit W-method, gamma = 1/2 (our reading of
+//                 Krus's method: A-stable, R(-inf) = -1), fixed step, order 2
+//   HYD_ROS2      same scheme with gamma = 1 + 1/sqrt(2): L-stable, order 2
+//   HYD_RK4       classical explicit Runge-Kutta, order 4
+//   HYD_ROS34PW2  Rang & Angermann W-method 3(2), adaptive
+//   HYD_RODAS3    Sandu et al. stiffly accurate 3(2), adaptive
+// All memory is allocated in hyd_solver_create; no step allocates.
+#ifndef HYD_SOLVER_H
+#define HYD_SOLVER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Right-hand side dydt = f(t, y). Return 0 on success; non-zero aborts the step
+/// (the solver returns HYD_ERR_RHS).
+typedef int (*hyd_rhs_fn)(void* user, double t, const double* y, double* dydt);
+
+/// Jacobian df/dy at (t, y), dense row-major n x n: J[i*n + j] = d f_i / d y_j.
+/// The solver zeroes J before the call, so a callback writes only non-zeros.
+/// Return 0 on success.
+typedef int (*hyd_jac_fn)(void* user, double t, const double* y, double* J);
+
+/// Partial derivative df/dt at (t, y), n values. Return 0 on success.
+typedef int (*hyd_dfdt_fn)(void* user, double t, const double* y, double* dfdt);
+
+/// The problem: sizes and callbacks. Kept by pointer; must outlive the solver.
+typedef struct hyd_problem {
+    int n;            ///< number of states
+    hyd_rhs_fn f;     ///< right-hand side (required)
+    hyd_jac_fn jac;   ///< analytic Jacobian, or NULL for forward differences
+    void* user;       ///< passed to f and jac
+    /// Optional block-diagonal Jacobian pattern. When nblock > 0, the solver
+    /// uses only the diagonal blocks of J (sizes block_size[0..nblock-1], summing
+    /// to n) to form W = I - gamma h J and factors each block on its own. All
+    /// methods here are W-methods or tolerate this, so the order is kept; only
+    /// stability and error constants change. NULL/0: dense J.
+    int nblock;
+    const int* block_size;
+    /// Optional df/dt at (t, y), n values (added by the solver module). Only
+    /// RODAS3 needs it: it is a classical Rosenbrock method, whose order for a
+    /// non-autonomous f relies on the gamma_i h^2 df/dt term. The W-methods
+    /// (Krus, ROS2, ROS34PW2) evaluate stages at t + alpha_i h and need no
+    /// df/dt (see docs/solvers.md). NULL: RODAS3 takes a forward difference in
+    /// t, one extra f evaluation per Jacobian evaluation.
+    hyd_dfdt_fn dfdt;
+    /// Non-zero when f does not depend on t: RODAS3 then skips df/dt.
+    int autonomous;
+} hyd_problem;
+
+typedef enum hyd_method {
+    HYD_KRUS = 0,
+    HYD_ROS2,
+    HYD_RK4,
+    HYD_ROS34PW2,
+    HYD_RODAS3,
+    HYD_METHOD_COUNT
+} hyd_method;
+
+/// Name of a method ("krus", "ros2", "rk4", "ros34pw2", "rodas3").
+const char* hyd_method_name(hyd_method m);
+/// Parse a method name; returns -1 if unknown.
+int hyd_method_parse(const char* name);
+/// True for the adaptive (error-controlled) methods.
+bool hyd_method_is_adaptive(hyd_method m);
+/// Classical order of the method (2, 2, 4, 3, 3).
+int hyd_method_order(hyd_method m);
+
+/// Solver options. Get defaults from hyd_default_solver_opts() and change only
+/// what differs.
+typedef struct hyd_solver_opts {
+    double h;           ///< fixed step [s] (fixed-step methods); initial step for adaptive (0: automatic)
+    double rtol;        ///< relative tolerance [-] (adaptive)
+    double atol;        ///< absolute tolerance [state units] (adaptive)
+    double h_min;       ///< smallest step [s] before giving up (adaptive)
+    double h_max;       ///< largest step [s] (adaptive; also capped by output/frame period)
+    int jac_every;      ///< recompute J every N accepted steps (1: every step)
+    double jac_max_age; ///< recompute J if older than this simulated time [s]
+    long max_steps;     ///< hard cap on steps per hyd_solver_advance call
+} hyd_solver_opts;
+
+hyd_solver_opts hyd_default_solver_opts(void);
+
+/// Work counters, cumulative since create (or hyd_solver_clear_stats).
+typedef struct hyd_solver_stats {
+    long steps;     ///< accepted steps
+    long rejected;  ///< rejected steps (adaptive)
+    long fevals;    ///< right-hand-side evaluations (including finite-difference ones)
+    long jevals;    ///< Jacobian evaluations
+    long lus;       ///< LU factorisations of W (a block-diagonal W counts once)
+} hyd_solver_stats;
+
+enum {
+    HYD_OK = 0,
+    HYD_ERR_RHS = -1,      ///< f or jac returned non-zero
+    HYD_ERR_SINGULAR = -2, ///< W is singular
+    HYD_ERR_NONFINITE = -3,///< a state became NaN/Inf; see hyd_solver_bad_state
+    HYD_ERR_HMIN = -4,     ///< adaptive step fell below h_min
+    HYD_ERR_STEPS = -5     ///< max_steps reached
+};
+
+typedef struct hyd_solver hyd_solver;
+
+/// Allocates all workspace. Returns NULL on bad arguments.
+hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solver_opts* o);
+void hyd_solver_destroy(hyd_solver* s);
+
+/// One step of size h from (t, y), in place. Works for every method (adaptive
+/// ones take the step without error control). Returns HYD_OK or an error.
+int hyd_solver_step(hyd_solver* s, double* t, double* y, double h);
+
+/// Advance from *t to exactly t_end, in place. Fixed-step methods take steps of
+/// opts.h (the last one shortened to land on t_end); adaptive methods control
+/// the step, never stepping past t_end.
+int hyd_solver_advance(hyd_solver* s, double* t, double* y, double t_end);
+
+/// Output callback for hyd_solver_integrate: called at every output time with
+/// the (interpolated, for adaptive methods) state. Return non-zero to stop.
+typedef int (*hyd_output_fn)(void* user, double t, const double* y);
+
+/// Integrate from t0 to t_end calling out() at t0, t0+dt_out, ..., t_end.
+/// Adaptive methods step freely across output times and interpolate (cubic
+/// Hermite on y and f at both step ends), so output rate does not limit h.
+/// y holds y(t0) on entry and y(t_end) (or the last good state) on return.
+int hyd_solver_integrate(hyd_solver* s, double t0, double* y, double t_end, double dt_out,
+                         hyd_output_fn out, void* user);
+
+/// Forget step-size history and force a new Jacobian: call at a known
+/// discontinuity (a command step, an end stop, a relief cracking).
+void hyd_solver_reset(hyd_solver* s);
+
+const hyd_solver_stats* hyd_solver_get_stats(const hyd_solver* s);
+void hyd_solver_clear_stats(hyd_solver* s);
+/// Last accepted step size [s].
+double hyd_solver_last_h(const hyd_solver* s);
+/// After HYD_ERR_NONFINITE: index of the first non-finite state, and its time [s].
+int hyd_solver_bad_state(const hyd_solver* s, double* t_bad);
+
+/// Small dense LU with partial pivoting, in place on row-major a (n x n).
+/// Returns 0, or -1 if singular. Exposed for tests and for callers that build
+/// their own implicit updates.
+int hyd_lu_factor(double* a, int n, int* piv);
+void hyd_lu_solve(const double* lu, int n, const int* piv, double* b);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

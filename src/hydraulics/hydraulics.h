@@ -1,0 +1,385 @@
+// hydraulics.h: the hydraulic circuit library of cranesim (pure C11, libm only).
+//
+// A circuit is data: named pressure nodes (volumes with a pressure state, or
+// fixed-pressure tanks) joined by typed components (pump, relief, check,
+// orifice, hose, 4/3 valve, cylinder). It is described with default-filled
+// definition structs (or loaded from JSON by hydraulics_json), compiled once
+// into index arrays (hyd_model, read-only during a step), and evaluated with a
+// separate hyd_data that holds inputs, outputs and scratch. hyd_eval and
+// hyd_jacobian never allocate.
+//
+// Conventions: SI units everywhere. Node pressures are ABSOLUTE [Pa]. Valve,
+// relief, pump and check settings are DIFFERENTIAL pressures [Pa] across the
+// component. Flows are volume flows [m^3/s]. Cylinder force is positive when
+// it pushes the rod out (extends). See docs/hydraulics.md for the equations.
+#ifndef HYDRAULICS_H
+#define HYDRAULICS_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Element types. Tanks and volumes are nodes; the rest are components.
+/// Hoses and cylinders also create nodes of their own: a hose "h" creates node
+/// "h" (its volume), a cylinder "c" creates chamber nodes "c.A" and "c.B".
+typedef enum hyd_type {
+    HYD_TANK = 0, ///< fixed-pressure node (tank, or an ideal supply)
+    HYD_VOLUME,   ///< pressure node with a fixed volume (e.g. the pump line)
+    HYD_PUMP,     ///< pressure-compensated flow source, inlet -> outlet
+    HYD_RELIEF,   ///< pressure relief valve, inlet -> outlet
+    HYD_CHECK,    ///< anti-cavitation check valve, inlet (tank) -> outlet (port)
+    HYD_ORIFICE,  ///< fixed two-regime orifice, inlet -> outlet (positive flow)
+    HYD_HOSE,     ///< hose volume node plus a laminar resistance to node "to"
+    HYD_VALVE,    ///< 4/3 closed-centre proportional valve, ports P, T, A, B
+    HYD_CYLINDER, ///< double-acting cylinder with chambers "<name>.A", "<name>.B"
+    HYD_TYPE_COUNT
+} hyd_type;
+
+/// Type name as used in JSON ("tank", "volume", "pump", ...).
+const char* hyd_type_name(hyd_type t);
+/// Parse a type name; returns -1 if unknown.
+int hyd_type_parse(const char* name);
+
+// ---------------------------------------------------------------------------
+// Definitions (Box2D style: get defaults from hyd_default_*_def(), change what
+// differs). Fields whose default is 0 and that must be > 0 are REQUIRED; the
+// compiler (and the JSON loader) reject a circuit that leaves them at 0.
+// Strings are copied when added to a builder.
+// ---------------------------------------------------------------------------
+
+/// Hydraulic fluid. air_fraction = 0 gives a constant bulk modulus.
+typedef struct hyd_fluid_def {
+    double density;          ///< rho [kg/m^3]; default 870
+    double viscosity;        ///< kinematic viscosity nu [m^2/s]; default 32e-6
+    double bulk_modulus;     ///< liquid bulk modulus Be_l [Pa]; default 1.2e9
+    double air_fraction;     ///< free air volume fraction alpha at p_atm [-]; default 0.005
+    double polytropic_index; ///< polytropic index n of the air [-]; default 1.4
+    double p_atm;            ///< atmospheric pressure p_a [Pa abs]; default 101325
+    double re_transition;    ///< orifice transition Reynolds number Re_tr [-]; default 100
+} hyd_fluid_def;
+
+/// Fixed-pressure node.
+typedef struct hyd_tank_def {
+    const char* name;
+    double pressure; ///< node pressure [Pa abs]; default 1e5
+} hyd_tank_def;
+
+/// Volume node with a pressure state "<name>.p".
+typedef struct hyd_volume_def {
+    const char* name;
+    double volume;       ///< REQUIRED fixed volume [m^3]
+    double bulk_modulus; ///< liquid/wall bulk modulus Be_l [Pa]; 0 (default) uses the fluid's
+    double p0;           ///< initial pressure [Pa abs]; default 1e5
+} hyd_volume_def;
+
+/// Pressure-compensated pump: Q_max while p_out - p_in <= p_set, falling C1 to
+/// 0 at p_set + band.
+typedef struct hyd_pump_def {
+    const char* name;
+    const char* inlet;  ///< suction node (usually the tank)
+    const char* outlet; ///< delivery node (usually the pump line)
+    double q_max;       ///< REQUIRED maximum flow [m^3/s] (35 L/min = 5.8333e-4)
+    double p_set;       ///< REQUIRED compensator setting, differential [Pa]
+    double band;        ///< regulation band [Pa]; default 0.5e6
+} hyd_pump_def;
+
+/// Relief valve: 0 below p_crack, q_rated at p_crack + dp_override (C1 quadratic
+/// corner), linear with slope 2 q_rated / dp_override beyond.
+typedef struct hyd_relief_def {
+    const char* name;
+    const char* inlet;  ///< protected node
+    const char* outlet; ///< usually the tank
+    double p_crack;     ///< REQUIRED cracking pressure, differential inlet - outlet [Pa]
+    double dp_override; ///< pressure rise from crack to rated flow [Pa]; default 1e6
+    double q_rated;     ///< flow at p_crack + dp_override [m^3/s]; default 6.6667e-4 (40 L/min)
+} hyd_relief_def;
+
+/// Anti-cavitation check valve, tank -> port: opens when p_out < p_in - p_crack,
+/// q_rated after a further dp_open (C1 quadratic corner), linear beyond.
+typedef struct hyd_check_def {
+    const char* name;
+    const char* inlet;  ///< supply side (the tank)
+    const char* outlet; ///< protected port (a cylinder chamber)
+    double p_crack;     ///< cracking pressure, differential inlet - outlet [Pa]; default 0.05e6
+    double dp_open;     ///< pressure from crack to rated flow [Pa]; default 0.02e6
+    double q_rated;     ///< flow at p_crack + dp_open [m^3/s]; default 6.6667e-4 (40 L/min)
+} hyd_check_def;
+
+/// Fixed sharp-edged orifice (two-regime law, see orifice functions below).
+typedef struct hyd_orifice_def {
+    const char* name;
+    const char* inlet;  ///< positive flow goes inlet -> outlet
+    const char* outlet;
+    double area; ///< REQUIRED opening area [m^2]
+    double cd;   ///< discharge coefficient [-]; default 0.65
+} hyd_orifice_def;
+
+/// Hose: a volume node named after the hose (state "<name>.p") of volume
+/// pi d^2 L / 4, plus a laminar (Hagen-Poiseuille) resistance to node "to".
+typedef struct hyd_hose_def {
+    const char* name;
+    const char* to;      ///< node at the far end (usually a cylinder chamber)
+    double length;       ///< REQUIRED hose length [m]
+    double diameter;     ///< REQUIRED inner diameter [m]
+    double bulk_modulus; ///< effective (oil + wall) bulk modulus [Pa]; default 0.8e9
+    double p0;           ///< initial pressure [Pa abs]; default 1e5
+} hyd_hose_def;
+
+/// 4/3 closed-centre proportional valve. Spool state "<name>.spool" u in
+/// [-1, 1]: u > 0 opens P->A and B->T, u < 0 opens P->B and A->T, each edge an
+/// orifice of area |u| A_max with A_max = q_nominal / (cd sqrt(2 dp_nominal / rho)).
+typedef struct hyd_valve_def {
+    const char* name;
+    const char* P; ///< pressure port node
+    const char* T; ///< tank port node
+    const char* A; ///< work port A node
+    const char* B; ///< work port B node
+    double q_nominal;  ///< rated flow per edge at dp_nominal [m^3/s]; default 6.6667e-4 (40 L/min)
+    double dp_nominal; ///< rated pressure drop per edge [Pa]; default 1e6
+    double cd;         ///< discharge coefficient [-]; default 0.65
+    double tau;        ///< spool time constant [s]; default 0.03
+    double u0;         ///< initial spool position [-]; default 0
+} hyd_valve_def;
+
+/// Double-acting cylinder. Chamber A (piston side) extends the rod.
+typedef struct hyd_cylinder_def {
+    const char* name;
+    double bore;           ///< REQUIRED piston diameter D [m]
+    double rod;            ///< REQUIRED rod diameter d [m], 0 < d < D
+    double stroke;         ///< REQUIRED stroke s [m]; x in [0, s]
+    double dead_volume_a;  ///< chamber A volume at x = 0 [m^3]; default 1e-4
+    double dead_volume_b;  ///< chamber B volume at x = s [m^3]; default 1e-4
+    double leakage;        ///< internal leakage C_L [m^3/(s Pa)]; default 1e-14
+    double friction;       ///< viscous friction b_v [N s/m]; default 5e3
+    double stop_stiffness; ///< end-stop spring k [N/m]; default 5e8
+    double stop_damping;   ///< end-stop damper c [N s/m]; default 1e6
+    double stop_width;     ///< end-stop onset depth delta [m] (C1 smoothing); default 1e-3
+    double p0_a;           ///< initial chamber A pressure [Pa abs]; default 1e5
+    double p0_b;           ///< initial chamber B pressure [Pa abs]; default 1e5
+} hyd_cylinder_def;
+
+hyd_fluid_def hyd_default_fluid_def(void);
+hyd_tank_def hyd_default_tank_def(void);
+hyd_volume_def hyd_default_volume_def(void);
+hyd_pump_def hyd_default_pump_def(void);
+hyd_relief_def hyd_default_relief_def(void);
+hyd_check_def hyd_default_check_def(void);
+hyd_orifice_def hyd_default_orifice_def(void);
+hyd_hose_def hyd_default_hose_def(void);
+hyd_valve_def hyd_default_valve_def(void);
+hyd_cylinder_def hyd_default_cylinder_def(void);
+
+// ---------------------------------------------------------------------------
+// Building and compiling
+// ---------------------------------------------------------------------------
+
+typedef struct hyd_builder hyd_builder;
+typedef struct hyd_model hyd_model;
+
+/// An empty circuit with the default fluid. Returns NULL only if out of memory.
+hyd_builder* hyd_builder_create(void);
+void hyd_builder_free(hyd_builder* b);
+void hyd_builder_set_fluid(hyd_builder* b, const hyd_fluid_def* fluid);
+
+/// Add a node or component; returns its index among nodes (tank, volume) or
+/// among components (the rest), in the order added, or -1 if out of memory.
+/// Port names are resolved, and values checked, in hyd_compile, so
+/// components may name nodes that are added later.
+int hyd_add_tank(hyd_builder* b, const hyd_tank_def* def);
+int hyd_add_volume(hyd_builder* b, const hyd_volume_def* def);
+int hyd_add_pump(hyd_builder* b, const hyd_pump_def* def);
+int hyd_add_relief(hyd_builder* b, const hyd_relief_def* def);
+int hyd_add_check(hyd_builder* b, const hyd_check_def* def);
+int hyd_add_orifice(hyd_builder* b, const hyd_orifice_def* def);
+int hyd_add_hose(hyd_builder* b, const hyd_hose_def* def);
+int hyd_add_valve(hyd_builder* b, const hyd_valve_def* def);
+int hyd_add_cylinder(hyd_builder* b, const hyd_cylinder_def* def);
+
+/// Where a build error was found (used by the JSON loader to name JSON paths).
+typedef struct hyd_build_error {
+    int where;       ///< 0: fluid, 1: nodes[index], 2: components[index], -1: none
+    int index;       ///< index in nodes or components
+    char field[32];  ///< offending field ("bore", "inlet", "name", ...)
+    char msg[224];   ///< problem, e.g. "must be > 0, got -0.08"
+} hyd_build_error;
+
+/// Validate and compile. On error returns NULL and writes one line
+/// "<element>.<field>: <problem>" into err (if non-NULL); e fills structured
+/// detail (may be NULL). State order: volume-node pressures in node order,
+/// then component states in component order (valve: spool; hose: p;
+/// cylinder: pA, pB).
+hyd_model* hyd_compile(const hyd_builder* b, char* err, size_t errsz);
+hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e);
+void hyd_model_free(hyd_model* m);
+
+/// The default two-actuator crane circuit of SPEC section 4 (components named
+/// as in tests/hydraulics/data/crane_circuit.json: "lift_valve", "lift_cyl",
+/// "jib_valve", "jib_cyl", ...). 11 states.
+hyd_model* hyd_model_default_crane(char* err, size_t errsz);
+
+// ---------------------------------------------------------------------------
+// Model queries (cheap; not for the hot loop)
+// ---------------------------------------------------------------------------
+
+int hyd_model_nstate(const hyd_model* m);    ///< number of states
+int hyd_model_nnode(const hyd_model* m);     ///< number of nodes, including owned ones
+int hyd_model_ncomp(const hyd_model* m);     ///< number of components
+int hyd_model_ncylinder(const hyd_model* m); ///< number of cylinders
+int hyd_model_nvalve(const hyd_model* m);    ///< number of valves
+
+/// Component index by name, or -1.
+int hyd_model_find(const hyd_model* m, const char* name);
+/// Node index by name ("tank", "pump_line", "lift_hose_A", "lift_cyl.A"), or -1.
+int hyd_model_find_node(const hyd_model* m, const char* name);
+/// Cylinder index (into hyd_data cyl_* arrays) by component name, or -1.
+int hyd_model_cylinder(const hyd_model* m, const char* name);
+/// Valve index (into hyd_data valve_cmd) by component name, or -1.
+int hyd_model_valve(const hyd_model* m, const char* name);
+/// State index by name ("lift_cyl.pA", "lift_valve.spool", "pump_line.p"), or -1.
+int hyd_model_find_state(const hyd_model* m, const char* name);
+
+const char* hyd_model_comp_name(const hyd_model* m, int comp);
+hyd_type hyd_model_comp_type(const hyd_model* m, int comp);
+const char* hyd_model_node_name(const hyd_model* m, int node);
+/// State index of a node's pressure [Pa abs], or -1 for a tank node.
+int hyd_model_node_state(const hyd_model* m, int node);
+/// Name of state i (e.g. "jib_cyl.pB").
+const char* hyd_model_state_name(const hyd_model* m, int i);
+/// State indices of cylinder c's chamber pressures pA, pB [Pa abs].
+void hyd_model_cylinder_states(const hyd_model* m, int cyl, int* iA, int* iB);
+/// State index of valve v's spool position u [-].
+int hyd_model_valve_state(const hyd_model* m, int valve);
+/// Component index of cylinder cyl / valve v.
+int hyd_model_cylinder_comp(const hyd_model* m, int cyl);
+int hyd_model_valve_comp(const hyd_model* m, int valve);
+/// Cylinder geometry: piston area A_A [m^2], annulus area A_B [m^2], stroke [m].
+void hyd_model_cylinder_geometry(const hyd_model* m, int cyl, double* AA, double* AB, double* s);
+/// Fill y (nstate) with the initial state (p0 of each node, u0 of each valve).
+void hyd_model_initial_state(const hyd_model* m, double* y);
+/// The fluid the model was compiled with.
+hyd_fluid_def hyd_model_fluid(const hyd_model* m);
+
+// ---------------------------------------------------------------------------
+// Live parameters. A path is "<element>.<field>" ("lift_cyl.bore",
+// "pump.p_set", "tank.pressure") or "fluid.<field>". Setting validates the
+// value (and cross-field rules such as rod < bore) and recomputes the derived
+// arrays; call it between steps only. The state layout never changes.
+// ---------------------------------------------------------------------------
+
+/// Returns 0, or -1 with a one-line message in err.
+int hyd_model_set(hyd_model* m, const char* path, double value, char* err, size_t errsz);
+/// Returns 0 and writes *value, or -1 if the path is unknown.
+int hyd_model_get(const hyd_model* m, const char* path, double* value);
+/// Number of numeric parameters of type t, and their names and units.
+int hyd_param_count(hyd_type t);
+const char* hyd_param_name(hyd_type t, int k);
+const char* hyd_param_unit(hyd_type t, int k);
+
+// ---------------------------------------------------------------------------
+// Data: inputs, outputs, scratch. One per thread of use; the model may be shared.
+// Arrays are allocated by hyd_data_create with the sizes in the comments.
+// ---------------------------------------------------------------------------
+
+typedef struct hyd_data {
+    // Inputs, written by the caller before hyd_eval / hyd_jacobian.
+    double* cyl_x;     ///< (ncyl) stroke x [m], 0 = retracted, s = extended
+    double* cyl_v;     ///< (ncyl) stroke rate x' [m/s], + extends
+    double* valve_cmd; ///< (nvalve) spool command u_cmd [-], clamped to [-1, 1]
+
+    // Outputs of the last hyd_eval / hyd_jacobian.
+    double* cyl_F;    ///< (ncyl) cylinder force F [N], + extends
+    int* cyl_stop;    ///< (ncyl) end stop engaged: -1 retracted stop, +1 extended stop, 0 none
+    double* comp_q;   ///< (ncomp x 2) flows [m^3/s]: pump delivery; relief/check/orifice
+                      ///< inlet->outlet; hose hose->to; valve [into A, out of B];
+                      ///< cylinder [leakage A->B, 0]; second entry 0 unless stated
+    int* comp_open;   ///< (ncomp) relief/check open, pump regulating, cylinder in stop: 1, else 0
+    double* node_p;   ///< (nnode) node pressure [Pa abs]
+    double* node_V;   ///< (nnode) node volume [m^3]
+    double* node_be;  ///< (nnode) effective bulk modulus Be(p) [Pa]
+    double* node_q;   ///< (nnode) net inflow from components [m^3/s] (excluding dV/dt); 0 for tanks
+    double* node_dV;  ///< (nnode) volume rate dV/dt [m^3/s]
+
+    // Coupling partials, written by hyd_jacobian (row-major, n = nstate).
+    double* dydx; ///< (ncyl x n) d ydot_i / d x_c [state unit / (s m)]
+    double* dydv; ///< (ncyl x n) d ydot_i / d x'_c [state unit / m]
+    double* dFdy; ///< (ncyl x n) d F_c / d y_i [N / state unit]
+    double* dFdx; ///< (ncyl) d F_c / d x_c [N/m]
+    double* dFdv; ///< (ncyl) d F_c / d x'_c [N s/m]
+
+    // Private scratch (flow partials); do not touch.
+    double* scratch_;
+    double* flow_; ///< (ncomp x 4) flow into the node at each port [m^3/s]
+    int n_, nnode_, ncomp_, ncyl_, nvalve_;
+} hyd_data;
+
+/// Allocate data for m, inputs zeroed (x = 0, x' = 0, u_cmd = 0). NULL if out of memory.
+hyd_data* hyd_data_create(const hyd_model* m);
+void hyd_data_free(hyd_data* d);
+
+// ---------------------------------------------------------------------------
+// Evaluation
+// ---------------------------------------------------------------------------
+
+/// ydot = f(t, y) for the hydraulic states, given the inputs in d. Also fills
+/// the outputs (forces, flows, node quantities). t [s] is unused by the
+/// circuit itself (commands are inputs) and kept for solver symmetry.
+void hyd_eval(const hyd_model* m, hyd_data* d, double t, const double* y, double* ydot);
+
+/// Analytic Jacobian d ydot / d y at (t, y), written into the n x n block of a
+/// caller's dense row-major matrix J at rows row0.., columns col0.. with leading
+/// dimension ldj (J[(row0+i)*ldj + col0+j] = d ydot_i / d y_j). Every entry of
+/// the block is written (zeros included); nothing outside it is touched. J
+/// may be NULL to get only the coupling partials. Also fills d->dydx, dydv,
+/// dFdy, dFdx, dFdv and all hyd_eval outputs; if ydot is non-NULL it receives f.
+void hyd_jacobian(const hyd_model* m, hyd_data* d, double t, const double* y, double* ydot,
+                  double* J, int ldj, int row0, int col0);
+
+// ---------------------------------------------------------------------------
+// JSON (in the separate library hydraulics_json, which links cJSON; the core
+// needs libm only). Schema: docs/hydraulics.md. Errors are one line,
+// "<file>: <prefix>.<path>: <problem>", e.g.
+// "model.json: hydraulics.components[1].bore: must be > 0, got -0.08".
+// ---------------------------------------------------------------------------
+
+struct cJSON;
+
+/// Build a model from an already-parsed circuit object. file names the source
+/// in messages; prefix is the JSON path of the circuit object ("hydraulics",
+/// or "" when the circuit is the whole document). NULL on error, with err set.
+hyd_model* hyd_model_from_json(const struct cJSON* circuit, const char* file, const char* prefix,
+                               char* err, size_t errsz);
+/// Load a circuit file: either the circuit object itself or a document with a
+/// "hydraulics" member holding it (prefix "hydraulics"). NULL on error.
+hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz);
+/// The model's current definition (fluid, nodes, components with every
+/// parameter, including live changes) as a new cJSON object; the caller frees
+/// it with cJSON_Delete. NULL if out of memory.
+struct cJSON* hyd_model_to_json(const hyd_model* m);
+
+// ---------------------------------------------------------------------------
+// Component laws, exposed for tests and for callers that build their own
+// circuits. All are pure functions.
+// ---------------------------------------------------------------------------
+
+/// Effective bulk modulus Be(p) [Pa] at absolute pressure p [Pa], entrained-air
+/// law; *dbe = dBe/dp [-] if dbe is non-NULL. Positive and C1 for all p.
+double hyd_bulk_modulus(const hyd_fluid_def* f, double be_liquid, double p, double* dbe);
+
+/// Two-regime orifice flow [m^3/s] for pressure drop dp [Pa] through area A
+/// [m^2] with discharge coefficient cd; optional partials dQ/ddp [m^3/(s Pa)]
+/// and dQ/dA [m/s]. A = 0 gives Q = 0, dQ/ddp = 0 without a special case.
+double hyd_orifice_flow(const hyd_fluid_def* f, double cd, double A, double dp, double* dq_ddp,
+                        double* dq_dA);
+/// Laminar-turbulent transition pressure p_tr [Pa] of an orifice of area A [m^2].
+double hyd_orifice_p_tr(const hyd_fluid_def* f, double cd, double A);
+
+/// C1 "valve opening" ramp used by relief and check valves: 0 for d <= 0,
+/// (d/w)^2 for 0 < d < w, 1 + 2 (d - w)/w beyond. *dr = dr/dd [1/Pa].
+double hyd_open_ramp(double d, double w, double* dr);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

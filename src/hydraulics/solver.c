@@ -1,0 +1,554 @@
+// solver.c: solver lifetime, Jacobian and W bookkeeping, the fixed-step and
+// adaptive drivers, Hermite output, and the method table. The methods' stage
+// arithmetic lives in krus.c, rk4.c and rosenbrock.c.
+#include "solver_internal.h"
+
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+// ---------------------------------------------------------------- methods --
+
+static const char* const method_names[HYD_METHOD_COUNT] = {"krus", "ros2", "rk4", "ros34pw2",
+                                                           "rodas3"};
+
+const char* hyd_method_name(hyd_method m) {
+    if ((int)m < 0 || m >= HYD_METHOD_COUNT) return "unknown";
+    return method_names[m];
+}
+
+int hyd_method_parse(const char* name) {
+    if (!name) return -1;
+    for (int m = 0; m < HYD_METHOD_COUNT; ++m)
+        if (strcmp(name, method_names[m]) == 0) return m;
+    return -1;
+}
+
+bool hyd_method_is_adaptive(hyd_method m) { return m == HYD_ROS34PW2 || m == HYD_RODAS3; }
+
+int hyd_method_order(hyd_method m) {
+    switch (m) {
+    case HYD_KRUS:
+    case HYD_ROS2: return 2;
+    case HYD_RK4: return 4;
+    case HYD_ROS34PW2:
+    case HYD_RODAS3: return 3;
+    default: return 0;
+    }
+}
+
+hyd_solver_opts hyd_default_solver_opts(void) {
+    hyd_solver_opts o;
+    o.h = 1e-4;           // the paper's Krus step [s]
+    o.rtol = 1e-3;
+    o.atol = 1e-6;
+    o.h_min = 1e-12;      // [s]
+    o.h_max = HUGE_VAL;   // no cap; <= 0 also means no cap
+    o.jac_every = 1;
+    o.jac_max_age = 0.01; // SPEC 3.3: older J diverged at larger h [s]; <= 0: no limit
+    o.max_steps = 100000000;
+    return o;
+}
+
+// --------------------------------------------------------------- lifetime --
+
+hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solver_opts* o) {
+    if (!p || !p->f || p->n <= 0 || (int)m < 0 || m >= HYD_METHOD_COUNT) return NULL;
+    const int n = p->n;
+    hyd_solver_opts opts = o ? *o : hyd_default_solver_opts();
+    if (!hyd_method_is_adaptive(m) && !(opts.h > 0.0)) return NULL;
+    if (hyd_method_is_adaptive(m) && !(opts.rtol >= 0.0 && opts.atol >= 0.0 &&
+                                       opts.rtol + opts.atol > 0.0))
+        return NULL;
+
+    int nblock = 1;
+    if (p->nblock > 0) {
+        if (!p->block_size) return NULL;
+        int sum = 0;
+        for (int b = 0; b < p->nblock; ++b) {
+            if (p->block_size[b] <= 0) return NULL;
+            sum += p->block_size[b];
+        }
+        if (sum != n) return NULL;
+        nblock = p->nblock;
+    }
+
+    hyd_solver* s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    s->p = p;
+    s->method = m;
+    s->o = opts;
+    s->n = n;
+    s->nblock = nblock;
+    if (hyd_method_is_adaptive(m)) hydRosenbrockTableau(m, &s->tab);
+
+    s->boff = calloc((size_t)nblock + 1, sizeof *s->boff);
+    s->moff = calloc((size_t)nblock, sizeof *s->moff);
+    s->bblk = calloc((size_t)n, sizeof *s->bblk);
+    s->piv = calloc((size_t)n, sizeof *s->piv);
+    if (!s->boff || !s->moff || !s->bblk || !s->piv) {
+        hyd_solver_destroy(s);
+        return NULL;
+    }
+    int msize = 0;
+    for (int b = 0; b < nblock; ++b) {
+        const int bs = p->nblock > 0 ? p->block_size[b] : n;
+        s->boff[b + 1] = s->boff[b] + bs;
+        s->moff[b] = msize;
+        msize += bs * bs;
+        for (int i = s->boff[b]; i < s->boff[b + 1]; ++i) s->bblk[i] = b;
+    }
+    s->msize = msize;
+
+    // One block for all vectors: jb, w, (jfull), 4 k, 4 hjk and 14 more n-vectors.
+    const int dense = nblock == 1;
+    const size_t nfull = (p->jac && !dense) ? (size_t)n * (size_t)n : 0;
+    const size_t total = 2 * (size_t)msize + nfull + 22 * (size_t)n;
+    double* mem = calloc(total, sizeof *mem);
+    if (!mem) {
+        hyd_solver_destroy(s);
+        return NULL;
+    }
+    double* q = mem;
+    s->jb = q, q += msize;
+    s->w = q, q += msize;
+    s->jfull = nfull ? q : s->jb; // dense: the callback writes straight into jb
+    q += nfull;
+    for (int i = 0; i < 4; ++i) s->k[i] = q, q += n;
+    for (int i = 0; i < 4; ++i) s->hjk[i] = q, q += n;
+    s->ys = q, q += n;
+    s->fs = q, q += n;
+    s->r = q, q += n;
+    s->ynew = q, q += n;
+    s->err = q, q += n;
+    s->fdy = q, q += n;
+    s->fdf = q, q += n;
+    s->yout = q, q += n;
+    s->fc_y = q, q += n;
+    s->fc_f = q, q += n;
+    s->fnew = q, q += n;
+    s->ft = q, q += n;
+    s->bad_i = -1;
+    hyd_solver_reset(s);
+    return s;
+}
+
+void hyd_solver_destroy(hyd_solver* s) {
+    if (!s) return;
+    // jb is the first vector of the single workspace block.
+    free(s->jb);
+    free(s->boff);
+    free(s->moff);
+    free(s->bblk);
+    free(s->piv);
+    free(s);
+}
+
+void hyd_solver_reset(hyd_solver* s) {
+    if (!s) return;
+    s->j_valid = 0;
+    s->j_force = 1;
+    s->w_valid = 0;
+    s->fc_valid = 0;
+    s->h_next = 0.0;
+    s->have_acc = 0;
+    s->last_rejected = 0;
+}
+
+const hyd_solver_stats* hyd_solver_get_stats(const hyd_solver* s) { return &s->st; }
+void hyd_solver_clear_stats(hyd_solver* s) { memset(&s->st, 0, sizeof s->st); }
+double hyd_solver_last_h(const hyd_solver* s) { return s->last_h; }
+
+int hyd_solver_bad_state(const hyd_solver* s, double* t_bad) {
+    if (t_bad) *t_bad = s->bad_t;
+    return s->bad_i;
+}
+
+// ------------------------------------------------------- f, J and W upkeep --
+
+int hydEvalF(hyd_solver* s, double t, const double* y, double* dydt) {
+    s->st.fevals++;
+    return s->p->f(s->p->user, t, y, dydt) == 0 ? HYD_OK : HYD_ERR_RHS;
+}
+
+// J by the callback, or by forward differences with the per-column step
+// sqrt(eps) max(|y_j|, 1); only the diagonal blocks are kept.
+static int eval_jacobian(hyd_solver* s, double t, const double* y, const double* f0,
+                         double h) {
+    const hyd_problem* p = s->p;
+    const int n = s->n;
+    if (p->jac) {
+        memset(s->jfull, 0, (size_t)n * (size_t)n * sizeof *s->jfull);
+        if (p->jac(p->user, t, y, s->jfull) != 0) return HYD_ERR_RHS;
+        if (s->jfull != s->jb) {
+            for (int b = 0; b < s->nblock; ++b) {
+                const int o = s->boff[b], m = s->boff[b + 1] - o;
+                double* jb = s->jb + s->moff[b];
+                for (int i = 0; i < m; ++i)
+                    for (int j = 0; j < m; ++j) jb[i * m + j] = s->jfull[(o + i) * n + o + j];
+            }
+        }
+    } else {
+        const double sq = sqrt(DBL_EPSILON);
+        memcpy(s->fdy, y, (size_t)n * sizeof *y);
+        for (int j = 0; j < n; ++j) {
+            const double yj = y[j];
+            s->fdy[j] = yj + sq * fmax(fabs(yj), 1.0);
+            const double d = s->fdy[j] - yj; // the step actually represented
+            int rc = hydEvalF(s, t, s->fdy, s->fdf);
+            s->fdy[j] = yj;
+            if (rc != HYD_OK) return rc;
+            const int b = s->bblk[j], o = s->boff[b], m = s->boff[b + 1] - o;
+            double* jb = s->jb + s->moff[b];
+            const double id = 1.0 / d;
+            for (int i = 0; i < m; ++i) jb[i * m + (j - o)] = (s->fdf[o + i] - f0[o + i]) * id;
+        }
+    }
+    // Only a classical Rosenbrock method needs df/dt (see rosenbrock.c).
+    if (s->tab.needs_dfdt && !p->autonomous) {
+        if (p->dfdt) {
+            if (p->dfdt(p->user, t, y, s->ft) != 0) return HYD_ERR_RHS;
+        } else {
+            // Forward difference, kept inside the step so f is never asked
+            // for a time beyond the step's end (t_end of an advance).
+            const double dt = fmin(sqrt(DBL_EPSILON) * fmax(fabs(t), 1.0), 0.5 * h);
+            const double t1 = t + dt;
+            int rc = hydEvalF(s, t1, y, s->fdf);
+            if (rc != HYD_OK) return rc;
+            const double id = 1.0 / (t1 - t);
+            for (int i = 0; i < n; ++i) s->ft[i] = (s->fdf[i] - f0[i]) * id;
+        }
+    }
+    s->st.jevals++;
+    s->j_valid = 1;
+    s->j_force = 0;
+    s->j_steps = 0;
+    s->j_t = t;
+    s->w_valid = 0;
+    return HYD_OK;
+}
+
+int hydPrepareW(hyd_solver* s, double t, const double* y, const double* f0, double gh) {
+    const hyd_solver_opts* o = &s->o;
+    int need_j = !s->j_valid || s->j_force || s->j_steps >= (o->jac_every > 1 ? o->jac_every : 1) ||
+                 (o->jac_max_age > 0.0 && fabs(t - s->j_t) > o->jac_max_age);
+    if (need_j) {
+        int rc = eval_jacobian(s, t, y, f0, s->tab.gamma > 0.0 ? gh / s->tab.gamma : gh);
+        if (rc != HYD_OK) return rc;
+    }
+    // W depends on h. A relative change below 1e-8 (a last step landing on an
+    // output time up to rounding) keeps the old W: for a W-method that is just
+    // another approximate J, and the stage algebra stays consistent with it.
+    if (!s->w_valid || fabs(gh - s->w_gh) > 1e-8 * fabs(gh)) {
+        int rc = hydFactorW(s, gh);
+        if (rc != HYD_OK) {
+            s->w_valid = 0;
+            return rc;
+        }
+    }
+    return HYD_OK;
+}
+
+// ------------------------------------------------------------------ steps --
+
+// Index of the first NaN/Inf in v, or -1. x * 0 is 0 for finite x and NaN
+// otherwise, so one sum answers for the whole vector without a branch per entry.
+static int first_nonfinite(const double* v, int n) {
+    double acc = 0.0;
+    for (int i = 0; i < n; ++i) acc += v[i] * 0.0;
+    if (acc == 0.0) return -1;
+    for (int i = 0; i < n; ++i)
+        if (!isfinite(v[i])) return i;
+    return -1;
+}
+
+static int trial_step(hyd_solver* s, double t, const double* y, const double* f0, double h,
+                      double* ynew, double* err) {
+    switch (s->method) {
+    case HYD_KRUS:
+    case HYD_ROS2: return hydKrusStep(s, t, y, f0, h, ynew);
+    case HYD_RK4: return hydRk4Step(s, t, y, f0, h, ynew);
+    case HYD_ROS34PW2:
+    case HYD_RODAS3: return hydRosenbrockStep(s, t, y, f0, h, ynew, err);
+    default: return HYD_ERR_RHS;
+    }
+}
+
+// f at (t, y): the cached value from the previous accepted adaptive step when
+// the caller has not moved t or y since, else a fresh evaluation.
+static int current_f(hyd_solver* s, double t, const double* y, const double** f0) {
+    const int n = s->n;
+    if (!(s->fc_valid && s->fc_t == t && memcmp(s->fc_y, y, (size_t)n * sizeof *y) == 0)) {
+        int rc = hydEvalF(s, t, y, s->fc_f);
+        if (rc != HYD_OK) return rc;
+        memcpy(s->fc_y, y, (size_t)n * sizeof *y);
+        s->fc_t = t;
+        s->fc_valid = 1;
+    }
+    *f0 = s->fc_f;
+    return HYD_OK;
+}
+
+// One fixed step with the bookkeeping shared by step() and the fixed driver.
+// On failure y and t are untouched.
+static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_new) {
+    const int n = s->n;
+    // Fixed-step methods never leave f(t_{n+1}, y_{n+1}) behind, so skip the
+    // cache check (and its copy of y) unless an adaptive run just filled it.
+    const double* f0 = s->fc_f;
+    int rc = s->fc_valid ? current_f(s, *t, y, &f0) : hydEvalF(s, *t, y, s->fc_f);
+    if (rc != HYD_OK) return rc;
+    rc = trial_step(s, *t, y, f0, h, s->ynew, NULL);
+    if (rc != HYD_OK) return rc;
+    int bad = first_nonfinite(s->ynew, n);
+    if (bad >= 0) {
+        s->bad_i = bad;
+        s->bad_t = t_new;
+        return HYD_ERR_NONFINITE;
+    }
+    memcpy(y, s->ynew, (size_t)n * sizeof *y);
+    *t = t_new;
+    s->fc_valid = 0;
+    s->st.steps++;
+    s->j_steps++;
+    s->last_h = h;
+    return HYD_OK;
+}
+
+int hyd_solver_step(hyd_solver* s, double* t, double* y, double h) {
+    if (!s || !t || !y || !(h > 0.0)) return HYD_ERR_HMIN;
+    return fixed_step(s, t, y, h, *t + h);
+}
+
+static int advance_fixed(hyd_solver* s, double* t, double* y, double t_end, long* budget) {
+    const double h0 = s->o.h;
+    while (*t < t_end) {
+        if (*budget <= 0) return HYD_ERR_STEPS;
+        --*budget;
+        // Land exactly on t_end; a remainder within 1e-9 h of a full step is
+        // taken as that step, so rounding never leaves a sliver step behind.
+        const double rem = t_end - *t;
+        const int land = rem <= h0 * (1.0 + 1e-9);
+        int rc = fixed_step(s, t, y, land ? rem : h0, land ? t_end : *t + h0);
+        if (rc != HYD_OK) return rc;
+    }
+    return HYD_OK;
+}
+
+// ------------------------------------------------------- adaptive driver --
+
+// Output schedule of hyd_solver_integrate: t0 + k dt for k = 1 .. nseg-1, then
+// t_end itself.
+typedef struct out_sched {
+    hyd_output_fn fn;
+    void* user;
+    double t0, dt, t_end;
+    long k, nseg;
+    int stopped;
+} out_sched;
+
+static double sched_time(const out_sched* o) {
+    return o->k >= o->nseg ? o->t_end : o->t0 + (double)o->k * o->dt;
+}
+
+static double err_norm(const hyd_solver* s, const double* y, const double* ynew,
+                       const double* e) {
+    const double atol = s->o.atol, rtol = s->o.rtol;
+    double sum = 0.0;
+    for (int i = 0; i < s->n; ++i) {
+        double sc = atol + rtol * fmax(fabs(y[i]), fabs(ynew[i]));
+        double r = e[i] / sc;
+        sum += r * r;
+    }
+    return sqrt(sum / s->n);
+}
+
+static double rms_scaled(const hyd_solver* s, const double* v, const double* y) {
+    double sum = 0.0;
+    for (int i = 0; i < s->n; ++i) {
+        double r = v[i] / (s->o.atol + s->o.rtol * fabs(y[i]));
+        sum += r * r;
+    }
+    return sqrt(sum / s->n);
+}
+
+// Starting step after create or reset when opts.h is 0 (Hairer, Norsett &
+// Wanner, I, II.4): balance h against |y|/|f| and a second-derivative estimate.
+static int initial_step(hyd_solver* s, double t, const double* y, const double* f0,
+                        double h_cap, double* h_out) {
+    const int n = s->n;
+    const double q = 3.0;
+    double d0 = rms_scaled(s, y, y), d1 = rms_scaled(s, f0, y);
+    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    h0 = fmin(h0, h_cap);
+    for (int i = 0; i < n; ++i) s->ys[i] = y[i] + h0 * f0[i];
+    int rc = hydEvalF(s, t + h0, s->ys, s->fs);
+    if (rc != HYD_OK) return rc;
+    for (int i = 0; i < n; ++i) s->r[i] = (s->fs[i] - f0[i]) / h0;
+    double d2 = rms_scaled(s, s->r, y);
+    double dm = fmax(d1, d2);
+    double h1 = dm <= 1e-15 ? fmax(1e-6, h0 * 1e-3) : pow(0.01 / dm, 1.0 / q);
+    double h = fmin(100.0 * h0, h1);
+    if (!(h > 0.0) || !isfinite(h)) h = 1e-6;
+    *h_out = fmin(h, h_cap);
+    return HYD_OK;
+}
+
+// Cubic Hermite interpolation on [t, t + h] from y0, f0, y1, f1 at theta.
+static void hermite(int n, double theta, double h, const double* y0, const double* f0,
+                    const double* y1, const double* f1, double* out) {
+    const double a = theta * (theta - 1.0);
+    const double c0 = (1.0 - 2.0 * theta) * a, cf0 = (theta - 1.0) * a * h, cf1 = theta * a * h;
+    for (int i = 0; i < n; ++i) {
+        double d = y1[i] - y0[i];
+        out[i] = y0[i] + theta * d + c0 * d + cf0 * f0[i] + cf1 * f1[i];
+    }
+}
+
+static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, long* budget,
+                            out_sched* os) {
+    const int n = s->n;
+    const double q = 3.0; // error of the order-2 embedded solution is O(h^3)
+    const double h_max = s->o.h_max > 0.0 ? s->o.h_max : HUGE_VAL;
+    while (*t < t_end) {
+        if (*budget <= 0) return HYD_ERR_STEPS;
+        const double* f0;
+        int rc = current_f(s, *t, y, &f0);
+        if (rc != HYD_OK) return rc;
+        if (!(s->h_next > 0.0)) {
+            if (s->o.h > 0.0) {
+                s->h_next = s->o.h;
+            } else {
+                rc = initial_step(s, *t, y, f0, fmin(h_max, t_end - *t), &s->h_next);
+                if (rc != HYD_OK) return rc;
+            }
+        }
+        const double h_prop = fmin(s->h_next, h_max);
+        const double rem = t_end - *t;
+        const int land = h_prop >= rem;
+        const double h = land ? rem : h_prop;
+
+        rc = trial_step(s, *t, y, f0, h, s->ynew, s->err);
+        if (rc == HYD_ERR_RHS) return rc;
+        const int singular = rc == HYD_ERR_SINGULAR;
+        const int bad = singular ? -1 : first_nonfinite(s->ynew, n);
+        double en = (singular || bad >= 0) ? HUGE_VAL : err_norm(s, y, s->ynew, s->err);
+        if (!(en <= 1.0)) {
+            // Reject. A singular W or a non-finite trial gets the largest cut.
+            s->st.rejected++;
+            double ratio = isfinite(en) ? fmax(1.0 / 6.0, 0.9 * pow(en, -1.0 / q)) : 1.0 / 6.0;
+            s->h_next = h * ratio;
+            s->last_rejected = 1;
+            if (s->j_steps > 0) s->j_force = 1; // a stale J may be the cause
+            if (!(s->h_next >= fmax(fmax(s->o.h_min, 16.0 * DBL_EPSILON * fabs(*t)), DBL_MIN))) {
+                if (bad >= 0) {
+                    s->bad_i = bad;
+                    s->bad_t = *t + h;
+                    return HYD_ERR_NONFINITE;
+                }
+                return singular ? HYD_ERR_SINGULAR : HYD_ERR_HMIN;
+            }
+            continue;
+        }
+
+        // Accept. f at the new point serves the Hermite output and the next
+        // step's first stage.
+        --*budget;
+        const double t_new = land ? t_end : *t + h;
+        rc = hydEvalF(s, t_new, s->ynew, s->fnew);
+        if (rc != HYD_OK) return rc;
+        if (os) {
+            while (!os->stopped && os->k <= os->nseg && sched_time(os) <= t_new) {
+                const double to = sched_time(os);
+                const double* yo = s->ynew;
+                if (to < t_new) {
+                    hermite(n, (to - *t) / h, h, y, f0, s->ynew, s->fnew, s->yout);
+                    yo = s->yout;
+                }
+                os->k++;
+                if (os->fn(os->user, to, yo) != 0) {
+                    // Stop at the output time: hand back that state.
+                    os->stopped = 1;
+                    memcpy(y, yo, (size_t)n * sizeof *y);
+                    *t = to;
+                    s->fc_valid = 0;
+                    s->h_next = h;
+                    return HYD_OK;
+                }
+            }
+        }
+
+        // Hairer-Wanner controller with Gustafsson's predictive correction.
+        double e = fmax(en, 1e-10);
+        double ratio = 0.9 * pow(e, -1.0 / q);
+        if (s->have_acc) {
+            double gus = 0.9 * (h / s->h_acc) * pow(s->err_acc / (e * e), 1.0 / q);
+            ratio = fmin(ratio, gus);
+        }
+        ratio = fmin(5.0, fmax(1.0 / 6.0, ratio));
+        if (s->last_rejected) ratio = fmin(ratio, 1.0);
+        double h_new = h * ratio;
+        // A step cut short only to land on t_end says nothing against the
+        // proposal it replaced; frame boundaries must not throttle h.
+        if (land && !s->last_rejected) h_new = fmax(h_new, h_prop);
+        s->h_acc = h;
+        s->err_acc = fmax(1e-2, en);
+        s->have_acc = 1;
+        s->last_rejected = 0;
+        s->h_next = h_new;
+
+        memcpy(y, s->ynew, (size_t)n * sizeof *y);
+        memcpy(s->fc_y, y, (size_t)n * sizeof *y);
+        double* tmp = s->fc_f;
+        s->fc_f = s->fnew;
+        s->fnew = tmp;
+        s->fc_t = t_new;
+        s->fc_valid = 1;
+        *t = t_new;
+        s->st.steps++;
+        s->j_steps++;
+        s->last_h = h;
+    }
+    return HYD_OK;
+}
+
+// ----------------------------------------------------------------- drivers --
+
+static long step_budget(const hyd_solver* s) { return s->o.max_steps > 0 ? s->o.max_steps : LONG_MAX; }
+
+int hyd_solver_advance(hyd_solver* s, double* t, double* y, double t_end) {
+    if (!s || !t || !y) return HYD_ERR_RHS;
+    long budget = step_budget(s);
+    if (hyd_method_is_adaptive(s->method)) return advance_adaptive(s, t, y, t_end, &budget, NULL);
+    return advance_fixed(s, t, y, t_end, &budget);
+}
+
+int hyd_solver_integrate(hyd_solver* s, double t0, double* y, double t_end, double dt_out,
+                         hyd_output_fn out, void* user) {
+    if (!s || !y || !(dt_out > 0.0) || !(t_end >= t0)) return HYD_ERR_RHS;
+    out_sched os = {out, user, t0, dt_out, t_end, 1, 0, 0};
+    // Output intervals; a last one shorter than 1e-9 dt_out merges into the one before.
+    double nint = (t_end - t0) / dt_out;
+    os.nseg = (long)ceil(nint - 1e-9);
+    if (os.nseg < 1) os.nseg = 1;
+    if (out && out(user, t0, y) != 0) return HYD_OK;
+    if (t_end == t0) return HYD_OK;
+
+    long budget = step_budget(s);
+    double t = t0;
+    if (hyd_method_is_adaptive(s->method)) {
+        if (!out) return advance_adaptive(s, &t, y, t_end, &budget, NULL);
+        return advance_adaptive(s, &t, y, t_end, &budget, &os);
+    }
+    // Fixed steps land on every output time; with dt_out a multiple of h that
+    // costs nothing.
+    for (long k = 1; k <= os.nseg; ++k) {
+        double tk = k >= os.nseg ? t_end : t0 + (double)k * dt_out;
+        int rc = advance_fixed(s, &t, y, tk, &budget);
+        if (rc != HYD_OK) return rc;
+        if (out && out(user, tk, y) != 0) return HYD_OK;
+    }
+    return HYD_OK;
+}

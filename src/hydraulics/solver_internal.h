@@ -1,0 +1,105 @@
+// solver_internal.h: the solver's private state, shared by solver.c, lu.c and
+// the method files (krus.c, rk4.c, rosenbrock.c). Not installed, not public.
+#ifndef HYD_SOLVER_INTERNAL_H
+#define HYD_SOLVER_INTERNAL_H
+
+#include "hyd_solver.h"
+
+/// A linearly implicit method in the "original" form
+///   (I - h gamma J) k_i = h f(t + c_i h, y + sum_j a_ij k_j) + h J sum_j g_ij k_j
+///                         + gs_i h^2 df/dt
+/// with y_new = y + sum b_i k_i and error estimate sum (b_i - bh_i) k_i.
+typedef struct hyd_tableau {
+    int stages;       ///< number of stages (<= 4)
+    double gamma;     ///< diagonal gamma
+    double a[4][4];   ///< alpha_ij, strictly lower
+    double g[4][4];   ///< gamma_ij, strictly lower
+    double c[4];      ///< c_i = sum_j a_ij (stage time fraction)
+    double gs[4];     ///< gamma + sum_j g_ij (weight of the df/dt term)
+    double b[4];      ///< solution weights
+    double e[4];      ///< b - bh, error weights
+    int needs_dfdt;   ///< 1 for classical Rosenbrock methods (not W-methods)
+} hyd_tableau;
+
+struct hyd_solver {
+    const hyd_problem* p;
+    hyd_method method;
+    hyd_solver_opts o;
+    int n;
+    hyd_tableau tab; ///< Rosenbrock tableau (adaptive methods), else zero
+
+    // Block structure of the iteration matrix: one block of size n when dense.
+    int nblock;
+    int* boff;   ///< (nblock + 1) first state index of each block
+    int* moff;   ///< (nblock) offset of each block's matrix in jb / w
+    int* bblk;   ///< (n) block of each state (finite differences)
+    int msize;   ///< sum of block_size^2
+
+    // Jacobian and iteration matrix W = I - gamma h J, per block, row-major.
+    double* jfull; ///< (n x n) dense scratch for the analytic callback
+    double* jb;    ///< (msize) diagonal blocks of J
+    double* w;     ///< (msize) LU factors of W
+    int* piv;      ///< (n) pivots, block-local
+    double* ft;    ///< (n) df/dt at the Jacobian point (RODAS3)
+    int j_valid;   ///< jb holds a usable Jacobian
+    int j_force;   ///< re-evaluate J at the next step (after a rejection or reset)
+    long j_steps;  ///< accepted steps since J was evaluated
+    double j_t;    ///< time J was evaluated at [s]
+    int w_valid;   ///< w holds LU(I - w_gh J)
+    double w_gh;   ///< gamma * h that w was factored with [s]
+
+    // Stage work vectors, n each.
+    double* k[4];
+    double* hjk[4]; ///< h J k_i, recovered from the stage equations (no J product)
+    double* ys;     ///< stage argument
+    double* fs;     ///< stage f
+    double* r;      ///< stage right-hand side
+    double* ynew;
+    double* err;
+    double* fdy;    ///< perturbed y for finite differences
+    double* fdf;    ///< f at the perturbed y
+    double* yout;   ///< interpolated output state
+
+    // Cache of f at the current point, so an adaptive step reuses f(y_{n+1})
+    // (already needed for Hermite output) as the next step's first stage.
+    int fc_valid;
+    double fc_t;
+    double* fc_y;
+    double* fc_f;
+    double* fnew;
+
+    // Step-size controller (adaptive methods).
+    double h_next;   ///< proposed next step [s]; 0: estimate one
+    double h_acc;    ///< previous accepted step [s] (Gustafsson)
+    double err_acc;  ///< previous accepted error norm (Gustafsson)
+    int have_acc;    ///< h_acc/err_acc are meaningful
+    int last_rejected;
+    double last_h;   ///< last accepted step [s]
+
+    hyd_solver_stats st;
+    int bad_i;
+    double bad_t;
+};
+
+// lu.c: build and factor W = I - gh J block by block, solve W x = b in place.
+int hydFactorW(hyd_solver* s, double gh);
+void hydSolveW(const hyd_solver* s, double* x);
+
+// solver.c: make J and LU(W) current for a step of gamma*h = gh from (t, y),
+// whose f is f0. Returns HYD_OK, HYD_ERR_RHS or HYD_ERR_SINGULAR.
+int hydPrepareW(hyd_solver* s, double t, const double* y, const double* f0, double gh);
+/// Evaluate f, counting it; maps a callback failure to HYD_ERR_RHS.
+int hydEvalF(hyd_solver* s, double t, const double* y, double* dydt);
+
+// Method steps: one trial step of size h from (t, y) with f0 = f(t, y) into
+// ynew; rosenbrock also writes the error estimate to err (when non-NULL).
+int hydKrusStep(hyd_solver* s, double t, const double* y, const double* f0, double h,
+                double* ynew);
+int hydRk4Step(hyd_solver* s, double t, const double* y, const double* f0, double h,
+               double* ynew);
+int hydRosenbrockStep(hyd_solver* s, double t, const double* y, const double* f0, double h,
+                      double* ynew, double* err);
+/// Fill the tableau of an adaptive method; -1 for other methods.
+int hydRosenbrockTableau(hyd_method m, hyd_tableau* out);
+
+#endif

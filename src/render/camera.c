@@ -1,0 +1,149 @@
+// camera.c: orbit / pan / zoom with the mouse, and presets that follow the
+// snapshot (operator at the column, side view of the boom plane, hook).
+#include <math.h>
+
+#include "render_internal.h"
+
+void render_camera_init(render_camera* c) {
+    memset(c, 0, sizeof *c);
+    c->preset = RENDER_CAM_ORBIT;
+    // A three-quarter view from the right front, the way a photo of a truck
+    // crane is usually taken.
+    c->yaw = -1.05f;
+    c->pitch = 0.38f;
+    c->dist = 17.0f;
+    c->fovy = 50.0f * (float)M_PI / 180.0f;
+    c->target = rm_v3(0, 0, 2.5f);
+}
+
+static rm_vec3 v3d(const double p[3]) { return rm_v3((float)p[0], (float)p[1], (float)p[2]); }
+
+static const world_snap_body* find_role(const world_snapshot* s, world_role role) {
+    for (int i = 0; i < s->nbody; ++i)
+        if (s->body[i].role == role) return &s->body[i];
+    return NULL;
+}
+
+/// Terrain height under (x, y) [m], bilinear; 0 for flat ground.
+static float ground_z(const world_snapshot* s, float x, float y) {
+    const world_snap_terrain* t = &s->terrain;
+    if (t->nx < 2 || t->ny < 2 || !t->height) return 0.0f;
+    // Grid centred on the origin, as world_snapshot.h specifies.
+    float fx = x / (float)t->dx + 0.5f * (float)(t->nx - 1), fy = y / (float)t->dy + 0.5f * (float)(t->ny - 1);
+    if (fx < 0) fx = 0;
+    if (fy < 0) fy = 0;
+    if (fx > (float)(t->nx - 1)) fx = (float)(t->nx - 1);
+    if (fy > (float)(t->ny - 1)) fy = (float)(t->ny - 1);
+    int i = (int)fx, j = (int)fy;
+    if (i > t->nx - 2) i = t->nx - 2;
+    if (j > t->ny - 2) j = t->ny - 2;
+    float u = fx - (float)i, v = fy - (float)j;
+    const float* h = t->height;
+    float h00 = h[j * t->nx + i], h10 = h[j * t->nx + i + 1];
+    float h01 = h[(j + 1) * t->nx + i], h11 = h[(j + 1) * t->nx + i + 1];
+    return (1 - v) * ((1 - u) * h00 + u * h10) + v * ((1 - u) * h01 + u * h11);
+}
+
+static rm_vec3 orbit_eye(const render_camera* c, rm_vec3 target) {
+    float cp = cosf(c->pitch);
+    return rm_add(target, rm_scale(rm_v3(cp * cosf(c->yaw), cp * sinf(c->yaw), sinf(c->pitch)), c->dist));
+}
+
+void render_camera_update(render_camera* c, const world_snapshot* s, int w, int h) {
+    const world_snap_body* col = find_role(s, WORLD_ROLE_COLUMN);
+    rm_vec3 base = col ? v3d(col->pos) : rm_v3(0, 0, 1.0f);
+    rm_vec3 tip = v3d(s->tip);
+    rm_vec3 mid = rm_scale(rm_add(base, tip), 0.5f);
+    if (rm_len(tip) < 1e-9f) mid = rm_add(base, rm_v3(0, 0, 1.5f));
+
+    switch (c->preset) {
+    case RENDER_CAM_OPERATOR: {
+        // The operator stands on the ground on the truck's right side, level
+        // with the column, eyes 1.7 m up, watching the tip.
+        float ex = base.x - 0.4f, ey = base.y - 2.1f;
+        c->eye = rm_v3(ex, ey, ground_z(s, ex, ey) + 1.7f);
+        c->at = tip;
+        break;
+    }
+    case RENDER_CAM_SIDE: {
+        // Perpendicular to the boom plane, which turns with the slew angle.
+        rm_vec3 n = rm_v3(-sinf((float)s->slew), cosf((float)s->slew), 0);
+        c->at = mid;
+        c->eye = rm_add(mid, rm_add(rm_scale(n, -14.0f), rm_v3(0, 0, 0.8f)));
+        break;
+    }
+    case RENDER_CAM_FOLLOW_HOOK:
+        c->at = v3d(s->hook);
+        c->eye = orbit_eye(c, c->at);
+        break;
+    case RENDER_CAM_ORBIT:
+    default:
+        if (!c->target_set) c->target = mid;
+        c->at = c->target;
+        c->eye = orbit_eye(c, c->at);
+        break;
+    }
+    float aspect = h > 0 ? (float)w / (float)h : 1.0f;
+    rm_look_at(c->view, c->eye, c->at, rm_v3(0, 0, 1));
+    rm_perspective(c->proj, c->fovy, aspect, 0.1f, 600.0f);
+    rm_mul(c->viewproj, c->proj, c->view);
+}
+
+/// Leave a fixed preset for the free orbit, starting from the current view
+/// so the picture does not jump.
+static void to_orbit(render_camera* c) {
+    if (c->preset == RENDER_CAM_ORBIT || c->preset == RENDER_CAM_FOLLOW_HOOK) return;
+    rm_vec3 d = rm_sub(c->eye, c->at);
+    c->dist = rm_len(d);
+    if (c->dist < 0.5f) c->dist = 0.5f;
+    c->pitch = asinf(d.z / c->dist);
+    c->yaw = atan2f(d.y, d.x);
+    c->target = c->at;
+    c->target_set = true;
+    c->preset = RENDER_CAM_ORBIT;
+}
+
+bool render_camera_event(render_camera* c, const SDL_Event* ev) {
+    switch (ev->type) {
+    case SDL_MOUSEBUTTONDOWN:
+        if (ev->button.button == SDL_BUTTON_LEFT) c->dragging_orbit = true;
+        else if (ev->button.button == SDL_BUTTON_RIGHT || ev->button.button == SDL_BUTTON_MIDDLE)
+            c->dragging_pan = true;
+        else return false;
+        to_orbit(c);
+        return true;
+    case SDL_MOUSEBUTTONUP:
+        if (ev->button.button == SDL_BUTTON_LEFT) c->dragging_orbit = false;
+        else c->dragging_pan = false;
+        return true;
+    case SDL_MOUSEMOTION:
+        if (c->dragging_orbit) {
+            c->yaw -= 0.006f * (float)ev->motion.xrel;
+            c->pitch += 0.006f * (float)ev->motion.yrel;
+            // Stay above the ground plane and short of the zenith.
+            if (c->pitch < -0.15f) c->pitch = -0.15f;
+            if (c->pitch > 1.52f) c->pitch = 1.52f;
+            return true;
+        }
+        if (c->dragging_pan && c->preset == RENDER_CAM_ORBIT) {
+            // Move the target in the view plane, scaled so the ground under
+            // the cursor roughly follows it.
+            float k = c->dist * 0.0015f;
+            rm_vec3 right = rm_v3(c->view[0], c->view[4], c->view[8]);
+            rm_vec3 up = rm_v3(c->view[1], c->view[5], c->view[9]);
+            c->target = rm_add(c->target, rm_add(rm_scale(right, -k * (float)ev->motion.xrel),
+                                                 rm_scale(up, k * (float)ev->motion.yrel)));
+            c->target_set = true;
+            return true;
+        }
+        return false;
+    case SDL_MOUSEWHEEL:
+        to_orbit(c);
+        c->dist *= powf(0.88f, (float)ev->wheel.y);
+        if (c->dist < 1.0f) c->dist = 1.0f;
+        if (c->dist > 200.0f) c->dist = 200.0f;
+        return true;
+    default:
+        return false;
+    }
+}

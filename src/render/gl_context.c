@@ -1,0 +1,137 @@
+// gl_context.c: the SDL2 window and the OpenGL 3.3 core context, plus the
+// framebuffer objects the scene renders into.
+//
+// Offscreen mode still makes an SDL window (hidden): under SDL's "offscreen"
+// video driver that window is backed by an EGL pbuffer on Mesa, which works
+// with no X server or GPU (llvmpipe). The frame itself goes into our own FBO
+// so its size does not depend on what the driver gives the window.
+#include <stdio.h>
+#include <string.h>
+
+#include "gl_context.h"
+
+static void set_err(char* err, size_t errsz, const char* what) {
+    if (err && errsz) snprintf(err, errsz, "render: %s: %s", what, SDL_GetError());
+}
+
+bool render_gl_open(render* r, char* err, size_t errsz) {
+    // Prefer the offscreen driver for headless rendering, but let an explicit
+    // SDL_VIDEODRIVER in the environment win (it overrides a default hint).
+    if (r->cfg.offscreen && !SDL_WasInit(SDL_INIT_VIDEO))
+        SDL_SetHintWithPriority(SDL_HINT_VIDEODRIVER, "offscreen", SDL_HINT_DEFAULT);
+    if (!SDL_WasInit(SDL_INIT_VIDEO)) {
+        if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0) {
+            set_err(err, errsz, "SDL video init");
+            return false;
+        }
+        r->own_video = true;
+    }
+    SDL_GL_SetAttribute(SDL_GL_CONTEXT_PROFILE_MASK, SDL_GL_CONTEXT_PROFILE_CORE);
+    SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 3);
+    SDL_GL_SetAttribute(SDL_GL_CONTEXT_MINOR_VERSION, 3);
+    SDL_GL_SetAttribute(SDL_GL_DOUBLEBUFFER, 1);
+    SDL_GL_SetAttribute(SDL_GL_DEPTH_SIZE, 24);
+    // Multisampling is done in our own FBO, so the window needs none.
+    SDL_GL_SetAttribute(SDL_GL_MULTISAMPLEBUFFERS, 0);
+    SDL_GL_SetAttribute(SDL_GL_MULTISAMPLESAMPLES, 0);
+
+    Uint32 flags = SDL_WINDOW_OPENGL | SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI;
+    if (r->cfg.offscreen) flags |= SDL_WINDOW_HIDDEN;
+    r->win = SDL_CreateWindow(r->title, SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED,
+                              r->cfg.width, r->cfg.height, flags);
+    if (!r->win) {
+        set_err(err, errsz, "SDL_CreateWindow");
+        return false;
+    }
+    r->gl = SDL_GL_CreateContext(r->win);
+    if (!r->gl) {
+        set_err(err, errsz, "OpenGL 3.3 core context");
+        return false;
+    }
+    SDL_GL_MakeCurrent(r->win, r->gl);
+    if (!r->cfg.offscreen) SDL_GL_SetSwapInterval(r->cfg.vsync ? 1 : 0);
+
+    if (r->cfg.offscreen) {
+        r->w = r->cfg.width;
+        r->h = r->cfg.height;
+    } else {
+        SDL_GL_GetDrawableSize(r->win, &r->w, &r->h);
+    }
+    return render_targets_resize(r, r->w, r->h);
+}
+
+static void free_targets(render* r) {
+    GLuint fb[2] = {r->fbo, r->msfbo};
+    GLuint rb[4] = {r->fbo_color, r->fbo_depth, r->ms_color, r->ms_depth};
+    glDeleteFramebuffers(2, fb);
+    glDeleteRenderbuffers(4, rb);
+    r->fbo = r->msfbo = r->fbo_color = r->fbo_depth = r->ms_color = r->ms_depth = 0;
+}
+
+static GLuint make_fbo(int w, int h, int samples, GLuint* color, GLuint* depth) {
+    GLuint fbo;
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glGenRenderbuffers(1, color);
+    glBindRenderbuffer(GL_RENDERBUFFER, *color);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, *color);
+    glGenRenderbuffers(1, depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, *depth);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH24_STENCIL8, w, h);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, *depth);
+    GLenum st = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (st != GL_FRAMEBUFFER_COMPLETE) {
+        fprintf(stderr, "render: framebuffer %dx%d (%d samples) incomplete: 0x%x\n", w, h, samples, st);
+        glDeleteFramebuffers(1, &fbo);
+        return 0;
+    }
+    return fbo;
+}
+
+bool render_targets_resize(render* r, int w, int h) {
+    if (w < 1) w = 1;
+    if (h < 1) h = 1;
+    free_targets(r);
+    r->w = w;
+    r->h = h;
+    // The offscreen frame needs a single-sample FBO to read back from; a
+    // window reads back from its own back buffer instead.
+    if (r->cfg.offscreen) {
+        r->fbo = make_fbo(w, h, 0, &r->fbo_color, &r->fbo_depth);
+        if (!r->fbo) return false;
+    }
+    if (r->cfg.msaa > 1) {
+        r->msfbo = make_fbo(w, h, r->cfg.msaa, &r->ms_color, &r->ms_depth);
+        // Multisampling is a nicety: without it we still draw.
+        if (!r->msfbo) r->cfg.msaa = 0;
+    }
+    return true;
+}
+
+void render_gl_close(render* r) {
+    if (r->gl) {
+        free_targets(r);
+        SDL_GL_DeleteContext(r->gl);
+        r->gl = NULL;
+    }
+    if (r->win) SDL_DestroyWindow(r->win);
+    r->win = NULL;
+    if (r->own_video) SDL_QuitSubSystem(SDL_INIT_VIDEO);
+    r->own_video = false;
+}
+
+GLuint render_target_fbo(const render* r) {
+    if (r->msfbo) return r->msfbo;
+    return r->fbo;
+}
+
+void render_resolve(render* r) {
+    if (!r->msfbo) return;
+    // Multisample resolve into the readable target (FBO or window).
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, r->msfbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, r->fbo);
+    glBlitFramebuffer(0, 0, r->w, r->h, 0, 0, r->w, r->h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+}

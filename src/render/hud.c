@@ -1,0 +1,335 @@
+// hud.c: the 2D overlay: pressure bars over each cylinder (as in the paper's
+// visualisation), readouts with units, and warnings.
+//
+// Everything 2D is batched into one triangle list and one line list per
+// frame, drawn with a single tiny shader; text comes from stb_easy_font
+// (quads from a built-in vector font, no texture, no font file).
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "render_internal.h"
+
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#endif
+#include <stb/stb_easy_font.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+static const char* k_hud_vs =
+    "#version 330 core\n"
+    "layout(location = 0) in vec2 a_pos;\n"
+    "layout(location = 1) in vec4 a_col;\n"
+    "uniform vec2 u_screen;\n"
+    "out vec4 v_col;\n"
+    "void main() {\n"
+    "    v_col = a_col;\n"
+    "    gl_Position = vec4(a_pos.x / u_screen.x * 2.0 - 1.0, 1.0 - a_pos.y / u_screen.y * 2.0, 0.0, 1.0);\n"
+    "}\n";
+
+static const char* k_hud_fs =
+    "#version 330 core\n"
+    "in vec4 v_col;\n"
+    "out vec4 o_color;\n"
+    "void main() { o_color = v_col; }\n";
+
+bool render_hud_create(render_hud* h) {
+    memset(h, 0, sizeof *h);
+    h->prog = render_shader_build("hud", k_hud_vs, k_hud_fs);
+    if (!h->prog) return false;
+    h->u_screen = glGetUniformLocation(h->prog, "u_screen");
+    glGenVertexArrays(1, &h->vao);
+    glGenBuffers(1, &h->vbo);
+    glBindVertexArray(h->vao);
+    glBindBuffer(GL_ARRAY_BUFFER, h->vbo);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(render_hud_vertex), (void*)0);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(render_hud_vertex),
+                          (void*)offsetof(render_hud_vertex, rgba));
+    glBindVertexArray(0);
+    // Generous first sizes; they only grow, so steady frames never allocate.
+    h->captri = 32768;
+    h->capline = 16384;
+    h->tri = malloc((size_t)h->captri * sizeof *h->tri);
+    h->line = malloc((size_t)h->capline * sizeof *h->line);
+    h->font_scratch_size = 64 * 1024;
+    h->font_scratch = malloc((size_t)h->font_scratch_size);
+    return h->tri && h->line && h->font_scratch;
+}
+
+void render_hud_free(render_hud* h) {
+    if (h->vbo) glDeleteBuffers(1, &h->vbo);
+    if (h->vao) glDeleteVertexArrays(1, &h->vao);
+    if (h->prog) glDeleteProgram(h->prog);
+    free(h->tri);
+    free(h->line);
+    free(h->font_scratch);
+    memset(h, 0, sizeof *h);
+}
+
+void render_hud_begin(render_hud* h, int w, int hh) {
+    h->ntri = h->nline = 0;
+    h->w = w;
+    h->h = hh;
+    memset(h->bar_valid, 0, sizeof h->bar_valid);
+}
+
+static bool grow(render_hud_vertex** buf, int* cap, int need) {
+    if (need <= *cap) return true;
+    int nc = *cap;
+    while (nc < need) nc *= 2;
+    render_hud_vertex* nb = realloc(*buf, (size_t)nc * sizeof *nb);
+    if (!nb) return false;
+    *buf = nb;
+    *cap = nc;
+    return true;
+}
+
+static render_hud_vertex hv(float x, float y, const unsigned char c[4]) {
+    render_hud_vertex v = {x, y, {c[0], c[1], c[2], c[3]}};
+    return v;
+}
+
+static void to_u8(const float rgba[4], unsigned char c[4]) {
+    for (int k = 0; k < 4; ++k) {
+        float f = rgba[k] < 0 ? 0 : rgba[k] > 1 ? 1 : rgba[k];
+        c[k] = (unsigned char)(f * 255.0f + 0.5f);
+    }
+}
+
+void render_hud_rect(render_hud* h, float x, float y, float w, float hh, const float rgba[4]) {
+    if (!grow(&h->tri, &h->captri, h->ntri + 6)) return;
+    unsigned char c[4];
+    to_u8(rgba, c);
+    render_hud_vertex* v = &h->tri[h->ntri];
+    v[0] = hv(x, y, c), v[1] = hv(x + w, y, c), v[2] = hv(x + w, y + hh, c);
+    v[3] = hv(x, y, c), v[4] = hv(x + w, y + hh, c), v[5] = hv(x, y + hh, c);
+    h->ntri += 6;
+}
+
+void render_hud_line(render_hud* h, float x0, float y0, float x1, float y1, const float rgba[4]) {
+    if (!grow(&h->line, &h->capline, h->nline + 2)) return;
+    unsigned char c[4];
+    to_u8(rgba, c);
+    // Pixel centres, so 1 px lines land on whole pixels.
+    h->line[h->nline++] = hv(x0 + 0.5f, y0 + 0.5f, c);
+    h->line[h->nline++] = hv(x1 + 0.5f, y1 + 0.5f, c);
+}
+
+float render_hud_text_width(const char* s, float scale) {
+    return (float)stb_easy_font_width((char*)s) * scale;
+}
+
+float render_hud_text(render_hud* h, float x, float y, float scale, const float rgba[4], const char* s) {
+    unsigned char c[4];
+    to_u8(rgba, c);
+    // stb_easy_font writes quads of 16-byte vertices (x, y, z, rgba).
+    int nq = stb_easy_font_print(0, 0, (char*)s, c, h->font_scratch, h->font_scratch_size);
+    if (!grow(&h->tri, &h->captri, h->ntri + 6 * nq)) return 0;
+    const char* q = h->font_scratch;
+    for (int i = 0; i < nq; ++i) {
+        render_hud_vertex v[4];
+        for (int k = 0; k < 4; ++k) {
+            const float* p = (const float*)(q + (size_t)(4 * i + k) * 16);
+            v[k] = hv(x + p[0] * scale, y + p[1] * scale, c);
+        }
+        render_hud_vertex* o = &h->tri[h->ntri];
+        o[0] = v[0], o[1] = v[1], o[2] = v[2];
+        o[3] = v[0], o[4] = v[2], o[5] = v[3];
+        h->ntri += 6;
+    }
+    return render_hud_text_width(s, scale);
+}
+
+void render_hud_flush(render_hud* h) {
+    if (!h->ntri && !h->nline) return;
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glUseProgram(h->prog);
+    glUniform2f(h->u_screen, (float)h->w, (float)h->h);
+    glBindVertexArray(h->vao);
+    glBindBuffer(GL_ARRAY_BUFFER, h->vbo);
+    // One upload per frame: orphan the buffer, then write both lists.
+    size_t bt = (size_t)h->ntri * sizeof(render_hud_vertex), bl = (size_t)h->nline * sizeof(render_hud_vertex);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(bt + bl), NULL, GL_STREAM_DRAW);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)bt, h->tri);
+    glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)bt, (GLsizeiptr)bl, h->line);
+    if (h->ntri) glDrawArrays(GL_TRIANGLES, 0, h->ntri);
+    if (h->nline) glDrawArrays(GL_LINES, h->ntri, h->nline);
+    glBindVertexArray(0);
+    glDisable(GL_BLEND);
+    glEnable(GL_DEPTH_TEST);
+}
+
+// ---- overlay content -------------------------------------------------------------
+
+static const float k_white[4] = {1, 1, 1, 1};
+static const float k_dim[4] = {0.75f, 0.78f, 0.82f, 1};
+static const float k_panel[4] = {0.05f, 0.06f, 0.08f, 0.62f};
+static const float k_warn_bg[4] = {0.70f, 0.05f, 0.05f, 0.88f};
+static const float k_amber[4] = {1.0f, 0.70f, 0.15f, 1};
+
+/// Pressure colour: green at low load, yellow in mid range, red near full scale.
+static void pressure_color(double frac, float rgba[4]) {
+    float f = (float)(frac < 0 ? 0 : frac > 1 ? 1 : frac);
+    if (f < 0.5f) {
+        float k = f / 0.5f;
+        rgba[0] = 0.15f + 0.80f * k, rgba[1] = 0.80f, rgba[2] = 0.20f;
+    } else {
+        float k = (f - 0.5f) / 0.5f;
+        rgba[0] = 0.95f, rgba[1] = 0.80f * (1.0f - k) + 0.10f * k, rgba[2] = 0.20f - 0.1f * k;
+    }
+    rgba[3] = 1.0f;
+}
+
+enum { BAR_W = 14, BAR_H = 96, BAR_GAP = 6, BAR_PAD = 4 };
+
+static void draw_pressure_bars(render* r, const world_snapshot* s) {
+    render_hud* h = &r->hud;
+    const float empty[4] = {((RENDER_BAR_EMPTY_RGB >> 16) & 255) / 255.0f, ((RENDER_BAR_EMPTY_RGB >> 8) & 255) / 255.0f,
+                            (RENDER_BAR_EMPTY_RGB & 255) / 255.0f, 1.0f};
+    const float frame[4] = {0.85f, 0.87f, 0.9f, 1.0f};
+    const float relief[4] = {1.0f, 0.1f, 0.1f, 1.0f};
+    int placed[WORLD_SNAP_MAX_CYLINDERS][4];
+    int nplaced = 0;
+    int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    for (int i = 0; i < ncyl; ++i) {
+        const world_snap_cylinder* c = &s->cyl[i];
+        double mid[3] = {0.5 * (c->base[0] + c->rod_end[0]), 0.5 * (c->base[1] + c->rod_end[1]),
+                         0.5 * (c->base[2] + c->rod_end[2])};
+        double px[2];
+        if (!render_project(r, mid, px)) continue;
+        // The group: two bars side by side, raised above the cylinder, with a
+        // leader line down to it. Keep it on screen and clear of the others.
+        int gw = 2 * BAR_W + BAR_GAP + 2 * BAR_PAD, gh = BAR_H + 2 * BAR_PAD + 30;
+        int gx = (int)px[0] - gw / 2, gy = (int)px[1] - 40 - gh;
+        if (gx < 4) gx = 4;
+        if (gy < 4) gy = 4;
+        if (gx + gw > h->w - 4) gx = h->w - 4 - gw;
+        if (gy + gh > h->h - 4) gy = h->h - 4 - gh;
+        for (int pass = 0; pass < 4; ++pass)
+            for (int k = 0; k < nplaced; ++k)
+                if (gx < placed[k][0] + placed[k][2] + 6 && placed[k][0] < gx + gw + 6 && gy < placed[k][1] + placed[k][3] &&
+                    placed[k][1] < gy + gh)
+                    gx = placed[k][0] + placed[k][2] + 8;
+        placed[nplaced][0] = gx, placed[nplaced][1] = gy, placed[nplaced][2] = gw, placed[nplaced][3] = gh;
+        ++nplaced;
+
+        render_hud_line(h, (float)gx + gw * 0.5f, (float)(gy + gh), (float)px[0], (float)px[1], k_dim);
+        render_hud_rect(h, (float)gx, (float)gy, (float)gw, (float)gh, k_panel);
+        char buf[64];
+        snprintf(buf, sizeof buf, "%s", c->name[0] ? c->name : "cyl");
+        render_hud_text(h, (float)gx + BAR_PAD, (float)gy + 3, 1.0f, c->end_stop ? k_amber : k_white, buf);
+        double p[2] = {c->pA, c->pB};
+        for (int ch = 0; ch < 2; ++ch) {
+            int bx = gx + BAR_PAD + ch * (BAR_W + BAR_GAP), by = gy + 14;
+            double frac = p[ch] / r->cfg.p_full_scale;
+            if (!(frac > 0)) frac = 0;  // also catches NaN
+            if (frac > 1) frac = 1;
+            // Outline (red while a port relief passes flow), then the empty
+            // bar, then the fill from the bottom.
+            render_hud_rect(h, (float)bx - 1, (float)by - 1, BAR_W + 2, BAR_H + 2, c->relief_open ? relief : frame);
+            render_hud_rect(h, (float)bx, (float)by, BAR_W, BAR_H, empty);
+            float fill = (float)(frac * BAR_H);
+            float col[4];
+            pressure_color(frac, col);
+            if (fill > 0) render_hud_rect(h, (float)bx, (float)by + BAR_H - fill, BAR_W, fill, col);
+            int* rr = r->hud.bar_rect[i][ch];
+            rr[0] = bx, rr[1] = by, rr[2] = BAR_W, rr[3] = BAR_H;
+            render_hud_text(h, (float)bx + 4, (float)(by + BAR_H + 3), 1.0f, k_dim, ch ? "B" : "A");
+        }
+        snprintf(buf, sizeof buf, "%.1f/%.1f", c->pA * 1e-6, c->pB * 1e-6);
+        render_hud_text(h, (float)gx + 2, (float)(gy + gh - 11), 1.0f, k_white, buf);
+        r->hud.bar_valid[i] = true;
+    }
+}
+
+/// Readouts table, top left. Units in every row header.
+static float draw_readouts(render* r, const world_snapshot* s) {
+    render_hud* h = &r->hud;
+    const float sc = 1.5f, lh = 14.0f, col0 = 96.0f, colw = 84.0f;
+    int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    const int nrows = 14;
+    float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
+    render_hud_rect(h, x - 6, y - 6, w, lh * (float)nrows + 10, k_panel);
+    char buf[160];
+    snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx   %.0f fps", s->t, s->rt_factor, r->fps_avg);
+    render_hud_text(h, x, y, sc, k_white, buf);
+    y += lh * 1.3f;
+    for (int i = 0; i < ncyl; ++i)
+        render_hud_text(h, x + col0 + colw * (float)i, y, sc, k_dim, s->cyl[i].name[0] ? s->cyl[i].name : "cyl");
+    y += lh;
+    static const char* rows[] = {"x [mm]", "v [mm/s]", "pA [MPa]", "pB [MPa]", "u [%]", "u_cmd [%]", "F [kN]"};
+    for (int row = 0; row < 7; ++row) {
+        render_hud_text(h, x, y, sc, k_dim, rows[row]);
+        for (int i = 0; i < ncyl; ++i) {
+            const world_snap_cylinder* c = &s->cyl[i];
+            double v[7] = {c->x * 1e3, c->v * 1e3, c->pA * 1e-6, c->pB * 1e-6, c->u * 100, c->u_cmd * 100, c->force * 1e-3};
+            const char* fmt = row == 4 || row == 5 ? "%+.0f" : row == 0 || row == 1 ? "%.1f" : "%.2f";
+            snprintf(buf, sizeof buf, fmt, v[row]);
+            const float* colr = (row == 2 || row == 3) && c->relief_open ? k_amber : k_white;
+            render_hud_text(h, x + col0 + colw * (float)i, y, sc, colr, buf);
+        }
+        y += lh;
+    }
+    y += 4;
+    snprintf(buf, sizeof buf, "tip  x %.2f  y %.2f  z %.2f m", s->tip[0], s->tip[1], s->tip[2]);
+    render_hud_text(h, x, y, sc, k_white, buf);
+    y += lh;
+    snprintf(buf, sizeof buf, "hook z %.2f m   load %.0f kg%s", s->hook[2], s->load_mass,
+             s->attached ? " (on hook)" : "");
+    render_hud_text(h, x, y, sc, k_white, buf);
+    y += lh;
+    snprintf(buf, sizeof buf, "slew %.1f deg  tilt %.1f deg  p_s %.1f MPa", s->slew * 180.0 / M_PI,
+             s->truck_tilt * 180.0 / M_PI, s->p_supply * 1e-6);
+    render_hud_text(h, x, y, sc, k_white, buf);
+    y += lh;
+    if (r->status[0]) {
+        render_hud_text(h, x, y, sc, k_amber, r->status);
+        y += lh;
+    }
+    return y;
+}
+
+static void draw_warnings(render* r, const world_snapshot* s) {
+    render_hud* h = &r->hud;
+    char w[12][96];
+    int n = 0;
+    int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    if (s->main_relief_open) snprintf(w[n++], sizeof w[0], "MAIN RELIEF OPEN");
+    for (int i = 0; i < ncyl && n < 10; ++i) {
+        const char* nm = s->cyl[i].name[0] ? s->cyl[i].name : "cylinder";
+        if (s->cyl[i].relief_open) snprintf(w[n++], sizeof w[0], "RELIEF OPEN: %s", nm);
+        if (s->cyl[i].end_stop && n < 10) snprintf(w[n++], sizeof w[0], "END STOP: %s", nm);
+    }
+    if (s->tipping && n < 11) snprintf(w[n++], sizeof w[0], "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
+    if (s->collision && n < 11) snprintf(w[n++], sizeof w[0], "COLLISION");
+    // Real time: the app's missed deadlines, or a measured factor below 1.
+    bool slow = r->missed_deadlines > 0 || (s->rt_factor > 0 && s->rt_factor < 0.97);
+    if (slow && n < 12) snprintf(w[n++], sizeof w[0], "CANNOT KEEP UP WITH REAL TIME (%.2fx)", s->rt_factor);
+    float y = 10;
+    for (int i = 0; i < n; ++i) {
+        float tw = render_hud_text_width(w[i], 2.0f);
+        float x = 0.5f * ((float)h->w - tw);
+        render_hud_rect(h, x - 8, y - 5, tw + 16, 26, k_warn_bg);
+        render_hud_text(h, x, y, 2.0f, k_white, w[i]);
+        y += 30;
+    }
+}
+
+void render_hud_draw_overlay(render* r, const world_snapshot* s) {
+    render_hud* h = &r->hud;
+    draw_pressure_bars(r, s);
+    draw_readouts(r, s);
+    draw_warnings(r, s);
+    if (r->charts.n > 0) {
+        float ch = 150.0f;
+        render_charts_draw(h, &r->charts, 10, (float)h->h - ch - 10, (float)h->w - 20, ch);
+    }
+}

@@ -1,0 +1,195 @@
+// render.c: the renderer object: create/destroy, one frame, events, and the
+// small queries the app and tests use.
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "gl_context.h"
+#include "panel.h"
+#include "render_internal.h"
+
+#ifndef CRANESIM_ASSETS
+#define CRANESIM_ASSETS "assets"
+#endif
+
+render_config render_default_config(void) {
+    render_config c;
+    memset(&c, 0, sizeof c);
+    c.width = 1280;
+    c.height = 720;
+    c.offscreen = false;
+    c.vsync = true;
+    c.msaa = 0;            // llvmpipe pays ~2x per sample; see docs/render.md
+    c.shadow_size = 2048;
+    c.title = "cranesim";
+    c.asset_dir = CRANESIM_ASSETS "/meshes";
+    c.p_full_scale = 30e6;
+    c.chart_seconds = 10.0;
+    c.hud = true;
+    return c;
+}
+
+render* render_create(const render_config* cfg, char* err, size_t errsz) {
+    render* r = calloc(1, sizeof *r);
+    if (!r) {
+        if (err && errsz) snprintf(err, errsz, "render: out of memory");
+        return NULL;
+    }
+    r->cfg = cfg ? *cfg : render_default_config();
+    if (r->cfg.width <= 0) r->cfg.width = 1280;
+    if (r->cfg.height <= 0) r->cfg.height = 720;
+    if (r->cfg.shadow_size < 256) r->cfg.shadow_size = 2048;
+    if (!(r->cfg.p_full_scale > 0)) r->cfg.p_full_scale = 30e6;
+    if (!(r->cfg.chart_seconds > 0)) r->cfg.chart_seconds = 10.0;
+    // Copy the strings: the caller's config may be a temporary.
+    snprintf(r->title, sizeof r->title, "%s", r->cfg.title ? r->cfg.title : "cranesim");
+    snprintf(r->asset_dir, sizeof r->asset_dir, "%s", r->cfg.asset_dir ? r->cfg.asset_dir : "");
+    r->cfg.title = r->title;
+    r->cfg.asset_dir = r->asset_dir;
+    snprintf(r->meshes.dir, sizeof r->meshes.dir, "%s", r->asset_dir);
+    r->charts.window = r->cfg.chart_seconds;
+
+    if (!render_gl_open(r, err, errsz)) {
+        render_destroy(r);
+        return NULL;
+    }
+    if (!render_scene_create(&r->scene) || !render_hud_create(&r->hud) ||
+        !render_shadow_create(&r->shadow, r->cfg.shadow_size)) {
+        if (err && errsz) snprintf(err, errsz, "render: cannot create GL resources (see stderr)");
+        render_destroy(r);
+        return NULL;
+    }
+    render_camera_init(&r->cam);
+    return r;
+}
+
+void render_destroy(render* r) {
+    if (!r) return;
+    if (r->gl) {
+        SDL_GL_MakeCurrent(r->win, r->gl);
+        if (r->panel_gui) panel_gui_shutdown(r->panel);
+        render_mesh_cache_free(&r->meshes);
+        render_scene_free(&r->scene);
+        render_hud_free(&r->hud);
+        render_shadow_free(&r->shadow);
+    }
+    render_gl_close(r);
+    free(r);
+}
+
+bool render_handle_event(render* r, const SDL_Event* ev) {
+    if (r->panel_gui && panel_gui_event(r->panel, ev)) return true;
+    if (ev->type == SDL_WINDOWEVENT && ev->window.event == SDL_WINDOWEVENT_SIZE_CHANGED && !r->cfg.offscreen) {
+        int w, h;
+        SDL_GL_GetDrawableSize(r->win, &w, &h);
+        render_targets_resize(r, w, h);
+        return true;
+    }
+    return render_camera_event(&r->cam, ev);
+}
+
+void render_frame(render* r, const world_snapshot* snap) {
+    Uint64 t0 = SDL_GetPerformanceCounter();
+    SDL_GL_MakeCurrent(r->win, r->gl);
+    if (!r->cfg.offscreen) {
+        int w, h;
+        SDL_GL_GetDrawableSize(r->win, &w, &h);
+        if (w != r->w || h != r->h) render_targets_resize(r, w, h);
+    }
+    render_camera_update(&r->cam, snap, r->w, r->h);
+
+    glBindFramebuffer(GL_FRAMEBUFFER, render_target_fbo(r));
+    glFinish(); Uint64 ta = SDL_GetPerformanceCounter();
+    render_scene_draw(&r->scene, &r->meshes, &r->shadow, &r->cam, snap, r->w, r->h);
+    glFinish(); Uint64 tb = SDL_GetPerformanceCounter();
+    render_resolve(r);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+    glViewport(0, 0, r->w, r->h);
+
+    render_hud_begin(&r->hud, r->w, r->h);
+    if (r->cfg.hud) render_hud_draw_overlay(r, snap);
+    render_hud_flush(&r->hud);
+    glFinish(); Uint64 tc = SDL_GetPerformanceCounter();
+    if (r->panel_gui) panel_gui_draw(r->panel);
+    if (getenv("PROF")) fprintf(stderr, "scene %.2f hud %.2f ms tri %d line %d\n", 1e3*(tb-ta)/(double)SDL_GetPerformanceFrequency(), 1e3*(tc-tb)/(double)SDL_GetPerformanceFrequency(), r->hud.ntri, r->hud.nline);
+
+    // Smoothed frame rate from the wall time between frames.
+    Uint64 now = SDL_GetPerformanceCounter();
+    if (r->last_frame_ticks) {
+        double dt = (double)(now - r->last_frame_ticks) / (double)SDL_GetPerformanceFrequency();
+        if (dt > 0) r->fps_avg = r->fps_avg > 0 ? 0.9 * r->fps_avg + 0.1 / dt : 1.0 / dt;
+    }
+    r->last_frame_ticks = now;
+    r->have_frame = true;
+    r->stats.triangles = r->scene.triangles;
+    r->stats.draw_calls = r->scene.draw_calls + 2;
+    r->stats.mesh_warnings = r->meshes.warnings;
+    r->stats.meshes_loaded = r->meshes.n - r->meshes.warnings;
+    r->stats.frame_ms = 1e3 * (double)(SDL_GetPerformanceCounter() - t0) / (double)SDL_GetPerformanceFrequency();
+}
+
+void render_present(render* r) {
+    if (r->cfg.offscreen) {
+        // Nothing to show; make sure the frame is finished like a swap would.
+        glFinish();
+        return;
+    }
+    SDL_GL_SwapWindow(r->win);
+}
+
+void render_set_camera_preset(render* r, render_cam_preset p) {
+    if (p < 0 || p >= RENDER_CAM_COUNT) return;
+    r->cam.preset = p;
+    if (p == RENDER_CAM_FOLLOW_HOOK) r->cam.dist = 7.0f;
+    if (p == RENDER_CAM_ORBIT) r->cam.target_set = false;
+}
+
+render_cam_preset render_get_camera_preset(const render* r) { return r->cam.preset; }
+
+void render_set_orbit(render* r, const double target[3], double yaw, double pitch, double dist) {
+    r->cam.preset = RENDER_CAM_ORBIT;
+    r->cam.target = rm_v3((float)target[0], (float)target[1], (float)target[2]);
+    r->cam.target_set = true;
+    r->cam.yaw = (float)yaw;
+    r->cam.pitch = (float)pitch;
+    r->cam.dist = (float)dist;
+}
+
+bool render_project(const render* r, const double world[3], double px[2]) {
+    float c[4];
+    rm_xform4(c, r->cam.viewproj, (float)world[0], (float)world[1], (float)world[2]);
+    if (c[3] <= 1e-6f) return false;
+    px[0] = (c[0] / c[3] * 0.5 + 0.5) * r->w;
+    px[1] = (0.5 - c[1] / c[3] * 0.5) * r->h;
+    return true;
+}
+
+bool render_hud_bar_rect(const render* r, int cyl, int chamber, int rect[4]) {
+    if (cyl < 0 || cyl >= WORLD_SNAP_MAX_CYLINDERS || chamber < 0 || chamber > 1) return false;
+    if (!r->hud.bar_valid[cyl]) return false;
+    memcpy(rect, r->hud.bar_rect[cyl][chamber], 4 * sizeof(int));
+    return true;
+}
+
+void render_size(const render* r, int* w, int* h) {
+    if (w) *w = r->w;
+    if (h) *h = r->h;
+}
+
+render_stats render_get_stats(const render* r) { return r->stats; }
+SDL_Window* render_window(render* r) { return r->win; }
+
+bool render_attach_panel(render* r, panel* p) {
+    if (r->panel_gui) panel_gui_shutdown(r->panel);
+    r->panel_gui = false;
+    r->panel = p;
+    if (!p) return true;
+    SDL_GL_MakeCurrent(r->win, r->gl);
+    r->panel_gui = panel_gui_init(p, r->win, r->gl);
+    return r->panel_gui;
+}
+
+void render_set_status(render* r, const char* text) {
+    snprintf(r->status, sizeof r->status, "%s", text ? text : "");
+}
+
+void render_set_missed_deadlines(render* r, int missed) { r->missed_deadlines = missed; }

@@ -1,0 +1,179 @@
+// render.h: the 3D view of cranesim (SDL2 + OpenGL 3.3 core).
+//
+// The renderer reads a world_snapshot and nothing else from the physics. A
+// frame is: render_frame(r, snap) draws the scene, shadows, HUD, pressure
+// bars, strip charts and (if attached) the parameter panel; then
+// render_present(r) swaps the window, or does nothing in offscreen mode,
+// where the frame lives in an FBO that render_screenshot() can save.
+//
+// Typical `cranesim drive` loop (the app owns SDL_Init and the event loop):
+//
+//     render_config cfg = render_default_config();
+//     render* r = render_create(&cfg, err, sizeof err);
+//     while (running) {
+//         while (SDL_PollEvent(&ev)) { input_handle_event(in, &ev); render_handle_event(r, &ev); }
+//         input_poll(in, dt, &cmd);           // valve commands, >= 75 Hz
+//         ... step the world, fill snap ...
+//         render_charts_sample(r, &snap);     // or render_chart_push() per variable
+//         render_frame(r, &snap);
+//         render_present(r);
+//     }
+//     render_destroy(r);
+//
+// All positions are world frame (x forward, y left, z up) in metres.
+#ifndef CRANESIM_RENDER_H
+#define CRANESIM_RENDER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include <SDL2/SDL.h>
+
+#include "world/world_snapshot.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct render render;
+typedef struct panel panel;
+
+/// Camera presets (also selectable with F1..F4 through input.h).
+typedef enum render_cam_preset {
+    RENDER_CAM_ORBIT = 0,  ///< free orbit around the crane, mouse driven
+    RENDER_CAM_OPERATOR,   ///< operator standing at the column, looking at the tip
+    RENDER_CAM_SIDE,       ///< side view across the boom plane
+    RENDER_CAM_FOLLOW_HOOK,///< orbit centred on the hook, follows it
+    RENDER_CAM_COUNT
+} render_cam_preset;
+
+typedef struct render_config {
+    int width, height;       ///< window or FBO size [px], default 1280 x 720
+    bool offscreen;          ///< render into an FBO, no visible window (tests, batch PNGs)
+    bool vsync;              ///< window mode only
+    int msaa;                ///< multisample count for the scene (0 = off, 4 typical)
+    int shadow_size;         ///< shadow map edge [texels], default 2048
+    const char* title;       ///< window title
+    const char* asset_dir;   ///< directory for relative mesh names, default CRANESIM_ASSETS "/meshes"
+    double p_full_scale;     ///< pressure at full bar height [Pa], default 30 MPa
+    double chart_seconds;    ///< strip-chart time window [s], default 10
+    bool hud;                ///< draw HUD text, bars and warnings (default true)
+} render_config;
+
+/// Counters from the last frame, for the report line and for tests.
+typedef struct render_stats {
+    long triangles;          ///< triangles submitted in the main pass
+    int draw_calls;          ///< main pass + shadow pass + HUD
+    int mesh_warnings;       ///< meshes that failed to load (primitive used instead)
+    int meshes_loaded;       ///< distinct meshes in the cache
+    double frame_ms;         ///< CPU time spent in render_frame [ms]
+} render_stats;
+
+/// Filled-in defaults; change only what differs.
+render_config render_default_config(void);
+
+/// Create the window (or hidden window + FBO), the GL 3.3 core context and all
+/// GPU resources. Initialises the SDL video subsystem if the app has not.
+/// Returns NULL and writes a message into err on failure.
+render* render_create(const render_config* cfg, char* err, size_t errsz);
+void render_destroy(render* r);
+
+/// Camera mouse control (orbit with left drag, pan with right/middle drag,
+/// zoom with the wheel), window resize, and the panel's events.
+/// Returns true when the event was consumed (e.g. typing into the panel).
+bool render_handle_event(render* r, const SDL_Event* ev);
+
+/// Draw one frame of the snapshot (scene, shadows, HUD, charts, panel).
+void render_frame(render* r, const world_snapshot* snap);
+/// Swap buffers (window mode); no-op offscreen.
+void render_present(render* r);
+
+/// Save the last rendered frame as PNG. Returns 0 on success, -1 on failure
+/// (message on stderr naming the file).
+int render_screenshot(render* r, const char* path);
+/// Copy the last frame as RGBA8, top row first, into a w*h*4 buffer.
+/// Returns 0 on success.
+int render_read_pixels(render* r, unsigned char* rgba, int w, int h);
+
+void render_set_camera_preset(render* r, render_cam_preset p);
+render_cam_preset render_get_camera_preset(const render* r);
+/// Orbit parameters for the free camera: target [m], yaw/pitch [rad], distance [m].
+void render_set_orbit(render* r, const double target[3], double yaw, double pitch, double dist);
+
+/// Project a world point [m] to pixel coordinates (x right, y down, origin top
+/// left) with the camera of the last frame. Returns false if it is behind the
+/// camera.
+bool render_project(const render* r, const double world[3], double px[2]);
+
+/// Screen rectangle (x, y, w, h [px], origin top left) of the inside of the
+/// pressure bar of cylinder `cyl`, chamber 0 = A or 1 = B, as drawn in the
+/// last frame; false if that bar was not drawn. The unfilled part of a bar is
+/// RENDER_BAR_EMPTY_RGB.
+bool render_hud_bar_rect(const render* r, int cyl, int chamber, int rect[4]);
+#define RENDER_BAR_EMPTY_RGB 0x141418
+
+/// Current framebuffer size [px].
+void render_size(const render* r, int* w, int* h);
+render_stats render_get_stats(const render* r);
+SDL_Window* render_window(render* r);
+
+/// Attach a parameter panel (panel.h); it is drawn on top of each frame and
+/// gets events. NULL detaches. The panel must outlive the attachment.
+/// Returns false if the ImGui backend could not start (panel still usable
+/// through its C API).
+bool render_attach_panel(render* r, panel* p);
+
+/// Short status line shown under the readouts (e.g. "PAUSED", "recording").
+void render_set_status(render* r, const char* text);
+/// The app reports missed real-time deadlines here; any count > 0 in the last
+/// second shows the "cannot keep up with real time" warning.
+void render_set_missed_deadlines(render* r, int missed_last_second);
+
+// ---- strip charts --------------------------------------------------------
+
+/// One scrolling time history. Samples outside [ymin, ymax] are clipped.
+typedef struct render_chart_def {
+    const char* label;   ///< e.g. "p1A"
+    const char* unit;    ///< display unit, e.g. "MPa"
+    double scale;        ///< SI value * scale = displayed value (1e-6 for Pa -> MPa)
+    double ymin, ymax;   ///< displayed range, in display units
+    float rgba[4];       ///< line colour
+    int group;           ///< charts with the same group share one plot box
+} render_chart_def;
+
+/// Add a chart channel; returns its id (>= 0) or -1 when full.
+int render_chart_add(render* r, const render_chart_def* def);
+/// Append a sample (t [s], SI value). Samples must come in increasing t.
+void render_chart_push(render* r, int id, double t, double value);
+/// Remove all samples (e.g. after a reset).
+void render_chart_clear(render* r);
+/// Register the standard channels: pressures of every cylinder chamber
+/// (MPa), strokes (mm) and spool openings (%), grouped in three plots.
+void render_charts_default(render* r, int ncyl);
+/// Push the standard channels from a snapshot (after render_charts_default).
+void render_charts_sample(render* r, const world_snapshot* snap);
+
+// ---- demo scene ------------------------------------------------------------
+
+/// Parameters of the synthetic crane scene used by render_demo and tests.
+typedef struct render_demo_params {
+    double slew;         ///< column slew [rad]
+    double q1_deg;       ///< lifting-arm elevation above horizontal [deg]
+    double q2_deg;       ///< end-arm angle relative to the lifting arm [deg] (negative = folded down)
+    double pA[2], pB[2]; ///< chamber pressures of lift and jib cylinder [Pa]
+    double u[2];         ///< spool openings -1..1
+    bool terrain;        ///< use a gentle heightfield instead of flat ground
+    bool use_meshes;     ///< name the assets/meshes OBJ files (else primitives only)
+} render_demo_params;
+
+render_demo_params render_demo_default_params(void);
+/// Fill snap with a truck-mounted crane, hook on a rope, loads and obstacles.
+/// terrain_buf (>= 65*65 floats) holds the heightfield when p->terrain.
+void render_demo_scene(world_snapshot* snap, const render_demo_params* p, float* terrain_buf);
+/// Terrain grid used by render_demo_scene (65 x 65 samples).
+#define RENDER_DEMO_TERRAIN_N 65
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,87 @@
+// crane_model.h: the mechanical description of the knuckle-boom crane.
+//
+// Planar geometry in the boom plane: x horizontal (reach), z up, origin at
+// joint 1 (column top). Angles follow the paper: q1 is the lifting arm's angle
+// from the downward vertical, q2 the end arm's angle relative to the lifting
+// arm (counter-clockwise positive when seen with x right, z up). So the lifting
+// arm's elevation above horizontal is q1 - pi/2. See docs/lagrange.md.
+//
+// Link frames: the column frame is fixed (x forward, z up, origin joint 1).
+// Link i's frame has its origin at joint i and x along the link towards the
+// next joint (or the tip); z is x rotated +90 degrees.
+#ifndef CRANE_MODEL_H
+#define CRANE_MODEL_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define CRANE_NAME 48
+
+/// One boom (rigid link).
+typedef struct crane_link {
+    char name[CRANE_NAME];
+    double length;  ///< joint to next joint (or tip) [m]
+    double mass;    ///< [kg]
+    double com;     ///< distance from its joint to its centre of mass, along the link [m]
+    double inertia; ///< moment of inertia about the COM, about the joint axis [kg m^2]
+    double width;   ///< box-section width, for the 3D world and rendering [m]
+    double height;  ///< box-section height [m]
+} crane_link;
+
+/// A cylinder acting across one joint. Mount points are 2D (x, z) coordinates
+/// relative to the joint, in the parent and child link frames.
+typedef struct crane_actuator {
+    char name[CRANE_NAME];     ///< "lift", "jib"
+    int joint;                 ///< 0: joint 1 (column-lifting arm); 1: joint 2 (lifting arm-end arm)
+    char cylinder[CRANE_NAME]; ///< name of the cylinder component in the hydraulic circuit
+    char valve[CRANE_NAME];    ///< name of its directional valve in the circuit
+    double base_mount[2];      ///< barrel pin in the parent frame, relative to the joint [m]
+    double rod_mount[2];       ///< rod pin in the child frame, relative to the joint [m]
+    double closed_length;      ///< pin-to-pin length at zero stroke [m]
+    /* Derived at load time (paper Eq. 5): x_pin = sqrt(a^2 + b^2 - 2ab cos(phi)),
+       phi = q_joint + phi_offset. */
+    double a;          ///< |base_mount| [m]
+    double b;          ///< |rod_mount| [m]
+    double phi_offset; ///< phi - q_joint [rad]
+} crane_actuator;
+
+/// Mechanical parameters of the crane (read-only during a step).
+typedef struct crane_mech {
+    double gravity;       ///< [m/s^2]
+    double column_height; ///< joint 1 above the truck bed [m]
+    double column_mass;   ///< [kg] (3D world only)
+    crane_link link[2];   ///< lifting arm, end arm
+    double load_mass;     ///< mass rigidly at the end-arm tip (lagrange, validation world) [kg]
+    crane_actuator act[2];
+} crane_mech;
+
+/// Fill with the built-in HIAB-031-class defaults (SPEC section 4).
+crane_mech crane_default_mech(void);
+
+/// Compute the derived fields (a, b, phi_offset) from the mount points.
+void crane_mech_derive(crane_mech* m);
+
+/// Cylinder pin-to-pin length [m] and its derivative d(x_pin)/d(q_joint) [m/rad]
+/// for actuator k at joint angle q [rad]. Paper Eq. 5.
+double crane_pin_length(const crane_actuator* a, double q, double* dx_dq);
+
+/// Stroke [m] (pin length minus closed length) at joint angle q [rad].
+double crane_stroke(const crane_actuator* a, double q);
+
+/// Joint angle [rad] that gives stroke x [m] (inverse of crane_stroke over the
+/// branch phi in (0, pi)). Returns NAN if unreachable.
+double crane_joint_for_stroke(const crane_actuator* a, double x);
+
+/// Tip position relative to joint 1 (x reach, z height) [m].
+void crane_tip(const crane_mech* m, double q1, double q2, double* x, double* z);
+
+/// Problem found by crane_mech_check, written as "field: message".
+/// Returns 0 if the geometry is usable: phi inside (0, pi) over the stroke
+/// [0, stroke_k] of each actuator, positive lengths and masses.
+int crane_mech_check(const crane_mech* m, const double stroke[2], char* err, int errsz);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

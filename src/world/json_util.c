@@ -1,0 +1,299 @@
+// json_util.c: see json_util.h.
+#include "json_util.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void json_fail(json_ctx* c, const char* path, const char* fmt, ...) {
+    if (c->failed) return;
+    c->failed = true;
+    if (!c->err || c->errsz == 0) return;
+    int k = snprintf(c->err, c->errsz, "%s: %s: ", c->file ? c->file : "(input)",
+                     path && *path ? path : "(top level)");
+    if (k < 0 || (size_t)k >= c->errsz) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(c->err + k, c->errsz - (size_t)k, fmt, ap);
+    va_end(ap);
+}
+
+cJSON* json_load_file(const char* path, char* err, size_t errsz) {
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, errsz, "%s: cannot open: %s", path, strerror(errno));
+        return NULL;
+    }
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    if (n < 0 || n > (64L << 20)) {
+        fclose(f);
+        snprintf(err, errsz, "%s: cannot read (size %ld bytes)", path, n);
+        return NULL;
+    }
+    char* buf = malloc((size_t)n + 1);
+    if (!buf) {
+        fclose(f);
+        snprintf(err, errsz, "%s: out of memory", path);
+        return NULL;
+    }
+    size_t got = fread(buf, 1, (size_t)n, f);
+    fclose(f);
+    buf[got] = 0;
+    const char* end = NULL;
+    cJSON* root = cJSON_ParseWithOpts(buf, &end, 1);
+    if (!root) {
+        // Report line and column of the parse failure: the one thing a user
+        // needs to find a missing comma.
+        const char* at = end ? end : cJSON_GetErrorPtr();
+        int line = 1, col = 1;
+        for (const char* p = buf; at && p < at && *p; ++p) {
+            if (*p == '\n') { ++line; col = 1; } else ++col;
+        }
+        snprintf(err, errsz, "%s: line %d, column %d: invalid JSON", path, line, col);
+    }
+    free(buf);
+    return root;
+}
+
+void json_path(char* out, size_t n, const char* parent, const char* key) {
+    if (parent && *parent) snprintf(out, n, "%s.%s", parent, key);
+    else snprintf(out, n, "%s", key);
+}
+
+void json_path_index(char* out, size_t n, const char* parent, int index) {
+    snprintf(out, n, "%s[%d]", parent ? parent : "", index);
+}
+
+static const char* type_name(const cJSON* v) {
+    if (cJSON_IsNumber(v)) return "a number";
+    if (cJSON_IsString(v)) return "a string";
+    if (cJSON_IsBool(v)) return "a boolean";
+    if (cJSON_IsNull(v)) return "null";
+    if (cJSON_IsArray(v)) return "an array";
+    if (cJSON_IsObject(v)) return "an object";
+    return "invalid";
+}
+
+// Member lookup shared by the getters: reports "missing" for required members.
+static const cJSON* member(json_ctx* c, const cJSON* obj, const char* path, const char* key,
+                           bool required, char* full, size_t fn) {
+    json_path(full, fn, path, key);
+    if (c->failed || !obj) return NULL;
+    const cJSON* v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v && required) json_fail(c, full, "missing (required)");
+    return v;
+}
+
+const cJSON* json_obj(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required) {
+    char full[256];
+    const cJSON* v = member(c, obj, path, key, required, full, sizeof full);
+    if (v && !cJSON_IsObject(v)) {
+        json_fail(c, full, "must be an object, got %s", type_name(v));
+        return NULL;
+    }
+    return v;
+}
+
+const cJSON* json_arr(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required) {
+    char full[256];
+    const cJSON* v = member(c, obj, path, key, required, full, sizeof full);
+    if (v && !cJSON_IsArray(v)) {
+        json_fail(c, full, "must be an array, got %s", type_name(v));
+        return NULL;
+    }
+    return v;
+}
+
+double json_num(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                double def, double lo, double hi) {
+    char full[256];
+    const cJSON* v = member(c, obj, path, key, required, full, sizeof full);
+    if (!v) return def;
+    if (!cJSON_IsNumber(v)) {
+        json_fail(c, full, "must be a number, got %s", type_name(v));
+        return def;
+    }
+    double x = v->valuedouble;
+    if (!isfinite(x)) json_fail(c, full, "must be finite");
+    else if (x < lo) json_fail(c, full, "must be >= %g, got %g", lo, x);
+    else if (x > hi) json_fail(c, full, "must be <= %g, got %g", hi, x);
+    return x;
+}
+
+double json_pos(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                double def) {
+    char full[256];
+    json_path(full, sizeof full, path, key);
+    double x = json_num(c, obj, path, key, required, def, -INFINITY, INFINITY);
+    if (!c->failed && !(x > 0)) json_fail(c, full, "must be > 0, got %g", x);
+    return x;
+}
+
+int json_int(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required, int def,
+             int lo, int hi) {
+    char full[256];
+    json_path(full, sizeof full, path, key);
+    double x = json_num(c, obj, path, key, required, def, lo, hi);
+    if (!c->failed && x != floor(x)) json_fail(c, full, "must be a whole number, got %g", x);
+    return (int)x;
+}
+
+bool json_bool(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool def) {
+    char full[256];
+    const cJSON* v = member(c, obj, path, key, false, full, sizeof full);
+    if (!v) return def;
+    if (!cJSON_IsBool(v)) {
+        json_fail(c, full, "must be true or false, got %s", type_name(v));
+        return def;
+    }
+    return cJSON_IsTrue(v);
+}
+
+void json_str(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+              const char* def, char* out, size_t n) {
+    char full[256];
+    const cJSON* v = member(c, obj, path, key, required, full, sizeof full);
+    const char* s = def ? def : "";
+    if (v) {
+        if (!cJSON_IsString(v)) {
+            json_fail(c, full, "must be a string, got %s", type_name(v));
+        } else {
+            s = v->valuestring;
+            if (strlen(s) >= n) json_fail(c, full, "too long (max %zu characters)", n - 1);
+        }
+    }
+    snprintf(out, n, "%s", s);
+}
+
+void json_vec(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+              double* out, int n) {
+    char full[256];
+    const cJSON* v = member(c, obj, path, key, required, full, sizeof full);
+    if (!v) return;
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != n) {
+        json_fail(c, full, "must be an array of %d numbers", n);
+        return;
+    }
+    for (int i = 0; i < n; ++i) {
+        const cJSON* e = cJSON_GetArrayItem(v, i);
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) {
+            char p[272];
+            json_path_index(p, sizeof p, full, i);
+            json_fail(c, p, "must be a finite number, got %s", type_name(e));
+            return;
+        }
+        out[i] = e->valuedouble;
+    }
+}
+
+void json_only_keys(json_ctx* c, const cJSON* obj, const char* path, const char* const* allowed) {
+    if (c->failed || !obj) return;
+    const cJSON* it;
+    cJSON_ArrayForEach(it, obj) {
+        bool ok = false;
+        for (const char* const* a = allowed; *a && !ok; ++a) ok = it->string && !strcmp(*a, it->string);
+        if (!ok) {
+            char full[256];
+            json_path(full, sizeof full, path, it->string ? it->string : "?");
+            json_fail(c, full, "unknown field (typo?)");
+            return;
+        }
+    }
+}
+
+// Find the child named by one path segment: an object key, "[i]" handled by
+// the caller, or for arrays the element whose "name" equals the segment.
+static cJSON* child_by_segment(cJSON* node, const char* seg) {
+    if (cJSON_IsObject(node)) return cJSON_GetObjectItemCaseSensitive(node, seg);
+    if (cJSON_IsArray(node)) {
+        char* endp;
+        long i = strtol(seg, &endp, 10);
+        if (*seg && !*endp) return cJSON_GetArrayItem(node, (int)i);
+        cJSON* e;
+        cJSON_ArrayForEach(e, node) {
+            cJSON* nm = cJSON_GetObjectItemCaseSensitive(e, "name");
+            if (cJSON_IsString(nm) && !strcmp(nm->valuestring, seg)) return e;
+        }
+    }
+    return NULL;
+}
+
+int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) {
+    const char* eq = strchr(assignment, '=');
+    if (!eq || eq == assignment) {
+        snprintf(err, errsz, "--set %s: expected path=value", assignment);
+        return -1;
+    }
+    char path[256];
+    size_t plen = (size_t)(eq - assignment);
+    if (plen >= sizeof path) {
+        snprintf(err, errsz, "--set: path too long");
+        return -1;
+    }
+    memcpy(path, assignment, plen);
+    path[plen] = 0;
+    const char* value = eq + 1;
+
+    // Split the path into segments on '.', '[' and ']'.
+    char segs[32][64];
+    int nseg = 0;
+    for (const char* p = path; *p;) {
+        if (*p == '.' || *p == '[' || *p == ']') { ++p; continue; }
+        size_t k = 0;
+        while (p[k] && p[k] != '.' && p[k] != '[' && p[k] != ']') ++k;
+        if (nseg == 32 || k >= 64) {
+            snprintf(err, errsz, "--set %s: path too deep or segment too long", path);
+            return -1;
+        }
+        memcpy(segs[nseg], p, k);
+        segs[nseg][k] = 0;
+        ++nseg;
+        p += k;
+    }
+    if (nseg == 0) {
+        snprintf(err, errsz, "--set %s: empty path", path);
+        return -1;
+    }
+    cJSON* parent = root;
+    for (int i = 0; i < nseg - 1; ++i) {
+        parent = child_by_segment(parent, segs[i]);
+        if (!parent) {
+            snprintf(err, errsz, "--set %s: no field '%s' in the model", path, segs[i]);
+            return -1;
+        }
+    }
+    cJSON* old = child_by_segment(parent, segs[nseg - 1]);
+    if (!old) {
+        snprintf(err, errsz, "--set %s: no field '%s' in the model", path, segs[nseg - 1]);
+        return -1;
+    }
+    cJSON* nv = cJSON_Parse(value);
+    if (!nv) {
+        // A bare word (no quotes) is taken as a string: --set solver=ros2.
+        bool word = *value != 0;
+        for (const char* q = value; *q; ++q) word = word && (isalnum((unsigned char)*q) || strchr("_-./:", *q));
+        if (!word) {
+            snprintf(err, errsz, "--set %s: cannot parse value '%s'", path, value);
+            return -1;
+        }
+        nv = cJSON_CreateString(value);
+    }
+    // Keep the member's type: a number stays a number, so a mistyped value is
+    // caught here and not deep inside the loader.
+    if ((cJSON_IsNumber(old) && !cJSON_IsNumber(nv)) || (cJSON_IsBool(old) && !cJSON_IsBool(nv)) ||
+        (cJSON_IsString(old) && !cJSON_IsString(nv)) || (cJSON_IsObject(old) && !cJSON_IsObject(nv)) ||
+        (cJSON_IsArray(old) && !cJSON_IsArray(nv))) {
+        snprintf(err, errsz, "--set %s: expected %s, got '%s'", path, type_name(old), value);
+        cJSON_Delete(nv);
+        return -1;
+    }
+    if (cJSON_IsArray(parent)) cJSON_ReplaceItemViaPointer(parent, old, nv);
+    else cJSON_ReplaceItemInObjectCaseSensitive(parent, segs[nseg - 1], nv);
+    return 0;
+}

@@ -1,0 +1,75 @@
+// json_util.h: strict, path-aware reading of JSON model, scenario and world files.
+//
+// Every getter names the file and the full field path in its one-line error,
+// e.g. "hiab031.json: mechanics.links[1].mass: must be > 0, got -3". The first
+// error wins; later calls become no-ops so a loader can read everything and
+// check once at the end.
+#ifndef JSON_UTIL_H
+#define JSON_UTIL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <cjson/cJSON.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct json_ctx {
+    const char* file; ///< file name used in messages
+    char* err;        ///< caller's buffer for the first error
+    size_t errsz;
+    bool failed;
+} json_ctx;
+
+/// Record an error "file: path: message" (printf-style message). First one wins.
+void json_fail(json_ctx* c, const char* path, const char* fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/// Read and parse a whole file. NULL with "file: line L, column C: message" on error.
+cJSON* json_load_file(const char* path, char* err, size_t errsz);
+
+/// Join a parent path and a key ("a.b" + "c" -> "a.b.c"; "" + "c" -> "c").
+void json_path(char* out, size_t n, const char* parent, const char* key);
+/// Parent path plus an index ("a.b" + 3 -> "a.b[3]").
+void json_path_index(char* out, size_t n, const char* parent, int index);
+
+/// Object member that must be an object (required) or NULL if absent and optional.
+const cJSON* json_obj(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required);
+/// Member that must be an array.
+const cJSON* json_arr(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required);
+
+/// Number with range check: value must satisfy lo <= v <= hi (use -INFINITY /
+/// INFINITY for open ends); if positive is true it must also be > 0.
+/// Absent and not required: returns def.
+double json_num(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                double def, double lo, double hi);
+/// Number that must be > 0.
+double json_pos(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                double def);
+/// Integer in [lo, hi].
+int json_int(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required, int def,
+             int lo, int hi);
+bool json_bool(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool def);
+/// String copied into out (truncated to n-1); absent and optional: def.
+void json_str(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+              const char* def, char* out, size_t n);
+/// Fixed-length number array [v0, v1, ...].
+void json_vec(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+              double* out, int n);
+
+/// Reject members not named in allowed (a NULL-terminated list): catches typos.
+void json_only_keys(json_ctx* c, const cJSON* obj, const char* path, const char* const* allowed);
+
+/// Apply "path=value" to a parsed document: path is dot-separated with [i]
+/// indices, and an array element can also be picked by its "name" member
+/// ("hydraulics.components.lift_cyl.bore"). value is parsed as JSON (number,
+/// true/false, "string", [array]); a bare word becomes a string. The member
+/// must already exist (a typo must not be silently added). Returns 0 or -1
+/// with a message in err.
+int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

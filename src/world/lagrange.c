@@ -1,0 +1,104 @@
+// lagrange.c: mass matrix, velocity and gravity terms of the 2-DOF crane.
+#include "lagrange.h"
+
+#include <math.h>
+#include <string.h>
+
+static const char* const variant_names[] = {"full", "paper", "paper-typo"};
+
+const char* lagrange_variant_name(lagrange_variant v) {
+    return (unsigned)v < 3 ? variant_names[v] : "?";
+}
+
+int lagrange_variant_parse(const char* s) {
+    for (int i = 0; i < 3; ++i)
+        if (!strcmp(s, variant_names[i])) return i;
+    return -1;
+}
+
+void lagrange_eval_terms(const crane_mech* m, lagrange_variant v, double m3, const double q[2],
+                         const double qd[2], lagrange_terms* o) {
+    const double g = m->gravity;
+    const double L1 = m->link[0].length, L2 = m->link[1].length;
+    const double m1 = m->link[0].mass, m2 = m->link[1].mass;
+    const double e1 = m->link[0].com, e2 = m->link[1].com;
+    // The paper's Eq. 2 is the point-mass special case.
+    const double I1 = v == LAGRANGE_FULL ? m->link[0].inertia : 0.0;
+    const double I2 = v == LAGRANGE_FULL ? m->link[1].inertia : 0.0;
+
+    // One sincos pair per angle; sin/cos(q1 + q2) by the addition identities.
+    const double s1 = sin(q[0]), c1 = cos(q[0]);
+    const double s2 = sin(q[1]), c2 = cos(q[1]);
+    const double s12 = s1 * c2 + c1 * s2, c12 = c1 * c2 - s1 * s2;
+
+    const double mu = m2 * e2 + m3 * L2; // first moment of end arm + load about joint 2 [kg m]
+    const double kc = mu * L1;           // coupling coefficient [kg m^2]
+    const double H22 = I2 + m2 * e2 * e2 + m3 * L2 * L2;
+    o->H[0][0] = I1 + m1 * e1 * e1 + (m2 + m3) * L1 * L1 + H22 + 2.0 * kc * c2;
+    o->H[0][1] = o->H[1][0] = H22 + kc * c2;
+    o->H[1][1] = H22;
+    o->dH_dq2[0][0] = -2.0 * kc * s2;
+    o->dH_dq2[0][1] = o->dH_dq2[1][0] = -kc * s2;
+    o->dH_dq2[1][1] = 0.0;
+
+    if (v == LAGRANGE_FULL) {
+        const double k = kc * s2;
+        o->C[0] = -k * (2.0 * qd[0] * qd[1] + qd[1] * qd[1]);
+        o->C[1] = k * qd[0] * qd[0];
+        const double dk = kc * c2;
+        o->dC_dq2[0] = -dk * (2.0 * qd[0] * qd[1] + qd[1] * qd[1]);
+        o->dC_dq2[1] = dk * qd[0] * qd[0];
+        o->dC_dqd1[0] = -2.0 * k * qd[1];
+        o->dC_dqd1[1] = 2.0 * k * qd[0];
+        o->dC_dqd2[0] = -2.0 * k * (qd[0] + qd[1]);
+        o->dC_dqd2[1] = 0.0;
+    } else {
+        // The paper neglects C at the crane's low angular speeds.
+        o->C[0] = o->C[1] = 0.0;
+        o->dC_dq2[0] = o->dC_dq2[1] = 0.0;
+        o->dC_dqd1[0] = o->dC_dqd1[1] = 0.0;
+        o->dC_dqd2[0] = o->dC_dqd2[1] = 0.0;
+    }
+
+    // Eq. 3 as printed has (m2 + m3) L2 where the derivation gives (m2 + m3) L1.
+    const double Lg = v == LAGRANGE_PAPER_TYPO ? L2 : L1;
+    const double A = (m1 * e1 + (m2 + m3) * Lg) * g;
+    const double B = mu * g;
+    o->G[0] = A * s1 + B * s12;
+    o->G[1] = B * s12;
+    o->dG_dq1[0] = A * c1 + B * c12;
+    o->dG_dq1[1] = B * c12;
+    o->dG_dq2[0] = B * c12;
+    o->dG_dq2[1] = B * c12;
+}
+
+void lagrange_accel(const lagrange_terms* t, const double tau[2], double qdd[2]) {
+    // 2x2 inverse in closed form (the paper's point: no decomposition needed).
+    const double r0 = tau[0] - t->C[0] - t->G[0];
+    const double r1 = tau[1] - t->C[1] - t->G[1];
+    const double det = t->H[0][0] * t->H[1][1] - t->H[0][1] * t->H[1][0];
+    qdd[0] = (t->H[1][1] * r0 - t->H[0][1] * r1) / det;
+    qdd[1] = (t->H[0][0] * r1 - t->H[1][0] * r0) / det;
+}
+
+double lagrange_energy(const crane_mech* m, double m3, const double q[2], const double qd[2]) {
+    lagrange_terms t;
+    lagrange_eval_terms(m, LAGRANGE_FULL, m3, q, qd, &t);
+    const double T = 0.5 * (t.H[0][0] * qd[0] * qd[0] + 2.0 * t.H[0][1] * qd[0] * qd[1] +
+                            t.H[1][1] * qd[1] * qd[1]);
+    const double g = m->gravity;
+    const double L1 = m->link[0].length, L2 = m->link[1].length;
+    const double m1 = m->link[0].mass, m2 = m->link[1].mass;
+    const double e1 = m->link[0].com, e2 = m->link[1].com;
+    // Heights of the mass centres: z = -e cos(angle from downward vertical).
+    const double V = -(m1 * e1 + (m2 + m3) * L1) * g * cos(q[0]) - (m2 * e2 + m3 * L2) * g * cos(q[0] + q[1]);
+    return T + V;
+}
+
+void lagrange_gravity(const crane_mech* m, lagrange_variant v, double m3, const double q[2], double G[2]) {
+    lagrange_terms t;
+    const double qd[2] = {0, 0};
+    lagrange_eval_terms(m, v, m3, q, qd, &t);
+    G[0] = t.G[0];
+    G[1] = t.G[1];
+}

@@ -1,0 +1,51 @@
+// lagrange.h: the analytic 2-DOF crane (SPEC section 3.1, paper Eqs. 1-4).
+//
+// H(q) q'' + C(q, q') + G(q) = tau, q1 from the downward vertical, q2 relative
+// to the lifting arm. Derivation in docs/lagrange.md.
+#ifndef LAGRANGE_H
+#define LAGRANGE_H
+
+#include "crane_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum lagrange_variant {
+    LAGRANGE_FULL = 0,  ///< link inertias and Coriolis/centrifugal terms (default; matches ode)
+    LAGRANGE_PAPER,     ///< paper Eqs. 2-3: point masses (I = 0), C = 0, G1 typo corrected
+    LAGRANGE_PAPER_TYPO ///< as printed: G1 uses (m2 + m3) L2 where L1 belongs
+} lagrange_variant;
+
+const char* lagrange_variant_name(lagrange_variant v);
+/// "full", "paper", "paper-typo"; -1 if unknown.
+int lagrange_variant_parse(const char* s);
+
+/// Mass-matrix, velocity and gravity terms and their partial derivatives.
+typedef struct lagrange_terms {
+    double H[2][2];    ///< mass matrix [kg m^2]
+    double C[2];       ///< Coriolis and centrifugal generalised forces [N m]
+    double G[2];       ///< gravity generalised forces [N m]
+    double dH_dq2[2][2];
+    double dC_dq2[2], dC_dqd1[2], dC_dqd2[2];
+    double dG_dq1[2], dG_dq2[2];
+} lagrange_terms;
+
+/// Evaluate the terms at (q, qd) [rad, rad/s] for a tip load m3 [kg].
+void lagrange_eval_terms(const crane_mech* m, lagrange_variant v, double m3, const double q[2],
+                         const double qd[2], lagrange_terms* out);
+
+/// Accelerations qdd = H^-1 (tau - C - G) [rad/s^2].
+void lagrange_accel(const lagrange_terms* t, const double tau[2], double qdd[2]);
+
+/// Total mechanical energy (kinetic + potential, zero at q = 0) of the full
+/// model [J]. Conserved with tau = 0 for LAGRANGE_FULL.
+double lagrange_energy(const crane_mech* m, double m3, const double q[2], const double qd[2]);
+
+/// Gravity torques G(q) for the full model [N m] (the static holding torques).
+void lagrange_gravity(const crane_mech* m, lagrange_variant v, double m3, const double q[2], double G[2]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

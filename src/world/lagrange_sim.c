@@ -1,0 +1,309 @@
+// lagrange_sim.c: the coupled crane ODE (mechanics + circuit), its analytic
+// Jacobian and its block pattern. Derivation in docs/lagrange.md.
+#include "lagrange_sim.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+// Find the hose state feeding chamber state ic: the state j whose pressure
+// enters d(p_c)/dt through a laminar hose. Looks at the Jacobian pattern at a
+// nominal state, so it works for any circuit naming.
+static int hose_of_chamber(const hyd_model* hm, const double* J, int nh, int ic, int other) {
+    for (int j = 0; j < nh; ++j) {
+        if (j == ic || j == other || J[ic * nh + j] == 0.0) continue;
+        char comp[96];
+        snprintf(comp, sizeof comp, "%s", hyd_model_state_name(hm, j));
+        char* dot = strrchr(comp, '.');
+        if (dot) *dot = 0;
+        int c = hyd_model_find(hm, comp);
+        if (c >= 0 && hyd_model_comp_type(hm, c) == HYD_HOSE) return j;
+    }
+    return -1;
+}
+
+int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err, size_t errsz) {
+    memset(s, 0, sizeof *s);
+    s->mdl = m;
+    s->variant = v;
+    s->m3 = m3;
+    const hyd_model* hm = m->hyd;
+    s->nh = hyd_model_nstate(hm);
+    s->n = s->nh + 4;
+    s->iq = s->nh;
+    if (s->n > LSIM_MAX_STATES) {
+        snprintf(err, errsz, "%s: circuit has %d states, at most %d supported", m->file, s->nh,
+                 LSIM_MAX_STATES - 4);
+        return -1;
+    }
+    s->hd = hyd_data_create(hm);
+    s->jh_ = calloc((size_t)s->nh * (size_t)s->nh, sizeof(double));
+    if (!s->hd || !s->jh_) {
+        snprintf(err, errsz, "out of memory");
+        lsim_free(s);
+        return -1;
+    }
+
+    // Jacobian pattern at a nominal state: mid-stroke, 5 MPa everywhere.
+    double y0[LSIM_MAX_STATES];
+    hyd_model_initial_state(hm, y0);
+    for (int i = 0; i < s->nh; ++i)
+        if (strstr(hyd_model_state_name(hm, i), ".p")) y0[i] = 5e6;
+    for (int k = 0; k < hyd_model_ncylinder(hm); ++k) {
+        double AA, AB, st;
+        hyd_model_cylinder_geometry(hm, k, &AA, &AB, &st);
+        s->hd->cyl_x[k] = 0.5 * st;
+    }
+    hyd_jacobian(hm, s->hd, 0.0, y0, NULL, s->jh_, s->nh, 0, 0);
+
+    // Order: per actuator [spool] [hose A, pA] [hose B, pB]; then the rest.
+    bool used[LSIM_MAX_STATES] = {false};
+    int n = 0;
+    for (int k = 0; k < 2; ++k) {
+        int iA, iB;
+        hyd_model_cylinder_states(hm, m->cyl[k], &iA, &iB);
+        int iu = hyd_model_valve_state(hm, m->valve[k]);
+        int hA = hose_of_chamber(hm, s->jh_, s->nh, iA, iB);
+        int hB = hose_of_chamber(hm, s->jh_, s->nh, iB, iA);
+        s->iu[k] = n;
+        s->perm[n++] = iu;
+        s->block[s->nblock++] = 1;
+        used[iu] = true;
+        int pair[2][2] = {{hA, iA}, {hB, iB}};
+        for (int c = 0; c < 2; ++c) {
+            int size = 0;
+            s->ihose[k][c] = -1;
+            for (int e = 0; e < 2; ++e) {
+                int j = pair[c][e];
+                if (j < 0 || used[j]) continue;
+                if (e == 0) s->ihose[k][c] = n;
+                if (e == 1) s->ip[k][c] = n;
+                s->perm[n++] = j;
+                used[j] = true;
+                ++size;
+            }
+            if (size) s->block[s->nblock++] = size;
+        }
+    }
+    for (int j = 0; j < s->nh; ++j) {
+        if (used[j]) continue;
+        s->perm[n++] = j;
+        s->block[s->nblock++] = 1;
+    }
+    s->block[s->nblock++] = 4; // q1, q2, q1', q2'
+    return 0;
+}
+
+void lsim_free(lsim* s) {
+    hyd_data_free(s->hd);
+    free(s->jh_);
+    s->hd = NULL;
+    s->jh_ = NULL;
+}
+
+hyd_problem lsim_problem(lsim* s, bool blocks) {
+    hyd_problem p;
+    memset(&p, 0, sizeof p);
+    p.n = s->n;
+    p.f = lsim_rhs;
+    p.jac = lsim_jac;
+    p.user = s;
+    if (blocks) {
+        p.nblock = s->nblock;
+        p.block_size = s->block;
+    }
+    return p;
+}
+
+// Kinematics of both cylinders: stroke, rate, lever r = dx/dq and dr/dq.
+typedef struct kin {
+    double x[2], v[2], r[2], dr[2];
+} kin;
+
+static void cylinder_kinematics(const crane_mech* me, const double* q, const double* qd, kin* k) {
+    for (int i = 0; i < 2; ++i) {
+        const crane_actuator* a = &me->act[i];
+        const double phi = q[i] + a->phi_offset;
+        const double sp = sin(phi), cp = cos(phi);
+        const double ab = a->a * a->b;
+        const double xp = sqrt(a->a * a->a + a->b * a->b - 2.0 * ab * cp); // paper Eq. 5
+        const double r = ab * sp / xp;                                      // dx/dphi
+        k->x[i] = xp - a->closed_length;
+        k->r[i] = r;
+        k->v[i] = r * qd[i];
+        k->dr[i] = (ab * cp - r * r) / xp; // d^2 x / dphi^2
+    }
+}
+
+static void set_inputs(lsim* s, double t, const kin* k) {
+    hyd_data* d = s->hd;
+    for (int i = 0; i < 2; ++i) {
+        d->cyl_x[s->mdl->cyl[i]] = k->x[i];
+        d->cyl_v[s->mdl->cyl[i]] = k->v[i];
+        d->valve_cmd[s->mdl->valve[i]] = s->scn ? scenario_command(s->scn, i, t) : s->u_cmd[i];
+    }
+}
+
+int lsim_rhs(void* user, double t, const double* y, double* dydt) {
+    lsim* s = user;
+    const crane_mech* me = &s->mdl->mech;
+    const int nh = s->nh, iq = s->iq;
+    const double* q = y + iq;
+    const double* qd = y + iq + 2;
+    kin k;
+    cylinder_kinematics(me, q, qd, &k);
+    set_inputs(s, t, &k);
+    for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i];
+    hyd_eval(s->mdl->hyd, s->hd, t, s->yh_, s->fh_);
+    for (int i = 0; i < nh; ++i) dydt[i] = s->fh_[s->perm[i]];
+
+    const double tau[2] = {s->hd->cyl_F[s->mdl->cyl[0]] * k.r[0], s->hd->cyl_F[s->mdl->cyl[1]] * k.r[1]};
+    lagrange_terms lt;
+    lagrange_eval_terms(me, s->variant, s->m3, q, qd, &lt);
+    double qdd[2];
+    lagrange_accel(&lt, tau, qdd);
+    for (int j = 0; j < 2; ++j) {
+        if (s->frozen_q[j]) qdd[j] = 0.0;
+        dydt[iq + j] = s->frozen_q[j] ? 0.0 : qd[j];
+        dydt[iq + 2 + j] = qdd[j];
+    }
+    ++s->nrhs;
+    return 0;
+}
+
+int lsim_jac(void* user, double t, const double* y, double* J) {
+    lsim* s = user;
+    const crane_mech* me = &s->mdl->mech;
+    const int nh = s->nh, n = s->n, iq = s->iq;
+    const double* q = y + iq;
+    const double* qd = y + iq + 2;
+    kin k;
+    cylinder_kinematics(me, q, qd, &k);
+    set_inputs(s, t, &k);
+    for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i];
+    hyd_data* d = s->hd;
+    hyd_jacobian(s->mdl->hyd, d, t, s->yh_, NULL, s->jh_, nh, 0, 0);
+
+    // Hydraulic block, permuted.
+    for (int i = 0; i < nh; ++i)
+        for (int j = 0; j < nh; ++j) J[i * n + j] = s->jh_[s->perm[i] * nh + s->perm[j]];
+
+    const int nhs = hyd_model_nstate(s->mdl->hyd);
+    double F[2], dtau_dq[2], dtau_dqd[2];
+    for (int c = 0; c < 2; ++c) {
+        const int cyl = s->mdl->cyl[c];
+        const double* dydx = d->dydx + (size_t)cyl * nhs;
+        const double* dydv = d->dydv + (size_t)cyl * nhs;
+        // Chain rule through x(q) and v = r(q) q'.
+        const double dv_dq = k.dr[c] * qd[c];
+        for (int i = 0; i < nh; ++i) {
+            const int h = s->perm[i];
+            J[i * n + iq + c] = dydx[h] * k.r[c] + dydv[h] * dv_dq;
+            J[i * n + iq + 2 + c] = dydv[h] * k.r[c];
+        }
+        F[c] = d->cyl_F[cyl];
+        dtau_dq[c] = F[c] * k.dr[c] + k.r[c] * (d->dFdx[cyl] * k.r[c] + d->dFdv[cyl] * dv_dq);
+        dtau_dqd[c] = k.r[c] * k.r[c] * d->dFdv[cyl];
+    }
+
+    lagrange_terms lt;
+    lagrange_eval_terms(me, s->variant, s->m3, q, qd, &lt);
+    const double tau[2] = {F[0] * k.r[0], F[1] * k.r[1]};
+    double qdd[2];
+    lagrange_accel(&lt, tau, qdd);
+    const double det = lt.H[0][0] * lt.H[1][1] - lt.H[0][1] * lt.H[1][0];
+    const double Hi[2][2] = {{lt.H[1][1] / det, -lt.H[0][1] / det}, {-lt.H[1][0] / det, lt.H[0][0] / det}};
+
+    // d qdd / dz = H^-1 (d tau/dz - dC/dz - dG/dz - dH/dz qdd), column by column.
+    for (int j = 0; j < n; ++j) {
+        double g0 = 0.0, g1 = 0.0; // d(tau - C - G - H qdd)/dz_j, with H fixed except via q2
+        if (j < nh) {
+            const int h = s->perm[j];
+            g0 = k.r[0] * d->dFdy[(size_t)s->mdl->cyl[0] * nhs + h];
+            g1 = k.r[1] * d->dFdy[(size_t)s->mdl->cyl[1] * nhs + h];
+        } else if (j == iq) {
+            g0 = dtau_dq[0] - lt.dG_dq1[0];
+            g1 = -lt.dG_dq1[1];
+        } else if (j == iq + 1) {
+            g0 = -lt.dC_dq2[0] - lt.dG_dq2[0] - (lt.dH_dq2[0][0] * qdd[0] + lt.dH_dq2[0][1] * qdd[1]);
+            g1 = dtau_dq[1] - lt.dC_dq2[1] - lt.dG_dq2[1] - (lt.dH_dq2[1][0] * qdd[0] + lt.dH_dq2[1][1] * qdd[1]);
+        } else if (j == iq + 2) {
+            g0 = dtau_dqd[0] - lt.dC_dqd1[0];
+            g1 = -lt.dC_dqd1[1];
+        } else {
+            g0 = -lt.dC_dqd2[0];
+            g1 = dtau_dqd[1] - lt.dC_dqd2[1];
+        }
+        J[(iq + 2) * n + j] = Hi[0][0] * g0 + Hi[0][1] * g1;
+        J[(iq + 3) * n + j] = Hi[1][0] * g0 + Hi[1][1] * g1;
+        J[iq * n + j] = (j == iq + 2) ? 1.0 : 0.0;
+        J[(iq + 1) * n + j] = (j == iq + 3) ? 1.0 : 0.0;
+    }
+    for (int c = 0; c < 2; ++c) {
+        if (!s->frozen_q[c]) continue;
+        for (int j = 0; j < n; ++j) J[(iq + c) * n + j] = J[(iq + 2 + c) * n + j] = 0.0;
+    }
+    return 0;
+}
+
+void lsim_initial_state(lsim* s, const double q0[2], double p_low, double* y) {
+    const hyd_model* hm = s->mdl->hyd;
+    double yh[LSIM_MAX_STATES];
+    hyd_model_initial_state(hm, yh);
+    for (int i = 0; i < s->nh; ++i) y[i] = yh[s->perm[i]];
+    const double qd0[2] = {0, 0};
+    y[s->iq] = q0[0];
+    y[s->iq + 1] = q0[1];
+    y[s->iq + 2] = y[s->iq + 3] = 0.0;
+    kin k;
+    cylinder_kinematics(&s->mdl->mech, q0, qd0, &k);
+    double G[2];
+    lagrange_gravity(&s->mdl->mech, s->variant, s->m3, q0, G);
+    for (int c = 0; c < 2; ++c) {
+        // Static balance: F r = G, with the unloaded chamber at p_low.
+        double AA, AB, st;
+        hyd_model_cylinder_geometry(hm, s->mdl->cyl[c], &AA, &AB, &st);
+        const double F = G[c] / k.r[c];
+        double pA = p_low, pB = p_low;
+        if (F >= 0) pA = (F + p_low * AB) / AA;
+        else pB = (p_low * AA - F) / AB;
+        const int iA = s->ip[c][0], iB = s->ip[c][1];
+        y[iA] = pA;
+        y[iB] = pB;
+        // The hoses start at their chambers' pressures: no flow at t = 0.
+        if (s->ihose[c][0] >= 0) y[s->ihose[c][0]] = pA;
+        if (s->ihose[c][1] >= 0) y[s->ihose[c][1]] = pB;
+    }
+}
+
+void lsim_outputs(lsim* s, double t, const double* y, lsim_out* o) {
+    double f[LSIM_MAX_STATES];
+    lsim_rhs(s, t, y, f);
+    --s->nrhs; // an output evaluation is not solver work
+    const crane_mech* me = &s->mdl->mech;
+    const hyd_data* d = s->hd;
+    memset(o, 0, sizeof *o);
+    for (int c = 0; c < 2; ++c) {
+        const int cyl = s->mdl->cyl[c];
+        o->x[c] = d->cyl_x[cyl];
+        o->v[c] = d->cyl_v[cyl];
+        o->pA[c] = y[s->ip[c][0]];
+        o->pB[c] = y[s->ip[c][1]];
+        o->u[c] = y[s->iu[c]];
+        o->u_cmd[c] = d->valve_cmd[s->mdl->valve[c]];
+        o->q[c] = y[s->iq + c];
+        o->qd[c] = y[s->iq + 2 + c];
+        o->F[c] = d->cyl_F[cyl];
+        double r;
+        crane_pin_length(&me->act[c], o->q[c], &r);
+        o->tau[c] = o->F[c] * r;
+        if (d->cyl_stop[cyl]) o->end_stop |= 1 << c;
+    }
+    crane_tip(me, o->q[0], o->q[1], &o->tip[0], &o->tip[1]);
+    const hyd_model* hm = s->mdl->hyd;
+    for (int c = 0; c < hyd_model_ncomp(hm); ++c)
+        if (hyd_model_comp_type(hm, c) == HYD_RELIEF && d->comp_open[c]) ++o->relief_open;
+    const int pl = hyd_model_find_node(hm, "pump_line");
+    if (pl >= 0) o->p_pump = d->node_p[pl];
+}

@@ -1,0 +1,81 @@
+// lagrange_sim.h: the analytic crane and its full hydraulic circuit as one
+// ODE system y' = f(t, y) for the generic integrators.
+//
+// State layout (n = nh + 4): the circuit's states in a block-friendly order
+// (see docs/lagrange.md), then q1, q2 [rad], q1', q2' [rad/s].
+#ifndef LAGRANGE_SIM_H
+#define LAGRANGE_SIM_H
+
+#include <stdbool.h>
+
+#include "hyd_solver.h"
+#include "lagrange.h"
+#include "model.h"
+#include "scenario.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LSIM_MAX_STATES 64
+#define LSIM_MAX_BLOCKS 64
+
+typedef struct lsim {
+    const model* mdl;
+    lagrange_variant variant;
+    double m3;             ///< tip load [kg]
+    hyd_data* hd;          ///< hydraulic inputs/outputs/scratch (owned)
+    int nh;                ///< hydraulic states
+    int n;                 ///< all states
+    int iq;                ///< index of q1 (q2 = iq+1, q1' = iq+2, q2' = iq+3)
+    int perm[LSIM_MAX_STATES]; ///< system index -> hydraulic state index (for i < nh)
+    int ip[2][2];          ///< system indices of chamber pressures pA, pB of actuator k
+    int iu[2];             ///< system index of actuator k's spool
+    int ihose[2][2];       ///< system index of the hose before chamber A, B of actuator k (-1: none)
+    int nblock;            ///< Jacobian blocks for block-diagonal W-methods
+    int block[LSIM_MAX_BLOCKS];
+    const scenario* scn;   ///< command source, or NULL to use u_cmd
+    double u_cmd[2];       ///< commands when scn is NULL, -1..1
+    bool frozen_q[2];      ///< hold joint k still (tests; q' = 0, q'' = 0)
+    // Scratch for the gather/scatter of the permuted hydraulic states.
+    double yh_[LSIM_MAX_STATES], fh_[LSIM_MAX_STATES];
+    double* jh_;           ///< nh x nh hydraulic Jacobian scratch (owned)
+    long nrhs;             ///< right-hand-side calls
+} lsim;
+
+/// Set up for model m. Returns 0, or -1 with a message.
+int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err, size_t errsz);
+void lsim_free(lsim* s);
+
+/// The problem for hyd_solver_create: f, analytic Jacobian, and (if blocks)
+/// the block-diagonal pattern [spool] [hose A, chamber A] [hose B, chamber B]
+/// per actuator, 1x1 for other hydraulic states, [q1, q2, q1', q2'].
+hyd_problem lsim_problem(lsim* s, bool blocks);
+
+/// Initial state at joint angles q0 [rad], at rest, with chamber pressures in
+/// static equilibrium with gravity (rod side or piston side at p_low [Pa abs])
+/// and the pump line at its set pressure.
+void lsim_initial_state(lsim* s, const double q0[2], double p_low, double* y);
+
+int lsim_rhs(void* user, double t, const double* y, double* dydt);
+int lsim_jac(void* user, double t, const double* y, double* J);
+
+/// Derived outputs at (t, y), computed fresh (calls the rhs once).
+typedef struct lsim_out {
+    double x[2], v[2];     ///< strokes [m], rates [m/s]
+    double pA[2], pB[2];   ///< chamber pressures [Pa abs]
+    double u[2], u_cmd[2]; ///< spool openings, commands [-]
+    double q[2], qd[2];    ///< joint angles [rad], rates [rad/s]
+    double tip[2];         ///< tip x (reach), z (height) relative to joint 1 [m]
+    double F[2];           ///< cylinder forces [N]
+    double tau[2];         ///< joint torques [N m]
+    double p_pump;         ///< pump line pressure [Pa abs] (0 if none)
+    int relief_open;       ///< number of relief valves passing flow
+    int end_stop;          ///< bit k set when cylinder k is at an end stop
+} lsim_out;
+void lsim_outputs(lsim* s, double t, const double* y, lsim_out* o);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,190 @@
+// live.c: the lagrange crane stepped by a real-time loop.
+#include "live.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+struct live {
+    lsim ls;
+    hyd_problem prob;
+    hyd_solver* solver;
+    sim_opts o;
+    double t;
+    double y[LSIM_MAX_STATES];
+    char err[320];
+};
+
+live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
+                           size_t errsz) {
+    live* l = calloc(1, sizeof *l);
+    if (!l) {
+        snprintf(err, errsz, "out of memory");
+        return NULL;
+    }
+    l->o = *o;
+    if (lsim_init(&l->ls, m, o->variant, m3, err, errsz)) {
+        free(l);
+        return NULL;
+    }
+    lsim_initial_state(&l->ls, q0, 0.5e6, l->y);
+    const bool adaptive = hyd_method_is_adaptive(o->solver);
+    l->prob = lsim_problem(&l->ls, !adaptive && !o->dense_jac);
+    hyd_solver_opts so = hyd_default_solver_opts();
+    so.h = adaptive ? 0.0 : o->h;
+    so.rtol = o->rtol;
+    so.atol = o->atol;
+    so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    l->solver = hyd_solver_create(&l->prob, o->solver, &so);
+    if (!l->solver) {
+        snprintf(err, errsz, "cannot create the %s solver", hyd_method_name(o->solver));
+        live_destroy(l);
+        return NULL;
+    }
+    return l;
+}
+
+void live_destroy(live* l) {
+    if (!l) return;
+    hyd_solver_destroy(l->solver);
+    lsim_free(&l->ls);
+    free(l);
+}
+
+void live_set_commands(live* l, const double u[3]) {
+    for (int k = 0; k < 2; ++k) {
+        double v = u[k] < -1 ? -1 : u[k] > 1 ? 1 : u[k];
+        // A command change is a kink in the input: adaptive methods restart
+        // their step-size history there (SPEC section 3.3).
+        if (v != l->ls.u_cmd[k] && hyd_method_is_adaptive(l->o.solver)) hyd_solver_reset(l->solver);
+        l->ls.u_cmd[k] = v;
+    }
+}
+
+int live_advance(live* l, double dt) {
+    int rc = hyd_solver_advance(l->solver, &l->t, l->y, l->t + dt);
+    if (rc == HYD_OK) return 0;
+    double tb = l->t;
+    int i = hyd_solver_bad_state(l->solver, &tb);
+    snprintf(l->err, sizeof l->err, "solver %s failed (code %d) at t = %.6g s, state %d", hyd_method_name(l->o.solver),
+             rc, tb, i);
+    return 1;
+}
+
+const char* live_error(const live* l) { return l->err; }
+double live_time(const live* l) { return l->t; }
+const hyd_solver_stats* live_stats(const live* l) { return hyd_solver_get_stats(l->solver); }
+
+void live_row(live* l, double row[SIM_NCOL]) {
+    lsim_out o;
+    lsim_outputs(&l->ls, l->t, l->y, &o);
+    const double v[SIM_NCOL] = {
+        l->t, o.x[0], o.x[1], o.pA[0], o.pB[0], o.pA[1], o.pB[1], o.u[0], o.u[1], o.q[0], o.q[1],
+        o.tip[0], o.tip[1], o.F[0], o.F[1], o.u_cmd[0], o.u_cmd[1],
+        o.v[0], o.v[1], o.p_pump, o.relief_open, o.end_stop};
+    memcpy(row, v, sizeof v);
+}
+
+// Planar crane placed in the world: boom plane = x-z, joint 1 at the column
+// top above the origin. Rotation about y by the elevation angle.
+static void rot_y(double ang, double R[9]) {
+    // The boom plane is x (reach) - z (up); a link's local x axis at elevation
+    // ang points (cos, 0, sin). Rotation about -y maps x to that direction.
+    const double c = cos(ang), s = sin(ang);
+    const double M[9] = {c, 0, -s, 0, 1, 0, s, 0, c};
+    memcpy(R, M, sizeof M);
+}
+
+static void add_body(world_snapshot* s, const char* name, world_role role, world_shape shape, const double pos[3],
+                     const double R[9], double sx, double sy, double sz, const float rgba[4], const char* mesh) {
+    if (s->nbody >= WORLD_SNAP_MAX_BODIES) return;
+    world_snap_body* b = &s->body[s->nbody++];
+    memset(b, 0, sizeof *b);
+    snprintf(b->name, sizeof b->name, "%s", name);
+    b->role = role;
+    b->shape = shape;
+    memcpy(b->pos, pos, sizeof b->pos);
+    memcpy(b->rot, R, sizeof b->rot);
+    b->size[0] = sx;
+    b->size[1] = sy;
+    b->size[2] = sz;
+    memcpy(b->rgba, rgba, sizeof b->rgba);
+    snprintf(b->mesh, sizeof b->mesh, "%s", mesh ? mesh : "");
+    b->mesh_scale = 1.0;
+    b->mesh_up = 2;
+}
+
+void live_snapshot(live* l, world_snapshot* s) {
+    lsim_out o;
+    lsim_outputs(&l->ls, l->t, l->y, &o);
+    const crane_mech* me = &l->ls.mdl->mech;
+    memset(s, 0, offsetof(world_snapshot, body));
+    s->nbody = 0;
+    s->ncyl = 0;
+    s->nrope = 0;
+    s->t = l->t;
+    const double H = me->column_height;
+    const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const float grey[4] = {0.55f, 0.57f, 0.6f, 1}, orange[4] = {0.95f, 0.55f, 0.1f, 1},
+                       load[4] = {0.5f, 0.35f, 0.2f, 1};
+    const double colpos[3] = {0, 0, 0.5 * H};
+    add_body(s, "column", WORLD_ROLE_COLUMN, WORLD_SHAPE_CYLINDER, colpos, I, 0.18, H, 0, grey, "column.obj");
+    // Link frames: elevation a1 = q1 - pi/2, a2 = a1 + q2; joint 1 at (0, 0, H).
+    const double a1 = o.q[0] - M_PI / 2, a2 = a1 + o.q[1];
+    const double j1[3] = {0, 0, H};
+    const double j2[3] = {me->link[0].length * cos(a1), 0, H + me->link[0].length * sin(a1)};
+    double R1[9], R2[9];
+    rot_y(a1, R1);
+    rot_y(a2, R2);
+    const crane_link* L = me->link;
+    // Box bodies sit at their centres; the boom meshes have their origin at
+    // the root joint, half a length behind the centre.
+    const double c1[3] = {j1[0] + 0.5 * L[0].length * cos(a1), 0, j1[2] + 0.5 * L[0].length * sin(a1)};
+    const double c2[3] = {j2[0] + 0.5 * L[1].length * cos(a2), 0, j2[2] + 0.5 * L[1].length * sin(a2)};
+    add_body(s, "boom1", WORLD_ROLE_BOOM1, WORLD_SHAPE_BOX, c1, R1, L[0].length, L[0].width, L[0].height, orange,
+             "boom1.obj");
+    s->body[s->nbody - 1].mesh_offset[0] = -0.5 * L[0].length;
+    add_body(s, "boom2", WORLD_ROLE_BOOM2, WORLD_SHAPE_BOX, c2, R2, L[1].length, L[1].width, L[1].height, orange,
+             "boom2.obj");
+    s->body[s->nbody - 1].mesh_offset[0] = -0.5 * L[1].length;
+    const double tip[3] = {j2[0] + L[1].length * cos(a2), 0, j2[2] + L[1].length * sin(a2)};
+    const double lp[3] = {tip[0], 0, tip[2] - 0.35};
+    add_body(s, "load", WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, lp, I, 0.6, 0.6, 0.6, load, "load_block.obj");
+    memcpy(s->tip, tip, sizeof s->tip);
+    memcpy(s->hook, tip, sizeof s->hook);
+    s->load_mass = l->ls.m3;
+    // Cylinders: barrel pin in the parent frame, rod pin in the child frame.
+    for (int k = 0; k < 2; ++k) {
+        const crane_actuator* ac = &me->act[k];
+        world_snap_cylinder* c = &s->cyl[s->ncyl++];
+        snprintf(c->name, sizeof c->name, "%s", ac->name);
+        const double pa = k == 0 ? 0.0 : a1, ca = k == 0 ? a1 : a2;
+        const double* org = k == 0 ? j1 : j2;
+        c->base[0] = org[0] + ac->base_mount[0] * cos(pa) - ac->base_mount[1] * sin(pa);
+        c->base[2] = org[2] + ac->base_mount[0] * sin(pa) + ac->base_mount[1] * cos(pa);
+        c->rod_end[0] = org[0] + ac->rod_mount[0] * cos(ca) - ac->rod_mount[1] * sin(ca);
+        c->rod_end[2] = org[2] + ac->rod_mount[0] * sin(ca) + ac->rod_mount[1] * cos(ca);
+        double AA, AB, st;
+        hyd_model_cylinder_geometry(l->ls.mdl->hyd, l->ls.mdl->cyl[k], &AA, &AB, &st);
+        c->bore = sqrt(4 * AA / M_PI);
+        c->rod = sqrt(4 * (AA - AB) / M_PI);
+        c->stroke_max = st;
+        c->closed_length = ac->closed_length;
+        c->x = o.x[k];
+        c->v = o.v[k];
+        c->pA = o.pA[k];
+        c->pB = o.pB[k];
+        c->force = o.F[k];
+        c->u = o.u[k];
+        c->u_cmd = o.u_cmd[k];
+        c->end_stop = (o.end_stop >> k) & 1;
+    }
+    s->p_supply = o.p_pump;
+    s->main_relief_open = o.relief_open > 0;
+}

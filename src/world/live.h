@@ -1,0 +1,38 @@
+// live.h: a crane stepped in real time by an outside loop (drive), with
+// commands set between steps, whatever the backend.
+#ifndef LIVE_H
+#define LIVE_H
+
+#include "sim.h"
+#include "world_snapshot.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct live live;
+
+/// A live lagrange crane at joint angles q0 [rad] with tip load m3 [kg].
+live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
+                           size_t errsz);
+void live_destroy(live* l);
+
+/// Valve commands lift, jib, slew in [-1, 1] (slew ignored by lagrange).
+void live_set_commands(live* l, const double u[3]);
+
+/// Advance dt [s] of simulated time. Returns 0, or 1 on a numerical failure
+/// (message from live_error).
+int live_advance(live* l, double dt);
+const char* live_error(const live* l);
+
+double live_time(const live* l);
+/// The CSV row at the current time (sim.h columns).
+void live_row(live* l, double row[SIM_NCOL]);
+/// Fill a snapshot for the renderer.
+void live_snapshot(live* l, world_snapshot* s);
+const hyd_solver_stats* live_stats(const live* l);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

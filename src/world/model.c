@@ -1,0 +1,178 @@
+// model.c: load and validate a crane model file.
+#include "model.h"
+
+#include "json_util.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#ifndef CRANESIM_ASSETS_DIR
+#define CRANESIM_ASSETS_DIR "assets"
+#endif
+
+const char* model_assets_dir(void) {
+    const char* env = getenv("CRANESIM_ASSETS");
+    if (env && *env) return env;
+    // The source tree's assets are compiled in so a freshly built binary finds
+    // its defaults from any working directory.
+    if (access(CRANESIM_ASSETS_DIR "/models/hiab031.json", R_OK) == 0) return CRANESIM_ASSETS_DIR;
+    return "assets";
+}
+
+const char* model_default_path(void) {
+    static char path[512]; // written once per call from constant inputs
+    snprintf(path, sizeof path, "%s/models/hiab031.json", model_assets_dir());
+    return path;
+}
+
+static void load_link(json_ctx* c, const cJSON* arr, int i, crane_link* l) {
+    char p[64];
+    json_path_index(p, sizeof p, "mechanics.links", i);
+    const cJSON* o = cJSON_GetArrayItem(arr, i);
+    if (!cJSON_IsObject(o)) {
+        json_fail(c, p, "must be an object");
+        return;
+    }
+    static const char* const keys[] = {"name", "length", "mass", "com", "inertia", "width", "height", NULL};
+    json_only_keys(c, o, p, keys);
+    json_str(c, o, p, "name", false, i ? "end_arm" : "lifting_arm", l->name, sizeof l->name);
+    l->length = json_pos(c, o, p, "length", true, 0);
+    l->mass = json_pos(c, o, p, "mass", true, 0);
+    l->com = json_num(c, o, p, "com", true, 0, 0, 100);
+    l->inertia = json_num(c, o, p, "inertia", true, 0, 0, 1e9);
+    l->width = json_pos(c, o, p, "width", false, 0.18);
+    l->height = json_pos(c, o, p, "height", false, 0.24);
+}
+
+static void load_actuator(json_ctx* c, const cJSON* arr, int i, crane_actuator* a) {
+    char p[64];
+    json_path_index(p, sizeof p, "mechanics.actuators", i);
+    const cJSON* o = cJSON_GetArrayItem(arr, i);
+    if (!cJSON_IsObject(o)) {
+        json_fail(c, p, "must be an object");
+        return;
+    }
+    static const char* const keys[] = {"name", "joint", "cylinder", "valve", "base_mount",
+                                       "rod_mount", "closed_length", NULL};
+    json_only_keys(c, o, p, keys);
+    json_str(c, o, p, "name", true, "", a->name, sizeof a->name);
+    a->joint = json_int(c, o, p, "joint", true, 0, 0, 1);
+    if (!c->failed && a->joint != i) json_fail(c, p, "actuator %d must act on joint %d", i, i);
+    json_str(c, o, p, "cylinder", true, "", a->cylinder, sizeof a->cylinder);
+    json_str(c, o, p, "valve", true, "", a->valve, sizeof a->valve);
+    json_vec(c, o, p, "base_mount", true, a->base_mount, 2);
+    json_vec(c, o, p, "rod_mount", true, a->rod_mount, 2);
+    a->closed_length = json_pos(c, o, p, "closed_length", true, 0);
+}
+
+model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
+    model* m = calloc(1, sizeof *m);
+    if (!m) {
+        cJSON_Delete(root);
+        snprintf(err, errsz, "%s: out of memory", file);
+        return NULL;
+    }
+    m->json = root;
+    snprintf(m->file, sizeof m->file, "%s", file);
+    json_ctx c = {.file = file, .err = err, .errsz = errsz};
+    if (!cJSON_IsObject(root)) json_fail(&c, "", "a model must be a JSON object");
+    static const char* const keys[] = {"name", "description", "mechanics", "hydraulics", NULL};
+    json_only_keys(&c, root, "", keys);
+    json_str(&c, root, "", "name", false, "crane", m->name, sizeof m->name);
+
+    crane_mech* me = &m->mech;
+    const cJSON* mech = json_obj(&c, root, "", "mechanics", true);
+    static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", NULL};
+    json_only_keys(&c, mech, "mechanics", mkeys);
+    me->gravity = json_num(&c, mech, "mechanics", "gravity", false, 9.81, 0, 100);
+    const cJSON* col = json_obj(&c, mech, "mechanics", "column", true);
+    json_only_keys(&c, col, "mechanics.column", (const char* const[]){"height", "mass", NULL});
+    me->column_height = json_pos(&c, col, "mechanics.column", "height", true, 0);
+    me->column_mass = json_pos(&c, col, "mechanics.column", "mass", false, 250);
+    const cJSON* links = json_arr(&c, mech, "mechanics", "links", true);
+    if (links && cJSON_GetArraySize(links) != 2) json_fail(&c, "mechanics.links", "must list exactly 2 links");
+    for (int i = 0; i < 2 && !c.failed; ++i) load_link(&c, links, i, &me->link[i]);
+    me->load_mass = json_num(&c, mech, "mechanics", "load_mass", true, 0, 0, 1e5);
+    const cJSON* acts = json_arr(&c, mech, "mechanics", "actuators", true);
+    if (acts && cJSON_GetArraySize(acts) != 2)
+        json_fail(&c, "mechanics.actuators", "must list exactly 2 actuators (lift, jib)");
+    for (int i = 0; i < 2 && !c.failed; ++i) load_actuator(&c, acts, i, &me->act[i]);
+    if (c.failed) goto fail;
+    crane_mech_derive(me);
+
+    const cJSON* hyd = json_obj(&c, root, "", "hydraulics", true);
+    if (c.failed) goto fail;
+    m->hyd = hyd_model_from_json(hyd, file, "hydraulics", err, errsz);
+    if (!m->hyd) goto fail_quiet;
+
+    for (int k = 0; k < 2; ++k) {
+        char p[64];
+        snprintf(p, sizeof p, "mechanics.actuators[%d]", k);
+        m->cyl[k] = hyd_model_cylinder(m->hyd, me->act[k].cylinder);
+        m->valve[k] = hyd_model_valve(m->hyd, me->act[k].valve);
+        char f[80];
+        snprintf(f, sizeof f, "%s.cylinder", p);
+        if (m->cyl[k] < 0) json_fail(&c, f, "no cylinder named \"%s\" in hydraulics", me->act[k].cylinder);
+        snprintf(f, sizeof f, "%s.valve", p);
+        if (m->valve[k] < 0) json_fail(&c, f, "no valve named \"%s\" in hydraulics", me->act[k].valve);
+        if (c.failed) goto fail;
+        double AA, AB;
+        hyd_model_cylinder_geometry(m->hyd, m->cyl[k], &AA, &AB, &m->stroke[k]);
+    }
+    char cerr[256];
+    if (crane_mech_check(me, m->stroke, cerr, (int)sizeof cerr)) {
+        snprintf(err, errsz, "%s: %s", file, cerr);
+        goto fail_quiet;
+    }
+    return m;
+fail:
+    (void)0;
+fail_quiet:
+    model_free(m);
+    return NULL;
+}
+
+model* model_load(const char* path, const char* const* sets, int nset, char* err, size_t errsz) {
+    if (!path) path = model_default_path();
+    cJSON* root = json_load_file(path, err, errsz);
+    if (!root) return NULL;
+    for (int i = 0; i < nset; ++i) {
+        char e[256];
+        if (json_set_path(root, sets[i], e, sizeof e)) {
+            snprintf(err, errsz, "%s: %s", path, e);
+            cJSON_Delete(root);
+            return NULL;
+        }
+    }
+    const char* base = strrchr(path, '/');
+    return model_from_json(root, base ? base + 1 : path, err, errsz);
+}
+
+void model_free(model* m) {
+    if (!m) return;
+    hyd_model_free(m->hyd);
+    cJSON_Delete(m->json);
+    free(m);
+}
+
+int model_save(const model* m, const char* path, char* err, size_t errsz) {
+    char* text = cJSON_Print(m->json);
+    if (!text) {
+        snprintf(err, errsz, "%s: out of memory", path);
+        return -1;
+    }
+    FILE* f = fopen(path, "w");
+    if (!f) {
+        snprintf(err, errsz, "%s: cannot write", path);
+        free(text);
+        return -1;
+    }
+    fputs(text, f);
+    fputc('\n', f);
+    int bad = ferror(f) | fclose(f);
+    free(text);
+    if (bad) snprintf(err, errsz, "%s: write failed", path);
+    return bad ? -1 : 0;
+}

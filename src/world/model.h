@@ -1,0 +1,52 @@
+// model.h: a complete crane model: mechanics plus hydraulic circuit, loaded
+// from one JSON file (assets/models/hiab031.json; schema in docs/model.md).
+#ifndef MODEL_H
+#define MODEL_H
+
+#include <cjson/cJSON.h>
+#include <stddef.h>
+
+#include "crane_model.h"
+#include "hydraulics.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct model {
+    char name[96];
+    char file[256];      ///< path it was loaded from ("" if built in)
+    crane_mech mech;     ///< mechanics (derived fields filled)
+    hyd_model* hyd;      ///< compiled circuit (owned)
+    int cyl[2];          ///< hydraulic cylinder index of actuator k (lift, jib)
+    int valve[2];        ///< hydraulic valve index of actuator k
+    double stroke[2];    ///< cylinder strokes [m]
+    cJSON* json;         ///< the document after --set overrides (owned), for saving
+} model;
+
+/// Load a model file and apply "path=value" overrides (see json_set_path) in
+/// order. NULL path loads the built-in default (assets/models/hiab031.json as
+/// found by model_default_path). Returns NULL with one line
+/// "file: field: problem" in err.
+model* model_load(const char* path, const char* const* sets, int nset, char* err, size_t errsz);
+
+/// Build from a parsed document (ownership of root passes to the model, also
+/// on failure). file is used in messages.
+model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz);
+
+void model_free(model* m);
+
+/// Write the model's JSON (with overrides applied) to path. Returns 0 or -1.
+int model_save(const model* m, const char* path, char* err, size_t errsz);
+
+/// The default model file: $CRANESIM_ASSETS/models/hiab031.json, else the
+/// source tree's assets folder compiled in, else ./assets/models/hiab031.json.
+const char* model_default_path(void);
+
+/// The assets folder in use (same search as model_default_path).
+const char* model_assets_dir(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

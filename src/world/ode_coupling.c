@@ -1,0 +1,274 @@
+// ode_coupling.c: the hydraulic circuit driving the ODE bodies.
+//
+// Scheme (docs/ode_world.md, "Coupling"): at the start of each ODE step of
+// length H the cylinders' strokes x0 and rates v0 are read from the bodies'
+// mount points. The circuit is then advanced over H in sub-steps h (default
+// 0.1 ms) with the mechanical inputs extrapolated linearly, x(t) = x0 +
+// v0 (t - t0), x'(t) = v0. The mean cylinder force over the sub-steps is
+// applied to the bodies during the ODE step. The stiff oil-column and hose
+// modes stay inside the implicit hydraulic integrator; the mechanics sees a
+// force lagged by at most one ODE step.
+#include "ode_world_internal.h"
+
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static void set_inputs(ode_world* w, double t) {
+    double tau = t - w->step_t0;
+    for (int k = 0; k < ODE_NACT; ++k) {
+        const ow_act* c = &w->act[k];
+        if (c->cyl < 0) continue;
+        w->hd->cyl_x[c->cyl] = w->x0[k] + w->v0[k] * tau;
+        w->hd->cyl_v[c->cyl] = w->v0[k];
+        if (c->valve >= 0) w->hd->valve_cmd[c->valve] = w->u_cmd[k];
+    }
+}
+
+static int rhs(void* user, double t, const double* y, double* dydt) {
+    ode_world* w = user;
+    set_inputs(w, t);
+    hyd_eval(w->hm, w->hd, t, y, dydt);
+    return 0;
+}
+
+static int jac(void* user, double t, const double* y, double* J) {
+    ode_world* w = user;
+    set_inputs(w, t);
+    hyd_jacobian(w->hm, w->hd, t, y, NULL, J, w->nh, 0, 0);
+    return 0;
+}
+
+// Append the world's extra nodes and components to a copy of the model's
+// circuit (cJSON-level merge, so the circuit loader checks everything once).
+static cJSON* merge_circuit(const cJSON* hydraulics, const cJSON* extra) {
+    cJSON* m = cJSON_Duplicate(hydraulics, 1);
+    if (!m || !extra) return m;
+    static const char* const lists[2] = {"nodes", "components"};
+    for (int l = 0; l < 2; ++l) {
+        const cJSON* add = cJSON_GetObjectItemCaseSensitive(extra, lists[l]);
+        if (!add) continue;
+        cJSON* dst = cJSON_GetObjectItemCaseSensitive(m, lists[l]);
+        if (!dst) {
+            dst = cJSON_AddArrayToObject(m, lists[l]);
+            if (!dst) goto oom;
+        }
+        const cJSON* it;
+        cJSON_ArrayForEach(it, add) {
+            cJSON* d = cJSON_Duplicate(it, 1);
+            if (!d) goto oom;
+            cJSON_AddItemToArray(dst, d);
+        }
+    }
+    return m;
+oom:
+    cJSON_Delete(m);
+    return NULL;
+}
+
+static int bind_actuator(ode_world* w, int k, const char* cyl, const char* valve, const char* file,
+                         const char* field, char* err, size_t errsz) {
+    ow_act* c = &w->act[k];
+    c->cyl = hyd_model_cylinder(w->hm, cyl);
+    c->valve = hyd_model_valve(w->hm, valve);
+    if (c->cyl < 0) {
+        snprintf(err, errsz, "%s: %s.cylinder: no cylinder named \"%s\" in the circuit", file, field, cyl);
+        return -1;
+    }
+    if (c->valve < 0) {
+        snprintf(err, errsz, "%s: %s.valve: no valve named \"%s\" in the circuit", file, field, valve);
+        return -1;
+    }
+    hyd_model_cylinder_states(w->hm, c->cyl, &c->iA, &c->iB);
+    c->iu = hyd_model_valve_state(w->hm, c->valve);
+    hyd_model_cylinder_geometry(w->hm, c->cyl, &c->AA, &c->AB, &c->stroke);
+    return 0;
+}
+
+int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz) {
+    const char* mfile = w->opt.model_file;
+    const int sandbox = w->kind == WORLD_SANDBOX;
+    cJSON* merged = merge_circuit(hydraulics, sandbox ? extra : NULL);
+    if (!merged) {
+        snprintf(err, errsz, "%s: hydraulics: out of memory", mfile);
+        return -1;
+    }
+    w->hm = hyd_model_from_json(merged, mfile, "hydraulics", err, errsz);
+    cJSON_Delete(merged);
+    if (!w->hm) {
+        // Blame the world file when the model's own circuit is fine: the
+        // problem is then in the appended nodes/components.
+        if (sandbox && extra) {
+            char e2[256];
+            hyd_model* alone = hyd_model_from_json(hydraulics, mfile, "hydraulics", e2, sizeof e2);
+            if (alone) {
+                hyd_model_free(alone);
+                char inner[256];
+                snprintf(inner, sizeof inner, "%s", err);
+                const char* wf = w->desc.file[0] ? w->desc.file : "world";
+                snprintf(err, errsz, "%s: circuit: merged with the model's circuit: %s", wf, inner);
+            }
+        }
+        return -1;
+    }
+    w->nh = hyd_model_nstate(w->hm);
+    if (w->nh > OW_MAX_HYD) {
+        snprintf(err, errsz, "%s: hydraulics: %d states, at most %d supported", mfile, w->nh, OW_MAX_HYD);
+        return -1;
+    }
+    for (int k = 0; k < 2; ++k) {
+        char f[48];
+        snprintf(f, sizeof f, "mechanics.actuators[%d]", k);
+        if (bind_actuator(w, k, w->mech.act[k].cylinder, w->mech.act[k].valve, mfile, f, err, errsz)) return -1;
+    }
+    if (sandbox) {
+        const char* wf = w->desc.file[0] ? w->desc.file : "world";
+        if (bind_actuator(w, ODE_SLEW, w->desc.slew.cylinder, w->desc.slew.valve, wf, "slew", err, errsz)) return -1;
+        w->act[ODE_SLEW].present = 1;
+    }
+    w->ipump = -1;
+    int pl = hyd_model_find_node(w->hm, "pump_line");
+    if (pl >= 0) w->ipump = hyd_model_node_state(w->hm, pl);
+
+    w->hd = hyd_data_create(w->hm);
+    if (!w->hd) {
+        snprintf(err, errsz, "ode world: out of memory");
+        return -1;
+    }
+    w->hp.n = w->nh;
+    w->hp.f = rhs;
+    w->hp.jac = jac;
+    w->hp.user = w;
+    hyd_solver_opts so = hyd_default_solver_opts();
+    so.h = w->opt.dt_hyd;
+    so.jac_every = w->opt.jac_every > 0 ? w->opt.jac_every : 1;
+    w->hs = hyd_solver_create(&w->hp, w->opt.solver, &so);
+    if (!w->hs) {
+        snprintf(err, errsz, "ode world: cannot create the %s solver", hyd_method_name(w->opt.solver));
+        return -1;
+    }
+    w->nsub = (int)floor(w->opt.dt_ode / w->opt.dt_hyd + 0.5);
+    return 0;
+}
+
+void ow_hyd_destroy(ode_world* w) {
+    if (w->hs) hyd_solver_destroy(w->hs);
+    if (w->hd) hyd_data_free(w->hd);
+    if (w->hm) hyd_model_free(w->hm);
+    w->hs = NULL;
+    w->hd = NULL;
+    w->hm = NULL;
+}
+
+// The hose feeding a chamber: the pressure state, other than the chambers
+// themselves, that the chamber's pressure rate depends on (found from the
+// Jacobian's pattern, so it works for any naming).
+static int hose_of(ode_world* w, const double* J, int ic, int iother) {
+    for (int j = 0; j < w->nh; ++j) {
+        if (j == ic || j == iother || J[ic * w->nh + j] == 0) continue;
+        const char* nm = hyd_model_state_name(w->hm, j);
+        size_t L = strlen(nm);
+        if (L > 2 && !strcmp(nm + L - 2, ".p")) return j;
+    }
+    return -1;
+}
+
+// Initial hydraulic state: the model's, then (init_hold) each boom cylinder's
+// chambers and hoses at the static pressures that hold the crane still, the
+// unloaded side at p_low. Same rule as lagrange's lsim_initial_state so the
+// two backends start from the same state.
+void ow_hyd_init_state(ode_world* w) {
+    hyd_model_initial_state(w->hm, w->y);
+    w->th = 0;
+    if (!w->opt.init_hold) return;
+    ow_read_actuators(w);
+    for (int k = 0; k < ODE_NACT; ++k) {
+        if (w->act[k].cyl < 0) continue;
+        w->hd->cyl_x[w->act[k].cyl] = w->act[k].x;
+        w->hd->cyl_v[w->act[k].cyl] = 0;
+    }
+    double J[OW_MAX_HYD * OW_MAX_HYD];
+    hyd_jacobian(w->hm, w->hd, 0.0, w->y, NULL, J, w->nh, 0, 0);
+
+    // Static gravity torques at the joints from the masses beyond each joint
+    // (lagrange's G(q) for the validation world; with rope and hook hanging
+    // at the tip in the sandbox).
+    const crane_mech* me = &w->mech;
+    double m3 = w->kind == WORLD_VALIDATION ? w->m3 : w->desc.hook.mass + w->desc.rope.mass_per_m * w->desc.rope.length;
+    double q1 = w->opt.q0[0], q2 = w->opt.q0[1], g = w->g;
+    const crane_link *l1 = &me->link[0], *l2 = &me->link[1];
+    double G2 = (l2->mass * l2->com + m3 * l2->length) * g * sin(q1 + q2);
+    double G1 = (l1->mass * l1->com + (l2->mass + m3) * l1->length) * g * sin(q1) + G2;
+    double G[2] = {G1, G2};
+    for (int k = 0; k < 2; ++k) {
+        ow_act* c = &w->act[k];
+        double r;
+        crane_pin_length(&me->act[k], w->opt.q0[k], &r);
+        double F = G[k] / r, p = w->opt.p_low;
+        double pA = p, pB = p;
+        if (F >= 0) pA = (F + p * c->AB) / c->AA;
+        else pB = (p * c->AA - F) / c->AB;
+        w->y[c->iA] = pA;
+        w->y[c->iB] = pB;
+        int hA = hose_of(w, J, c->iA, c->iB), hB = hose_of(w, J, c->iB, c->iA);
+        if (hA >= 0) w->y[hA] = pA;
+        if (hB >= 0) w->y[hB] = pB;
+        c->F = F;
+    }
+    // The slew is balanced with both chambers at p_low (no static torque on a
+    // level truck).
+    ow_act* s = &w->act[ODE_SLEW];
+    if (s->cyl >= 0) {
+        double p = w->opt.p_low;
+        w->y[s->iA] = p;
+        w->y[s->iB] = p * s->AA / s->AB;
+        int hA = hose_of(w, J, s->iA, s->iB), hB = hose_of(w, J, s->iB, s->iA);
+        if (hA >= 0) w->y[hA] = w->y[s->iA];
+        if (hB >= 0) w->y[hB] = w->y[s->iB];
+    }
+}
+
+int ow_hyd_step(ode_world* w, double H) {
+    for (int k = 0; k < ODE_NACT; ++k) {
+        w->x0[k] = w->act[k].x;
+        w->v0[k] = w->act[k].v;
+    }
+    w->step_t0 = w->th;
+    double Fsum[ODE_NACT] = {0, 0, 0};
+    double ydot[OW_MAX_HYD];
+    const double h = H / w->nsub;
+    for (int i = 0; i < w->nsub; ++i) {
+        int rc = hyd_solver_step(w->hs, &w->th, w->y, h);
+        if (rc != HYD_OK) {
+            double tb = w->th;
+            int bad = rc == HYD_ERR_NONFINITE ? hyd_solver_bad_state(w->hs, &tb) : -1;
+            if (bad >= 0)
+                snprintf(w->err, sizeof w->err, "hydraulics: state %s became non-finite at t = %.6f s",
+                         hyd_model_state_name(w->hm, bad), tb);
+            else
+                snprintf(w->err, sizeof w->err, "hydraulics: %s solver failed (code %d) at t = %.6f s",
+                         hyd_method_name(w->opt.solver), rc, w->th);
+            return -1;
+        }
+        // Force at the end of the sub-step (the solver's last f call was at a
+        // stage point, not at the new state).
+        rhs(w, w->th, w->y, ydot);
+        for (int k = 0; k < ODE_NACT; ++k)
+            if (w->act[k].cyl >= 0) Fsum[k] += w->hd->cyl_F[w->act[k].cyl];
+    }
+    w->hyd_steps += w->nsub;
+    // Re-anchor hydraulic time on the step count so it never drifts from the
+    // mechanical clock.
+    w->th = (double)(w->nstep + 1) * H;
+    for (int k = 0; k < ODE_NACT; ++k) {
+        ow_act* c = &w->act[k];
+        if (c->cyl < 0) continue;
+        c->F = w->opt.force_average ? Fsum[k] / w->nsub : w->hd->cyl_F[c->cyl];
+        if (!isfinite(c->F)) {
+            snprintf(w->err, sizeof w->err, "hydraulics: cylinder force %d became non-finite at t = %.6f s", k, w->th);
+            return -1;
+        }
+    }
+    return 0;
+}

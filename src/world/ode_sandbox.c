@@ -1,0 +1,489 @@
+// ode_sandbox.c: the sandbox world: terrain heightfield, truck on outriggers,
+// slewing column, rope and hook, loads, obstacles, contacts, attach/release.
+#include "ode_world_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static const float RGBA_TRUCK[4] = {0.95f, 0.95f, 0.92f, 1};
+static const float RGBA_CAB[4] = {0.2f, 0.35f, 0.6f, 1};
+static const float RGBA_WHEEL[4] = {0.1f, 0.1f, 0.1f, 1};
+static const float RGBA_OUTRIGGER[4] = {0.95f, 0.75f, 0.1f, 1};
+static const float RGBA_TERRAIN[4] = {0.35f, 0.5f, 0.25f, 1};
+static const float RGBA_ROPE[4] = {0.25f, 0.25f, 0.25f, 1};
+static const float RGBA_HOOK[4] = {0.95f, 0.8f, 0.1f, 1};
+static const float RGBA_LOAD[4] = {0.3f, 0.45f, 0.75f, 1};
+static const float RGBA_WALL[4] = {0.6f, 0.6f, 0.6f, 1};
+static const float RGBA_BOX[4] = {0.65f, 0.5f, 0.3f, 1};
+static const float RGBA_BUILDING[4] = {0.75f, 0.7f, 0.6f, 1};
+
+// Which categories collide (symmetric). Crane parts do not touch the truck
+// they stand on or the rope hanging from them; rope links do not touch each
+// other (neighbours are jointed anyway).
+static uint32_t collide_mask(uint32_t cat) {
+    switch (cat) {
+    case OW_CAT_TERRAIN: return OW_CAT_TRUCK | OW_CAT_CRANE | OW_CAT_ROPE | OW_CAT_HOOK | OW_CAT_LOAD | OW_CAT_OBST;
+    case OW_CAT_TRUCK: return OW_CAT_TERRAIN | OW_CAT_HOOK | OW_CAT_LOAD | OW_CAT_OBST;
+    case OW_CAT_CRANE: return OW_CAT_TERRAIN | OW_CAT_HOOK | OW_CAT_LOAD | OW_CAT_OBST;
+    case OW_CAT_ROPE: return OW_CAT_TERRAIN | OW_CAT_LOAD | OW_CAT_OBST;
+    case OW_CAT_HOOK: return OW_CAT_TERRAIN | OW_CAT_TRUCK | OW_CAT_CRANE | OW_CAT_LOAD | OW_CAT_OBST;
+    default: return OW_CAT_TERRAIN | OW_CAT_TRUCK | OW_CAT_CRANE | OW_CAT_ROPE | OW_CAT_HOOK | OW_CAT_LOAD | OW_CAT_OBST;
+    }
+}
+
+static void set_rot(dBodyID b, const double R[9]) {
+    dMatrix3 M;
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) M[4 * i + j] = R[3 * i + j];
+        M[4 * i + 3] = 0;
+    }
+    dBodySetRotation(b, M);
+}
+
+static void geom_rot(dGeomID g, const double R[9]) {
+    dMatrix3 M;
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) M[4 * i + j] = R[3 * i + j];
+        M[4 * i + 3] = 0;
+    }
+    dGeomSetRotation(g, M);
+}
+
+// ---- terrain ----
+
+static int build_terrain(ode_world* w, char* err, size_t errsz) {
+    const world_terrain* t = &w->desc.terrain;
+    int nx = t->samples[0], ny = t->samples[1];
+    w->tnx = nx;
+    w->tny = ny;
+    w->tdx = t->size[0] / (nx - 1);
+    w->tdy = t->size[1] / (ny - 1);
+    w->terrain = malloc((size_t)nx * (size_t)ny * sizeof *w->terrain);
+    double* ode_h = malloc((size_t)nx * (size_t)ny * sizeof *ode_h);
+    if (!w->terrain || !ode_h) {
+        free(ode_h);
+        snprintf(err, errsz, "ode world: out of memory (terrain)");
+        return -1;
+    }
+    double hmin = 0, hmax = 0;
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            double x = -0.5 * t->size[0] + i * w->tdx, y = -0.5 * t->size[1] + j * w->tdy;
+            double h = world_desc_terrain_height(&w->desc, x, y);
+            w->terrain[j * nx + i] = (float)h;
+            // ODE's heightfield lies in its local x-z plane with y up; we
+            // rotate it +90 deg about x (local y -> world z, local z -> world
+            // -y), so its rows run towards -y: flip them.
+            ode_h[(ny - 1 - j) * nx + i] = h;
+            if (h < hmin) hmin = h;
+            if (h > hmax) hmax = h;
+        }
+    w->hfield = dGeomHeightfieldDataCreate();
+    dGeomHeightfieldDataBuildDouble(w->hfield, ode_h, 1, t->size[0], t->size[1], nx, ny, 1.0, 0.0, 1.0, 0);
+    dGeomHeightfieldDataSetBounds(w->hfield, hmin - 1.0, hmax + 1.0);
+    free(ode_h);
+    dGeomID g = dCreateHeightfield(w->static_space, w->hfield, 1);
+    static const double Rx[9] = {1, 0, 0, 0, 0, -1, 0, 1, 0};
+    geom_rot(g, Rx);
+    dGeomSetPosition(g, 0, 0, 0);
+    ow_add_geom(w, g, OW_CAT_TERRAIN, t->friction);
+    double sz[3] = {t->size[0], t->size[1], hmax - hmin};
+    ow_add_vis(w, "terrain", WORLD_ROLE_TERRAIN, WORLD_SHAPE_TERRAIN, sz, RGBA_TERRAIN, -1, 0, NULL, NULL);
+    return 0;
+}
+
+// ---- truck ----
+
+// Add a box geom to the truck at truck-frame position p (and its drawing).
+static void truck_box(ode_world* w, const char* name, world_role role, const float* rgba, int mesh,
+                      const double size[3], const double p[3], int collide) {
+    double o[3] = {p[0] + w->truck_org[0], p[1] + w->truck_org[1], p[2] + w->truck_org[2]};
+    if (collide) {
+        dGeomID g = dCreateBox(w->dyn_space, size[0], size[1], size[2]);
+        dGeomSetBody(g, w->truck);
+        dGeomSetOffsetPosition(g, o[0], o[1], o[2]);
+        ow_add_geom(w, g, OW_CAT_TRUCK, w->desc.truck.friction);
+    }
+    ow_add_vis(w, name, role, WORLD_SHAPE_BOX, size, rgba, mesh, w->truck, o, NULL);
+}
+
+static void build_truck(ode_world* w, const double T[3], const double R[9]) {
+    const world_truck* k = &w->desc.truck;
+    // COM a little below the bed: chassis, engine and axles are low; the cab
+    // and the crane sit higher (the crane is its own bodies).
+    double zc = k->bed_height - 0.2;
+    dMass m;
+    dMassSetBoxTotal(&m, k->mass, k->chassis[0], k->chassis[1], 1.5);
+    w->truck = dBodyCreate(w->world);
+    dBodySetMass(w->truck, &m);
+    double c[3] = {0, 0, zc}, cw[3];
+    ow_mat_vec(R, c, cw);
+    dBodySetPosition(w->truck, T[0] + cw[0], T[1] + cw[1], T[2] + cw[2]);
+    set_rot(w->truck, R);
+    w->truck_org[0] = 0, w->truck_org[1] = 0, w->truck_org[2] = -zc;
+
+    double p[3] = {0, 0, k->bed_height - 0.5 * k->chassis[2]};
+    truck_box(w, "truck", WORLD_ROLE_TRUCK, RGBA_TRUCK, WORLD_MESH_TRUCK, k->chassis, p, 1);
+    double pc[3] = {k->cab_x, 0, k->bed_height - k->chassis[2] + 0.5 * k->cab[2] + 0.15};
+    truck_box(w, "cab", WORLD_ROLE_TRUCK, RGBA_CAB, -1, k->cab, pc, 1);
+
+    // Wheels: spheres for contact (robust on a heightfield), cylinders for
+    // drawing. With outriggers out the wheels hang 5 cm clear of the ground.
+    double lift = k->outriggers ? 0.05 : 0.0;
+    static const double Rw[9] = {1, 0, 0, 0, 0, -1, 0, 1, 0}; // cylinder axis z -> truck y
+    for (int a = 0; a < 2; ++a)
+        for (int s = 0; s < 2; ++s) {
+            double wp[3] = {k->wheel_x[a] + w->truck_org[0], (s ? -0.5 : 0.5) * k->track + w->truck_org[1],
+                            k->wheel_radius + lift + w->truck_org[2]};
+            dGeomID g = dCreateSphere(w->dyn_space, k->wheel_radius);
+            dGeomSetBody(g, w->truck);
+            dGeomSetOffsetPosition(g, wp[0], wp[1], wp[2]);
+            ow_add_geom(w, g, OW_CAT_TRUCK, k->friction);
+            char nm[32];
+            snprintf(nm, sizeof nm, "wheel_%d", 2 * a + s);
+            double sz[3] = {k->wheel_radius, k->wheel_width, 0};
+            ow_add_vis(w, nm, WORLD_ROLE_WHEEL, WORLD_SHAPE_CYLINDER, sz, RGBA_WHEEL, WORLD_MESH_WHEEL, w->truck, wp, Rw);
+        }
+    if (!k->outriggers) return;
+    for (int a = 0; a < 2; ++a)
+        for (int s = 0; s < 2; ++s) {
+            double y = (s ? -0.5 : 0.5) * k->outrigger_span;
+            char nm[32];
+            snprintf(nm, sizeof nm, "outrigger_pad_%d", 2 * a + s);
+            double pp[3] = {k->outrigger_x[a], y, 0.5 * k->pad[2]};
+            truck_box(w, nm, WORLD_ROLE_OUTRIGGER, RGBA_OUTRIGGER, WORLD_MESH_OUTRIGGER, k->pad, pp, 1);
+            // Beam and leg, drawn only: the pad carries the contact.
+            double half = 0.5 * k->outrigger_span - 0.5 * k->chassis[1];
+            double bz = k->bed_height - k->chassis[2] + 0.1;
+            double bs[3] = {0.2, half, 0.16}, bp[3] = {k->outrigger_x[a], (s ? -1 : 1) * (0.5 * k->chassis[1] + 0.5 * half), bz};
+            snprintf(nm, sizeof nm, "outrigger_beam_%d", 2 * a + s);
+            truck_box(w, nm, WORLD_ROLE_OUTRIGGER, RGBA_OUTRIGGER, -1, bs, bp, 0);
+            double ls[3] = {0.14, 0.14, bz - k->pad[2]}, lp[3] = {k->outrigger_x[a], y, k->pad[2] + 0.5 * ls[2]};
+            snprintf(nm, sizeof nm, "outrigger_leg_%d", 2 * a + s);
+            truck_box(w, nm, WORLD_ROLE_OUTRIGGER, RGBA_OUTRIGGER, -1, ls, lp, 0);
+        }
+}
+
+// ---- rope and hook ----
+
+static void build_rope(ode_world* w) {
+    const world_rope* r = &w->desc.rope;
+    const world_hook* hk = &w->desc.hook;
+    double tip[3], tl[3] = {w->mech.link[1].length, 0, 0};
+    ow_frame_point(w, 2, tl, tip);
+    static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    int n = r->links;
+    double l = r->length / n, ml = r->mass_per_m * l;
+    w->nrope = n;
+    w->rope_len = l;
+    w->rope_mass = ml;
+    dBodyID prev = w->frame[2].body;
+    for (int i = 0; i < n; ++i) {
+        dMass m;
+        dMassSetCapsuleTotal(&m, ml, 3, r->radius, l);
+        dBodyID b = dBodyCreate(w->world);
+        dBodySetMass(b, &m);
+        dBodySetPosition(b, tip[0], tip[1], tip[2] - (i + 0.5) * l);
+        set_rot(b, I);
+        // A capsule a little shorter than the link so neighbours do not overlap.
+        double cl = l - 2.0 * r->radius > 0.01 ? l - 2.0 * r->radius : 0.01;
+        dGeomID g = dCreateCapsule(w->dyn_space, r->radius, cl);
+        dGeomSetBody(g, b);
+        ow_add_geom(w, g, OW_CAT_ROPE, 0.3);
+        char nm[32];
+        snprintf(nm, sizeof nm, "rope_%d", i);
+        double sz[3] = {r->radius, cl, 0};
+        ow_add_vis(w, nm, WORLD_ROLE_OTHER, WORLD_SHAPE_CAPSULE, sz, RGBA_ROPE, -1, b, NULL, NULL);
+        dJointID j = dJointCreateBall(w->world, 0);
+        dJointAttach(j, b, prev);
+        dJointSetBallAnchor(j, tip[0], tip[1], tip[2] - i * l);
+        w->rope[i] = b;
+        prev = b;
+    }
+    dMass m;
+    dMassSetBoxTotal(&m, hk->mass, hk->size[0], hk->size[1], hk->size[2]);
+    w->hook = dBodyCreate(w->world);
+    dBodySetMass(w->hook, &m);
+    dBodySetPosition(w->hook, tip[0], tip[1], tip[2] - r->length - 0.5 * hk->size[2]);
+    set_rot(w->hook, I);
+    dGeomID g = dCreateBox(w->dyn_space, hk->size[0], hk->size[1], hk->size[2]);
+    dGeomSetBody(g, w->hook);
+    ow_add_geom(w, g, OW_CAT_HOOK, 0.4);
+    ow_add_vis(w, "hook", WORLD_ROLE_HOOK, WORLD_SHAPE_BOX, hk->size, RGBA_HOOK, WORLD_MESH_HOOK, w->hook, NULL, NULL);
+    dJointID j = dJointCreateBall(w->world, 0);
+    dJointAttach(j, w->hook, prev);
+    dJointSetBallAnchor(j, tip[0], tip[1], tip[2] - r->length);
+    // The load joint exists from the start and is only re-attached, so
+    // picking up and putting down never allocates.
+    w->hook_joint = dJointCreateBall(w->world, 0);
+    dJointAttach(w->hook_joint, 0, 0);
+    dJointDisable(w->hook_joint);
+}
+
+void ow_hook_point(const ode_world* w, double p[3], double v[3]) {
+    double z = -0.5 * w->desc.hook.size[2];
+    dVector3 a;
+    dBodyGetRelPointPos(w->hook, 0, 0, z, a);
+    p[0] = a[0], p[1] = a[1], p[2] = a[2];
+    if (v) {
+        dBodyGetRelPointVel(w->hook, 0, 0, z, a);
+        v[0] = a[0], v[1] = a[1], v[2] = a[2];
+    }
+}
+
+int ow_attach(ode_world* w, int attach) {
+    if (!attach) {
+        if (w->attached >= 0) {
+            dJointAttach(w->hook_joint, 0, 0);
+            dJointDisable(w->hook_joint);
+            w->attached = -1;
+        }
+        return -1;
+    }
+    if (w->attached >= 0) return w->attached;
+    double hp[3];
+    ow_hook_point(w, hp, NULL);
+    int best = -1;
+    double bd = w->desc.hook.reach;
+    for (int i = 0; i < w->nload; ++i) {
+        dVector3 top;
+        dBodyGetRelPointPos(w->load[i], 0, 0, 0.5 * w->desc.load[i].size[2], top);
+        double d = sqrt((top[0] - hp[0]) * (top[0] - hp[0]) + (top[1] - hp[1]) * (top[1] - hp[1]) +
+                        (top[2] - hp[2]) * (top[2] - hp[2]));
+        if (d <= bd) {
+            bd = d;
+            best = i;
+        }
+    }
+    if (best < 0) return -1;
+    // One anchor at the hook point for both bodies: the load hangs from where
+    // the hook touched it, like a short rigid sling, with no initial joint
+    // error for ERP to snap shut.
+    dJointEnable(w->hook_joint);
+    dJointAttach(w->hook_joint, w->hook, w->load[best]);
+    dJointSetBallAnchor(w->hook_joint, hp[0], hp[1], hp[2]);
+    w->attached = best;
+    return best;
+}
+
+// ---- loads and obstacles ----
+
+static void build_loads(ode_world* w) {
+    w->nload = w->desc.nload;
+    for (int i = 0; i < w->nload; ++i) {
+        const world_load* L = &w->desc.load[i];
+        dMass m;
+        dMassSetBoxTotal(&m, L->mass, L->size[0], L->size[1], L->size[2]);
+        dBodyID b = dBodyCreate(w->world);
+        dBodySetMass(b, &m);
+        dBodySetPosition(b, L->position[0], L->position[1], L->position[2]);
+        double R[9];
+        ow_rot_z(L->yaw, R);
+        set_rot(b, R);
+        dGeomID g = dCreateBox(w->dyn_space, L->size[0], L->size[1], L->size[2]);
+        dGeomSetBody(g, b);
+        ow_add_geom(w, g, OW_CAT_LOAD, L->friction);
+        ow_add_vis(w, L->name, WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, L->size, RGBA_LOAD, WORLD_MESH_LOAD, b, NULL, NULL);
+        w->load[i] = b;
+    }
+}
+
+static void build_obstacles(ode_world* w) {
+    for (int i = 0; i < w->desc.nobstacle; ++i) {
+        const world_obstacle* o = &w->desc.obstacle[i];
+        static const int mesh[3] = {WORLD_MESH_WALL, WORLD_MESH_BOX, WORLD_MESH_BUILDING};
+        const float* col = o->kind == WORLD_OBST_WALL ? RGBA_WALL : o->kind == WORLD_OBST_BOX ? RGBA_BOX : RGBA_BUILDING;
+        double R[9];
+        ow_rot_z(o->yaw, R);
+        if (o->mass > 0) {
+            dMass m;
+            dMassSetBoxTotal(&m, o->mass, o->size[0], o->size[1], o->size[2]);
+            dBodyID b = dBodyCreate(w->world);
+            dBodySetMass(b, &m);
+            dBodySetPosition(b, o->position[0], o->position[1], o->position[2]);
+            set_rot(b, R);
+            dGeomID g = dCreateBox(w->dyn_space, o->size[0], o->size[1], o->size[2]);
+            dGeomSetBody(g, b);
+            ow_add_geom(w, g, OW_CAT_OBST, o->friction);
+            ow_add_vis(w, o->name, WORLD_ROLE_OBSTACLE, WORLD_SHAPE_BOX, o->size, col, mesh[o->kind], b, NULL, NULL);
+            w->obst_body[i] = b;
+        } else {
+            dGeomID g = dCreateBox(w->static_space, o->size[0], o->size[1], o->size[2]);
+            dGeomSetPosition(g, o->position[0], o->position[1], o->position[2]);
+            geom_rot(g, R);
+            ow_add_geom(w, g, OW_CAT_OBST, o->friction);
+            ow_add_vis(w, o->name, WORLD_ROLE_OBSTACLE, WORLD_SHAPE_BOX, o->size, col, mesh[o->kind], 0, o->position, R);
+        }
+    }
+}
+
+int ow_build_sandbox(ode_world* w, char* err, size_t errsz) {
+    const world_truck* k = &w->desc.truck;
+    if (build_terrain(w, err, errsz)) return -1;
+    double T[3] = {k->position[0], k->position[1], 0}, R[9];
+    // Stand the truck on the ground under its centre, 0.5 mm up so it settles
+    // onto its pads without an initial overlap.
+    T[2] = world_desc_terrain_height(&w->desc, T[0], T[1]) + 0.5e-3;
+    ow_rot_z(k->yaw, R);
+    build_truck(w, T, R);
+
+    // Column on the bed, slewed by slew0 about the truck's z axis.
+    const ow_act* s = &w->act[ODE_SLEW];
+    double r = w->desc.slew.pinion_radius, smax = s->stroke > 0 ? 0.5 * s->stroke / r : M_PI;
+    if (s->present && fabs(w->opt.slew0) > smax) {
+        snprintf(err, errsz, "initial slew %.1f deg is outside the slew cylinder's range +-%.1f deg",
+                 w->opt.slew0 * 180.0 / M_PI, smax * 180.0 / M_PI);
+        return -1;
+    }
+    double base_t[3] = {k->column_x, 0, k->bed_height}, base[3];
+    ow_mat_vec(R, base_t, base);
+    for (int i = 0; i < 3; ++i) base[i] += T[i];
+    double Rs[9], Rc[9];
+    ow_rot_z(w->opt.slew0, Rs);
+    ow_mat_mul(R, Rs, Rc);
+    double j1[3] = {base[0] + R[2] * w->mech.column_height, base[1] + R[5] * w->mech.column_height,
+                    base[2] + R[8] * w->mech.column_height};
+    if (ow_build_crane(w, j1, Rc, w->truck, err, errsz)) return -1;
+    w->slew_joint = dJointCreateHinge(w->world, 0);
+    dJointAttach(w->slew_joint, w->frame[0].body, w->truck);
+    dJointSetHingeAnchor(w->slew_joint, base[0], base[1], base[2]);
+    dJointSetHingeAxis(w->slew_joint, R[2], R[5], R[8]);
+    w->slew_off = w->opt.slew0;
+    if (s->present && s->stroke > 0 && smax < M_PI) {
+        // The rack's end stops as hinge limits (docs/ode_world.md, "End stops").
+        dJointSetHingeParam(w->slew_joint, dParamLoStop, -smax - w->opt.slew0);
+        dJointSetHingeParam(w->slew_joint, dParamHiStop, smax - w->opt.slew0);
+        dJointSetHingeParam(w->slew_joint, dParamBounce, 0.0);
+    }
+    build_rope(w);
+    build_loads(w);
+    build_obstacles(w);
+    return 0;
+}
+
+// ---- contacts ----
+
+static void near_cb(void* data, dGeomID g1, dGeomID g2) {
+    ode_world* w = data;
+    const ow_geom* a = dGeomGetData(g1);
+    const ow_geom* b = dGeomGetData(g2);
+    if (!a || !b || !(collide_mask(a->cat) & b->cat)) return;
+    dBodyID b1 = dGeomGetBody(g1), b2 = dGeomGetBody(g2);
+    if (!b1 && !b2) return;
+    if (b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
+    // Two frozen (kinematic) bodies cannot push each other.
+    if ((!b1 || dBodyIsKinematic(b1)) && (!b2 || dBodyIsKinematic(b2))) return;
+    int max = w->desc.ode.max_contacts;
+    if (max > (int)(sizeof w->cbuf / sizeof w->cbuf[0])) max = (int)(sizeof w->cbuf / sizeof w->cbuf[0]);
+    int n = dCollide(g1, g2, max, w->cbuf, sizeof(dContactGeom));
+    if (n <= 0) return;
+    double mu = sqrt(a->friction * b->friction);
+    int crane = a->cat == OW_CAT_CRANE || b->cat == OW_CAT_CRANE;
+    for (int i = 0; i < n; ++i) {
+        dContact c;
+        memset(&c, 0, sizeof c);
+        c.geom = w->cbuf[i];
+        // Friction pyramid scaled by the normal force (Approx1), and the
+        // world-file softness so contacts are stiff but regular.
+        c.surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM;
+        c.surface.mu = mu;
+        c.surface.soft_erp = w->desc.ode.contact_erp;
+        c.surface.soft_cfm = w->desc.ode.contact_cfm;
+        dJointID j = dJointCreateContact(w->world, w->contacts, &c);
+        dJointAttach(j, b1, b2);
+        double d = c.geom.depth;
+        if (d > w->max_depth) w->max_depth = d;
+        if (crane) {
+            if (d > w->max_depth_crane) w->max_depth_crane = d;
+            if ((a->cat | b->cat) & (OW_CAT_OBST | OW_CAT_LOAD | OW_CAT_HOOK)) w->crane_contact = 1;
+        }
+    }
+    w->ncontact += n;
+}
+
+void ow_collide(ode_world* w) {
+    w->ncontact = 0;
+    w->max_depth = 0;
+    w->max_depth_crane = 0;
+    w->crane_contact = 0;
+    dSpaceCollide(w->dyn_space, w, near_cb);
+    dSpaceCollide2((dGeomID)w->dyn_space, (dGeomID)w->static_space, w, near_cb);
+}
+
+double ow_truck_tilt(const ode_world* w) {
+    const dReal* R = dBodyGetRotation(w->truck);
+    double c = R[10]; // z component of the truck's z axis
+    if (c > 1) c = 1;
+    if (c < -1) c = -1;
+    return acos(c);
+}
+
+// ---- snapshot extras ----
+
+void ow_sandbox_snapshot(const ode_world* w, world_snapshot* s) {
+    s->terrain.height = w->terrain;
+    s->terrain.nx = w->tnx;
+    s->terrain.ny = w->tny;
+    s->terrain.dx = w->tdx;
+    s->terrain.dy = w->tdy;
+    // Rope polyline: tip pin, each link joint, hook pin.
+    int n = 0;
+    for (int i = 0; i < w->nrope && n < WORLD_SNAP_MAX_ROPE - 1; ++i) {
+        dVector3 p;
+        dBodyGetRelPointPos(w->rope[i], 0, 0, 0.5 * w->rope_len, p);
+        s->rope[n][0] = p[0], s->rope[n][1] = p[1], s->rope[n][2] = p[2];
+        ++n;
+    }
+    if (w->nrope) {
+        dVector3 p;
+        dBodyGetRelPointPos(w->rope[w->nrope - 1], 0, 0, -0.5 * w->rope_len, p);
+        s->rope[n][0] = p[0], s->rope[n][1] = p[1], s->rope[n][2] = p[2];
+        ++n;
+    }
+    s->nrope = n;
+    ow_hook_point(w, s->hook, NULL);
+    s->attached = w->attached >= 0;
+    s->load_mass = w->attached >= 0 ? w->desc.load[w->attached].mass : 0;
+    s->slew = dJointGetHingeAngle(w->slew_joint) + w->slew_off;
+    s->truck_tilt = ow_truck_tilt(w);
+    s->tipping = s->truck_tilt > 5.0 * M_PI / 180.0;
+    s->collision = (uint8_t)w->crane_contact;
+
+    // The slew rack drawn as a cylinder lying across the truck at the column
+    // foot, its rod end moving with the rack travel.
+    const ow_act* c = &w->act[ODE_SLEW];
+    if (c->present && s->ncyl < WORLD_SNAP_MAX_CYLINDERS) {
+        world_snap_cylinder* y = &s->cyl[s->ncyl++];
+        snprintf(y->name, sizeof y->name, "slew");
+        const world_truck* k = &w->desc.truck;
+        double closed = c->stroke + 0.2;
+        double o = w->truck_org[2];
+        double pb[3] = {k->column_x - 0.35, -0.5 * (closed + c->stroke), k->bed_height + 0.15 + o};
+        double pr[3] = {pb[0], pb[1] + closed + c->x, pb[2]};
+        dVector3 a;
+        dBodyGetRelPointPos(w->truck, pb[0], pb[1], pb[2], a);
+        y->base[0] = a[0], y->base[1] = a[1], y->base[2] = a[2];
+        dBodyGetRelPointPos(w->truck, pr[0], pr[1], pr[2], a);
+        y->rod_end[0] = a[0], y->rod_end[1] = a[1], y->rod_end[2] = a[2];
+        y->closed_length = closed;
+        y->stroke_max = c->stroke;
+        y->x = c->x;
+        y->v = c->v;
+        y->force = c->F;
+        y->u_cmd = w->u_cmd[ODE_SLEW];
+        y->end_stop = (uint8_t)c->at_stop;
+        if (w->hm && c->cyl >= 0) {
+            y->bore = sqrt(4.0 * c->AA / M_PI);
+            y->rod = sqrt(4.0 * (c->AA - c->AB) / M_PI);
+            y->pA = w->y[c->iA];
+            y->pB = w->y[c->iB];
+            y->u = c->iu >= 0 ? w->y[c->iu] : 0;
+        }
+    }
+}

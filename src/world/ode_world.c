@@ -1,0 +1,831 @@
+// ode_world.c: ODE world lifecycle, the crane (column, lifting arm, end arm,
+// hinges, cylinder mounts), the step loop, state and snapshot.
+#include "ode_world_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+// ODE keeps global tables (collider registry, thread-local data); it must be
+// initialised once before the first world and closed after the last. A
+// counter lets several worlds coexist (tests, compare runs). This is the one
+// piece of global mutable state the project allows (STYLE.md); worlds must be
+// created and destroyed from one thread.
+static int g_ode_users = 0;
+
+static void ode_acquire(void) {
+    if (g_ode_users++ == 0) dInitODE2(0);
+}
+
+static void ode_release(void) {
+    if (--g_ode_users == 0) dCloseODE();
+}
+
+ode_world_opts ode_world_default_opts(void) {
+    ode_world_opts o;
+    memset(&o, 0, sizeof o);
+    o.dt_ode = 1e-3;
+    o.dt_hyd = 1e-4;
+    o.solver = HYD_KRUS;
+    o.jac_every = 10;
+    o.q0[0] = 95.0 * M_PI / 180.0;
+    o.q0[1] = -110.0 * M_PI / 180.0;
+    o.slew0 = 0;
+    o.load_mass = -1;
+    o.hydraulics = 1;
+    o.stop_limits = 1;
+    o.init_hold = 1;
+    o.p_low = 2e6;
+    o.force_average = 1;
+    o.model_file = "model";
+    return o;
+}
+
+// ---- small 3x3 helpers (row-major) ----
+
+void ow_rot_z(double yaw, double R[9]) {
+    double c = cos(yaw), s = sin(yaw);
+    double r[9] = {c, -s, 0, s, c, 0, 0, 0, 1};
+    memcpy(R, r, sizeof r);
+}
+
+void ow_mat_mul(const double A[9], const double B[9], double C[9]) {
+    double t[9];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) t[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+    memcpy(C, t, sizeof t);
+}
+
+void ow_mat_vec(const double A[9], const double v[3], double out[3]) {
+    double t[3];
+    for (int i = 0; i < 3; ++i) t[i] = A[3 * i] * v[0] + A[3 * i + 1] * v[1] + A[3 * i + 2] * v[2];
+    memcpy(out, t, sizeof t);
+}
+
+// Rotation of a link frame relative to its parent: the boom plane is x-z and
+// a positive (counter-clockwise, x towards z) angle a is a rotation about -y.
+static void rot_plane(double a, double R[9]) {
+    double c = cos(a), s = sin(a);
+    double r[9] = {c, 0, -s, 0, 1, 0, s, 0, c};
+    memcpy(R, r, sizeof r);
+}
+
+static void to_dmatrix(const double R[9], dMatrix3 M) {
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) M[4 * i + j] = R[3 * i + j];
+        M[4 * i + 3] = 0;
+    }
+}
+
+static void from_dmatrix(const dReal* M, double R[9]) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) R[3 * i + j] = M[4 * i + j];
+}
+
+// ---- frames ----
+
+void ow_frame_point(const ode_world* w, int f, const double p[3], double out[3]) {
+    const ow_frame* fr = &w->frame[f];
+    if (fr->body) {
+        dVector3 r;
+        dBodyGetRelPointPos(fr->body, fr->org[0] + p[0], fr->org[1] + p[1], fr->org[2] + p[2], r);
+        out[0] = r[0], out[1] = r[1], out[2] = r[2];
+    } else {
+        ow_mat_vec(fr->wrot, p, out);
+        for (int i = 0; i < 3; ++i) out[i] += fr->wpos[i];
+    }
+}
+
+void ow_frame_point_vel(const ode_world* w, int f, const double p[3], double out[3]) {
+    const ow_frame* fr = &w->frame[f];
+    if (fr->body) {
+        dVector3 r;
+        dBodyGetRelPointVel(fr->body, fr->org[0] + p[0], fr->org[1] + p[1], fr->org[2] + p[2], r);
+        out[0] = r[0], out[1] = r[1], out[2] = r[2];
+    } else {
+        out[0] = out[1] = out[2] = 0;
+    }
+}
+
+void ow_frame_rot(const ode_world* w, int f, double R[9]) {
+    const ow_frame* fr = &w->frame[f];
+    if (fr->body) from_dmatrix(dBodyGetRotation(fr->body), R);
+    else memcpy(R, fr->wrot, sizeof fr->wrot);
+}
+
+// ---- registration of geoms and snapshot entries (fixed arrays, so the
+// pointers given to ODE as geom data never move) ----
+
+ow_geom* ow_add_geom(ode_world* w, dGeomID g, uint32_t cat, double friction) {
+    if (w->ngeom >= OW_MAX_GEOMS) return NULL;
+    ow_geom* e = &w->geom[w->ngeom++];
+    e->g = g;
+    e->cat = cat;
+    e->friction = friction;
+    dGeomSetData(g, e);
+    return e;
+}
+
+ow_vis* ow_add_vis(ode_world* w, const char* name, world_role role, world_shape shape, const double size[3],
+                   const float rgba[4], int mesh, dBodyID body, const double pos[3], const double* rot) {
+    if (w->nvis >= OW_MAX_VIS) return NULL;
+    ow_vis* v = &w->vis[w->nvis++];
+    memset(v, 0, sizeof *v);
+    snprintf(v->name, sizeof v->name, "%s", name);
+    v->role = role;
+    v->shape = shape;
+    memcpy(v->size, size, sizeof v->size);
+    memcpy(v->rgba, rgba, sizeof v->rgba);
+    v->mesh = mesh;
+    v->body = body;
+    if (pos) memcpy(v->pos, pos, sizeof v->pos);
+    static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    memcpy(v->rot, rot ? rot : I, sizeof v->rot);
+    return v;
+}
+
+static dBodyID new_body(ode_world* w, const double pos[3], const double R[9], const dMass* m) {
+    (void)w;
+    dBodyID b = dBodyCreate(w->world);
+    dBodySetPosition(b, pos[0], pos[1], pos[2]);
+    dMatrix3 M;
+    to_dmatrix(R, M);
+    dBodySetRotation(b, M);
+    dBodySetMass(b, m);
+    return b;
+}
+
+// Mass of a boom: a box of the link's section whose inertia about the hinge
+// axis (body y) is the model's I_i, with COM on the link axis at com, plus an
+// optional point mass m_tip at the tip. Returns the combined COM along the
+// link [m] and fills an ODE mass centred at that COM (ODE wants the COM at the
+// body origin).
+static double boom_mass(const crane_link* l, double m_tip, dMass* out) {
+    double m = l->mass, M = m + m_tip;
+    double c = (m * l->com + m_tip * l->length) / M;
+    double dc1 = l->com - c, dc2 = l->length - c;
+    double Ixx = m * (l->width * l->width + l->height * l->height) / 12.0;
+    double Iyy = l->inertia + m * dc1 * dc1 + m_tip * dc2 * dc2;
+    double Izz = m * (l->length * l->length + l->width * l->width) / 12.0 + m * dc1 * dc1 + m_tip * dc2 * dc2;
+    dMassSetZero(out);
+    dMassSetParameters(out, M, 0, 0, 0, Ixx, Iyy, Izz, 0, 0, 0);
+    return c;
+}
+
+static const float RGBA_COLUMN[4] = {0.85f, 0.2f, 0.15f, 1};
+static const float RGBA_BOOM1[4] = {0.9f, 0.25f, 0.15f, 1};
+static const float RGBA_BOOM2[4] = {0.95f, 0.35f, 0.2f, 1};
+static const float RGBA_LOAD[4] = {0.3f, 0.45f, 0.75f, 1};
+
+// Hinge stop angles (relative to the hinge's zero at build time) from the
+// cylinder's stroke range, so the ODE joint limit takes the end-stop impact
+// implicitly (docs/ode_world.md, "End stops").
+static int joint_limits(const crane_actuator* a, double stroke, double q0, double* lo, double* hi) {
+    double qa = crane_joint_for_stroke(a, 0.0), qb = crane_joint_for_stroke(a, stroke);
+    if (!isfinite(qa) || !isfinite(qb)) return -1;
+    if (qa > qb) {
+        double t = qa;
+        qa = qb;
+        qb = t;
+    }
+    *lo = qa - q0;
+    *hi = qb - q0;
+    return 0;
+}
+
+int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9], dBodyID base, char* err,
+                   size_t errsz) {
+    const crane_mech* me = &w->mech;
+    const double* q0 = w->opt.q0;
+    const world_desc* d = &w->desc;
+    double zero3[3] = {0, 0, 0};
+
+    // Column: a body slewing on the truck (sandbox) or the fixed world frame.
+    ow_frame* f0 = &w->frame[0];
+    memset(f0, 0, sizeof *f0);
+    double hcol = me->column_height, rcol = d->slew.column_radius;
+    if (base) {
+        dMass m;
+        dMassSetCylinderTotal(&m, me->column_mass, 3, rcol, hcol);
+        double R[9];
+        memcpy(R, col_rot, sizeof R);
+        double pos[3] = {col_pos[0] - R[2] * 0.5 * hcol, col_pos[1] - R[5] * 0.5 * hcol, col_pos[2] - R[8] * 0.5 * hcol};
+        f0->body = new_body(w, pos, R, &m);
+        f0->org[2] = 0.5 * hcol;
+        dGeomID g = dCreateCylinder(w->dyn_space, rcol, hcol);
+        dGeomSetBody(g, f0->body);
+        ow_add_geom(w, g, OW_CAT_CRANE, 0.5);
+    } else {
+        memcpy(f0->wpos, col_pos, sizeof f0->wpos);
+        memcpy(f0->wrot, col_rot, sizeof f0->wrot);
+    }
+    {
+        double sz[3] = {rcol, hcol, 0};
+        double p[3] = {0, 0, base ? 0 : -0.5 * hcol};
+        ow_add_vis(w, "column", WORLD_ROLE_COLUMN, WORLD_SHAPE_CYLINDER, sz, RGBA_COLUMN, WORLD_MESH_COLUMN,
+                   f0->body, base ? zero3 : p, NULL);
+        if (!base) {
+            // Fixed column: its entry is in world coordinates.
+            ow_vis* v = &w->vis[w->nvis - 1];
+            double pw[3];
+            ow_mat_vec(col_rot, p, pw);
+            for (int i = 0; i < 3; ++i) v->pos[i] = col_pos[i] + pw[i];
+            memcpy(v->rot, col_rot, sizeof v->rot);
+        }
+    }
+
+    // Booms, built in the initial pose so each hinge's zero angle is q0.
+    double a1 = q0[0] - 0.5 * M_PI, a2 = q0[0] + q0[1] - 0.5 * M_PI;
+    double R1[9], R2[9], P[9];
+    rot_plane(a1, P);
+    ow_mat_mul(col_rot, P, R1);
+    rot_plane(a2, P);
+    ow_mat_mul(col_rot, P, R2);
+    double m_tip = w->kind == WORLD_VALIDATION ? w->m3 : 0.0;
+    static const char* const name[2] = {"boom1", "boom2"};
+    static const world_role role[2] = {WORLD_ROLE_BOOM1, WORLD_ROLE_BOOM2};
+    static const int mesh[2] = {WORLD_MESH_BOOM1, WORLD_MESH_BOOM2};
+    double jpos[3];
+    memcpy(jpos, col_pos, sizeof jpos);
+    for (int i = 0; i < 2; ++i) {
+        const crane_link* l = &me->link[i];
+        const double* R = i ? R2 : R1;
+        dMass m;
+        double c = boom_mass(l, i == 1 ? m_tip : 0.0, &m);
+        if (!dMassCheck(&m)) {
+            snprintf(err, errsz, "%s: mechanics.links[%d]: inertia %g kg m^2 gives an impossible inertia tensor",
+                     w->opt.model_file, i, l->inertia);
+            return -1;
+        }
+        double off[3] = {c, 0, 0}, pos[3];
+        ow_mat_vec(R, off, pos);
+        for (int k = 0; k < 3; ++k) pos[k] += jpos[k];
+        ow_frame* f = &w->frame[i + 1];
+        memset(f, 0, sizeof *f);
+        f->body = new_body(w, pos, R, &m);
+        f->org[0] = -c;
+        // The box covers the link from its joint to its tip.
+        double sz[3] = {l->length, l->width, l->height}, gp[3] = {0.5 * l->length - c, 0, 0};
+        if (w->kind == WORLD_SANDBOX) {
+            dGeomID g = dCreateBox(w->dyn_space, sz[0], sz[1], sz[2]);
+            dGeomSetBody(g, f->body);
+            dGeomSetOffsetPosition(g, gp[0], gp[1], gp[2]);
+            ow_add_geom(w, g, OW_CAT_CRANE, 0.5);
+        }
+        ow_add_vis(w, name[i], role[i], WORLD_SHAPE_BOX, sz, i ? RGBA_BOOM2 : RGBA_BOOM1, mesh[i], f->body, gp, NULL);
+        double step[3] = {l->length, 0, 0}, dj[3];
+        ow_mat_vec(R, step, dj);
+        for (int k = 0; k < 3; ++k) jpos[k] += dj[k];
+    }
+    if (w->kind == WORLD_VALIDATION && w->m3 > 0) {
+        // The tip load is merged into the end arm's mass (a point mass, as in
+        // lagrange); this entry only draws it hanging under the tip.
+        double s = 0.5, sz[3] = {s, s, s};
+        double p[3] = {me->link[1].length + w->frame[2].org[0], 0, -0.5 * s - 0.1};
+        ow_add_vis(w, "load", WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, sz, RGBA_LOAD, WORLD_MESH_LOAD, w->frame[2].body, p, NULL);
+    }
+
+    // Hinges: axis -y of the column frame, so a positive hinge angle is a
+    // positive (counter-clockwise) q.
+    double axis_l[3] = {0, -1, 0}, axis[3];
+    ow_mat_vec(col_rot, axis_l, axis);
+    w->j1 = dJointCreateHinge(w->world, 0);
+    dJointAttach(w->j1, w->frame[1].body, w->frame[0].body);
+    dJointSetHingeAnchor(w->j1, col_pos[0], col_pos[1], col_pos[2]);
+    dJointSetHingeAxis(w->j1, axis[0], axis[1], axis[2]);
+    double j2p[3], l1[3] = {me->link[0].length, 0, 0};
+    ow_frame_point(w, 1, l1, j2p);
+    w->j2 = dJointCreateHinge(w->world, 0);
+    dJointAttach(w->j2, w->frame[2].body, w->frame[1].body);
+    dJointSetHingeAnchor(w->j2, j2p[0], j2p[1], j2p[2]);
+    dJointSetHingeAxis(w->j2, axis[0], axis[1], axis[2]);
+    w->qoff[0] = q0[0];
+    w->qoff[1] = q0[1];
+
+    // Boom cylinders: mounts from crane_mech (planar x, z -> frame x, 0, z).
+    for (int k = 0; k < 2; ++k) {
+        const crane_actuator* a = &me->act[k];
+        ow_act* c = &w->act[k];
+        c->present = 1;
+        c->parent = a->joint;      // joint 0: column -> lifting arm; joint 1: lifting arm -> end arm
+        c->child = a->joint + 1;
+        c->base[0] = a->base_mount[0], c->base[1] = 0, c->base[2] = a->base_mount[1];
+        c->rod[0] = a->rod_mount[0], c->rod[1] = 0, c->rod[2] = a->rod_mount[1];
+        c->closed_length = a->closed_length;
+        if (c->stroke > 0) {
+            // Reject an initial pose the cylinder cannot reach: the hinge
+            // limit would otherwise snap the boom on the first step.
+            double xs = crane_stroke(a, q0[k]);
+            if (!(xs >= -1e-9 && xs <= c->stroke + 1e-9)) {
+                snprintf(err, errsz, "initial q%d = %.2f deg puts cylinder %s at stroke %.4f m, outside [0, %.3f] m",
+                         k + 1, q0[k] * 180.0 / M_PI, a->cylinder, xs, c->stroke);
+                return -1;
+            }
+            double lo, hi;
+            if (w->opt.stop_limits && joint_limits(a, c->stroke, q0[k], &lo, &hi) == 0 && lo > -M_PI && hi < M_PI) {
+                dJointID j = k ? w->j2 : w->j1;
+                dJointSetHingeParam(j, dParamLoStop, lo);
+                dJointSetHingeParam(j, dParamHiStop, hi);
+                dJointSetHingeParam(j, dParamBounce, 0.0);
+            }
+        }
+    }
+    return 0;
+}
+
+// Stroke and rate of every actuator from the bodies' mount points (boom
+// cylinders) or the slew hinge (rack and pinion).
+void ow_read_actuators(ode_world* w) {
+    for (int k = 0; k < 2; ++k) {
+        ow_act* c = &w->act[k];
+        double pb[3], pr[3], vb[3], vr[3];
+        ow_frame_point(w, c->parent, c->base, pb);
+        ow_frame_point(w, c->child, c->rod, pr);
+        ow_frame_point_vel(w, c->parent, c->base, vb);
+        ow_frame_point_vel(w, c->child, c->rod, vr);
+        double d[3] = {pr[0] - pb[0], pr[1] - pb[1], pr[2] - pb[2]};
+        double L = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        c->x = L - c->closed_length;
+        c->v = ((vr[0] - vb[0]) * d[0] + (vr[1] - vb[1]) * d[1] + (vr[2] - vb[2]) * d[2]) / L;
+        dJointID j = k ? w->j2 : w->j1;
+        double ang = dJointGetHingeAngle(j);
+        double lo = dJointGetHingeParam(j, dParamLoStop), hi = dJointGetHingeParam(j, dParamHiStop);
+        c->at_stop = (lo > -dInfinity && ang <= lo + 1e-6) || (hi < dInfinity && ang >= hi - 1e-6);
+    }
+    ow_act* s = &w->act[ODE_SLEW];
+    if (s->present && w->slew_joint) {
+        double r = w->desc.slew.pinion_radius;
+        double th = dJointGetHingeAngle(w->slew_joint) + w->slew_off;
+        s->x = 0.5 * s->stroke + r * th;
+        s->v = r * dJointGetHingeAngleRate(w->slew_joint);
+    }
+}
+
+// Cylinder forces as equal and opposite forces at the two pins along the
+// cylinder axis (exactly the hinge torque F dx/dphi, but valid in 3D and for
+// any parent body), the slew force as torque F r on the slew hinge, and the
+// test torques.
+void ow_apply_forces(ode_world* w) {
+    if (w->held) return;
+    for (int k = 0; k < 2; ++k) {
+        ow_act* c = &w->act[k];
+        if (c->F == 0) continue;
+        double pb[3], pr[3];
+        ow_frame_point(w, c->parent, c->base, pb);
+        ow_frame_point(w, c->child, c->rod, pr);
+        double d[3] = {pr[0] - pb[0], pr[1] - pb[1], pr[2] - pb[2]};
+        double L = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        double s = c->F / L;
+        dBodyAddForceAtPos(w->frame[c->child].body, s * d[0], s * d[1], s * d[2], pr[0], pr[1], pr[2]);
+        if (w->frame[c->parent].body)
+            dBodyAddForceAtPos(w->frame[c->parent].body, -s * d[0], -s * d[1], -s * d[2], pb[0], pb[1], pb[2]);
+    }
+    if (w->slew_joint) {
+        double tau = w->act[ODE_SLEW].F * w->desc.slew.pinion_radius -
+                     w->desc.slew.damping * dJointGetHingeAngleRate(w->slew_joint);
+        dJointAddHingeTorque(w->slew_joint, tau);
+    }
+    if (w->tau_extra[0] != 0) dJointAddHingeTorque(w->j1, w->tau_extra[0]);
+    if (w->tau_extra[1] != 0) dJointAddHingeTorque(w->j2, w->tau_extra[1]);
+}
+
+// ---- create / destroy ----
+
+ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, const world_desc* desc,
+                            const ode_world_opts* o, char* err, size_t errsz) {
+    ode_world_opts opt = o ? *o : ode_world_default_opts();
+    if (!opt.model_file) opt.model_file = "model";
+    if (!(opt.dt_ode > 0) || !(opt.dt_hyd > 0) || opt.dt_hyd > opt.dt_ode * (1 + 1e-9)) {
+        snprintf(err, errsz, "ode world: need 0 < dt_hyd <= dt_ode, got dt_hyd = %g s, dt_ode = %g s", opt.dt_hyd,
+                 opt.dt_ode);
+        return NULL;
+    }
+    double ratio = opt.dt_ode / opt.dt_hyd;
+    if (fabs(ratio - floor(ratio + 0.5)) > 1e-6) {
+        snprintf(err, errsz, "ode world: dt_ode = %g s must be a whole multiple of dt_hyd = %g s", opt.dt_ode, opt.dt_hyd);
+        return NULL;
+    }
+    if (opt.hydraulics && !hydraulics) {
+        snprintf(err, errsz, "%s: hydraulics: missing (required by the ode world)", opt.model_file);
+        return NULL;
+    }
+    ode_world* w = calloc(1, sizeof *w);
+    if (!w) {
+        snprintf(err, errsz, "ode world: out of memory");
+        return NULL;
+    }
+    ode_acquire();
+    w->opt = opt;
+    w->mech = *mech;
+    crane_mech_derive(&w->mech);
+    if (desc) {
+        w->desc = *desc;
+    } else {
+        world_desc_default(&w->desc, WORLD_VALIDATION);
+    }
+    w->desc.circuit = NULL; // never owned here
+    w->kind = w->desc.kind;
+    w->g = w->desc.gravity > 0 ? w->desc.gravity : w->mech.gravity;
+    w->m3 = opt.load_mass >= 0 ? opt.load_mass : w->mech.load_mass;
+    w->attached = -1;
+    w->ipump = -1;
+    for (int k = 0; k < ODE_NACT; ++k) w->act[k].cyl = w->act[k].valve = -1;
+
+    w->world = dWorldCreate();
+    dWorldSetGravity(w->world, 0, 0, -w->g);
+    dWorldSetERP(w->world, w->desc.ode.erp);
+    dWorldSetCFM(w->world, w->desc.ode.cfm);
+    dWorldSetContactSurfaceLayer(w->world, w->desc.ode.surface_layer);
+    // No automatic disabling: a resting crane must react to the next command
+    // at once, and disabling would make runs depend on thresholds.
+    dWorldSetAutoDisableFlag(w->world, 0);
+    w->dyn_space = dSimpleSpaceCreate(0);
+    w->static_space = dSimpleSpaceCreate(0);
+    w->contacts = dJointGroupCreate(0);
+
+    // The hydraulic circuit first: cylinder strokes are needed for the limits.
+    if (opt.hydraulics) {
+        if (ow_hyd_create(w, hydraulics, desc ? desc->circuit : NULL, err, errsz)) goto fail;
+    } else {
+        // Without a circuit, strokes come from nowhere; hinge limits are off.
+        for (int k = 0; k < 2; ++k) w->act[k].stroke = 0;
+    }
+
+    if (w->kind == WORLD_VALIDATION) {
+        static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        double p[3] = {0, 0, w->mech.column_height};
+        if (ow_build_crane(w, p, I, 0, err, errsz)) goto fail;
+    } else {
+        if (ow_build_sandbox(w, err, errsz)) goto fail;
+    }
+    if (opt.hydraulics) ow_hyd_init_state(w);
+    ow_read_actuators(w);
+    return w;
+fail:
+    ode_world_destroy(w);
+    return NULL;
+}
+
+void ode_world_destroy(ode_world* w) {
+    if (!w) return;
+    ow_hyd_destroy(w);
+    if (w->contacts) dJointGroupDestroy(w->contacts);
+    if (w->dyn_space) dSpaceDestroy(w->dyn_space);
+    if (w->static_space) dSpaceDestroy(w->static_space);
+    if (w->hfield) dGeomHeightfieldDataDestroy(w->hfield);
+    if (w->world) dWorldDestroy(w->world);
+    free(w->terrain);
+    free(w);
+    ode_release();
+}
+
+// ---- stepping ----
+
+static int body_finite(dBodyID b) {
+    const dReal* p = dBodyGetPosition(b);
+    const dReal* v = dBodyGetLinearVel(b);
+    const dReal* a = dBodyGetAngularVel(b);
+    for (int i = 0; i < 3; ++i)
+        if (!isfinite(p[i]) || !isfinite(v[i]) || !isfinite(a[i])) return 0;
+    return 1;
+}
+
+static int check_finite(ode_world* w) {
+    for (int f = 0; f < 3; ++f)
+        if (w->frame[f].body && !body_finite(w->frame[f].body)) {
+            static const char* const n[3] = {"column", "boom1", "boom2"};
+            snprintf(w->err, sizeof w->err, "ode world: body %s became non-finite at t = %.6f s", n[f], w->t);
+            return -1;
+        }
+    if (w->truck && !body_finite(w->truck)) {
+        snprintf(w->err, sizeof w->err, "ode world: body truck became non-finite at t = %.6f s", w->t);
+        return -1;
+    }
+    for (int i = 0; i < w->nrope; ++i)
+        if (!body_finite(w->rope[i])) {
+            snprintf(w->err, sizeof w->err, "ode world: body rope_%d became non-finite at t = %.6f s", i, w->t);
+            return -1;
+        }
+    if (w->hook && !body_finite(w->hook)) {
+        snprintf(w->err, sizeof w->err, "ode world: body hook became non-finite at t = %.6f s", w->t);
+        return -1;
+    }
+    for (int i = 0; i < w->nload; ++i)
+        if (!body_finite(w->load[i])) {
+            snprintf(w->err, sizeof w->err, "ode world: body %s became non-finite at t = %.6f s", w->desc.load[i].name,
+                     w->t);
+            return -1;
+        }
+    return 0;
+}
+
+int ode_world_step(ode_world* w, double dt) {
+    if (w->failed) return -1;
+    long n = (long)floor(dt / w->opt.dt_ode + 0.5);
+    if (n < 1) n = 1;
+    const double h = w->opt.dt_ode;
+    for (long i = 0; i < n; ++i) {
+        ow_read_actuators(w);
+        if (w->hm) {
+            if (ow_hyd_step(w, h)) {
+                w->failed = 1;
+                return -1;
+            }
+        }
+        ow_apply_forces(w);
+        if (w->kind == WORLD_SANDBOX) ow_collide(w);
+        dWorldStep(w->world, h);
+        if (w->kind == WORLD_SANDBOX) dJointGroupEmpty(w->contacts);
+        ++w->nstep;
+        // Time as a step count times h, so long runs do not accumulate
+        // round-off and repeated runs land on identical times.
+        w->t = (double)w->nstep * h;
+        if (check_finite(w)) {
+            w->failed = 1;
+            return -1;
+        }
+    }
+    return 0;
+}
+
+const char* ode_world_error(const ode_world* w) { return w->err; }
+double ode_world_time(const ode_world* w) { return w->t; }
+double ode_world_dt(const ode_world* w) { return w->opt.dt_ode; }
+world_kind ode_world_kind(const ode_world* w) { return w->kind; }
+long ode_world_hyd_steps(const ode_world* w) { return w->hyd_steps; }
+
+void ode_world_set_commands(ode_world* w, const double u_cmd[ODE_NACT]) {
+    for (int k = 0; k < ODE_NACT; ++k) {
+        double u = u_cmd[k];
+        w->u_cmd[k] = u > 1 ? 1 : u < -1 ? -1 : (u == u ? u : 0);
+    }
+}
+
+void ode_world_set_joint_torques(ode_world* w, const double tau[2]) {
+    w->tau_extra[0] = tau[0];
+    w->tau_extra[1] = tau[1];
+}
+
+void ode_world_set_joint_rates(ode_world* w, const double qd[2]) {
+    // Rigid-body velocities of the booms for joint rates qd about the fixed
+    // joint 1 (validation column at rest): omega along the hinge axis.
+    double axis_l[3] = {0, -1, 0}, R[9], ax[3];
+    ow_frame_rot(w, 0, R);
+    ow_mat_vec(R, axis_l, ax);
+    double j1[3], j2[3], zero[3] = {0, 0, 0}, l1[3] = {w->mech.link[0].length, 0, 0};
+    ow_frame_point(w, 1, zero, j1);
+    ow_frame_point(w, 1, l1, j2);
+    double om1 = qd[0], om2 = qd[0] + qd[1];
+    for (int i = 1; i <= 2; ++i) {
+        dBodyID b = w->frame[i].body;
+        const dReal* p = dBodyGetPosition(b);
+        double om = i == 1 ? om1 : om2;
+        // v = v_joint + omega x (p - joint); joint 2 moves with boom 1.
+        double r1[3] = {p[0] - j1[0], p[1] - j1[1], p[2] - j1[2]};
+        double v[3];
+        if (i == 1) {
+            v[0] = om * (ax[1] * r1[2] - ax[2] * r1[1]);
+            v[1] = om * (ax[2] * r1[0] - ax[0] * r1[2]);
+            v[2] = om * (ax[0] * r1[1] - ax[1] * r1[0]);
+        } else {
+            double rj[3] = {j2[0] - j1[0], j2[1] - j1[1], j2[2] - j1[2]};
+            double r2[3] = {p[0] - j2[0], p[1] - j2[1], p[2] - j2[2]};
+            double vj[3] = {om1 * (ax[1] * rj[2] - ax[2] * rj[1]), om1 * (ax[2] * rj[0] - ax[0] * rj[2]),
+                            om1 * (ax[0] * rj[1] - ax[1] * rj[0])};
+            v[0] = vj[0] + om * (ax[1] * r2[2] - ax[2] * r2[1]);
+            v[1] = vj[1] + om * (ax[2] * r2[0] - ax[0] * r2[2]);
+            v[2] = vj[2] + om * (ax[0] * r2[1] - ax[1] * r2[0]);
+        }
+        dBodySetLinearVel(b, v[0], v[1], v[2]);
+        dBodySetAngularVel(b, om * ax[0], om * ax[1], om * ax[2]);
+    }
+}
+
+static double body_energy(dBodyID b, double g) {
+    dMass m;
+    dBodyGetMass(b, &m);
+    const dReal* v = dBodyGetLinearVel(b);
+    const dReal* om = dBodyGetAngularVel(b);
+    const dReal* p = dBodyGetPosition(b);
+    double R[9], I[9], t[9], Iw[9], Rt[9];
+    from_dmatrix(dBodyGetRotation(b), R);
+    from_dmatrix(m.I, I);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) Rt[3 * i + j] = R[3 * j + i];
+    ow_mat_mul(R, I, t);
+    ow_mat_mul(t, Rt, Iw);
+    double o[3] = {om[0], om[1], om[2]}, Io[3];
+    ow_mat_vec(Iw, o, Io);
+    double ke = 0.5 * m.mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + 0.5 * (o[0] * Io[0] + o[1] * Io[1] + o[2] * Io[2]);
+    return ke + m.mass * g * p[2];
+}
+
+double ode_world_energy(const ode_world* w) {
+    double e = 0;
+    for (int f = 0; f < 3; ++f)
+        if (w->frame[f].body) e += body_energy(w->frame[f].body, w->g);
+    if (w->truck) e += body_energy(w->truck, w->g);
+    for (int i = 0; i < w->nrope; ++i) e += body_energy(w->rope[i], w->g);
+    if (w->hook) e += body_energy(w->hook, w->g);
+    for (int i = 0; i < w->nload; ++i) e += body_energy(w->load[i], w->g);
+    return e;
+}
+
+// ---- state ----
+
+static void tip_point(const ode_world* w, double p[3], double v[3]) {
+    double tip[3] = {w->mech.link[1].length, 0, 0};
+    ow_frame_point(w, 2, tip, p);
+    if (v) ow_frame_point_vel(w, 2, tip, v);
+}
+
+void ode_world_get_state(const ode_world* w, ode_world_state* s) {
+    memset(s, 0, sizeof *s);
+    s->t = w->t;
+    for (int k = 0; k < ODE_NACT; ++k) {
+        const ow_act* c = &w->act[k];
+        if (!c->present) continue;
+        s->x[k] = c->x;
+        s->v[k] = c->v;
+        s->F[k] = c->F;
+        s->u_cmd[k] = w->u_cmd[k];
+        if (w->hm && c->cyl >= 0) {
+            s->pA[k] = w->y[c->iA];
+            s->pB[k] = w->y[c->iB];
+            s->u[k] = c->iu >= 0 ? w->y[c->iu] : 0;
+            if (w->hd->cyl_stop[c->cyl]) s->end_stop |= 1 << k;
+        }
+        if (c->at_stop) s->end_stop |= 1 << k;
+    }
+    s->q[0] = dJointGetHingeAngle(w->j1) + w->qoff[0];
+    s->q[1] = dJointGetHingeAngle(w->j2) + w->qoff[1];
+    s->qd[0] = dJointGetHingeAngleRate(w->j1);
+    s->qd[1] = dJointGetHingeAngleRate(w->j2);
+    if (w->slew_joint) {
+        s->slew = dJointGetHingeAngle(w->slew_joint) + w->slew_off;
+        s->slew_rate = dJointGetHingeAngleRate(w->slew_joint);
+    }
+    // Tip relative to joint 1 in the column's boom plane.
+    double tp[3], j1[3], zero[3] = {0, 0, 0}, R[9];
+    tip_point(w, tp, NULL);
+    ow_frame_point(w, 0, zero, j1);
+    ow_frame_rot(w, 0, R);
+    double d[3] = {tp[0] - j1[0], tp[1] - j1[1], tp[2] - j1[2]};
+    s->tip[0] = R[0] * d[0] + R[3] * d[1] + R[6] * d[2];
+    s->tip[1] = R[2] * d[0] + R[5] * d[1] + R[8] * d[2];
+    memcpy(s->tip_world, tp, sizeof tp);
+    if (w->hook) ow_hook_point(w, s->hook, s->hook_vel);
+    else tip_point(w, s->hook, s->hook_vel);
+    if (w->hm) {
+        if (w->ipump >= 0) s->p_pump = w->y[w->ipump];
+        int nc = hyd_model_ncomp(w->hm);
+        for (int i = 0; i < nc; ++i)
+            if (hyd_model_comp_type(w->hm, i) == HYD_RELIEF && w->hd->comp_open[i]) ++s->relief_open;
+    }
+    s->truck_tilt = w->truck ? ow_truck_tilt(w) : 0.0;
+    s->ncontact = w->ncontact;
+    s->max_depth = w->max_depth;
+    s->max_depth_crane = w->max_depth_crane;
+    s->attached = w->attached;
+}
+
+int ode_world_nload(const ode_world* w) { return w->nload; }
+
+void ode_world_load_state(const ode_world* w, int i, double pos[3], double vel[3]) {
+    if (i < 0 || i >= w->nload) {
+        memset(pos, 0, 3 * sizeof *pos);
+        if (vel) memset(vel, 0, 3 * sizeof *vel);
+        return;
+    }
+    const dReal* p = dBodyGetPosition(w->load[i]);
+    const dReal* v = dBodyGetLinearVel(w->load[i]);
+    for (int k = 0; k < 3; ++k) {
+        pos[k] = p[k];
+        if (vel) vel[k] = v[k];
+    }
+}
+
+int ode_world_obstacle_pos(const ode_world* w, const char* name, double pos[3]) {
+    for (int i = 0; i < w->desc.nobstacle; ++i) {
+        if (strcmp(w->desc.obstacle[i].name, name)) continue;
+        if (w->obst_body[i]) {
+            const dReal* p = dBodyGetPosition(w->obst_body[i]);
+            pos[0] = p[0], pos[1] = p[1], pos[2] = p[2];
+        } else {
+            memcpy(pos, w->desc.obstacle[i].position, 3 * sizeof *pos);
+        }
+        return 0;
+    }
+    return -1;
+}
+
+int ode_world_hook(ode_world* w, int attach) { return w->kind == WORLD_SANDBOX ? ow_attach(w, attach) : -1; }
+
+void ode_world_hold_crane(ode_world* w, int hold) {
+    hold = hold != 0;
+    if (hold == w->held) return;
+    w->held = hold;
+    dBodyID b[4] = {w->truck, w->frame[0].body, w->frame[1].body, w->frame[2].body};
+    for (int i = 0; i < 4; ++i) {
+        if (!b[i]) continue;
+        if (hold) {
+            dBodySetKinematic(b[i]);
+            dBodySetLinearVel(b[i], 0, 0, 0);
+            dBodySetAngularVel(b[i], 0, 0, 0);
+        } else {
+            dBodySetDynamic(b[i]);
+        }
+    }
+    // Joints between two kinematic bodies carry nothing; switch them off so the
+    // solver does not see empty rows.
+    dJointID j[3] = {w->slew_joint, w->j1, w->j2};
+    for (int i = 0; i < 3; ++i) {
+        if (!j[i]) continue;
+        if (hold) dJointDisable(j[i]);
+        else dJointEnable(j[i]);
+    }
+}
+
+// ---- snapshot ----
+
+void ode_world_snapshot(const ode_world* w, world_snapshot* s) {
+    memset(s, 0, sizeof *s);
+    s->t = w->t;
+    int n = 0;
+    for (int i = 0; i < w->nvis && n < WORLD_SNAP_MAX_BODIES; ++i) {
+        const ow_vis* v = &w->vis[i];
+        world_snap_body* b = &s->body[n++];
+        snprintf(b->name, sizeof b->name, "%s", v->name);
+        b->role = v->role;
+        b->shape = v->shape;
+        memcpy(b->size, v->size, sizeof b->size);
+        memcpy(b->rgba, v->rgba, sizeof b->rgba);
+        if (v->body) {
+            double R[9], p[3];
+            from_dmatrix(dBodyGetRotation(v->body), R);
+            const dReal* bp = dBodyGetPosition(v->body);
+            ow_mat_vec(R, v->pos, p);
+            for (int k = 0; k < 3; ++k) b->pos[k] = bp[k] + p[k];
+            ow_mat_mul(R, v->rot, b->rot);
+        } else {
+            memcpy(b->pos, v->pos, sizeof b->pos);
+            memcpy(b->rot, v->rot, sizeof b->rot);
+        }
+        b->mesh_scale = 1.0;
+        b->mesh_up = 2;
+        if (v->mesh >= 0) {
+            const world_mesh* m = &w->desc.mesh[v->mesh];
+            snprintf(b->mesh, sizeof b->mesh, "%s", m->file);
+            b->mesh_scale = m->scale;
+            b->mesh_up = m->up;
+            memcpy(b->mesh_offset, m->offset, sizeof b->mesh_offset);
+        }
+    }
+    s->nbody = n;
+
+    // Boom cylinders.
+    for (int k = 0; k < 2; ++k) {
+        const ow_act* c = &w->act[k];
+        world_snap_cylinder* y = &s->cyl[s->ncyl++];
+        snprintf(y->name, sizeof y->name, "%s", w->mech.act[k].name);
+        ow_frame_point(w, c->parent, c->base, y->base);
+        ow_frame_point(w, c->child, c->rod, y->rod_end);
+        y->closed_length = c->closed_length;
+        y->stroke_max = c->stroke;
+        y->x = c->x;
+        y->v = c->v;
+        y->force = c->F;
+        y->u_cmd = w->u_cmd[k];
+        y->bore = k ? 0.08 : 0.1;
+        y->rod = k ? 0.045 : 0.06;
+        y->end_stop = (uint8_t)c->at_stop;
+        if (w->hm && c->cyl >= 0) {
+            double AA = c->AA, AB = c->AB;
+            y->bore = sqrt(4.0 * AA / M_PI);
+            y->rod = sqrt(4.0 * (AA - AB) / M_PI);
+            y->pA = w->y[c->iA];
+            y->pB = w->y[c->iB];
+            y->u = c->iu >= 0 ? w->y[c->iu] : 0;
+            y->end_stop |= (uint8_t)(w->hd->cyl_stop[c->cyl] != 0);
+        }
+    }
+    double tp[3];
+    tip_point(w, tp, NULL);
+    memcpy(s->tip, tp, sizeof tp);
+    memcpy(s->hook, tp, sizeof tp);
+    s->load_mass = w->kind == WORLD_VALIDATION ? w->m3 : 0;
+    if (w->hm) {
+        if (w->ipump >= 0) s->p_supply = w->y[w->ipump];
+        int nc = hyd_model_ncomp(w->hm);
+        for (int i = 0; i < nc; ++i)
+            // The public circuit API does not say which port a relief guards,
+            // so any open relief raises the one flag; per-cylinder flags stay 0.
+            if (hyd_model_comp_type(w->hm, i) == HYD_RELIEF && w->hd->comp_open[i]) s->main_relief_open = 1;
+    }
+    if (w->kind == WORLD_SANDBOX) ow_sandbox_snapshot(w, s);
+}

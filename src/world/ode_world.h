@@ -1,0 +1,149 @@
+// ode_world.h: the Open Dynamics Engine backend of the crane world.
+//
+// Two worlds (world_desc.h): "validation" (column fixed to the ground, the
+// load merged rigidly into the end arm at its tip, no contacts: the same
+// system as lagrange "full") and "sandbox" (truck on outriggers on a terrain
+// heightfield, slewing column, rope and hook, loads to pick up, obstacles).
+// The hydraulic circuit (hydraulics.h) drives the cylinders; ode_coupling.c
+// sub-steps it inside each ODE step (docs/ode_world.md, "Coupling").
+//
+// Model/data split: the crane_mech, the world_desc and the circuit are read
+// at create time and copied/compiled; the ode_world then holds only state.
+// Nothing allocates inside ode_world_step (ODE's own step arena is reserved
+// at create time and reused; see docs/ode_world.md).
+//
+// Angle conventions are the paper's (crane_model.h): q1 from the downward
+// vertical, q2 relative to the lifting arm, counter-clockwise positive seen
+// with the boom plane's x to the right and z up. The slew angle is about the
+// truck's z axis, 0 = boom plane along the truck's +x.
+#ifndef ODE_WORLD_H
+#define ODE_WORLD_H
+
+#include <cjson/cJSON.h>
+#include <stddef.h>
+
+#include "crane_model.h"
+#include "hyd_solver.h"
+#include "world_desc.h"
+#include "world_snapshot.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ode_world ode_world;
+
+/// Actuator indices in ode_world_state arrays and in commands.
+enum { ODE_LIFT = 0, ODE_JIB = 1, ODE_SLEW = 2, ODE_NACT = 3 };
+
+/// Options of an ODE world run. Get defaults from ode_world_default_opts().
+typedef struct ode_world_opts {
+    double dt_ode;        ///< ODE step [s]; default 1e-3
+    double dt_hyd;        ///< hydraulic sub-step [s]; default 1e-4; dt_ode must be a whole multiple
+    hyd_method solver;    ///< hydraulic integrator (fixed-step use); default HYD_KRUS
+    int jac_every;        ///< reuse the hydraulic Jacobian for this many sub-steps; default 10
+    double q0[2];         ///< initial joint angles q1, q2 [rad], paper convention; default 95, -130 deg
+    double slew0;         ///< initial slew angle [rad]; default 0
+    double load_mass;     ///< validation world: tip mass [kg]; < 0 (default) uses mech->load_mass
+    int hydraulics;       ///< 1 (default): cylinders driven by the circuit; 0: no hydraulic forces
+    int stop_limits;      ///< 1 (default): cylinder end stops as ODE hinge limits; 0: none
+    int init_hold;        ///< 1 (default): initial chamber pressures hold the crane still
+    double p_low;         ///< init_hold: pressure of the unloaded chamber side [Pa abs]; default 2e6
+    int force_average;    ///< 1 (default): apply the mean sub-step force; 0: the last one
+    const char* model_file; ///< name used in circuit error messages; default "model"
+} ode_world_opts;
+
+ode_world_opts ode_world_default_opts(void);
+
+/// Everything the CSV and the tests read, in SI units. Actuator arrays are
+/// indexed ODE_LIFT, ODE_JIB, ODE_SLEW (slew entries are 0 in validation).
+typedef struct ode_world_state {
+    double t;                 ///< simulated time [s]
+    double x[ODE_NACT];       ///< cylinder strokes [m] (pin length - closed length; slew: rack travel)
+    double v[ODE_NACT];       ///< stroke rates [m/s]
+    double pA[ODE_NACT];      ///< chamber A pressures [Pa abs]
+    double pB[ODE_NACT];      ///< chamber B pressures [Pa abs]
+    double u[ODE_NACT];       ///< spool openings [-]
+    double u_cmd[ODE_NACT];   ///< spool commands [-]
+    double F[ODE_NACT];       ///< cylinder forces as applied to the bodies [N], + extends
+    double q[2];              ///< joint angles [rad], paper convention
+    double qd[2];             ///< joint rates [rad/s]
+    double slew;              ///< slew angle [rad]
+    double slew_rate;         ///< [rad/s]
+    double tip[2];            ///< end-arm tip relative to joint 1 in the boom plane: reach x, height z [m]
+    double tip_world[3];      ///< end-arm tip in the world [m]
+    double hook[3];           ///< hook attach point (bottom of the hook block) [m]; tip in validation
+    double hook_vel[3];       ///< its velocity [m/s]
+    double p_pump;            ///< pump-line pressure [Pa abs] (0 if the circuit has none)
+    double truck_tilt;        ///< angle of the truck's z axis from vertical [rad]
+    double max_depth_crane;   ///< deepest contact of a crane part (column, booms) in the last step [m]
+    double max_depth;         ///< deepest contact of any pair in the last step [m]
+    int ncontact;             ///< contact points in the last step
+    int attached;             ///< index of the load on the hook, or -1
+    int end_stop;             ///< bit k: cylinder k at an end stop (hinge limit active or hydraulic stop)
+    int relief_open;          ///< number of relief valves passing flow
+} ode_world_state;
+
+/// Build a world. mech: crane mechanics (copied). hydraulics: the model's
+/// "hydraulics" JSON section (read, not kept); may be NULL when
+/// o->hydraulics == 0. The world's circuit extras are appended to it before
+/// compiling. Returns NULL with one line "file: field: problem" in err.
+ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, const world_desc* w,
+                            const ode_world_opts* o, char* err, size_t errsz);
+void ode_world_destroy(ode_world* w);
+
+/// Valve commands lift, jib, slew in [-1, 1] (clamped), held until changed.
+void ode_world_set_commands(ode_world* w, const double u_cmd[ODE_NACT]);
+/// 1: attach the nearest load whose top centre is within hook.reach of the
+/// hook's attach point (no-op if none or already attached); 0: release.
+/// Returns the load index attached, or -1.
+int ode_world_hook(ode_world* w, int attach);
+
+/// Advance by dt [s] (rounded to a whole number of ODE steps, at least one).
+/// Returns 0, or -1 when a body or hydraulic state became non-finite; then
+/// ode_world_error() names it and the time, and the world stays stopped.
+int ode_world_step(ode_world* w, double dt);
+const char* ode_world_error(const ode_world* w);
+
+/// Fill the renderer's picture completely (all bodies, cylinders, rope, terrain, flags).
+void ode_world_snapshot(const ode_world* w, world_snapshot* s);
+/// Current state for CSV and tests.
+void ode_world_get_state(const ode_world* w, ode_world_state* s);
+
+/// Simulated time [s].
+double ode_world_time(const ode_world* w);
+/// ODE step actually used [s].
+double ode_world_dt(const ode_world* w);
+world_kind ode_world_kind(const ode_world* w);
+
+/// Loads (sandbox): count, and centre position [m] and velocity [m/s] of load i.
+int ode_world_nload(const ode_world* w);
+void ode_world_load_state(const ode_world* w, int i, double pos[3], double vel[3]);
+/// Body centre [m] of the obstacle named name; returns 0, or -1 if not found.
+int ode_world_obstacle_pos(const ode_world* w, const char* name, double pos[3]);
+
+// ---- Test and study hooks (not needed for ordinary runs) ----
+
+/// Extra joint torques [N m] added every step at joints 1, 2 (in the q
+/// directions), e.g. the analytic holding torque G(q) with hydraulics off.
+void ode_world_set_joint_torques(ode_world* w, const double tau[2]);
+/// 1: freeze the truck, column and booms (kinematic, at rest) so only rope,
+/// hook and loads move; 0: release them.
+void ode_world_hold_crane(ode_world* w, int hold);
+/// Mechanical energy of all dynamic bodies [J]: kinetic (translation and
+/// rotation) plus gravitational potential relative to z = 0.
+double ode_world_energy(const ode_world* w);
+/// Set the joint rates q1', q2' [rad/s] (rigidly moving the distal bodies), for tests.
+void ode_world_set_joint_rates(ode_world* w, const double qd[2]);
+/// Rope model for analytic checks: number of rope links, link length [m] and
+/// mass [kg], hook mass [kg], hook pin-to-COM distance [m] and hook inertia
+/// about its COM about the body y axis [kg m^2].
+void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, double* link_mass,
+                         double* hook_mass, double* hook_com, double* hook_inertia);
+/// Per-step hydraulic sub-steps taken since create (for benchmarks).
+long ode_world_hyd_steps(const ode_world* w);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,174 @@
+// ode_world_internal.h: module-private layout of ode_world, shared by
+// ode_world.c (crane), ode_sandbox.c (truck, terrain, rope, loads, contacts)
+// and ode_coupling.c (hydraulics). Include only from those files.
+#ifndef ODE_WORLD_INTERNAL_H
+#define ODE_WORLD_INTERNAL_H
+
+#include <ode/ode.h>
+#include <stdint.h>
+
+#include "hydraulics.h"
+#include "hyd_solver.h"
+#include "ode_world.h"
+
+#define OW_MAX_GEOMS 256
+#define OW_MAX_VIS WORLD_SNAP_MAX_BODIES
+#define OW_MAX_CONTACT_JOINTS 4096
+#define OW_MAX_HYD 96
+
+/// Collision categories (bits); which pairs collide is a table in ode_sandbox.c.
+enum {
+    OW_CAT_TERRAIN = 1, OW_CAT_TRUCK = 2, OW_CAT_CRANE = 4, OW_CAT_ROPE = 8,
+    OW_CAT_HOOK = 16, OW_CAT_LOAD = 32, OW_CAT_OBST = 64
+};
+
+/// Per-geom data, pointed to by dGeomGetData.
+typedef struct ow_geom {
+    dGeomID g;
+    uint32_t cat;     ///< OW_CAT_*
+    double friction;  ///< Coulomb coefficient [-]; a pair uses the geometric mean
+} ow_geom;
+
+/// One entry of the snapshot: a primitive placed in a body's frame (or in the
+/// world when body is 0, e.g. static obstacles).
+typedef struct ow_vis {
+    char name[WORLD_SNAP_NAME];
+    world_role role;
+    world_shape shape;
+    double size[3];     ///< see world_shape [m]
+    float rgba[4];
+    int mesh;           ///< WORLD_MESH_* slot, or -1
+    dBodyID body;       ///< 0: pose is in the world
+    double pos[3];      ///< primitive centre in the body frame (or world) [m]
+    double rot[9];      ///< primitive-to-body rotation, row-major
+} ow_vis;
+
+/// A crane frame (column, lifting arm, end arm) carried by an ODE body: the
+/// body's axes are the frame's axes; org is the frame origin (the joint) in
+/// body coordinates, because ODE bodies have their origin at the COM.
+typedef struct ow_frame {
+    dBodyID body;       ///< 0: fixed to the world (validation column)
+    double org[3];      ///< frame origin in body coordinates [m]
+    double wpos[3];     ///< body == 0: frame origin in the world [m]
+    double wrot[9];     ///< body == 0: frame-to-world rotation, row-major
+} ow_frame;
+
+/// One hydraulic actuator as the mechanics sees it.
+typedef struct ow_act {
+    int present;
+    int cyl;            ///< hydraulic cylinder index, -1 if none
+    int valve;          ///< hydraulic valve index, -1 if none
+    int iA, iB, iu;     ///< state indices of pA, pB, spool
+    double AA, AB, stroke; ///< piston area, annulus area [m^2], stroke [m]
+    // Boom cylinders: mount points in the parent and child crane frames.
+    int parent, child;  ///< frame indices (0 column, 1 lifting arm, 2 end arm)
+    double base[3], rod[3]; ///< in frame coordinates [m]
+    double closed_length; ///< [m]
+    // Latest kinematics and force.
+    double x, v;        ///< stroke [m], rate [m/s] at the start of the step
+    double F;           ///< force applied over the step [N]
+    int at_stop;        ///< hinge limit or hydraulic stop active
+} ow_act;
+
+struct ode_world {
+    world_kind kind;
+    crane_mech mech;
+    world_desc desc;     ///< copy (circuit fragment not kept: circuit = NULL)
+    ode_world_opts opt;
+    double g;            ///< gravity [m/s^2]
+    double m3;           ///< validation: tip mass [kg]
+    double t;            ///< [s]
+    long nstep;          ///< ODE steps taken
+    int failed;
+    char err[256];
+
+    dWorldID world;
+    dSpaceID dyn_space;    ///< moving geoms
+    dSpaceID static_space; ///< terrain and fixed obstacles
+    dJointGroupID contacts;
+    dHeightfieldDataID hfield;
+
+    // Crane: frames 0 column, 1 lifting arm, 2 end arm.
+    ow_frame frame[3];
+    dJointID slew_joint, j1, j2, column_fix;
+    double qoff[2];      ///< q = hinge angle + qoff [rad]
+    double slew_off;     ///< slew = hinge angle + slew_off [rad]
+    double tau_extra[2]; ///< test torques [N m]
+    ow_act act[ODE_NACT];
+
+    // Sandbox bodies.
+    dBodyID truck;
+    double truck_org[3]; ///< truck frame origin (ground under chassis centre) in body coordinates [m]
+    int nrope;
+    dBodyID rope[WORLD_DESC_MAX_ROPE];
+    double rope_len;     ///< one link [m]
+    double rope_mass;    ///< one link [kg]
+    dBodyID hook;
+    dJointID hook_joint; ///< pre-created ball joint for attaching a load
+    int attached;        ///< load index or -1
+    int nload;
+    dBodyID load[WORLD_DESC_MAX_LOADS];
+    dBodyID obst_body[WORLD_DESC_MAX_OBSTACLES]; ///< 0 for static obstacles
+    int held;            ///< crane frozen (kinematic)
+
+    // Geoms and snapshot entries.
+    int ngeom;
+    ow_geom geom[OW_MAX_GEOMS];
+    int nvis;
+    ow_vis vis[OW_MAX_VIS];
+    float* terrain;      ///< nx*ny heights, world row order (snapshot)
+    int tnx, tny;
+    double tdx, tdy;
+
+    // Contacts of the last step.
+    dContactGeom cbuf[32];
+    int ncontact;
+    double max_depth, max_depth_crane;
+    int crane_contact;
+
+    // Hydraulics (ode_coupling.c).
+    hyd_model* hm;       ///< compiled circuit (owned), NULL without hydraulics
+    hyd_data* hd;
+    hyd_solver* hs;
+    hyd_problem hp;
+    int nh;
+    double y[OW_MAX_HYD];
+    double th;           ///< hydraulic time [s]
+    int nsub;            ///< sub-steps per ODE step
+    double u_cmd[ODE_NACT];
+    double step_t0;      ///< start of the current ODE step [s] (for extrapolation)
+    double x0[ODE_NACT], v0[ODE_NACT]; ///< strokes and rates at the step start
+    int ipump;           ///< state index of the pump-line pressure, or -1
+    long hyd_steps;
+};
+
+// ode_world.c
+void ow_frame_point(const ode_world* w, int f, const double p[3], double out[3]);
+void ow_frame_point_vel(const ode_world* w, int f, const double p[3], double out[3]);
+void ow_frame_rot(const ode_world* w, int f, double R[9]);
+ow_geom* ow_add_geom(ode_world* w, dGeomID g, uint32_t cat, double friction);
+ow_vis* ow_add_vis(ode_world* w, const char* name, world_role role, world_shape shape, const double size[3],
+                   const float rgba[4], int mesh, dBodyID body, const double pos[3], const double* rot);
+void ow_rot_z(double yaw, double R[9]);
+void ow_mat_mul(const double A[9], const double B[9], double C[9]);
+void ow_mat_vec(const double A[9], const double v[3], double out[3]);
+int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9], dBodyID base,
+                   char* err, size_t errsz);
+void ow_read_actuators(ode_world* w);
+void ow_apply_forces(ode_world* w);
+
+// ode_sandbox.c
+int ow_build_sandbox(ode_world* w, char* err, size_t errsz);
+void ow_collide(ode_world* w);
+void ow_sandbox_snapshot(const ode_world* w, world_snapshot* s);
+double ow_truck_tilt(const ode_world* w);
+void ow_hook_point(const ode_world* w, double p[3], double v[3]);
+int ow_attach(ode_world* w, int attach);
+
+// ode_coupling.c
+int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz);
+void ow_hyd_destroy(ode_world* w);
+void ow_hyd_init_state(ode_world* w);
+int ow_hyd_step(ode_world* w, double dt);
+
+#endif

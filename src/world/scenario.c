@@ -1,0 +1,145 @@
+// scenario.c: scenario loading and command interpolation.
+#include "scenario.h"
+
+#include "json_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+const char* const scenario_cmd_name[SCENARIO_NCMD] = {"lift", "jib", "slew"};
+
+static void load_signal(json_ctx* c, const cJSON* arr, const char* path, scenario_signal* sig) {
+    sig->n = 0;
+    if (!arr) return;
+    int n = cJSON_GetArraySize(arr);
+    if (n > SCENARIO_MAX_POINTS) {
+        json_fail(c, path, "at most %d points, got %d", SCENARIO_MAX_POINTS, n);
+        return;
+    }
+    for (int i = 0; i < n && !c->failed; ++i) {
+        const cJSON* pt = cJSON_GetArrayItem(arr, i);
+        char p[160];
+        json_path_index(p, sizeof p, path, i);
+        if (!cJSON_IsArray(pt) || cJSON_GetArraySize(pt) != 2 ||
+            !cJSON_IsNumber(cJSON_GetArrayItem(pt, 0)) || !cJSON_IsNumber(cJSON_GetArrayItem(pt, 1))) {
+            json_fail(c, p, "must be a [t, u] pair of numbers");
+            return;
+        }
+        double t = cJSON_GetArrayItem(pt, 0)->valuedouble, u = cJSON_GetArrayItem(pt, 1)->valuedouble;
+        if (!isfinite(t) || t < 0) json_fail(c, p, "time must be >= 0, got %g", t);
+        else if (i > 0 && t < sig->t[i - 1]) json_fail(c, p, "times must not decrease (%g after %g)", t, sig->t[i - 1]);
+        else if (!isfinite(u) || u < -1 || u > 1) json_fail(c, p, "command must be in [-1, 1], got %g", u);
+        sig->t[i] = t;
+        sig->u[i] = u;
+        sig->n = i + 1;
+    }
+}
+
+int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* err, size_t errsz) {
+    memset(s, 0, sizeof *s);
+    json_ctx c = {.file = file, .err = err, .errsz = errsz};
+    if (!cJSON_IsObject(root)) {
+        json_fail(&c, "", "a scenario must be a JSON object");
+        return -1;
+    }
+    static const char* const keys[] = {"name", "description", "model", "duration", "load_mass",
+                                       "initial", "commands", "hook", NULL};
+    json_only_keys(&c, root, "", keys);
+    json_str(&c, root, "", "name", false, "", s->name, sizeof s->name);
+    json_str(&c, root, "", "description", false, "", s->description, sizeof s->description);
+    json_str(&c, root, "", "model", false, "", s->model, sizeof s->model);
+    s->duration = json_pos(&c, root, "", "duration", true, 0);
+    s->load_mass = json_num(&c, root, "", "load_mass", false, -1.0, 0.0, 1e5);
+
+    const cJSON* ini = json_obj(&c, root, "", "initial", true);
+    static const char* const ikeys[] = {"q1_deg", "q2_deg", "slew_deg", NULL};
+    json_only_keys(&c, ini, "initial", ikeys);
+    s->q0[0] = json_num(&c, ini, "initial", "q1_deg", true, 0, 0, 360) * M_PI / 180.0;
+    s->q0[1] = json_num(&c, ini, "initial", "q2_deg", true, 0, -360, 360) * M_PI / 180.0;
+    s->slew0 = json_num(&c, ini, "initial", "slew_deg", false, 0, -360, 360) * M_PI / 180.0;
+
+    const cJSON* cmds = json_obj(&c, root, "", "commands", true);
+    json_only_keys(&c, cmds, "commands", (const char* const[]){"lift", "jib", "slew", NULL});
+    for (int k = 0; k < SCENARIO_NCMD; ++k) {
+        char p[64];
+        json_path(p, sizeof p, "commands", scenario_cmd_name[k]);
+        load_signal(&c, json_arr(&c, cmds, "commands", scenario_cmd_name[k], false), p, &s->cmd[k]);
+    }
+
+    const cJSON* hook = json_arr(&c, root, "", "hook", false);
+    if (hook && !c.failed) {
+        int n = cJSON_GetArraySize(hook);
+        if (n > SCENARIO_MAX_EVENTS) json_fail(&c, "hook", "at most %d events", SCENARIO_MAX_EVENTS);
+        for (int i = 0; i < n && !c.failed; ++i) {
+            const cJSON* e = cJSON_GetArrayItem(hook, i);
+            char p[64];
+            json_path_index(p, sizeof p, "hook", i);
+            const cJSON* t = cJSON_GetArrayItem(e, 0);
+            const cJSON* k = cJSON_GetArrayItem(e, 1);
+            if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != 2 || !cJSON_IsNumber(t) || !cJSON_IsString(k)) {
+                json_fail(&c, p, "must be a [t, \"attach\" | \"release\"] pair");
+                break;
+            }
+            if (strcmp(k->valuestring, "attach") && strcmp(k->valuestring, "release")) {
+                json_fail(&c, p, "event must be \"attach\" or \"release\", got \"%s\"", k->valuestring);
+                break;
+            }
+            if (t->valuedouble < 0 || (i > 0 && t->valuedouble < s->event[i - 1].t)) {
+                json_fail(&c, p, "event times must be >= 0 and not decrease");
+                break;
+            }
+            s->event[i].t = t->valuedouble;
+            s->event[i].kind = strcmp(k->valuestring, "attach") ? SCENARIO_RELEASE : SCENARIO_ATTACH;
+            s->nevent = i + 1;
+        }
+    }
+    return c.failed ? -1 : 0;
+}
+
+int scenario_load(const char* path, scenario* s, char* err, size_t errsz) {
+    cJSON* root = json_load_file(path, err, errsz);
+    if (!root) return -1;
+    const char* base = strrchr(path, '/');
+    int rc = scenario_from_json(root, base ? base + 1 : path, s, err, errsz);
+    cJSON_Delete(root);
+    return rc;
+}
+
+double scenario_command(const scenario* s, int k, double t) {
+    const scenario_signal* g = &s->cmd[k];
+    if (g->n == 0) return 0.0;
+    if (t <= g->t[0]) return g->u[0];
+    if (t >= g->t[g->n - 1]) return g->u[g->n - 1];
+    // Tables are short (< 64 points): a linear scan is cheaper than bisection
+    // bookkeeping. The last segment containing t wins, so a step (two points at
+    // the same time) takes its new value exactly at the step time.
+    int i = 0;
+    while (i + 1 < g->n && g->t[i + 1] <= t) ++i;
+    if (i + 1 >= g->n) return g->u[g->n - 1];
+    double dt = g->t[i + 1] - g->t[i];
+    double w = dt > 0 ? (t - g->t[i]) / dt : 1.0;
+    return g->u[i] + w * (g->u[i + 1] - g->u[i]);
+}
+
+static int cmp_double(const void* a, const void* b) {
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+int scenario_breakpoints(const scenario* s, double* t, int cap) {
+    int n = 0;
+    for (int k = 0; k < SCENARIO_NCMD; ++k)
+        for (int i = 0; i < s->cmd[k].n && n < cap; ++i) t[n++] = s->cmd[k].t[i];
+    for (int i = 0; i < s->nevent && n < cap; ++i) t[n++] = s->event[i].t;
+    qsort(t, (size_t)n, sizeof *t, cmp_double);
+    int m = 0;
+    for (int i = 0; i < n; ++i)
+        if (m == 0 || t[i] > t[m - 1]) t[m++] = t[i];
+    return m;
+}

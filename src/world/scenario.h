@@ -1,0 +1,63 @@
+// scenario.h: scripted runs. Valve commands as piecewise-linear (t, u)
+// tables, hook events, initial joint angles and the load.
+#ifndef SCENARIO_H
+#define SCENARIO_H
+
+#include <cjson/cJSON.h>
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SCENARIO_MAX_POINTS 64
+#define SCENARIO_MAX_EVENTS 32
+#define SCENARIO_NCMD 3 ///< lift, jib, slew
+
+/// A piecewise-linear signal u(t), held constant before the first and after
+/// the last point. A step is two points with the same t.
+typedef struct scenario_signal {
+    int n;
+    double t[SCENARIO_MAX_POINTS]; ///< [s], non-decreasing
+    double u[SCENARIO_MAX_POINTS]; ///< valve opening command, -1..1
+} scenario_signal;
+
+typedef enum scenario_event_kind { SCENARIO_ATTACH = 1, SCENARIO_RELEASE = 2 } scenario_event_kind;
+
+typedef struct scenario_event {
+    double t;                  ///< [s]
+    scenario_event_kind kind;
+} scenario_event;
+
+typedef struct scenario {
+    char name[64];
+    char description[256];
+    char model[256];           ///< model file it was written for ("" = default)
+    double duration;           ///< [s]
+    double load_mass;          ///< [kg]; < 0 means "use the model's"
+    double q0[2];              ///< initial joint angles, paper convention [rad]
+    double slew0;              ///< initial slew angle [rad]
+    scenario_signal cmd[SCENARIO_NCMD]; ///< lift, jib, slew
+    int nevent;
+    scenario_event event[SCENARIO_MAX_EVENTS];
+} scenario;
+
+/// Names of the command channels: "lift", "jib", "slew".
+extern const char* const scenario_cmd_name[SCENARIO_NCMD];
+
+/// Load from a file. Returns 0, or -1 with "file: field: problem" in err.
+int scenario_load(const char* path, scenario* s, char* err, size_t errsz);
+/// Load from a parsed document; file is used in messages.
+int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* err, size_t errsz);
+
+/// Command of channel k at time t [s] (piecewise-linear, clamped to [-1, 1]).
+double scenario_command(const scenario* s, int k, double t);
+
+/// Times [s] at which any command has a kink or step (for solver resets), in
+/// increasing order without duplicates. Returns the count (<= cap).
+int scenario_breakpoints(const scenario* s, double* t, int cap);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

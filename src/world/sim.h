@@ -1,0 +1,80 @@
+// sim.h: one headless run of a model on a scenario, whatever the backend.
+// This is what `cranesim run`, `compare` and `bench` drive, and what tests use.
+#ifndef SIM_H
+#define SIM_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "hyd_solver.h"
+#include "lagrange_sim.h"
+#include "model.h"
+#include "scenario.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum sim_mechanics { SIM_LAGRANGE = 0, SIM_ODE } sim_mechanics;
+
+typedef struct sim_opts {
+    sim_mechanics mechanics;
+    lagrange_variant variant;
+    hyd_method solver;
+    double h;          ///< fixed step [s] (default 1e-4)
+    double rtol, atol; ///< adaptive tolerances [-], [state units]
+    double dt_out;     ///< output period [s] (default 1e-3)
+    double duration;   ///< [s]; 0 = the scenario's
+    bool dense_jac;    ///< fixed-step methods: dense J instead of the block pattern
+    int jac_every;     ///< fixed-step methods: J every N steps (default 10)
+} sim_opts;
+
+sim_opts sim_default_opts(void);
+
+/// CSV columns, in order. The first 17 are the SPEC section 5 contract.
+enum {
+    COL_T, COL_X1, COL_X2, COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_U1, COL_U2, COL_Q1, COL_Q2,
+    COL_TIP_X, COL_TIP_Z, COL_F1, COL_F2, COL_U1_CMD, COL_U2_CMD,
+    COL_V1, COL_V2, COL_P_PUMP, COL_RELIEF_OPEN, COL_END_STOP,
+    SIM_NCOL
+};
+extern const char* const sim_col_name[SIM_NCOL];
+extern const char* const sim_col_unit[SIM_NCOL];
+
+/// A recorded run held in memory (for plots and comparisons).
+typedef struct sim_trace {
+    int nrow, cap;
+    double* v; ///< nrow x SIM_NCOL, row-major
+} sim_trace;
+void sim_trace_free(sim_trace* tr);
+
+/// Called for every output row; return non-zero to stop the run.
+typedef int (*sim_row_fn)(void* user, const double* row);
+
+typedef struct sim_result {
+    int status;          ///< 0 ok, 1 numerical failure, 2 stopped by callback
+    char message[320];   ///< failure description: state name, time
+    double t_end;        ///< simulated time reached [s]
+    double wall;         ///< wall time of the integration [s]
+    hyd_solver_stats stats;
+    long rows;
+} sim_result;
+
+/// Run the scenario. Rows go to row_fn (may be NULL) and to trace (may be
+/// NULL). progress (may be NULL) is called about every 0.1 s of wall time.
+typedef void (*sim_progress_fn)(void* user, double t, double t_end);
+int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
+            sim_trace* trace, sim_progress_fn progress, void* progress_user, sim_result* res);
+
+/// Write the CSV header line (column names) to f.
+void sim_csv_header(FILE* f);
+/// Write one row; full precision, C locale.
+void sim_csv_row(FILE* f, const double* row);
+
+/// Wall clock [s], monotonic.
+double sim_wall_time(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

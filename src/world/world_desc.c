@@ -1,0 +1,466 @@
+// world_desc.c: world file loading (schema in docs/ode_world.md).
+#include "world_desc.h"
+
+#include "json_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180.0)
+
+const char* const world_mesh_key[WORLD_MESH_COUNT] = {
+    "truck", "wheel", "outrigger", "column", "boom1", "boom2", "hook", "load", "wall", "box", "building"};
+
+static const char* const default_mesh_file[WORLD_MESH_COUNT] = {
+    "truck.obj", "", "", "column.obj", "boom1.obj", "boom2.obj", "hook.obj", "load_block.obj", "wall.obj",
+    "", ""};
+
+int world_kind_parse(const char* s) {
+    if (!strcmp(s, "validation")) return WORLD_VALIDATION;
+    if (!strcmp(s, "sandbox")) return WORLD_SANDBOX;
+    return -1;
+}
+
+const char* world_kind_name(world_kind k) { return k == WORLD_SANDBOX ? "sandbox" : "validation"; }
+
+static void set3(double* v, double a, double b, double c) {
+    v[0] = a;
+    v[1] = b;
+    v[2] = c;
+}
+
+void world_desc_default(world_desc* w, world_kind kind) {
+    memset(w, 0, sizeof *w);
+    snprintf(w->name, sizeof w->name, "%s", world_kind_name(kind));
+    w->kind = kind;
+    w->gravity = 0; // the model's
+    // dWorldStep solves the constraints directly, so a tiny CFM only keeps the
+    // LCP matrix regular; ERP 0.2 removes drift over about 5 steps without
+    // adding noticeable energy (docs/ode_world.md, "ERP and CFM").
+    w->ode.erp = 0.2;
+    w->ode.cfm = 1e-10;
+    w->ode.contact_erp = 0.2;
+    w->ode.contact_cfm = 1e-8;
+    w->ode.surface_layer = 0.5e-3;
+    w->ode.max_contacts = 8;
+
+    world_terrain* t = &w->terrain;
+    t->size[0] = t->size[1] = 120.0;
+    t->samples[0] = t->samples[1] = 121;
+    t->flat_radius = 18.0;
+    t->friction = 0.9;
+
+    // A 6.5 t two-axle truck with a small knuckle-boom crane behind the cab.
+    world_truck* k = &w->truck;
+    k->mass = 6500.0;
+    set3(k->chassis, 6.4, 2.3, 0.5);
+    k->bed_height = 1.1;
+    set3(k->cab, 1.7, 2.3, 1.6);
+    k->cab_x = 2.3;
+    k->wheel_radius = 0.45;
+    k->wheel_width = 0.3;
+    k->wheel_x[0] = 2.1;
+    k->wheel_x[1] = -1.6;
+    k->track = 1.9;
+    k->outriggers = 1;
+    k->outrigger_x[0] = 1.0;
+    k->outrigger_x[1] = -2.9;
+    k->outrigger_span = 4.0;
+    set3(k->pad, 0.4, 0.4, 0.08);
+    k->column_x = 0.9;
+    k->friction = 0.8;
+
+    w->slew.pinion_radius = 0.1;
+    snprintf(w->slew.cylinder, sizeof w->slew.cylinder, "slew_cyl");
+    snprintf(w->slew.valve, sizeof w->slew.valve, "slew_valve");
+    w->slew.column_radius = 0.16;
+    w->slew.damping = 2000.0;
+
+    w->rope.length = 2.0;
+    w->rope.links = 6;
+    w->rope.radius = 0.012;
+    w->rope.mass_per_m = 0.6;
+
+    w->hook.mass = 40.0;
+    set3(w->hook.size, 0.2, 0.12, 0.3);
+    w->hook.reach = 0.5;
+
+    for (int i = 0; i < WORLD_MESH_COUNT; ++i) {
+        snprintf(w->mesh[i].file, sizeof w->mesh[i].file, "%s", default_mesh_file[i]);
+        w->mesh[i].scale = 1.0;
+        w->mesh[i].up = 2;
+    }
+}
+
+void world_desc_free(world_desc* w) {
+    if (!w) return;
+    cJSON_Delete(w->circuit);
+    w->circuit = NULL;
+}
+
+double world_desc_terrain_height(const world_desc* w, double x, double y) {
+    const world_terrain* t = &w->terrain;
+    double h = 0;
+    for (int i = 0; i < t->nhill; ++i) {
+        const world_hill* g = &t->hill[i];
+        double dx = x - g->x, dy = y - g->y;
+        h += g->height * exp(-(dx * dx + dy * dy) / (2.0 * g->radius * g->radius));
+    }
+    // Fade the hills out over 6 m towards the work area, with a smoothstep so the
+    // ground has no kink where it meets the flat (the heightfield is piecewise
+    // linear anyway; this keeps its facets gentle).
+    double r = hypot(x, y), s = (r - t->flat_radius) / 6.0;
+    if (s <= 0) return 0.0;
+    if (s < 1) h *= s * s * (3.0 - 2.0 * s);
+    return h;
+}
+
+// Position [x, y] or [x, y, z]; a missing or negative z means "rest on the
+// ground" and is resolved after the terrain is known (z = -1 marks it).
+static void read_position(json_ctx* c, const cJSON* o, const char* path, double* p) {
+    char full[256];
+    json_path(full, sizeof full, path, "position");
+    const cJSON* a = json_arr(c, o, path, "position", true);
+    if (c->failed) return;
+    int n = cJSON_GetArraySize(a);
+    if (n != 2 && n != 3) {
+        json_fail(c, full, "must be [x, y] or [x, y, z], got %d numbers", n);
+        return;
+    }
+    p[2] = -1.0;
+    for (int i = 0; i < n; ++i) {
+        const cJSON* v = cJSON_GetArrayItem(a, i);
+        if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble)) {
+            json_fail(c, full, "element %d must be a finite number", i);
+            return;
+        }
+        p[i] = v->valuedouble;
+    }
+}
+
+static void read_size(json_ctx* c, const cJSON* o, const char* path, const char* key, bool required,
+                      double* v) {
+    char full[256];
+    json_path(full, sizeof full, path, key);
+    if (!cJSON_GetObjectItemCaseSensitive(o, key) && !required) return;
+    json_vec(c, o, path, key, required, v, 3);
+    for (int i = 0; i < 3 && !c->failed; ++i)
+        if (!(v[i] > 0)) json_fail(c, full, "all sizes must be > 0, got %g", v[i]);
+}
+
+static void load_ode(json_ctx* c, const cJSON* o, world_ode_params* p) {
+    if (!o) return;
+    static const char* const keys[] = {"erp", "cfm", "contact_erp", "contact_cfm", "surface_layer",
+                                       "max_contacts", NULL};
+    json_only_keys(c, o, "ode", keys);
+    p->erp = json_num(c, o, "ode", "erp", false, p->erp, 0.0, 1.0);
+    p->cfm = json_num(c, o, "ode", "cfm", false, p->cfm, 0.0, 1.0);
+    p->contact_erp = json_num(c, o, "ode", "contact_erp", false, p->contact_erp, 0.0, 1.0);
+    p->contact_cfm = json_num(c, o, "ode", "contact_cfm", false, p->contact_cfm, 0.0, 1.0);
+    p->surface_layer = json_num(c, o, "ode", "surface_layer", false, p->surface_layer, 0.0, 0.1);
+    p->max_contacts = json_int(c, o, "ode", "max_contacts", false, p->max_contacts, 1, 32);
+}
+
+static void load_terrain(json_ctx* c, const cJSON* o, world_terrain* t) {
+    if (!o) return;
+    static const char* const keys[] = {"size", "samples", "flat_radius", "friction", "hills", NULL};
+    json_only_keys(c, o, "terrain", keys);
+    if (cJSON_GetObjectItemCaseSensitive(o, "size")) {
+        json_vec(c, o, "terrain", "size", true, t->size, 2);
+        if (!c->failed && !(t->size[0] >= 10 && t->size[1] >= 10))
+            json_fail(c, "terrain.size", "must be >= 10 m each way, got [%g, %g]", t->size[0], t->size[1]);
+    }
+    if (cJSON_GetObjectItemCaseSensitive(o, "samples")) {
+        double s[2];
+        json_vec(c, o, "terrain", "samples", true, s, 2);
+        for (int i = 0; i < 2 && !c->failed; ++i) {
+            if (s[i] != floor(s[i]) || s[i] < 2 || s[i] > 1024)
+                json_fail(c, "terrain.samples", "must be whole numbers in [2, 1024], got %g", s[i]);
+            t->samples[i] = (int)s[i];
+        }
+    }
+    t->flat_radius = json_num(c, o, "terrain", "flat_radius", false, t->flat_radius, 0, 1e4);
+    t->friction = json_num(c, o, "terrain", "friction", false, t->friction, 0, 10);
+    const cJSON* hills = json_arr(c, o, "terrain", "hills", false);
+    if (!hills || c->failed) return;
+    int n = cJSON_GetArraySize(hills);
+    if (n > WORLD_DESC_MAX_HILLS) {
+        json_fail(c, "terrain.hills", "at most %d hills, got %d", WORLD_DESC_MAX_HILLS, n);
+        return;
+    }
+    for (int i = 0; i < n && !c->failed; ++i) {
+        char p[64];
+        json_path_index(p, sizeof p, "terrain.hills", i);
+        const cJSON* h = cJSON_GetArrayItem(hills, i);
+        if (!cJSON_IsObject(h)) {
+            json_fail(c, p, "must be an object");
+            return;
+        }
+        json_only_keys(c, h, p, (const char* const[]){"x", "y", "radius", "height", NULL});
+        world_hill* g = &t->hill[i];
+        g->x = json_num(c, h, p, "x", true, 0, -1e4, 1e4);
+        g->y = json_num(c, h, p, "y", true, 0, -1e4, 1e4);
+        g->radius = json_pos(c, h, p, "radius", true, 1);
+        g->height = json_num(c, h, p, "height", true, 0, -100, 100);
+        t->nhill = i + 1;
+    }
+}
+
+static void load_truck(json_ctx* c, const cJSON* o, world_truck* k) {
+    if (!o) return;
+    static const char* const keys[] = {"position", "yaw_deg", "mass", "chassis", "bed_height", "cab",
+                                       "cab_x", "wheel_radius", "wheel_width", "wheel_x", "track",
+                                       "outriggers", "outrigger_x", "outrigger_span", "pad",
+                                       "column_x", "friction", NULL};
+    const char* p = "truck";
+    json_only_keys(c, o, p, keys);
+    if (cJSON_GetObjectItemCaseSensitive(o, "position")) json_vec(c, o, p, "position", true, k->position, 2);
+    k->yaw = json_num(c, o, p, "yaw_deg", false, k->yaw / DEG, -360, 360) * DEG;
+    k->mass = json_pos(c, o, p, "mass", false, k->mass);
+    read_size(c, o, p, "chassis", false, k->chassis);
+    k->bed_height = json_pos(c, o, p, "bed_height", false, k->bed_height);
+    read_size(c, o, p, "cab", false, k->cab);
+    k->cab_x = json_num(c, o, p, "cab_x", false, k->cab_x, -50, 50);
+    k->wheel_radius = json_pos(c, o, p, "wheel_radius", false, k->wheel_radius);
+    k->wheel_width = json_pos(c, o, p, "wheel_width", false, k->wheel_width);
+    if (cJSON_GetObjectItemCaseSensitive(o, "wheel_x")) json_vec(c, o, p, "wheel_x", true, k->wheel_x, 2);
+    k->track = json_pos(c, o, p, "track", false, k->track);
+    k->outriggers = json_bool(c, o, p, "outriggers", k->outriggers != 0);
+    if (cJSON_GetObjectItemCaseSensitive(o, "outrigger_x"))
+        json_vec(c, o, p, "outrigger_x", true, k->outrigger_x, 2);
+    k->outrigger_span = json_pos(c, o, p, "outrigger_span", false, k->outrigger_span);
+    read_size(c, o, p, "pad", false, k->pad);
+    k->column_x = json_num(c, o, p, "column_x", false, k->column_x, -50, 50);
+    k->friction = json_num(c, o, p, "friction", false, k->friction, 0, 10);
+    if (c->failed) return;
+    // The chassis sits on the wheels: the bed must be above the axles, or the
+    // wheels would be inside the chassis box.
+    if (k->bed_height - k->chassis[2] < k->wheel_radius * 0.5)
+        json_fail(c, "truck.bed_height", "chassis bottom (bed_height - chassis height = %g m) must be above half the wheel radius",
+                  k->bed_height - k->chassis[2]);
+    else if (k->outriggers && k->outrigger_span <= k->track)
+        json_fail(c, "truck.outrigger_span", "must exceed the track (%g m) when outriggers are out, got %g",
+                  k->track, k->outrigger_span);
+}
+
+static void load_slew(json_ctx* c, const cJSON* o, world_slew* s) {
+    if (!o) return;
+    static const char* const keys[] = {"pinion_radius", "cylinder", "valve", "column_radius", "damping", NULL};
+    json_only_keys(c, o, "slew", keys);
+    s->pinion_radius = json_pos(c, o, "slew", "pinion_radius", false, s->pinion_radius);
+    json_str(c, o, "slew", "cylinder", false, s->cylinder, s->cylinder, sizeof s->cylinder);
+    json_str(c, o, "slew", "valve", false, s->valve, s->valve, sizeof s->valve);
+    s->column_radius = json_pos(c, o, "slew", "column_radius", false, s->column_radius);
+    s->damping = json_num(c, o, "slew", "damping", false, s->damping, 0, 1e9);
+}
+
+static void load_rope(json_ctx* c, const cJSON* o, world_rope* r) {
+    if (!o) return;
+    static const char* const keys[] = {"length", "links", "radius", "mass_per_m", NULL};
+    json_only_keys(c, o, "rope", keys);
+    r->length = json_num(c, o, "rope", "length", false, r->length, 0.2, 50);
+    r->links = json_int(c, o, "rope", "links", false, r->links, 1, WORLD_DESC_MAX_ROPE);
+    r->radius = json_num(c, o, "rope", "radius", false, r->radius, 0.002, 0.2);
+    r->mass_per_m = json_pos(c, o, "rope", "mass_per_m", false, r->mass_per_m);
+}
+
+static void load_hook(json_ctx* c, const cJSON* o, world_hook* h) {
+    if (!o) return;
+    static const char* const keys[] = {"mass", "size", "reach", NULL};
+    json_only_keys(c, o, "hook", keys);
+    h->mass = json_pos(c, o, "hook", "mass", false, h->mass);
+    read_size(c, o, "hook", "size", false, h->size);
+    h->reach = json_pos(c, o, "hook", "reach", false, h->reach);
+}
+
+static void load_loads(json_ctx* c, const cJSON* arr, world_desc* w) {
+    if (!arr) return;
+    int n = cJSON_GetArraySize(arr);
+    if (n > WORLD_DESC_MAX_LOADS) {
+        json_fail(c, "loads", "at most %d loads, got %d", WORLD_DESC_MAX_LOADS, n);
+        return;
+    }
+    for (int i = 0; i < n && !c->failed; ++i) {
+        char p[64];
+        json_path_index(p, sizeof p, "loads", i);
+        const cJSON* o = cJSON_GetArrayItem(arr, i);
+        if (!cJSON_IsObject(o)) {
+            json_fail(c, p, "must be an object");
+            return;
+        }
+        static const char* const keys[] = {"name", "mass", "size", "position", "yaw_deg", "friction", NULL};
+        json_only_keys(c, o, p, keys);
+        world_load* l = &w->load[i];
+        char def[WORLD_DESC_NAME];
+        snprintf(def, sizeof def, "load_%d", i);
+        json_str(c, o, p, "name", false, def, l->name, sizeof l->name);
+        l->mass = json_pos(c, o, p, "mass", true, 0);
+        read_size(c, o, p, "size", true, l->size);
+        read_position(c, o, p, l->position);
+        l->yaw = json_num(c, o, p, "yaw_deg", false, 0, -360, 360) * DEG;
+        l->friction = json_num(c, o, p, "friction", false, 0.6, 0, 10);
+        w->nload = i + 1;
+    }
+}
+
+static void load_obstacles(json_ctx* c, const cJSON* arr, world_desc* w) {
+    if (!arr) return;
+    int n = cJSON_GetArraySize(arr);
+    if (n > WORLD_DESC_MAX_OBSTACLES) {
+        json_fail(c, "obstacles", "at most %d obstacles, got %d", WORLD_DESC_MAX_OBSTACLES, n);
+        return;
+    }
+    for (int i = 0; i < n && !c->failed; ++i) {
+        char p[64];
+        json_path_index(p, sizeof p, "obstacles", i);
+        const cJSON* o = cJSON_GetArrayItem(arr, i);
+        if (!cJSON_IsObject(o)) {
+            json_fail(c, p, "must be an object");
+            return;
+        }
+        static const char* const keys[] = {"name", "kind", "size", "position", "yaw_deg", "mass", "friction", NULL};
+        json_only_keys(c, o, p, keys);
+        world_obstacle* b = &w->obstacle[i];
+        char def[WORLD_DESC_NAME], kind[16];
+        snprintf(def, sizeof def, "obstacle_%d", i);
+        json_str(c, o, p, "name", false, def, b->name, sizeof b->name);
+        json_str(c, o, p, "kind", false, "box", kind, sizeof kind);
+        if (!c->failed) {
+            if (!strcmp(kind, "wall")) b->kind = WORLD_OBST_WALL;
+            else if (!strcmp(kind, "box")) b->kind = WORLD_OBST_BOX;
+            else if (!strcmp(kind, "building")) b->kind = WORLD_OBST_BUILDING;
+            else {
+                char f[80];
+                json_path(f, sizeof f, p, "kind");
+                json_fail(c, f, "must be \"wall\", \"box\" or \"building\", got \"%s\"", kind);
+            }
+        }
+        read_size(c, o, p, "size", true, b->size);
+        read_position(c, o, p, b->position);
+        b->yaw = json_num(c, o, p, "yaw_deg", false, 0, -360, 360) * DEG;
+        b->mass = json_num(c, o, p, "mass", false, 0, 0, 1e6);
+        b->friction = json_num(c, o, p, "friction", false, 0.6, 0, 10);
+        w->nobstacle = i + 1;
+    }
+}
+
+static void load_meshes(json_ctx* c, const cJSON* o, world_desc* w) {
+    if (!o) return;
+    // json_only_keys needs a NULL-terminated list.
+    const char* allowed[WORLD_MESH_COUNT + 1];
+    for (int i = 0; i < WORLD_MESH_COUNT; ++i) allowed[i] = world_mesh_key[i];
+    allowed[WORLD_MESH_COUNT] = NULL;
+    json_only_keys(c, o, "meshes", allowed);
+    for (int i = 0; i < WORLD_MESH_COUNT && !c->failed; ++i) {
+        char p[64];
+        json_path(p, sizeof p, "meshes", world_mesh_key[i]);
+        const cJSON* m = json_obj(c, o, "meshes", world_mesh_key[i], false);
+        if (!m) continue;
+        json_only_keys(c, m, p, (const char* const[]){"file", "scale", "up", "offset", NULL});
+        world_mesh* s = &w->mesh[i];
+        json_str(c, m, p, "file", false, s->file, s->file, sizeof s->file);
+        s->scale = json_pos(c, m, p, "scale", false, s->scale);
+        char up[8];
+        json_str(c, m, p, "up", false, s->up == 1 ? "y" : "z", up, sizeof up);
+        if (!c->failed) {
+            if (!strcmp(up, "y")) s->up = 1;
+            else if (!strcmp(up, "z")) s->up = 2;
+            else {
+                char f[80];
+                json_path(f, sizeof f, p, "up");
+                json_fail(c, f, "must be \"y\" or \"z\", got \"%s\"", up);
+            }
+        }
+        if (cJSON_GetObjectItemCaseSensitive(m, "offset")) json_vec(c, m, p, "offset", true, s->offset, 3);
+    }
+}
+
+// The circuit fragment must look like a hydraulics section's lists; its
+// contents are checked when the merged circuit is compiled.
+static void load_circuit(json_ctx* c, const cJSON* o, world_desc* w) {
+    if (!o) return;
+    json_only_keys(c, o, "circuit", (const char* const[]){"nodes", "components", NULL});
+    json_arr(c, o, "circuit", "nodes", false);
+    json_arr(c, o, "circuit", "components", false);
+    if (c->failed) return;
+    w->circuit = cJSON_Duplicate(o, 1);
+    if (!w->circuit) json_fail(c, "circuit", "out of memory");
+}
+
+// Resolve "rest on the ground" positions (z < 0) now that the terrain is known.
+static void settle_on_ground(const world_desc* w, double* pos, const double* size) {
+    if (pos[2] >= 0) return;
+    pos[2] = world_desc_terrain_height(w, pos[0], pos[1]) + 0.5 * size[2];
+}
+
+int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, char* err, size_t errsz) {
+    json_ctx c = {.file = file, .err = err, .errsz = errsz};
+    char kind[32];
+    world_desc_default(w, WORLD_VALIDATION);
+    if (!cJSON_IsObject(root)) {
+        json_fail(&c, "", "a world must be a JSON object");
+        return -1;
+    }
+    static const char* const keys[] = {"name", "description", "type", "gravity", "ode", "terrain", "truck",
+                                       "slew", "circuit", "rope", "hook", "loads", "obstacles",
+                                       "meshes", NULL};
+    json_only_keys(&c, root, "", keys);
+    json_str(&c, root, "", "type", true, "", kind, sizeof kind);
+    if (c.failed) return -1;
+    int k = world_kind_parse(kind);
+    if (k < 0) {
+        json_fail(&c, "type", "must be \"validation\" or \"sandbox\", got \"%s\"", kind);
+        return -1;
+    }
+    world_desc_default(w, (world_kind)k);
+    snprintf(w->file, sizeof w->file, "%s", file);
+    json_str(&c, root, "", "name", false, w->name, w->name, sizeof w->name);
+    w->gravity = json_num(&c, root, "", "gravity", false, 0, 0, 100);
+    load_ode(&c, json_obj(&c, root, "", "ode", false), &w->ode);
+    load_terrain(&c, json_obj(&c, root, "", "terrain", false), &w->terrain);
+    load_truck(&c, json_obj(&c, root, "", "truck", false), &w->truck);
+    load_slew(&c, json_obj(&c, root, "", "slew", false), &w->slew);
+    load_rope(&c, json_obj(&c, root, "", "rope", false), &w->rope);
+    load_hook(&c, json_obj(&c, root, "", "hook", false), &w->hook);
+    load_loads(&c, json_arr(&c, root, "", "loads", false), w);
+    load_obstacles(&c, json_arr(&c, root, "", "obstacles", false), w);
+    load_meshes(&c, json_obj(&c, root, "", "meshes", false), w);
+    load_circuit(&c, json_obj(&c, root, "", "circuit", false), w);
+    if (!c.failed) {
+        for (int i = 0; i < w->nload; ++i) settle_on_ground(w, w->load[i].position, w->load[i].size);
+        for (int i = 0; i < w->nobstacle; ++i) settle_on_ground(w, w->obstacle[i].position, w->obstacle[i].size);
+        // Names must be unique: the snapshot and the CSV address bodies by name.
+        for (int i = 0; i < w->nload + w->nobstacle && !c.failed; ++i) {
+            const char* a = i < w->nload ? w->load[i].name : w->obstacle[i - w->nload].name;
+            for (int j = 0; j < i; ++j) {
+                const char* b = j < w->nload ? w->load[j].name : w->obstacle[j - w->nload].name;
+                if (!strcmp(a, b)) {
+                    char p[64];
+                    if (i < w->nload) snprintf(p, sizeof p, "loads[%d].name", i);
+                    else snprintf(p, sizeof p, "obstacles[%d].name", i - w->nload);
+                    json_fail(&c, p, "duplicate name \"%s\"", a);
+                    break;
+                }
+            }
+        }
+    }
+    if (c.failed) {
+        world_desc_free(w);
+        return -1;
+    }
+    return 0;
+}
+
+int world_desc_load(const char* path, world_desc* w, char* err, size_t errsz) {
+    memset(w, 0, sizeof *w);
+    cJSON* root = json_load_file(path, err, errsz);
+    if (!root) return -1;
+    const char* base = strrchr(path, '/');
+    int rc = world_desc_from_json(root, base ? base + 1 : path, w, err, errsz);
+    cJSON_Delete(root);
+    return rc;
+}

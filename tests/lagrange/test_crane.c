@@ -1,0 +1,294 @@
+// test_crane.c: the analytic crane with its full circuit, against physics:
+// Jacobian vs finite differences, static equilibrium, flow continuity,
+// pump-limited speed, the SPEC section 4 sanity targets, variants, scenarios.
+#include "check.h"
+#include "sim.h"
+
+#include <dirent.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static model* load_default(void) {
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "default model: %s", err);
+    return m;
+}
+
+static void test_jacobian_matches_finite_differences(void) {
+    model* m = load_default();
+    if (!m) return;
+    lsim s;
+    char err[256];
+    CHECK(lsim_init(&s, m, LAGRANGE_FULL, 500, err, sizeof err) == 0, "%s", err);
+    const int n = s.n;
+    double y[LSIM_MAX_STATES];
+    static double J[LSIM_MAX_STATES * LSIM_MAX_STATES], Jfd[LSIM_MAX_STATES * LSIM_MAX_STATES];
+    const double q0[2] = {110 * M_PI / 180, -80 * M_PI / 180};
+    lsim_initial_state(&s, q0, 0.5e6, y);
+    // Moving, valves partly open, pressures away from any corner.
+    y[s.iq + 2] = 0.05;
+    y[s.iq + 3] = -0.08;
+    y[s.iu[0]] = 0.4;
+    y[s.iu[1]] = -0.3;
+    s.u_cmd[0] = 0.5;
+    s.u_cmd[1] = -0.2;
+    lsim_jac(&s, 0.0, y, J);
+    double f1[LSIM_MAX_STATES], f2[LSIM_MAX_STATES];
+    for (int j = 0; j < n; ++j) {
+        double h = 1e-6 * fmax(fabs(y[j]), j >= s.iq ? 1.0 : 1e5);
+        double yj = y[j];
+        y[j] = yj + h;
+        lsim_rhs(&s, 0.0, y, f1);
+        y[j] = yj - h;
+        lsim_rhs(&s, 0.0, y, f2);
+        y[j] = yj;
+        for (int i = 0; i < n; ++i) Jfd[i * n + j] = (f1[i] - f2[i]) / (2 * h);
+    }
+    int bad = 0;
+    for (int i = 0; i < n; ++i) {
+        double rowmax = 0;
+        for (int j = 0; j < n; ++j) rowmax = fmax(rowmax, fabs(Jfd[i * n + j]));
+        for (int j = 0; j < n; ++j) {
+            double a = J[i * n + j], b = Jfd[i * n + j];
+            if (fabs(a - b) > 1e-4 * fabs(b) + 1e-7 * rowmax + 1e-12) {
+                if (bad++ < 8)
+                    fprintf(stderr, "  J[%d][%d] analytic %.8g vs fd %.8g\n", i, j, a, b);
+            }
+        }
+    }
+    CHECK(bad == 0, "%d Jacobian entries differ from central differences", bad);
+    lsim_free(&s);
+    model_free(m);
+}
+
+static scenario make_scenario(double duration, double q1_deg, double q2_deg, double m3) {
+    scenario sc;
+    memset(&sc, 0, sizeof sc);
+    snprintf(sc.name, sizeof sc.name, "test");
+    sc.duration = duration;
+    sc.load_mass = m3;
+    sc.q0[0] = q1_deg * M_PI / 180;
+    sc.q0[1] = q2_deg * M_PI / 180;
+    return sc;
+}
+
+static const double* last_row(const sim_trace* tr) { return tr->v + (size_t)(tr->nrow - 1) * SIM_NCOL; }
+
+// Valves closed with a load: the crane holds, and the trapped chamber
+// pressures balance gravity through the lever arms (torque balance computed
+// from the model's own parameters, independent of the simulation).
+static void test_static_hold_matches_torque_balance(void) {
+    model* m = load_default();
+    if (!m) return;
+    scenario sc = make_scenario(5.0, 120, -70, 1000);
+    sim_opts o = sim_default_opts();
+    sim_trace tr = {0};
+    sim_result r;
+    CHECK(sim_run(m, &sc, &o, NULL, NULL, &tr, NULL, NULL, &r) == 0, "%s", r.message);
+    const double* e = last_row(&tr);
+    CHECK_NEAR(e[COL_Q1], sc.q0[0], 0.05 * M_PI / 180);
+    CHECK_NEAR(e[COL_Q2], sc.q0[1], 0.05 * M_PI / 180);
+    double G[2];
+    const double q[2] = {e[COL_Q1], e[COL_Q2]};
+    lagrange_gravity(&m->mech, LAGRANGE_FULL, 1000, q, G);
+    for (int k = 0; k < 2; ++k) {
+        double AA, AB, st, r_k;
+        hyd_model_cylinder_geometry(m->hyd, m->cyl[k], &AA, &AB, &st);
+        crane_pin_length(&m->mech.act[k], q[k], &r_k);
+        double pA = e[COL_P1A + 2 * k], pB = e[COL_P1B + 2 * k];
+        // At rest friction is zero, so pA AA - pB AB = G / r.
+        CHECK_REL(pA * AA - pB * AB, G[k] / r_k, 2e-3);
+    }
+    sim_trace_free(&tr);
+    model_free(m);
+}
+
+// Lift valve fully open: the pump's flow limit, not the valve, sets the
+// speed. At steady state the piston speed is the pump flow over the piston
+// area (less what the main relief and leakage take, both ~0 here).
+static void test_steady_lift_speed_matches_flow(void) {
+    model* m = load_default();
+    if (!m) return;
+    scenario sc = make_scenario(3.0, 80, -120, 500);
+    sc.cmd[0].n = 2;
+    sc.cmd[0].t[0] = 0.0;
+    sc.cmd[0].u[0] = 0.0;
+    sc.cmd[0].t[1] = 0.1;
+    sc.cmd[0].u[1] = 1.0;
+    sim_opts o = sim_default_opts();
+    sim_trace tr = {0};
+    sim_result r;
+    CHECK(sim_run(m, &sc, &o, NULL, NULL, &tr, NULL, NULL, &r) == 0, "%s", r.message);
+    double AA, AB, st, qmax;
+    hyd_model_cylinder_geometry(m->hyd, m->cyl[0], &AA, &AB, &st);
+    CHECK(hyd_model_get(m->hyd, "pump.q_max", &qmax) == 0, "pump.q_max");
+    // Mean speed over 1.5..2.5 s from the stroke difference.
+    const double* a = tr.v + (size_t)1500 * SIM_NCOL;
+    const double* b = tr.v + (size_t)2500 * SIM_NCOL;
+    double v = (b[COL_X1] - a[COL_X1]) / (b[COL_T] - a[COL_T]);
+    CHECK_REL(v, qmax / AA, 0.01);
+    // Still inside the stroke, so the end stop did not limit it.
+    CHECK(b[COL_X1] < st - 0.01, "reached the end stop: x1 = %g", b[COL_X1]);
+    sim_trace_free(&tr);
+    model_free(m);
+}
+
+// Partly open, the valve meters the flow: flow continuity says the piston
+// speed equals the flow into chamber A over the piston area at steady state.
+static void test_steady_speed_is_valve_flow_over_area(void) {
+    model* m = load_default();
+    if (!m) return;
+    lsim s;
+    char err[256];
+    CHECK(lsim_init(&s, m, LAGRANGE_FULL, 500, err, sizeof err) == 0, "%s", err);
+    double y[LSIM_MAX_STATES];
+    const double q0[2] = {85 * M_PI / 180, -120 * M_PI / 180};
+    lsim_initial_state(&s, q0, 0.5e6, y);
+    s.u_cmd[0] = 0.25;
+    hyd_problem p = lsim_problem(&s, true);
+    hyd_solver_opts so = hyd_default_solver_opts();
+    so.h = 1e-4;
+    hyd_solver* sol = hyd_solver_create(&p, HYD_KRUS, &so);
+    double t = 0;
+    CHECK(hyd_solver_advance(sol, &t, y, 2.0) == HYD_OK, "advance");
+    lsim_out o;
+    lsim_outputs(&s, t, y, &o);
+    int vc = hyd_model_valve_comp(m->hyd, m->valve[0]);
+    double qA = s.hd->comp_q[2 * vc]; // flow into the valve's A port line [m^3/s]
+    double AA, AB, st;
+    hyd_model_cylinder_geometry(m->hyd, m->cyl[0], &AA, &AB, &st);
+    CHECK(o.v[0] > 0.005, "lifting: v = %g", o.v[0]);
+    CHECK_REL(o.v[0] * AA, qA, 0.01);
+    // The metering edge limits it: below the pump's maximum.
+    double qmax;
+    hyd_model_get(m->hyd, "pump.q_max", &qmax);
+    CHECK(qA < 0.9 * qmax, "valve-limited flow %g vs pump %g", qA, qmax);
+    hyd_solver_destroy(sol);
+    lsim_free(&s);
+    model_free(m);
+}
+
+// SPEC section 4: with the default load, static holding pressures stay well
+// below the reliefs over the whole workspace, and 2000 kg can be held close in.
+static double holding_pressure(const model* m, double m3, double q1, double q2, int k) {
+    const double q[2] = {q1, q2};
+    double G[2], r, AA, AB, st;
+    lagrange_gravity(&m->mech, LAGRANGE_FULL, m3, q, G);
+    crane_pin_length(&m->mech.act[k], q[k], &r);
+    hyd_model_cylinder_geometry(m->hyd, m->cyl[k], &AA, &AB, &st);
+    double F = G[k] / r;
+    const double p_low = 0.5e6;
+    return F >= 0 ? (F + p_low * AB) / AA : (p_low * AA - F) / AB;
+}
+
+static void test_sanity_targets(void) {
+    model* m = load_default();
+    if (!m) return;
+    double relief;
+    CHECK(hyd_model_get(m->hyd, "lift_relief_A.p_crack", &relief) == 0, "port relief setting");
+    double worst = 0;
+    for (int i = 0; i <= 30; ++i) {
+        for (int k = 0; k < 2; ++k) {
+            // Sweep each joint over its stroke, the other over its range.
+            for (int j = 0; j <= 30; ++j) {
+                double q1 = crane_joint_for_stroke(&m->mech.act[0], m->stroke[0] * i / 30.0);
+                double q2 = crane_joint_for_stroke(&m->mech.act[1], m->stroke[1] * j / 30.0);
+                worst = fmax(worst, holding_pressure(m, m->mech.load_mass, q1, q2, k));
+            }
+        }
+    }
+    CHECK(worst < 0.8 * relief, "worst holding pressure %.2f MPa vs relief %.2f MPa", worst * 1e-6, relief * 1e-6);
+    // 2000 kg close in: lifting arm at 45 deg, end arm folded back to bring
+    // the tip within ~1.5 m of the column.
+    double q1 = 135 * M_PI / 180, q2 = -125 * M_PI / 180, x, z;
+    crane_tip(&m->mech, q1, q2, &x, &z);
+    CHECK(x < 2.0, "close in: reach %.2f m", x);
+    for (int k = 0; k < 2; ++k) {
+        double p = holding_pressure(m, 2000, q1, q2, k);
+        CHECK(p < relief, "2000 kg close in: cylinder %d needs %.2f MPa, relief %.2f MPa", k, p * 1e-6,
+              relief * 1e-6);
+    }
+    model_free(m);
+}
+
+// paper-typo differs measurably from paper; paper differs from full only by
+// the terms it drops, which are small at the crane's speeds.
+static void test_variants_on_ramp(void) {
+    model* m = load_default();
+    if (!m) return;
+    scenario sc;
+    char err[512];
+    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/ramp.json", &sc, err, sizeof err) == 0, "%s", err);
+    sim_trace tr[3] = {{0}, {0}, {0}};
+    for (int v = 0; v < 3; ++v) {
+        sim_opts o = sim_default_opts();
+        o.variant = (lagrange_variant)v;
+        sim_result r;
+        CHECK(sim_run(m, &sc, &o, NULL, NULL, &tr[v], NULL, NULL, &r) == 0, "%s", r.message);
+    }
+    double dtypo = 0, dfull = 0, pmax = 0;
+    for (int i = 0; i < tr[0].nrow; ++i) {
+        const double* f = tr[0].v + (size_t)i * SIM_NCOL;
+        const double* p = tr[1].v + (size_t)i * SIM_NCOL;
+        const double* t = tr[2].v + (size_t)i * SIM_NCOL;
+        pmax = fmax(pmax, f[COL_P1A]);
+        dtypo = fmax(dtypo, fabs(t[COL_P1A] - p[COL_P1A]));
+        dfull = fmax(dfull, fabs(f[COL_P1A] - p[COL_P1A]));
+    }
+    CHECK(dtypo > 0.02 * pmax, "typo changes lift pressure by only %.3g MPa", dtypo * 1e-6);
+    CHECK(dfull > 0, "full and paper identical");
+    CHECK(dfull < dtypo, "full vs paper (%.3g MPa) should be smaller than the typo effect (%.3g MPa)",
+          dfull * 1e-6, dtypo * 1e-6);
+    for (int v = 0; v < 3; ++v) sim_trace_free(&tr[v]);
+    model_free(m);
+}
+
+// Every shipped scenario runs to its end with finite values.
+static void test_all_scenarios_run(void) {
+    model* m = load_default();
+    if (!m) return;
+    DIR* d = opendir(CRANESIM_ASSETS "/scenarios");
+    CHECK(d != NULL, "no scenarios folder");
+    if (!d) return;
+    struct dirent* e;
+    int count = 0;
+    while ((e = readdir(d))) {
+        size_t L = strlen(e->d_name);
+        if (L < 6 || strcmp(e->d_name + L - 5, ".json")) continue;
+        char path[512], err[512];
+        snprintf(path, sizeof path, "%s/scenarios/%s", CRANESIM_ASSETS, e->d_name);
+        scenario sc;
+        CHECK(scenario_load(path, &sc, err, sizeof err) == 0, "%s", err);
+        sim_opts o = sim_default_opts();
+        sim_trace tr = {0};
+        sim_result r;
+        int rc = sim_run(m, &sc, &o, NULL, NULL, &tr, NULL, NULL, &r);
+        CHECK(rc == 0, "%s: %s", e->d_name, r.message);
+        CHECK(tr.nrow > 0 && fabs(last_row(&tr)[COL_T] - sc.duration) < 1e-9, "%s ended at %g of %g s",
+              e->d_name, tr.nrow ? last_row(&tr)[COL_T] : -1.0, sc.duration);
+        bool finite = true;
+        for (int i = 0; i < tr.nrow * SIM_NCOL; ++i) finite &= isfinite(tr.v[i]);
+        CHECK(finite, "%s: non-finite values", e->d_name);
+        sim_trace_free(&tr);
+        ++count;
+    }
+    closedir(d);
+    CHECK(count >= 4, "only %d scenarios shipped", count);
+    model_free(m);
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_jacobian_matches_finite_differences);
+    RUN_TEST(test_static_hold_matches_torque_balance);
+    RUN_TEST(test_steady_lift_speed_matches_flow);
+    RUN_TEST(test_steady_speed_is_valve_flow_over_area);
+    RUN_TEST(test_sanity_targets);
+    RUN_TEST(test_variants_on_ramp);
+    RUN_TEST(test_all_scenarios_run);
+    TEST_MAIN_END();
+}

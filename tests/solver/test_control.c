@@ -1,0 +1,223 @@
+// test_control.c: the adaptive driver around the methods. Step-size control
+// through a discontinuity and a kink, Hermite output against an exact
+// solution, landing on t_end without evaluating f beyond it, and the
+// non-finite report (index and time).
+#include "check.h"
+#include "hyd_solver.h"
+#include "problems.h"
+
+// y' = 1 for t < 1, then y' = -1e3 (y - 2): y = t up to 1, then
+// y = 2 - exp(-1e3 (t - 1)). The solver is not told about the jump.
+static int jump_f(void* user, double t, const double* y, double* dy) {
+    (void)user;
+    dy[0] = t < 1.0 ? 1.0 : -1e3 * (y[0] - 2.0);
+    return 0;
+}
+static int jump_jac(void* user, double t, const double* y, double* J) {
+    (void)user;
+    (void)y;
+    J[0] = t < 1.0 ? 0.0 : -1e3;
+    return 0;
+}
+
+// A relief-like kink in y: y' = 1 - 1e3 max(y - 1, 0); y rises at rate 1 until
+// it cracks at y = 1 and then settles at 1 + 1e-3.
+static int kink_f(void* user, double t, const double* y, double* dy) {
+    (void)user;
+    (void)t;
+    dy[0] = 1.0 - 1e3 * fmax(y[0] - 1.0, 0.0);
+    return 0;
+}
+
+static hyd_solver* make(hyd_problem* p, hyd_method m, double rtol, double atol) {
+    hyd_solver_opts o = hyd_default_solver_opts();
+    o.rtol = rtol, o.atol = atol, o.h = 0.0;
+    return hyd_solver_create(p, m, &o);
+}
+
+static void test_discontinuous_rhs(void) {
+    for (int m = HYD_ROS34PW2; m <= HYD_RODAS3; ++m) {
+        for (int fd = 0; fd < 2; ++fd) {
+            hyd_problem p = {0};
+            p.n = 1, p.f = jump_f, p.jac = fd ? NULL : jump_jac;
+            hyd_solver* s = make(&p, (hyd_method)m, 1e-6, 1e-9);
+            double t = 0.0, y = 0.0;
+            CHECK(hyd_solver_advance(s, &t, &y, 1.02) == HYD_OK, "through the jump");
+            CHECK_NEAR(y, 2.0 - exp(-1e3 * 0.02), 1e-4);
+            const hyd_solver_stats* st = hyd_solver_get_stats(s);
+            CHECK(st->rejected >= 1, "%s: the jump should cost a rejection", hyd_method_name(m));
+            CHECK(st->steps < 300, "%s: %ld steps up to t = 1.02", hyd_method_name(m), st->steps);
+            // After the transient h must grow back: 1.02 .. 1000 in few steps.
+            hyd_solver_clear_stats(s);
+            CHECK(hyd_solver_advance(s, &t, &y, 1000.0) == HYD_OK, "long tail");
+            CHECK_NEAR(y, 2.0, 1e-6);
+            CHECK(st->steps < 150, "%s fd=%d: %ld steps for the flat tail", hyd_method_name(m), fd,
+                  st->steps);
+            CHECK(hyd_solver_last_h(s) > 10.0, "%s: last h %.3g", hyd_method_name(m),
+                  hyd_solver_last_h(s));
+            hyd_solver_destroy(s);
+        }
+    }
+}
+
+static void test_kink(void) {
+    for (int m = HYD_ROS34PW2; m <= HYD_RODAS3; ++m) {
+        hyd_problem p = {0};
+        p.n = 1, p.f = kink_f, p.autonomous = 1; // finite-difference J across the kink
+        hyd_solver* s = make(&p, (hyd_method)m, 1e-6, 1e-9);
+        double t = 0.0, y = 0.0;
+        int rc = hyd_solver_advance(s, &t, &y, 100.0);
+        CHECK(rc == HYD_OK, "%s rc %d", hyd_method_name(m), rc);
+        CHECK_NEAR(y, 1.001, 1e-7);
+        const hyd_solver_stats* st = hyd_solver_get_stats(s);
+        CHECK(st->steps < 300, "%s: %ld steps", hyd_method_name(m), st->steps);
+        CHECK(hyd_solver_last_h(s) > 1.0, "%s: last h %.3g", hyd_method_name(m),
+              hyd_solver_last_h(s));
+        hyd_solver_destroy(s);
+    }
+}
+
+// Output callback recording the worst deviation from the exact solution.
+typedef struct out_rec {
+    double t_prev, emax;
+    long count;
+    int monotone;
+} out_rec;
+
+static int record(void* user, double t, const double* y) {
+    out_rec* r = user;
+    double g[3];
+    conv_exact(t, g);
+    for (int i = 0; i < 3; ++i) r->emax = fmax(r->emax, fabs(y[i] - g[i]));
+    if (r->count > 0 && !(t > r->t_prev)) r->monotone = 0;
+    r->t_prev = t;
+    r->count++;
+    return 0;
+}
+
+// Refuses any evaluation beyond t = 2 (the end of the run).
+static int conv_f_bounded(void* user, double t, const double* y, double* dy) {
+    if (t > 2.0) return 1;
+    return conv_f(user, t, y, dy);
+}
+
+static void test_hermite_output(void) {
+    for (int m = HYD_ROS34PW2; m <= HYD_RODAS3; ++m) {
+        hyd_problem p = {0};
+        p.n = 3, p.f = conv_f_bounded, p.jac = conv_jac, p.dfdt = conv_dfdt;
+        hyd_solver* s = make(&p, (hyd_method)m, 1e-6, 1e-9);
+        double y[3];
+        conv_exact(0.0, y);
+        out_rec r = {0.0, 0.0, 0, 1};
+        // dt_out = 1 ms: 2001 outputs; steps must span many of them.
+        int rc = hyd_solver_integrate(s, 0.0, y, 2.0, 1e-3, record, &r);
+        CHECK(rc == HYD_OK, "%s rc %d", hyd_method_name(m), rc);
+        CHECK(r.count == 2001, "%ld outputs", r.count);
+        CHECK(r.monotone, "output times increase");
+        CHECK(r.t_prev == 2.0, "last output at %.17g", r.t_prev);
+        const hyd_solver_stats* st = hyd_solver_get_stats(s);
+        CHECK(st->steps < 200, "%s: %ld steps for 2000 outputs", hyd_method_name(m), st->steps);
+        // Hermite is O(h^4) locally, above the methods' order: its error stays
+        // at the solution's level.
+        CHECK(r.emax < 2e-5, "%s: output error %.3g", hyd_method_name(m), r.emax);
+        printf("  hermite %-8s: %ld steps, max output error %.3g\n", hyd_method_name(m), st->steps,
+               r.emax);
+        hyd_solver_destroy(s);
+    }
+    // Fixed-step methods land on each output time.
+    hyd_problem p = {0};
+    p.n = 3, p.f = conv_f_bounded, p.jac = conv_jac;
+    hyd_solver_opts o = hyd_default_solver_opts();
+    o.h = 1e-3;
+    hyd_solver* s = hyd_solver_create(&p, HYD_KRUS, &o);
+    double y[3];
+    conv_exact(0.0, y);
+    out_rec r = {0.0, 0.0, 0, 1};
+    CHECK(hyd_solver_integrate(s, 0.0, y, 2.0, 0.01, record, &r) == HYD_OK, "krus integrate");
+    CHECK(r.count == 201 && r.t_prev == 2.0, "%ld outputs, last %.17g", r.count, r.t_prev);
+    CHECK(r.emax < 1e-5, "krus output error %.3g", r.emax);
+    CHECK(hyd_solver_get_stats(s)->steps == 2000, "%ld steps", hyd_solver_get_stats(s)->steps);
+    hyd_solver_destroy(s);
+}
+
+// Component 1 of f turns NaN for t > 0.57.
+static int nan_f(void* user, double t, const double* y, double* dy) {
+    (void)user;
+    (void)y;
+    dy[0] = 1.0;
+    dy[1] = t > 0.57 ? NAN : 1.0;
+    dy[2] = -y[2];
+    return 0;
+}
+
+static void test_nonfinite(void) {
+    for (int m = 0; m < HYD_METHOD_COUNT; ++m) {
+        hyd_problem p = {0};
+        p.n = 3, p.f = nan_f;
+        hyd_solver_opts o = hyd_default_solver_opts();
+        o.h = 0.1;
+        hyd_solver* s = hyd_solver_create(&p, (hyd_method)m, &o);
+        double t = 0.0, y[3] = {0.0, 0.0, 1.0};
+        int rc = hyd_solver_advance(s, &t, y, 1.0);
+        double t_bad = -1.0;
+        int i_bad = hyd_solver_bad_state(s, &t_bad);
+        CHECK(rc == HYD_ERR_NONFINITE, "%s rc %d", hyd_method_name(m), rc);
+        CHECK(i_bad == 1, "%s: bad index %d", hyd_method_name(m), i_bad);
+        if (hyd_method_is_adaptive((hyd_method)m)) {
+            // The controller closes in on the time f breaks down.
+            CHECK_NEAR(t_bad, 0.57, 1e-6);
+            CHECK(t <= 0.57 && t > 0.57 - 1e-6, "%s stopped at %.12g", hyd_method_name(m), t);
+        } else {
+            CHECK_NEAR(t_bad, 0.6, 1e-12); // the step 0.5 -> 0.6 went bad
+            CHECK_NEAR(t, 0.5, 1e-12);     // y kept at the last good state
+        }
+        CHECK(isfinite(y[0]) && isfinite(y[1]) && isfinite(y[2]), "y kept finite");
+        CHECK_NEAR(y[0], t, 1e-9);
+        CHECK_NEAR(y[1], t, 1e-9);
+        hyd_solver_destroy(s);
+    }
+}
+
+// Reset drops step history: after it, the first step is opts.h again.
+static void test_reset(void) {
+    hyd_problem p = {0};
+    p.n = 1, p.f = jump_f, p.jac = jump_jac;
+    hyd_solver_opts o = hyd_default_solver_opts();
+    o.h = 1e-3, o.rtol = 1e-6, o.atol = 1e-9;
+    hyd_solver* s = hyd_solver_create(&p, HYD_ROS34PW2, &o);
+    double t = 0.0, y = 0.0;
+    CHECK(hyd_solver_advance(s, &t, &y, 0.9) == HYD_OK, "advance");
+    CHECK(hyd_solver_last_h(s) > 0.05, "h grew on y' = 1: %.3g", hyd_solver_last_h(s));
+    hyd_solver_reset(s);
+    long jev = hyd_solver_get_stats(s)->jevals;
+    CHECK(hyd_solver_advance(s, &t, &y, 0.95) == HYD_OK, "advance");
+    CHECK(hyd_solver_get_stats(s)->jevals > jev, "reset forces a new J");
+    CHECK(hyd_solver_get_stats(s)->steps > 0, "steps");
+    hyd_solver_destroy(s);
+}
+
+static void test_bad_arguments(void) {
+    hyd_problem p = {0};
+    p.n = 3, p.f = conv_f;
+    CHECK(hyd_solver_create(NULL, HYD_KRUS, NULL) == NULL, "NULL problem");
+    int bad_sizes[2] = {1, 1};
+    p.nblock = 2, p.block_size = bad_sizes;
+    CHECK(hyd_solver_create(&p, HYD_KRUS, NULL) == NULL, "blocks not summing to n");
+    p.nblock = 0;
+    hyd_solver_opts o = hyd_default_solver_opts();
+    o.h = 0.0;
+    CHECK(hyd_solver_create(&p, HYD_KRUS, &o) == NULL, "fixed step needs h > 0");
+    hyd_solver* s = hyd_solver_create(&p, HYD_ROS34PW2, &o);
+    CHECK(s != NULL, "adaptive accepts h = 0 (automatic initial step)");
+    hyd_solver_destroy(s);
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_discontinuous_rhs);
+    RUN_TEST(test_kink);
+    RUN_TEST(test_hermite_output);
+    RUN_TEST(test_nonfinite);
+    RUN_TEST(test_reset);
+    RUN_TEST(test_bad_arguments);
+    TEST_MAIN_END();
+}
