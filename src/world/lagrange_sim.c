@@ -92,6 +92,10 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
         s->block[s->nblock++] = 1;
     }
     s->block[s->nblock++] = 4; // q1, q2, q1', q2'
+    for (int i = 0; i < s->nh; ++i) {
+        const char* nm = strrchr(hyd_model_state_name(hm, s->perm[i]), '.');
+        s->is_pressure[i] = nm && nm[1] == 'p';
+    }
     return 0;
 }
 

@@ -31,6 +31,7 @@ typedef struct lsim {
     int perm[LSIM_MAX_STATES]; ///< system index -> hydraulic state index (for i < nh)
     int ip[2][2];          ///< system indices of chamber pressures pA, pB of actuator k
     int iu[2];             ///< system index of actuator k's spool
+    bool is_pressure[LSIM_MAX_STATES]; ///< system state i is a pressure [Pa abs]
     int ihose[2][2];       ///< system index of the hose before chamber A, B of actuator k (-1: none)
     int nblock;            ///< Jacobian blocks for block-diagonal W-methods
     int block[LSIM_MAX_BLOCKS];

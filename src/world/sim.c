@@ -76,12 +76,27 @@ typedef struct run_ctx {
     double t_end, t_last_row, wall_next;
     long rows;
     int stop;
+    int bad_state; ///< state index found implausible by emit, or -1
+    double bad_value, bad_t;
 } run_ctx;
+
+// A pressure below -1 MPa absolute cannot be physical: the pressure-dependent
+// bulk modulus makes absolute zero a barrier the exact solution never
+// crosses, so only an unstable integration lands there. Treat it like NaN.
+static const double P_IMPLAUSIBLE = -1e6;
 
 static int emit(void* user, double t, const double* y) {
     run_ctx* c = user;
     // Segments share their end points: write each output time once.
     if (c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out) return 0;
+    for (int i = 0; i < c->ls->nh; ++i) {
+        if (!(y[i] > P_IMPLAUSIBLE) && c->ls->is_pressure[i]) {
+            c->bad_state = i;
+            c->bad_value = y[i];
+            c->bad_t = t;
+            return (c->stop = 3);
+        }
+    }
     c->t_last_row = t;
     ++c->rows;
     // Benchmarks consume nothing: skip the output evaluation entirely.
@@ -141,8 +156,13 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     }
 
     const double t_end = o->duration > 0 ? o->duration : sc->duration;
+    // A fixed step longer than the output period outputs once per step
+    // (fixed-step methods land on every output time).
+    sim_opts oo = *o;
+    if (!adaptive && oo.h > oo.dt_out) oo.dt_out = oo.h;
+    o = &oo;
     run_ctx c = {.ls = &ls, .o = o, .row_fn = row_fn, .row_user = row_user, .trace = trace,
-                 .progress = progress, .progress_user = progress_user, .t_end = t_end};
+                 .progress = progress, .progress_user = progress_user, .t_end = t_end, .bad_state = -1};
     // Integrate between command breakpoints (rounded to the output grid) and
     // reset the solver at each: a kink in a valve command is a discontinuity
     // in f' that an adaptive controller should not have to discover.
@@ -164,14 +184,20 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     res->stats = *hyd_solver_get_stats(s);
     res->rows = c.rows;
     res->t_end = c.t_last_row;
-    if (c.stop) {
+    char nb[96];
+    if (c.stop == 3) {
+        res->status = 1;
+        snprintf(res->message, sizeof res->message,
+                 "numerical blow-up: state %s = %.4g Pa (below absolute zero) at t = %.6g s (solver %s, h = %g s)",
+                 state_name(&ls, c.bad_state, nb, sizeof nb), c.bad_value, c.bad_t, hyd_method_name(o->solver),
+                 adaptive ? hyd_solver_last_h(s) : o->h);
+    } else if (c.stop) {
         res->status = 2;
         snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c.t_last_row);
     } else if (rc != HYD_OK) {
         res->status = 1;
         double tb = c.t_last_row;
         int bi = hyd_solver_bad_state(s, &tb);
-        char nb[96];
         if (rc == HYD_ERR_NONFINITE && bi >= 0)
             snprintf(res->message, sizeof res->message,
                      "numerical blow-up: state %s became non-finite at t = %.6g s (solver %s, h = %g s)",

@@ -138,8 +138,9 @@ static void test_steady_lift_speed_matches_flow(void) {
     model_free(m);
 }
 
-// Partly open, the valve meters the flow: flow continuity says the piston
-// speed equals the flow into chamber A over the piston area at steady state.
+// Partly open, the valve meters the flow: at steady state the piston speed is
+// the metering edge's orifice flow for the steady pressure drop, over the
+// piston area (flow continuity; compressibility terms vanish at steady state).
 static void test_steady_speed_is_valve_flow_over_area(void) {
     model* m = load_default();
     if (!m) return;
@@ -149,21 +150,40 @@ static void test_steady_speed_is_valve_flow_over_area(void) {
     double y[LSIM_MAX_STATES];
     const double q0[2] = {85 * M_PI / 180, -120 * M_PI / 180};
     lsim_initial_state(&s, q0, 0.5e6, y);
-    s.u_cmd[0] = 0.25;
+    s.u_cmd[0] = 0.1;
     hyd_problem p = lsim_problem(&s, true);
     hyd_solver_opts so = hyd_default_solver_opts();
     so.h = 1e-4;
     hyd_solver* sol = hyd_solver_create(&p, HYD_KRUS, &so);
     double t = 0;
-    CHECK(hyd_solver_advance(sol, &t, y, 2.0) == HYD_OK, "advance");
+    CHECK(hyd_solver_advance(sol, &t, y, 1.5) == HYD_OK, "advance");
+    // The oil column is lightly damped (2-12 Hz modes), so compare means over
+    // 2 s rather than instantaneous values.
+    double qn, dpn, cd;
+    hyd_model_get(m->hyd, "lift_valve.q_nominal", &qn);
+    hyd_model_get(m->hyd, "lift_valve.dp_nominal", &dpn);
+    hyd_model_get(m->hyd, "lift_valve.cd", &cd);
+    hyd_fluid_def fl = hyd_model_fluid(m->hyd);
+    double Amax = qn / (cd * sqrt(2 * dpn / fl.density));
     lsim_out o;
     lsim_outputs(&s, t, y, &o);
-    int vc = hyd_model_valve_comp(m->hyd, m->valve[0]);
-    double qA = s.hd->comp_q[2 * vc]; // flow into the valve's A port line [m^3/s]
+    const double x_start = o.x[0];
+    double qsum = 0;
+    const int nsamp = 2000;
+    for (int i = 1; i <= nsamp; ++i) {
+        CHECK(hyd_solver_advance(sol, &t, y, 1.5 + 1e-3 * i) == HYD_OK, "advance");
+        lsim_outputs(&s, t, y, &o);
+        // Orifice law of the P->A edge at the spool opening and the pressure
+        // drop from the pump line to the hose, with A_max from the rating.
+        double p_hose = y[s.ihose[0][0]];
+        qsum += hyd_orifice_flow(&fl, cd, o.u[0] * Amax, o.p_pump - p_hose, NULL, NULL);
+    }
+    double qA = qsum / nsamp;
+    double vmean = (o.x[0] - x_start) / (1e-3 * nsamp);
     double AA, AB, st;
     hyd_model_cylinder_geometry(m->hyd, m->cyl[0], &AA, &AB, &st);
-    CHECK(o.v[0] > 0.005, "lifting: v = %g", o.v[0]);
-    CHECK_REL(o.v[0] * AA, qA, 0.01);
+    CHECK(vmean > 0.005, "lifting: v = %g", vmean);
+    CHECK_REL(vmean * AA, qA, 0.01);
     // The metering edge limits it: below the pump's maximum.
     double qmax;
     hyd_model_get(m->hyd, "pump.q_max", &qmax);
@@ -205,7 +225,7 @@ static void test_sanity_targets(void) {
     CHECK(worst < 0.8 * relief, "worst holding pressure %.2f MPa vs relief %.2f MPa", worst * 1e-6, relief * 1e-6);
     // 2000 kg close in: lifting arm at 45 deg, end arm folded back to bring
     // the tip within ~1.5 m of the column.
-    double q1 = 135 * M_PI / 180, q2 = -125 * M_PI / 180, x, z;
+    double q1 = 135 * M_PI / 180, q2 = -130 * M_PI / 180, x, z;
     crane_tip(&m->mech, q1, q2, &x, &z);
     CHECK(x < 2.0, "close in: reach %.2f m", x);
     for (int k = 0; k < 2; ++k) {
