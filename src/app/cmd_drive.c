@@ -50,7 +50,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (rc) return rc;
     double duration = c->sim.duration > 0 ? c->sim.duration : sc.duration;
     char err[320];
-    double m3 = sc.load_mass >= 0 ? sc.load_mass : m->mech.load_mass;
+    double m3 = sim_load_mass(m, &sc, &c->sim);
     live* l = live_create_lagrange(m, &c->sim, sc.q0, m3, err, sizeof err);
     if (!l) {
         fprintf(stderr, "cranesim drive: %s\n", err);

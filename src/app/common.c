@@ -44,7 +44,7 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
     }
     static const char* const with_value[] = {"--model", "--scenario", "--mechanics", "--variant", "--solver",
                                              "--dt", "--rtol", "--atol", "--duration", "--every",
-                                             "--set", "--jac-every", NULL};
+                                             "--set", "--jac-every", "--load", NULL};
     int k = -1;
     for (int j = 0; with_value[j]; ++j)
         if (!strcmp(a, with_value[j])) k = j;
@@ -104,6 +104,13 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
         }
         c->sim.jac_every = (int)d;
         break;
+    case 12:
+        if (app_parse_double(v, &d) || d < 0 || d > 1e5) {
+            fprintf(stderr, "cranesim: --load: expected a mass in kg (0..100000), got '%s'\n", v);
+            return -1;
+        }
+        c->sim.load_mass = d;
+        break;
     }
     return 1;
 }
@@ -114,6 +121,7 @@ void app_common_help(FILE* f, bool with_solver) {
             "  --scenario S         scenario JSON file, or a name in assets/scenarios (e.g. ramp)\n"
             "  --set PATH=VALUE     override any model value, e.g. --set mechanics.load_mass=800\n"
             "                       or --set hydraulics.components.lift_cyl.bore=0.11 (repeatable)\n"
+            "  --load KG            tip load [kg] (default: the scenario's, else the model's)\n"
             "  --mechanics M        lagrange (analytic 2-DOF, default) or ode\n"
             "  --variant V          lagrange equations: full (default), paper, paper-typo\n");
     if (with_solver)

@@ -27,7 +27,13 @@ sim_opts sim_default_opts(void) {
     o.atol = 1e-6;
     o.dt_out = 1e-3;
     o.jac_every = 10;
+    o.load_mass = -1.0;
     return o;
+}
+
+double sim_load_mass(const model* m, const scenario* sc, const sim_opts* o) {
+    if (o->load_mass >= 0) return o->load_mass;
+    return sc->load_mass >= 0 ? sc->load_mass : m->mech.load_mass;
 }
 
 double sim_wall_time(void) {
@@ -134,7 +140,7 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
         return res->status = 2;
     }
     lsim ls;
-    double m3 = sc->load_mass >= 0 ? sc->load_mass : m->mech.load_mass;
+    double m3 = sim_load_mass(m, sc, o);
     if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = 2;
     ls.scn = sc;
     double y[LSIM_MAX_STATES];

@@ -27,7 +27,11 @@ typedef struct sim_opts {
     double duration;   ///< [s]; 0 = the scenario's
     bool dense_jac;    ///< fixed-step methods: dense J instead of the block pattern
     int jac_every;     ///< fixed-step methods: J every N steps (default 10)
+    double load_mass;  ///< tip load [kg]; < 0: the scenario's, else the model's
 } sim_opts;
+
+/// The tip load a run uses [kg]: the option, else the scenario's, else the model's.
+double sim_load_mass(const model* m, const scenario* sc, const sim_opts* o);
 
 sim_opts sim_default_opts(void);
 

@@ -268,6 +268,35 @@ static void test_variants_on_ramp(void) {
     model_free(m);
 }
 
+// The overload scenario opens port reliefs, and they hold the pressure
+// within their override band (crack + override), never far above.
+static void test_overload_opens_relief(void) {
+    model* m = load_default();
+    if (!m) return;
+    scenario sc;
+    char err[512];
+    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/overload.json", &sc, err, sizeof err) == 0, "%s", err);
+    sim_opts o = sim_default_opts();
+    sim_trace tr = {0};
+    sim_result r;
+    CHECK(sim_run(m, &sc, &o, NULL, NULL, &tr, NULL, NULL, &r) == 0, "%s", r.message);
+    double crack, over, tank = 1e5;
+    hyd_model_get(m->hyd, "lift_relief_A.p_crack", &crack);
+    hyd_model_get(m->hyd, "lift_relief_A.dp_override", &over);
+    int open_rows = 0;
+    double pmax = 0;
+    for (int i = 0; i < tr.nrow; ++i) {
+        const double* v = tr.v + (size_t)i * SIM_NCOL;
+        open_rows += v[COL_RELIEF_OPEN] > 0;
+        for (int k = COL_P1A; k <= COL_P2B; ++k) pmax = fmax(pmax, v[k]);
+    }
+    CHECK(open_rows > 100, "relief open in only %d rows", open_rows);
+    CHECK(pmax > tank + crack, "peak %.2f MPa never reached the %.2f MPa relief", pmax * 1e-6, (tank + crack) * 1e-6);
+    CHECK(pmax < tank + crack + 2 * over, "peak %.2f MPa beyond the relief band", pmax * 1e-6);
+    sim_trace_free(&tr);
+    model_free(m);
+}
+
 // Every shipped scenario runs to its end with finite values.
 static void test_all_scenarios_run(void) {
     model* m = load_default();
@@ -309,6 +338,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_steady_speed_is_valve_flow_over_area);
     RUN_TEST(test_sanity_targets);
     RUN_TEST(test_variants_on_ramp);
+    RUN_TEST(test_overload_opens_relief);
     RUN_TEST(test_all_scenarios_run);
     TEST_MAIN_END();
 }
