@@ -48,6 +48,7 @@ int cmd_run(int argc, char** argv);
 int cmd_bench(int argc, char** argv);
 int cmd_compare(int argc, char** argv);
 int cmd_drive(int argc, char** argv);
+int cmd_study(int argc, char** argv);
 
 /// Plot a run's main time histories to a PNG (PLplot). Returns 0, or -1 with
 /// a message (also when cranesim was built without PLplot).

@@ -23,7 +23,7 @@ static void compare_help(FILE* f) {
             "\n"
             "options:\n"
             "  --backends A,B      lagrange | ode\n"
-            "  --solvers A,B       krus | ros2 | rk4 | ros34pw2 | rodas3\n"
+            "  --solvers A,B       krus | ros2 | rk4 | ros34pw2 | rodas3 | cvode\n"
             "  --variants A,B      full | paper | paper-typo\n"
             "  --dts H1,H2         fixed steps [s]\n"
             "  --tol-stroke MM     fail (exit 1) if the stroke RMS difference exceeds MM millimetres\n"
@@ -120,6 +120,8 @@ int cmd_compare(int argc, char** argv) {
                     fprintf(stderr, "cranesim compare: --backends: expected lagrange or ode, got '%s'\n", v[s]);
                     return EXIT_USAGE;
                 }
+            } else if (k == 1 && !strcmp(v[s], "cvode")) {
+                side[s].cvode = true;
             } else if (k == 1) {
                 int m = hyd_method_parse(v[s]);
                 if (m < 0) {

@@ -51,8 +51,8 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
         }
     }
     printf("cranesim run: %s, %s/%s, solver %s", scen, o->mechanics == SIM_LAGRANGE ? "lagrange" : "ode",
-           lagrange_variant_name(o->variant), hyd_method_name(o->solver));
-    if (hyd_method_is_adaptive(o->solver)) printf(" (rtol %g, atol %g)\n", o->rtol, o->atol);
+           lagrange_variant_name(o->variant), o->cvode ? "cvode" : hyd_method_name(o->solver));
+    if (o->cvode || hyd_method_is_adaptive(o->solver)) printf(" (rtol %g, atol %g)\n", o->rtol, o->atol);
     else printf(" (h = %g ms)\n", o->h * 1e3);
     printf("  simulated %.3f s in %.3f s wall: %.0fx real time; %ld steps, %ld rejected, %ld f evals, %ld LU\n",
            r->t_end, r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, r->stats.steps, r->stats.rejected,
@@ -118,7 +118,7 @@ int cmd_run(int argc, char** argv) {
     if (plot && tr.nrow > 1) {
         char err[256], title[160];
         snprintf(title, sizeof title, "%s: %s, %s", sc.name, lagrange_variant_name(c.sim.variant),
-                 hyd_method_name(c.sim.solver));
+                 c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
         if (app_plot_run(&tr, title, plot, err, sizeof err)) {
             fprintf(stderr, "cranesim run: plot: %s\n", err);
             if (code == EXIT_OK_) code = EXIT_RUNTIME;

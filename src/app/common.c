@@ -73,9 +73,14 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
         break;
     }
     case 4: {
+        if (!strcmp(v, "cvode")) {
+            c->sim.cvode = true;
+            break;
+        }
+        c->sim.cvode = false;
         int m = hyd_method_parse(v);
         if (m < 0) {
-            fprintf(stderr, "cranesim: --solver: expected krus, ros2, rk4, ros34pw2 or rodas3, got '%s'\n", v);
+            fprintf(stderr, "cranesim: --solver: expected krus, ros2, rk4, ros34pw2, rodas3 or cvode, got '%s'\n", v);
             return -1;
         }
         c->sim.solver = (hyd_method)m;
@@ -126,7 +131,7 @@ void app_common_help(FILE* f, bool with_solver) {
             "  --variant V          lagrange equations: full (default), paper, paper-typo\n");
     if (with_solver)
         fprintf(f,
-                "  --solver S           krus (default), ros2, rk4, ros34pw2, rodas3\n"
+                "  --solver S           krus (default), ros2, rk4, ros34pw2, rodas3, cvode (SUNDIALS BDF)\n"
                 "  --dt H               fixed step [s] (default 1e-4)\n"
                 "  --rtol R, --atol A   adaptive tolerances (default 1e-3, 1e-6)\n"
                 "  --jac-every N        fixed-step: new Jacobian every N steps (default 10)\n"

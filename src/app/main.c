@@ -19,6 +19,7 @@ static void usage(FILE* f) {
             "  run       run a scenario headless, faster than real time, to CSV (and a plot)\n"
             "  compare   run one scenario two ways (backends or solvers); error metrics, overlay plots\n"
             "  bench     real-time factors as JSON lines\n"
+            "  study     solver study: every integrator against a CVODE reference, work-precision plot\n"
             "  help      this text\n"
             "\n"
             "examples:\n"
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
     if (!strcmp(cmd, "bench")) return cmd_bench(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare")) return cmd_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "drive")) return cmd_drive(argc - 2, argv + 2);
+    if (!strcmp(cmd, "study")) return cmd_study(argc - 2, argv + 2);
     fprintf(stderr, "cranesim: unknown command '%s' (try cranesim help)\n", cmd);
     return EXIT_USAGE;
 }

@@ -7,6 +7,10 @@
 #include <string.h>
 #include <time.h>
 
+#ifdef CRANESIM_HAVE_CVODE
+#include "hyd_cvode.h"
+#endif
+
 const char* const sim_col_name[SIM_NCOL] = {
     "t", "x1", "x2", "p1A", "p1B", "p2A", "p2B", "u1", "u2", "q1", "q2",
     "tip_x", "tip_z", "F1", "F2", "u1_cmd", "u2_cmd",
@@ -29,6 +33,14 @@ sim_opts sim_default_opts(void) {
     o.jac_every = 10;
     o.load_mass = -1.0;
     return o;
+}
+
+bool sim_have_cvode(void) {
+#ifdef CRANESIM_HAVE_CVODE
+    return true;
+#else
+    return false;
+#endif
 }
 
 double sim_load_mass(const model* m, const scenario* sc, const sim_opts* o) {
@@ -146,7 +158,14 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     double y[LSIM_MAX_STATES];
     lsim_initial_state(&ls, sc->q0, 0.5e6, y);
 
-    const bool adaptive = hyd_method_is_adaptive(o->solver);
+    const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
+#ifndef CRANESIM_HAVE_CVODE
+    if (o->cvode) {
+        snprintf(res->message, sizeof res->message, "this build has no CVODE (install libsundials-dev)");
+        lsim_free(&ls);
+        return res->status = 2;
+    }
+#endif
     hyd_problem prob = lsim_problem(&ls, !adaptive && !o->dense_jac);
     hyd_solver_opts so = hyd_default_solver_opts();
     so.h = adaptive ? 0.0 : o->h;
@@ -154,8 +173,9 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     so.atol = o->atol;
     so.h_max = 0.5;
     so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
-    hyd_solver* s = hyd_solver_create(&prob, o->solver, &so);
-    if (!s) {
+    // CVODE brings its own integrator; the in-house one is not created then.
+    hyd_solver* s = o->cvode ? NULL : hyd_solver_create(&prob, o->solver, &so);
+    if (!s && !o->cvode) {
         snprintf(res->message, sizeof res->message, "cannot create the %s solver", hyd_method_name(o->solver));
         lsim_free(&ls);
         return res->status = 2;
@@ -175,6 +195,7 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     double bp[2 * SCENARIO_MAX_POINTS * SCENARIO_NCMD + SCENARIO_MAX_EVENTS + 2];
     int nbp = scenario_breakpoints(sc, bp, (int)(sizeof bp / sizeof bp[0]) - 1);
     double t = 0.0;
+    hyd_solver_stats cv = {0};
     double w0 = sim_wall_time();
     int rc = HYD_OK;
     emit(&c, 0.0, y);
@@ -182,12 +203,27 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
         double tb = i < nbp ? ceil(bp[i] / o->dt_out - 1e-9) * o->dt_out : t_end;
         if (tb > t_end) tb = t_end;
         if (tb <= t + 1e-12) continue;
-        hyd_solver_reset(s);
-        rc = hyd_solver_integrate(s, t, y, tb, o->dt_out, emit, &c);
+        if (s) hyd_solver_reset(s);
+#ifdef CRANESIM_HAVE_CVODE
+        if (o->cvode) {
+            hyd_cvode_opts co = hyd_cvode_default_opts();
+            co.rtol = o->rtol;
+            co.atol = o->atol;
+            co.h_max = 0.5;
+            hyd_solver_stats cs = {0};
+            rc = hyd_cvode_integrate(&prob, &co, t, y, tb, o->dt_out, emit, &c, &cs);
+            cv.steps += cs.steps;
+            cv.rejected += cs.rejected;
+            cv.fevals += cs.fevals;
+            cv.jevals += cs.jevals;
+            cv.lus += cs.lus;
+        } else
+#endif
+            rc = hyd_solver_integrate(s, t, y, tb, o->dt_out, emit, &c);
         if (rc == HYD_OK && !c.stop) t = tb;
     }
     res->wall = sim_wall_time() - w0;
-    res->stats = *hyd_solver_get_stats(s);
+    res->stats = o->cvode ? cv : *hyd_solver_get_stats(s);
     res->rows = c.rows;
     res->t_end = c.t_last_row;
     char nb[96];
@@ -196,22 +232,22 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
         snprintf(res->message, sizeof res->message,
                  "numerical blow-up: state %s = %.4g Pa (below absolute zero) at t = %.6g s (solver %s, h = %g s)",
                  state_name(&ls, c.bad_state, nb, sizeof nb), c.bad_value, c.bad_t, hyd_method_name(o->solver),
-                 adaptive ? hyd_solver_last_h(s) : o->h);
+                 adaptive && s ? hyd_solver_last_h(s) : o->h);
     } else if (c.stop) {
         res->status = 2;
         snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c.t_last_row);
     } else if (rc != HYD_OK) {
         res->status = 1;
         double tb = c.t_last_row;
-        int bi = hyd_solver_bad_state(s, &tb);
+        int bi = s ? hyd_solver_bad_state(s, &tb) : -1;
         if (rc == HYD_ERR_NONFINITE && bi >= 0)
             snprintf(res->message, sizeof res->message,
                      "numerical blow-up: state %s became non-finite at t = %.6g s (solver %s, h = %g s)",
                      state_name(&ls, bi, nb, sizeof nb), tb, hyd_method_name(o->solver),
-                     adaptive ? hyd_solver_last_h(s) : o->h);
+                     adaptive && s ? hyd_solver_last_h(s) : o->h);
         else
             snprintf(res->message, sizeof res->message, "solver %s failed (code %d) near t = %.6g s",
-                     hyd_method_name(o->solver), rc, c.t_last_row);
+                     o->cvode ? "cvode" : hyd_method_name(o->solver), rc, c.t_last_row);
     }
     hyd_solver_destroy(s);
     lsim_free(&ls);

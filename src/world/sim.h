@@ -28,7 +28,12 @@ typedef struct sim_opts {
     bool dense_jac;    ///< fixed-step methods: dense J instead of the block pattern
     int jac_every;     ///< fixed-step methods: J every N steps (default 10)
     double load_mass;  ///< tip load [kg]; < 0: the scenario's, else the model's
+    bool cvode;        ///< integrate with SUNDIALS CVODE (BDF) instead of `solver`
+                       ///< (the outside reference; rtol/atol apply)
 } sim_opts;
+
+/// True when this build has the CVODE reference solver.
+bool sim_have_cvode(void);
 
 /// The tip load a run uses [kg]: the option, else the scenario's, else the model's.
 double sim_load_mass(const model* m, const scenario* sc, const sim_opts* o);
