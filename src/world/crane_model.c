@@ -72,6 +72,8 @@ void crane_mech_derive(crane_mech* m) {
         // Wrap to (-pi, pi]: only cos(phi) and sin(phi) are used.
         off = atan2(sin(off), cos(off));
         a->phi_offset = off;
+        a->sin_offset = sin(off);
+        a->cos_offset = cos(off);
     }
 }
 

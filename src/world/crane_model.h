@@ -44,6 +44,8 @@ typedef struct crane_actuator {
     double a;          ///< |base_mount| [m]
     double b;          ///< |rod_mount| [m]
     double phi_offset; ///< phi - q_joint [rad]
+    double sin_offset; ///< sin(phi_offset), cos(phi_offset): phi by addition identities
+    double cos_offset;
 } crane_actuator;
 
 /// Mechanical parameters of the crane (read-only during a step).

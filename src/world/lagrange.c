@@ -18,6 +18,12 @@ int lagrange_variant_parse(const char* s) {
 
 void lagrange_eval_terms(const crane_mech* m, lagrange_variant v, double m3, const double q[2],
                          const double qd[2], lagrange_terms* o) {
+    const double trig[4] = {sin(q[0]), cos(q[0]), sin(q[1]), cos(q[1])};
+    lagrange_eval_terms_trig(m, v, m3, trig, qd, o);
+}
+
+void lagrange_eval_terms_trig(const crane_mech* m, lagrange_variant v, double m3, const double trig[4],
+                              const double qd[2], lagrange_terms* o) {
     const double g = m->gravity;
     const double L1 = m->link[0].length, L2 = m->link[1].length;
     const double m1 = m->link[0].mass, m2 = m->link[1].mass;
@@ -27,8 +33,8 @@ void lagrange_eval_terms(const crane_mech* m, lagrange_variant v, double m3, con
     const double I2 = v == LAGRANGE_FULL ? m->link[1].inertia : 0.0;
 
     // One sincos pair per angle; sin/cos(q1 + q2) by the addition identities.
-    const double s1 = sin(q[0]), c1 = cos(q[0]);
-    const double s2 = sin(q[1]), c2 = cos(q[1]);
+    const double s1 = trig[0], c1 = trig[1];
+    const double s2 = trig[2], c2 = trig[3];
     const double s12 = s1 * c2 + c1 * s2, c12 = c1 * c2 - s1 * s2;
 
     const double mu = m2 * e2 + m3 * L2; // first moment of end arm + load about joint 2 [kg m]

@@ -35,6 +35,11 @@ typedef struct lagrange_terms {
 void lagrange_eval_terms(const crane_mech* m, lagrange_variant v, double m3, const double q[2],
                          const double qd[2], lagrange_terms* out);
 
+/// Same, with sin/cos of q1 and q2 given (trig = {sin q1, cos q1, sin q2, cos q2}),
+/// so a caller that also needs them for the cylinders computes them once.
+void lagrange_eval_terms_trig(const crane_mech* m, lagrange_variant v, double m3, const double trig[4],
+                              const double qd[2], lagrange_terms* out);
+
 /// Accelerations qdd = H^-1 (tau - C - G) [rad/s^2].
 void lagrange_accel(const lagrange_terms* t, const double tau[2], double qdd[2]);
 

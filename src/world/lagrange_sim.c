@@ -125,11 +125,14 @@ typedef struct kin {
     double x[2], v[2], r[2], dr[2];
 } kin;
 
-static void cylinder_kinematics(const crane_mech* me, const double* q, const double* qd, kin* k) {
+// trig = {sin q1, cos q1, sin q2, cos q2}; phi = q + phi_offset by the
+// addition identities, so the whole rhs needs only the two sincos of q.
+static void cylinder_kinematics(const crane_mech* me, const double* trig, const double* qd, kin* k) {
     for (int i = 0; i < 2; ++i) {
         const crane_actuator* a = &me->act[i];
-        const double phi = q[i] + a->phi_offset;
-        const double sp = sin(phi), cp = cos(phi);
+        const double so = a->sin_offset, co = a->cos_offset;
+        const double sq = trig[2 * i], cq = trig[2 * i + 1];
+        const double sp = sq * co + cq * so, cp = cq * co - sq * so;
         const double ab = a->a * a->b;
         const double xp = sqrt(a->a * a->a + a->b * a->b - 2.0 * ab * cp); // paper Eq. 5
         const double r = ab * sp / xp;                                      // dx/dphi
@@ -155,8 +158,9 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt) {
     const int nh = s->nh, iq = s->iq;
     const double* q = y + iq;
     const double* qd = y + iq + 2;
+    const double trig[4] = {sin(q[0]), cos(q[0]), sin(q[1]), cos(q[1])};
     kin k;
-    cylinder_kinematics(me, q, qd, &k);
+    cylinder_kinematics(me, trig, qd, &k);
     set_inputs(s, t, &k);
     for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i];
     hyd_eval(s->mdl->hyd, s->hd, t, s->yh_, s->fh_);
@@ -164,7 +168,7 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt) {
 
     const double tau[2] = {s->hd->cyl_F[s->mdl->cyl[0]] * k.r[0], s->hd->cyl_F[s->mdl->cyl[1]] * k.r[1]};
     lagrange_terms lt;
-    lagrange_eval_terms(me, s->variant, s->m3, q, qd, &lt);
+    lagrange_eval_terms_trig(me, s->variant, s->m3, trig, qd, &lt);
     double qdd[2];
     lagrange_accel(&lt, tau, qdd);
     for (int j = 0; j < 2; ++j) {
@@ -182,8 +186,9 @@ int lsim_jac(void* user, double t, const double* y, double* J) {
     const int nh = s->nh, n = s->n, iq = s->iq;
     const double* q = y + iq;
     const double* qd = y + iq + 2;
+    const double trig[4] = {sin(q[0]), cos(q[0]), sin(q[1]), cos(q[1])};
     kin k;
-    cylinder_kinematics(me, q, qd, &k);
+    cylinder_kinematics(me, trig, qd, &k);
     set_inputs(s, t, &k);
     for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i];
     hyd_data* d = s->hd;
@@ -261,7 +266,8 @@ void lsim_initial_state(lsim* s, const double q0[2], double p_low, double* y) {
     y[s->iq + 1] = q0[1];
     y[s->iq + 2] = y[s->iq + 3] = 0.0;
     kin k;
-    cylinder_kinematics(&s->mdl->mech, q0, qd0, &k);
+    const double trig[4] = {sin(q0[0]), cos(q0[0]), sin(q0[1]), cos(q0[1])};
+    cylinder_kinematics(&s->mdl->mech, trig, qd0, &k);
     double G[2];
     lagrange_gravity(&s->mdl->mech, s->variant, s->m3, q0, G);
     for (int c = 0; c < 2; ++c) {
