@@ -5,14 +5,17 @@
 //   r(P)  = (p_a / P)^(1/n)                  (free-air volume per unit air at p_a)
 //   Be(P) = Be_l (1 + alpha r) / (1 + alpha Be_l r / (n P))
 // It tends to n P as P -> 0, so a node cannot be pushed through absolute zero
-// by a finite flow. Below P_LO the law is continued by an exponential that
-// matches value and slope, so an integrator that overshoots into P <= 0 still
+// by a finite flow. Below P_LO the law is continued by a tail that matches
+// value and slope, so an integrator that overshoots into P <= 0 still
 // gets a positive, C1 modulus instead of pow() of a negative number (NaN).
+// The continuation is rational, Be_lo^2 / (Be_lo + Be'_lo (P_LO - P)): it
+// matches value and slope at P_LO and decays like 1/|P| without underflowing
+// to 0 (a zero modulus would freeze the node).
 #include "hyd_internal.h"
 
 #include <math.h>
 
-/// Below this absolute pressure [Pa] Be is continued exponentially (see above).
+/// Below this absolute pressure [Pa] Be is continued by a rational tail (see above).
 #define HYD_BE_P_LO 100.0
 
 hyd_fluid_def hyd_default_fluid_def(void) {
@@ -57,12 +60,12 @@ static double be_eval(double alpha, double inv_n, double pa, double bel, double 
             *dbe = d;
         return be;
     }
-    // C1 exponential continuation below P_LO: Be = Be_lo exp(k (P - P_LO)).
+    // C1 rational continuation below P_LO (see the file comment).
     const double be_lo = be_law(alpha, inv_n, pa, bel, HYD_BE_P_LO, &d);
-    const double k = d / be_lo;
-    const double be = be_lo * exp(k * (P - HYD_BE_P_LO));
+    const double den = be_lo + d * (HYD_BE_P_LO - P);
+    const double be = be_lo * be_lo / den;
     if (dbe)
-        *dbe = k * be;
+        *dbe = be * d / den;
     return be;
 }
 

@@ -104,10 +104,25 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
             hyd_model* alone = hyd_model_from_json(hydraulics, mfile, "hydraulics", e2, sizeof e2);
             if (alone) {
                 hyd_model_free(alone);
+                // Re-address "hydraulics.<list>[i].field: problem" to the
+                // world file's own list index when i is past the model's items.
                 char inner[256];
                 snprintf(inner, sizeof inner, "%s", err);
                 const char* wf = w->desc.file[0] ? w->desc.file : "world";
-                snprintf(err, errsz, "%s: circuit: merged with the model's circuit: %s", wf, inner);
+                static const char* const lists[2] = {"nodes", "components"};
+                int done = 0;
+                for (int l = 0; l < 2 && !done; ++l) {
+                    char key[48];
+                    snprintf(key, sizeof key, "hydraulics.%s[", lists[l]);
+                    const char* at = strstr(inner, key);
+                    const cJSON* ml = cJSON_GetObjectItemCaseSensitive(hydraulics, lists[l]);
+                    int nmodel = ml ? cJSON_GetArraySize(ml) : 0, idx = -1, used = 0;
+                    if (at && sscanf(at + strlen(key), "%d]%n", &idx, &used) == 1 && used > 0 && idx >= nmodel) {
+                        snprintf(err, errsz, "%s: circuit.%s[%d]%s", wf, lists[l], idx - nmodel, at + strlen(key) + used);
+                        done = 1;
+                    }
+                }
+                if (!done) snprintf(err, errsz, "%s: circuit: merged with the model's circuit: %s", wf, inner);
             }
         }
         return -1;
@@ -252,10 +267,13 @@ int ow_hyd_step(ode_world* w, double H) {
             return -1;
         }
         // Force at the end of the sub-step (the solver's last f call was at a
-        // stage point, not at the new state).
-        rhs(w, w->th, w->y, ydot);
-        for (int k = 0; k < ODE_NACT; ++k)
-            if (w->act[k].cyl >= 0) Fsum[k] += w->hd->cyl_F[w->act[k].cyl];
+        // stage point, not at the new state); only the last one is needed
+        // unless averaging.
+        if (w->opt.force_average || i == w->nsub - 1) {
+            rhs(w, w->th, w->y, ydot);
+            for (int k = 0; k < ODE_NACT; ++k)
+                if (w->act[k].cyl >= 0) Fsum[k] += w->hd->cyl_F[w->act[k].cyl];
+        }
     }
     w->hyd_steps += w->nsub;
     // Re-anchor hydraulic time on the step count so it never drifts from the

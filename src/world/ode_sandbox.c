@@ -157,7 +157,17 @@ static void build_truck(ode_world* w, const double T[3], const double R[9]) {
             char nm[32];
             snprintf(nm, sizeof nm, "outrigger_pad_%d", 2 * a + s);
             double pp[3] = {k->outrigger_x[a], y, 0.5 * k->pad[2]};
-            truck_box(w, nm, WORLD_ROLE_OUTRIGGER, RGBA_OUTRIGGER, WORLD_MESH_OUTRIGGER, k->pad, pp, 1);
+            truck_box(w, nm, WORLD_ROLE_OUTRIGGER, RGBA_OUTRIGGER, WORLD_MESH_OUTRIGGER, k->pad, pp, 0);
+            // The pad touches the ground through one sphere under its centre:
+            // four point contacts carry the truck as well as four boxes would
+            // (the support polygon is the same), with a quarter of the contact
+            // rows in the truck's island, which dominates the step cost.
+            double rs = 0.5 * k->pad[0];
+            double sp[3] = {pp[0] + w->truck_org[0], pp[1] + w->truck_org[1], rs + w->truck_org[2]};
+            dGeomID gs = dCreateSphere(w->dyn_space, rs);
+            dGeomSetBody(gs, w->truck);
+            dGeomSetOffsetPosition(gs, sp[0], sp[1], sp[2]);
+            ow_add_geom(w, gs, OW_CAT_TRUCK, k->friction);
             // Beam and leg, drawn only: the pad carries the contact.
             double half = 0.5 * k->outrigger_span - 0.5 * k->chassis[1];
             double bz = k->bed_height - k->chassis[2] + 0.1;
@@ -274,6 +284,18 @@ int ow_attach(ode_world* w, int attach) {
 
 // ---- loads and obstacles ----
 
+// Loose bodies (loads, movable boxes) sleep when at rest: a resting box costs
+// nothing in the solver and its ground contacts are not even computed
+// (near_cb). Anything enabled that touches it wakes it (ODE enables disabled
+// bodies joined to enabled ones). The crane, truck, rope and hook never sleep.
+static void allow_sleep(dBodyID b) {
+    dBodySetAutoDisableFlag(b, 1);
+    dBodySetAutoDisableLinearThreshold(b, 0.01);
+    dBodySetAutoDisableAngularThreshold(b, 0.01);
+    dBodySetAutoDisableSteps(b, 20);
+    dBodySetAutoDisableTime(b, 0);
+}
+
 static void build_loads(ode_world* w) {
     w->nload = w->desc.nload;
     for (int i = 0; i < w->nload; ++i) {
@@ -290,6 +312,7 @@ static void build_loads(ode_world* w) {
         dGeomSetBody(g, b);
         ow_add_geom(w, g, OW_CAT_LOAD, L->friction);
         ow_add_vis(w, L->name, WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, L->size, RGBA_LOAD, WORLD_MESH_LOAD, b, NULL, NULL);
+        allow_sleep(b);
         w->load[i] = b;
     }
 }
@@ -312,6 +335,7 @@ static void build_obstacles(ode_world* w) {
             dGeomSetBody(g, b);
             ow_add_geom(w, g, OW_CAT_OBST, o->friction);
             ow_add_vis(w, o->name, WORLD_ROLE_OBSTACLE, WORLD_SHAPE_BOX, o->size, col, mesh[o->kind], b, NULL, NULL);
+            allow_sleep(b);
             w->obst_body[i] = b;
         } else {
             dGeomID g = dCreateBox(w->static_space, o->size[0], o->size[1], o->size[2]);
@@ -376,6 +400,8 @@ static void near_cb(void* data, dGeomID g1, dGeomID g2) {
     if (!a || !b || !(collide_mask(a->cat) & b->cat)) return;
     dBodyID b1 = dGeomGetBody(g1), b2 = dGeomGetBody(g2);
     if (!b1 && !b2) return;
+    // Nothing to do between sleeping bodies and the static world.
+    if ((!b1 || !dBodyIsEnabled(b1)) && (!b2 || !dBodyIsEnabled(b2))) return;
     if (b1 && b2 && dAreConnectedExcluding(b1, b2, dJointTypeContact)) return;
     // Two frozen (kinematic) bodies cannot push each other.
     if ((!b1 || dBodyIsKinematic(b1)) && (!b2 || dBodyIsKinematic(b2))) return;
@@ -486,4 +512,30 @@ void ow_sandbox_snapshot(const ode_world* w, world_snapshot* s) {
             y->u = c->iu >= 0 ? w->y[c->iu] : 0;
         }
     }
+}
+
+static void set_rigid_vel(dBodyID b, const double tip[3], const double om[3]) {
+    const dReal* p = dBodyGetPosition(b);
+    double r[3] = {p[0] - tip[0], p[1] - tip[1], p[2] - tip[2]};
+    dBodySetLinearVel(b, om[1] * r[2] - om[2] * r[1], om[2] * r[0] - om[0] * r[2], om[0] * r[1] - om[1] * r[0]);
+    dBodySetAngularVel(b, om[0], om[1], om[2]);
+}
+
+void ode_world_swing_hook(ode_world* w, const double omega[3]) {
+    if (w->kind != WORLD_SANDBOX) return;
+    double tip[3], tl[3] = {w->mech.link[1].length, 0, 0};
+    ow_frame_point(w, 2, tl, tip);
+    for (int i = 0; i < w->nrope; ++i) set_rigid_vel(w->rope[i], tip, omega);
+    set_rigid_vel(w->hook, tip, omega);
+}
+
+void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, double* link_mass, double* hook_mass,
+                         double* hook_com, double* hook_inertia) {
+    const world_hook* h = &w->desc.hook;
+    *nlink = w->nrope;
+    *link_len = w->rope_len;
+    *link_mass = w->rope_mass;
+    *hook_mass = h->mass;
+    *hook_com = 0.5 * h->size[2];
+    *hook_inertia = h->mass * (h->size[0] * h->size[0] + h->size[2] * h->size[2]) / 12.0;
 }

@@ -41,7 +41,7 @@ ode_world_opts ode_world_default_opts(void) {
     o.stop_limits = 1;
     o.init_hold = 1;
     o.p_low = 2e6;
-    o.force_average = 1;
+    o.force_average = 0;
     o.model_file = "model";
     return o;
 }
@@ -306,6 +306,10 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
     dJointSetHingeAxis(w->j2, axis[0], axis[1], axis[2]);
     w->qoff[0] = q0[0];
     w->qoff[1] = q0[1];
+    for (int k = 0; k < 2; ++k) {
+        w->lim[k][0] = -dInfinity;
+        w->lim[k][1] = dInfinity;
+    }
 
     // Boom cylinders: mounts from crane_mech (planar x, z -> frame x, 0, z).
     for (int k = 0; k < 2; ++k) {
@@ -314,7 +318,11 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
         c->present = 1;
         c->parent = a->joint;      // joint 0: column -> lifting arm; joint 1: lifting arm -> end arm
         c->child = a->joint + 1;
-        c->base[0] = a->base_mount[0], c->base[1] = 0, c->base[2] = a->base_mount[1];
+        // Mounts are given relative to the joint they act across; the parent
+        // frame's origin is the previous joint (joint 1 for the lifting arm),
+        // so the jib's barrel pin shifts by L1 along the lifting arm.
+        double shift = a->joint == 1 ? me->link[0].length : 0.0;
+        c->base[0] = a->base_mount[0] + shift, c->base[1] = 0, c->base[2] = a->base_mount[1];
         c->rod[0] = a->rod_mount[0], c->rod[1] = 0, c->rod[2] = a->rod_mount[1];
         c->closed_length = a->closed_length;
         if (c->stroke > 0) {
@@ -332,6 +340,8 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
                 dJointSetHingeParam(j, dParamLoStop, lo);
                 dJointSetHingeParam(j, dParamHiStop, hi);
                 dJointSetHingeParam(j, dParamBounce, 0.0);
+                w->lim[k][0] = lo;
+                w->lim[k][1] = hi;
             }
         }
     }
@@ -340,18 +350,22 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
 
 // Stroke and rate of every actuator from the bodies' mount points (boom
 // cylinders) or the slew hinge (rack and pinion).
+static void boom_cyl_kinematics(const ode_world* w, const ow_act* c, double* x, double* v) {
+    double pb[3], pr[3], vb[3], vr[3];
+    ow_frame_point(w, c->parent, c->base, pb);
+    ow_frame_point(w, c->child, c->rod, pr);
+    ow_frame_point_vel(w, c->parent, c->base, vb);
+    ow_frame_point_vel(w, c->child, c->rod, vr);
+    double d[3] = {pr[0] - pb[0], pr[1] - pb[1], pr[2] - pb[2]};
+    double L = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    *x = L - c->closed_length;
+    *v = ((vr[0] - vb[0]) * d[0] + (vr[1] - vb[1]) * d[1] + (vr[2] - vb[2]) * d[2]) / L;
+}
+
 void ow_read_actuators(ode_world* w) {
     for (int k = 0; k < 2; ++k) {
         ow_act* c = &w->act[k];
-        double pb[3], pr[3], vb[3], vr[3];
-        ow_frame_point(w, c->parent, c->base, pb);
-        ow_frame_point(w, c->child, c->rod, pr);
-        ow_frame_point_vel(w, c->parent, c->base, vb);
-        ow_frame_point_vel(w, c->child, c->rod, vr);
-        double d[3] = {pr[0] - pb[0], pr[1] - pb[1], pr[2] - pb[2]};
-        double L = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        c->x = L - c->closed_length;
-        c->v = ((vr[0] - vb[0]) * d[0] + (vr[1] - vb[1]) * d[1] + (vr[2] - vb[2]) * d[2]) / L;
+        boom_cyl_kinematics(w, c, &c->x, &c->v);
         dJointID j = k ? w->j2 : w->j1;
         double ang = dJointGetHingeAngle(j);
         double lo = dJointGetHingeParam(j, dParamLoStop), hi = dJointGetHingeParam(j, dParamHiStop);
@@ -650,8 +664,15 @@ void ode_world_get_state(const ode_world* w, ode_world_state* s) {
     for (int k = 0; k < ODE_NACT; ++k) {
         const ow_act* c = &w->act[k];
         if (!c->present) continue;
-        s->x[k] = c->x;
-        s->v[k] = c->v;
+        // Strokes fresh from the current body poses (act[].x is the value
+        // the last step started from).
+        if (k < 2) {
+            boom_cyl_kinematics(w, c, &s->x[k], &s->v[k]);
+        } else if (w->slew_joint) {
+            double r = w->desc.slew.pinion_radius;
+            s->x[k] = 0.5 * c->stroke + r * (dJointGetHingeAngle(w->slew_joint) + w->slew_off);
+            s->v[k] = r * dJointGetHingeAngleRate(w->slew_joint);
+        }
         s->F[k] = c->F;
         s->u_cmd[k] = w->u_cmd[k];
         if (w->hm && c->cyl >= 0) {
@@ -828,4 +849,21 @@ void ode_world_snapshot(const ode_world* w, world_snapshot* s) {
             if (hyd_model_comp_type(w->hm, i) == HYD_RELIEF && w->hd->comp_open[i]) s->main_relief_open = 1;
     }
     if (w->kind == WORLD_SANDBOX) ow_sandbox_snapshot(w, s);
+}
+
+void ode_world_lock_booms(ode_world* w, int lock) {
+    dJointID j[2] = {w->j1, w->j2};
+    for (int k = 0; k < 2; ++k) {
+        // Set hi before lo (or lo before hi) so ODE never sees lo > hi.
+        if (lock) {
+            double a = dJointGetHingeAngle(j[k]);
+            dJointSetHingeParam(j[k], dParamLoStop, -dInfinity);
+            dJointSetHingeParam(j[k], dParamHiStop, a);
+            dJointSetHingeParam(j[k], dParamLoStop, a);
+        } else {
+            dJointSetHingeParam(j[k], dParamLoStop, -dInfinity);
+            dJointSetHingeParam(j[k], dParamHiStop, w->lim[k][1]);
+            dJointSetHingeParam(j[k], dParamLoStop, w->lim[k][0]);
+        }
+    }
 }

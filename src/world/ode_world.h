@@ -41,7 +41,7 @@ typedef struct ode_world_opts {
     double dt_ode;        ///< ODE step [s]; default 1e-3
     double dt_hyd;        ///< hydraulic sub-step [s]; default 1e-4; dt_ode must be a whole multiple
     hyd_method solver;    ///< hydraulic integrator (fixed-step use); default HYD_KRUS
-    int jac_every;        ///< reuse the hydraulic Jacobian for this many sub-steps; default 10
+    int jac_every;        ///< reuse the hydraulic Jacobian for this many sub-steps; default 10 (1 ms of J age at 0.1 ms; SPEC 3.3 allows up to 10 ms)
     double q0[2];         ///< initial joint angles q1, q2 [rad], paper convention; default 95, -130 deg
     double slew0;         ///< initial slew angle [rad]; default 0
     double load_mass;     ///< validation world: tip mass [kg]; < 0 (default) uses mech->load_mass
@@ -49,7 +49,7 @@ typedef struct ode_world_opts {
     int stop_limits;      ///< 1 (default): cylinder end stops as ODE hinge limits; 0: none
     int init_hold;        ///< 1 (default): initial chamber pressures hold the crane still
     double p_low;         ///< init_hold: pressure of the unloaded chamber side [Pa abs]; default 2e6
-    int force_average;    ///< 1 (default): apply the mean sub-step force; 0: the last one
+    int force_average;    ///< 0 (default): apply the force at the end of the sub-steps (symplectic, stable); 1: their mean (unstable for light booms, see docs/ode_world.md)
     const char* model_file; ///< name used in circuit error messages; default "model"
 } ode_world_opts;
 
@@ -130,6 +130,10 @@ void ode_world_set_joint_torques(ode_world* w, const double tau[2]);
 /// 1: freeze the truck, column and booms (kinematic, at rest) so only rope,
 /// hook and loads move; 0: release them.
 void ode_world_hold_crane(ode_world* w, int hold);
+/// 1: lock both boom hinges at their current angles (hinge stops lo = hi),
+/// as if the load-holding valves were shut on an incompressible column, to
+/// study the truck's stability alone; 0: restore the stroke-derived limits.
+void ode_world_lock_booms(ode_world* w, int lock);
 /// Mechanical energy of all dynamic bodies [J]: kinetic (translation and
 /// rotation) plus gravitational potential relative to z = 0.
 double ode_world_energy(const ode_world* w);
@@ -140,6 +144,10 @@ void ode_world_set_joint_rates(ode_world* w, const double qd[2]);
 /// about its COM about the body y axis [kg m^2].
 void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, double* link_mass,
                          double* hook_mass, double* hook_com, double* hook_inertia);
+/// Set rope links and hook moving as one rigid body rotating with angular
+/// velocity omega [rad/s] (world axes) about the end-arm tip pin: starts a
+/// clean pendulum swing (sandbox only).
+void ode_world_swing_hook(ode_world* w, const double omega[3]);
 /// Per-step hydraulic sub-steps taken since create (for benchmarks).
 long ode_world_hyd_steps(const ode_world* w);
 

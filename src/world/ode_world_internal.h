@@ -92,6 +92,7 @@ struct ode_world {
     ow_frame frame[3];
     dJointID slew_joint, j1, j2, column_fix;
     double qoff[2];      ///< q = hinge angle + qoff [rad]
+    double lim[2][2];    ///< stroke-derived hinge stops lo, hi [rad] (+-dInfinity if none)
     double slew_off;     ///< slew = hinge angle + slew_off [rad]
     double tau_extra[2]; ///< test torques [N m]
     ow_act act[ODE_NACT];

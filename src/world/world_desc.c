@@ -44,7 +44,7 @@ void world_desc_default(world_desc* w, world_kind kind) {
     w->ode.erp = 0.2;
     w->ode.cfm = 1e-10;
     w->ode.contact_erp = 0.2;
-    w->ode.contact_cfm = 1e-8;
+    w->ode.contact_cfm = 1e-5;
     w->ode.surface_layer = 0.5e-3;
     w->ode.max_contacts = 8;
 
@@ -80,8 +80,8 @@ void world_desc_default(world_desc* w, world_kind kind) {
     w->slew.column_radius = 0.16;
     w->slew.damping = 2000.0;
 
-    w->rope.length = 2.0;
-    w->rope.links = 6;
+    w->rope.length = 1.2;
+    w->rope.links = 4;
     w->rope.radius = 0.012;
     w->rope.mass_per_m = 0.6;
 

@@ -3,7 +3,7 @@
 // chamber pressures, a pump line, and two joints. Not a test (tests never time
 // anything); run by hand:  ./bench_solver [seconds_simulated]
 // Prints ns per step for each Jacobian strategy.
-#define _POSIX_C_SOURCE 199309L
+
 #include "hyd_solver.h"
 
 #include <math.h>
