@@ -64,7 +64,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         model_free(m);
         return EXIT_USAGE;
     }
-    sim_csv_header(f);
+    sim_csv_header(f, SIM_NCOL_BASE);
     printf("cranesim drive: %s: driving %s headless in real time for %.1f s\n", why, m->name, duration);
     printf("  operator input: scripted (%s), %.0f frames/s, solver %s h = %g ms\n", sc.name, frame_rate,
            hyd_method_name(c->sim.solver), c->sim.h * 1e3);
@@ -84,7 +84,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
             break;
         }
         live_row(l, row);
-        sim_csv_row(f, row);
+        sim_csv_row(f, row, SIM_NCOL_BASE);
         double we = sim_wall_time();
         busy += we - ws;
         worst = fmax(worst, we - ws);

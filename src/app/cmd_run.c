@@ -15,6 +15,8 @@ static void run_help(FILE* f) {
             "  v1,v2,p_pump,relief_open,end_stop\n"
             "(x: cylinder strokes, p: absolute chamber pressures, u: spool openings,\n"
             " q: joint angles in the paper's convention, tip: end-arm tip from joint 1, F: forces)\n"
+            "With --mechanics ode also: slew,hook_x,hook_y,hook_z,load_x,load_y,load_z,attached,\n"
+            "  truck_tilt,contacts,max_depth (world frame, m, rad)\n"
             "\n"
             "options:\n"
             "  --out FILE           CSV output (default run.csv)\n"
@@ -28,11 +30,12 @@ static void run_help(FILE* f) {
 typedef struct csv_sink {
     FILE* f;
     long rows;
+    int ncol;
 } csv_sink;
 
 static int csv_row(void* user, const double* row) {
     csv_sink* s = user;
-    sim_csv_row(s->f, row);
+    sim_csv_row(s->f, row, s->ncol);
     // Flush about once a simulated second at 1 kHz, so a crash or a kill
     // keeps nearly everything already computed.
     if (++s->rows % 1000 == 0) fflush(s->f);
@@ -54,9 +57,13 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
            lagrange_variant_name(o->variant), o->cvode ? "cvode" : hyd_method_name(o->solver));
     if (o->cvode || hyd_method_is_adaptive(o->solver)) printf(" (rtol %g, atol %g)\n", o->rtol, o->atol);
     else printf(" (h = %g ms)\n", o->h * 1e3);
-    printf("  simulated %.3f s in %.3f s wall: %.0fx real time; %ld steps, %ld rejected, %ld f evals, %ld LU\n",
-           r->t_end, r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, r->stats.steps, r->stats.rejected,
-           r->stats.fevals, r->stats.lus);
+    if (o->mechanics == SIM_ODE)
+        printf("  simulated %.3f s in %.3f s wall: %.0fx real time; ODE step %g ms, %ld hydraulic sub-steps\n",
+               r->t_end, r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, o->dt_ode * 1e3, r->stats.steps);
+    else
+        printf("  simulated %.3f s in %.3f s wall: %.0fx real time; %ld steps, %ld rejected, %ld f evals, %ld LU\n",
+               r->t_end, r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, r->stats.steps, r->stats.rejected,
+               r->stats.fevals, r->stats.lus);
     printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
            1e3 * xmax[1]);
     printf("  peak pressures: p1A %.2f, p1B %.2f, p2A %.2f, p2B %.2f MPa (absolute)\n", pmax[0] * 1e-6,
@@ -96,7 +103,8 @@ int cmd_run(int argc, char** argv) {
         model_free(m);
         return EXIT_USAGE;
     }
-    sim_csv_header(sink.f);
+    sink.ncol = sim_ncol(&c.sim);
+    sim_csv_header(sink.f, sink.ncol);
     sim_trace tr = {0};
     sim_result res;
     sim_run(m, &sc, &c.sim, csv_row, &sink, &tr, c.quiet ? NULL : app_progress, NULL, &res);

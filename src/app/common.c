@@ -44,7 +44,7 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
     }
     static const char* const with_value[] = {"--model", "--scenario", "--mechanics", "--variant", "--solver",
                                              "--dt", "--rtol", "--atol", "--duration", "--every",
-                                             "--set", "--jac-every", "--load", NULL};
+                                             "--set", "--jac-every", "--load", "--world", "--dt-ode", NULL};
     int k = -1;
     for (int j = 0; with_value[j]; ++j)
         if (!strcmp(a, with_value[j])) k = j;
@@ -116,6 +116,8 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
         }
         c->sim.load_mass = d;
         break;
+    case 13: c->sim.world = v; break;
+    case 14: if (positive(a, v, &c->sim.dt_ode)) return -1; break;
     }
     return 1;
 }
@@ -128,7 +130,9 @@ void app_common_help(FILE* f, bool with_solver) {
             "                       or --set hydraulics.components.lift_cyl.bore=0.11 (repeatable)\n"
             "  --load KG            tip load [kg] (default: the scenario's, else the model's)\n"
             "  --mechanics M        lagrange (analytic 2-DOF, default) or ode\n"
-            "  --variant V          lagrange equations: full (default), paper, paper-typo\n");
+            "  --variant V          lagrange equations: full (default), paper, paper-typo\n"
+            "  --world W            ode: world file or name: validation (default for run), sandbox\n"
+            "  --dt-ode H           ode: rigid-body step [s] (default 1e-3; hydraulics sub-step at --dt)\n");
     if (with_solver)
         fprintf(f,
                 "  --solver S           krus (default), ros2, rk4, ros34pw2, rodas3, cvode (SUNDIALS BDF)\n"

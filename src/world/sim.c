@@ -10,15 +10,19 @@
 #ifdef CRANESIM_HAVE_CVODE
 #include "hyd_cvode.h"
 #endif
+#include "ode_world.h"
 
 const char* const sim_col_name[SIM_NCOL] = {
     "t", "x1", "x2", "p1A", "p1B", "p2A", "p2B", "u1", "u2", "q1", "q2",
     "tip_x", "tip_z", "F1", "F2", "u1_cmd", "u2_cmd",
-    "v1", "v2", "p_pump", "relief_open", "end_stop"};
+    "v1", "v2", "p_pump", "relief_open", "end_stop",
+    "slew", "hook_x", "hook_y", "hook_z", "load_x", "load_y", "load_z", "attached", "truck_tilt", "contacts",
+    "max_depth"};
 const char* const sim_col_unit[SIM_NCOL] = {
     "s", "m", "m", "Pa", "Pa", "Pa", "Pa", "-", "-", "rad", "rad",
     "m", "m", "N", "N", "-", "-",
-    "m/s", "m/s", "Pa", "count", "bits"};
+    "m/s", "m/s", "Pa", "count", "bits",
+    "rad", "m", "m", "m", "m", "m", "m", "index", "rad", "count", "m"};
 
 sim_opts sim_default_opts(void) {
     sim_opts o;
@@ -32,6 +36,7 @@ sim_opts sim_default_opts(void) {
     o.dt_out = 1e-3;
     o.jac_every = 10;
     o.load_mass = -1.0;
+    o.dt_ode = 1e-3;
     return o;
 }
 
@@ -72,15 +77,24 @@ static int trace_push(sim_trace* tr, const double* row) {
     return 0;
 }
 
-void sim_csv_header(FILE* f) {
-    for (int c = 0; c < SIM_NCOL; ++c) fprintf(f, "%s%s", c ? "," : "", sim_col_name[c]);
+int sim_ncol(const sim_opts* o) { return o->mechanics == SIM_ODE ? SIM_NCOL : SIM_NCOL_BASE; }
+
+void sim_csv_header(FILE* f, int ncol) {
+    for (int c = 0; c < ncol; ++c) fprintf(f, "%s%s", c ? "," : "", sim_col_name[c]);
     fputc('\n', f);
 }
 
-void sim_csv_row(FILE* f, const double* row) {
+void sim_csv_row(FILE* f, const double* row, int ncol) {
     // %.9g keeps 1e-9 relative precision: sub-micrometre strokes, mPa pressures.
-    for (int c = 0; c < SIM_NCOL; ++c) fprintf(f, "%s%.9g", c ? "," : "", row[c]);
+    for (int c = 0; c < ncol; ++c) fprintf(f, "%s%.9g", c ? "," : "", row[c]);
     fputc('\n', f);
+}
+
+const char* sim_world_path(const char* arg, char* buf, size_t n) {
+    if (!arg) arg = "validation";
+    if (strchr(arg, '/') || strstr(arg, ".json")) return arg;
+    snprintf(buf, n, "%s/worlds/%s.json", model_assets_dir(), arg);
+    return buf;
 }
 
 typedef struct run_ctx {
@@ -102,6 +116,8 @@ typedef struct run_ctx {
 // bulk modulus makes absolute zero a barrier the exact solution never
 // crosses, so only an unstable integration lands there. Treat it like NaN.
 static const double P_IMPLAUSIBLE = -1e6;
+
+static int deliver(run_ctx* c, const double* row);
 
 static int emit(void* user, double t, const double* y) {
     run_ctx* c = user;
@@ -125,6 +141,12 @@ static int emit(void* user, double t, const double* y) {
         t, o.x[0], o.x[1], o.pA[0], o.pB[0], o.pA[1], o.pB[1], o.u[0], o.u[1], o.q[0], o.q[1],
         o.tip[0], o.tip[1], o.F[0], o.F[1], o.u_cmd[0], o.u_cmd[1],
         o.v[0], o.v[1], o.p_pump, o.relief_open, o.end_stop};
+    return deliver(c, row);
+}
+
+// Hand a finished row to the trace, the row callback and the progress bar.
+static int deliver(run_ctx* c, const double* row) {
+    const double t = row[COL_T];
     if (c->trace && trace_push(c->trace, row)) return (c->stop = 2);
     if (c->row_fn && c->row_fn(c->row_user, row)) return (c->stop = 2);
     if (c->progress) {
@@ -144,12 +166,124 @@ static const char* state_name(const lsim* ls, int i, char* buf, size_t n) {
     return buf;
 }
 
+// One CSV row from the ode world's state.
+static void ode_row(ode_world* w, double* row) {
+    ode_world_state st;
+    ode_world_get_state(w, &st);
+    const double v[SIM_NCOL] = {
+        st.t, st.x[0], st.x[1], st.pA[0], st.pB[0], st.pA[1], st.pB[1], st.u[0], st.u[1], st.q[0], st.q[1],
+        st.tip[0], st.tip[1], st.F[0], st.F[1], st.u_cmd[0], st.u_cmd[1],
+        st.v[0], st.v[1], st.p_pump, st.relief_open, st.end_stop,
+        st.slew, st.hook[0], st.hook[1], st.hook[2], 0, 0, 0, st.attached, st.truck_tilt, st.ncontact,
+        st.max_depth};
+    memcpy(row, v, sizeof v);
+    // The attached load, else the first one: where the payload is.
+    int li = st.attached >= 0 ? st.attached : (ode_world_nload(w) > 0 ? 0 : -1);
+    if (li >= 0) {
+        double pos[3], vel[3];
+        ode_world_load_state(w, li, pos, vel);
+        row[COL_LOAD_X] = pos[0];
+        row[COL_LOAD_Y] = pos[1];
+        row[COL_LOAD_Z] = pos[2];
+    }
+}
+
+static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ctx* c, sim_result* res) {
+    if (o->cvode || hyd_method_is_adaptive(o->solver)) {
+        snprintf(res->message, sizeof res->message,
+                 "--mechanics ode sub-steps the hydraulics with a fixed-step method: use --solver krus, ros2 or rk4");
+        return res->status = 2;
+    }
+    char wbuf[512];
+    const char* wpath = sim_world_path(o->world, wbuf, sizeof wbuf);
+    world_desc wd;
+    if (world_desc_load(wpath, &wd, res->message, sizeof res->message)) return res->status = 2;
+    ode_world_opts wo = ode_world_default_opts();
+    wo.dt_ode = o->dt_ode > 0 ? o->dt_ode : 1e-3;
+    wo.dt_hyd = o->h < wo.dt_ode ? o->h : wo.dt_ode;
+    const double ratio = wo.dt_ode / wo.dt_hyd;
+    if (fabs(ratio - floor(ratio + 0.5)) > 1e-6) {
+        snprintf(res->message, sizeof res->message,
+                 "--dt %g s must divide the ODE step %g s (hydraulic sub-steps)", wo.dt_hyd, wo.dt_ode);
+        world_desc_free(&wd);
+        return res->status = 2;
+    }
+    wo.solver = o->solver;
+    wo.jac_every = o->jac_every > 0 ? o->jac_every : 1;
+    wo.q0[0] = sc->q0[0];
+    wo.q0[1] = sc->q0[1];
+    wo.slew0 = sc->slew0;
+    wo.load_mass = sim_load_mass(m, sc, o);
+    wo.p_low = 0.5e6; // as the lagrange backend, so both start from the same state
+    wo.model_file = m->file;
+    const cJSON* hyd = cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics");
+    ode_world* w = ode_world_create(&m->mech, hyd, &wd, &wo, res->message, sizeof res->message);
+    world_desc_free(&wd);
+    if (!w) return res->status = 2;
+
+    const double dt = ode_world_dt(w);
+    const long nstep = (long)floor(c->t_end / dt + 0.5);
+    long nout = (long)floor(o->dt_out / dt + 0.5);
+    if (nout < 1) nout = 1;
+    double row[SIM_NCOL];
+    int ev = 0;
+    double w0 = sim_wall_time();
+    ode_row(w, row);
+    deliver(c, row);
+    ++c->rows;
+    for (long i = 0; i < nstep && !c->stop; ++i) {
+        const double t = (double)i * dt;
+        // Commands at the step's midpoint: second-order accurate for ramps,
+        // and steps land within half an ODE step of their time.
+        const double tm = t + 0.5 * dt;
+        const double u[3] = {scenario_command(sc, 0, tm), scenario_command(sc, 1, tm), scenario_command(sc, 2, tm)};
+        ode_world_set_commands(w, u);
+        while (ev < sc->nevent && sc->event[ev].t <= tm) {
+            ode_world_hook(w, sc->event[ev].kind == SCENARIO_ATTACH);
+            ++ev;
+        }
+        if (ode_world_step(w, dt)) {
+            res->status = 1;
+            snprintf(res->message, sizeof res->message, "numerical blow-up: %s", ode_world_error(w));
+            break;
+        }
+        if ((i + 1) % nout && i + 1 != nstep) continue;
+        ode_row(w, row);
+        row[COL_T] = (double)(i + 1) * dt; // exact grid times, no accumulated round-off
+        for (int k = COL_P1A; k <= COL_P2B; ++k) {
+            if (!(row[k] > P_IMPLAUSIBLE)) {
+                res->status = 1;
+                snprintf(res->message, sizeof res->message,
+                         "numerical blow-up: state %s = %.4g Pa (below absolute zero) at t = %.6g s (solver %s, "
+                         "h = %g s, ODE step %g s)",
+                         sim_col_name[k], row[k], row[COL_T], hyd_method_name(o->solver), wo.dt_hyd, dt);
+            }
+        }
+        if (res->status) break;
+        c->t_last_row = row[COL_T];
+        ++c->rows;
+        deliver(c, row);
+    }
+    res->wall = sim_wall_time() - w0;
+    res->stats.steps = ode_world_hyd_steps(w);
+    res->rows = c->rows;
+    res->t_end = c->t_last_row;
+    ode_world_destroy(w);
+    if (c->stop && !res->status) {
+        res->status = 2;
+        snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c->t_last_row);
+    }
+    return res->status;
+}
+
 int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
             sim_trace* trace, sim_progress_fn progress, void* progress_user, sim_result* res) {
     memset(res, 0, sizeof *res);
-    if (o->mechanics != SIM_LAGRANGE) {
-        snprintf(res->message, sizeof res->message, "the ode backend is not available in sim_run yet");
-        return res->status = 2;
+    if (o->mechanics == SIM_ODE) {
+        run_ctx c = {.o = o, .row_fn = row_fn, .row_user = row_user, .trace = trace, .progress = progress,
+                     .progress_user = progress_user, .t_end = o->duration > 0 ? o->duration : sc->duration,
+                     .bad_state = -1};
+        return run_ode(m, sc, o, &c, res);
     }
     lsim ls;
     double m3 = sim_load_mass(m, sc, o);

@@ -28,6 +28,8 @@ typedef struct sim_opts {
     bool dense_jac;    ///< fixed-step methods: dense J instead of the block pattern
     int jac_every;     ///< fixed-step methods: J every N steps (default 10)
     double load_mass;  ///< tip load [kg]; < 0: the scenario's, else the model's
+    const char* world; ///< ode: world file (NULL: assets/worlds/validation.json)
+    double dt_ode;     ///< ode: rigid-body step [s] (default 1e-3; hydraulics sub-step at h)
     bool cvode;        ///< integrate with SUNDIALS CVODE (BDF) instead of `solver`
                        ///< (the outside reference; rtol/atol apply)
 } sim_opts;
@@ -45,6 +47,10 @@ enum {
     COL_T, COL_X1, COL_X2, COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_U1, COL_U2, COL_Q1, COL_Q2,
     COL_TIP_X, COL_TIP_Z, COL_F1, COL_F2, COL_U1_CMD, COL_U2_CMD,
     COL_V1, COL_V2, COL_P_PUMP, COL_RELIEF_OPEN, COL_END_STOP,
+    SIM_NCOL_BASE, ///< columns every backend writes
+    // World extras, written by the ode backend only.
+    COL_SLEW = SIM_NCOL_BASE, COL_HOOK_X, COL_HOOK_Y, COL_HOOK_Z, COL_LOAD_X, COL_LOAD_Y, COL_LOAD_Z,
+    COL_ATTACHED, COL_TRUCK_TILT, COL_CONTACTS, COL_MAX_DEPTH,
     SIM_NCOL
 };
 extern const char* const sim_col_name[SIM_NCOL];
@@ -75,10 +81,17 @@ typedef void (*sim_progress_fn)(void* user, double t, double t_end);
 int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
             sim_trace* trace, sim_progress_fn progress, void* progress_user, sim_result* res);
 
-/// Write the CSV header line (column names) to f.
-void sim_csv_header(FILE* f);
-/// Write one row; full precision, C locale.
-void sim_csv_row(FILE* f, const double* row);
+/// Number of CSV columns a run with these options writes (base, or base plus
+/// the world extras for the ode backend).
+int sim_ncol(const sim_opts* o);
+/// Write the CSV header line (the first ncol column names) to f.
+void sim_csv_header(FILE* f, int ncol);
+/// Write one row of ncol values; full precision, C locale.
+void sim_csv_row(FILE* f, const double* row, int ncol);
+
+/// The world file a name resolves to: an existing path, or
+/// assets/worlds/<name>.json ("validation", "sandbox").
+const char* sim_world_path(const char* arg, char* buf, size_t n);
 
 /// Wall clock [s], monotonic.
 double sim_wall_time(void);

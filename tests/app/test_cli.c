@@ -150,6 +150,51 @@ static void test_blow_up_keeps_output(void) {
     CHECK(strstr(csv, "nan") == NULL && strstr(csv, "inf") == NULL, "non-finite values written");
 }
 
+static int files_equal(const char* a, const char* b) {
+    FILE* fa = fopen(a, "rb");
+    FILE* fb = fopen(b, "rb");
+    int eq = fa && fb;
+    while (eq) {
+        int ca = fgetc(fa), cb = fgetc(fb);
+        if (ca != cb) eq = 0;
+        if (ca == EOF || cb == EOF) break;
+    }
+    if (fa) fclose(fa);
+    if (fb) fclose(fb);
+    return eq;
+}
+
+// The sandbox (contacts, rope, hook events) run twice gives byte-identical CSV.
+static void test_ode_runs_are_deterministic(void) {
+    static char out[8192];
+    const char* args = "run --quiet --mechanics ode --world sandbox --scenario sandbox_pick_place --duration 6";
+    char a[512];
+    snprintf(a, sizeof a, "%s --out cli_det1.csv", args);
+    CHECK(run(a, out, sizeof out) == 0, "%s", out);
+    snprintf(a, sizeof a, "%s --out cli_det2.csv", args);
+    CHECK(run(a, out, sizeof out) == 0, "%s", out);
+    CHECK(files_equal("cli_det1.csv", "cli_det2.csv"), "two identical runs wrote different CSV");
+    static char csv[4096];
+    read_file("cli_det1.csv", csv, sizeof csv);
+    CHECK(strstr(csv, ",hook_x,hook_y,hook_z,") && strstr(csv, "truck_tilt"), "ode extras missing: %.300s", csv);
+}
+
+static void test_bad_world_and_compare_tolerance(void) {
+    static char out[8192];
+    int rc = run("run --quiet --mechanics ode --world " DATA "/missing_world.json --scenario ramp --out /dev/null", out,
+                 sizeof out);
+    CHECK(rc == 2 && strstr(out, "missing_world.json") && count_lines(out) == 1, "exit %d: %s", rc, out);
+    rc = run("run --quiet --mechanics ode --scenario ramp --solver rodas3 --out /dev/null", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "fixed-step"), "adaptive in ode mode: exit %d: %s", rc, out);
+    // compare fails (exit 1) when a difference exceeds the given tolerance.
+    rc = run("compare --quiet --scenario hold --duration 1 --solvers krus,ros2 --dts 1e-4,1e-3 --tol-pressure 1e-9",
+             out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "FAIL"), "compare beyond tolerance: exit %d: %s", rc, out);
+    rc = run("compare --quiet --scenario ramp --duration 4 --tol-stroke 0.5 --tol-pressure 1", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "x1") && strstr(out, "p2B"), "lagrange vs ode within tolerance: exit %d: %s", rc,
+          out);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_help_and_usage);
     RUN_TEST(test_bad_models);
@@ -157,5 +202,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_bad_set);
     RUN_TEST(test_csv_contract);
     RUN_TEST(test_blow_up_keeps_output);
+    RUN_TEST(test_ode_runs_are_deterministic);
+    RUN_TEST(test_bad_world_and_compare_tolerance);
     TEST_MAIN_END();
 }
