@@ -12,13 +12,19 @@
 #include <string.h>
 #include <time.h>
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 static void drive_help(FILE* f) {
     fprintf(f,
-            "usage: cranesim drive [--model M] [--headless] [--duration T] [--record FILE.csv] [--set P=V]\n"
+            "usage: cranesim drive [--model M] [--world W] [--headless] [--duration T] [--record FILE.csv]\n"
             "\n"
-            "Drive the crane in real time. With a display: a 3D window, joystick or keyboard.\n"
-            "Without a display (or with --headless): the same real-time loop driven by the\n"
-            "scripted operator input of assets/scenarios/drive_demo.json, paced to wall time.\n"
+            "Drive the crane in real time, by default in the sandbox world (truck, terrain, hook,\n"
+            "loads, obstacles; --mechanics lagrange for the bare 2-DOF crane). With a display: a\n"
+            "3D window, joystick or keyboard. Without a display (or with --headless): the same\n"
+            "real-time loop driven by a scripted operator (assets/scenarios/sandbox_pick_place.json,\n"
+            "or drive_demo.json with lagrange), paced to wall time.\n"
             "\n"
             "options:\n"
             "  --headless          no window, even if a display is available\n"
@@ -45,13 +51,15 @@ static bool have_display(void) {
 static int drive_headless(app_common* c, double frame_rate, const char* record, const char* why) {
     model* m;
     scenario sc;
-    if (!c->scenario_path) c->scenario_path = "drive_demo";
+    const bool ode = c->sim.mechanics == SIM_ODE;
+    if (!c->scenario_path) c->scenario_path = ode ? "sandbox_pick_place" : "drive_demo";
     int rc = app_load(c, &m, &sc);
     if (rc) return rc;
     double duration = c->sim.duration > 0 ? c->sim.duration : sc.duration;
     char err[320];
     double m3 = sim_load_mass(m, &sc, &c->sim);
-    live* l = live_create_lagrange(m, &c->sim, sc.q0, m3, err, sizeof err);
+    live* l = ode ? live_create_ode(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err)
+                  : live_create_lagrange(m, &c->sim, sc.q0, m3, err, sizeof err);
     if (!l) {
         fprintf(stderr, "cranesim drive: %s\n", err);
         model_free(m);
@@ -64,46 +72,64 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         model_free(m);
         return EXIT_USAGE;
     }
-    sim_csv_header(f, SIM_NCOL_BASE);
+    const int ncol = live_ncol(l);
+    sim_csv_header(f, ncol);
     printf("cranesim drive: %s: driving %s headless in real time for %.1f s\n", why, m->name, duration);
-    printf("  operator input: scripted (%s), %.0f frames/s, solver %s h = %g ms\n", sc.name, frame_rate,
+    printf("  world: %s; operator input: scripted (%s), %.0f commands/s; hydraulics %s at h = %g ms\n",
+           ode ? (c->sim.world ? c->sim.world : "sandbox") : "lagrange 2-DOF (no world)", sc.name, frame_rate,
            hyd_method_name(c->sim.solver), c->sim.h * 1e3);
     const double frame = 1.0 / frame_rate;
     const int nframes = (int)ceil(duration * frame_rate - 1e-9);
     double w0 = sim_wall_time(), busy = 0, worst = 0;
-    int missed = 0, code = 0;
+    int missed = 0, code = 0, ev = 0, frames_done = 0;
     double row[SIM_NCOL];
     for (int i = 0; i < nframes; ++i) {
         double ws = sim_wall_time();
         double t = live_time(l);
-        const double u[3] = {scenario_command(&sc, 0, t), scenario_command(&sc, 1, t), scenario_command(&sc, 2, t)};
+        // The operator's stick positions at the middle of this frame.
+        const double tm = t + 0.5 * frame;
+        const double u[3] = {scenario_command(&sc, 0, tm), scenario_command(&sc, 1, tm), scenario_command(&sc, 2, tm)};
         live_set_commands(l, u);
-        if (live_advance(l, frame)) {
+        while (ev < sc.nevent && sc.event[ev].t <= tm) {
+            int attach = sc.event[ev].kind == SCENARIO_ATTACH;
+            int got = live_hook(l, attach);
+            if (attach)
+                printf("  t = %5.2f s: hook %s\n", t, got >= 0 ? "picked up a load" : "found no load in reach");
+            else
+                printf("  t = %5.2f s: hook released the load\n", t);
+            ++ev;
+        }
+        // Advance to the frame's end on the simulated clock (the ode world
+        // steps whole ODE steps, so aim at the target, not at +frame).
+        if (live_advance(l, (i + 1) * frame - live_time(l))) {
             fprintf(stderr, "cranesim drive: %s; record kept in %s\n", live_error(l), record);
             code = EXIT_RUNTIME;
             break;
         }
         live_row(l, row);
-        sim_csv_row(f, row, SIM_NCOL_BASE);
+        sim_csv_row(f, row, ncol);
+        ++frames_done;
         double we = sim_wall_time();
         busy += we - ws;
         worst = fmax(worst, we - ws);
         // A deadline is missed when the frame's work ends after its slot.
         if (we > w0 + (i + 1) * frame) ++missed;
-        if (c->quiet == false) app_progress(NULL, live_time(l), duration);
+        if (!c->quiet) app_progress(NULL, live_time(l), duration);
         sleep_until(w0 + (i + 1) * frame);
     }
     if (!c->quiet) app_progress_done();
     fclose(f);
     double wall = sim_wall_time() - w0;
-    const hyd_solver_stats* st = live_stats(l);
     printf("  simulated %.2f s in %.2f s wall; physics busy %.1f %% of the time: capacity %.0fx real time\n",
            live_time(l), wall, 100 * busy / wall, busy > 0 ? live_time(l) / busy : 0.0);
-    printf("  frames: %d of %.1f ms, worst frame %.2f ms, missed deadlines %d; %ld solver steps\n", nframes,
-           frame * 1e3, worst * 1e3, missed, st->steps);
-    printf("  final: lift stroke %.0f mm, jib stroke %.0f mm, tip at reach %.2f m, height %.2f m\n", row[COL_X1] * 1e3,
+    printf("  frames: %d of %.1f ms, worst frame %.2f ms, missed deadlines %d\n", frames_done, frame * 1e3,
+           worst * 1e3, missed);
+    printf("  final: lift stroke %.0f mm, jib stroke %.0f mm, tip at reach %.2f m, height %.2f m", row[COL_X1] * 1e3,
            row[COL_X2] * 1e3, row[COL_TIP_X], row[COL_TIP_Z]);
-    printf("  record -> %s (%d rows); for the 3D window run on a machine with a display\n", record, nframes);
+    if (ode)
+        printf("; slew %.1f deg; load at (%.2f, %.2f, %.2f) m; truck tilt %.2f deg", row[COL_SLEW] * 180 / M_PI,
+               row[COL_LOAD_X], row[COL_LOAD_Y], row[COL_LOAD_Z], row[COL_TRUCK_TILT] * 180 / M_PI);
+    printf("\n  record -> %s (%d rows); for the 3D window run it on a machine with a display\n", record, frames_done);
     live_destroy(l);
     model_free(m);
     return code;
@@ -111,6 +137,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
 
 int cmd_drive(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE; // drive's default: the sandbox world
     bool headless = false;
     double frame_rate = 75.0;
     const char* record = NULL;

@@ -1,6 +1,8 @@
 // live.c: the lagrange crane stepped by a real-time loop.
 #include "live.h"
 
+#include "ode_world.h"
+
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -12,6 +14,7 @@
 #endif
 
 struct live {
+    ode_world* ode; ///< the ode backend, or NULL for lagrange
     lsim ls;
     hyd_problem prob;
     hyd_solver* solver;
@@ -50,14 +53,66 @@ live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2]
     return l;
 }
 
+live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
+                      size_t errsz) {
+    live* l = calloc(1, sizeof *l);
+    if (!l) {
+        snprintf(err, errsz, "out of memory");
+        return NULL;
+    }
+    l->o = *o;
+    char wbuf[512];
+    const char* wpath = sim_world_path(o->world ? o->world : "sandbox", wbuf, sizeof wbuf);
+    world_desc wd;
+    if (world_desc_load(wpath, &wd, err, errsz)) {
+        free(l);
+        return NULL;
+    }
+    ode_world_opts wo = ode_world_default_opts();
+    wo.dt_ode = o->dt_ode > 0 ? o->dt_ode : 1e-3;
+    wo.dt_hyd = o->h < wo.dt_ode ? o->h : wo.dt_ode;
+    wo.solver = hyd_method_is_adaptive(o->solver) ? HYD_KRUS : o->solver;
+    wo.jac_every = o->jac_every > 0 ? o->jac_every : 1;
+    wo.q0[0] = q0[0];
+    wo.q0[1] = q0[1];
+    wo.slew0 = slew0;
+    wo.load_mass = m3;
+    wo.p_low = 0.5e6;
+    wo.model_file = m->file;
+    l->ode = ode_world_create(&m->mech, cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics"), &wd, &wo, err,
+                              errsz);
+    world_desc_free(&wd);
+    if (!l->ode) {
+        free(l);
+        return NULL;
+    }
+    return l;
+}
+
 void live_destroy(live* l) {
     if (!l) return;
+    if (l->ode) ode_world_destroy(l->ode);
     hyd_solver_destroy(l->solver);
-    lsim_free(&l->ls);
+    if (!l->ode) lsim_free(&l->ls);
     free(l);
 }
 
+int live_hook(live* l, int attach) { return l->ode ? ode_world_hook(l->ode, attach) : -1; }
+
+bool live_attached(const live* l) {
+    if (!l->ode) return false;
+    ode_world_state st;
+    ode_world_get_state(l->ode, &st);
+    return st.attached >= 0;
+}
+
+int live_ncol(const live* l) { return l->ode ? SIM_NCOL : SIM_NCOL_BASE; }
+
 void live_set_commands(live* l, const double u[3]) {
+    if (l->ode) {
+        ode_world_set_commands(l->ode, u);
+        return;
+    }
     for (int k = 0; k < 2; ++k) {
         double v = u[k] < -1 ? -1 : u[k] > 1 ? 1 : u[k];
         // A command change is a kink in the input: adaptive methods restart
@@ -68,6 +123,11 @@ void live_set_commands(live* l, const double u[3]) {
 }
 
 int live_advance(live* l, double dt) {
+    if (l->ode) {
+        if (ode_world_step(l->ode, dt) == 0) return 0;
+        snprintf(l->err, sizeof l->err, "%s", ode_world_error(l->ode));
+        return 1;
+    }
     int rc = hyd_solver_advance(l->solver, &l->t, l->y, l->t + dt);
     if (rc == HYD_OK) return 0;
     double tb = l->t;
@@ -78,13 +138,23 @@ int live_advance(live* l, double dt) {
 }
 
 const char* live_error(const live* l) { return l->err; }
-double live_time(const live* l) { return l->t; }
-const hyd_solver_stats* live_stats(const live* l) { return hyd_solver_get_stats(l->solver); }
+double live_time(const live* l) { return l->ode ? ode_world_time(l->ode) : l->t; }
+const hyd_solver_stats* live_stats(const live* l) {
+    if (l->ode) {
+        static const hyd_solver_stats none = {0};
+        return &none;
+    }
+    return hyd_solver_get_stats(l->solver);
+}
 
 void live_row(live* l, double row[SIM_NCOL]) {
+    if (l->ode) {
+        sim_ode_row(l->ode, row);
+        return;
+    }
     lsim_out o;
     lsim_outputs(&l->ls, l->t, l->y, &o);
-    const double v[SIM_NCOL] = {
+    double v[SIM_NCOL] = {
         l->t, o.x[0], o.x[1], o.pA[0], o.pB[0], o.pA[1], o.pB[1], o.u[0], o.u[1], o.q[0], o.q[1],
         o.tip[0], o.tip[1], o.F[0], o.F[1], o.u_cmd[0], o.u_cmd[1],
         o.v[0], o.v[1], o.p_pump, o.relief_open, o.end_stop};
@@ -121,6 +191,10 @@ static void add_body(world_snapshot* s, const char* name, world_role role, world
 }
 
 void live_snapshot(live* l, world_snapshot* s) {
+    if (l->ode) {
+        ode_world_snapshot(l->ode, s);
+        return;
+    }
     lsim_out o;
     lsim_outputs(&l->ls, l->t, l->y, &o);
     const crane_mech* me = &l->ls.mdl->mech;

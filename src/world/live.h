@@ -6,6 +6,8 @@
 #include "sim.h"
 #include "world_snapshot.h"
 
+#include <stdbool.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -15,6 +17,18 @@ typedef struct live live;
 /// A live lagrange crane at joint angles q0 [rad] with tip load m3 [kg].
 live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
                            size_t errsz);
+/// A live ode world (o->world: file or name, default sandbox) starting at
+/// joint angles q0 [rad] and slew angle slew0 [rad]; m3 [kg] is the tip load
+/// of the validation world (the sandbox picks loads up with the hook).
+live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
+                      size_t errsz);
+/// Hook: 1 attach the nearest load in reach, 0 release (ode sandbox only).
+/// Returns the load index attached, or -1.
+int live_hook(live* l, int attach);
+/// True while a load hangs on the hook.
+bool live_attached(const live* l);
+/// Columns live_row fills (base, or base plus world extras for ode).
+int live_ncol(const live* l);
 void live_destroy(live* l);
 
 /// Valve commands lift, jib, slew in [-1, 1] (slew ignored by lagrange).

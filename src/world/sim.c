@@ -167,7 +167,7 @@ static const char* state_name(const lsim* ls, int i, char* buf, size_t n) {
 }
 
 // One CSV row from the ode world's state.
-static void ode_row(ode_world* w, double* row) {
+void sim_ode_row(ode_world* w, double* row) {
     ode_world_state st;
     ode_world_get_state(w, &st);
     const double v[SIM_NCOL] = {
@@ -228,7 +228,7 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     double row[SIM_NCOL];
     int ev = 0;
     double w0 = sim_wall_time();
-    ode_row(w, row);
+    sim_ode_row(w, row);
     deliver(c, row);
     ++c->rows;
     for (long i = 0; i < nstep && !c->stop; ++i) {
@@ -248,7 +248,7 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
             break;
         }
         if ((i + 1) % nout && i + 1 != nstep) continue;
-        ode_row(w, row);
+        sim_ode_row(w, row);
         row[COL_T] = (double)(i + 1) * dt; // exact grid times, no accumulated round-off
         for (int k = COL_P1A; k <= COL_P2B; ++k) {
             if (!(row[k] > P_IMPLAUSIBLE)) {

@@ -93,6 +93,10 @@ void sim_csv_row(FILE* f, const double* row, int ncol);
 /// assets/worlds/<name>.json ("validation", "sandbox").
 const char* sim_world_path(const char* arg, char* buf, size_t n);
 
+struct ode_world;
+/// One row (all SIM_NCOL columns) from an ode world's current state.
+void sim_ode_row(struct ode_world* w, double* row);
+
 /// Wall clock [s], monotonic.
 double sim_wall_time(void);
 
