@@ -9,9 +9,9 @@ void render_camera_init(render_camera* c) {
     c->preset = RENDER_CAM_ORBIT;
     // A three-quarter view from the right front, the way a photo of a truck
     // crane is usually taken.
-    c->yaw = -1.05f;
-    c->pitch = 0.38f;
-    c->dist = 17.0f;
+    c->yaw = -0.95f;
+    c->pitch = 0.30f;
+    c->dist = 13.5f;
     c->fovy = 50.0f * (float)M_PI / 180.0f;
     c->target = rm_v3(0, 0, 2.5f);
 }

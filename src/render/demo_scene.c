@@ -130,11 +130,11 @@ void render_demo_scene(world_snapshot* s, const render_demo_params* p, float* te
         s->terrain.dx = s->terrain.dy = dx;
     }
 
-    // Truck: body origin at its box centre; the mesh origin is on the ground
-    // under the slew axis, 1.2 m forward of that centre.
-    world_snap_body* b = add(s, "truck", WORLD_ROLE_TRUCK, WORLD_SHAPE_BOX, 7.6, 2.45, 1.9, truck_rgba);
-    set_pose(b, -1.2, 0, 1.25, 0);
-    set_mesh(b, m, "truck.obj", 1.2, 0, -1.25);
+    // Truck: body origin at its chassis box centre; the mesh origin is on the
+    // ground under the slew axis, 1.2 m forward of that centre.
+    world_snap_body* b = add(s, "truck", WORLD_ROLE_TRUCK, WORLD_SHAPE_BOX, 7.6, 2.45, 1.0, truck_rgba);
+    set_pose(b, -1.2, 0, 0.6, 0);
+    set_mesh(b, m, "truck.obj", 1.2, 0, -0.6);
     const double wheel_x[3] = {1.75, -3.05, -4.35};
     for (int i = 0; i < 6; ++i) {
         char nm[16];
@@ -207,7 +207,7 @@ void render_demo_scene(world_snapshot* s, const render_demo_params* p, float* te
     cylinder(&s->cyl[0], "lift", a0, a1, 0.100, 0.060, 0.95, 0.70, p->pA[0], p->pB[0], p->u[0]);
     xform(a0, j1, r1, 0.55, 0, 0.26);
     xform(a1, j2, r2, -0.30, 0, 0.30);
-    cylinder(&s->cyl[1], "jib", a0, a1, 0.080, 0.045, 1.00, 0.60, p->pA[1], p->pB[1], p->u[1]);
+    cylinder(&s->cyl[1], "jib", a0, a1, 0.080, 0.045, 1.45, 0.60, p->pA[1], p->pB[1], p->u[1]);
     s->ncyl = 2;
 
     // Rope and hook: hanging 1.7 m under the tip, swung slightly.

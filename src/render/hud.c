@@ -155,9 +155,13 @@ void render_hud_flush(render_hud* h) {
     glUniform2f(h->u_screen, (float)h->w, (float)h->h);
     glBindVertexArray(h->vao);
     glBindBuffer(GL_ARRAY_BUFFER, h->vbo);
-    // One upload per frame: orphan the buffer, then write both lists.
+    // One upload per frame into a buffer that only grows; re-specifying it
+    // every frame would make llvmpipe allocate and zero fresh memory.
     size_t bt = (size_t)h->ntri * sizeof(render_hud_vertex), bl = (size_t)h->nline * sizeof(render_hud_vertex);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(bt + bl), NULL, GL_STREAM_DRAW);
+    if (bt + bl > h->vbo_bytes) {
+        h->vbo_bytes = 2 * (bt + bl);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)h->vbo_bytes, NULL, GL_STREAM_DRAW);
+    }
     glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)bt, h->tri);
     glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)bt, (GLsizeiptr)bl, h->line);
     if (h->ntri) glDrawArrays(GL_TRIANGLES, 0, h->ntri);
@@ -259,7 +263,8 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
     render_hud_rect(h, x - 6, y - 6, w, lh * (float)nrows + 10, k_panel);
     char buf[160];
-    snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx   %.0f fps", s->t, s->rt_factor, r->fps_avg);
+    if (r->fps_avg > 0) snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx   %.0f fps", s->t, s->rt_factor, r->fps_avg);
+    else snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx", s->t, s->rt_factor);
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh * 1.3f;
     for (int i = 0; i < ncyl; ++i)
@@ -329,7 +334,7 @@ void render_hud_draw_overlay(render* r, const world_snapshot* s) {
     draw_readouts(r, s);
     draw_warnings(r, s);
     if (r->charts.n > 0) {
-        float ch = 150.0f;
+        float ch = 124.0f;
         render_charts_draw(h, &r->charts, 10, (float)h->h - ch - 10, (float)h->w - 20, ch);
     }
 }

@@ -198,31 +198,56 @@ static bool has_supported_ext(const char* path) {
     return aiIsExtensionSupported(dot) == AI_TRUE;
 }
 
+static void put_vertex(builder* b, int up, struct aiVector3D p, struct aiVector3D n, const float tint[3]) {
+    int vi;
+    // y-up files: mesh y becomes body z, mesh z becomes body -y.
+    if (up == 1) vi = b_vert(b, p.x, -p.z, p.y, n.x, -n.z, n.y);
+    else vi = b_vert(b, p.x, p.y, p.z, n.x, n.y, n.z);
+    memcpy(b->v[vi].c, tint, 3 * sizeof(float));
+}
+
+static bool bad_normal(struct aiVector3D n) {
+    float l2 = n.x * n.x + n.y * n.y + n.z * n.z;
+    return !(l2 > 1e-12f) || !isfinite(l2);
+}
+
 /// Append all triangle meshes of an assimp scene (already pre-transformed).
+/// Meshes whose normals are missing or zero (STL exporters often write
+/// "facet normal 0 0 0") get flat normals from their triangles instead.
 static bool convert_scene(const struct aiScene* sc, int up, builder* b) {
     for (unsigned mi = 0; mi < sc->mNumMeshes; ++mi) {
         const struct aiMesh* m = sc->mMeshes[mi];
-        if (!(m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || !m->mNormals) continue;
+        if (!(m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
         struct aiColor4D kd = {1, 1, 1, 1};
         if (m->mMaterialIndex < sc->mNumMaterials)
             aiGetMaterialColor(sc->mMaterials[m->mMaterialIndex], AI_MATKEY_COLOR_DIFFUSE, &kd);
+        bool flat = !m->mNormals;
+        for (unsigned i = 0; !flat && i < m->mNumVertices; ++i) flat = bad_normal(m->mNormals[i]);
         int base = b->nv;
-        for (unsigned i = 0; i < m->mNumVertices; ++i) {
-            struct aiVector3D p = m->mVertices[i], n = m->mNormals[i];
-            int vi;
-            // y-up files: mesh y becomes body z, mesh z becomes body -y.
-            if (up == 1) vi = b_vert(b, p.x, -p.z, p.y, n.x, -n.z, n.y);
-            else vi = b_vert(b, p.x, p.y, p.z, n.x, n.y, n.z);
-            float tint[3] = {kd.r, kd.g, kd.b};
-            if (m->mColors[0])
-                tint[0] *= m->mColors[0][i].r, tint[1] *= m->mColors[0][i].g, tint[2] *= m->mColors[0][i].b;
-            memcpy(b->v[vi].c, tint, sizeof tint);
+        if (!flat) {
+            for (unsigned i = 0; i < m->mNumVertices; ++i) {
+                float tint[3] = {kd.r, kd.g, kd.b};
+                if (m->mColors[0])
+                    tint[0] *= m->mColors[0][i].r, tint[1] *= m->mColors[0][i].g, tint[2] *= m->mColors[0][i].b;
+                put_vertex(b, up, m->mVertices[i], m->mNormals[i], tint);
+            }
         }
         for (unsigned f = 0; f < m->mNumFaces; ++f) {
             const struct aiFace* face = &m->mFaces[f];
             if (face->mNumIndices != 3) continue;
-            b_tri(b, base + (int)face->mIndices[0], base + (int)face->mIndices[1],
-                  base + (int)face->mIndices[2]);
+            const unsigned* ix = face->mIndices;
+            if (!flat) {
+                b_tri(b, base + (int)ix[0], base + (int)ix[1], base + (int)ix[2]);
+                continue;
+            }
+            struct aiVector3D p0 = m->mVertices[ix[0]], p1 = m->mVertices[ix[1]], p2 = m->mVertices[ix[2]];
+            rm_vec3 e1 = rm_v3(p1.x - p0.x, p1.y - p0.y, p1.z - p0.z), e2 = rm_v3(p2.x - p0.x, p2.y - p0.y, p2.z - p0.z);
+            rm_vec3 fn = rm_norm(rm_cross(e1, e2));
+            struct aiVector3D n = {fn.x, fn.y, fn.z};
+            float tint[3] = {kd.r, kd.g, kd.b};
+            int v0 = b->nv;
+            for (int k = 0; k < 3; ++k) put_vertex(b, up, m->mVertices[ix[k]], n, tint);
+            b_tri(b, v0, v0 + 1, v0 + 2);
         }
     }
     return b->ni > 0;

@@ -105,10 +105,15 @@ void render_shadow_fit(render_shadow* s, rm_vec3 centre, float radius);
 
 // ---- scene (scene.c) -----------------------------------------------------
 
+/// A lit program (objects or ground) and its uniform locations.
+typedef struct render_lit_prog {
+    GLuint id;
+    GLint u_model, u_normal, u_vp, u_light_vp, u_color, u_light_dir, u_eye, u_shadow;
+} render_lit_prog;
+
 typedef struct render_scene {
-    GLuint prog, depth_prog, sky_prog;
-    GLint u_model, u_normal, u_vp, u_light_vp, u_color, u_light_dir, u_eye, u_shadow, u_ground,
-        u_shadow_texel;
+    render_lit_prog obj, ground_prog;
+    GLuint depth_prog, sky_prog;
     GLint ud_model, ud_vp;
     GLint us_top, us_bottom;
     GLuint sky_vao;
@@ -140,6 +145,7 @@ typedef struct render_hud_vertex {
 
 typedef struct render_hud {
     GLuint prog, vao, vbo;
+    size_t vbo_bytes;            ///< allocated size of vbo
     GLint u_screen;
     render_hud_vertex* tri;
     int ntri, captri;

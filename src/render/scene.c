@@ -15,8 +15,14 @@ typedef struct render_draw_item {
     const render_mesh* mesh;
     float model[16];
     float rgba[4];
+    float depth;        ///< squared distance from the eye, for sorting
     bool casts_shadow;
 } render_draw_item;
+
+static int nearer_first(const void* a, const void* b) {
+    float da = ((const render_draw_item*)a)->depth, db = ((const render_draw_item*)b)->depth;
+    return da < db ? -1 : da > db;
+}
 
 // ---- shaders ---------------------------------------------------------------
 
@@ -29,6 +35,10 @@ static const char* k_scene_vs =
     "uniform mat3 u_normal;\n"
     "uniform mat4 u_vp;\n"
     "uniform mat4 u_light_vp;\n"
+    "uniform vec3 u_light_dir;\n"
+    "uniform vec3 u_eye;\n"
+    "out vec3 v_half;\n"
+
     "out vec3 v_world;\n"
     "out vec3 v_nrm;\n"
     "out vec3 v_tint;\n"
@@ -39,54 +49,68 @@ static const char* k_scene_vs =
     "    v_nrm = u_normal * a_nrm;\n"
     "    v_tint = a_tint;\n"
     "    v_lightpos = u_light_vp * w;\n"
+    // Per-vertex terms: interpolating them is close enough and saves
+    // per-pixel work, which is what llvmpipe pays for.
+    "    vec3 to_eye = u_eye - w.xyz;\n"
+    "    float d = length(to_eye);\n"
+    "    v_half = normalize(u_light_dir + to_eye / d);\n"
+
     "    gl_Position = u_vp * w;\n"
     "}\n";
 
-// Lambert + Blinn with a sky/ground hemisphere ambient; the shadow term uses
-// four hardware-filtered (2x2 PCF) taps, i.e. a soft 3x3-texel footprint.
-static const char* k_scene_fs =
+// Objects: Lambert + Blinn with a sky/ground hemisphere ambient. Written
+// for llvmpipe, where every ALU op is paid per pixel on the CPU: one shadow
+// lookup (the depth comparison + linear filter give 2x2 PCF in hardware),
+// the specular power by repeated squaring instead of pow(), the half vector
+// from the vertex shader, no haze (objects are near).
+static const char* k_obj_fs =
     "#version 330 core\n"
     "in vec3 v_world;\n"
     "in vec3 v_nrm;\n"
     "in vec3 v_tint;\n"
     "in vec4 v_lightpos;\n"
+    "in vec3 v_half;\n"
+    "uniform vec4 u_color;\n"
+    "uniform vec3 u_light_dir;\n"
+    "uniform sampler2DShadow u_shadow;\n"
+    "out vec4 o_color;\n"
+    "void main() {\n"
+    // Normals are trusted as given (not flipped by winding): CAD exports
+    // often have inconsistent winding but sound normals.
+    "    vec3 n = normalize(v_nrm);\n"
+    "    vec3 l = u_light_dir;\n"
+    "    float ndl = max(dot(n, l), 0.0);\n"
+    "    vec3 q = v_lightpos.xyz * 0.5 + 0.5;\n"
+    "    float sh = texture(u_shadow, vec3(q.xy, q.z - 0.0015 - 0.003 * (1.0 - ndl)));\n"
+    "    float s = max(dot(n, v_half), 0.0);\n"
+    "    s *= s; s *= s; s *= s; s *= s; s *= s;\n"
+    "    vec3 amb = mix(vec3(0.18, 0.165, 0.15), vec3(0.31, 0.35, 0.41), 0.5 + 0.5 * n.z);\n"
+    "    vec3 c = u_color.rgb * v_tint * (amb + (0.80 * ndl * sh) * vec3(1.0, 0.97, 0.90)) + (0.22 * s * sh);\n"
+    "    o_color = vec4(c, u_color.a);\n"
+    "}\n";
+
+// Ground and terrain: a 1 m grid to judge distance and motion, the shadow,
+// and aerial haze toward the horizon. No specular.
+static const char* k_ground_fs =
+    "#version 330 core\n"
+    "in vec3 v_world;\n"
+    "in vec3 v_nrm;\n"
+    "in vec4 v_lightpos;\n"
     "uniform vec4 u_color;\n"
     "uniform vec3 u_light_dir;\n"
     "uniform vec3 u_eye;\n"
     "uniform sampler2DShadow u_shadow;\n"
-    "uniform float u_shadow_texel;\n"
-    "uniform int u_ground;\n"
     "out vec4 o_color;\n"
-    "float lit_fraction(float ndl) {\n"
-    "    vec3 q = v_lightpos.xyz / v_lightpos.w * 0.5 + 0.5;\n"
-    "    if (q.z >= 1.0) return 1.0;\n"
-    "    float bias = 0.0008 + 0.0025 * (1.0 - ndl);\n"
-    "    return texture(u_shadow, vec3(q.xy, q.z - bias));\n"
-    "}\n"
     "void main() {\n"
-    "    if (u_ground == 2) { o_color = vec4(v_tint, 1.0); return; }\n"
-    "    vec3 n = normalize(v_nrm);\n"
-    "    if (!gl_FrontFacing) n = -n;\n"
-    "    vec3 base = u_color.rgb * v_tint;\n"
-    "    if (u_ground == 1) {\n"
-    "        // 1 m grid, stronger every 5 m: judges distances and motion.\n"
-    "        vec2 w1 = abs(fract(v_world.xy + 0.5) - 0.5) / max(fwidth(v_world.xy), vec2(1e-4));\n"
-    "        vec2 w5 = abs(fract(v_world.xy / 5.0 + 0.5) - 0.5) / max(fwidth(v_world.xy / 5.0), vec2(1e-4));\n"
-    "        float l1 = 1.0 - clamp(min(w1.x, w1.y), 0.0, 1.0);\n"
-    "        float l5 = 1.0 - clamp(min(w5.x, w5.y), 0.0, 1.0);\n"
-    "        base *= 1.0 - 0.10 * l1 - 0.15 * l5;\n"
-    "    }\n"
-    "    vec3 l = u_light_dir;\n"
-    "    vec3 v = normalize(u_eye - v_world);\n"
-    "    float ndl = max(dot(n, l), 0.0);\n"
-    "    float sh = ndl > 0.0 ? lit_fraction(ndl) : 0.0;\n"
-    "    vec3 amb = mix(vec3(0.36, 0.33, 0.30), vec3(0.62, 0.70, 0.82), 0.5 + 0.5 * n.z);\n"
-    "    float spec = pow(max(dot(n, normalize(l + v)), 0.0), 40.0) * 0.22;\n"
-    "    vec3 c = base * (0.50 * amb + 0.80 * ndl * sh * vec3(1.0, 0.97, 0.90)) + spec * sh;\n"
-    "    // Aerial haze toward the horizon colour of the sky.\n"
-    "    float d = length(u_eye - v_world);\n"
-    "    float haze = 1.0 - exp(-0.0035 * d);\n"
-    "    o_color = vec4(mix(c, vec3(0.74, 0.80, 0.88), haze), u_color.a);\n"
+    "    vec2 g = abs(fract(v_world.xy + 0.5) - 0.5) / max(fwidth(v_world.xy), vec2(1e-4));\n"
+    "    float line = 0.12 * (1.0 - clamp(min(g.x, g.y), 0.0, 1.0));\n"
+    "    float ndl = max(dot(v_nrm, u_light_dir), 0.0);\n"
+    "    vec3 q = v_lightpos.xyz * 0.5 + 0.5;\n"
+    "    float sh = texture(u_shadow, vec3(q.xy, q.z - 0.002));\n"
+    "    vec3 c = u_color.rgb * (1.0 - line) * (vec3(0.30, 0.33, 0.38) + (0.80 * ndl * sh) * vec3(1.0, 0.97, 0.90));\n"
+    // Haze: a rational stand-in for 1 - exp(-k d), cheaper on llvmpipe.
+    "    float kd = 0.0035 * length(u_eye - v_world);\n"
+    "    o_color = vec4(mix(c, vec3(0.74, 0.80, 0.88), kd / (1.0 + kd)), 1.0);\n"
     "}\n";
 
 static const char* k_depth_vs =
@@ -135,22 +159,26 @@ static render_mesh make_ground(void) {
     return render_mesh_upload(v, 4, idx, 6);
 }
 
+static bool lit_prog(render_lit_prog* p, const char* name, const char* fs) {
+    p->id = render_shader_build(name, k_scene_vs, fs);
+    if (!p->id) return false;
+    p->u_model = glGetUniformLocation(p->id, "u_model");
+    p->u_normal = glGetUniformLocation(p->id, "u_normal");
+    p->u_vp = glGetUniformLocation(p->id, "u_vp");
+    p->u_light_vp = glGetUniformLocation(p->id, "u_light_vp");
+    p->u_color = glGetUniformLocation(p->id, "u_color");
+    p->u_light_dir = glGetUniformLocation(p->id, "u_light_dir");
+    p->u_eye = glGetUniformLocation(p->id, "u_eye");
+    p->u_shadow = glGetUniformLocation(p->id, "u_shadow");
+    return true;
+}
+
 bool render_scene_create(render_scene* sc) {
     memset(sc, 0, sizeof *sc);
-    sc->prog = render_shader_build("scene", k_scene_vs, k_scene_fs);
+    if (!lit_prog(&sc->obj, "objects", k_obj_fs) || !lit_prog(&sc->ground_prog, "ground", k_ground_fs)) return false;
     sc->depth_prog = render_shader_build("depth", k_depth_vs, k_depth_fs);
     sc->sky_prog = render_shader_build("sky", k_sky_vs, k_sky_fs);
-    if (!sc->prog || !sc->depth_prog || !sc->sky_prog) return false;
-    sc->u_model = glGetUniformLocation(sc->prog, "u_model");
-    sc->u_normal = glGetUniformLocation(sc->prog, "u_normal");
-    sc->u_vp = glGetUniformLocation(sc->prog, "u_vp");
-    sc->u_light_vp = glGetUniformLocation(sc->prog, "u_light_vp");
-    sc->u_color = glGetUniformLocation(sc->prog, "u_color");
-    sc->u_light_dir = glGetUniformLocation(sc->prog, "u_light_dir");
-    sc->u_eye = glGetUniformLocation(sc->prog, "u_eye");
-    sc->u_shadow = glGetUniformLocation(sc->prog, "u_shadow");
-    sc->u_ground = glGetUniformLocation(sc->prog, "u_ground");
-    sc->u_shadow_texel = glGetUniformLocation(sc->prog, "u_shadow_texel");
+    if (!sc->depth_prog || !sc->sky_prog) return false;
     sc->ud_model = glGetUniformLocation(sc->depth_prog, "u_model");
     sc->ud_vp = glGetUniformLocation(sc->depth_prog, "u_vp");
     sc->us_top = glGetUniformLocation(sc->sky_prog, "u_top");
@@ -169,7 +197,8 @@ void render_scene_free(render_scene* sc) {
     render_mesh_free(&sc->ground);
     render_mesh_free(&sc->terrain);
     if (sc->sky_vao) glDeleteVertexArrays(1, &sc->sky_vao);
-    if (sc->prog) glDeleteProgram(sc->prog);
+    if (sc->obj.id) glDeleteProgram(sc->obj.id);
+    if (sc->ground_prog.id) glDeleteProgram(sc->ground_prog.id);
     if (sc->depth_prog) glDeleteProgram(sc->depth_prog);
     if (sc->sky_prog) glDeleteProgram(sc->sky_prog);
     free(sc->items);
@@ -252,8 +281,19 @@ static void segment_matrix(float m[16], rm_vec3 a, rm_vec3 b, float radius, floa
 
 static rm_vec3 v3d(const double p[3]) { return rm_v3((float)p[0], (float)p[1], (float)p[2]); }
 
+static void add_body_items(render_scene* sc, render_mesh_cache* mc, const world_snap_body* b);
+
 static void add_body(render_scene* sc, render_mesh_cache* mc, const world_snap_body* b) {
     if (b->shape == WORLD_SHAPE_TERRAIN || b->role == WORLD_ROLE_TERRAIN) return;
+    int first = sc->nitems;
+    add_body_items(sc, mc, b);
+    // Wheels stand in the truck's own shadow and are the densest meshes;
+    // leaving them out of the shadow pass halves its vertex work.
+    if (b->role == WORLD_ROLE_WHEEL)
+        for (int i = first; i < sc->nitems; ++i) sc->items[i].casts_shadow = false;
+}
+
+static void add_body_items(render_scene* sc, render_mesh_cache* mc, const world_snap_body* b) {
     const render_mesh* mesh = b->mesh[0] ? render_mesh_get(mc, b->mesh, b->mesh_up) : NULL;
     if (mesh) {
         // world = R (s p + offset) + pos
@@ -383,6 +423,15 @@ static void scene_bounds(const world_snapshot* s, rm_vec3* centre, float* radius
 
 // ---- the two passes ---------------------------------------------------------------
 
+static void use_lit(const render_lit_prog* p, const render_camera* cam, const render_shadow* sh) {
+    glUseProgram(p->id);
+    glUniformMatrix4fv(p->u_vp, 1, GL_FALSE, cam->viewproj);
+    glUniformMatrix4fv(p->u_light_vp, 1, GL_FALSE, sh->light_vp);
+    glUniform3f(p->u_light_dir, sh->light_dir.x, sh->light_dir.y, sh->light_dir.z);
+    glUniform3f(p->u_eye, cam->eye.x, cam->eye.y, cam->eye.z);
+    glUniform1i(p->u_shadow, 0);
+}
+
 void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* sh, const render_camera* cam,
                        const world_snapshot* s, int w, int h) {
     sc->nitems = 0;
@@ -402,8 +451,6 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
     // Caller has the scene target bound; remember it for after the shadow pass.
     GLint target = 0;
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target);
-    glFinish(); Uint64 tp = SDL_GetPerformanceCounter();
-    if (getenv("PROF")) fprintf(stderr, "shadowpass start at %.2f\n", 1e3*(double)(tp % 100000000)/(double)SDL_GetPerformanceFrequency());
 
     // Shadow pass: depth only, polygon offset against acne on the booms.
     glBindFramebuffer(GL_FRAMEBUFFER, sh->fbo);
@@ -424,8 +471,6 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
 
-    glFinish(); Uint64 tq = SDL_GetPerformanceCounter();
-    if (getenv("PROF")) fprintf(stderr, "shadowpass done at %.2f\n", 1e3*(double)(tq % 100000000)/(double)SDL_GetPerformanceFrequency());
     // Colour pass.
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)target);
     glViewport(0, 0, w, h);
@@ -433,54 +478,50 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LEQUAL);
 
-    glUseProgram(sc->prog);
-    glUniformMatrix4fv(sc->u_vp, 1, GL_FALSE, cam->viewproj);
-    glUniformMatrix4fv(sc->u_light_vp, 1, GL_FALSE, sh->light_vp);
-    glUniform3f(sc->u_light_dir, sh->light_dir.x, sh->light_dir.y, sh->light_dir.z);
-    glUniform3f(sc->u_eye, cam->eye.x, cam->eye.y, cam->eye.z);
-    glUniform1f(sc->u_shadow_texel, 1.0f / (float)sh->size);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, sh->tex);
-    glUniform1i(sc->u_shadow, 0);
-
     // Opaque things nearest the camera first, so the early depth test
     // skips shading most of the ground and sky behind them (llvmpipe is
     // fill-rate bound).
-    float m[16], nm[9];
-    glUniform1i(sc->u_ground, getenv("B") ? atoi(getenv("B")) : 0);
+    for (int i = 0; i < sc->nitems; ++i) {
+        const float* t = &sc->items[i].model[12];
+        rm_vec3 d = rm_sub(rm_v3(t[0], t[1], t[2]), cam->eye);
+        sc->items[i].depth = rm_dot(d, d);
+    }
+    qsort(sc->items, (size_t)sc->nitems, sizeof *sc->items, nearer_first);
+    use_lit(&sc->obj, cam, sh);
+    float nm[9];
     for (int i = 0; i < sc->nitems; ++i) {
         const render_draw_item* it = &sc->items[i];
         rm_normal_matrix(nm, it->model);
-        glUniformMatrix4fv(sc->u_model, 1, GL_FALSE, it->model);
-        glUniformMatrix3fv(sc->u_normal, 1, GL_FALSE, nm);
-        glUniform4fv(sc->u_color, 1, it->rgba);
+        glUniformMatrix4fv(sc->obj.u_model, 1, GL_FALSE, it->model);
+        glUniformMatrix3fv(sc->obj.u_normal, 1, GL_FALSE, nm);
+        glUniform4fv(sc->obj.u_color, 1, it->rgba);
         render_mesh_draw(it->mesh);
         sc->triangles += it->mesh->nidx / 3;
         ++sc->draw_calls;
     }
     // Ground: the heightfield if there is one, and a flat plane beyond it.
-    glUniform1i(sc->u_ground, getenv("G") ? atoi(getenv("G")) : 1);
+    use_lit(&sc->ground_prog, cam, sh);
+    float m[16];
+    rm_identity(m);
+    rm_normal_matrix(nm, m);
+    glUniformMatrix3fv(sc->ground_prog.u_normal, 1, GL_FALSE, nm);
     const bool has_terrain = s->terrain.nx >= 2 && s->terrain.ny >= 2 && sc->terrain.vao;
     if (has_terrain) {
         static const float terrain_rgba[4] = {0.55f, 0.58f, 0.42f, 1.0f};
-        rm_identity(m);
-        rm_normal_matrix(nm, m);
-        glUniformMatrix4fv(sc->u_model, 1, GL_FALSE, m);
-        glUniformMatrix3fv(sc->u_normal, 1, GL_FALSE, nm);
-        glUniform4fv(sc->u_color, 1, terrain_rgba);
+        glUniformMatrix4fv(sc->ground_prog.u_model, 1, GL_FALSE, m);
+        glUniform4fv(sc->ground_prog.u_color, 1, terrain_rgba);
         render_mesh_draw(&sc->terrain);
         sc->triangles += sc->terrain.nidx / 3;
         ++sc->draw_calls;
     }
     {
         static const float ground_rgba[4] = {0.60f, 0.60f, 0.55f, 1.0f};
-        rm_identity(m);
         // Under a heightfield, sink the plane to its lowest point.
         if (has_terrain) m[14] = sc->terrain.bmin[2] - 0.02f;
-        rm_normal_matrix(nm, m);
-        glUniformMatrix4fv(sc->u_model, 1, GL_FALSE, m);
-        glUniformMatrix3fv(sc->u_normal, 1, GL_FALSE, nm);
-        glUniform4fv(sc->u_color, 1, ground_rgba);
+        glUniformMatrix4fv(sc->ground_prog.u_model, 1, GL_FALSE, m);
+        glUniform4fv(sc->ground_prog.u_color, 1, ground_rgba);
         render_mesh_draw(&sc->ground);
         sc->triangles += 2;
         ++sc->draw_calls;

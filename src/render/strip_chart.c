@@ -106,19 +106,29 @@ static void draw_box(render_hud* h, const render_charts* c, int group, double t1
     // Range: fixed from the first channel of the group, or autoscaled.
     double lo = 0, hi = 0;
     const char* unit = "";
-    bool first = true;
+    bool first = true, fixed = false, have = false;
     for (int i = 0; i < c->n; ++i) {
         const render_chart* ch = &c->ch[i];
         if (ch->def.group != group) continue;
-        if (first) lo = ch->def.ymin, hi = ch->def.ymax, unit = ch->unit, first = false;
-        if (ch->def.ymin < ch->def.ymax) continue;
+        if (first) {
+            unit = ch->unit;
+            fixed = ch->def.ymin < ch->def.ymax;
+            if (fixed) lo = ch->def.ymin, hi = ch->def.ymax;
+            first = false;
+        }
+        if (fixed) continue;
         for (int k = 0; k < ch->count; ++k) {
             int j = (ch->head - ch->count + k + RENDER_CHART_CAP) % RENDER_CHART_CAP;
             if (ch->t[j] < t0) continue;
-            if (lo >= hi) lo = hi = ch->v[j];
+            if (!have) lo = hi = ch->v[j], have = true;
             if (ch->v[j] < lo) lo = ch->v[j];
             if (ch->v[j] > hi) hi = ch->v[j];
         }
+    }
+    if (have) {
+        // A little headroom so traces do not sit on the frame.
+        double pad = 0.05 * (hi - lo);
+        lo -= pad, hi += pad;
     }
     if (!(hi > lo)) {
         double m = 0.5 * (lo + hi);
@@ -158,6 +168,9 @@ static void draw_box(render_hud* h, const render_charts* c, int group, double t1
             if (f < 0) f = 0;
             if (f > 1) f = 1;
             float sx = px + pw * (float)((ch->t[j] - t0) / c->window), sy = py + ph * (float)(1.0 - f);
+            // At most one segment per 2 px column: more is invisible and
+            // each line costs llvmpipe a primitive setup.
+            if (have && sx < ox + 2.0f && k + 1 < ch->count) continue;
             if (have) render_hud_line(h, ox, oy, sx, sy, ch->def.rgba);
             ox = sx, oy = sy, have = true;
         }
