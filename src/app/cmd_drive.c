@@ -6,6 +6,9 @@
 // factor capacity, missed frame deadlines, and where the record went.
 #include "app.h"
 #include "live.h"
+#ifdef CRANESIM_HAVE_RENDER
+#include "drive_session.h"
+#endif
 
 #include <math.h>
 #include <stdlib.h>
@@ -30,7 +33,16 @@ static void drive_help(FILE* f) {
             "  --headless          no window, even if a display is available\n"
             "  --duration T        headless: seconds to drive (default: the demo's)\n"
             "  --record FILE.csv   record every frame to CSV (headless default: drive.csv)\n"
-            "  --frame-rate F      frames per second of the loop (default 75, the paper's rate)\n");
+            "  --frame-rate F      headless: command updates per second (default 75, the paper's rate);\n"
+            "                      window: frame-rate cap (default 65)\n"
+            "  --scripted          window: drive by the scenario's commands instead of the devices\n"
+            "  --mapping FILE      joystick axis mapping (JSON, see docs/render.md)\n"
+            "  --screenshot FILE   save a PNG of the view at --screenshot-at seconds and stop\n"
+            "                      (offscreen when there is no display)\n"
+            "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
+            "  --size WxH          window size in pixels (default 1280x720)\n"
+            "keys: arrows = lift, W/S = jib, A/D = slew, H = hook, P = pause, R = reset,\n"
+            "      C / F1..F4 = camera, F5 = record CSV, F12 = screenshot, Esc = quit\n");
     app_common_help(f, true);
 }
 
@@ -138,9 +150,12 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
 int cmd_drive(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     c.sim.mechanics = SIM_ODE; // drive's default: the sandbox world
-    bool headless = false;
-    double frame_rate = 75.0;
+    bool headless = false, scripted = false, rate_given = false;
+    double frame_rate = 75.0, shot_at = 2.0;
     const char* record = NULL;
+    const char* shot = NULL;
+    const char* mapping = NULL;
+    int width = 1280, height = 720;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             drive_help(stdout);
@@ -157,7 +172,35 @@ int cmd_drive(int argc, char** argv) {
             record = argv[++i];
             continue;
         }
+        if (!strcmp(argv[i], "--scripted")) {
+            scripted = true;
+            continue;
+        }
+        if (!strcmp(argv[i], "--mapping") && i + 1 < argc) {
+            mapping = argv[++i];
+            continue;
+        }
+        if (!strcmp(argv[i], "--screenshot") && i + 1 < argc) {
+            shot = argv[++i];
+            continue;
+        }
+        if (!strcmp(argv[i], "--screenshot-at") && i + 1 < argc) {
+            if (app_parse_double(argv[++i], &shot_at) || shot_at < 0) {
+                fprintf(stderr, "cranesim drive: --screenshot-at: expected a time >= 0 s, got '%s'\n", argv[i]);
+                return EXIT_USAGE;
+            }
+            continue;
+        }
+        if (!strcmp(argv[i], "--size") && i + 1 < argc) {
+            if (sscanf(argv[++i], "%dx%d", &width, &height) != 2 || width < 64 || height < 64 || width > 8192 ||
+                height > 8192) {
+                fprintf(stderr, "cranesim drive: --size: expected WxH like 1280x720, got '%s'\n", argv[i]);
+                return EXIT_USAGE;
+            }
+            continue;
+        }
         if (!strcmp(argv[i], "--frame-rate") && i + 1 < argc) {
+            rate_given = true;
             if (app_parse_double(argv[++i], &frame_rate) || frame_rate < 10 || frame_rate > 1000) {
                 fprintf(stderr, "cranesim drive: --frame-rate: expected 10..1000 frames/s, got '%s'\n", argv[i]);
                 return EXIT_USAGE;
@@ -168,6 +211,27 @@ int cmd_drive(int argc, char** argv) {
         return EXIT_USAGE;
     }
     const char* why = headless ? "--headless" : "no display (DISPLAY and WAYLAND_DISPLAY unset)";
-    if (!headless && have_display()) why = "the 3D window is not built into this binary yet";
+#ifdef CRANESIM_HAVE_RENDER
+    // A window when there is a display; an offscreen view when only a
+    // screenshot is wanted; else the headless loop below.
+    if (!headless && (have_display() || shot)) {
+        drive_opts o = drive_default_opts();
+        o.width = width;
+        o.height = height;
+        o.offscreen = !have_display();
+        if (rate_given) o.fps_cap = frame_rate;
+        o.mapping_file = mapping;
+        o.record_path = record;
+        o.scripted = scripted || o.offscreen;
+        return drive_window_main(&c, &o, c.sim.duration, shot, shot_at);
+    }
+#else
+    (void)scripted, (void)mapping, (void)width, (void)height, (void)shot_at;
+    if (shot) {
+        fprintf(stderr, "cranesim drive: --screenshot needs the render module (built without SDL2/GL)\n");
+        return EXIT_USAGE;
+    }
+    if (!headless && have_display()) why = "this binary was built without the render module (CRANESIM_CORE_ONLY)";
+#endif
     return drive_headless(&c, frame_rate, record ? record : "drive.csv", why);
 }

@@ -106,6 +106,18 @@ bool live_attached(const live* l) {
     return st.attached >= 0;
 }
 
+hyd_model* live_circuit(live* l) { return l->ode ? ode_world_circuit(l->ode) : l->ls.mdl->hyd; }
+
+crane_mech* live_mech(live* l) {
+    // The lagrange rhs reads the model's mechanics on every call; the live
+    // session owns that model, so editing it in place between steps is safe.
+    return l->ode ? NULL : (crane_mech*)&l->ls.mdl->mech;
+}
+
+void live_set_load(live* l, double m3) {
+    if (!l->ode) l->ls.m3 = m3;
+}
+
 int live_ncol(const live* l) { return l->ode ? SIM_NCOL : SIM_NCOL_BASE; }
 
 void live_set_commands(live* l, const double u[3]) {

@@ -27,6 +27,15 @@ live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], dou
 int live_hook(live* l, int attach);
 /// True while a load hangs on the hook.
 bool live_attached(const live* l);
+/// The circuit the running simulation uses (the model's for lagrange, the
+/// world's own copy for ode): hyd_model_set on it takes effect at the next step.
+hyd_model* live_circuit(live* l);
+/// The mechanics the running lagrange simulation reads every step (NULL for
+/// ode, whose bodies are built once: mechanical changes need a new world).
+crane_mech* live_mech(live* l);
+/// Set the tip load [kg] (lagrange; takes effect at the next step).
+void live_set_load(live* l, double m3);
+
 /// Columns live_row fills (base, or base plus world extras for ode).
 int live_ncol(const live* l);
 void live_destroy(live* l);

@@ -867,3 +867,5 @@ void ode_world_lock_booms(ode_world* w, int lock) {
         }
     }
 }
+
+hyd_model* ode_world_circuit(ode_world* w) { return w->hm; }

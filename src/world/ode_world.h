@@ -110,6 +110,10 @@ void ode_world_snapshot(const ode_world* w, world_snapshot* s);
 /// Current state for CSV and tests.
 void ode_world_get_state(const ode_world* w, ode_world_state* s);
 
+/// The world's own compiled circuit (model plus world extras), for live
+/// parameter changes with hyd_model_set between steps; NULL without hydraulics.
+hyd_model* ode_world_circuit(ode_world* w);
+
 /// Simulated time [s].
 double ode_world_time(const ode_world* w);
 /// ODE step actually used [s].

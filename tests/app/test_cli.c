@@ -7,7 +7,7 @@
 #include <sys/wait.h>
 
 #define BIN CRANESIM_BINARY_DIR "/cranesim"
-#define DATA CRANESIM_TESTDATA "/../app/data"
+#define DATA CRANESIM_TESTDATA
 
 // Run cranesim with args (stderr merged into out). Returns the exit code.
 static int run(const char* args, char* out, size_t n) {

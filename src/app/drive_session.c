@@ -1,0 +1,512 @@
+// drive_session.c: the real-time loop of `cranesim drive` (see drive_session.h).
+#include "drive_session.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <SDL2/SDL.h>
+
+#include "input.h"
+#include "json_util.h"
+#include "panel.h"
+#include "render.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+// How a panel parameter reaches the simulation.
+typedef enum param_kind {
+    PK_HYD,  ///< a circuit parameter: hyd_model_set on the live circuit, at once
+    PK_MECH, ///< a mechanical parameter: live for lagrange, a rebuilt world for ode
+    PK_LOAD, ///< the tip load (lagrange) [kg]
+} param_kind;
+
+#define MAX_PARAMS 40
+
+typedef struct drive_param {
+    param_kind kind;
+    char group[32], label[32], unit[12];
+    double value;      ///< shown value, display units (edited by the panel)
+    double scale;      ///< SI value = value * scale
+    double min, max;   ///< display units
+    char hyd_path[64]; ///< PK_HYD: "lift_cyl.bore", "fluid.bulk_modulus"
+    char json[128];    ///< path in the model file, for saving
+} drive_param;
+
+struct drive_session {
+    app_common c;
+    drive_opts o;
+    model* m;
+    scenario sc;
+    live* l;
+    render* r;
+    input* in;
+    panel* pn;
+    world_snapshot* snap; // large: heap
+    drive_param param[MAX_PARAMS];
+    int nparam;
+    int pid[MAX_PARAMS]; // panel ids
+    bool paused, rebuild;
+    double wall_last, wall_next_frame, wall_pause;
+    double sim_offset;   // simulated time = wall - sim_offset while running
+    FILE* rec;
+    char rec_path[256];
+    int ncol;
+    int ev;              // next scripted hook event
+    int missed_window;   // missed ticks in the current second
+    double missed_t0;
+    drive_stats st;
+    char err[400];
+    char status[512];
+};
+
+drive_opts drive_default_opts(void) {
+    drive_opts o;
+    memset(&o, 0, sizeof o);
+    o.width = 1280;
+    o.height = 720;
+    o.fps_cap = 65.0;
+    o.hud = true;
+    return o;
+}
+
+static void add_param(drive_session* s, param_kind k, const char* group, const char* label, const char* unit,
+                      double scale, double min, double max, const char* hyd_path, const char* json, double si) {
+    if (s->nparam == MAX_PARAMS) return;
+    drive_param* p = &s->param[s->nparam++];
+    p->kind = k;
+    snprintf(p->group, sizeof p->group, "%s", group);
+    snprintf(p->label, sizeof p->label, "%s", label);
+    snprintf(p->unit, sizeof p->unit, "%s", unit);
+    p->scale = scale;
+    p->min = min;
+    p->max = max;
+    snprintf(p->hyd_path, sizeof p->hyd_path, "%s", hyd_path ? hyd_path : "");
+    snprintf(p->json, sizeof p->json, "%s", json ? json : "");
+    p->value = si / scale;
+}
+
+// A circuit parameter whose current value is read from the model.
+static void add_hyd(drive_session* s, const char* group, const char* label, const char* unit, double scale,
+                    double min, double max, const char* comp, const char* field) {
+    char hp[64], jp[128];
+    double v;
+    if (!strcmp(comp, "fluid")) {
+        snprintf(hp, sizeof hp, "fluid.%s", field);
+        snprintf(jp, sizeof jp, "hydraulics.fluid.%s", field);
+    } else {
+        snprintf(hp, sizeof hp, "%s.%s", comp, field);
+        snprintf(jp, sizeof jp, "hydraulics.components.%s.%s", comp, field);
+    }
+    if (hyd_model_get(s->m->hyd, hp, &v)) return; // not in this circuit
+    add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, jp, v);
+}
+
+static void build_params(drive_session* s) {
+    const crane_mech* me = &s->m->mech;
+    add_param(s, PK_MECH, "booms", "lifting arm mass", "kg", 1, 20, 2000, NULL, "mechanics.links[0].mass",
+              me->link[0].mass);
+    add_param(s, PK_MECH, "booms", "end arm mass", "kg", 1, 20, 2000, NULL, "mechanics.links[1].mass",
+              me->link[1].mass);
+    add_param(s, PK_MECH, "booms", "lifting arm length", "m", 1, 1.0, 5.0, NULL, "mechanics.links[0].length",
+              me->link[0].length);
+    add_param(s, PK_MECH, "booms", "end arm length", "m", 1, 1.0, 5.0, NULL, "mechanics.links[1].length",
+              me->link[1].length);
+    if (s->c.sim.mechanics == SIM_LAGRANGE)
+        add_param(s, PK_LOAD, "load", "tip load", "kg", 1, 0, 5000, NULL, "mechanics.load_mass",
+                  sim_load_mass(s->m, &s->sc, &s->c.sim));
+    static const char* const cyl[2] = {"lift_cyl", "jib_cyl"};
+    static const char* const grp[2] = {"lift cylinder", "jib cylinder"};
+    for (int k = 0; k < 2; ++k) {
+        add_hyd(s, grp[k], "bore", "mm", 1e-3, 40, 200, cyl[k], "bore");
+        add_hyd(s, grp[k], "rod", "mm", 1e-3, 20, 150, cyl[k], "rod");
+        add_hyd(s, grp[k], "friction", "kN s/m", 1e3, 0, 100, cyl[k], "friction");
+    }
+    static const char* const val[3] = {"lift_valve", "jib_valve", "slew_valve"};
+    static const char* const vgrp[3] = {"lift valve", "jib valve", "slew valve"};
+    for (int k = 0; k < 3; ++k) {
+        add_hyd(s, vgrp[k], "rated flow", "L/min", 1.0 / 60000.0, 5, 200, val[k], "q_nominal");
+        add_hyd(s, vgrp[k], "spool time constant", "ms", 1e-3, 1, 500, val[k], "tau");
+    }
+    add_hyd(s, "supply", "pump pressure", "MPa", 1e6, 2, 35, "pump", "p_set");
+    add_hyd(s, "supply", "pump max flow", "L/min", 1.0 / 60000.0, 5, 200, "pump", "q_max");
+    add_hyd(s, "reliefs", "main relief", "MPa", 1e6, 2, 40, "main_relief", "p_crack");
+    add_hyd(s, "reliefs", "lift port A", "MPa", 1e6, 2, 40, "lift_relief_A", "p_crack");
+    add_hyd(s, "reliefs", "lift port B", "MPa", 1e6, 2, 40, "lift_relief_B", "p_crack");
+    add_hyd(s, "reliefs", "jib port A", "MPa", 1e6, 2, 40, "jib_relief_A", "p_crack");
+    add_hyd(s, "reliefs", "jib port B", "MPa", 1e6, 2, 40, "jib_relief_B", "p_crack");
+    add_hyd(s, "oil", "bulk modulus", "GPa", 1e9, 0.2, 2.5, "fluid", "bulk_modulus");
+    add_hyd(s, "oil", "density", "kg/m3", 1, 700, 1000, "fluid", "density");
+}
+
+// Keep the model document in step with a changed parameter, so "save model"
+// writes what is being driven.
+static void sync_json(drive_session* s, const drive_param* p) {
+    if (!p->json[0]) return;
+    char a[200], e[200];
+    snprintf(a, sizeof a, "%s=%.10g", p->json, p->value * p->scale);
+    json_set_path(s->m->json, a, e, sizeof e);
+}
+
+static live* make_live(drive_session* s, const double q0[2], double slew0) {
+    char err[400];
+    live* l = s->c.sim.mechanics == SIM_ODE
+                  ? live_create_ode(s->m, &s->c.sim, q0, slew0, sim_load_mass(s->m, &s->sc, &s->c.sim), err,
+                                    sizeof err)
+                  : live_create_lagrange(s->m, &s->c.sim, q0, sim_load_mass(s->m, &s->sc, &s->c.sim), err,
+                                         sizeof err);
+    if (!l) snprintf(s->err, sizeof s->err, "%s", err);
+    return l;
+}
+
+// Apply one accepted panel change to the running simulation.
+static void apply_param(drive_session* s, int i) {
+    drive_param* p = &s->param[i];
+    const double si = p->value * p->scale;
+    char e[256];
+    switch (p->kind) {
+    case PK_HYD:
+        // Both the world's own circuit and the model's (which a rebuilt world
+        // or a saved file starts from).
+        if (hyd_model_set(live_circuit(s->l), p->hyd_path, si, e, sizeof e) ||
+            hyd_model_set(s->m->hyd, p->hyd_path, si, e, sizeof e)) {
+            snprintf(s->status, sizeof s->status, "rejected: %s", e);
+            double old;
+            if (!hyd_model_get(s->m->hyd, p->hyd_path, &old)) p->value = old / p->scale;
+            return;
+        }
+        break;
+    case PK_MECH: {
+        crane_mech* me = &s->m->mech;
+        if (strstr(p->json, "links[0].mass")) me->link[0].mass = si;
+        if (strstr(p->json, "links[1].mass")) me->link[1].mass = si;
+        if (strstr(p->json, "links[0].length")) me->link[0].length = si, me->link[0].com = 0.5 * si;
+        if (strstr(p->json, "links[1].length")) me->link[1].length = si, me->link[1].com = 0.5 * si;
+        for (int k = 0; k < 2; ++k)
+            me->link[k].inertia = me->link[k].mass * me->link[k].length * me->link[k].length / 12.0;
+        crane_mech_derive(me);
+        // Lagrange reads the model's mechanics every step; the ode world's
+        // bodies are built once, so it is rebuilt at the current pose.
+        if (s->c.sim.mechanics == SIM_ODE) s->rebuild = true;
+        break;
+    }
+    case PK_LOAD:
+        live_set_load(s->l, si);
+        s->c.sim.load_mass = si;
+        break;
+    }
+    sync_json(s, p);
+    snprintf(s->status, sizeof s->status, "%s/%s = %.4g %s", p->group, p->label, p->value, p->unit);
+}
+
+static void rebuild_world(drive_session* s, bool at_start) {
+    double row[SIM_NCOL];
+    live_row(s->l, row);
+    double q0[2] = {row[COL_Q1], row[COL_Q2]}, slew0 = s->c.sim.mechanics == SIM_ODE ? row[COL_SLEW] : 0;
+    if (at_start) {
+        q0[0] = s->sc.q0[0];
+        q0[1] = s->sc.q0[1];
+        slew0 = s->sc.slew0;
+    }
+    live* l = make_live(s, q0, slew0);
+    if (!l) {
+        snprintf(s->status, sizeof s->status, "rebuild failed: %s", s->err);
+        return;
+    }
+    live_destroy(s->l);
+    s->l = l;
+    s->sim_offset = s->wall_last; // the new world's clock starts at 0 now
+    s->ev = 0;
+    render_chart_clear(s->r);
+}
+
+static void act_reset(void* user) {
+    drive_session* s = user;
+    rebuild_world(s, true);
+    snprintf(s->status, sizeof s->status, "run reset");
+}
+
+static void act_save(void* user) {
+    drive_session* s = user;
+    char e[256];
+    const char* path = "cranesim_model_saved.json";
+    if (model_save(s->m, path, e, sizeof e)) snprintf(s->status, sizeof s->status, "save failed: %s", e);
+    else snprintf(s->status, sizeof s->status, "model saved to %s", path);
+}
+
+static void act_pause(void* user) {
+    drive_session* s = user;
+    s->paused = !s->paused;
+}
+
+static void start_recording(drive_session* s, const char* path) {
+    s->rec = fopen(path, "w");
+    if (!s->rec) {
+        snprintf(s->status, sizeof s->status, "cannot write %s", path);
+        return;
+    }
+    snprintf(s->rec_path, sizeof s->rec_path, "%s", path);
+    sim_csv_header(s->rec, s->ncol);
+}
+
+drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz) {
+    drive_session* s = calloc(1, sizeof *s);
+    if (!s) {
+        snprintf(err, errsz, "out of memory");
+        return NULL;
+    }
+    s->c = *c;
+    s->o = *o;
+    s->snap = calloc(1, sizeof *s->snap);
+    if (!s->c.scenario_path)
+        s->c.scenario_path = s->c.sim.mechanics == SIM_ODE ? "sandbox_pick_place" : "drive_demo";
+    char e2[512];
+    s->m = model_load(s->c.model_path, s->c.sets, s->c.nset, e2, sizeof e2);
+    char sb[512];
+    if (!s->m || scenario_load(app_scenario_path(s->c.scenario_path, sb, sizeof sb), &s->sc, e2, sizeof e2)) {
+        snprintf(err, errsz, "%s", e2);
+        drive_session_destroy(s);
+        return NULL;
+    }
+    s->l = make_live(s, s->sc.q0, s->sc.slew0);
+    if (!s->l) {
+        snprintf(err, errsz, "%s", s->err);
+        drive_session_destroy(s);
+        return NULL;
+    }
+    s->ncol = live_ncol(s->l);
+    render_config rc = render_default_config();
+    rc.width = o->width;
+    rc.height = o->height;
+    rc.offscreen = o->offscreen;
+    rc.hud = o->hud;
+    rc.title = "cranesim drive";
+    char asset_dir[512];
+    snprintf(asset_dir, sizeof asset_dir, "%s/meshes", model_assets_dir());
+    rc.asset_dir = asset_dir;
+    s->r = render_create(&rc, err, errsz);
+    if (!s->r) {
+        drive_session_destroy(s);
+        return NULL;
+    }
+    input_mapping map = input_default_mapping();
+    if (o->mapping_file && input_load_mapping(o->mapping_file, &map, err, errsz)) {
+        drive_session_destroy(s);
+        return NULL;
+    }
+    s->in = input_create(&map);
+    s->pn = panel_create();
+    build_params(s);
+    for (int i = 0; i < s->nparam; ++i) {
+        drive_param* p = &s->param[i];
+        panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0};
+        s->pid[i] = panel_add_param(s->pn, &d);
+    }
+    panel_add_action(s->pn, "reset run", act_reset, s);
+    panel_add_action(s->pn, "save model", act_save, s);
+    panel_add_action(s->pn, "pause / resume", act_pause, s);
+    render_attach_panel(s->r, s->pn);
+    render_charts_default(s->r, s->c.sim.mechanics == SIM_ODE ? 3 : 2);
+    if (o->record_path) start_recording(s, o->record_path);
+    s->missed_t0 = 0;
+    return s;
+}
+
+void drive_session_destroy(drive_session* s) {
+    if (!s) return;
+    if (s->rec) fclose(s->rec);
+    if (s->pn) {
+        if (s->r) render_attach_panel(s->r, NULL);
+        panel_destroy(s->pn);
+    }
+    if (s->in) input_destroy(s->in);
+    if (s->r) render_destroy(s->r);
+    live_destroy(s->l);
+    model_free(s->m);
+    free(s->snap);
+    free(s);
+}
+
+void drive_session_render(drive_session* s) {
+    live_snapshot(s->l, s->snap);
+    s->snap->rt_factor = s->st.wall_time > 0 ? s->st.sim_time / s->st.wall_time : 0;
+    uint64_t t0 = SDL_GetPerformanceCounter();
+    render_frame(s->r, s->snap);
+    render_present(s->r);
+    double ms = 1e3 * (double)(SDL_GetPerformanceCounter() - t0) / (double)SDL_GetPerformanceFrequency();
+    s->st.render_ms_max = fmax(s->st.render_ms_max, ms);
+    s->st.triangles = render_get_stats(s->r).triangles;
+    ++s->st.frames;
+}
+
+int drive_session_screenshot(drive_session* s, const char* png) { return render_screenshot(s->r, png); }
+
+int drive_session_tick(drive_session* s, double wall) {
+    ++s->st.ticks;
+    double dt_wall = wall - s->wall_last;
+    if (dt_wall < 0) dt_wall = 0;
+    s->wall_last = wall;
+    s->st.wall_time = wall;
+
+    // Events: devices (hot-plug, keys), camera and panel, window close.
+    SDL_Event ev;
+    bool quit = false;
+    while (SDL_PollEvent(&ev)) {
+        if (ev.type == SDL_QUIT) quit = true;
+        if (ev.type == SDL_KEYDOWN && ev.key.keysym.scancode == SDL_SCANCODE_F5 && !ev.key.repeat) {
+            if (s->rec) {
+                fclose(s->rec);
+                s->rec = NULL;
+                snprintf(s->status, sizeof s->status, "recording stopped: %s", s->rec_path);
+            } else {
+                char path[64];
+                snprintf(path, sizeof path, "cranesim_record_%ld.csv", (long)time(NULL));
+                start_recording(s, path);
+                snprintf(s->status, sizeof s->status, "recording to %s", path);
+            }
+            continue;
+        }
+        if (render_handle_event(s->r, &ev)) continue; // the panel took it
+        input_handle_event(s->in, &ev);
+    }
+    input_command cmd;
+    input_poll(s->in, dt_wall, &cmd);
+    if (cmd.quit) quit = true;
+    if (cmd.pause) s->paused = !s->paused;
+    if (cmd.reset) act_reset(s);
+    if (cmd.camera_next) render_set_camera_preset(s->r, (render_get_camera_preset(s->r) + 1) % RENDER_CAM_COUNT);
+    if (cmd.camera_preset >= 0) render_set_camera_preset(s->r, (render_cam_preset)cmd.camera_preset);
+    if (cmd.screenshot) {
+        char path[64];
+        snprintf(path, sizeof path, "cranesim_%ld.png", (long)time(NULL));
+        snprintf(s->status, sizeof s->status, render_screenshot(s->r, path) ? "screenshot failed" : "saved %s",
+                 path);
+    }
+    for (int id; (id = panel_next_changed(s->pn)) >= 0;)
+        for (int i = 0; i < s->nparam; ++i)
+            if (s->pid[i] == id) apply_param(s, i);
+    if (s->rebuild) {
+        s->rebuild = false;
+        rebuild_world(s, false);
+    }
+
+    double t = live_time(s->l);
+    if (s->paused) {
+        // Hold simulated time: the clock offset grows with the paused time.
+        s->sim_offset += dt_wall;
+    } else {
+        double u[3] = {cmd.lift, cmd.jib, cmd.slew};
+        if (s->o.scripted) {
+            const double tm = t + 0.5 * dt_wall;
+            for (int k = 0; k < 3; ++k) u[k] = scenario_command(&s->sc, k, tm);
+            while (s->ev < s->sc.nevent && s->sc.event[s->ev].t <= tm) {
+                live_hook(s->l, s->sc.event[s->ev].kind == SCENARIO_ATTACH);
+                ++s->ev;
+            }
+        } else if (cmd.hook_toggle) {
+            live_hook(s->l, !live_attached(s->l));
+        }
+        live_set_commands(s->l, u);
+        ++s->st.input_samples;
+        // Keep simulated time on wall time. More than 0.1 s behind means the
+        // machine cannot keep up: count it and let the clock slip rather than
+        // run a long catch-up burst the operator would feel.
+        double target = wall - s->sim_offset;
+        if (target - t > 0.1) {
+            ++s->st.missed;
+            ++s->missed_window;
+            s->sim_offset += target - t - 0.1;
+            target = t + 0.1;
+        }
+        if (target > t && live_advance(s->l, target - t)) {
+            snprintf(s->err, sizeof s->err, "%s", live_error(s->l));
+            return -1;
+        }
+    }
+    s->st.sim_time = live_time(s->l);
+    if (wall - s->missed_t0 >= 1.0) {
+        render_set_missed_deadlines(s->r, s->missed_window);
+        s->missed_window = 0;
+        s->missed_t0 = wall;
+    }
+    if (s->rec) {
+        double row[SIM_NCOL];
+        live_row(s->l, row);
+        sim_csv_row(s->rec, row, s->ncol);
+    }
+    char status[640];
+    snprintf(status, sizeof status, "%s%s%s%s", s->paused ? "PAUSED  " : "", s->rec ? "REC  " : "", s->status,
+             input_device_name(s->in) ? "" : "  [keyboard]");
+    render_set_status(s->r, status);
+
+    if (wall >= s->wall_next_frame) {
+        live_snapshot(s->l, s->snap);
+        render_charts_sample(s->r, s->snap);
+        drive_session_render(s);
+        double interval = 1e3 * (wall - (s->wall_next_frame - 1.0 / s->o.fps_cap));
+        s->st.frame_ms[s->st.nframe_ms++ % 4096] = interval;
+        s->wall_next_frame += 1.0 / s->o.fps_cap;
+        if (s->wall_next_frame < wall) s->wall_next_frame = wall; // do not queue up frames
+    }
+    return quit ? 1 : 0;
+}
+
+const char* drive_session_error(const drive_session* s) { return s->err; }
+const drive_stats* drive_session_stats(const drive_session* s) { return &s->st; }
+live* drive_session_live(drive_session* s) { return s->l; }
+render* drive_session_render_ctx(drive_session* s) { return s->r; }
+input* drive_session_input(drive_session* s) { return s->in; }
+panel* drive_session_panel(drive_session* s) { return s->pn; }
+void drive_session_row(drive_session* s, double* row) { live_row(s->l, row); }
+
+int drive_window_main(const app_common* c, const drive_opts* o, double duration, const char* screenshot,
+                      double screenshot_at) {
+    char err[512];
+    drive_session* s = drive_session_create(c, o, err, sizeof err);
+    if (!s) {
+        fprintf(stderr, "cranesim drive: %s\n", err);
+        return EXIT_USAGE;
+    }
+    printf("cranesim drive: %s in the %s; %s\n", s->m->name,
+           c->sim.mechanics == SIM_ODE ? "sandbox" : "lagrange 2-DOF view",
+           o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, P pause, R reset, "
+                                               "C camera, F5 record, F12 screenshot, Esc quit)");
+    // Ticks at 240 Hz: between rendered frames the loop still pumps events,
+    // reads the sticks and commands the valves, so commands run faster than
+    // frames (>= 75 Hz, the paper's rate, even while a frame takes 12 ms).
+    const double tick = 1.0 / 240.0;
+    const uint64_t f = SDL_GetPerformanceFrequency(), t0 = SDL_GetPerformanceCounter();
+    int code = 0;
+    bool shot_done = false;
+    for (;;) {
+        double wall = (double)(SDL_GetPerformanceCounter() - t0) / (double)f;
+        int rc = drive_session_tick(s, wall);
+        if (rc < 0) {
+            fprintf(stderr, "cranesim drive: %s\n", drive_session_error(s));
+            code = EXIT_RUNTIME;
+            break;
+        }
+        if (screenshot && !shot_done && live_time(s->l) >= screenshot_at) {
+            drive_session_render(s);
+            if (drive_session_screenshot(s, screenshot)) code = EXIT_RUNTIME;
+            else printf("  screenshot -> %s\n", screenshot);
+            shot_done = true;
+            if (duration <= 0) break;
+        }
+        if (rc > 0 || (duration > 0 && wall >= duration)) break;
+        double next = (double)(SDL_GetPerformanceCounter() - t0) / (double)f;
+        double left = wall + tick - next;
+        if (left > 0) SDL_Delay((Uint32)(left * 1e3));
+    }
+    const drive_stats* st = drive_session_stats(s);
+    printf("  simulated %.2f s in %.2f s wall; %ld frames (%.1f fps), %ld command updates (%.0f Hz), missed %ld; "
+           "%ld triangles\n",
+           st->sim_time, st->wall_time, st->frames, st->wall_time > 0 ? st->frames / st->wall_time : 0,
+           st->input_samples, st->wall_time > 0 ? st->input_samples / st->wall_time : 0, st->missed, st->triangles);
+    drive_session_destroy(s);
+    return code;
+}

@@ -1,0 +1,78 @@
+// drive_session.h: the interactive simulator's loop, as a library so tests can
+// drive it headless (offscreen GL, virtual joystick, virtual clock).
+//
+// One session = one model + one live world (ode sandbox by default) + the
+// renderer, the input devices and the parameter panel. drive_session_tick()
+// is one iteration of the real-time loop: events, operator input, physics up
+// to the given wall time (0.1 ms hydraulics inside), and a rendered frame
+// when one is due.
+#ifndef DRIVE_SESSION_H
+#define DRIVE_SESSION_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "app.h"
+#include "live.h"
+
+struct render;
+struct input;
+struct panel;
+
+typedef struct drive_opts {
+    int width, height;        ///< window or offscreen size [px] (default 1280 x 720)
+    bool offscreen;           ///< render into an FBO, no window
+    double fps_cap;           ///< render at most this many frames per second (default 75)
+    const char* mapping_file; ///< joystick axis mapping JSON, or NULL for defaults
+    const char* record_path;  ///< start recording to this CSV at once, or NULL (F5 toggles)
+    bool scripted;            ///< operator input from the scenario instead of devices
+    bool hud;                 ///< draw the HUD (default true)
+} drive_opts;
+
+drive_opts drive_default_opts(void);
+
+typedef struct drive_stats {
+    long frames;          ///< frames rendered
+    long ticks;           ///< loop iterations
+    long input_samples;   ///< valve-command updates applied
+    long missed;          ///< ticks whose physics could not catch up with wall time
+    double sim_time;      ///< simulated time [s]
+    double wall_time;     ///< wall time since start [s]
+    double render_ms_max; ///< slowest frame [ms]
+    long triangles;       ///< triangles in the last frame
+    double frame_ms[4096];///< recent frame intervals [ms] (ring buffer)
+    int nframe_ms;
+} drive_stats;
+
+typedef struct drive_session drive_session;
+
+/// Load the model, build the world, open the renderer and devices. c holds the
+/// model, world, scenario and solver options (drive's defaults: ode sandbox).
+/// Returns NULL with a message.
+drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz);
+void drive_session_destroy(drive_session* s);
+
+/// One loop iteration at wall time `wall` [s] since the session started
+/// (real clock in the app, a virtual one in tests). Returns 1 when the
+/// operator asked to quit, -1 on a numerical failure (message in
+/// drive_session_error), else 0.
+int drive_session_tick(drive_session* s, double wall);
+
+/// Force a rendered frame now (e.g. before a screenshot).
+void drive_session_render(drive_session* s);
+int drive_session_screenshot(drive_session* s, const char* png);
+
+const char* drive_session_error(const drive_session* s);
+const drive_stats* drive_session_stats(const drive_session* s);
+live* drive_session_live(drive_session* s);
+struct render* drive_session_render_ctx(drive_session* s);
+struct input* drive_session_input(drive_session* s);
+struct panel* drive_session_panel(drive_session* s);
+/// The row (CSV columns) at the current simulated time.
+void drive_session_row(drive_session* s, double* row);
+
+/// Run the interactive loop on the real clock until quit (the `drive` command).
+int drive_window_main(const app_common* c, const drive_opts* o, double duration, const char* screenshot,
+                      double screenshot_at);
+
+#endif
