@@ -279,6 +279,9 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         return NULL;
     }
     s->ncol = live_ncol(s->l);
+    // Keep reading the sticks when the 3D window is not focused (the operator
+    // may click a plot or a terminal; and an offscreen view never has focus).
+    SDL_SetHint(SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, "1");
     render_config rc = render_default_config();
     rc.width = o->width;
     rc.height = o->height;

@@ -394,6 +394,7 @@ void hyd_model_free(hyd_model* m) {
     free(m->node_sidx);
     free(m->node_V0);
     free(m->node_bel);
+    free(m->node_bec);
     free(m->node_pfix);
     free(m->node_p0);
     free(m->vol_node);
@@ -519,6 +520,7 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
              ALLOC_(m->node_name, nnode) && ALLOC_(m->node_state, nnode) &&
              ALLOC_(m->node_sidx, nnode) && ALLOC_(m->node_V0, nnode) &&
              ALLOC_(m->node_bel, nnode) && ALLOC_(m->node_pfix, nnode) &&
+             ALLOC_(m->node_bec, nnode) &&
              ALLOC_(m->node_p0, nnode) && ALLOC_(m->vol_node, nnode) &&
              ALLOC_(m->tank_node, nnode) && ALLOC_(m->pump, m->npump) &&
              ALLOC_(m->relief, m->nrelief) && ALLOC_(m->check, m->ncheck) &&
@@ -753,6 +755,10 @@ int hyd_model_derive(hyd_model* m, hyd_build_error* e) {
         }
         default: break;
         }
+    }
+    hyd_air_tab_init(&m->air, f);
+    for (int i = 0; i < m->nnode; ++i) {
+        m->node_bec[i] = m->be_alpha * m->node_bel[i] * m->be_inv_n;
     }
     for (int k = 0; k < m->nvol; ++k)
         m->y0[m->node_state[m->vol_node[k]]] = m->node_p0[m->vol_node[k]];

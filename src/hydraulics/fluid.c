@@ -11,12 +11,21 @@
 // The continuation is rational, Be_lo^2 / (Be_lo + Be'_lo (P_LO - P)): it
 // matches value and slope at P_LO and decays like 1/|P| without underflowing
 // to 0 (a zero modulus would freeze the node).
+//
+// Speed. The law runs once per pressure node per f evaluation, and pow() (as
+// exp(log)) was ~40 % of a whole crane step. A compiled model therefore takes
+// r = (p_a/P)^(1/n) from tables built here at derive time (hyd_air_ratio in
+// hyd_internal.h): P = 2^e m splits r into oct[e] (one pow per octave, exact
+// to rounding) times m^(-1/n) on [1, 2), which is a degree-6 Taylor polynomial
+// about the centre of one of 128 segments. With |x| <= 1/256 the remainder is
+// |binom(-1/n, 7)| (1/256)^7 < 1.4e-17 for n >= 1, so r and Be agree with
+// exp(log) to a few ulp (tests/hydraulics/test_components.c checks 1e-13 over
+// the whole range). The law is then written with one division (see
+// hyd_be_nd). The public hyd_bulk_modulus keeps the plain exp/log form as the
+// reference.
 #include "hyd_internal.h"
 
 #include <math.h>
-
-/// Below this absolute pressure [Pa] Be is continued by a rational tail (see above).
-#define HYD_BE_P_LO 100.0
 
 hyd_fluid_def hyd_default_fluid_def(void) {
     hyd_fluid_def f;
@@ -73,6 +82,44 @@ double hyd_bulk_modulus(const hyd_fluid_def* f, double be_liquid, double p, doub
     return be_eval(f->air_fraction, 1.0 / f->polytropic_index, f->p_atm, be_liquid, p, dbe);
 }
 
+double hyd_be_slow(const hyd_model* m, double bel, double P, double* dbe) {
+    return be_eval(m->be_alpha, m->be_inv_n, m->fluid.p_atm, bel, P, dbe);
+}
+
+// Below n = 1 the Taylor remainder grows (|binom(-1/n, 7)| is 36 at n = 1/3);
+// such fluids keep the exact exp/log path rather than a weaker guarantee.
+void hyd_air_tab_init(hyd_air_tab* t, const hyd_fluid_def* f) {
+    const double a = -1.0 / f->polytropic_index;
+    t->use = f->air_fraction > 0.0 && f->polytropic_index >= 1.0;
+    if (!t->use)
+        return;
+    for (int e = 0; e < HYD_AIR_OCT; ++e)
+        t->oct[e] = pow(ldexp(1.0, e) / f->p_atm, a);
+    for (int j = 0; j < HYD_AIR_SEG; ++j) {
+        const double mc = 1.0 + (j + 0.5) / HYD_AIR_SEG;
+        // f(mc + x) = sum_k binom(a, k) mc^(a - k) x^k
+        double binom = 1.0;
+        for (int k = 0; k <= HYD_AIR_DEG; ++k) {
+            t->seg[j][k] = binom * pow(mc, a - k);
+            binom *= (a - k) / (k + 1);
+        }
+        t->seg[j][HYD_AIR_DEG + 1] = mc;
+    }
+}
+
+// Fast path as in hyd_be_nd; dBe/dP from dr/dP = -r / (n P):
+//   dN/dP = bel (1 + alpha r (1 - 1/n)),  dD/dP = 1 - bec r / (n P)
 double hyd_be(const hyd_model* m, double bel, double p, double* dbe) {
-    return be_eval(m->be_alpha, m->be_inv_n, m->fluid.p_atm, bel, p, dbe);
+    const double bec = m->be_alpha * bel * m->be_inv_n;
+    double N, D, r;
+    if (!m->air.use || !hyd_be_nd(m, bel, bec, p, &N, &D, &r))
+        return hyd_be_slow(m, bel, p, dbe);
+    const double iD = 1.0 / D;
+    const double be = N * iD;
+    if (dbe) {
+        const double dN = bel * (1.0 + m->be_alpha * r * (1.0 - m->be_inv_n));
+        const double dD = 1.0 - bec * r * m->be_inv_n / p;
+        *dbe = (dN - be * dD) * iD;
+    }
+    return be;
 }

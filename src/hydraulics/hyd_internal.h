@@ -6,8 +6,11 @@
 
 #include "hydraulics.h"
 
+#include <math.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <string.h>
 
 #define HYD_MAXPORT 4
 /// pi (M_PI is not part of strict C11).
@@ -111,6 +114,29 @@ typedef struct hyd_cyl_c {
     double AA, AB, s, VA0, VB0, CL, bv, ks, cs, ws;
 } hyd_cyl_c;
 
+/// Segments per octave of the air-ratio table (a power of two).
+#define HYD_AIR_SEG 128
+/// Octaves covered: absolute pressures in [1, 2^HYD_AIR_OCT) Pa (the law is
+/// only used above HYD_BE_P_LO = 100 Pa; beyond 2^64 Pa the exact law runs).
+#define HYD_AIR_OCT 64
+/// Degree of the per-segment Taylor polynomial of m^(-1/n).
+#define HYD_AIR_DEG 6
+/// Below this absolute pressure [Pa] Be is continued by a rational tail (fluid.c).
+#define HYD_BE_P_LO 100.0
+
+/// Tables for the air ratio r(P) = (p_a / P)^(1/n) of the entrained-air law,
+/// built at derive time (fluid.c). With P = 2^e m, m in [1, 2):
+///   r = oct[e] * m^(-1/n),  oct[e] = (2^e / p_a)^(-1/n)
+/// and m^(-1/n) is a degree-6 Taylor polynomial about the centre of one of
+/// HYD_AIR_SEG segments of [1, 2). The truncation error is below 1e-16
+/// relative for n >= 1 (see fluid.c), so r is exact to a few ulp: a fast pow
+/// for a fixed exponent, not an approximation of the law.
+typedef struct hyd_air_tab {
+    int use;                                   ///< 0: evaluate the law with exp/log
+    double oct[HYD_AIR_OCT];                   ///< (p_a / 2^e)^(1/n)
+    double seg[HYD_AIR_SEG][HYD_AIR_DEG + 2];  ///< Taylor coefficients c_0..c_6, then the centre
+} hyd_air_tab;
+
 struct hyd_model {
     hyd_fluid_def fluid;
     int nstate, nnode, ncomp, nunode; ///< nunode: user-declared nodes (first in node order)
@@ -149,6 +175,8 @@ struct hyd_model {
 
     // Fluid constants used by the bulk-modulus law for every node.
     double be_inv_n, be_alpha;
+    double* node_bec; ///< (nnode) alpha Be_l / n [Pa], the air term's weight
+    hyd_air_tab air;
 
     char** state_name; ///< (nstate)
     double* y0;        ///< (nstate) initial state
@@ -171,8 +199,26 @@ void hyd_cylinder_derive(const hyd_cylinder_def* d, hyd_cyl_c* c);
 int hyd_cylinder_validate(const hyd_cylinder_def* d, char* field, size_t fsz, char* msg,
                           size_t msz);
 
-/// Orifice law on precomputed constants: Q [m^3/s], *g = dQ/ddp, *gA = dQ/dA.
-double hyd_orifice_q(const hyd_orif_k* k, double A, double dp, double* g, double* gA);
+/// Orifice law on precomputed constants: Q [m^3/s], *g = dQ/ddp, *gA = dQ/dA
+/// (see orifice.c). Inline: it runs twice per valve per evaluation, and the
+/// caller's unused partials then cost nothing.
+static inline double hyd_orifice_q(const hyd_orif_k* k, double A, double dp, double* g, double* gA) {
+    const double x = dp * A * k->invP0;
+    if (fabs(x) < 1.0) {
+        const double sA = sqrt(A);
+        const double G = k->kl * A * sA;
+        const double x2 = x * x;
+        const double lam = 1.0 - 0.2 * x2;
+        *g = G * (1.0 - 0.6 * x2);
+        // dQ/dA = dG/dA dp (1 - x^2/5) - G dp (2x/5) dx/dA, dx/dA = dp / P0
+        *gA = 1.5 * k->kl * sA * dp * lam - G * dp * 0.4 * x * dp * k->invP0;
+        return G * dp * lam;
+    }
+    const double s = sqrt(fabs(dp));
+    *g = 0.5 * k->k * A / s;
+    *gA = k->k * copysign(s, dp);
+    return k->k * A * copysign(s, dp);
+}
 
 // ---------------------------------------------------------------------------
 // Kernels: each loops over all components of its type, adds flows into
@@ -195,8 +241,57 @@ void hyd_valves_eval(const hyd_model* m, hyd_data* d, const double* y, double* y
 void hyd_volumes_eval(const hyd_model* m, hyd_data* d, double* ydot, const double* G, double* J,
                       int ldj);
 
-/// Bulk modulus on the model's precomputed fluid constants.
+/// Bulk modulus on the model's precomputed fluid constants (the same law as
+/// hyd_bulk_modulus to a few ulp, through the air-ratio table).
 double hyd_be(const hyd_model* m, double bel, double p, double* dbe);
+/// Build m->air from the fluid (fluid.c).
+void hyd_air_tab_init(hyd_air_tab* t, const hyd_fluid_def* f);
+/// The entrained-air law away from the fast path (P < P_LO, P >= 2^64, NaN,
+/// or no table): exact, with exp/log (fluid.c).
+double hyd_be_slow(const hyd_model* m, double bel, double P, double* dbe);
+
+/// r(P) = (p_a / P)^(1/n) from the table, for P in [1, 2^HYD_AIR_OCT).
+/// The exponent and the top mantissa bits of P index the tables directly, so
+/// there is no log, exp or division.
+static inline double hyd_air_ratio(const hyd_air_tab* t, double P) {
+    uint64_t b;
+    memcpy(&b, &P, sizeof b);
+    const int e = (int)(b >> 52) - 1023;
+    const int j = (int)(b >> (52 - 7)) & (HYD_AIR_SEG - 1);
+    const uint64_t mb = (b & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
+    double mant;
+    memcpy(&mant, &mb, sizeof mant);
+    const double* c = t->seg[j];
+    const double x = mant - c[HYD_AIR_DEG + 1]; // exact: both in [1, 2]
+    // Estrin's scheme: a shorter dependency chain than Horner, same rounding class.
+    const double x2 = x * x;
+    const double p01 = c[0] + c[1] * x, p23 = c[2] + c[3] * x, p45 = c[4] + c[5] * x;
+    const double p = p01 + x2 * (p23 + x2 * (p45 + x2 * c[6]));
+    return t->oct[e] * p;
+}
+
+/// Numerator and denominator of the law at absolute pressure P for a node with
+/// liquid modulus bel and air weight bec = alpha bel / n:
+///   Be = N / D,  N = bel (1 + alpha r) P,  D = P + bec r
+/// (the SPEC form multiplied through by P, so Be costs one division, which the
+/// caller can share with 1/V). Returns 0 when P is off the fast path; the
+/// caller then uses hyd_be_slow.
+static inline int hyd_be_nd(const hyd_model* m, double bel, double bec, double P, double* N,
+                            double* D, double* r) {
+    const hyd_air_tab* restrict t = &m->air;
+    if (!t->use) {
+        // alpha = 0 or an unusual n: constant modulus or the slow path.
+        *N = bel, *D = 1.0, *r = 0.0;
+        return m->be_alpha == 0.0;
+    }
+    if (!(P >= HYD_BE_P_LO && P < 18446744073709551616.0)) // 2^64; false for NaN
+        return 0;
+    const double rr = hyd_air_ratio(t, P);
+    *r = rr;
+    *N = bel * (1.0 + m->be_alpha * rr) * P;
+    *D = P + bec * rr;
+    return 1;
+}
 
 /// Flow partials of a flow from node a to node b: ga = dq/dp_a, gb = dq/dp_b.
 static inline void hyd_jac_flow(const hyd_model* m, double* G, int a, int b, double ga, double gb) {

@@ -9,16 +9,25 @@
 #include <float.h>
 #include <math.h>
 
-int hyd_lu_factor(double* a, int n, int* piv) {
+// Shared by hyd_lu_factor and the solver's blocks. Rows are unit stride, so
+// the elimination update is a plain axpy the compiler vectorises (row i and
+// row k never overlap, hence restrict). When idiag is non-NULL it receives
+// 1/U_kk, so a solve multiplies instead of dividing; *swapped says whether any
+// row exchange happened (the solve then skips the permutation replay).
+static int lu_factor(double* a, int n, int* piv, double* idiag, int* swapped) {
     // A pivot at or below eps * max|a_ij| is zero to working precision: treat
     // the matrix as singular rather than return huge, meaningless factors.
-    double amax = 0.0, sum = 0.0;
+    // amax sticks at NaN once it meets one (v != v), and Inf fails the
+    // final test too: no separate pass for the non-finite check. Not fmax():
+    // that is a libm call here.
+    double amax = 0.0;
     for (int i = 0; i < n * n; ++i) {
-        amax = fmax(amax, fabs(a[i]));
-        sum += a[i] * 0.0; // NaN if any entry is NaN or Inf
+        const double v = fabs(a[i]);
+        amax = (v > amax || v != v) ? v : amax;
     }
-    if (sum != 0.0) return -1;
+    if (!(amax <= DBL_MAX)) return -1;
     const double tiny = amax * DBL_EPSILON;
+    int sw = 0;
 
     for (int k = 0; k < n; ++k) {
         int p = k;
@@ -33,6 +42,7 @@ int hyd_lu_factor(double* a, int n, int* piv) {
         piv[k] = p;
         if (!(pmax > tiny)) return -1;
         if (p != k) {
+            sw = 1;
             for (int j = 0; j < n; ++j) {
                 double tmp = a[k * n + j];
                 a[k * n + j] = a[p * n + j];
@@ -40,16 +50,28 @@ int hyd_lu_factor(double* a, int n, int* piv) {
             }
         }
         const double inv = 1.0 / a[k * n + k];
+        if (idiag) idiag[k] = inv;
+        const double* restrict rk = a + k * n;
         for (int i = k + 1; i < n; ++i) {
-            double l = a[i * n + k] * inv;
-            a[i * n + k] = l;
+            double* restrict ri = a + i * n;
+            const double l = ri[k] * inv;
+            ri[k] = l;
             if (l == 0.0) continue; // sparse rows cost nothing
-            for (int j = k + 1; j < n; ++j) a[i * n + j] -= l * a[k * n + j];
+            for (int j = k + 1; j < n; ++j) ri[j] -= l * rk[j];
         }
     }
+    if (swapped) *swapped = sw;
     return 0;
 }
 
+int hyd_lu_factor(double* a, int n, int* piv) { return lu_factor(a, n, piv, NULL, NULL); }
+
+// Forward and back substitution. With finite b the zero multipliers need no
+// test: subtracting 0 * b_j changes nothing, so the branch-free loops give the
+// same numbers. Only a non-finite b takes the careful loops, where zero
+// multipliers are skipped so that a NaN in one component does not spread
+// through 0 * NaN into decoupled ones (the non-finite report then names the
+// state that actually went bad).
 void hyd_lu_solve(const double* lu, int n, const int* piv, double* b) {
     // Row swaps were applied in order during the factorisation; replay them.
     for (int k = 0; k < n; ++k) {
@@ -60,9 +82,23 @@ void hyd_lu_solve(const double* lu, int n, const int* piv, double* b) {
             b[p] = tmp;
         }
     }
-    // L has a unit diagonal. Zero multipliers are skipped so that a NaN in one
-    // component does not spread through 0 * NaN into decoupled ones (the
-    // non-finite report then names the state that actually went bad).
+    double acc = 0.0;
+    for (int i = 0; i < n; ++i) acc += b[i] * 0.0;
+    if (acc == 0.0) {
+        for (int i = 1; i < n; ++i) {
+            const double* li = lu + i * n;
+            double sum = b[i];
+            for (int j = 0; j < i; ++j) sum -= li[j] * b[j];
+            b[i] = sum;
+        }
+        for (int i = n - 1; i >= 0; --i) {
+            const double* ui = lu + i * n;
+            double sum = b[i];
+            for (int j = i + 1; j < n; ++j) sum -= ui[j] * b[j];
+            b[i] = sum / ui[i];
+        }
+        return;
+    }
     for (int i = 1; i < n; ++i) {
         double sum = b[i];
         for (int j = 0; j < i; ++j) {
@@ -78,6 +114,39 @@ void hyd_lu_solve(const double* lu, int n, const int* piv, double* b) {
             if (u != 0.0) sum -= u * b[j];
         }
         b[i] = sum / lu[i * n + i];
+    }
+}
+
+// The solver's blocks larger than 2: as hyd_lu_solve, but multiplying by the
+// stored 1/U_ii instead of dividing, and replaying pivots only when the
+// factorisation exchanged rows. Inline so that the crane's 4x4 block gets a
+// fully unrolled copy (see hydSolveW).
+static inline void lu_solve_blk(const double* lu, int n, const int* piv, const double* idiag,
+                                int swapped, double* b) {
+    double acc = 0.0;
+    for (int i = 0; i < n; ++i) acc += b[i] * 0.0;
+    if (acc != 0.0) {
+        hyd_lu_solve(lu, n, piv, b); // non-finite b: the careful loops
+        return;
+    }
+    if (swapped)
+        for (int k = 0; k < n; ++k) {
+            const int p = piv[k];
+            const double tmp = b[k];
+            b[k] = b[p];
+            b[p] = tmp;
+        }
+    for (int i = 1; i < n; ++i) {
+        const double* li = lu + i * n;
+        double sum = b[i];
+        for (int j = 0; j < i; ++j) sum -= li[j] * b[j];
+        b[i] = sum;
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        const double* ui = lu + i * n;
+        double sum = b[i];
+        for (int j = i + 1; j < n; ++j) sum -= ui[j] * b[j];
+        b[i] = sum * idiag[i];
     }
 }
 
@@ -108,7 +177,8 @@ int hydFactorW(hyd_solver* s, double gh) {
         } else {
             for (int i = 0; i < m * m; ++i) w[i] = -gh * jb[i];
             for (int i = 0; i < m; ++i) w[i * m + i] += 1.0;
-            if (hyd_lu_factor(w, m, s->piv + s->boff[b]) != 0) return HYD_ERR_SINGULAR;
+            if (lu_factor(w, m, s->piv + s->boff[b], s->widiag + s->boff[b], &s->wswap[b]) != 0)
+                return HYD_ERR_SINGULAR;
         }
     }
     s->w_valid = 1;
@@ -118,18 +188,28 @@ int hydFactorW(hyd_solver* s, double gh) {
 }
 
 void hydSolveW(const hyd_solver* s, double* x) {
-    for (int b = 0; b < s->nblock; ++b) {
-        const int o = s->boff[b];
-        const int m = s->boff[b + 1] - o;
+    const int* restrict bo = s->border;
+    const int e1 = s->nb1, e2 = s->nb1 + s->nb2;
+    for (int t = 0; t < e1; ++t) {
+        const int b = bo[t];
+        x[s->boff[b]] *= s->w[s->moff[b]];
+    }
+    for (int t = e1; t < e2; ++t) {
+        const int b = bo[t], o = s->boff[b];
         const double* w = s->w + s->moff[b];
-        if (m == 1) {
-            x[o] *= w[0];
-        } else if (m == 2) {
-            double x0 = x[o], x1 = x[o + 1];
-            x[o] = w[0] * x0 + w[1] * x1;
-            x[o + 1] = w[2] * x0 + w[3] * x1;
-        } else {
-            hyd_lu_solve(w, m, s->piv + o, x + o);
-        }
+        const double x0 = x[o], x1 = x[o + 1];
+        x[o] = w[0] * x0 + w[1] * x1;
+        x[o + 1] = w[2] * x0 + w[3] * x1;
+    }
+    for (int t = e2; t < s->nblock; ++t) {
+        const int b = bo[t], o = s->boff[b], m = s->boff[b + 1] - o;
+        const double* w = s->w + s->moff[b];
+        // A literal size lets the compiler unroll the loops completely: the
+        // crane's mechanics block is 4x4 and small-trip loops cost more in
+        // loop control than in arithmetic.
+        if (m == 4)
+            lu_solve_blk(w, 4, s->piv + o, s->widiag + o, s->wswap[b], x + o);
+        else
+            lu_solve_blk(w, m, s->piv + o, s->widiag + o, s->wswap[b], x + o);
     }
 }

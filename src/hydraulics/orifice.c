@@ -29,24 +29,6 @@ hyd_orif_k hyd_orifice_constants(const hyd_fluid_def* f, double cd) {
     return k;
 }
 
-double hyd_orifice_q(const hyd_orif_k* k, double A, double dp, double* g, double* gA) {
-    const double x = dp * A * k->invP0;
-    if (fabs(x) < 1.0) {
-        const double sA = sqrt(A);
-        const double G = k->kl * A * sA;
-        const double x2 = x * x;
-        const double lam = 1.0 - 0.2 * x2;
-        *g = G * (1.0 - 0.6 * x2);
-        // dQ/dA = dG/dA dp (1 - x^2/5) - G dp (2x/5) dx/dA, dx/dA = dp / P0
-        *gA = 1.5 * k->kl * sA * dp * lam - G * dp * 0.4 * x * dp * k->invP0;
-        return G * dp * lam;
-    }
-    const double s = sqrt(fabs(dp));
-    *g = 0.5 * k->k * A / s;
-    *gA = k->k * copysign(s, dp);
-    return k->k * A * copysign(s, dp);
-}
-
 double hyd_orifice_flow(const hyd_fluid_def* f, double cd, double A, double dp, double* dq_ddp,
                         double* dq_dA) {
     const hyd_orif_k k = hyd_orifice_constants(f, cd);

@@ -14,9 +14,8 @@ hyd_relief_def hyd_default_relief_def(void) {
     return d;
 }
 
-// On 1/w so the kernel needs no division.
-static inline double open_ramp(double d, double inv_w, double* dr) {
-    const double t = d * inv_w;
+// On t = d / w and 1/w, so the kernel needs no division.
+static inline double open_ramp_t(double t, double inv_w, double* dr) {
     if (t <= 0.0) {
         *dr = 0.0;
         return 0.0;
@@ -29,7 +28,10 @@ static inline double open_ramp(double d, double inv_w, double* dr) {
     return 2.0 * t - 1.0;
 }
 
-double hyd_open_ramp(double d, double w, double* dr) { return open_ramp(d, 1.0 / w, dr); }
+double hyd_open_ramp(double d, double w, double* dr) {
+    const double inv_w = 1.0 / w;
+    return open_ramp_t(d * inv_w, inv_w, dr);
+}
 
 void hyd_relief_derive(const hyd_relief_def* d, hyd_ramp_c* c) {
     c->pcr = d->p_crack;
@@ -38,17 +40,34 @@ void hyd_relief_derive(const hyd_relief_def* d, hyd_ramp_c* c) {
 }
 
 // Shared by relief and check valves (check_valve.c): both are the same
-// opening law between two nodes; only their defaults and roles differ.
+// opening law between two nodes; only their defaults and roles differ. Most
+// of them are closed most of the time (d <= 0), which takes the short branch:
+// zero flow, no partials.
 void hyd_ramps_eval(const hyd_model* m, hyd_data* d, double* G, const hyd_ramp_c* v, int nv) {
+    const double* restrict p = d->node_p;
+    double* restrict cq = d->comp_q;
+    int* restrict open = d->comp_open;
+    double* restrict fl = d->flow_;
     for (int i = 0; i < nv; ++i) {
         const hyd_ramp_c* c = &v[i];
+        const double t = (p[c->in] - p[c->out] - c->pcr) * c->inv_w;
+        if (t <= 0.0) { // (a NaN takes the full path and propagates)
+            cq[2 * c->comp] = 0.0;
+            open[c->comp] = 0;
+            fl[4 * c->comp] = 0.0;
+            fl[4 * c->comp + 1] = 0.0;
+            continue;
+        }
         double dr;
-        const double r = open_ramp(d->node_p[c->in] - d->node_p[c->out] - c->pcr, c->inv_w, &dr);
+        const double r = open_ramp_t(t, c->inv_w, &dr);
         const double q = c->qr * r;
         const double g = c->qr * dr;
-        d->comp_q[2 * c->comp] = q;
-        d->comp_open[c->comp] = q > 0.0;
-        hyd_flow2(m, d, G, c->comp, c->in, c->out, q, g, -g);
+        cq[2 * c->comp] = q;
+        open[c->comp] = q > 0.0;
+        fl[4 * c->comp] = -q;
+        fl[4 * c->comp + 1] = q;
+        if (G)
+            hyd_jac_flow(m, G, c->in, c->out, g, -g);
     }
 }
 

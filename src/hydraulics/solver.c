@@ -88,7 +88,9 @@ hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solv
     s->moff = calloc((size_t)nblock, sizeof *s->moff);
     s->bblk = calloc((size_t)n, sizeof *s->bblk);
     s->piv = calloc((size_t)n, sizeof *s->piv);
-    if (!s->boff || !s->moff || !s->bblk || !s->piv) {
+    s->wswap = calloc((size_t)nblock, sizeof *s->wswap);
+    s->border = calloc((size_t)nblock, sizeof *s->border);
+    if (!s->boff || !s->moff || !s->bblk || !s->piv || !s->wswap || !s->border) {
         hyd_solver_destroy(s);
         return NULL;
     }
@@ -101,11 +103,20 @@ hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solv
         for (int i = s->boff[b]; i < s->boff[b + 1]; ++i) s->bblk[i] = b;
     }
     s->msize = msize;
+    int nb = 0;
+    for (int cls = 1; cls <= 3; ++cls) {
+        for (int b = 0; b < nblock; ++b) {
+            const int bs = s->boff[b + 1] - s->boff[b];
+            if ((cls < 3 && bs == cls) || (cls == 3 && bs > 2)) s->border[nb++] = b;
+        }
+        if (cls == 1) s->nb1 = nb;
+        if (cls == 2) s->nb2 = nb - s->nb1;
+    }
 
-    // One block for all vectors: jb, w, (jfull), 4 k, 4 hjk and 14 more n-vectors.
+    // One block for all vectors: jb, w, (jfull), 4 k, 4 hjk and 15 more n-vectors.
     const int dense = nblock == 1;
     const size_t nfull = (p->jac && !dense) ? (size_t)n * (size_t)n : 0;
-    const size_t total = 2 * (size_t)msize + nfull + 22 * (size_t)n;
+    const size_t total = 2 * (size_t)msize + nfull + 23 * (size_t)n;
     double* mem = calloc(total, sizeof *mem);
     if (!mem) {
         hyd_solver_destroy(s);
@@ -130,6 +141,7 @@ hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solv
     s->fc_f = q, q += n;
     s->fnew = q, q += n;
     s->ft = q, q += n;
+    s->widiag = q, q += n;
     s->bad_i = -1;
     hyd_solver_reset(s);
     return s;
@@ -143,6 +155,8 @@ void hyd_solver_destroy(hyd_solver* s) {
     free(s->moff);
     free(s->bblk);
     free(s->piv);
+    free(s->wswap);
+    free(s->border);
     free(s);
 }
 

@@ -40,6 +40,13 @@ struct hyd_solver {
     double* jb;    ///< (msize) diagonal blocks of J
     double* w;     ///< (msize) LU factors of W
     int* piv;      ///< (n) pivots, block-local
+    double* widiag; ///< (n) 1 / U_ii of blocks larger than 2 (lu.c)
+    int* wswap;    ///< (nblock) the block's LU exchanged rows
+    // Blocks grouped by size class, so the solve runs one tight loop per class
+    // instead of a size switch per block: first the nb1 blocks of size 1, then
+    // the nb2 of size 2, then the rest (block indices).
+    int nb1, nb2;
+    int* border;   ///< (nblock)
     double* ft;    ///< (n) df/dt at the Jacobian point (RODAS3)
     int j_valid;   ///< jb holds a usable Jacobian
     int j_force;   ///< re-evaluate J at the next step (after a rejection or reset)

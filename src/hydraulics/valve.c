@@ -28,7 +28,10 @@ void hyd_valve_derive(const hyd_fluid_def* f, const hyd_valve_def* d, hyd_valve_
     c->inv_tau = 1.0 / d->tau;
 }
 
-void hyd_valves_eval(const hyd_model* m, hyd_data* d, const double* y, double* ydot, double* G) {
+// The kernel is inlined twice, with and without G, so that the plain
+// evaluation drops the dQ/dA partials and the Jacobian bookkeeping entirely.
+static inline void valves_kernel(const hyd_model* m, hyd_data* d, const double* y, double* ydot,
+                                 double* G) {
     const int ld = m->nstate + 1;
     for (int i = 0; i < m->nvalve; ++i) {
         const hyd_valve_c* c = &m->valve[i];
@@ -67,4 +70,11 @@ void hyd_valves_eval(const hyd_model* m, hyd_data* d, const double* y, double* y
             G[m->node_sidx[c->T] * ld + c->adr] += du2;
         }
     }
+}
+
+void hyd_valves_eval(const hyd_model* m, hyd_data* d, const double* y, double* ydot, double* G) {
+    if (G)
+        valves_kernel(m, d, y, ydot, G);
+    else
+        valves_kernel(m, d, y, ydot, NULL);
 }

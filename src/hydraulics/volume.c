@@ -18,34 +18,58 @@ hyd_volume_def hyd_default_volume_def(void) {
     return d;
 }
 
-// Jacobian rows of a node state i: the flow partials scaled by Be/V, plus the
-// term from Be depending on the node's own pressure. G holds d(sum Q)/dy.
+// Per node: gather the inflow, then Be/V through hyd_be_nd with a single
+// division, c = N / (D V), Be = c V. Jacobian rows (when J is non-NULL): the
+// flow partials scaled by Be/V, plus the term from Be depending on the node's
+// own pressure. G holds d(sum Q)/dy. Model and data arrays are taken into
+// restrict locals first: the stores into hyd_data would otherwise force the
+// compiler to reload every model field on each node.
 void hyd_volumes_eval(const hyd_model* m, hyd_data* d, double* ydot, const double* G, double* J,
                       int ldj) {
-    const int n = m->nstate, ldg = n + 1;
-    for (int k = 0; k < m->nvol; ++k) {
-        const int node = m->vol_node[k];
-        const int i = m->node_state[node];
-        const double p = d->node_p[node];
-        const double V = d->node_V[node];
-        double dbe;
-        const double be = hyd_be(m, m->node_bel[node], p, &dbe);
+    const int n = m->nstate, ldg = n + 1, nvol = m->nvol;
+    const double* restrict flow = d->flow_;
+    const int* restrict vf = m->vol_flow;
+    const int* restrict vp = m->vol_ptr;
+    const int* restrict vnode = m->vol_node;
+    const int* restrict nstate = m->node_state;
+    const double* restrict np = d->node_p;
+    const double* restrict nV = d->node_V;
+    const double* restrict ndV = d->node_dV;
+    const double* restrict nbel = m->node_bel;
+    const double* restrict nbec = m->node_bec;
+    double* restrict nq = d->node_q;
+    double* restrict nbe = d->node_be;
+    for (int k = 0; k < nvol; ++k) {
+        const int node = vnode[k];
+        const int i = nstate[node];
+        const double p = np[node];
+        const double V = nV[node];
+        const double bel = nbel[node];
         double qin = 0.0;
-        for (int e = m->vol_ptr[k]; e < m->vol_ptr[k + 1]; ++e)
-            qin += d->flow_[m->vol_flow[e]];
-        d->node_q[node] = qin;
-        const double net = qin - d->node_dV[node];
-        const double iV = 1.0 / V;
-        const double c = be * iV;
-        d->node_be[node] = be;
+        const int e1 = vp[k + 1];
+        for (int e = vp[k]; e < e1; ++e)
+            qin += flow[vf[e]];
+        nq[node] = qin;
+        const double net = qin - ndV[node];
+        double N, D, r, c, be;
+        if (hyd_be_nd(m, bel, nbec[node], p, &N, &D, &r)) {
+            c = N / (D * V);
+            be = c * V;
+        } else {
+            be = hyd_be_slow(m, bel, p, NULL);
+            c = be / V;
+        }
+        nbe[node] = be;
         if (ydot)
             ydot[i] = c * net;
         if (J) {
+            double dbe;
+            hyd_be(m, bel, p, &dbe);
             double* row = J + (size_t)i * ldj;
             const double* grow = G + (size_t)i * ldg;
             for (int j = 0; j < n; ++j)
                 row[j] = c * grow[j];
-            row[i] += dbe * iV * net;
+            row[i] += dbe / V * net;
         }
     }
 }
