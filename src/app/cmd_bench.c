@@ -16,13 +16,16 @@ static void bench_help(FILE* f) {
             "solver, step or tolerances, simulated time [s], median wall time [s], real-time\n"
             "factor (simulated/wall), steps, f evaluations, LU factorisations, ns per step.\n"
             "\n"
-            "configurations (default: all lagrange ones):\n"
+            "configurations (default: all):\n"
             "  krus-0.1ms   Krus, h = 0.1 ms, block-diagonal J every 10 steps (the paper's setting)\n"
             "  krus-dense   Krus, h = 0.1 ms, dense J every 10 steps\n"
             "  ros2-0.1ms   ROS2, h = 0.1 ms, block J\n"
             "  krus-1ms     Krus, h = 1 ms\n"
             "  ros34pw2     adaptive ROS34PW2, rtol 1e-3\n"
             "  rodas3       adaptive RODAS3, rtol 1e-3\n"
+            "  rodas3-1pct  adaptive RODAS3, rtol 1e-2 (the paper's 1 %% tolerance)\n"
+            "  sandbox-ode1ms    ode sandbox (pick and place), ODE step 1 ms, hydraulics Krus 0.1 ms\n"
+            "  sandbox-ode0.1ms  the same with ODE step 0.1 ms\n"
             "\n"
             "options:\n"
             "  --scenario S   default ramp\n"
@@ -37,15 +40,24 @@ typedef struct bench_cfg {
     double h;
     bool dense;
     double rtol;
+    sim_mechanics mech;
+    const char* world;    ///< ode only
+    double dt_ode;        ///< ode only [s]
+    const char* scenario; ///< NULL: the --scenario option (default ramp)
 } bench_cfg;
 
+// The lagrange set runs the chosen scenario; the sandbox set runs the
+// pick-and-place scenario (truck, booms, rope, hook, load, 16 obstacles).
 static const bench_cfg configs[] = {
-    {"krus-0.1ms", HYD_KRUS, 1e-4, false, 0},
-    {"krus-dense", HYD_KRUS, 1e-4, true, 0},
-    {"ros2-0.1ms", HYD_ROS2, 1e-4, false, 0},
-    {"krus-1ms", HYD_KRUS, 1e-3, false, 0},
-    {"ros34pw2", HYD_ROS34PW2, 0, false, 1e-3},
-    {"rodas3", HYD_RODAS3, 0, false, 1e-3},
+    {"krus-0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL},
+    {"krus-dense", HYD_KRUS, 1e-4, true, 0, SIM_LAGRANGE, NULL, 0, NULL},
+    {"ros2-0.1ms", HYD_ROS2, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL},
+    {"krus-1ms", HYD_KRUS, 1e-3, false, 0, SIM_LAGRANGE, NULL, 0, NULL},
+    {"ros34pw2", HYD_ROS34PW2, 0, false, 1e-3, SIM_LAGRANGE, NULL, 0, NULL},
+    {"rodas3", HYD_RODAS3, 0, false, 1e-3, SIM_LAGRANGE, NULL, 0, NULL},
+    {"rodas3-1pct", HYD_RODAS3, 0, false, 1e-2, SIM_LAGRANGE, NULL, 0, NULL},
+    {"sandbox-ode1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-3, "sandbox_pick_place"},
+    {"sandbox-ode0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-4, "sandbox_pick_place"},
 };
 
 static int cmp_d(const void* a, const void* b) {
@@ -91,7 +103,7 @@ int cmd_bench(int argc, char** argv) {
         }
     }
     model* m;
-    scenario sc;
+    scenario sc, sc_own;
     int rc = app_load(&c, &m, &sc);
     if (rc) return rc;
     int code = 0;
@@ -103,12 +115,25 @@ int cmd_bench(int argc, char** argv) {
         sim_opts o = c.sim;
         o.solver = b->solver;
         o.dense_jac = b->dense;
+        o.mechanics = b->mech;
         if (b->h > 0) o.h = b->h;
         if (b->rtol > 0) o.rtol = b->rtol;
+        if (b->world) o.world = b->world;
+        if (b->dt_ode > 0) o.dt_ode = b->dt_ode;
+        const scenario* use = &sc;
+        if (b->scenario) {
+            char buf[512], err[512];
+            if (scenario_load(app_scenario_path(b->scenario, buf, sizeof buf), &sc_own, err, sizeof err)) {
+                printf("{\"config\":\"%s\",\"error\":\"%s\"}\n", b->name, err);
+                code = EXIT_RUNTIME;
+                continue;
+            }
+            use = &sc_own;
+        }
         double walls[100];
         sim_result r;
         for (int i = 0; i < repeat; ++i) {
-            sim_run(m, &sc, &o, NULL, NULL, NULL, NULL, NULL, &r);
+            sim_run(m, use, &o, NULL, NULL, NULL, NULL, NULL, &r);
             walls[i] = r.wall;
             if (r.status) break;
         }
@@ -119,11 +144,13 @@ int cmd_bench(int argc, char** argv) {
         }
         qsort(walls, (size_t)repeat, sizeof walls[0], cmp_d);
         double wall = walls[repeat / 2];
-        printf("{\"config\":\"%s\",\"scenario\":\"%s\",\"mechanics\":\"lagrange\",\"variant\":\"%s\","
+        printf("{\"config\":\"%s\",\"scenario\":\"%s\",\"mechanics\":\"%s\",\"world\":\"%s\","
+               "\"dt_ode_s\":%g,\"variant\":\"%s\","
                "\"solver\":\"%s\",\"h_s\":%g,\"rtol\":%g,\"jacobian\":\"%s\",\"sim_time_s\":%.6g,"
                "\"wall_s_median\":%.6g,\"repeat\":%d,\"rt_factor\":%.1f,\"steps\":%ld,\"rejected\":%ld,"
                "\"fevals\":%ld,\"jevals\":%ld,\"lus\":%ld,\"ns_per_step\":%.1f}\n",
-               b->name, sc.name, lagrange_variant_name(o.variant), hyd_method_name(o.solver),
+               b->name, use->name, o.mechanics == SIM_ODE ? "ode" : "lagrange", o.mechanics == SIM_ODE ? o.world : "",
+               o.mechanics == SIM_ODE ? o.dt_ode : 0.0, lagrange_variant_name(o.variant), hyd_method_name(o.solver),
                hyd_method_is_adaptive(o.solver) ? 0.0 : o.h, hyd_method_is_adaptive(o.solver) ? o.rtol : 0.0,
                hyd_method_is_adaptive(o.solver) ? "dense" : (o.dense_jac ? "dense" : "blocks"), r.t_end, wall,
                repeat, r.t_end / wall, r.stats.steps, r.stats.rejected, r.stats.fevals, r.stats.jevals,

@@ -226,7 +226,7 @@ int cmd_drive(int argc, char** argv) {
         return drive_window_main(&c, &o, c.sim.duration, shot, shot_at);
     }
 #else
-    (void)scripted, (void)mapping, (void)width, (void)height, (void)shot_at;
+    (void)scripted, (void)mapping, (void)width, (void)height, (void)shot_at, (void)rate_given;
     if (shot) {
         fprintf(stderr, "cranesim drive: --screenshot needs the render module (built without SDL2/GL)\n");
         return EXIT_USAGE;

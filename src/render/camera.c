@@ -19,7 +19,7 @@ void render_camera_init(render_camera* c) {
 static rm_vec3 v3d(const double p[3]) { return rm_v3((float)p[0], (float)p[1], (float)p[2]); }
 
 static const world_snap_body* find_role(const world_snapshot* s, world_role role) {
-    for (int i = 0; i < s->nbody; ++i)
+    for (int i = 0; i < s->nbody && i < WORLD_SNAP_MAX_BODIES; ++i)
         if (s->body[i].role == role) return &s->body[i];
     return NULL;
 }
@@ -59,15 +59,24 @@ void render_camera_update(render_camera* c, const world_snapshot* s, int w, int 
     switch (c->preset) {
     case RENDER_CAM_OPERATOR: {
         // The operator stands on the ground on the truck's right side, level
-        // with the column, eyes 1.7 m up, watching the tip.
-        float ex = base.x - 0.4f, ey = base.y - 2.1f;
-        c->eye = rm_v3(ex, ey, ground_z(s, ex, ey) + 1.7f);
+        // with the column, eyes 1.7 m up, watching the tip. "Right" follows
+        // the truck's heading, not the world axes.
+        const world_snap_body* truck = find_role(s, WORLD_ROLE_TRUCK);
+        rm_vec3 fwd = truck ? rm_v3((float)truck->rot[0], (float)truck->rot[3], 0) : rm_v3(1, 0, 0);
+        rm_vec3 left = truck ? rm_v3((float)truck->rot[1], (float)truck->rot[4], 0) : rm_v3(0, 1, 0);
+        fwd = rm_norm(fwd), left = rm_norm(left);
+        rm_vec3 e = rm_sub(base, rm_add(rm_scale(fwd, 0.4f), rm_scale(left, 2.1f)));
+        c->eye = rm_v3(e.x, e.y, ground_z(s, e.x, e.y) + 1.7f);
         c->at = tip;
         break;
     }
     case RENDER_CAM_SIDE: {
-        // Perpendicular to the boom plane, which turns with the slew angle.
-        rm_vec3 n = rm_v3(-sinf((float)s->slew), cosf((float)s->slew), 0);
+        // Perpendicular to the boom plane: the plane through the column and
+        // the tip (so it follows slew and truck heading alike).
+        rm_vec3 d = rm_v3(tip.x - base.x, tip.y - base.y, 0);
+        if (rm_len(d) < 0.3f) d = rm_v3(cosf((float)s->slew), sinf((float)s->slew), 0);
+        d = rm_norm(d);
+        rm_vec3 n = rm_v3(-d.y, d.x, 0);
         c->at = mid;
         c->eye = rm_add(mid, rm_add(rm_scale(n, -14.0f), rm_v3(0, 0, 0.8f)));
         break;

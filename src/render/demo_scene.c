@@ -235,7 +235,7 @@ void render_demo_scene(world_snapshot* s, const render_demo_params* p, float* te
         b = add(s, nm, WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, 1.2, 0.6, 0.6, concrete_rgba);
         double rr = 5.4 + 0.2 * i, a = p->slew + (i - 1) * 0.32;
         set_pose(b, rr * cos(a), rr * sin(a), 0.3, a + 0.1 * i);
-        set_mesh(b, m, "block.obj", 0, 0, 0);
+        set_mesh(b, m, "load_block.obj", 0, 0, 0);
     }
     for (int i = 0; i < 2; ++i) {
         char nm[16];

@@ -3,8 +3,8 @@
 //
 // Offscreen mode still makes an SDL window (hidden): under SDL's "offscreen"
 // video driver that window is backed by an EGL pbuffer on Mesa, which works
-// with no X server or GPU (llvmpipe). The frame itself goes into our own FBO
-// so its size does not depend on what the driver gives the window.
+// with no X server or GPU (llvmpipe). The frame itself always goes into our
+// own FBO; a visible window gets it by one blit before the swap.
 #include <stdio.h>
 #include <string.h>
 
@@ -96,12 +96,11 @@ bool render_targets_resize(render* r, int w, int h) {
     free_targets(r);
     r->w = w;
     r->h = h;
-    // The offscreen frame needs a single-sample FBO to read back from; a
-    // window reads back from its own back buffer instead.
-    if (r->cfg.offscreen) {
-        r->fbo = make_fbo(w, h, 0, &r->fbo_color, &r->fbo_depth);
-        if (!r->fbo) return false;
-    }
+    // Every frame lands in our own single-sample FBO, in a window too: it
+    // survives the swap, so a screenshot can be taken at any time, and its
+    // size does not depend on what the offscreen driver gives the window.
+    r->fbo = make_fbo(w, h, 0, &r->fbo_color, &r->fbo_depth);
+    if (!r->fbo) return false;
     if (r->cfg.msaa > 1) {
         r->msfbo = make_fbo(w, h, r->cfg.msaa, &r->ms_color, &r->ms_depth);
         // Multisampling is a nicety: without it we still draw.
@@ -129,9 +128,16 @@ GLuint render_target_fbo(const render* r) {
 
 void render_resolve(render* r) {
     if (!r->msfbo) return;
-    // Multisample resolve into the readable target (FBO or window).
+    // Multisample resolve into the readable single-sample FBO.
     glBindFramebuffer(GL_READ_FRAMEBUFFER, r->msfbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, r->fbo);
+    glBlitFramebuffer(0, 0, r->w, r->h, 0, 0, r->w, r->h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+}
+
+void render_blit_to_window(render* r) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, r->fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glBlitFramebuffer(0, 0, r->w, r->h, 0, 0, r->w, r->h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo);
 }

@@ -11,5 +11,7 @@ void render_gl_close(render* r);
 GLuint render_target_fbo(const render* r);
 /// Resolve multisampling into the readable framebuffer and bind that.
 void render_resolve(render* r);
+/// Copy the finished frame to the window's back buffer.
+void render_blit_to_window(render* r);
 
 #endif

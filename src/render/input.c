@@ -295,6 +295,12 @@ bool input_handle_event(input* in, const SDL_Event* ev) {
     case SDL_KEYUP:
         key_axis(in, ev->key.keysym.scancode, false);
         return true;
+    case SDL_WINDOWEVENT:
+        // Key-up events go to the new focus: drop held keys so no axis sticks.
+        if (ev->window.event != SDL_WINDOWEVENT_FOCUS_LOST) return false;
+        memset(in->key_pos, 0, sizeof in->key_pos);
+        memset(in->key_neg, 0, sizeof in->key_neg);
+        return true;
     case SDL_JOYDEVICEADDED:
         // Game controllers also send CONTROLLERDEVICEADDED; this one covers both.
         if (!in->js) open_device(in, ev->jdevice.which);

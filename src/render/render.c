@@ -125,10 +125,13 @@ void render_frame(render* r, const world_snapshot* snap) {
 
 void render_present(render* r) {
     if (r->cfg.offscreen) {
-        // Nothing to show; make sure the frame is finished like a swap would.
-        glFinish();
+        // Nothing to show. Flush (not finish): llvmpipe can then bin the next
+        // frame while its threads still rasterise this one, as with a swap.
+        // Read-back (render_read_pixels) waits for the frame by itself.
+        glFlush();
         return;
     }
+    render_blit_to_window(r);
     SDL_GL_SwapWindow(r->win);
 }
 

@@ -3,8 +3,9 @@
 // The renderer reads a world_snapshot and nothing else from the physics. A
 // frame is: render_frame(r, snap) draws the scene, shadows, HUD, pressure
 // bars, strip charts and (if attached) the parameter panel; then
-// render_present(r) swaps the window, or does nothing in offscreen mode,
-// where the frame lives in an FBO that render_screenshot() can save.
+// render_present(r) copies the frame to the window and swaps (offscreen: only
+// flushes). The frame always lives in the renderer's own FBO, which
+// render_screenshot() saves at any time.
 //
 // Typical `cranesim drive` loop (the app owns SDL_Init and the event loop):
 //
@@ -88,8 +89,8 @@ void render_frame(render* r, const world_snapshot* snap);
 /// Swap buffers (window mode); no-op offscreen.
 void render_present(render* r);
 
-/// Save the last rendered frame as PNG. Returns 0 on success, -1 on failure
-/// (message on stderr naming the file).
+/// Save the last rendered frame as PNG (before or after render_present).
+/// Returns 0 on success, -1 on failure (message on stderr naming the file).
 int render_screenshot(render* r, const char* path);
 /// Copy the last frame as RGBA8, top row first, into a w*h*4 buffer.
 /// Returns 0 on success.

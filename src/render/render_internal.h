@@ -204,7 +204,7 @@ struct render {
     SDL_GLContext gl;
     bool own_video;              ///< we initialised SDL video, so we quit it
     int w, h;                    ///< framebuffer size [px]
-    GLuint fbo, fbo_color, fbo_depth;      ///< offscreen target (resolved, single-sample)
+    GLuint fbo, fbo_color, fbo_depth;      ///< the frame (resolved, single-sample), also in a window
     GLuint msfbo, ms_color, ms_depth;      ///< multisampled scene target, 0 if msaa off
     render_camera cam;
     render_shadow shadow;

@@ -12,7 +12,9 @@
 #include "render_internal.h"
 
 typedef struct render_draw_item {
-    const render_mesh* mesh;
+    // A copy, not a pointer: loading a new mesh may move the cache's array
+    // while this frame's list is being built.
+    render_mesh mesh;
     float model[16];
     float rgba[4];
     float depth;        ///< squared distance from the eye, for sorting
@@ -259,7 +261,7 @@ static void update_terrain(render_scene* sc, const world_snap_terrain* t) {
 static render_draw_item* push_item(render_scene* sc, const render_mesh* m, const float rgba[4]) {
     if (sc->nitems >= sc->capitems) return NULL;
     render_draw_item* it = &sc->items[sc->nitems++];
-    it->mesh = m;
+    it->mesh = *m;
     memcpy(it->rgba, rgba, 4 * sizeof(float));
     it->casts_shadow = true;
     return it;
@@ -398,7 +400,7 @@ static void add_rope(render_scene* sc, const world_snapshot* s) {
 static void scene_bounds(const world_snapshot* s, rm_vec3* centre, float* radius) {
     rm_vec3 lo = rm_v3(1e30f, 1e30f, 1e30f), hi = rm_scale(lo, -1.0f);
     int n = 0;
-    for (int i = 0; i < s->nbody; ++i) {
+    for (int i = 0; i < s->nbody && i < WORLD_SNAP_MAX_BODIES; ++i) {
         const world_snap_body* b = &s->body[i];
         if (b->shape == WORLD_SHAPE_TERRAIN || b->role == WORLD_ROLE_TERRAIN) continue;
         float e = (float)fmax(fmax(b->size[0], b->size[1]), b->size[2]);
@@ -438,7 +440,7 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
     sc->triangles = 0;
     sc->draw_calls = 0;
     update_terrain(sc, &s->terrain);
-    for (int i = 0; i < s->nbody; ++i) add_body(sc, mc, &s->body[i]);
+    for (int i = 0; i < s->nbody && i < WORLD_SNAP_MAX_BODIES; ++i) add_body(sc, mc, &s->body[i]);
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
     for (int i = 0; i < ncyl; ++i) add_cylinder(sc, mc, &s->cyl[i]);
     add_rope(sc, s);
@@ -466,7 +468,7 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
         const render_draw_item* it = &sc->items[i];
         if (!it->casts_shadow) continue;
         glUniformMatrix4fv(sc->ud_model, 1, GL_FALSE, it->model);
-        render_mesh_draw(it->mesh);
+        render_mesh_draw(&it->mesh);
         ++sc->draw_calls;
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
@@ -497,8 +499,8 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
         glUniformMatrix4fv(sc->obj.u_model, 1, GL_FALSE, it->model);
         glUniformMatrix3fv(sc->obj.u_normal, 1, GL_FALSE, nm);
         glUniform4fv(sc->obj.u_color, 1, it->rgba);
-        render_mesh_draw(it->mesh);
-        sc->triangles += it->mesh->nidx / 3;
+        render_mesh_draw(&it->mesh);
+        sc->triangles += it->mesh.nidx / 3;
         ++sc->draw_calls;
     }
     // Ground: the heightfield if there is one, and a flat plane beyond it.

@@ -1,8 +1,8 @@
 // screenshot.c: read the last frame back and write it as PNG (stb from
 // Debian's libstb; the implementation lives in the library, not here).
 //
-// In window mode call this between render_frame() and render_present():
-// after the swap the back buffer's contents are undefined.
+// The frame is kept in the renderer's own FBO (also in a window), so this
+// works before or after render_present().
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -13,7 +13,6 @@
 int render_read_pixels(render* r, unsigned char* rgba, int w, int h) {
     if (!r || !rgba || w != r->w || h != r->h || !r->have_frame) return -1;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, r->fbo);
-    if (!r->fbo) glReadBuffer(GL_BACK);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
     // GL rows start at the bottom; images start at the top. Flip in place

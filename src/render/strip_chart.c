@@ -147,18 +147,19 @@ static void draw_box(render_hud* h, const render_charts* c, int group, double t1
     render_hud_text(h, px, py + ph + 4, 1.0f, dim, buf);
     render_hud_text(h, px + pw - 22, py + ph + 4, 1.0f, dim, "now");
 
-    float lx = px;
+    float lx = px, ly = y + 3;
     for (int i = 0; i < c->n; ++i) {
         const render_chart* ch = &c->ch[i];
         if (ch->def.group != group) continue;
-        // Legend with the latest value and unit.
+        // Legend with the latest value and unit, wrapped inside the box.
         if (ch->count) {
             int last = (ch->head + RENDER_CHART_CAP - 1) % RENDER_CHART_CAP;
-            snprintf(buf, sizeof buf, "%s %.4g %s", ch->label, ch->v[last], ch->unit);
+            snprintf(buf, sizeof buf, "%s %.3g %s", ch->label, ch->v[last], ch->unit);
         } else {
             snprintf(buf, sizeof buf, "%s", ch->label);
         }
-        lx += render_hud_text(h, lx, y + 3, 1.0f, ch->def.rgba, buf) + 10;
+        if (lx > px && lx + render_hud_text_width(buf, 1.0f) > x + w - 4) lx = px, ly += 10;
+        lx += render_hud_text(h, lx, ly, 1.0f, ch->def.rgba, buf) + 10;
         float ox = 0, oy = 0;
         bool have = false;
         for (int k = 0; k < ch->count; ++k) {

@@ -13,6 +13,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static void set_inputs(ode_world* w, double t) {
@@ -86,6 +87,45 @@ static int bind_actuator(ode_world* w, int k, const char* cyl, const char* valve
     return 0;
 }
 
+// Block-diagonal pattern for W = I - gamma h J. Any partition keeps the
+// order of the W-methods (Krus, ROS2); what matters for stability is that
+// the stiff couplings (hose <-> chamber, |J_ij| h >> 1) sit inside blocks.
+// At a nominal state (5 MPa, mid-stroke) every pair with |J_ij| h > 0.05
+// joins one block, and each block is widened to the contiguous index range
+// it spans (the solver wants contiguous blocks).
+static void block_pattern(ode_world* w) {
+    const int n = w->nh;
+    double y[OW_MAX_HYD];
+    double* J = calloc((size_t)n * (size_t)n, sizeof *J);
+    w->nblock = 0;
+    if (!J) return; // dense W then: slower, still correct
+    hyd_model_initial_state(w->hm, y);
+    for (int i = 0; i < n; ++i) {
+        const char* nm = strrchr(hyd_model_state_name(w->hm, i), '.');
+        if (nm && nm[1] == 'p') y[i] = 5e6;
+    }
+    for (int k = 0; k < ODE_NACT; ++k)
+        if (w->act[k].cyl >= 0) w->hd->cyl_x[w->act[k].cyl] = 0.5 * w->act[k].stroke;
+    hyd_jacobian(w->hm, w->hd, 0.0, y, NULL, J, n, 0, 0);
+    int reach[OW_MAX_HYD]; // furthest index each state is stiffly tied to
+    for (int i = 0; i < n; ++i) {
+        reach[i] = i;
+        for (int j = 0; j < n; ++j)
+            if (j != i && (fabs(J[i * n + j]) + fabs(J[j * n + i])) * w->opt.dt_hyd > 0.05) {
+                int a = i < j ? i : j, b = i < j ? j : i;
+                if (b > reach[a]) reach[a] = b;
+            }
+    }
+    free(J);
+    for (int i = 0; i < n;) {
+        int end = reach[i];
+        for (int k = i; k <= end; ++k)
+            if (reach[k] > end) end = reach[k];
+        w->block[w->nblock++] = end - i + 1;
+        i = end + 1;
+    }
+}
+
 int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz) {
     const char* mfile = w->opt.model_file;
     const int sandbox = w->kind == WORLD_SANDBOX;
@@ -155,9 +195,18 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
     w->hp.f = rhs;
     w->hp.jac = jac;
     w->hp.user = w;
+    const int adaptive = hyd_method_is_adaptive(w->opt.solver);
+    if (!adaptive && !w->opt.dense_jac) {
+        block_pattern(w);
+        w->hp.nblock = w->nblock;
+        w->hp.block_size = w->block;
+    }
     hyd_solver_opts so = hyd_default_solver_opts();
-    so.h = w->opt.dt_hyd;
-    so.jac_every = w->opt.jac_every > 0 ? w->opt.jac_every : 1;
+    so.h = adaptive ? 0.0 : w->opt.dt_hyd;
+    so.h_max = w->opt.dt_ode;
+    if (w->opt.rtol > 0) so.rtol = w->opt.rtol;
+    if (w->opt.atol > 0) so.atol = w->opt.atol;
+    so.jac_every = adaptive ? 1 : (w->opt.jac_every > 0 ? w->opt.jac_every : 1);
     w->hs = hyd_solver_create(&w->hp, w->opt.solver, &so);
     if (!w->hs) {
         snprintf(err, errsz, "ode world: cannot create the %s solver", hyd_method_name(w->opt.solver));
@@ -253,8 +302,13 @@ int ow_hyd_step(ode_world* w, double H) {
     double Fsum[ODE_NACT] = {0, 0, 0};
     double ydot[OW_MAX_HYD];
     const double h = H / w->nsub;
-    for (int i = 0; i < w->nsub; ++i) {
-        int rc = hyd_solver_step(w->hs, &w->th, w->y, h);
+    const int adaptive = hyd_method_is_adaptive(w->opt.solver);
+    // Adaptive methods take their own steps over the whole ODE step, landing
+    // on its end; fixed-step ones take nsub sub-steps.
+    const int nloop = adaptive ? 1 : w->nsub;
+    for (int i = 0; i < nloop; ++i) {
+        int rc = adaptive ? hyd_solver_advance(w->hs, &w->th, w->y, w->step_t0 + H)
+                          : hyd_solver_step(w->hs, &w->th, w->y, h);
         if (rc != HYD_OK) {
             double tb = w->th;
             int bad = rc == HYD_ERR_NONFINITE ? hyd_solver_bad_state(w->hs, &tb) : -1;
@@ -269,20 +323,20 @@ int ow_hyd_step(ode_world* w, double H) {
         // Force at the end of the sub-step (the solver's last f call was at a
         // stage point, not at the new state); only the last one is needed
         // unless averaging.
-        if (w->opt.force_average || i == w->nsub - 1) {
+        if (w->opt.force_average || i == nloop - 1) {
             rhs(w, w->th, w->y, ydot);
             for (int k = 0; k < ODE_NACT; ++k)
                 if (w->act[k].cyl >= 0) Fsum[k] += w->hd->cyl_F[w->act[k].cyl];
         }
     }
-    w->hyd_steps += w->nsub;
+    w->hyd_steps = adaptive ? hyd_solver_get_stats(w->hs)->steps : w->hyd_steps + w->nsub;
     // Re-anchor hydraulic time on the step count so it never drifts from the
     // mechanical clock.
     w->th = (double)(w->nstep + 1) * H;
     for (int k = 0; k < ODE_NACT; ++k) {
         ow_act* c = &w->act[k];
         if (c->cyl < 0) continue;
-        c->F = w->opt.force_average ? Fsum[k] / w->nsub : w->hd->cyl_F[c->cyl];
+        c->F = w->opt.force_average ? Fsum[k] / nloop : w->hd->cyl_F[c->cyl];
         if (!isfinite(c->F)) {
             snprintf(w->err, sizeof w->err, "hydraulics: cylinder force %d became non-finite at t = %.6f s", k, w->th);
             return -1;

@@ -40,7 +40,12 @@ enum { ODE_LIFT = 0, ODE_JIB = 1, ODE_SLEW = 2, ODE_NACT = 3 };
 typedef struct ode_world_opts {
     double dt_ode;        ///< ODE step [s]; default 1e-3
     double dt_hyd;        ///< hydraulic sub-step [s]; default 1e-4; dt_ode must be a whole multiple
-    hyd_method solver;    ///< hydraulic integrator (fixed-step use); default HYD_KRUS
+    hyd_method solver;    ///< hydraulic integrator; default HYD_KRUS. Fixed-step methods take
+                          ///< dt_hyd sub-steps; adaptive ones (ros34pw2, rodas3) choose their
+                          ///< own steps, bounded by and landing on each ODE step
+    double rtol, atol;    ///< adaptive hydraulics: tolerances [-], [state units]; 0: 1e-3, 1e-6
+    int dense_jac;        ///< fixed-step: 1 = dense W; 0 (default) = block-diagonal W from the
+                          ///< circuit's stiff couplings (W-methods keep their order for any W)
     int jac_every;        ///< reuse the hydraulic Jacobian for this many sub-steps; default 10 (1 ms of J age at 0.1 ms; SPEC 3.3 allows up to 10 ms)
     double q0[2];         ///< initial joint angles q1, q2 [rad], paper convention; default 95, -130 deg
     double slew0;         ///< initial slew angle [rad]; default 0

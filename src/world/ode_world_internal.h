@@ -132,6 +132,8 @@ struct ode_world {
     hyd_data* hd;
     hyd_solver* hs;
     hyd_problem hp;
+    int nblock;               ///< block-diagonal W pattern of the circuit (fixed-step methods)
+    int block[OW_MAX_HYD];
     int nh;
     double y[OW_MAX_HYD];
     double th;           ///< hydraulic time [s]

@@ -189,9 +189,9 @@ void sim_ode_row(ode_world* w, double* row) {
 }
 
 static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ctx* c, sim_result* res) {
-    if (o->cvode || hyd_method_is_adaptive(o->solver)) {
+    if (o->cvode) {
         snprintf(res->message, sizeof res->message,
-                 "--mechanics ode sub-steps the hydraulics with a fixed-step method: use --solver krus, ros2 or rk4");
+                 "--mechanics ode steps the hydraulics inside each ODE step: use krus, ros2, rk4, ros34pw2 or rodas3");
         return res->status = 2;
     }
     char wbuf[512];
@@ -210,6 +210,9 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     }
     wo.solver = o->solver;
     wo.jac_every = o->jac_every > 0 ? o->jac_every : 1;
+    wo.rtol = o->rtol;
+    wo.atol = o->atol;
+    wo.dense_jac = o->dense_jac;
     wo.q0[0] = sc->q0[0];
     wo.q0[1] = sc->q0[1];
     wo.slew0 = sc->slew0;
