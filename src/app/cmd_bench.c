@@ -4,6 +4,9 @@
 // reported: this machine is shared and noisy, so medians and ratios are the
 // honest figures. Benchmarks measure; tests never time anything.
 #include "app.h"
+#ifdef CRANESIM_HAVE_RENDER
+#include "drive_session.h"
+#endif
 
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +29,9 @@ static void bench_help(FILE* f) {
             "  rodas3-1pct  adaptive RODAS3, rtol 1e-2 (the paper's 1 %% tolerance)\n"
             "  sandbox-ode1ms    ode sandbox (pick and place), ODE step 1 ms, hydraulics Krus 0.1 ms\n"
             "  sandbox-ode0.1ms  the same with ODE step 0.1 ms\n"
+            "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
+            "               operator, for --duration seconds of wall time (default 60): fps,\n"
+            "               frame times, missed real-time deadlines, command rate\n"
             "\n"
             "options:\n"
             "  --scenario S   default ramp\n"
@@ -94,7 +100,12 @@ int cmd_bench(int argc, char** argv) {
         fprintf(stderr, "cranesim bench: unknown option '%s' (see cranesim bench --help)\n", argv[i]);
         return EXIT_USAGE;
     }
+    bool want_drive = nonly == 0;
     for (int j = 0; j < nonly; ++j) {
+        if (!strcmp(only[j], "drive")) {
+            want_drive = true;
+            continue;
+        }
         bool found = false;
         for (size_t k = 0; k < sizeof configs / sizeof configs[0]; ++k) found |= !strcmp(only[j], configs[k].name);
         if (!found) {
@@ -158,5 +169,16 @@ int cmd_bench(int argc, char** argv) {
         fflush(stdout);
     }
     model_free(m);
+    if (want_drive) {
+#ifdef CRANESIM_HAVE_RENDER
+        app_common dc = c;
+        dc.sim.mechanics = SIM_ODE;
+        dc.scenario_path = "sandbox_pick_place";
+        int dcode = drive_bench(&dc, 1280, 720, c.sim.duration > 0 ? c.sim.duration : 60.0);
+        if (dcode) code = dcode;
+#else
+        printf("{\"config\":\"drive\",\"error\":\"built without the render module\"}\n");
+#endif
+    }
     return code;
 }

@@ -513,3 +513,54 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     drive_session_destroy(s);
     return code;
 }
+
+static int cmp_dbl(const void* a, const void* b) {
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+int drive_bench(const app_common* c, int w, int h, double seconds) {
+    drive_opts o = drive_default_opts();
+    o.width = w;
+    o.height = h;
+    o.offscreen = true;
+    o.scripted = true;
+    o.fps_cap = 1000; // uncapped: measure what the renderer can do
+    char err[512];
+    drive_session* s = drive_session_create(c, &o, err, sizeof err);
+    if (!s) {
+        printf("{\"config\":\"drive\",\"error\":\"%s\"}\n", err);
+        return EXIT_RUNTIME;
+    }
+    const uint64_t f = SDL_GetPerformanceFrequency(), t0 = SDL_GetPerformanceCounter();
+    int code = 0;
+    for (;;) {
+        double wall = (double)(SDL_GetPerformanceCounter() - t0) / (double)f;
+        if (wall >= seconds) break;
+        if (drive_session_tick(s, wall) < 0) {
+            code = EXIT_RUNTIME;
+            break;
+        }
+    }
+    const drive_stats* st = drive_session_stats(s);
+    int n = st->nframe_ms < 4096 ? st->nframe_ms : 4096;
+    double* ms = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1));
+    // Skip the first frames (shader compilation, mesh upload).
+    int skip = n > 20 ? 10 : 0, m = 0;
+    for (int i = skip; i < n; ++i) ms[m++] = st->frame_ms[i];
+    qsort(ms, (size_t)m, sizeof *ms, cmp_dbl);
+    double p50 = m ? ms[m / 2] : 0, p95 = m ? ms[(int)(0.95 * (m - 1))] : 0;
+    printf("{\"config\":\"drive\",\"width\":%d,\"height\":%d,\"world\":\"%s\",\"wall_s\":%.3f,"
+           "\"sim_time_s\":%.3f,\"rt_factor\":%.3f,\"frames\":%ld,\"fps_mean\":%.1f,\"fps_median\":%.1f,"
+           "\"fps_p5\":%.1f,\"frame_ms_p50\":%.2f,\"frame_ms_p95\":%.2f,\"missed_deadlines\":%ld,"
+           "\"command_rate_hz\":%.1f,\"triangles\":%ld%s}\n",
+           w, h, c->sim.mechanics == SIM_ODE ? "sandbox" : "lagrange", st->wall_time, st->sim_time,
+           st->wall_time > 0 ? st->sim_time / st->wall_time : 0, st->frames,
+           st->wall_time > 0 ? st->frames / st->wall_time : 0, p50 > 0 ? 1e3 / p50 : 0, p95 > 0 ? 1e3 / p95 : 0,
+           p50, p95, st->missed, st->wall_time > 0 ? st->input_samples / st->wall_time : 0, st->triangles,
+           code ? ",\"error\":\"numerical failure\"" : "");
+    fflush(stdout);
+    free(ms);
+    drive_session_destroy(s);
+    return code;
+}

@@ -75,4 +75,10 @@ void drive_session_row(drive_session* s, double* row);
 int drive_window_main(const app_common* c, const drive_opts* o, double duration, const char* screenshot,
                       double screenshot_at);
 
+/// Benchmark: the real-time loop offscreen at w x h with the scripted
+/// operator for `seconds` of wall time; prints one JSON line (fps median and
+/// 5th percentile, frame-time p50/p95 [ms], missed deadlines, command rate,
+/// triangles, real-time factor). Returns 0 or an exit code.
+int drive_bench(const app_common* c, int w, int h, double seconds);
+
 #endif
