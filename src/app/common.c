@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 int app_parse_double(const char* s, double* v) {
@@ -146,7 +147,11 @@ void app_common_help(FILE* f, bool with_solver) {
 }
 
 const char* app_scenario_path(const char* arg, char* buf, size_t n) {
-    if (access(arg, R_OK) == 0 || strchr(arg, '/') || strstr(arg, ".json")) return arg;
+    // A path if it looks like one or is a readable file; else a name in the
+    // assets (a folder called "step" in the working directory is not a file).
+    struct stat st;
+    bool file = stat(arg, &st) == 0 && S_ISREG(st.st_mode);
+    if (file || strchr(arg, '/') || strstr(arg, ".json")) return arg;
     snprintf(buf, n, "%s/scenarios/%s.json", model_assets_dir(), arg);
     return buf;
 }

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 void json_fail(json_ctx* c, const char* path, const char* fmt, ...) {
     if (c->failed) return;
@@ -23,6 +24,11 @@ void json_fail(json_ctx* c, const char* path, const char* fmt, ...) {
 }
 
 cJSON* json_load_file(const char* path, char* err, size_t errsz) {
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        snprintf(err, errsz, "%s: not a regular file", path);
+        return NULL;
+    }
     FILE* f = fopen(path, "rb");
     if (!f) {
         snprintf(err, errsz, "%s: cannot open: %s", path, strerror(errno));

@@ -368,7 +368,8 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
         res->status = 1;
         snprintf(res->message, sizeof res->message,
                  "numerical blow-up: state %s = %.4g Pa (below absolute zero) at t = %.6g s (solver %s, h = %g s)",
-                 state_name(&ls, c.bad_state, nb, sizeof nb), c.bad_value, c.bad_t, hyd_method_name(o->solver),
+                 state_name(&ls, c.bad_state, nb, sizeof nb), c.bad_value, c.bad_t,
+                 o->cvode ? "cvode" : hyd_method_name(o->solver),
                  adaptive && s ? hyd_solver_last_h(s) : o->h);
     } else if (c.stop) {
         res->status = 2;
