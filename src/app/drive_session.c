@@ -23,6 +23,8 @@ typedef enum param_kind {
     PK_HYD,  ///< a circuit parameter: hyd_model_set on the live circuit, at once
     PK_MECH, ///< a mechanical parameter: live for lagrange, a rebuilt world for ode
     PK_LOAD, ///< the tip load (lagrange) [kg]
+    PK_SOLVER, ///< hydraulic integrator: 0 Krus, 1 ROS2 (a rebuilt world/solver at the current pose)
+    PK_STEP,   ///< hydraulic step [s] (rebuilt likewise)
 } param_kind;
 
 #define MAX_PARAMS 40
@@ -141,6 +143,9 @@ static void build_params(drive_session* s) {
     add_hyd(s, "reliefs", "jib port B", "MPa", 1e6, 2, 40, "jib_relief_B", "p_crack");
     add_hyd(s, "oil", "bulk modulus", "GPa", 1e9, 0.2, 2.5, "fluid", "bulk_modulus");
     add_hyd(s, "oil", "density", "kg/m3", 1, 700, 1000, "fluid", "density");
+    add_param(s, PK_SOLVER, "solver", "method 0 Krus 1 ROS2", "-", 1, 0, 1, NULL, NULL,
+              s->c.sim.solver == HYD_ROS2 ? 1.0 : 0.0);
+    add_param(s, PK_STEP, "solver", "step", "ms", 1e-3, 0.05, 1.0, NULL, NULL, s->c.sim.h);
 }
 
 // Keep the model document in step with a changed parameter, so "save model"
@@ -198,6 +203,19 @@ static void apply_param(drive_session* s, int i) {
         live_set_load(s->l, si);
         s->c.sim.load_mass = si;
         break;
+    case PK_SOLVER:
+        p->value = si < 0.5 ? 0.0 : 1.0; // a choice, not a continuum
+        s->c.sim.solver = p->value > 0.5 ? HYD_ROS2 : HYD_KRUS;
+        s->rebuild = true;
+        break;
+    case PK_STEP: {
+        // The ode world needs the hydraulic step to divide its 1 ms step.
+        double sub = s->c.sim.mechanics == SIM_ODE ? floor(s->c.sim.dt_ode / si + 0.5) : 0;
+        s->c.sim.h = sub > 0 ? s->c.sim.dt_ode / sub : si;
+        p->value = s->c.sim.h / p->scale;
+        s->rebuild = true;
+        break;
+    }
     }
     sync_json(s, p);
     snprintf(s->status, sizeof s->status, "%s/%s = %.4g %s", p->group, p->label, p->value, p->unit);
