@@ -16,7 +16,9 @@ void render_camera_init(render_camera* c) {
     c->target = rm_v3(0, 0, 2.5f);
 }
 
-static rm_vec3 v3d(const double p[3]) { return rm_v3((float)p[0], (float)p[1], (float)p[2]); }
+static rm_vec3 v3d(const double p[3]) {
+    return rm_v3((float)p[0], (float)p[1], (float)p[2]);
+}
 
 static const world_snap_body* find_role(const world_snapshot* s, world_role role) {
     for (int i = 0; i < s->nbody && i < WORLD_SNAP_MAX_BODIES; ++i)
@@ -29,7 +31,8 @@ static float ground_z(const world_snapshot* s, float x, float y) {
     const world_snap_terrain* t = &s->terrain;
     if (t->nx < 2 || t->ny < 2 || !t->height) return 0.0f;
     // Grid centred on the origin, as world_snapshot.h specifies.
-    float fx = x / (float)t->dx + 0.5f * (float)(t->nx - 1), fy = y / (float)t->dy + 0.5f * (float)(t->ny - 1);
+    float fx = x / (float)t->dx + 0.5f * (float)(t->nx - 1),
+          fy = y / (float)t->dy + 0.5f * (float)(t->ny - 1);
     if (fx < 0) fx = 0;
     if (fy < 0) fy = 0;
     if (fx > (float)(t->nx - 1)) fx = (float)(t->nx - 1);
@@ -46,7 +49,8 @@ static float ground_z(const world_snapshot* s, float x, float y) {
 
 static rm_vec3 orbit_eye(const render_camera* c, rm_vec3 target) {
     float cp = cosf(c->pitch);
-    return rm_add(target, rm_scale(rm_v3(cp * cosf(c->yaw), cp * sinf(c->yaw), sinf(c->pitch)), c->dist));
+    return rm_add(target,
+                  rm_scale(rm_v3(cp * cosf(c->yaw), cp * sinf(c->yaw), sinf(c->pitch)), c->dist));
 }
 
 void render_camera_update(render_camera* c, const world_snapshot* s, int w, int h) {
@@ -63,7 +67,8 @@ void render_camera_update(render_camera* c, const world_snapshot* s, int w, int 
         // the truck's heading, not the world axes.
         const world_snap_body* truck = find_role(s, WORLD_ROLE_TRUCK);
         rm_vec3 fwd = truck ? rm_v3((float)truck->rot[0], (float)truck->rot[3], 0) : rm_v3(1, 0, 0);
-        rm_vec3 left = truck ? rm_v3((float)truck->rot[1], (float)truck->rot[4], 0) : rm_v3(0, 1, 0);
+        rm_vec3 left =
+            truck ? rm_v3((float)truck->rot[1], (float)truck->rot[4], 0) : rm_v3(0, 1, 0);
         fwd = rm_norm(fwd), left = rm_norm(left);
         rm_vec3 e = rm_sub(base, rm_add(rm_scale(fwd, 0.4f), rm_scale(left, 2.1f)));
         c->eye = rm_v3(e.x, e.y, ground_z(s, e.x, e.y) + 1.7f);
@@ -115,15 +120,19 @@ static void to_orbit(render_camera* c) {
 bool render_camera_event(render_camera* c, const SDL_Event* ev) {
     switch (ev->type) {
     case SDL_MOUSEBUTTONDOWN:
-        if (ev->button.button == SDL_BUTTON_LEFT) c->dragging_orbit = true;
+        if (ev->button.button == SDL_BUTTON_LEFT)
+            c->dragging_orbit = true;
         else if (ev->button.button == SDL_BUTTON_RIGHT || ev->button.button == SDL_BUTTON_MIDDLE)
             c->dragging_pan = true;
-        else return false;
+        else
+            return false;
         to_orbit(c);
         return true;
     case SDL_MOUSEBUTTONUP:
-        if (ev->button.button == SDL_BUTTON_LEFT) c->dragging_orbit = false;
-        else c->dragging_pan = false;
+        if (ev->button.button == SDL_BUTTON_LEFT)
+            c->dragging_orbit = false;
+        else
+            c->dragging_pan = false;
         return true;
     case SDL_MOUSEMOTION:
         if (c->dragging_orbit) {

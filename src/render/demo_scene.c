@@ -45,16 +45,19 @@ static void rot_elev(double r[9], double a) {
 static void mat_mul(double o[9], const double a[9], const double b[9]) {
     double t[9];
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) t[i * 3 + j] = a[i * 3] * b[j] + a[i * 3 + 1] * b[3 + j] + a[i * 3 + 2] * b[6 + j];
+        for (int j = 0; j < 3; ++j)
+            t[i * 3 + j] = a[i * 3] * b[j] + a[i * 3 + 1] * b[3 + j] + a[i * 3 + 2] * b[6 + j];
     memcpy(o, t, sizeof t);
 }
 /// out = pos + R * local
-static void xform(double out[3], const double pos[3], const double r[9], double x, double y, double z) {
-    for (int i = 0; i < 3; ++i) out[i] = pos[i] + r[i * 3] * x + r[i * 3 + 1] * y + r[i * 3 + 2] * z;
+static void xform(double out[3], const double pos[3], const double r[9], double x, double y,
+                  double z) {
+    for (int i = 0; i < 3; ++i)
+        out[i] = pos[i] + r[i * 3] * x + r[i * 3 + 1] * y + r[i * 3 + 2] * z;
 }
 
-static world_snap_body* add(world_snapshot* s, const char* name, world_role role, world_shape shape, double sx,
-                            double sy, double sz, const float rgba[4]) {
+static world_snap_body* add(world_snapshot* s, const char* name, world_role role, world_shape shape,
+                            double sx, double sy, double sz, const float rgba[4]) {
     if (s->nbody >= WORLD_SNAP_MAX_BODIES) return NULL;
     world_snap_body* b = &s->body[s->nbody++];
     memset(b, 0, sizeof *b);
@@ -69,7 +72,8 @@ static world_snap_body* add(world_snapshot* s, const char* name, world_role role
     return b;
 }
 
-static void set_mesh(world_snap_body* b, bool on, const char* file, double ox, double oy, double oz) {
+static void set_mesh(world_snap_body* b, bool on, const char* file, double ox, double oy,
+                     double oz) {
     if (!b || !on) return;
     snprintf(b->mesh, sizeof b->mesh, "%s", file);
     b->mesh_offset[0] = ox, b->mesh_offset[1] = oy, b->mesh_offset[2] = oz;
@@ -81,8 +85,9 @@ static void set_pose(world_snap_body* b, double x, double y, double z, double ya
     rot_z(b->rot, yaw);
 }
 
-static void cylinder(world_snap_cylinder* c, const char* name, const double base[3], const double rod_end[3],
-                     double bore, double rod, double closed, double stroke, double pA, double pB, double u) {
+static void cylinder(world_snap_cylinder* c, const char* name, const double base[3],
+                     const double rod_end[3], double bore, double rod, double closed, double stroke,
+                     double pA, double pB, double u) {
     memset(c, 0, sizeof *c);
     snprintf(c->name, sizeof c->name, "%s", name);
     memcpy(c->base, base, 3 * sizeof(double));
@@ -132,7 +137,8 @@ void render_demo_scene(world_snapshot* s, const render_demo_params* p, float* te
 
     // Truck: body origin at its chassis box centre; the mesh origin is on the
     // ground under the slew axis, 1.2 m forward of that centre.
-    world_snap_body* b = add(s, "truck", WORLD_ROLE_TRUCK, WORLD_SHAPE_BOX, 7.6, 2.45, 1.0, truck_rgba);
+    world_snap_body* b =
+        add(s, "truck", WORLD_ROLE_TRUCK, WORLD_SHAPE_BOX, 7.6, 2.45, 1.0, truck_rgba);
     set_pose(b, -1.2, 0, 0.6, 0);
     set_mesh(b, m, "truck.obj", 1.2, 0, -0.6);
     const double wheel_x[3] = {1.75, -3.05, -4.35};
@@ -156,8 +162,8 @@ void render_demo_scene(world_snapshot* s, const render_demo_params* p, float* te
         }
     }
     for (int side = 0; side < 2; ++side) {
-        b = add(s, side ? "outrigger_r" : "outrigger_l", WORLD_ROLE_OUTRIGGER, WORLD_SHAPE_BOX, 0.22, 2.1, 0.22,
-                crane_rgba);
+        b = add(s, side ? "outrigger_r" : "outrigger_l", WORLD_ROLE_OUTRIGGER, WORLD_SHAPE_BOX,
+                0.22, 2.1, 0.22, crane_rgba);
         double sg = side ? -1.0 : 1.0;
         set_pose(b, -0.75, sg * 1.35, 0.75, side ? M_PI : 0);
         set_mesh(b, m, "outrigger.obj", 0, -1.35, 0);

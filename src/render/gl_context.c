@@ -83,7 +83,8 @@ static GLuint make_fbo(int w, int h, int samples, GLuint* color, GLuint* depth) 
     GLenum st = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (st != GL_FRAMEBUFFER_COMPLETE) {
-        fprintf(stderr, "render: framebuffer %dx%d (%d samples) incomplete: 0x%x\n", w, h, samples, st);
+        fprintf(stderr, "render: framebuffer %dx%d (%d samples) incomplete: 0x%x\n", w, h, samples,
+                st);
         glDeleteFramebuffers(1, &fbo);
         return 0;
     }

@@ -20,22 +20,21 @@
 #pragma GCC diagnostic pop
 #endif
 
-static const char* k_hud_vs =
-    "#version 330 core\n"
-    "layout(location = 0) in vec2 a_pos;\n"
-    "layout(location = 1) in vec4 a_col;\n"
-    "uniform vec2 u_screen;\n"
-    "out vec4 v_col;\n"
-    "void main() {\n"
-    "    v_col = a_col;\n"
-    "    gl_Position = vec4(a_pos.x / u_screen.x * 2.0 - 1.0, 1.0 - a_pos.y / u_screen.y * 2.0, 0.0, 1.0);\n"
-    "}\n";
+static const char* k_hud_vs = "#version 330 core\n"
+                              "layout(location = 0) in vec2 a_pos;\n"
+                              "layout(location = 1) in vec4 a_col;\n"
+                              "uniform vec2 u_screen;\n"
+                              "out vec4 v_col;\n"
+                              "void main() {\n"
+                              "    v_col = a_col;\n"
+                              "    gl_Position = vec4(a_pos.x / u_screen.x * 2.0 - 1.0, 1.0 - "
+                              "a_pos.y / u_screen.y * 2.0, 0.0, 1.0);\n"
+                              "}\n";
 
-static const char* k_hud_fs =
-    "#version 330 core\n"
-    "in vec4 v_col;\n"
-    "out vec4 o_color;\n"
-    "void main() { o_color = v_col; }\n";
+static const char* k_hud_fs = "#version 330 core\n"
+                              "in vec4 v_col;\n"
+                              "out vec4 o_color;\n"
+                              "void main() { o_color = v_col; }\n";
 
 bool render_hud_create(render_hud* h) {
     memset(h, 0, sizeof *h);
@@ -82,7 +81,8 @@ void render_hud_begin(render_hud* h, int w, int hh) {
 static bool grow(render_hud_vertex** buf, int* cap, int need) {
     if (need <= *cap) return true;
     int nc = *cap;
-    while (nc < need) nc *= 2;
+    while (nc < need)
+        nc *= 2;
     render_hud_vertex* nb = realloc(*buf, (size_t)nc * sizeof *nb);
     if (!nb) return false;
     *buf = nb;
@@ -125,7 +125,8 @@ float render_hud_text_width(const char* s, float scale) {
     return (float)stb_easy_font_width((char*)s) * scale;
 }
 
-float render_hud_text(render_hud* h, float x, float y, float scale, const float rgba[4], const char* s) {
+float render_hud_text(render_hud* h, float x, float y, float scale, const float rgba[4],
+                      const char* s) {
     unsigned char c[4];
     to_u8(rgba, c);
     // stb_easy_font writes quads of 16-byte vertices (x, y, z, rgba).
@@ -157,7 +158,8 @@ void render_hud_flush(render_hud* h) {
     glBindBuffer(GL_ARRAY_BUFFER, h->vbo);
     // One upload per frame into a buffer that only grows; re-specifying it
     // every frame would make llvmpipe allocate and zero fresh memory.
-    size_t bt = (size_t)h->ntri * sizeof(render_hud_vertex), bl = (size_t)h->nline * sizeof(render_hud_vertex);
+    size_t bt = (size_t)h->ntri * sizeof(render_hud_vertex),
+           bl = (size_t)h->nline * sizeof(render_hud_vertex);
     if (bt + bl > h->vbo_bytes) {
         h->vbo_bytes = 2 * (bt + bl);
         glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)h->vbo_bytes, NULL, GL_STREAM_DRAW);
@@ -196,7 +198,8 @@ enum { BAR_W = 14, BAR_H = 96, BAR_GAP = 6, BAR_PAD = 4 };
 
 static void draw_pressure_bars(render* r, const world_snapshot* s) {
     render_hud* h = &r->hud;
-    const float empty[4] = {((RENDER_BAR_EMPTY_RGB >> 16) & 255) / 255.0f, ((RENDER_BAR_EMPTY_RGB >> 8) & 255) / 255.0f,
+    const float empty[4] = {((RENDER_BAR_EMPTY_RGB >> 16) & 255) / 255.0f,
+                            ((RENDER_BAR_EMPTY_RGB >> 8) & 255) / 255.0f,
                             (RENDER_BAR_EMPTY_RGB & 255) / 255.0f, 1.0f};
     const float frame[4] = {0.85f, 0.87f, 0.9f, 1.0f};
     const float relief[4] = {1.0f, 0.1f, 0.1f, 1.0f};
@@ -219,26 +222,30 @@ static void draw_pressure_bars(render* r, const world_snapshot* s) {
         if (gy + gh > h->h - 4) gy = h->h - 4 - gh;
         for (int pass = 0; pass < 4; ++pass)
             for (int k = 0; k < nplaced; ++k)
-                if (gx < placed[k][0] + placed[k][2] + 6 && placed[k][0] < gx + gw + 6 && gy < placed[k][1] + placed[k][3] &&
-                    placed[k][1] < gy + gh)
+                if (gx < placed[k][0] + placed[k][2] + 6 && placed[k][0] < gx + gw + 6 &&
+                    gy < placed[k][1] + placed[k][3] && placed[k][1] < gy + gh)
                     gx = placed[k][0] + placed[k][2] + 8;
-        placed[nplaced][0] = gx, placed[nplaced][1] = gy, placed[nplaced][2] = gw, placed[nplaced][3] = gh;
+        placed[nplaced][0] = gx, placed[nplaced][1] = gy, placed[nplaced][2] = gw,
+        placed[nplaced][3] = gh;
         ++nplaced;
 
-        render_hud_line(h, (float)gx + gw * 0.5f, (float)(gy + gh), (float)px[0], (float)px[1], k_dim);
+        render_hud_line(h, (float)gx + gw * 0.5f, (float)(gy + gh), (float)px[0], (float)px[1],
+                        k_dim);
         render_hud_rect(h, (float)gx, (float)gy, (float)gw, (float)gh, k_panel);
         char buf[64];
         snprintf(buf, sizeof buf, "%s", c->name[0] ? c->name : "cyl");
-        render_hud_text(h, (float)gx + BAR_PAD, (float)gy + 3, 1.0f, c->end_stop ? k_amber : k_white, buf);
+        render_hud_text(h, (float)gx + BAR_PAD, (float)gy + 3, 1.0f,
+                        c->end_stop ? k_amber : k_white, buf);
         double p[2] = {c->pA, c->pB};
         for (int ch = 0; ch < 2; ++ch) {
             int bx = gx + BAR_PAD + ch * (BAR_W + BAR_GAP), by = gy + 14;
             double frac = p[ch] / r->cfg.p_full_scale;
-            if (!(frac > 0)) frac = 0;  // also catches NaN
+            if (!(frac > 0)) frac = 0; // also catches NaN
             if (frac > 1) frac = 1;
             // Outline (red while a port relief passes flow), then the empty
             // bar, then the fill from the bottom.
-            render_hud_rect(h, (float)bx - 1, (float)by - 1, BAR_W + 2, BAR_H + 2, c->relief_open ? relief : frame);
+            render_hud_rect(h, (float)bx - 1, (float)by - 1, BAR_W + 2, BAR_H + 2,
+                            c->relief_open ? relief : frame);
             render_hud_rect(h, (float)bx, (float)by, BAR_W, BAR_H, empty);
             float fill = (float)(frac * BAR_H);
             float col[4];
@@ -263,20 +270,27 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
     render_hud_rect(h, x - 6, y - 6, w, lh * (float)nrows + 10, k_panel);
     char buf[160];
-    if (r->fps_avg > 0) snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx   %.0f fps", s->t, s->rt_factor, r->fps_avg);
-    else snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx", s->t, s->rt_factor);
+    if (r->fps_avg > 0)
+        snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx   %.0f fps", s->t, s->rt_factor, r->fps_avg);
+    else
+        snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx", s->t, s->rt_factor);
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh * 1.3f;
     for (int i = 0; i < ncyl; ++i)
-        render_hud_text(h, x + col0 + colw * (float)i, y, sc, k_dim, s->cyl[i].name[0] ? s->cyl[i].name : "cyl");
+        render_hud_text(h, x + col0 + colw * (float)i, y, sc, k_dim,
+                        s->cyl[i].name[0] ? s->cyl[i].name : "cyl");
     y += lh;
-    static const char* rows[] = {"x [mm]", "v [mm/s]", "pA [MPa]", "pB [MPa]", "u [%]", "u_cmd [%]", "F [kN]"};
+    static const char* rows[] = {"x [mm]", "v [mm/s]",  "pA [MPa]", "pB [MPa]",
+                                 "u [%]",  "u_cmd [%]", "F [kN]"};
     for (int row = 0; row < 7; ++row) {
         render_hud_text(h, x, y, sc, k_dim, rows[row]);
         for (int i = 0; i < ncyl; ++i) {
             const world_snap_cylinder* c = &s->cyl[i];
-            double v[7] = {c->x * 1e3, c->v * 1e3, c->pA * 1e-6, c->pB * 1e-6, c->u * 100, c->u_cmd * 100, c->force * 1e-3};
-            const char* fmt = row == 4 || row == 5 ? "%+.0f" : row == 0 || row == 1 ? "%.1f" : "%.2f";
+            double v[7] = {c->x * 1e3, c->v * 1e3,     c->pA * 1e-6,   c->pB * 1e-6,
+                           c->u * 100, c->u_cmd * 100, c->force * 1e-3};
+            const char* fmt = row == 4 || row == 5   ? "%+.0f"
+                              : row == 0 || row == 1 ? "%.1f"
+                                                     : "%.2f";
             snprintf(buf, sizeof buf, fmt, v[row]);
             const float* colr = (row == 2 || row == 3) && c->relief_open ? k_amber : k_white;
             render_hud_text(h, x + col0 + colw * (float)i, y, sc, colr, buf);
@@ -313,11 +327,13 @@ static void draw_warnings(render* r, const world_snapshot* s) {
         if (s->cyl[i].relief_open) snprintf(w[n++], sizeof w[0], "RELIEF OPEN: %s", nm);
         if (s->cyl[i].end_stop && n < 10) snprintf(w[n++], sizeof w[0], "END STOP: %s", nm);
     }
-    if (s->tipping && n < 11) snprintf(w[n++], sizeof w[0], "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
+    if (s->tipping && n < 11)
+        snprintf(w[n++], sizeof w[0], "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
     if (s->collision && n < 11) snprintf(w[n++], sizeof w[0], "COLLISION");
     // Real time: the app's missed deadlines, or a measured factor below 1.
     bool slow = r->missed_deadlines > 0 || (s->rt_factor > 0 && s->rt_factor < 0.97);
-    if (slow && n < 12) snprintf(w[n++], sizeof w[0], "CANNOT KEEP UP WITH REAL TIME (%.2fx)", s->rt_factor);
+    if (slow && n < 12)
+        snprintf(w[n++], sizeof w[0], "CANNOT KEEP UP WITH REAL TIME (%.2fx)", s->rt_factor);
     float y = 10;
     for (int i = 0; i < n; ++i) {
         float tw = render_hud_text_width(w[i], 2.0f);

@@ -11,11 +11,11 @@
 
 struct input {
     input_mapping map;
-    SDL_GameController* gc;   ///< active device if it is a game controller
-    SDL_Joystick* js;         ///< active device's joystick (also set for gc)
-    SDL_JoystickID id;        ///< its instance id, -1 if none
+    SDL_GameController* gc; ///< active device if it is a game controller
+    SDL_Joystick* js;       ///< active device's joystick (also set for gc)
+    SDL_JoystickID id;      ///< its instance id, -1 if none
     char name[128];
-    Uint32 own_subsystems;    ///< SDL subsystems we started, to quit them again
+    Uint32 own_subsystems; ///< SDL subsystems we started, to quit them again
     bool key_pos[INPUT_AXIS_COUNT], key_neg[INPUT_AXIS_COUNT];
     double kb[INPUT_AXIS_COUNT]; ///< ramped keyboard contribution
     // Edges collected between polls.
@@ -27,7 +27,8 @@ input_mapping input_default_mapping(void) {
     input_mapping m;
     memset(&m, 0, sizeof m);
     // SDL reports stick "up" as negative y: invert so pushing up raises.
-    const int ca[INPUT_AXIS_COUNT] = {SDL_CONTROLLER_AXIS_LEFTY, SDL_CONTROLLER_AXIS_RIGHTY, SDL_CONTROLLER_AXIS_LEFTX};
+    const int ca[INPUT_AXIS_COUNT] = {SDL_CONTROLLER_AXIS_LEFTY, SDL_CONTROLLER_AXIS_RIGHTY,
+                                      SDL_CONTROLLER_AXIS_LEFTX};
     const int ja[INPUT_AXIS_COUNT] = {1, 3, 0};
     for (int i = 0; i < INPUT_AXIS_COUNT; ++i) {
         m.axis[i].controller_axis = ca[i];
@@ -38,8 +39,9 @@ input_mapping input_default_mapping(void) {
         m.axis[i].expo = 0.3;
         m.axis[i].scale = 1.0;
     }
-    const int cb[INPUT_BUTTON_COUNT] = {SDL_CONTROLLER_BUTTON_A, SDL_CONTROLLER_BUTTON_START, SDL_CONTROLLER_BUTTON_BACK,
-                                        SDL_CONTROLLER_BUTTON_Y, SDL_CONTROLLER_BUTTON_X};
+    const int cb[INPUT_BUTTON_COUNT] = {SDL_CONTROLLER_BUTTON_A, SDL_CONTROLLER_BUTTON_START,
+                                        SDL_CONTROLLER_BUTTON_BACK, SDL_CONTROLLER_BUTTON_Y,
+                                        SDL_CONTROLLER_BUTTON_X};
     const int jb[INPUT_BUTTON_COUNT] = {0, 7, 6, 3, 2};
     for (int i = 0; i < INPUT_BUTTON_COUNT; ++i) {
         m.controller_button[i] = cb[i];
@@ -62,11 +64,12 @@ double input_shape(double raw, double dead_zone, double expo) {
 // ---- mapping file ----------------------------------------------------------------
 
 static const char* k_axis_names[INPUT_AXIS_COUNT] = {"lift", "jib", "slew"};
-static const char* k_button_names[INPUT_BUTTON_COUNT] = {"hook", "pause", "reset", "screenshot", "camera"};
+static const char* k_button_names[INPUT_BUTTON_COUNT] = {"hook", "pause", "reset", "screenshot",
+                                                         "camera"};
 
 /// Reads an optional number field within [lo, hi].
-static int get_num(const cJSON* o, const char* key, double lo, double hi, double* out, const char* path,
-                   const char* where, char* err, size_t errsz) {
+static int get_num(const cJSON* o, const char* key, double lo, double hi, double* out,
+                   const char* path, const char* where, char* err, size_t errsz) {
     const cJSON* v = cJSON_GetObjectItemCaseSensitive(o, key);
     if (!v) return 0;
     if (!cJSON_IsNumber(v) || !(v->valuedouble >= lo && v->valuedouble <= hi)) {
@@ -79,8 +82,8 @@ static int get_num(const cJSON* o, const char* key, double lo, double hi, double
 
 /// A device reference: a name (controller), an integer (joystick), or
 /// null / "none" for unbound.
-static int get_ref(const cJSON* o, const char* key, bool controller, bool is_axis, int* out, const char* path,
-                   const char* where, char* err, size_t errsz) {
+static int get_ref(const cJSON* o, const char* key, bool controller, bool is_axis, int* out,
+                   const char* path, const char* where, char* err, size_t errsz) {
     const cJSON* v = cJSON_GetObjectItemCaseSensitive(o, key);
     if (!v) return 0;
     if (cJSON_IsNull(v) || (cJSON_IsString(v) && strcmp(v->valuestring, "none") == 0)) {
@@ -93,17 +96,19 @@ static int get_ref(const cJSON* o, const char* key, bool controller, bool is_axi
             k = is_axis ? (int)SDL_GameControllerGetAxisFromString(v->valuestring)
                         : (int)SDL_GameControllerGetButtonFromString(v->valuestring);
         if (k < 0) {
-            snprintf(err, errsz, "%s: %s.%s: unknown game controller %s \"%s\" (e.g. %s)", path, where, key,
-                     is_axis ? "axis" : "button", cJSON_IsString(v) ? v->valuestring : "?",
-                     is_axis ? "leftx, lefty, rightx, righty, lefttrigger" : "a, b, x, y, start, back");
+            snprintf(
+                err, errsz, "%s: %s.%s: unknown game controller %s \"%s\" (e.g. %s)", path, where,
+                key, is_axis ? "axis" : "button", cJSON_IsString(v) ? v->valuestring : "?",
+                is_axis ? "leftx, lefty, rightx, righty, lefttrigger" : "a, b, x, y, start, back");
             return -1;
         }
         *out = k;
         return 0;
     }
-    if (!cJSON_IsNumber(v) || v->valuedouble < 0 || v->valuedouble > 255 || v->valuedouble != floor(v->valuedouble)) {
-        snprintf(err, errsz, "%s: %s.%s: must be a joystick %s index 0..255 or null", path, where, key,
-                 is_axis ? "axis" : "button");
+    if (!cJSON_IsNumber(v) || v->valuedouble < 0 || v->valuedouble > 255 ||
+        v->valuedouble != floor(v->valuedouble)) {
+        snprintf(err, errsz, "%s: %s.%s: must be a joystick %s index 0..255 or null", path, where,
+                 key, is_axis ? "axis" : "button");
         return -1;
     }
     *out = v->valueint;
@@ -153,7 +158,8 @@ int input_load_mapping(const char* path, input_mapping* m, char* err, size_t err
         }
         input_axis_map* x = &t.axis[i];
         rc |= get_ref(a, "controller", true, true, &x->controller_axis, path, where, err, errsz);
-        if (!rc) rc |= get_ref(a, "joystick", false, true, &x->joystick_axis, path, where, err, errsz);
+        if (!rc)
+            rc |= get_ref(a, "joystick", false, true, &x->joystick_axis, path, where, err, errsz);
         if (!rc) rc |= get_num(a, "dead_zone", 0.0, 0.94, &x->dead_zone, path, where, err, errsz);
         if (!rc) rc |= get_num(a, "expo", 0.0, 1.0, &x->expo, path, where, err, errsz);
         if (!rc) rc |= get_num(a, "scale", 0.01, 1.0, &x->scale, path, where, err, errsz);
@@ -173,10 +179,15 @@ int input_load_mapping(const char* path, input_mapping* m, char* err, size_t err
         if (!b) continue;
         char where[48];
         snprintf(where, sizeof where, "buttons.%s", k_button_names[i]);
-        rc |= get_ref(b, "controller", true, false, &t.controller_button[i], path, where, err, errsz);
-        if (!rc) rc |= get_ref(b, "joystick", false, false, &t.joystick_button[i], path, where, err, errsz);
+        rc |=
+            get_ref(b, "controller", true, false, &t.controller_button[i], path, where, err, errsz);
+        if (!rc)
+            rc |= get_ref(b, "joystick", false, false, &t.joystick_button[i], path, where, err,
+                          errsz);
     }
-    if (rc == 0) rc = get_num(root, "keyboard_ramp_s", 0.0, 10.0, &t.keyboard_ramp, path, "(top)", err, errsz);
+    if (rc == 0)
+        rc = get_num(root, "keyboard_ramp_s", 0.0, 10.0, &t.keyboard_ramp, path, "(top)", err,
+                     errsz);
     cJSON_Delete(root);
     if (rc == 0) *m = t;
     return rc;
@@ -185,8 +196,10 @@ int input_load_mapping(const char* path, input_mapping* m, char* err, size_t err
 // ---- devices ---------------------------------------------------------------------
 
 static void close_device(input* in) {
-    if (in->gc) SDL_GameControllerClose(in->gc);
-    else if (in->js) SDL_JoystickClose(in->js);
+    if (in->gc)
+        SDL_GameControllerClose(in->gc);
+    else if (in->js)
+        SDL_JoystickClose(in->js);
     in->gc = NULL;
     in->js = NULL;
     in->id = -1;
@@ -211,7 +224,8 @@ static bool open_device(input* in, int index) {
 }
 
 static void open_first(input* in) {
-    for (int i = 0; i < SDL_NumJoysticks() && !in->js; ++i) open_device(in, i);
+    for (int i = 0; i < SDL_NumJoysticks() && !in->js; ++i)
+        open_device(in, i);
 }
 
 input* input_create(const input_mapping* m) {
@@ -223,8 +237,10 @@ input* input_create(const input_mapping* m) {
     const Uint32 need[2] = {SDL_INIT_JOYSTICK, SDL_INIT_GAMECONTROLLER};
     for (int k = 0; k < 2; ++k)
         if (!SDL_WasInit(need[k])) {
-            if (SDL_InitSubSystem(need[k]) == 0) in->own_subsystems |= need[k];
-            else fprintf(stderr, "input: %s; keyboard only\n", SDL_GetError());
+            if (SDL_InitSubSystem(need[k]) == 0)
+                in->own_subsystems |= need[k];
+            else
+                fprintf(stderr, "input: %s; keyboard only\n", SDL_GetError());
         }
     open_first(in);
     return in;
@@ -239,46 +255,91 @@ void input_destroy(input* in) {
 
 static void press(input* in, int button) {
     switch (button) {
-    case INPUT_BTN_HOOK: in->hook = true; break;
-    case INPUT_BTN_PAUSE: in->pause = true; break;
-    case INPUT_BTN_RESET: in->reset = true; break;
-    case INPUT_BTN_SCREENSHOT: in->screenshot = true; break;
-    case INPUT_BTN_CAMERA: in->camera_next = true; break;
-    default: break;
+    case INPUT_BTN_HOOK:
+        in->hook = true;
+        break;
+    case INPUT_BTN_PAUSE:
+        in->pause = true;
+        break;
+    case INPUT_BTN_RESET:
+        in->reset = true;
+        break;
+    case INPUT_BTN_SCREENSHOT:
+        in->screenshot = true;
+        break;
+    case INPUT_BTN_CAMERA:
+        in->camera_next = true;
+        break;
+    default:
+        break;
     }
 }
 
 /// Keys: arrows up/down = lift, W/S = jib, arrows left/right (or A/D) = slew.
 static void key_axis(input* in, SDL_Scancode sc, bool down) {
     switch (sc) {
-    case SDL_SCANCODE_UP: in->key_pos[INPUT_LIFT] = down; break;
-    case SDL_SCANCODE_DOWN: in->key_neg[INPUT_LIFT] = down; break;
-    case SDL_SCANCODE_W: in->key_pos[INPUT_JIB] = down; break;
-    case SDL_SCANCODE_S: in->key_neg[INPUT_JIB] = down; break;
+    case SDL_SCANCODE_UP:
+        in->key_pos[INPUT_LIFT] = down;
+        break;
+    case SDL_SCANCODE_DOWN:
+        in->key_neg[INPUT_LIFT] = down;
+        break;
+    case SDL_SCANCODE_W:
+        in->key_pos[INPUT_JIB] = down;
+        break;
+    case SDL_SCANCODE_S:
+        in->key_neg[INPUT_JIB] = down;
+        break;
     case SDL_SCANCODE_LEFT:
-    case SDL_SCANCODE_A: in->key_pos[INPUT_SLEW] = down; break;
+    case SDL_SCANCODE_A:
+        in->key_pos[INPUT_SLEW] = down;
+        break;
     case SDL_SCANCODE_RIGHT:
-    case SDL_SCANCODE_D: in->key_neg[INPUT_SLEW] = down; break;
-    default: break;
+    case SDL_SCANCODE_D:
+        in->key_neg[INPUT_SLEW] = down;
+        break;
+    default:
+        break;
     }
 }
 
 static bool key_edge(input* in, SDL_Scancode sc) {
     switch (sc) {
     case SDL_SCANCODE_H:
-    case SDL_SCANCODE_RETURN: in->hook = true; return true;
+    case SDL_SCANCODE_RETURN:
+        in->hook = true;
+        return true;
     case SDL_SCANCODE_P:
-    case SDL_SCANCODE_SPACE: in->pause = true; return true;
+    case SDL_SCANCODE_SPACE:
+        in->pause = true;
+        return true;
     case SDL_SCANCODE_R:
-    case SDL_SCANCODE_BACKSPACE: in->reset = true; return true;
-    case SDL_SCANCODE_F12: in->screenshot = true; return true;
-    case SDL_SCANCODE_C: in->camera_next = true; return true;
-    case SDL_SCANCODE_F1: in->camera_preset = 0; return true;
-    case SDL_SCANCODE_F2: in->camera_preset = 1; return true;
-    case SDL_SCANCODE_F3: in->camera_preset = 2; return true;
-    case SDL_SCANCODE_F4: in->camera_preset = 3; return true;
-    case SDL_SCANCODE_ESCAPE: in->quit = true; return true;
-    default: return false;
+    case SDL_SCANCODE_BACKSPACE:
+        in->reset = true;
+        return true;
+    case SDL_SCANCODE_F12:
+        in->screenshot = true;
+        return true;
+    case SDL_SCANCODE_C:
+        in->camera_next = true;
+        return true;
+    case SDL_SCANCODE_F1:
+        in->camera_preset = 0;
+        return true;
+    case SDL_SCANCODE_F2:
+        in->camera_preset = 1;
+        return true;
+    case SDL_SCANCODE_F3:
+        in->camera_preset = 2;
+        return true;
+    case SDL_SCANCODE_F4:
+        in->camera_preset = 3;
+        return true;
+    case SDL_SCANCODE_ESCAPE:
+        in->quit = true;
+        return true;
+    default:
+        return false;
     }
 }
 
@@ -333,7 +394,8 @@ static double device_axis(const input* in, int a) {
     double raw = 0;
     if (in->gc) {
         if (m->controller_axis < 0 || m->controller_axis >= SDL_CONTROLLER_AXIS_MAX) return 0;
-        raw = SDL_GameControllerGetAxis(in->gc, (SDL_GameControllerAxis)m->controller_axis) / 32767.0;
+        raw =
+            SDL_GameControllerGetAxis(in->gc, (SDL_GameControllerAxis)m->controller_axis) / 32767.0;
     } else if (in->js) {
         if (m->joystick_axis < 0 || m->joystick_axis >= SDL_JoystickNumAxes(in->js)) return 0;
         raw = SDL_JoystickGetAxis(in->js, m->joystick_axis) / 32767.0;
@@ -372,7 +434,9 @@ void input_poll(input* in, double dt, input_command* out) {
     in->camera_preset = -1;
 }
 
-const char* input_device_name(const input* in) { return in->js ? in->name : NULL; }
+const char* input_device_name(const input* in) {
+    return in->js ? in->name : NULL;
+}
 
 input_source input_active_source(const input* in) {
     return in->gc ? INPUT_SRC_CONTROLLER : in->js ? INPUT_SRC_JOYSTICK : INPUT_SRC_KEYBOARD;

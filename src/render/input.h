@@ -26,11 +26,11 @@ typedef enum input_axis {
 } input_axis;
 
 typedef enum input_button {
-    INPUT_BTN_HOOK = 0,   ///< attach / release the load
+    INPUT_BTN_HOOK = 0, ///< attach / release the load
     INPUT_BTN_PAUSE,
     INPUT_BTN_RESET,
     INPUT_BTN_SCREENSHOT,
-    INPUT_BTN_CAMERA,     ///< next camera preset
+    INPUT_BTN_CAMERA, ///< next camera preset
     INPUT_BUTTON_COUNT
 } input_button;
 
@@ -45,25 +45,25 @@ typedef enum input_source {
 typedef struct input_command {
     double lift, jib, slew;
     bool hook_toggle, pause, reset, screenshot, quit;
-    bool camera_next;       ///< cycle camera presets
-    int camera_preset;      ///< -1 = no change, else a render_cam_preset (F1..F4)
-    input_source source;    ///< the device that is active
+    bool camera_next;    ///< cycle camera presets
+    int camera_preset;   ///< -1 = no change, else a render_cam_preset (F1..F4)
+    input_source source; ///< the device that is active
 } input_command;
 
 typedef struct input_axis_map {
-    int controller_axis;    ///< SDL_GameControllerAxis, -1 = none
-    int joystick_axis;      ///< raw joystick axis index, -1 = none
-    bool invert;            ///< flip the sign (SDL sticks give + for down/right)
-    double dead_zone;       ///< |raw| below this gives 0, in [0, 0.95)
-    double expo;            ///< 0 = linear .. 1 = cubic, fine control near centre
-    double scale;           ///< output gain, (0, 1]
+    int controller_axis; ///< SDL_GameControllerAxis, -1 = none
+    int joystick_axis;   ///< raw joystick axis index, -1 = none
+    bool invert;         ///< flip the sign (SDL sticks give + for down/right)
+    double dead_zone;    ///< |raw| below this gives 0, in [0, 0.95)
+    double expo;         ///< 0 = linear .. 1 = cubic, fine control near centre
+    double scale;        ///< output gain, (0, 1]
 } input_axis_map;
 
 typedef struct input_mapping {
     input_axis_map axis[INPUT_AXIS_COUNT];
     int controller_button[INPUT_BUTTON_COUNT]; ///< SDL_GameControllerButton, -1 = none
     int joystick_button[INPUT_BUTTON_COUNT];   ///< raw button index, -1 = none
-    double keyboard_ramp;   ///< time for a key to take its axis from 0 to 1 [s], 0 = instant
+    double keyboard_ramp; ///< time for a key to take its axis from 0 to 1 [s], 0 = instant
 } input_mapping;
 
 typedef struct input input;

@@ -34,6 +34,21 @@ render_mesh render_mesh_upload(const render_vertex* v, int nv, const unsigned* i
     glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, sizeof *v, (void*)offsetof(render_vertex, c));
     glBindVertexArray(0);
     m.nidx = ni;
+    // Back-face culling halves the triangles llvmpipe rasterises, but is
+    // only safe when the winding is consistent: CAD exports often mix it.
+    // Cull a mesh only if no triangle's winding disagrees with its normals.
+    int agree = 0, disagree = 0;
+    for (int t = 0; t + 2 < ni; t += 3) {
+        const render_vertex *a = &v[idx[t]], *b = &v[idx[t + 1]], *c = &v[idx[t + 2]];
+        rm_vec3 g = rm_cross(rm_v3(b->p[0] - a->p[0], b->p[1] - a->p[1], b->p[2] - a->p[2]),
+                             rm_v3(c->p[0] - a->p[0], c->p[1] - a->p[1], c->p[2] - a->p[2]));
+        if (rm_dot(g, g) < 1e-20f) continue;
+        rm_vec3 ns = rm_v3(a->n[0] + b->n[0] + c->n[0], a->n[1] + b->n[1] + c->n[1], a->n[2] + b->n[2] + c->n[2]);
+        float d = rm_dot(g, ns);
+        agree += d > 0;
+        disagree += d < 0;
+    }
+    m.cull = agree > 0 && disagree == 0;
     for (int k = 0; k < 3; ++k) {
         m.bmin[k] = nv ? 1e30f : 0;
         m.bmax[k] = nv ? -1e30f : 0;
@@ -99,7 +114,8 @@ static render_mesh b_finish(builder* b) {
 
 static void build_box(builder* b) {
     // Six faces with their own vertices so edges stay sharp.
-    static const float n[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const float n[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                  {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     for (int f = 0; f < 6; ++f) {
         float nx = n[f][0], ny = n[f][1], nz = n[f][2];
         // Two tangents spanning the face, with t1 x t2 = n for CCW winding.
@@ -125,14 +141,18 @@ static void build_cyl(builder* b, int ax, float a0, float a1, int seg) {
         int first = b->nv;
         for (int k = 0; k < seg; ++k) {
             float th = 2.0f * (float)M_PI * (float)k / (float)seg, u = cosf(th), w = sinf(th);
-            if (ax == 2) b_vert(b, u, w, a, 0, 0, sgn);
-            else b_vert(b, a, u, w, sgn, 0, 0);
+            if (ax == 2)
+                b_vert(b, u, w, a, 0, 0, sgn);
+            else
+                b_vert(b, a, u, w, sgn, 0, 0);
         }
         for (int k = 0; k < seg; ++k) {
             int p = first + k, q = first + (k + 1) % seg;
             // The +end cap faces along +axis: CCW seen from outside.
-            if (end) b_tri(b, c, p, q);
-            else b_tri(b, c, q, p);
+            if (end)
+                b_tri(b, c, p, q);
+            else
+                b_tri(b, c, q, p);
         }
     }
     int first = b->nv;
@@ -198,11 +218,14 @@ static bool has_supported_ext(const char* path) {
     return aiIsExtensionSupported(dot) == AI_TRUE;
 }
 
-static void put_vertex(builder* b, int up, struct aiVector3D p, struct aiVector3D n, const float tint[3]) {
+static void put_vertex(builder* b, int up, struct aiVector3D p, struct aiVector3D n,
+                       const float tint[3]) {
     int vi;
     // y-up files: mesh y becomes body z, mesh z becomes body -y.
-    if (up == 1) vi = b_vert(b, p.x, -p.z, p.y, n.x, -n.z, n.y);
-    else vi = b_vert(b, p.x, p.y, p.z, n.x, n.y, n.z);
+    if (up == 1)
+        vi = b_vert(b, p.x, -p.z, p.y, n.x, -n.z, n.y);
+    else
+        vi = b_vert(b, p.x, p.y, p.z, n.x, n.y, n.z);
     memcpy(b->v[vi].c, tint, 3 * sizeof(float));
 }
 
@@ -222,13 +245,15 @@ static bool convert_scene(const struct aiScene* sc, int up, builder* b) {
         if (m->mMaterialIndex < sc->mNumMaterials)
             aiGetMaterialColor(sc->mMaterials[m->mMaterialIndex], AI_MATKEY_COLOR_DIFFUSE, &kd);
         bool flat = !m->mNormals;
-        for (unsigned i = 0; !flat && i < m->mNumVertices; ++i) flat = bad_normal(m->mNormals[i]);
+        for (unsigned i = 0; !flat && i < m->mNumVertices; ++i)
+            flat = bad_normal(m->mNormals[i]);
         int base = b->nv;
         if (!flat) {
             for (unsigned i = 0; i < m->mNumVertices; ++i) {
                 float tint[3] = {kd.r, kd.g, kd.b};
                 if (m->mColors[0])
-                    tint[0] *= m->mColors[0][i].r, tint[1] *= m->mColors[0][i].g, tint[2] *= m->mColors[0][i].b;
+                    tint[0] *= m->mColors[0][i].r, tint[1] *= m->mColors[0][i].g,
+                        tint[2] *= m->mColors[0][i].b;
                 put_vertex(b, up, m->mVertices[i], m->mNormals[i], tint);
             }
         }
@@ -240,13 +265,16 @@ static bool convert_scene(const struct aiScene* sc, int up, builder* b) {
                 b_tri(b, base + (int)ix[0], base + (int)ix[1], base + (int)ix[2]);
                 continue;
             }
-            struct aiVector3D p0 = m->mVertices[ix[0]], p1 = m->mVertices[ix[1]], p2 = m->mVertices[ix[2]];
-            rm_vec3 e1 = rm_v3(p1.x - p0.x, p1.y - p0.y, p1.z - p0.z), e2 = rm_v3(p2.x - p0.x, p2.y - p0.y, p2.z - p0.z);
+            struct aiVector3D p0 = m->mVertices[ix[0]], p1 = m->mVertices[ix[1]],
+                              p2 = m->mVertices[ix[2]];
+            rm_vec3 e1 = rm_v3(p1.x - p0.x, p1.y - p0.y, p1.z - p0.z),
+                    e2 = rm_v3(p2.x - p0.x, p2.y - p0.y, p2.z - p0.z);
             rm_vec3 fn = rm_norm(rm_cross(e1, e2));
             struct aiVector3D n = {fn.x, fn.y, fn.z};
             float tint[3] = {kd.r, kd.g, kd.b};
             int v0 = b->nv;
-            for (int k = 0; k < 3; ++k) put_vertex(b, up, m->mVertices[ix[k]], n, tint);
+            for (int k = 0; k < 3; ++k)
+                put_vertex(b, up, m->mVertices[ix[k]], n, tint);
             b_tri(b, v0, v0 + 1, v0 + 2);
         }
     }
@@ -268,8 +296,9 @@ static bool load_file(const char* path, int up, render_mesh* out, char* why, siz
     // Files without normals get smooth normals only across gentle bends, so
     // box sections keep their sharp edges.
     aiSetImportPropertyFloat(props, AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 40.0f);
-    unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals |
-                     aiProcess_PreTransformVertices | aiProcess_SortByPType;
+    unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                     aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices |
+                     aiProcess_SortByPType;
     const struct aiScene* sc = aiImportFileExWithProperties(path, flags, NULL, props);
     aiReleasePropertyStore(props);
     if (!sc) {
@@ -306,13 +335,16 @@ const render_mesh* render_mesh_get(render_mesh_cache* c, const char* file, int u
     memset(e, 0, sizeof *e);
     snprintf(e->key, sizeof e->key, "%s", key);
     char path[1024];
-    if (file[0] == '/' || !c->dir[0]) snprintf(path, sizeof path, "%s", file);
-    else snprintf(path, sizeof path, "%s/%s", c->dir, file);
+    if (file[0] == '/' || !c->dir[0])
+        snprintf(path, sizeof path, "%s", file);
+    else
+        snprintf(path, sizeof path, "%s/%s", c->dir, file);
     char why[256] = "";
     e->ok = load_file(path, up, &e->mesh, why, sizeof why);
     if (!e->ok) {
         ++c->warnings;
-        fprintf(stderr, "render: warning: mesh %s: %s; drawing its primitive shape instead\n", path, why);
+        fprintf(stderr, "render: warning: mesh %s: %s; drawing its primitive shape instead\n", path,
+                why);
         return NULL;
     }
     return &e->mesh;

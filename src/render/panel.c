@@ -26,7 +26,8 @@ int panel_add_param(panel* p, const panel_param_def* d) {
     if (!p || !d || !d->value || !d->label || !d->label[0] || !(d->min <= d->max)) return -1;
     const char* group = d->group && d->group[0] ? d->group : "general";
     for (int i = 0; i < p->nparam; ++i)
-        if (strcmp(p->param[i].label, d->label) == 0 && strcmp(p->param[i].group, group) == 0) return -1;
+        if (strcmp(p->param[i].label, d->label) == 0 && strcmp(p->param[i].group, group) == 0)
+            return -1;
     if (p->nparam == p->capparam) {
         int nc = p->capparam ? 2 * p->capparam : 32;
         panel_param* np = realloc(p->param, (size_t)nc * sizeof *np);
@@ -111,8 +112,8 @@ panel_status panel_set_id(panel* p, int id, double value, char* msg, size_t msgs
         return PANEL_NOT_FINITE;
     }
     if (value < q->min || value > q->max) {
-        snprintf(text, sizeof text, "panel: %s/%s: %g %s is outside [%g, %g] %s; unchanged", q->group, q->label,
-                 value, q->unit, q->min, q->max, q->unit);
+        snprintf(text, sizeof text, "panel: %s/%s: %g %s is outside [%g, %g] %s; unchanged",
+                 q->group, q->label, value, q->unit, q->min, q->max, q->unit);
         say(p, msg, msgsz, text);
         return PANEL_OUT_OF_RANGE;
     }
@@ -132,7 +133,9 @@ panel_status panel_set(panel* p, const char* label, double value, char* msg, siz
     int id = find(p, label, &amb);
     if (id < 0) {
         char text[sizeof p->last_error];
-        snprintf(text, sizeof text, amb ? "panel: \"%s\" is in several groups; say \"group/%s\"" : "panel: no parameter \"%s\"",
+        snprintf(text, sizeof text,
+                 amb ? "panel: \"%s\" is in several groups; say \"group/%s\""
+                     : "panel: no parameter \"%s\"",
                  label ? label : "(null)", label ? label : "");
         say(p, msg, msgsz, text);
         return amb ? PANEL_AMBIGUOUS : PANEL_NOT_FOUND;
@@ -178,18 +181,30 @@ bool panel_run_action(panel* p, const char* label) {
     return false;
 }
 
-int panel_count(const panel* p) { return p ? p->nparam : 0; }
-const char* panel_label(const panel* p, int id) { return p && id >= 0 && id < p->nparam ? p->param[id].label : NULL; }
-const char* panel_group(const panel* p, int id) { return p && id >= 0 && id < p->nparam ? p->param[id].group : NULL; }
-const char* panel_unit(const panel* p, int id) { return p && id >= 0 && id < p->nparam ? p->param[id].unit : NULL; }
+int panel_count(const panel* p) {
+    return p ? p->nparam : 0;
+}
+const char* panel_label(const panel* p, int id) {
+    return p && id >= 0 && id < p->nparam ? p->param[id].label : NULL;
+}
+const char* panel_group(const panel* p, int id) {
+    return p && id >= 0 && id < p->nparam ? p->param[id].group : NULL;
+}
+const char* panel_unit(const panel* p, int id) {
+    return p && id >= 0 && id < p->nparam ? p->param[id].unit : NULL;
+}
 void panel_range(const panel* p, int id, double* min, double* max, double* step) {
     if (!p || id < 0 || id >= p->nparam) return;
     if (min) *min = p->param[id].min;
     if (max) *max = p->param[id].max;
     if (step) *step = p->param[id].step;
 }
-int panel_action_count(const panel* p) { return p ? p->naction : 0; }
+int panel_action_count(const panel* p) {
+    return p ? p->naction : 0;
+}
 const char* panel_action_label(const panel* p, int id) {
     return p && id >= 0 && id < p->naction ? p->action[id].label : NULL;
 }
-const char* panel_last_error(const panel* p) { return p ? p->last_error : ""; }
+const char* panel_last_error(const panel* p) {
+    return p ? p->last_error : "";
+}

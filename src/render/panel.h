@@ -24,21 +24,21 @@ struct SDL_Window;
 union SDL_Event;
 
 typedef struct panel_param_def {
-    const char* label;   ///< unique within its group, e.g. "bore"
-    const char* group;   ///< e.g. "lift cylinder"; NULL = "general"
-    const char* unit;    ///< display unit, e.g. "m", "kg", "MPa"
-    double* value;       ///< the app's variable, edited in place
-    double min, max;     ///< accepted range, inclusive (same units as *value)
-    double step;         ///< widget step, 0 = range/100
+    const char* label; ///< unique within its group, e.g. "bore"
+    const char* group; ///< e.g. "lift cylinder"; NULL = "general"
+    const char* unit;  ///< display unit, e.g. "m", "kg", "MPa"
+    double* value;     ///< the app's variable, edited in place
+    double min, max;   ///< accepted range, inclusive (same units as *value)
+    double step;       ///< widget step, 0 = range/100
 } panel_param_def;
 
 /// Result of panel_set().
 typedef enum panel_status {
     PANEL_OK = 0,
-    PANEL_NOT_FOUND = -1,   ///< no parameter with that label
-    PANEL_OUT_OF_RANGE = -2,///< value outside [min, max]; nothing changed
-    PANEL_NOT_FINITE = -3,  ///< NaN or infinity; nothing changed
-    PANEL_AMBIGUOUS = -4    ///< label used in several groups; use "group/label"
+    PANEL_NOT_FOUND = -1,    ///< no parameter with that label
+    PANEL_OUT_OF_RANGE = -2, ///< value outside [min, max]; nothing changed
+    PANEL_NOT_FINITE = -3,   ///< NaN or infinity; nothing changed
+    PANEL_AMBIGUOUS = -4     ///< label used in several groups; use "group/label"
 } panel_status;
 
 typedef void (*panel_change_fn)(void* user, int id, const char* label, double value);

@@ -17,7 +17,9 @@
 
 namespace {
 
-ImGuiContext* ctx_of(panel* p) { return static_cast<ImGuiContext*>(p->imgui_ctx); }
+ImGuiContext* ctx_of(panel* p) {
+    return static_cast<ImGuiContext*>(p->imgui_ctx);
+}
 
 /// Slider format showing the unit; a literal '%' must be doubled.
 void unit_format(char* out, size_t n, const char* unit) {
@@ -45,7 +47,7 @@ void draw_group(panel* p, const char* group) {
     }
 }
 
-}  // namespace
+} // namespace
 
 extern "C" bool panel_gui_init(panel* p, SDL_Window* win, void* gl_context) {
     if (!p || !win) return false;
@@ -53,10 +55,11 @@ extern "C" bool panel_gui_init(panel* p, SDL_Window* win, void* gl_context) {
     ImGuiContext* ctx = ImGui::CreateContext();
     ImGui::SetCurrentContext(ctx);
     ImGuiIO& io = ImGui::GetIO();
-    io.IniFilename = nullptr;  // no imgui.ini littering the working directory
+    io.IniFilename = nullptr; // no imgui.ini littering the working directory
     ImGui::StyleColorsDark();
     ImGui::GetStyle().Alpha = 0.92f;
-    bool ok = ImGui_ImplSDL2_InitForOpenGL(win, gl_context) && ImGui_ImplOpenGL3_Init("#version 330 core");
+    bool ok = ImGui_ImplSDL2_InitForOpenGL(win, gl_context) &&
+              ImGui_ImplOpenGL3_Init("#version 330 core");
     if (!ok) {
         ImGui::DestroyContext(ctx);
         ImGui::SetCurrentContext(prev);
@@ -117,11 +120,14 @@ extern "C" void panel_gui_draw(panel* p) {
         // Groups in the order they were first registered.
         for (int i = 0; i < p->nparam; ++i) {
             bool first = true;
-            for (int j = 0; j < i && first; ++j) first = std::strcmp(p->param[j].group, p->param[i].group) != 0;
+            for (int j = 0; j < i && first; ++j)
+                first = std::strcmp(p->param[j].group, p->param[i].group) != 0;
             if (!first) continue;
-            if (ImGui::CollapsingHeader(p->param[i].group, ImGuiTreeNodeFlags_DefaultOpen)) draw_group(p, p->param[i].group);
+            if (ImGui::CollapsingHeader(p->param[i].group, ImGuiTreeNodeFlags_DefaultOpen))
+                draw_group(p, p->param[i].group);
         }
-        if (p->last_error[0]) ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "%s", p->last_error);
+        if (p->last_error[0])
+            ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "%s", p->last_error);
         ImGui::End();
     }
     ImGui::Render();

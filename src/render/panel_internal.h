@@ -31,7 +31,7 @@ struct panel {
     void* on_change_user;
     char last_error[256];
     bool visible;
-    void* imgui_ctx;      ///< ImGuiContext*, owned by panel_imgui.cpp
+    void* imgui_ctx; ///< ImGuiContext*, owned by panel_imgui.cpp
 };
 
 #ifdef __cplusplus

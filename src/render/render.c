@@ -18,8 +18,8 @@ render_config render_default_config(void) {
     c.height = 720;
     c.offscreen = false;
     c.vsync = true;
-    c.msaa = 0;            // llvmpipe pays ~2x per sample; see docs/render.md
-    c.shadow_size = 1024;  // 2048 costs ~6 ms more per frame on llvmpipe
+    c.msaa = 0;           // llvmpipe pays ~2x per sample; see docs/render.md
+    c.shadow_size = 1024; // 2048 costs ~6 ms more per frame on llvmpipe
     c.title = "cranesim";
     c.asset_dir = CRANESIM_ASSETS "/meshes";
     c.p_full_scale = 30e6;
@@ -78,7 +78,8 @@ void render_destroy(render* r) {
 
 bool render_handle_event(render* r, const SDL_Event* ev) {
     if (r->panel_gui && panel_gui_event(r->panel, ev)) return true;
-    if (ev->type == SDL_WINDOWEVENT && ev->window.event == SDL_WINDOWEVENT_SIZE_CHANGED && !r->cfg.offscreen) {
+    if (ev->type == SDL_WINDOWEVENT && ev->window.event == SDL_WINDOWEVENT_SIZE_CHANGED &&
+        !r->cfg.offscreen) {
         int w, h;
         SDL_GL_GetDrawableSize(r->win, &w, &h);
         render_targets_resize(r, w, h);
@@ -108,11 +109,14 @@ void render_frame(render* r, const world_snapshot* snap) {
     render_hud_flush(&r->hud);
     if (r->panel_gui) panel_gui_draw(r->panel);
 
-    // Smoothed frame rate from the wall time between frames.
+    // Frame rate from the smoothed wall time between frames. Average the
+    // interval, not its inverse: frames that only queue work in the driver
+    // alternate with frames that wait, and 1/dt would overweight the short ones.
     Uint64 now = SDL_GetPerformanceCounter();
     if (r->last_frame_ticks) {
         double dt = (double)(now - r->last_frame_ticks) / (double)SDL_GetPerformanceFrequency();
-        if (dt > 0) r->fps_avg = r->fps_avg > 0 ? 0.9 * r->fps_avg + 0.1 / dt : 1.0 / dt;
+        r->frame_dt_avg = r->frame_dt_avg > 0 ? 0.95 * r->frame_dt_avg + 0.05 * dt : dt;
+        r->fps_avg = r->frame_dt_avg > 0 ? 1.0 / r->frame_dt_avg : 0;
     }
     r->last_frame_ticks = now;
     r->have_frame = true;
@@ -120,7 +124,8 @@ void render_frame(render* r, const world_snapshot* snap) {
     r->stats.draw_calls = r->scene.draw_calls + 2;
     r->stats.mesh_warnings = r->meshes.warnings;
     r->stats.meshes_loaded = r->meshes.n - r->meshes.warnings;
-    r->stats.frame_ms = 1e3 * (double)(SDL_GetPerformanceCounter() - t0) / (double)SDL_GetPerformanceFrequency();
+    r->stats.frame_ms =
+        1e3 * (double)(SDL_GetPerformanceCounter() - t0) / (double)SDL_GetPerformanceFrequency();
 }
 
 void render_present(render* r) {
@@ -142,7 +147,9 @@ void render_set_camera_preset(render* r, render_cam_preset p) {
     if (p == RENDER_CAM_ORBIT) r->cam.target_set = false;
 }
 
-render_cam_preset render_get_camera_preset(const render* r) { return r->cam.preset; }
+render_cam_preset render_get_camera_preset(const render* r) {
+    return r->cam.preset;
+}
 
 void render_set_orbit(render* r, const double target[3], double yaw, double pitch, double dist) {
     r->cam.preset = RENDER_CAM_ORBIT;
@@ -174,8 +181,12 @@ void render_size(const render* r, int* w, int* h) {
     if (h) *h = r->h;
 }
 
-render_stats render_get_stats(const render* r) { return r->stats; }
-SDL_Window* render_window(render* r) { return r->win; }
+render_stats render_get_stats(const render* r) {
+    return r->stats;
+}
+SDL_Window* render_window(render* r) {
+    return r->win;
+}
 
 bool render_attach_panel(render* r, panel* p) {
     if (r->panel_gui) panel_gui_shutdown(r->panel);
@@ -191,4 +202,6 @@ void render_set_status(render* r, const char* text) {
     snprintf(r->status, sizeof r->status, "%s", text ? text : "");
 }
 
-void render_set_missed_deadlines(render* r, int missed) { r->missed_deadlines = missed; }
+void render_set_missed_deadlines(render* r, int missed) {
+    r->missed_deadlines = missed;
+}

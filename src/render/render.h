@@ -41,33 +41,33 @@ typedef struct panel panel;
 
 /// Camera presets (also selectable with F1..F4 through input.h).
 typedef enum render_cam_preset {
-    RENDER_CAM_ORBIT = 0,  ///< free orbit around the crane, mouse driven
-    RENDER_CAM_OPERATOR,   ///< operator standing at the column, looking at the tip
-    RENDER_CAM_SIDE,       ///< side view across the boom plane
-    RENDER_CAM_FOLLOW_HOOK,///< orbit centred on the hook, follows it
+    RENDER_CAM_ORBIT = 0,   ///< free orbit around the crane, mouse driven
+    RENDER_CAM_OPERATOR,    ///< operator standing at the column, looking at the tip
+    RENDER_CAM_SIDE,        ///< side view across the boom plane
+    RENDER_CAM_FOLLOW_HOOK, ///< orbit centred on the hook, follows it
     RENDER_CAM_COUNT
 } render_cam_preset;
 
 typedef struct render_config {
-    int width, height;       ///< window or FBO size [px], default 1280 x 720
-    bool offscreen;          ///< render into an FBO, no visible window (tests, batch PNGs)
-    bool vsync;              ///< window mode only
-    int msaa;                ///< multisample count for the scene (0 = off, 4 typical)
-    int shadow_size;         ///< shadow map edge [texels], default 1024
-    const char* title;       ///< window title
-    const char* asset_dir;   ///< directory for relative mesh names, default CRANESIM_ASSETS "/meshes"
-    double p_full_scale;     ///< pressure at full bar height [Pa], default 30 MPa
-    double chart_seconds;    ///< strip-chart time window [s], default 10
-    bool hud;                ///< draw HUD text, bars and warnings (default true)
+    int width, height;     ///< window or FBO size [px], default 1280 x 720
+    bool offscreen;        ///< render into an FBO, no visible window (tests, batch PNGs)
+    bool vsync;            ///< window mode only
+    int msaa;              ///< multisample count for the scene (0 = off, 4 typical)
+    int shadow_size;       ///< shadow map edge [texels], default 1024
+    const char* title;     ///< window title
+    const char* asset_dir; ///< directory for relative mesh names, default CRANESIM_ASSETS "/meshes"
+    double p_full_scale;   ///< pressure at full bar height [Pa], default 30 MPa
+    double chart_seconds;  ///< strip-chart time window [s], default 10
+    bool hud;              ///< draw HUD text, bars and warnings (default true)
 } render_config;
 
 /// Counters from the last frame, for the report line and for tests.
 typedef struct render_stats {
-    long triangles;          ///< triangles submitted in the main pass
-    int draw_calls;          ///< main pass + shadow pass + HUD
-    int mesh_warnings;       ///< meshes that failed to load (primitive used instead)
-    int meshes_loaded;       ///< distinct meshes in the cache
-    double frame_ms;         ///< CPU time spent in render_frame [ms]
+    long triangles;    ///< triangles submitted in the main pass
+    int draw_calls;    ///< main pass + shadow pass + HUD
+    int mesh_warnings; ///< meshes that failed to load (primitive used instead)
+    int meshes_loaded; ///< distinct meshes in the cache
+    double frame_ms;   ///< CPU time spent in render_frame [ms]
 } render_stats;
 
 /// Filled-in defaults; change only what differs.
@@ -134,12 +134,12 @@ void render_set_missed_deadlines(render* r, int missed_last_second);
 
 /// One scrolling time history. Samples outside [ymin, ymax] are clipped.
 typedef struct render_chart_def {
-    const char* label;   ///< e.g. "p1A"
-    const char* unit;    ///< display unit, e.g. "MPa"
-    double scale;        ///< SI value * scale = displayed value (1e-6 for Pa -> MPa)
-    double ymin, ymax;   ///< displayed range, in display units
-    float rgba[4];       ///< line colour
-    int group;           ///< charts with the same group share one plot box
+    const char* label; ///< e.g. "p1A"
+    const char* unit;  ///< display unit, e.g. "MPa"
+    double scale;      ///< SI value * scale = displayed value (1e-6 for Pa -> MPa)
+    double ymin, ymax; ///< displayed range, in display units
+    float rgba[4];     ///< line colour
+    int group;         ///< charts with the same group share one plot box
 } render_chart_def;
 
 /// Add a chart channel; returns its id (>= 0) or -1 when full.
@@ -158,9 +158,9 @@ void render_charts_sample(render* r, const world_snapshot* snap);
 
 /// Parameters of the synthetic crane scene used by render_demo and tests.
 typedef struct render_demo_params {
-    double slew;         ///< column slew [rad]
-    double q1_deg;       ///< lifting-arm elevation above horizontal [deg]
-    double q2_deg;       ///< end-arm angle relative to the lifting arm [deg] (negative = folded down)
+    double slew;   ///< column slew [rad]
+    double q1_deg; ///< lifting-arm elevation above horizontal [deg]
+    double q2_deg; ///< end-arm angle relative to the lifting arm [deg] (negative = folded down)
     double pA[2], pB[2]; ///< chamber pressures of lift and jib cylinder [Pa]
     double u[2];         ///< spool openings -1..1
     bool terrain;        ///< use a gentle heightfield instead of flat ground

@@ -23,7 +23,9 @@ static int cmp_double(const void* a, const void* b) {
     return x < y ? -1 : x > y;
 }
 
-static void noop(void* user) { (void)user; }
+static void noop(void* user) {
+    (void)user;
+}
 
 int main(int argc, char** argv) {
     const char* out = "render_demo.png";
@@ -33,20 +35,31 @@ int main(int argc, char** argv) {
     render_demo_params dp = render_demo_default_params();
     bool want_panel = false;
     for (int i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--frames") && i + 1 < argc) frames = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--size") && i + 1 < argc) sscanf(argv[++i], "%dx%d", &cfg.width, &cfg.height);
-        else if (!strcmp(argv[i], "--shadow") && i + 1 < argc) cfg.shadow_size = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--msaa") && i + 1 < argc) cfg.msaa = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--primitives")) dp.use_meshes = false;
-        else if (!strcmp(argv[i], "--terrain")) dp.terrain = true;
-        else if (!strcmp(argv[i], "--no-hud")) cfg.hud = false;
-        else if (!strcmp(argv[i], "--panel")) want_panel = true;
-        else if (!strcmp(argv[i], "--window")) cfg.offscreen = false, cfg.vsync = false;
+        if (!strcmp(argv[i], "--frames") && i + 1 < argc)
+            frames = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--size") && i + 1 < argc)
+            sscanf(argv[++i], "%dx%d", &cfg.width, &cfg.height);
+        else if (!strcmp(argv[i], "--shadow") && i + 1 < argc)
+            cfg.shadow_size = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--msaa") && i + 1 < argc)
+            cfg.msaa = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--primitives"))
+            dp.use_meshes = false;
+        else if (!strcmp(argv[i], "--terrain"))
+            dp.terrain = true;
+        else if (!strcmp(argv[i], "--no-hud"))
+            cfg.hud = false;
+        else if (!strcmp(argv[i], "--panel"))
+            want_panel = true;
+        else if (!strcmp(argv[i], "--window"))
+            cfg.offscreen = false, cfg.vsync = false;
         else if (!strcmp(argv[i], "--help")) {
-            printf("usage: render_demo [out.png] [--frames N] [--size WxH] [--shadow N] [--msaa N]\n"
-                   "                   [--primitives] [--terrain] [--no-hud] [--panel] [--window]\n");
+            printf(
+                "usage: render_demo [out.png] [--frames N] [--size WxH] [--shadow N] [--msaa N]\n"
+                "                   [--primitives] [--terrain] [--no-hud] [--panel] [--window]\n");
             return 0;
-        } else if (argv[i][0] != '-') out = argv[i];
+        } else if (argv[i][0] != '-')
+            out = argv[i];
         else {
             fprintf(stderr, "render_demo: unknown option %s\n", argv[i]);
             return 2;
@@ -101,19 +114,22 @@ int main(int argc, char** argv) {
         Uint64 t0 = SDL_GetPerformanceCounter();
         render_frame(r, &snap);
         render_present(r);
-        ms[f] = 1e3 * (double)(SDL_GetPerformanceCounter() - t0) / (double)SDL_GetPerformanceFrequency();
+        ms[f] = 1e3 * (double)(SDL_GetPerformanceCounter() - t0) /
+                (double)SDL_GetPerformanceFrequency();
     }
     double cpu_ms = 1e3 * (double)(clock() - c0) / CLOCKS_PER_SEC / frames;
     // Throughput: frames may overlap in the driver, so total time / frames
     // is the honest frame rate; the median per-frame time is shown too.
-    double avg_ms = 1e3 * (double)(SDL_GetPerformanceCounter() - w0) / (double)SDL_GetPerformanceFrequency() / frames;
+    double avg_ms = 1e3 * (double)(SDL_GetPerformanceCounter() - w0) /
+                    (double)SDL_GetPerformanceFrequency() / frames;
     render_stats st = render_get_stats(r);
     qsort(ms, (size_t)frames, sizeof *ms, cmp_double);
     double med = ms[frames / 2];
-    printf("render_demo: %dx%d, %d frames, %.2f ms/frame = %.1f fps (median frame %.2f ms), CPU %.2f ms/frame, "
+    printf("render_demo: %dx%d, %d frames, %.2f ms/frame = %.1f fps (median frame %.2f ms), CPU "
+           "%.2f ms/frame, "
            "triangles %ld, draw calls %d, mesh warnings %d\n",
-           cfg.width, cfg.height, frames, avg_ms, 1e3 / avg_ms, med, cpu_ms, st.triangles, st.draw_calls,
-           st.mesh_warnings);
+           cfg.width, cfg.height, frames, avg_ms, 1e3 / avg_ms, med, cpu_ms, st.triangles,
+           st.draw_calls, st.mesh_warnings);
     free(ms);
     int rc = render_screenshot(r, out) == 0 ? 0 : 1;
     if (!rc) printf("render_demo: wrote %s\n", out);

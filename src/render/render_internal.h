@@ -30,7 +30,8 @@ typedef struct render_vertex {
 
 typedef struct render_mesh {
     GLuint vao, vbo, ibo;
-    int nidx;           ///< index count (triangles * 3)
+    int nidx;  ///< index count (triangles * 3)
+    bool cull; ///< winding agrees with the normals everywhere: back faces may be culled
     float bmin[3], bmax[3];
 } render_mesh;
 
@@ -41,11 +42,11 @@ void render_mesh_draw(const render_mesh* m);
 
 /// Built-in primitives, all unit sized so a model matrix scales them.
 typedef enum render_prim {
-    RENDER_PRIM_BOX = 0,     ///< -0.5..0.5 on every axis
-    RENDER_PRIM_CYLINDER,    ///< radius 1, z from -0.5 to 0.5
-    RENDER_PRIM_SPHERE,      ///< radius 1
-    RENDER_PRIM_HEMISPHERE,  ///< radius 1, z >= 0 (capsule ends)
-    RENDER_PRIM_TUBE_X,      ///< radius 1, x from 0 to 1 (cylinder barrel/rod fallback)
+    RENDER_PRIM_BOX = 0,    ///< -0.5..0.5 on every axis
+    RENDER_PRIM_CYLINDER,   ///< radius 1, z from -0.5 to 0.5
+    RENDER_PRIM_SPHERE,     ///< radius 1
+    RENDER_PRIM_HEMISPHERE, ///< radius 1, z >= 0 (capsule ends)
+    RENDER_PRIM_TUBE_X,     ///< radius 1, x from 0 to 1 (cylinder barrel/rod fallback)
     RENDER_PRIM_COUNT
 } render_prim;
 
@@ -61,8 +62,8 @@ typedef struct render_mesh_entry {
 typedef struct render_mesh_cache {
     render_mesh_entry* e;
     int n, cap;
-    int warnings;        ///< files that failed (each warned once on stderr)
-    char dir[512];       ///< asset dir for relative names
+    int warnings;  ///< files that failed (each warned once on stderr)
+    char dir[512]; ///< asset dir for relative names
 } render_mesh_cache;
 
 /// Find or load a mesh file (relative to the asset dir, or absolute).
@@ -75,12 +76,12 @@ void render_mesh_cache_free(render_mesh_cache* c);
 
 typedef struct render_camera {
     render_cam_preset preset;
-    rm_vec3 target;          ///< orbit centre [m]
-    float yaw, pitch, dist;  ///< orbit angles [rad] and distance [m]
-    float fovy;              ///< vertical field of view [rad]
+    rm_vec3 target;         ///< orbit centre [m]
+    float yaw, pitch, dist; ///< orbit angles [rad] and distance [m]
+    float fovy;             ///< vertical field of view [rad]
     bool dragging_orbit, dragging_pan;
-    bool target_set;         ///< orbit target chosen by user / set_orbit
-    rm_vec3 eye, at;         ///< resolved this frame
+    bool target_set; ///< orbit target chosen by user / set_orbit
+    rm_vec3 eye, at; ///< resolved this frame
     float view[16], proj[16], viewproj[16];
 } render_camera;
 
@@ -94,8 +95,8 @@ bool render_camera_event(render_camera* c, const SDL_Event* ev);
 typedef struct render_shadow {
     GLuint fbo, tex;
     int size;
-    float light_vp[16];      ///< world -> light clip
-    rm_vec3 light_dir;       ///< unit vector toward the sun
+    float light_vp[16]; ///< world -> light clip
+    rm_vec3 light_dir;  ///< unit vector toward the sun
 } render_shadow;
 
 bool render_shadow_create(render_shadow* s, int size);
@@ -118,8 +119,8 @@ typedef struct render_scene {
     GLint us_top, us_bottom;
     GLuint sky_vao;
     render_mesh prim[RENDER_PRIM_COUNT];
-    render_mesh ground;          ///< flat ground quad
-    render_mesh terrain;         ///< heightfield, rebuilt when the source changes
+    render_mesh ground;  ///< flat ground quad
+    render_mesh terrain; ///< heightfield, rebuilt when the source changes
     const float* terrain_src;
     int terrain_nx, terrain_ny;
     double terrain_dx, terrain_dy;
@@ -145,13 +146,13 @@ typedef struct render_hud_vertex {
 
 typedef struct render_hud {
     GLuint prog, vao, vbo;
-    size_t vbo_bytes;            ///< allocated size of vbo
+    size_t vbo_bytes; ///< allocated size of vbo
     GLint u_screen;
     render_hud_vertex* tri;
     int ntri, captri;
     render_hud_vertex* line;
     int nline, capline;
-    char* font_scratch;          ///< stb_easy_font output, allocated once
+    char* font_scratch; ///< stb_easy_font output, allocated once
     int font_scratch_size;
     int w, h;
     int bar_rect[WORLD_SNAP_MAX_CYLINDERS][2][4]; ///< last frame's bar frames, x y w h [px]
@@ -164,7 +165,8 @@ void render_hud_begin(render_hud* h, int w, int h_px);
 void render_hud_rect(render_hud* h, float x, float y, float w, float hh, const float rgba[4]);
 void render_hud_line(render_hud* h, float x0, float y0, float x1, float y1, const float rgba[4]);
 /// Text with stb_easy_font at an integer-ish scale; returns the width [px].
-float render_hud_text(render_hud* h, float x, float y, float scale, const float rgba[4], const char* s);
+float render_hud_text(render_hud* h, float x, float y, float scale, const float rgba[4],
+                      const char* s);
 float render_hud_text_width(const char* s, float scale);
 void render_hud_flush(render_hud* h);
 
@@ -180,16 +182,16 @@ typedef struct render_chart {
     render_chart_def def;
     char label[32], unit[16];
     double t[RENDER_CHART_CAP];
-    float v[RENDER_CHART_CAP];   ///< display units
-    int head, count;             ///< ring buffer: next write index, valid samples
+    float v[RENDER_CHART_CAP]; ///< display units
+    int head, count;           ///< ring buffer: next write index, valid samples
 } render_chart;
 
 typedef struct render_charts {
     render_chart ch[RENDER_MAX_CHARTS];
     int n;
-    double window;               ///< seconds shown
-    int std_ncyl;                ///< cylinders registered by render_charts_default, 0 = none
-    int std_first;               ///< id of the first standard channel
+    double window; ///< seconds shown
+    int std_ncyl;  ///< cylinders registered by render_charts_default, 0 = none
+    int std_first; ///< id of the first standard channel
 } render_charts;
 
 void render_charts_draw(render_hud* h, const render_charts* c, float x, float y, float w, float hh);
@@ -202,10 +204,10 @@ struct render {
     char title[128];
     SDL_Window* win;
     SDL_GLContext gl;
-    bool own_video;              ///< we initialised SDL video, so we quit it
-    int w, h;                    ///< framebuffer size [px]
-    GLuint fbo, fbo_color, fbo_depth;      ///< the frame (resolved, single-sample), also in a window
-    GLuint msfbo, ms_color, ms_depth;      ///< multisampled scene target, 0 if msaa off
+    bool own_video;                   ///< we initialised SDL video, so we quit it
+    int w, h;                         ///< framebuffer size [px]
+    GLuint fbo, fbo_color, fbo_depth; ///< the frame (resolved, single-sample), also in a window
+    GLuint msfbo, ms_color, ms_depth; ///< multisampled scene target, 0 if msaa off
     render_camera cam;
     render_shadow shadow;
     render_scene scene;
@@ -218,7 +220,8 @@ struct render {
     char status[128];
     int missed_deadlines;
     bool have_frame;
-    double fps_avg;              ///< smoothed frame rate for the HUD [1/s]
+    double frame_dt_avg; ///< smoothed wall time between frames [s]
+    double fps_avg;      ///< 1 / frame_dt_avg, shown in the HUD [1/s]
     Uint64 last_frame_ticks;
 };
 

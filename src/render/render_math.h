@@ -24,14 +24,24 @@ static inline rm_vec3 rm_v3(float x, float y, float z) {
     rm_vec3 v = {x, y, z};
     return v;
 }
-static inline rm_vec3 rm_add(rm_vec3 a, rm_vec3 b) { return rm_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
-static inline rm_vec3 rm_sub(rm_vec3 a, rm_vec3 b) { return rm_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
-static inline rm_vec3 rm_scale(rm_vec3 a, float s) { return rm_v3(a.x * s, a.y * s, a.z * s); }
-static inline float rm_dot(rm_vec3 a, rm_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline rm_vec3 rm_add(rm_vec3 a, rm_vec3 b) {
+    return rm_v3(a.x + b.x, a.y + b.y, a.z + b.z);
+}
+static inline rm_vec3 rm_sub(rm_vec3 a, rm_vec3 b) {
+    return rm_v3(a.x - b.x, a.y - b.y, a.z - b.z);
+}
+static inline rm_vec3 rm_scale(rm_vec3 a, float s) {
+    return rm_v3(a.x * s, a.y * s, a.z * s);
+}
+static inline float rm_dot(rm_vec3 a, rm_vec3 b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 static inline rm_vec3 rm_cross(rm_vec3 a, rm_vec3 b) {
     return rm_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
-static inline float rm_len(rm_vec3 a) { return sqrtf(rm_dot(a, a)); }
+static inline float rm_len(rm_vec3 a) {
+    return sqrtf(rm_dot(a, a));
+}
 static inline rm_vec3 rm_norm(rm_vec3 a) {
     float l = rm_len(a);
     return l > 1e-12f ? rm_scale(a, 1.0f / l) : rm_v3(0, 0, 1);
@@ -47,14 +57,16 @@ static inline void rm_mul(float out[16], const float a[16], const float b[16]) {
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) {
             float s = 0;
-            for (int k = 0; k < 4; ++k) s += a[k * 4 + r] * b[c * 4 + k];
+            for (int k = 0; k < 4; ++k)
+                s += a[k * 4 + r] * b[c * 4 + k];
             out[c * 4 + r] = s;
         }
 }
 
 /// Transform a point (w = 1) and return clip coordinates in out[4].
 static inline void rm_xform4(float out[4], const float m[16], float x, float y, float z) {
-    for (int r = 0; r < 4; ++r) out[r] = m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r];
+    for (int r = 0; r < 4; ++r)
+        out[r] = m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r];
 }
 
 /// Right-handed look-at view matrix (camera looks down its -z).
@@ -96,10 +108,12 @@ static inline void rm_ortho(float m[16], float l, float r, float b, float t, flo
 
 /// Model matrix from a row-major 3x3 rotation (as in world_snapshot), a
 /// per-axis scale applied first, and a translation.
-static inline void rm_model(float m[16], const double rot[9], const float scale[3], const double pos[3]) {
+static inline void rm_model(float m[16], const double rot[9], const float scale[3],
+                            const double pos[3]) {
     rm_identity(m);
     for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) m[c * 4 + r] = (float)rot[r * 3 + c] * scale[c];
+        for (int r = 0; r < 3; ++r)
+            m[c * 4 + r] = (float)rot[r * 3 + c] * scale[c];
     m[12] = (float)pos[0];
     m[13] = (float)pos[1];
     m[14] = (float)pos[2];

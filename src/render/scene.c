@@ -17,7 +17,7 @@ typedef struct render_draw_item {
     render_mesh mesh;
     float model[16];
     float rgba[4];
-    float depth;        ///< squared distance from the eye, for sorting
+    float depth; ///< squared distance from the eye, for sorting
     bool casts_shadow;
 } render_draw_item;
 
@@ -28,37 +28,36 @@ static int nearer_first(const void* a, const void* b) {
 
 // ---- shaders ---------------------------------------------------------------
 
-static const char* k_scene_vs =
-    "#version 330 core\n"
-    "layout(location = 0) in vec3 a_pos;\n"
-    "layout(location = 1) in vec3 a_nrm;\n"
-    "layout(location = 2) in vec3 a_tint;\n"
-    "uniform mat4 u_model;\n"
-    "uniform mat3 u_normal;\n"
-    "uniform mat4 u_vp;\n"
-    "uniform mat4 u_light_vp;\n"
-    "uniform vec3 u_light_dir;\n"
-    "uniform vec3 u_eye;\n"
-    "out vec3 v_half;\n"
+static const char* k_scene_vs = "#version 330 core\n"
+                                "layout(location = 0) in vec3 a_pos;\n"
+                                "layout(location = 1) in vec3 a_nrm;\n"
+                                "layout(location = 2) in vec3 a_tint;\n"
+                                "uniform mat4 u_model;\n"
+                                "uniform mat3 u_normal;\n"
+                                "uniform mat4 u_vp;\n"
+                                "uniform mat4 u_light_vp;\n"
+                                "uniform vec3 u_light_dir;\n"
+                                "uniform vec3 u_eye;\n"
+                                "out vec3 v_half;\n"
 
-    "out vec3 v_world;\n"
-    "out vec3 v_nrm;\n"
-    "out vec3 v_tint;\n"
-    "out vec4 v_lightpos;\n"
-    "void main() {\n"
-    "    vec4 w = u_model * vec4(a_pos, 1.0);\n"
-    "    v_world = w.xyz;\n"
-    "    v_nrm = u_normal * a_nrm;\n"
-    "    v_tint = a_tint;\n"
-    "    v_lightpos = u_light_vp * w;\n"
-    // Per-vertex terms: interpolating them is close enough and saves
-    // per-pixel work, which is what llvmpipe pays for.
-    "    vec3 to_eye = u_eye - w.xyz;\n"
-    "    float d = length(to_eye);\n"
-    "    v_half = normalize(u_light_dir + to_eye / d);\n"
+                                "out vec3 v_world;\n"
+                                "out vec3 v_nrm;\n"
+                                "out vec3 v_tint;\n"
+                                "out vec4 v_lightpos;\n"
+                                "void main() {\n"
+                                "    vec4 w = u_model * vec4(a_pos, 1.0);\n"
+                                "    v_world = w.xyz;\n"
+                                "    v_nrm = u_normal * a_nrm;\n"
+                                "    v_tint = a_tint;\n"
+                                "    v_lightpos = u_light_vp * w;\n"
+                                // Per-vertex terms: interpolating them is close enough and saves
+                                // per-pixel work, which is what llvmpipe pays for.
+                                "    vec3 to_eye = u_eye - w.xyz;\n"
+                                "    float d = length(to_eye);\n"
+                                "    v_half = normalize(u_light_dir + to_eye / d);\n"
 
-    "    gl_Position = u_vp * w;\n"
-    "}\n";
+                                "    gl_Position = u_vp * w;\n"
+                                "}\n";
 
 // Objects: Lambert + Blinn with a sky/ground hemisphere ambient. Written
 // for llvmpipe, where every ALU op is paid per pixel on the CPU: one shadow
@@ -87,7 +86,8 @@ static const char* k_obj_fs =
     "    float s = max(dot(n, v_half), 0.0);\n"
     "    s *= s; s *= s; s *= s; s *= s; s *= s;\n"
     "    vec3 amb = mix(vec3(0.18, 0.165, 0.15), vec3(0.31, 0.35, 0.41), 0.5 + 0.5 * n.z);\n"
-    "    vec3 c = u_color.rgb * v_tint * (amb + (0.80 * ndl * sh) * vec3(1.0, 0.97, 0.90)) + (0.22 * s * sh);\n"
+    "    vec3 c = u_color.rgb * v_tint * (amb + (0.80 * ndl * sh) * vec3(1.0, 0.97, 0.90)) + (0.22 "
+    "* s * sh);\n"
     "    o_color = vec4(c, u_color.a);\n"
     "}\n";
 
@@ -109,7 +109,8 @@ static const char* k_ground_fs =
     "    float ndl = max(dot(v_nrm, u_light_dir), 0.0);\n"
     "    vec3 q = v_lightpos.xyz * 0.5 + 0.5;\n"
     "    float sh = texture(u_shadow, vec3(q.xy, q.z - 0.002));\n"
-    "    vec3 c = u_color.rgb * (1.0 - line) * (vec3(0.30, 0.33, 0.38) + (0.80 * ndl * sh) * vec3(1.0, 0.97, 0.90));\n"
+    "    vec3 c = u_color.rgb * (1.0 - line) * (vec3(0.30, 0.33, 0.38) + (0.80 * ndl * sh) * "
+    "vec3(1.0, 0.97, 0.90));\n"
     // Haze: a rational stand-in for 1 - exp(-k d), cheaper on llvmpipe.
     "    float kd = 0.0035 * length(u_eye - v_world);\n"
     "    o_color = vec4(mix(c, vec3(0.74, 0.80, 0.88), kd / (1.0 + kd)), 1.0);\n"
@@ -122,9 +123,8 @@ static const char* k_depth_vs =
     "uniform mat4 u_vp;\n"
     "void main() { gl_Position = u_vp * (u_model * vec4(a_pos, 1.0)); }\n";
 
-static const char* k_depth_fs =
-    "#version 330 core\n"
-    "void main() {}\n";
+static const char* k_depth_fs = "#version 330 core\n"
+                                "void main() {}\n";
 
 // Sky: one triangle covering the screen, vertical gradient.
 static const char* k_sky_vs =
@@ -177,7 +177,9 @@ static bool lit_prog(render_lit_prog* p, const char* name, const char* fs) {
 
 bool render_scene_create(render_scene* sc) {
     memset(sc, 0, sizeof *sc);
-    if (!lit_prog(&sc->obj, "objects", k_obj_fs) || !lit_prog(&sc->ground_prog, "ground", k_ground_fs)) return false;
+    if (!lit_prog(&sc->obj, "objects", k_obj_fs) ||
+        !lit_prog(&sc->ground_prog, "ground", k_ground_fs))
+        return false;
     sc->depth_prog = render_shader_build("depth", k_depth_vs, k_depth_fs);
     sc->sky_prog = render_shader_build("sky", k_sky_vs, k_sky_fs);
     if (!sc->depth_prog || !sc->sky_prog) return false;
@@ -189,13 +191,15 @@ bool render_scene_create(render_scene* sc) {
     render_prims_create(sc->prim);
     sc->ground = make_ground();
     // Worst case: a capsule is 3 draws per body, plus cylinders and rope.
-    sc->capitems = 3 * WORLD_SNAP_MAX_BODIES + 2 * WORLD_SNAP_MAX_CYLINDERS + WORLD_SNAP_MAX_ROPE + 4;
+    sc->capitems =
+        3 * WORLD_SNAP_MAX_BODIES + 2 * WORLD_SNAP_MAX_CYLINDERS + WORLD_SNAP_MAX_ROPE + 4;
     sc->items = calloc((size_t)sc->capitems, sizeof *sc->items);
     return sc->items != NULL;
 }
 
 void render_scene_free(render_scene* sc) {
-    for (int i = 0; i < RENDER_PRIM_COUNT; ++i) render_mesh_free(&sc->prim[i]);
+    for (int i = 0; i < RENDER_PRIM_COUNT; ++i)
+        render_mesh_free(&sc->prim[i]);
     render_mesh_free(&sc->ground);
     render_mesh_free(&sc->terrain);
     if (sc->sky_vao) glDeleteVertexArrays(1, &sc->sky_vao);
@@ -213,8 +217,8 @@ void render_scene_free(render_scene* sc) {
 /// grid: the world owns the heights and they do not change during a run.
 static void update_terrain(render_scene* sc, const world_snap_terrain* t) {
     if (t->nx < 2 || t->ny < 2 || !t->height) return;
-    if (sc->terrain.vao && sc->terrain_src == t->height && sc->terrain_nx == t->nx && sc->terrain_ny == t->ny &&
-        sc->terrain_dx == t->dx && sc->terrain_dy == t->dy)
+    if (sc->terrain.vao && sc->terrain_src == t->height && sc->terrain_nx == t->nx &&
+        sc->terrain_ny == t->ny && sc->terrain_dx == t->dx && sc->terrain_dy == t->dy)
         return;
     render_mesh_free(&sc->terrain);
     int nx = t->nx, ny = t->ny;
@@ -235,8 +239,10 @@ static void update_terrain(render_scene* sc, const world_snap_terrain* t) {
             // Central differences (one-sided at the border) for the normal.
             int i0 = i > 0 ? i - 1 : i, i1 = i < nx - 1 ? i + 1 : i;
             int j0 = j > 0 ? j - 1 : j, j1 = j < ny - 1 ? j + 1 : j;
-            float dzdx = (t->height[j * nx + i1] - t->height[j * nx + i0]) / ((float)(i1 - i0) * (float)t->dx);
-            float dzdy = (t->height[j1 * nx + i] - t->height[j0 * nx + i]) / ((float)(j1 - j0) * (float)t->dy);
+            float dzdx = (t->height[j * nx + i1] - t->height[j * nx + i0]) /
+                         ((float)(i1 - i0) * (float)t->dx);
+            float dzdy = (t->height[j1 * nx + i] - t->height[j0 * nx + i]) /
+                         ((float)(j1 - j0) * (float)t->dy);
             rm_vec3 n = rm_norm(rm_v3(-dzdx, -dzdy, 1.0f));
             p->n[0] = n.x, p->n[1] = n.y, p->n[2] = n.z;
             p->c[0] = p->c[1] = p->c[2] = 1.0f;
@@ -281,7 +287,9 @@ static void segment_matrix(float m[16], rm_vec3 a, rm_vec3 b, float radius, floa
     m[12] = a.x, m[13] = a.y, m[14] = a.z;
 }
 
-static rm_vec3 v3d(const double p[3]) { return rm_v3((float)p[0], (float)p[1], (float)p[2]); }
+static rm_vec3 v3d(const double p[3]) {
+    return rm_v3((float)p[0], (float)p[1], (float)p[2]);
+}
 
 static void add_body_items(render_scene* sc, render_mesh_cache* mc, const world_snap_body* b);
 
@@ -292,7 +300,8 @@ static void add_body(render_scene* sc, render_mesh_cache* mc, const world_snap_b
     // Wheels stand in the truck's own shadow and are the densest meshes;
     // leaving them out of the shadow pass halves its vertex work.
     if (b->role == WORLD_ROLE_WHEEL)
-        for (int i = first; i < sc->nitems; ++i) sc->items[i].casts_shadow = false;
+        for (int i = first; i < sc->nitems; ++i)
+            sc->items[i].casts_shadow = false;
 }
 
 static void add_body_items(render_scene* sc, render_mesh_cache* mc, const world_snap_body* b) {
@@ -303,8 +312,8 @@ static void add_body_items(render_scene* sc, render_mesh_cache* mc, const world_
         float sc3[3] = {s, s, s};
         double pos[3];
         for (int r = 0; r < 3; ++r)
-            pos[r] = b->pos[r] + b->rot[r * 3 + 0] * b->mesh_offset[0] + b->rot[r * 3 + 1] * b->mesh_offset[1] +
-                     b->rot[r * 3 + 2] * b->mesh_offset[2];
+            pos[r] = b->pos[r] + b->rot[r * 3 + 0] * b->mesh_offset[0] +
+                     b->rot[r * 3 + 1] * b->mesh_offset[1] + b->rot[r * 3 + 2] * b->mesh_offset[2];
         render_draw_item* it = push_item(sc, mesh, b->rgba);
         if (it) rm_model(it->model, b->rot, sc3, pos);
         return;
@@ -339,7 +348,8 @@ static void add_body_items(render_scene* sc, render_mesh_cache* mc, const world_
             float sgn = end ? 1.0f : -1.0f;
             float e3[3] = {sx, sx, sgn * sx};
             double p[3];
-            for (int r = 0; r < 3; ++r) p[r] = b->pos[r] + b->rot[r * 3 + 2] * sgn * 0.5 * sy;
+            for (int r = 0; r < 3; ++r)
+                p[r] = b->pos[r] + b->rot[r * 3 + 2] * sgn * 0.5 * sy;
             render_draw_item* h = push_item(sc, &sc->prim[RENDER_PRIM_HEMISPHERE], b->rgba);
             if (h) rm_model(h->model, b->rot, e3, p);
         }
@@ -360,13 +370,14 @@ static void add_cylinder(render_scene* sc, render_mesh_cache* mc, const world_sn
     if (barrel_len > len) barrel_len = len;
     float rod_len = len - barrel_len + 0.15f * barrel_len;
     if (rod_len > len) rod_len = len;
-    float barrel_r = 0.5f * (float)c->bore * 1.28f;   // bore + wall
+    float barrel_r = 0.5f * (float)c->bore * 1.28f; // bore + wall
     float rod_r = 0.5f * (float)(c->rod > 0 ? c->rod : 0.6 * c->bore);
     const render_mesh* barrel = render_mesh_get(mc, "cyl_barrel.obj", 2);
     const render_mesh* rod = render_mesh_get(mc, "cyl_rod.obj", 2);
     static const float barrel_rgba[4] = {0.23f, 0.25f, 0.28f, 1.0f};
     static const float rod_rgba[4] = {0.86f, 0.88f, 0.90f, 1.0f};
-    render_draw_item* it = push_item(sc, barrel ? barrel : &sc->prim[RENDER_PRIM_TUBE_X], barrel_rgba);
+    render_draw_item* it =
+        push_item(sc, barrel ? barrel : &sc->prim[RENDER_PRIM_TUBE_X], barrel_rgba);
     if (it) segment_matrix(it->model, a, b, barrel_r, barrel_len);
     it = push_item(sc, rod ? rod : &sc->prim[RENDER_PRIM_TUBE_X], rod_rgba);
     if (it) segment_matrix(it->model, b, a, rod_r, rod_len);
@@ -425,6 +436,20 @@ static void scene_bounds(const world_snapshot* s, rm_vec3* centre, float* radius
 
 // ---- the two passes ---------------------------------------------------------------
 
+/// Cull back faces only for meshes with consistent winding; a mirrored
+/// model matrix (negative determinant, e.g. the lower capsule cap) turns
+/// the winding around.
+static void set_cull(const render_mesh* mesh, const float m[16]) {
+    if (!mesh->cull) {
+        glDisable(GL_CULL_FACE);
+        return;
+    }
+    float det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
+                m[8] * (m[1] * m[6] - m[5] * m[2]);
+    glEnable(GL_CULL_FACE);
+    glFrontFace(det < 0 ? GL_CW : GL_CCW);
+}
+
 static void use_lit(const render_lit_prog* p, const render_camera* cam, const render_shadow* sh) {
     glUseProgram(p->id);
     glUniformMatrix4fv(p->u_vp, 1, GL_FALSE, cam->viewproj);
@@ -434,15 +459,17 @@ static void use_lit(const render_lit_prog* p, const render_camera* cam, const re
     glUniform1i(p->u_shadow, 0);
 }
 
-void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* sh, const render_camera* cam,
-                       const world_snapshot* s, int w, int h) {
+void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* sh,
+                       const render_camera* cam, const world_snapshot* s, int w, int h) {
     sc->nitems = 0;
     sc->triangles = 0;
     sc->draw_calls = 0;
     update_terrain(sc, &s->terrain);
-    for (int i = 0; i < s->nbody && i < WORLD_SNAP_MAX_BODIES; ++i) add_body(sc, mc, &s->body[i]);
+    for (int i = 0; i < s->nbody && i < WORLD_SNAP_MAX_BODIES; ++i)
+        add_body(sc, mc, &s->body[i]);
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
-    for (int i = 0; i < ncyl; ++i) add_cylinder(sc, mc, &s->cyl[i]);
+    for (int i = 0; i < ncyl; ++i)
+        add_cylinder(sc, mc, &s->cyl[i]);
     add_rope(sc, s);
 
     rm_vec3 centre;
@@ -468,10 +495,13 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
         const render_draw_item* it = &sc->items[i];
         if (!it->casts_shadow) continue;
         glUniformMatrix4fv(sc->ud_model, 1, GL_FALSE, it->model);
+        set_cull(&it->mesh, it->model);
         render_mesh_draw(&it->mesh);
         ++sc->draw_calls;
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_CULL_FACE);
+    glFrontFace(GL_CCW);
 
     // Colour pass.
     glBindFramebuffer(GL_FRAMEBUFFER, (GLuint)target);
@@ -499,11 +529,15 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
         glUniformMatrix4fv(sc->obj.u_model, 1, GL_FALSE, it->model);
         glUniformMatrix3fv(sc->obj.u_normal, 1, GL_FALSE, nm);
         glUniform4fv(sc->obj.u_color, 1, it->rgba);
+        set_cull(&it->mesh, it->model);
         render_mesh_draw(&it->mesh);
         sc->triangles += it->mesh.nidx / 3;
         ++sc->draw_calls;
     }
     // Ground: the heightfield if there is one, and a flat plane beyond it.
+    // Drawn both sides: the camera may dip below a hill.
+    glDisable(GL_CULL_FACE);
+    glFrontFace(GL_CCW);
     use_lit(&sc->ground_prog, cam, sh);
     float m[16];
     rm_identity(m);

@@ -38,7 +38,8 @@ int render_screenshot(render* r, const char* path) {
     int rc = render_read_pixels(r, px, r->w, r->h);
     if (rc == 0) {
         // The alpha channel holds blending leftovers; force opaque.
-        for (size_t i = 3; i < (size_t)r->w * (size_t)r->h * 4; i += 4) px[i] = 255;
+        for (size_t i = 3; i < (size_t)r->w * (size_t)r->h * 4; i += 4)
+            px[i] = 255;
         if (!stbi_write_png(path, r->w, r->h, 4, px, r->w * 4)) rc = -1;
     }
     free(px);

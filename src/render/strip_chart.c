@@ -30,8 +30,10 @@ void render_chart_push(render* r, int id, double t, double value) {
     if (ch->count > 0) {
         int last = (ch->head + RENDER_CHART_CAP - 1) % RENDER_CHART_CAP;
         // Time went backwards: the run was reset, start the trace afresh.
-        if (t < ch->t[last]) ch->count = 0;
-        else if (t - ch->t[last] < c->window / (0.9 * RENDER_CHART_CAP)) return;
+        if (t < ch->t[last])
+            ch->count = 0;
+        else if (t - ch->t[last] < c->window / (0.9 * RENDER_CHART_CAP))
+            return;
     }
     ch->t[ch->head] = t;
     ch->v[ch->head] = (float)(value * ch->def.scale);
@@ -40,12 +42,14 @@ void render_chart_push(render* r, int id, double t, double value) {
 }
 
 void render_chart_clear(render* r) {
-    for (int i = 0; i < r->charts.n; ++i) r->charts.ch[i].count = 0;
+    for (int i = 0; i < r->charts.n; ++i)
+        r->charts.ch[i].count = 0;
 }
 
 static const float k_palette[8][4] = {
-    {0.95f, 0.35f, 0.30f, 1}, {0.35f, 0.70f, 1.00f, 1}, {1.00f, 0.80f, 0.25f, 1}, {0.45f, 0.90f, 0.45f, 1},
-    {0.85f, 0.50f, 0.95f, 1}, {0.30f, 0.90f, 0.90f, 1}, {1.00f, 0.60f, 0.80f, 1}, {0.80f, 0.80f, 0.80f, 1},
+    {0.95f, 0.35f, 0.30f, 1}, {0.35f, 0.70f, 1.00f, 1}, {1.00f, 0.80f, 0.25f, 1},
+    {0.45f, 0.90f, 0.45f, 1}, {0.85f, 0.50f, 0.95f, 1}, {0.30f, 0.90f, 0.90f, 1},
+    {1.00f, 0.60f, 0.80f, 1}, {0.80f, 0.80f, 0.80f, 1},
 };
 
 void render_charts_default(render* r, int ncyl) {
@@ -58,13 +62,14 @@ void render_charts_default(render* r, int ncyl) {
         // Pressures: chamber A solid colour, B the next palette entry.
         for (int ch = 0; ch < 2; ++ch) {
             snprintf(label, sizeof label, "p%d%c", i + 1, ch ? 'B' : 'A');
-            d.label = label, d.unit = "MPa", d.scale = 1e-6, d.ymin = 0, d.ymax = r->cfg.p_full_scale * 1e-6;
+            d.label = label, d.unit = "MPa", d.scale = 1e-6, d.ymin = 0,
+            d.ymax = r->cfg.p_full_scale * 1e-6;
             memcpy(d.rgba, k_palette[(2 * i + ch) % 8], sizeof d.rgba);
             d.group = 0;
             render_chart_add(r, &d);
         }
         snprintf(label, sizeof label, "x%d", i + 1);
-        d.label = label, d.unit = "mm", d.scale = 1e3, d.ymin = d.ymax = 0;  // autoscale
+        d.label = label, d.unit = "mm", d.scale = 1e3, d.ymin = d.ymax = 0; // autoscale
         memcpy(d.rgba, k_palette[(2 * i) % 8], sizeof d.rgba);
         d.group = 1;
         render_chart_add(r, &d);
@@ -97,7 +102,8 @@ static double latest_t(const render_charts* c) {
     return t;
 }
 
-static void draw_box(render_hud* h, const render_charts* c, int group, double t1, float x, float y, float w, float hh) {
+static void draw_box(render_hud* h, const render_charts* c, int group, double t1, float x, float y,
+                     float w, float hh) {
     static const float bg[4] = {0.04f, 0.05f, 0.07f, 0.70f};
     static const float grid[4] = {1, 1, 1, 0.18f};
     static const float dim[4] = {0.75f, 0.78f, 0.82f, 1};
@@ -135,7 +141,8 @@ static void draw_box(render_hud* h, const render_charts* c, int group, double t1
         lo = m - 1, hi = m + 1;
     }
     const float px = x + 44, pw = w - 50, py = y + 16, ph = hh - 30;
-    for (int g = 0; g <= 4; ++g) render_hud_line(h, px, py + ph * (float)g / 4, px + pw, py + ph * (float)g / 4, grid);
+    for (int g = 0; g <= 4; ++g)
+        render_hud_line(h, px, py + ph * (float)g / 4, px + pw, py + ph * (float)g / 4, grid);
     char buf[64];
     snprintf(buf, sizeof buf, "%.4g", hi);
     render_hud_text(h, x + 3, py - 3, 1.0f, dim, buf);
@@ -168,7 +175,8 @@ static void draw_box(render_hud* h, const render_charts* c, int group, double t1
             double f = (ch->v[j] - lo) / (hi - lo);
             if (f < 0) f = 0;
             if (f > 1) f = 1;
-            float sx = px + pw * (float)((ch->t[j] - t0) / c->window), sy = py + ph * (float)(1.0 - f);
+            float sx = px + pw * (float)((ch->t[j] - t0) / c->window),
+                  sy = py + ph * (float)(1.0 - f);
             // At most one segment per 2 px column: more is invisible and
             // each line costs llvmpipe a primitive setup.
             if (have && sx < ox + 2.0f && k + 1 < ch->count) continue;
@@ -178,15 +186,18 @@ static void draw_box(render_hud* h, const render_charts* c, int group, double t1
     }
 }
 
-void render_charts_draw(render_hud* h, const render_charts* c, float x, float y, float w, float hh) {
+void render_charts_draw(render_hud* h, const render_charts* c, float x, float y, float w,
+                        float hh) {
     int groups[RENDER_MAX_CHARTS], ng = 0;
     for (int i = 0; i < c->n; ++i) {
         bool seen = false;
-        for (int g = 0; g < ng; ++g) seen |= groups[g] == c->ch[i].def.group;
+        for (int g = 0; g < ng; ++g)
+            seen |= groups[g] == c->ch[i].def.group;
         if (!seen) groups[ng++] = c->ch[i].def.group;
     }
     double t1 = latest_t(c);
     if (!ng || !isfinite(t1)) return;
     float gap = 8, bw = (w - gap * (float)(ng - 1)) / (float)ng;
-    for (int g = 0; g < ng; ++g) draw_box(h, c, groups[g], t1, x + (bw + gap) * (float)g, y, bw, hh);
+    for (int g = 0; g < ng; ++g)
+        draw_box(h, c, groups[g], t1, x + (bw + gap) * (float)g, y, bw, hh);
 }

@@ -8,7 +8,8 @@
 /// Deliver queued SDL events to the input layer, as the app's loop does.
 static void pump(input* in) {
     SDL_Event ev;
-    while (SDL_PollEvent(&ev)) input_handle_event(in, &ev);
+    while (SDL_PollEvent(&ev))
+        input_handle_event(in, &ev);
 }
 
 static void push_key(SDL_Scancode sc, bool down) {
@@ -65,9 +66,10 @@ static void test_virtual_controller_lift(void) {
         input_destroy(in);
         return;
     }
-    pump(in);  // hot-plug: JOYDEVICEADDED opens it
+    pump(in); // hot-plug: JOYDEVICEADDED opens it
     CHECK(input_device_name(in) != NULL, "device opened on hot-plug");
-    CHECK(input_active_source(in) == INPUT_SRC_CONTROLLER, "as a game controller (%d)", input_active_source(in));
+    CHECK(input_active_source(in) == INPUT_SRC_CONTROLLER, "as a game controller (%d)",
+          input_active_source(in));
     SDL_Joystick* js = SDL_JoystickOpen(idx);
     CHECK(js != NULL, "open our own handle to drive it");
     // Stick half up (SDL: negative y). Default mapping inverts, dead zone
@@ -161,7 +163,8 @@ static void test_mapping_file(void) {
     FILE* f = fopen(path, "w");
     CHECK(f != NULL, "write %s", path);
     if (!f) return;
-    fputs("{ \"axes\": { \"lift\": { \"controller\": \"righty\", \"joystick\": 2, \"invert\": false,\n"
+    fputs("{ \"axes\": { \"lift\": { \"controller\": \"righty\", \"joystick\": 2, \"invert\": "
+          "false,\n"
           "                      \"dead_zone\": 0.2, \"expo\": 0.0, \"scale\": 0.5 },\n"
           "            \"slew\": { \"controller\": null } },\n"
           "  \"buttons\": { \"hook\": { \"controller\": \"b\", \"joystick\": 5 } },\n"
@@ -172,7 +175,8 @@ static void test_mapping_file(void) {
     char err[256] = "";
     CHECK(input_load_mapping(path, &m, err, sizeof err) == 0, "load: %s", err);
     CHECK(m.axis[INPUT_LIFT].controller_axis == SDL_CONTROLLER_AXIS_RIGHTY, "lift on righty");
-    CHECK(m.axis[INPUT_LIFT].joystick_axis == 2 && !m.axis[INPUT_LIFT].invert, "joystick axis 2, not inverted");
+    CHECK(m.axis[INPUT_LIFT].joystick_axis == 2 && !m.axis[INPUT_LIFT].invert,
+          "joystick axis 2, not inverted");
     CHECK_NEAR(m.axis[INPUT_LIFT].dead_zone, 0.2, 0);
     CHECK_NEAR(m.axis[INPUT_LIFT].scale, 0.5, 0);
     CHECK(m.axis[INPUT_SLEW].controller_axis == -1, "slew unbound");
@@ -202,7 +206,8 @@ static void test_mapping_file(void) {
     fclose(f);
     input_mapping before = m;
     CHECK(input_load_mapping(path, &m, err, sizeof err) == -1, "dead zone 2 rejected");
-    CHECK(strstr(err, "axes.jib.dead_zone") && strstr(err, "render_input_map.json"), "message: %s", err);
+    CHECK(strstr(err, "axes.jib.dead_zone") && strstr(err, "render_input_map.json"), "message: %s",
+          err);
     CHECK(memcmp(&before, &m, sizeof m) == 0, "mapping untouched on error");
     f = fopen(path, "w");
     fputs("{ \"axes\": { \"lift\": { \"controller\": \"stick_of_joy\" } } }", f);
@@ -222,7 +227,7 @@ static void test_plain_joystick(void) {
     CHECK(input_device_name(in) != NULL, "opened");
     SDL_Joystick* js = SDL_JoystickOpen(idx);
     if (input_active_source(in) == INPUT_SRC_JOYSTICK) {
-        SDL_JoystickSetVirtualAxis(js, 1, -32767);  // axis 1 = lift, inverted
+        SDL_JoystickSetVirtualAxis(js, 1, -32767); // axis 1 = lift, inverted
         SDL_JoystickUpdate();
         pump(in);
         input_command cmd;

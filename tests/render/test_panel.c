@@ -16,7 +16,9 @@ static void on_change(void* user, int id, const char* label, double value) {
     s->last_value = value;
 }
 
-static void count_action(void* user) { ++*(int*)user; }
+static void count_action(void* user) {
+    ++*(int*)user;
+}
 
 static void test_set_in_range(void) {
     panel* p = panel_create();
@@ -59,7 +61,8 @@ static void test_reject_out_of_range(void) {
     CHECK(panel_set(p, "bore", 0.5, msg, sizeof msg) == PANEL_OUT_OF_RANGE, "0.5 m rejected");
     CHECK_NEAR(bore, 0.1, 0);
     CHECK(strstr(msg, "bore") && strstr(msg, "outside") && strstr(msg, "0.2"), "message: %s", msg);
-    CHECK(strcmp(panel_last_error(p), msg) == 0, "last error kept for the GUI: %s", panel_last_error(p));
+    CHECK(strcmp(panel_last_error(p), msg) == 0, "last error kept for the GUI: %s",
+          panel_last_error(p));
     CHECK(!panel_take_changed(p, id), "no change flag on rejection");
     CHECK(s.calls == 0, "no callback on rejection");
     CHECK(panel_set(p, "bore", -1, msg, sizeof msg) == PANEL_OUT_OF_RANGE, "negative rejected");
@@ -88,7 +91,7 @@ static void test_groups_and_actions(void) {
     CHECK_NEAR(b1, 0.1, 0);
     double mn = 0, mx = 0, st = 0;
     panel_range(p, 0, &mn, &mx, &st);
-    CHECK_NEAR(st, 0.0015, 1e-12);  // default step = range / 100
+    CHECK_NEAR(st, 0.0015, 1e-12); // default step = range / 100
     int runs = 0;
     CHECK(panel_add_action(p, "reset run", count_action, &runs) == 0, "action id");
     CHECK(panel_run_action(p, "reset run") && runs == 1, "action ran %d", runs);

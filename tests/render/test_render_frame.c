@@ -12,7 +12,7 @@
 
 enum { W = 1280, H = 720 };
 
-static world_snapshot snap;   // big: keep off the stack
+static world_snapshot snap; // big: keep off the stack
 static float terrain[RENDER_DEMO_TERRAIN_N * RENDER_DEMO_TERRAIN_N];
 static unsigned char px[W * H * 4];
 
@@ -26,7 +26,9 @@ static render* make(bool hud) {
     return r;
 }
 
-static const unsigned char* at(int x, int y) { return &px[((size_t)y * W + (size_t)x) * 4]; }
+static const unsigned char* at(int x, int y) {
+    return &px[((size_t)y * W + (size_t)x) * 4];
+}
 
 /// Orange crane paint, lit or in shadow: a saturated red-over-green-over-blue
 /// hue (grey ground, blue truck, brick and wood are less saturated).
@@ -75,7 +77,8 @@ static void test_frame_not_blank_and_png(void) {
     CHECK(f != NULL, "png written: %s", path);
     if (f) {
         unsigned char sig[8] = {0};
-        CHECK(fread(sig, 1, 8, f) == 8 && sig[1] == 'P' && sig[2] == 'N' && sig[3] == 'G', "PNG signature");
+        CHECK(fread(sig, 1, 8, f) == 8 && sig[1] == 'P' && sig[2] == 'N' && sig[3] == 'G',
+              "PNG signature");
         fclose(f);
     }
     render_destroy(r);
@@ -97,11 +100,14 @@ static void test_crane_where_it_projects(void) {
             double q[2];
             CHECK(b && render_project(r, b->pos, q), "%s projects", parts[k]);
             if (!b) continue;
-            CHECK(q[0] > 0 && q[0] < W && q[1] > 0 && q[1] < H, "%s on screen at %.0f,%.0f", parts[k], q[0], q[1]);
+            CHECK(q[0] > 0 && q[0] < W && q[1] > 0 && q[1] < H, "%s on screen at %.0f,%.0f",
+                  parts[k], q[0], q[1]);
             int n = count_crane_near(q[0], q[1], 3);
             const unsigned char* c = at((int)q[0], (int)q[1]);
-            CHECK(n >= 10, "%s (meshes %d): %d/49 crane-coloured pixels near %.0f,%.0f (centre rgb %d %d %d)", parts[k],
-                  meshes, n, q[0], q[1], c[0], c[1], c[2]);
+            CHECK(
+                n >= 10,
+                "%s (meshes %d): %d/49 crane-coloured pixels near %.0f,%.0f (centre rgb %d %d %d)",
+                parts[k], meshes, n, q[0], q[1], c[0], c[1], c[2]);
         }
         // High up in the sky there is no crane.
         double sky[3] = {snap.tip[0], snap.tip[1], snap.tip[2] + 30};
@@ -161,7 +167,8 @@ static void test_camera_presets(void) {
     render_demo_params p = render_demo_default_params();
     p.terrain = true;
     render_demo_scene(&snap, &p, terrain);
-    const render_cam_preset presets[] = {RENDER_CAM_OPERATOR, RENDER_CAM_SIDE, RENDER_CAM_FOLLOW_HOOK, RENDER_CAM_ORBIT};
+    const render_cam_preset presets[] = {RENDER_CAM_OPERATOR, RENDER_CAM_SIDE,
+                                         RENDER_CAM_FOLLOW_HOOK, RENDER_CAM_ORBIT};
     for (int k = 0; k < 4; ++k) {
         render_set_camera_preset(r, presets[k]);
         render_frame(r, &snap);
@@ -228,17 +235,19 @@ static void test_missing_mesh_falls_back(void) {
     const char* w1 = strstr(text, "does_not_exist.obj");
     CHECK(w1 != NULL, "warning names the missing file: [%s]", text);
     CHECK(w1 && !strstr(w1 + 1, "does_not_exist.obj"), "warned once, not every frame: [%s]", text);
-    CHECK(strstr(text, "render_broken_mesh.obj") != NULL, "warning names the broken file: [%s]", text);
+    CHECK(strstr(text, "render_broken_mesh.obj") != NULL, "warning names the broken file: [%s]",
+          text);
     int lines = 0;
-    for (const char* c = text; *c; ++c) lines += *c == '\n';
+    for (const char* c = text; *c; ++c)
+        lines += *c == '\n';
     CHECK(lines == 2, "one line per file, got %d: [%s]", lines, text);
     // The primitive box is drawn in its colour where the body is.
     render_read_pixels(r, px, W, H);
     double q[2];
     CHECK(render_project(r, b->pos, q), "box projects");
     const unsigned char* c = at((int)q[0], (int)q[1]);
-    CHECK(c[0] > 40 && c[2] > 40 && c[1] < c[0] / 2 && c[1] < c[2] / 2, "magenta box drawn, rgb %d %d %d", c[0], c[1],
-          c[2]);
+    CHECK(c[0] > 40 && c[2] > 40 && c[1] < c[0] / 2 && c[1] < c[2] / 2,
+          "magenta box drawn, rgb %d %d %d", c[0], c[1], c[2]);
     render_destroy(r);
 }
 
@@ -251,16 +260,18 @@ static void test_cad_mesh_formats(void) {
     CHECK(f != NULL, "write %s", stl);
     if (!f) return;
     // A 1000 mm cube from (-500, 0, -500) to (500, 1000, 500): y is up.
-    static const float v[8][3] = {{-500, 0, -500}, {500, 0, -500}, {500, 1000, -500}, {-500, 1000, -500},
-                                  {-500, 0, 500},  {500, 0, 500},  {500, 1000, 500},  {-500, 1000, 500}};
-    static const int q[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {3, 0, 4, 7}};
+    static const float v[8][3] = {{-500, 0, -500},    {500, 0, -500},   {500, 1000, -500},
+                                  {-500, 1000, -500}, {-500, 0, 500},   {500, 0, 500},
+                                  {500, 1000, 500},   {-500, 1000, 500}};
+    static const int q[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                {2, 3, 7, 6}, {1, 2, 6, 5}, {3, 0, 4, 7}};
     fputs("solid cube\n", f);
     for (int k = 0; k < 6; ++k)
         for (int t = 0; t < 2; ++t) {
             int a = q[k][0], b = q[k][1 + t], c = q[k][2 + t];
             fprintf(f, " facet normal 0 0 0\n  outer loop\n");
-            fprintf(f, "   vertex %g %g %g\n   vertex %g %g %g\n   vertex %g %g %g\n", v[a][0], v[a][1], v[a][2],
-                    v[b][0], v[b][1], v[b][2], v[c][0], v[c][1], v[c][2]);
+            fprintf(f, "   vertex %g %g %g\n   vertex %g %g %g\n   vertex %g %g %g\n", v[a][0],
+                    v[a][1], v[a][2], v[b][0], v[b][1], v[b][2], v[c][0], v[c][1], v[c][2]);
             fprintf(f, "  endloop\n endfacet\n");
         }
     fputs("endsolid cube\n", f);
@@ -273,7 +284,7 @@ static void test_cad_mesh_formats(void) {
     memset(b, 0, sizeof *b);
     snprintf(b->name, sizeof b->name, "cad_cube");
     b->role = WORLD_ROLE_OBSTACLE;
-    b->shape = WORLD_SHAPE_SPHERE;  // a different fallback, to tell them apart
+    b->shape = WORLD_SHAPE_SPHERE; // a different fallback, to tell them apart
     b->size[0] = 0.1;
     b->pos[0] = 4, b->pos[1] = -3, b->pos[2] = 0;
     b->rot[0] = b->rot[4] = b->rot[8] = 1;
@@ -289,7 +300,8 @@ static void test_cad_mesh_formats(void) {
     double top[3] = {4, -3, 0.9}, q2[2];
     CHECK(render_project(r, top, q2), "projects");
     const unsigned char* c = at((int)q2[0], (int)q2[1]);
-    CHECK(c[1] > c[0] + 30 && c[2] > c[0] + 30, "cyan cube 0.9 m up (y-up, mm scaled), rgb %d %d %d", c[0], c[1], c[2]);
+    CHECK(c[1] > c[0] + 30 && c[2] > c[0] + 30,
+          "cyan cube 0.9 m up (y-up, mm scaled), rgb %d %d %d", c[0], c[1], c[2]);
     render_destroy(r);
 }
 
@@ -315,7 +327,8 @@ static void test_warnings_shown(void) {
             red += c[0] > 140 && c[1] < 60 && c[2] < 60;
             red_calm += d[0] > 140 && d[1] < 60 && d[2] < 60;
         }
-    CHECK(red > 3000 && red_calm == 0, "warning boxes: %d red pixels (calm frame %d)", red, red_calm);
+    CHECK(red > 3000 && red_calm == 0, "warning boxes: %d red pixels (calm frame %d)", red,
+          red_calm);
     render_destroy(r);
 }
 
@@ -333,11 +346,13 @@ static void test_panel_draws_offscreen(void) {
     panel_add_param(pn, &d);
     CHECK(render_attach_panel(r, pn), "ImGui panel starts on the offscreen context");
     // ImGui needs a frame or two to lay out its window.
-    for (int i = 0; i < 3; ++i) render_frame(r, &snap);
+    for (int i = 0; i < 3; ++i)
+        render_frame(r, &snap);
     render_read_pixels(r, px, W, H);
     int diff = 0;
     for (int y = 20; y < 200; ++y)
-        for (int x = W - 330; x < W - 20; ++x) diff += memcmp(at(x, y), &before[((size_t)y * W + x) * 4], 3) != 0;
+        for (int x = W - 330; x < W - 20; ++x)
+            diff += memcmp(at(x, y), &before[((size_t)y * W + x) * 4], 3) != 0;
     CHECK(diff > 1000, "panel window drawn top right (%d pixels changed)", diff);
     render_attach_panel(r, NULL);
     render_destroy(r);

@@ -45,14 +45,27 @@ class Mesh:
         self.faces.setdefault(mat, []).append((a, b, c))
 
     def flat_poly(self, mat, pts):
-        """Convex planar polygon (CCW seen from outside), one flat normal."""
-        n = cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]))
+        """Convex planar polygon (CCW seen from outside), one flat normal.
+        Repeated corners are dropped, so no zero-area triangle is written."""
+        clean = []
+        for p in pts:
+            if not clean or length(sub(p, clean[-1])) > 1e-9:
+                clean.append(p)
+        if len(clean) > 1 and length(sub(clean[0], clean[-1])) <= 1e-9:
+            clean.pop()
+        if len(clean) < 3:
+            return
+        pts = clean
+        n = (0.0, 0.0, 0.0)
+        for k in range(1, len(pts) - 1):  # Newell-style sum: robust normal
+            n = add(n, cross(sub(pts[k], pts[0]), sub(pts[k + 1], pts[0])))
         if length(n) < 1e-12:
-            n = cross(sub(pts[2], pts[0]), sub(pts[3 % len(pts)], pts[0]))
+            return
         ni = self.norm(n)
         vi = [self.vert(p) for p in pts]
         for k in range(1, len(pts) - 1):
-            self.tri(mat, (vi[0], ni), (vi[k], ni), (vi[k + 1], ni))
+            if length(cross(sub(pts[k], pts[0]), sub(pts[k + 1], pts[0]))) > 1e-12:
+                self.tri(mat, (vi[0], ni), (vi[k], ni), (vi[k + 1], ni))
 
     def triangles(self):
         return sum(len(f) for f in self.faces.values())
@@ -188,8 +201,11 @@ def lathe(m, mat, profile, seg, axis="z", centre=(0, 0, 0), smooth=True, a0=0.0,
                 # Orientation: for axis y the angle runs clockwise seen from +y.
                 order = [0, 1, 2, 3] if axis != "y" else [0, 3, 2, 1]
                 c = [(vi[j], ni[j]) for j in order]
-                m.tri(mat, c[0], c[1], c[2])
-                m.tri(mat, c[0], c[2], c[3])
+                # Skip the zero-area half of quads that touch the axis.
+                for tri in ((0, 1, 2), (0, 2, 3)):
+                    pa, pb, pc = (q[order[k]] for k in tri)
+                    if length(cross(sub(pb, pa), sub(pc, pa))) > 1e-12:
+                        m.tri(mat, *(c[k] for k in tri))
             else:
                 order = q if axis != "y" else [q[0], q[3], q[2], q[1]]
                 if length(sub(order[0], order[1])) < 1e-12:
@@ -232,11 +248,17 @@ def extrude_y(m, mat, poly_xz, y0, y1):
 def sweep_tube(m, mat, path, r, sides):
     """Tube of radius r along a polyline path (smooth normals), open ends."""
     rings = []
+    u = None
     for i, p in enumerate(path):
         t = sub(path[min(i + 1, len(path) - 1)], path[max(i - 1, 0)])
         t = mul(t, 1.0 / (length(t) or 1.0))
-        ref = (0, 1, 0) if abs(t[1]) < 0.9 else (1, 0, 0)
-        u = cross(t, ref)
+        if u is None:
+            ref = (0, 1, 0) if abs(t[1]) < 0.9 else (1, 0, 0)
+            u = cross(t, ref)
+        else:
+            # Parallel transport: keep the previous ring's u, minus its
+            # component along the new tangent, so the tube never twists.
+            u = sub(u, mul(t, sum(u[k] * t[k] for k in range(3))))
         u = mul(u, 1.0 / length(u))
         w = cross(t, u)
         ring = []
@@ -479,12 +501,12 @@ def hook():
     lathe(m, "paint", [(0.0, -0.34), (0.08, -0.34), (0.11, -0.30), (0.11, -0.12), (0.09, -0.08), (0.0, -0.08)],
           28)
     cyl(m, "steel", 0.03, -0.45, -0.34, 16)
-    # The hook itself: a tube swept down the shank and round the bowl.
-    path = [(0, 0, -0.44), (0, 0, -0.50)]
-    cx, cz, rr = 0.0, -0.62, 0.11
-    for k in range(0, 29):
-        a = math.pi / 2 + 0.35 - (2 * math.pi * 0.78) * k / 28
-        path.append((cx + rr * math.cos(a) * 0.95 - 0.02, 0, cz + rr * math.sin(a)))
+    # The hook itself: a tube swept down the shank and, without a kink,
+    # round the bowl (circle centre (-0.10, -0.60), radius 0.10) up to the tip.
+    path = [(0, 0, -0.44), (0, 0, -0.52), (0, 0, -0.57)]
+    for k in range(29):
+        a = -(math.pi + 1.0) * k / 28
+        path.append((-0.10 + 0.10 * math.cos(a), 0, -0.60 + 0.10 * math.sin(a)))
     sweep_tube(m, "paint", path, 0.03, 14)
     # Rounded end caps.
     for p in (path[0], path[-1]):
@@ -495,9 +517,9 @@ def hook():
     return m
 
 
-def block():
+def load_block():
     """Concrete block 1.2 x 0.6 x 0.6 m, origin at its centre; two lifting loops."""
-    m = Mesh("block")
+    m = Mesh("load_block")
     c = 0.03
     sx, sy, sz = 0.6, 0.3, 0.3
     loft_x(m, "paint", -sx, chamfer_section(2 * sy - 2 * c, 2 * sz - 2 * c, 0.0), -sx + c,
@@ -612,7 +634,7 @@ def main():
             r, g, b = MATERIALS[name]
             f.write("newmtl %s\nKd %.3f %.3f %.3f\n\n" % (name, r, g, b))
     total = 0
-    for fn in (truck, wheel, outrigger, column, boom1, boom2, cyl_barrel, cyl_rod, hook, block, pallet, crate, wall,
+    for fn in (truck, wheel, outrigger, column, boom1, boom2, cyl_barrel, cyl_rod, hook, load_block, pallet, crate, wall,
                building):
         m = fn()
         m.write(out)
