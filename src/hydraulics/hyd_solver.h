@@ -84,6 +84,12 @@ typedef struct hyd_solver_opts {
     int jac_every;      ///< recompute J every N accepted steps (1: every step)
     double jac_max_age; ///< recompute J if older than this simulated time [s]
     long max_steps;     ///< hard cap on steps per hyd_solver_advance call
+    /// Step hysteresis (adaptive; 0: off, today's behaviour). After an
+    /// accepted step, a proposal h_new with h <= h_new <= (1 + h_hold) h keeps
+    /// h unchanged, so W = I - gamma h J need not be refactored while J is
+    /// reused (W-methods with jac_every > 1). Shrinking is never held back.
+    /// 0.2 to 0.5 are typical.
+    double h_hold;
 } hyd_solver_opts;
 
 hyd_solver_opts hyd_default_solver_opts(void);

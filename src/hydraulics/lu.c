@@ -8,6 +8,8 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 // Shared by hyd_lu_factor and the solver's blocks. Rows are unit stride, so
 // the elimination update is a plain axpy the compiler vectorises (row i and
@@ -150,7 +152,189 @@ static inline void lu_solve_blk(const double* lu, int n, const int* piv, const d
     }
 }
 
+// ------------------------------------------------ sparse path, dense W --
+//
+// The crane's 15x15 J has about 60 non-zeros and LU in natural order adds
+// about 10 fill-ins: some 60 multiply-adds instead of the ~1100 of a dense
+// factorisation, and some 70 per solve instead of ~210. The pattern is not
+// declared by the problem; it is learnt from the J values (the union of every
+// non-zero seen), so a new non-zero only costs one symbolic pass.
+
+// A diagonal pivot is accepted when |a_kk| >= HYD_SP_THRESH max_{i>k} |a_ik|
+// on the scaled matrix (threshold partial pivoting, as in sparse direct
+// solvers; 0.01 is MA48's default): growth stays bounded by
+// (1 + 1/HYD_SP_THRESH) per elimination step. Otherwise the dense, partially
+// pivoted LU factors that W. On the crane about 4 % of the factorisations
+// fall back (a joint-angle column against a joint-velocity row, whose error
+// weight is atol-sized).
+#define HYD_SP_THRESH 0.01
+
+// Fill of an LU without row exchanges over sp_mask, then the index lists.
+static void sp_symbolic(hyd_solver* s) {
+    const int n = s->n;
+    unsigned char* m = s->sp_mask;
+    for (int k = 0; k < n; ++k)
+        for (int i = k + 1; i < n; ++i) {
+            if (!m[i * n + k]) continue;
+            for (int j = k + 1; j < n; ++j) m[i * n + j] |= m[k * n + j];
+        }
+    int nl = 0, nu = 0, nf = 0;
+    for (int k = 0; k < n; ++k) {
+        s->sp_lptr[k] = nl;
+        for (int i = k + 1; i < n; ++i)
+            if (m[i * n + k]) s->sp_lrow[nl++] = i;
+        s->sp_uptr[k] = nu;
+        for (int j = k + 1; j < n; ++j)
+            if (m[k * n + j]) {
+                s->sp_ucol[nu] = j;
+                s->sp_upos[nu++] = k * n + j;
+            }
+        s->sp_fptr[k] = nf;
+        for (int j = 0; j < k; ++j)
+            if (m[k * n + j]) {
+                s->sp_fcol[nf] = j;
+                s->sp_fpos[nf++] = k * n + j;
+            }
+    }
+    s->sp_lptr[n] = nl;
+    s->sp_uptr[n] = nu;
+    s->sp_fptr[n] = nf;
+    // Positions inside the pattern (W's checks) and the off-pattern mask.
+    int np = 0;
+    for (int i = 0; i < n * n; ++i) {
+        s->sp_zmask[i] = m[i] ? 0 : ~(UINT64_C(1) << 63); // magnitude bits only: -0.0 is 0
+        if (m[i]) s->sp_ppos[np++] = i;
+    }
+    s->sp_np = np;
+}
+
+void hydSparseInit(hyd_solver* s) { sp_symbolic(s); }
+
+// W = I - gh J, dense storage, factored over the learnt pattern. Returns 0,
+// 1 when a pivot fails the threshold test (the caller falls back), or -1 when
+// W is singular or not finite.
+static int sp_factor(hyd_solver* s, double gh) {
+    const int n = s->n, nn = n * n;
+    const double* restrict jb = s->jb;
+    double* restrict w = s->w;
+    unsigned char* mask = s->sp_mask;
+    // W's entries, then two cheap checks instead of one branchy pass over
+    // n^2 entries: (1) any non-zero outside the known pattern (integer OR of
+    // the magnitude bits, masked to the off-pattern positions: vectorises),
+    // (2) max |J| and non-finiteness over the pattern's positions only (off
+    // the pattern every entry is then an exact zero). The magnitude bits of
+    // doubles order like unsigned integers, Inf and NaN above every finite.
+    for (int i = 0; i < nn; ++i) w[i] = -gh * jb[i];
+    const uint64_t* restrict zm = s->sp_zmask;
+    uint64_t off = 0;
+    for (int i = 0; i < nn; ++i) {
+        uint64_t b;
+        memcpy(&b, &jb[i], sizeof b);
+        off |= b & zm[i];
+    }
+    if (off) {
+        // New non-zeros (or NaN/Inf off the pattern): grow the pattern.
+        for (int i = 0; i < nn; ++i)
+            if (jb[i] != 0.0 || jb[i] != jb[i]) mask[i] = 1;
+        sp_symbolic(s);
+    }
+    const int* restrict pp = s->sp_ppos;
+    const int np = s->sp_np;
+    uint64_t bmax = 0;
+    for (int p = 0; p < np; ++p) {
+        uint64_t b;
+        memcpy(&b, &jb[pp[p]], sizeof b);
+        b &= ~(UINT64_C(1) << 63);
+        bmax = b > bmax ? b : bmax;
+    }
+    if (bmax >= UINT64_C(0x7ff0000000000000)) return -1; // Inf or NaN in J
+    double jmax;
+    memcpy(&jmax, &bmax, sizeof jmax);
+    for (int i = 0; i < n; ++i) w[i * n + i] += 1.0;
+    // The scale of W for the singularity test: max |W_ij| <= 1 + |gh| max |J|.
+    const double tiny = (1.0 + fabs(gh) * jmax) * DBL_EPSILON;
+    const int* restrict lptr = s->sp_lptr;
+    const int* restrict lrow = s->sp_lrow;
+    const int* restrict uptr = s->sp_uptr;
+    const int* restrict ucol = s->sp_ucol;
+    const double* restrict sc = s->sp_scale;
+    double* restrict idiag = s->widiag;
+    for (int k = 0; k < n; ++k) {
+        const double akk = w[k * n + k];
+        // The test runs on D^-1 W D, D = diag(1 / sc): W's factors without
+        // row exchanges are that matrix's factors scaled back, and its
+        // entries compare like with like (a spool column against pressure
+        // rows differs by ~1e10 in raw units).
+        double cmax = 0.0;
+        for (int p = lptr[k]; p < lptr[k + 1]; ++p) {
+            const int i = lrow[p];
+            const double v = fabs(w[i * n + k]) * sc[i];
+            cmax = v > cmax ? v : cmax;
+        }
+        const double pk = fabs(akk);
+        if (!(pk * sc[k] >= HYD_SP_THRESH * cmax) || !(pk > tiny)) return 1;
+        const double inv = 1.0 / akk;
+        idiag[k] = inv;
+        const double* rk = w + k * n;
+        for (int p = lptr[k]; p < lptr[k + 1]; ++p) {
+            double* ri = w + lrow[p] * n;
+            const double l = ri[k] * inv;
+            ri[k] = l;
+            if (l == 0.0) continue;
+            for (int q = uptr[k]; q < uptr[k + 1]; ++q) {
+                const int j = ucol[q];
+                ri[j] -= l * rk[j];
+            }
+        }
+    }
+    for (int k = 0; k < n; ++k) s->piv[k] = k; // for the careful non-finite solve
+    return 0;
+}
+
+static void sp_solve(const hyd_solver* s, double* restrict b) {
+    const int n = s->n;
+    const double* restrict w = s->w;
+    double acc = 0.0;
+    for (int i = 0; i < n; ++i) acc += b[i] * 0.0;
+    if (acc != 0.0) {
+        // Non-finite b: the zero-skipping loops (identity pivots; the entries
+        // outside the pattern are exact zeros).
+        hyd_lu_solve(w, n, s->piv, b);
+        return;
+    }
+    const int* restrict fptr = s->sp_fptr;
+    const int* restrict fpos = s->sp_fpos;
+    const int* restrict fcol = s->sp_fcol;
+    for (int i = 1; i < n; ++i) {
+        double sum = b[i];
+        for (int p = fptr[i]; p < fptr[i + 1]; ++p) sum -= w[fpos[p]] * b[fcol[p]];
+        b[i] = sum;
+    }
+    const int* restrict uptr = s->sp_uptr;
+    const int* restrict upos = s->sp_upos;
+    const int* restrict ucol = s->sp_ucol;
+    const double* restrict idiag = s->widiag;
+    for (int i = n - 1; i >= 0; --i) {
+        double sum = b[i];
+        for (int p = uptr[i]; p < uptr[i + 1]; ++p) sum -= w[upos[p]] * b[ucol[p]];
+        b[i] = sum * idiag[i];
+    }
+}
+
 int hydFactorW(hyd_solver* s, double gh) {
+    s->w_sparse = 0;
+    if (s->sp_on) {
+        const int rc = sp_factor(s, gh);
+        if (rc < 0) return HYD_ERR_SINGULAR;
+        if (rc == 0) {
+            s->w_sparse = 1;
+            s->w_valid = 1;
+            s->w_gh = gh;
+            s->st.lus++;
+            return HYD_OK;
+        }
+        s->sp_fallbacks++; // a weak diagonal pivot: the dense LU below
+    }
     for (int b = 0; b < s->nblock; ++b) {
         const int m = s->boff[b + 1] - s->boff[b];
         const double* jb = s->jb + s->moff[b];
@@ -188,6 +372,10 @@ int hydFactorW(hyd_solver* s, double gh) {
 }
 
 void hydSolveW(const hyd_solver* s, double* x) {
+    if (s->w_sparse) {
+        sp_solve(s, x);
+        return;
+    }
     const int* restrict bo = s->border;
     const int e1 = s->nb1, e2 = s->nb1 + s->nb2;
     for (int t = 0; t < e1; ++t) {

@@ -49,6 +49,7 @@ hyd_solver_opts hyd_default_solver_opts(void) {
     o.jac_every = 1;
     o.jac_max_age = 0.01; // SPEC 3.3: older J diverged at larger h [s]; <= 0: no limit
     o.max_steps = 100000000;
+    o.h_hold = 0.0;       // no step hysteresis
     return o;
 }
 
@@ -143,6 +144,33 @@ hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solv
     s->ft = q, q += n;
     s->widiag = q, q += n;
     s->bad_i = -1;
+    // Sparse path of a dense W (lu.c). Lists hold at most n(n-1)/2 entries.
+    if (dense && n >= 3) {
+        const size_t nn = (size_t)n * (size_t)n, tri = (size_t)n * (size_t)(n - 1) / 2;
+        s->sp_mask = calloc(nn, 1);
+        s->sp_lptr = calloc(3 * ((size_t)n + 1) + 5 * tri, sizeof(int));
+        s->sp_scale = calloc((size_t)n, sizeof(double));
+        s->sp_zmask = calloc(nn, sizeof(uint64_t));
+        s->sp_ppos = calloc(nn, sizeof(int));
+        if (!s->sp_mask || !s->sp_lptr || !s->sp_scale || !s->sp_zmask || !s->sp_ppos) {
+            hyd_solver_destroy(s);
+            return NULL;
+        }
+        for (int i = 0; i < n; ++i) {
+            s->sp_mask[(size_t)i * (size_t)n + (size_t)i] = 1;
+            s->sp_scale[i] = 1.0;
+        }
+        int* ip = s->sp_lptr + (n + 1);
+        s->sp_uptr = ip, ip += n + 1;
+        s->sp_fptr = ip, ip += n + 1;
+        s->sp_lrow = ip, ip += tri;
+        s->sp_ucol = ip, ip += tri;
+        s->sp_upos = ip, ip += tri;
+        s->sp_fpos = ip, ip += tri;
+        s->sp_fcol = ip, ip += tri;
+        s->sp_on = 1;
+        hydSparseInit(s);
+    }
     hyd_solver_reset(s);
     return s;
 }
@@ -157,6 +185,11 @@ void hyd_solver_destroy(hyd_solver* s) {
     free(s->piv);
     free(s->wswap);
     free(s->border);
+    free(s->sp_mask);
+    free(s->sp_lptr);
+    free(s->sp_scale);
+    free(s->sp_zmask);
+    free(s->sp_ppos);
     free(s);
 }
 
@@ -249,6 +282,14 @@ int hydPrepareW(hyd_solver* s, double t, const double* y, const double* f0, doub
     int need_j = !s->j_valid || s->j_force || s->j_steps >= (o->jac_every > 1 ? o->jac_every : 1) ||
                  (o->jac_max_age > 0.0 && fabs(t - s->j_t) > o->jac_max_age);
     if (need_j) {
+        if (s->sp_on) {
+            // State scales for the sparse LU's pivot test (lu.c): the error
+            // weights, so the test is blind to the states' units.
+            for (int i = 0; i < s->n; ++i) {
+                const double d = o->atol + o->rtol * fabs(y[i]);
+                s->sp_scale[i] = d > 0.0 && d <= DBL_MAX ? 1.0 / d : 1.0;
+            }
+        }
         int rc = eval_jacobian(s, t, y, f0, s->tab.gamma > 0.0 ? gh / s->tab.gamma : gh);
         if (rc != HYD_OK) return rc;
     }
@@ -410,15 +451,16 @@ static int initial_step(hyd_solver* s, double t, const double* y, const double* 
     return HYD_OK;
 }
 
-// Cubic Hermite interpolation on [t, t + h] from y0, f0, y1, f1 at theta.
-static void hermite(int n, double theta, double h, const double* y0, const double* f0,
-                    const double* y1, const double* f1, double* out) {
+// Cubic Hermite interpolation on [t, t + h] from y0, f0, y1, f1 at theta:
+// y0 + (theta + c0) (y1 - y0) + cf0 f0 + cf1 f1. The buffers never overlap
+// (restrict lets the loop vectorise without run-time alias checks).
+static void hermite(int n, double theta, double h, const double* restrict y0,
+                    const double* restrict f0, const double* restrict y1,
+                    const double* restrict f1, double* restrict out) {
     const double a = theta * (theta - 1.0);
-    const double c0 = (1.0 - 2.0 * theta) * a, cf0 = (theta - 1.0) * a * h, cf1 = theta * a * h;
-    for (int i = 0; i < n; ++i) {
-        double d = y1[i] - y0[i];
-        out[i] = y0[i] + theta * d + c0 * d + cf0 * f0[i] + cf1 * f1[i];
-    }
+    const double cd = theta + (1.0 - 2.0 * theta) * a, cf0 = (theta - 1.0) * a * h,
+                 cf1 = theta * a * h;
+    for (int i = 0; i < n; ++i) out[i] = y0[i] + cd * (y1[i] - y0[i]) + cf0 * f0[i] + cf1 * f1[i];
 }
 
 static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, long* budget,
@@ -507,6 +549,8 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
         // A step cut short only to land on t_end says nothing against the
         // proposal it replaced; frame boundaries must not throttle h.
         if (land && !s->last_rejected) h_new = fmax(h_new, h_prop);
+        // Hysteresis: a modest growth is not worth a new LU of W.
+        else if (s->o.h_hold > 0.0 && h_new >= h && h_new <= h * (1.0 + s->o.h_hold)) h_new = h;
         s->h_acc = h;
         s->err_acc = fmax(1e-2, en);
         s->have_acc = 1;

@@ -5,6 +5,8 @@
 
 #include "hyd_solver.h"
 
+#include <stdint.h>
+
 /// A linearly implicit method in the "original" form
 ///   (I - h gamma J) k_i = h f(t + c_i h, y + sum_j a_ij k_j) + h J sum_j g_ij k_j
 ///                         + gs_i h^2 df/dt
@@ -55,6 +57,31 @@ struct hyd_solver {
     int w_valid;   ///< w holds LU(I - w_gh J)
     double w_gh;   ///< gamma * h that w was factored with [s]
 
+    // Sparse path for a dense W (nblock == 1; lu.c). J's non-zeros seen so
+    // far (their union, plus the diagonal and the fill of an LU in natural
+    // order) are kept in sp_mask; W is factored without row exchanges over
+    // that pattern only, accepting a diagonal pivot when it is at least
+    // HYD_SP_THRESH times the largest entry below it in its column (threshold
+    // partial pivoting). Otherwise that W falls back to the dense LU with
+    // partial pivoting.
+    int sp_on;             ///< the sparse path is available (dense W, n >= 3)
+    int w_sparse;          ///< w holds a sparse, unpivoted factorisation
+    unsigned char* sp_mask;///< (n x n) pattern of W's factors
+    int* sp_lptr;          ///< (n + 1) column k of L: rows sp_lrow[sp_lptr[k] ..]
+    int* sp_lrow;
+    int* sp_uptr;          ///< (n + 1) row k of U right of the diagonal: sp_ucol[...]
+    int* sp_ucol;
+    int* sp_upos;          ///< position k*n + j of each sp_ucol entry
+    int* sp_fptr;          ///< (n + 1) row i of L left of the diagonal: sp_fpos/sp_fcol
+    int* sp_fpos;
+    int* sp_fcol;
+    double* sp_scale;      ///< (n) 1 / (atol + rtol |y_i|) at the Jacobian point: the
+                           ///< threshold test runs on D^-1 W D (state units differ)
+    uint64_t* sp_zmask;    ///< (n x n) magnitude-bit mask of the positions off the pattern
+    int* sp_ppos;          ///< (n x n) positions on the pattern, sp_np of them
+    int sp_np;
+    long sp_fallbacks;     ///< factorisations that needed the dense pivoting path
+
     // Stage work vectors, n each.
     double* k[4];
     double* hjk[4]; ///< h J k_i, recovered from the stage equations (no J product)
@@ -90,6 +117,8 @@ struct hyd_solver {
 
 // lu.c: build and factor W = I - gh J block by block, solve W x = b in place.
 int hydFactorW(hyd_solver* s, double gh);
+/// Symbolic set-up of the sparse path from sp_mask (the diagonal at create).
+void hydSparseInit(hyd_solver* s);
 void hydSolveW(const hyd_solver* s, double* x);
 
 // solver.c: make J and LU(W) current for a step of gamma*h = gh from (t, y),

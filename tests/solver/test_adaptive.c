@@ -77,6 +77,10 @@ static void test_l_stability(void) {
     }
 }
 
+// Work policy of a run: 0 as the defaults; 1 step hysteresis (h_hold) with a
+// J kept for many steps (W-method only) or fresh every step (RODAS3).
+static int g_reuse = 0;
+
 // Adaptive run from t0 to t1; returns rc and fills stats.
 static int run(hyd_method m, hyd_problem* p, double* y, double t1, double rtol, double atol,
                hyd_solver_stats* st) {
@@ -84,6 +88,10 @@ static int run(hyd_method m, hyd_problem* p, double* y, double t1, double rtol, 
     o.rtol = rtol;
     o.atol = atol;
     o.h = 0.0; // automatic initial step
+    if (g_reuse) {
+        o.h_hold = 0.5;
+        if (m == HYD_ROS34PW2) o.jac_every = 20, o.jac_max_age = 0.0;
+    }
     hyd_solver* s = hyd_solver_create(p, m, &o);
     double t = 0.0;
     int rc = hyd_solver_advance(s, &t, y, t1);
@@ -160,6 +168,33 @@ static void test_vdpol(void) {
     }
 }
 
+// Step hysteresis and J reuse: the same published references must hold, and W
+// must be refactored on fewer than all attempted steps (ROS34PW2). Order 3 of ROS34PW2
+// with a W from a stale J is test_ros34pw2_order3's J_BLOCK_STALE case.
+static void test_hold_and_reuse(void) {
+    g_reuse = 1;
+    test_robertson();
+    test_hires();
+    test_vdpol();
+    for (int m = HYD_ROS34PW2; m <= HYD_RODAS3; ++m) {
+        hyd_problem p = {0};
+        p.n = 8, p.f = hires_f, p.jac = hires_jac, p.autonomous = 1;
+        double y[8] = {1, 0, 0, 0, 0, 0, 0, 0.0057};
+        hyd_solver_stats st;
+        CHECK(run((hyd_method)m, &p, y, 321.8122, 1e-7, 1e-11, &st) == HYD_OK, "rc");
+        // RODAS3 needs a fresh J, hence a new W, on every step: only the
+        // W-method can keep W.
+        if (m == HYD_ROS34PW2) {
+            CHECK(st.lus < 0.9 * (double)(st.steps + st.rejected), "%ld LUs for %ld + %ld steps",
+                  st.lus, st.steps, st.rejected);
+            CHECK(st.jevals < st.steps / 2, "ros34pw2: %ld J for %ld steps", st.jevals, st.steps);
+        }
+        printf("  hires hold %-8s: %ld steps, %ld rejected, %ld J, %ld LU\n", hyd_method_name(m),
+               st.steps, st.rejected, st.jevals, st.lus);
+    }
+    g_reuse = 0;
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_ros34pw2_order3);
     RUN_TEST(test_rodas3_order3);
@@ -167,5 +202,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_robertson);
     RUN_TEST(test_hires);
     RUN_TEST(test_vdpol);
+    RUN_TEST(test_hold_and_reuse);
     TEST_MAIN_END();
 }

@@ -2,8 +2,10 @@
 // singular matrices.
 #include "check.h"
 #include "hyd_solver.h"
+#include "solver_internal.h" // the sparse path of a dense W (white-box)
 
 #include <stdint.h>
+#include <string.h>
 
 // Deterministic uniform numbers in [-1, 1) (xorshift64*), so the test is reproducible.
 static double urand(uint64_t* s) {
@@ -61,9 +63,101 @@ static void test_singular(void) {
     CHECK(hyd_lu_factor(nan, 2, piv) == -1, "NaN entry");
 }
 
+
+// ---- sparse path of a dense W (lu.c): W = I - gh J factored over J's learnt
+// pattern without row exchanges when the threshold test allows, else by the
+// dense partially pivoted LU. Both must solve W x = b.
+typedef struct spj {
+    int n;
+    double J[256];
+} spj;
+static int spj_f(void* user, double t, const double* y, double* dy) {
+    const spj* q = user;
+    (void)t;
+    for (int i = 0; i < q->n; ++i) {
+        dy[i] = 0.0;
+        for (int j = 0; j < q->n; ++j) dy[i] += q->J[i * q->n + j] * y[j];
+    }
+    return 0;
+}
+static int spj_jac(void* user, double t, const double* y, double* J) {
+    const spj* q = user;
+    (void)t, (void)y;
+    memcpy(J, q->J, sizeof(double) * (size_t)(q->n * q->n));
+    return 0;
+}
+
+// Factor W for gh, solve W x = b for a known x; returns the max error and
+// whether the sparse path was taken.
+static double spj_solve(hyd_solver* s, spj* q, double gh, int* sparse) {
+    const int n = q->n;
+    double y[16] = {0}, f0[16] = {0}, x[16] = {0}, b[16] = {0};
+    uint64_t seed = 0x1234567ULL + (uint64_t)(gh * 1e6);
+    for (int i = 0; i < n; ++i) y[i] = 1.0 + 0.1 * i, x[i] = urand(&seed);
+    spj_f(q, 0.0, y, f0);
+    s->j_force = 1;
+    int rc = hydPrepareW(s, 0.0, y, f0, gh);
+    CHECK(rc == HYD_OK, "prepare W rc %d", rc);
+    for (int i = 0; i < n; ++i) {
+        b[i] = x[i];
+        for (int j = 0; j < n; ++j) b[i] -= gh * q->J[i * n + j] * x[j];
+    }
+    hydSolveW(s, b);
+    *sparse = s->w_sparse;
+    double e = 0.0;
+    for (int i = 0; i < n; ++i) e = fmax(e, fabs(b[i] - x[i]));
+    return e;
+}
+
+static void test_sparse_w(void) {
+    uint64_t seed = 0xC0FFEEULL;
+    for (int n = 3; n <= 16; ++n) {
+        spj q = {.n = n};
+        // A stiff, sparse J: negative diagonal, about 3 off-diagonals per row.
+        for (int i = 0; i < n; ++i) {
+            q.J[i * n + i] = -10.0 - 100.0 * fabs(urand(&seed));
+            for (int k = 0; k < 3; ++k) {
+                int j = (int)((urand(&seed) + 1.0) * 0.5 * n) % n;
+                if (j != i) q.J[i * n + j] = 20.0 * urand(&seed);
+            }
+        }
+        hyd_problem p = {0};
+        p.n = n, p.f = spj_f, p.jac = spj_jac, p.user = &q, p.autonomous = 1;
+        hyd_solver* s = hyd_solver_create(&p, HYD_RODAS3, NULL);
+        CHECK(s && s->sp_on, "n = %d: sparse path available", n);
+        if (!s) continue;
+        int sparse = 0;
+        double e = spj_solve(s, &q, 0.01, &sparse);
+        CHECK(e < 1e-12, "n = %d sparse: error %.3g", n, e);
+        CHECK(sparse, "n = %d: diagonally dominant W takes the sparse path", n);
+        // A new non-zero grows the pattern (and its fill).
+        q.J[(n - 1) * n] = 50.0;
+        q.J[n - 1] = -30.0;
+        e = spj_solve(s, &q, 0.02, &sparse);
+        CHECK(e < 1e-12, "n = %d grown pattern: error %.3g", n, e);
+        // Zero the diagonal of W's first row (J_00 = 1/gh) and make the first
+        // column large: the threshold test must hand over to the pivoting LU.
+        const double gh = 0.05;
+        q.J[0] = 1.0 / gh;
+        q.J[1 * n + 0] = 500.0;
+        q.J[1] = 7.0;
+        long fb = s->sp_fallbacks;
+        e = spj_solve(s, &q, gh, &sparse);
+        CHECK(e < 1e-10, "n = %d fallback: error %.3g", n, e);
+        CHECK(!sparse && s->sp_fallbacks == fb + 1, "n = %d: weak pivot falls back", n);
+        // Non-finite J: W is singular, as with the dense LU.
+        q.J[2] = NAN;
+        double y[16] = {0}, f0[16] = {0};
+        s->j_force = 1;
+        CHECK(hydPrepareW(s, 0.0, y, f0, gh) == HYD_ERR_SINGULAR, "n = %d: NaN in J", n);
+        hyd_solver_destroy(s);
+    }
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_random_system);
     RUN_TEST(test_pivoting_needed);
     RUN_TEST(test_singular);
+    RUN_TEST(test_sparse_w);
     TEST_MAIN_END();
 }
