@@ -92,6 +92,12 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
         s->block[s->nblock++] = 1;
     }
     s->block[s->nblock++] = 4; // q1, q2, q1', q2'
+    for (int k = 0; k < 2; ++k) {
+        char path[96];
+        double tau = 0;
+        snprintf(path, sizeof path, "%s.tau", hyd_model_comp_name(hm, hyd_model_valve_comp(hm, m->valve[k])));
+        s->inv_tau[k] = hyd_model_get(hm, path, &tau) == 0 && tau > 0 ? 1.0 / tau : 0.0;
+    }
     for (int i = 0; i < s->nh; ++i) {
         const char* nm = strrchr(hyd_model_state_name(hm, s->perm[i]), '.');
         s->is_pressure[i] = nm && nm[1] == 'p';
@@ -112,6 +118,7 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
     p.n = s->n;
     p.f = lsim_rhs;
     p.jac = lsim_jac;
+    p.dfdt = lsim_dfdt;
     p.user = s;
     if (blocks) {
         p.nblock = s->nblock;
@@ -177,6 +184,15 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt) {
         dydt[iq + 2 + j] = qdd[j];
     }
     ++s->nrhs;
+    return 0;
+}
+
+int lsim_dfdt(void* user, double t, const double* y, double* dfdt) {
+    (void)y;
+    lsim* s = user;
+    for (int i = 0; i < s->n; ++i) dfdt[i] = 0.0;
+    if (!s->scn) return 0; // live commands are held constant over a step
+    for (int k = 0; k < 2; ++k) dfdt[s->iu[k]] = scenario_command_rate(s->scn, k, t) * s->inv_tau[k];
     return 0;
 }
 

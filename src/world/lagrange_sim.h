@@ -41,6 +41,7 @@ typedef struct lsim {
     // Scratch for the gather/scatter of the permuted hydraulic states.
     double yh_[LSIM_MAX_STATES], fh_[LSIM_MAX_STATES];
     double* jh_;           ///< nh x nh hydraulic Jacobian scratch (owned)
+    double inv_tau[2];     ///< 1 / spool time constant of actuator k's valve [1/s]
     long nrhs;             ///< right-hand-side calls
 } lsim;
 
@@ -59,6 +60,9 @@ hyd_problem lsim_problem(lsim* s, bool blocks);
 void lsim_initial_state(lsim* s, const double q0[2], double p_low, double* y);
 
 int lsim_rhs(void* user, double t, const double* y, double* dydt);
+/// df/dt: time enters only through the valve commands of the scenario, so
+/// only the spool rows are non-zero: (du_cmd/dt) / tau_s.
+int lsim_dfdt(void* user, double t, const double* y, double* dfdt);
 int lsim_jac(void* user, double t, const double* y, double* J);
 
 /// Derived outputs at (t, y), computed fresh (calls the rhs once).

@@ -127,6 +127,19 @@ double scenario_command(const scenario* s, int k, double t) {
     return g->u[i] + w * (g->u[i + 1] - g->u[i]);
 }
 
+double scenario_command_rate(const scenario* s, int k, double t) {
+    const scenario_signal* g = &s->cmd[k];
+    if (g->n < 2 || t < g->t[0] || t >= g->t[g->n - 1]) return 0.0;
+    int i = 0;
+    while (i + 1 < g->n && g->t[i + 1] <= t) ++i;
+    if (i + 1 >= g->n) return 0.0;
+    double dt = g->t[i + 1] - g->t[i];
+    double r = dt > 0 ? (g->u[i + 1] - g->u[i]) / dt : 0.0;
+    // The command is clamped to [-1, 1]; beyond that it does not move.
+    double u = scenario_command(s, k, t);
+    return (u >= 1.0 && r > 0) || (u <= -1.0 && r < 0) ? 0.0 : r;
+}
+
 static int cmp_double(const void* a, const void* b) {
     double x = *(const double*)a, y = *(const double*)b;
     return (x > y) - (x < y);

@@ -53,6 +53,10 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
 /// Command of channel k at time t [s] (piecewise-linear, clamped to [-1, 1]).
 double scenario_command(const scenario* s, int k, double t);
 
+/// Slope du/dt [1/s] of channel k at time t (0 outside the table and on
+/// flat segments; at a breakpoint, the slope of the segment that starts there).
+double scenario_command_rate(const scenario* s, int k, double t);
+
 /// Times [s] at which any command has a kink or step (for solver resets), in
 /// increasing order without duplicates. Returns the count (<= cap).
 int scenario_breakpoints(const scenario* s, double* t, int cap);
