@@ -57,6 +57,9 @@ void drive_session_destroy(drive_session* s);
 /// operator asked to quit, -1 on a numerical failure (message in
 /// drive_session_error), else 0.
 int drive_session_tick(drive_session* s, double wall);
+/// Idle for up to `left` seconds until the next tick: on the frame in flight
+/// if there is one (returning when the driver has finished it), else sleep.
+void drive_session_idle(drive_session* s, double left);
 
 /// Force a rendered frame now (e.g. before a screenshot).
 void drive_session_render(drive_session* s);

@@ -3,8 +3,9 @@
 // obstacles), built from a few joint angles with plain forward kinematics.
 // The demo program and the tests draw it; no physics is involved.
 //
-// Geometry follows assets/meshes/README.md: the slew axis is at the world
-// origin, the truck bed at z = 1.05 m, joint 1 is 1.6 m above the bed.
+// Geometry follows assets/worlds/sandbox.json and assets/models/hiab031.json
+// (as the generated meshes do, assets/meshes/README.md): the slew axis is at
+// the world origin, the truck bed at z = 1.1 m, joint 1 is 1.6 m above it.
 #include <math.h>
 
 #ifndef M_PI
@@ -135,59 +136,66 @@ void render_demo_scene(world_snapshot* s, const render_demo_params* p, float* te
         s->terrain.dx = s->terrain.dy = dx;
     }
 
-    // Truck: body origin at its chassis box centre; the mesh origin is on the
-    // ground under the slew axis, 1.2 m forward of that centre.
+    // Truck, as the sandbox world builds it (assets/worlds/sandbox.json
+    // "truck"; the meshes are generated from the same numbers): the truck
+    // frame's origin is on the ground, column_x behind the slew axis.
+    const double col_x = 0.9, bed = 1.1, chassis_h = 0.5;
+    const double tx = -col_x;
     world_snap_body* b =
-        add(s, "truck", WORLD_ROLE_TRUCK, WORLD_SHAPE_BOX, 7.6, 2.45, 1.0, truck_rgba);
-    set_pose(b, -1.2, 0, 0.6, 0);
-    set_mesh(b, m, "truck.obj", 1.2, 0, -0.6);
-    const double wheel_x[3] = {1.75, -3.05, -4.35};
-    for (int i = 0; i < 6; ++i) {
+        add(s, "truck", WORLD_ROLE_TRUCK, WORLD_SHAPE_BOX, 6.4, 2.3, chassis_h, truck_rgba);
+    // Body origin at the chassis box centre; the mesh origin is on the ground.
+    set_pose(b, tx, 0, bed - 0.5 * chassis_h, 0);
+    set_mesh(b, m, "truck.obj", 0, 0, -(bed - 0.5 * chassis_h));
+    const double wheel_x[2] = {2.1, -1.6}, wheel_r = 0.45, wheel_z = 0.5, track = 1.9;
+    for (int i = 0; i < 4; ++i) {
         char nm[16];
         snprintf(nm, sizeof nm, "wheel_%d", i);
-        double y = (i & 1) ? -1.0 : 1.0;
-        b = add(s, nm, WORLD_ROLE_WHEEL, WORLD_SHAPE_CYLINDER, 0.5, 0.4, 0, dark_rgba);
+        double y = (i & 1) ? -0.5 * track : 0.5 * track;
+        b = add(s, nm, WORLD_ROLE_WHEEL, WORLD_SHAPE_CYLINDER, wheel_r, 0.3, 0, dark_rgba);
         if (!b) break;
-        b->pos[0] = wheel_x[i / 2], b->pos[1] = y, b->pos[2] = 0.5;
+        b->pos[0] = tx + wheel_x[i / 2], b->pos[1] = y, b->pos[2] = wheel_z;
         // Cylinder axis (body z) along world y; the wheel mesh has its axle on y already.
         double r[9] = {1, 0, 0, 0, 0, -1, 0, 1, 0};
         memcpy(b->rot, r, sizeof r);
         if (m) {
             set_mesh(b, m, "wheel.obj", 0, 0, 0);
             // The mesh is modelled axle-along-y: undo the primitive's rotation.
-            b->rot[0] = 1, b->rot[1] = 0, b->rot[2] = 0;
-            b->rot[3] = 0, b->rot[4] = 1, b->rot[5] = 0;
-            b->rot[6] = 0, b->rot[7] = 0, b->rot[8] = 1;
-            if (y < 0) rot_z(b->rot, M_PI);
+            rot_z(b->rot, y < 0 ? M_PI : 0.0);
         }
     }
-    for (int side = 0; side < 2; ++side) {
-        b = add(s, side ? "outrigger_r" : "outrigger_l", WORLD_ROLE_OUTRIGGER, WORLD_SHAPE_BOX,
-                0.22, 2.1, 0.22, crane_rgba);
-        double sg = side ? -1.0 : 1.0;
-        set_pose(b, -0.75, sg * 1.35, 0.75, side ? M_PI : 0);
-        set_mesh(b, m, "outrigger.obj", 0, -1.35, 0);
+    // Outriggers: beam from the chassis side (y 1.15) to the jack at half the
+    // 4 m span, at the beam height 0.7 m; the mesh origin is on the centreline.
+    const double outrigger_x[2] = {1.0, -2.9};
+    for (int i = 0; i < 4; ++i) {
+        char nm[16];
+        snprintf(nm, sizeof nm, "outrigger_%d", i);
+        b = add(s, nm, WORLD_ROLE_OUTRIGGER, WORLD_SHAPE_BOX, 0.2, 1.0, 0.2, crane_rgba);
+        double sg = (i & 1) ? -1.0 : 1.0;
+        set_pose(b, tx + outrigger_x[i / 2], sg * 1.65, 0.7, (i & 1) ? M_PI : 0);
+        set_mesh(b, m, "outrigger.obj", 0, -1.65, 0);
     }
 
-    // Crane: column slews about the world z axis at the origin.
-    const double bed = 1.05;
+    // Crane (assets/models/hiab031.json mechanics): the column slews about
+    // the world z axis at the origin; joint 1 is on the slew axis, 1.6 m
+    // above the bed.
+    const double H = 1.6;
     double rc[9], r1[9], r2[9], e[9];
     rot_z(rc, p->slew);
-    b = add(s, "column", WORLD_ROLE_COLUMN, WORLD_SHAPE_CYLINDER, 0.2, 1.6, 0, crane_rgba);
+    b = add(s, "column", WORLD_ROLE_COLUMN, WORLD_SHAPE_CYLINDER, 0.16, H, 0, crane_rgba);
     double col_pos[3] = {0, 0, bed};
     if (b) {
         memcpy(b->pos, col_pos, sizeof col_pos);
         memcpy(b->rot, rc, sizeof rc);
         // Primitive cylinder is centred; the mesh origin is at the column foot.
-        b->pos[2] = bed + 0.8;
-        set_mesh(b, m, "column.obj", 0, 0, -0.8);
+        b->pos[2] = bed + 0.5 * H;
+        set_mesh(b, m, "column.obj", 0, 0, -0.5 * H);
     }
     double j1[3];
-    xform(j1, col_pos, rc, 0.15, 0, 1.6);
+    xform(j1, col_pos, rc, 0, 0, H);
     rot_elev(e, p->q1_deg * DEG);
     mat_mul(r1, rc, e);
     const double L1 = 2.3, L2 = 2.5;
-    b = add(s, "boom1", WORLD_ROLE_BOOM1, WORLD_SHAPE_BOX, L1 + 0.3, 0.26, 0.32, crane_rgba);
+    b = add(s, "boom1", WORLD_ROLE_BOOM1, WORLD_SHAPE_BOX, L1, 0.18, 0.24, crane_rgba);
     if (b) {
         xform(b->pos, j1, r1, 0.5 * L1, 0, 0);
         memcpy(b->rot, r1, sizeof r1);
@@ -197,7 +205,7 @@ void render_demo_scene(world_snapshot* s, const render_demo_params* p, float* te
     xform(j2, j1, r1, L1, 0, 0);
     rot_elev(e, p->q2_deg * DEG);
     mat_mul(r2, r1, e);
-    b = add(s, "boom2", WORLD_ROLE_BOOM2, WORLD_SHAPE_BOX, L2 + 0.2, 0.2, 0.24, crane_rgba);
+    b = add(s, "boom2", WORLD_ROLE_BOOM2, WORLD_SHAPE_BOX, L2, 0.15, 0.2, crane_rgba);
     if (b) {
         xform(b->pos, j2, r2, 0.5 * L2, 0, 0);
         memcpy(b->rot, r2, sizeof r2);
@@ -205,15 +213,16 @@ void render_demo_scene(world_snapshot* s, const render_demo_params* p, float* te
     }
     xform(s->tip, j2, r2, L2, 0, 0);
 
-    // Lift cylinder: column foot (front) to under boom 1; jib cylinder: top
-    // of boom 1 to the end arm's lever above joint 2.
+    // Cylinders between the model's mounts: lift from the column (relative to
+    // joint 1) to under the lifting arm; jib from the lifting arm (relative to
+    // joint 2) to the end arm.
     double a0[3], a1[3];
-    xform(a0, col_pos, rc, 0.38, 0, 0.45);
-    xform(a1, j1, r1, 0.85, 0, -0.24);
-    cylinder(&s->cyl[0], "lift", a0, a1, 0.100, 0.060, 0.95, 0.70, p->pA[0], p->pB[0], p->u[0]);
-    xform(a0, j1, r1, 0.55, 0, 0.26);
-    xform(a1, j2, r2, -0.30, 0, 0.30);
-    cylinder(&s->cyl[1], "jib", a0, a1, 0.080, 0.045, 1.45, 0.60, p->pA[1], p->pB[1], p->u[1]);
+    xform(a0, j1, rc, 0.2113, 0, -0.4532);
+    xform(a1, j1, r1, 1.5541, 0, -0.1360);
+    cylinder(&s->cyl[0], "lift", a0, a1, 0.100, 0.060, 1.2201, 0.70, p->pA[0], p->pB[0], p->u[0]);
+    xform(a0, j2, r1, -1.1954, 0, 0.1046);
+    xform(a1, j2, r2, 0.3864, 0, -0.1035);
+    cylinder(&s->cyl[1], "jib", a0, a1, 0.080, 0.045, 0.902, 0.60, p->pA[1], p->pB[1], p->u[1]);
     s->ncyl = 2;
 
     // Rope and hook: hanging 1.7 m under the tip, swung slightly.

@@ -66,6 +66,7 @@ void render_destroy(render* r) {
     if (!r) return;
     if (r->gl) {
         SDL_GL_MakeCurrent(r->win, r->gl);
+        if (r->frame_fence) glDeleteSync(r->frame_fence);
         if (r->panel_gui) panel_gui_shutdown(r->panel);
         render_mesh_cache_free(&r->meshes);
         render_scene_free(&r->scene);
@@ -129,15 +130,37 @@ void render_frame(render* r, const world_snapshot* snap) {
 }
 
 void render_present(render* r) {
+    SDL_GL_MakeCurrent(r->win, r->gl);
+    if (!r->cfg.offscreen) render_blit_to_window(r);
+    // A fence after the frame's last command tells render_busy() when the
+    // driver has finished it. One at a time: the previous one is signalled or
+    // superseded (fences complete in order).
+    if (r->frame_fence) glDeleteSync(r->frame_fence);
+    r->frame_fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     if (r->cfg.offscreen) {
-        // Nothing to show. Flush (not finish): llvmpipe can then bin the next
-        // frame while its threads still rasterise this one, as with a swap.
-        // Read-back (render_read_pixels) waits for the frame by itself.
+        // Nothing to show. Flush (not finish): the driver starts drawing now
+        // and the caller goes on; read-back (render_read_pixels) waits for
+        // the frame by itself.
         glFlush();
         return;
     }
-    render_blit_to_window(r);
     SDL_GL_SwapWindow(r->win);
+}
+
+bool render_busy(render* r) {
+    return !render_wait(r, 0.0);
+}
+
+bool render_wait(render* r, double timeout_s) {
+    if (!r->frame_fence) return true;
+    SDL_GL_MakeCurrent(r->win, r->gl);
+    // The frame was flushed in render_present, so no flush bit is needed.
+    GLuint64 ns = timeout_s > 0 ? (GLuint64)(timeout_s * 1e9) : 0;
+    GLenum st = glClientWaitSync(r->frame_fence, 0, ns);
+    if (st == GL_TIMEOUT_EXPIRED) return false;
+    glDeleteSync(r->frame_fence);
+    r->frame_fence = 0;
+    return true;
 }
 
 void render_set_camera_preset(render* r, render_cam_preset p) {

@@ -86,8 +86,18 @@ bool render_handle_event(render* r, const SDL_Event* ev);
 
 /// Draw one frame of the snapshot (scene, shadows, HUD, charts, panel).
 void render_frame(render* r, const world_snapshot* snap);
-/// Swap buffers (window mode); no-op offscreen.
+/// Swap buffers (window mode); offscreen only flushes. Either way it marks
+/// the end of the frame for render_busy().
 void render_present(render* r);
+/// True while the driver is still drawing the last presented frame. A loop
+/// that starts the next frame only when this is false never blocks inside
+/// render_frame() waiting for queued frames (llvmpipe keeps just a couple of
+/// scenes in flight), so it can keep stepping physics and reading input.
+bool render_busy(render* r);
+/// Sleep until the driver has finished the last presented frame or
+/// timeout_s has passed; returns !render_busy(). Lets a paced loop idle on
+/// the frame instead of a fixed delay, so the next frame can start at once.
+bool render_wait(render* r, double timeout_s);
 
 /// Save the last rendered frame as PNG (before or after render_present).
 /// Returns 0 on success, -1 on failure (message on stderr naming the file).

@@ -223,6 +223,7 @@ struct render {
     double frame_dt_avg; ///< smoothed wall time between frames [s]
     double fps_avg;      ///< 1 / frame_dt_avg, shown in the HUD [1/s]
     Uint64 last_frame_ticks;
+    GLsync frame_fence; ///< signalled when the last presented frame is drawn, 0 if none
 };
 
 /// Resize the offscreen/multisample targets to w x h.

@@ -215,6 +215,9 @@ void render_scene_free(render_scene* sc) {
 
 /// Rebuild the heightfield mesh only when the snapshot points at a different
 /// grid: the world owns the heights and they do not change during a run.
+/// Cells per side of the drawn terrain mesh at most (see update_terrain).
+#define TERRAIN_MAX_CELLS 64
+
 static void update_terrain(render_scene* sc, const world_snap_terrain* t) {
     if (t->nx < 2 || t->ny < 2 || !t->height) return;
     if (sc->terrain.vao && sc->terrain_src == t->height && sc->terrain_nx == t->nx &&
@@ -247,13 +250,25 @@ static void update_terrain(render_scene* sc, const world_snap_terrain* t) {
             p->n[0] = n.x, p->n[1] = n.y, p->n[2] = n.z;
             p->c[0] = p->c[1] = p->c[2] = 1.0f;
         }
+    // Triangles over every s-th sample (s chosen for at most 64 cells per
+    // side, plus the last row/column), vertices keep their exact heights and
+    // full-resolution normals. The sandbox's 121 x 121 field drew 28,800
+    // mostly sub-pixel triangles out to the horizon, about 4.5 ms per frame
+    // of llvmpipe setup; at stride 2 its flat work area is unchanged and the
+    // gentle hills differ by centimetres between samples.
+    int sx = (nx - 1 + TERRAIN_MAX_CELLS - 1) / TERRAIN_MAX_CELLS;
+    int sy = (ny - 1 + TERRAIN_MAX_CELLS - 1) / TERRAIN_MAX_CELLS;
     int k = 0;
-    for (int j = 0; j < ny - 1; ++j)
-        for (int i = 0; i < nx - 1; ++i) {
-            unsigned a = (unsigned)(j * nx + i), b = a + 1, c = a + (unsigned)nx, d = c + 1;
+    for (int j = 0; j < ny - 1; j += sy) {
+        int j1 = j + sy < ny - 1 ? j + sy : ny - 1;
+        for (int i = 0; i < nx - 1; i += sx) {
+            int i1 = i + sx < nx - 1 ? i + sx : nx - 1;
+            unsigned a = (unsigned)(j * nx + i), b = (unsigned)(j * nx + i1);
+            unsigned c = (unsigned)(j1 * nx + i), d = (unsigned)(j1 * nx + i1);
             idx[k++] = a, idx[k++] = b, idx[k++] = d;
             idx[k++] = a, idx[k++] = d, idx[k++] = c;
         }
+    }
     sc->terrain = render_mesh_upload(v, nx * ny, idx, k);
     free(v);
     free(idx);

@@ -221,6 +221,8 @@ void live_snapshot(live* l, world_snapshot* s) {
                        load[4] = {0.5f, 0.35f, 0.2f, 1};
     const double colpos[3] = {0, 0, 0.5 * H};
     add_body(s, "column", WORLD_ROLE_COLUMN, WORLD_SHAPE_CYLINDER, colpos, I, 0.18, H, 0, grey, "column.obj");
+    // The cylinder is centred at mid-height; the column mesh's origin is its foot.
+    s->body[s->nbody - 1].mesh_offset[2] = -0.5 * H;
     // Link frames: elevation a1 = q1 - pi/2, a2 = a1 + q2; joint 1 at (0, 0, H).
     const double a1 = o.q[0] - M_PI / 2, a2 = a1 + o.q[1];
     const double j1[3] = {0, 0, H};
@@ -241,7 +243,9 @@ void live_snapshot(live* l, world_snapshot* s) {
     s->body[s->nbody - 1].mesh_offset[0] = -0.5 * L[1].length;
     const double tip[3] = {j2[0] + L[1].length * cos(a2), 0, j2[2] + L[1].length * sin(a2)};
     const double lp[3] = {tip[0], 0, tip[2] - 0.35};
-    add_body(s, "load", WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, lp, I, 0.6, 0.6, 0.6, load, "load_block.obj");
+    // Box the size of load_block.obj (1.2 x 0.6 x 0.6, origin at its centre),
+    // so mesh and fallback primitive cover the same space.
+    add_body(s, "load", WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, lp, I, 1.2, 0.6, 0.6, load, "load_block.obj");
     memcpy(s->tip, tip, sizeof s->tip);
     memcpy(s->hook, tip, sizeof s->hook);
     s->load_mass = l->ls.m3;

@@ -131,7 +131,16 @@ static void build_truck(ode_world* w, const double T[3], const double R[9]) {
     double p[3] = {0, 0, k->bed_height - 0.5 * k->chassis[2]};
     truck_box(w, "truck", WORLD_ROLE_TRUCK, RGBA_TRUCK, WORLD_MESH_TRUCK, k->chassis, p, 1);
     double pc[3] = {k->cab_x, 0, k->bed_height - k->chassis[2] + 0.5 * k->cab[2] + 0.15};
-    truck_box(w, "cab", WORLD_ROLE_TRUCK, RGBA_CAB, -1, k->cab, pc, 1);
+    if (w->desc.mesh[WORLD_MESH_TRUCK].file[0]) {
+        // The truck mesh has its own cab (drawn on the chassis entry): the
+        // cab box only collides, so it is not drawn twice.
+        dGeomID g = dCreateBox(w->dyn_space, k->cab[0], k->cab[1], k->cab[2]);
+        dGeomSetBody(g, w->truck);
+        dGeomSetOffsetPosition(g, pc[0] + w->truck_org[0], pc[1] + w->truck_org[1], pc[2] + w->truck_org[2]);
+        ow_add_geom(w, g, OW_CAT_TRUCK, k->friction);
+    } else {
+        truck_box(w, "cab", WORLD_ROLE_TRUCK, RGBA_CAB, -1, k->cab, pc, 1);
+    }
 
     // Wheels: spheres for contact (robust on a heightfield), cylinders for
     // drawing. With outriggers out the wheels hang 5 cm clear of the ground.

@@ -7,12 +7,18 @@ x along the boom toward the next joint). Materials are colour *tints*
 (materials.mtl): the renderer multiplies each material's Kd by the body's
 rgba, so "paint" (Kd 1) takes the body colour and rubber/glass stay dark.
 
-Usage:  python3 tools/meshgen/meshgen.py [out_dir]   (default: assets/meshes)
+The truck, wheel, outrigger, column and boom meshes are sized from the world
+file's "truck" section and the crane model's "mechanics" (and cylinder bores),
+so they match the physics bodies and the cylinder mounts.
+
+Usage:  python3 tools/meshgen/meshgen.py [out_dir] [--world W] [--model M] [--write-offsets]
+        (defaults: assets/meshes, assets/worlds/sandbox.json, assets/models/hiab031.json)
 Pure Python 3, no dependencies; the output is deterministic.
 """
+import argparse
+import json
 import math
 import os
-import sys
 
 
 class Mesh:
@@ -281,195 +287,367 @@ def pin_y(m, mat, x, z, r, half, seg=16):
 
 # ---- the meshes -----------------------------------------------------------------------
 
-def truck():
-    """Origin on the ground under the slew axis, x forward, bed top at z 1.05."""
+# ---- geometry from the world and model files --------------------------------------------
+#
+# The truck, wheel, outrigger, column and boom meshes are built from the same
+# numbers the physics uses (assets/worlds/sandbox.json "truck",
+# assets/models/hiab031.json "mechanics"), so the brackets sit exactly on the
+# cylinder mounts and the truck on its wheels and pads. Change those files and
+# rerun this script; --write-offsets also updates the world file's mesh offsets.
+
+class Geo:
+    """The numbers the meshes need, read from the world and model files."""
+
+    def __init__(self, world, model):
+        t = world["truck"]
+        self.chassis = t["chassis"]                 # [l, w, h]
+        self.bed = t["bed_height"]                  # bed top above the ground
+        self.cab = t["cab"]                         # [l, w, h]
+        self.cab_x = t["cab_x"]
+        self.wheel_r = t["wheel_radius"]
+        self.wheel_w = t["wheel_width"]
+        self.wheel_x = t["wheel_x"]
+        self.track = t["track"]
+        # With outriggers out the physics hangs the wheels 5 cm clear of the
+        # ground (ode_sandbox.c, build_truck).
+        self.wheel_z = self.wheel_r + (0.05 if t.get("outriggers", True) else 0.0)
+        self.outrigger_x = t["outrigger_x"]
+        self.span = t["outrigger_span"]
+        self.pad = t["pad"]
+        self.column_x = t["column_x"]
+        # Outrigger beam height: the centre of the beam box ode_sandbox.c draws.
+        self.beam_z = self.bed - self.chassis[2] + 0.1
+        # Physics cab box: its bottom is 0.15 above the chassis box's bottom.
+        self.cab_z0 = self.bed - self.chassis[2] + 0.15
+        me = model["mechanics"]
+        self.col_h = me["column"]["height"]
+        self.col_r = world.get("slew", {}).get("column_radius", 0.16)
+        self.links = me["links"]
+        self.L1, self.L2 = self.links[0]["length"], self.links[1]["length"]
+        act = {a["name"]: a for a in me["actuators"]}
+        lift, jib = act["lift"], act["jib"]
+        # Mount points in each mesh's own frame (x along, z up, y = 0):
+        # the lift base is relative to joint 1 in the column frame, and the
+        # column mesh's origin is the column foot, col_h below joint 1.
+        self.lift_base = (lift["base_mount"][0], lift["base_mount"][1] + self.col_h)
+        self.lift_rod = tuple(lift["rod_mount"])                      # boom1 frame
+        # The jib base is relative to joint 2 in the lifting-arm frame.
+        self.jib_base = (jib["base_mount"][0] + self.L1, jib["base_mount"][1])  # boom1 frame
+        self.jib_rod = tuple(jib["rod_mount"])                        # boom2 frame
+        cyl = {c["name"]: c for c in model["hydraulics"]["components"] if c.get("type") == "cylinder"}
+        # Outer barrel radius as the renderer draws it (docs/render.md: 1.28 bore/2)
+        # and the rod-eye radius (cyl_rod.obj: 1.4 x rod radius).
+        self.lift_barrel = 1.28 * 0.5 * cyl[lift["cylinder"]]["bore"]
+        self.jib_barrel = 1.28 * 0.5 * cyl[jib["cylinder"]]["bore"]
+        self.lift_eye = 1.4 * 0.5 * cyl[lift["cylinder"]]["rod"]
+        self.jib_eye = 1.4 * 0.5 * cyl[jib["cylinder"]]["rod"]
+        slew = world.get("slew", {})
+        sc = [c for c in world.get("circuit", {}).get("components", []) if c.get("name") == slew.get("cylinder")]
+        self.slew_stroke = sc[0]["stroke"] if sc else 0.6
+
+    def offsets(self):
+        """Mesh origin in each physics body's primitive frame (world file "offset")."""
+        return {
+            # The chassis box is centred half its height under the bed top;
+            # the truck mesh's origin is on the ground.
+            "truck": [0.0, 0.0, -round(self.bed - 0.5 * self.chassis[2], 6)],
+            # The column cylinder is centred at mid-height; the mesh origin is its foot.
+            "column": [0.0, 0.0, -round(0.5 * self.col_h, 6)],
+            # Boom boxes are centred on the link; the meshes' origins are the root joints.
+            "boom1": [-round(0.5 * self.L1, 6), 0.0, 0.0],
+            "boom2": [-round(0.5 * self.L2, 6), 0.0, 0.0],
+        }
+
+
+def truck(g):
+    """Truck frame: origin on the ground at the truck's reference point (the
+    physics truck position), x forward, z up; bed top at g.bed. Chassis, cab,
+    axles and mudguards follow the physics boxes and wheels; the crane foot
+    (fixed slewing-ring housing) stands at column_x."""
     m = Mesh("truck")
-    # Chassis rails and cross members.
-    for y in (-0.48, 0.48):
-        box(m, "dark", (-5.0, y - 0.05, 0.70), (2.45, y + 0.05, 0.98))
-    for x in (-4.8, -3.7, -2.4, -1.3, 0.9, 2.2):
-        box(m, "dark", (x - 0.05, -0.48, 0.74), (x + 0.05, 0.48, 0.94))
-    # Crane subframe and outrigger housing (the beams slide in it).
-    box(m, "dark", (-0.75, -0.62, 0.90), (0.75, 0.62, 1.05))
-    box(m, "paint2", (-0.90, -1.12, 0.62), (-0.60, 1.12, 0.90))
-    # Flat bed with drop sides and headboard.
-    box(m, "deck", (-5.05, -1.24, 0.98), (-0.85, 1.24, 1.08))
-    for y in (-1.24, 1.20):
-        box(m, "paint", (-5.05, y, 1.08), (-0.85, y + 0.04, 1.45))
-    box(m, "paint", (-5.05, -1.24, 1.08), (-5.01, 1.24, 1.45))
-    box(m, "paint", (-0.95, -1.24, 1.08), (-0.85, 1.24, 1.80))
-    for x in (-4.1, -3.1, -2.1, -1.5):
-        for y in (-1.25, 1.21):
-            box(m, "steel", (x - 0.03, y - 0.005, 1.08), (x + 0.03, y + 0.045, 1.45))
-    # Cab: a side profile with a raked windscreen, extruded across the width,
-    # then glass, grille, bumper, lights, mirrors, steps and sun visor.
-    prof = [(0.85, 0.95), (2.58, 0.95), (2.62, 1.62), (2.50, 2.05), (2.30, 2.88), (2.15, 3.0), (0.95, 3.0), (0.85, 2.9)]
-    extrude_y(m, "paint", prof, -1.22, 1.22)
+    L, W, H = g.chassis
+    x_rear, x_front = -0.5 * L, 0.5 * L
+    bed = g.bed
+    cl, cw, ch = g.cab
+    xr, xf = g.cab_x - 0.5 * cl, g.cab_x + 0.5 * cl
+    top = g.cab_z0 + ch
+    wz, wr = g.wheel_z, g.wheel_r
+    arch = wr + 0.08                      # mudguard radius
+    hw = 0.5 * W
+    # Frame rails and cross members under the bed, inside the chassis box.
+    rail_y, rail_top = 0.45, bed - 0.1
+    for y in (-rail_y, rail_y):
+        box(m, "dark", (x_rear + 0.05, y - 0.05, rail_top - 0.28), (x_front - 0.25, y + 0.05, rail_top))
+    nx = max(3, int(L / 1.1))
+    for k in range(nx):
+        x = x_rear + 0.15 + (L - 0.6) * k / (nx - 1)
+        box(m, "dark", (x - 0.05, -rail_y, rail_top - 0.24), (x + 0.05, rail_y, rail_top - 0.04))
+    # Outrigger housings across the frame at the physics beam positions.
+    for x in g.outrigger_x:
+        box(m, "paint2", (x - 0.15, -hw, g.beam_z - 0.11), (x + 0.15, hw, g.beam_z + 0.11))
+    # Flat bed behind the crane foot, with drop sides and a headboard.
+    foot = 0.5                                     # crane foot half length
+    x_hb = g.column_x - foot - 0.05
+    box(m, "deck", (x_rear, -hw, bed - 0.1), (x_hb, hw, bed))
+    for y in (-hw, hw - 0.04):
+        box(m, "paint", (x_rear, y, bed), (x_hb, y + 0.04, bed + 0.35))
+    box(m, "paint", (x_rear, -hw, bed), (x_rear + 0.04, hw, bed + 0.35))
+    box(m, "paint", (x_hb - 0.1, -hw, bed), (x_hb, hw, bed + 0.75))
+    nst = max(2, int((x_hb - x_rear) / 1.0))
+    for k in range(1, nst):
+        x = x_rear + (x_hb - x_rear) * k / nst
+        for y in (-hw - 0.005, hw - 0.04):
+            box(m, "steel", (x - 0.03, y, bed), (x + 0.03, y + 0.045, bed + 0.35))
+    # Crane foot: base plate on the frame, fixed slewing-ring housing around
+    # the column (the column mesh turns above it); the slew rack cylinder is
+    # drawn by the renderer 0.35 m behind the axis, so the housing clears it.
+    cx = g.column_x
+    box(m, "paint2", (cx - foot, -0.55, bed - 0.1), (cx + foot, 0.55, bed + 0.04))
+    cyl(m, "paint", 0.26, bed + 0.04, bed + 0.28, 32, centre=(cx, 0, 0))
+    cyl(m, "dark", 0.29, bed + 0.28, bed + 0.32, 32, centre=(cx, 0, 0))
+    # Rack guide blocks at both ends of the slew cylinder's travel.
+    half_rack = 0.5 * (2 * g.slew_stroke + 0.2) + 0.05
+    for s in (-1, 1):
+        box(m, "paint2", (cx - 0.45, s * half_rack - 0.05, bed + 0.04), (cx - 0.25, s * half_rack + 0.05, bed + 0.26))
+    # Cab: side profile with a raked windscreen, extruded across the width.
+    # It sits above the front wheel's arch; the physics cab box is the same
+    # length, width and top.
+    zb = wz + arch + 0.03
+    ws0, ws1 = (xf, zb + 0.62), (xf - 0.28, top - 0.08)
+    prof = [(xr, zb), (xf, zb), ws0, ws1, (xf - 0.38, top), (xr + 0.05, top), (xr, top - 0.05)]
+    ch_w = 0.5 * cw - 0.02
+    extrude_y(m, "paint", prof, -ch_w, ch_w)
     # Windscreen: a thin slab just outside the raked face.
-    a, b = (2.50, 2.05), (2.30, 2.88)
-    nx, nz = (b[1] - a[1]), -(b[0] - a[0])
-    ln = math.hypot(nx, nz)
-    nx, nz = nx / ln * 0.012, nz / ln * 0.012
-    m.flat_poly("glass", [(a[0] + nx + 0.0, -1.08, a[1] + nz + 0.06), (a[0] + nx, 1.08, a[1] + nz + 0.06),
-                          (b[0] + nx, 1.08, b[1] + nz - 0.08), (b[0] + nx, -1.08, b[1] + nz - 0.08)])
-    for y, s in ((1.225, 1), (-1.225, -1)):
-        pts = [(1.55, y, 2.05), (2.42, y, 2.05), (2.25, y, 2.80), (1.55, y, 2.80)]
-        m.flat_poly("glass", pts[::-1] if s > 0 else pts)
-        pts = [(0.98, y, 2.05), (1.45, y, 2.05), (1.45, y, 2.80), (0.98, y, 2.80)]
-        m.flat_poly("glass", pts[::-1] if s > 0 else pts)
-        # Door seam and handle.
-        box(m, "dark", (1.48, y - 0.004 * s - 0.004, 1.05), (1.51, y + 0.004 * s + 0.004, 2.85))
-        box(m, "steel", (1.30, y - 0.02, 1.90), (1.45, y + 0.02, 1.94))
+    a, b = ws0, ws1
+    nnx, nnz = (b[1] - a[1]), -(b[0] - a[0])
+    ln = math.hypot(nnx, nnz)
+    nnx, nnz = nnx / ln * 0.012, nnz / ln * 0.012
+    gy = ch_w - 0.12
+    m.flat_poly("glass", [(a[0] + nnx, -gy, a[1] + nnz + 0.06), (a[0] + nnx, gy, a[1] + nnz + 0.06),
+                          (b[0] + nnx, gy, b[1] + nnz - 0.06), (b[0] + nnx, -gy, b[1] + nnz - 0.06)])
+    zw0, zw1 = zb + 0.66, top - 0.15
+    for y, s in ((ch_w + 0.004, 1), (-ch_w - 0.004, -1)):
+        # Side window (door) and rear quarter window, door seam and handle.
+        xw = xf - 0.12 - (zw0 - ws0[1]) * (ws0[0] - ws1[0]) / (ws1[1] - ws0[1])
+        xw1 = xf - 0.12 - (zw1 - ws0[1]) * (ws0[0] - ws1[0]) / (ws1[1] - ws0[1])
+        xd = xr + 0.45
+        pts = [(xd + 0.05, y, zw0), (xw, y, zw0), (xw1, y, zw1), (xd + 0.05, y, zw1)]
+        m.flat_poly("glass", pts[::-1] if s < 0 else pts)
+        pts = [(xr + 0.1, y, zw0), (xd - 0.05, y, zw0), (xd - 0.05, y, zw1), (xr + 0.1, y, zw1)]
+        m.flat_poly("glass", pts[::-1] if s < 0 else pts)
+        box(m, "dark", (xd - 0.015, y - 0.004, zb + 0.05), (xd + 0.015, y + 0.004, top - 0.08))
+        box(m, "steel", (xd + 0.05, y - 0.02 * s if s < 0 else y, zb + 0.55), (xd + 0.2, y + 0.02 if s > 0 else y, zb + 0.59))
         # Mirror arm and head.
-        box(m, "dark", (2.30, y, 2.45), (2.36, y + 0.25 * s, 2.49))
-        box(m, "dark", (2.28, y + 0.22 * s - 0.04, 2.10), (2.38, y + 0.22 * s + 0.04, 2.55))
-        # Steps.
-        for z in (0.55, 0.80):
-            box(m, "steel", (1.60, y - 0.18 * s - 0.06, z), (2.20, y - 0.18 * s + 0.06, z + 0.04))
-    box(m, "dark", (2.58, -0.80, 1.15), (2.64, 0.80, 1.60))          # grille
-    for z in (1.22, 1.32, 1.42, 1.52):
-        box(m, "steel", (2.63, -0.78, z), (2.66, 0.78, z + 0.03))
-    box(m, "dark", (2.55, -1.25, 0.62), (2.78, 1.25, 0.95))          # bumper
-    for y in (-0.95, 0.95):
-        box(m, "light", (2.76, y - 0.18, 0.78), (2.80, y + 0.18, 0.90))
-    box(m, "paint", (2.18, -1.15, 2.98), (2.45, 1.15, 3.03))         # sun visor
+        box(m, "dark", (xf - 0.2, min(y, y + 0.25 * s), zw0 + 0.3), (xf - 0.14, max(y, y + 0.25 * s), zw0 + 0.34))
+        box(m, "dark", (xf - 0.22, y + 0.22 * s - 0.04, zw0 - 0.05), (xf - 0.12, y + 0.22 * s + 0.04, zw0 + 0.40))
+        # Steps behind the front wheel, below the door.
+        for z in (zb - 0.45, zb - 0.2):
+            box(m, "steel", (xr + 0.02, y - 0.16 * s - 0.06, z), (min(xd, g.wheel_x[0] - arch) - 0.02, y - 0.16 * s + 0.06, z + 0.04))
+    # Front: grille, lower panel ahead of the wheel, bumper with lights.
+    box(m, "dark", (xf - 0.02, -0.75, zb + 0.1), (xf + 0.03, 0.75, zb + 0.52))
+    for k in range(4):
+        z = zb + 0.15 + 0.1 * k
+        box(m, "steel", (xf + 0.02, -0.73, z), (xf + 0.05, 0.73, z + 0.03))
+    x_arch = g.wheel_x[0] + arch + 0.03
+    if x_arch < xf:
+        box(m, "paint", (x_arch, -ch_w, zb - 0.25), (xf, ch_w, zb))
+    box(m, "dark", (max(x_arch, xf - 0.2), -hw, zb - 0.6), (x_front, hw, zb - 0.25))
+    for y in (-hw + 0.3, hw - 0.3):
+        box(m, "light", (x_front - 0.01, y - 0.18, zb - 0.45), (x_front + 0.01, y + 0.18, zb - 0.33))
+    box(m, "paint", (xf - 0.45, -ch_w + 0.05, top - 0.01), (xf - 0.2, ch_w - 0.05, top + 0.04))   # sun visor
     for y in (-0.6, -0.2, 0.2, 0.6):
-        box(m, "amber", (1.2, y - 0.07, 3.0), (1.36, y + 0.07, 3.08))  # roof beacons
-    # Fuel tank (right), battery box and air tanks (left).
-    cyl(m, "steel", 0.27, -1.95, -0.95, 24, axis="x", centre=(0, -0.82, 0.68))
-    box(m, "dark", (-2.35, 0.55, 0.45), (-1.55, 1.05, 0.90))
-    cyl(m, "steel", 0.13, -3.6, -2.7, 16, axis="x", centre=(0, 0.70, 0.72))
-    cyl(m, "steel", 0.13, -3.6, -2.7, 16, axis="x", centre=(0, -0.70, 0.72))
-    # Mudguards over the wheels: curved shells made of a half lathe.
-    for x in (1.75, -3.05, -4.35):
-        for y in (-1.0, 1.0):
-            lathe(m, "dark", [(0.60, y - 0.22), (0.60, y + 0.22)], 16, axis="y", centre=(x, 0, 0.5),
-                  smooth=False, a0=0.15, a1=math.pi - 0.15)
+        box(m, "amber", (xr + 0.2, y - 0.07, top), (xr + 0.36, y + 0.07, top + 0.08))      # roof beacons
+    # Exhaust stack behind the cab (clear of the crane foot).
+    cyl(m, "steel", 0.06, zb, top + 0.2, 16, centre=(xr - 0.09, -hw + 0.12, 0))
+    # Fuel tank (right) and battery box (left) between the axles, clear of
+    # the outrigger housings.
+    xa, xb = g.wheel_x[1] + arch + 0.1, g.wheel_x[0] - arch - 0.1
+    xs = [x for x in g.outrigger_x if xa - 0.2 < x < xb + 0.2]
+    if xs:
+        xb = min(xb, min(xs) - 0.25)
+    if xb - xa > 0.4:
+        cyl(m, "steel", 0.24, xa, xb, 24, axis="x", centre=(0, -hw + 0.32, rail_top - 0.32))
+        box(m, "dark", (xa, hw - 0.5, rail_top - 0.5), (min(xb, xa + 0.8), hw - 0.06, rail_top - 0.05))
+    # Mudguards over the wheels (curved shells) and axles.
+    for x in g.wheel_x:
+        for s in (-1, 1):
+            y = s * 0.5 * g.track
+            lathe(m, "dark", [(arch, y - 0.5 * g.wheel_w - 0.04), (arch, y + 0.5 * g.wheel_w + 0.04)], 16, axis="y",
+                  centre=(x, 0, wz), smooth=False, a0=0.2, a1=math.pi - 0.2)
+        cyl(m, "dark", 0.07, -0.5 * g.track + 0.1, 0.5 * g.track - 0.1, 12, axis="y", centre=(x, 0, wz))
     # Rear bumper with lights.
-    box(m, "dark", (-5.15, -1.20, 0.55), (-5.02, 1.20, 0.72))
-    for y in (-1.0, 1.0):
-        box(m, "tail", (-5.17, y - 0.15, 0.58), (-5.14, y + 0.15, 0.69))
-    # Exhaust stack behind the cab.
-    cyl(m, "steel", 0.07, 1.0, 3.1, 16, centre=(0.80, -1.05, 0))
-    # Axles.
-    for x in (1.75, -3.05, -4.35):
-        cyl(m, "dark", 0.07, -0.85, 0.85, 12, axis="y", centre=(x, 0, 0.5))
+    box(m, "dark", (x_rear - 0.06, -hw + 0.05, bed - 0.62), (x_rear + 0.06, hw - 0.05, bed - 0.45))
+    for y in (-hw + 0.2, hw - 0.2):
+        box(m, "tail", (x_rear - 0.08, y - 0.15, bed - 0.6), (x_rear - 0.05, y + 0.15, bed - 0.48))
     return m
 
 
-def wheel():
-    """Origin at the wheel centre, axle along y, outer (rim) face toward +y."""
+def wheel(g):
+    """Origin at the wheel centre, axle along y; radius and width from the
+    world file. Symmetric (rim dish on both faces), so one mesh serves both
+    sides whichever way the axle points."""
     m = Mesh("wheel")
-    seg = 44
-    # Tyre cross-section (r, y): rounded shoulders; tread blocks by alternating
-    # the radius of neighbouring segments.
-    tyre = [(0.30, -0.15), (0.40, -0.165), (0.46, -0.16), (0.49, -0.135), (0.50, -0.09), (0.50, -0.03),
-            (0.50, 0.03), (0.50, 0.09), (0.49, 0.135), (0.46, 0.16), (0.40, 0.165), (0.30, 0.15)]
+    seg = 36  # the densest mesh in the scene (4 per truck), drawn every frame
+    r, hw = g.wheel_r, 0.5 * g.wheel_w
+    # Tyre cross-section (r, y) as fractions of radius and half width: rounded
+    # shoulders; tread blocks by alternating the radius of neighbouring segments.
+    fr = [(0.60, -0.91), (0.80, -1.0), (0.92, -0.97), (0.98, -0.82), (1.0, -0.55), (1.0, -0.18),
+          (1.0, 0.18), (1.0, 0.55), (0.98, 0.82), (0.92, 0.97), (0.80, 1.0), (0.60, 0.91)]
+    tyre = [(a * r, b * hw) for a, b in fr]
     lathe(m, "rubber", tyre[:4], seg, axis="y")
     lathe(m, "rubber", tyre[3:9], seg, axis="y", wobble=lambda k: 1.0 if k % 2 == 0 else 0.975)
     lathe(m, "rubber", tyre[8:], seg, axis="y")
-    # Rim: dished disc with a hub and ten nuts.
-    rim = [(0.30, 0.15), (0.29, 0.12), (0.22, 0.10), (0.12, 0.13), (0.08, 0.16), (0.0, 0.16)]
-    lathe(m, "steel", rim, 32, axis="y")
-    lathe(m, "steel", [(0.0, -0.12), (0.30, -0.12)], 32, axis="y")
-    lathe(m, "steel", [(0.30, -0.12), (0.30, 0.15)], 32, axis="y")
-    for k in range(10):
-        a = 2 * math.pi * k / 10
-        cyl(m, "dark", 0.016, 0.13, 0.17, 8, axis="y", centre=(0.155 * math.cos(a), 0, 0.155 * math.sin(a)))
+    # Rim: a dished disc with hub and nuts on each face.
+    for s in (1, -1):
+        rim = [(0.60 * r, 0.91 * hw), (0.58 * r, 0.73 * hw), (0.44 * r, 0.6 * hw), (0.24 * r, 0.79 * hw),
+               (0.16 * r, 0.97 * hw), (0.0, 0.97 * hw)]
+        if s < 0:
+            # Mirrored profile: reversed so it still runs counter-clockwise.
+            rim = [(a, -b) for a, b in reversed(rim)]
+        lathe(m, "steel", rim, 24, axis="y")
+        for k in range(10):
+            a = 2 * math.pi * k / 10
+            y0, y1 = sorted((s * 0.79 * hw, s * 1.03 * hw))
+            cyl(m, "dark", 0.032 * r, y0, y1, 6, axis="y", centre=(0.31 * r * math.cos(a), 0, 0.31 * r * math.sin(a)))
     return m
 
 
-def outrigger():
-    """Left outrigger: origin at the beam root on the truck centreline (beam
-    height), beam along +y to y = 2.45, leg down to a foot 0.75 m below."""
+def outrigger(g):
+    """Left outrigger: origin at the beam root on the truck centreline at beam
+    height, beam along +y to the jack at half the outrigger span, foot pad on
+    the ground (beam height below the origin)."""
     m = Mesh("outrigger")
+    yj = 0.5 * g.span
+    y0, y1 = 0.5 * g.chassis[1], yj + 0.15
+    drop = g.beam_z
     sec = chamfer_section(0.20, 0.20, 0.02)
-    # Beam along y: build as loft along x, then swap axes by construction.
     for k in range(len(sec)):
         j = (k + 1) % len(sec)
         (a0, b0), (a1, b1) = sec[k], sec[j]
-        m.flat_poly("paint", [(a0, 0.25, b0), (a0, 2.45, b0), (a1, 2.45, b1), (a1, 0.25, b1)])
-    m.flat_poly("paint", [(a, 2.45, b) for a, b in sec][::-1])
-    # Leg (hydraulic jack): barrel and rod, and the foot pad.
-    cyl(m, "paint", 0.09, -0.10, 0.35, 20, centre=(0, 2.30, 0))
-    cyl(m, "chrome", 0.055, -0.62, -0.10, 16, centre=(0, 2.30, 0))
-    cyl(m, "dark", 0.20, -0.75, -0.68, 24, centre=(0, 2.30, 0))
-    box(m, "light", (-0.06, 2.44, -0.05), (0.06, 2.46, 0.05))  # warning reflector
+        m.flat_poly("paint", [(a0, y0, b0), (a0, y1, b0), (a1, y1, b1), (a1, y0, b1)])
+    m.flat_poly("paint", [(a, y1, b) for a, b in sec][::-1])
+    # Leg (hydraulic jack): barrel and rod, and the foot pad on the ground.
+    pad_h = g.pad[2]
+    cyl(m, "paint", 0.09, -0.10, 0.35, 20, centre=(0, yj, 0))
+    cyl(m, "chrome", 0.055, -drop + pad_h, -0.10, 16, centre=(0, yj, 0))
+    box(m, "dark", (-0.5 * g.pad[0], yj - 0.5 * g.pad[1], -drop), (0.5 * g.pad[0], yj + 0.5 * g.pad[1], -drop + pad_h))
+    box(m, "light", (-0.06, y1 - 0.01, -0.05), (0.06, y1 + 0.01, 0.05))  # warning reflector
     return m
 
 
-def column():
-    """Origin on the slew axis at the column foot (truck bed level), z up;
-    joint 1 at (0.15, 0, 1.6). Lift cylinder base pin at (0.38, 0, 0.45)."""
+def lug_pair(m, mat, x, z, gap, t, r, toward):
+    """Two bracket plates (y = +-gap .. +-(gap + t)) around a pin at (x, z),
+    reaching toward the point `toward` (x, z) inside the parent part."""
+    dx, dz = toward[0] - x, toward[1] - z
+    ln = math.hypot(dx, dz) or 1.0
+    ux, uz = dx / ln, dz / ln
+    px, pz = -uz, ux                       # across the plate
+    w = r + 0.025
+    poly = [(x + px * w, z + pz * w), (x - px * w, z - pz * w),
+            (toward[0] - px * w * 1.3, toward[1] - pz * w * 1.3), (toward[0] + px * w * 1.3, toward[1] + pz * w * 1.3)]
+    for s in (-1, 1):
+        extrude_y(m, mat, poly, s * gap, s * (gap + t))
+    # Round ends around the pin.
+    for s in (-1, 1):
+        lo, hi = sorted((s * gap, s * (gap + t)))
+        cyl(m, mat, w, lo, hi, 16, axis="y", centre=(x, 0, z))
+    pin_y(m, "steel", x, z, 0.022, gap + t + 0.015, 12)
+
+
+def column(g):
+    """Slewing column: origin on the slew axis at the column foot (bed top),
+    z up; joint 1 pin at (0, 0, column height); lift-cylinder base pin at the
+    model's base mount. The fixed slewing-ring housing belongs to the truck."""
     m = Mesh("column")
-    box(m, "paint", (-0.55, -0.50, 0.0), (0.55, 0.50, 0.42))
-    # Slew gear housings (rack cylinders) front and back.
-    for x in (-0.45, 0.45):
-        cyl(m, "paint", 0.11, -0.62, 0.62, 20, axis="y", centre=(x, 0, 0.22))
-        cyl(m, "chrome", 0.05, -0.70, 0.70, 12, axis="y", centre=(x, 0, 0.22))
-    cyl(m, "dark", 0.40, 0.42, 0.56, 40)
-    # Column tube: octagonal, slightly tapered.
-    lathe(m, "paint", [(0.26, 0.56), (0.22, 1.45)], 8, smooth=False)
-    # Head around the joint-1 pin, side plates and pin.
-    box(m, "paint", (-0.18, -0.17, 1.40), (0.34, 0.17, 1.82))
-    pin_y(m, "steel", 0.15, 1.6, 0.05, 0.24)
-    # Lift-cylinder base lugs.
-    for y in (-0.09, 0.09):
-        box(m, "paint", (0.25, y - 0.015, 0.30), (0.50, y + 0.015, 0.58))
-    pin_y(m, "steel", 0.38, 0.45, 0.035, 0.12)
+    H = g.col_h
+    # Turntable on the fixed housing, then a tapered octagonal tube.
+    cyl(m, "paint", 0.27, 0.32, 0.42, 32)
+    r0, r1 = g.col_r * 0.95, g.col_r * 0.85
+    lathe(m, "paint", [(r0, 0.42), (r1, H - 0.2)], 8, smooth=False, a0=math.pi / 8, a1=math.pi / 8 + 2 * math.pi)
+    cyl(m, "paint", r1 + 0.01, H - 0.2, H - 0.16, 8, smooth=False)
+    # Head: fork plates around the joint-1 pin; the lifting arm's root sits
+    # between them.
+    bw = 0.5 * g.links[0]["width"]
+    for s in (-1, 1):
+        lo, hi = sorted((s * (bw + 0.01), s * (bw + 0.04)))
+        extrude_y(m, "paint", [(-0.14, H - 0.24), (0.14, H - 0.24), (0.16, H), (0.0, H + 0.14), (-0.16, H)], lo, hi)
+    pin_y(m, "steel", 0.0, H, 0.045, bw + 0.06)
+    # Lift-cylinder base lugs at the model's mount, reaching back to the tube.
+    bx, bz = g.lift_base
+    lug_pair(m, "paint", bx, bz, g.lift_barrel + 0.008, 0.025, g.lift_barrel * 0.55, (0.0, bz + 0.05))
     # Control valve bank and levers on the right side (the operator's post).
-    box(m, "dark", (-0.30, -0.72, 0.55), (0.20, -0.55, 0.85))
+    box(m, "dark", (-0.30, -0.50, 0.55), (0.20, -0.33, 0.85))
+    box(m, "dark", (-0.05, -0.33, 0.60), (0.05, -0.1, 0.80))
     for k in range(3):
         x = -0.22 + 0.16 * k
-        box(m, "steel", (x - 0.01, -0.70, 0.85), (x + 0.01, -0.68, 1.15))
-        cyl(m, "amber", 0.025, 1.15, 1.21, 10, centre=(x, -0.69, 0))
-    box(m, "steel", (-0.35, -0.85, 0.95), (0.25, -0.82, 0.98))  # hand rail
+        box(m, "steel", (x - 0.01, -0.48, 0.85), (x + 0.01, -0.46, 1.15))
+        cyl(m, "amber", 0.025, 1.15, 1.21, 10, centre=(x, -0.47, 0))
     return m
 
 
-def boom1():
-    """Lifting arm: origin at joint 1, x toward joint 2 at (2.3, 0, 0).
-    Lift cylinder rod pin at (0.85, 0, -0.24); jib cylinder base at (0.55, 0, 0.26)."""
+def boom1(g):
+    """Lifting arm: origin at joint 1, x toward joint 2 at (L1, 0, 0), pins
+    along y. A closed box section at the root; from ahead of the jib-cylinder
+    base pin to joint 2 two side plates with the jib cylinder between them
+    (the model's mounts put that cylinder's line through the arm)."""
     m = Mesh("boom1")
-    loft_x(m, "paint", -0.12, chamfer_section(0.26, 0.34, 0.04), 2.18, chamfer_section(0.20, 0.26, 0.03))
-    cyl(m, "paint", 0.13, -0.15, 0.15, 24, axis="y")
-    pin_y(m, "steel", 0.0, 0.0, 0.05, 0.19)
-    # Knuckle plates at joint 2.
-    for y in (-0.115, 0.115):
-        extrude_y(m, "paint", [(2.05, -0.13), (2.30, -0.12), (2.40, 0.0), (2.30, 0.12), (2.05, 0.13)], y - 0.015, y + 0.015)
-    pin_y(m, "steel", 2.3, 0.0, 0.045, 0.15)
-    # Cylinder lugs.
-    for y in (-0.08, 0.08):
-        extrude_y(m, "paint", [(0.70, -0.14), (1.00, -0.14), (0.92, -0.30), (0.78, -0.30)], y - 0.015, y + 0.015)
-        extrude_y(m, "paint", [(0.42, 0.14), (0.68, 0.14), (0.62, 0.32), (0.48, 0.32)], y - 0.015, y + 0.015)
-    pin_y(m, "steel", 0.85, -0.24, 0.03, 0.11)
-    pin_y(m, "steel", 0.55, 0.26, 0.03, 0.11)
-    # Hose guide along the top.
-    for x in (0.9, 1.4, 1.9):
-        box(m, "dark", (x - 0.03, -0.06, 0.13), (x + 0.03, 0.06, 0.19))
-    for y in (-0.03, 0.03):
-        cyl(m, "rubber", 0.012, 0.7, 2.1, 8, axis="x", centre=(0, y, 0.2))
+    lk = g.links[0]
+    L, w, h = g.L1, lk["width"], lk["height"]
+    jx, jz = g.jib_base
+    x_open = jx - g.jib_barrel - 0.08            # the box section ends here
+    loft_x(m, "paint", -0.05, chamfer_section(w, h, 0.03), x_open, chamfer_section(w, h * 0.96, 0.03))
+    cyl(m, "paint", 0.5 * h, -0.5 * w, 0.5 * w, 24, axis="y")
+    pin_y(m, "steel", 0.0, 0.0, 0.04, 0.5 * w + 0.07)
+    # Side plates: outside the end arm's width at the knuckle, and wide enough
+    # apart for the jib barrel.
+    gap = max(0.5 * g.links[1]["width"] + 0.005, g.jib_barrel + 0.01)
+    t = max(0.5 * w - gap, 0.02)
+    hh0, hh1 = 0.5 * h * 0.96, 0.5 * h * 0.8
+    side = [(x_open - 0.02, -hh0), (L - 0.05, -hh1), (L + 0.5 * h * 0.75, 0.0), (L - 0.05, hh1), (x_open - 0.02, hh0)]
+    for s in (-1, 1):
+        extrude_y(m, "paint", side, s * gap, s * (gap + t))
+        lo, hi = sorted((s * gap, s * (gap + t)))
+        cyl(m, "paint", 0.5 * h * 0.75, lo, hi, 24, axis="y", centre=(L, 0, 0))
+    # Tie plates across the top where the jib cylinder runs below them.
+    x_tie = jx + 0.3
+    box(m, "paint", (x_tie, -gap - t, hh1 - 0.015), (L - 0.25, gap + t, hh1 + 0.005))
+    pin_y(m, "steel", L, 0.0, 0.04, gap + t + 0.03)
+    # Jib-cylinder base pin across the plates.
+    pin_y(m, "steel", jx, jz, 0.022, gap + t + 0.015, 12)
+    for s in (-1, 1):
+        cyl(m, "paint", 0.045, *sorted((s * (gap + t), s * (gap + t + 0.01))), 16, axis="y", centre=(jx, 0, jz))
+    # Lift-cylinder rod lugs under the arm at the model's mount.
+    rx, rz = g.lift_rod
+    lug_pair(m, "paint", rx, rz, g.lift_eye + 0.01, 0.02, g.lift_eye * 0.8, (rx, -0.5 * h + 0.03))
+    # Hose guides and hoses along the top of the box section.
+    for x in (0.35, 0.65):
+        if x < x_open - 0.05:
+            box(m, "dark", (x - 0.03, -0.05, 0.5 * h - 0.01), (x + 0.03, 0.05, 0.5 * h + 0.05))
+    for y in (-0.025, 0.025):
+        cyl(m, "rubber", 0.011, 0.2, x_open - 0.05, 8, axis="x", centre=(0, y, 0.5 * h + 0.06))
     return m
 
 
-def boom2():
-    """End arm: origin at joint 2, x toward the tip at (2.5, 0, 0).
-    Jib cylinder rod pin on the lever at (-0.30, 0, 0.30)."""
+def boom2(g):
+    """End arm: origin at joint 2, x toward the tip at (L2, 0, 0). Root boss on
+    the joint-2 pin, rod lugs of the jib cylinder at the model's mount, sheave
+    housing at the tip (where the rope hangs)."""
     m = Mesh("boom2")
-    loft_x(m, "paint", 0.08, chamfer_section(0.20, 0.25, 0.03), 2.42, chamfer_section(0.16, 0.19, 0.025))
-    cyl(m, "paint", 0.10, -0.10, 0.10, 24, axis="y")
-    for y in (-0.09, 0.09):
-        extrude_y(m, "paint", [(-0.38, 0.36), (-0.22, 0.40), (0.35, 0.12), (0.35, -0.12), (0.0, -0.12), (-0.12, 0.0)],
-                  y - 0.015, y + 0.015)
-    pin_y(m, "steel", -0.30, 0.30, 0.03, 0.12)
-    # Tip: sheave housing and hook attachment.
-    for y in (-0.07, 0.07):
-        extrude_y(m, "paint", [(2.30, -0.10), (2.50, -0.14), (2.60, -0.02), (2.52, 0.10), (2.30, 0.10)],
-                  y - 0.012, y + 0.012)
-    cyl(m, "dark", 0.09, -0.055, 0.055, 24, axis="y", centre=(2.5, 0, 0))
-    pin_y(m, "steel", 2.5, 0.0, 0.025, 0.09)
-    # Rotator link hanging at the tip (the rope starts here).
-    cyl(m, "dark", 0.04, -0.15, -0.02, 12, centre=(2.5, 0, 0))
+    lk = g.links[1]
+    L, w, h = g.L2, lk["width"], lk["height"]
+    loft_x(m, "paint", 0.0, chamfer_section(w, h, 0.025), L - 0.1, chamfer_section(w * 0.85, h * 0.8, 0.02))
+    cyl(m, "paint", 0.5 * h * 0.9, -0.5 * w, 0.5 * w, 24, axis="y")
+    rx, rz = g.jib_rod
+    lug_pair(m, "paint", rx, rz, g.jib_eye + 0.01, 0.018, g.jib_eye * 0.8, (rx + 0.05, -0.5 * h + 0.03))
+    # Tip: sheave housing plates, sheave and pin.
+    for s in (-1, 1):
+        lo, hi = sorted((s * 0.06, s * 0.085))
+        extrude_y(m, "paint", [(L - 0.2, -0.5 * h * 0.8), (L, -0.14), (L + 0.1, -0.02), (L + 0.02, 0.5 * h * 0.8),
+                               (L - 0.2, 0.5 * h * 0.8)], lo, hi)
+    cyl(m, "dark", 0.09, -0.055, 0.055, 24, axis="y", centre=(L, 0, 0))
+    pin_y(m, "steel", L, 0.0, 0.025, 0.1)
+    # Rotator link hanging at the tip (the rope starts at the tip pin).
+    cyl(m, "dark", 0.04, -0.15, -0.02, 12, centre=(L, 0, 0))
     return m
 
 
@@ -624,23 +802,54 @@ MATERIALS = {
 }
 
 
+def write_offsets(world_path, world, offsets):
+    """Put the mesh offsets into the world file's "meshes" section, keeping
+    everything else (the file is plain json.dump output, indent 2)."""
+    meshes = world.setdefault("meshes", {})
+    for key, off in offsets.items():
+        meshes.setdefault(key, {"file": key + ".obj", "scale": 1, "up": "z"})["offset"] = off
+    with open(world_path, "w") as f:
+        f.write(json.dumps(world, indent=2) + "\n")
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "..", "assets", "meshes")
+    root = os.path.join(here, "..", "..")
+    ap = argparse.ArgumentParser(description="Write cranesim's OBJ meshes (see assets/meshes/README.md).")
+    ap.add_argument("out_dir", nargs="?", default=os.path.join(root, "assets", "meshes"))
+    ap.add_argument("--world", default=os.path.join(root, "assets", "worlds", "sandbox.json"),
+                    help="world file whose \"truck\" section sizes the truck, wheel and outrigger meshes")
+    ap.add_argument("--model", default=os.path.join(root, "assets", "models", "hiab031.json"),
+                    help="crane model whose mechanics size the column and booms and place the cylinder brackets")
+    ap.add_argument("--write-offsets", action="store_true",
+                    help="also write the truck/column/boom mesh offsets into the world file's \"meshes\"")
+    a = ap.parse_args()
+    with open(a.world) as f:
+        world = json.load(f)
+    with open(a.model) as f:
+        model = json.load(f)
+    g = Geo(world, model)
+    out = a.out_dir
     os.makedirs(out, exist_ok=True)
     with open(os.path.join(out, "materials.mtl"), "w") as f:
         f.write("# materials.mtl: colour tints for cranesim meshes (Kd x body rgba)\n")
         for name in sorted(MATERIALS):
-            r, g, b = MATERIALS[name]
-            f.write("newmtl %s\nKd %.3f %.3f %.3f\n\n" % (name, r, g, b))
+            r, gg, b = MATERIALS[name]
+            f.write("newmtl %s\nKd %.3f %.3f %.3f\n\n" % (name, r, gg, b))
     total = 0
-    for fn in (truck, wheel, outrigger, column, boom1, boom2, cyl_barrel, cyl_rod, hook, load_block, pallet, crate, wall,
-               building):
-        m = fn()
+    sized = (truck, wheel, outrigger, column, boom1, boom2)
+    for fn in sized + (cyl_barrel, cyl_rod, hook, load_block, pallet, crate, wall, building):
+        m = fn(g) if fn in sized else fn()
         m.write(out)
         total += m.triangles()
         print("%-12s %6d triangles" % (m.name, m.triangles()))
     print("%-12s %6d triangles (one of each)" % ("total", total))
+    offs = g.offsets()
+    for k, v in offs.items():
+        print("offset %-7s %s" % (k, v))
+    if a.write_offsets:
+        write_offsets(a.world, world, offs)
+        print("offsets written to %s" % a.world)
 
 
 if __name__ == "__main__":
