@@ -398,7 +398,10 @@ int drive_session_tick(drive_session* s, double wall) {
             }
             continue;
         }
-        if (render_handle_event(s->r, &ev)) continue; // the panel took it
+        // The panel may take an event (typing a value); a key release still
+        // goes to the input layer, or a crane axis held when the panel took
+        // focus would stay held.
+        if (render_handle_event(s->r, &ev) && ev.type != SDL_KEYUP) continue;
         input_handle_event(s->in, &ev);
     }
     input_command cmd;
