@@ -159,17 +159,25 @@ static void set_inputs(lsim* s, double t, const kin* k) {
     }
 }
 
+// Shared by rhs and Jacobian: the one sincos pair of q, the cylinder
+// kinematics, the circuit's inputs at t, and the circuit's states gathered
+// into its own order.
+static void prepare(lsim* s, double t, const double* y, double trig[4], kin* k) {
+    const double* q = y + s->iq;
+    trig[0] = sin(q[0]), trig[1] = cos(q[0]), trig[2] = sin(q[1]), trig[3] = cos(q[1]);
+    cylinder_kinematics(&s->mdl->mech, trig, y + s->iq + 2, k);
+    set_inputs(s, t, k);
+    for (int i = 0; i < s->nh; ++i) s->yh_[s->perm[i]] = y[i];
+}
+
 int lsim_rhs(void* user, double t, const double* y, double* dydt) {
     lsim* s = user;
     const crane_mech* me = &s->mdl->mech;
     const int nh = s->nh, iq = s->iq;
-    const double* q = y + iq;
     const double* qd = y + iq + 2;
-    const double trig[4] = {sin(q[0]), cos(q[0]), sin(q[1]), cos(q[1])};
+    double trig[4];
     kin k;
-    cylinder_kinematics(me, trig, qd, &k);
-    set_inputs(s, t, &k);
-    for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i];
+    prepare(s, t, y, trig, &k);
     hyd_eval(s->mdl->hyd, s->hd, t, s->yh_, s->fh_);
     for (int i = 0; i < nh; ++i) dydt[i] = s->fh_[s->perm[i]];
 
@@ -200,13 +208,10 @@ int lsim_jac(void* user, double t, const double* y, double* J) {
     lsim* s = user;
     const crane_mech* me = &s->mdl->mech;
     const int nh = s->nh, n = s->n, iq = s->iq;
-    const double* q = y + iq;
     const double* qd = y + iq + 2;
-    const double trig[4] = {sin(q[0]), cos(q[0]), sin(q[1]), cos(q[1])};
+    double trig[4];
     kin k;
-    cylinder_kinematics(me, trig, qd, &k);
-    set_inputs(s, t, &k);
-    for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i];
+    prepare(s, t, y, trig, &k);
     hyd_data* d = s->hd;
     hyd_jacobian(s->mdl->hyd, d, t, s->yh_, NULL, s->jh_, nh, 0, 0);
 
@@ -233,7 +238,7 @@ int lsim_jac(void* user, double t, const double* y, double* J) {
     }
 
     lagrange_terms lt;
-    lagrange_eval_terms(me, s->variant, s->m3, q, qd, &lt);
+    lagrange_eval_terms_trig(me, s->variant, s->m3, trig, qd, &lt);
     const double tau[2] = {F[0] * k.r[0], F[1] * k.r[1]};
     double qdd[2];
     lagrange_accel(&lt, tau, qdd);
