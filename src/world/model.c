@@ -105,7 +105,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     const cJSON* hyd = json_obj(&c, root, "", "hydraulics", true);
     if (c.failed) goto fail;
     m->hyd = hyd_model_from_json(hyd, file, "hydraulics", err, errsz);
-    if (!m->hyd) goto fail_quiet;
+    if (!m->hyd) goto fail;
 
     for (int k = 0; k < 2; ++k) {
         char p[64];
@@ -124,12 +124,10 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     char cerr[256];
     if (crane_mech_check(me, m->stroke, cerr, (int)sizeof cerr)) {
         snprintf(err, errsz, "%s: %s", file, cerr);
-        goto fail_quiet;
+        goto fail;
     }
     return m;
-fail:
-    (void)0;
-fail_quiet:
+fail: // err already holds the one-line message
     model_free(m);
     return NULL;
 }
