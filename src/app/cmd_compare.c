@@ -204,7 +204,7 @@ int cmd_compare(int argc, char** argv) {
         code = EXIT_RUNTIME;
     }
     if (plot) {
-        char err[256], title[200];
+        char err[256], title[320];
         snprintf(title, sizeof title, "%s: %s vs %s", sc.name, label[0], label[1]);
         if (app_plot_compare(&tr[0], label[0], &tr[1], label[1], title, plot, err, sizeof err)) {
             fprintf(stderr, "cranesim compare: plot: %s\n", err);
