@@ -19,7 +19,7 @@ render_config render_default_config(void) {
     c.offscreen = false;
     c.vsync = true;
     c.msaa = 0;           // llvmpipe pays ~2x per sample; see docs/render.md
-    c.shadow_size = 512;  // llvmpipe: 1024 costs ~3 ms per frame (51 vs 59 fps in drive), 2048 ~6 ms more
+    c.shadow_size = 512;  // llvmpipe: a few % faster than 1024 in drive (docs/render.md), 2048 ~6 ms more
     c.title = "cranesim";
     c.asset_dir = CRANESIM_ASSETS "/meshes";
     c.p_full_scale = 30e6;
