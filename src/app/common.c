@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -164,7 +165,26 @@ int app_load(const app_common* c, model** m, scenario* sc) {
         return EXIT_USAGE;
     }
     char buf[512];
-    const char* sp = app_scenario_path(c->scenario_path ? c->scenario_path : "ramp", buf, sizeof buf);
+    const char* arg = c->scenario_path ? c->scenario_path : "ramp";
+    const char* sp = app_scenario_path(arg, buf, sizeof buf);
+    if (sp == buf && access(sp, R_OK) != 0) {
+        // A name that is not in the assets: say which names there are.
+        char names[512] = "";
+        char dir[512];
+        snprintf(dir, sizeof dir, "%s/scenarios", model_assets_dir());
+        DIR* d = opendir(dir);
+        for (struct dirent* e; d && (e = readdir(d));) {
+            size_t L = strlen(e->d_name);
+            if (L < 6 || strcmp(e->d_name + L - 5, ".json")) continue;
+            size_t k = strlen(names);
+            snprintf(names + k, sizeof names - k, "%s%.*s", k ? ", " : "", (int)(L - 5), e->d_name);
+        }
+        if (d) closedir(d);
+        fprintf(stderr, "cranesim: --scenario %s: no such file or scenario (scenarios: %s)\n", arg, names);
+        model_free(*m);
+        *m = NULL;
+        return EXIT_USAGE;
+    }
     if (scenario_load(sp, sc, err, sizeof err)) {
         fprintf(stderr, "cranesim: %s\n", err);
         model_free(*m);
