@@ -105,8 +105,12 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         while (ev < sc.nevent && sc.event[ev].t <= tm) {
             int attach = sc.event[ev].kind == SCENARIO_ATTACH;
             int got = live_hook(l, attach);
-            if (attach)
-                printf("  t = %5.2f s: hook %s\n", t, got >= 0 ? "picked up a load" : "found no load in reach");
+            double mass = 0;
+            const char* name = got >= 0 ? live_load_name(l, got, &mass) : NULL;
+            if (attach && name)
+                printf("  t = %5.2f s: hook picked up %s (%.0f kg)\n", t, name, mass);
+            else if (attach)
+                printf("  t = %5.2f s: hook found no load in reach\n", t);
             else
                 printf("  t = %5.2f s: hook released the load\n", t);
             ++ev;

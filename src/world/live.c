@@ -99,6 +99,10 @@ void live_destroy(live* l) {
 
 int live_hook(live* l, int attach) { return l->ode ? ode_world_hook(l->ode, attach) : -1; }
 
+const char* live_load_name(const live* l, int i, double* mass) {
+    return l->ode ? ode_world_load_name(l->ode, i, mass) : NULL;
+}
+
 bool live_attached(const live* l) {
     if (!l->ode) return false;
     ode_world_state st;

@@ -25,6 +25,8 @@ live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], dou
 /// Hook: 1 attach the nearest load in reach, 0 release (ode sandbox only).
 /// Returns the load index attached, or -1.
 int live_hook(live* l, int attach);
+/// Name and mass [kg] of load i of the world, or NULL.
+const char* live_load_name(const live* l, int i, double* mass);
 /// True while a load hangs on the hook.
 bool live_attached(const live* l);
 /// The circuit the running simulation uses (the model's for lagrange, the

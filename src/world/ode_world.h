@@ -128,6 +128,8 @@ world_kind ode_world_kind(const ode_world* w);
 /// Loads (sandbox): count, and centre position [m] and velocity [m/s] of load i.
 int ode_world_nload(const ode_world* w);
 void ode_world_load_state(const ode_world* w, int i, double pos[3], double vel[3]);
+/// Name and mass [kg] of load i (from the world file); NULL if i is out of range.
+const char* ode_world_load_name(const ode_world* w, int i, double* mass);
 /// Body centre [m] of the obstacle named name; returns 0, or -1 if not found.
 int ode_world_obstacle_pos(const ode_world* w, const char* name, double pos[3]);
 
