@@ -41,7 +41,7 @@ static void drive_help(FILE* f) {
             "                      (offscreen when there is no display)\n"
             "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
             "  --size WxH          window size in pixels (default 1280x720)\n"
-            "keys: arrows = lift, W/S = jib, A/D = slew, H = hook, P = pause, R = reset,\n"
+            "keys: arrows = lift, W/S = jib, A/D = slew, H = hook, Tab = parameter panel, P = pause, R = reset,\n"
             "      C / F1..F4 = camera, F5 = record CSV, F12 = screenshot, Esc = quit\n");
     app_common_help(f, true);
 }

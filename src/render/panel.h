@@ -96,6 +96,8 @@ bool panel_gui_event(panel* p, const union SDL_Event* ev);
 void panel_gui_draw(panel* p);
 /// Show or hide the window (it starts visible).
 void panel_gui_show(panel* p, bool show);
+/// Whether the window is shown.
+bool panel_gui_visible(const panel* p);
 
 #ifdef __cplusplus
 }

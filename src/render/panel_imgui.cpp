@@ -102,6 +102,8 @@ extern "C" void panel_gui_show(panel* p, bool show) {
     if (p) p->visible = show;
 }
 
+extern "C" bool panel_gui_visible(const panel* p) { return p && p->visible; }
+
 extern "C" void panel_gui_draw(panel* p) {
     if (!p || !p->imgui_ctx) return;
     ImGui::SetCurrentContext(ctx_of(p));
