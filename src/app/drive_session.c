@@ -306,6 +306,9 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     rc.offscreen = o->offscreen;
     rc.hud = o->hud;
     rc.title = "cranesim drive";
+    // No vsync: a swap that waits for the display's refresh would stall the
+    // loop's 240 Hz ticks (valve commands); the 65 fps cap paces the frames.
+    rc.vsync = false;
     char asset_dir[512];
     snprintf(asset_dir, sizeof asset_dir, "%s/meshes", model_assets_dir());
     rc.asset_dir = asset_dir;

@@ -92,6 +92,9 @@ bool render_handle_event(render* r, const SDL_Event* ev) {
 void render_frame(render* r, const world_snapshot* snap) {
     Uint64 t0 = SDL_GetPerformanceCounter();
     SDL_GL_MakeCurrent(r->win, r->gl);
+    // A frame still waiting for its swap is shown first: no frame is lost,
+    // whoever drives the loop.
+    if (r->swap_pending) render_wait(r, 1.0);
     if (!r->cfg.offscreen) {
         int w, h;
         SDL_GL_GetDrawableSize(r->win, &w, &h);
@@ -137,14 +140,13 @@ void render_present(render* r) {
     // superseded (fences complete in order).
     if (r->frame_fence) glDeleteSync(r->frame_fence);
     r->frame_fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
-    if (r->cfg.offscreen) {
-        // Nothing to show. Flush (not finish): the driver starts drawing now
-        // and the caller goes on; read-back (render_read_pixels) waits for
-        // the frame by itself.
-        glFlush();
-        return;
-    }
-    SDL_GL_SwapWindow(r->win);
+    // Flush (not finish): the driver starts drawing now and the caller goes
+    // on; read-back (render_read_pixels) waits for the frame by itself. In a
+    // window the swap is deferred until the frame is drawn (render_wait): on
+    // llvmpipe a swap right away blocks for the whole frame, and the drive
+    // loop would then read the sticks only once per frame.
+    glFlush();
+    if (!r->cfg.offscreen) r->swap_pending = true;
 }
 
 bool render_busy(render* r) {
@@ -160,6 +162,10 @@ bool render_wait(render* r, double timeout_s) {
     if (st == GL_TIMEOUT_EXPIRED) return false;
     glDeleteSync(r->frame_fence);
     r->frame_fence = 0;
+    if (r->swap_pending) {
+        r->swap_pending = false;
+        SDL_GL_SwapWindow(r->win);
+    }
     return true;
 }
 

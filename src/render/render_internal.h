@@ -224,6 +224,7 @@ struct render {
     double fps_avg;      ///< 1 / frame_dt_avg, shown in the HUD [1/s]
     Uint64 last_frame_ticks;
     GLsync frame_fence; ///< signalled when the last presented frame is drawn, 0 if none
+    bool swap_pending;  ///< window mode: the presented frame is swapped once its fence signals
 };
 
 /// Resize the offscreen/multisample targets to w x h.
