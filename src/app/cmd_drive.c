@@ -37,6 +37,8 @@ static void drive_help(FILE* f) {
             "                      window: frame-rate cap (default 65)\n"
             "  --scripted          window: drive by the scenario's commands instead of the devices\n"
             "  --mapping FILE      joystick axis mapping (JSON, see docs/render.md)\n"
+            "  --charts LIST       strip-chart channels, CSV column names (up to 8), e.g.\n"
+            "                      p1A,p1B,x1,u1,F1 (default: pressures, strokes, spools)\n"
             "  --screenshot FILE   save a PNG of the view at --screenshot-at seconds and stop\n"
             "                      (offscreen when there is no display)\n"
             "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
@@ -159,6 +161,7 @@ int cmd_drive(int argc, char** argv) {
     const char* record = NULL;
     const char* shot = NULL;
     const char* mapping = NULL;
+    const char* charts = NULL;
     int width = 1280, height = 720;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -178,6 +181,10 @@ int cmd_drive(int argc, char** argv) {
         }
         if (!strcmp(argv[i], "--scripted")) {
             scripted = true;
+            continue;
+        }
+        if (!strcmp(argv[i], "--charts") && i + 1 < argc) {
+            charts = argv[++i];
             continue;
         }
         if (!strcmp(argv[i], "--mapping") && i + 1 < argc) {
@@ -225,12 +232,13 @@ int cmd_drive(int argc, char** argv) {
         o.offscreen = !have_display();
         if (rate_given) o.fps_cap = frame_rate;
         o.mapping_file = mapping;
+        o.charts = charts;
         o.record_path = record;
         o.scripted = scripted || o.offscreen;
         return drive_window_main(&c, &o, c.sim.duration, shot, shot_at);
     }
 #else
-    (void)scripted, (void)mapping, (void)width, (void)height, (void)shot_at, (void)rate_given;
+    (void)scripted, (void)mapping, (void)charts, (void)width, (void)height, (void)shot_at, (void)rate_given;
     if (shot) {
         fprintf(stderr, "cranesim drive: --screenshot needs the render module (built without SDL2/GL)\n");
         return EXIT_USAGE;

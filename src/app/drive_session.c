@@ -59,6 +59,9 @@ struct drive_session {
     char rec_path[256];
     int ncol;
     int ev;              // next scripted hook event
+    int nchart;          // user-chosen strip-chart channels (0: the default set)
+    int chart_col[8];    // their CSV columns
+    int chart_id[8];     // their render chart ids
     int missed_window;   // missed ticks in the current second
     double missed_t0;
     drive_stats st;
@@ -242,6 +245,42 @@ static void rebuild_world(drive_session* s, bool at_start) {
     render_chart_clear(s->r);
 }
 
+// Chosen strip-chart channels: CSV column names, shown in display units
+// (MPa, mm, %, deg, kN), one plot per unit.
+static int setup_charts(drive_session* s, const char* list, char* err, size_t errsz) {
+    static const float colours[8][4] = {{0.95f, 0.35f, 0.3f, 1}, {0.3f, 0.75f, 0.95f, 1}, {0.95f, 0.8f, 0.25f, 1},
+                                        {0.5f, 0.9f, 0.4f, 1},   {0.8f, 0.5f, 0.95f, 1},  {0.95f, 0.6f, 0.2f, 1},
+                                        {0.6f, 0.9f, 0.9f, 1},   {0.9f, 0.9f, 0.9f, 1}};
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", list);
+    for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        int col = -1;
+        for (int c = 1; c < s->ncol; ++c)
+            if (!strcmp(tok, sim_col_name[c])) col = c;
+        if (col < 0) {
+            snprintf(err, errsz, "--charts: no column '%s' (see cranesim run --help for the names)", tok);
+            return -1;
+        }
+        if (s->nchart == 8) {
+            snprintf(err, errsz, "--charts: at most 8 channels");
+            return -1;
+        }
+        const char* u = sim_col_unit[col];
+        render_chart_def d = {.label = sim_col_name[col], .unit = u, .scale = 1, .ymin = -1, .ymax = 1, .group = 5};
+        if (!strcmp(u, "Pa")) d.unit = "MPa", d.scale = 1e-6, d.ymin = 0, d.ymax = 30, d.group = 0;
+        else if (!strcmp(u, "m")) d.unit = "mm", d.scale = 1e3, d.ymin = -5000, d.ymax = 5000, d.group = 1;
+        else if (!strcmp(u, "-")) d.unit = "%", d.scale = 100, d.ymin = -100, d.ymax = 100, d.group = 2;
+        else if (!strcmp(u, "rad")) d.unit = "deg", d.scale = 180 / M_PI, d.ymin = -180, d.ymax = 180, d.group = 3;
+        else if (!strcmp(u, "N")) d.unit = "kN", d.scale = 1e-3, d.ymin = -200, d.ymax = 200, d.group = 4;
+        if (col == COL_X1 || col == COL_X2) d.ymin = 0, d.ymax = 700;
+        memcpy(d.rgba, colours[s->nchart], sizeof d.rgba);
+        s->chart_col[s->nchart] = col;
+        s->chart_id[s->nchart] = render_chart_add(s->r, &d);
+        ++s->nchart;
+    }
+    return 0;
+}
+
 static void act_reset(void* user) {
     drive_session* s = user;
     rebuild_world(s, true);
@@ -338,7 +377,14 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     // 1280x720 (56 vs 60 fps, cranesim bench --config drive), and the scene
     // is what an operator watches while driving.
     panel_gui_show(s->pn, false);
-    render_charts_default(s->r, s->c.sim.mechanics == SIM_ODE ? 3 : 2);
+    if (o->charts) {
+        if (setup_charts(s, o->charts, err, errsz)) {
+            drive_session_destroy(s);
+            return NULL;
+        }
+    } else {
+        render_charts_default(s->r, s->c.sim.mechanics == SIM_ODE ? 3 : 2);
+    }
     if (o->record_path) start_recording(s, o->record_path);
     s->missed_t0 = 0;
     // Warm-up frame before the caller starts its clock: the first frame
@@ -491,7 +537,13 @@ int drive_session_tick(drive_session* s, double wall) {
     // or input runs meanwhile. Waiting here instead keeps the 240 Hz ticks.
     if (wall >= s->wall_next_frame && !render_busy(s->r)) {
         live_snapshot(s->l, s->snap);
-        render_charts_sample(s->r, s->snap);
+        if (s->nchart) {
+            double row[SIM_NCOL];
+            live_row(s->l, row);
+            for (int i = 0; i < s->nchart; ++i) render_chart_push(s->r, s->chart_id[i], row[COL_T], row[s->chart_col[i]]);
+        } else {
+            render_charts_sample(s->r, s->snap);
+        }
         drive_session_render(s);
         double interval = 1e3 * (wall - (s->wall_next_frame - 1.0 / s->o.fps_cap));
         s->st.frame_ms[s->st.nframe_ms++ % 4096] = interval;

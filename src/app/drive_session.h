@@ -27,6 +27,8 @@ typedef struct drive_opts {
     const char* record_path;  ///< start recording to this CSV at once, or NULL (F5 toggles)
     bool scripted;            ///< operator input from the scenario instead of devices
     bool hud;                 ///< draw the HUD (default true)
+    const char* charts;       ///< strip-chart channels: CSV column names, comma-separated
+                              ///< ("p1A,p2A,x1,u1"); NULL: pressures, strokes, spools
 } drive_opts;
 
 drive_opts drive_default_opts(void);
