@@ -980,13 +980,25 @@ hyd_data* hyd_data_create(const hyd_model* m) {
 
 // Shared by hyd_eval and hyd_jacobian: node pressures, then every kernel.
 // G (flow partials) is NULL for a plain evaluation.
+// map (NULL: identity; only without G) is the state order of hyd_eval_mapped.
 static void run_kernels(const hyd_model* m, hyd_data* d, const double* y, double* ydot,
-                        double* G) {
-    double* p = d->node_p;
-    for (int k = 0; k < m->ntank; ++k)
-        p[m->tank_node[k]] = m->node_pfix[m->tank_node[k]];
-    for (int k = 0; k < m->nvol; ++k)
-        p[m->vol_node[k]] = y[m->node_state[m->vol_node[k]]];
+                        double* G, const int* restrict map) {
+    // Restrict locals: the stores into node_p would otherwise force a reload
+    // of every model array on each node.
+    double* restrict p = d->node_p;
+    const int* restrict tn = m->tank_node;
+    const int* restrict vn = m->vol_node;
+    const int* restrict ns = m->node_state;
+    const double* restrict pfix = m->node_pfix;
+    const int ntank = m->ntank, nvol = m->nvol;
+    for (int k = 0; k < ntank; ++k)
+        p[tn[k]] = pfix[tn[k]];
+    if (map)
+        for (int k = 0; k < nvol; ++k)
+            p[vn[k]] = y[map[ns[vn[k]]]];
+    else
+        for (int k = 0; k < nvol; ++k)
+            p[vn[k]] = y[ns[vn[k]]];
     const size_t nb = (size_t)m->nnode * sizeof(double);
     memset(d->node_dV, 0, nb);
     memcpy(d->node_V, m->node_V0, nb);
@@ -997,13 +1009,27 @@ static void run_kernels(const hyd_model* m, hyd_data* d, const double* y, double
     hyd_checks_eval(m, d, G);
     hyd_orifices_eval(m, d, G);
     hyd_hoses_eval(m, d, G);
-    hyd_valves_eval(m, d, y, ydot, G);
+    if (map)
+        hyd_valves_eval_mapped(m, d, y, ydot, map);
+    else
+        hyd_valves_eval(m, d, y, ydot, G);
 }
 
 void hyd_eval(const hyd_model* m, hyd_data* d, double t, const double* y, double* ydot) {
     (void)t;
-    run_kernels(m, d, y, ydot, NULL);
+    run_kernels(m, d, y, ydot, NULL, NULL);
     hyd_volumes_eval(m, d, ydot, NULL, NULL, 0);
+}
+
+void hyd_eval_mapped(const hyd_model* m, hyd_data* d, double t, const double* y, double* ydot,
+                     const int* map) {
+    (void)t;
+    if (!map) {
+        hyd_eval(m, d, t, y, ydot);
+        return;
+    }
+    run_kernels(m, d, y, ydot, NULL, map);
+    hyd_volumes_eval_mapped(m, d, ydot, map);
 }
 
 void hyd_jacobian(const hyd_model* m, hyd_data* d, double t, const double* y, double* ydot,
@@ -1012,7 +1038,7 @@ void hyd_jacobian(const hyd_model* m, hyd_data* d, double t, const double* y, do
     const int n = m->nstate;
     double* G = d->scratch_;
     memset(G, 0, (size_t)(n + 1) * (size_t)(n + 1) * sizeof *G);
-    run_kernels(m, d, y, ydot, G);
+    run_kernels(m, d, y, ydot, G, NULL);
     double* Jb = J ? J + (size_t)row0 * ldj + col0 : NULL;
     hyd_volumes_eval(m, d, ydot, G, Jb, ldj);
     if (Jb) {

@@ -326,6 +326,12 @@ void hyd_data_free(hyd_data* d);
 /// the outputs (forces, flows, node quantities). t [s] is unused by the
 /// circuit itself (commands are inputs) and kept for solver symmetry.
 void hyd_eval(const hyd_model* m, hyd_data* d, double t, const double* y, double* ydot);
+/// hyd_eval on a caller's state vector in its own order: circuit state i is
+/// y[map[i]] and its derivative goes to ydot[map[i]] (map injective; other
+/// entries of ydot are left alone). map NULL is hyd_eval. The same
+/// arithmetic as hyd_eval, without gathering into a circuit-ordered copy.
+void hyd_eval_mapped(const hyd_model* m, hyd_data* d, double t, const double* y, double* ydot,
+                     const int* map);
 
 /// Analytic Jacobian d ydot / d y at (t, y), written into the n x n block of a
 /// caller's dense row-major matrix J at rows row0.., columns col0.. with leading

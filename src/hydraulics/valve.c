@@ -30,16 +30,18 @@ void hyd_valve_derive(const hyd_fluid_def* f, const hyd_valve_def* d, hyd_valve_
 
 // The kernel is inlined twice, with and without G, so that the plain
 // evaluation drops the dQ/dA partials and the Jacobian bookkeeping entirely.
+// map (NULL: identity) is the caller's state order of hyd_eval_mapped.
 static inline void valves_kernel(const hyd_model* m, hyd_data* d, const double* y, double* ydot,
-                                 double* G) {
+                                 double* G, const int* map) {
     const int ld = m->nstate + 1;
     for (int i = 0; i < m->nvalve; ++i) {
         const hyd_valve_c* c = &m->valve[i];
-        const double u = y[c->adr];
+        const int at = map ? map[c->adr] : c->adr;
+        const double u = y[at];
         const double raw = d->valve_cmd[i];
         const double cmd = raw > 1.0 ? 1.0 : (raw < -1.0 ? -1.0 : raw);
         if (ydot)
-            ydot[c->adr] = (cmd - u) * c->inv_tau;
+            ydot[at] = (cmd - u) * c->inv_tau;
 
         const int pos = u >= 0.0;
         const double sgn = pos ? 1.0 : -1.0;
@@ -74,7 +76,12 @@ static inline void valves_kernel(const hyd_model* m, hyd_data* d, const double* 
 
 void hyd_valves_eval(const hyd_model* m, hyd_data* d, const double* y, double* ydot, double* G) {
     if (G)
-        valves_kernel(m, d, y, ydot, G);
+        valves_kernel(m, d, y, ydot, G, NULL);
     else
-        valves_kernel(m, d, y, ydot, NULL);
+        valves_kernel(m, d, y, ydot, NULL, NULL);
+}
+
+void hyd_valves_eval_mapped(const hyd_model* m, hyd_data* d, const double* y, double* ydot,
+                            const int* map) {
+    valves_kernel(m, d, y, ydot, NULL, map);
 }

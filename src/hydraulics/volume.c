@@ -24,8 +24,59 @@ hyd_volume_def hyd_default_volume_def(void) {
 // own pressure. G holds d(sum Q)/dy. Model and data arrays are taken into
 // restrict locals first: the stores into hyd_data would otherwise force the
 // compiler to reload every model field on each node.
+// The plain evaluation (no Jacobian), the hot path of every f evaluation:
+// the same arithmetic as the loop below, in a loop of its own so that the
+// Jacobian's locals do not crowd the registers.
+// map (NULL: identity) is the caller's state order of hyd_eval_mapped.
+static inline void volumes_f(const hyd_model* m, hyd_data* d, double* restrict ydot,
+                             const int* restrict map) {
+    const int nvol = m->nvol;
+    const double* restrict flow = d->flow_;
+    const int* restrict vf = m->vol_flow;
+    const int* restrict vp = m->vol_ptr;
+    const int* restrict vnode = m->vol_node;
+    const int* restrict nstate = m->node_state;
+    const double* restrict np = d->node_p;
+    const double* restrict nV = d->node_V;
+    const double* restrict ndV = d->node_dV;
+    const double* restrict nbel = m->node_bel;
+    const double* restrict nbec = m->node_bec;
+    double* restrict nq = d->node_q;
+    double* restrict nbe = d->node_be;
+    for (int k = 0; k < nvol; ++k) {
+        const int node = vnode[k];
+        const double p = np[node];
+        const double V = nV[node];
+        const double bel = nbel[node];
+        double qin = 0.0;
+        const int e1 = vp[k + 1];
+        for (int e = vp[k]; e < e1; ++e)
+            qin += flow[vf[e]];
+        nq[node] = qin;
+        const double net = qin - ndV[node];
+        double N, D, r, c, be;
+        if (hyd_be_nd(m, bel, nbec[node], p, &N, &D, &r)) {
+            c = N / (D * V);
+            be = c * V;
+        } else {
+            be = hyd_be_slow(m, bel, p, NULL);
+            c = be / V;
+        }
+        nbe[node] = be;
+        ydot[map ? map[nstate[node]] : nstate[node]] = c * net;
+    }
+}
+
+void hyd_volumes_eval_mapped(const hyd_model* m, hyd_data* d, double* ydot, const int* map) {
+    volumes_f(m, d, ydot, map);
+}
+
 void hyd_volumes_eval(const hyd_model* m, hyd_data* d, double* ydot, const double* G, double* J,
                       int ldj) {
+    if (!J && ydot) {
+        volumes_f(m, d, ydot, NULL);
+        return;
+    }
     const int n = m->nstate, ldg = n + 1, nvol = m->nvol;
     const double* restrict flow = d->flow_;
     const int* restrict vf = m->vol_flow;

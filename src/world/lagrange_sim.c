@@ -1,5 +1,8 @@
 // lagrange_sim.c: the coupled crane ODE (mechanics + circuit), its analytic
 // Jacobian and its block pattern. Derivation in docs/lagrange.md.
+#ifndef _GNU_SOURCE
+#define _GNU_SOURCE // sincos: one call per angle (glibc shares the sin and cos code)
+#endif
 #include "lagrange_sim.h"
 
 #include <math.h>
@@ -98,6 +101,7 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
         snprintf(path, sizeof path, "%s.tau", hyd_model_comp_name(hm, hyd_model_valve_comp(hm, m->valve[k])));
         s->inv_tau[k] = hyd_model_get(hm, path, &tau) == 0 && tau > 0 ? 1.0 / tau : 0.0;
     }
+    for (int i = 0; i < s->nh; ++i) s->hpos[s->perm[i]] = i;
     for (int i = 0; i < s->nh; ++i) {
         const char* nm = strrchr(hyd_model_state_name(hm, s->perm[i]), '.');
         s->is_pressure[i] = nm && nm[1] == 'p';
@@ -155,31 +159,34 @@ static void set_inputs(lsim* s, double t, const kin* k) {
     for (int i = 0; i < 2; ++i) {
         d->cyl_x[s->mdl->cyl[i]] = k->x[i];
         d->cyl_v[s->mdl->cyl[i]] = k->v[i];
-        d->valve_cmd[s->mdl->valve[i]] = s->scn ? scenario_command(s->scn, i, t) : s->u_cmd[i];
+        d->valve_cmd[s->mdl->valve[i]] = s->scn ? scenario_command_hint(s->scn, i, t, &s->scn_seg_[i]) : s->u_cmd[i];
     }
 }
 
 // Shared by rhs and Jacobian: the one sincos pair of q, the cylinder
-// kinematics, the circuit's inputs at t, and the circuit's states gathered
-// into its own order.
+// kinematics and the circuit's inputs at t.
 static void prepare(lsim* s, double t, const double* y, double trig[4], kin* k) {
     const double* q = y + s->iq;
+#if defined(__GLIBC__)
+    sincos(q[0], &trig[0], &trig[1]);
+    sincos(q[1], &trig[2], &trig[3]);
+#else
     trig[0] = sin(q[0]), trig[1] = cos(q[0]), trig[2] = sin(q[1]), trig[3] = cos(q[1]);
+#endif
     cylinder_kinematics(&s->mdl->mech, trig, y + s->iq + 2, k);
     set_inputs(s, t, k);
-    for (int i = 0; i < s->nh; ++i) s->yh_[s->perm[i]] = y[i];
 }
 
 int lsim_rhs(void* user, double t, const double* y, double* dydt) {
     lsim* s = user;
     const crane_mech* me = &s->mdl->mech;
-    const int nh = s->nh, iq = s->iq;
+    const int iq = s->iq;
     const double* qd = y + iq + 2;
     double trig[4];
     kin k;
     prepare(s, t, y, trig, &k);
-    hyd_eval(s->mdl->hyd, s->hd, t, s->yh_, s->fh_);
-    for (int i = 0; i < nh; ++i) dydt[i] = s->fh_[s->perm[i]];
+    // The circuit reads and writes its states in place: state h is y[hpos[h]].
+    hyd_eval_mapped(s->mdl->hyd, s->hd, t, y, dydt, s->hpos);
 
     const double tau[2] = {s->hd->cyl_F[s->mdl->cyl[0]] * k.r[0], s->hd->cyl_F[s->mdl->cyl[1]] * k.r[1]};
     lagrange_terms lt;
@@ -212,6 +219,7 @@ int lsim_jac(void* user, double t, const double* y, double* J) {
     double trig[4];
     kin k;
     prepare(s, t, y, trig, &k);
+    for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i]; // the circuit's own order
     hyd_data* d = s->hd;
     hyd_jacobian(s->mdl->hyd, d, t, s->yh_, NULL, s->jh_, nh, 0, 0);
 

@@ -29,6 +29,7 @@ typedef struct lsim {
     int n;                 ///< all states
     int iq;                ///< index of q1 (q2 = iq+1, q1' = iq+2, q2' = iq+3)
     int perm[LSIM_MAX_STATES]; ///< system index -> hydraulic state index (for i < nh)
+    int hpos[LSIM_MAX_STATES]; ///< its inverse: hydraulic state -> system index
     int ip[2][2];          ///< system indices of chamber pressures pA, pB of actuator k
     int iu[2];             ///< system index of actuator k's spool
     bool is_pressure[LSIM_MAX_STATES]; ///< system state i is a pressure [Pa abs]
@@ -37,9 +38,10 @@ typedef struct lsim {
     int block[LSIM_MAX_BLOCKS];
     const scenario* scn;   ///< command source, or NULL to use u_cmd
     double u_cmd[2];       ///< commands when scn is NULL, -1..1
+    int scn_seg_[2];       ///< segment hints for scenario_command_hint
     bool frozen_q[2];      ///< hold joint k still (tests; q' = 0, q'' = 0)
-    // Scratch for the gather/scatter of the permuted hydraulic states.
-    double yh_[LSIM_MAX_STATES], fh_[LSIM_MAX_STATES];
+    // Scratch: the hydraulic states in the circuit's order (Jacobian only).
+    double yh_[LSIM_MAX_STATES];
     double* jh_;           ///< nh x nh hydraulic Jacobian scratch (owned)
     double inv_tau[2];     ///< 1 / spool time constant of actuator k's valve [1/s]
     long nrhs;             ///< right-hand-side calls

@@ -111,20 +111,34 @@ int scenario_load(const char* path, scenario* s, char* err, size_t errsz) {
     return rc;
 }
 
-double scenario_command(const scenario* s, int k, double t) {
-    const scenario_signal* g = &s->cmd[k];
+// The segment search shared by scenario_command and scenario_command_hint:
+// the last i with t[i+1] <= t, scanning up from i0. Starting at any i0 with
+// t[i0] <= t gives the same i as starting at 0, since the times never
+// decrease (the scan from 0 would pass through i0).
+static inline double command_from(const scenario_signal* g, double t, int* seg) {
     if (g->n == 0) return 0.0;
     if (t <= g->t[0]) return g->u[0];
     if (t >= g->t[g->n - 1]) return g->u[g->n - 1];
     // Tables are short (< 64 points): a linear scan is cheaper than bisection
     // bookkeeping. The last segment containing t wins, so a step (two points at
     // the same time) takes its new value exactly at the step time.
-    int i = 0;
+    int i = *seg;
+    if (i < 0 || i + 1 >= g->n || !(g->t[i] <= t)) i = 0;
     while (i + 1 < g->n && g->t[i + 1] <= t) ++i;
+    *seg = i;
     if (i + 1 >= g->n) return g->u[g->n - 1];
     double dt = g->t[i + 1] - g->t[i];
     double w = dt > 0 ? (t - g->t[i]) / dt : 1.0;
     return g->u[i] + w * (g->u[i + 1] - g->u[i]);
+}
+
+double scenario_command(const scenario* s, int k, double t) {
+    int seg = 0;
+    return command_from(&s->cmd[k], t, &seg);
+}
+
+double scenario_command_seg(const scenario* s, int k, double t, int* seg) {
+    return command_from(&s->cmd[k], t, seg);
 }
 
 double scenario_command_rate(const scenario* s, int k, double t) {

@@ -52,6 +52,22 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
 
 /// Command of channel k at time t [s] (piecewise-linear, clamped to [-1, 1]).
 double scenario_command(const scenario* s, int k, double t);
+/// scenario_command with a cached segment index *seg (start it at 0, keep one
+/// per caller and channel): the same value for any t, in any order, but a
+/// run that moves forward in time skips the scan from the first point.
+double scenario_command_seg(const scenario* s, int k, double t, int* seg);
+static inline double scenario_command_hint(const scenario* s, int k, double t, int* seg) {
+    // Fast path: t strictly inside the cached segment [t_i, t_i+1), which is
+    // then the segment scenario_command would find (the last with t_i <= t),
+    // and the same interpolation formula gives the same bits.
+    const scenario_signal* g = &s->cmd[k];
+    const int i = *seg;
+    if (i + 1 < g->n && g->t[i] <= t && t < g->t[i + 1] && t > g->t[0]) {
+        const double w = (t - g->t[i]) / (g->t[i + 1] - g->t[i]);
+        return g->u[i] + w * (g->u[i + 1] - g->u[i]);
+    }
+    return scenario_command_seg(s, k, t, seg);
+}
 
 /// Slope du/dt [1/s] of channel k at time t (0 outside the table and on
 /// flat segments; at a breakpoint, the slope of the segment that starts there).
