@@ -52,29 +52,6 @@ void hyd_cylinder_derive(const hyd_cylinder_def* d, hyd_cyl_c* c) {
     c->ws = d->stop_width;
 }
 
-// One end stop: force magnitude for penetration delta and its rate ddelta,
-// with partials d|F|/ddelta and d|F|/dddelta.
-static double stop_force(const hyd_cyl_c* c, double delta, double ddelta, double* fd, double* fv) {
-    if (delta <= 0.0) {
-        *fd = 0.0;
-        *fv = 0.0;
-        return 0.0;
-    }
-    const double t = delta / c->ws;
-    double S, dS, dW;
-    if (t < 1.0) {
-        S = 0.5 * delta * t;
-        dS = t;
-    } else {
-        S = delta - 0.5 * c->ws;
-        dS = 1.0;
-    }
-    const double W = hyd_smoothstep(t, &dW);
-    *fd = c->ks * dS + c->cs * dW / c->ws * ddelta;
-    *fv = c->cs * W;
-    return c->ks * S + c->cs * W * ddelta;
-}
-
 void hyd_cylinders_eval(const hyd_model* m, hyd_data* d, double* G) {
     for (int i = 0; i < m->ncyl; ++i) {
         const hyd_cyl_c* c = &m->cyl[i];
@@ -94,8 +71,8 @@ void hyd_cylinders_eval(const hyd_model* m, hyd_data* d, double* G) {
 
         // Retracted stop pushes out (+), extended stop pushes in (-).
         double fdl, fvl, fdh, fvh;
-        const double flo = stop_force(c, -x, -v, &fdl, &fvl);
-        const double fhi = stop_force(c, x - c->s, v, &fdh, &fvh);
+        const double flo = hyd_stop_force(c, -x, -v, &fdl, &fvl);
+        const double fhi = hyd_stop_force(c, x - c->s, v, &fdh, &fvh);
         d->cyl_F[i] = pA * c->AA - pB * c->AB - c->bv * v + flo - fhi;
         d->cyl_stop[i] = (x > c->s) - (x < 0.0);
         d->comp_open[c->comp] = d->cyl_stop[i] != 0;

@@ -335,4 +335,43 @@ static inline double hyd_smoothstep(double t, double* ds) {
     return t * t * (3.0 - 2.0 * t);
 }
 
+/// Relief/check opening law on t = d / w (see relief.c): 0, t^2, then 2t - 1;
+/// *dr = d ramp / d d (so it includes 1/w).
+static inline double hyd_open_ramp_t(double t, double inv_w, double* dr) {
+    if (t <= 0.0) {
+        *dr = 0.0;
+        return 0.0;
+    }
+    if (t < 1.0) {
+        *dr = 2.0 * t * inv_w;
+        return t * t;
+    }
+    *dr = 2.0 * inv_w;
+    return 2.0 * t - 1.0;
+}
+
+/// Cylinder end stop (see cylinder.c): force magnitude for penetration delta
+/// and its rate ddelta, with partials d|F|/ddelta (*fd) and d|F|/dddelta (*fv).
+static inline double hyd_stop_force(const hyd_cyl_c* c, double delta, double ddelta, double* fd, double* fv) {
+    if (delta <= 0.0) {
+        *fd = 0.0;
+        *fv = 0.0;
+        return 0.0;
+    }
+    const double t = delta / c->ws;
+    double S, dS, dW;
+    if (t < 1.0) {
+        S = 0.5 * delta * t;
+        dS = t;
+    } else {
+        S = delta - 0.5 * c->ws;
+        dS = 1.0;
+    }
+    const double W = hyd_smoothstep(t, &dW);
+    *fd = c->ks * dS + c->cs * dW / c->ws * ddelta;
+    *fv = c->cs * W;
+    return c->ks * S + c->cs * W * ddelta;
+}
+
+
 #endif

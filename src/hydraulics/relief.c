@@ -14,23 +14,9 @@ hyd_relief_def hyd_default_relief_def(void) {
     return d;
 }
 
-// On t = d / w and 1/w, so the kernel needs no division.
-static inline double open_ramp_t(double t, double inv_w, double* dr) {
-    if (t <= 0.0) {
-        *dr = 0.0;
-        return 0.0;
-    }
-    if (t < 1.0) {
-        *dr = 2.0 * t * inv_w;
-        return t * t;
-    }
-    *dr = 2.0 * inv_w;
-    return 2.0 * t - 1.0;
-}
-
 double hyd_open_ramp(double d, double w, double* dr) {
     const double inv_w = 1.0 / w;
-    return open_ramp_t(d * inv_w, inv_w, dr);
+    return hyd_open_ramp_t(d * inv_w, inv_w, dr);
 }
 
 void hyd_relief_derive(const hyd_relief_def* d, hyd_ramp_c* c) {
@@ -59,7 +45,7 @@ void hyd_ramps_eval(const hyd_model* m, hyd_data* d, double* G, const hyd_ramp_c
             continue;
         }
         double dr;
-        const double r = open_ramp_t(t, c->inv_w, &dr);
+        const double r = hyd_open_ramp_t(t, c->inv_w, &dr);
         const double q = c->qr * r;
         const double g = c->qr * dr;
         cq[2 * c->comp] = q;

@@ -87,6 +87,77 @@ void lagrange_accel(const lagrange_terms* t, const double tau[2], double qdd[2])
     qdd[1] = (t->H[0][0] * r1 - t->H[1][0] * r0) / det;
 }
 
+void lagrange_consts_init(const crane_mech* m, lagrange_variant v, double m3, lagrange_consts* k) {
+    const double g = m->gravity;
+    const double L1 = m->link[0].length, L2 = m->link[1].length;
+    const double m1 = m->link[0].mass, m2 = m->link[1].mass;
+    const double e1 = m->link[0].com, e2 = m->link[1].com;
+    const double I1 = v == LAGRANGE_FULL ? m->link[0].inertia : 0.0;
+    const double I2 = v == LAGRANGE_FULL ? m->link[1].inertia : 0.0;
+    const double mu = m2 * e2 + m3 * L2;
+    k->kc = mu * L1;
+    k->H22 = I2 + m2 * e2 * e2 + m3 * L2 * L2;
+    k->H11c = I1 + m1 * e1 * e1 + (m2 + m3) * L1 * L1 + k->H22;
+    const double Lg = v == LAGRANGE_PAPER_TYPO ? L2 : L1;
+    k->A = (m1 * e1 + (m2 + m3) * Lg) * g;
+    k->B = mu * g;
+    k->coriolis = v == LAGRANGE_FULL;
+}
+
+void lagrange_accel_fast(const lagrange_consts* k, const double trig[4], const double qd[2],
+                         const double tau[2], double qdd[2]) {
+    const double s1 = trig[0], c1 = trig[1], s2 = trig[2], c2 = trig[3];
+    const double s12 = s1 * c2 + c1 * s2;
+    const double kc2 = k->kc * c2;
+    const double H00 = k->H11c + 2.0 * kc2, H01 = k->H22 + kc2, H11 = k->H22;
+    double C0 = 0.0, C1 = 0.0;
+    if (k->coriolis) {
+        const double ks = k->kc * s2;
+        C0 = -ks * (2.0 * qd[0] * qd[1] + qd[1] * qd[1]);
+        C1 = ks * qd[0] * qd[0];
+    }
+    const double Bs = k->B * s12;
+    const double r0 = tau[0] - C0 - (k->A * s1 + Bs);
+    const double r1 = tau[1] - C1 - Bs;
+    const double det = H00 * H11 - H01 * H01;
+    qdd[0] = (H11 * r0 - H01 * r1) / det;
+    qdd[1] = (H00 * r1 - H01 * r0) / det;
+}
+
+// Cody-Waite: pi/2 = P1 + P2 + P3, P1 and P2 with 33 significant bits, so
+// n P1 and n P2 are exact for |n| < 2^20 (|x| < 1e5 gives |n| < 65,000).
+// Taylor remainders on |r| <= pi/4: r^17/17! < 5e-17 (sin), r^18/18! < 3e-18
+// (cos), below half an ulp of the results there.
+void lagrange_sincos(double x, double* s, double* c) {
+    if (!(fabs(x) < 1e5)) {
+        *s = sin(x);
+        *c = cos(x);
+        return;
+    }
+    static const double P1 = 1.5707963267341256e+00; // 0x3FF921FB54400000
+    static const double P2 = 6.0771005063039660e-11; // 0x3DD0B4611A600000
+    static const double P3 = 2.0222662487959506e-21; // pi/2 - P1 - P2
+    static const double TWO_OVER_PI = 6.3661977236758138e-01;
+    // Round to nearest by the 1.5 * 2^52 trick (no libm call, no SSE4.1).
+    const double big = 6755399441055744.0;
+    const double fn = (x * TWO_OVER_PI + big) - big;
+    const double r = ((x - fn * P1) - fn * P2) - fn * P3;
+    const double r2 = r * r;
+    const double sp =
+        r + r * r2 *
+                (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 + r2 * (1.0 / 362880 +
+                 r2 * (-1.0 / 39916800 + r2 * (1.0 / 6227020800.0 + r2 * (-1.0 / 1307674368000.0)))))));
+    const double cp =
+        1.0 + r2 * (-0.5 + r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 + r2 * (-1.0 / 3628800 +
+              r2 * (1.0 / 479001600 + r2 * (-1.0 / 87178291200.0 + r2 * (1.0 / 20922789888000.0))))))));
+    switch ((long)fn & 3) {
+    case 0: *s = sp, *c = cp; break;
+    case 1: *s = cp, *c = -sp; break;
+    case 2: *s = -sp, *c = -cp; break;
+    default: *s = -cp, *c = sp; break;
+    }
+}
+
 double lagrange_energy(const crane_mech* m, double m3, const double q[2], const double qd[2]) {
     lagrange_terms t;
     lagrange_eval_terms(m, LAGRANGE_FULL, m3, q, qd, &t);

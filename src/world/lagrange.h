@@ -43,6 +43,31 @@ void lagrange_eval_terms_trig(const crane_mech* m, lagrange_variant v, double m3
 /// Accelerations qdd = H^-1 (tau - C - G) [rad/s^2].
 void lagrange_accel(const lagrange_terms* t, const double tau[2], double qdd[2]);
 
+/// The constant parts of H, C and G for one mechanics, variant and load, so a
+/// right-hand side evaluates them in a couple of dozen flops
+/// (lagrange_accel_fast). Same expressions as lagrange_eval_terms_trig.
+typedef struct lagrange_consts {
+    double H11c;  ///< H11 without its 2 kc cos q2 part [kg m^2]
+    double H22;   ///< [kg m^2]
+    double kc;    ///< coupling coefficient mu L1 [kg m^2]
+    double A, B;  ///< gravity moments [N m]
+    int coriolis; ///< 1 for LAGRANGE_FULL
+} lagrange_consts;
+
+void lagrange_consts_init(const crane_mech* m, lagrange_variant v, double m3, lagrange_consts* k);
+
+/// qdd = H^-1 (tau - C - G) from the constants and trig = {sin q1, cos q1,
+/// sin q2, cos q2}; equal to lagrange_eval_terms_trig + lagrange_accel to
+/// rounding.
+void lagrange_accel_fast(const lagrange_consts* k, const double trig[4], const double qd[2],
+                         const double tau[2], double qdd[2]);
+
+/// sin and cos of x together, to within about 1 ulp of libm: Cody-Waite
+/// reduction by pi/2 and Taylor polynomials on [-pi/4, pi/4] (|x| >= 1e5 and
+/// non-finite x go to libm). About a third of glibc's sincos on this machine,
+/// which is two sincos calls per crane right-hand side.
+void lagrange_sincos(double x, double* s, double* c);
+
 /// Total mechanical energy (kinetic + potential, zero at q = 0) of the full
 /// model [J]. Conserved with tau = 0 for LAGRANGE_FULL.
 double lagrange_energy(const crane_mech* m, double m3, const double q[2], const double qd[2]);

@@ -102,6 +102,12 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
         s->inv_tau[k] = hyd_model_get(hm, path, &tau) == 0 && tau > 0 ? 1.0 / tau : 0.0;
     }
     for (int i = 0; i < s->nh; ++i) s->hpos[s->perm[i]] = i;
+    // The fused kernel when the circuit has the standard shape (hyd_fused.h).
+    const int fv[2] = {m->valve[0], m->valve[1]}, fc[2] = {m->cyl[0], m->cyl[1]};
+    s->have_fused = hyd_fused_build(hm, fv, fc, 2, &s->fz, s->fused_why, sizeof s->fused_why) == 0;
+    if (s->have_fused) hyd_fused_map(&s->fz, s->hpos);
+    s->use_fused = s->have_fused;
+    lagrange_consts_init(&m->mech, v, m3, &s->lk);
     for (int i = 0; i < s->nh; ++i) {
         const char* nm = strrchr(hyd_model_state_name(hm, s->perm[i]), '.');
         s->is_pressure[i] = nm && nm[1] == 'p';
@@ -120,8 +126,9 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
     hyd_problem p;
     memset(&p, 0, sizeof p);
     p.n = s->n;
-    p.f = lsim_rhs;
-    p.jac = lsim_jac;
+    const bool fz = s->use_fused && s->have_fused;
+    p.f = fz ? lsim_rhs_fused : lsim_rhs;
+    p.jac = fz ? lsim_jac_fused : lsim_jac;
     p.dfdt = lsim_dfdt;
     p.user = s;
     if (blocks) {
@@ -154,25 +161,35 @@ static void cylinder_kinematics(const crane_mech* me, const double* trig, const 
     }
 }
 
-static void set_inputs(lsim* s, double t, const kin* k) {
-    hyd_data* d = s->hd;
-    for (int i = 0; i < 2; ++i) {
-        d->cyl_x[s->mdl->cyl[i]] = k->x[i];
-        d->cyl_v[s->mdl->cyl[i]] = k->v[i];
-        d->valve_cmd[s->mdl->valve[i]] = s->scn ? scenario_command_hint(s->scn, i, t, &s->scn_seg_[i]) : s->u_cmd[i];
-    }
+static void commands(lsim* s, double t, double cmd[2]) {
+    for (int i = 0; i < 2; ++i)
+        cmd[i] = s->scn ? scenario_command_hint(s->scn, i, t, &s->scn_seg_[i]) : s->u_cmd[i];
 }
 
-// Shared by rhs and Jacobian: the one sincos pair of q, the cylinder
-// kinematics and the circuit's inputs at t.
-static void prepare(lsim* s, double t, const double* y, double trig[4], kin* k) {
-    const double* q = y + s->iq;
+static inline void trig_of(const double* q, double trig[4]) {
 #if defined(__GLIBC__)
     sincos(q[0], &trig[0], &trig[1]);
     sincos(q[1], &trig[2], &trig[3]);
 #else
     trig[0] = sin(q[0]), trig[1] = cos(q[0]), trig[2] = sin(q[1]), trig[3] = cos(q[1]);
 #endif
+}
+
+static void set_inputs(lsim* s, double t, const kin* k) {
+    hyd_data* d = s->hd;
+    double cmd[2];
+    commands(s, t, cmd);
+    for (int i = 0; i < 2; ++i) {
+        d->cyl_x[s->mdl->cyl[i]] = k->x[i];
+        d->cyl_v[s->mdl->cyl[i]] = k->v[i];
+        d->valve_cmd[s->mdl->valve[i]] = cmd[i];
+    }
+}
+
+// Shared by rhs and Jacobian: the one sincos pair of q, the cylinder
+// kinematics and the circuit's inputs at t.
+static void prepare(lsim* s, double t, const double* y, double trig[4], kin* k) {
+    trig_of(y + s->iq, trig);
     cylinder_kinematics(&s->mdl->mech, trig, y + s->iq + 2, k);
     set_inputs(s, t, k);
 }
@@ -211,56 +228,31 @@ int lsim_dfdt(void* user, double t, const double* y, double* dfdt) {
     return 0;
 }
 
-int lsim_jac(void* user, double t, const double* y, double* J) {
-    lsim* s = user;
-    const crane_mech* me = &s->mdl->mech;
+// Rows q1, q2, q1', q2' for the mechanical columns (j >= nh), and H^-1 for the
+// hydraulic columns, which the callers fill from their own dF/dy:
+//   d qdd / dz = H^-1 (d tau/dz - dC/dz - dG/dz - dH/dz qdd), column by column.
+// F, dFdx, dFdv: cylinder forces and their stroke and rate partials.
+static void mech_jac(const lsim* s, const double trig[4], const double* qd, const kin* k,
+                     const double F[2], const double dFdx[2], const double dFdv[2], double Hi[2][2],
+                     double* J) {
     const int nh = s->nh, n = s->n, iq = s->iq;
-    const double* qd = y + iq + 2;
-    double trig[4];
-    kin k;
-    prepare(s, t, y, trig, &k);
-    for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i]; // the circuit's own order
-    hyd_data* d = s->hd;
-    hyd_jacobian(s->mdl->hyd, d, t, s->yh_, NULL, s->jh_, nh, 0, 0);
-
-    // Hydraulic block, permuted.
-    for (int i = 0; i < nh; ++i)
-        for (int j = 0; j < nh; ++j) J[i * n + j] = s->jh_[s->perm[i] * nh + s->perm[j]];
-
-    const int nhs = hyd_model_nstate(s->mdl->hyd);
-    double F[2], dtau_dq[2], dtau_dqd[2];
+    double dtau_dq[2], dtau_dqd[2];
     for (int c = 0; c < 2; ++c) {
-        const int cyl = s->mdl->cyl[c];
-        const double* dydx = d->dydx + (size_t)cyl * nhs;
-        const double* dydv = d->dydv + (size_t)cyl * nhs;
-        // Chain rule through x(q) and v = r(q) q'.
-        const double dv_dq = k.dr[c] * qd[c];
-        for (int i = 0; i < nh; ++i) {
-            const int h = s->perm[i];
-            J[i * n + iq + c] = dydx[h] * k.r[c] + dydv[h] * dv_dq;
-            J[i * n + iq + 2 + c] = dydv[h] * k.r[c];
-        }
-        F[c] = d->cyl_F[cyl];
-        dtau_dq[c] = F[c] * k.dr[c] + k.r[c] * (d->dFdx[cyl] * k.r[c] + d->dFdv[cyl] * dv_dq);
-        dtau_dqd[c] = k.r[c] * k.r[c] * d->dFdv[cyl];
+        const double dv_dq = k->dr[c] * qd[c];
+        dtau_dq[c] = F[c] * k->dr[c] + k->r[c] * (dFdx[c] * k->r[c] + dFdv[c] * dv_dq);
+        dtau_dqd[c] = k->r[c] * k->r[c] * dFdv[c];
     }
-
     lagrange_terms lt;
-    lagrange_eval_terms_trig(me, s->variant, s->m3, trig, qd, &lt);
-    const double tau[2] = {F[0] * k.r[0], F[1] * k.r[1]};
+    lagrange_eval_terms_trig(&s->mdl->mech, s->variant, s->m3, trig, qd, &lt);
+    const double tau[2] = {F[0] * k->r[0], F[1] * k->r[1]};
     double qdd[2];
     lagrange_accel(&lt, tau, qdd);
     const double det = lt.H[0][0] * lt.H[1][1] - lt.H[0][1] * lt.H[1][0];
-    const double Hi[2][2] = {{lt.H[1][1] / det, -lt.H[0][1] / det}, {-lt.H[1][0] / det, lt.H[0][0] / det}};
-
-    // d qdd / dz = H^-1 (d tau/dz - dC/dz - dG/dz - dH/dz qdd), column by column.
-    for (int j = 0; j < n; ++j) {
-        double g0 = 0.0, g1 = 0.0; // d(tau - C - G - H qdd)/dz_j, with H fixed except via q2
-        if (j < nh) {
-            const int h = s->perm[j];
-            g0 = k.r[0] * d->dFdy[(size_t)s->mdl->cyl[0] * nhs + h];
-            g1 = k.r[1] * d->dFdy[(size_t)s->mdl->cyl[1] * nhs + h];
-        } else if (j == iq) {
+    Hi[0][0] = lt.H[1][1] / det, Hi[0][1] = -lt.H[0][1] / det;
+    Hi[1][0] = -lt.H[1][0] / det, Hi[1][1] = lt.H[0][0] / det;
+    for (int j = nh; j < n; ++j) {
+        double g0, g1; // d(tau - C - G - H qdd)/dz_j, with H fixed except via q2
+        if (j == iq) {
             g0 = dtau_dq[0] - lt.dG_dq1[0];
             g1 = -lt.dG_dq1[1];
         } else if (j == iq + 1) {
@@ -278,10 +270,127 @@ int lsim_jac(void* user, double t, const double* y, double* J) {
         J[iq * n + j] = (j == iq + 2) ? 1.0 : 0.0;
         J[(iq + 1) * n + j] = (j == iq + 3) ? 1.0 : 0.0;
     }
+}
+
+static void freeze_rows(const lsim* s, double* J) {
     for (int c = 0; c < 2; ++c) {
         if (!s->frozen_q[c]) continue;
-        for (int j = 0; j < n; ++j) J[(iq + c) * n + j] = J[(iq + 2 + c) * n + j] = 0.0;
+        for (int j = 0; j < s->n; ++j) J[(s->iq + c) * s->n + j] = J[(s->iq + 2 + c) * s->n + j] = 0.0;
     }
+}
+
+int lsim_jac(void* user, double t, const double* y, double* J) {
+    lsim* s = user;
+    const int nh = s->nh, n = s->n, iq = s->iq;
+    const double* qd = y + iq + 2;
+    double trig[4];
+    kin k;
+    prepare(s, t, y, trig, &k);
+    for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i]; // the circuit's own order
+    hyd_data* d = s->hd;
+    hyd_jacobian(s->mdl->hyd, d, t, s->yh_, NULL, s->jh_, nh, 0, 0);
+
+    // Hydraulic block, permuted.
+    for (int i = 0; i < nh; ++i)
+        for (int j = 0; j < nh; ++j) J[i * n + j] = s->jh_[s->perm[i] * nh + s->perm[j]];
+
+    const int nhs = hyd_model_nstate(s->mdl->hyd);
+    double F[2], dFdx[2], dFdv[2];
+    for (int c = 0; c < 2; ++c) {
+        const int cyl = s->mdl->cyl[c];
+        const double* dydx = d->dydx + (size_t)cyl * nhs;
+        const double* dydv = d->dydv + (size_t)cyl * nhs;
+        // Chain rule through x(q) and v = r(q) q'.
+        const double dv_dq = k.dr[c] * qd[c];
+        for (int i = 0; i < nh; ++i) {
+            const int h = s->perm[i];
+            J[i * n + iq + c] = dydx[h] * k.r[c] + dydv[h] * dv_dq;
+            J[i * n + iq + 2 + c] = dydv[h] * k.r[c];
+        }
+        F[c] = d->cyl_F[cyl];
+        dFdx[c] = d->dFdx[cyl];
+        dFdv[c] = d->dFdv[cyl];
+    }
+    double Hi[2][2];
+    mech_jac(s, trig, qd, &k, F, dFdx, dFdv, Hi, J);
+    for (int j = 0; j < nh; ++j) {
+        const int h = s->perm[j];
+        const double g0 = k.r[0] * d->dFdy[(size_t)s->mdl->cyl[0] * nhs + h];
+        const double g1 = k.r[1] * d->dFdy[(size_t)s->mdl->cyl[1] * nhs + h];
+        J[(iq + 2) * n + j] = Hi[0][0] * g0 + Hi[0][1] * g1;
+        J[(iq + 3) * n + j] = Hi[1][0] * g0 + Hi[1][1] * g1;
+        J[iq * n + j] = J[(iq + 1) * n + j] = 0.0;
+    }
+    freeze_rows(s, J);
+    return 0;
+}
+
+// ---------------------------------------------------------------------------
+// Fused path: the same system through hyd_fused (one pass over the circuit)
+// instead of the general component loops. Same laws, agreement to rounding
+// (tests/lagrange/test_lagrange_fused.c); about 4x fewer instructions.
+// ---------------------------------------------------------------------------
+
+int lsim_rhs_fused(void* user, double t, const double* y, double* dydt) {
+    lsim* s = user;
+    const int iq = s->iq;
+    const double* qd = y + iq + 2;
+    double trig[4], cmd[2], F[2];
+    kin k;
+    lagrange_sincos(y[iq], &trig[0], &trig[1]);
+    lagrange_sincos(y[iq + 1], &trig[2], &trig[3]);
+    cylinder_kinematics(&s->mdl->mech, trig, qd, &k);
+    commands(s, t, cmd);
+    hyd_fused_eval(&s->fz, y, k.x, k.v, cmd, dydt, F);
+    const double tau[2] = {F[0] * k.r[0], F[1] * k.r[1]};
+    double qdd[2];
+    lagrange_accel_fast(&s->lk, trig, qd, tau, qdd);
+    for (int j = 0; j < 2; ++j) {
+        if (s->frozen_q[j]) qdd[j] = 0.0;
+        dydt[iq + j] = s->frozen_q[j] ? 0.0 : qd[j];
+        dydt[iq + 2 + j] = qdd[j];
+    }
+    ++s->nrhs;
+    return 0;
+}
+
+int lsim_jac_fused(void* user, double t, const double* y, double* J) {
+    lsim* s = user;
+    const int n = s->n, iq = s->iq;
+    const double* qd = y + iq + 2;
+    double trig[4], cmd[2], F[2], ydot[LSIM_MAX_STATES];
+    kin k;
+    trig_of(y + iq, trig);
+    cylinder_kinematics(&s->mdl->mech, trig, qd, &k);
+    commands(s, t, cmd);
+    memset(J, 0, (size_t)n * (size_t)n * sizeof *J);
+    hyd_fused_coupling cp[2];
+    hyd_fused_jacobian(&s->fz, y, k.x, k.v, cmd, ydot, F, J, n, cp);
+    double dFdx[2], dFdv[2];
+    for (int c = 0; c < 2; ++c) {
+        const double dv_dq = k.dr[c] * qd[c];
+        const int iA = s->ip[c][0], iB = s->ip[c][1];
+        J[iA * n + iq + c] = cp[c].dA_dx * k.r[c] + cp[c].dA_dv * dv_dq;
+        J[iA * n + iq + 2 + c] = cp[c].dA_dv * k.r[c];
+        J[iB * n + iq + c] = cp[c].dB_dx * k.r[c] + cp[c].dB_dv * dv_dq;
+        J[iB * n + iq + 2 + c] = cp[c].dB_dv * k.r[c];
+        dFdx[c] = cp[c].dF_dx;
+        dFdv[c] = cp[c].dF_dv;
+    }
+    double Hi[2][2];
+    mech_jac(s, trig, qd, &k, F, dFdx, dFdv, Hi, J);
+    // Hydraulic columns of q'': only the chamber pressures move F (dF/dpA =
+    // AA, dF/dpB = -AB).
+    for (int c = 0; c < 2; ++c) {
+        const hyd_fused_act* a = &s->fz.act[c];
+        const double gA = k.r[c] * a->AA, gB = -k.r[c] * a->AB;
+        const int iA = s->ip[c][0], iB = s->ip[c][1];
+        J[(iq + 2) * n + iA] = Hi[0][c] * gA;
+        J[(iq + 3) * n + iA] = Hi[1][c] * gA;
+        J[(iq + 2) * n + iB] = Hi[0][c] * gB;
+        J[(iq + 3) * n + iB] = Hi[1][c] * gB;
+    }
+    freeze_rows(s, J);
     return 0;
 }
 

@@ -8,6 +8,7 @@
 
 #include <stdbool.h>
 
+#include "hyd_fused.h"
 #include "hyd_solver.h"
 #include "lagrange.h"
 #include "model.h"
@@ -45,13 +46,20 @@ typedef struct lsim {
     double* jh_;           ///< nh x nh hydraulic Jacobian scratch (owned)
     double inv_tau[2];     ///< 1 / spool time constant of actuator k's valve [1/s]
     long nrhs;             ///< right-hand-side calls
+    // The fused circuit kernel (hyd_fused.h), in the system's state order.
+    hyd_fused fz;
+    lagrange_consts lk;    ///< H, C, G constants for the fused rhs (variant, m3 at init)
+    bool have_fused;       ///< the circuit has the standard shape
+    bool use_fused;        ///< lsim_problem hands out the fused f and J (default: have_fused)
+    char fused_why[96];    ///< why not, when !have_fused
 } lsim;
 
 /// Set up for model m. Returns 0, or -1 with a message.
 int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err, size_t errsz);
 void lsim_free(lsim* s);
 
-/// The problem for hyd_solver_create: f, analytic Jacobian, and (if blocks)
+/// The problem for hyd_solver_create: f, analytic Jacobian (the fused ones
+/// when use_fused and have_fused), and (if blocks)
 /// the block-diagonal pattern [spool] [hose A, chamber A] [hose B, chamber B]
 /// per actuator, 1x1 for other hydraulic states, [q1, q2, q1', q2'].
 hyd_problem lsim_problem(lsim* s, bool blocks);
@@ -66,6 +74,11 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt);
 /// only the spool rows are non-zero: (du_cmd/dt) / tau_s.
 int lsim_dfdt(void* user, double t, const double* y, double* dfdt);
 int lsim_jac(void* user, double t, const double* y, double* J);
+/// The same f and J through the fused circuit kernel (requires have_fused;
+/// the model's circuit parameters, mechanics and m3 must not change after
+/// lsim_init: the kernel holds packed copies).
+int lsim_rhs_fused(void* user, double t, const double* y, double* dydt);
+int lsim_jac_fused(void* user, double t, const double* y, double* J);
 
 /// Derived outputs at (t, y), computed fresh (calls the rhs once).
 typedef struct lsim_out {

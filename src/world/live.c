@@ -37,6 +37,11 @@ live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2]
         return NULL;
     }
     lsim_initial_state(&l->ls, q0, 0.5e6, l->y);
+    // The drive panel edits circuit parameters in place (hyd_model_set), and
+    // the fused kernel holds a packed copy of them: live runs keep the
+    // general path, which reads the model on every call. Real time needs 1x,
+    // not the fused kernel's speed.
+    l->ls.use_fused = false;
     const bool adaptive = hyd_method_is_adaptive(o->solver);
     l->prob = lsim_problem(&l->ls, !adaptive && !o->dense_jac);
     hyd_solver_opts so = hyd_default_solver_opts();

@@ -3,6 +3,7 @@
 // differences, flow continuity, live parameters and JSON round trips.
 #include "check.h"
 #include "hydraulics.h"
+#include "hyd_fused.h"
 
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -330,6 +331,141 @@ static void test_eval_mapped(void) {
     hyd_model_free(m);
 }
 
+// The fused kernel (hyd_fused.h) against the general evaluation: the same
+// laws summed in a different order, so every derivative agrees to rounding
+// of the terms it sums (term_scale), over random states concentrated at the
+// regime switches; the Jacobian rows and the coupling partials likewise,
+// entry by entry, including the entries the general Jacobian has as zero.
+static void test_fused(void) {
+    char err[256];
+    hyd_model* m = hyd_model_default_crane(err, sizeof err);
+    if (!m)
+        return;
+    hyd_data* d = hyd_data_create(m);
+    const int n = hyd_model_nstate(m);
+    int valve[2], cyl[2];
+    for (int k = 0; k < 2; ++k) {
+        cyl[k] = hyd_model_cylinder(m, k ? "jib_cyl" : "lift_cyl");
+        valve[k] = hyd_model_valve(m, k ? "jib_valve" : "lift_valve");
+    }
+    hyd_fused f;
+    char why[128] = "";
+    CHECK(hyd_fused_build(m, valve, cyl, 2, &f, why, sizeof why) == 0, "refused: %s", why);
+    double y[NMAX], yd[NMAX], ydf[NMAX], fs[NMAX], J[NMAX * NMAX], Jf[NMAX * NMAX];
+    srand(4242);
+    int nbad_f = 0, nbad_j = 0, nbad_c = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        random_state(m, d, y);
+        double x[2], v[2], cmd[2], F[2], Ff[2];
+        for (int k = 0; k < 2; ++k)
+            x[k] = d->cyl_x[cyl[k]], v[k] = d->cyl_v[cyl[k]], cmd[k] = d->valve_cmd[valve[k]];
+        hyd_jacobian(m, d, 0, y, yd, J, n, 0, 0);
+        term_scale(m, d, fs);
+        for (int k = 0; k < 2; ++k) F[k] = d->cyl_F[cyl[k]];
+        hyd_fused_eval(&f, y, x, v, cmd, ydf, Ff);
+        for (int i = 0; i < n; ++i)
+            nbad_f += !(fabs(ydf[i] - yd[i]) <= 1e-13 * fs[i] + 1e-300);
+        for (int k = 0; k < 2; ++k)
+            nbad_f += !(fabs(Ff[k] - F[k]) <= 1e-13 * (fabs(F[k]) + 1e6));
+        memset(Jf, 0, sizeof Jf);
+        hyd_fused_coupling cp[2];
+        double ydj[NMAX];
+        hyd_fused_jacobian(&f, y, x, v, cmd, ydj, Ff, Jf, n, cp);
+        for (int i = 0; i < n; ++i) {
+            nbad_f += memcmp(&ydj[i], &ydf[i], sizeof ydf[i]) != 0;
+            double rs = 0.0;
+            for (int j = 0; j < n; ++j) rs = fmax(rs, fabs(J[i * n + j]));
+            for (int j = 0; j < n; ++j)
+                nbad_j += !(fabs(Jf[i * n + j] - J[i * n + j]) <= 1e-12 * rs + 1e-300);
+        }
+        for (int k = 0; k < 2; ++k) {
+            int iA, iB;
+            hyd_model_cylinder_states(m, cyl[k], &iA, &iB);
+            const double* gx = d->dydx + (size_t)cyl[k] * n;
+            const double* gv = d->dydv + (size_t)cyl[k] * n;
+            nbad_c += !(fabs(cp[k].dA_dx - gx[iA]) <= 1e-12 * fabs(gx[iA]) + 1e-13 * fs[iA]);
+            nbad_c += !(fabs(cp[k].dB_dx - gx[iB]) <= 1e-12 * fabs(gx[iB]) + 1e-13 * fs[iB]);
+            nbad_c += !(fabs(cp[k].dA_dv - gv[iA]) <= 1e-13 * fabs(gv[iA]));
+            nbad_c += !(fabs(cp[k].dB_dv - gv[iB]) <= 1e-13 * fabs(gv[iB]));
+            nbad_c += cp[k].dF_dx != d->dFdx[cyl[k]] || cp[k].dF_dv != d->dFdv[cyl[k]];
+        }
+    }
+    CHECK(nbad_f == 0, "%d derivatives or forces differ beyond rounding", nbad_f);
+    CHECK(nbad_j == 0, "%d Jacobian entries differ", nbad_j);
+    CHECK(nbad_c == 0, "%d coupling partials differ", nbad_c);
+
+    // A mapped copy reads and writes the caller's slots.
+    int map[NMAX];
+    for (int i = 0; i < n; ++i) map[i] = n - 1 - i;
+    hyd_fused fm = f;
+    hyd_fused_map(&fm, map);
+    random_state(m, d, y);
+    double yr[NMAX], ydr[NMAX], x[2], v[2], cmd[2], F[2];
+    for (int i = 0; i < n; ++i) yr[map[i]] = y[i];
+    for (int k = 0; k < 2; ++k)
+        x[k] = d->cyl_x[cyl[k]], v[k] = d->cyl_v[cyl[k]], cmd[k] = d->valve_cmd[valve[k]];
+    hyd_fused_eval(&f, y, x, v, cmd, ydf, F);
+    hyd_fused_eval(&fm, yr, x, v, cmd, ydr, F);
+    int bad = 0;
+    for (int i = 0; i < n; ++i) bad += memcmp(&ydr[map[i]], &ydf[i], sizeof ydf[i]) != 0;
+    CHECK(bad == 0, "mapped fused evaluation differs in %d states", bad);
+    hyd_data_free(d);
+    hyd_model_free(m);
+}
+
+// Circuits of another shape are refused with a reason, not mis-evaluated.
+static void test_fused_refuses(void) {
+    char err[256];
+    hyd_model* m = hyd_model_default_crane(err, sizeof err);
+    if (!m)
+        return;
+    hyd_fused f;
+    char why[128] = "";
+    int valve[2] = {0, 1}, cyl[2] = {0, 1};
+    // One actuator of two: the other's nodes are unaccounted for.
+    CHECK(hyd_fused_build(m, valve, cyl, 1, &f, why, sizeof why) != 0, "one of two actuators accepted");
+    CHECK(why[0] != 0, "no reason given");
+    // Valve 0 paired with cylinder 1: its hoses lead elsewhere.
+    int swapped[2] = {1, 0};
+    why[0] = 0;
+    CHECK(hyd_fused_build(m, valve, swapped, 2, &f, why, sizeof why) != 0, "crossed actuators accepted");
+    CHECK(strstr(why, "hose") != NULL, "reason: %s", why);
+    hyd_model_free(m);
+
+    // An orifice anywhere: the general path only.
+    hyd_builder* b = hyd_builder_create();
+    hyd_tank_def t = hyd_default_tank_def();
+    t.name = "tank";
+    hyd_add_tank(b, &t);
+    hyd_volume_def vol = hyd_default_volume_def();
+    vol.name = "line";
+    vol.volume = 1e-3;
+    hyd_add_volume(b, &vol);
+    hyd_pump_def pu = hyd_default_pump_def();
+    pu.name = "pump";
+    pu.inlet = "tank";
+    pu.outlet = "line";
+    pu.q_max = 1e-4;
+    pu.p_set = 1e7;
+    hyd_add_pump(b, &pu);
+    hyd_orifice_def o = hyd_default_orifice_def();
+    o.name = "bleed";
+    o.inlet = "line";
+    o.outlet = "tank";
+    o.area = 1e-6;
+    hyd_add_orifice(b, &o);
+    hyd_model* m2 = hyd_compile(b, err, sizeof err);
+    hyd_builder_free(b);
+    CHECK(m2 != NULL, "compile: %s", err);
+    if (m2) {
+        why[0] = 0;
+        int none[1] = {0};
+        CHECK(hyd_fused_build(m2, none, none, 1, &f, why, sizeof why) != 0, "orifice circuit accepted");
+        CHECK(why[0] != 0, "no reason");
+        hyd_model_free(m2);
+    }
+}
+
 static void test_live_parameters(void) {
     char err[256];
     hyd_model* m = hyd_model_default_crane(err, sizeof err);
@@ -418,6 +554,8 @@ int main(int argc, char** argv) {
     RUN_TEST(test_jacobian_fd);
     RUN_TEST(test_flow_continuity);
     RUN_TEST(test_eval_mapped);
+    RUN_TEST(test_fused);
+    RUN_TEST(test_fused_refuses);
     RUN_TEST(test_live_parameters);
     RUN_TEST(test_json_matches_default);
     TEST_MAIN_END();

@@ -1,0 +1,108 @@
+// hyd_fused.h: the "standard actuator circuit" evaluated by one straight-line
+// kernel instead of the general per-type component loops.
+//
+// The general evaluation (hyd_eval) walks component arrays, writes every flow
+// into per-port slots and gathers them per node: flexible, but about 2,200
+// instructions per call on the crane circuit, most of it bookkeeping. Almost
+// every crane circuit has one shape, though:
+//
+//   tank --pump--> pump line (a volume node), valves P = pump line, T = a tank;
+//   per actuator: valve A/B -> hose -> cylinder chamber A/B;
+//   reliefs and check valves only between a tank and a volume node.
+//
+// hyd_fused_build() recognises that shape on a compiled model and packs its
+// derived constants per actuator; hyd_fused_eval() then computes the same
+// right-hand side (the same component laws, the same Be(p) kernel) in one pass
+// with every flow in a register. A circuit of any other shape (orifices,
+// valves fed from another node, reliefs between two volumes...) is refused
+// with a reason, and the caller keeps the general path. See
+// docs/performance.md and the bit-level comparison in
+// tests/hydraulics/test_fused.c.
+#ifndef HYD_FUSED_H
+#define HYD_FUSED_H
+
+#include "hydraulics.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HYD_FUSED_MAXACT 4  ///< actuators (valve + hoses + cylinder)
+#define HYD_FUSED_MAXRAMP 4 ///< reliefs/checks between one node and a tank
+
+/// A relief (flow out of the node to a tank) or check valve (flow from a tank
+/// into the node), q = qr ramp((dp - pcr) / w).
+typedef struct hyd_fused_ramp {
+    double pcr, inv_w, qr; ///< cracking pressure [Pa], 1/override band [1/Pa], rated flow [m^3/s]
+    double p_tank;         ///< pressure of the tank at the other end [Pa abs]
+    int into;              ///< 1: check valve (tank -> node), 0: relief (node -> tank)
+} hyd_fused_ramp;
+
+/// A pressure node: its state index (caller order), fixed volume, liquid
+/// modulus and air weight, and the ramps to tanks.
+typedef struct hyd_fused_node {
+    int s;                 ///< state index in the caller's vector
+    double V0;             ///< fixed volume [m^3] (0 for chambers)
+    double bel, bec;       ///< liquid modulus [Pa], alpha bel / n [Pa]
+    int nramp;
+    hyd_fused_ramp ramp[HYD_FUSED_MAXRAMP];
+    /// Every ramp is closed while p_lo < p < p_hi [Pa abs] (checks crack
+    /// below p_lo, reliefs above p_hi): the common case costs two compares.
+    double p_lo, p_hi;
+} hyd_fused_node;
+
+typedef struct hyd_fused_act {
+    int valve, cyl;        ///< valve and cylinder indices in the model
+    int su;                ///< spool state index (caller order)
+    hyd_fused_node hA, hB, cA, cB; ///< hoses and chambers
+    double Amax, inv_tau;  ///< valve: full opening area [m^2], 1 / spool time constant [1/s]
+    double ok, oinvP0, okl; ///< orifice constants (hyd_orif_k: k, 1/P0, kl)
+    double pT;             ///< valve tank pressure [Pa abs]
+    double GA, GB;         ///< hose conductances [m^3/(s Pa)]
+    double AA, AB, s, VA0, VB0, CL, bv, ks, cs, ws; ///< cylinder (hyd_cyl_c)
+} hyd_fused_act;
+
+/// Coupling partials of one actuator for the mechanics (hyd_fused_jacobian).
+typedef struct hyd_fused_coupling {
+    double dA_dx, dA_dv;   ///< d pA' / dx [Pa/(s m)], d pA' / dx' [Pa/m]
+    double dB_dx, dB_dv;
+    double dF_dx, dF_dv;   ///< cylinder force partials [N/m], [N s/m] (dF/dpA = AA, dF/dpB = -AB)
+} hyd_fused_coupling;
+
+typedef struct hyd_fused {
+    const hyd_model* m;    ///< the model the constants came from
+    int nact, nstate;
+    hyd_fused_act act[HYD_FUSED_MAXACT];
+    hyd_fused_node pl;     ///< the pump line
+    double qmax, pset, inv_band, p_in; ///< pump; p_in: its tank pressure [Pa abs]
+} hyd_fused;
+
+/// Pack model m for actuators k = 0..nact-1 (valve[k] drives cylinder[k];
+/// model indices). Returns 0, or -1 with the reason in why when the circuit is
+/// not of the standard shape. State indices are the circuit's own until
+/// hyd_fused_map. Rebuild after any hyd_model_set.
+int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int nact, hyd_fused* f,
+                    char* why, size_t whysz);
+
+/// Renumber states: circuit state i lives at y[map[i]] from now on.
+void hyd_fused_map(hyd_fused* f, const int* map);
+
+/// ydot of every circuit state and the cylinder forces F[k] [N], given the
+/// strokes x [m], rates v [m/s] and valve commands cmd [-] of the actuators.
+/// The same laws as hyd_eval, summed in a different order (agreement to
+/// rounding, not bit for bit).
+void hyd_fused_eval(const hyd_fused* f, const double* y, const double* x, const double* v,
+                    const double* cmd, double* ydot, double* F);
+
+/// The circuit's Jacobian rows, written into J (row-major, leading dimension
+/// ldj, caller's state order): only the non-zero entries of the circuit's
+/// rows and columns are written, so J must be zeroed by the caller. Also
+/// ydot and F as hyd_fused_eval, and the coupling partials per actuator.
+void hyd_fused_jacobian(const hyd_fused* f, const double* y, const double* x, const double* v,
+                        const double* cmd, double* ydot, double* F, double* J, int ldj,
+                        hyd_fused_coupling* cpl);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
