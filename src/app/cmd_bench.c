@@ -157,13 +157,14 @@ int cmd_bench(int argc, char** argv) {
         double wall = walls[repeat / 2];
         printf("{\"config\":\"%s\",\"scenario\":\"%s\",\"mechanics\":\"%s\",\"world\":\"%s\","
                "\"dt_ode_s\":%g,\"variant\":\"%s\","
-               "\"solver\":\"%s\",\"h_s\":%g,\"rtol\":%g,\"jacobian\":\"%s\",\"sim_time_s\":%.6g,"
+               "\"solver\":\"%s\",\"h_s\":%g,\"rtol\":%g,\"jacobian\":\"%s\",\"kernel\":\"%s\",\"sim_time_s\":%.6g,"
                "\"wall_s_median\":%.6g,\"repeat\":%d,\"rt_factor\":%.1f,\"steps\":%ld,\"rejected\":%ld,"
                "\"fevals\":%ld,\"jevals\":%ld,\"lus\":%ld,\"ns_per_step\":%.1f}\n",
                b->name, use->name, o.mechanics == SIM_ODE ? "ode" : "lagrange", o.mechanics == SIM_ODE ? o.world : "",
                o.mechanics == SIM_ODE ? o.dt_ode : 0.0, lagrange_variant_name(o.variant), hyd_method_name(o.solver),
                hyd_method_is_adaptive(o.solver) ? 0.0 : o.h, hyd_method_is_adaptive(o.solver) ? o.rtol : 0.0,
-               hyd_method_is_adaptive(o.solver) ? "dense" : (o.dense_jac ? "dense" : "blocks"), r.t_end, wall,
+               hyd_method_is_adaptive(o.solver) ? "dense" : (o.dense_jac ? "dense" : "blocks"),
+               o.mechanics == SIM_ODE ? "ode" : (r.fused ? "fused" : "general"), r.t_end, wall,
                repeat, r.t_end / wall, r.stats.steps, r.stats.rejected, r.stats.fevals, r.stats.jevals,
                r.stats.lus, 1e9 * wall / (double)(r.stats.steps ? r.stats.steps : 1));
         fflush(stdout);

@@ -46,7 +46,7 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
     }
     static const char* const with_value[] = {"--model", "--scenario", "--mechanics", "--variant", "--solver",
                                              "--dt", "--rtol", "--atol", "--duration", "--every",
-                                             "--set", "--jac-every", "--load", "--world", "--dt-ode", NULL};
+                                             "--set", "--jac-every", "--load", "--world", "--dt-ode", "--kernel", NULL};
     int k = -1;
     for (int j = 0; with_value[j]; ++j)
         if (!strcmp(a, with_value[j])) k = j;
@@ -120,6 +120,13 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
         break;
     case 13: c->sim.world = v; break;
     case 14: if (positive(a, v, &c->sim.dt_ode)) return -1; break;
+    case 15:
+        if (strcmp(v, "fused") && strcmp(v, "general")) {
+            fprintf(stderr, "cranesim: --kernel: expected fused or general, got '%s'\n", v);
+            return -1;
+        }
+        c->sim.general_kernel = !strcmp(v, "general");
+        break;
     }
     return 1;
 }
@@ -142,6 +149,8 @@ void app_common_help(FILE* f, bool with_solver) {
                 "  --rtol R, --atol A   adaptive tolerances (default 1e-3, 1e-6)\n"
                 "  --jac-every N        fixed-step: new Jacobian every N steps (default 10)\n"
                 "  --dense-jac          fixed-step: dense Jacobian instead of the block pattern\n"
+                "  --kernel K           lagrange circuit evaluation: fused (default when the circuit\n"
+                "                       has the standard shape) or general (the component loops)\n"
                 "  --duration T         simulated time [s] (default: the scenario's)\n"
                 "  --every DT           output period [s] (default 1e-3, i.e. 1 kHz)\n");
     fprintf(f, "  --quiet              no progress bar or summary\n");

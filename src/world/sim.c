@@ -292,6 +292,8 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     double m3 = sim_load_mass(m, sc, o);
     if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = 2;
     ls.scn = sc;
+    ls.use_fused = ls.have_fused && !o->general_kernel;
+    res->fused = ls.use_fused;
     double y[LSIM_MAX_STATES];
     lsim_initial_state(&ls, sc->q0, 0.5e6, y);
 

@@ -32,6 +32,8 @@ typedef struct sim_opts {
     double dt_ode;     ///< ode: rigid-body step [s] (default 1e-3; hydraulics sub-step at h)
     bool cvode;        ///< integrate with SUNDIALS CVODE (BDF) instead of `solver`
                        ///< (the outside reference; rtol/atol apply)
+    bool general_kernel; ///< lagrange: the general circuit evaluation even when the
+                         ///< fused kernel applies (hyd_fused.h; for comparisons)
 } sim_opts;
 
 /// True when this build has the CVODE reference solver.
@@ -73,6 +75,7 @@ typedef struct sim_result {
     double wall;         ///< wall time of the integration [s]
     hyd_solver_stats stats;
     long rows;
+    bool fused;          ///< lagrange: the run used the fused circuit kernel
 } sim_result;
 
 /// Run the scenario. Rows go to row_fn (may be NULL) and to trace (may be
