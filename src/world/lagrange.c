@@ -24,23 +24,17 @@ void lagrange_eval_terms(const crane_mech* m, lagrange_variant v, double m3, con
 
 void lagrange_eval_terms_trig(const crane_mech* m, lagrange_variant v, double m3, const double trig[4],
                               const double qd[2], lagrange_terms* o) {
-    const double g = m->gravity;
-    const double L1 = m->link[0].length, L2 = m->link[1].length;
-    const double m1 = m->link[0].mass, m2 = m->link[1].mass;
-    const double e1 = m->link[0].com, e2 = m->link[1].com;
-    // The paper's Eq. 2 is the point-mass special case.
-    const double I1 = v == LAGRANGE_FULL ? m->link[0].inertia : 0.0;
-    const double I2 = v == LAGRANGE_FULL ? m->link[1].inertia : 0.0;
+    // The paper's Eq. 2 is the point-mass special case (I = 0 in the constants).
+    lagrange_consts lk;
+    lagrange_consts_init(m, v, m3, &lk);
+    const double kc = lk.kc, H22 = lk.H22;
 
     // One sincos pair per angle; sin/cos(q1 + q2) by the addition identities.
     const double s1 = trig[0], c1 = trig[1];
     const double s2 = trig[2], c2 = trig[3];
     const double s12 = s1 * c2 + c1 * s2, c12 = c1 * c2 - s1 * s2;
 
-    const double mu = m2 * e2 + m3 * L2; // first moment of end arm + load about joint 2 [kg m]
-    const double kc = mu * L1;           // coupling coefficient [kg m^2]
-    const double H22 = I2 + m2 * e2 * e2 + m3 * L2 * L2;
-    o->H[0][0] = I1 + m1 * e1 * e1 + (m2 + m3) * L1 * L1 + H22 + 2.0 * kc * c2;
+    o->H[0][0] = lk.H11c + 2.0 * kc * c2;
     o->H[0][1] = o->H[1][0] = H22 + kc * c2;
     o->H[1][1] = H22;
     o->dH_dq2[0][0] = -2.0 * kc * s2;
@@ -66,10 +60,7 @@ void lagrange_eval_terms_trig(const crane_mech* m, lagrange_variant v, double m3
         o->dC_dqd2[0] = o->dC_dqd2[1] = 0.0;
     }
 
-    // Eq. 3 as printed has (m2 + m3) L2 where the derivation gives (m2 + m3) L1.
-    const double Lg = v == LAGRANGE_PAPER_TYPO ? L2 : L1;
-    const double A = (m1 * e1 + (m2 + m3) * Lg) * g;
-    const double B = mu * g;
+    const double A = lk.A, B = lk.B;
     o->G[0] = A * s1 + B * s12;
     o->G[1] = B * s12;
     o->dG_dq1[0] = A * c1 + B * c12;
@@ -98,6 +89,7 @@ void lagrange_consts_init(const crane_mech* m, lagrange_variant v, double m3, la
     k->kc = mu * L1;
     k->H22 = I2 + m2 * e2 * e2 + m3 * L2 * L2;
     k->H11c = I1 + m1 * e1 * e1 + (m2 + m3) * L1 * L1 + k->H22;
+    // Eq. 3 as printed has (m2 + m3) L2 where the derivation gives (m2 + m3) L1.
     const double Lg = v == LAGRANGE_PAPER_TYPO ? L2 : L1;
     k->A = (m1 * e1 + (m2 + m3) * Lg) * g;
     k->B = mu * g;

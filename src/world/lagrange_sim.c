@@ -194,6 +194,16 @@ static void prepare(lsim* s, double t, const double* y, double trig[4], kin* k) 
     set_inputs(s, t, k);
 }
 
+// q' and q'' into the last four slots (d = dydt + iq), honouring frozen joints.
+static void mech_out(lsim* s, const double* qd, double qdd[2], double* d) {
+    for (int j = 0; j < 2; ++j) {
+        if (s->frozen_q[j]) qdd[j] = 0.0;
+        d[j] = s->frozen_q[j] ? 0.0 : qd[j];
+        d[2 + j] = qdd[j];
+    }
+    ++s->nrhs;
+}
+
 int lsim_rhs(void* user, double t, const double* y, double* dydt) {
     lsim* s = user;
     const crane_mech* me = &s->mdl->mech;
@@ -210,12 +220,7 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt) {
     lagrange_eval_terms_trig(me, s->variant, s->m3, trig, qd, &lt);
     double qdd[2];
     lagrange_accel(&lt, tau, qdd);
-    for (int j = 0; j < 2; ++j) {
-        if (s->frozen_q[j]) qdd[j] = 0.0;
-        dydt[iq + j] = s->frozen_q[j] ? 0.0 : qd[j];
-        dydt[iq + 2 + j] = qdd[j];
-    }
-    ++s->nrhs;
+    mech_out(s, qd, qdd, dydt + iq);
     return 0;
 }
 
@@ -345,12 +350,7 @@ int lsim_rhs_fused(void* user, double t, const double* y, double* dydt) {
     const double tau[2] = {F[0] * k.r[0], F[1] * k.r[1]};
     double qdd[2];
     lagrange_accel_fast(&s->lk, trig, qd, tau, qdd);
-    for (int j = 0; j < 2; ++j) {
-        if (s->frozen_q[j]) qdd[j] = 0.0;
-        dydt[iq + j] = s->frozen_q[j] ? 0.0 : qd[j];
-        dydt[iq + 2 + j] = qdd[j];
-    }
-    ++s->nrhs;
+    mech_out(s, qd, qdd, dydt + iq);
     return 0;
 }
 
