@@ -93,6 +93,7 @@ struct hyd_solver {
     double* fdy;    ///< perturbed y for finite differences
     double* fdf;    ///< f at the perturbed y
     double* yout;   ///< interpolated output state
+    double* hc[3];  ///< Hermite coefficients of the current step (see hermite_prepare)
 
     // Cache of f at the current point, so an adaptive step reuses f(y_{n+1})
     // (already needed for Hermite output) as the next step's first stage.

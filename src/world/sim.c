@@ -110,6 +110,8 @@ typedef struct run_ctx {
     int stop;
     int bad_state; ///< state index found implausible by emit, or -1
     double bad_value, bad_t;
+    int npress;    ///< pressure states (emit checks only these)
+    int press[LSIM_MAX_STATES];
 } run_ctx;
 
 // A pressure below -1 MPa absolute cannot be physical: the pressure-dependent
@@ -123,8 +125,9 @@ static int emit(void* user, double t, const double* y) {
     run_ctx* c = user;
     // Segments share their end points: write each output time once.
     if (c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out) return 0;
-    for (int i = 0; i < c->ls->nh; ++i) {
-        if (!(y[i] > P_IMPLAUSIBLE) && c->ls->is_pressure[i]) {
+    for (int k = 0; k < c->npress; ++k) {
+        const int i = c->press[k];
+        if (!(y[i] > P_IMPLAUSIBLE)) {
             c->bad_state = i;
             c->bad_value = y[i];
             c->bad_t = t;
@@ -328,6 +331,8 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     o = &oo;
     run_ctx c = {.ls = &ls, .o = o, .row_fn = row_fn, .row_user = row_user, .trace = trace,
                  .progress = progress, .progress_user = progress_user, .t_end = t_end, .bad_state = -1};
+    for (int i = 0; i < ls.nh; ++i)
+        if (ls.is_pressure[i]) c.press[c.npress++] = i;
     // Integrate between command breakpoints (rounded to the output grid) and
     // reset the solver at each: a kink in a valve command is a discontinuity
     // in f' that an adaptive controller should not have to discover.
