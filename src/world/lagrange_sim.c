@@ -360,7 +360,8 @@ int lsim_jac_fused(void* user, double t, const double* y, double* J) {
     const double* qd = y + iq + 2;
     double trig[4], cmd[2], F[2], ydot[LSIM_MAX_STATES];
     kin k;
-    trig_of(y + iq, trig);
+    lagrange_sincos(y[iq], &trig[0], &trig[1]); // as lsim_rhs_fused
+    lagrange_sincos(y[iq + 1], &trig[2], &trig[3]);
     cylinder_kinematics(&s->mdl->mech, trig, qd, &k);
     commands(s, t, cmd);
     memset(J, 0, (size_t)n * (size_t)n * sizeof *J);
