@@ -53,6 +53,16 @@ typedef struct hyd_problem {
     hyd_dfdt_fn dfdt;
     /// Non-zero when f does not depend on t: RODAS3 then skips df/dt.
     int autonomous;
+    /// Optional structured linear algebra for W = I - gh J, used only with a
+    /// dense pattern (nblock == 0). wfactor receives the J of the last
+    /// Jacobian evaluation (row-major n x n) and gh; it returns 0 when it has
+    /// factored W (wsolve then solves W x = b in place), or non-zero when it
+    /// cannot (a structure it does not know, a weak pivot, non-finite
+    /// entries): the solver then factors that W itself. For problems whose
+    /// structure allows a cheaper elimination than the general sparse LU
+    /// (the crane: lagrange_sim.c). NULL: the solver's own LU.
+    int (*wfactor)(void* user, const double* J, double gh);
+    void (*wsolve)(void* user, double* x);
 } hyd_problem;
 
 typedef enum hyd_method {
@@ -90,6 +100,13 @@ typedef struct hyd_solver_opts {
     /// reused (W-methods with jac_every > 1). Shrinking is never held back.
     /// 0.2 to 0.5 are typical.
     double h_hold;
+    /// Adaptive output (hyd_solver_integrate): interpolate only these
+    /// n_out_states states (indices into y) at output times; the callback
+    /// must then read only them (the other entries of the y it receives are
+    /// unspecified). NULL/0: all states. For callers that only check a few
+    /// states between rows nobody consumes (benchmarks).
+    const int* out_states;
+    int n_out_states;
 } hyd_solver_opts;
 
 hyd_solver_opts hyd_default_solver_opts(void);

@@ -323,6 +323,18 @@ static void sp_solve(const hyd_solver* s, double* restrict b) {
 
 int hydFactorW(hyd_solver* s, double gh) {
     s->w_sparse = 0;
+    s->w_custom = 0;
+    const hyd_problem* p = s->p;
+    if (p->wfactor && p->wsolve && s->nblock == 1) {
+        if (p->wfactor(p->user, s->jb, gh) == 0) {
+            s->w_custom = 1;
+            s->w_valid = 1;
+            s->w_gh = gh;
+            s->st.lus++;
+            return HYD_OK;
+        }
+        s->custom_fallbacks++; // the problem declined: our own LU below
+    }
     if (s->sp_on) {
         const int rc = sp_factor(s, gh);
         if (rc < 0) return HYD_ERR_SINGULAR;
@@ -372,6 +384,10 @@ int hydFactorW(hyd_solver* s, double gh) {
 }
 
 void hydSolveW(const hyd_solver* s, double* x) {
+    if (s->w_custom) {
+        s->p->wsolve(s->p->user, x);
+        return;
+    }
     if (s->w_sparse) {
         sp_solve(s, x);
         return;

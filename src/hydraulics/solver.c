@@ -50,6 +50,8 @@ hyd_solver_opts hyd_default_solver_opts(void) {
     o.jac_max_age = 0.01; // SPEC 3.3: older J diverged at larger h [s]; <= 0: no limit
     o.max_steps = 100000000;
     o.h_hold = 0.0;       // no step hysteresis
+    o.out_states = NULL;  // interpolate every state at output times
+    o.n_out_states = 0;
     return o;
 }
 
@@ -414,7 +416,8 @@ static double err_norm(const hyd_solver* s, const double* y, const double* ynew,
     const double atol = s->o.atol, rtol = s->o.rtol;
     double sum = 0.0;
     for (int i = 0; i < s->n; ++i) {
-        double sc = atol + rtol * fmax(fabs(y[i]), fabs(ynew[i]));
+        const double a = fabs(y[i]), b = fabs(ynew[i]);
+        double sc = atol + rtol * (a > b ? a : b); // not fmax: a libm call here
         double r = e[i] / sc;
         sum += r * r;
     }
@@ -475,10 +478,34 @@ static void hermite(int n, double theta, const double* restrict y0, const double
     for (int i = 0; i < n; ++i) out[i] = y0[i] + theta * (c1[i] + theta * (c2[i] + theta * c3[i]));
 }
 
+// The same for the states listed in idx only (opts.out_states).
+static void hermite_prepare_idx(int m, const int* restrict idx, double h, const double* restrict y0,
+                                const double* restrict f0, const double* restrict y1,
+                                const double* restrict f1, double* restrict c1,
+                                double* restrict c2, double* restrict c3) {
+    for (int k = 0; k < m; ++k) {
+        const int i = idx[k];
+        const double d = y1[i] - y0[i], a = h * f0[i], b = h * f1[i];
+        c1[i] = a;
+        c2[i] = 3.0 * d - (2.0 * a + b);
+        c3[i] = (a + b) - 2.0 * d;
+    }
+}
+
+static void hermite_idx(int m, const int* restrict idx, double theta, const double* restrict y0,
+                        const double* restrict c1, const double* restrict c2,
+                        const double* restrict c3, double* restrict out) {
+    for (int k = 0; k < m; ++k) {
+        const int i = idx[k];
+        out[i] = y0[i] + theta * (c1[i] + theta * (c2[i] + theta * c3[i]));
+    }
+}
+
 static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, long* budget,
                             out_sched* os) {
     const int n = s->n;
-    const double q = 3.0; // error of the order-2 embedded solution is O(h^3)
+    // The error of the order-2 embedded solution is O(h^3): the controller
+    // exponents are 1/3 (cbrt below).
     const double h_max = s->o.h_max > 0.0 ? s->o.h_max : HUGE_VAL;
     while (*t < t_end) {
         if (*budget <= 0) return HYD_ERR_STEPS;
@@ -506,7 +533,7 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
         if (!(en <= 1.0)) {
             // Reject. A singular W or a non-finite trial gets the largest cut.
             s->st.rejected++;
-            double ratio = isfinite(en) ? fmax(1.0 / 6.0, 0.9 * pow(en, -1.0 / q)) : 1.0 / 6.0;
+            double ratio = isfinite(en) ? fmax(1.0 / 6.0, 0.9 / cbrt(en)) : 1.0 / 6.0;
             s->h_next = h * ratio;
             s->last_rejected = 1;
             if (s->j_steps > 0) s->j_force = 1; // a stale J may be the cause
@@ -533,17 +560,31 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
                 const double to = sched_time(os);
                 const double* yo = s->ynew;
                 if (to < t_new) {
+                    const int m = s->o.n_out_states;
+                    const int* idx = m > 0 ? s->o.out_states : NULL;
                     if (!prepared) {
-                        hermite_prepare(n, h, y, f0, s->ynew, s->fnew, s->hc[0], s->hc[1], s->hc[2]);
+                        if (idx)
+                            hermite_prepare_idx(m, idx, h, y, f0, s->ynew, s->fnew, s->hc[0], s->hc[1], s->hc[2]);
+                        else
+                            hermite_prepare(n, h, y, f0, s->ynew, s->fnew, s->hc[0], s->hc[1], s->hc[2]);
                         prepared = 1;
                     }
-                    hermite(n, (to - *t) / h, y, s->hc[0], s->hc[1], s->hc[2], s->yout);
+                    const double theta = (to - *t) / h;
+                    if (idx)
+                        hermite_idx(m, idx, theta, y, s->hc[0], s->hc[1], s->hc[2], s->yout);
+                    else
+                        hermite(n, theta, y, s->hc[0], s->hc[1], s->hc[2], s->yout);
                     yo = s->yout;
                 }
                 os->k++;
                 if (os->fn(os->user, to, yo) != 0) {
-                    // Stop at the output time: hand back that state.
+                    // Stop at the output time: hand back that state, in
+                    // full (the callback may have seen only some states).
                     os->stopped = 1;
+                    if (yo == s->yout && s->o.n_out_states > 0) {
+                        hermite_prepare(n, h, y, f0, s->ynew, s->fnew, s->hc[0], s->hc[1], s->hc[2]);
+                        hermite(n, (to - *t) / h, y, s->hc[0], s->hc[1], s->hc[2], s->yout);
+                    }
                     memcpy(y, yo, (size_t)n * sizeof *y);
                     *t = to;
                     s->fc_valid = 0;
@@ -555,9 +596,9 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
 
         // Hairer-Wanner controller with Gustafsson's predictive correction.
         double e = fmax(en, 1e-10);
-        double ratio = 0.9 * pow(e, -1.0 / q);
+        double ratio = 0.9 / cbrt(e); // e^(-1/q), q = 3: cbrt is a third of pow's cost
         if (s->have_acc) {
-            double gus = 0.9 * (h / s->h_acc) * pow(s->err_acc / (e * e), 1.0 / q);
+            double gus = 0.9 * (h / s->h_acc) * cbrt(s->err_acc / (e * e));
             ratio = fmin(ratio, gus);
         }
         ratio = fmin(5.0, fmax(1.0 / 6.0, ratio));

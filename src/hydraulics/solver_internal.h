@@ -81,6 +81,8 @@ struct hyd_solver {
     int* sp_ppos;          ///< (n x n) positions on the pattern, sp_np of them
     int sp_np;
     long sp_fallbacks;     ///< factorisations that needed the dense pivoting path
+    int w_custom;          ///< W is factored by the problem's wfactor (solve with wsolve)
+    long custom_fallbacks; ///< W the problem's wfactor declined
 
     // Stage work vectors, n each.
     double* k[4];

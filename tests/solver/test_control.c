@@ -2,6 +2,8 @@
 // through a discontinuity and a kink, Hermite output against an exact
 // solution, landing on t_end without evaluating f beyond it, and the
 // non-finite report (index and time).
+#include <string.h>
+
 #include "check.h"
 #include "hyd_solver.h"
 #include "problems.h"
@@ -140,6 +142,105 @@ static void test_hermite_output(void) {
     hyd_solver_destroy(s);
 }
 
+// Output of selected states (opts.out_states): those states are exactly the
+// full run's, and a stop hands back the whole interpolated state.
+typedef struct sel_rec {
+    double t[4096], y1[4096], full[3];
+    long count;
+    double t_stop;
+} sel_rec;
+
+static int record_sel(void* user, double t, const double* y) {
+    sel_rec* r = user;
+    if (r->count < 4096) r->t[r->count] = t, r->y1[r->count] = y[1];
+    r->count++;
+    return t >= r->t_stop;
+}
+
+static void test_out_states(void) {
+    static const int only1[1] = {1};
+    static sel_rec all, sel;
+    for (int pass = 0; pass < 2; ++pass) {
+        sel_rec* r = pass ? &sel : &all;
+        hyd_problem p = {0};
+        p.n = 3, p.f = conv_f_bounded, p.jac = conv_jac, p.dfdt = conv_dfdt;
+        hyd_solver_opts o = hyd_default_solver_opts();
+        o.rtol = 1e-6, o.atol = 1e-9, o.h = 0.0;
+        if (pass) o.out_states = only1, o.n_out_states = 1;
+        hyd_solver* s = hyd_solver_create(&p, HYD_RODAS3, &o);
+        double y[3];
+        conv_exact(0.0, y);
+        r->count = 0;
+        r->t_stop = 1.2345; // not a step end: the stop state is interpolated
+        CHECK(hyd_solver_integrate(s, 0.0, y, 2.0, 1e-3, record_sel, r) == HYD_OK, "integrate");
+        for (int i = 0; i < 3; ++i) r->full[i] = y[i];
+        hyd_solver_destroy(s);
+    }
+    CHECK(sel.count == all.count && all.count > 1000, "%ld vs %ld outputs", sel.count, all.count);
+    long differ = 0;
+    for (long k = 0; k < all.count && k < 4096; ++k)
+        differ += sel.t[k] != all.t[k] || sel.y1[k] != all.y1[k];
+    CHECK(differ == 0, "%ld selected outputs differ from the full interpolation", differ);
+    for (int i = 0; i < 3; ++i)
+        CHECK(sel.full[i] == all.full[i], "stop state %d: %.17g vs %.17g", i, sel.full[i], all.full[i]);
+}
+
+// A problem-supplied W factorisation (hyd_problem.wfactor/wsolve): used when
+// it accepts, the solver's own LU when it declines, same results either way.
+typedef struct dense_w {
+    double lu[9];
+    int piv[3];
+    long factors, solves, declined;
+    int decline_every; ///< decline every Nth factorisation (0: never)
+} dense_w;
+
+static dense_w g_w;
+
+static int dw_factor(void* user, const double* J, double gh) {
+    (void)user;
+    g_w.factors++;
+    if (g_w.decline_every && g_w.factors % g_w.decline_every == 0) return ++g_w.declined, 1;
+    for (int i = 0; i < 9; ++i) g_w.lu[i] = (i % 4 == 0) - gh * J[i];
+    return hyd_lu_factor(g_w.lu, 3, g_w.piv) != 0;
+}
+
+static void dw_solve(void* user, double* x) {
+    (void)user;
+    g_w.solves++;
+    hyd_lu_solve(g_w.lu, 3, g_w.piv, x);
+}
+
+static void test_wfactor_hook(void) {
+    for (int m = HYD_KRUS; m < HYD_METHOD_COUNT; ++m) {
+        if (m == HYD_RK4) continue;
+        double yend[3][3];
+        long lus[3];
+        for (int mode = 0; mode < 3; ++mode) { // none, hook, hook declining every 3rd
+            hyd_problem p = {0};
+            p.n = 3, p.f = conv_f_bounded, p.jac = conv_jac, p.dfdt = conv_dfdt;
+            memset(&g_w, 0, sizeof g_w);
+            g_w.decline_every = mode == 2 ? 3 : 0;
+            if (mode) p.wfactor = dw_factor, p.wsolve = dw_solve;
+            hyd_solver_opts o = hyd_default_solver_opts();
+            o.rtol = 1e-6, o.atol = 1e-9;
+            o.h = hyd_method_is_adaptive((hyd_method)m) ? 0.0 : 1e-3;
+            hyd_solver* s = hyd_solver_create(&p, (hyd_method)m, &o);
+            double t = 0.0;
+            conv_exact(0.0, yend[mode]);
+            CHECK(hyd_solver_advance(s, &t, yend[mode], 2.0) == HYD_OK, "%s mode %d", hyd_method_name((hyd_method)m), mode);
+            lus[mode] = hyd_solver_get_stats(s)->lus;
+            hyd_solver_destroy(s);
+            if (mode == 1) CHECK(g_w.factors == lus[1] && g_w.solves > 0, "%s: hook used for %ld of %ld LUs", hyd_method_name((hyd_method)m), g_w.factors, lus[1]);
+            if (mode == 2) CHECK(g_w.declined > 0, "declines exercised");
+        }
+        for (int mode = 1; mode < 3; ++mode)
+            for (int i = 0; i < 3; ++i)
+                CHECK(fabs(yend[mode][i] - yend[0][i]) <= 1e-12 * (1.0 + fabs(yend[0][i])),
+                      "%s mode %d state %d: %.17g vs %.17g", hyd_method_name((hyd_method)m), mode, i,
+                      yend[mode][i], yend[0][i]);
+    }
+}
+
 // Component 1 of f turns NaN for t > 0.57.
 static int nan_f(void* user, double t, const double* y, double* dy) {
     (void)user;
@@ -216,6 +317,8 @@ int main(int argc, char** argv) {
     RUN_TEST(test_discontinuous_rhs);
     RUN_TEST(test_kink);
     RUN_TEST(test_hermite_output);
+    RUN_TEST(test_out_states);
+    RUN_TEST(test_wfactor_hook);
     RUN_TEST(test_nonfinite);
     RUN_TEST(test_reset);
     RUN_TEST(test_bad_arguments);
