@@ -107,6 +107,8 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
     s->have_fused = hyd_fused_build(hm, fv, fc, 2, &s->fz, s->fused_why, sizeof s->fused_why) == 0;
     if (s->have_fused) hyd_fused_map(&s->fz, s->hpos);
     s->use_fused = s->have_fused;
+    s->w_layout = lsim_w_layout(s);
+    s->use_w = s->w_layout;
     lagrange_consts_init(&m->mech, v, m3, &s->lk);
     for (int i = 0; i < s->nh; ++i) {
         const char* nm = strrchr(hyd_model_state_name(hm, s->perm[i]), '.');
@@ -134,6 +136,9 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
     if (blocks) {
         p.nblock = s->nblock;
         p.block_size = s->block;
+    } else if (s->use_w && s->w_layout) {
+        p.wfactor = lsim_wfactor;
+        p.wsolve = lsim_wsolve;
     }
     return p;
 }

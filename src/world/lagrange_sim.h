@@ -21,6 +21,20 @@ extern "C" {
 #define LSIM_MAX_STATES 64
 #define LSIM_MAX_BLOCKS 64
 
+/// Factors of W = I - gh J by block elimination (lsim_w.c): per actuator
+/// the LU of its 5x5 interior block A_k, A_k^-1 B_k and C_k, and the LU of
+/// the 5x5 Schur complement on [pump line, q1, q2, q1', q2'].
+typedef struct lsim_w {
+    double a[2][25];
+    int pa[2][5];
+    const int* piv[2];  ///< pa[k] when A_k needed row exchanges, else NULL
+    double x[2][5][5];  ///< x[k][c] = column c of A_k^-1 B_k
+    double c[2][5][5];  ///< c[k][r] = row r of C_k
+    bool xnz[2][5], cnz[2][5]; ///< that column / row is not all zero
+    double s[25];
+    int ps[5];
+} lsim_w;
+
 typedef struct lsim {
     const model* mdl;
     lagrange_variant variant;
@@ -52,6 +66,10 @@ typedef struct lsim {
     bool have_fused;       ///< the circuit has the standard shape
     bool use_fused;        ///< lsim_problem hands out the fused f and J (default: have_fused)
     char fused_why[96];    ///< why not, when !have_fused
+    // Structured W (lsim_w.c) for the dense-pattern solvers.
+    bool w_layout;         ///< the state layout lsim_w.c needs (standard circuit, 2 actuators)
+    bool use_w;            ///< lsim_problem hands out wfactor/wsolve (default: w_layout)
+    lsim_w w;
 } lsim;
 
 /// Set up for model m. Returns 0, or -1 with a message.
@@ -68,6 +86,14 @@ hyd_problem lsim_problem(lsim* s, bool blocks);
 /// static equilibrium with gravity (rod side or piston side at p_low [Pa abs])
 /// and the pump line at its set pressure.
 void lsim_initial_state(lsim* s, const double q0[2], double p_low, double* y);
+
+/// True when s has the layout of lsim_w.c: 15 states, actuator k at
+/// 5k..5k+4 = [spool, hose A, chamber A, hose B, chamber B], then the pump
+/// line and q1, q2, q1', q2'.
+bool lsim_w_layout(const lsim* s);
+/// hyd_problem.wfactor / wsolve for that layout (see lsim_w.c).
+int lsim_wfactor(void* user, const double* J, double gh);
+void lsim_wsolve(void* user, double* x);
 
 int lsim_rhs(void* user, double t, const double* y, double* dydt);
 /// df/dt: time enters only through the valve commands of the scenario, so
