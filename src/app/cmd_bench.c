@@ -27,6 +27,8 @@ static void bench_help(FILE* f) {
             "  ros34pw2     adaptive ROS34PW2, rtol 1e-3\n"
             "  rodas3       adaptive RODAS3, rtol 1e-3\n"
             "  rodas3-1pct  adaptive RODAS3, rtol 1e-2 (the paper's 1 %% tolerance)\n"
+            "  rodas3-2e-3  adaptive RODAS3, rtol 2e-3: the loosest tolerance whose max chamber-\n"
+            "               pressure error on ramp stays below 1 %% of peak (0.98 %%, cranesim study)\n"
             "  sandbox-ode1ms    ode sandbox (pick and place), ODE step 1 ms, hydraulics Krus 0.1 ms\n"
             "  sandbox-ode0.1ms  the same with ODE step 0.1 ms\n"
             "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
@@ -62,6 +64,7 @@ static const bench_cfg configs[] = {
     {"ros34pw2", HYD_ROS34PW2, 0, false, 1e-3, SIM_LAGRANGE, NULL, 0, NULL},
     {"rodas3", HYD_RODAS3, 0, false, 1e-3, SIM_LAGRANGE, NULL, 0, NULL},
     {"rodas3-1pct", HYD_RODAS3, 0, false, 1e-2, SIM_LAGRANGE, NULL, 0, NULL},
+    {"rodas3-2e-3", HYD_RODAS3, 0, false, 2e-3, SIM_LAGRANGE, NULL, 0, NULL},
     {"sandbox-ode1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-3, "sandbox_pick_place"},
     {"sandbox-ode0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-4, "sandbox_pick_place"},
 };

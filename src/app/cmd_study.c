@@ -19,8 +19,9 @@ static void study_help(FILE* f) {
             "usage: cranesim study [--scenario S] [--out-dir DIR] [--repeat N] [--quick]\n"
             "\n"
             "Integrates the scenario (default ramp) with Krus and ROS2 at h = 0.1, 0.2, 0.5, 1 ms,\n"
-            "RK4, the adaptive ROS34PW2 and RODAS3 at rtol 1e-2..1e-5, and SUNDIALS CVODE, and\n"
-            "compares each with a CVODE reference at rtol 1e-10. Reports per configuration:\n"
+            "RK4, the adaptive ROS34PW2 and RODAS3 at rtol 1e-2, 2e-3, 1e-3, 1e-4, 1e-5, and\n"
+            "SUNDIALS CVODE, and compares each with a CVODE reference at rtol 1e-10. Reports\n"
+            "per configuration:\n"
             "max and RMS chamber-pressure error [MPa and %% of peak], max stroke error [mm],\n"
             "steps, f evaluations, Jacobians, LU factorisations and median wall time [s].\n"
             "Writes DIR/study.md (table), DIR/study.jsonl and DIR/work_precision.png.\n"
@@ -177,8 +178,11 @@ int cmd_study(int argc, char** argv) {
     study_cfg cfg[40];
     int n = 0;
     const double hs[] = {1e-4, 2e-4, 5e-4, 1e-3};
-    const double tols[] = {1e-2, 1e-3, 1e-4, 1e-5};
-    const int nh = quick ? 2 : 4, nt = quick ? 2 : 4;
+    // 2e-3: the loosest tolerance at which RODAS3 keeps the ramp's chamber
+    // pressures within 1 % of peak (the SPEC's "1 % pressure accuracy").
+    const double tols_all[] = {1e-2, 2e-3, 1e-3, 1e-4, 1e-5}, tols_quick[] = {1e-2, 1e-3};
+    const double* tols = quick ? tols_quick : tols_all;
+    const int nh = quick ? 2 : 4, nt = quick ? 2 : 5;
     for (int i = 0; i < nh; ++i) n = add_fixed(cfg, n, &c.sim, HYD_KRUS, quick ? hs[i * 3] : hs[i]);
     for (int i = 0; i < nh; ++i) n = add_fixed(cfg, n, &c.sim, HYD_ROS2, quick ? hs[i * 3] : hs[i]);
     n = add_fixed(cfg, n, &c.sim, HYD_RK4, 1e-4);

@@ -149,8 +149,9 @@ void app_common_help(FILE* f, bool with_solver) {
                 "  --rtol R, --atol A   adaptive tolerances (default 1e-3, 1e-6)\n"
                 "  --jac-every N        fixed-step: new Jacobian every N steps (default 10)\n"
                 "  --dense-jac          fixed-step: dense Jacobian instead of the block pattern\n"
-                "  --kernel K           lagrange circuit evaluation: fused (default when the circuit\n"
-                "                       has the standard shape) or general (the component loops)\n"
+                "  --kernel K           lagrange: fused (default when the circuit has the standard\n"
+                "                       shape: one-pass circuit, block-eliminated W) or general\n"
+                "                       (the component loops and the solver's own sparse LU)\n"
                 "  --duration T         simulated time [s] (default: the scenario's)\n"
                 "  --every DT           output period [s] (default 1e-3, i.e. 1 kHz)\n");
     fprintf(f, "  --quiet              no progress bar or summary\n");

@@ -296,6 +296,7 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = 2;
     ls.scn = sc;
     ls.use_fused = ls.have_fused && !o->general_kernel;
+    ls.use_w = ls.w_layout && !o->general_kernel; // the crane-specialised W too (lsim_w.c)
     res->fused = ls.use_fused;
     double y[LSIM_MAX_STATES];
     lsim_initial_state(&ls, sc->q0, 0.5e6, y);
@@ -315,6 +316,16 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     so.atol = o->atol;
     so.h_max = 0.5;
     so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    // emit checks the pressure states at every output; when no row is
+    // consumed (benchmarks) that is all it reads, so an adaptive solver
+    // interpolates only those.
+    int press[LSIM_MAX_STATES], npress = 0;
+    for (int i = 0; i < ls.nh; ++i)
+        if (ls.is_pressure[i]) press[npress++] = i;
+    if (!trace && !row_fn && !progress) {
+        so.out_states = press;
+        so.n_out_states = npress;
+    }
     // CVODE brings its own integrator; the in-house one is not created then.
     hyd_solver* s = o->cvode ? NULL : hyd_solver_create(&prob, o->solver, &so);
     if (!s && !o->cvode) {
@@ -331,8 +342,8 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     o = &oo;
     run_ctx c = {.ls = &ls, .o = o, .row_fn = row_fn, .row_user = row_user, .trace = trace,
                  .progress = progress, .progress_user = progress_user, .t_end = t_end, .bad_state = -1};
-    for (int i = 0; i < ls.nh; ++i)
-        if (ls.is_pressure[i]) c.press[c.npress++] = i;
+    memcpy(c.press, press, sizeof press);
+    c.npress = npress;
     // Integrate between command breakpoints (rounded to the output grid) and
     // reset the solver at each: a kink in a valve command is a discontinuity
     // in f' that an adaptive controller should not have to discover.
