@@ -44,6 +44,18 @@ static const int zmap[NZ] = {IZ + 3, IZ + 4, IZ, IZ + 1, IZ + 2};
 #define UNROLL
 #endif
 
+// Step k of an LU in place: store 1/U_kk on the diagonal, the multipliers
+// below it, and update the trailing block.
+static inline void eliminate(double* a, int m, int k) {
+    const double inv = 1.0 / a[k * m + k];
+    a[k * m + k] = inv;
+    UNROLL for (int i = k + 1; i < m; ++i) {
+        const double l = a[i * m + k] * inv;
+        a[i * m + k] = l;
+        UNROLL for (int j = k + 1; j < m; ++j) a[i * m + j] -= l * a[k * m + j];
+    }
+}
+
 // Dense LU with partial pivoting of an m x m row-major matrix (m a literal at
 // every call site); U's diagonal is stored inverted. Returns 0, or -1 when a
 // pivot is at or below eps * max|a| (or a is not finite).
@@ -73,13 +85,7 @@ static inline int lu_pivot(double* out, int m, int* piv) {
                 a[k * m + j] = a[p * m + j];
                 a[p * m + j] = t;
             }
-        const double inv = 1.0 / a[k * m + k];
-        a[k * m + k] = inv;
-        UNROLL for (int i = k + 1; i < m; ++i) {
-            const double l = a[i * m + k] * inv;
-            a[i * m + k] = l;
-            UNROLL for (int j = k + 1; j < m; ++j) a[i * m + j] -= l * a[k * m + j];
-        }
+        eliminate(a, m, k);
     }
     UNROLL for (int i = 0; i < m * m; ++i) out[i] = a[i];
     return 0;
@@ -106,13 +112,7 @@ static inline int lu_interior(double* out) {
             cmax = v > cmax ? v : cmax;
         }
         ok &= ((pk >= 0.1 * cmax) | (k == 0 && spool_free)) & (pk > 0.0);
-        const double inv = 1.0 / a[k * m + k];
-        a[k * m + k] = inv;
-        UNROLL for (int i = k + 1; i < m; ++i) {
-            const double l = a[i * m + k] * inv;
-            a[i * m + k] = l;
-            UNROLL for (int j = k + 1; j < m; ++j) a[i * m + j] -= l * a[k * m + j];
-        }
+        eliminate(a, m, k);
     }
     if (!ok) return 1;
     UNROLL for (int i = 0; i < m * m; ++i) out[i] = a[i];

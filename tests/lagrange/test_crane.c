@@ -340,6 +340,23 @@ static void test_all_scenarios_run(void) {
 // component laws but not their summation order, so they agree to rounding:
 // derivatives within 1e-12 of their row's largest term, Jacobian entries
 // within 1e-9 of themselves plus 1e-13 of their row's largest entry.
+// A random crane state at the circuit's regime switches: angles over the
+// workspace, pressures near vacuum, near the reliefs or anywhere between,
+// random spools, joint rates and commands.
+static void random_crane_state(lsim* s, double* y) {
+    const double q0[2] = {(70 + 90 * urand01()) * M_PI / 180, (-130 + 100 * urand01()) * M_PI / 180};
+    lsim_initial_state(s, q0, 0.5e6, y);
+    for (int i = 0; i < s->nh; ++i) {
+        if (!s->is_pressure[i]) { y[i] = 2 * urand01() - 1; continue; }
+        const int r = rand() % 4;
+        y[i] = r == 0 ? 1e3 + 5e4 * urand01() : r == 1 ? 24.5e6 + 2e6 * urand01() : 0.2e6 + 22e6 * urand01();
+    }
+    y[s->iq + 2] = 0.3 * (2 * urand01() - 1);
+    y[s->iq + 3] = 0.3 * (2 * urand01() - 1);
+    s->u_cmd[0] = 1.2 * (2 * urand01() - 1);
+    s->u_cmd[1] = 1.2 * (2 * urand01() - 1);
+}
+
 static void test_fused_matches_general(void) {
     model* m = load_default();
     if (!m) return;
@@ -355,18 +372,8 @@ static void test_fused_matches_general(void) {
         static double J[LSIM_MAX_STATES * LSIM_MAX_STATES], Jf[LSIM_MAX_STATES * LSIM_MAX_STATES];
         double y[LSIM_MAX_STATES], f[LSIM_MAX_STATES], ff[LSIM_MAX_STATES];
         for (int trial = 0; trial < 1000; ++trial, ++trials) {
-            const double q0[2] = {(70 + 90 * urand01()) * M_PI / 180, (-130 + 100 * urand01()) * M_PI / 180};
-            lsim_initial_state(&s, q0, 0.5e6, y);
-            for (int i = 0; i < s.nh; ++i) {
-                if (!s.is_pressure[i]) { y[i] = 2 * urand01() - 1; continue; }
-                const int r = rand() % 4;
-                y[i] = r == 0 ? 1e3 + 5e4 * urand01() : r == 1 ? 24.5e6 + 2e6 * urand01() : 0.2e6 + 22e6 * urand01();
-            }
+            random_crane_state(&s, y);
             if (rand() % 3 == 0) y[s.iu[0]] = 1e-4 * (2 * urand01() - 1);
-            y[s.iq + 2] = 0.3 * (2 * urand01() - 1);
-            y[s.iq + 3] = 0.3 * (2 * urand01() - 1);
-            s.u_cmd[0] = 1.2 * (2 * urand01() - 1);
-            s.u_cmd[1] = 1.2 * (2 * urand01() - 1);
             lsim_rhs(&s, 0.0, y, f);
             lsim_rhs_fused(&s, 0.0, y, ff);
             lsim_jac(&s, 0.0, y, J);
@@ -434,17 +441,7 @@ static void test_structured_w(void) {
     double worst_ratio = 0.0, worst = 0.0, worst_diff = 0.0;
     int declined = 0, solved = 0, dense_singular = 0;
     for (int trial = 0; trial < 600; ++trial) {
-        const double q0[2] = {(70 + 90 * urand01()) * M_PI / 180, (-130 + 100 * urand01()) * M_PI / 180};
-        lsim_initial_state(&s, q0, 0.5e6, y);
-        for (int i = 0; i < s.nh; ++i) {
-            if (!s.is_pressure[i]) { y[i] = 2 * urand01() - 1; continue; }
-            const int r = rand() % 4;
-            y[i] = r == 0 ? 1e3 + 5e4 * urand01() : r == 1 ? 24.5e6 + 2e6 * urand01() : 0.2e6 + 22e6 * urand01();
-        }
-        y[s.iq + 2] = 0.3 * (2 * urand01() - 1);
-        y[s.iq + 3] = 0.3 * (2 * urand01() - 1);
-        s.u_cmd[0] = 1.2 * (2 * urand01() - 1);
-        s.u_cmd[1] = 1.2 * (2 * urand01() - 1);
+        random_crane_state(&s, y);
         memset(J, 0, sizeof J);
         if (trial % 2) lsim_jac_fused(&s, 0.0, y, J);
         else lsim_jac(&s, 0.0, y, J);
