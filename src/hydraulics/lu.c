@@ -333,7 +333,7 @@ int hydFactorW(hyd_solver* s, double gh) {
             s->st.lus++;
             return HYD_OK;
         }
-        s->custom_fallbacks++; // the problem declined: our own LU below
+        // The problem declined: our own LU below.
     }
     if (s->sp_on) {
         const int rc = sp_factor(s, gh);

@@ -460,12 +460,14 @@ static int initial_step(hyd_solver* s, double t, const double* y, const double* 
 //   c1 = h f0,  c2 = 3 d - h (2 f0 + f1),  c3 = -2 d + h (f0 + f1),  d = y1 - y0.
 // The coefficients are formed once per step that has outputs in it (an
 // adaptive step spans up to a few dozen 1 kHz output times), so each output
-// costs three multiply-adds per state. The buffers never overlap (restrict
-// lets the loops vectorise without run-time alias checks).
-static void hermite_prepare(int n, double h, const double* restrict y0, const double* restrict f0,
-                            const double* restrict y1, const double* restrict f1,
-                            double* restrict c1, double* restrict c2, double* restrict c3) {
-    for (int i = 0; i < n; ++i) {
+// costs three multiply-adds per state. idx lists the states to interpolate
+// (m of them; NULL: states 0 .. m-1). The buffers never overlap (restrict).
+static void hermite_prepare(int m, const int* restrict idx, double h, const double* restrict y0,
+                            const double* restrict f0, const double* restrict y1,
+                            const double* restrict f1, double* restrict c1, double* restrict c2,
+                            double* restrict c3) {
+    for (int k = 0; k < m; ++k) {
+        const int i = idx ? idx[k] : k;
         const double d = y1[i] - y0[i], a = h * f0[i], b = h * f1[i];
         c1[i] = a;
         c2[i] = 3.0 * d - (2.0 * a + b);
@@ -473,30 +475,11 @@ static void hermite_prepare(int n, double h, const double* restrict y0, const do
     }
 }
 
-static void hermite(int n, double theta, const double* restrict y0, const double* restrict c1,
-                    const double* restrict c2, const double* restrict c3, double* restrict out) {
-    for (int i = 0; i < n; ++i) out[i] = y0[i] + theta * (c1[i] + theta * (c2[i] + theta * c3[i]));
-}
-
-// The same for the states listed in idx only (opts.out_states).
-static void hermite_prepare_idx(int m, const int* restrict idx, double h, const double* restrict y0,
-                                const double* restrict f0, const double* restrict y1,
-                                const double* restrict f1, double* restrict c1,
-                                double* restrict c2, double* restrict c3) {
+static void hermite(int m, const int* restrict idx, double theta, const double* restrict y0,
+                    const double* restrict c1, const double* restrict c2, const double* restrict c3,
+                    double* restrict out) {
     for (int k = 0; k < m; ++k) {
-        const int i = idx[k];
-        const double d = y1[i] - y0[i], a = h * f0[i], b = h * f1[i];
-        c1[i] = a;
-        c2[i] = 3.0 * d - (2.0 * a + b);
-        c3[i] = (a + b) - 2.0 * d;
-    }
-}
-
-static void hermite_idx(int m, const int* restrict idx, double theta, const double* restrict y0,
-                        const double* restrict c1, const double* restrict c2,
-                        const double* restrict c3, double* restrict out) {
-    for (int k = 0; k < m; ++k) {
-        const int i = idx[k];
+        const int i = idx ? idx[k] : k;
         out[i] = y0[i] + theta * (c1[i] + theta * (c2[i] + theta * c3[i]));
     }
 }
@@ -560,20 +543,14 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
                 const double to = sched_time(os);
                 const double* yo = s->ynew;
                 if (to < t_new) {
-                    const int m = s->o.n_out_states;
-                    const int* idx = m > 0 ? s->o.out_states : NULL;
+                    // Only the states the callback reads (opts.out_states), else all.
+                    const int* idx = s->o.n_out_states > 0 ? s->o.out_states : NULL;
+                    const int m = idx ? s->o.n_out_states : n;
                     if (!prepared) {
-                        if (idx)
-                            hermite_prepare_idx(m, idx, h, y, f0, s->ynew, s->fnew, s->hc[0], s->hc[1], s->hc[2]);
-                        else
-                            hermite_prepare(n, h, y, f0, s->ynew, s->fnew, s->hc[0], s->hc[1], s->hc[2]);
+                        hermite_prepare(m, idx, h, y, f0, s->ynew, s->fnew, s->hc[0], s->hc[1], s->hc[2]);
                         prepared = 1;
                     }
-                    const double theta = (to - *t) / h;
-                    if (idx)
-                        hermite_idx(m, idx, theta, y, s->hc[0], s->hc[1], s->hc[2], s->yout);
-                    else
-                        hermite(n, theta, y, s->hc[0], s->hc[1], s->hc[2], s->yout);
+                    hermite(m, idx, (to - *t) / h, y, s->hc[0], s->hc[1], s->hc[2], s->yout);
                     yo = s->yout;
                 }
                 os->k++;
@@ -582,8 +559,8 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
                     // full (the callback may have seen only some states).
                     os->stopped = 1;
                     if (yo == s->yout && s->o.n_out_states > 0) {
-                        hermite_prepare(n, h, y, f0, s->ynew, s->fnew, s->hc[0], s->hc[1], s->hc[2]);
-                        hermite(n, (to - *t) / h, y, s->hc[0], s->hc[1], s->hc[2], s->yout);
+                        hermite_prepare(n, NULL, h, y, f0, s->ynew, s->fnew, s->hc[0], s->hc[1], s->hc[2]);
+                        hermite(n, NULL, (to - *t) / h, y, s->hc[0], s->hc[1], s->hc[2], s->yout);
                     }
                     memcpy(y, yo, (size_t)n * sizeof *y);
                     *t = to;

@@ -82,7 +82,6 @@ struct hyd_solver {
     int sp_np;
     long sp_fallbacks;     ///< factorisations that needed the dense pivoting path
     int w_custom;          ///< W is factored by the problem's wfactor (solve with wsolve)
-    long custom_fallbacks; ///< W the problem's wfactor declined
 
     // Stage work vectors, n each.
     double* k[4];
