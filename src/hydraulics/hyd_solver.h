@@ -63,6 +63,17 @@ typedef struct hyd_problem {
     /// (the crane: lagrange_sim.c). NULL: the solver's own LU.
     int (*wfactor)(void* user, const double* J, double gh);
     void (*wsolve)(void* user, double* x);
+    /// Optional whole-step kernel for the fixed-step W-methods Krus and ROS2:
+    /// from (t, y) take one step of size h with W = I - gamma h J and write
+    /// y(t + h) to ynew. new_jac asks for a new J at (t, y) first (the solver
+    /// keeps the jac_every / jac_max_age / reset bookkeeping); otherwise the
+    /// kernel keeps its last J, and re-forms W itself when gamma h changed.
+    /// Returns the number of W factorisations it did (>= 0, for the stats), or
+    /// a negative HYD_ERR_* code. The solver counts two f evaluations per
+    /// step. For problems that can share work between the two stages (the
+    /// crane: lsim_krus.c). NULL: the generic stage arithmetic (krus.c).
+    int (*wstep)(void* user, double t, const double* y, double h, double gamma, int new_jac,
+                 double* ynew);
 } hyd_problem;
 
 typedef enum hyd_method {

@@ -280,11 +280,17 @@ static int eval_jacobian(hyd_solver* s, double t, const double* y, const double*
     return HYD_OK;
 }
 
+// A new Jacobian is due: none yet, forced (reset, rejection), too many steps
+// or too much simulated time since the last one.
+static int jacobian_due(const hyd_solver* s, double t) {
+    const hyd_solver_opts* o = &s->o;
+    return !s->j_valid || s->j_force || s->j_steps >= (o->jac_every > 1 ? o->jac_every : 1) ||
+           (o->jac_max_age > 0.0 && fabs(t - s->j_t) > o->jac_max_age);
+}
+
 int hydPrepareW(hyd_solver* s, double t, const double* y, const double* f0, double gh) {
     const hyd_solver_opts* o = &s->o;
-    int need_j = !s->j_valid || s->j_force || s->j_steps >= (o->jac_every > 1 ? o->jac_every : 1) ||
-                 (o->jac_max_age > 0.0 && fabs(t - s->j_t) > o->jac_max_age);
-    if (need_j) {
+    if (jacobian_due(s, t)) {
         if (s->sp_on) {
             // State scales for the sparse LU's pivot test (lu.c): the error
             // weights, so the test is blind to the states' units.
@@ -355,11 +361,29 @@ static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_ne
     const int n = s->n;
     // Fixed-step methods never leave f(t_{n+1}, y_{n+1}) behind, so skip the
     // cache check (and its copy of y) unless an adaptive run just filled it.
-    const double* f0 = s->fc_f;
-    int rc = s->fc_valid ? current_f(s, *t, y, &f0) : hydEvalF(s, *t, y, s->fc_f);
-    if (rc != HYD_OK) return rc;
-    rc = trial_step(s, *t, y, f0, h, s->ynew, NULL);
-    if (rc != HYD_OK) return rc;
+    int rc;
+    if (s->p->wstep && (s->method == HYD_KRUS || s->method == HYD_ROS2)) {
+        // The problem's own step kernel (hyd_problem.wstep).
+        const int need_j = jacobian_due(s, *t);
+        const double gamma = s->method == HYD_KRUS ? 0.5 : 1.0 + 1.0 / sqrt(2.0);
+        rc = s->p->wstep(s->p->user, *t, y, h, gamma, need_j, s->ynew);
+        if (rc < 0) return rc;
+        s->st.fevals += 2;
+        s->st.lus += rc;
+        if (need_j) {
+            s->st.jevals++;
+            s->j_valid = 1;
+            s->j_force = 0;
+            s->j_steps = 0;
+            s->j_t = *t;
+        }
+    } else {
+        const double* f0 = s->fc_f;
+        rc = s->fc_valid ? current_f(s, *t, y, &f0) : hydEvalF(s, *t, y, s->fc_f);
+        if (rc != HYD_OK) return rc;
+        rc = trial_step(s, *t, y, f0, h, s->ynew, NULL);
+        if (rc != HYD_OK) return rc;
+    }
     int bad = first_nonfinite(s->ynew, n);
     if (bad >= 0) {
         s->bad_i = bad;

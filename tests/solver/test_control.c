@@ -241,6 +241,81 @@ static void test_wfactor_hook(void) {
     }
 }
 
+// A problem-supplied whole step (hyd_problem.wstep) for Krus and ROS2: the
+// solver asks for a new J every jac_every steps and after a reset, counts
+// two f per step and the factorisations the hook reports; a hook that does
+// the generic stage arithmetic gives the generic result.
+typedef struct ws_state {
+    double J[9], lu[9];
+    int piv[3];
+    double gh;
+    long calls, new_jacs, factors;
+} ws_state;
+
+static int ws_step(void* user, double t, const double* y, double h, double gamma, int new_jac, double* ynew) {
+    ws_state* w = user;
+    w->calls++;
+    int nlu = 0;
+    if (new_jac) {
+        w->new_jacs++;
+        memset(w->J, 0, sizeof w->J);
+        conv_jac(NULL, t, y, w->J);
+        w->gh = 0.0;
+    }
+    if (w->gh != gamma * h) {
+        w->gh = gamma * h;
+        for (int i = 0; i < 9; ++i) w->lu[i] = (i % 4 == 0) - w->gh * w->J[i];
+        if (hyd_lu_factor(w->lu, 3, w->piv)) return HYD_ERR_SINGULAR;
+        w->factors++;
+        nlu = 1;
+    }
+    double f0[3], k1[3], ys[3], f1[3], k2[3];
+    conv_f_bounded(NULL, t, y, f0);
+    for (int i = 0; i < 3; ++i) k1[i] = h * f0[i];
+    hyd_lu_solve(w->lu, 3, w->piv, k1);
+    for (int i = 0; i < 3; ++i) ys[i] = y[i] + k1[i];
+    conv_f_bounded(NULL, t + h, ys, f1);
+    for (int i = 0; i < 3; ++i) k2[i] = h * f1[i] - 2.0 * (k1[i] - h * f0[i]);
+    hyd_lu_solve(w->lu, 3, w->piv, k2);
+    for (int i = 0; i < 3; ++i) ynew[i] = y[i] + 0.5 * (k1[i] + k2[i]);
+    return nlu;
+}
+
+static void test_wstep_hook(void) {
+    const hyd_method ms[2] = {HYD_KRUS, HYD_ROS2};
+    for (int j = 0; j < 2; ++j) {
+        double yend[2][3];
+        hyd_solver_stats st[2];
+        ws_state w = {0};
+        for (int mode = 0; mode < 2; ++mode) {
+            hyd_problem p = {0};
+            p.n = 3, p.f = conv_f_bounded, p.jac = conv_jac, p.user = &w;
+            if (mode) p.wstep = ws_step;
+            hyd_solver_opts o = hyd_default_solver_opts();
+            o.h = 1e-3;
+            o.jac_every = 3;
+            hyd_solver* s = hyd_solver_create(&p, ms[j], &o);
+            double t = 0.0;
+            conv_exact(0.0, yend[mode]);
+            CHECK(hyd_solver_advance(s, &t, yend[mode], 1.0) == HYD_OK, "%s mode %d", hyd_method_name(ms[j]), mode);
+            hyd_solver_reset(s); // forces a new J at the next step
+            CHECK(hyd_solver_advance(s, &t, yend[mode], 1.0005) == HYD_OK, "%s mode %d", hyd_method_name(ms[j]), mode);
+            st[mode] = *hyd_solver_get_stats(s);
+            hyd_solver_destroy(s);
+        }
+        // 1000 steps, J at steps 0, 3, ..., 999 (334), then the reset's J
+        // (the 0.5 ms landing step refactors W too).
+        CHECK(w.calls == 1001 && st[1].steps == 1001, "%ld calls, %ld steps", w.calls, st[1].steps);
+        CHECK(w.new_jacs == 335 && st[1].jevals == 335, "%ld new J asked, %ld counted", w.new_jacs, st[1].jevals);
+        CHECK(st[1].fevals == 2 * st[1].steps, "%ld f for %ld steps", st[1].fevals, st[1].steps);
+        CHECK(st[1].lus == w.factors && st[1].lus == st[0].lus, "LUs: %ld counted, %ld done, %ld generic", st[1].lus,
+              w.factors, st[0].lus);
+        for (int i = 0; i < 3; ++i)
+            CHECK(fabs(yend[1][i] - yend[0][i]) <= 1e-13 * (1.0 + fabs(yend[0][i])), "%s state %d: %.17g vs %.17g",
+                  hyd_method_name(ms[j]), i, yend[1][i], yend[0][i]);
+    }
+}
+
 // Component 1 of f turns NaN for t > 0.57.
 static int nan_f(void* user, double t, const double* y, double* dy) {
     (void)user;
@@ -319,6 +394,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_hermite_output);
     RUN_TEST(test_out_states);
     RUN_TEST(test_wfactor_hook);
+    RUN_TEST(test_wstep_hook);
     RUN_TEST(test_nonfinite);
     RUN_TEST(test_reset);
     RUN_TEST(test_bad_arguments);
