@@ -41,6 +41,30 @@ static int hose_at(const hyd_model* m, int node) {
     return -1;
 }
 
+// The lane copy of a two-actuator circuit (hyd_fused_lanes), refreshed
+// whenever the records change (build, map).
+static void pack_lanes(hyd_fused* f) {
+    f->lanes_ok = f->nact == 2 && f->m->air.use;
+    if (!f->lanes_ok) return;
+    hyd_fused_lanes* L = &f->ln;
+    for (int k = 0; k < 2; ++k) {
+        const hyd_fused_act* a = &f->act[k];
+        L->Amax[k] = a->Amax, L->inv_tau[k] = a->inv_tau, L->ok[k] = a->ok, L->oinvP0[k] = a->oinvP0;
+        L->okl[k] = a->okl, L->pT[k] = a->pT, L->GA[k] = a->GA, L->GB[k] = a->GB;
+        L->AA[k] = a->AA, L->AB[k] = a->AB, L->s[k] = a->s, L->VA0[k] = a->VA0, L->VB0[k] = a->VB0;
+        L->VAmin[k] = HYD_VMIN_FRAC * a->VA0, L->VBmin[k] = HYD_VMIN_FRAC * a->VB0;
+        L->CL[k] = a->CL, L->bv[k] = a->bv;
+        L->hV0[0][k] = a->hA.V0, L->hV0[1][k] = a->hB.V0;
+        L->su[k] = a->su;
+        const hyd_fused_node* nd[4] = {&a->hA, &a->hB, &a->cA, &a->cB};
+        for (int j = 0; j < 4; ++j) {
+            L->bel[j][k] = nd[j]->bel, L->bec[j][k] = nd[j]->bec;
+            L->p_lo[j][k] = nd[j]->p_lo, L->p_hi[j][k] = nd[j]->p_hi;
+            L->s_node[j][k] = nd[j]->s;
+        }
+    }
+}
+
 int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int nact, hyd_fused* f,
                     char* why, size_t whysz) {
     memset(f, 0, sizeof *f);
@@ -123,6 +147,7 @@ int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int na
             else n->p_hi = fmin(n->p_hi, q->p_tank + q->pcr);
         }
     }
+    pack_lanes(f);
     return 0;
 }
 
@@ -136,6 +161,7 @@ void hyd_fused_map(hyd_fused* f, const int* map) {
         a->cA.s = map[a->cA.s];
         a->cB.s = map[a->cB.s];
     }
+    pack_lanes(f);
 }
 
 // Net inflow through the node's reliefs and checks, and its pressure partial
@@ -344,3 +370,194 @@ void hyd_fused_jacobian(const hyd_fused* f, const double* y, const double* x, co
     }
 #undef J_
 }
+
+// ------------------------------------------------------------------------
+// Two lanes: hyd_fused_eval for two actuators with actuator k in lane k of
+// SSE2 registers. Every lane runs exactly the scalar operations of
+// actuator() / node_c() in the same order (IEEE add, mul, div and sqrt round
+// the same in a lane as in a scalar register, and -ffp-contract=off keeps
+// them unfused), so the result is bit for bit hyd_fused_eval's
+// (tests/hydraulics/test_fused.c). Only the branches are replaced: both
+// orifice regimes are computed and blended, open reliefs and checks are
+// evaluated lane by lane, and the rare cases (an end stop, a pressure off the
+// Be table) send the whole evaluation to the scalar kernel.
+// ------------------------------------------------------------------------
+#if defined(__SSE2__)
+#include <emmintrin.h>
+
+typedef __m128d v2;
+
+// Memory that nothing wrote just before (model constants, y): a 16-byte load.
+// Values the kernel itself has just produced go lane by lane through
+// _mm_set_pd instead: a 16-byte load of two fresh 8-byte stores cannot be
+// store-forwarded and stalls.
+static inline v2 ld(const double* p) { return _mm_loadu_pd(p); }
+static inline v2 set2(double l0, double l1) { return _mm_set_pd(l1, l0); }
+static inline v2 ld_at(const double* y, const int* i) { return _mm_set_pd(y[i[1]], y[i[0]]); }
+static inline void st_at(double* y, const int* i, v2 v) {
+    _mm_storel_pd(&y[i[0]], v);
+    _mm_storeh_pd(&y[i[1]], v);
+}
+static inline v2 blend(v2 m, v2 a, v2 b) { return _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b)); }
+
+// hyd_orifice_q's flow, both regimes, blended on |x| < 1.
+static inline v2 orifice2(v2 k, v2 invP0, v2 kl, v2 A, v2 sA, v2 dp) {
+    const v2 sign = _mm_set1_pd(-0.0);
+    const v2 x = _mm_mul_pd(_mm_mul_pd(dp, A), invP0);
+    const v2 lamm = _mm_cmplt_pd(_mm_andnot_pd(sign, x), _mm_set1_pd(1.0));
+    const v2 G = _mm_mul_pd(_mm_mul_pd(kl, A), sA);
+    const v2 lam = _mm_sub_pd(_mm_set1_pd(1.0), _mm_mul_pd(_mm_set1_pd(0.2), _mm_mul_pd(x, x)));
+    const v2 ql = _mm_mul_pd(_mm_mul_pd(G, dp), lam);
+    const v2 s = _mm_sqrt_pd(_mm_andnot_pd(sign, dp));
+    const v2 qt = _mm_mul_pd(_mm_mul_pd(k, A), _mm_or_pd(s, _mm_and_pd(sign, dp)));
+    return blend(lamm, ql, qt);
+}
+
+// node_c for two nodes with the table path (hyd_be_nd, hyd_air_ratio):
+// Be(P) / V. The caller has checked P is on the fast path in both lanes.
+// P holds y[idx[0]], y[idx[1]]; the table indices are read from y.
+static inline v2 node_c2(const hyd_model* m, const double* bel, const double* bec, v2 P, v2 V,
+                         const double* y, const int* idx) {
+    const hyd_air_tab* t = &m->air;
+    const double* c[2];
+    double oct[2];
+    for (int l = 0; l < 2; ++l) {
+        uint64_t b;
+        memcpy(&b, &y[idx[l]], sizeof b);
+        const int e = (int)(b >> 52) - 1023;
+        const int j = (int)(b >> (52 - 7)) & (HYD_AIR_SEG - 1);
+        c[l] = t->seg[j];
+        oct[l] = t->oct[e];
+    }
+    // The mantissa in [1, 2), in both lanes at once.
+    const __m128i bits = _mm_castpd_si128(P);
+    const v2 mant = _mm_castsi128_pd(_mm_or_si128(_mm_and_si128(bits, _mm_set1_epi64x(0x000FFFFFFFFFFFFFll)),
+                                                  _mm_set1_epi64x(0x3FF0000000000000ll)));
+#define CO(i) _mm_set_pd(c[1][i], c[0][i])
+    const v2 x = _mm_sub_pd(mant, CO(HYD_AIR_DEG + 1));
+    const v2 x2 = _mm_mul_pd(x, x);
+    const v2 p01 = _mm_add_pd(CO(0), _mm_mul_pd(CO(1), x));
+    const v2 p23 = _mm_add_pd(CO(2), _mm_mul_pd(CO(3), x));
+    const v2 p45 = _mm_add_pd(CO(4), _mm_mul_pd(CO(5), x));
+    const v2 p = _mm_add_pd(p01, _mm_mul_pd(x2, _mm_add_pd(p23, _mm_mul_pd(x2, _mm_add_pd(p45, _mm_mul_pd(x2, CO(6)))))));
+#undef CO
+    const v2 rr = _mm_mul_pd(set2(oct[0], oct[1]), p);
+    const v2 N = _mm_mul_pd(_mm_mul_pd(ld(bel), _mm_add_pd(_mm_set1_pd(1.0), _mm_mul_pd(_mm_set1_pd(m->be_alpha), rr))), P);
+    const v2 D = _mm_add_pd(P, _mm_mul_pd(ld(bec), rr));
+    return _mm_div_pd(N, _mm_mul_pd(D, V));
+}
+
+// Lane mask (bits 0, 1) of p_lo < p < p_hi: every relief and check of the
+// node closed.
+static inline int closed2(const double* lo, const double* hi, v2 p) {
+    return _mm_movemask_pd(_mm_and_pd(_mm_cmplt_pd(ld(lo), p), _mm_cmplt_pd(p, ld(hi))));
+}
+
+// P >= HYD_BE_P_LO && P < 2^64 (false for NaN), as hyd_be_nd.
+static inline int fast2(v2 p) {
+    return _mm_movemask_pd(_mm_and_pd(_mm_cmpge_pd(p, _mm_set1_pd(HYD_BE_P_LO)),
+                                      _mm_cmplt_pd(p, _mm_set1_pd(18446744073709551616.0))));
+}
+
+void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const double* v,
+                     const double* cmd, double* ydot, double* F) {
+    const hyd_fused_lanes* L = &f->ln;
+    if (!f->lanes_ok) {
+        hyd_fused_eval(f, y, x, v, cmd, ydot, F);
+        return;
+    }
+    const hyd_model* m = f->m;
+    const v2 ph[2] = {ld_at(y, L->s_node[0]), ld_at(y, L->s_node[1])}; // hoses A, B
+    const v2 pc[2] = {ld_at(y, L->s_node[2]), ld_at(y, L->s_node[3])}; // chambers A, B
+    const v2 xs = set2(x[0], x[1]), vs = set2(v[0], v[1]);
+    // The common case in every lane, else the scalar kernel decides. Open
+    // reliefs and checks (an anti-cavitation valve while an overrunning load
+    // is lowered) are taken lane by lane with the scalar ramps_in.
+    int ok = 3, shut = 3;
+    int cl[4];
+    for (int j = 0; j < 2; ++j) {
+        ok &= fast2(ph[j]) & fast2(pc[j]);
+        shut &= (cl[j] = closed2(L->p_lo[j], L->p_hi[j], ph[j]));
+        shut &= (cl[2 + j] = closed2(L->p_lo[2 + j], L->p_hi[2 + j], pc[j]));
+    }
+    // hyd_stop_force is zero while -x <= 0 and x - s <= 0.
+    ok &= _mm_movemask_pd(_mm_and_pd(_mm_cmple_pd(_mm_sub_pd(_mm_setzero_pd(), xs), _mm_setzero_pd()),
+                                     _mm_cmple_pd(_mm_sub_pd(xs, ld(L->s)), _mm_setzero_pd())));
+    if (ok != 3) {
+        hyd_fused_eval(f, y, x, v, cmd, ydot, F);
+        return;
+    }
+    const double pPL = y[f->pl.s];
+    double g;
+    double qpl = pump_in(f, pPL, &g);
+
+    // Spools.
+    double c2[2];
+    for (int k = 0; k < 2; ++k) c2[k] = cmd[k] > 1.0 ? 1.0 : (cmd[k] < -1.0 ? -1.0 : cmd[k]);
+    const v2 u = ld_at(y, L->su);
+    st_at(ydot, L->su, _mm_mul_pd(_mm_sub_pd(set2(c2[0], c2[1]), u), ld(L->inv_tau)));
+
+    // Valve edges: 1 feeds a work port from P, 2 drains the other to T.
+    const v2 sign = _mm_set1_pd(-0.0);
+    const v2 pos = _mm_cmpge_pd(u, _mm_setzero_pd());
+    const v2 A = _mm_mul_pd(ld(L->Amax), _mm_andnot_pd(sign, u));
+    const v2 sA = _mm_sqrt_pd(A);
+    const v2 dp1 = _mm_sub_pd(_mm_set1_pd(pPL), blend(pos, ph[0], ph[1]));
+    const v2 dp2 = _mm_sub_pd(blend(pos, ph[1], ph[0]), ld(L->pT));
+    const v2 k = ld(L->ok), invP0 = ld(L->oinvP0), kl = ld(L->okl);
+    const v2 q1 = orifice2(k, invP0, kl, A, sA, dp1);
+    const v2 q2 = orifice2(k, invP0, kl, A, sA, dp2);
+    const v2 nq2 = _mm_xor_pd(q2, sign);
+    const v2 inA = blend(pos, q1, nq2), inB = blend(pos, nq2, q1);
+
+    // Hoses, leakage, volumes.
+    const v2 qhA = _mm_mul_pd(ld(L->GA), _mm_sub_pd(ph[0], pc[0]));
+    const v2 qhB = _mm_mul_pd(ld(L->GB), _mm_sub_pd(ph[1], pc[1]));
+    const v2 leak = _mm_mul_pd(ld(L->CL), _mm_sub_pd(pc[0], pc[1]));
+    const v2 AA = ld(L->AA), AB = ld(L->AB);
+    const v2 VA = _mm_max_pd(_mm_add_pd(ld(L->VA0), _mm_mul_pd(AA, xs)), ld(L->VAmin));
+    const v2 VB = _mm_max_pd(_mm_add_pd(ld(L->VB0), _mm_mul_pd(AB, _mm_sub_pd(ld(L->s), xs))), ld(L->VBmin));
+    // Reliefs and checks: closed ones add +0.0, as ramps_in returns.
+    const v2 z = _mm_setzero_pd();
+    v2 rq[4] = {z, z, z, z};
+    if (shut != 3) {
+        const v2 pn[4] = {ph[0], ph[1], pc[0], pc[1]};
+        for (int j = 0; j < 4; ++j) {
+            if (cl[j] == 3) continue;
+            double p[2], r[2] = {0.0, 0.0};
+            _mm_storeu_pd(p, pn[j]);
+            for (int l = 0; l < 2; ++l) {
+                const hyd_fused_act* a = &f->act[l];
+                const hyd_fused_node* nd[4] = {&a->hA, &a->hB, &a->cA, &a->cB};
+                double gr;
+                if (!(cl[j] >> l & 1)) r[l] = ramps_in(nd[j], p[l], &gr);
+            }
+            rq[j] = set2(r[0], r[1]);
+        }
+    }
+    const v2 nhA = _mm_add_pd(_mm_sub_pd(inA, qhA), rq[0]);
+    const v2 nhB = _mm_add_pd(_mm_sub_pd(inB, qhB), rq[1]);
+    const v2 nA = _mm_sub_pd(_mm_add_pd(_mm_sub_pd(qhA, leak), rq[2]), _mm_mul_pd(AA, vs));
+    const v2 nB = _mm_add_pd(_mm_add_pd(_mm_add_pd(qhB, leak), rq[3]), _mm_mul_pd(AB, vs));
+    const v2 Fv = _mm_sub_pd(_mm_add_pd(_mm_sub_pd(_mm_sub_pd(_mm_mul_pd(pc[0], AA), _mm_mul_pd(pc[1], AB)),
+                                                   _mm_mul_pd(ld(L->bv), vs)), z), z);
+    _mm_storeu_pd(F, Fv);
+
+    st_at(ydot, L->s_node[0], _mm_mul_pd(node_c2(m, L->bel[0], L->bec[0], ph[0], ld(L->hV0[0]), y, L->s_node[0]), nhA));
+    st_at(ydot, L->s_node[1], _mm_mul_pd(node_c2(m, L->bel[1], L->bec[1], ph[1], ld(L->hV0[1]), y, L->s_node[1]), nhB));
+    st_at(ydot, L->s_node[2], _mm_mul_pd(node_c2(m, L->bel[2], L->bec[2], pc[0], VA, y, L->s_node[2]), nA));
+    st_at(ydot, L->s_node[3], _mm_mul_pd(node_c2(m, L->bel[3], L->bec[3], pc[1], VB, y, L->s_node[3]), nB));
+
+    double q1s[2];
+    _mm_storeu_pd(q1s, q1);
+    qpl -= q1s[0];
+    qpl -= q1s[1];
+    qpl += ramps_in(&f->pl, pPL, &g);
+    ydot[f->pl.s] = node_c(m, &f->pl, pPL, f->pl.V0) * qpl;
+}
+#else
+void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const double* v,
+                     const double* cmd, double* ydot, double* F) {
+    hyd_fused_eval(f, y, x, v, cmd, ydot, F);
+}
+#endif

@@ -69,12 +69,25 @@ typedef struct hyd_fused_coupling {
     double dF_dx, dF_dv;   ///< cylinder force partials [N/m], [N s/m] (dF/dpA = AA, dF/dpB = -AB)
 } hyd_fused_coupling;
 
+/// Two actuators side by side, lane k = actuator k, for the two-lane kernel
+/// (hyd_fused_eval2). Node order in the [4] arrays: hose A, hose B, chamber A,
+/// chamber B.
+typedef struct hyd_fused_lanes {
+    double Amax[2], inv_tau[2], ok[2], oinvP0[2], okl[2], pT[2], GA[2], GB[2];
+    double AA[2], AB[2], s[2], VA0[2], VB0[2], VAmin[2], VBmin[2], CL[2], bv[2];
+    double hV0[2][2];      ///< hose volumes [side A, B][lane] [m^3]
+    double bel[4][2], bec[4][2], p_lo[4][2], p_hi[4][2];
+    int su[2], s_node[4][2]; ///< state indices (caller order)
+} hyd_fused_lanes;
+
 typedef struct hyd_fused {
     const hyd_model* m;    ///< the model the constants came from
     int nact, nstate;
     hyd_fused_act act[HYD_FUSED_MAXACT];
     hyd_fused_node pl;     ///< the pump line
     double qmax, pset, inv_band, p_in; ///< pump; p_in: its tank pressure [Pa abs]
+    int lanes_ok;          ///< nact == 2 and the air tables are in use: hyd_fused_eval2 applies
+    hyd_fused_lanes ln;
 } hyd_fused;
 
 /// Pack model m for actuators k = 0..nact-1 (valve[k] drives cylinder[k];
@@ -93,6 +106,13 @@ void hyd_fused_map(hyd_fused* f, const int* map);
 /// rounding, not bit for bit).
 void hyd_fused_eval(const hyd_fused* f, const double* y, const double* x, const double* v,
                     const double* cmd, double* ydot, double* F);
+
+/// The same as hyd_fused_eval, bit for bit, with the two actuators of a
+/// two-actuator circuit in the two lanes of SSE2 registers. It takes the
+/// common case only (no end stop touched, every pressure on the fast path of
+/// the Be(p) tables) and hands anything else to hyd_fused_eval. Without SSE2, or unless f->lanes_ok, it is hyd_fused_eval.
+void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const double* v,
+                     const double* cmd, double* ydot, double* F);
 
 /// The circuit's Jacobian rows, written into J (row-major, leading dimension
 /// ldj, caller's state order): only the non-zero entries of the circuit's
