@@ -121,11 +121,12 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
     case 13: c->sim.world = v; break;
     case 14: if (positive(a, v, &c->sim.dt_ode)) return -1; break;
     case 15:
-        if (strcmp(v, "fused") && strcmp(v, "general")) {
-            fprintf(stderr, "cranesim: --kernel: expected fused or general, got '%s'\n", v);
+        if (strcmp(v, "split") && strcmp(v, "fused") && strcmp(v, "general")) {
+            fprintf(stderr, "cranesim: --kernel: expected split, fused or general, got '%s'\n", v);
             return -1;
         }
         c->sim.general_kernel = !strcmp(v, "general");
+        c->sim.whole_step = !strcmp(v, "fused");
         break;
     }
     return 1;
@@ -149,9 +150,11 @@ void app_common_help(FILE* f, bool with_solver) {
                 "  --rtol R, --atol A   adaptive tolerances (default 1e-3, 1e-6)\n"
                 "  --jac-every N        fixed-step: new Jacobian every N steps (default 10)\n"
                 "  --dense-jac          fixed-step: dense Jacobian instead of the block pattern\n"
-                "  --kernel K           lagrange: fused (default when the circuit has the standard\n"
-                "                       shape: one-pass circuit, block-eliminated W) or general\n"
-                "                       (the component loops and the solver's own sparse LU)\n"
+                "  --kernel K           lagrange, when the circuit has the standard shape:\n"
+                "                       split (default): one-pass circuit, block-eliminated W, and\n"
+                "                         for krus/ros2 the mechanics once per step (docs/lagrange.md);\n"
+                "                       fused: the same, but f in full at every Krus/ROS2 stage;\n"
+                "                       general: the component loops and the solver's own sparse LU\n"
                 "  --duration T         simulated time [s] (default: the scenario's)\n"
                 "  --every DT           output period [s] (default 1e-3, i.e. 1 kHz)\n");
     fprintf(f, "  --quiet              no progress bar or summary\n");

@@ -4,6 +4,7 @@
 #define _GNU_SOURCE // sincos: one call per angle (glibc shares the sin and cos code)
 #endif
 #include "lagrange_sim.h"
+#include "lsim_kin.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -109,6 +110,8 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
     s->use_fused = s->have_fused;
     s->w_layout = lsim_w_layout(s);
     s->use_w = s->w_layout;
+    s->use_split = s->w_layout;
+    s->ks.cmd_t = NAN;
     lagrange_consts_init(&m->mech, v, m3, &s->lk);
     for (int i = 0; i < s->nh; ++i) {
         const char* nm = strrchr(hyd_model_state_name(hm, s->perm[i]), '.');
@@ -136,34 +139,12 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
     if (blocks) {
         p.nblock = s->nblock;
         p.block_size = s->block;
+        if (fz && s->use_split && s->w_layout) p.wstep = lsim_wstep;
     } else if (s->use_w && s->w_layout) {
         p.wfactor = lsim_wfactor;
         p.wsolve = lsim_wsolve;
     }
     return p;
-}
-
-// Kinematics of both cylinders: stroke, rate, lever r = dx/dq and dr/dq.
-typedef struct kin {
-    double x[2], v[2], r[2], dr[2];
-} kin;
-
-// trig = {sin q1, cos q1, sin q2, cos q2}; phi = q + phi_offset by the
-// addition identities, so the whole rhs needs only the two sincos of q.
-static void cylinder_kinematics(const crane_mech* me, const double* trig, const double* qd, kin* k) {
-    for (int i = 0; i < 2; ++i) {
-        const crane_actuator* a = &me->act[i];
-        const double so = a->sin_offset, co = a->cos_offset;
-        const double sq = trig[2 * i], cq = trig[2 * i + 1];
-        const double sp = sq * co + cq * so, cp = cq * co - sq * so;
-        const double ab = a->a * a->b;
-        const double xp = sqrt(a->a * a->a + a->b * a->b - 2.0 * ab * cp); // paper Eq. 5
-        const double r = ab * sp / xp;                                      // dx/dphi
-        k->x[i] = xp - a->closed_length;
-        k->r[i] = r;
-        k->v[i] = r * qd[i];
-        k->dr[i] = (ab * cp - r * r) / xp; // d^2 x / dphi^2
-    }
 }
 
 static void commands(lsim* s, double t, double cmd[2]) {
@@ -351,7 +332,7 @@ int lsim_rhs_fused(void* user, double t, const double* y, double* dydt) {
     lagrange_sincos(y[iq + 1], &trig[2], &trig[3]);
     cylinder_kinematics(&s->mdl->mech, trig, qd, &k);
     commands(s, t, cmd);
-    hyd_fused_eval(&s->fz, y, k.x, k.v, cmd, dydt, F);
+    hyd_fused_eval2(&s->fz, y, k.x, k.v, cmd, dydt, F);
     const double tau[2] = {F[0] * k.r[0], F[1] * k.r[1]};
     double qdd[2];
     lagrange_accel_fast(&s->lk, trig, qd, tau, qdd);

@@ -35,6 +35,23 @@ typedef struct lsim_w {
     int ps[5];
 } lsim_w;
 
+/// State of the split Krus/ROS2 step kernel (lsim_krus.c): the diagonal
+/// blocks of the last J, W^-1 of each block for the current gamma h, and the
+/// last valve commands.
+typedef struct lsim_ks {
+    double ju[2];          ///< spool rows: d u' / d u [1/s]
+    double jh[2][2][4];    ///< [actuator][side A, B]: 2x2 block on [hose, chamber], row-major
+    double jpl;            ///< pump line: d p' / d p [1/s]
+    double jm[16];         ///< [q1, q2, q1', q2'] block, row-major
+    bool have_j;
+    double gh;             ///< gamma h the inverses below were formed for [s] (0: none)
+    double wu[2], wpl;     ///< 1 / W of the 1x1 blocks
+    double wh[2][2][4];    ///< W^-1 of the 2x2 blocks
+    double wm[16];         ///< W^-1 of the mechanics block
+    double cmd_t;          ///< time of cmd [s] (NaN: none)
+    double cmd[2];         ///< valve commands at cmd_t [-]
+} lsim_ks;
+
 typedef struct lsim {
     const model* mdl;
     lagrange_variant variant;
@@ -70,6 +87,9 @@ typedef struct lsim {
     bool w_layout;         ///< the state layout lsim_w.c needs (standard circuit, 2 actuators)
     bool use_w;            ///< lsim_problem hands out wfactor/wsolve (default: w_layout)
     lsim_w w;
+    // Split Krus/ROS2 step (lsim_krus.c) for the block-pattern fixed-step runs.
+    bool use_split;        ///< lsim_problem(s, true) hands out lsim_wstep (default: w_layout)
+    lsim_ks ks;
 } lsim;
 
 /// Set up for model m. Returns 0, or -1 with a message.
@@ -95,6 +115,12 @@ bool lsim_w_layout(const lsim* s);
 int lsim_wfactor(void* user, const double* J, double gh);
 void lsim_wsolve(void* user, double* x);
 
+/// hyd_problem.wstep for Krus and ROS2 with the block pattern (lsim_krus.c):
+/// the mechanics (sines, cylinder kinematics, mass matrix) evaluated once per
+/// step at the predicted midpoint and carried to both stages to first order.
+/// Requires w_layout.
+int lsim_wstep(void* user, double t, const double* y, double h, double gamma, int new_jac,
+               double* ynew);
 int lsim_rhs(void* user, double t, const double* y, double* dydt);
 /// df/dt: time enters only through the valve commands of the scenario, so
 /// only the spool rows are non-zero: (du_cmd/dt) / tau_s.

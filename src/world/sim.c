@@ -297,6 +297,7 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     ls.scn = sc;
     ls.use_fused = ls.have_fused && !o->general_kernel;
     ls.use_w = ls.w_layout && !o->general_kernel; // the crane-specialised W too (lsim_w.c)
+    ls.use_split = ls.w_layout && !o->general_kernel && !o->whole_step;
     res->fused = ls.use_fused;
     double y[LSIM_MAX_STATES];
     lsim_initial_state(&ls, sc->q0, 0.5e6, y);
@@ -310,6 +311,7 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     }
 #endif
     hyd_problem prob = lsim_problem(&ls, !adaptive && !o->dense_jac);
+    res->split = prob.wstep && (o->solver == HYD_KRUS || o->solver == HYD_ROS2) && !o->cvode;
     hyd_solver_opts so = hyd_default_solver_opts();
     so.h = adaptive ? 0.0 : o->h;
     so.rtol = o->rtol;

@@ -34,6 +34,9 @@ typedef struct sim_opts {
                        ///< (the outside reference; rtol/atol apply)
     bool general_kernel; ///< lagrange: the general circuit evaluation even when the
                          ///< fused kernel applies (hyd_fused.h; for comparisons)
+    bool whole_step;     ///< lagrange, Krus/ROS2 with the block pattern: the generic
+                         ///< stage arithmetic with f in full at every stage, instead
+                         ///< of the split step (lsim_krus.c; for comparisons)
 } sim_opts;
 
 /// True when this build has the CVODE reference solver.
@@ -76,6 +79,7 @@ typedef struct sim_result {
     hyd_solver_stats stats;
     long rows;
     bool fused;          ///< lagrange: the run used the fused circuit kernel
+    bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lsim_krus.c)
 } sim_result;
 
 /// Run the scenario. Rows go to row_fn (may be NULL) and to trace (may be
