@@ -285,10 +285,22 @@ void hyd_fused_eval(const hyd_fused* f, const double* y, const double* x, const 
 }
 
 // Be/V and the diagonal term d(Be/V)/dp * net of one node's Jacobian row.
+// On the table path dBe/dp comes from the same N, D and r as Be (the
+// formulas of hyd_be, with node_bec = alpha bel / n as hyd_be forms it), so
+// one table evaluation serves both.
 static inline double node_c_d(const hyd_model* m, const hyd_fused_node* n, double p, double V,
                               double net, double* diag) {
+    double N, D, r, dbe;
+    if (m->air.use && hyd_be_nd(m, n->bel, n->bec, p, &N, &D, &r)) {
+        const double iD = 1.0 / D;
+        const double be = N * iD;
+        const double dN = n->bel * (1.0 + m->be_alpha * r * (1.0 - m->be_inv_n));
+        const double dD = 1.0 - n->bec * r * m->be_inv_n / p;
+        dbe = (dN - be * dD) * iD;
+        *diag = dbe / V * net;
+        return N / (D * V);
+    }
     const double c = node_c(m, n, p, V);
-    double dbe;
     hyd_be(m, n->bel, p, &dbe);
     *diag = dbe / V * net;
     return c;

@@ -48,6 +48,8 @@ typedef struct lsim_ks {
     double wu[2], wpl;     ///< 1 / W of the 1x1 blocks
     double wh[2][2][4];    ///< W^-1 of the 2x2 blocks
     double wm[16];         ///< W^-1 of the mechanics block
+    double qa[2], sa[2], ca[2]; ///< last midpoint angles [rad] and their sines, cosines
+    bool have_anchor;      ///< qa, sa, ca are set (cleared with each new J)
     double cmd_t;          ///< time of cmd [s] (NaN: none)
     double cmd[2];         ///< valve commands at cmd_t [-]
 } lsim_ks;
