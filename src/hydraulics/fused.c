@@ -503,11 +503,13 @@ void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const
     double g;
     double qpl = pump_in(f, pPL, &g);
 
-    // Spools.
-    double c2[2];
-    for (int k = 0; k < 2; ++k) c2[k] = cmd[k] > 1.0 ? 1.0 : (cmd[k] < -1.0 ? -1.0 : cmd[k]);
+    // Spools. The command clamped to [-1, 1]: maxpd/minpd return their
+    // second operand unless the first compares greater/less, so a NaN
+    // command stays NaN, as in actuator().
+    const v2 one = _mm_set1_pd(1.0);
+    const v2 c2 = _mm_min_pd(one, _mm_max_pd(_mm_set1_pd(-1.0), set2(cmd[0], cmd[1])));
     const v2 u = ld_at(y, L->su);
-    st_at(ydot, L->su, _mm_mul_pd(_mm_sub_pd(set2(c2[0], c2[1]), u), ld(L->inv_tau)));
+    st_at(ydot, L->su, _mm_mul_pd(_mm_sub_pd(c2, u), ld(L->inv_tau)));
 
     // Valve edges: 1 feeds a work port from P, 2 drains the other to T.
     const v2 sign = _mm_set1_pd(-0.0);

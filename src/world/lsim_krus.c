@@ -211,23 +211,41 @@ static int form_w(lsim_ks* ks, double gh) {
     return HYD_OK;
 }
 
-// x <- W^-1 x, block by block.
-static void wsolve(const lsim_ks* ks, double* x) {
-    for (int k = 0; k < 2; ++k) {
-        const int b = 5 * k;
-        x[b] *= ks->wu[k];
+// k = W^-1 b block by block, where b = h f + c2 (k1 - h f0) (c2 = 0 for
+// stage 1), and the stage's output: stage 1 writes h f0 and y + k1, stage 2
+// y + (k1 + k2) / 2. One pass, every block's values in registers.
+static inline void solve_stage(const lsim_ks* restrict ks, int stage, double h, const double* restrict f,
+                               const double* restrict y, double* restrict hf0, double* restrict k1,
+                               double* restrict out) {
+#define RHS(i) (stage == 1 ? (hf0[i] = h * f[i]) : h * f[i] - 2.0 * (k1[i] - hf0[i]))
+#define PUT(i, k)                                                                                       \
+    do {                                                                                                \
+        if (stage == 1) k1[i] = (k), out[i] = y[i] + (k);                                               \
+        else out[i] = y[i] + 0.5 * (k1[i] + (k));                                                       \
+    } while (0)
+    for (int a = 0; a < 2; ++a) {
+        const int b = 5 * a;
+        const double ku = ks->wu[a] * RHS(b);
+        PUT(b, ku);
         for (int c = 0; c < 2; ++c) {
-            const double* w = ks->wh[k][c];
+            const double* w = ks->wh[a][c];
             const int i = b + 1 + 2 * c;
-            const double h0 = x[i], p0 = x[i + 1];
-            x[i] = w[0] * h0 + w[1] * p0;
-            x[i + 1] = w[2] * h0 + w[3] * p0;
+            const double r0 = RHS(i), r1 = RHS(i + 1);
+            const double x0 = w[0] * r0 + w[1] * r1, x1 = w[2] * r0 + w[3] * r1;
+            PUT(i, x0);
+            PUT(i + 1, x1);
         }
     }
-    x[IPL] *= ks->wpl;
-    const double m0 = x[IQ], m1 = x[IQ + 1], m2 = x[IQ + 2], m3 = x[IQ + 3];
+    const double kp = ks->wpl * RHS(IPL);
+    PUT(IPL, kp);
+    const double m0 = RHS(IQ), m1 = RHS(IQ + 1), m2 = RHS(IQ + 2), m3 = RHS(IQ + 3);
     const double* w = ks->wm;
-    for (int i = 0; i < 4; ++i) x[IQ + i] = w[4 * i] * m0 + w[4 * i + 1] * m1 + w[4 * i + 2] * m2 + w[4 * i + 3] * m3;
+    for (int i = 0; i < 4; ++i) {
+        const double x = w[4 * i] * m0 + w[4 * i + 1] * m1 + w[4 * i + 2] * m2 + w[4 * i + 3] * m3;
+        PUT(IQ + i, x);
+    }
+#undef RHS
+#undef PUT
 }
 
 int lsim_wstep(void* user, double t, const double* y, double h, double gamma, int new_jac,
@@ -252,15 +270,11 @@ int lsim_wstep(void* user, double t, const double* y, double h, double gamma, in
     }
     geo g;
     geo_at(s, y, h, &g);
-    double f0[NS], k1[NS], ys[NS], f1[NS], k2[NS];
-    stage_f(s, &g, t, y, f0);
-    for (int i = 0; i < NS; ++i) k1[i] = h * f0[i];
-    wsolve(ks, k1);
-    for (int i = 0; i < NS; ++i) ys[i] = y[i] + k1[i];
-    stage_f(s, &g, t + h, ys, f1);
+    double f[NS], hf0[NS], k1[NS], ys[NS];
+    stage_f(s, &g, t, y, f);
+    solve_stage(ks, 1, h, f, y, hf0, k1, ys);
+    stage_f(s, &g, t + h, ys, f);
     // g21 h J k1 = -2 (k1 - h f0) for both gammas (krus.c).
-    for (int i = 0; i < NS; ++i) k2[i] = h * f1[i] - 2.0 * (k1[i] - h * f0[i]);
-    wsolve(ks, k2);
-    for (int i = 0; i < NS; ++i) ynew[i] = y[i] + 0.5 * (k1[i] + k2[i]);
+    solve_stage(ks, 2, h, f, y, hf0, k1, ynew);
     return nlu;
 }
