@@ -14,6 +14,7 @@
 static void bench_help(FILE* f) {
     fprintf(f,
             "usage: cranesim bench [--scenario S] [--duration T] [--repeat N] [--config NAME] [--model M]\n"
+            "                      [--kernel split|fused|general]\n"
             "\n"
             "Prints one JSON object per line and configuration: scenario, mechanics, variant,\n"
             "solver, step or tolerances, simulated time [s], median wall time [s], real-time\n"
@@ -39,7 +40,8 @@ static void bench_help(FILE* f) {
             "  --scenario S   default ramp\n"
             "  --duration T   simulated seconds per run (default: the scenario's)\n"
             "  --repeat N     runs per configuration, median reported (default 3)\n"
-            "  --config NAME  only this configuration (repeatable)\n");
+            "  --config NAME  only this configuration (repeatable)\n"
+            "  --kernel K     lagrange kernel (see cranesim run --help; default split)\n");
 }
 
 typedef struct bench_cfg {
