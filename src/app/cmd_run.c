@@ -55,8 +55,11 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     }
     printf("cranesim run: %s, %s/%s, solver %s", scen, o->mechanics == SIM_LAGRANGE ? "lagrange" : "ode",
            lagrange_variant_name(o->variant), o->cvode ? "cvode" : hyd_method_name(o->solver));
-    if (o->cvode || hyd_method_is_adaptive(o->solver)) printf(" (rtol %g, atol %g)\n", o->rtol, o->atol);
-    else printf(" (h = %g ms)\n", o->h * 1e3);
+    // Which lagrange kernel ran (cranesim run --help, --kernel).
+    const char* kern = o->mechanics != SIM_LAGRANGE ? "" : r->split ? ", split step" : r->fused ? ", fused kernel"
+                                                                                               : ", general kernel";
+    if (o->cvode || hyd_method_is_adaptive(o->solver)) printf(" (rtol %g, atol %g%s)\n", o->rtol, o->atol, kern);
+    else printf(" (h = %g ms%s)\n", o->h * 1e3, kern);
     if (o->mechanics == SIM_ODE)
         printf("  simulated %.3f s in %.3f s wall: %.0fx real time; ODE step %g ms, %ld hydraulic sub-steps\n",
                r->t_end, r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, o->dt_ode * 1e3, r->stats.steps);
