@@ -87,29 +87,54 @@ static void plot_wp(const study_cfg* c, int n, const char* title, const char* pn
     pllab("max chamber-pressure error [% of peak] (log)", "wall time [s] (log)", title);
     plschr(0, 0.7);
     static const int col[] = {1, 3, 9, 8, 12, 13};
-    // One colour per method family; a line through each family's points.
+    // One colour per method family, a line through its points and a legend;
+    // each point carries only its step or tolerance, offset per family so
+    // neighbouring families (ROS34PW2 and RODAS3 lie on top of each other)
+    // keep their labels apart. Offsets in decades of the log axes.
     const char* fam[] = {"krus", "ros2", "rk4", "ros34pw2", "rodas3", "cvode"};
+    static const double dx[] = {0.06, 0.06, 0.06, -0.06, 0.06, 0.06};
+    static const double dy[] = {-0.07, 0.07, 0.0, -0.03, 0.07, 0.07};
+    static const double just[] = {0.0, 0.0, 0.0, 1.0, 0.0, 0.0};
+    int shown[6], nshown = 0;
     for (int f = 0; f < 6; ++f) {
         PLFLT xs[16], ys[16];
+        const char* lab[16];
         int k = 0;
+        const size_t lf = strlen(fam[f]);
         for (int i = 0; i < n && k < 16; ++i) {
-            if (c[i].failed || strncmp(c[i].name, fam[f], strlen(fam[f])) || c[i].name[strlen(fam[f])] != ' ')
+            if (c[i].failed || !(c[i].p_max > 0) || !(c[i].wall > 0) || strncmp(c[i].name, fam[f], lf) ||
+                c[i].name[lf] != ' ')
                 continue;
             xs[k] = log10(c[i].p_max);
             ys[k] = log10(c[i].wall);
+            lab[k] = c[i].name + lf + 1; // "h=0.1ms", "rtol=0.001"
             ++k;
         }
         if (!k) continue;
+        shown[nshown++] = f;
         plcol0(col[f]);
         plline(k, xs, ys);
         plpoin(k, xs, ys, 17);
-        for (int j = 0; j < k; ++j) {
-            for (int i = 0; i < n; ++i)
-                if (!c[i].failed && log10(c[i].p_max) == xs[j] && log10(c[i].wall) == ys[j] &&
-                    !strncmp(c[i].name, fam[f], strlen(fam[f])))
-                    plptex(xs[j] + 0.05, ys[j], 1, 0, 0, c[i].name);
-        }
+        // CVODE's loose tolerances bunch up: alternate above and below.
+        for (int j = 0; j < k; ++j)
+            plptex(xs[j] + dx[f], ys[j] + (f == 5 && j % 2 ? -dy[f] - 0.05 : dy[f]), 1, 0, just[f], lab[j]);
     }
+    PLINT opt[6], tcol[6], lcol[6], lsty[6], scol[6], snum[6];
+    PLFLT lwid[6], sscale[6];
+    const char* text[6];
+    const char* sym[6];
+    for (int i = 0; i < nshown; ++i) {
+        const int f = shown[i];
+        opt[i] = PL_LEGEND_LINE | PL_LEGEND_SYMBOL;
+        tcol[i] = 15, lcol[i] = scol[i] = col[f], lsty[i] = 1, lwid[i] = 1.0;
+        sscale[i] = 1.0, snum[i] = 1, sym[i] = "•";
+        text[i] = fam[f];
+    }
+    PLFLT lw, lh;
+    plschr(0, 0.8);
+    pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE,
+             0.02, 0.02, 0.08, 0, 15, 1, 0, 0, nshown, opt, 1.0, 1.0, 2.0, 0.0, tcol, text, NULL, NULL, NULL, NULL,
+             lcol, lsty, lwid, scol, sscale, snum, sym);
     plend();
 }
 #endif
