@@ -459,6 +459,27 @@ static inline v2 node_c2(const hyd_model* m, const double* bel, const double* be
     return _mm_div_pd(N, _mm_mul_pd(D, V));
 }
 
+// Flows of the open reliefs and checks, lane by lane with the scalar law;
+// closed lanes keep +0.0. Out of line (cold): keeping it out of the hot path
+// keeps the register allocation of hyd_fused_eval2's common case tight.
+#if defined(__GNUC__)
+__attribute__((noinline, cold))
+#endif
+static void open_ramps2(const hyd_fused* f, const double* y, const int* cl, v2* rq) {
+    const hyd_fused_lanes* L = &f->ln;
+    for (int j = 0; j < 4; ++j) {
+        if (cl[j] == 3) continue;
+        double r[2] = {0.0, 0.0};
+        for (int l = 0; l < 2; ++l) {
+            const hyd_fused_act* a = &f->act[l];
+            const hyd_fused_node* nd[4] = {&a->hA, &a->hB, &a->cA, &a->cB};
+            double gr;
+            if (!(cl[j] >> l & 1)) r[l] = ramps_in(nd[j], y[L->s_node[j][l]], &gr);
+        }
+        rq[j] = set2(r[0], r[1]);
+    }
+}
+
 // Lane mask (bits 0, 1) of p_lo < p < p_hi: every relief and check of the
 // node closed.
 static inline int closed2(const double* lo, const double* hi, v2 p) {
@@ -534,21 +555,7 @@ void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const
     // Reliefs and checks: closed ones add +0.0, as ramps_in returns.
     const v2 z = _mm_setzero_pd();
     v2 rq[4] = {z, z, z, z};
-    if (shut != 3) {
-        const v2 pn[4] = {ph[0], ph[1], pc[0], pc[1]};
-        for (int j = 0; j < 4; ++j) {
-            if (cl[j] == 3) continue;
-            double p[2], r[2] = {0.0, 0.0};
-            _mm_storeu_pd(p, pn[j]);
-            for (int l = 0; l < 2; ++l) {
-                const hyd_fused_act* a = &f->act[l];
-                const hyd_fused_node* nd[4] = {&a->hA, &a->hB, &a->cA, &a->cB};
-                double gr;
-                if (!(cl[j] >> l & 1)) r[l] = ramps_in(nd[j], p[l], &gr);
-            }
-            rq[j] = set2(r[0], r[1]);
-        }
-    }
+    if (shut != 3) open_ramps2(f, y, cl, rq);
     const v2 nhA = _mm_add_pd(_mm_sub_pd(inA, qhA), rq[0]);
     const v2 nhB = _mm_add_pd(_mm_sub_pd(inB, qhB), rq[1]);
     const v2 nA = _mm_sub_pd(_mm_add_pd(_mm_sub_pd(qhA, leak), rq[2]), _mm_mul_pd(AA, vs));
