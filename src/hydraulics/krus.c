@@ -18,7 +18,7 @@
 int hydKrusStep(hyd_solver* s, double t, const double* y, const double* f0, double h,
                 double* ynew) {
     const int n = s->n;
-    const double gamma = s->method == HYD_KRUS ? 0.5 : 1.0 + 1.0 / sqrt(2.0);
+    const double gamma = hydKrusGamma(s->method);
     int rc = hydPrepareW(s, t, y, f0, gamma * h);
     if (rc != HYD_OK) return rc;
 

@@ -365,8 +365,7 @@ static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_ne
     if (s->p->wstep && (s->method == HYD_KRUS || s->method == HYD_ROS2)) {
         // The problem's own step kernel (hyd_problem.wstep).
         const int need_j = jacobian_due(s, *t);
-        const double gamma = s->method == HYD_KRUS ? 0.5 : 1.0 + 1.0 / sqrt(2.0);
-        rc = s->p->wstep(s->p->user, *t, y, h, gamma, need_j, s->ynew);
+        rc = s->p->wstep(s->p->user, *t, y, h, hydKrusGamma(s->method), need_j, s->ynew);
         if (rc < 0) return rc;
         s->st.fevals += 2;
         s->st.lus += rc;
