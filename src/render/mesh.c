@@ -322,17 +322,21 @@ static bool load_file(const char* path, int up, render_mesh* out, char* why, siz
 const render_mesh* render_mesh_get(render_mesh_cache* c, const char* file, int up) {
     if (!file || !file[0]) return NULL;
     if (up != 1) up = 2;
-    char key[sizeof c->e[0].key];
+    char key[sizeof c->e[0]->key];
     snprintf(key, sizeof key, "%d:%s", up, file);
     for (int i = 0; i < c->n; ++i)
-        if (strcmp(c->e[i].key, key) == 0) return c->e[i].ok ? &c->e[i].mesh : NULL;
+        if (strcmp(c->e[i]->key, key) == 0) return c->e[i]->ok ? &c->e[i]->mesh : NULL;
 
     if (c->n == c->cap) {
-        c->cap = c->cap ? 2 * c->cap : 32;
-        c->e = realloc(c->e, (size_t)c->cap * sizeof *c->e);
+        const int cap = c->cap ? 2 * c->cap : 32;
+        render_mesh_entry** ne = realloc(c->e, (size_t)cap * sizeof *ne);
+        if (!ne) return NULL; // out of memory: the primitive is drawn
+        c->e = ne;
+        c->cap = cap;
     }
-    render_mesh_entry* e = &c->e[c->n++];
-    memset(e, 0, sizeof *e);
+    render_mesh_entry* e = calloc(1, sizeof *e);
+    if (!e) return NULL;
+    c->e[c->n++] = e;
     snprintf(e->key, sizeof e->key, "%s", key);
     char path[1024];
     if (file[0] == '/' || !c->dir[0])
@@ -351,8 +355,10 @@ const render_mesh* render_mesh_get(render_mesh_cache* c, const char* file, int u
 }
 
 void render_mesh_cache_free(render_mesh_cache* c) {
-    for (int i = 0; i < c->n; ++i)
-        if (c->e[i].ok) render_mesh_free(&c->e[i].mesh);
+    for (int i = 0; i < c->n; ++i) {
+        if (c->e[i]->ok) render_mesh_free(&c->e[i]->mesh);
+        free(c->e[i]);
+    }
     free(c->e);
     c->e = NULL;
     c->n = c->cap = 0;

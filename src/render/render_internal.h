@@ -60,7 +60,9 @@ typedef struct render_mesh_entry {
 } render_mesh_entry;
 
 typedef struct render_mesh_cache {
-    render_mesh_entry* e;
+    /// One allocation per entry, so a render_mesh_get pointer stays valid
+    /// while later loads grow the array.
+    render_mesh_entry** e;
     int n, cap;
     int warnings;  ///< files that failed (each warned once on stderr)
     char dir[512]; ///< asset dir for relative names

@@ -12,9 +12,7 @@
 #include "render_internal.h"
 
 typedef struct render_draw_item {
-    // A copy, not a pointer: loading a new mesh may move the cache's array
-    // while this frame's list is being built.
-    render_mesh mesh;
+    const render_mesh* mesh; ///< a primitive or a cache entry (both stable)
     float model[16];
     float rgba[4];
     float depth; ///< squared distance from the eye, for sorting
@@ -282,7 +280,7 @@ static void update_terrain(render_scene* sc, const world_snap_terrain* t) {
 static render_draw_item* push_item(render_scene* sc, const render_mesh* m, const float rgba[4]) {
     if (sc->nitems >= sc->capitems) return NULL;
     render_draw_item* it = &sc->items[sc->nitems++];
-    it->mesh = *m;
+    it->mesh = m;
     memcpy(it->rgba, rgba, 4 * sizeof(float));
     it->casts_shadow = true;
     return it;
@@ -510,8 +508,8 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
         const render_draw_item* it = &sc->items[i];
         if (!it->casts_shadow) continue;
         glUniformMatrix4fv(sc->ud_model, 1, GL_FALSE, it->model);
-        set_cull(&it->mesh, it->model);
-        render_mesh_draw(&it->mesh);
+        set_cull(it->mesh, it->model);
+        render_mesh_draw(it->mesh);
         ++sc->draw_calls;
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
@@ -544,9 +542,9 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
         glUniformMatrix4fv(sc->obj.u_model, 1, GL_FALSE, it->model);
         glUniformMatrix3fv(sc->obj.u_normal, 1, GL_FALSE, nm);
         glUniform4fv(sc->obj.u_color, 1, it->rgba);
-        set_cull(&it->mesh, it->model);
-        render_mesh_draw(&it->mesh);
-        sc->triangles += it->mesh.nidx / 3;
+        set_cull(it->mesh, it->model);
+        render_mesh_draw(it->mesh);
+        sc->triangles += it->mesh->nidx / 3;
         ++sc->draw_calls;
     }
     // Ground: the heightfield if there is one, and a flat plane beyond it.
