@@ -53,7 +53,8 @@ struct drive_session {
     int nparam;
     int pid[MAX_PARAMS]; // panel ids
     bool paused, rebuild;
-    double wall_last, wall_next_frame, wall_pause;
+    double wall_last, wall_next_frame;
+    double wall_last_frame; ///< wall time the last timed frame started [s] (< 0: none yet)
     double sim_offset;   // simulated time = wall - sim_offset while running
     FILE* rec;
     char rec_path[256];
@@ -310,7 +311,11 @@ static void start_recording(drive_session* s, const char* path) {
     sim_csv_header(s->rec, s->ncol);
 }
 
-drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz) {
+drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz,
+                                    int* code) {
+    int dummy;
+    if (!code) code = &dummy;
+    *code = EXIT_RUNTIME;
     drive_session* s = calloc(1, sizeof *s);
     if (!s) {
         snprintf(err, errsz, "out of memory");
@@ -327,12 +332,15 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     if (!s->m || scenario_load(app_scenario_path(s->c.scenario_path, sb, sizeof sb), &s->sc, e2, sizeof e2)) {
         snprintf(err, errsz, "%s", e2);
         drive_session_destroy(s);
+        *code = EXIT_USAGE;
         return NULL;
     }
     s->l = make_live(s, s->sc.q0, s->sc.slew0);
     if (!s->l) {
+        // A world file or model the world cannot be built from.
         snprintf(err, errsz, "%s", s->err);
         drive_session_destroy(s);
+        *code = EXIT_USAGE;
         return NULL;
     }
     s->ncol = live_ncol(s->l);
@@ -359,6 +367,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     input_mapping map = input_default_mapping();
     if (o->mapping_file && input_load_mapping(o->mapping_file, &map, err, errsz)) {
         drive_session_destroy(s);
+        *code = EXIT_USAGE;
         return NULL;
     }
     s->in = input_create(&map);
@@ -380,13 +389,14 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     if (o->charts) {
         if (setup_charts(s, o->charts, err, errsz)) {
             drive_session_destroy(s);
+            *code = EXIT_USAGE;
             return NULL;
         }
     } else {
         render_charts_default(s->r, s->c.sim.mechanics == SIM_ODE ? 3 : 2);
     }
     if (o->record_path) start_recording(s, o->record_path);
-    s->missed_t0 = 0;
+    s->wall_last_frame = -1.0;
     // Warm-up frame before the caller starts its clock: the first frame
     // compiles the shaders and loads the meshes (well over 100 ms on
     // llvmpipe), which would otherwise count as a missed deadline.
@@ -412,22 +422,23 @@ void drive_session_destroy(drive_session* s) {
     free(s);
 }
 
-void drive_session_render(drive_session* s) {
-    live_snapshot(s->l, s->snap);
+// Draw s->snap as it stands (the caller took the snapshot).
+static void render_snapshot(drive_session* s) {
     s->snap->rt_factor = s->st.wall_time > 0 ? s->st.sim_time / s->st.wall_time : 0;
-    uint64_t t0 = SDL_GetPerformanceCounter();
     render_frame(s->r, s->snap);
     render_present(s->r);
-    double ms = 1e3 * (double)(SDL_GetPerformanceCounter() - t0) / (double)SDL_GetPerformanceFrequency();
-    s->st.render_ms_max = fmax(s->st.render_ms_max, ms);
     s->st.triangles = render_get_stats(s->r).triangles;
     ++s->st.frames;
+}
+
+void drive_session_render(drive_session* s) {
+    live_snapshot(s->l, s->snap);
+    render_snapshot(s);
 }
 
 int drive_session_screenshot(drive_session* s, const char* png) { return render_screenshot(s->r, png); }
 
 int drive_session_tick(drive_session* s, double wall) {
-    ++s->st.ticks;
     double dt_wall = wall - s->wall_last;
     if (dt_wall < 0) dt_wall = 0;
     s->wall_last = wall;
@@ -450,8 +461,8 @@ int drive_session_tick(drive_session* s, double wall) {
             } else {
                 char path[64];
                 snprintf(path, sizeof path, "cranesim_record_%ld.csv", (long)time(NULL));
-                start_recording(s, path);
-                snprintf(s->status, sizeof s->status, "recording to %s", path);
+                start_recording(s, path); // on failure it says so in the status line
+                if (s->rec) snprintf(s->status, sizeof s->status, "recording to %s", path);
             }
             continue;
         }
@@ -521,32 +532,30 @@ int drive_session_tick(drive_session* s, double wall) {
         s->missed_window = 0;
         s->missed_t0 = wall;
     }
-    if (s->rec) {
-        double row[SIM_NCOL];
-        live_row(s->l, row);
-        sim_csv_row(s->rec, row, s->ncol);
-    }
-    char status[640];
-    snprintf(status, sizeof status, "%s%s%s%s%s", s->paused ? "PAUSED  " : "", s->rec ? "REC  " : "", s->status,
-             input_device_name(s->in) ? "" : "  [keyboard]", panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]");
-    render_set_status(s->r, status);
-
     // A frame is due, and the driver has finished the last one: starting a
     // frame while llvmpipe still draws earlier ones blocks inside the GL
     // calls until its scene queue drains (40-100 ms at 720p), and no physics
     // or input runs meanwhile. Waiting here instead keeps the 240 Hz ticks.
-    if (wall >= s->wall_next_frame && !render_busy(s->r)) {
+    const bool frame = wall >= s->wall_next_frame && !render_busy(s->r);
+    // One CSV row per tick at most, shared by the recording and the charts.
+    double row[SIM_NCOL];
+    if (s->rec || (frame && s->nchart)) live_row(s->l, row);
+    if (s->rec) sim_csv_row(s->rec, row, s->ncol);
+    if (frame) {
+        char status[640];
+        snprintf(status, sizeof status, "%s%s%s%s%s", s->paused ? "PAUSED  " : "", s->rec ? "REC  " : "", s->status,
+                 input_device_name(s->in) ? "" : "  [keyboard]",
+                 panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]");
+        render_set_status(s->r, status);
         live_snapshot(s->l, s->snap);
-        if (s->nchart) {
-            double row[SIM_NCOL];
-            live_row(s->l, row);
+        if (s->nchart)
             for (int i = 0; i < s->nchart; ++i) render_chart_push(s->r, s->chart_id[i], row[COL_T], row[s->chart_col[i]]);
-        } else {
+        else
             render_charts_sample(s->r, s->snap);
-        }
-        drive_session_render(s);
-        double interval = 1e3 * (wall - (s->wall_next_frame - 1.0 / s->o.fps_cap));
-        s->st.frame_ms[s->st.nframe_ms++ % 4096] = interval;
+        render_snapshot(s);
+        // Interval between frame starts; the first frame has none.
+        if (s->wall_last_frame >= 0.0) s->st.frame_ms[s->st.nframe_ms++ % 4096] = 1e3 * (wall - s->wall_last_frame);
+        s->wall_last_frame = wall;
         s->wall_next_frame += 1.0 / s->o.fps_cap;
         if (s->wall_next_frame < wall) s->wall_next_frame = wall; // do not queue up frames
     }
@@ -572,10 +581,11 @@ void drive_session_row(drive_session* s, double* row) { live_row(s->l, row); }
 int drive_window_main(const app_common* c, const drive_opts* o, double duration, const char* screenshot,
                       double screenshot_at) {
     char err[512];
-    drive_session* s = drive_session_create(c, o, err, sizeof err);
+    int code;
+    drive_session* s = drive_session_create(c, o, err, sizeof err, &code);
     if (!s) {
         fprintf(stderr, "cranesim drive: %s\n", err);
-        return EXIT_USAGE;
+        return code;
     }
     printf("cranesim drive: %s in the %s; %s\n", s->m->name,
            c->sim.mechanics == SIM_ODE ? "sandbox" : "lagrange 2-DOF view",
@@ -586,7 +596,7 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     // frames (>= 75 Hz, the paper's rate, even while a frame takes 12 ms).
     const double tick = 1.0 / 240.0;
     const uint64_t f = SDL_GetPerformanceFrequency(), t0 = SDL_GetPerformanceCounter();
-    int code = 0;
+    code = 0;
     bool shot_done = false;
     for (;;) {
         double wall = (double)(SDL_GetPerformanceCounter() - t0) / (double)f;
@@ -629,16 +639,17 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
     o.scripted = true;
     o.fps_cap = 1000; // uncapped: measure what the renderer can do
     char err[512];
-    drive_session* s = drive_session_create(c, &o, err, sizeof err);
+    int code;
+    drive_session* s = drive_session_create(c, &o, err, sizeof err, &code);
     if (!s) {
         printf("{\"config\":\"drive\",\"error\":\"%s\"}\n", err);
-        return EXIT_RUNTIME;
+        return code;
     }
     // The same 240 Hz ticks as the window loop. Spinning instead would take
     // a core from the driver's rasteriser threads on a small machine.
     const double tick = 1.0 / 240.0;
     const uint64_t f = SDL_GetPerformanceFrequency(), t0 = SDL_GetPerformanceCounter();
-    int code = 0;
+    code = 0;
     for (;;) {
         double wall = (double)(SDL_GetPerformanceCounter() - t0) / (double)f;
         if (wall >= seconds) break;

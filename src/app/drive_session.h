@@ -22,7 +22,7 @@ struct panel;
 typedef struct drive_opts {
     int width, height;        ///< window or offscreen size [px] (default 1280 x 720)
     bool offscreen;           ///< render into an FBO, no window
-    double fps_cap;           ///< render at most this many frames per second (default 75)
+    double fps_cap;           ///< render at most this many frames per second (default 65)
     const char* mapping_file; ///< joystick axis mapping JSON, or NULL for defaults
     const char* record_path;  ///< start recording to this CSV at once, or NULL (F5 toggles)
     bool scripted;            ///< operator input from the scenario instead of devices
@@ -35,12 +35,10 @@ drive_opts drive_default_opts(void);
 
 typedef struct drive_stats {
     long frames;          ///< frames rendered
-    long ticks;           ///< loop iterations
     long input_samples;   ///< valve-command updates applied
     long missed;          ///< ticks whose physics could not catch up with wall time
     double sim_time;      ///< simulated time [s]
     double wall_time;     ///< wall time since start [s]
-    double render_ms_max; ///< slowest frame [ms]
     long triangles;       ///< triangles in the last frame
     double frame_ms[4096];///< recent frame intervals [ms] (ring buffer)
     int nframe_ms;
@@ -50,8 +48,11 @@ typedef struct drive_session drive_session;
 
 /// Load the model, build the world, open the renderer and devices. c holds the
 /// model, world, scenario and solver options (drive's defaults: ode sandbox).
-/// Returns NULL with a message.
-drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz);
+/// Returns NULL with a message, and (when code is not NULL) the exit code it
+/// calls for: 2 for bad input (model, scenario, mapping, chart names), 1 when
+/// the renderer or the world cannot start.
+drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz,
+                                    int* code);
 void drive_session_destroy(drive_session* s);
 
 /// One loop iteration at wall time `wall` [s] since the session started

@@ -37,7 +37,7 @@ render* render_create(const render_config* cfg, char* err, size_t errsz) {
     r->cfg = cfg ? *cfg : render_default_config();
     if (r->cfg.width <= 0) r->cfg.width = 1280;
     if (r->cfg.height <= 0) r->cfg.height = 720;
-    if (r->cfg.shadow_size < 256) r->cfg.shadow_size = 1024;
+    if (r->cfg.shadow_size < 256) r->cfg.shadow_size = render_default_config().shadow_size;
     if (!(r->cfg.p_full_scale > 0)) r->cfg.p_full_scale = 30e6;
     if (!(r->cfg.chart_seconds > 0)) r->cfg.chart_seconds = 10.0;
     // Copy the strings: the caller's config may be a temporary.

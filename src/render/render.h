@@ -53,7 +53,7 @@ typedef struct render_config {
     bool offscreen;        ///< render into an FBO, no visible window (tests, batch PNGs)
     bool vsync;            ///< window mode only
     int msaa;              ///< multisample count for the scene (0 = off, 4 typical)
-    int shadow_size;       ///< shadow map edge [texels], default 1024
+    int shadow_size;       ///< shadow map edge [texels], default 512 (docs/render.md)
     const char* title;     ///< window title
     const char* asset_dir; ///< directory for relative mesh names, default CRANESIM_ASSETS "/meshes"
     double p_full_scale;   ///< pressure at full bar height [Pa], default 30 MPa

@@ -20,7 +20,7 @@ static drive_session* open_session(void) {
     o.width = 1280;
     o.height = 720;
     char err[512];
-    drive_session* s = drive_session_create(&c, &o, err, sizeof err);
+    drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
     CHECK(s != NULL, "session: %s", err);
     return s;
 }
