@@ -170,6 +170,12 @@ int hyd_solver_integrate(hyd_solver* s, double t0, double* y, double t_end, doub
 /// discontinuity (a command step, an end stop, a relief cracking).
 void hyd_solver_reset(hyd_solver* s);
 
+/// f has changed at the current (t, y) without a discontinuity (an input
+/// the problem reads outside y, such as the strokes an ODE step hands the
+/// circuit, or a load): drop the cached f(t, y) an adaptive method would
+/// reuse as its next first stage, and keep the step-size history and J.
+void hyd_solver_inputs_changed(hyd_solver* s);
+
 const hyd_solver_stats* hyd_solver_get_stats(const hyd_solver* s);
 void hyd_solver_clear_stats(hyd_solver* s);
 /// Last accepted step size [s].

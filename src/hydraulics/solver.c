@@ -207,6 +207,10 @@ void hyd_solver_reset(hyd_solver* s) {
     s->last_rejected = 0;
 }
 
+void hyd_solver_inputs_changed(hyd_solver* s) {
+    if (s) s->fc_valid = 0;
+}
+
 const hyd_solver_stats* hyd_solver_get_stats(const hyd_solver* s) { return &s->st; }
 void hyd_solver_clear_stats(hyd_solver* s) { memset(&s->st, 0, sizeof s->st); }
 double hyd_solver_last_h(const hyd_solver* s) { return s->last_h; }

@@ -117,14 +117,11 @@ bool live_attached(const live* l) {
 
 hyd_model* live_circuit(live* l) { return l->ode ? ode_world_circuit(l->ode) : l->ls.mdl->hyd; }
 
-crane_mech* live_mech(live* l) {
-    // The lagrange rhs reads the model's mechanics on every call; the live
-    // session owns that model, so editing it in place between steps is safe.
-    return l->ode ? NULL : (crane_mech*)&l->ls.mdl->mech;
-}
-
 void live_set_load(live* l, double m3) {
-    if (!l->ode) l->ls.m3 = m3;
+    if (l->ode || l->ls.m3 == m3) return;
+    l->ls.m3 = m3;
+    lagrange_consts_init(&l->ls.mdl->mech, l->ls.variant, m3, &l->ls.lk);
+    hyd_solver_inputs_changed(l->solver); // f changed at the same (t, y)
 }
 
 int live_ncol(const live* l) { return l->ode ? SIM_NCOL : SIM_NCOL_BASE; }
@@ -160,14 +157,6 @@ int live_advance(live* l, double dt) {
 
 const char* live_error(const live* l) { return l->err; }
 double live_time(const live* l) { return l->ode ? ode_world_time(l->ode) : l->t; }
-const hyd_solver_stats* live_stats(const live* l) {
-    if (l->ode) {
-        static const hyd_solver_stats none = {0};
-        return &none;
-    }
-    return hyd_solver_get_stats(l->solver);
-}
-
 void live_row(live* l, double row[SIM_NCOL]) {
     if (l->ode) {
         sim_ode_row(l->ode, row);

@@ -32,9 +32,6 @@ bool live_attached(const live* l);
 /// The circuit the running simulation uses (the model's for lagrange, the
 /// world's own copy for ode): hyd_model_set on it takes effect at the next step.
 hyd_model* live_circuit(live* l);
-/// The mechanics the running lagrange simulation reads every step (NULL for
-/// ode, whose bodies are built once: mechanical changes need a new world).
-crane_mech* live_mech(live* l);
 /// Set the tip load [kg] (lagrange; takes effect at the next step).
 void live_set_load(live* l, double m3);
 
@@ -55,7 +52,6 @@ double live_time(const live* l);
 void live_row(live* l, double row[SIM_NCOL]);
 /// Fill a snapshot for the renderer.
 void live_snapshot(live* l, world_snapshot* s);
-const hyd_solver_stats* live_stats(const live* l);
 
 #ifdef __cplusplus
 }

@@ -299,6 +299,8 @@ int ow_hyd_step(ode_world* w, double H) {
         w->v0[k] = w->act[k].v;
     }
     w->step_t0 = w->th;
+    // New strokes and rates: f at (th, y) is not what the solver cached.
+    hyd_solver_inputs_changed(w->hs);
     double Fsum[ODE_NACT] = {0, 0, 0};
     double ydot[OW_MAX_HYD];
     const double h = H / w->nsub;

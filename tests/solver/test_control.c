@@ -316,6 +316,42 @@ static void test_wstep_hook(void) {
     }
 }
 
+// y' = rate, with rate an input the solver cannot see. After the input
+// changes, hyd_solver_inputs_changed makes an adaptive method drop its cached
+// f(t, y): every method then integrates the new rate exactly (a constant
+// rate is within every method's order), and without the call the first stage
+// still uses the old one.
+static int rate_f(void* user, double t, const double* y, double* dy) {
+    (void)t, (void)y;
+    dy[0] = *(const double*)user;
+    return 0;
+}
+
+static void test_inputs_changed(void) {
+    for (int m = HYD_ROS34PW2; m < HYD_METHOD_COUNT; ++m) {
+        double yend[2];
+        for (int tell = 0; tell < 2; ++tell) {
+            double rate = 1.0;
+            hyd_problem p = {0};
+            p.n = 1, p.f = rate_f, p.user = &rate, p.autonomous = 1;
+            hyd_solver_opts o = hyd_default_solver_opts();
+            o.rtol = 1e-6, o.atol = 1e-9;
+            hyd_solver* s = hyd_solver_create(&p, (hyd_method)m, &o);
+            double t = 0.0, y = 0.0;
+            CHECK(hyd_solver_advance(s, &t, &y, 1.0) == HYD_OK, "first advance");
+            rate = 2.0;
+            if (tell) hyd_solver_inputs_changed(s);
+            CHECK(hyd_solver_advance(s, &t, &y, 2.0) == HYD_OK, "second advance");
+            yend[tell] = y;
+            hyd_solver_destroy(s);
+        }
+        CHECK(fabs(yend[1] - 3.0) < 1e-12, "%s: y(2) = %.15g with the call, expected 3",
+              hyd_method_name((hyd_method)m), yend[1]);
+        CHECK(fabs(yend[0] - 3.0) > 1e-6, "%s: the stale f went unnoticed (y(2) = %.15g)",
+              hyd_method_name((hyd_method)m), yend[0]);
+    }
+}
+
 // Component 1 of f turns NaN for t > 0.57.
 static int nan_f(void* user, double t, const double* y, double* dy) {
     (void)user;
@@ -395,6 +431,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_out_states);
     RUN_TEST(test_wfactor_hook);
     RUN_TEST(test_wstep_hook);
+    RUN_TEST(test_inputs_changed);
     RUN_TEST(test_nonfinite);
     RUN_TEST(test_reset);
     RUN_TEST(test_bad_arguments);
