@@ -1,8 +1,5 @@
 // lagrange_sim.c: the coupled crane ODE (mechanics + circuit), its analytic
 // Jacobian and its block pattern. Derivation in docs/lagrange.md.
-#ifndef _GNU_SOURCE
-#define _GNU_SOURCE // sincos: one call per angle (glibc shares the sin and cos code)
-#endif
 #include "lagrange_sim.h"
 #include "lsim_kin.h"
 
@@ -152,15 +149,6 @@ static void commands(lsim* s, double t, double cmd[2]) {
         cmd[i] = s->scn ? scenario_command_hint(s->scn, i, t, &s->scn_seg_[i]) : s->u_cmd[i];
 }
 
-static inline void trig_of(const double* q, double trig[4]) {
-#if defined(__GLIBC__)
-    sincos(q[0], &trig[0], &trig[1]);
-    sincos(q[1], &trig[2], &trig[3]);
-#else
-    trig[0] = sin(q[0]), trig[1] = cos(q[0]), trig[2] = sin(q[1]), trig[3] = cos(q[1]);
-#endif
-}
-
 static void set_inputs(lsim* s, double t, const kin* k) {
     hyd_data* d = s->hd;
     double cmd[2];
@@ -175,19 +163,10 @@ static void set_inputs(lsim* s, double t, const kin* k) {
 // Shared by rhs and Jacobian: the one sincos pair of q, the cylinder
 // kinematics and the circuit's inputs at t.
 static void prepare(lsim* s, double t, const double* y, double trig[4], kin* k) {
-    trig_of(y + s->iq, trig);
+    lagrange_sincos(y[s->iq], &trig[0], &trig[1]);
+    lagrange_sincos(y[s->iq + 1], &trig[2], &trig[3]);
     cylinder_kinematics(&s->mdl->mech, trig, y + s->iq + 2, k);
     set_inputs(s, t, k);
-}
-
-// q' and q'' into the last four slots (d = dydt + iq), honouring frozen joints.
-static void mech_out(lsim* s, const double* qd, double qdd[2], double* d) {
-    for (int j = 0; j < 2; ++j) {
-        if (s->frozen_q[j]) qdd[j] = 0.0;
-        d[j] = s->frozen_q[j] ? 0.0 : qd[j];
-        d[2 + j] = qdd[j];
-    }
-    ++s->nrhs;
 }
 
 int lsim_rhs(void* user, double t, const double* y, double* dydt) {
@@ -206,7 +185,7 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt) {
     lagrange_eval_terms_trig(me, s->variant, s->m3, trig, qd, &lt);
     double qdd[2];
     lagrange_accel(&lt, tau, qdd);
-    mech_out(s, qd, qdd, dydt + iq);
+    lsim_mech_out(s, qd, qdd, dydt + iq);
     return 0;
 }
 
@@ -336,7 +315,7 @@ int lsim_rhs_fused(void* user, double t, const double* y, double* dydt) {
     const double tau[2] = {F[0] * k.r[0], F[1] * k.r[1]};
     double qdd[2];
     lagrange_accel_fast(&s->lk, trig, qd, tau, qdd);
-    mech_out(s, qd, qdd, dydt + iq);
+    lsim_mech_out(s, qd, qdd, dydt + iq);
     return 0;
 }
 

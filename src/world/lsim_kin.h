@@ -1,12 +1,13 @@
-// lsim_kin.h: cylinder kinematics of the 2-DOF crane, shared by the
-// right-hand sides (lagrange_sim.c) and the split step kernel (lsim_krus.c).
-// Internal to src/world.
+// lsim_kin.h: cylinder kinematics of the 2-DOF crane and the mechanics rows
+// of f, shared by the right-hand sides (lagrange_sim.c) and the split step
+// kernel (lsim_krus.c). Internal to src/world.
 #ifndef LSIM_KIN_H
 #define LSIM_KIN_H
 
 #include <math.h>
 
 #include "crane_model.h"
+#include "lagrange_sim.h"
 
 // Kinematics of both cylinders: stroke, rate, lever r = dx/dq and dr/dq.
 typedef struct kin {
@@ -29,6 +30,17 @@ static inline void cylinder_kinematics(const crane_mech* me, const double* trig,
         k->v[i] = r * qd[i];
         k->dr[i] = (ab * cp - r * r) / xp; // d^2 x / dphi^2
     }
+}
+
+// q' and q'' into the last four slots (d = dydt + iq), honouring frozen
+// joints; counts one right-hand side.
+static inline void lsim_mech_out(lsim* s, const double* qd, double qdd[2], double* d) {
+    for (int j = 0; j < 2; ++j) {
+        if (s->frozen_q[j]) qdd[j] = 0.0;
+        d[j] = s->frozen_q[j] ? 0.0 : qd[j];
+        d[2 + j] = qdd[j];
+    }
+    ++s->nrhs;
 }
 
 #endif

@@ -115,12 +115,7 @@ static void stage_f(lsim* s, const geo* g, double t, const double* y, double* f)
     const double tau[2] = {F[0] * r[0], F[1] * r[1]};
     double qdd[2];
     lagrange_accel_fast(&s->lk, trig, qd, tau, qdd);
-    for (int j = 0; j < 2; ++j) {
-        const bool fr = s->frozen_q[j];
-        f[IQ + j] = fr ? 0.0 : qd[j];
-        f[IQ + 2 + j] = fr ? 0.0 : qdd[j];
-    }
-    ++s->nrhs;
+    lsim_mech_out(s, qd, qdd, f + IQ);
 }
 
 // The diagonal blocks of J at (t, y), from the fused analytic Jacobian.

@@ -1,7 +1,7 @@
 // lsim_w.c: W = I - gh J for the crane's standard layout, by block
 // elimination onto a 5x5 Schur complement (hyd_problem.wfactor/wsolve).
 //
-// Layout (lsim_w_init checks it): actuator k owns the interior states
+// Layout (lsim_w_layout checks it): actuator k owns the interior states
 // 5k .. 5k+4 = [spool, hose A, chamber A, hose B, chamber B]; the interface is
 // z = [pump line, q1, q2, q1', q2'] at 10 .. 14. The two actuators' interior
 // states never meet directly, only through the pump line (valve P ports) and
@@ -156,9 +156,7 @@ static int factor_actuator(lsim_w* w, int k, const double* J, double gh, double*
     for (int i = 0; i < NI; ++i)
         for (int j = 0; j < NI; ++j) A[i * NI + j] = (i == j) - gh * J[(b + i) * NW + b + j];
     w->piv[k] = NULL;
-    if (lu_interior(A) != 0) {
-        for (int i = 0; i < NI; ++i)
-            for (int j = 0; j < NI; ++j) A[i * NI + j] = (i == j) - gh * J[(b + i) * NW + b + j];
+    if (lu_interior(A) != 0) { // A is left as it was
         if (lu_pivot(A, NI, w->pa[k]) != 0) return 1;
         w->piv[k] = w->pa[k];
     }

@@ -4,8 +4,9 @@
 // length H the cylinders' strokes x0 and rates v0 are read from the bodies'
 // mount points. The circuit is then advanced over H in sub-steps h (default
 // 0.1 ms) with the mechanical inputs extrapolated linearly, x(t) = x0 +
-// v0 (t - t0), x'(t) = v0. The mean cylinder force over the sub-steps is
-// applied to the bodies during the ODE step. The stiff oil-column and hose
+// v0 (t - t0), x'(t) = v0. The cylinder force at the end of the sub-steps is
+// applied to the bodies during the ODE step (opts.force_average applies their
+// mean instead, unstable for light booms). The stiff oil-column and hose
 // modes stay inside the implicit hydraulic integrator; the mechanics sees a
 // force lagged by at most one ODE step.
 #include "ode_world_internal.h"

@@ -362,6 +362,14 @@ static void boom_cyl_kinematics(const ode_world* w, const ow_act* c, double* x, 
     *v = ((vr[0] - vb[0]) * d[0] + (vr[1] - vb[1]) * d[1] + (vr[2] - vb[2]) * d[2]) / L;
 }
 
+// Rack-and-pinion slew: stroke [m] from mid-stroke at the hinge angle, rate
+// [m/s].
+static void slew_kinematics(const ode_world* w, const ow_act* c, double* x, double* v) {
+    const double r = w->desc.slew.pinion_radius;
+    *x = 0.5 * c->stroke + r * (dJointGetHingeAngle(w->slew_joint) + w->slew_off);
+    *v = r * dJointGetHingeAngleRate(w->slew_joint);
+}
+
 void ow_read_actuators(ode_world* w) {
     for (int k = 0; k < 2; ++k) {
         ow_act* c = &w->act[k];
@@ -372,12 +380,7 @@ void ow_read_actuators(ode_world* w) {
         c->at_stop = (lo > -dInfinity && ang <= lo + 1e-6) || (hi < dInfinity && ang >= hi - 1e-6);
     }
     ow_act* s = &w->act[ODE_SLEW];
-    if (s->present && w->slew_joint) {
-        double r = w->desc.slew.pinion_radius;
-        double th = dJointGetHingeAngle(w->slew_joint) + w->slew_off;
-        s->x = 0.5 * s->stroke + r * th;
-        s->v = r * dJointGetHingeAngleRate(w->slew_joint);
-    }
+    if (s->present && w->slew_joint) slew_kinematics(w, s, &s->x, &s->v);
 }
 
 // Cylinder forces as equal and opposite forces at the two pins along the
@@ -455,8 +458,9 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
     dWorldSetERP(w->world, w->desc.ode.erp);
     dWorldSetCFM(w->world, w->desc.ode.cfm);
     dWorldSetContactSurfaceLayer(w->world, w->desc.ode.surface_layer);
-    // No automatic disabling: a resting crane must react to the next command
-    // at once, and disabling would make runs depend on thresholds.
+    // No automatic disabling by default: a resting crane must react to the
+    // next command at once. Loads and obstacles opt in per body
+    // (ode_sandbox.c, allow_sleep).
     dWorldSetAutoDisableFlag(w->world, 0);
     w->dyn_space = dSimpleSpaceCreate(0);
     w->static_space = dSimpleSpaceCreate(0);
@@ -669,9 +673,7 @@ void ode_world_get_state(const ode_world* w, ode_world_state* s) {
         if (k < 2) {
             boom_cyl_kinematics(w, c, &s->x[k], &s->v[k]);
         } else if (w->slew_joint) {
-            double r = w->desc.slew.pinion_radius;
-            s->x[k] = 0.5 * c->stroke + r * (dJointGetHingeAngle(w->slew_joint) + w->slew_off);
-            s->v[k] = r * dJointGetHingeAngleRate(w->slew_joint);
+            slew_kinematics(w, c, &s->x[k], &s->v[k]);
         }
         s->F[k] = c->F;
         s->u_cmd[k] = w->u_cmd[k];

@@ -144,14 +144,14 @@ double scenario_command_seg(const scenario* s, int k, double t, int* seg) {
 double scenario_command_rate(const scenario* s, int k, double t) {
     const scenario_signal* g = &s->cmd[k];
     if (g->n < 2 || t < g->t[0] || t >= g->t[g->n - 1]) return 0.0;
+    // The last segment starting at or before t (a step at t takes its new
+    // slope). Loaded tables hold commands in [-1, 1] only (checked above), so
+    // no clamp can flatten the slope.
     int i = 0;
     while (i + 1 < g->n && g->t[i + 1] <= t) ++i;
     if (i + 1 >= g->n) return 0.0;
     double dt = g->t[i + 1] - g->t[i];
-    double r = dt > 0 ? (g->u[i + 1] - g->u[i]) / dt : 0.0;
-    // The command is clamped to [-1, 1]; beyond that it does not move.
-    double u = scenario_command(s, k, t);
-    return (u >= 1.0 && r > 0) || (u <= -1.0 && r < 0) ? 0.0 : r;
+    return dt > 0 ? (g->u[i + 1] - g->u[i]) / dt : 0.0;
 }
 
 static int cmp_double(const void* a, const void* b) {
