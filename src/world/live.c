@@ -66,27 +66,7 @@ live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], dou
         return NULL;
     }
     l->o = *o;
-    char wbuf[512];
-    const char* wpath = sim_world_path(o->world ? o->world : "sandbox", wbuf, sizeof wbuf);
-    world_desc wd;
-    if (world_desc_load(wpath, &wd, err, errsz)) {
-        free(l);
-        return NULL;
-    }
-    ode_world_opts wo = ode_world_default_opts();
-    wo.dt_ode = o->dt_ode > 0 ? o->dt_ode : 1e-3;
-    wo.dt_hyd = o->h < wo.dt_ode ? o->h : wo.dt_ode;
-    wo.solver = hyd_method_is_adaptive(o->solver) ? HYD_KRUS : o->solver;
-    wo.jac_every = o->jac_every > 0 ? o->jac_every : 1;
-    wo.q0[0] = q0[0];
-    wo.q0[1] = q0[1];
-    wo.slew0 = slew0;
-    wo.load_mass = m3;
-    wo.p_low = 0.5e6;
-    wo.model_file = m->file;
-    l->ode = ode_world_create(&m->mech, cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics"), &wd, &wo, err,
-                              errsz);
-    world_desc_free(&wd);
+    l->ode = sim_ode_world_create(m, o, "sandbox", q0, slew0, m3, err, errsz);
     if (!l->ode) {
         free(l);
         return NULL;

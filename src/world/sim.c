@@ -191,40 +191,47 @@ void sim_ode_row(ode_world* w, double* row) {
     }
 }
 
-static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ctx* c, sim_result* res) {
-    if (o->cvode) {
-        snprintf(res->message, sizeof res->message,
-                 "--mechanics ode steps the hydraulics inside each ODE step: use krus, ros2, rk4, ros34pw2 or rodas3");
-        return res->status = 2;
-    }
+ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* default_world, const double q0[2],
+                                double slew0, double m3, char* err, size_t errsz) {
     char wbuf[512];
-    const char* wpath = sim_world_path(o->world, wbuf, sizeof wbuf);
+    const char* wpath = sim_world_path(o->world ? o->world : default_world, wbuf, sizeof wbuf);
     world_desc wd;
-    if (world_desc_load(wpath, &wd, res->message, sizeof res->message)) return res->status = 2;
+    if (world_desc_load(wpath, &wd, err, errsz)) return NULL;
     ode_world_opts wo = ode_world_default_opts();
     wo.dt_ode = o->dt_ode > 0 ? o->dt_ode : 1e-3;
     wo.dt_hyd = o->h < wo.dt_ode ? o->h : wo.dt_ode;
     const double ratio = wo.dt_ode / wo.dt_hyd;
     if (fabs(ratio - floor(ratio + 0.5)) > 1e-6) {
-        snprintf(res->message, sizeof res->message,
-                 "--dt %g s must divide the ODE step %g s (hydraulic sub-steps)", wo.dt_hyd, wo.dt_ode);
+        // ode_world_create checks this too; here it is said in the options' words.
+        snprintf(err, errsz, "--dt %g s must divide the ODE step %g s (hydraulic sub-steps)", wo.dt_hyd, wo.dt_ode);
         world_desc_free(&wd);
-        return res->status = 2;
+        return NULL;
     }
     wo.solver = o->solver;
     wo.jac_every = o->jac_every > 0 ? o->jac_every : 1;
     wo.rtol = o->rtol;
     wo.atol = o->atol;
     wo.dense_jac = o->dense_jac;
-    wo.q0[0] = sc->q0[0];
-    wo.q0[1] = sc->q0[1];
-    wo.slew0 = sc->slew0;
-    wo.load_mass = sim_load_mass(m, sc, o);
+    wo.q0[0] = q0[0];
+    wo.q0[1] = q0[1];
+    wo.slew0 = slew0;
+    wo.load_mass = m3;
     wo.p_low = 0.5e6; // as the lagrange backend, so both start from the same state
     wo.model_file = m->file;
     const cJSON* hyd = cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics");
-    ode_world* w = ode_world_create(&m->mech, hyd, &wd, &wo, res->message, sizeof res->message);
+    ode_world* w = ode_world_create(&m->mech, hyd, &wd, &wo, err, errsz);
     world_desc_free(&wd);
+    return w;
+}
+
+static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ctx* c, sim_result* res) {
+    if (o->cvode) {
+        snprintf(res->message, sizeof res->message,
+                 "--mechanics ode steps the hydraulics inside each ODE step: use krus, ros2, rk4, ros34pw2 or rodas3");
+        return res->status = 2;
+    }
+    ode_world* w = sim_ode_world_create(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
+                                        sizeof res->message);
     if (!w) return res->status = 2;
 
     const double dt = ode_world_dt(w);
@@ -262,7 +269,7 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
                 snprintf(res->message, sizeof res->message,
                          "numerical blow-up: state %s = %.4g Pa (below absolute zero) at t = %.6g s (solver %s, "
                          "h = %g s, ODE step %g s)",
-                         sim_col_name[k], row[k], row[COL_T], hyd_method_name(o->solver), wo.dt_hyd, dt);
+                         sim_col_name[k], row[k], row[COL_T], hyd_method_name(o->solver), o->h < dt ? o->h : dt, dt);
             }
         }
         if (res->status) break;
