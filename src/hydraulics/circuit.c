@@ -981,11 +981,12 @@ hyd_data* hyd_data_create(const hyd_model* m) {
 // Shared by hyd_eval and hyd_jacobian: node pressures, then every kernel.
 // G (flow partials) is NULL for a plain evaluation.
 // map (NULL: identity; only without G) is the state order of hyd_eval_mapped.
-static void run_kernels(const hyd_model* m, hyd_data* d, const double* y, double* ydot,
-                        double* G, const int* restrict map) {
-    // Restrict locals: the stores into node_p would otherwise force a reload
-    // of every model array on each node.
-    double* restrict p = d->node_p;
+// Node pressures from y. Restrict locals: the stores into node_p would
+// otherwise force a reload of every model array on each node. In a function
+// of its own, so that the restrict promise ends before the kernels read
+// node_p through d (C11 6.7.3.1).
+static void fill_pressures(const hyd_model* m, double* restrict p, const double* restrict y,
+                           const int* restrict map) {
     const int* restrict tn = m->tank_node;
     const int* restrict vn = m->vol_node;
     const int* restrict ns = m->node_state;
@@ -999,6 +1000,11 @@ static void run_kernels(const hyd_model* m, hyd_data* d, const double* y, double
     else
         for (int k = 0; k < nvol; ++k)
             p[vn[k]] = y[ns[vn[k]]];
+}
+
+static void run_kernels(const hyd_model* m, hyd_data* d, const double* y, double* ydot,
+                        double* G, const int* restrict map) {
+    fill_pressures(m, d->node_p, y, map);
     const size_t nb = (size_t)m->nnode * sizeof(double);
     memset(d->node_dV, 0, nb);
     memcpy(d->node_V, m->node_V0, nb);

@@ -106,20 +106,3 @@ void hyd_air_tab_init(hyd_air_tab* t, const hyd_fluid_def* f) {
         t->seg[j][HYD_AIR_DEG + 1] = mc;
     }
 }
-
-// Fast path as in hyd_be_nd; dBe/dP from dr/dP = -r / (n P):
-//   dN/dP = bel (1 + alpha r (1 - 1/n)),  dD/dP = 1 - bec r / (n P)
-double hyd_be(const hyd_model* m, double bel, double p, double* dbe) {
-    const double bec = m->be_alpha * bel * m->be_inv_n;
-    double N, D, r;
-    if (!m->air.use || !hyd_be_nd(m, bel, bec, p, &N, &D, &r))
-        return hyd_be_slow(m, bel, p, dbe);
-    const double iD = 1.0 / D;
-    const double be = N * iD;
-    if (dbe) {
-        const double dN = bel * (1.0 + m->be_alpha * r * (1.0 - m->be_inv_n));
-        const double dD = 1.0 - bec * r * m->be_inv_n / p;
-        *dbe = (dN - be * dD) * iD;
-    }
-    return be;
-}

@@ -70,7 +70,6 @@ int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int na
     memset(f, 0, sizeof *f);
     f->m = m;
     f->nact = nact;
-    f->nstate = m->nstate;
     if (nact < 1 || nact > HYD_FUSED_MAXACT) return set_why(why, whysz, "too many actuators"), -1;
     if (m->norifice) return set_why(why, whysz, "the circuit has fixed orifices"), -1;
     if (m->npump != 1) return set_why(why, whysz, "the circuit needs exactly one pump"), -1;
@@ -104,8 +103,6 @@ int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int na
         const int ha = hose_at(m, v->A), hb = hose_at(m, v->B);
         if (ha < 0 || hb < 0 || m->hose[ha].to != c->nA || m->hose[hb].to != c->nB)
             return set_why(why, whysz, "a valve port does not reach its cylinder through a hose"), -1;
-        a->valve = valve[k];
-        a->cyl = cyl[k];
         a->su = v->adr;
         a->Amax = v->Amax;
         a->inv_tau = v->inv_tau;
@@ -190,9 +187,7 @@ FUSED_INLINE double ramps_in(const hyd_fused_node* n, double p, double* g) {
 
 // Be(p) / V with the model's kernel (volume.c does the same).
 FUSED_INLINE double node_c(const hyd_model* m, const hyd_fused_node* n, double p, double V) {
-    double N, D, r;
-    if (hyd_be_nd(m, n->bel, n->bec, p, &N, &D, &r)) return N / (D * V);
-    return hyd_be_slow(m, n->bel, p, NULL) / V;
+    return hyd_node_c(m, n->bel, n->bec, p, V, NULL, NULL);
 }
 
 // Everything one actuator contributes, with or without partials. The
@@ -285,23 +280,10 @@ void hyd_fused_eval(const hyd_fused* f, const double* y, const double* x, const 
 }
 
 // Be/V and the diagonal term d(Be/V)/dp * net of one node's Jacobian row.
-// On the table path dBe/dp comes from the same N, D and r as Be (the
-// formulas of hyd_be, with node_bec = alpha bel / n as hyd_be forms it), so
-// one table evaluation serves both.
 static inline double node_c_d(const hyd_model* m, const hyd_fused_node* n, double p, double V,
                               double net, double* diag) {
-    double N, D, r, dbe;
-    if (m->air.use && hyd_be_nd(m, n->bel, n->bec, p, &N, &D, &r)) {
-        const double iD = 1.0 / D;
-        const double be = N * iD;
-        const double dN = n->bel * (1.0 + m->be_alpha * r * (1.0 - m->be_inv_n));
-        const double dD = 1.0 - n->bec * r * m->be_inv_n / p;
-        dbe = (dN - be * dD) * iD;
-        *diag = dbe / V * net;
-        return N / (D * V);
-    }
-    const double c = node_c(m, n, p, V);
-    hyd_be(m, n->bel, p, &dbe);
+    double dbe;
+    const double c = hyd_node_c(m, n->bel, n->bec, p, V, NULL, &dbe);
     *diag = dbe / V * net;
     return c;
 }

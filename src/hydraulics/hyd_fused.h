@@ -52,7 +52,6 @@ typedef struct hyd_fused_node {
 } hyd_fused_node;
 
 typedef struct hyd_fused_act {
-    int valve, cyl;        ///< valve and cylinder indices in the model
     int su;                ///< spool state index (caller order)
     hyd_fused_node hA, hB, cA, cB; ///< hoses and chambers
     double Amax, inv_tau;  ///< valve: full opening area [m^2], 1 / spool time constant [1/s]
@@ -82,7 +81,7 @@ typedef struct hyd_fused_lanes {
 
 typedef struct hyd_fused {
     const hyd_model* m;    ///< the model the constants came from
-    int nact, nstate;
+    int nact;
     hyd_fused_act act[HYD_FUSED_MAXACT];
     hyd_fused_node pl;     ///< the pump line
     double qmax, pset, inv_band, p_in; ///< pump; p_in: its tank pressure [Pa abs]

@@ -246,9 +246,6 @@ void hyd_volumes_eval_mapped(const hyd_model* m, hyd_data* d, double* ydot, cons
 void hyd_volumes_eval(const hyd_model* m, hyd_data* d, double* ydot, const double* G, double* J,
                       int ldj);
 
-/// Bulk modulus on the model's precomputed fluid constants (the same law as
-/// hyd_bulk_modulus to a few ulp, through the air-ratio table).
-double hyd_be(const hyd_model* m, double bel, double p, double* dbe);
 /// Build m->air from the fluid (fluid.c).
 void hyd_air_tab_init(hyd_air_tab* t, const hyd_fluid_def* f);
 /// The entrained-air law away from the fast path (P < P_LO, P >= 2^64, NaN,
@@ -296,6 +293,35 @@ static inline int hyd_be_nd(const hyd_model* m, double bel, double bec, double P
     *N = bel * (1.0 + m->be_alpha * rr) * P;
     *D = P + bec * rr;
     return 1;
+}
+
+/// Be / V of a node at absolute pressure P [Pa] and volume V [m^3]: the table
+/// path of hyd_be_nd, else the exact law (hyd_be_slow). Optionally Be itself
+/// (*be; c V on the table path, saving a division) and dBe/dP (*dbe; on the
+/// table path from the same N, D and r, so one table evaluation serves both:
+///   dN/dP = bel (1 + alpha r (1 - 1/n)),  dD/dP = 1 - bec r / (n P)).
+static inline double hyd_node_c(const hyd_model* m, double bel, double bec, double P, double V, double* be,
+                                double* dbe) {
+    double N, D, r;
+    if (hyd_be_nd(m, bel, bec, P, &N, &D, &r)) {
+        const double c = N / (D * V);
+        if (be) *be = c * V;
+        if (dbe) {
+            if (m->air.use) {
+                const double iD = 1.0 / D;
+                const double b = N * iD;
+                const double dN = bel * (1.0 + m->be_alpha * r * (1.0 - m->be_inv_n));
+                const double dD = 1.0 - bec * r * m->be_inv_n / P;
+                *dbe = (dN - b * dD) * iD;
+            } else {
+                *dbe = 0.0; // alpha = 0: constant modulus
+            }
+        }
+        return c;
+    }
+    const double b = hyd_be_slow(m, bel, P, dbe);
+    if (be) *be = b;
+    return b / V;
 }
 
 /// Flow partials of a flow from node a to node b: ga = dq/dp_a, gb = dq/dp_b.

@@ -54,14 +54,8 @@ static inline void volumes_f(const hyd_model* m, hyd_data* d, double* restrict y
             qin += flow[vf[e]];
         nq[node] = qin;
         const double net = qin - ndV[node];
-        double N, D, r, c, be;
-        if (hyd_be_nd(m, bel, nbec[node], p, &N, &D, &r)) {
-            c = N / (D * V);
-            be = c * V;
-        } else {
-            be = hyd_be_slow(m, bel, p, NULL);
-            c = be / V;
-        }
+        double be;
+        const double c = hyd_node_c(m, bel, nbec[node], p, V, &be, NULL);
         nbe[node] = be;
         ydot[map ? map[nstate[node]] : nstate[node]] = c * net;
     }
@@ -102,20 +96,12 @@ void hyd_volumes_eval(const hyd_model* m, hyd_data* d, double* ydot, const doubl
             qin += flow[vf[e]];
         nq[node] = qin;
         const double net = qin - ndV[node];
-        double N, D, r, c, be;
-        if (hyd_be_nd(m, bel, nbec[node], p, &N, &D, &r)) {
-            c = N / (D * V);
-            be = c * V;
-        } else {
-            be = hyd_be_slow(m, bel, p, NULL);
-            c = be / V;
-        }
+        double be, dbe = 0.0;
+        const double c = hyd_node_c(m, bel, nbec[node], p, V, &be, J ? &dbe : NULL);
         nbe[node] = be;
         if (ydot)
             ydot[i] = c * net;
         if (J) {
-            double dbe;
-            hyd_be(m, bel, p, &dbe);
             double* row = J + (size_t)i * ldj;
             const double* grow = G + (size_t)i * ldg;
             for (int j = 0; j < n; ++j)
