@@ -41,7 +41,8 @@ hyd_fluid_def hyd_default_fluid_def(void) {
 
 // The law itself at P >= P_LO; alpha = 0 reduces it to Be_l exactly, which is
 // the constant-bulk-modulus option (and skips the pow()). Written with two
-// divisions (1/P, 1/D): this runs once per node per evaluation.
+// divisions (1/P, 1/D). Compiled models use it only off the table's range
+// (hyd_be_slow); hyd_bulk_modulus is the reference the table is tested on.
 //   q = (alpha Be_l / n) r / P,  D = 1 + q,  N = 1 + alpha r
 //   dN/dP = -alpha r / (n P),    dD/dP = -(1 + 1/n) q / P
 static double be_law(double alpha, double inv_n, double pa, double bel, double P, double* dbe) {

@@ -371,7 +371,7 @@ void hyd_fused_jacobian(const hyd_fused* f, const double* y, const double* x, co
 // actuator() / node_c() in the same order (IEEE add, mul, div and sqrt round
 // the same in a lane as in a scalar register, and -ffp-contract=off keeps
 // them unfused), so the result is bit for bit hyd_fused_eval's
-// (tests/hydraulics/test_fused.c). Only the branches are replaced: both
+// (test_fused in tests/hydraulics/test_circuit.c). Only the branches are replaced: both
 // orifice regimes are computed and blended, open reliefs and checks are
 // evaluated lane by lane, and the rare cases (an end stop, a pressure off the
 // Be table) send the whole evaluation to the scalar kernel.

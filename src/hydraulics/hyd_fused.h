@@ -17,7 +17,7 @@
 // valves fed from another node, reliefs between two volumes...) is refused
 // with a reason, and the caller keeps the general path. See
 // docs/performance.md and the bit-level comparison in
-// tests/hydraulics/test_fused.c.
+// test_fused in tests/hydraulics/test_circuit.c.
 #ifndef HYD_FUSED_H
 #define HYD_FUSED_H
 

@@ -239,10 +239,10 @@ void hyd_valves_eval(const hyd_model* m, hyd_data* d, const double* y, double* y
 /// hyd_valves_eval without G, circuit state i at y[map[i]] (hyd_eval_mapped).
 void hyd_valves_eval_mapped(const hyd_model* m, hyd_data* d, const double* y, double* ydot,
                             const int* map);
-/// Pressure derivative of every volume node; with J non-NULL also the node
-/// rows of the Jacobian (see volume.c).
 /// The plain evaluation with circuit state i written to ydot[map[i]].
 void hyd_volumes_eval_mapped(const hyd_model* m, hyd_data* d, double* ydot, const int* map);
+/// Pressure derivative of every volume node; with J non-NULL also the node
+/// rows of the Jacobian (see volume.c).
 void hyd_volumes_eval(const hyd_model* m, hyd_data* d, double* ydot, const double* G, double* J,
                       int ldj);
 

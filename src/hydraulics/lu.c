@@ -321,6 +321,14 @@ static void sp_solve(const hyd_solver* s, double* restrict b) {
     }
 }
 
+// W now holds a factorisation for gh.
+static int w_factored(hyd_solver* s, double gh) {
+    s->w_valid = 1;
+    s->w_gh = gh;
+    s->st.lus++;
+    return HYD_OK;
+}
+
 int hydFactorW(hyd_solver* s, double gh) {
     s->w_sparse = 0;
     s->w_custom = 0;
@@ -328,10 +336,7 @@ int hydFactorW(hyd_solver* s, double gh) {
     if (p->wfactor && p->wsolve && s->nblock == 1) {
         if (p->wfactor(p->user, s->jb, gh) == 0) {
             s->w_custom = 1;
-            s->w_valid = 1;
-            s->w_gh = gh;
-            s->st.lus++;
-            return HYD_OK;
+            return w_factored(s, gh);
         }
         // The problem declined: our own LU below.
     }
@@ -340,10 +345,7 @@ int hydFactorW(hyd_solver* s, double gh) {
         if (rc < 0) return HYD_ERR_SINGULAR;
         if (rc == 0) {
             s->w_sparse = 1;
-            s->w_valid = 1;
-            s->w_gh = gh;
-            s->st.lus++;
-            return HYD_OK;
+            return w_factored(s, gh);
         }
         s->sp_fallbacks++; // a weak diagonal pivot: the dense LU below
     }
@@ -377,10 +379,7 @@ int hydFactorW(hyd_solver* s, double gh) {
                 return HYD_ERR_SINGULAR;
         }
     }
-    s->w_valid = 1;
-    s->w_gh = gh;
-    s->st.lus++;
-    return HYD_OK;
+    return w_factored(s, gh);
 }
 
 void hydSolveW(const hyd_solver* s, double* x) {

@@ -129,10 +129,11 @@ int hydPrepareW(hyd_solver* s, double t, const double* y, const double* f0, doub
 /// Evaluate f, counting it; maps a callback failure to HYD_ERR_RHS.
 int hydEvalF(hyd_solver* s, double t, const double* y, double* dydt);
 
-// Method steps: one trial step of size h from (t, y) with f0 = f(t, y) into
-// ynew; rosenbrock also writes the error estimate to err (when non-NULL).
 /// gamma of the two-stage W-methods: 1/2 for Krus, 1 + 1/sqrt(2) for ROS2.
 static inline double hydKrusGamma(hyd_method m) { return m == HYD_KRUS ? 0.5 : 1.0 + 0.70710678118654752440; }
+
+// Method steps: one trial step of size h from (t, y) with f0 = f(t, y) into
+// ynew; rosenbrock also writes the error estimate to err (when non-NULL).
 int hydKrusStep(hyd_solver* s, double t, const double* y, const double* f0, double h,
                 double* ynew);
 int hydRk4Step(hyd_solver* s, double t, const double* y, const double* f0, double h,

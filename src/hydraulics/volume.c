@@ -18,12 +18,6 @@ hyd_volume_def hyd_default_volume_def(void) {
     return d;
 }
 
-// Per node: gather the inflow, then Be/V through hyd_be_nd with a single
-// division, c = N / (D V), Be = c V. Jacobian rows (when J is non-NULL): the
-// flow partials scaled by Be/V, plus the term from Be depending on the node's
-// own pressure. G holds d(sum Q)/dy. Model and data arrays are taken into
-// restrict locals first: the stores into hyd_data would otherwise force the
-// compiler to reload every model field on each node.
 // The plain evaluation (no Jacobian), the hot path of every f evaluation:
 // the same arithmetic as the loop below, in a loop of its own so that the
 // Jacobian's locals do not crowd the registers.
@@ -65,6 +59,12 @@ void hyd_volumes_eval_mapped(const hyd_model* m, hyd_data* d, double* ydot, cons
     volumes_f(m, d, ydot, map);
 }
 
+// Per node: gather the inflow, then Be/V through hyd_node_c with a single
+// division, c = N / (D V), Be = c V. Jacobian rows (when J is non-NULL): the
+// flow partials scaled by Be/V, plus the term from Be depending on the node's
+// own pressure. G holds d(sum Q)/dy. Model and data arrays are taken into
+// restrict locals first: the stores into hyd_data would otherwise force the
+// compiler to reload every model field on each node.
 void hyd_volumes_eval(const hyd_model* m, hyd_data* d, double* ydot, const double* G, double* J,
                       int ldj) {
     if (!J && ydot) {
