@@ -202,6 +202,7 @@ typedef struct act_out {
     int pos;
     double gA, gB, ghA, ghB;     ///< ramp partials of chamber A, B, hose A, B
     double fdl, fvl, fdh, fvh;   ///< end-stop partials
+    double dVA, dVB;             ///< dV/dx of the chambers (0 once the volume floor holds V, cylinder.c)
 } act_out;
 
 FUSED_INLINE void actuator(const hyd_fused_act* a, const double* y, double pPL, double x, double v,
@@ -248,6 +249,8 @@ FUSED_INLINE void actuator(const hyd_fused_act* a, const double* y, double pPL, 
         o->du2 = g2A * a->Amax * sgn;
         o->gA = gA, o->gB = gB, o->ghA = ghA, o->ghB = ghB;
         o->fdl = fdl, o->fvl = fvl, o->fdh = fdh, o->fvh = fvh;
+        o->dVA = VA > VAmin ? a->AA : 0.0;
+        o->dVB = VB > VBmin ? -a->AB : 0.0;
     }
 }
 
@@ -339,12 +342,9 @@ void hyd_fused_jacobian(const hyd_fused* f, const double* y, const double* x, co
         ydot[sB] = cB * o.nB;
         J_(sB, shB) = cB * a->GB, J_(sB, sB) = cB * (-a->GB - a->CL + o.gB) + dg, J_(sB, sA) = cB * a->CL;
 
-        // The volume floor makes V constant in x once reached (cylinder.c).
-        const double dVA = (a->VA0 + a->AA * x[k] > HYD_VMIN_FRAC * a->VA0) ? a->AA : 0.0;
-        const double dVB = (a->VB0 + a->AB * (a->s - x[k]) > HYD_VMIN_FRAC * a->VB0) ? -a->AB : 0.0;
         hyd_fused_coupling* cp = &cpl[k];
-        cp->dA_dx = -cA / o.VA * dVA * o.nA;
-        cp->dB_dx = -cB / o.VB * dVB * o.nB;
+        cp->dA_dx = -cA / o.VA * o.dVA * o.nA;
+        cp->dB_dx = -cB / o.VB * o.dVB * o.nB;
         cp->dA_dv = -cA * a->AA;
         cp->dB_dv = cB * a->AB;
         cp->dF_dx = -o.fdl - o.fdh;
