@@ -43,6 +43,12 @@ void app_progress_done(void);
 
 /// Parse a double with a unit-less strict check; returns 0 on success.
 int app_parse_double(const char* s, double* v);
+/// Set one sim_opts field from its option value ("lagrange"/"ode"; "full",
+/// "paper", "paper-typo"; a solver name or "cvode"). opt names the option in
+/// the one-line error on stderr. Return 0, or -1 on a bad value.
+int app_set_mechanics(sim_opts* o, const char* opt, const char* v);
+int app_set_variant(sim_opts* o, const char* opt, const char* v);
+int app_set_solver(sim_opts* o, const char* opt, const char* v);
 
 int cmd_run(int argc, char** argv);
 int cmd_bench(int argc, char** argv);

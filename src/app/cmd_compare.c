@@ -64,7 +64,7 @@ int cmd_compare(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     sim_opts side[2];
     char label[2][96] = {"lagrange", "ode"};
-    bool backends_given = false, any_pair = false;
+    bool any_pair = false;
     double tol_stroke = -1, tol_pressure = -1;
     const char* plot = NULL;
     char pa[64], pb[64];
@@ -113,29 +113,11 @@ int cmd_compare(int argc, char** argv) {
         const char* v[2] = {pa, pb};
         for (int s = 0; s < 2; ++s) {
             if (k == 0) {
-                backends_given = true;
-                if (!strcmp(v[s], "lagrange")) side[s].mechanics = SIM_LAGRANGE;
-                else if (!strcmp(v[s], "ode")) side[s].mechanics = SIM_ODE;
-                else {
-                    fprintf(stderr, "cranesim compare: --backends: expected lagrange or ode, got '%s'\n", v[s]);
-                    return EXIT_USAGE;
-                }
-            } else if (k == 1 && !strcmp(v[s], "cvode")) {
-                side[s].cvode = true;
+                if (app_set_mechanics(&side[s], "--backends", v[s])) return EXIT_USAGE;
             } else if (k == 1) {
-                int m = hyd_method_parse(v[s]);
-                if (m < 0) {
-                    fprintf(stderr, "cranesim compare: --solvers: unknown solver '%s'\n", v[s]);
-                    return EXIT_USAGE;
-                }
-                side[s].solver = (hyd_method)m;
+                if (app_set_solver(&side[s], "--solvers", v[s])) return EXIT_USAGE;
             } else if (k == 2) {
-                int m = lagrange_variant_parse(v[s]);
-                if (m < 0) {
-                    fprintf(stderr, "cranesim compare: --variants: unknown variant '%s'\n", v[s]);
-                    return EXIT_USAGE;
-                }
-                side[s].variant = (lagrange_variant)m;
+                if (app_set_variant(&side[s], "--variants", v[s])) return EXIT_USAGE;
             } else if (app_parse_double(v[s], &side[s].h) || !(side[s].h > 0)) {
                 fprintf(stderr, "cranesim compare: --dts: expected positive steps [s], got '%s'\n", v[s]);
                 return EXIT_USAGE;
@@ -144,7 +126,6 @@ int cmd_compare(int argc, char** argv) {
             snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? "/" : "", v[s]);
         }
     }
-    (void)backends_given;
     if (!any_pair) { // the default comparison: lagrange full vs the ode validation world
         side[0].mechanics = SIM_LAGRANGE;
         side[1].mechanics = SIM_ODE;

@@ -34,6 +34,38 @@ static int positive(const char* opt, const char* s, double* v) {
     return 0;
 }
 
+int app_set_mechanics(sim_opts* o, const char* opt, const char* v) {
+    if (!strcmp(v, "lagrange")) o->mechanics = SIM_LAGRANGE;
+    else if (!strcmp(v, "ode")) o->mechanics = SIM_ODE;
+    else {
+        fprintf(stderr, "cranesim: %s: expected lagrange or ode, got '%s'\n", opt, v);
+        return -1;
+    }
+    return 0;
+}
+
+int app_set_variant(sim_opts* o, const char* opt, const char* v) {
+    const int var = lagrange_variant_parse(v);
+    if (var < 0) {
+        fprintf(stderr, "cranesim: %s: expected full, paper or paper-typo, got '%s'\n", opt, v);
+        return -1;
+    }
+    o->variant = (lagrange_variant)var;
+    return 0;
+}
+
+int app_set_solver(sim_opts* o, const char* opt, const char* v) {
+    o->cvode = !strcmp(v, "cvode");
+    if (o->cvode) return 0;
+    const int m = hyd_method_parse(v);
+    if (m < 0) {
+        fprintf(stderr, "cranesim: %s: expected krus, ros2, rk4, ros34pw2, rodas3 or cvode, got '%s'\n", opt, v);
+        return -1;
+    }
+    o->solver = (hyd_method)m;
+    return 0;
+}
+
 int app_parse_common(app_common* c, int argc, char** argv, int* i) {
     const char* a = argv[*i];
     if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
@@ -57,37 +89,9 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
     switch (k) {
     case 0: c->model_path = v; break;
     case 1: c->scenario_path = v; break;
-    case 2:
-        if (!strcmp(v, "lagrange")) c->sim.mechanics = SIM_LAGRANGE;
-        else if (!strcmp(v, "ode")) c->sim.mechanics = SIM_ODE;
-        else {
-            fprintf(stderr, "cranesim: --mechanics: expected lagrange or ode, got '%s'\n", v);
-            return -1;
-        }
-        break;
-    case 3: {
-        int var = lagrange_variant_parse(v);
-        if (var < 0) {
-            fprintf(stderr, "cranesim: --variant: expected full, paper or paper-typo, got '%s'\n", v);
-            return -1;
-        }
-        c->sim.variant = (lagrange_variant)var;
-        break;
-    }
-    case 4: {
-        if (!strcmp(v, "cvode")) {
-            c->sim.cvode = true;
-            break;
-        }
-        c->sim.cvode = false;
-        int m = hyd_method_parse(v);
-        if (m < 0) {
-            fprintf(stderr, "cranesim: --solver: expected krus, ros2, rk4, ros34pw2, rodas3 or cvode, got '%s'\n", v);
-            return -1;
-        }
-        c->sim.solver = (hyd_method)m;
-        break;
-    }
+    case 2: if (app_set_mechanics(&c->sim, a, v)) return -1; break;
+    case 3: if (app_set_variant(&c->sim, a, v)) return -1; break;
+    case 4: if (app_set_solver(&c->sim, a, v)) return -1; break;
     case 5: if (positive(a, v, &c->sim.h)) return -1; break;
     case 6: if (positive(a, v, &c->sim.rtol)) return -1; break;
     case 7: if (positive(a, v, &c->sim.atol)) return -1; break;

@@ -190,6 +190,12 @@ static void test_bad_world_and_compare_tolerance(void) {
     rc = run("compare --quiet --scenario hold --duration 1 --solvers krus,ros2 --dts 1e-4,1e-3 --tol-pressure 1e-9",
              out, sizeof out);
     CHECK(rc == 1 && strstr(out, "FAIL"), "compare beyond tolerance: exit %d: %s", rc, out);
+    // --solvers overrides a common --solver cvode on both sides (both ran
+    // CVODE, labelled krus and ros2, and agreed).
+    rc = run("compare --quiet --scenario hold --duration 1 --solver cvode --solvers krus,ros2 --dts 1e-4,1e-3 "
+             "--tol-pressure 1e-9",
+             out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "FAIL"), "--solvers after --solver cvode: exit %d: %s", rc, out);
     rc = run("compare --quiet --scenario ramp --duration 4 --tol-stroke 0.5 --tol-pressure 1", out, sizeof out);
     CHECK(rc == 0 && strstr(out, "x1") && strstr(out, "p2B"), "lagrange vs ode within tolerance: exit %d: %s", rc,
           out);
