@@ -190,14 +190,28 @@ static void apply_param(drive_session* s, int i) {
         }
         break;
     case PK_MECH: {
+        // Only the edited link changes, and it keeps its own mass
+        // distribution: a new mass scales its inertia, a new length scales
+        // its centre of mass and (squared) its inertia. The model file's com
+        // and inertia follow, so "save model" saves what is being driven.
         crane_mech* me = &s->m->mech;
-        if (strstr(p->json, "links[0].mass")) me->link[0].mass = si;
-        if (strstr(p->json, "links[1].mass")) me->link[1].mass = si;
-        if (strstr(p->json, "links[0].length")) me->link[0].length = si, me->link[0].com = 0.5 * si;
-        if (strstr(p->json, "links[1].length")) me->link[1].length = si, me->link[1].com = 0.5 * si;
-        for (int k = 0; k < 2; ++k)
-            me->link[k].inertia = me->link[k].mass * me->link[k].length * me->link[k].length / 12.0;
+        const int k = strstr(p->json, "links[1]") ? 1 : 0;
+        crane_link* ln = &me->link[k];
+        if (strstr(p->json, ".mass") && ln->mass > 0) {
+            ln->inertia *= si / ln->mass;
+            ln->mass = si;
+        } else if (strstr(p->json, ".length") && ln->length > 0) {
+            const double r = si / ln->length;
+            ln->com *= r;
+            ln->inertia *= r * r;
+            ln->length = si;
+        }
         crane_mech_derive(me);
+        char a[160], e2[200];
+        snprintf(a, sizeof a, "mechanics.links[%d].com=%.10g", k, ln->com);
+        json_set_path(s->m->json, a, e2, sizeof e2);
+        snprintf(a, sizeof a, "mechanics.links[%d].inertia=%.10g", k, ln->inertia);
+        json_set_path(s->m->json, a, e2, sizeof e2);
         // Lagrange reads the model's mechanics every step; the ode world's
         // bodies are built once, so it is rebuilt at the current pose.
         if (s->c.sim.mechanics == SIM_ODE) s->rebuild = true;
@@ -573,6 +587,7 @@ void drive_session_idle(drive_session* s, double left) {
 const char* drive_session_error(const drive_session* s) { return s->err; }
 const drive_stats* drive_session_stats(const drive_session* s) { return &s->st; }
 live* drive_session_live(drive_session* s) { return s->l; }
+const model* drive_session_model(const drive_session* s) { return s->m; }
 render* drive_session_render_ctx(drive_session* s) { return s->r; }
 input* drive_session_input(drive_session* s) { return s->in; }
 panel* drive_session_panel(drive_session* s) { return s->pn; }

@@ -74,6 +74,8 @@ live* drive_session_live(drive_session* s);
 struct render* drive_session_render_ctx(drive_session* s);
 struct input* drive_session_input(drive_session* s);
 struct panel* drive_session_panel(drive_session* s);
+/// The model being driven (edited in place by the panel; "save model" writes it).
+const model* drive_session_model(const drive_session* s);
 /// The row (CSV columns) at the current simulated time.
 void drive_session_row(drive_session* s, double* row);
 

@@ -11,8 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-static drive_session* open_session(void) {
+// sets: model overrides (--set path=value), nset of them.
+static drive_session* open_session_with(const char* const* sets, int nset) {
     app_common c = {.sim = sim_default_opts()};
+    for (int i = 0; i < nset; ++i) c.sets[c.nset++] = sets[i];
     c.sim.mechanics = SIM_ODE; // the default sandbox
     c.scenario_path = CRANESIM_ASSETS "/scenarios/sandbox_pick_place.json"; // initial pose only
     drive_opts o = drive_default_opts();
@@ -24,6 +26,8 @@ static drive_session* open_session(void) {
     CHECK(s != NULL, "session: %s", err);
     return s;
 }
+
+static drive_session* open_session(void) { return open_session_with(NULL, 0); }
 
 // Run the loop for `seconds` of virtual wall time at 240 ticks per second.
 static int run_for(drive_session* s, double* wall, double seconds) {
@@ -205,6 +209,38 @@ static void test_panel_change_takes_effect(void) {
     drive_session_destroy(s);
 }
 
+// A boom's mass or length edited in the panel rescales that boom's own
+// inertia (and centre of mass) and leaves the other boom as the model file
+// gave it; the model's JSON follows, so "save model" saves what is driven.
+static void test_panel_boom_edit(void) {
+    // Booms that are not uniform beams, so a recomputed m L^2 / 12 or L / 2
+    // would show.
+    static const char* const sets[] = {"mechanics.links[1].inertia=50", "mechanics.links[0].com=1.0"};
+    drive_session* s = open_session_with(sets, 2);
+    if (!s) return;
+    const model* m = drive_session_model(s);
+    const crane_link l0 = m->mech.link[0], l1 = m->mech.link[1];
+    char msg[256];
+    CHECK(panel_set(drive_session_panel(s), "booms/end arm mass", 2.0 * l1.mass, msg, sizeof msg) == PANEL_OK, "%s",
+          msg);
+    CHECK(panel_set(drive_session_panel(s), "booms/lifting arm length", 1.1 * l0.length, msg, sizeof msg) == PANEL_OK,
+          "%s", msg);
+    double wall = 0;
+    run_for(s, &wall, 2.0 / 240.0); // the ticks apply the changes
+    const crane_link n0 = m->mech.link[0], n1 = m->mech.link[1];
+    CHECK(fabs(n1.inertia - 2.0 * l1.inertia) < 1e-9 * l1.inertia && n1.com == l1.com && n1.length == l1.length,
+          "end arm: inertia %g -> %g kg m^2, com %g -> %g m", l1.inertia, n1.inertia, l1.com, n1.com);
+    CHECK(fabs(n0.com - 1.1 * l0.com) < 1e-12 && fabs(n0.inertia - 1.21 * l0.inertia) < 1e-9 * l0.inertia &&
+              n0.mass == l0.mass,
+          "lifting arm: com %g -> %g m, inertia %g -> %g kg m^2", l0.com, n0.com, l0.inertia, n0.inertia);
+    double jv = 0.0;
+    const cJSON* links = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m->json, "mechanics"), "links");
+    const cJSON* inertia1 = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(links, 1), "inertia");
+    if (inertia1) jv = inertia1->valuedouble;
+    CHECK(fabs(jv - n1.inertia) < 1e-6 * n1.inertia, "model JSON end-arm inertia %g vs %g", jv, n1.inertia);
+    drive_session_destroy(s);
+}
+
 int main(int argc, char** argv) {
     // Headless: SDL's offscreen video driver on Mesa's EGL (llvmpipe).
     setenv("SDL_VIDEODRIVER", "offscreen", 0);
@@ -213,6 +249,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_default_scene_frame);
     RUN_TEST(test_joystick_and_keyboard_drive_the_lift);
     RUN_TEST(test_panel_change_takes_effect);
+    RUN_TEST(test_panel_boom_edit);
     SDL_Quit();
     TEST_MAIN_END();
 }
