@@ -49,6 +49,13 @@ int app_parse_double(const char* s, double* v);
 int app_set_mechanics(sim_opts* o, const char* opt, const char* v);
 int app_set_variant(sim_opts* o, const char* opt, const char* v);
 int app_set_solver(sim_opts* o, const char* opt, const char* v);
+/// Sort v[0..n-1] ascending in place.
+void app_sort(double* v, int n);
+/// The median of v[0..n-1] (v is sorted in place; n >= 1).
+double app_median(double* v, int n);
+/// The scenario drive uses when none is given: the sandbox pick-and-place for
+/// the ode world, the scripted lagrange demo otherwise.
+const char* app_default_drive_scenario(sim_mechanics mech);
 
 int cmd_run(int argc, char** argv);
 int cmd_bench(int argc, char** argv);

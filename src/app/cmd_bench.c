@@ -71,11 +71,6 @@ static const bench_cfg configs[] = {
     {"sandbox-ode0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-4, "sandbox_pick_place"},
 };
 
-static int cmp_d(const void* a, const void* b) {
-    double x = *(const double*)a, y = *(const double*)b;
-    return (x > y) - (x < y);
-}
-
 int cmd_bench(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     int repeat = 3;
@@ -158,8 +153,7 @@ int cmd_bench(int argc, char** argv) {
             code = EXIT_RUNTIME;
             continue;
         }
-        qsort(walls, (size_t)repeat, sizeof walls[0], cmp_d);
-        double wall = walls[repeat / 2];
+        const double wall = app_median(walls, repeat);
         printf("{\"config\":\"%s\",\"scenario\":\"%s\",\"mechanics\":\"%s\",\"world\":\"%s\","
                "\"dt_ode_s\":%g,\"variant\":\"%s\","
                "\"solver\":\"%s\",\"h_s\":%g,\"rtol\":%g,\"jacobian\":\"%s\",\"kernel\":\"%s\",\"sim_time_s\":%.6g,"

@@ -66,7 +66,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     model* m;
     scenario sc;
     const bool ode = c->sim.mechanics == SIM_ODE;
-    if (!c->scenario_path) c->scenario_path = ode ? "sandbox_pick_place" : "drive_demo";
+    if (!c->scenario_path) c->scenario_path = app_default_drive_scenario(c->sim.mechanics);
     int rc = app_load(c, &m, &sc);
     if (rc) return rc;
     double duration = c->sim.duration > 0 ? c->sim.duration : sc.duration;

@@ -44,11 +44,6 @@ typedef struct study_cfg {
     hyd_solver_stats st;
 } study_cfg;
 
-static int cmp_d(const void* a, const void* b) {
-    double x = *(const double*)a, y = *(const double*)b;
-    return (x > y) - (x < y);
-}
-
 static int add_fixed(study_cfg* c, int n, const sim_opts* base, hyd_method m, double h) {
     c[n].o = *base;
     c[n].o.solver = m;
@@ -68,11 +63,12 @@ static int add_adaptive(study_cfg* c, int n, const sim_opts* base, hyd_method m,
 }
 
 #ifdef CRANESIM_HAVE_PLPLOT
-static void plot_wp(const study_cfg* c, int n, const char* title, const char* png) {
+// x: max pressure error in % of ppeak [Pa]; y: wall time.
+static void plot_wp(const study_cfg* c, int n, double ppeak, const char* title, const char* png) {
     double xlo = 1e300, xhi = -1e300, ylo = 1e300, yhi = -1e300;
     for (int i = 0; i < n; ++i) {
         if (c[i].failed || !(c[i].p_max > 0) || !(c[i].wall > 0)) continue;
-        double x = log10(c[i].p_max), y = log10(c[i].wall);
+        double x = log10(100 * c[i].p_max / ppeak), y = log10(c[i].wall);
         xlo = fmin(xlo, x), xhi = fmax(xhi, x), ylo = fmin(ylo, y), yhi = fmax(yhi, y);
     }
     if (!(xhi >= xlo)) return;
@@ -105,7 +101,7 @@ static void plot_wp(const study_cfg* c, int n, const char* title, const char* pn
             if (c[i].failed || !(c[i].p_max > 0) || !(c[i].wall > 0) || strncmp(c[i].name, fam[f], lf) ||
                 c[i].name[lf] != ' ')
                 continue;
-            xs[k] = log10(c[i].p_max);
+            xs[k] = log10(100 * c[i].p_max / ppeak);
             ys[k] = log10(c[i].wall);
             lab[k] = c[i].name + lf + 1; // "h=0.1ms", "rtol=0.001"
             ++k;
@@ -236,8 +232,7 @@ int cmd_study(int argc, char** argv) {
             sim_run(m, &sc, &s->o, NULL, NULL, NULL, NULL, NULL, &rt);
             walls[k] = rt.wall;
         }
-        qsort(walls, (size_t)repeat, sizeof walls[0], cmp_d);
-        s->wall = walls[repeat / 2];
+        s->wall = app_median(walls, repeat);
         int rows = tr.nrow < ref.nrow ? tr.nrow : ref.nrow;
         double s2 = 0;
         for (int j = 0; j < rows; ++j) {
@@ -298,13 +293,10 @@ int cmd_study(int argc, char** argv) {
     fclose(md);
     fclose(js);
 #ifdef CRANESIM_HAVE_PLPLOT
-    study_cfg pc[40];
-    memcpy(pc, cfg, sizeof(study_cfg) * (size_t)n);
-    for (int i = 0; i < n; ++i) pc[i].p_max = 100 * pc[i].p_max / ppeak;
     snprintf(path, sizeof path, "%s/work_precision.png", dir);
     char title[160];
     snprintf(title, sizeof title, "Work-precision, scenario %s (reference CVODE rtol 1e-10)", sc.name);
-    plot_wp(pc, n, title, path);
+    plot_wp(cfg, n, ppeak, title, path);
     printf("\nwrote %s/study.md, %s/study.jsonl, %s\n", dir, dir, path);
 #else
     printf("\nwrote %s/study.md, %s/study.jsonl (no plot: built without PLplot)\n", dir, dir);

@@ -34,6 +34,22 @@ static int positive(const char* opt, const char* s, double* v) {
     return 0;
 }
 
+static int cmp_double(const void* a, const void* b) {
+    const double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+void app_sort(double* v, int n) { qsort(v, (size_t)n, sizeof *v, cmp_double); }
+
+double app_median(double* v, int n) {
+    app_sort(v, n);
+    return v[n / 2];
+}
+
+const char* app_default_drive_scenario(sim_mechanics mech) {
+    return mech == SIM_ODE ? "sandbox_pick_place" : "drive_demo";
+}
+
 int app_set_mechanics(sim_opts* o, const char* opt, const char* v) {
     if (!strcmp(v, "lagrange")) o->mechanics = SIM_LAGRANGE;
     else if (!strcmp(v, "ode")) o->mechanics = SIM_ODE;

@@ -339,7 +339,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     s->o = *o;
     s->snap = calloc(1, sizeof *s->snap);
     if (!s->c.scenario_path)
-        s->c.scenario_path = s->c.sim.mechanics == SIM_ODE ? "sandbox_pick_place" : "drive_demo";
+        s->c.scenario_path = app_default_drive_scenario(s->c.sim.mechanics);
     char e2[512];
     s->m = model_load(s->c.model_path, s->c.sets, s->c.nset, e2, sizeof e2);
     char sb[512];
@@ -641,11 +641,6 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     return code;
 }
 
-static int cmp_dbl(const void* a, const void* b) {
-    double x = *(const double*)a, y = *(const double*)b;
-    return (x > y) - (x < y);
-}
-
 int drive_bench(const app_common* c, int w, int h, double seconds) {
     drive_opts o = drive_default_opts();
     o.width = w;
@@ -681,7 +676,7 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
     // Skip the first frames (shader compilation, mesh upload).
     int skip = n > 20 ? 10 : 0, m = 0;
     for (int i = skip; i < n; ++i) ms[m++] = st->frame_ms[i];
-    qsort(ms, (size_t)m, sizeof *ms, cmp_dbl);
+    app_sort(ms, m);
     double p50 = m ? ms[m / 2] : 0, p95 = m ? ms[(int)(0.95 * (m - 1))] : 0;
     printf("{\"config\":\"drive\",\"width\":%d,\"height\":%d,\"world\":\"%s\",\"wall_s\":%.3f,"
            "\"sim_time_s\":%.3f,\"rt_factor\":%.3f,\"frames\":%ld,\"fps_mean\":%.1f,\"fps_median\":%.1f,"
