@@ -72,8 +72,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     double duration = c->sim.duration > 0 ? c->sim.duration : sc.duration;
     char err[320];
     double m3 = sim_load_mass(m, &sc, &c->sim);
-    live* l = ode ? live_create_ode(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err)
-                  : live_create_lagrange(m, &c->sim, sc.q0, m3, err, sizeof err);
+    live* l = live_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
     if (!l) {
         fprintf(stderr, "cranesim drive: %s\n", err);
         model_free(m);

@@ -163,11 +163,7 @@ static void sync_json(drive_session* s, const drive_param* p) {
 
 static live* make_live(drive_session* s, const double q0[2], double slew0) {
     char err[400];
-    live* l = s->c.sim.mechanics == SIM_ODE
-                  ? live_create_ode(s->m, &s->c.sim, q0, slew0, sim_load_mass(s->m, &s->sc, &s->c.sim), err,
-                                    sizeof err)
-                  : live_create_lagrange(s->m, &s->c.sim, q0, sim_load_mass(s->m, &s->sc, &s->c.sim), err,
-                                         sizeof err);
+    live* l = live_create(s->m, &s->c.sim, q0, slew0, sim_load_mass(s->m, &s->sc, &s->c.sim), err, sizeof err);
     if (!l) snprintf(s->err, sizeof s->err, "%s", err);
     return l;
 }

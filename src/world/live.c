@@ -74,6 +74,12 @@ live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], dou
     return l;
 }
 
+live* live_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
+                  size_t errsz) {
+    return o->mechanics == SIM_ODE ? live_create_ode(m, o, q0, slew0, m3, err, errsz)
+                                   : live_create_lagrange(m, o, q0, m3, err, errsz);
+}
+
 void live_destroy(live* l) {
     if (!l) return;
     if (l->ode) ode_world_destroy(l->ode);

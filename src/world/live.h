@@ -22,6 +22,10 @@ live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2]
 /// of the validation world (the sandbox picks loads up with the hook).
 live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
                       size_t errsz);
+/// live_create_ode or live_create_lagrange, as o->mechanics says (slew0 is
+/// used by the ode world only).
+live* live_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
+                  size_t errsz);
 /// Hook: 1 attach the nearest load in reach, 0 release (ode sandbox only).
 /// Returns the load index attached, or -1.
 int live_hook(live* l, int attach);
