@@ -55,9 +55,8 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     }
     printf("cranesim run: %s, %s/%s, solver %s", scen, o->mechanics == SIM_LAGRANGE ? "lagrange" : "ode",
            lagrange_variant_name(o->variant), o->cvode ? "cvode" : hyd_method_name(o->solver));
-    // Which lagrange kernel ran (cranesim run --help, --kernel).
-    const char* kern = o->mechanics != SIM_LAGRANGE ? "" : r->split ? ", split step" : r->fused ? ", fused kernel"
-                                                                                               : ", general kernel";
+    // Which circuit kernel ran (cranesim run --help, --kernel).
+    const char* kern = r->split ? ", split step" : r->fused ? ", fused kernel" : ", general kernel";
     if (o->cvode || hyd_method_is_adaptive(o->solver)) printf(" (rtol %g, atol %g%s)\n", o->rtol, o->atol, kern);
     else printf(" (h = %g ms%s)\n", o->h * 1e3, kern);
     if (o->mechanics == SIM_ODE)

@@ -174,7 +174,9 @@ void app_common_help(FILE* f, bool with_solver) {
                 "                       split (default): one-pass circuit, block-eliminated W, and\n"
                 "                         for krus/ros2 the mechanics once per step (docs/lagrange.md);\n"
                 "                       fused: the same, but f in full at every Krus/ROS2 stage;\n"
-                "                       general: the component loops and the solver's own sparse LU\n"
+                "                       general: the component loops and the solver's own sparse LU;\n"
+                "                       with --mechanics ode, split and fused both mean the one-pass\n"
+                "                         circuit in the hydraulic sub-steps, general the loops\n"
                 "  --duration T         simulated time [s] (default: the scenario's)\n"
                 "  --every DT           output period [s] (default 1e-3, i.e. 1 kHz)\n");
     fprintf(f, "  --quiet              no progress bar or summary\n");

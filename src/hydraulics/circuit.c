@@ -916,8 +916,11 @@ int hyd_model_set(hyd_model* m, const char* path, double value, char* err, size_
         m->fluid = f;
     }
     hyd_model_derive(m, NULL);
+    m->revision++;
     return 0;
 }
+
+unsigned hyd_model_revision(const hyd_model* m) { return m->revision; }
 
 // ---------------------------------------------------------------------------
 // Data

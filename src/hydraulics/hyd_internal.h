@@ -140,6 +140,7 @@ typedef struct hyd_air_tab {
 struct hyd_model {
     hyd_fluid_def fluid;
     int nstate, nnode, ncomp, nunode; ///< nunode: user-declared nodes (first in node order)
+    unsigned revision; ///< bumped by every accepted hyd_model_set (packed copies go stale)
 
     hyd_elem* unode; ///< (nunode) user node definitions
     hyd_elem* comp;  ///< (ncomp) component definitions

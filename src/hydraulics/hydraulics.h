@@ -270,6 +270,9 @@ hyd_fluid_def hyd_model_fluid(const hyd_model* m);
 
 /// Returns 0, or -1 with a one-line message in err.
 int hyd_model_set(hyd_model* m, const char* path, double value, char* err, size_t errsz);
+/// Counts the accepted hyd_model_set calls: a packed copy of the parameters
+/// (hyd_fused_build) made at another revision is stale.
+unsigned hyd_model_revision(const hyd_model* m);
 /// Returns 0 and writes *value, or -1 if the path is unknown.
 int hyd_model_get(const hyd_model* m, const char* path, double* value);
 /// Number of numeric parameters of type t, and their names and units.

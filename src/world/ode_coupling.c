@@ -28,6 +28,8 @@ static void set_inputs(ode_world* w, double t) {
     }
 }
 
+// The general path: the circuit's component loops, which also set the
+// flags the state readout uses (end stops, open reliefs).
 static int rhs(void* user, double t, const double* y, double* dydt) {
     ode_world* w = user;
     set_inputs(w, t);
@@ -40,6 +42,60 @@ static int jac(void* user, double t, const double* y, double* J) {
     set_inputs(w, t);
     hyd_jacobian(w->hm, w->hd, t, y, NULL, J, w->nh, 0, 0);
     return 0;
+}
+
+// The straight-line kernel: the same laws in one pass (hyd_fused.h), about a
+// third of hyd_eval's instructions on the sandbox circuit. Its inputs per
+// lane are what set_inputs writes into hd.
+static void fused_inputs(const ode_world* w, double t, double* x, double* v, double* cmd) {
+    const double tau = t - w->step_t0;
+    for (int j = 0; j < w->nfz; ++j) {
+        const int k = w->fz_act[j];
+        x[j] = w->x0[k] + w->v0[k] * tau;
+        v[j] = w->v0[k];
+        cmd[j] = w->u_cmd[k];
+    }
+}
+
+static int rhs_fused(void* user, double t, const double* y, double* dydt) {
+    ode_world* w = user;
+    double x[ODE_NACT], v[ODE_NACT], cmd[ODE_NACT], F[ODE_NACT];
+    fused_inputs(w, t, x, v, cmd);
+    hyd_fused_eval(&w->fz, y, x, v, cmd, dydt, F);
+    return 0;
+}
+
+static int jac_fused(void* user, double t, const double* y, double* J) {
+    ode_world* w = user;
+    double x[ODE_NACT], v[ODE_NACT], cmd[ODE_NACT], F[ODE_NACT], ydot[OW_MAX_HYD];
+    hyd_fused_coupling cpl[HYD_FUSED_MAXACT]; // partials for a mechanics in the state; unused here
+    fused_inputs(w, t, x, v, cmd);
+    memset(J, 0, (size_t)w->nh * (size_t)w->nh * sizeof *J);
+    hyd_fused_jacobian(&w->fz, y, x, v, cmd, ydot, F, J, w->nh, cpl);
+    return 0;
+}
+
+// (Re)pack the straight-line kernel for the present parameters, or fall
+// back to the general path when the circuit does not have its shape.
+static void fused_setup(ode_world* w) {
+    w->use_fused = 0;
+    w->hp.f = rhs;
+    w->hp.jac = jac;
+    if (w->opt.general_circuit) return;
+    int valve[ODE_NACT], cyl[ODE_NACT];
+    w->nfz = 0;
+    for (int k = 0; k < ODE_NACT; ++k) {
+        if (w->act[k].cyl < 0) continue;
+        valve[w->nfz] = w->act[k].valve;
+        cyl[w->nfz] = w->act[k].cyl;
+        w->fz_act[w->nfz++] = k;
+    }
+    char why[128];
+    if (hyd_fused_build(w->hm, valve, cyl, w->nfz, &w->fz, why, sizeof why)) return;
+    w->fz_rev = hyd_model_revision(w->hm);
+    w->use_fused = 1;
+    w->hp.f = rhs_fused;
+    w->hp.jac = jac_fused;
 }
 
 // Append the world's extra nodes and components to a copy of the model's
@@ -193,9 +249,8 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
         return -1;
     }
     w->hp.n = w->nh;
-    w->hp.f = rhs;
-    w->hp.jac = jac;
     w->hp.user = w;
+    fused_setup(w);
     const int adaptive = hyd_method_is_adaptive(w->opt.solver);
     if (!adaptive && !w->opt.dense_jac) {
         block_pattern(w);
@@ -300,6 +355,9 @@ int ow_hyd_step(ode_world* w, double H) {
         w->v0[k] = w->act[k].v;
     }
     w->step_t0 = w->th;
+    // A live parameter edit (hyd_model_set) since the last step: the packed
+    // constants are stale. (The solver reads f and jac through &w->hp.)
+    if (w->use_fused && hyd_model_revision(w->hm) != w->fz_rev) fused_setup(w);
     // New strokes and rates: f at (th, y) is not what the solver cached.
     hyd_solver_inputs_changed(w->hs);
     double Fsum[ODE_NACT] = {0, 0, 0};

@@ -872,6 +872,8 @@ void ode_world_lock_booms(ode_world* w, int lock) {
 
 hyd_model* ode_world_circuit(ode_world* w) { return w->hm; }
 
+int ode_world_fused(const ode_world* w) { return w->hm && w->use_fused; }
+
 const char* ode_world_load_name(const ode_world* w, int i, double* mass) {
     if (i < 0 || i >= w->desc.nload) return NULL;
     if (mass) *mass = w->desc.load[i].mass;

@@ -56,6 +56,9 @@ typedef struct ode_world_opts {
     double p_low;         ///< init_hold: pressure of the unloaded chamber side [Pa abs]; default 2e6
     int force_average;    ///< 0 (default): apply the force at the end of the sub-steps (symplectic, stable); 1: their mean (unstable for light booms, see docs/ode_world.md)
     const char* model_file; ///< name used in circuit error messages; default "model"
+    int general_circuit;  ///< 1: the circuit's component loops (hyd_eval) for the hydraulic
+                          ///< solver even when the straight-line kernel applies (hyd_fused.h);
+                          ///< 0 (default): that kernel when the circuit has its shape
 } ode_world_opts;
 
 ode_world_opts ode_world_default_opts(void);
@@ -118,6 +121,10 @@ void ode_world_get_state(const ode_world* w, ode_world_state* s);
 /// The world's own compiled circuit (model plus world extras), for live
 /// parameter changes with hyd_model_set between steps; NULL without hydraulics.
 hyd_model* ode_world_circuit(ode_world* w);
+/// 1 when the hydraulic solver runs on the straight-line circuit kernel
+/// (hyd_fused.h), 0 on the component loops (opts.general_circuit, or a
+/// circuit of another shape).
+int ode_world_fused(const ode_world* w);
 
 /// Simulated time [s].
 double ode_world_time(const ode_world* w);

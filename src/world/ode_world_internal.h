@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "hydraulics.h"
+#include "hyd_fused.h"
 #include "hyd_solver.h"
 #include "ode_world.h"
 
@@ -143,6 +144,14 @@ struct ode_world {
     double x0[ODE_NACT], v0[ODE_NACT]; ///< strokes and rates at the step start
     int ipump;           ///< state index of the pump-line pressure, or -1
     long hyd_steps;
+    // The straight-line circuit kernel (hyd_fused.h) for the solver's f and
+    // J, when the circuit has the standard shape and opts.general_circuit is
+    // 0. Lane j drives actuator fz_act[j]. Rebuilt when the circuit's
+    // revision moves (live parameter edits).
+    hyd_fused fz;
+    int use_fused, nfz;
+    int fz_act[ODE_NACT];
+    unsigned fz_rev;
 };
 
 // ode_world.c

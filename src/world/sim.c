@@ -212,6 +212,7 @@ ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* d
     wo.rtol = o->rtol;
     wo.atol = o->atol;
     wo.dense_jac = o->dense_jac;
+    wo.general_circuit = o->general_kernel;
     wo.q0[0] = q0[0];
     wo.q0[1] = q0[1];
     wo.slew0 = slew0;
@@ -233,6 +234,7 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     ode_world* w = sim_ode_world_create(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
                                         sizeof res->message);
     if (!w) return res->status = 2;
+    res->fused = ode_world_fused(w);
 
     const double dt = ode_world_dt(w);
     const long nstep = (long)floor(c->t_end / dt + 0.5);

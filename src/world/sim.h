@@ -32,8 +32,8 @@ typedef struct sim_opts {
     double dt_ode;     ///< ode: rigid-body step [s] (default 1e-3; hydraulics sub-step at h)
     bool cvode;        ///< integrate with SUNDIALS CVODE (BDF) instead of `solver`
                        ///< (the outside reference; rtol/atol apply)
-    bool general_kernel; ///< lagrange: the general circuit evaluation even when the
-                         ///< fused kernel applies (hyd_fused.h; for comparisons)
+    bool general_kernel; ///< lagrange and ode: the general circuit evaluation even when
+                         ///< the fused kernel applies (hyd_fused.h; for comparisons)
     bool whole_step;     ///< lagrange, Krus/ROS2 with the block pattern: the generic
                          ///< stage arithmetic with f in full at every stage, instead
                          ///< of the split step (lsim_krus.c; for comparisons)
@@ -78,7 +78,7 @@ typedef struct sim_result {
     double wall;         ///< wall time of the integration [s]
     hyd_solver_stats stats;
     long rows;
-    bool fused;          ///< lagrange: the run used the fused circuit kernel
+    bool fused;          ///< the run used the fused circuit kernel (lagrange or ode)
     bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lsim_krus.c)
 } sim_result;
 
