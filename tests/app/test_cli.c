@@ -179,6 +179,23 @@ static void test_ode_runs_are_deterministic(void) {
     CHECK(strstr(csv, ",hook_x,hook_y,hook_z,") && strstr(csv, "truck_tilt"), "ode extras missing: %.300s", csv);
 }
 
+// The paper's scenarios start folded (q = 100, -110 deg); on the sandbox
+// the hook used to start inside the ground and the run blew up at 0.01 s.
+// A pose with no room at all is bad input: one line naming the pose, exit 2.
+static void test_sandbox_start_poses(void) {
+    static char out[8192];
+    CHECK(run("run --quiet --mechanics ode --world sandbox --scenario ramp --duration 1 --out /dev/null", out,
+              sizeof out) == 0,
+          "ramp on the sandbox: %s", out);
+    CHECK(out[0] == 0, "no output with --quiet: %s", out);
+    char a[1024];
+    snprintf(a, sizeof a, "run --quiet --mechanics ode --world sandbox --scenario %s/scn_tip_low.json --out /dev/null",
+             DATA);
+    CHECK(run(a, out, sizeof out) == 2, "want exit 2: %s", out);
+    CHECK(strstr(out, "q1 = 80.0 deg, q2 = -110.0 deg leaves no room for the rope") && count_lines(out) == 1,
+          "want one line naming the pose: %s", out);
+}
+
 static void test_bad_world_and_compare_tolerance(void) {
     static char out[8192];
     int rc = run("run --quiet --mechanics ode --world " DATA "/missing_world.json --scenario ramp --out /dev/null", out,
@@ -209,6 +226,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_csv_contract);
     RUN_TEST(test_blow_up_keeps_output);
     RUN_TEST(test_ode_runs_are_deterministic);
+    RUN_TEST(test_sandbox_start_poses);
     RUN_TEST(test_bad_world_and_compare_tolerance);
     TEST_MAIN_END();
 }
