@@ -34,8 +34,20 @@ void app_common_help(FILE* f, bool with_solver);
 /// Resolve a scenario argument: an existing file, or assets/scenarios/<name>.json.
 const char* app_scenario_path(const char* arg, char* buf, size_t n);
 
-/// Load model and scenario for c; prints the error and returns EXIT_USAGE on failure.
+/// Load model and scenario for c (scenario "ramp" when c names none). Returns
+/// 0, or EXIT_USAGE with a one-line message in err (an unknown scenario name
+/// lists the shipped ones).
+int app_load_msg(const app_common* c, model** m, scenario* sc, char* err, size_t errsz);
+/// app_load_msg, printing the message as "cranesim: ..." on stderr.
 int app_load(const app_common* c, model** m, scenario* sc);
+
+typedef struct live live;
+/// The scripted operator (a scenario's command tables and hook events) at
+/// simulated time tm: the stick positions into u[3], and every hook event
+/// due by tm, from *ev on, applied to l (*ev advances). on_hook (may be
+/// NULL) hears each: attach or release, and live_hook's answer.
+void app_scripted_input(const scenario* sc, live* l, double tm, int* ev, double u[3],
+                        void (*on_hook)(void* user, live* l, int attach, int got), void* user);
 
 /// Progress bar on stderr, only when stderr is a terminal.
 void app_progress(void* user, double t, double t_end);

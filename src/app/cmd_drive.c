@@ -62,6 +62,17 @@ static bool have_display(void) {
     return (d && *d) || (w && *w);
 }
 
+// Say what the scripted operator's hook did.
+static void report_hook(void* user, live* l, int attach, int got) {
+    (void)user;
+    double mass = 0;
+    const char* name = got >= 0 ? live_load_name(l, got, &mass) : NULL;
+    const double t = live_time(l);
+    if (attach && name) printf("  t = %5.2f s: hook picked up %s (%.0f kg)\n", t, name, mass);
+    else if (attach) printf("  t = %5.2f s: hook found no load in reach\n", t);
+    else printf("  t = %5.2f s: hook released the load\n", t);
+}
+
 static int drive_headless(app_common* c, double frame_rate, const char* record, const char* why) {
     model* m;
     scenario sc;
@@ -101,21 +112,9 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         double t = live_time(l);
         // The operator's stick positions at the middle of this frame.
         const double tm = t + 0.5 * frame;
-        const double u[3] = {scenario_command(&sc, 0, tm), scenario_command(&sc, 1, tm), scenario_command(&sc, 2, tm)};
+        double u[3];
+        app_scripted_input(&sc, l, tm, &ev, u, report_hook, NULL);
         live_set_commands(l, u);
-        while (ev < sc.nevent && sc.event[ev].t <= tm) {
-            int attach = sc.event[ev].kind == SCENARIO_ATTACH;
-            int got = live_hook(l, attach);
-            double mass = 0;
-            const char* name = got >= 0 ? live_load_name(l, got, &mass) : NULL;
-            if (attach && name)
-                printf("  t = %5.2f s: hook picked up %s (%.0f kg)\n", t, name, mass);
-            else if (attach)
-                printf("  t = %5.2f s: hook found no load in reach\n", t);
-            else
-                printf("  t = %5.2f s: hook released the load\n", t);
-            ++ev;
-        }
         // Advance to the frame's end on the simulated clock (the ode world
         // steps whole ODE steps, so aim at the target, not at +frame).
         if (live_advance(l, (i + 1) * frame - live_time(l))) {

@@ -1,5 +1,6 @@
 // common.c: option parsing and loading shared by the subcommands.
 #include "app.h"
+#include "live.h"
 
 #include <errno.h>
 #include <math.h>
@@ -193,12 +194,15 @@ const char* app_scenario_path(const char* arg, char* buf, size_t n) {
 }
 
 int app_load(const app_common* c, model** m, scenario* sc) {
-    char err[512];
-    *m = model_load(c->model_path, c->sets, c->nset, err, sizeof err);
-    if (!*m) {
-        fprintf(stderr, "cranesim: %s\n", err);
-        return EXIT_USAGE;
-    }
+    char err[1024];
+    const int rc = app_load_msg(c, m, sc, err, sizeof err);
+    if (rc) fprintf(stderr, "cranesim: %s\n", err);
+    return rc;
+}
+
+int app_load_msg(const app_common* c, model** m, scenario* sc, char* err, size_t errsz) {
+    *m = model_load(c->model_path, c->sets, c->nset, err, errsz);
+    if (!*m) return EXIT_USAGE;
     char buf[512];
     const char* arg = c->scenario_path ? c->scenario_path : "ramp";
     const char* sp = app_scenario_path(arg, buf, sizeof buf);
@@ -215,18 +219,27 @@ int app_load(const app_common* c, model** m, scenario* sc) {
             snprintf(names + k, sizeof names - k, "%s%.*s", k ? ", " : "", (int)(L - 5), e->d_name);
         }
         if (d) closedir(d);
-        fprintf(stderr, "cranesim: --scenario %s: no such file or scenario (scenarios: %s)\n", arg, names);
+        snprintf(err, errsz, "--scenario %s: no such file or scenario (scenarios: %s)", arg, names);
         model_free(*m);
         *m = NULL;
         return EXIT_USAGE;
     }
-    if (scenario_load(sp, sc, err, sizeof err)) {
-        fprintf(stderr, "cranesim: %s\n", err);
+    if (scenario_load(sp, sc, err, errsz)) {
         model_free(*m);
         *m = NULL;
         return EXIT_USAGE;
     }
     return 0;
+}
+
+void app_scripted_input(const scenario* sc, live* l, double tm, int* ev, double u[3],
+                        void (*on_hook)(void* user, live* l, int attach, int got), void* user) {
+    for (int k = 0; k < 3; ++k) u[k] = scenario_command(sc, k, tm);
+    for (; *ev < sc->nevent && sc->event[*ev].t <= tm; ++*ev) {
+        const int attach = sc->event[*ev].kind == SCENARIO_ATTACH;
+        const int got = live_hook(l, attach);
+        if (on_hook) on_hook(user, l, attach, got);
+    }
 }
 
 void app_progress(void* user, double t, double t_end) {

@@ -336,11 +336,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     s->snap = calloc(1, sizeof *s->snap);
     if (!s->c.scenario_path)
         s->c.scenario_path = app_default_drive_scenario(s->c.sim.mechanics);
-    char e2[512];
-    s->m = model_load(s->c.model_path, s->c.sets, s->c.nset, e2, sizeof e2);
-    char sb[512];
-    if (!s->m || scenario_load(app_scenario_path(s->c.scenario_path, sb, sizeof sb), &s->sc, e2, sizeof e2)) {
-        snprintf(err, errsz, "%s", e2);
+    if (app_load_msg(&s->c, &s->m, &s->sc, err, errsz)) {
         drive_session_destroy(s);
         *code = EXIT_USAGE;
         return NULL;
@@ -510,12 +506,7 @@ int drive_session_tick(drive_session* s, double wall) {
     } else {
         double u[3] = {cmd.lift, cmd.jib, cmd.slew};
         if (s->o.scripted) {
-            const double tm = t + 0.5 * dt_wall;
-            for (int k = 0; k < 3; ++k) u[k] = scenario_command(&s->sc, k, tm);
-            while (s->ev < s->sc.nevent && s->sc.event[s->ev].t <= tm) {
-                live_hook(s->l, s->sc.event[s->ev].kind == SCENARIO_ATTACH);
-                ++s->ev;
-            }
+            app_scripted_input(&s->sc, s->l, t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
         } else if (cmd.hook_toggle) {
             live_hook(s->l, !live_attached(s->l));
         }
