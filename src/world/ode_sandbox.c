@@ -100,16 +100,20 @@ static int build_terrain(ode_world* w, char* err, size_t errsz) {
 
 // ---- truck ----
 
-// Add a box geom to the truck at truck-frame position p (and its drawing).
+// Attach collision geom g to the truck body at truck-frame position p
+// (the body's origin is at the centre of mass, truck_org from the frame's).
+static void truck_geom(ode_world* w, dGeomID g, const double p[3]) {
+    dGeomSetBody(g, w->truck);
+    dGeomSetOffsetPosition(g, p[0] + w->truck_org[0], p[1] + w->truck_org[1], p[2] + w->truck_org[2]);
+    ow_add_geom(w, g, OW_CAT_TRUCK, w->desc.truck.friction);
+}
+
+// Add a box to the truck at truck-frame position p: its drawing, and with
+// collide its collision geom.
 static void truck_box(ode_world* w, const char* name, world_role role, const float* rgba, int mesh,
                       const double size[3], const double p[3], int collide) {
-    double o[3] = {p[0] + w->truck_org[0], p[1] + w->truck_org[1], p[2] + w->truck_org[2]};
-    if (collide) {
-        dGeomID g = dCreateBox(w->dyn_space, size[0], size[1], size[2]);
-        dGeomSetBody(g, w->truck);
-        dGeomSetOffsetPosition(g, o[0], o[1], o[2]);
-        ow_add_geom(w, g, OW_CAT_TRUCK, w->desc.truck.friction);
-    }
+    if (collide) truck_geom(w, dCreateBox(w->dyn_space, size[0], size[1], size[2]), p);
+    const double o[3] = {p[0] + w->truck_org[0], p[1] + w->truck_org[1], p[2] + w->truck_org[2]};
     ow_add_vis(w, name, role, WORLD_SHAPE_BOX, size, rgba, mesh, w->truck, o, NULL);
 }
 
@@ -134,10 +138,7 @@ static void build_truck(ode_world* w, const double T[3], const double R[9]) {
     if (w->desc.mesh[WORLD_MESH_TRUCK].file[0]) {
         // The truck mesh has its own cab (drawn on the chassis entry): the
         // cab box only collides, so it is not drawn twice.
-        dGeomID g = dCreateBox(w->dyn_space, k->cab[0], k->cab[1], k->cab[2]);
-        dGeomSetBody(g, w->truck);
-        dGeomSetOffsetPosition(g, pc[0] + w->truck_org[0], pc[1] + w->truck_org[1], pc[2] + w->truck_org[2]);
-        ow_add_geom(w, g, OW_CAT_TRUCK, k->friction);
+        truck_geom(w, dCreateBox(w->dyn_space, k->cab[0], k->cab[1], k->cab[2]), pc);
     } else {
         truck_box(w, "cab", WORLD_ROLE_TRUCK, RGBA_CAB, -1, k->cab, pc, 1);
     }
@@ -148,12 +149,9 @@ static void build_truck(ode_world* w, const double T[3], const double R[9]) {
     static const double Rw[9] = {1, 0, 0, 0, 0, -1, 0, 1, 0}; // cylinder axis z -> truck y
     for (int a = 0; a < 2; ++a)
         for (int s = 0; s < 2; ++s) {
-            double wp[3] = {k->wheel_x[a] + w->truck_org[0], (s ? -0.5 : 0.5) * k->track + w->truck_org[1],
-                            k->wheel_radius + lift + w->truck_org[2]};
-            dGeomID g = dCreateSphere(w->dyn_space, k->wheel_radius);
-            dGeomSetBody(g, w->truck);
-            dGeomSetOffsetPosition(g, wp[0], wp[1], wp[2]);
-            ow_add_geom(w, g, OW_CAT_TRUCK, k->friction);
+            const double wt[3] = {k->wheel_x[a], (s ? -0.5 : 0.5) * k->track, k->wheel_radius + lift};
+            truck_geom(w, dCreateSphere(w->dyn_space, k->wheel_radius), wt);
+            double wp[3] = {wt[0] + w->truck_org[0], wt[1] + w->truck_org[1], wt[2] + w->truck_org[2]};
             char nm[32];
             snprintf(nm, sizeof nm, "wheel_%d", 2 * a + s);
             double sz[3] = {k->wheel_radius, k->wheel_width, 0};
@@ -171,12 +169,8 @@ static void build_truck(ode_world* w, const double T[3], const double R[9]) {
             // four point contacts carry the truck as well as four boxes would
             // (the support polygon is the same), with a quarter of the contact
             // rows in the truck's island, which dominates the step cost.
-            double rs = 0.5 * k->pad[0];
-            double sp[3] = {pp[0] + w->truck_org[0], pp[1] + w->truck_org[1], rs + w->truck_org[2]};
-            dGeomID gs = dCreateSphere(w->dyn_space, rs);
-            dGeomSetBody(gs, w->truck);
-            dGeomSetOffsetPosition(gs, sp[0], sp[1], sp[2]);
-            ow_add_geom(w, gs, OW_CAT_TRUCK, k->friction);
+            const double rs = 0.5 * k->pad[0], sp[3] = {pp[0], pp[1], rs};
+            truck_geom(w, dCreateSphere(w->dyn_space, rs), sp);
             // Beam and leg, drawn only: the pad carries the contact.
             double half = 0.5 * k->outrigger_span - 0.5 * k->chassis[1];
             double bz = k->bed_height - k->chassis[2] + 0.1;
