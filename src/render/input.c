@@ -303,26 +303,34 @@ static void key_axis(input* in, SDL_Scancode sc, bool down) {
     }
 }
 
-static bool key_edge(input* in, SDL_Scancode sc) {
+// The keys that do what a device button does (press).
+static int key_button(SDL_Scancode sc) {
     switch (sc) {
     case SDL_SCANCODE_H:
     case SDL_SCANCODE_RETURN:
-        in->hook = true;
-        return true;
+        return INPUT_BTN_HOOK;
     case SDL_SCANCODE_P:
     case SDL_SCANCODE_SPACE:
-        in->pause = true;
-        return true;
+        return INPUT_BTN_PAUSE;
     case SDL_SCANCODE_R:
     case SDL_SCANCODE_BACKSPACE:
-        in->reset = true;
-        return true;
+        return INPUT_BTN_RESET;
     case SDL_SCANCODE_F12:
-        in->screenshot = true;
-        return true;
+        return INPUT_BTN_SCREENSHOT;
     case SDL_SCANCODE_C:
-        in->camera_next = true;
+        return INPUT_BTN_CAMERA;
+    default:
+        return -1;
+    }
+}
+
+static bool key_edge(input* in, SDL_Scancode sc) {
+    const int b = key_button(sc);
+    if (b >= 0) {
+        press(in, b);
         return true;
+    }
+    switch (sc) {
     case SDL_SCANCODE_F1:
         in->camera_preset = 0;
         return true;

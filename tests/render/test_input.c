@@ -154,6 +154,20 @@ static void test_keyboard(void) {
     CHECK(cmd.camera_preset == 2, "F3 = preset 2, got %d", cmd.camera_preset);
     input_poll(in, 1.0, &cmd);
     CHECK(!cmd.hook_toggle && cmd.camera_preset == -1, "edges reported once");
+    // The other edge keys, each alone.
+    static const struct { SDL_Scancode sc; const char* name; } keys[] = {
+        {SDL_SCANCODE_P, "P"}, {SDL_SCANCODE_R, "R"}, {SDL_SCANCODE_F12, "F12"}, {SDL_SCANCODE_C, "C"},
+        {SDL_SCANCODE_ESCAPE, "Esc"}};
+    for (int k = 0; k < 5; ++k) {
+        push_key(keys[k].sc, true);
+        push_key(keys[k].sc, false);
+        pump(in);
+        input_poll(in, 1.0, &cmd);
+        const bool got[5] = {cmd.pause, cmd.reset, cmd.screenshot, cmd.camera_next, cmd.quit};
+        for (int j = 0; j < 5; ++j)
+            CHECK(got[j] == (j == k), "%s: flag %d is %d", keys[k].name, j, got[j]);
+        CHECK(!cmd.hook_toggle, "%s does not touch the hook", keys[k].name);
+    }
     input_destroy(in);
 }
 
