@@ -1,6 +1,7 @@
 // test_circuit.c: the compiled default crane circuit. State layout and
 // lookups, the analytic Jacobian and coupling partials against central
 // differences, flow continuity, live parameters and JSON round trips.
+#include "circuits.h"
 #include "check.h"
 #include "hydraulics.h"
 #include "hyd_fused.h"
@@ -445,20 +446,9 @@ static void test_fused_refuses(void) {
 
     // An orifice anywhere: the general path only.
     hyd_builder* b = hyd_builder_create();
-    hyd_tank_def t = hyd_default_tank_def();
-    t.name = "tank";
-    hyd_add_tank(b, &t);
-    hyd_volume_def vol = hyd_default_volume_def();
-    vol.name = "line";
-    vol.volume = 1e-3;
-    hyd_add_volume(b, &vol);
-    hyd_pump_def pu = hyd_default_pump_def();
-    pu.name = "pump";
-    pu.inlet = "tank";
-    pu.outlet = "line";
-    pu.q_max = 1e-4;
-    pu.p_set = 1e7;
-    hyd_add_pump(b, &pu);
+    add_tank(b, "tank", 0);
+    add_volume(b, "line", 1e-3);
+    add_pump(b, "pump", "tank", "line", 1e-4, 1e7);
     hyd_orifice_def o = hyd_default_orifice_def();
     o.name = "bleed";
     o.inlet = "line";

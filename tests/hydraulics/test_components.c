@@ -1,5 +1,6 @@
 // test_components.c: each component law against its analytic form, limits
 // and continuity (no integrator needed).
+#include "circuits.h"
 #include "check.h"
 #include "hyd_internal.h" // hyd_be: the compiled model's fast Be(p) path
 #include "hydraulics.h"
@@ -182,21 +183,9 @@ static void test_open_ramp(void) {
 // Tiny circuits built through the C API.
 static hyd_model* pump_circuit(void) {
     hyd_builder* b = hyd_builder_create();
-    hyd_tank_def t = hyd_default_tank_def();
-    t.name = "tank";
-    hyd_add_tank(b, &t);
-    hyd_volume_def v = hyd_default_volume_def();
-    v.name = "line";
-    v.volume = 1e-3;
-    hyd_add_volume(b, &v);
-    hyd_pump_def p = hyd_default_pump_def();
-    p.name = "pump";
-    p.inlet = "tank";
-    p.outlet = "line";
-    p.q_max = 5e-4;
-    p.p_set = 20e6;
-    p.band = 0.5e6;
-    hyd_add_pump(b, &p);
+    add_tank(b, "tank", 0);
+    add_volume(b, "line", 1e-3);
+    add_pump(b, "pump", "tank", "line", 5e-4, 20e6); // the default band, 0.5 MPa
     char err[256];
     hyd_model* m = hyd_compile(b, err, sizeof err);
     CHECK(m != NULL, "%s", err);

@@ -2,6 +2,7 @@
 // each run checked against an analytic result, limit or invariant.
 #include "check.h"
 #include "hyd_solver.h"
+#include "circuits.h"
 #include "hydraulics.h"
 
 #include <math.h>
@@ -88,6 +89,16 @@ static hyd_model* compile(hyd_builder* b) {
     return m;
 }
 
+// A rig on the circuit b describes (b is consumed): compiled, with its data,
+// n = all the circuit's states. Returns 0, or -1 when it does not compile.
+static int rig_open(rig* r, hyd_builder* b) {
+    *r = (rig){0};
+    if (!(r->m = compile(b))) return -1;
+    r->d = hyd_data_create(r->m);
+    r->n = hyd_model_nstate(r->m);
+    return 0;
+}
+
 static hyd_cylinder_def cyl_def(void) {
     hyd_cylinder_def c = hyd_default_cylinder_def();
     c.name = "cyl";
@@ -112,12 +123,9 @@ static void test_closed_volume(void) {
         c.p0_a = air ? 2e5 : 10e6;
         c.p0_b = 10e6;
         hyd_add_cylinder(b, &c);
-        rig r = {0};
-        r.m = compile(b);
-        if (!r.m)
+        rig r;
+        if (rig_open(&r, b))
             return;
-        r.d = hyd_data_create(r.m);
-        r.n = hyd_model_nstate(r.m);
         r.x0 = 0.3;
         r.v0 = air ? -0.06 : -1e-3; // retracting compresses A, expands B
         double y[2];
@@ -156,31 +164,17 @@ static void test_closed_volume(void) {
 static void test_valve_cylinder_speed(void) {
     const double ps = 10e6, pt = 1e5, Fl = 20e3, M = 500.0;
     hyd_builder* b = hyd_builder_create();
-    hyd_tank_def t = hyd_default_tank_def();
-    t.name = "supply";
-    t.pressure = ps;
-    hyd_add_tank(b, &t);
-    t.name = "tank";
-    t.pressure = pt;
-    hyd_add_tank(b, &t);
-    hyd_valve_def v = hyd_default_valve_def();
-    v.name = "valve";
-    v.P = "supply";
-    v.T = "tank";
-    v.A = "cyl.A";
-    v.B = "cyl.B";
-    v.u0 = 1.0;
-    hyd_add_valve(b, &v);
+    add_tank(b, "supply", ps);
+    add_tank(b, "tank", pt);
+    add_valve(b, "valve", "supply", "tank", "cyl.A", "cyl.B", 1.0);
+    const hyd_valve_def v = hyd_default_valve_def(); // its rated flow for the check
     hyd_cylinder_def c = cyl_def();
     c.p0_a = 3e6;
     c.p0_b = 1e6;
     hyd_add_cylinder(b, &c);
-    rig r = {0};
-    r.m = compile(b);
-    if (!r.m)
+    rig r;
+    if (rig_open(&r, b))
         return;
-    r.d = hyd_data_create(r.m);
-    r.n = hyd_model_nstate(r.m);
     r.mech = 1;
     r.M = M;
     r.Fload = Fl;
@@ -217,52 +211,28 @@ static void test_valve_cylinder_speed(void) {
 // so the line settles at p_cr + w sqrt(q_pump / q_rated), inside the band.
 static void test_relief_holds(void) {
     hyd_builder* b = hyd_builder_create();
-    hyd_tank_def t = hyd_default_tank_def();
-    t.name = "tank";
-    hyd_add_tank(b, &t);
-    hyd_volume_def pl = hyd_default_volume_def();
-    pl.name = "line";
-    pl.volume = 1e-3;
-    hyd_add_volume(b, &pl);
-    hyd_pump_def p = hyd_default_pump_def();
-    p.name = "pump";
-    p.inlet = "tank";
-    p.outlet = "line";
-    p.q_max = 30.0 / 60000.0;
-    p.p_set = 30e6; // above the relief: the relief must hold
-    hyd_add_pump(b, &p);
-    hyd_relief_def rl = hyd_default_relief_def();
-    rl.name = "relief";
-    rl.inlet = "line";
-    rl.outlet = "tank";
-    rl.p_crack = 22e6;
-    hyd_add_relief(b, &rl);
-    hyd_valve_def v = hyd_default_valve_def();
-    v.name = "valve";
-    v.P = "line";
-    v.T = "tank";
-    v.A = "cyl.A";
-    v.B = "cyl.B";
-    v.u0 = 1.0;
-    hyd_add_valve(b, &v);
+    const double q_pump = 30.0 / 60000.0, p_crack = 22e6;
+    const hyd_relief_def rl = hyd_default_relief_def(); // its override band and rated flow
+    add_tank(b, "tank", 0);
+    add_volume(b, "line", 1e-3);
+    add_pump(b, "pump", "tank", "line", q_pump, 30e6); // p_set above the relief: the relief must hold
+    add_relief(b, "relief", "line", "tank", p_crack, 0);
+    add_valve(b, "valve", "line", "tank", "cyl.A", "cyl.B", 1.0);
     hyd_cylinder_def c = cyl_def();
     hyd_add_cylinder(b, &c);
-    rig r = {0};
-    r.m = compile(b);
-    if (!r.m)
+    rig r;
+    if (rig_open(&r, b))
         return;
-    r.d = hyd_data_create(r.m);
-    r.n = hyd_model_nstate(r.m);
     r.x0 = c.stroke; // stalled at the extended end stop
     r.v0 = 0.0;
     r.d->valve_cmd[0] = 1.0;
     double y[8];
     hyd_model_initial_state(r.m, y);
     rig_run(&r, HYD_ROS2, 1e-4, y, 2.0);
-    const double expect = 1e5 + rl.p_crack + rl.dp_override * sqrt(p.q_max / rl.q_rated);
+    const double expect = 1e5 + p_crack + rl.dp_override * sqrt(q_pump / rl.q_rated);
     const int il = hyd_model_find_state(r.m, "line.p"), iA = hyd_model_find_state(r.m, "cyl.pA");
     CHECK_REL(y[il], expect, 1e-6);
-    CHECK(y[il] > 1e5 + rl.p_crack && y[il] < 1e5 + rl.p_crack + rl.dp_override, "in band");
+    CHECK(y[il] > 1e5 + p_crack && y[il] < 1e5 + p_crack + rl.dp_override, "in band");
     CHECK_REL(y[iA], y[il], 1e-6); // no flow through the open edge at steady state
     CHECK(r.d->comp_open[hyd_model_find(r.m, "relief")] == 1, "relief flagged open");
     hyd_data_free(r.d);
@@ -273,24 +243,13 @@ static void test_relief_holds(void) {
 static void test_spool_step(void) {
     hyd_builder* b = hyd_builder_create();
     const char* names[4] = {"P", "T", "A", "B"};
-    for (int i = 0; i < 4; ++i) {
-        hyd_tank_def t = hyd_default_tank_def();
-        t.name = names[i];
-        hyd_add_tank(b, &t);
-    }
-    hyd_valve_def v = hyd_default_valve_def();
-    v.name = "v";
-    v.P = "P";
-    v.T = "T";
-    v.A = "A";
-    v.B = "B";
-    hyd_add_valve(b, &v);
-    rig r = {0};
-    r.m = compile(b);
-    if (!r.m)
+    for (int i = 0; i < 4; ++i) add_tank(b, names[i], 0);
+    const hyd_valve_def v = hyd_default_valve_def(); // its spool time constant for the check
+    add_valve(b, "v", "P", "T", "A", "B", v.u0);
+    rig r;
+    if (rig_open(&r, b))
         return;
-    r.d = hyd_data_create(r.m);
-    r.n = 1;
+    r.n = 1; // the spool alone: the tanks have no states
     r.d->valve_cmd[0] = 1.0;
     double y[1] = {0.0};
     rig_run(&r, HYD_RK4, 1e-4, y, v.tau);
@@ -306,9 +265,7 @@ static void test_spool_step(void) {
 static void test_anti_cavitation(void) {
     for (int with_check = 0; with_check < 2; ++with_check) {
         hyd_builder* b = hyd_builder_create();
-        hyd_tank_def t = hyd_default_tank_def();
-        t.name = "tank";
-        hyd_add_tank(b, &t);
+        add_tank(b, "tank", 0);
         hyd_cylinder_def c = cyl_def();
         c.p0_a = c.p0_b = 2e6;
         hyd_add_cylinder(b, &c);
@@ -318,19 +275,10 @@ static void test_anti_cavitation(void) {
         ck.outlet = "cyl.A";
         if (with_check)
             hyd_add_check(b, &ck);
-        hyd_relief_def rl = hyd_default_relief_def(); // B is compressed
-        rl.name = "relief_B";
-        rl.inlet = "cyl.B";
-        rl.outlet = "tank";
-        rl.p_crack = 25e6;
-        rl.q_rated = 1e-3;
-        hyd_add_relief(b, &rl);
-        rig r = {0};
-        r.m = compile(b);
-        if (!r.m)
+        add_relief(b, "relief_B", "cyl.B", "tank", 25e6, 1e-3); // B is compressed
+        rig r;
+        if (rig_open(&r, b))
             return;
-        r.d = hyd_data_create(r.m);
-        r.n = hyd_model_nstate(r.m);
         r.x0 = 0.2;
         r.v0 = 0.1;
         double y[4];
