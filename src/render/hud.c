@@ -270,8 +270,8 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
     render_hud_rect(h, x - 6, y - 6, w, lh * (float)nrows + 10, k_panel);
     char buf[160];
-    if (r->fps_avg > 0)
-        snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx   %.0f fps", s->t, s->rt_factor, r->fps_avg);
+    if (r->frame_dt_avg > 0)
+        snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx   %.0f fps", s->t, s->rt_factor, 1.0 / r->frame_dt_avg);
     else
         snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx", s->t, s->rt_factor);
     render_hud_text(h, x, y, sc, k_white, buf);

@@ -120,7 +120,6 @@ void render_frame(render* r, const world_snapshot* snap) {
     if (r->last_frame_ticks) {
         double dt = (double)(now - r->last_frame_ticks) / (double)SDL_GetPerformanceFrequency();
         r->frame_dt_avg = r->frame_dt_avg > 0 ? 0.95 * r->frame_dt_avg + 0.05 * dt : dt;
-        r->fps_avg = r->frame_dt_avg > 0 ? 1.0 / r->frame_dt_avg : 0;
     }
     r->last_frame_ticks = now;
     r->have_frame = true;

@@ -222,8 +222,7 @@ struct render {
     char status[128];
     int missed_deadlines;
     bool have_frame;
-    double frame_dt_avg; ///< smoothed wall time between frames [s]
-    double fps_avg;      ///< 1 / frame_dt_avg, shown in the HUD [1/s]
+    double frame_dt_avg; ///< smoothed wall time between frames [s]; the HUD shows 1 / it
     Uint64 last_frame_ticks;
     GLsync frame_fence; ///< signalled when the last presented frame is drawn, 0 if none
     bool swap_pending;  ///< window mode: the presented frame is swapped once its fence signals
