@@ -71,8 +71,8 @@ void hyd_cylinders_eval(const hyd_model* m, hyd_data* d, double* G) {
 
         // Retracted stop pushes out (+), extended stop pushes in (-).
         double fdl, fvl, fdh, fvh;
-        const double flo = hyd_stop_force(c, -x, -v, &fdl, &fvl);
-        const double fhi = hyd_stop_force(c, x - c->s, v, &fdh, &fvh);
+        const double flo = hyd_stop_force(c->ks, c->cs, c->ws, -x, -v, &fdl, &fvl);
+        const double fhi = hyd_stop_force(c->ks, c->cs, c->ws, x - c->s, v, &fdh, &fvh);
         d->cyl_F[i] = pA * c->AA - pB * c->AB - c->bv * v + flo - fhi;
         d->cyl_stop[i] = (x > c->s) - (x < 0.0);
         d->comp_open[c->comp] = d->cyl_stop[i] != 0;

@@ -237,10 +237,9 @@ FUSED_INLINE void actuator(const hyd_fused_act* a, const double* y, double pPL, 
     o->nB = qhB + leak + ramps_in(&a->cB, pB, &gB) + a->AB * v;
 
     // Force with the end stops (cylinder.c).
-    const hyd_cyl_c cc = {.s = a->s, .ks = a->ks, .cs = a->cs, .ws = a->ws};
     double fdl, fvl, fdh, fvh;
-    const double flo = hyd_stop_force(&cc, -x, -v, &fdl, &fvl);
-    const double fhi = hyd_stop_force(&cc, x - a->s, v, &fdh, &fvh);
+    const double flo = hyd_stop_force(a->ks, a->cs, a->ws, -x, -v, &fdl, &fvl);
+    const double fhi = hyd_stop_force(a->ks, a->cs, a->ws, x - a->s, v, &fdh, &fvh);
     o->F = pA * a->AA - pB * a->AB - a->bv * v + flo - fhi;
     if (partials) {
         const double sgn = pos ? 1.0 : -1.0;

@@ -377,27 +377,29 @@ static inline double hyd_open_ramp_t(double t, double inv_w, double* dr) {
     return 2.0 * t - 1.0;
 }
 
-/// Cylinder end stop (see cylinder.c): force magnitude for penetration delta
+/// Cylinder end stop (see cylinder.c) of stiffness ks [N/m], damping cs
+/// [N s/m] and smoothing width ws [m]: force magnitude for penetration delta
 /// and its rate ddelta, with partials d|F|/ddelta (*fd) and d|F|/dddelta (*fv).
-static inline double hyd_stop_force(const hyd_cyl_c* c, double delta, double ddelta, double* fd, double* fv) {
+static inline double hyd_stop_force(double ks, double cs, double ws, double delta, double ddelta, double* fd,
+                                    double* fv) {
     if (delta <= 0.0) {
         *fd = 0.0;
         *fv = 0.0;
         return 0.0;
     }
-    const double t = delta / c->ws;
+    const double t = delta / ws;
     double S, dS, dW;
     if (t < 1.0) {
         S = 0.5 * delta * t;
         dS = t;
     } else {
-        S = delta - 0.5 * c->ws;
+        S = delta - 0.5 * ws;
         dS = 1.0;
     }
     const double W = hyd_smoothstep(t, &dW);
-    *fd = c->ks * dS + c->cs * dW / c->ws * ddelta;
-    *fv = c->cs * W;
-    return c->ks * S + c->cs * W * ddelta;
+    *fd = ks * dS + cs * dW / ws * ddelta;
+    *fv = cs * W;
+    return ks * S + cs * W * ddelta;
 }
 
 
