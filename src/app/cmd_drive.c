@@ -1,18 +1,23 @@
 // cmd_drive.c: `cranesim drive`: the real-time simulator.
 //
 // With a display (and the render module built) it opens the 3D window. Without
-// one it runs the same real-time loop headless on a scripted operator input,
-// paced to wall time, and reports what it did: simulated time, real-time
-// factor capacity, missed frame deadlines, and where the record went.
+// one, or when no window opens on the display the environment names, it runs
+// the same real-time loop headless on a scripted operator input, paced to
+// wall time, and reports what it did: simulated time, real-time factor
+// capacity, missed frame deadlines, and where the record went. Every option
+// is checked before any of that, whichever mode follows.
 #include "app.h"
 #include "live.h"
+#include "world_desc.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
 #endif
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #ifndef M_PI
@@ -24,14 +29,15 @@ static void drive_help(FILE* f) {
             "usage: cranesim drive [--model M] [--world W] [--headless] [--duration T] [--record FILE.csv]\n"
             "\n"
             "Drive the crane in real time, by default in the sandbox world (truck, terrain, hook,\n"
-            "loads, obstacles; --mechanics lagrange for the bare 2-DOF crane). With a display: a\n"
-            "3D window, joystick or keyboard. Without a display (or with --headless): the same\n"
-            "real-time loop driven by a scripted operator (assets/scenarios/sandbox_pick_place.json,\n"
-            "or drive_demo.json with lagrange), paced to wall time.\n"
+            "loads, obstacles; --world validation for the column and booms alone, --mechanics\n"
+            "lagrange for the bare 2-DOF crane). With a display: a 3D window, joystick or keyboard.\n"
+            "Without a display, or when the window cannot open (or with --headless): the same\n"
+            "real-time loop driven by a scripted operator (assets/scenarios/sandbox_pick_place.json\n"
+            "in the sandbox, drive_demo.json otherwise), paced to wall time.\n"
             "\n"
             "options:\n"
             "  --headless          no window, even if a display is available\n"
-            "  --duration T        headless: seconds to drive (default: the demo's)\n"
+            "  --duration T        seconds to drive (headless default: the scenario's; window: until Esc)\n"
             "  --record FILE.csv   record every frame to CSV (headless default: drive.csv)\n"
             "  --frame-rate F      headless: command updates per second (default 75, the paper's rate);\n"
             "                      window: frame-rate cap (default 65)\n"
@@ -42,10 +48,14 @@ static void drive_help(FILE* f) {
             "  --screenshot FILE   save a PNG of the view at --screenshot-at seconds and stop\n"
             "                      (offscreen when there is no display)\n"
             "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
-            "  --size WxH          window size in pixels (default 1280x720)\n"
+            "  --size WxH          window size in pixels (default 1280x720)\n");
+    app_common_help(f, true);
+    // Keys last: they are what an operator looks up while the window is open.
+    fprintf(f,
+            "(--solver cvode and --every do not apply to drive: it steps in real time and records one\n"
+            "row per command update)\n"
             "keys: arrows = lift, W/S = jib, A/D = slew, H = hook, Tab = parameter panel, P = pause, R = reset,\n"
             "      C / F1..F4 = camera, F5 = record CSV, F12 = screenshot, Esc = quit\n");
-    app_common_help(f, true);
 }
 
 static void sleep_until(double wall) {
@@ -56,15 +66,66 @@ static void sleep_until(double wall) {
     nanosleep(&ts, NULL);
 }
 
-static bool have_display(void) {
+// A display the environment names and that can exist: DISPLAY (an X server,
+// perhaps remote, so only SDL can tell whether it answers), or
+// WAYLAND_DISPLAY naming a socket that is there. Otherwise false, with why
+// in one line.
+static bool have_display(char* why, size_t n) {
     const char* d = getenv("DISPLAY");
     const char* w = getenv("WAYLAND_DISPLAY");
-    return (d && *d) || (w && *w);
+    if (d && *d) return true;
+    if (w && *w) {
+        const char* dir = getenv("XDG_RUNTIME_DIR");
+        char path[512];
+        if (w[0] == '/') snprintf(path, sizeof path, "%s", w);
+        else if (dir && *dir) snprintf(path, sizeof path, "%s/%s", dir, w);
+        else {
+            snprintf(why, n, "no display (WAYLAND_DISPLAY=%s, but XDG_RUNTIME_DIR is unset)", w);
+            return false;
+        }
+        struct stat st;
+        if (stat(path, &st) == 0) return true;
+        snprintf(why, n, "no display (WAYLAND_DISPLAY=%s: no socket %s)", w, path);
+        return false;
+    }
+    snprintf(why, n, "no display (DISPLAY and WAYLAND_DISPLAY unset)");
+    return false;
 }
+
+// The ode world's kind and name, from its file. Returns the kind, or -1
+// with the loader's one-line message.
+static int world_info(const app_common* c, char* name, size_t n, char* err, size_t errsz) {
+    char buf[512];
+    const char* path = sim_world_path(c->sim.world ? c->sim.world : "sandbox", buf, sizeof buf);
+    world_desc* wd = malloc(sizeof *wd); // large (fixed arrays of loads, obstacles)
+    if (!wd) {
+        snprintf(err, errsz, "out of memory");
+        return -1;
+    }
+    int kind = -1;
+    if (world_desc_load(path, wd, err, errsz) == 0) {
+        kind = (int)wd->kind;
+        snprintf(name, n, "%s", wd->name[0] ? wd->name : world_kind_name(wd->kind));
+        world_desc_free(wd);
+    }
+    free(wd);
+    return kind;
+}
+
+// What the world has, so the report says only that.
+typedef struct drive_world {
+    bool hook;        // a hook to attach loads (sandbox)
+    bool noted;       // said once that a hook event had nothing to act on
+} drive_world;
 
 // Say what the scripted operator's hook did.
 static void report_hook(void* user, live* l, int attach, int got) {
-    (void)user;
+    drive_world* dw = user;
+    if (!dw->hook) {
+        if (!dw->noted) printf("  (the scenario's hook events are ignored: this world has no hook)\n");
+        dw->noted = true;
+        return;
+    }
     double mass = 0;
     const char* name = got >= 0 ? live_load_name(l, got, &mass) : NULL;
     const double t = live_time(l);
@@ -73,7 +134,24 @@ static void report_hook(void* user, live* l, int attach, int got) {
     else printf("  t = %5.2f s: hook released the load\n", t);
 }
 
-static int drive_headless(app_common* c, double frame_rate, const char* record, const char* why) {
+// One CSV row; false (errno kept) when the stream has failed.
+static bool write_row(FILE* f, const double* row, int ncol) {
+    errno = 0;
+    sim_csv_row(f, row, ncol);
+    return !ferror(f);
+}
+
+// Flush and close a record; 0, or errno of the first failure.
+static int close_record(FILE* f) {
+    errno = 0;
+    int e = ferror(f) ? (errno ? errno : EIO) : 0;
+    if (fflush(f) != 0 && !e) e = errno;
+    if (fclose(f) != 0 && !e) e = errno;
+    return e;
+}
+
+static int drive_headless(app_common* c, double frame_rate, const char* record, const char* why, int kind,
+                          const char* world_name) {
     model* m;
     scenario sc;
     const bool ode = c->sim.mechanics == SIM_ODE;
@@ -91,39 +169,53 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     }
     FILE* f = fopen(record, "w");
     if (!f) {
-        fprintf(stderr, "cranesim drive: cannot write %s\n", record);
+        fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(errno));
         live_destroy(l);
         model_free(m);
         return EXIT_USAGE;
     }
     const int ncol = live_ncol(l);
+    // The sandbox has the truck, the slew and the hook; loads only if its
+    // file has some. The validation world and the lagrange view have none.
+    const bool sandbox = ode && kind == WORLD_SANDBOX;
+    const bool loads = sandbox && live_load_name(l, 0, NULL) != NULL;
+    drive_world dw = {.hook = sandbox};
+    int wr = 0; // errno of the first failed write to the record
     sim_csv_header(f, ncol);
+    if (ferror(f)) wr = errno ? errno : EIO;
     printf("cranesim drive: %s: driving %s headless in real time for %.1f s\n", why, m->name, duration);
     printf("  world: %s; operator input: scripted (%s), %.0f commands/s; hydraulics %s at h = %g ms\n",
-           ode ? (c->sim.world ? c->sim.world : "sandbox") : "lagrange 2-DOF (no world)", sc.name, frame_rate,
-           hyd_method_name(c->sim.solver), c->sim.h * 1e3);
+           ode ? world_name : "lagrange 2-DOF (no world)", sc.name, frame_rate, hyd_method_name(c->sim.solver),
+           c->sim.h * 1e3);
     const double frame = 1.0 / frame_rate;
     const int nframes = (int)ceil(duration * frame_rate - 1e-9);
     double w0 = sim_wall_time(), busy = 0, worst = 0;
     int missed = 0, code = 0, ev = 0, frames_done = 0;
     double row[SIM_NCOL];
-    for (int i = 0; i < nframes; ++i) {
+    live_row(l, row);
+    for (int i = 0; i < nframes && !wr; ++i) {
         double ws = sim_wall_time();
         double t = live_time(l);
         // The operator's stick positions at the middle of this frame.
         const double tm = t + 0.5 * frame;
         double u[3];
-        app_scripted_input(&sc, l, tm, &ev, u, report_hook, NULL);
+        app_scripted_input(&sc, l, tm, &ev, u, report_hook, &dw);
         live_set_commands(l, u);
         // Advance to the frame's end on the simulated clock (the ode world
         // steps whole ODE steps, so aim at the target, not at +frame).
         if (live_advance(l, (i + 1) * frame - live_time(l))) {
+            if (!c->quiet) app_progress_done();
             fprintf(stderr, "cranesim drive: %s; record kept in %s\n", live_error(l), record);
             code = EXIT_RUNTIME;
             break;
         }
         live_row(l, row);
-        sim_csv_row(f, row, ncol);
+        // A record that cannot be written stops the run: driving on would
+        // only lose more of it.
+        if (!write_row(f, row, ncol)) {
+            wr = errno ? errno : EIO;
+            break;
+        }
         ++frames_done;
         double we = sim_wall_time();
         busy += we - ws;
@@ -134,18 +226,27 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         sleep_until(w0 + (i + 1) * frame);
     }
     if (!c->quiet) app_progress_done();
-    fclose(f);
+    const int ce = close_record(f);
+    if (!wr) wr = ce;
+    if (wr) {
+        fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(wr));
+        code = EXIT_RUNTIME;
+    }
     double wall = sim_wall_time() - w0;
     printf("  simulated %.2f s in %.2f s wall; physics busy %.1f %% of the time: capacity %.0fx real time\n",
-           live_time(l), wall, 100 * busy / wall, busy > 0 ? live_time(l) / busy : 0.0);
+           live_time(l), wall, wall > 0 ? 100 * busy / wall : 0.0, busy > 0 ? live_time(l) / busy : 0.0);
     printf("  frames: %d of %.1f ms, worst frame %.2f ms, missed deadlines %d\n", frames_done, frame * 1e3,
            worst * 1e3, missed);
     printf("  final: lift stroke %.0f mm, jib stroke %.0f mm, tip at reach %.2f m, height %.2f m", row[COL_X1] * 1e3,
            row[COL_X2] * 1e3, row[COL_TIP_X], row[COL_TIP_Z]);
-    if (ode)
-        printf("; slew %.1f deg; load at (%.2f, %.2f, %.2f) m; truck tilt %.2f deg", row[COL_SLEW] * 180 / M_PI,
-               row[COL_LOAD_X], row[COL_LOAD_Y], row[COL_LOAD_Z], row[COL_TRUCK_TILT] * 180 / M_PI);
-    printf("\n  record -> %s (%d rows); for the 3D window run it on a machine with a display\n", record, frames_done);
+    if (sandbox) printf("; slew %.1f deg", row[COL_SLEW] * 180 / M_PI);
+    if (loads) printf("; load at (%.2f, %.2f, %.2f) m", row[COL_LOAD_X], row[COL_LOAD_Y], row[COL_LOAD_Z]);
+    if (sandbox) printf("; truck tilt %.2f deg", row[COL_TRUCK_TILT] * 180 / M_PI);
+    if (!sandbox && m3 > 0) printf("; %.0f kg at the tip", m3);
+    printf("\n");
+    if (!wr)
+        printf("  record -> %s (%d rows); for the 3D window run it on a machine with a display\n", record,
+               frames_done);
     live_destroy(l);
     model_free(m);
     return code;
@@ -165,6 +266,11 @@ int cmd_drive(int argc, char** argv) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             drive_help(stdout);
             return 0;
+        }
+        if (!strcmp(argv[i], "--every")) {
+            // A common option drive would otherwise take and ignore.
+            fprintf(stderr, "cranesim drive: --every: drive records one row per command update (use --frame-rate)\n");
+            return EXIT_USAGE;
         }
         int rc = app_parse_common(&c, argc, argv, &i);
         if (rc < 0) return EXIT_USAGE;
@@ -219,29 +325,78 @@ int cmd_drive(int argc, char** argv) {
         fprintf(stderr, "cranesim drive: unknown option '%s' (see cranesim drive --help)\n", argv[i]);
         return EXIT_USAGE;
     }
-    const char* why = headless ? "--headless" : "no display (DISPLAY and WAYLAND_DISPLAY unset)";
+    // Every option is checked before anything runs, whichever mode follows:
+    // an option accepted in one mode and ignored in another would hide a
+    // mistake until the other mode is used.
+    char err[600], wname[64] = "";
+    int kind = -1;
+    if (c.sim.mechanics == SIM_ODE) {
+        kind = world_info(&c, wname, sizeof wname, err, sizeof err);
+        if (kind < 0) {
+            fprintf(stderr, "cranesim drive: %s\n", err);
+            return EXIT_USAGE;
+        }
+        // The validation world has no hook, loads or slew: its scripted
+        // operator is the 2-DOF demo (lift and jib), not the pick-and-place.
+        if (!c.scenario_path && kind == WORLD_VALIDATION) c.scenario_path = app_default_drive_scenario(SIM_LAGRANGE);
+    }
+    char why[700];
+    const bool display = have_display(why, sizeof why);
+    if (headless) snprintf(why, sizeof why, "--headless");
 #ifdef CRANESIM_HAVE_RENDER
+    drive_opts o = drive_default_opts();
+    o.width = width;
+    o.height = height;
+    if (rate_given) o.fps_cap = frame_rate;
+    o.mapping_file = mapping;
+    o.charts = charts;
+    o.record_path = record;
+    o.world_name = c.sim.mechanics == SIM_ODE ? wname : NULL;
+    int rc = drive_opts_check(&c, &o, err, sizeof err);
+    if (rc) {
+        fprintf(stderr, "cranesim drive: %s\n", err);
+        return rc;
+    }
     // A window when there is a display; an offscreen view when only a
     // screenshot is wanted; else the headless loop below.
-    if (!headless && (have_display() || shot)) {
-        drive_opts o = drive_default_opts();
-        o.width = width;
-        o.height = height;
-        o.offscreen = !have_display();
-        if (rate_given) o.fps_cap = frame_rate;
-        o.mapping_file = mapping;
-        o.charts = charts;
-        o.record_path = record;
+    if (!headless && (display || shot)) {
+        o.offscreen = !display;
         o.scripted = scripted || o.offscreen;
-        return drive_window_main(&c, &o, c.sim.duration, shot, shot_at);
+        char nowin[512];
+        rc = drive_window_main(&c, &o, c.sim.duration, shot, shot_at, nowin, sizeof nowin);
+        if (rc != DRIVE_NO_WINDOW) return rc;
+        // The display is named but no window opens on it (no X server
+        // there, or SDL only found a driver with no screen). A window nobody
+        // sees would be a session nobody drives: do what no display does.
+        const char* reason = strncmp(nowin, "render: ", 8) ? nowin : nowin + 8;
+        if (!shot) {
+            snprintf(why, sizeof why, "%s", reason);
+        } else {
+            printf("cranesim drive: %s: rendering offscreen\n", reason);
+            o.offscreen = true;
+            o.scripted = true;
+            rc = drive_window_main(&c, &o, c.sim.duration, shot, shot_at, nowin, sizeof nowin);
+            if (rc == DRIVE_NO_WINDOW) {
+                fprintf(stderr, "cranesim drive: %s\n", nowin);
+                return EXIT_RUNTIME;
+            }
+            return rc;
+        }
     }
 #else
-    (void)scripted, (void)mapping, (void)charts, (void)width, (void)height, (void)shot_at, (void)rate_given;
-    if (shot) {
-        fprintf(stderr, "cranesim drive: --screenshot needs the render module (built without SDL2/GL)\n");
+    (void)scripted, (void)width, (void)height, (void)shot_at, (void)rate_given;
+    // Without the render module these options have nothing to act on.
+    const char* needs = shot ? "--screenshot" : mapping ? "--mapping" : charts ? "--charts" : NULL;
+    if (needs) {
+        fprintf(stderr, "cranesim drive: %s needs the render module (built without SDL2/GL)\n", needs);
         return EXIT_USAGE;
     }
-    if (!headless && have_display()) why = "this binary was built without the render module (CRANESIM_CORE_ONLY)";
+    if (c.sim.cvode) {
+        fprintf(stderr, "cranesim drive: --solver cvode: drive steps the hydraulics in real time with the in-house "
+                        "solvers: use krus, ros2, rk4, ros34pw2 or rodas3\n");
+        return EXIT_USAGE;
+    }
+    if (!headless && display) snprintf(why, sizeof why, "this binary was built without the render module (CRANESIM_CORE_ONLY)");
 #endif
-    return drive_headless(&c, frame_rate, record ? record : "drive.csv", why);
+    return drive_headless(&c, frame_rate, record ? record : "drive.csv", why, kind, wname);
 }

@@ -1,6 +1,7 @@
 // drive_session.c: the real-time loop of `cranesim drive` (see drive_session.h).
 #include "drive_session.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,6 +59,8 @@ struct drive_session {
     double sim_offset;   // simulated time = wall - sim_offset while running
     FILE* rec;
     char rec_path[256];
+    long rec_rows;       // rows written to the open recording
+    char rec_err[320];   // first recording failure ("cannot write FILE: ..."), "" if none
     int ncol;
     int ev;              // next scripted hook event
     int nchart;          // user-chosen strip-chart channels (0: the default set)
@@ -256,26 +259,67 @@ static void rebuild_world(drive_session* s, bool at_start) {
     render_chart_clear(s->r);
 }
 
+// Strip-chart channel list: CSV column names (not t), comma-separated, 1 to 8
+// of them, among the first ncol columns. Fills col[] and returns the count,
+// or -1 with a one-line message.
+static int parse_charts(const char* list, int ncol, int col[8], char* err, size_t errsz) {
+    int n = 0;
+    for (const char* p = list;; ++p) {
+        const char* e = strchr(p, ',');
+        size_t len = e ? (size_t)(e - p) : strlen(p);
+        if (len == 0) {
+            snprintf(err, errsz, "--charts: expected column names separated by commas, got '%s'", list);
+            return -1;
+        }
+        int c = -1;
+        for (int k = 1; k < ncol; ++k)
+            if (strlen(sim_col_name[k]) == len && !strncmp(p, sim_col_name[k], len)) c = k;
+        if (c < 0) {
+            snprintf(err, errsz, "--charts: no column '%.*s'%s (see cranesim run --help for the names)", (int)len, p,
+                     ncol < SIM_NCOL ? " in the lagrange view" : "");
+            return -1;
+        }
+        if (n == 8) {
+            snprintf(err, errsz, "--charts: at most 8 channels, got more in '%s'", list);
+            return -1;
+        }
+        col[n++] = c;
+        if (!e) return n;
+        p = e;
+    }
+}
+
+int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t errsz) {
+    if (c->sim.cvode) {
+        // live.c steps the hydraulics with the in-house solvers only; run
+        // says the same for the ode world (sim.c).
+        snprintf(err, errsz, "--solver cvode: drive steps the hydraulics in real time with the in-house solvers: use "
+                             "krus, ros2, rk4, ros34pw2 or rodas3");
+        return EXIT_USAGE;
+    }
+    if (o->charts) {
+        int col[8];
+        if (parse_charts(o->charts, c->sim.mechanics == SIM_ODE ? SIM_NCOL : SIM_NCOL_BASE, col, err, errsz) < 0)
+            return EXIT_USAGE;
+    }
+    if (o->mapping_file) {
+        input_mapping map = input_default_mapping();
+        if (input_load_mapping(o->mapping_file, &map, err, errsz)) return EXIT_USAGE;
+    }
+    return 0;
+}
+
 // Chosen strip-chart channels: CSV column names, shown in display units
 // (MPa, mm, %, deg, kN), one plot per unit.
 static int setup_charts(drive_session* s, const char* list, char* err, size_t errsz) {
     static const float colours[8][4] = {{0.95f, 0.35f, 0.3f, 1}, {0.3f, 0.75f, 0.95f, 1}, {0.95f, 0.8f, 0.25f, 1},
                                         {0.5f, 0.9f, 0.4f, 1},   {0.8f, 0.5f, 0.95f, 1},  {0.95f, 0.6f, 0.2f, 1},
                                         {0.6f, 0.9f, 0.9f, 1},   {0.9f, 0.9f, 0.9f, 1}};
-    char buf[256];
-    snprintf(buf, sizeof buf, "%s", list);
-    for (char* tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-        int col = -1;
-        for (int c = 1; c < s->ncol; ++c)
-            if (!strcmp(tok, sim_col_name[c])) col = c;
-        if (col < 0) {
-            snprintf(err, errsz, "--charts: no column '%s' (see cranesim run --help for the names)", tok);
-            return -1;
-        }
-        if (s->nchart == 8) {
-            snprintf(err, errsz, "--charts: at most 8 channels");
-            return -1;
-        }
+    int cols[8];
+    const int n = parse_charts(list, s->ncol, cols, err, errsz);
+    if (n < 0) return -1;
+    for (int i = 0; i < n; ++i) {
+        const int col = cols[i];
         const char* u = sim_col_unit[col];
         render_chart_def d = {.label = sim_col_name[col], .unit = u, .scale = 1, .ymin = -1, .ymax = 1, .group = 5};
         if (!strcmp(u, "Pa")) d.unit = "MPa", d.scale = 1e-6, d.ymin = 0, d.ymax = 30, d.group = 0;
@@ -311,14 +355,92 @@ static void act_pause(void* user) {
     s->paused = !s->paused;
 }
 
-static void start_recording(drive_session* s, const char* path) {
-    s->rec = fopen(path, "w");
-    if (!s->rec) {
-        snprintf(s->status, sizeof s->status, "cannot write %s", path);
+// A recording that cannot be written is stopped at once and remembered
+// (drive_session_finish_record reports it): a CSV that silently stops
+// growing is output lost. What was written before stays in the file.
+static void record_failed(drive_session* s, int e) {
+    if (!s->rec_err[0])
+        snprintf(s->rec_err, sizeof s->rec_err, "cannot write %s: %s", s->rec_path, strerror(e ? e : EIO));
+    snprintf(s->status, sizeof s->status, "recording failed: cannot write %s: %s", s->rec_path, strerror(e ? e : EIO));
+    fclose(s->rec);
+    s->rec = NULL;
+}
+
+// Close the recording, checking that the buffered rows reached the file.
+static void stop_recording(drive_session* s) {
+    if (!s->rec) return;
+    errno = 0;
+    int e = ferror(s->rec) ? (errno ? errno : EIO) : 0;
+    if (!e && fflush(s->rec) != 0) e = errno;
+    if (e) {
+        record_failed(s, e);
         return;
     }
+    if (fclose(s->rec) != 0) {
+        s->rec = NULL;
+        snprintf(s->rec_err, sizeof s->rec_err, "cannot write %s: %s", s->rec_path, strerror(errno));
+        snprintf(s->status, sizeof s->status, "recording failed: %s", s->rec_err);
+        return;
+    }
+    s->rec = NULL;
+    snprintf(s->status, sizeof s->status, "recording stopped: %s (%ld rows)", s->rec_path, s->rec_rows);
+}
+
+static int start_recording(drive_session* s, const char* path) {
     snprintf(s->rec_path, sizeof s->rec_path, "%s", path);
+    s->rec_rows = 0;
+    s->rec = fopen(path, "w");
+    if (!s->rec) {
+        snprintf(s->status, sizeof s->status, "cannot write %s: %s", path, strerror(errno));
+        return -1;
+    }
+    errno = 0;
     sim_csv_header(s->rec, s->ncol);
+    if (ferror(s->rec)) {
+        record_failed(s, errno);
+        return -1;
+    }
+    return 0;
+}
+
+static void record_row(drive_session* s, const double* row) {
+    errno = 0;
+    sim_csv_row(s->rec, row, s->ncol);
+    if (ferror(s->rec)) record_failed(s, errno);
+    else ++s->rec_rows;
+}
+
+int drive_session_finish_record(drive_session* s, long* rows, char* err, size_t errsz) {
+    stop_recording(s);
+    if (rows) *rows = s->rec_rows;
+    if (!s->rec_err[0]) return 0;
+    snprintf(err, errsz, "%s", s->rec_err);
+    return -1;
+}
+
+// Interim, until ode_world_snapshot fills these itself (docs/render.md,
+// "The validation world's meshes"): the crane meshes have their origin at
+// the joint (column: at its foot; assets/meshes/README.md), the ode world's
+// primitives theirs at the centre. The sandbox's world file gives each mesh
+// that offset; the validation world file has no "meshes" section, so its
+// snapshot put each mesh origin at the primitive's centre: booms drawn half
+// a length [m] off their joints, the column half its height up. A crane mesh
+// with no offset gets the one its primitive implies; one with an offset is
+// left as its world file says, so this is a no-op once the world is fixed.
+static void crane_mesh_offsets(world_snapshot* snap) {
+    for (int i = 0; i < snap->nbody; ++i) {
+        world_snap_body* b = &snap->body[i];
+        if (!b->mesh[0] || b->mesh_offset[0] != 0 || b->mesh_offset[1] != 0 || b->mesh_offset[2] != 0) continue;
+        if (b->role == WORLD_ROLE_COLUMN && b->shape == WORLD_SHAPE_CYLINDER)
+            b->mesh_offset[2] = -0.5 * b->size[1]; // size[1]: column height [m]
+        else if ((b->role == WORLD_ROLE_BOOM1 || b->role == WORLD_ROLE_BOOM2) && b->shape == WORLD_SHAPE_BOX)
+            b->mesh_offset[0] = -0.5 * b->size[0]; // size[0]: link length [m]
+    }
+}
+
+static void take_snapshot(drive_session* s) {
+    live_snapshot(s->l, s->snap);
+    crane_mesh_offsets(s->snap);
 }
 
 drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz,
@@ -334,6 +456,14 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     s->c = *c;
     s->o = *o;
     s->snap = calloc(1, sizeof *s->snap);
+    // Options first: a bad chart name or mapping file is bad input whatever
+    // else happens (and before a window opens).
+    if ((*code = drive_opts_check(c, o, err, errsz)) != 0 || !s->snap) {
+        if (!s->snap) snprintf(err, errsz, "out of memory");
+        drive_session_destroy(s);
+        return NULL;
+    }
+    *code = EXIT_RUNTIME;
     if (!s->c.scenario_path)
         s->c.scenario_path = app_default_drive_scenario(s->c.sim.mechanics);
     if (app_load_msg(&s->c, &s->m, &s->sc, err, errsz)) {
@@ -367,6 +497,8 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     rc.asset_dir = asset_dir;
     s->r = render_create(&rc, err, errsz);
     if (!s->r) {
+        // No window on this display: the caller may run headless instead.
+        if (!o->offscreen) *code = DRIVE_NO_WINDOW;
         drive_session_destroy(s);
         return NULL;
     }
@@ -392,6 +524,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     // 1280x720 (56 vs 60 fps, cranesim bench --config drive), and the scene
     // is what an operator watches while driving.
     panel_gui_show(s->pn, false);
+    take_snapshot(s);
     if (o->charts) {
         if (setup_charts(s, o->charts, err, errsz)) {
             drive_session_destroy(s);
@@ -399,14 +532,21 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
             return NULL;
         }
     } else {
-        render_charts_default(s->r, s->c.sim.mechanics == SIM_ODE ? 3 : 2);
+        // One set of channels per cylinder the world has: the sandbox's
+        // slew rack is the third; the validation world and the lagrange
+        // view have only the two boom cylinders.
+        render_charts_default(s->r, s->snap->ncyl);
     }
-    if (o->record_path) start_recording(s, o->record_path);
+    if (o->record_path && start_recording(s, o->record_path)) {
+        snprintf(err, errsz, "%s", s->status);
+        drive_session_destroy(s);
+        *code = EXIT_USAGE;
+        return NULL;
+    }
     s->wall_last_frame = -1.0;
     // Warm-up frame before the caller starts its clock: the first frame
     // compiles the shaders and loads the meshes (well over 100 ms on
     // llvmpipe), which would otherwise count as a missed deadline.
-    live_snapshot(s->l, s->snap);
     render_frame(s->r, s->snap);
     render_present(s->r);
     render_wait(s->r, 1.0);
@@ -415,7 +555,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
 
 void drive_session_destroy(drive_session* s) {
     if (!s) return;
-    if (s->rec) fclose(s->rec);
+    if (s->rec) fclose(s->rec); // drive_session_finish_record checks it; here only freed
     if (s->pn) {
         if (s->r) render_attach_panel(s->r, NULL);
         panel_destroy(s->pn);
@@ -430,7 +570,9 @@ void drive_session_destroy(drive_session* s) {
 
 // Draw s->snap as it stands (the caller took the snapshot).
 static void render_snapshot(drive_session* s) {
-    s->snap->rt_factor = s->st.wall_time > 0 ? s->st.sim_time / s->st.wall_time : 0;
+    // Over less than 0.1 s of wall time the ratio means nothing (a frame at
+    // t = 0 would read thousands); 0 is "unknown" (world_snapshot.h).
+    s->snap->rt_factor = s->st.wall_time >= DRIVE_MIN_RATE_S ? s->st.sim_time / s->st.wall_time : 0;
     render_frame(s->r, s->snap);
     render_present(s->r);
     s->st.triangles = render_get_stats(s->r).triangles;
@@ -438,11 +580,15 @@ static void render_snapshot(drive_session* s) {
 }
 
 void drive_session_render(drive_session* s) {
-    live_snapshot(s->l, s->snap);
+    take_snapshot(s);
     render_snapshot(s);
 }
 
-int drive_session_screenshot(drive_session* s, const char* png) { return render_screenshot(s->r, png); }
+int drive_session_screenshot(drive_session* s, const char* png, char* err, size_t errsz) {
+    return render_save_png(s->r, png, err, errsz);
+}
+
+const world_snapshot* drive_session_snapshot(const drive_session* s) { return s->snap; }
 
 int drive_session_tick(drive_session* s, double wall) {
     double dt_wall = wall - s->wall_last;
@@ -461,14 +607,12 @@ int drive_session_tick(drive_session* s, double wall) {
         }
         if (ev.type == SDL_KEYDOWN && ev.key.keysym.scancode == SDL_SCANCODE_F5 && !ev.key.repeat) {
             if (s->rec) {
-                fclose(s->rec);
-                s->rec = NULL;
-                snprintf(s->status, sizeof s->status, "recording stopped: %s", s->rec_path);
+                stop_recording(s); // says "stopped" or "failed" in the status line
             } else {
                 char path[64];
                 snprintf(path, sizeof path, "cranesim_record_%ld.csv", (long)time(NULL));
-                start_recording(s, path); // on failure it says so in the status line
-                if (s->rec) snprintf(s->status, sizeof s->status, "recording to %s", path);
+                // On failure it says so in the status line.
+                if (start_recording(s, path) == 0) snprintf(s->status, sizeof s->status, "recording to %s", path);
             }
             continue;
         }
@@ -486,10 +630,10 @@ int drive_session_tick(drive_session* s, double wall) {
     if (cmd.camera_next) render_set_camera_preset(s->r, (render_get_camera_preset(s->r) + 1) % RENDER_CAM_COUNT);
     if (cmd.camera_preset >= 0) render_set_camera_preset(s->r, (render_cam_preset)cmd.camera_preset);
     if (cmd.screenshot) {
-        char path[64];
+        char path[64], e[320];
         snprintf(path, sizeof path, "cranesim_%ld.png", (long)time(NULL));
-        snprintf(s->status, sizeof s->status, render_screenshot(s->r, path) ? "screenshot failed" : "saved %s",
-                 path);
+        if (render_save_png(s->r, path, e, sizeof e)) snprintf(s->status, sizeof s->status, "screenshot failed: %s", e);
+        else snprintf(s->status, sizeof s->status, "saved %s", path);
     }
     for (int id; (id = panel_next_changed(s->pn)) >= 0;)
         for (int i = 0; i < s->nparam; ++i)
@@ -541,14 +685,15 @@ int drive_session_tick(drive_session* s, double wall) {
     // One CSV row per tick at most, shared by the recording and the charts.
     double row[SIM_NCOL];
     if (s->rec || (frame && s->nchart)) live_row(s->l, row);
-    if (s->rec) sim_csv_row(s->rec, row, s->ncol);
+    if (s->rec) record_row(s, row);
     if (frame) {
         char status[640];
+        // Who drives: the scenario, a named device, or the keyboard alone.
+        const char* src = s->o.scripted ? "  [scripted]" : input_device_name(s->in) ? "" : "  [keyboard]";
         snprintf(status, sizeof status, "%s%s%s%s%s", s->paused ? "PAUSED  " : "", s->rec ? "REC  " : "", s->status,
-                 input_device_name(s->in) ? "" : "  [keyboard]",
-                 panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]");
+                 src, panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]");
         render_set_status(s->r, status);
-        live_snapshot(s->l, s->snap);
+        take_snapshot(s);
         if (s->nchart)
             for (int i = 0; i < s->nchart; ++i) render_chart_push(s->r, s->chart_id[i], row[COL_T], row[s->chart_col[i]]);
         else
@@ -580,17 +725,31 @@ input* drive_session_input(drive_session* s) { return s->in; }
 panel* drive_session_panel(drive_session* s) { return s->pn; }
 void drive_session_row(drive_session* s, double* row) { live_row(s->l, row); }
 
+// "%.1f fps" of n events over wall seconds, or "n/a" when the interval is too
+// short for a rate to mean anything (a screenshot at t = 0).
+static const char* rate_str(char* buf, size_t n, double count, double wall, const char* fmt) {
+    if (wall >= DRIVE_MIN_RATE_S) snprintf(buf, n, fmt, count / wall);
+    else snprintf(buf, n, "n/a");
+    return buf;
+}
+
 int drive_window_main(const app_common* c, const drive_opts* o, double duration, const char* screenshot,
-                      double screenshot_at) {
+                      double screenshot_at, char* no_window, size_t no_window_sz) {
     char err[512];
     int code;
     drive_session* s = drive_session_create(c, o, err, sizeof err, &code);
     if (!s) {
+        if (code == DRIVE_NO_WINDOW) {
+            snprintf(no_window, no_window_sz, "%s", err);
+            return code;
+        }
         fprintf(stderr, "cranesim drive: %s\n", err);
         return code;
     }
-    printf("cranesim drive: %s in the %s; %s\n", s->m->name,
-           c->sim.mechanics == SIM_ODE ? "sandbox" : "lagrange 2-DOF view",
+    char where[96];
+    if (c->sim.mechanics != SIM_ODE) snprintf(where, sizeof where, "the lagrange 2-DOF view");
+    else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : "sandbox");
+    printf("cranesim drive: %s in %s%s; %s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
            o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
                                                "R reset, C camera, F5 record, F12 screenshot, Esc quit)");
     // Ticks at 240 Hz: between rendered frames the loop still pumps events,
@@ -610,8 +769,12 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
         }
         if (screenshot && !shot_done && live_time(s->l) >= screenshot_at) {
             drive_session_render(s);
-            if (drive_session_screenshot(s, screenshot)) code = EXIT_RUNTIME;
-            else printf("  screenshot -> %s\n", screenshot);
+            if (drive_session_screenshot(s, screenshot, err, sizeof err)) {
+                fprintf(stderr, "cranesim drive: %s\n", err);
+                code = EXIT_RUNTIME;
+            } else {
+                printf("  screenshot -> %s\n", screenshot);
+            }
             shot_done = true;
             if (duration <= 0) break;
         }
@@ -620,10 +783,19 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
         drive_session_idle(s, wall + tick - next);
     }
     const drive_stats* st = drive_session_stats(s);
-    printf("  simulated %.2f s in %.2f s wall; %ld frames (%.1f fps), %ld command updates (%.0f Hz), missed %ld; "
+    char fps[32], hz[32];
+    printf("  simulated %.2f s in %.2f s wall; %ld frames (%s fps), %ld command updates (%s Hz), missed %ld; "
            "%ld triangles\n",
-           st->sim_time, st->wall_time, st->frames, st->wall_time > 0 ? st->frames / st->wall_time : 0,
-           st->input_samples, st->wall_time > 0 ? st->input_samples / st->wall_time : 0, st->missed, st->triangles);
+           st->sim_time, st->wall_time, st->frames, rate_str(fps, sizeof fps, (double)st->frames, st->wall_time, "%.1f"),
+           st->input_samples, rate_str(hz, sizeof hz, (double)st->input_samples, st->wall_time, "%.0f"), st->missed,
+           st->triangles);
+    long rows = 0;
+    if (drive_session_finish_record(s, &rows, err, sizeof err)) {
+        fprintf(stderr, "cranesim drive: %s\n", err);
+        code = EXIT_RUNTIME;
+    } else if (s->rec_path[0]) {
+        printf("  record -> %s (%ld rows)\n", s->rec_path, rows);
+    }
     drive_session_destroy(s);
     return code;
 }

@@ -19,6 +19,16 @@ struct render;
 struct input;
 struct panel;
 
+/// drive_session_create's code (never an exit code) when the renderer could
+/// not open a window (no X server or compositor behind DISPLAY or
+/// WAYLAND_DISPLAY, or SDL only has a driver with no screen): the caller may
+/// fall back to a headless run.
+#define DRIVE_NO_WINDOW (-2)
+/// Rates (fps, command updates per second, the HUD's real-time factor) are
+/// not given over less wall time than this [s]: a ratio of two tiny times
+/// reads millions.
+#define DRIVE_MIN_RATE_S 0.1
+
 typedef struct drive_opts {
     int width, height;        ///< window or offscreen size [px] (default 1280 x 720)
     bool offscreen;           ///< render into an FBO, no window
@@ -29,9 +39,16 @@ typedef struct drive_opts {
     bool hud;                 ///< draw the HUD (default true)
     const char* charts;       ///< strip-chart channels: CSV column names, comma-separated
                               ///< ("p1A,p2A,x1,u1"); NULL: pressures, strokes, spools
+    const char* world_name;   ///< the ode world's name for the banner ("validation"); NULL: "sandbox"
 } drive_opts;
 
 drive_opts drive_default_opts(void);
+
+/// Check what drive cannot use, before anything starts, in every mode: the
+/// solver (cvode cannot step in real time), the chart names (o->charts), and
+/// the mapping file (o->mapping_file, read and validated). Returns 0, or
+/// EXIT_USAGE with one line naming the option, file or field.
+int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t errsz);
 
 typedef struct drive_stats {
     long frames;          ///< frames rendered
@@ -49,8 +66,9 @@ typedef struct drive_session drive_session;
 /// Load the model, build the world, open the renderer and devices. c holds the
 /// model, world, scenario and solver options (drive's defaults: ode sandbox).
 /// Returns NULL with a message, and (when code is not NULL) the exit code it
-/// calls for: 2 for bad input (model, scenario, mapping, chart names), 1 when
-/// the renderer or the world cannot start.
+/// calls for: 2 for bad input (model, scenario, mapping, chart names, a
+/// record file that cannot be opened), 1 when the renderer or the world
+/// cannot start, DRIVE_NO_WINDOW when a window (not offscreen) cannot open.
 drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz,
                                     int* code);
 void drive_session_destroy(drive_session* s);
@@ -66,7 +84,16 @@ void drive_session_idle(drive_session* s, double left);
 
 /// Force a rendered frame now (e.g. before a screenshot).
 void drive_session_render(drive_session* s);
-int drive_session_screenshot(drive_session* s, const char* png);
+/// Save the last frame as PNG. Returns 0, or -1 with "cannot write FILE:
+/// <strerror>" in err (the file is checked to the last byte: a full disk fails).
+int drive_session_screenshot(drive_session* s, const char* png, char* err, size_t errsz);
+/// The snapshot the last frame was drawn from (as given to the renderer).
+const world_snapshot* drive_session_snapshot(const drive_session* s);
+/// Close the CSV recording, if any, and say whether every recording of the
+/// session reached its file. Returns 0 (rows: rows of the last recording), or
+/// -1 with "cannot write FILE: <strerror>" in err; rows written before the
+/// failure stay in the file.
+int drive_session_finish_record(drive_session* s, long* rows, char* err, size_t errsz);
 
 const char* drive_session_error(const drive_session* s);
 const drive_stats* drive_session_stats(const drive_session* s);
@@ -80,8 +107,10 @@ const model* drive_session_model(const drive_session* s);
 void drive_session_row(drive_session* s, double* row);
 
 /// Run the interactive loop on the real clock until quit (the `drive` command).
+/// Returns an exit code, or DRIVE_NO_WINDOW (nothing printed, the reason in
+/// no_window) when the window cannot open.
 int drive_window_main(const app_common* c, const drive_opts* o, double duration, const char* screenshot,
-                      double screenshot_at);
+                      double screenshot_at, char* no_window, size_t no_window_sz);
 
 /// Benchmark: the real-time loop offscreen at w x h with the scripted
 /// operator for `seconds` of wall time; prints one JSON line (fps median and

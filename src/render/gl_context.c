@@ -6,7 +6,9 @@
 // with no X server or GPU (llvmpipe). The frame itself always goes into our
 // own FBO; a visible window gets it by one blit before the swap.
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "gl_context.h"
 
@@ -14,17 +16,73 @@ static void set_err(char* err, size_t errsz, const char* what) {
     if (err && errsz) snprintf(err, errsz, "render: %s: %s", what, SDL_GetError());
 }
 
+// The display a window would go to, as the environment names it, for
+// messages: "on DISPLAY=:0", "on WAYLAND_DISPLAY=wayland-0", or "".
+static void display_name(char* buf, size_t n) {
+    const char* x = getenv("DISPLAY");
+    const char* w = getenv("WAYLAND_DISPLAY");
+    if (x && *x) snprintf(buf, n, " on DISPLAY=%s", x);
+    else if (w && *w) snprintf(buf, n, " on WAYLAND_DISPLAY=%s", w);
+    else buf[0] = 0;
+}
+
+// WAYLAND_DISPLAY names a socket that exists (absolute, or in
+// XDG_RUNTIME_DIR). Without it libwayland prints its own error line when SDL
+// tries to connect, so the wayland driver is only tried when it can work.
+static bool wayland_socket(const char* name) {
+    char path[512];
+    const char* dir = getenv("XDG_RUNTIME_DIR");
+    if (name[0] == '/') snprintf(path, sizeof path, "%s", name);
+    else if (dir && *dir) snprintf(path, sizeof path, "%s/%s", dir, name);
+    else return false;
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
 bool render_gl_open(render* r, char* err, size_t errsz) {
     // Prefer the offscreen driver for headless rendering, but let an explicit
     // SDL_VIDEODRIVER in the environment win (it overrides a default hint).
     if (r->cfg.offscreen && !SDL_WasInit(SDL_INIT_VIDEO))
         SDL_SetHintWithPriority(SDL_HINT_VIDEODRIVER, "offscreen", SDL_HINT_DEFAULT);
+    // A window: only the drivers of the displays the environment names.
+    // Left to itself, SDL falls back to its offscreen or dummy driver when
+    // the X server or compositor is not there, and the "window" is then
+    // invisible; it would also try wayland without one, where libwayland
+    // prints its own error line. (An explicit SDL_VIDEODRIVER still wins.)
+    if (!r->cfg.offscreen && !SDL_WasInit(SDL_INIT_VIDEO)) {
+        const char* x = getenv("DISPLAY");
+        const char* w = getenv("WAYLAND_DISPLAY");
+        char list[32] = "";
+        if (x && *x) snprintf(list, sizeof list, "x11");
+        if (w && *w && wayland_socket(w))
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%swayland", list[0] ? "," : "");
+        if (list[0]) SDL_SetHintWithPriority(SDL_HINT_VIDEODRIVER, list, SDL_HINT_DEFAULT);
+    }
     if (!SDL_WasInit(SDL_INIT_VIDEO)) {
         if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0) {
-            set_err(err, errsz, "SDL video init");
+            if (r->cfg.offscreen) {
+                set_err(err, errsz, "SDL video init");
+            } else if (err && errsz) {
+                char d[160];
+                display_name(d, sizeof d);
+                snprintf(err, errsz, "render: cannot open a window%s (%s)", d, SDL_GetError());
+            }
             return false;
         }
         r->own_video = true;
+    }
+    if (!r->cfg.offscreen) {
+        // These drivers have no screen: a window there is one nobody sees.
+        const char* drv = SDL_GetCurrentVideoDriver();
+        if (drv && (!strcmp(drv, "offscreen") || !strcmp(drv, "dummy"))) {
+            if (err && errsz) {
+                char d[160];
+                display_name(d, sizeof d);
+                snprintf(err, errsz, "render: cannot open a window%s (SDL's video driver '%s' has no screen)", d,
+                         drv);
+            }
+            return false;
+        }
     }
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_PROFILE_MASK, SDL_GL_CONTEXT_PROFILE_CORE);
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 3);

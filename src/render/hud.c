@@ -269,11 +269,15 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     const int nrows = 14;
     float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
     render_hud_rect(h, x - 6, y - 6, w, lh * (float)nrows + 10, k_panel);
-    char buf[160];
+    char buf[160], rt[32];
+    // rt_factor 0 means unknown (world_snapshot.h), e.g. over the first
+    // instants, where a ratio of two tiny times means nothing.
+    if (s->rt_factor > 0) snprintf(rt, sizeof rt, "%.2fx", s->rt_factor);
+    else snprintf(rt, sizeof rt, "n/a");
     if (r->frame_dt_avg > 0)
-        snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx   %.0f fps", s->t, s->rt_factor, 1.0 / r->frame_dt_avg);
+        snprintf(buf, sizeof buf, "t %.2f s   RT %s   %.0f fps", s->t, rt, 1.0 / r->frame_dt_avg);
     else
-        snprintf(buf, sizeof buf, "t %.2f s   RT %.2fx", s->t, s->rt_factor);
+        snprintf(buf, sizeof buf, "t %.2f s   RT %s", s->t, rt);
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh * 1.3f;
     for (int i = 0; i < ncyl; ++i)

@@ -1,5 +1,6 @@
 // input.c: game controllers, plain joysticks and the keyboard -> one
 // input_command per frame (see input.h for the why).
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -63,9 +64,29 @@ double input_shape(double raw, double dead_zone, double expo) {
 
 // ---- mapping file ----------------------------------------------------------------
 
-static const char* k_axis_names[INPUT_AXIS_COUNT] = {"lift", "jib", "slew"};
-static const char* k_button_names[INPUT_BUTTON_COUNT] = {"hook", "pause", "reset", "screenshot",
-                                                         "camera"};
+static const char* const k_axis_names[INPUT_AXIS_COUNT] = {"lift", "jib", "slew"};
+static const char* const k_button_names[INPUT_BUTTON_COUNT] = {"hook",       "pause", "reset",
+                                                               "screenshot", "camera"};
+
+/// Every key of object o must be one of the n names in allowed: a field the
+/// format does not have is a typo, and skipping it would leave the setting
+/// the user meant at its default. where: the object's path ("" at the top).
+static int only_keys(const cJSON* o, const char* const* allowed, int n, const char* path,
+                     const char* where, char* err, size_t errsz) {
+    for (const cJSON* k = o->child; k; k = k->next) {
+        bool ok = false;
+        for (int i = 0; i < n && !ok; ++i) ok = k->string && strcmp(k->string, allowed[i]) == 0;
+        if (ok) continue;
+        char list[160] = "";
+        for (int i = 0; i < n; ++i)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "",
+                     allowed[i]);
+        snprintf(err, errsz, "%s: %s%s%s: unknown field (expected %s)", path, where,
+                 where[0] ? "." : "", k->string ? k->string : "?", list);
+        return -1;
+    }
+    return 0;
+}
 
 /// Reads an optional number field within [lo, hi].
 static int get_num(const cJSON* o, const char* key, double lo, double hi, double* out,
@@ -120,7 +141,7 @@ int input_load_mapping(const char* path, input_mapping* m, char* err, size_t err
     if (!err || !errsz) err = dummy, errsz = sizeof dummy;
     FILE* f = fopen(path, "rb");
     if (!f) {
-        snprintf(err, errsz, "%s: cannot open", path);
+        snprintf(err, errsz, "%s: cannot open: %s", path, strerror(errno));
         return -1;
     }
     fseek(f, 0, SEEK_END);
@@ -135,17 +156,40 @@ int input_load_mapping(const char* path, input_mapping* m, char* err, size_t err
     }
     text[got] = '\0';
     cJSON* root = cJSON_Parse(text);
-    free(text);
     if (!root || !cJSON_IsObject(root)) {
-        snprintf(err, errsz, "%s: not a JSON object (syntax error near \"%.20s\")", path,
-                 cJSON_GetErrorPtr() ? cJSON_GetErrorPtr() : "");
+        // cJSON's error pointer points into text: quote it before freeing.
+        const char* at = root ? NULL : cJSON_GetErrorPtr();
+        if (at) {
+            int line = 1;
+            for (const char* c = text; c < at; ++c) line += *c == '\n';
+            int n = 0; // quote up to 20 characters, on one line
+            while (n < 20 && at[n] && at[n] != '\n' && at[n] != '\r') ++n;
+            snprintf(err, errsz, "%s: line %d: not valid JSON near \"%.*s\"", path, line, n, at);
+        } else {
+            snprintf(err, errsz, "%s: must be a JSON object", path);
+        }
+        free(text);
         cJSON_Delete(root);
         return -1;
     }
+    free(text);
     // Work on a copy so a bad file leaves the caller's mapping untouched.
     input_mapping t = *m;
-    int rc = 0;
+    static const char* const k_top[] = {"axes", "buttons", "keyboard_ramp_s"};
+    static const char* const k_axis_fields[] = {"controller", "joystick", "invert",
+                                                "dead_zone",  "expo",     "scale"};
+    static const char* const k_button_fields[] = {"controller", "joystick"};
+    int rc = only_keys(root, k_top, 3, path, "", err, errsz);
     const cJSON* axes = cJSON_GetObjectItemCaseSensitive(root, "axes");
+    const cJSON* buttons = cJSON_GetObjectItemCaseSensitive(root, "buttons");
+    if (rc == 0 && ((axes && !cJSON_IsObject(axes)) || (buttons && !cJSON_IsObject(buttons)))) {
+        snprintf(err, errsz, "%s: %s: must be an object", path,
+                 axes && !cJSON_IsObject(axes) ? "axes" : "buttons");
+        rc = -1;
+    }
+    if (rc == 0 && axes) rc = only_keys(axes, k_axis_names, INPUT_AXIS_COUNT, path, "axes", err, errsz);
+    if (rc == 0 && buttons)
+        rc = only_keys(buttons, k_button_names, INPUT_BUTTON_COUNT, path, "buttons", err, errsz);
     for (int i = 0; axes && rc == 0 && i < INPUT_AXIS_COUNT; ++i) {
         const cJSON* a = cJSON_GetObjectItemCaseSensitive(axes, k_axis_names[i]);
         if (!a) continue;
@@ -157,7 +201,8 @@ int input_load_mapping(const char* path, input_mapping* m, char* err, size_t err
             break;
         }
         input_axis_map* x = &t.axis[i];
-        rc |= get_ref(a, "controller", true, true, &x->controller_axis, path, where, err, errsz);
+        rc |= only_keys(a, k_axis_fields, 6, path, where, err, errsz);
+        if (!rc) rc |= get_ref(a, "controller", true, true, &x->controller_axis, path, where, err, errsz);
         if (!rc)
             rc |= get_ref(a, "joystick", false, true, &x->joystick_axis, path, where, err, errsz);
         if (!rc) rc |= get_num(a, "dead_zone", 0.0, 0.94, &x->dead_zone, path, where, err, errsz);
@@ -173,14 +218,20 @@ int input_load_mapping(const char* path, input_mapping* m, char* err, size_t err
             }
         }
     }
-    const cJSON* buttons = cJSON_GetObjectItemCaseSensitive(root, "buttons");
     for (int i = 0; buttons && rc == 0 && i < INPUT_BUTTON_COUNT; ++i) {
         const cJSON* b = cJSON_GetObjectItemCaseSensitive(buttons, k_button_names[i]);
         if (!b) continue;
         char where[48];
         snprintf(where, sizeof where, "buttons.%s", k_button_names[i]);
-        rc |=
-            get_ref(b, "controller", true, false, &t.controller_button[i], path, where, err, errsz);
+        if (!cJSON_IsObject(b)) {
+            snprintf(err, errsz, "%s: %s: must be an object", path, where);
+            rc = -1;
+            break;
+        }
+        rc |= only_keys(b, k_button_fields, 2, path, where, err, errsz);
+        if (!rc)
+            rc |= get_ref(b, "controller", true, false, &t.controller_button[i], path, where, err,
+                          errsz);
         if (!rc)
             rc |= get_ref(b, "joystick", false, false, &t.joystick_button[i], path, where, err,
                           errsz);

@@ -230,6 +230,8 @@ void render_set_status(render* r, const char* text) {
     snprintf(r->status, sizeof r->status, "%s", text ? text : "");
 }
 
+const char* render_get_status(const render* r) { return r->status; }
+
 void render_set_missed_deadlines(render* r, int missed) {
     r->missed_deadlines = missed;
 }

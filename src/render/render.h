@@ -102,6 +102,11 @@ bool render_wait(render* r, double timeout_s);
 /// Save the last rendered frame as PNG (before or after render_present).
 /// Returns 0 on success, -1 on failure (message on stderr naming the file).
 int render_screenshot(render* r, const char* path);
+/// render_screenshot without the stderr line: on failure (no frame yet, or
+/// the file cannot be opened, written, flushed or closed, e.g. a full disk)
+/// returns -1 with "cannot write FILE: <strerror>" in err. Bytes written
+/// before a failure stay in the file.
+int render_save_png(render* r, const char* path, char* err, size_t errsz);
 /// Copy the last frame as RGBA8, top row first, into a w*h*4 buffer.
 /// Returns 0 on success.
 int render_read_pixels(render* r, unsigned char* rgba, int w, int h);
@@ -115,6 +120,14 @@ void render_set_orbit(render* r, const double target[3], double yaw, double pitc
 /// left) with the camera of the last frame. Returns false if it is behind the
 /// camera.
 bool render_project(const render* r, const double world[3], double px[2]);
+
+/// Where the scene draws point p of body b [m, world]. With a mesh named, p is
+/// in the mesh's own coordinates (mesh units, z up after the mesh_up turn)
+/// and lands at pos + rot (mesh_scale p + mesh_offset); without one, p is in
+/// the primitive's frame (centre at 0) [m] and lands at pos + rot p. The scene
+/// places every mesh with this, so a test can check that, e.g., boom1.obj's
+/// joint-2 pin (L1, 0, 0) is drawn where the physics has joint 2.
+void render_body_point(const world_snap_body* b, const double p[3], double world[3]);
 
 /// Screen rectangle (x, y, w, h [px], origin top left) of the inside of the
 /// pressure bar of cylinder `cyl`, chamber 0 = A or 1 = B, as drawn in the
@@ -136,6 +149,8 @@ bool render_attach_panel(render* r, panel* p);
 
 /// Short status line shown under the readouts (e.g. "PAUSED", "recording").
 void render_set_status(render* r, const char* text);
+/// The status line as last set.
+const char* render_get_status(const render* r);
 /// The app reports missed real-time deadlines here; any count > 0 in the last
 /// second shows the "cannot keep up with real time" warning.
 void render_set_missed_deadlines(render* r, int missed_last_second);
@@ -154,6 +169,9 @@ typedef struct render_chart_def {
 
 /// Add a chart channel; returns its id (>= 0) or -1 when full.
 int render_chart_add(render* r, const render_chart_def* def);
+/// Channels registered so far, and the label of channel id (NULL if none).
+int render_chart_count(const render* r);
+const char* render_chart_label(const render* r, int id);
 /// Append a sample (t [s], SI value). Samples must come in increasing t.
 void render_chart_push(render* r, int id, double t, double value);
 /// Remove all samples (e.g. after a reset).

@@ -306,6 +306,17 @@ static rm_vec3 v3d(const double p[3]) {
 
 static void add_body_items(render_scene* sc, render_mesh_cache* mc, const world_snap_body* b);
 
+void render_body_point(const world_snap_body* b, const double p[3], double world[3]) {
+    // Mesh: p in mesh units, scaled to metres and shifted by the mesh origin's
+    // place in the body frame; primitive: p already in the body frame [m].
+    const bool mesh = b->mesh[0] != 0;
+    const double s = mesh && b->mesh_scale > 0 ? b->mesh_scale : 1.0;
+    double q[3];
+    for (int k = 0; k < 3; ++k) q[k] = s * p[k] + (mesh ? b->mesh_offset[k] : 0.0);
+    for (int r = 0; r < 3; ++r)
+        world[r] = b->pos[r] + b->rot[r * 3 + 0] * q[0] + b->rot[r * 3 + 1] * q[1] + b->rot[r * 3 + 2] * q[2];
+}
+
 static void add_body(render_scene* sc, render_mesh_cache* mc, const world_snap_body* b) {
     if (b->shape == WORLD_SHAPE_TERRAIN || b->role == WORLD_ROLE_TERRAIN) return;
     int first = sc->nitems;
@@ -320,13 +331,13 @@ static void add_body(render_scene* sc, render_mesh_cache* mc, const world_snap_b
 static void add_body_items(render_scene* sc, render_mesh_cache* mc, const world_snap_body* b) {
     const render_mesh* mesh = b->mesh[0] ? render_mesh_get(mc, b->mesh, b->mesh_up) : NULL;
     if (mesh) {
-        // world = R (s p + offset) + pos
+        // world = R (s p + offset) + pos: the mesh origin goes where
+        // render_body_point puts p = 0, so tests can check what is drawn.
         float s = b->mesh_scale > 0 ? (float)b->mesh_scale : 1.0f;
         float sc3[3] = {s, s, s};
+        static const double origin[3] = {0, 0, 0};
         double pos[3];
-        for (int r = 0; r < 3; ++r)
-            pos[r] = b->pos[r] + b->rot[r * 3 + 0] * b->mesh_offset[0] +
-                     b->rot[r * 3 + 1] * b->mesh_offset[1] + b->rot[r * 3 + 2] * b->mesh_offset[2];
+        render_body_point(b, origin, pos);
         render_draw_item* it = push_item(sc, mesh, b->rgba);
         if (it) rm_model(it->model, b->rot, sc3, pos);
         return;

@@ -3,8 +3,10 @@
 //
 // The frame is kept in the renderer's own FBO (also in a window), so this
 // works before or after render_present().
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <stb/stb_image_write.h>
 
@@ -31,18 +33,52 @@ int render_read_pixels(render* r, unsigned char* rgba, int w, int h) {
     return glGetError() == GL_NO_ERROR ? 0 : -1;
 }
 
-int render_screenshot(render* r, const char* path) {
+// stbi_write_png() ignores fwrite's and fclose's results, so a full disk
+// would pass for a saved picture: write through a callback that keeps the
+// first error instead.
+typedef struct png_sink {
+    FILE* f;
+    int err; ///< errno of the first failed write, 0 if none
+} png_sink;
+
+static void png_write(void* ctx, void* data, int size) {
+    png_sink* k = ctx;
+    if (k->err || size <= 0) return;
+    if (fwrite(data, 1, (size_t)size, k->f) != (size_t)size) k->err = errno ? errno : EIO;
+}
+
+int render_save_png(render* r, const char* path, char* err, size_t errsz) {
     if (!r || !path) return -1;
     unsigned char* px = malloc((size_t)r->w * (size_t)r->h * 4);
-    if (!px) return -1;
-    int rc = render_read_pixels(r, px, r->w, r->h);
-    if (rc == 0) {
-        // The alpha channel holds blending leftovers; force opaque.
-        for (size_t i = 3; i < (size_t)r->w * (size_t)r->h * 4; i += 4)
-            px[i] = 255;
-        if (!stbi_write_png(path, r->w, r->h, 4, px, r->w * 4)) rc = -1;
+    if (!px || render_read_pixels(r, px, r->w, r->h) != 0) {
+        free(px);
+        if (err && errsz) snprintf(err, errsz, "cannot write %s: no frame to save", path);
+        return -1;
+    }
+    // The alpha channel holds blending leftovers; force opaque.
+    for (size_t i = 3; i < (size_t)r->w * (size_t)r->h * 4; i += 4)
+        px[i] = 255;
+    png_sink k = {fopen(path, "wb"), 0};
+    int rc = 0;
+    if (!k.f) {
+        k.err = errno;
+        rc = -1;
+    } else {
+        errno = 0;
+        // Whatever was written stays: a partial file says more than none.
+        if (!stbi_write_png_to_func(png_write, &k, r->w, r->h, 4, px, r->w * 4) && !k.err) k.err = ENOMEM;
+        if (fflush(k.f) != 0 && !k.err) k.err = errno;
+        if (fclose(k.f) != 0 && !k.err) k.err = errno;
+        if (k.err) rc = -1;
     }
     free(px);
-    if (rc != 0) fprintf(stderr, "render: cannot write screenshot %s\n", path);
+    if (rc && err && errsz) snprintf(err, errsz, "cannot write %s: %s", path, strerror(k.err ? k.err : EIO));
+    return rc;
+}
+
+int render_screenshot(render* r, const char* path) {
+    char err[512];
+    int rc = render_save_png(r, path, err, sizeof err);
+    if (rc) fprintf(stderr, "render: %s\n", err);
     return rc;
 }

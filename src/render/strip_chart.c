@@ -23,6 +23,12 @@ int render_chart_add(render* r, const render_chart_def* def) {
     return c->n++;
 }
 
+int render_chart_count(const render* r) { return r->charts.n; }
+
+const char* render_chart_label(const render* r, int id) {
+    return id >= 0 && id < r->charts.n ? r->charts.ch[id].label : NULL;
+}
+
 void render_chart_push(render* r, int id, double t, double value) {
     render_charts* c = &r->charts;
     if (id < 0 || id >= c->n) return;

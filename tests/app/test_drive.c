@@ -8,6 +8,8 @@
 #include "render.h"
 
 #include <SDL2/SDL.h>
+#include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -28,6 +30,233 @@ static drive_session* open_session_with(const char* const* sets, int nset) {
 }
 
 static drive_session* open_session(void) { return open_session_with(NULL, 0); }
+
+static int run_for(drive_session* s, double* wall, double seconds);
+
+// A session in the validation world (column on the ground at the origin,
+// booms on hinges, no truck), driven by the 2-DOF demo as `cranesim drive
+// --world validation` does.
+static drive_session* open_validation(bool scripted) {
+    app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE;
+    c.sim.world = "validation";
+    c.scenario_path = CRANESIM_ASSETS "/scenarios/drive_demo.json";
+    drive_opts o = drive_default_opts();
+    o.offscreen = true;
+    o.scripted = scripted;
+    char err[512];
+    drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
+    CHECK(s != NULL, "validation session: %s", err);
+    return s;
+}
+
+static const world_snap_body* find_role(const world_snapshot* snap, world_role role) {
+    for (int i = 0; i < snap->nbody; ++i)
+        if (snap->body[i].role == role) return &snap->body[i];
+    return NULL;
+}
+
+static double dist3(const double a[3], const double b[3]) {
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+// Where the renderer draws point p (metres, in the body's mesh or primitive
+// frame) of body b, against where it should be, within tol [m].
+static void check_drawn(const world_snap_body* b, double px, double py, double pz, const double want[3], double tol,
+                        const char* what) {
+    const double p[3] = {px, py, pz};
+    double got[3];
+    render_body_point(b, p, got);
+    double d = dist3(got, want);
+    CHECK(d <= tol, "%s: drawn at (%.3f, %.3f, %.3f) m, joint at (%.3f, %.3f, %.3f) m: %.3f m apart", what, got[0],
+          got[1], got[2], want[0], want[1], want[2], d);
+}
+
+// The drawn crane is one piece: each boom mesh starts at the pin the previous
+// part ends at (assets/meshes/README.md: column.obj has its foot at the
+// origin and joint 1 at (0, 0, H); boom1.obj joint 1 at the origin, joint 2
+// at (L1, 0, 0); boom2.obj joint 2 at the origin, the tip at (L2, 0, 0)),
+// and every cylinder pin lies on the part that carries it.
+static void check_crane_drawn_in_one_piece(const world_snapshot* snap, const crane_mech* me, const char* world) {
+    const world_snap_body* col = find_role(snap, WORLD_ROLE_COLUMN);
+    const world_snap_body* b1 = find_role(snap, WORLD_ROLE_BOOM1);
+    const world_snap_body* b2 = find_role(snap, WORLD_ROLE_BOOM2);
+    CHECK(col && b1 && b2, "%s: column, lifting arm and end arm in the snapshot", world);
+    if (!col || !b1 || !b2) return;
+    CHECK(col->mesh[0] && b1->mesh[0] && b2->mesh[0], "%s: crane drawn with its meshes", world);
+    const double H = me->column_height, L1 = me->link[0].length, L2 = me->link[1].length;
+    const double o[3] = {0, 0, 0};
+    double j1[3], j2[3];
+    // Joint 1 as the column draws it, joint 2 as the lifting arm draws it.
+    const double pin1[3] = {0, 0, H}, pin2[3] = {L1, 0, 0};
+    render_body_point(col, pin1, j1);
+    render_body_point(b1, pin2, j2);
+    char what[96];
+    snprintf(what, sizeof what, "%s: lifting arm root at the column's joint-1 pin", world);
+    check_drawn(b1, o[0], o[1], o[2], j1, 0.01, what);
+    snprintf(what, sizeof what, "%s: end arm root at the lifting arm's joint-2 pin", world);
+    check_drawn(b2, o[0], o[1], o[2], j2, 0.01, what);
+    snprintf(what, sizeof what, "%s: end arm tip at the snapshot's tip", world);
+    check_drawn(b2, L2, 0, 0, snap->tip, 0.01, what);
+    // Cylinder pins: base in the parent part, rod end in the child part
+    // (mounts relative to the joint; the lift's parent is the column, whose
+    // mesh origin is H below joint 1; the jib's is the lifting arm, whose
+    // mesh origin is joint 1, L1 behind joint 2).
+    CHECK(snap->ncyl >= 2, "%s: two boom cylinders", world);
+    const crane_actuator* lift = &me->act[0];
+    const crane_actuator* jib = &me->act[1];
+    snprintf(what, sizeof what, "%s: lift barrel pin on the column", world);
+    check_drawn(col, lift->base_mount[0], 0, lift->base_mount[1] + H, snap->cyl[0].base, 0.01, what);
+    snprintf(what, sizeof what, "%s: lift rod pin on the lifting arm", world);
+    check_drawn(b1, lift->rod_mount[0], 0, lift->rod_mount[1], snap->cyl[0].rod_end, 0.01, what);
+    snprintf(what, sizeof what, "%s: jib barrel pin on the lifting arm", world);
+    check_drawn(b1, L1 + jib->base_mount[0], 0, jib->base_mount[1], snap->cyl[1].base, 0.01, what);
+    snprintf(what, sizeof what, "%s: jib rod pin on the end arm", world);
+    check_drawn(b2, jib->rod_mount[0], 0, jib->rod_mount[1], snap->cyl[1].rod_end, 0.01, what);
+}
+
+// `drive --world validation` drew the booms apart (QA): the meshes must be
+// drawn where the joints are. In the validation world the column stands on
+// the ground at the origin, so the joints also follow from the joint angles
+// alone (paper convention: q1 from the downward vertical, q2 relative to the
+// lifting arm, boom plane x-z): an independent check of the whole chain.
+static void test_validation_world_drawn_at_the_joints(void) {
+    drive_session* s = open_validation(true);
+    if (!s) return;
+    double wall = 0;
+    const crane_mech* me = &drive_session_model(s)->mech;
+    // At the start and after the demo has moved both booms.
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass) CHECK(run_for(s, &wall, 3.0) == 0, "loop: %s", drive_session_error(s));
+        drive_session_render(s);
+        const world_snapshot* snap = drive_session_snapshot(s);
+        check_crane_drawn_in_one_piece(snap, me, "validation");
+        double row[SIM_NCOL];
+        drive_session_row(s, row);
+        const double q1 = row[COL_Q1], q12 = row[COL_Q1] + row[COL_Q2];
+        const double H = me->column_height, L1 = me->link[0].length, L2 = me->link[1].length;
+        const double j1[3] = {0, 0, H};
+        const double j2[3] = {L1 * sin(q1), 0, H - L1 * cos(q1)};
+        const double tip[3] = {j2[0] + L2 * sin(q12), 0, j2[2] - L2 * cos(q12)};
+        // The angles and the CSV's tip agree (reach and height from joint 1).
+        CHECK_NEAR(tip[0], row[COL_TIP_X], 1e-3);
+        CHECK_NEAR(tip[2] - H, row[COL_TIP_Z], 1e-3);
+        const world_snap_body* col = find_role(snap, WORLD_ROLE_COLUMN);
+        const world_snap_body* b1 = find_role(snap, WORLD_ROLE_BOOM1);
+        const world_snap_body* b2 = find_role(snap, WORLD_ROLE_BOOM2);
+        if (!col || !b1 || !b2) break;
+        const double ground[3] = {0, 0, 0};
+        check_drawn(col, 0, 0, 0, ground, 0.01, "column foot on the ground");
+        check_drawn(col, 0, 0, H, j1, 0.01, "column's joint-1 pin");
+        check_drawn(b1, 0, 0, 0, j1, 0.01, "lifting arm at joint 1");
+        check_drawn(b1, L1, 0, 0, j2, 0.01, "lifting arm at joint 2");
+        check_drawn(b2, 0, 0, 0, j2, 0.01, "end arm at joint 2");
+        check_drawn(b2, L2, 0, 0, tip, 0.01, "end arm at the tip");
+    }
+    drive_session_destroy(s);
+}
+
+// The sandbox's crane (on the truck, slewed) is drawn in one piece too.
+static void test_sandbox_crane_drawn_in_one_piece(void) {
+    drive_session* s = open_session();
+    if (!s) return;
+    double wall = 0;
+    CHECK(run_for(s, &wall, 0.5) == 0, "loop: %s", drive_session_error(s));
+    drive_session_render(s);
+    check_crane_drawn_in_one_piece(drive_session_snapshot(s), &drive_session_model(s)->mech, "sandbox");
+    drive_session_destroy(s);
+}
+
+static bool has_chart(render* r, const char* label) {
+    for (int i = 0; i < render_chart_count(r); ++i)
+        if (!strcmp(render_chart_label(r, i), label)) return true;
+    return false;
+}
+
+// Strip charts for the cylinders the world has: the sandbox's third is the
+// slew rack; the validation world has none, so no empty p3A/x3/u3 traces.
+// The HUD names who drives: the scenario when scripted.
+static void test_charts_and_status_follow_the_world(void) {
+    drive_session* s = open_validation(true);
+    if (!s) return;
+    render* r = drive_session_render_ctx(s);
+    const int ncyl = drive_session_snapshot(s)->ncyl;
+    CHECK(ncyl == 2, "validation world: %d cylinders", ncyl);
+    CHECK(has_chart(r, "p1A") && has_chart(r, "x2") && has_chart(r, "u2"), "boom channels present");
+    CHECK(!has_chart(r, "p3A") && !has_chart(r, "x3") && !has_chart(r, "u3"), "validation world charts p3A/x3/u3");
+    CHECK(render_chart_count(r) == 4 * ncyl, "%d channels for %d cylinders", render_chart_count(r), ncyl);
+    double wall = 0;
+    run_for(s, &wall, 0.1);
+    const char* st = render_get_status(r);
+    CHECK(strstr(st, "[scripted]") && !strstr(st, "[keyboard]"), "status while scripted: '%s'", st);
+    drive_session_destroy(s);
+
+    s = open_session();
+    if (!s) return;
+    r = drive_session_render_ctx(s);
+    CHECK(drive_session_snapshot(s)->ncyl == 3 && has_chart(r, "p3A") && has_chart(r, "u3"),
+          "sandbox: the slew's channels");
+    wall = 0;
+    run_for(s, &wall, 0.1);
+    st = render_get_status(r);
+    CHECK(strstr(st, "[keyboard]") && !strstr(st, "[scripted]"), "status with no device, not scripted: '%s'", st);
+    drive_session_destroy(s);
+}
+
+// The real-time factor is simulated over wall time; over a few milliseconds
+// (a frame at t = 0) the ratio means nothing and the HUD must not show it.
+static void test_no_rate_over_an_instant(void) {
+    drive_session* s = open_validation(true);
+    if (!s) return;
+    // 0.1 ms of wall time: the world still steps a whole 1 ms ODE step.
+    CHECK(drive_session_tick(s, 1e-4) == 0, "tick");
+    drive_session_render(s);
+    const double rt0 = drive_session_snapshot(s)->rt_factor;
+    CHECK(rt0 == 0, "real-time factor over 0.1 ms of wall time: %g (want 0 = unknown)", rt0);
+    double wall = 1e-4;
+    run_for(s, &wall, 1.0);
+    drive_session_render(s);
+    const double rt1 = drive_session_snapshot(s)->rt_factor;
+    CHECK(rt1 > 0.95 && rt1 < 1.05, "real-time factor over 1 s on a virtual clock: %g", rt1);
+    drive_session_destroy(s);
+}
+
+// A record that cannot be written is reported, with the error, and the rows
+// written before stay counted; one that can is complete.
+static void test_record_write_failure(void) {
+    app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE;
+    c.sim.world = "validation";
+    c.scenario_path = CRANESIM_ASSETS "/scenarios/drive_demo.json";
+    drive_opts o = drive_default_opts();
+    o.offscreen = true;
+    o.scripted = true;
+    o.record_path = "/dev/full"; // every write fails with ENOSPC
+    char err[512] = "";
+    drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
+    CHECK(s != NULL, "session: %s", err);
+    if (!s) return;
+    double wall = 0;
+    run_for(s, &wall, 0.5);
+    long rows = -1;
+    CHECK(drive_session_finish_record(s, &rows, err, sizeof err) != 0, "writing to /dev/full reported success");
+    CHECK(strstr(err, "cannot write /dev/full") && strstr(err, strerror(ENOSPC)), "message: %s", err);
+    drive_session_destroy(s);
+
+    o.record_path = "drive_session_record.csv";
+    s = drive_session_create(&c, &o, err, sizeof err, NULL);
+    CHECK(s != NULL, "session: %s", err);
+    if (!s) return;
+    for (int i = 1; i <= 120; ++i) drive_session_tick(s, i / 240.0); // 0.5 s of ticks
+    CHECK(drive_session_finish_record(s, &rows, err, sizeof err) == 0, "record: %s", err);
+    drive_session_destroy(s);
+    // One row per tick, plus the header.
+    FILE* f = fopen("drive_session_record.csv", "r");
+    int lines = 0;
+    for (int ch; f && (ch = fgetc(f)) != EOF;) lines += ch == '\n';
+    if (f) fclose(f);
+    CHECK(rows == 120 && lines == rows + 1, "%ld rows reported, %d lines in the file", rows, lines);
+}
 
 // Run the loop for `seconds` of virtual wall time at 240 ticks per second.
 static int run_for(drive_session* s, double* wall, double seconds) {
@@ -120,7 +349,8 @@ static void test_default_scene_frame(void) {
         }
     }
     CHECK(found, "no lifting arm in the snapshot");
-    CHECK(drive_session_screenshot(s, "drive_default_scene.png") == 0, "screenshot");
+    char err[320];
+    CHECK(drive_session_screenshot(s, "drive_default_scene.png", err, sizeof err) == 0, "screenshot: %s", err);
     free(snap);
     free(px);
     drive_session_destroy(s);
@@ -250,6 +480,11 @@ int main(int argc, char** argv) {
     RUN_TEST(test_joystick_and_keyboard_drive_the_lift);
     RUN_TEST(test_panel_change_takes_effect);
     RUN_TEST(test_panel_boom_edit);
+    RUN_TEST(test_validation_world_drawn_at_the_joints);
+    RUN_TEST(test_sandbox_crane_drawn_in_one_piece);
+    RUN_TEST(test_charts_and_status_follow_the_world);
+    RUN_TEST(test_no_rate_over_an_instant);
+    RUN_TEST(test_record_write_failure);
     SDL_Quit();
     TEST_MAIN_END();
 }

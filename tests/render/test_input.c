@@ -229,6 +229,27 @@ static void test_mapping_file(void) {
     CHECK(input_load_mapping(path, &m, err, sizeof err) == -1, "unknown axis rejected");
     CHECK(strstr(err, "stick_of_joy") != NULL, "message: %s", err);
     CHECK(input_load_mapping("/nonexistent/map.json", &m, err, sizeof err) == -1, "missing file");
+    // A field the format does not have is a typo (it would leave the setting
+    // meant at its default): rejected, named with its path, at every level.
+    static const char* const typos[][2] = {
+        {"{ \"bogus\": 1 }", "bogus"},
+        {"{ \"axes\": { \"lfit\": { \"expo\": 0.2 } } }", "axes.lfit"},
+        {"{ \"axes\": { \"lift\": { \"deadzone\": 0.1 } } }", "axes.lift.deadzone"},
+        {"{ \"buttons\": { \"hook\": { \"controler\": \"a\" } } }", "buttons.hook.controler"},
+        {"{ \"buttons\": { \"hoook\": { \"controller\": \"a\" } } }", "buttons.hoook"},
+        {"{ \"axes\": [] }", "axes"},
+        {"not json", "render_input_map.json"},
+    };
+    for (size_t i = 0; i < sizeof typos / sizeof typos[0]; ++i) {
+        f = fopen(path, "w");
+        fputs(typos[i][0], f);
+        fclose(f);
+        before = m;
+        CHECK(input_load_mapping(path, &m, err, sizeof err) == -1, "accepted: %s", typos[i][0]);
+        CHECK(strstr(err, typos[i][1]) && strstr(err, "render_input_map.json"), "%s: message: %s",
+              typos[i][0], err);
+        CHECK(memcmp(&before, &m, sizeof m) == 0, "mapping untouched on error");
+    }
 }
 
 static void test_plain_joystick(void) {

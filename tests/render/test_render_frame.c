@@ -3,6 +3,7 @@
 // the pressure, camera presets that keep the crane in view, mesh fallback
 // with a warning, and the ImGui panel drawing offscreen.
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <stdlib.h>
 #include <unistd.h>
 
@@ -359,6 +360,84 @@ static void test_panel_draws_offscreen(void) {
     panel_destroy(pn);
 }
 
+// A mesh is drawn where render_body_point says: its origin at pos + R
+// offset, not at the primitive's centre pos. (The drive tests check the
+// crane's joints through render_body_point, so it must be what the scene does.)
+static void test_mesh_drawn_where_body_point_says(void) {
+    render* r = make(false);
+    if (!r) return;
+    memset(&snap, 0, sizeof snap);
+    snap.nbody = 1;
+    world_snap_body* b = &snap.body[0];
+    snprintf(b->name, sizeof b->name, "probe");
+    b->role = WORLD_ROLE_OBSTACLE;
+    b->shape = WORLD_SHAPE_BOX;
+    b->size[0] = b->size[1] = b->size[2] = 0.3;
+    b->pos[2] = 1.0;
+    // Turned 90 degrees about z: the offset along body x goes to world y.
+    b->rot[1] = -1, b->rot[3] = 1, b->rot[8] = 1;
+    b->rgba[0] = 1, b->rgba[1] = 0.1f, b->rgba[2] = 1, b->rgba[3] = 1;
+    snprintf(b->mesh, sizeof b->mesh, "load_block.obj"); // 1.2 x 0.6 x 0.6 m, origin at its centre
+    b->mesh_scale = 1;
+    b->mesh_up = 2;
+    b->mesh_offset[0] = 2.5;
+    const double o[3] = {0, 0, 0};
+    double centre[3];
+    render_body_point(b, o, centre);
+    CHECK(fabs(centre[0]) < 1e-12 && fabs(centre[1] - 2.5) < 1e-12 && fabs(centre[2] - 1.0) < 1e-12,
+          "mesh origin at (%g, %g, %g), want (0, 2.5, 1)", centre[0], centre[1], centre[2]);
+    const double target[3] = {0, 1.25, 1};
+    render_set_orbit(r, target, 0.3, 0.25, 9.0);
+    render_frame(r, &snap);
+    CHECK(render_get_stats(r).mesh_warnings == 0, "load_block.obj loads");
+    render_read_pixels(r, px, W, H);
+    double q[2];
+    CHECK(render_project(r, centre, q), "mesh centre projects");
+    const unsigned char* c = at((int)q[0], (int)q[1]);
+    CHECK(c[0] > c[1] + 40 && c[2] > c[1] + 40, "magenta block at its mesh origin, rgb %d %d %d", c[0], c[1],
+          c[2]);
+    CHECK(render_project(r, b->pos, q), "body origin projects");
+    c = at((int)q[0], (int)q[1]);
+    CHECK(!(c[0] > c[1] + 40 && c[2] > c[1] + 40), "block drawn at the primitive's centre, rgb %d %d %d", c[0],
+          c[1], c[2]);
+    render_destroy(r);
+}
+
+// A PNG that cannot be written fully (a full disk: /dev/full) is an error
+// with the system's reason, not a saved picture.
+static void test_png_write_failure(void) {
+    render* r = make(false);
+    if (!r) return;
+    render_demo_params p = render_demo_default_params();
+    render_demo_scene(&snap, &p, terrain);
+    render_frame(r, &snap);
+    char err[512] = "";
+    CHECK(render_save_png(r, "/dev/full", err, sizeof err) == -1, "PNG to /dev/full reported written");
+    CHECK(strstr(err, "/dev/full") && strstr(err, strerror(ENOSPC)), "message: %s", err);
+    CHECK(render_save_png(r, "/nonexistent/dir/x.png", err, sizeof err) == -1 && strstr(err, strerror(ENOENT)),
+          "missing directory: %s", err);
+    char path[512];
+    snprintf(path, sizeof path, "%s/render_save.png", CRANESIM_BINARY_DIR);
+    CHECK(render_save_png(r, path, err, sizeof err) == 0, "save: %s", err);
+    render_destroy(r);
+}
+
+// A window asked for where SDL has no screen (its offscreen driver, which
+// these tests run under) is refused: it would be a window nobody sees.
+static void test_window_needs_a_screen(void) {
+    render_config cfg = render_default_config();
+    cfg.offscreen = false;
+    cfg.vsync = false;
+    char err[256] = "";
+    render* r = render_create(&cfg, err, sizeof err);
+    CHECK(r == NULL, "window created under SDL's '%s' video driver", SDL_GetCurrentVideoDriver());
+    CHECK(strstr(err, "cannot open a window") && strstr(err, "has no screen"), "message: %s", err);
+    render_destroy(r);
+    // Offscreen still works afterwards.
+    r = make(false);
+    render_destroy(r);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_frame_not_blank_and_png);
     RUN_TEST(test_crane_where_it_projects);
@@ -368,6 +447,9 @@ int main(int argc, char** argv) {
     RUN_TEST(test_cad_mesh_formats);
     RUN_TEST(test_warnings_shown);
     RUN_TEST(test_panel_draws_offscreen);
+    RUN_TEST(test_mesh_drawn_where_body_point_says);
+    RUN_TEST(test_png_write_failure);
+    RUN_TEST(test_window_needs_a_screen);
     SDL_Quit();
     TEST_MAIN_END();
 }

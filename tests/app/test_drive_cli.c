@@ -1,0 +1,250 @@
+// test_drive_cli.c: `cranesim drive` as a user meets it: what happens when the
+// display named in the environment has no server, options checked in every
+// mode (exit 2, one line), write failures reported (exit 1, never "-> FILE"),
+// no rates over an instant, and a report that says only what the world has.
+// Each case runs the real binary; the ctest environment gives it Mesa's
+// surfaceless EGL, so offscreen views work without a GPU.
+#define _POSIX_C_SOURCE 200809L
+#include "check.h"
+
+#include <errno.h>
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#define BIN CRANESIM_BINARY_DIR "/cranesim"
+
+static char out[65536];
+
+// Run `env ENV cranesim drive ARGS` with stderr merged into out. Returns the
+// exit code (-1 if it did not exit normally).
+static int drive(const char* env, const char* args) {
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "env %s %s drive %s 2>&1", env, BIN, args);
+    FILE* p = popen(cmd, "r");
+    if (!p) return -1;
+    size_t got = fread(out, 1, sizeof out - 1, p);
+    out[got] = 0;
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+// No display at all (the QA machine's case) and the offscreen driver for
+// screenshots.
+#define NO_DISPLAY "-u DISPLAY -u WAYLAND_DISPLAY SDL_VIDEODRIVER=offscreen"
+
+static int count_lines(const char* s) {
+    int n = 0;
+    for (; *s; ++s) n += *s == '\n';
+    return n;
+}
+
+static int file_lines(const char* path) {
+    FILE* f = fopen(path, "r");
+    if (!f) return -1;
+    int n = 0;
+    for (int c; (c = fgetc(f)) != EOF;) n += c == '\n';
+    fclose(f);
+    return n;
+}
+
+static long file_size(const char* path) {
+    struct stat st;
+    return stat(path, &st) == 0 ? (long)st.st_size : -1;
+}
+
+static int occurrences(const char* s, const char* what) {
+    int n = 0;
+    for (const char* p = s; (p = strstr(p, what)); p += strlen(what)) ++n;
+    return n;
+}
+
+// An X display number nothing listens on: no socket file and no abstract
+// socket of that name (xvfb-run -a, used by another test, starts at :99).
+static int dead_display(void) {
+    for (int n = 4711; n < 4811; ++n) {
+        char path[64], name[64];
+        snprintf(path, sizeof path, "/tmp/.X11-unix/X%d", n);
+        snprintf(name, sizeof name, "/tmp/.X11-unix/X%d\n", n);
+        if (access(path, F_OK) == 0) continue;
+        bool used = false;
+        FILE* f = fopen("/proc/net/unix", "r");
+        char line[512];
+        while (f && fgets(line, sizeof line, f))
+            if (strstr(line, name)) used = true;
+        if (f) fclose(f);
+        if (!used) return n;
+    }
+    return -1;
+}
+
+// DISPLAY names an X server that is not there: SDL used to fall back to its
+// offscreen driver and run an invisible interactive session. Now it runs
+// headless (scripted, with the record) and says why in one line.
+static void test_dead_display_runs_headless(void) {
+    const int n = dead_display();
+    CHECK(n > 0, "no free display number found");
+    if (n < 0) return;
+    char env[256];
+    snprintf(env, sizeof env, "-u SDL_VIDEODRIVER -u WAYLAND_DISPLAY DISPLAY=:%d", n);
+    remove("dead_display.csv");
+    int rc = drive(env, "--duration 1 --record dead_display.csv");
+    char disp[32];
+    snprintf(disp, sizeof disp, "DISPLAY=:%d", n);
+    CHECK(rc == 0, "exit %d: %s", rc, out);
+    CHECK(strstr(out, "headless") && strstr(out, "cannot open a window") && strstr(out, disp),
+          "no headless fallback naming the display: %s", out);
+    CHECK(!strstr(out, "joystick or keyboard"), "an interactive session nobody sees: %s", out);
+    // 1 s at the headless 75 commands per second, plus the header.
+    CHECK(file_lines("dead_display.csv") == 76, "record has %d lines", file_lines("dead_display.csv"));
+
+    // The same with SDL forced onto its offscreen driver: no screen, no window.
+    snprintf(env, sizeof env, "-u WAYLAND_DISPLAY SDL_VIDEODRIVER=offscreen DISPLAY=:%d", n);
+    rc = drive(env, "--duration 0.3 --record dead_display.csv");
+    CHECK(rc == 0 && strstr(out, "headless") && strstr(out, "has no screen"), "exit %d: %s", rc, out);
+
+    // A screenshot was asked for: it is rendered offscreen instead.
+    snprintf(env, sizeof env, "-u SDL_VIDEODRIVER -u WAYLAND_DISPLAY DISPLAY=:%d", n);
+    remove("dead_display.png");
+    rc = drive(env, "--screenshot dead_display.png --screenshot-at 0.2");
+    CHECK(rc == 0 && strstr(out, "rendering offscreen") && strstr(out, "screenshot -> dead_display.png"),
+          "exit %d: %s", rc, out);
+    CHECK(file_size("dead_display.png") > 1000, "screenshot of %ld bytes", file_size("dead_display.png"));
+}
+
+// WAYLAND_DISPLAY names a socket that does not exist: headless, with the
+// reason, and without libwayland's own "XDG_RUNTIME_DIR is invalid" line.
+static void test_dead_wayland_runs_headless(void) {
+    int rc = drive("-u SDL_VIDEODRIVER -u DISPLAY -u XDG_RUNTIME_DIR WAYLAND_DISPLAY=wayland-9",
+                   "--duration 0.3 --record dead_wayland.csv");
+    CHECK(rc == 0 && strstr(out, "headless") && strstr(out, "WAYLAND_DISPLAY=wayland-9"), "exit %d: %s", rc, out);
+    CHECK(!strstr(out, "XDG_RUNTIME_DIR is invalid"), "libwayland's message leaked: %s", out);
+}
+
+typedef struct bad_opt {
+    const char* args;
+    const char* names; // the message must contain this
+} bad_opt;
+
+// Options drive cannot use are rejected in every mode, headless included,
+// with exit 2 and one line naming the option, file or field.
+static void test_bad_options_rejected_in_every_mode(void) {
+    FILE* f = fopen("map_not_json.json", "w");
+    if (f) fputs("not json\n", f), fclose(f);
+    f = fopen("map_bogus_key.json", "w");
+    if (f) fputs("{\"bogus\": 1}\n", f), fclose(f);
+    static const bad_opt cases[] = {
+        {"--solver cvode", "cvode"},
+        {"--mechanics lagrange --solver cvode", "cvode"},
+        {"--charts bogus", "bogus"},
+        {"--charts p1A,,x1", "--charts"},
+        {"--mechanics lagrange --charts slew", "slew"},
+        {"--mapping /nonexistent/map.json", "/nonexistent/map.json"},
+        {"--mapping map_not_json.json", "map_not_json.json"},
+        {"--mapping map_bogus_key.json", "bogus"},
+        {"--every 0.01", "--every"},
+    };
+    // Headless by option, headless for want of a display, and offscreen.
+    static const char* const modes[] = {"--headless --duration 0.2", "--duration 0.2",
+                                        "--screenshot bad_opt.png --screenshot-at 0"};
+    for (size_t m = 0; m < sizeof modes / sizeof modes[0]; ++m)
+        for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+            char a[512];
+            snprintf(a, sizeof a, "%s --record bad_opt.csv %s", modes[m], cases[i].args);
+            int rc = drive(NO_DISPLAY, a);
+            CHECK(rc == 2, "drive %s: exit %d, want 2: %s", a, rc, out);
+            CHECK(strstr(out, cases[i].names) != NULL, "drive %s: message does not name %s: %s", a, cases[i].names,
+                  out);
+            CHECK(count_lines(out) == 1, "drive %s: want one line, got: %s", a, out);
+        }
+}
+
+// A record or screenshot that cannot be written: exit 1, the file and the
+// system's reason on stderr, and no "-> FILE" line claiming it was written.
+static void test_write_failures_reported(void) {
+    CHECK(access("/dev/full", W_OK) == 0, "/dev/full is needed to simulate a full disk");
+    const char* nospace = strerror(ENOSPC);
+    int rc = drive(NO_DISPLAY, "--headless --duration 0.3 --record /dev/full");
+    CHECK(rc == 1, "headless record to /dev/full: exit %d: %s", rc, out);
+    CHECK(strstr(out, "cranesim drive: cannot write /dev/full: ") && strstr(out, nospace), "message: %s", out);
+    CHECK(!strstr(out, "record -> /dev/full"), "claims the record was written: %s", out);
+
+    rc = drive(NO_DISPLAY, "--screenshot /dev/full --screenshot-at 0.1");
+    CHECK(rc == 1, "screenshot to /dev/full: exit %d: %s", rc, out);
+    CHECK(strstr(out, "cranesim drive: cannot write /dev/full: ") && strstr(out, nospace), "message: %s", out);
+    CHECK(!strstr(out, "screenshot -> /dev/full"), "claims the screenshot was written: %s", out);
+
+    // The offscreen view's record.
+    rc = drive(NO_DISPLAY, "--screenshot write_ok.png --screenshot-at 0.3 --record /dev/full");
+    CHECK(rc == 1, "offscreen record to /dev/full: exit %d: %s", rc, out);
+    CHECK(strstr(out, "cranesim drive: cannot write /dev/full: ") && strstr(out, nospace), "message: %s", out);
+    CHECK(!strstr(out, "record -> /dev/full"), "claims the record was written: %s", out);
+
+    // And when all is well, both are said.
+    remove("write_ok.csv");
+    rc = drive(NO_DISPLAY, "--screenshot write_ok.png --screenshot-at 0.3 --record write_ok.csv");
+    CHECK(rc == 0 && strstr(out, "screenshot -> write_ok.png") && strstr(out, "record -> write_ok.csv"),
+          "exit %d: %s", rc, out);
+    // The rows reported are the rows in the file (one per tick: how many
+    // depends on the machine's speed), after the header.
+    long rows = -1;
+    const char* r = strstr(out, "record -> write_ok.csv (");
+    if (r) rows = strtol(r + strlen("record -> write_ok.csv ("), NULL, 10);
+    CHECK(rows >= 1 && file_lines("write_ok.csv") == rows + 1, "%ld rows reported, %d lines in the file", rows,
+          file_lines("write_ok.csv"));
+}
+
+// A screenshot at t = 0 ends the session within milliseconds: no rate over
+// that (it read millions of fps).
+static void test_no_rates_over_an_instant(void) {
+    int rc = drive(NO_DISPLAY, "--screenshot instant.png --screenshot-at 0");
+    CHECK(rc == 0, "exit %d: %s", rc, out);
+    CHECK(strstr(out, "(n/a fps)") && strstr(out, "(n/a Hz)"), "rates over an instant: %s", out);
+}
+
+// The validation world (column and booms only) is named as such, is driven by
+// the 2-DOF demo, and its report has no slew, load, truck or hook.
+static void test_validation_world_report(void) {
+    int rc = drive(NO_DISPLAY, "--world validation --screenshot validation.png --screenshot-at 0.2");
+    CHECK(rc == 0 && strstr(out, "in the validation world") && !strstr(out, "sandbox"), "exit %d: %s", rc, out);
+
+    rc = drive(NO_DISPLAY, "--headless --world validation --duration 0.5 --record validation.csv");
+    CHECK(rc == 0, "exit %d: %s", rc, out);
+    CHECK(strstr(out, "world: validation") && strstr(out, "drive_demo"), "world or operator: %s", out);
+    static const char* const absent[] = {"slew", "load at", "truck tilt", "hook"};
+    for (int i = 0; i < 4; ++i) CHECK(!strstr(out, absent[i]), "validation report mentions '%s': %s", absent[i], out);
+    CHECK(strstr(out, "record -> validation.csv"), "%s", out);
+
+    // A scenario with hook events: said once that there is no hook.
+    rc = drive(NO_DISPLAY, "--headless --world validation --scenario sandbox_pick_place --duration 1 "
+                           "--record validation.csv");
+    CHECK(rc == 0 && occurrences(out, "has no hook") == 1 && !strstr(out, "found no load"), "exit %d: %s", rc, out);
+
+    // The sandbox still reports all it has.
+    rc = drive(NO_DISPLAY, "--headless --duration 1 --record sandbox.csv");
+    CHECK(rc == 0, "exit %d: %s", rc, out);
+    static const char* const present[] = {"world: sandbox", "hook picked up", "slew", "load at", "truck tilt"};
+    for (int i = 0; i < 5; ++i) CHECK(strstr(out, present[i]), "sandbox report lacks '%s': %s", present[i], out);
+}
+
+// --help: the keys come last, after the shared options.
+static void test_help_keys_last(void) {
+    int rc = drive("", "--help");
+    const char* keys = strstr(out, "keys:");
+    const char* shared = strstr(out, "--quiet");
+    CHECK(rc == 0 && keys && shared && keys > shared, "keys before the shared options: %s", out);
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_dead_display_runs_headless);
+    RUN_TEST(test_dead_wayland_runs_headless);
+    RUN_TEST(test_bad_options_rejected_in_every_mode);
+    RUN_TEST(test_write_failures_reported);
+    RUN_TEST(test_no_rates_over_an_instant);
+    RUN_TEST(test_validation_world_report);
+    RUN_TEST(test_help_keys_last);
+    TEST_MAIN_END();
+}
