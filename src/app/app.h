@@ -15,6 +15,19 @@
 /// Exit codes (SPEC section 5).
 enum { EXIT_OK_ = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
 
+/// The common options, as bits of app_common.given (APP_GIVEN(APP_OPT_DT)):
+/// which ones the user gave, so a command can tell a choice from a default,
+/// note an option that has no effect and reject one it cannot honour.
+enum app_opt {
+    APP_OPT_MODEL, APP_OPT_SCENARIO, APP_OPT_MECHANICS, APP_OPT_VARIANT, APP_OPT_SOLVER, APP_OPT_DT,
+    APP_OPT_RTOL, APP_OPT_ATOL, APP_OPT_DURATION, APP_OPT_EVERY, APP_OPT_SET, APP_OPT_JAC_EVERY,
+    APP_OPT_LOAD, APP_OPT_WORLD, APP_OPT_DT_ODE, APP_OPT_KERNEL, APP_OPT_DENSE_JAC, APP_OPT_QUIET,
+    APP_OPT_COUNT
+};
+#define APP_GIVEN(opt) (1u << (opt))
+/// Option names by app_opt ("--model", ...).
+extern const char* const app_opt_name[APP_OPT_COUNT];
+
 /// Options common to the subcommands that run a model.
 typedef struct app_common {
     const char* model_path;      ///< NULL: built-in default
@@ -23,13 +36,56 @@ typedef struct app_common {
     int nset;
     sim_opts sim;
     bool quiet;
+    unsigned given;              ///< APP_GIVEN bits of the options on the command line
 } app_common;
 
 /// Try to consume argv[*i] (and its value) as a common option. Returns 1 if
 /// consumed, 0 if not a common option, -1 on a bad value (message printed).
 int app_parse_common(app_common* c, int argc, char** argv, int* i);
+/// The value of the option argv[*i], advancing *i; NULL after "option X needs
+/// a value" on stderr when it is missing: argv[*i] is the last argument, or
+/// the next one is itself an option ("--out --quiet": starts with "--").
+const char* app_value(int argc, char** argv, int* i);
+/// Before cmd parses its arguments: every option of cmd that takes a value
+/// (its own and the common ones) has one. Returns 0, or EXIT_USAGE after
+/// "cranesim CMD: option X needs a value" (so `drive --record` at the end is
+/// not called an unknown option).
+int app_check_values(const char* cmd, int argc, char** argv);
 /// Help text for the common options.
 void app_common_help(FILE* f, bool with_solver);
+/// Help text for the common options in `which` (APP_GIVEN bits), in the usual order.
+void app_options_help(FILE* f, unsigned which);
+
+/// Check an output file named by option opt before anything runs, without
+/// creating it: a non-empty name, not a directory, its folder exists and is
+/// writable, an existing file is writable; with ext (".png") the name must end
+/// in it unless it is an existing device or pipe (/dev/stdout). Returns 0, or
+/// -1 after one line "cranesim CMD: OPT FILE: problem" on stderr.
+int app_check_output(const char* cmd, const char* opt, const char* path, const char* ext);
+/// Create directory dir and its parents (mkdir -p) and check it is a writable
+/// directory. Returns 0, or -1 after one line on stderr naming opt and dir.
+int app_make_dir(const char* cmd, const char* opt, const char* dir);
+/// Reject, before anything runs, a run sim_run cannot honour as asked:
+/// --solver cvode with ode or without CVODE in the build, an output period
+/// (--every) that is not a whole multiple of the fixed step (--dt; with ode,
+/// the ODE step), --load on a sandbox world. given: the options the user gave
+/// (APP_GIVEN bits). Returns 0, or EXIT_USAGE after one line on stderr.
+int app_check_sim(const char* cmd, const sim_opts* o, unsigned given);
+/// Give an option that has no effect in this run a value that cannot be
+/// refused: with --mechanics ode and an adaptive hydraulic solver, --dt (unused:
+/// the solver spans each ODE step) becomes the ODE step, so sim.c's check that
+/// a fixed sub-step divides the ODE step does not reject it.
+void app_settle_unused(sim_opts* o);
+/// One line "cranesim CMD: note: --X has no effect with ..." on stderr for each
+/// given option that none of the n runs o[0..n) uses (--dt with adaptive
+/// solvers, --rtol/--atol with fixed steps, --world/--dt-ode with lagrange, ...).
+void app_note_unused(const char* cmd, unsigned given, const sim_opts* o, int n);
+/// A note when a --set of mechanics.load_mass is overridden (decision 9: --load >
+/// the scenario's load_mass > the model's), or unused (the sandbox world).
+void app_note_load(const char* cmd, const app_common* c, const sim_opts* o, const scenario* sc);
+/// The period a run writes rows at [s]: --every, or one row per fixed step
+/// when the step is longer (decision 7); with ode a whole number of ODE steps.
+double app_output_period(const sim_opts* o);
 
 /// Resolve a scenario argument: an existing file, or assets/scenarios/<name>.json.
 const char* app_scenario_path(const char* arg, char* buf, size_t n);
@@ -75,6 +131,15 @@ int cmd_compare(int argc, char** argv);
 int cmd_drive(int argc, char** argv);
 int cmd_study(int argc, char** argv);
 
+/// Render a PLplot page into memory and write it to the PNG file png, checking
+/// every write (PLplot itself does not report a failed write). Before draw it
+/// selects the PNG device, the geometry ("1400x1000") and a white background
+/// with black as colour 15; draw starts the page (plinit or plstar) and draws;
+/// after it the plot is ended. Returns 0, or -1 with "cannot write FILE:
+/// reason" in err (also when built without PLplot). A failed write removes a
+/// partly written regular file.
+int app_png_render(const char* png, const char* geometry, void (*draw)(void* user), void* user, char* err,
+                   size_t errsz);
 /// Plot a run's main time histories to a PNG (PLplot). Returns 0, or -1 with
 /// a message (also when cranesim was built without PLplot).
 int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz);

@@ -8,6 +8,7 @@
 #include "drive_session.h"
 #endif
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -71,6 +72,20 @@ static const bench_cfg configs[] = {
     {"sandbox-ode0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-4, "sandbox_pick_place"},
 };
 
+// The run options of configuration b on top of the command line's.
+static sim_opts bench_opts(const sim_opts* common, const bench_cfg* b) {
+    sim_opts o = *common;
+    o.solver = b->solver;
+    o.cvode = false;
+    o.dense_jac = b->dense;
+    o.mechanics = b->mech;
+    if (b->h > 0) o.h = b->h;
+    if (b->rtol > 0) o.rtol = b->rtol;
+    o.world = b->world;
+    if (b->dt_ode > 0) o.dt_ode = b->dt_ode;
+    return o;
+}
+
 int cmd_bench(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     int repeat = 3;
@@ -84,17 +99,25 @@ int cmd_bench(int argc, char** argv) {
         int rc = app_parse_common(&c, argc, argv, &i);
         if (rc < 0) return EXIT_USAGE;
         if (rc > 0) continue;
-        if (!strcmp(argv[i], "--repeat") && i + 1 < argc) {
+        if (!strcmp(argv[i], "--repeat")) {
+            const char* v = app_value(argc, argv, &i);
             double d;
-            if (app_parse_double(argv[++i], &d) || d < 1 || d > 100) {
-                fprintf(stderr, "cranesim bench: --repeat: expected 1..100, got '%s'\n", argv[i]);
+            if (!v) return EXIT_USAGE;
+            if (app_parse_double(v, &d) || d < 1 || d > 100 || d != floor(d)) {
+                fprintf(stderr, "cranesim bench: --repeat: expected a whole number 1..100, got '%s'\n", v);
                 return EXIT_USAGE;
             }
             repeat = (int)d;
             continue;
         }
-        if (!strcmp(argv[i], "--config") && i + 1 < argc && nonly < 16) {
-            only[nonly++] = argv[++i];
+        if (!strcmp(argv[i], "--config")) {
+            const char* v = app_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            if (nonly == 16) {
+                fprintf(stderr, "cranesim bench: at most 16 --config options\n");
+                return EXIT_USAGE;
+            }
+            only[nonly++] = v;
             continue;
         }
         fprintf(stderr, "cranesim bench: unknown option '%s' (see cranesim bench --help)\n", argv[i]);
@@ -113,6 +136,23 @@ int cmd_bench(int argc, char** argv) {
             return EXIT_USAGE;
         }
     }
+    // Each configuration fixes these itself: say so rather than ignore them.
+    static const int fixed[] = {APP_OPT_SOLVER, APP_OPT_DT,    APP_OPT_RTOL,   APP_OPT_ATOL,
+                                APP_OPT_MECHANICS, APP_OPT_WORLD, APP_OPT_DT_ODE, APP_OPT_DENSE_JAC};
+    for (size_t k = 0; k < sizeof fixed / sizeof fixed[0]; ++k)
+        if (c.given & APP_GIVEN(fixed[k]))
+            fprintf(stderr, "cranesim bench: note: %s has no effect: each configuration sets its own (see --help)\n",
+                    app_opt_name[fixed[k]]);
+    // The options that do apply (--every, --load) must suit every configuration.
+    for (size_t k = 0; k < sizeof configs / sizeof configs[0]; ++k) {
+        bool want = nonly == 0;
+        for (int j = 0; j < nonly; ++j) want |= !strcmp(only[j], configs[k].name);
+        if (!want) continue;
+        sim_opts o = bench_opts(&c.sim, &configs[k]);
+        // --load applies to the lagrange configurations, not the sandbox's loads.
+        const int rc = app_check_sim("bench", &o, c.given & ~APP_GIVEN(APP_OPT_LOAD));
+        if (rc) return rc;
+    }
     model* m;
     scenario sc, sc_own;
     int rc = app_load(&c, &m, &sc);
@@ -123,14 +163,7 @@ int cmd_bench(int argc, char** argv) {
         bool want = nonly == 0;
         for (int j = 0; j < nonly; ++j) want |= !strcmp(only[j], b->name);
         if (!want) continue;
-        sim_opts o = c.sim;
-        o.solver = b->solver;
-        o.dense_jac = b->dense;
-        o.mechanics = b->mech;
-        if (b->h > 0) o.h = b->h;
-        if (b->rtol > 0) o.rtol = b->rtol;
-        if (b->world) o.world = b->world;
-        if (b->dt_ode > 0) o.dt_ode = b->dt_ode;
+        sim_opts o = bench_opts(&c.sim, b);
         const scenario* use = &sc;
         if (b->scenario) {
             char buf[512], err[512];

@@ -23,7 +23,7 @@ static void compare_help(FILE* f) {
             "\n"
             "options:\n"
             "  --backends A,B      lagrange | ode\n"
-            "  --solvers A,B       krus | ros2 | rk4 | ros34pw2 | rodas3 | cvode\n"
+            "  --solvers A,B       krus | ros2 | rk4 | ros34pw2 | rodas3 | cvode (lagrange only)\n"
             "  --variants A,B      full | paper | paper-typo\n"
             "  --dts H1,H2         fixed steps [s]\n"
             "  --tol-stroke MM     fail (exit 1) if the stroke RMS difference exceeds MM millimetres\n"
@@ -78,26 +78,28 @@ int cmd_compare(int argc, char** argv) {
         if (rc < 0) return EXIT_USAGE;
         if (rc > 0) continue;
         static const char* const popt[] = {"--backends", "--solvers", "--variants", "--dts"};
-        bool used = false;
+        int pk = -1;
         for (int k = 0; k < 4; ++k)
-            if (!strcmp(argv[i], popt[k]) && i + 1 < argc) {
-                pairs[k] = argv[++i];
-                used = true;
-            }
-        if (used) continue;
-        if ((!strcmp(argv[i], "--tol-stroke") || !strcmp(argv[i], "--tol-pressure")) && i + 1 < argc) {
-            double d;
-            if (app_parse_double(argv[i + 1], &d) || d < 0) {
-                fprintf(stderr, "cranesim compare: %s: expected a number >= 0, got '%s'\n", argv[i], argv[i + 1]);
-                return EXIT_USAGE;
-            }
-            if (argv[i][6] == 's') tol_stroke = d;
-            else tol_pressure = d;
-            ++i;
+            if (!strcmp(argv[i], popt[k])) pk = k;
+        if (pk >= 0) {
+            if (!(pairs[pk] = app_value(argc, argv, &i))) return EXIT_USAGE;
             continue;
         }
-        if (!strcmp(argv[i], "--plot") && i + 1 < argc) {
-            plot = argv[++i];
+        if (!strcmp(argv[i], "--tol-stroke") || !strcmp(argv[i], "--tol-pressure")) {
+            const char* opt = argv[i];
+            const char* v = app_value(argc, argv, &i);
+            double d;
+            if (!v) return EXIT_USAGE;
+            if (app_parse_double(v, &d) || d < 0) {
+                fprintf(stderr, "cranesim compare: %s: expected a number >= 0, got '%s'\n", opt, v);
+                return EXIT_USAGE;
+            }
+            if (opt[6] == 's') tol_stroke = d;
+            else tol_pressure = d;
+            continue;
+        }
+        if (!strcmp(argv[i], "--plot")) {
+            if (!(plot = app_value(argc, argv, &i))) return EXIT_USAGE;
             continue;
         }
         fprintf(stderr, "cranesim compare: unknown option '%s' (see cranesim compare --help)\n", argv[i]);
@@ -132,10 +134,25 @@ int cmd_compare(int argc, char** argv) {
         snprintf(label[0], sizeof label[0], "lagrange");
         snprintf(label[1], sizeof label[1], "ode");
     }
+    // Both runs and the plot file are checked before anything runs.
+    if (plot && app_check_output("compare", "--plot", plot, ".png")) return EXIT_USAGE;
+    for (int s = 0; s < 2; ++s) {
+        // A side's own choice (--backends, --solvers) counts as given.
+        unsigned given = c.given;
+        if (pairs[0]) given |= APP_GIVEN(APP_OPT_MECHANICS);
+        if (pairs[1]) given |= APP_GIVEN(APP_OPT_SOLVER);
+        if (pairs[3]) given |= APP_GIVEN(APP_OPT_DT);
+        const int rc = app_check_sim("compare", &side[s], given);
+        if (rc) return rc;
+    }
     model* m;
     scenario sc;
     int rc = app_load(&c, &m, &sc);
     if (rc) return rc;
+    app_note_unused("compare", c.given, side, 2);
+    app_note_load("compare", &c, &side[0], &sc);
+    app_settle_unused(&side[0]);
+    app_settle_unused(&side[1]);
     sim_trace tr[2] = {{0}, {0}};
     sim_result res[2];
     for (int s = 0; s < 2; ++s) {
@@ -185,7 +202,7 @@ int cmd_compare(int argc, char** argv) {
         code = EXIT_RUNTIME;
     }
     if (plot) {
-        char err[256], title[320];
+        char err[512], title[320];
         snprintf(title, sizeof title, "%s: %s vs %s", sc.name, label[0], label[1]);
         if (app_plot_compare(&tr[0], label[0], &tr[1], label[1], title, plot, err, sizeof err)) {
             fprintf(stderr, "cranesim compare: plot: %s\n", err);

@@ -1,6 +1,7 @@
 // cmd_run.c: `cranesim run`: a headless run of a scenario to CSV (and a plot).
 #include "app.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,27 +20,60 @@ static void run_help(FILE* f) {
             "  truck_tilt,contacts,max_depth (world frame, m, rad)\n"
             "\n"
             "options:\n"
-            "  --out FILE           CSV output (default run.csv)\n"
+            "  --out FILE           CSV output (default run.csv); created when the run starts\n"
             "  --plot FILE.png      also plot strokes, pressures, valve openings and tip path\n");
     app_common_help(f, true);
     fprintf(f,
-            "\nexit codes: 0 ok, 1 numerical failure (rows so far are kept), 2 bad input\n"
+            "\nexit codes: 0 ok, 1 runtime failure (a numerical blow-up keeps the rows so far; a failed\n"
+            "write), 2 bad input or usage (nothing is written)\n"
             "example: cranesim run --scenario ramp --out ramp.csv --plot ramp.png\n");
 }
 
 typedef struct csv_sink {
-    FILE* f;
+    const char* path;
+    FILE* f;     ///< opened at the first row
     long rows;
     int ncol;
+    int err;     ///< errno of the first failed open or write, 0 if none
+    bool opened; ///< the file was created (or truncated)
 } csv_sink;
 
+// The CSV is opened at the first row (t = 0, before any step): a run refused
+// while it sets up (a bad world, a start pose, an option sim_run rejects)
+// then creates or truncates nothing. A failed write stops the run.
 static int csv_row(void* user, const double* row) {
     csv_sink* s = user;
+    if (!s->f) {
+        s->f = fopen(s->path, "w");
+        if (!s->f) {
+            s->err = errno;
+            return 1;
+        }
+        s->opened = true;
+        sim_csv_header(s->f, s->ncol);
+    }
+    errno = 0;
     sim_csv_row(s->f, row, s->ncol);
     // Flush about once a simulated second at 1 kHz, so a crash or a kill
     // keeps nearly everything already computed.
     if (++s->rows % 1000 == 0) fflush(s->f);
-    return ferror(s->f) ? 1 : 0;
+    if (ferror(s->f)) {
+        s->err = errno ? errno : EIO;
+        return 1;
+    }
+    return 0;
+}
+
+// Close the CSV; 0, or the errno of the first failure (a full disk often
+// shows only when the last buffer is flushed).
+static int csv_close(csv_sink* s) {
+    if (!s->f) return s->err;
+    if (ferror(s->f) && !s->err) s->err = EIO;
+    errno = 0;
+    if (fflush(s->f) && !s->err) s->err = errno ? errno : EIO;
+    if (fclose(s->f) && !s->err) s->err = errno ? errno : EIO;
+    s->f = NULL;
+    return s->err;
 }
 
 static void print_summary(const char* scen, const sim_opts* o, const sim_result* r, const sim_trace* tr,
@@ -53,24 +87,35 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
             xmax[k] = fmax(xmax[k], v[COL_X1 + k]);
         }
     }
-    printf("cranesim run: %s, %s/%s, solver %s", scen, o->mechanics == SIM_LAGRANGE ? "lagrange" : "ode",
-           lagrange_variant_name(o->variant), o->cvode ? "cvode" : hyd_method_name(o->solver));
+    const bool ode = o->mechanics == SIM_ODE;
+    const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
+    // The variant is the lagrange backend's; an ode run is named by its world.
+    if (ode) printf("cranesim run: %s, ode/%s", scen, o->world ? o->world : "validation");
+    else printf("cranesim run: %s, lagrange/%s", scen, lagrange_variant_name(o->variant));
+    printf(", solver %s", o->cvode ? "cvode" : hyd_method_name(o->solver));
     // Which circuit kernel ran (cranesim run --help, --kernel).
     const char* kern = r->split ? ", split step" : r->fused ? ", fused kernel" : ", general kernel";
-    if (o->cvode || hyd_method_is_adaptive(o->solver)) printf(" (rtol %g, atol %g%s)\n", o->rtol, o->atol, kern);
+    if (adaptive) printf(" (rtol %g, atol %g%s)\n", o->rtol, o->atol, kern);
+    else if (ode && o->h > o->dt_ode) // the ode world sub-steps at min(--dt, --dt-ode)
+        printf(" (h = %g ms: --dt %g ms reduced to the ODE step%s)\n", o->dt_ode * 1e3, o->h * 1e3, kern);
     else printf(" (h = %g ms%s)\n", o->h * 1e3, kern);
-    if (o->mechanics == SIM_ODE)
-        printf("  simulated %.3f s in %.3f s wall: %.0fx real time; ODE step %g ms, %ld hydraulic sub-steps\n",
-               r->t_end, r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, o->dt_ode * 1e3, r->stats.steps);
+    if (ode)
+        printf("  simulated %.3f s in %.3f s wall: %.0fx real time; ODE step %g ms, %ld hydraulic %s\n", r->t_end,
+               r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, o->dt_ode * 1e3, r->stats.steps,
+               adaptive ? "steps" : "sub-steps");
     else
         printf("  simulated %.3f s in %.3f s wall: %.0fx real time; %ld steps, %ld rejected, %ld f evals, %ld LU\n",
                r->t_end, r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, r->stats.steps, r->stats.rejected,
                r->stats.fevals, r->stats.lus);
     printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
            1e3 * xmax[1]);
-    printf("  peak pressures: p1A %.2f, p1B %.2f, p2A %.2f, p2B %.2f MPa (absolute)\n", pmax[0] * 1e-6,
-           pmax[1] * 1e-6, pmax[2] * 1e-6, pmax[3] * 1e-6);
-    printf("  %ld rows -> %s\n", r->rows, out);
+    // Only the rows are seen here: between coarse rows the true peak can be
+    // far higher (decision text: a per-step peak needs sim.c).
+    const double every = app_output_period(o);
+    printf("  peak pressures at the output rows: p1A %.2f, p1B %.2f, p2A %.2f, p2B %.2f MPa (absolute)",
+           pmax[0] * 1e-6, pmax[1] * 1e-6, pmax[2] * 1e-6, pmax[3] * 1e-6);
+    if (every > 1e-3 * (1 + 1e-9)) printf(", rows every %g ms", every * 1e3);
+    printf("\n  %ld rows -> %s\n", r->rows, out);
 }
 
 int cmd_run(int argc, char** argv) {
@@ -85,50 +130,64 @@ int cmd_run(int argc, char** argv) {
         int rc = app_parse_common(&c, argc, argv, &i);
         if (rc < 0) return EXIT_USAGE;
         if (rc > 0) continue;
-        if ((!strcmp(argv[i], "--out") || !strcmp(argv[i], "--plot")) && i + 1 < argc) {
-            if (argv[i][2] == 'o') out = argv[++i];
-            else plot = argv[++i];
+        if (!strcmp(argv[i], "--out") || !strcmp(argv[i], "--plot")) {
+            const bool is_out = argv[i][2] == 'o';
+            const char* v = app_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            if (is_out) out = v;
+            else plot = v;
             continue;
         }
         fprintf(stderr, "cranesim run: unknown option '%s' (see cranesim run --help)\n", argv[i]);
         return EXIT_USAGE;
     }
+    // Everything that can be checked is checked before a file is touched.
+    if (app_check_output("run", "--out", out, NULL) || (plot && app_check_output("run", "--plot", plot, ".png")))
+        return EXIT_USAGE;
+    int rc = app_check_sim("run", &c.sim, c.given);
+    if (rc) return rc;
     model* m;
     scenario sc;
-    int rc = app_load(&c, &m, &sc);
+    rc = app_load(&c, &m, &sc);
     if (rc) return rc;
+    app_note_unused("run", c.given, &c.sim, 1);
+    app_note_load("run", &c, &c.sim, &sc);
+    app_settle_unused(&c.sim);
 
-    csv_sink sink = {0};
-    sink.f = fopen(out, "w");
-    if (!sink.f) {
-        fprintf(stderr, "cranesim run: cannot write %s\n", out);
-        model_free(m);
-        return EXIT_USAGE;
-    }
-    sink.ncol = sim_ncol(&c.sim);
-    sim_csv_header(sink.f, sink.ncol);
+    csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim)};
     sim_trace tr = {0};
     sim_result res;
     sim_run(m, &sc, &c.sim, csv_row, &sink, &tr, c.quiet ? NULL : app_progress, NULL, &res);
     if (!c.quiet) app_progress_done();
-    int bad_write = fclose(sink.f) != 0;
+    const int werr = csv_close(&sink);
     int code = EXIT_OK_;
-    if (res.status == 1) {
+    if (werr && !sink.opened) {
+        // The path passed app_check_output, yet could not be created: still
+        // bad input, and nothing was written.
+        fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
+        code = EXIT_USAGE;
+    } else if (res.status == 1) {
         fprintf(stderr, "cranesim run: %s; %ld rows up to t = %.6g s kept in %s\n", res.message, res.rows,
                 res.t_end, out);
+        if (werr) fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
+        code = EXIT_RUNTIME;
+    } else if (werr) {
+        fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
         code = EXIT_RUNTIME;
     } else if (res.status == 2) {
+        // Refused while setting up: no row was written, so no file exists.
         fprintf(stderr, "cranesim run: %s\n", res.message);
-        code = bad_write || sink.rows ? EXIT_RUNTIME : EXIT_USAGE;
-    } else if (bad_write) {
-        fprintf(stderr, "cranesim run: writing %s failed\n", out);
-        code = EXIT_RUNTIME;
+        code = sink.rows ? EXIT_RUNTIME : EXIT_USAGE;
     }
     if (code == EXIT_OK_ && !c.quiet) print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &tr, out);
-    if (plot && tr.nrow > 1) {
-        char err[256], title[160];
-        snprintf(title, sizeof title, "%s: %s, %s", sc.name, lagrange_variant_name(c.sim.variant),
-                 c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
+    if (plot && tr.nrow > 1 && code != EXIT_USAGE) {
+        char err[512], title[160];
+        if (c.sim.mechanics == SIM_ODE)
+            snprintf(title, sizeof title, "%s: ode/%s, %s", sc.name, c.sim.world ? c.sim.world : "validation",
+                     c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
+        else
+            snprintf(title, sizeof title, "%s: %s, %s", sc.name, lagrange_variant_name(c.sim.variant),
+                     c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
         if (app_plot_run(&tr, title, plot, err, sizeof err)) {
             fprintf(stderr, "cranesim run: plot: %s\n", err);
             if (code == EXIT_OK_) code = EXIT_RUNTIME;

@@ -5,33 +5,40 @@
 // table (Markdown), JSON lines and a work-precision plot.
 #include "app.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #ifdef CRANESIM_HAVE_PLPLOT
 #include <plplot.h>
 #endif
 
+// The common options the study honours. The solver, step, tolerances and
+// output grid are the study's own choice per configuration, and its CVODE
+// reference runs the lagrange model only, so the rest are refused.
+static const unsigned study_opts = APP_GIVEN(APP_OPT_MODEL) | APP_GIVEN(APP_OPT_SCENARIO) | APP_GIVEN(APP_OPT_SET) |
+                                   APP_GIVEN(APP_OPT_LOAD) | APP_GIVEN(APP_OPT_VARIANT) |
+                                   APP_GIVEN(APP_OPT_DURATION) | APP_GIVEN(APP_OPT_JAC_EVERY) |
+                                   APP_GIVEN(APP_OPT_DENSE_JAC) | APP_GIVEN(APP_OPT_KERNEL) | APP_GIVEN(APP_OPT_QUIET);
+
 static void study_help(FILE* f) {
     fprintf(f,
-            "usage: cranesim study [--scenario S] [--out-dir DIR] [--repeat N] [--quick]\n"
+            "usage: cranesim study [--scenario S] [--out-dir DIR] [--repeat N] [--quick] [options]\n"
             "\n"
             "Integrates the scenario (default ramp) with Krus and ROS2 at h = 0.1, 0.2, 0.5, 1 ms,\n"
             "RK4, the adaptive ROS34PW2 and RODAS3 at rtol 1e-2, 2e-3, 1e-3, 1e-4, 1e-5, and\n"
-            "SUNDIALS CVODE, and compares each with a CVODE reference at rtol 1e-10. Reports\n"
-            "per configuration:\n"
+            "SUNDIALS CVODE, and compares each with a CVODE reference at rtol 1e-10, on the\n"
+            "lagrange model and the 1 ms output grid. Reports per configuration:\n"
             "max and RMS chamber-pressure error [MPa and %% of peak], max stroke error [mm],\n"
             "steps, f evaluations, Jacobians, LU factorisations and median wall time [s].\n"
             "Writes DIR/study.md (table), DIR/study.jsonl and DIR/work_precision.png.\n"
             "\n"
             "options:\n"
-            "  --scenario S   default ramp (try step for the stiff phases)\n"
-            "  --out-dir DIR  default study\n"
-            "  --repeat N     timed runs per configuration, median reported (default 3)\n"
-            "  --quick        fewer configurations (for tests)\n");
-    app_common_help(f, false);
+            "  --out-dir DIR        default study (created with its parents before the runs)\n"
+            "  --repeat N           timed runs per configuration, median reported (1..50, default 3)\n"
+            "  --quick              fewer configurations (for tests)\n");
+    app_options_help(f, study_opts);
 }
 
 typedef struct study_cfg {
@@ -63,24 +70,24 @@ static int add_adaptive(study_cfg* c, int n, const sim_opts* base, hyd_method m,
 }
 
 #ifdef CRANESIM_HAVE_PLPLOT
+typedef struct wp_plot {
+    const study_cfg* c;
+    int n;
+    double ppeak; ///< [Pa]
+    const char* title;
+    double xlo, xhi, ylo, yhi;
+} wp_plot;
+
 // x: max pressure error in % of ppeak [Pa]; y: wall time.
-static void plot_wp(const study_cfg* c, int n, double ppeak, const char* title, const char* png) {
-    double xlo = 1e300, xhi = -1e300, ylo = 1e300, yhi = -1e300;
-    for (int i = 0; i < n; ++i) {
-        if (c[i].failed || !(c[i].p_max > 0) || !(c[i].wall > 0)) continue;
-        double x = log10(100 * c[i].p_max / ppeak), y = log10(c[i].wall);
-        xlo = fmin(xlo, x), xhi = fmax(xhi, x), ylo = fmin(ylo, y), yhi = fmax(yhi, y);
-    }
-    if (!(xhi >= xlo)) return;
-    plsdev("pngcairo");
-    plsfnam(png);
-    plsetopt("geometry", "1200x850");
-    plscolbg(255, 255, 255);
-    plscol0(15, 0, 0, 0);
+static void draw_wp(void* user) {
+    const wp_plot* p = user;
+    const study_cfg* c = p->c;
+    const int n = p->n;
+    const double ppeak = p->ppeak;
     plinit();
     plcol0(15);
-    plenv(floor(xlo - 0.2), ceil(xhi + 0.2), floor(ylo - 0.2), ceil(yhi + 0.3), 0, 30);
-    pllab("max chamber-pressure error [% of peak] (log)", "wall time [s] (log)", title);
+    plenv(floor(p->xlo - 0.2), ceil(p->xhi + 0.2), floor(p->ylo - 0.2), ceil(p->yhi + 0.3), 0, 30);
+    pllab("max chamber-pressure error [% of peak] (log)", "wall time [s] (log)", p->title);
     plschr(0, 0.7);
     static const int col[] = {1, 3, 9, 8, 12, 13};
     // One colour per method family, a line through its points and a legend;
@@ -131,9 +138,32 @@ static void plot_wp(const study_cfg* c, int n, double ppeak, const char* title, 
     pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE,
              0.02, 0.02, 0.08, 0, 15, 1, 0, 0, nshown, opt, 1.0, 1.0, 2.0, 0.0, tcol, text, NULL, NULL, NULL, NULL,
              lcol, lsty, lwid, scol, sscale, snum, sym);
-    plend();
+}
+
+// The work-precision plot; 1 when no configuration has a point to plot
+// (nothing written), 0 when written, -1 with the reason in err.
+static int plot_wp(const study_cfg* c, int n, double ppeak, const char* title, const char* png, char* err,
+                   size_t errsz) {
+    wp_plot p = {c, n, ppeak, title, 1e300, -1e300, 1e300, -1e300};
+    for (int i = 0; i < n; ++i) {
+        if (c[i].failed || !(c[i].p_max > 0) || !(c[i].wall > 0)) continue;
+        double x = log10(100 * c[i].p_max / ppeak), y = log10(c[i].wall);
+        p.xlo = fmin(p.xlo, x), p.xhi = fmax(p.xhi, x), p.ylo = fmin(p.ylo, y), p.yhi = fmax(p.yhi, y);
+    }
+    if (!(p.xhi >= p.xlo)) return 1;
+    return app_png_render(png, "1200x850", draw_wp, &p, err, errsz);
 }
 #endif
+
+// Close a result file, reporting a failed write: "cannot write FILE: reason".
+static int close_checked(FILE* f, const char* path) {
+    int e = ferror(f) ? (errno ? errno : EIO) : 0;
+    errno = 0;
+    if (fflush(f) && !e) e = errno ? errno : EIO;
+    if (fclose(f) && !e) e = errno ? errno : EIO;
+    if (e) fprintf(stderr, "cranesim study: cannot write %s: %s\n", path, strerror(e));
+    return e ? -1 : 0;
+}
 
 int cmd_study(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
@@ -148,24 +178,40 @@ int cmd_study(int argc, char** argv) {
         int rc = app_parse_common(&c, argc, argv, &i);
         if (rc < 0) return EXIT_USAGE;
         if (rc > 0) continue;
-        if (!strcmp(argv[i], "--out-dir") && i + 1 < argc) {
-            dir = argv[++i];
+        if (!strcmp(argv[i], "--out-dir")) {
+            if (!(dir = app_value(argc, argv, &i))) return EXIT_USAGE;
             continue;
         }
         if (!strcmp(argv[i], "--quick")) {
             quick = true;
             continue;
         }
-        if (!strcmp(argv[i], "--repeat") && i + 1 < argc) {
+        if (!strcmp(argv[i], "--repeat")) {
+            const char* v = app_value(argc, argv, &i);
             double d;
-            if (app_parse_double(argv[++i], &d) || d < 1 || d > 50) {
-                fprintf(stderr, "cranesim study: --repeat: expected 1..50, got '%s'\n", argv[i]);
+            if (!v) return EXIT_USAGE;
+            if (app_parse_double(v, &d) || d < 1 || d > 50 || d != floor(d)) {
+                fprintf(stderr, "cranesim study: --repeat: expected a whole number 1..50, got '%s'\n", v);
                 return EXIT_USAGE;
             }
             repeat = (int)d;
             continue;
         }
         fprintf(stderr, "cranesim study: unknown option '%s' (see cranesim study --help)\n", argv[i]);
+        return EXIT_USAGE;
+    }
+    // Refuse, before any run, what the study cannot honour.
+    for (int k = 0; k < APP_OPT_COUNT; ++k) {
+        if (!(c.given & APP_GIVEN(k)) || (study_opts & APP_GIVEN(k))) continue;
+        if (k == APP_OPT_MECHANICS && c.sim.mechanics == SIM_LAGRANGE) continue; // what it runs anyway
+        const char* why = k == APP_OPT_MECHANICS || k == APP_OPT_WORLD || k == APP_OPT_DT_ODE
+                              ? "the study's CVODE reference runs the lagrange model only"
+                          : k == APP_OPT_EVERY ? "the study compares every configuration with the reference on the "
+                                                 "1 ms output grid"
+                                               : "the study sets the solver, step and tolerances of each "
+                                                 "configuration itself";
+        if (k == APP_OPT_MECHANICS) fprintf(stderr, "cranesim study: --mechanics ode: %s\n", why);
+        else fprintf(stderr, "cranesim study: %s is not an option of study: %s\n", app_opt_name[k], why);
         return EXIT_USAGE;
     }
     if (!sim_have_cvode()) {
@@ -176,7 +222,18 @@ int cmd_study(int argc, char** argv) {
     scenario sc;
     int rc = app_load(&c, &m, &sc);
     if (rc) return rc;
-    mkdir(dir, 0755);
+    app_note_load("study", &c, &c.sim, &sc);
+    // The output folder exists and takes files before hours of runs.
+    char path_md[1024], path_js[1024], path_png[1024];
+    snprintf(path_md, sizeof path_md, "%s/study.md", dir);
+    snprintf(path_js, sizeof path_js, "%s/study.jsonl", dir);
+    snprintf(path_png, sizeof path_png, "%s/work_precision.png", dir);
+    if (app_make_dir("study", "--out-dir", dir) || app_check_output("study", "--out-dir", path_md, NULL) ||
+        app_check_output("study", "--out-dir", path_js, NULL) ||
+        app_check_output("study", "--out-dir", path_png, ".png")) {
+        model_free(m);
+        return EXIT_USAGE;
+    }
 
     // The reference: CVODE (variable-order BDF, an independent code) at a
     // tolerance far below every configuration's error.
@@ -249,18 +306,14 @@ int cmd_study(int argc, char** argv) {
         sim_trace_free(&tr);
     }
 
-    char path[512];
-    snprintf(path, sizeof path, "%s/study.md", dir);
-    FILE* md = fopen(path, "w");
-    snprintf(path, sizeof path, "%s/study.jsonl", dir);
-    FILE* js = fopen(path, "w");
+    FILE* md = fopen(path_md, "w");
+    FILE* js = md ? fopen(path_js, "w") : NULL;
     if (!md || !js) {
-        fprintf(stderr, "cranesim study: cannot write into %s\n", dir);
+        fprintf(stderr, "cranesim study: cannot write %s: %s\n", md ? path_js : path_md, strerror(errno));
         if (md) fclose(md);
-        if (js) fclose(js);
         model_free(m);
         sim_trace_free(&ref);
-        return EXIT_USAGE;
+        return EXIT_RUNTIME;
     }
     FILE* outs[2] = {stdout, md};
     for (int o = 0; o < 2; ++o) {
@@ -290,18 +343,23 @@ int cmd_study(int argc, char** argv) {
                 sc.name, s->name, s->failed, s->p_max, 100 * s->p_max / ppeak, s->p_rms, s->x_max, s->st.steps,
                 s->st.fevals, s->st.jevals, s->st.lus, s->wall);
     }
-    fclose(md);
-    fclose(js);
+    int code = 0;
+    if (close_checked(md, path_md)) code = EXIT_RUNTIME;
+    if (close_checked(js, path_js)) code = EXIT_RUNTIME;
 #ifdef CRANESIM_HAVE_PLPLOT
-    snprintf(path, sizeof path, "%s/work_precision.png", dir);
-    char title[160];
+    char title[160], err[512];
     snprintf(title, sizeof title, "Work-precision, scenario %s (reference CVODE rtol 1e-10)", sc.name);
-    plot_wp(cfg, n, ppeak, title, path);
-    printf("\nwrote %s/study.md, %s/study.jsonl, %s\n", dir, dir, path);
+    const int prc = plot_wp(cfg, n, ppeak, title, path_png, err, sizeof err);
+    if (prc < 0) {
+        fprintf(stderr, "cranesim study: plot: %s\n", err);
+        code = EXIT_RUNTIME;
+    }
+    if (!code) printf("\nwrote %s, %s%s%s\n", path_md, path_js, prc == 0 ? ", " : " (no plot: no configuration succeeded)",
+                      prc == 0 ? path_png : "");
 #else
-    printf("\nwrote %s/study.md, %s/study.jsonl (no plot: built without PLplot)\n", dir, dir);
+    if (!code) printf("\nwrote %s, %s (no plot: built without PLplot)\n", path_md, path_js);
 #endif
     sim_trace_free(&ref);
     model_free(m);
-    return 0;
+    return code;
 }

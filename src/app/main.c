@@ -20,14 +20,28 @@ static void usage(FILE* f) {
             "  compare   run one scenario two ways (backends or solvers); error metrics, overlay plots\n"
             "  bench     real-time factors as JSON lines\n"
             "  study     solver study: every integrator against a CVODE reference, work-precision plot\n"
-            "  help      this text\n"
+            "  help      this text; cranesim help <command>: that command's help\n"
             "\n"
             "examples:\n"
             "  cranesim drive\n"
             "  cranesim run --scenario ramp --out ramp.csv --plot ramp.png\n"
-            "  cranesim run --scenario hold --set mechanics.load_mass=2000\n"
+            "  cranesim run --scenario hold --load 2000 --out hold.csv\n"
+            "  cranesim run --scenario step --set hydraulics.components.lift_cyl.bore=0.11\n"
             "  cranesim compare --scenario ramp --solvers krus,ros34pw2 --plot cmp.png\n",
             CRANESIM_VERSION);
+}
+
+static const struct {
+    const char* name;
+    int (*fn)(int argc, char** argv);
+} commands[] = {
+    {"run", cmd_run}, {"bench", cmd_bench}, {"compare", cmd_compare}, {"drive", cmd_drive}, {"study", cmd_study},
+};
+
+static int (*find_command(const char* name))(int, char**) {
+    for (size_t k = 0; k < sizeof commands / sizeof commands[0]; ++k)
+        if (!strcmp(name, commands[k].name)) return commands[k].fn;
+    return NULL;
 }
 
 int main(int argc, char** argv) {
@@ -37,18 +51,29 @@ int main(int argc, char** argv) {
     }
     const char* cmd = argv[1];
     if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
-        usage(stdout);
-        return 0;
+        if (argc < 3) {
+            usage(stdout);
+            return 0;
+        }
+        // cranesim help run = cranesim run --help
+        int (*fn)(int, char**) = find_command(argv[2]);
+        if (!fn) {
+            fprintf(stderr, "cranesim help: unknown command '%s' (try cranesim help)\n", argv[2]);
+            return EXIT_USAGE;
+        }
+        char help[] = "--help";
+        char* args[] = {help, NULL};
+        return fn(1, args);
     }
     if (!strcmp(cmd, "--version")) {
         printf("cranesim %s\n", CRANESIM_VERSION);
         return 0;
     }
-    if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
-    if (!strcmp(cmd, "bench")) return cmd_bench(argc - 2, argv + 2);
-    if (!strcmp(cmd, "compare")) return cmd_compare(argc - 2, argv + 2);
-    if (!strcmp(cmd, "drive")) return cmd_drive(argc - 2, argv + 2);
-    if (!strcmp(cmd, "study")) return cmd_study(argc - 2, argv + 2);
-    fprintf(stderr, "cranesim: unknown command '%s' (try cranesim help)\n", cmd);
-    return EXIT_USAGE;
+    int (*fn)(int, char**) = find_command(cmd);
+    if (!fn) {
+        fprintf(stderr, "cranesim: unknown command '%s' (try cranesim help)\n", cmd);
+        return EXIT_USAGE;
+    }
+    if (app_check_values(cmd, argc - 2, argv + 2)) return EXIT_USAGE;
+    return fn(argc - 2, argv + 2);
 }

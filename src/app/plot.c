@@ -1,13 +1,102 @@
 // plot.c: PNG plots of runs with PLplot (cairo driver): strokes, chamber
 // pressures, valve openings and the tip path, as the paper's WinSimu showed.
+//
+// PLplot writes its output file itself and ignores write errors (a plot to a
+// full disk "succeeds"), so the PNG is rendered into a memory stream
+// (fopencookie, a GNU extension, hence _GNU_SOURCE) and written to the file
+// here, where every fwrite, fflush and fclose is checked.
+#define _GNU_SOURCE
 #include "app.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+// Write n bytes to path; on failure "cannot write FILE: reason" in err, and a
+// partly written regular file is removed (it would pass for a plot).
+static int write_file(const char* path, const void* data, size_t n, char* err, size_t errsz) {
+    FILE* f = fopen(path, "wb");
+    if (!f) {
+        snprintf(err, errsz, "cannot write %s: %s", path, strerror(errno));
+        return -1;
+    }
+    int e = 0;
+    if (fwrite(data, 1, n, f) != n) e = errno ? errno : EIO;
+    if (fflush(f) && !e) e = errno ? errno : EIO;
+    if (fclose(f) && !e) e = errno ? errno : EIO;
+    if (!e) return 0;
+    snprintf(err, errsz, "cannot write %s: %s", path, strerror(e));
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISREG(st.st_mode)) remove(path);
+    return -1;
+}
 
 #ifdef CRANESIM_HAVE_PLPLOT
 #include <plplot.h>
+
+// The memory stream PLplot writes the PNG into.
+typedef struct png_mem {
+    char* buf;
+    size_t n, cap;
+    bool oom, closed;
+} png_mem;
+
+static ssize_t mem_write(void* cookie, const char* b, size_t n) {
+    png_mem* m = cookie;
+    if (m->n + n > m->cap) {
+        size_t cap = m->cap ? m->cap : 1 << 16;
+        while (cap < m->n + n) cap *= 2;
+        char* nb = realloc(m->buf, cap);
+        if (!nb) {
+            m->oom = true;
+            return -1;
+        }
+        m->buf = nb;
+        m->cap = cap;
+    }
+    memcpy(m->buf + m->n, b, n);
+    m->n += n;
+    return (ssize_t)n;
+}
+
+static int mem_close(void* cookie) {
+    ((png_mem*)cookie)->closed = true;
+    return 0;
+}
+
+int app_png_render(const char* png, const char* geometry, void (*draw)(void* user), void* user, char* err,
+                   size_t errsz) {
+    png_mem m = {0};
+    cookie_io_functions_t io = {.read = NULL, .write = mem_write, .seek = NULL, .close = mem_close};
+    FILE* f = fopencookie(&m, "w", io);
+    if (!f) {
+        snprintf(err, errsz, "cannot write %s: %s", png, strerror(errno));
+        return -1;
+    }
+    plsdev("pngcairo");
+    plsfile(f);
+    plsetopt("geometry", geometry);
+    plscolbg(255, 255, 255);
+    plscol0(15, 0, 0, 0);
+    draw(user);
+    plend(); // writes the page to f; PLplot 5.15 also closes f
+    if (!m.closed) fclose(f);
+    int rc = 0;
+    if (m.oom) {
+        snprintf(err, errsz, "cannot write %s: out of memory", png);
+        rc = -1;
+    } else if (m.n == 0) {
+        snprintf(err, errsz, "cannot write %s: PLplot produced no image (is plplot-driver-cairo installed?)", png);
+        rc = -1;
+    } else {
+        rc = write_file(png, m.buf, m.n, err, errsz);
+    }
+    free(m.buf);
+    return rc;
+}
 
 typedef struct series {
     const sim_trace* tr;
@@ -70,6 +159,36 @@ static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, c
     }
 }
 
+typedef struct traces_plot {
+    const sim_trace *a, *b;
+    const char *la, *lb, *title;
+    PLFLT *xb, *yb;
+} traces_plot;
+
+static void draw_traces(void* user) {
+    const traces_plot* p = user;
+    const sim_trace *a = p->a, *b = p->b;
+    PLFLT *xb = p->xb, *yb = p->yb;
+    plstar(2, 2);
+    plschr(0, 0.9);
+    const int xs[] = {COL_X1, COL_X2};
+    const char* const xn[] = {"x1 lift", "x2 jib"};
+    const int ps[] = {COL_P1A, COL_P1B, COL_P2A, COL_P2B};
+    const char* const pn[] = {"p1A", "p1B", "p2A", "p2B"};
+    const int us[] = {COL_U1, COL_U2, COL_U1_CMD, COL_U2_CMD};
+    const char* const un[] = {"u1 spool", "u2 spool", "u1 cmd", "u2 cmd"};
+    const int tz[] = {COL_TIP_Z};
+    char t1[300];
+    snprintf(t1, sizeof t1, "Cylinder strokes - %s", p->title);
+    panel(a, b, COL_T, 1, xs, 2, 1e3, "t [s]", "stroke [mm]", t1, xn, xb, yb);
+    panel(a, b, COL_T, 1, ps, 4, 1e-6, "t [s]", "pressure [MPa abs]", "Chamber pressures", pn, xb, yb);
+    panel(a, b, COL_T, 1, us, 4, 100, "t [s]", "opening [%]", "Valve spools and commands", un, xb, yb);
+    char t4[200];
+    if (b) snprintf(t4, sizeof t4, "Tip path (solid: %s, dashed: %s)", p->la, p->lb);
+    else snprintf(t4, sizeof t4, "Tip path relative to joint 1");
+    panel(a, b, COL_TIP_X, 1, tz, 1, 1, "reach [m]", "height [m]", t4, NULL, xb, yb);
+}
+
 static int plot_traces(const sim_trace* a, const char* la, const sim_trace* b, const char* lb, const char* title,
                        const char* png, char* err, size_t errsz) {
     int n = a->nrow > (b ? b->nrow : 0) ? a->nrow : b->nrow;
@@ -81,43 +200,11 @@ static int plot_traces(const sim_trace* a, const char* la, const sim_trace* b, c
         snprintf(err, errsz, "out of memory");
         return -1;
     }
-    FILE* probe = fopen(png, "wb");
-    if (!probe) {
-        free(xb);
-        free(yb);
-        snprintf(err, errsz, "cannot write %s", png);
-        return -1;
-    }
-    fclose(probe);
-    plsdev("pngcairo");
-    plsfnam(png);
-    plsetopt("geometry", "1400x1000");
-    plscolbg(255, 255, 255);
-    plscol0(15, 0, 0, 0);
-    plstar(2, 2);
-    plschr(0, 0.9);
-    char sup[256];
-    snprintf(sup, sizeof sup, "%s", title);
-    const int xs[] = {COL_X1, COL_X2};
-    const char* const xn[] = {"x1 lift", "x2 jib"};
-    const int ps[] = {COL_P1A, COL_P1B, COL_P2A, COL_P2B};
-    const char* const pn[] = {"p1A", "p1B", "p2A", "p2B"};
-    const int us[] = {COL_U1, COL_U2, COL_U1_CMD, COL_U2_CMD};
-    const char* const un[] = {"u1 spool", "u2 spool", "u1 cmd", "u2 cmd"};
-    const int tz[] = {COL_TIP_Z};
-    char t1[300];
-    snprintf(t1, sizeof t1, "Cylinder strokes - %s", sup);
-    panel(a, b, COL_T, 1, xs, 2, 1e3, "t [s]", "stroke [mm]", t1, xn, xb, yb);
-    panel(a, b, COL_T, 1, ps, 4, 1e-6, "t [s]", "pressure [MPa abs]", "Chamber pressures", pn, xb, yb);
-    panel(a, b, COL_T, 1, us, 4, 100, "t [s]", "opening [%]", "Valve spools and commands", un, xb, yb);
-    char t4[200];
-    if (b) snprintf(t4, sizeof t4, "Tip path (solid: %s, dashed: %s)", la, lb);
-    else snprintf(t4, sizeof t4, "Tip path relative to joint 1");
-    panel(a, b, COL_TIP_X, 1, tz, 1, 1, "reach [m]", "height [m]", t4, NULL, xb, yb);
-    plend();
+    traces_plot p = {a, b, la, lb, title, xb, yb};
+    const int rc = app_png_render(png, "1400x1000", draw_traces, &p, err, errsz);
     free(xb);
     free(yb);
-    return 0;
+    return rc;
 }
 
 int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz) {
@@ -129,6 +216,12 @@ int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, con
     return plot_traces(a, la, b, lb, title, png, err, errsz);
 }
 #else
+int app_png_render(const char* png, const char* geometry, void (*draw)(void* user), void* user, char* err,
+                   size_t errsz) {
+    (void)png, (void)geometry, (void)draw, (void)user, (void)write_file;
+    snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
+    return -1;
+}
 int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz) {
     (void)tr, (void)title, (void)png;
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");

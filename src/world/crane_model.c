@@ -109,8 +109,11 @@ int crane_mech_check(const crane_mech* m, const double stroke[2], char* err, int
     static const char* const lname[2] = {"links[0]", "links[1]"};
     for (int i = 0; i < 2; ++i) {
         const crane_link* l = &m->link[i];
-        if (!(l->length > 0) || !(l->mass > 0) || !(l->inertia >= 0) || !(l->com >= 0)) {
-            snprintf(err, (size_t)errsz, "mechanics.%s: length and mass must be > 0, com and inertia >= 0", lname[i]);
+        // As model.c reads them: the centre of mass on the link, a positive
+        // inertia (the ODE world's bodies need a positive-definite mass matrix).
+        if (!(l->length > 0) || !(l->mass > 0) || !(l->inertia > 0) || !(l->com >= 0) || !(l->com <= l->length)) {
+            snprintf(err, (size_t)errsz, "mechanics.%s: length, mass and inertia must be > 0, com in 0..length",
+                     lname[i]);
             return -1;
         }
     }

@@ -79,8 +79,9 @@ double crane_joint_for_stroke(const crane_actuator* a, double x);
 void crane_tip(const crane_mech* m, double q1, double q2, double* x, double* z);
 
 /// Problem found by crane_mech_check, written as "field: message".
-/// Returns 0 if the geometry is usable: phi inside (0, pi) over the stroke
-/// [0, stroke_k] of each actuator, positive lengths and masses.
+/// Returns 0 if the geometry is usable: phi inside (15, 165) deg over the
+/// stroke [0, stroke_k] of each actuator, positive lengths, masses and
+/// inertias, each centre of mass on its link (0 <= com <= length).
 int crane_mech_check(const crane_mech* m, const double stroke[2], char* err, int errsz);
 
 #ifdef __cplusplus

@@ -23,6 +23,85 @@ void json_fail(json_ctx* c, const char* path, const char* fmt, ...) {
     va_end(ap);
 }
 
+// Length of the JSON number at s (RFC 8259: -?(0|[1-9][0-9]*)(.[0-9]+)?([eE][+-]?[0-9]+)?),
+// or 0 if s does not start with one. cJSON hands any run of [0-9+-.eE] to
+// strtod, so it takes 00.1 or 1. that other JSON readers reject; our files
+// must stay readable by every tool.
+static size_t json_number_len(const char* s) {
+    const char* p = s;
+    if (*p == '-') ++p;
+    if (*p == '0') ++p;
+    else if (*p >= '1' && *p <= '9') while (isdigit((unsigned char)*p)) ++p;
+    else return 0;
+    if (*p == '.') {
+        ++p;
+        if (!isdigit((unsigned char)*p)) return 0;
+        while (isdigit((unsigned char)*p)) ++p;
+    }
+    if (*p == 'e' || *p == 'E') {
+        ++p;
+        if (*p == '+' || *p == '-') ++p;
+        if (!isdigit((unsigned char)*p)) return 0;
+        while (isdigit((unsigned char)*p)) ++p;
+    }
+    return (size_t)(p - s);
+}
+
+// True if c can continue a token cJSON reads as a number.
+static bool number_char(char c) { return isdigit((unsigned char)c) || strchr("+-.eE", c); }
+
+// Every number outside strings of an already parsed text must be a JSON
+// number: "file: line L, column C: invalid number '00.1'".
+static int check_numbers(const char* text, const char* path, char* err, size_t errsz) {
+    int line = 1, col = 1;
+    for (const char* p = text; *p;) {
+        if (*p == '"') { // skip the string, escapes included
+            for (++p, ++col; *p && *p != '"'; ++p, ++col)
+                if (*p == '\\' && p[1]) ++p, ++col;
+            if (*p) ++p, ++col;
+            continue;
+        }
+        if (*p == '-' || isdigit((unsigned char)*p)) {
+            size_t run = 0;
+            while (p[run] && number_char(p[run])) ++run;
+            if (json_number_len(p) != run) {
+                snprintf(err, errsz, "%s: line %d, column %d: invalid number '%.*s' (JSON: no leading zeros, digits "
+                                     "on both sides of a decimal point)",
+                         path, line, col, (int)(run < 32 ? run : 32), p);
+                return -1;
+            }
+            p += run, col += (int)run;
+            continue;
+        }
+        if (*p == '\n') ++line, col = 1;
+        else ++col;
+        ++p;
+    }
+    return 0;
+}
+
+// Reject an object member given twice: cJSON keeps both and every lookup
+// finds the first, so the second would be silently ignored.
+static int check_duplicates(const cJSON* node, const char* at, const char* path, char* err, size_t errsz) {
+    int i = 0;
+    for (const cJSON* it = node ? node->child : NULL; it; it = it->next, ++i) {
+        char p[256];
+        if (cJSON_IsObject(node)) {
+            for (const cJSON* later = it->next; later; later = later->next)
+                if (it->string && later->string && !strcmp(it->string, later->string)) {
+                    json_path(p, sizeof p, at, it->string);
+                    snprintf(err, errsz, "%s: %s: given twice (duplicate field)", path, p);
+                    return -1;
+                }
+            json_path(p, sizeof p, at, it->string ? it->string : "?");
+        } else {
+            json_path_index(p, sizeof p, at, i);
+        }
+        if ((cJSON_IsObject(it) || cJSON_IsArray(it)) && check_duplicates(it, p, path, err, errsz)) return -1;
+    }
+    return 0;
+}
+
 cJSON* json_load_file(const char* path, char* err, size_t errsz) {
     struct stat st;
     if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
@@ -62,6 +141,9 @@ cJSON* json_load_file(const char* path, char* err, size_t errsz) {
             if (*p == '\n') { ++line; col = 1; } else ++col;
         }
         snprintf(err, errsz, "%s: line %d, column %d: invalid JSON", path, line, col);
+    } else if (check_numbers(buf, path, err, errsz) || check_duplicates(root, "", path, err, errsz)) {
+        cJSON_Delete(root);
+        root = NULL;
     }
     free(buf);
     return root;
@@ -213,79 +295,140 @@ void json_only_keys(json_ctx* c, const cJSON* obj, const char* path, const char*
     }
 }
 
-// Find the child named by one path segment: an object key, "[i]" handled by
-// the caller, or for arrays the element whose "name" equals the segment.
-static cJSON* child_by_segment(cJSON* node, const char* seg) {
-    if (cJSON_IsObject(node)) return cJSON_GetObjectItemCaseSensitive(node, seg);
+// One step of a --set path: a field name (".name", also an array element's
+// "name" member, or its index when all digits) or an index ("[i]").
+typedef struct path_seg {
+    char key[64];
+    bool index; ///< written as [i]
+} path_seg;
+
+// Split a --set path into segments. The grammar is strict so that a typo
+// such as "mechanics..gravity" or "links[0" is an error, not a guess:
+//   path := name ( "." name | "[" digits "]" )*
+// Returns the number of segments, or -1 with the problem in why.
+static int parse_set_path(const char* path, path_seg* seg, int maxseg, char* why, size_t whysz) {
+    int n = 0;
+    const char* p = path;
+    for (;;) {
+        const bool index = n > 0 && *p == '[';
+        if (n > 0 && !index) {
+            if (*p != '.') {
+                snprintf(why, whysz, "expected '.' or '[' at character %d", (int)(p - path) + 1);
+                return -1;
+            }
+            ++p;
+        }
+        if (index) ++p;
+        const char* start = p;
+        size_t k = 0;
+        if (index) {
+            while (isdigit((unsigned char)p[k])) ++k;
+            if (!k || p[k] != ']') {
+                snprintf(why, whysz, "expected an index [0], [1], ... at character %d", (int)(start - path));
+                return -1;
+            }
+        } else {
+            while (p[k] && !strchr(".[]", p[k])) ++k;
+            if (!k) {
+                snprintf(why, whysz, "empty field name at character %d", (int)(start - path) + 1);
+                return -1;
+            }
+        }
+        if (n == maxseg || k >= sizeof seg[0].key) {
+            snprintf(why, whysz, "path too deep or a name too long");
+            return -1;
+        }
+        memcpy(seg[n].key, start, k);
+        seg[n].key[k] = 0;
+        seg[n].index = index;
+        ++n;
+        p = start + k + (index ? 1 : 0);
+        if (!*p) return n;
+    }
+}
+
+// Find the child named by one path segment: an object key, or for arrays an
+// index or the element whose "name" equals the segment.
+static cJSON* child_by_segment(cJSON* node, const path_seg* seg) {
+    if (seg->index) {
+        if (!cJSON_IsArray(node)) return NULL;
+        char* endp;
+        long i = strtol(seg->key, &endp, 10);
+        return i < cJSON_GetArraySize(node) ? cJSON_GetArrayItem(node, (int)i) : NULL;
+    }
+    if (cJSON_IsObject(node)) return cJSON_GetObjectItemCaseSensitive(node, seg->key);
     if (cJSON_IsArray(node)) {
         char* endp;
-        long i = strtol(seg, &endp, 10);
-        if (*seg && !*endp) return cJSON_GetArrayItem(node, (int)i);
+        long i = strtol(seg->key, &endp, 10);
+        if (isdigit((unsigned char)seg->key[0]) && !*endp)
+            return i < cJSON_GetArraySize(node) ? cJSON_GetArrayItem(node, (int)i) : NULL;
         cJSON* e;
         cJSON_ArrayForEach(e, node) {
             cJSON* nm = cJSON_GetObjectItemCaseSensitive(e, "name");
-            if (cJSON_IsString(nm) && !strcmp(nm->valuestring, seg)) return e;
+            if (cJSON_IsString(nm) && !strcmp(nm->valuestring, seg->key)) return e;
         }
     }
     return NULL;
 }
 
+// Every number in a --set value must be a JSON number (see check_numbers).
+static bool value_numbers_ok(const char* v) {
+    char e[8];
+    return check_numbers(v, "", e, sizeof e) == 0;
+}
+
 int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) {
+    // Messages quote the whole argument: it is what the user typed.
     const char* eq = strchr(assignment, '=');
     if (!eq || eq == assignment) {
-        snprintf(err, errsz, "--set %s: expected path=value", assignment);
+        snprintf(err, errsz, "--set '%s': expected PATH=VALUE", assignment);
         return -1;
     }
     char path[256];
     size_t plen = (size_t)(eq - assignment);
     if (plen >= sizeof path) {
-        snprintf(err, errsz, "--set: path too long");
+        snprintf(err, errsz, "--set '%.40s...': path too long", assignment);
         return -1;
     }
     memcpy(path, assignment, plen);
     path[plen] = 0;
     const char* value = eq + 1;
 
-    // Split the path into segments on '.', '[' and ']'.
-    char segs[32][64];
-    int nseg = 0;
-    for (const char* p = path; *p;) {
-        if (*p == '.' || *p == '[' || *p == ']') { ++p; continue; }
-        size_t k = 0;
-        while (p[k] && p[k] != '.' && p[k] != '[' && p[k] != ']') ++k;
-        if (nseg == 32 || k >= 64) {
-            snprintf(err, errsz, "--set %s: path too deep or segment too long", path);
-            return -1;
-        }
-        memcpy(segs[nseg], p, k);
-        segs[nseg][k] = 0;
-        ++nseg;
-        p += k;
-    }
-    if (nseg == 0) {
-        snprintf(err, errsz, "--set %s: empty path", path);
+    path_seg segs[32];
+    char why[96];
+    const int nseg = parse_set_path(path, segs, 32, why, sizeof why);
+    if (nseg < 0) {
+        snprintf(err, errsz, "--set '%s': malformed path '%s': %s", assignment, path, why);
         return -1;
     }
     cJSON* parent = root;
     for (int i = 0; i < nseg - 1; ++i) {
-        parent = child_by_segment(parent, segs[i]);
+        parent = child_by_segment(parent, &segs[i]);
         if (!parent) {
-            snprintf(err, errsz, "--set %s: no field '%s' in the model", path, segs[i]);
+            snprintf(err, errsz, "--set '%s': no field '%s%s%s' in the model", assignment, segs[i].index ? "[" : "",
+                     segs[i].key, segs[i].index ? "]" : "");
             return -1;
         }
     }
-    cJSON* old = child_by_segment(parent, segs[nseg - 1]);
+    const path_seg* last = &segs[nseg - 1];
+    cJSON* old = child_by_segment(parent, last);
     if (!old) {
-        snprintf(err, errsz, "--set %s: no field '%s' in the model", path, segs[nseg - 1]);
+        snprintf(err, errsz, "--set '%s': no field '%s%s%s' in the model", assignment, last->index ? "[" : "",
+                 last->key, last->index ? "]" : "");
         return -1;
     }
-    cJSON* nv = cJSON_Parse(value);
+    // The whole value must be one JSON value: "5 xyz", "5,6" or "5}" are
+    // typos, not 5 (cJSON alone stops at the end of the first value).
+    const char* vend = NULL;
+    cJSON* nv = value_numbers_ok(value) ? cJSON_ParseWithOpts(value, &vend, 1) : NULL;
     if (!nv) {
         // A bare word (no quotes) is taken as a string: --set solver=ros2.
         bool word = *value != 0;
         for (const char* q = value; *q; ++q) word = word && (isalnum((unsigned char)*q) || strchr("_-./:", *q));
         if (!word) {
-            snprintf(err, errsz, "--set %s: cannot parse value '%s'", path, value);
+            snprintf(err, errsz, "--set '%s': cannot parse the value '%s' (a number, true/false, \"text\", "
+                                 "[array] or a bare word)",
+                     assignment, value);
             return -1;
         }
         nv = cJSON_CreateString(value);
@@ -295,11 +438,11 @@ int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) 
     if ((cJSON_IsNumber(old) && !cJSON_IsNumber(nv)) || (cJSON_IsBool(old) && !cJSON_IsBool(nv)) ||
         (cJSON_IsString(old) && !cJSON_IsString(nv)) || (cJSON_IsObject(old) && !cJSON_IsObject(nv)) ||
         (cJSON_IsArray(old) && !cJSON_IsArray(nv))) {
-        snprintf(err, errsz, "--set %s: expected %s, got '%s'", path, type_name(old), value);
+        snprintf(err, errsz, "--set '%s': %s must be %s, got '%s'", assignment, path, type_name(old), value);
         cJSON_Delete(nv);
         return -1;
     }
     if (cJSON_IsArray(parent)) cJSON_ReplaceItemViaPointer(parent, old, nv);
-    else cJSON_ReplaceItemInObjectCaseSensitive(parent, segs[nseg - 1], nv);
+    else cJSON_ReplaceItemInObjectCaseSensitive(parent, last->key, nv);
     return 0;
 }

@@ -26,7 +26,9 @@ typedef struct json_ctx {
 void json_fail(json_ctx* c, const char* path, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-/// Read and parse a whole file. NULL with "file: line L, column C: message" on error.
+/// Read and parse a whole file. NULL with "file: line L, column C: message" on
+/// a syntax error, also for a number JSON does not allow (00.1, 1.), and
+/// "file: field.path: given twice (duplicate field)" for a repeated member.
 cJSON* json_load_file(const char* path, char* err, size_t errsz);
 
 /// Join a parent path and a key ("a.b" + "c" -> "a.b.c"; "" + "c" -> "c").
@@ -63,10 +65,12 @@ void json_only_keys(json_ctx* c, const cJSON* obj, const char* path, const char*
 
 /// Apply "path=value" to a parsed document: path is dot-separated with [i]
 /// indices, and an array element can also be picked by its "name" member
-/// ("hydraulics.components.lift_cyl.bore"). value is parsed as JSON (number,
-/// true/false, "string", [array]); a bare word becomes a string. The member
-/// must already exist (a typo must not be silently added). Returns 0 or -1
-/// with a message in err.
+/// ("hydraulics.components.lift_cyl.bore"); an empty name ("a..b"), an
+/// unclosed or non-numeric index is an error. value must be exactly one JSON
+/// value (number, true/false, "string", [array]; nothing after it); a bare
+/// word becomes a string. The member must already exist (a typo must not be
+/// silently added) and keep its type. Returns 0 or -1 with a message in err
+/// that quotes the whole assignment ("--set 'a.b=1': ...").
 int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz);
 
 #ifdef __cplusplus

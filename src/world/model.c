@@ -41,7 +41,14 @@ static void load_link(json_ctx* c, const cJSON* arr, int i, crane_link* l) {
     l->length = json_pos(c, o, p, "length", true, 0);
     l->mass = json_pos(c, o, p, "mass", true, 0);
     l->com = json_num(c, o, p, "com", true, 0, 0, 100);
-    l->inertia = json_num(c, o, p, "inertia", true, 0, 0, 1e9);
+    // A centre of mass past the link's end is a typo (a point mass beyond the
+    // tip belongs in load_mass), and a zero inertia is a body ODE cannot
+    // integrate (its mass matrix must be positive definite).
+    char f[80];
+    json_path(f, sizeof f, p, "com");
+    if (!c->failed && l->com > l->length)
+        json_fail(c, f, "must lie on the link (0..length %g m), got %g m", l->length, l->com);
+    l->inertia = json_pos(c, o, p, "inertia", true, 0);
     l->width = json_pos(c, o, p, "width", false, 0.18);
     l->height = json_pos(c, o, p, "height", false, 0.24);
 }
@@ -94,11 +101,17 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     const cJSON* links = json_arr(&c, mech, "mechanics", "links", true);
     if (links && cJSON_GetArraySize(links) != 2) json_fail(&c, "mechanics.links", "must list exactly 2 links");
     for (int i = 0; i < 2 && !c.failed; ++i) load_link(&c, links, i, &me->link[i]);
+    // Names pick elements in --set paths (mechanics.links.end_arm.mass): two
+    // equal names would make the second unreachable.
+    if (!c.failed && !strcmp(me->link[0].name, me->link[1].name))
+        json_fail(&c, "mechanics.links[1].name", "\"%s\" is already the name of links[0]", me->link[1].name);
     me->load_mass = json_num(&c, mech, "mechanics", "load_mass", true, 0, 0, 1e5);
     const cJSON* acts = json_arr(&c, mech, "mechanics", "actuators", true);
     if (acts && cJSON_GetArraySize(acts) != 2)
         json_fail(&c, "mechanics.actuators", "must list exactly 2 actuators (lift, jib)");
     for (int i = 0; i < 2 && !c.failed; ++i) load_actuator(&c, acts, i, &me->act[i]);
+    if (!c.failed && !strcmp(me->act[0].name, me->act[1].name))
+        json_fail(&c, "mechanics.actuators[1].name", "\"%s\" is already the name of actuators[0]", me->act[1].name);
     if (c.failed) goto fail;
     crane_mech_derive(me);
 
@@ -117,6 +130,15 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         if (m->cyl[k] < 0) json_fail(&c, f, "no cylinder named \"%s\" in hydraulics", me->act[k].cylinder);
         snprintf(f, sizeof f, "%s.valve", p);
         if (m->valve[k] < 0) json_fail(&c, f, "no valve named \"%s\" in hydraulics", me->act[k].valve);
+        // One cylinder (valve) per actuator: two joints driven by one
+        // cylinder are two rigid constraints on one stroke, which the
+        // integrator meets as a blow-up rather than an error.
+        if (k == 1 && m->cyl[1] == m->cyl[0])
+            json_fail(&c, "mechanics.actuators[1].cylinder",
+                      "\"%s\" is also the cylinder of actuators[0]; each actuator needs its own", me->act[1].cylinder);
+        if (k == 1 && m->valve[1] == m->valve[0])
+            json_fail(&c, "mechanics.actuators[1].valve",
+                      "\"%s\" is also the valve of actuators[0]; each actuator needs its own", me->act[1].valve);
         if (c.failed) goto fail;
         double AA, AB;
         hyd_model_cylinder_geometry(m->hyd, m->cyl[k], &AA, &AB, &m->stroke[k]);
@@ -132,20 +154,51 @@ fail: // err already holds the one-line message
     return NULL;
 }
 
-model* model_load(const char* path, const char* const* sets, int nset, char* err, size_t errsz) {
-    if (!path) path = model_default_path();
+// The file with the first n overrides applied, or NULL with the message.
+static cJSON* load_with_sets(const char* path, const char* const* sets, int n, char* err, size_t errsz) {
     cJSON* root = json_load_file(path, err, errsz);
     if (!root) return NULL;
-    for (int i = 0; i < nset; ++i) {
-        char e[256];
+    for (int i = 0; i < n; ++i) {
+        char e[400];
         if (json_set_path(root, sets[i], e, sizeof e)) {
             snprintf(err, errsz, "%s: %s", path, e);
             cJSON_Delete(root);
             return NULL;
         }
     }
+    return root;
+}
+
+// Which override turned a valid file into an invalid model: the first k with
+// sets[0..k] failing, or -1 when the file fails on its own. Only called on
+// the failure path; a model loads in well under a millisecond.
+static int first_bad_set(const char* path, const char* file, const char* const* sets, int nset) {
+    for (int k = 0; k <= nset; ++k) {
+        char e[1024];
+        cJSON* root = load_with_sets(path, sets, k, e, sizeof e);
+        if (!root) return -1;
+        model* m = model_from_json(root, file, e, sizeof e);
+        if (!m) return k - 1;
+        model_free(m);
+    }
+    return -1;
+}
+
+model* model_load(const char* path, const char* const* sets, int nset, char* err, size_t errsz) {
+    if (!path) path = model_default_path();
+    cJSON* root = load_with_sets(path, sets, nset, err, errsz);
+    if (!root) return NULL;
     const char* base = strrchr(path, '/');
-    return model_from_json(root, base ? base + 1 : path, err, errsz);
+    base = base ? base + 1 : path;
+    model* m = model_from_json(root, base, err, errsz);
+    if (m || nset == 0) return m;
+    // A range error reads like a fault of the file; say which --set it was.
+    const int k = first_bad_set(path, base, sets, nset);
+    if (k >= 0) {
+        const size_t L = strlen(err);
+        snprintf(err + L, errsz - L, " (from --set '%s')", sets[k]);
+    }
+    return NULL;
 }
 
 void model_free(model* m) {

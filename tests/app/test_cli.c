@@ -60,6 +60,15 @@ static void test_bad_models(void) {
         {"bad_mount.json", "actuators[0]"},
         {"bad_port.json", "components[2].A"},
         {"syntax_error.json", "line"},
+        // Strict reading (docs/files.md): a field given twice, a number JSON
+        // does not allow, a centre of mass past the link, a massless
+        // rotation, two actuators on one cylinder or with one name.
+        {"dup_key.json", "components[5].bore"},
+        {"leading_zero.json", "00.1"},
+        {"com_beyond_link.json", "links[0].com"},
+        {"zero_inertia.json", "links[1].inertia"},
+        {"two_on_one_cylinder.json", "actuators[1].cylinder"},
+        {"dup_actuator_name.json", "actuators[1].name"},
     };
     static char out[8192];
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
@@ -106,6 +115,32 @@ static void test_bad_set(void) {
         int rc = run(a, out, sizeof out);
         CHECK(rc == 2 && strstr(out, want[i]) && count_lines(out) == 1, "--set %s: exit %d: %s", bad[i], rc, out);
     }
+    // Trailing junk after the value and malformed paths are errors that quote
+    // the whole --set argument (each of these used to run with gravity 5 or 1).
+    const char* const junk[] = {"mechanics.gravity=5 xyz", "mechanics.gravity=5,6", "mechanics.gravity=5}",
+                                "mechanics.gravity=5 ]",   "mechanics.gravity=00.1", "mechanics..gravity=1",
+                                "mechanics.links[0.mass=200", "mechanics.links[x].mass=200",
+                                ".mechanics.gravity=1",   "mechanics.gravity.=1",
+                                // one cylinder for both actuators; one name for both
+                                "mechanics.actuators[0].cylinder=jib_cyl", "mechanics.actuators[0].name=jib"};
+    for (size_t i = 0; i < sizeof junk / sizeof junk[0]; ++i) {
+        char a[512], quoted[128];
+        snprintf(a, sizeof a, "run --quiet --scenario hold --duration 0.01 --out /dev/null --set '%s'", junk[i]);
+        snprintf(quoted, sizeof quoted, "--set '%s'", junk[i]);
+        int rc = run(a, out, sizeof out);
+        CHECK(rc == 2 && strstr(out, quoted) && count_lines(out) == 1, "--set '%s': exit %d, want 2 naming it: %s",
+              junk[i], rc, out);
+    }
+    // A range error found by the loader says which --set caused it.
+    CHECK(run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set hydraulics.components.lift_cyl.bore=-0.1",
+              out, sizeof out) == 2 &&
+              strstr(out, "components[5].bore") && strstr(out, "--set 'hydraulics.components.lift_cyl.bore=-0.1'"),
+          "range error should name the --set: %s", out);
+    // Well-formed paths still work: a named array element, an index.
+    CHECK(run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links.end_arm.mass=150 "
+              "--set 'mechanics.links[0].mass=200' --set mechanics.gravity=9.8",
+              out, sizeof out) == 0,
+          "good paths: %s", out);
     // A good --set takes effect: a heavier load needs more lift pressure.
     char a[512];
     snprintf(a, sizeof a, "run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.load_mass=800");
@@ -218,6 +253,235 @@ static void test_bad_world_and_compare_tolerance(void) {
           out);
 }
 
+static int exists(const char* path) {
+    FILE* f = fopen(path, "r");
+    if (f) fclose(f);
+    return f != NULL;
+}
+
+// `cranesim help CMD` is CMD's help; the examples and the help say what works.
+static void test_help_topics(void) {
+    static char out[16384];
+    const char* const cmds[] = {"run", "compare", "bench", "study", "drive"};
+    for (int i = 0; i < 5; ++i) {
+        char a[64], want[64];
+        snprintf(a, sizeof a, "help %s", cmds[i]);
+        snprintf(want, sizeof want, "usage: cranesim %s", cmds[i]);
+        CHECK(run(a, out, sizeof out) == 0 && strstr(out, want), "%s: %.200s", a, out);
+    }
+    CHECK(run("help fly", out, sizeof out) == 2 && strstr(out, "fly"), "help fly: %s", out);
+    // The top-level example used to set a load the scenario overrides.
+    CHECK(run("help", out, sizeof out) == 0 && !strstr(out, "--set mechanics.load_mass") && strstr(out, "--load"),
+          "help examples: %s", out);
+    // cvode is a solver, for lagrange only.
+    CHECK(run("run --help", out, sizeof out) == 0 && strstr(out, "cvode (SUNDIALS BDF; --mechanics lagrange only)"),
+          "run --help: %s", out);
+    // study lists each option once and none it cannot use.
+    CHECK(run("study --help", out, sizeof out) == 0, "study --help: %s", out);
+    int nscen = 0;
+    for (const char* p = out; (p = strstr(p, "\n  --scenario")); ++p) ++nscen;
+    CHECK(nscen == 1, "study --help lists --scenario %d times: %s", nscen, out);
+    const char* const unusable[] = {"\n  --mechanics", "\n  --world", "\n  --dt-ode", "\n  --solver", "\n  --dt ",
+                                    "\n  --every"};
+    for (int i = 0; i < 6; ++i) CHECK(!strstr(out, unusable[i]), "study --help offers%s", unusable[i] + 1);
+}
+
+// An option at the end, or followed by another option, is missing its value,
+// whichever command owns it; "--out --quiet" must not create "--quiet".
+static void test_missing_values(void) {
+    static char out[8192];
+    const char* const cases[][2] = {
+        {"run --out", "--out"},          {"run --plot", "--plot"},       {"run --dt", "--dt"},
+        {"compare --plot", "--plot"},    {"study --out-dir", "--out-dir"}, {"bench --config", "--config"},
+        {"drive --record", "--record"},  {"run --set", "--set"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        char want[64];
+        snprintf(want, sizeof want, "option %s needs a value", cases[i][1]);
+        int rc = run(cases[i][0], out, sizeof out);
+        CHECK(rc == 2 && strstr(out, want) && count_lines(out) == 1, "%s: exit %d: %s", cases[i][0], rc, out);
+    }
+    remove("--quiet");
+    int rc = run("run --scenario hold --duration 0.01 --out --quiet", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "option --out needs a value"), "--out --quiet: exit %d: %s", rc, out);
+    CHECK(!exists("--quiet"), "a file named --quiet was created");
+    remove("--quiet");
+}
+
+// Numbers are decimal or scientific; counts are range-checked before they
+// are converted (2^31 and 2^32 used to wrap).
+static void test_strict_numbers(void) {
+    static char out[8192];
+    const char* const bad[] = {"--dt 0x10", "--dt 1e-4x", "--dt inf", "--jac-every 2147483648",
+                               "--jac-every 4294967296", "--jac-every 1e12", "--jac-every 2.5", "--jac-every 0"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        char a[256], opt[32];
+        snprintf(a, sizeof a, "run --quiet --scenario hold --duration 0.01 --out /dev/null %s", bad[i]);
+        snprintf(opt, sizeof opt, "%.*s", (int)strcspn(bad[i], " "), bad[i]);
+        int rc = run(a, out, sizeof out);
+        CHECK(rc == 2 && strstr(out, opt) && count_lines(out) == 1, "%s: exit %d: %s", bad[i], rc, out);
+    }
+    CHECK(run("run --quiet --scenario hold --duration 0.01 --out /dev/null --jac-every 1000000 --dt 1e-4", out,
+              sizeof out) == 0,
+          "--jac-every 1000000: %s", out);
+}
+
+// A run refused as bad input (exit 2) creates or truncates nothing.
+static void test_rejected_run_writes_nothing(void) {
+    static char out[8192];
+    remove("cli_rej.csv");
+    int rc = run("run --quiet --mechanics ode --solver cvode --out cli_rej.csv", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "cvode") && count_lines(out) == 1, "ode + cvode: exit %d: %s", rc, out);
+    CHECK(!exists("cli_rej.csv"), "ode + cvode left cli_rej.csv behind");
+    // Refused inside the run's setup (the sandbox has no room for the rope).
+    char a[1024];
+    snprintf(a, sizeof a, "run --quiet --mechanics ode --world sandbox --scenario %s/scn_tip_low.json --out cli_rej.csv",
+             DATA);
+    rc = run(a, out, sizeof out);
+    CHECK(rc == 2 && !exists("cli_rej.csv"), "start pose refused: exit %d, file %s: %s", rc,
+          exists("cli_rej.csv") ? "created" : "absent", out);
+    // An existing file keeps its content.
+    FILE* f = fopen("cli_keep.csv", "w");
+    CHECK(f != NULL, "cannot create cli_keep.csv");
+    if (!f) return;
+    fputs("keep\n", f);
+    fclose(f);
+    rc = run("run --quiet --mechanics ode --world sandbox --scenario ramp --dt 3e-4 --out cli_keep.csv", out, sizeof out);
+    static char csv[64];
+    CHECK(rc == 2 && read_file("cli_keep.csv", csv, sizeof csv) == 5 && !strcmp(csv, "keep\n"),
+          "refused run touched cli_keep.csv: exit %d, now '%s': %s", rc, csv, out);
+    remove("cli_rej.csv");
+    remove("cli_keep.csv");
+}
+
+// A failed write is an error (exit 1) that says why; a plot is named .png.
+static void test_write_failures(void) {
+    static char out[8192];
+    remove("cli_plot.png");
+    int rc = run("run --quiet --scenario hold --duration 0.05 --out /dev/null --plot cli_plot.png", out, sizeof out);
+    const int have_plplot = !strstr(out, "without PLplot");
+    if (have_plplot) {
+        static char png[16];
+        CHECK(rc == 0 && read_file("cli_plot.png", png, sizeof png) > 8 && !memcmp(png, "\x89PNG\r\n\x1a\n", 8),
+              "plot to a file: exit %d: %s", rc, out);
+        rc = run("run --scenario hold --duration 0.05 --out /dev/null --plot /dev/full", out, sizeof out);
+        CHECK(rc == 1 && strstr(out, "cannot write /dev/full: No space left on device") && !strstr(out, "plot ->"),
+              "run --plot /dev/full: exit %d: %s", rc, out);
+        rc = run("compare --quiet --scenario hold --duration 0.05 --solvers krus,ros2 --plot /dev/full", out,
+                 sizeof out);
+        CHECK(rc == 1 && strstr(out, "cannot write /dev/full: No space left on device") && !strstr(out, "plot ->"),
+              "compare --plot /dev/full: exit %d: %s", rc, out);
+    }
+    rc = run("run --quiet --scenario hold --duration 1 --out /dev/full", out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "cannot write /dev/full: No space left on device"), "run --out /dev/full: exit %d: %s",
+          rc, out);
+    // PNG data in a .jpg is refused before the run, and nothing is created.
+    remove("cli_plot.jpg");
+    rc = run("run --quiet --scenario hold --duration 0.05 --out /dev/null --plot cli_plot.jpg", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--plot cli_plot.jpg") && count_lines(out) == 1 && !exists("cli_plot.jpg"),
+          "--plot .jpg: exit %d: %s", rc, out);
+    rc = run("run --quiet --scenario hold --duration 0.05 --out no_such_dir/x.csv", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--out no_such_dir/x.csv") && count_lines(out) == 1, "--out in a missing folder: %s",
+          out);
+    remove("cli_plot.png");
+}
+
+// The study checks (and makes) its folder before any run, and refuses what
+// it cannot honour up front.
+static void test_study_usage(void) {
+    static char out[16384];
+    if (run("study --quick --repeat 1 --duration 0.05 --mechanics ode", out, sizeof out) == 2 &&
+        strstr(out, "needs the CVODE reference"))
+        return; // no CVODE in this build: the study cannot run at all
+    int rc = run("study --quick --repeat 1 --duration 0.05 --mechanics ode", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--mechanics ode") && !strstr(out, "reference:") && !strstr(out, "reference run failed"), "--mechanics ode: exit %d: %s", rc,
+          out);
+    rc = run("study --quick --repeat 1 --duration 0.05 --solver krus", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--solver") && count_lines(out) == 1, "--solver: exit %d: %s", rc, out);
+    rc = run("study --quick --repeat 1 --duration 0.05 --out-dir ''", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--out-dir") && count_lines(out) == 1, "empty --out-dir: exit %d: %s", rc, out);
+    // A file where the folder should be: refused before the reference run.
+    FILE* f = fopen("cli_study_file", "w");
+    if (f) fclose(f);
+    rc = run("study --quick --repeat 1 --duration 0.05 --out-dir cli_study_file", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--out-dir cli_study_file") && !strstr(out, "reference:") && !strstr(out, "reference run failed"),
+          "--out-dir naming a file: exit %d: %s", rc, out);
+    remove("cli_study_file");
+    // A nested folder is made with its parents.
+    remove("cli_study/sub/deeper/study.md");
+    rc = run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study/sub/deeper", out, sizeof out);
+    CHECK(rc == 0 && exists("cli_study/sub/deeper/study.md") && exists("cli_study/sub/deeper/study.jsonl"),
+          "nested --out-dir: exit %d: %.300s", rc, out);
+}
+
+// A fixed step lands on every output time, so --every must be a whole number
+// of steps (else steps are silently shortened); adaptive solvers take any.
+static void test_every_multiple_of_step(void) {
+    static char out[8192];
+    int rc = run("run --quiet --scenario ramp --duration 0.01 --every 0.00015 --dt 1e-4 --out /dev/null", out,
+                 sizeof out);
+    CHECK(rc == 2 && strstr(out, "--every 0.00015") && strstr(out, "0.0001 or 0.0002") && count_lines(out) == 1,
+          "--every 0.00015 --dt 1e-4: exit %d: %s", rc, out);
+    rc = run("run --quiet --scenario ramp --duration 0.05 --every 0.0015 --mechanics ode --out /dev/null", out,
+             sizeof out);
+    CHECK(rc == 2 && strstr(out, "ODE step") && count_lines(out) == 1, "ode --every 0.0015: exit %d: %s", rc, out);
+    rc = run("run --quiet --scenario ramp --duration 0.01 --every 0.00015 --solver rodas3 --out /dev/null", out,
+             sizeof out);
+    CHECK(rc == 0, "adaptive solvers take any --every: exit %d: %s", rc, out);
+    // A whole multiple: 0.01 s at 0.2 ms is 50 periods, 51 rows.
+    static char csv[1 << 16];
+    rc = run("run --quiet --scenario ramp --duration 0.01 --every 0.0002 --dt 1e-4 --out cli_every.csv", out,
+             sizeof out);
+    CHECK(rc == 0 && read_file("cli_every.csv", csv, sizeof csv) > 0 && count_lines(csv) == 1 + 51,
+          "--every 0.0002: exit %d, %d lines: %s", rc, count_lines(csv), out);
+}
+
+// Options that cannot act say so in one line; --load on the sandbox is refused.
+static void test_notes_on_unused_options(void) {
+    static char out[8192];
+    int rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.load_mass=2000", out,
+                 sizeof out);
+    CHECK(rc == 0 && strstr(out, "note: --set mechanics.load_mass=2000 has no effect") && strstr(out, "--load 2000") &&
+              count_lines(out) == 1,
+          "load_mass overridden by the scenario: exit %d: %s", rc, out);
+    rc = run("run --quiet --scenario ramp --duration 0.01 --mechanics ode --world sandbox --load 100 --out /dev/null",
+             out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--load") && strstr(out, "sandbox") && count_lines(out) == 1,
+          "--load on the sandbox: exit %d: %s", rc, out);
+    const char* const cases[][2] = {
+        {"--solver rodas3 --dt 1e-3", "note: --dt has no effect"},
+        // ... and is not then refused for not dividing the ODE step
+        {"--mechanics ode --solver rodas3 --dt 3e-4", "note: --dt has no effect"},
+        {"--rtol 1e-5", "note: --rtol has no effect"},
+        {"--world sandbox", "note: --world has no effect"},
+        {"--dt-ode 1e-4", "note: --dt-ode has no effect"},
+        {"--mechanics ode --variant paper", "note: --variant has no effect"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        char a[256];
+        snprintf(a, sizeof a, "run --quiet --scenario ramp --duration 0.01 --out /dev/null %s", cases[i][0]);
+        rc = run(a, out, sizeof out);
+        CHECK(rc == 0 && strstr(out, cases[i][1]) && count_lines(out) == 1, "%s: exit %d: %s", cases[i][0], rc, out);
+    }
+    rc = run("bench --config krus-1ms --repeat 1 --duration 0.01 --solver rodas3", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "note: --solver has no effect") && strstr(out, "\"solver\":\"krus\""),
+          "bench --solver: exit %d: %s", rc, out);
+}
+
+// The summary says what ran: the ode hydraulic step min(--dt, --dt-ode), the
+// world rather than a lagrange variant, where the peaks come from.
+static void test_run_summary(void) {
+    static char out[8192];
+    int rc = run("run --scenario ramp --duration 0.1 --mechanics ode --dt 2e-3 --out /dev/null", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "ode/validation") && strstr(out, "h = 1 ms") && strstr(out, "reduced"),
+          "ode --dt 2e-3: %s", out);
+    rc = run("run --scenario ramp --duration 0.01 --mechanics ode --dt-ode 1e-5 --out /dev/null", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "h = 0.01 ms") && !strstr(out, "h = 0.1 ms"), "ode --dt-ode 1e-5: %s", out);
+    rc = run("run --scenario ramp --duration 1 --every 0.5 --out /dev/null", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "peak pressures at the output rows") && strstr(out, "rows every 500 ms"),
+          "--every 0.5: %s", out);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_help_and_usage);
     RUN_TEST(test_bad_models);
@@ -228,5 +492,14 @@ int main(int argc, char** argv) {
     RUN_TEST(test_ode_runs_are_deterministic);
     RUN_TEST(test_sandbox_start_poses);
     RUN_TEST(test_bad_world_and_compare_tolerance);
+    RUN_TEST(test_help_topics);
+    RUN_TEST(test_missing_values);
+    RUN_TEST(test_strict_numbers);
+    RUN_TEST(test_rejected_run_writes_nothing);
+    RUN_TEST(test_write_failures);
+    RUN_TEST(test_study_usage);
+    RUN_TEST(test_every_multiple_of_step);
+    RUN_TEST(test_notes_on_unused_options);
+    RUN_TEST(test_run_summary);
     TEST_MAIN_END();
 }
