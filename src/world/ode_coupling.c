@@ -248,6 +248,19 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
     if (sandbox) {
         const char* wf = w->desc.file[0] ? w->desc.file : "world";
         if (bind_actuator(w, ODE_SLEW, w->desc.slew.cylinder, w->desc.slew.valve, wf, "slew", err, errsz)) return -1;
+        // One cylinder or valve driving two functions would couple them
+        // through one set of states: a slew that moves the boom.
+        for (int k = 0; k < 2; ++k) {
+            const char* what = w->act[ODE_SLEW].cyl == w->act[k].cyl     ? "cylinder"
+                               : w->act[ODE_SLEW].valve == w->act[k].valve ? "valve"
+                                                                           : NULL;
+            if (what) {
+                snprintf(err, errsz, "%s: slew.%s: \"%s\" already drives the %s boom (%s mechanics.actuators[%d])", wf,
+                         what, what[0] == 'c' ? w->desc.slew.cylinder : w->desc.slew.valve, k ? "end" : "lifting",
+                         mfile, k);
+                return -1;
+            }
+        }
         w->act[ODE_SLEW].present = 1;
     }
     w->ipump = -1;

@@ -447,7 +447,7 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
     }
     w->desc.circuit = NULL; // never owned here
     w->kind = w->desc.kind;
-    w->g = w->desc.gravity > 0 ? w->desc.gravity : w->mech.gravity;
+    w->g = w->desc.gravity >= 0 ? w->desc.gravity : w->mech.gravity;
     w->m3 = opt.load_mass >= 0 ? opt.load_mass : w->mech.load_mass;
     w->attached = -1;
     w->ipump = -1;

@@ -141,7 +141,7 @@ typedef struct world_desc {
     char name[64];
     char file[256];        ///< file it came from ("" if built in), for messages
     world_kind kind;
-    double gravity;        ///< [m/s^2]; <= 0 means "the model's"
+    double gravity;        ///< [m/s^2], 0 allowed (weightless); < 0 (absent from the file): the model's
     world_ode_params ode;
     // Sandbox only (ignored by the validation world).
     world_terrain terrain;
