@@ -17,12 +17,12 @@ const char* const sim_col_name[SIM_NCOL] = {
     "tip_x", "tip_z", "F1", "F2", "u1_cmd", "u2_cmd",
     "v1", "v2", "p_pump", "relief_open", "end_stop",
     "slew", "hook_x", "hook_y", "hook_z", "load_x", "load_y", "load_z", "attached", "truck_tilt", "contacts",
-    "max_depth"};
+    "max_depth", "x3", "v3", "p3A", "p3B", "u3", "u3_cmd", "F3"};
 const char* const sim_col_unit[SIM_NCOL] = {
     "s", "m", "m", "Pa", "Pa", "Pa", "Pa", "-", "-", "rad", "rad",
     "m", "m", "N", "N", "-", "-",
     "m/s", "m/s", "Pa", "count", "bits",
-    "rad", "m", "m", "m", "m", "m", "m", "index", "rad", "count", "m"};
+    "rad", "m", "m", "m", "m", "m", "m", "index", "rad", "count", "m", "m", "m/s", "Pa", "Pa", "-", "-", "N"};
 
 sim_opts sim_default_opts(void) {
     sim_opts o;
@@ -224,7 +224,7 @@ void sim_ode_row(ode_world* w, double* row) {
         st.tip[0], st.tip[1], st.F[0], st.F[1], st.u_cmd[0], st.u_cmd[1],
         st.v[0], st.v[1], st.p_pump, st.relief_open, st.end_stop,
         st.slew, st.hook[0], st.hook[1], st.hook[2], 0, 0, 0, st.attached, st.truck_tilt, st.ncontact,
-        st.max_depth};
+        st.max_depth, st.x[2], st.v[2], st.pA[2], st.pB[2], st.u[2], st.u_cmd[2], st.F[2]};
     memcpy(row, v, sizeof v);
     // The attached load, else the first one: where the payload is.
     int li = st.attached >= 0 ? st.attached : (ode_world_nload(w) > 0 ? 0 : -1);
