@@ -397,6 +397,10 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     so.atol = o->atol;
     so.h_max = 0.5;
     so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    // A fixed-step run ends by construction (check_fixed_step bounds it to
+    // 1e12 steps): no per-call budget, which at 1e8 stopped a 1 ns step at
+    // 0.1 s. The adaptive budget guards against a controller that stalls.
+    if (!adaptive) so.max_steps = 0;
     // emit checks the pressure states at every output; when no row is
     // consumed (benchmarks) that is all it reads, so an adaptive solver
     // interpolates only those.
