@@ -472,11 +472,15 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     char nb[96];
     if (c.stop == 3) {
         res->status = 1;
+        // The step for fixed-step methods, the last step tried for ours, the
+        // tolerance for CVODE (whose steps are its own).
+        char how[48];
+        if (o->cvode) snprintf(how, sizeof how, "rtol %g", o->rtol);
+        else snprintf(how, sizeof how, "h = %g s", adaptive && s ? hyd_solver_last_h(s) : o->h);
         snprintf(res->message, sizeof res->message,
-                 "numerical blow-up: state %s = %.4g Pa (below absolute zero) at t = %.6g s (solver %s, h = %g s): %s",
+                 "numerical blow-up: state %s = %.4g Pa (below absolute zero) at t = %.6g s (solver %s, %s): %s",
                  state_name(&ls, c.bad_state, nb, sizeof nb), c.bad_value, c.bad_t,
-                 o->cvode ? "cvode" : hyd_method_name(o->solver),
-                 adaptive && s ? hyd_solver_last_h(s) : o->h, coarse_hint(adaptive));
+                 o->cvode ? "cvode" : hyd_method_name(o->solver), how, coarse_hint(adaptive));
     } else if (c.stop) {
         res->status = 2;
         snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c.t_last_row);
