@@ -75,7 +75,7 @@ typedef int (*sim_row_fn)(void* user, const double* row);
 
 typedef struct sim_result {
     int status;          ///< 0 ok, 1 numerical failure, 2 stopped by callback
-    char message[320];   ///< failure description: state name, time
+    char message[512];   ///< failure description: state name, time
     double t_end;        ///< simulated time reached [s]
     double wall;         ///< wall time of the integration [s]
     hyd_solver_stats stats;
