@@ -375,7 +375,10 @@ static void load_meshes(json_ctx* c, const cJSON* o, world_desc* w) {
                 json_fail(c, f, "must be \"y\" or \"z\", got \"%s\"", up);
             }
         }
-        if (cJSON_GetObjectItemCaseSensitive(m, "offset")) json_vec(c, m, p, "offset", true, s->offset, 3);
+        if (cJSON_GetObjectItemCaseSensitive(m, "offset")) {
+            json_vec(c, m, p, "offset", true, s->offset, 3);
+            s->has_offset = 1;
+        }
     }
 }
 
