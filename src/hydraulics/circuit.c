@@ -1179,3 +1179,64 @@ hyd_model* hyd_model_default_crane(char* err, size_t errsz) {
     hyd_builder_free(b);
     return m;
 }
+
+// Spectral radius by repeated squaring: rho(J) = lim ||J^k||^(1/k). B = J /
+// ||J||_F keeps the entries in range; after m squarings B^(2^m) carries a
+// scale 2^-m in its log. ||A^k||^(1/k) overshoots rho by at most
+// cond(V)^(1/k) for a diagonalisable J (V its eigenvectors), so 12 squarings
+// (k = 4096) bring even a factor 1e6 of conditioning to within 0.4 %.
+static double spectral_radius(double* A, double* T, int n) {
+    double f = 0.0;
+    for (int i = 0; i < n * n; ++i) f += A[i] * A[i];
+    f = sqrt(f);
+    if (!(f > 0.0) || !isfinite(f)) return f > 0.0 ? -1.0 : 0.0;
+    for (int i = 0; i < n * n; ++i) A[i] /= f;
+    double logscale = 0.0; // log of the factor divided out of A^(2^m) so far, over 2^m
+    double k = 1.0;
+    for (int m = 0; m < 12; ++m) {
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                double s = 0.0;
+                for (int l = 0; l < n; ++l) s += A[i * n + l] * A[l * n + j];
+                T[i * n + j] = s;
+            }
+        k *= 2.0;
+        double g = 0.0;
+        for (int i = 0; i < n * n; ++i) g += T[i] * T[i];
+        g = sqrt(g);
+        if (!(g > 0.0)) return 0.0; // nilpotent: every mode at rest
+        for (int i = 0; i < n * n; ++i) A[i] = T[i] / g;
+        logscale = 2.0 * logscale + log(g); // log ||J_scaled^k|| so far
+    }
+    return f * exp(logscale / k);
+}
+
+double hyd_model_fastest_rate(const hyd_model* m, double p, double u) {
+    const int n = m->nstate;
+    if (n == 0) return 0.0;
+    hyd_data* d = hyd_data_create(m);
+    double* y = calloc((size_t)n, sizeof *y);
+    double* J = calloc((size_t)n * (size_t)n, sizeof *J);
+    double* T = calloc((size_t)n * (size_t)n, sizeof *T);
+    double rate = -1.0;
+    if (d && y && J && T) {
+        hyd_model_initial_state(m, y);
+        for (int i = 0; i < m->nnode; ++i)
+            if (m->node_state[i] >= 0) y[m->node_state[i]] = p;
+        for (int v = 0; v < m->nvalve; ++v) {
+            y[hyd_model_valve_state(m, v)] = u;
+            d->valve_cmd[v] = u;
+        }
+        for (int c = 0; c < m->ncyl; ++c) {
+            d->cyl_x[c] = 0.5 * m->cyl[c].s;
+            d->cyl_v[c] = 0.0;
+        }
+        hyd_jacobian(m, d, 0.0, y, NULL, J, n, 0, 0);
+        rate = spectral_radius(J, T, n);
+    }
+    free(T);
+    free(J);
+    free(y);
+    hyd_data_free(d);
+    return rate;
+}

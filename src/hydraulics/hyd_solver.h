@@ -74,6 +74,13 @@ typedef struct hyd_problem {
     /// crane: lsim_krus.c). NULL: the generic stage arithmetic (krus.c).
     int (*wstep)(void* user, double t, const double* y, double h, double gamma, int new_jac,
                  double* ynew);
+    /// Optional domain of the states: returns 0 when y is admissible, else
+    /// 1 + the index of a state outside it. The adaptive methods reject a
+    /// trial step that leaves the domain and retry with a smaller h, as they
+    /// do for a non-finite one (absolute pressures below zero: the exact
+    /// solution never gets there, a step too long for its error estimate
+    /// can). NULL: every finite y is admissible.
+    int (*outside)(void* user, const double* y);
 } hyd_problem;
 
 typedef enum hyd_method {
@@ -129,6 +136,7 @@ typedef struct hyd_solver_stats {
     long fevals;    ///< right-hand-side evaluations (including finite-difference ones)
     long jevals;    ///< Jacobian evaluations
     long lus;       ///< LU factorisations of W (a block-diagonal W counts once)
+    long outside;   ///< trial steps rejected for leaving the domain (hyd_problem.outside; adaptive)
 } hyd_solver_stats;
 
 enum {
@@ -137,8 +145,12 @@ enum {
     HYD_ERR_SINGULAR = -2, ///< W is singular
     HYD_ERR_NONFINITE = -3,///< a state became NaN/Inf; see hyd_solver_bad_state
     HYD_ERR_HMIN = -4,     ///< adaptive step fell below h_min
-    HYD_ERR_STEPS = -5     ///< max_steps reached
+    HYD_ERR_STEPS = -5,    ///< max_steps reached
+    HYD_ERR_DOMAIN = -6    ///< adaptive: even the smallest step leaves the domain; see hyd_solver_bad_state
 };
+
+/// What a HYD_ERR_* code means, in a few words for a message.
+const char* hyd_error_text(int code);
 
 typedef struct hyd_solver hyd_solver;
 

@@ -258,6 +258,12 @@ int hyd_model_valve_comp(const hyd_model* m, int valve);
 void hyd_model_cylinder_geometry(const hyd_model* m, int cyl, double* AA, double* AB, double* s);
 /// Fill y (nstate) with the initial state (p0 of each node, u0 of each valve).
 void hyd_model_initial_state(const hyd_model* m, double* y);
+/// The circuit's fastest mode [1/s]: the spectral radius of its Jacobian
+/// with every volume node at p [Pa abs], every cylinder at mid-stroke and at
+/// rest, every spool at u (0: closed). An explicit method of real stability
+/// interval [-r, 0] is unstable for h > r / rate (RK4: r = 2.785). Returns
+/// 0 when the circuit has no states, or -1 when it cannot be evaluated.
+double hyd_model_fastest_rate(const hyd_model* m, double p, double u);
 /// The fluid the model was compiled with.
 hyd_fluid_def hyd_model_fluid(const hyd_model* m);
 

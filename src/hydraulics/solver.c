@@ -215,6 +215,19 @@ const hyd_solver_stats* hyd_solver_get_stats(const hyd_solver* s) { return &s->s
 void hyd_solver_clear_stats(hyd_solver* s) { memset(&s->st, 0, sizeof s->st); }
 double hyd_solver_last_h(const hyd_solver* s) { return s->last_h; }
 
+const char* hyd_error_text(int code) {
+    switch (code) {
+    case HYD_OK: return "no error";
+    case HYD_ERR_RHS: return "the right-hand side or Jacobian reported a failure";
+    case HYD_ERR_SINGULAR: return "the iteration matrix W = I - gamma h J is singular";
+    case HYD_ERR_NONFINITE: return "a state became NaN or infinite";
+    case HYD_ERR_HMIN: return "the step size fell below its minimum (the error test kept failing)";
+    case HYD_ERR_STEPS: return "the step budget ran out (more than max_steps steps in one call)";
+    case HYD_ERR_DOMAIN: return "every step tried left the states' domain";
+    default: return "unknown solver error";
+    }
+}
+
 int hyd_solver_bad_state(const hyd_solver* s, double* t_bad) {
     if (t_bad) *t_bad = s->bad_t;
     return s->bad_i;
@@ -408,15 +421,18 @@ int hyd_solver_step(hyd_solver* s, double* t, double* y, double h) {
 }
 
 static int advance_fixed(hyd_solver* s, double* t, double* y, double t_end, long* budget) {
-    const double h0 = s->o.h;
-    while (*t < t_end) {
+    const double h0 = s->o.h, t0 = *t;
+    // Times as t0 + k h0, not summed step by step: over a long segment (a
+    // 1 s output period is 10,000 steps of 0.1 ms) the summed rounding grows
+    // past the landing tolerance below and leaves a sliver step at the end.
+    for (long k = 1; *t < t_end; ++k) {
         if (*budget <= 0) return HYD_ERR_STEPS;
         --*budget;
         // Land exactly on t_end; a remainder within 1e-9 h of a full step is
         // taken as that step, so rounding never leaves a sliver step behind.
         const double rem = t_end - *t;
         const int land = rem <= h0 * (1.0 + 1e-9);
-        int rc = fixed_step(s, t, y, land ? rem : h0, land ? t_end : *t + h0);
+        int rc = fixed_step(s, t, y, land ? rem : h0, land ? t_end : t0 + (double)k * h0);
         if (rc != HYD_OK) return rc;
     }
     return HYD_OK;
@@ -539,7 +555,11 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
         if (rc == HYD_ERR_RHS) return rc;
         const int singular = rc == HYD_ERR_SINGULAR;
         const int bad = singular ? -1 : first_nonfinite(s->ynew, n);
-        double en = (singular || bad >= 0) ? HUGE_VAL : err_norm(s, y, s->ynew, s->err);
+        // A finite trial outside the problem's domain: rejected like a
+        // non-finite one (largest cut), never accepted on its error estimate.
+        const int out = singular || bad >= 0 || !s->p->outside ? 0 : s->p->outside(s->p->user, s->ynew);
+        if (out) s->st.outside++;
+        double en = (singular || bad >= 0 || out) ? HUGE_VAL : err_norm(s, y, s->ynew, s->err);
         if (!(en <= 1.0)) {
             // Reject. A singular W or a non-finite trial gets the largest cut.
             s->st.rejected++;
@@ -548,10 +568,10 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
             s->last_rejected = 1;
             if (s->j_steps > 0) s->j_force = 1; // a stale J may be the cause
             if (!(s->h_next >= fmax(fmax(s->o.h_min, 16.0 * DBL_EPSILON * fabs(*t)), DBL_MIN))) {
-                if (bad >= 0) {
-                    s->bad_i = bad;
+                if (bad >= 0 || out) {
+                    s->bad_i = bad >= 0 ? bad : out - 1;
                     s->bad_t = *t + h;
-                    return HYD_ERR_NONFINITE;
+                    return bad >= 0 ? HYD_ERR_NONFINITE : HYD_ERR_DOMAIN;
                 }
                 return singular ? HYD_ERR_SINGULAR : HYD_ERR_HMIN;
             }

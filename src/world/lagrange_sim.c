@@ -124,9 +124,20 @@ void lsim_free(lsim* s) {
     s->jh_ = NULL;
 }
 
+// hyd_problem.outside: an absolute pressure below zero. The bulk modulus
+// falls to zero there, so the exact solution never crosses it; a step that
+// does was too long, whatever its error estimate says.
+static int lsim_outside(void* user, const double* y) {
+    const lsim* s = user;
+    for (int i = 0; i < s->nh; ++i)
+        if (s->is_pressure[i] && !(y[i] >= 0.0)) return i + 1;
+    return 0;
+}
+
 hyd_problem lsim_problem(lsim* s, bool blocks) {
     hyd_problem p;
     memset(&p, 0, sizeof p);
+    p.outside = lsim_outside;
     p.n = s->n;
     const bool fz = s->use_fused && s->have_fused;
     p.f = fz ? lsim_rhs_fused : lsim_rhs;
@@ -357,6 +368,20 @@ int lsim_jac_fused(void* user, double t, const double* y, double* J) {
         J[(iq + 3) * n + iB] = Hi[1][c] * gB;
     }
     freeze_rows(s, J);
+    return 0;
+}
+
+int lsim_check_pose(const lsim* s, const double q0[2], char* err, size_t errsz) {
+    const model* m = s->mdl;
+    for (int k = 0; k < 2; ++k) {
+        const crane_actuator* a = &m->mech.act[k];
+        const double x = crane_stroke(a, q0[a->joint]);
+        if (!(x >= -1e-9 && x <= m->stroke[k] + 1e-9)) {
+            snprintf(err, errsz, "initial q%d = %.2f deg puts cylinder %s at stroke %.4f m, outside [0, %.3f] m",
+                     a->joint + 1, q0[a->joint] * (180.0 / 3.14159265358979323846), a->cylinder, x, m->stroke[k]);
+            return -1;
+        }
+    }
     return 0;
 }
 

@@ -109,6 +109,12 @@ hyd_problem lsim_problem(lsim* s, bool blocks);
 /// and the pump line at its set pressure.
 void lsim_initial_state(lsim* s, const double q0[2], double p_low, double* y);
 
+/// Returns 0 when both cylinders can reach the joint angles q0 [rad] (stroke
+/// in [0, s]), else -1 with one line naming the angle, the cylinder and its
+/// stroke (the same rule as the ode world's: an unreachable start pose would
+/// put a boom through its end stop at t = 0).
+int lsim_check_pose(const lsim* s, const double q0[2], char* err, size_t errsz);
+
 /// True when s has the layout of lsim_w.c: 15 states, actuator k at
 /// 5k..5k+4 = [spool, hose A, chamber A, hose B, chamber B], then the pump
 /// line and q1, q2, q1', q2'.

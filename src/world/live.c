@@ -36,6 +36,11 @@ live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2]
         free(l);
         return NULL;
     }
+    if (lsim_check_pose(&l->ls, q0, err, errsz)) {
+        lsim_free(&l->ls);
+        free(l);
+        return NULL;
+    }
     lsim_initial_state(&l->ls, q0, 0.5e6, l->y);
     // The drive panel edits circuit parameters in place (hyd_model_set), and
     // the fused kernel holds a packed copy of them: live runs keep the

@@ -75,6 +75,17 @@ static int jac_fused(void* user, double t, const double* y, double* J) {
     return 0;
 }
 
+// hyd_problem.outside: a node pressure below absolute zero (the adaptive
+// methods then retry with a shorter step; see lagrange_sim.c).
+static int outside(void* user, const double* y) {
+    const ode_world* w = user;
+    for (int i = 0; i < hyd_model_nnode(w->hm); ++i) {
+        const int s = hyd_model_node_state(w->hm, i);
+        if (s >= 0 && !(y[s] >= 0.0)) return s + 1;
+    }
+    return 0;
+}
+
 // (Re)pack the straight-line kernel for the present parameters, or fall
 // back to the general path when the circuit does not have its shape.
 static void fused_setup(ode_world* w) {
@@ -237,6 +248,19 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
     if (sandbox) {
         const char* wf = w->desc.file[0] ? w->desc.file : "world";
         if (bind_actuator(w, ODE_SLEW, w->desc.slew.cylinder, w->desc.slew.valve, wf, "slew", err, errsz)) return -1;
+        // One cylinder or valve driving two functions would couple them
+        // through one set of states: a slew that moves the boom.
+        for (int k = 0; k < 2; ++k) {
+            const char* what = w->act[ODE_SLEW].cyl == w->act[k].cyl     ? "cylinder"
+                               : w->act[ODE_SLEW].valve == w->act[k].valve ? "valve"
+                                                                           : NULL;
+            if (what) {
+                snprintf(err, errsz, "%s: slew.%s: \"%s\" already drives the %s boom (%s mechanics.actuators[%d])", wf,
+                         what, what[0] == 'c' ? w->desc.slew.cylinder : w->desc.slew.valve, k ? "end" : "lifting",
+                         mfile, k);
+                return -1;
+            }
+        }
         w->act[ODE_SLEW].present = 1;
     }
     w->ipump = -1;
@@ -250,6 +274,7 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
     }
     w->hp.n = w->nh;
     w->hp.user = w;
+    w->hp.outside = outside;
     fused_setup(w);
     const int adaptive = hyd_method_is_adaptive(w->opt.solver);
     if (!adaptive && !w->opt.dense_jac) {
@@ -372,13 +397,15 @@ int ow_hyd_step(ode_world* w, double H) {
                           : hyd_solver_step(w->hs, &w->th, w->y, h);
         if (rc != HYD_OK) {
             double tb = w->th;
-            int bad = rc == HYD_ERR_NONFINITE ? hyd_solver_bad_state(w->hs, &tb) : -1;
+            int bad = rc == HYD_ERR_NONFINITE || rc == HYD_ERR_DOMAIN ? hyd_solver_bad_state(w->hs, &tb) : -1;
             if (bad >= 0)
-                snprintf(w->err, sizeof w->err, "hydraulics: state %s became non-finite at t = %.6f s",
-                         hyd_model_state_name(w->hm, bad), tb);
+                snprintf(w->err, sizeof w->err, "hydraulics: state %s %s at t = %.6f s",
+                         hyd_model_state_name(w->hm, bad),
+                         rc == HYD_ERR_DOMAIN ? "went below absolute zero at every step size tried" : "became non-finite",
+                         tb);
             else
-                snprintf(w->err, sizeof w->err, "hydraulics: %s solver failed (code %d) at t = %.6f s",
-                         hyd_method_name(w->opt.solver), rc, w->th);
+                snprintf(w->err, sizeof w->err, "hydraulics: %s solver stopped at t = %.6f s: %s",
+                         hyd_method_name(w->opt.solver), w->th, hyd_error_text(rc));
             return -1;
         }
         // Force at the end of the sub-step (the solver's last f call was at a

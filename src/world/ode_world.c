@@ -227,8 +227,10 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
     {
         double sz[3] = {rcol, hcol, 0};
         double p[3] = {0, 0, base ? 0 : -0.5 * hcol};
-        ow_add_vis(w, "column", WORLD_ROLE_COLUMN, WORLD_SHAPE_CYLINDER, sz, RGBA_COLUMN, WORLD_MESH_COLUMN,
-                   f0->body, base ? zero3 : p, NULL);
+        ow_vis* cv = ow_add_vis(w, "column", WORLD_ROLE_COLUMN, WORLD_SHAPE_CYLINDER, sz, RGBA_COLUMN,
+                                WORLD_MESH_COLUMN, f0->body, base ? zero3 : p, NULL);
+        // column.obj has its origin at the column foot, half the height below the centre [m].
+        if (cv) cv->mesh_offset[2] = -0.5 * hcol;
         if (!base) {
             // Fixed column: its entry is in world coordinates.
             ow_vis* v = &w->vis[w->nvis - 1];
@@ -277,17 +279,21 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
             dGeomSetOffsetPosition(g, gp[0], gp[1], gp[2]);
             ow_add_geom(w, g, OW_CAT_CRANE, 0.5);
         }
-        ow_add_vis(w, name[i], role[i], WORLD_SHAPE_BOX, sz, i ? RGBA_BOOM2 : RGBA_BOOM1, mesh[i], f->body, gp, NULL);
+        ow_vis* bv = ow_add_vis(w, name[i], role[i], WORLD_SHAPE_BOX, sz, i ? RGBA_BOOM2 : RGBA_BOOM1, mesh[i], f->body,
+                                gp, NULL);
+        // boom1.obj / boom2.obj have their origin at the root joint, half a length behind the box centre [m].
+        if (bv) bv->mesh_offset[0] = -0.5 * l->length;
         double step[3] = {l->length, 0, 0}, dj[3];
         ow_mat_vec(R, step, dj);
         for (int k = 0; k < 3; ++k) jpos[k] += dj[k];
     }
     if (w->kind == WORLD_VALIDATION && w->m3 > 0) {
         // The tip load is merged into the end arm's mass (a point mass, as in
-        // lagrange); this entry only draws it hanging under the tip.
+        // lagrange); this entry only draws it hanging under the tip, as a
+        // plain box: the load mesh is a 1.2 m pallet that would not match it.
         double s = 0.5, sz[3] = {s, s, s};
         double p[3] = {me->link[1].length + w->frame[2].org[0], 0, -0.5 * s - 0.1};
-        ow_add_vis(w, "load", WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, sz, RGBA_LOAD, WORLD_MESH_LOAD, w->frame[2].body, p, NULL);
+        ow_add_vis(w, "load", WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, sz, RGBA_LOAD, -1, w->frame[2].body, p, NULL);
     }
 
     // Hinges: axis -y of the column frame, so a positive hinge angle is a
@@ -447,7 +453,7 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
     }
     w->desc.circuit = NULL; // never owned here
     w->kind = w->desc.kind;
-    w->g = w->desc.gravity > 0 ? w->desc.gravity : w->mech.gravity;
+    w->g = w->desc.gravity >= 0 ? w->desc.gravity : w->mech.gravity;
     w->m3 = opt.load_mass >= 0 ? opt.load_mass : w->mech.load_mass;
     w->attached = -1;
     w->ipump = -1;
@@ -806,7 +812,7 @@ void ode_world_snapshot(const ode_world* w, world_snapshot* s) {
             snprintf(b->mesh, sizeof b->mesh, "%s", m->file);
             b->mesh_scale = m->scale;
             b->mesh_up = m->up;
-            memcpy(b->mesh_offset, m->offset, sizeof b->mesh_offset);
+            memcpy(b->mesh_offset, m->has_offset ? m->offset : v->mesh_offset, sizeof b->mesh_offset);
         }
     }
     s->nbody = n;

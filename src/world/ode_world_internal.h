@@ -42,6 +42,7 @@ typedef struct ow_vis {
     dBodyID body;       ///< 0: pose is in the world
     double pos[3];      ///< primitive centre in the body frame (or world) [m]
     double rot[9];      ///< primitive-to-body rotation, row-major
+    double mesh_offset[3]; ///< mesh origin in the primitive frame [m] when the world file gives none
 } ow_vis;
 
 /// A crane frame (column, lifting arm, end arm) carried by an ODE body: the

@@ -56,6 +56,8 @@ enum {
     // World extras, written by the ode backend only.
     COL_SLEW = SIM_NCOL_BASE, COL_HOOK_X, COL_HOOK_Y, COL_HOOK_Z, COL_LOAD_X, COL_LOAD_Y, COL_LOAD_Z,
     COL_ATTACHED, COL_TRUCK_TILT, COL_CONTACTS, COL_MAX_DEPTH,
+    // The slew function's actuator (sandbox; zeros in the validation world).
+    COL_X3, COL_V3, COL_P3A, COL_P3B, COL_U3, COL_U3_CMD, COL_F3,
     SIM_NCOL
 };
 extern const char* const sim_col_name[SIM_NCOL];
@@ -73,7 +75,7 @@ typedef int (*sim_row_fn)(void* user, const double* row);
 
 typedef struct sim_result {
     int status;          ///< 0 ok, 1 numerical failure, 2 stopped by callback
-    char message[320];   ///< failure description: state name, time
+    char message[512];   ///< failure description: state name, time
     double t_end;        ///< simulated time reached [s]
     double wall;         ///< wall time of the integration [s]
     hyd_solver_stats stats;

@@ -37,7 +37,7 @@ void world_desc_default(world_desc* w, world_kind kind) {
     memset(w, 0, sizeof *w);
     snprintf(w->name, sizeof w->name, "%s", world_kind_name(kind));
     w->kind = kind;
-    w->gravity = 0; // the model's
+    w->gravity = -1; // the model's (a file may set 0: weightless)
     // dWorldStep solves the constraints directly, so a tiny CFM only keeps the
     // LCP matrix regular; ERP 0.2 removes drift over about 5 steps without
     // adding noticeable energy (docs/ode_world.md, "ERP and CFM").
@@ -375,7 +375,10 @@ static void load_meshes(json_ctx* c, const cJSON* o, world_desc* w) {
                 json_fail(c, f, "must be \"y\" or \"z\", got \"%s\"", up);
             }
         }
-        if (cJSON_GetObjectItemCaseSensitive(m, "offset")) json_vec(c, m, p, "offset", true, s->offset, 3);
+        if (cJSON_GetObjectItemCaseSensitive(m, "offset")) {
+            json_vec(c, m, p, "offset", true, s->offset, 3);
+            s->has_offset = 1;
+        }
     }
 }
 
@@ -417,9 +420,24 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
         return -1;
     }
     world_desc_default(w, (world_kind)k);
+    if (k == WORLD_VALIDATION) {
+        // The validation world is the lagrange crane in ODE (SPEC 6): no
+        // terrain, truck, rope or loads. A sandbox section there would be
+        // silently ignored, so it is an error.
+        static const char* const vkeys[] = {"name", "description", "type", "gravity", "ode", NULL};
+        const cJSON* it;
+        cJSON_ArrayForEach(it, root) {
+            bool ok = false;
+            for (const char* const* a = vkeys; *a && !ok; ++a) ok = !strcmp(*a, it->string);
+            if (!ok) {
+                json_fail(&c, it->string, "only a sandbox world has this (type is \"validation\")");
+                return -1;
+            }
+        }
+    }
     snprintf(w->file, sizeof w->file, "%s", file);
     json_str(&c, root, "", "name", false, w->name, w->name, sizeof w->name);
-    w->gravity = json_num(&c, root, "", "gravity", false, 0, 0, 100);
+    w->gravity = json_num(&c, root, "", "gravity", false, w->gravity, 0, 100);
     load_ode(&c, json_obj(&c, root, "", "ode", false), &w->ode);
     load_terrain(&c, json_obj(&c, root, "", "terrain", false), &w->terrain);
     load_truck(&c, json_obj(&c, root, "", "truck", false), &w->truck);

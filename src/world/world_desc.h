@@ -33,6 +33,7 @@ typedef struct world_mesh {
     double scale;      ///< mesh units to metres [m/unit]
     int up;            ///< 1 = mesh is y-up, 2 = z-up
     double offset[3];  ///< mesh origin in the body's primitive frame [m]
+    int has_offset;    ///< 1: offset given in the world file; 0: the body's own (ode_world.c: a crane part's joint)
 } world_mesh;
 
 /// Mesh slots, one per body type.
@@ -141,7 +142,7 @@ typedef struct world_desc {
     char name[64];
     char file[256];        ///< file it came from ("" if built in), for messages
     world_kind kind;
-    double gravity;        ///< [m/s^2]; <= 0 means "the model's"
+    double gravity;        ///< [m/s^2], 0 allowed (weightless); < 0 (absent from the file): the model's
     world_ode_params ode;
     // Sandbox only (ignored by the validation world).
     world_terrain terrain;

@@ -171,12 +171,14 @@ static void test_csv_contract(void) {
     CHECK(count_lines(csv) == 1 + 6, "want 6 rows at 100 Hz, got %d", count_lines(csv) - 1);
 }
 
-// RK4 far beyond its stability limit on the stiff circuit: exit 1, a message
-// naming the state and the time, and the rows before the failure kept.
+// Krus (A-stable, R(-inf) = -1) at 20 times its step rings on the valve
+// steps until a pressure leaves the physical range: exit 1, a message naming
+// the state and the time, and the rows before the failure kept. (RK4 beyond
+// its stability limit is refused up front: test_rk4_refused.)
 static void test_blow_up_keeps_output(void) {
     static char out[8192];
     static char csv[1 << 20];
-    int rc = run("run --quiet --scenario step --solver rk4 --dt 2e-3 --out cli_blowup.csv", out, sizeof out);
+    int rc = run("run --quiet --scenario step --solver krus --dt 2e-3 --out cli_blowup.csv", out, sizeof out);
     CHECK(rc == 1, "exit %d, want 1: %s", rc, out);
     CHECK(strstr(out, "state ") && strstr(out, "t = "), "message should name state and time: %s", out);
     CHECK(strstr(out, "kept in cli_blowup.csv"), "message should say where the rows are: %s", out);
@@ -200,6 +202,21 @@ static int files_equal(const char* a, const char* b) {
 }
 
 // The sandbox (contacts, rope, hook events) run twice gives byte-identical CSV.
+// RK4 at the default 0.1 ms is outside its stability interval on the
+// hose/chamber modes (about 5e4 1/s): refused as bad input, naming the limit,
+// with no CSV written; at 10 us it runs.
+static void test_rk4_refused(void) {
+    static char out[8192];
+    remove("cli_rk4.csv");
+    int rc = run("run --quiet --scenario step --solver rk4 --duration 0.2 --out cli_rk4.csv", out, sizeof out);
+    CHECK(rc == 2, "exit %d, want 2: %s", rc, out);
+    CHECK(strstr(out, "rk4 is unstable at h = 0.0001 s") && strstr(out, "needs h <") && count_lines(out) == 1,
+          "message: %s", out);
+    rc = run("run --quiet --scenario step --solver rk4 --dt 1e-5 --duration 0.2 --out cli_rk4.csv", out, sizeof out);
+    CHECK(rc == 0, "rk4 at 10 us: exit %d: %s", rc, out);
+    remove("cli_rk4.csv");
+}
+
 static void test_ode_runs_are_deterministic(void) {
     static char out[8192];
     const char* args = "run --quiet --mechanics ode --world sandbox --scenario sandbox_pick_place --duration 6";
@@ -489,6 +506,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_bad_set);
     RUN_TEST(test_csv_contract);
     RUN_TEST(test_blow_up_keeps_output);
+    RUN_TEST(test_rk4_refused);
     RUN_TEST(test_ode_runs_are_deterministic);
     RUN_TEST(test_sandbox_start_poses);
     RUN_TEST(test_bad_world_and_compare_tolerance);

@@ -550,6 +550,42 @@ static void test_json_matches_default(void) {
     hyd_model_free(c);
 }
 
+// The circuit's fastest mode (hyd_model_fastest_rate), on a one-state
+// circuit solved by hand: a volume V draining to the tank through an
+// orifice, at the tank's pressure, is dp/dt = -(Be(p) / V) g (p - p_T) with
+// g the orifice's laminar conductance: rate Be g / V.
+static void test_fastest_rate(void) {
+    hyd_builder* b = hyd_builder_create();
+    add_tank(b, "tank", 0);
+    add_volume(b, "line", 1e-3);
+    hyd_orifice_def o = hyd_default_orifice_def();
+    o.name = "bleed";
+    o.inlet = "line";
+    o.outlet = "tank";
+    o.area = 1e-6;
+    hyd_add_orifice(b, &o);
+    char err[256];
+    hyd_model* m = hyd_compile(b, err, sizeof err);
+    hyd_builder_free(b);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    const hyd_fluid_def f = hyd_model_fluid(m);
+    const double pT = hyd_default_tank_def().pressure;
+    double g;
+    hyd_orifice_flow(&f, o.cd, o.area, 0.0, &g, NULL);
+    const double expect = hyd_bulk_modulus(&f, f.bulk_modulus, pT, NULL) * g / 1e-3;
+    CHECK_REL(hyd_model_fastest_rate(m, pT, 0.0), expect, 1e-3);
+    hyd_model_free(m);
+    // The crane: the hose/chamber pairs are its fastest modes, 1e4..1e5 1/s
+    // (SPEC 3.2: a calibration prototype found 4e4..9e4).
+    hyd_model* c = hyd_model_default_crane(err, sizeof err);
+    if (!c) return;
+    const double r = hyd_model_fastest_rate(c, 10e6, 0.0);
+    printf("  crane circuit at 10 MPa, valves closed: fastest mode %.3g 1/s\n", r);
+    CHECK(r > 1e4 && r < 1e6, "rate %g", r);
+    hyd_model_free(c);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_layout);
     RUN_TEST(test_jacobian_fd);
@@ -559,5 +595,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_fused_refuses);
     RUN_TEST(test_live_parameters);
     RUN_TEST(test_json_matches_default);
+    RUN_TEST(test_fastest_rate);
     TEST_MAIN_END();
 }

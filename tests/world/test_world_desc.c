@@ -6,6 +6,7 @@
 #include "ode_world.h"
 #include "world_desc.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -53,6 +54,9 @@ static void test_bad_files(void) {
     expect_error("bad_type.json", "{\"type\": \"moon\"}", "type", "\"moon\"");
     expect_error("bad_missing_type.json", "{\"name\": \"x\"}", "type", "missing");
     expect_error("bad_key.json", "{\"type\": \"sandbox\", \"trcuk\": {}}", "trcuk", NULL);
+    // Sandbox sections in a validation world would be ignored.
+    expect_error("bad_validation_truck.json", "{\"type\": \"validation\", \"truck\": {}}", "truck",
+                 "only a sandbox world");
     expect_error("bad_mass.json",
                  "{\"type\": \"sandbox\", \"loads\": [{\"mass\": 200, \"size\": [1,1,1], \"position\": [3, 3]},"
                  " {\"mass\": -5, \"size\": [1,1,1], \"position\": [4, 4]}]}",
@@ -109,12 +113,64 @@ static void test_bad_circuit(void) {
     printf("  bad_slew.json -> %s\n", err);
     ode_world_destroy(w);
     world_desc_free(&d);
+
+    // A slew on the lifting arm's cylinder (the QA pass found it accepted,
+    // and the slew then moved the boom).
+    CHECK(write_file("slew_on_lift.json",
+                     "{\"type\": \"sandbox\", \"slew\": {\"cylinder\": \"lift_cyl\", \"valve\": \"lift_valve\"}}") == 0,
+          "write");
+    CHECK(world_desc_load("slew_on_lift.json", &d, err, sizeof err) == 0, "%s", err);
+    w = ode_world_create(&m->mech, cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics"), &d, &o, err, sizeof err);
+    CHECK(w == NULL, "must fail");
+    CHECK(strstr(err, "slew_on_lift.json") && strstr(err, "slew.cylinder") && strstr(err, "already drives"),
+          "message: \"%s\"", err);
+    printf("  slew_on_lift.json -> %s\n", err);
+    ode_world_destroy(w);
+    world_desc_free(&d);
     model_free(m);
+}
+
+// "gravity": 0 in a world file is a weightless world, not "the model's"
+// (which absent means). Unpowered booms (no hydraulic forces) then stay
+// where they start; with the model's gravity they fall.
+static void test_zero_gravity(void) {
+    char err[512];
+    CHECK(write_file("g0.json", "{\"type\": \"validation\", \"gravity\": 0}") == 0, "write");
+    world_desc d0, dm;
+    CHECK(world_desc_load("g0.json", &d0, err, sizeof err) == 0, "%s", err);
+    CHECK(world_desc_load(CRANESIM_ASSETS "/worlds/validation.json", &dm, err, sizeof err) == 0, "%s", err);
+    CHECK(d0.gravity == 0.0 && dm.gravity < 0.0, "gravity %g (file says 0), %g (absent)", d0.gravity, dm.gravity);
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    double drop[2];
+    for (int k = 0; k < 2; ++k) {
+        ode_world_opts o = ode_world_default_opts();
+        o.hydraulics = 0;
+        ode_world* w = ode_world_create(&m->mech, cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics"),
+                                        k ? &dm : &d0, &o, err, sizeof err);
+        CHECK(w != NULL, "%s", err);
+        if (!w) continue;
+        ode_world_state s0, s1;
+        ode_world_get_state(w, &s0);
+        ode_world_step(w, 0.1);
+        ode_world_get_state(w, &s1);
+        drop[k] = fabs(s1.q[0] - s0.q[0]) + fabs(s1.q[1] - s0.q[1]);
+        ode_world_destroy(w);
+    }
+    printf("  joint motion in 0.1 s unpowered: %.3g rad weightless, %.3g rad with the model's gravity\n", drop[0],
+           drop[1]);
+    CHECK(drop[0] < 1e-9, "weightless booms moved %.3g rad", drop[0]);
+    CHECK(drop[1] > 1e-2, "booms under gravity moved only %.3g rad", drop[1]);
+    model_free(m);
+    world_desc_free(&d0);
+    world_desc_free(&dm);
 }
 
 int main(int argc, char** argv) {
     RUN_TEST(test_shipped_worlds_load);
     RUN_TEST(test_bad_files);
     RUN_TEST(test_bad_circuit);
+    RUN_TEST(test_zero_gravity);
     TEST_MAIN_END();
 }
