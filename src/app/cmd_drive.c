@@ -328,6 +328,15 @@ int cmd_drive(int argc, char** argv) {
     // Every option is checked before anything runs, whichever mode follows:
     // an option accepted in one mode and ignored in another would hide a
     // mistake until the other mode is used.
+    if ((record && app_check_output("drive", "--record", record, NULL)) ||
+        (shot && app_check_output("drive", "--screenshot", shot, ".png")))
+        return EXIT_USAGE;
+    // drive's ode world is the sandbox unless --world says otherwise (run's
+    // is the validation world): name it, so the checks see the same world.
+    if (c.sim.mechanics == SIM_ODE && !c.sim.world) c.sim.world = "sandbox";
+    if (app_check_sim("drive", &c.sim, c.given)) return EXIT_USAGE;
+    app_note_unused("drive", c.given, &c.sim, 1);
+    app_settle_unused(&c.sim);
     char err[600], wname[64] = "";
     int kind = -1;
     if (c.sim.mechanics == SIM_ODE) {

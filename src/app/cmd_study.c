@@ -46,7 +46,7 @@ typedef struct study_cfg {
     sim_opts o;
     // results
     int failed;
-    char why[400];
+    char why[512];
     double wall, p_max, p_rms, x_max;
     hyd_solver_stats st;
 } study_cfg;

@@ -418,30 +418,7 @@ int drive_session_finish_record(drive_session* s, long* rows, char* err, size_t 
     return -1;
 }
 
-// Interim, until ode_world_snapshot fills these itself (docs/render.md,
-// "The validation world's meshes"): the crane meshes have their origin at
-// the joint (column: at its foot; assets/meshes/README.md), the ode world's
-// primitives theirs at the centre. The sandbox's world file gives each mesh
-// that offset; the validation world file has no "meshes" section, so its
-// snapshot put each mesh origin at the primitive's centre: booms drawn half
-// a length [m] off their joints, the column half its height up. A crane mesh
-// with no offset gets the one its primitive implies; one with an offset is
-// left as its world file says, so this is a no-op once the world is fixed.
-static void crane_mesh_offsets(world_snapshot* snap) {
-    for (int i = 0; i < snap->nbody; ++i) {
-        world_snap_body* b = &snap->body[i];
-        if (!b->mesh[0] || b->mesh_offset[0] != 0 || b->mesh_offset[1] != 0 || b->mesh_offset[2] != 0) continue;
-        if (b->role == WORLD_ROLE_COLUMN && b->shape == WORLD_SHAPE_CYLINDER)
-            b->mesh_offset[2] = -0.5 * b->size[1]; // size[1]: column height [m]
-        else if ((b->role == WORLD_ROLE_BOOM1 || b->role == WORLD_ROLE_BOOM2) && b->shape == WORLD_SHAPE_BOX)
-            b->mesh_offset[0] = -0.5 * b->size[0]; // size[0]: link length [m]
-    }
-}
-
-static void take_snapshot(drive_session* s) {
-    live_snapshot(s->l, s->snap);
-    crane_mesh_offsets(s->snap);
-}
+static void take_snapshot(drive_session* s) { live_snapshot(s->l, s->snap); }
 
 drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz,
                                     int* code) {

@@ -258,7 +258,9 @@ ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* d
         world_desc_free(&wd);
         return NULL;
     }
-    wo.dt_hyd = o->h < wo.dt_ode ? o->h : wo.dt_ode;
+    // Adaptive hydraulics choose their own steps inside each ODE step and
+    // never use dt_hyd: --dt does not apply, so it cannot be wrong.
+    wo.dt_hyd = hyd_method_is_adaptive(o->solver) || o->h >= wo.dt_ode ? wo.dt_ode : o->h;
     const double ratio = wo.dt_ode / wo.dt_hyd;
     if (fabs(ratio - floor(ratio + 0.5)) > 1e-6) {
         // ode_world_create checks this too; here it is said in the options' words.

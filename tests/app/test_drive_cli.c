@@ -146,6 +146,8 @@ static void test_bad_options_rejected_in_every_mode(void) {
         {"--mapping map_not_json.json", "map_not_json.json"},
         {"--mapping map_bogus_key.json", "bogus"},
         {"--every 0.01", "--every"},
+        {"--load 500", "--load"},                                 // the sandbox's loads are world objects
+        {"--record /nonexistent/dir/r.csv", "/nonexistent/dir"}, // checked before driving, not after
     };
     // Headless by option, headless for want of a display, and offscreen.
     static const char* const modes[] = {"--headless --duration 0.2", "--duration 0.2",
