@@ -159,6 +159,7 @@ int cmd_compare(int argc, char** argv) {
         if (!c.quiet && isatty(2)) fprintf(stderr, "run %s:\n", label[s]);
         sim_run(m, &sc, &side[s], NULL, NULL, &tr[s], c.quiet ? NULL : app_progress, NULL, &res[s]);
         if (!c.quiet) app_progress_done();
+        if (res[s].note[0]) fprintf(stderr, "cranesim compare: %s: note: %s\n", label[s], res[s].note);
         if (res[s].status) {
             fprintf(stderr, "cranesim compare: %s: %s\n", label[s], res[s].message);
             sim_trace_free(&tr[0]);

@@ -160,6 +160,7 @@ int cmd_run(int argc, char** argv) {
     sim_result res;
     sim_run(m, &sc, &c.sim, csv_row, &sink, &tr, c.quiet ? NULL : app_progress, NULL, &res);
     if (!c.quiet) app_progress_done();
+    if (res.note[0]) fprintf(stderr, "cranesim run: note: %s\n", res.note);
     const int werr = csv_close(&sink);
     int code = EXIT_OK_;
     if (werr && !sink.opened) {

@@ -3,6 +3,7 @@
 #include "ode_world_internal.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,14 +17,37 @@
 // counter lets several worlds coexist (tests, compare runs). This is the one
 // piece of global mutable state the project allows (STYLE.md); worlds must be
 // created and destroyed from one thread.
-static int g_ode_users = 0;
+// The ODE library's state: its users, and the non-fatal messages it sends
+// (dMessage: "LCP internal error, s <= 0" on a degenerate contact set),
+// which it would print to stderr itself, outside our one-line messages and
+// unrelated to the run. They are counted here and reported by the caller
+// (ode_world_messages).
+static struct {
+    int users;
+    long messages;
+    char last[160];
+} g_ode;
+
+static void ode_message(int num, const char* msg, va_list ap) {
+    (void)num;
+    vsnprintf(g_ode.last, sizeof g_ode.last, msg, ap);
+    g_ode.messages++;
+}
 
 static void ode_acquire(void) {
-    if (g_ode_users++ == 0) dInitODE2(0);
+    if (g_ode.users++ == 0) {
+        dInitODE2(0);
+        dSetMessageHandler(ode_message);
+    }
 }
 
 static void ode_release(void) {
-    if (--g_ode_users == 0) dCloseODE();
+    if (--g_ode.users == 0) dCloseODE();
+}
+
+long ode_world_messages(const char** last) {
+    if (last) *last = g_ode.last;
+    return g_ode.messages;
 }
 
 ode_world_opts ode_world_default_opts(void) {

@@ -125,6 +125,9 @@ hyd_model* ode_world_circuit(ode_world* w);
 /// (hyd_fused.h), 0 on the component loops (opts.general_circuit, or a
 /// circuit of another shape).
 int ode_world_fused(const ode_world* w);
+/// Non-fatal messages ODE has sent so far in this process (a degenerate
+/// contact LCP), and the last one's text in *last (may be NULL).
+long ode_world_messages(const char** last);
 
 /// Simulated time [s].
 double ode_world_time(const ode_world* w);

@@ -296,6 +296,7 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
                                         sizeof res->message);
     if (!w) return res->status = 2;
     res->fused = ode_world_fused(w);
+    const long ode_msgs = ode_world_messages(NULL);
     const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
     if (check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res)) {
         ode_world_destroy(w);
@@ -351,6 +352,13 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     res->rows = c->rows;
     res->t_end = c->t_last_row;
     ode_world_destroy(w);
+    const char* last;
+    const long msgs = ode_world_messages(&last) - ode_msgs;
+    if (msgs > 0)
+        snprintf(res->note, sizeof res->note,
+                 "ODE reported %ld solver message%s during the run (last: %.120s): a degenerate contact set, which "
+                 "ODE stepped through",
+                 msgs, msgs > 1 ? "s" : "", last);
     if (c->stop && !res->status) {
         res->status = 2;
         snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c->t_last_row);

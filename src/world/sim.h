@@ -76,6 +76,7 @@ typedef int (*sim_row_fn)(void* user, const double* row);
 typedef struct sim_result {
     int status;          ///< 0 ok, 1 numerical failure, 2 stopped by callback
     char message[512];   ///< failure description: state name, time
+    char note[256];      ///< something the run noticed but went on with (ode: ODE solver messages), else ""
     double t_end;        ///< simulated time reached [s]
     double wall;         ///< wall time of the integration [s]
     hyd_solver_stats stats;
