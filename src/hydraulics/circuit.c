@@ -1189,7 +1189,8 @@ static double spectral_radius(double* A, double* T, int n) {
     double f = 0.0;
     for (int i = 0; i < n * n; ++i) f += A[i] * A[i];
     f = sqrt(f);
-    if (!(f > 0.0) || !isfinite(f)) return f > 0.0 ? -1.0 : 0.0;
+    if (!isfinite(f)) return -1.0; // NaN or Inf in J: no rate to give
+    if (f == 0.0) return 0.0;
     for (int i = 0; i < n * n; ++i) A[i] /= f;
     double logscale = 0.0; // log of the factor divided out of A^(2^m) so far, over 2^m
     double k = 1.0;
