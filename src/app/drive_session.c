@@ -391,7 +391,10 @@ static int start_recording(drive_session* s, const char* path) {
     s->rec_rows = 0;
     s->rec = fopen(path, "w");
     if (!s->rec) {
-        snprintf(s->status, sizeof s->status, "cannot write %s: %s", path, strerror(errno));
+        // Remembered like a failed write: the session's end must not report
+        // a record that was never opened (F5 in an unwritable folder).
+        snprintf(s->rec_err, sizeof s->rec_err, "cannot write %s: %s", path, strerror(errno));
+        snprintf(s->status, sizeof s->status, "%s", s->rec_err);
         return -1;
     }
     errno = 0;
@@ -436,7 +439,10 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     // Options first: a bad chart name or mapping file is bad input whatever
     // else happens (and before a window opens).
     if ((*code = drive_opts_check(c, o, err, errsz)) != 0 || !s->snap) {
-        if (!s->snap) snprintf(err, errsz, "out of memory");
+        if (!s->snap) {
+            snprintf(err, errsz, "out of memory");
+            *code = EXIT_RUNTIME;
+        }
         drive_session_destroy(s);
         return NULL;
     }
@@ -474,8 +480,10 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     rc.asset_dir = asset_dir;
     s->r = render_create(&rc, err, errsz);
     if (!s->r) {
-        // No window on this display: the caller may run headless instead.
-        if (!o->offscreen) *code = DRIVE_NO_WINDOW;
+        // No screen to open a window on: the caller may run headless
+        // instead. A window or GL context that fails on a real display is a
+        // runtime failure (exit 1), not a reason to drive unseen.
+        if (!o->offscreen && render_err_no_screen(err)) *code = DRIVE_NO_WINDOW;
         drive_session_destroy(s);
         return NULL;
     }

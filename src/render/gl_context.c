@@ -65,7 +65,7 @@ bool render_gl_open(render* r, char* err, size_t errsz) {
             } else if (err && errsz) {
                 char d[160];
                 display_name(d, sizeof d);
-                snprintf(err, errsz, "render: cannot open a window%s (%s)", d, SDL_GetError());
+                snprintf(err, errsz, "render: " RENDER_ERR_NO_SCREEN "%s (%s)", d, SDL_GetError());
             }
             return false;
         }
@@ -78,7 +78,7 @@ bool render_gl_open(render* r, char* err, size_t errsz) {
             if (err && errsz) {
                 char d[160];
                 display_name(d, sizeof d);
-                snprintf(err, errsz, "render: cannot open a window%s (SDL's video driver '%s' has no screen)", d,
+                snprintf(err, errsz, "render: " RENDER_ERR_NO_SCREEN "%s (SDL's video driver '%s' has no screen)", d,
                          drv);
             }
             return false;

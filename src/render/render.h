@@ -27,6 +27,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <string.h>
 
 #include <SDL2/SDL.h>
 
@@ -77,6 +78,15 @@ render_config render_default_config(void);
 /// GPU resources. Initialises the SDL video subsystem if the app has not.
 /// Returns NULL and writes a message into err on failure.
 render* render_create(const render_config* cfg, char* err, size_t errsz);
+/// The text render_create's message starts with (after "render: ") when the
+/// window failed only for want of a screen (no display server, or a video
+/// driver without a screen), as opposed to a window or GL context that would
+/// not start on a real display: the caller may then run without a window.
+#define RENDER_ERR_NO_SCREEN "cannot open a window"
+/// True when err, as render_create wrote it, says there is no screen.
+static inline bool render_err_no_screen(const char* err) {
+    return !strncmp(err, "render: " RENDER_ERR_NO_SCREEN, 8 + sizeof RENDER_ERR_NO_SCREEN - 1);
+}
 void render_destroy(render* r);
 
 /// Camera mouse control (orbit with left drag, pan with right/middle drag,
