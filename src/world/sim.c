@@ -309,6 +309,7 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     if (!w) return res->status = 2;
     res->fused = ode_world_fused(w);
     const long ode_msgs = ode_world_messages(NULL);
+    const bool slew = ode_world_kind(w) == WORLD_SANDBOX;
     const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
     if (check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res)) {
         ode_world_destroy(w);
@@ -344,7 +345,10 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
         if ((i + 1) % nout && i + 1 != nstep) continue;
         sim_ode_row(w, row);
         row[COL_T] = (double)(i + 1) * dt; // exact grid times, no accumulated round-off
-        for (int k = COL_P1A; k <= COL_P2B; ++k) {
+        // The boom chambers, and the slew's where the world has one.
+        static const int pcol[6] = {COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_P3A, COL_P3B};
+        for (int j = 0; j < (slew ? 6 : 4); ++j) {
+            const int k = pcol[j];
             if (!(row[k] > P_IMPLAUSIBLE)) {
                 res->status = 1;
                 snprintf(res->message, sizeof res->message,

@@ -407,9 +407,6 @@ static void test_write_failures(void) {
 // it cannot honour up front.
 static void test_study_usage(void) {
     static char out[16384];
-    if (run("study --quick --repeat 1 --duration 0.05 --mechanics ode", out, sizeof out) == 2 &&
-        strstr(out, "needs the CVODE reference"))
-        return; // no CVODE in this build: the study cannot run at all
     int rc = run("study --quick --repeat 1 --duration 0.05 --mechanics ode", out, sizeof out);
     CHECK(rc == 2 && strstr(out, "--mechanics ode") && !strstr(out, "reference:") && !strstr(out, "reference run failed"), "--mechanics ode: exit %d: %s", rc,
           out);
@@ -427,6 +424,12 @@ static void test_study_usage(void) {
     // A nested folder is made with its parents.
     remove("cli_study/sub/deeper/study.md");
     rc = run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study/sub/deeper", out, sizeof out);
+    if (rc == 2 && strstr(out, "needs the CVODE reference")) {
+        // Only a build without SUNDIALS gets here (the study cannot run at
+        // all); the checks above still ran. Said, not counted as a pass.
+        printf("  SKIPPED: nested --out-dir (no CVODE in this build)\n");
+        return;
+    }
     CHECK(rc == 0 && exists("cli_study/sub/deeper/study.md") && exists("cli_study/sub/deeper/study.jsonl"),
           "nested --out-dir: exit %d: %.300s", rc, out);
 }
