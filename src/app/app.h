@@ -62,6 +62,12 @@ void app_options_help(FILE* f, unsigned which);
 /// in it unless it is an existing device or pipe (/dev/stdout). Returns 0, or
 /// -1 after one line "cranesim CMD: OPT FILE: problem" on stderr.
 int app_check_output(const char* cmd, const char* opt, const char* path, const char* ext);
+/// Flush and close f. Returns 0, or the errno of the first failure: first
+/// (a write the caller already saw fail, 0 if none), else the flush's or the
+/// close's, else EIO for an error flagged on the stream with no errno left
+/// to tell (a failed write's errno is gone once later calls ran: callers
+/// that want it pass it as first).
+int app_fclose_checked(FILE* f, int first);
 /// Create directory dir and its parents (mkdir -p) and check it is a writable
 /// directory. Returns 0, or -1 after one line on stderr naming opt and dir.
 int app_make_dir(const char* cmd, const char* opt, const char* dir);

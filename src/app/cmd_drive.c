@@ -11,13 +11,13 @@
 #include "world_desc.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
+#include "render.h"
 #endif
 
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <time.h>
 
 #ifndef M_PI
@@ -70,26 +70,15 @@ static void sleep_until(double wall) {
 // perhaps remote, so only SDL can tell whether it answers), or
 // WAYLAND_DISPLAY naming a socket that is there. Otherwise false, with why
 // in one line.
+// A display a window could open on (render_display_available); a build
+// without the render module has none.
 static bool have_display(char* why, size_t n) {
-    const char* d = getenv("DISPLAY");
-    const char* w = getenv("WAYLAND_DISPLAY");
-    if (d && *d) return true;
-    if (w && *w) {
-        const char* dir = getenv("XDG_RUNTIME_DIR");
-        char path[512];
-        if (w[0] == '/') snprintf(path, sizeof path, "%s", w);
-        else if (dir && *dir) snprintf(path, sizeof path, "%s/%s", dir, w);
-        else {
-            snprintf(why, n, "no display (WAYLAND_DISPLAY=%s, but XDG_RUNTIME_DIR is unset)", w);
-            return false;
-        }
-        struct stat st;
-        if (stat(path, &st) == 0) return true;
-        snprintf(why, n, "no display (WAYLAND_DISPLAY=%s: no socket %s)", w, path);
-        return false;
-    }
-    snprintf(why, n, "no display (DISPLAY and WAYLAND_DISPLAY unset)");
+#ifdef CRANESIM_HAVE_RENDER
+    return render_display_available(why, n);
+#else
+    snprintf(why, n, "this build has no window (the render module was not built)");
     return false;
+#endif
 }
 
 // The ode world's kind and name, from its file. Returns the kind, or -1
@@ -142,13 +131,6 @@ static bool write_row(FILE* f, const double* row, int ncol) {
 }
 
 // Flush and close a record; 0, or errno of the first failure.
-static int close_record(FILE* f) {
-    errno = 0;
-    int e = ferror(f) ? (errno ? errno : EIO) : 0;
-    if (fflush(f) != 0 && !e) e = errno;
-    if (fclose(f) != 0 && !e) e = errno;
-    return e;
-}
 
 static int drive_headless(app_common* c, double frame_rate, const char* record, const char* why, int kind,
                           const char* world_name) {
@@ -226,8 +208,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         sleep_until(w0 + (i + 1) * frame);
     }
     if (!c->quiet) app_progress_done();
-    const int ce = close_record(f);
-    if (!wr) wr = ce;
+    wr = app_fclose_checked(f, wr);
     if (wr) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(wr));
         code = EXIT_RUNTIME;

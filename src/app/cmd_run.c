@@ -69,10 +69,7 @@ static int csv_row(void* user, const double* row) {
 // shows only when the last buffer is flushed).
 static int csv_close(csv_sink* s) {
     if (!s->f) return s->err;
-    if (ferror(s->f) && !s->err) s->err = EIO;
-    errno = 0;
-    if (fflush(s->f) && !s->err) s->err = errno ? errno : EIO;
-    if (fclose(s->f) && !s->err) s->err = errno ? errno : EIO;
+    s->err = app_fclose_checked(s->f, s->err);
     s->f = NULL;
     return s->err;
 }

@@ -157,10 +157,7 @@ static int plot_wp(const study_cfg* c, int n, double ppeak, const char* title, c
 
 // Close a result file, reporting a failed write: "cannot write FILE: reason".
 static int close_checked(FILE* f, const char* path) {
-    int e = ferror(f) ? (errno ? errno : EIO) : 0;
-    errno = 0;
-    if (fflush(f) && !e) e = errno ? errno : EIO;
-    if (fclose(f) && !e) e = errno ? errno : EIO;
+    const int e = app_fclose_checked(f, 0);
     if (e) fprintf(stderr, "cranesim study: cannot write %s: %s\n", path, strerror(e));
     return e ? -1 : 0;
 }

@@ -271,6 +271,17 @@ void app_common_help(FILE* f, bool with_solver) {
     app_options_help(f, with_solver ? all : all & ~solver);
 }
 
+int app_fclose_checked(FILE* f, int first) {
+    int e = first;
+    const int flagged = ferror(f);
+    errno = 0;
+    if (fflush(f) != 0 && !e) e = errno ? errno : EIO;
+    errno = 0;
+    if (fclose(f) != 0 && !e) e = errno ? errno : EIO;
+    if (flagged && !e) e = EIO;
+    return e;
+}
+
 int app_check_output(const char* cmd, const char* opt, const char* path, const char* ext) {
     if (!*path) {
         fprintf(stderr, "cranesim %s: %s: empty file name\n", cmd, opt);

@@ -369,20 +369,13 @@ static void record_failed(drive_session* s, int e) {
 // Close the recording, checking that the buffered rows reached the file.
 static void stop_recording(drive_session* s) {
     if (!s->rec) return;
-    errno = 0;
-    int e = ferror(s->rec) ? (errno ? errno : EIO) : 0;
-    if (!e && fflush(s->rec) != 0) e = errno;
+    const int e = app_fclose_checked(s->rec, 0);
+    s->rec = NULL;
     if (e) {
-        record_failed(s, e);
-        return;
-    }
-    if (fclose(s->rec) != 0) {
-        s->rec = NULL;
-        snprintf(s->rec_err, sizeof s->rec_err, "cannot write %s: %s", s->rec_path, strerror(errno));
+        if (!s->rec_err[0]) snprintf(s->rec_err, sizeof s->rec_err, "cannot write %s: %s", s->rec_path, strerror(e));
         snprintf(s->status, sizeof s->status, "recording failed: %s", s->rec_err);
         return;
     }
-    s->rec = NULL;
     snprintf(s->status, sizeof s->status, "recording stopped: %s (%ld rows)", s->rec_path, s->rec_rows);
 }
 

@@ -39,6 +39,24 @@ static bool wayland_socket(const char* name) {
     return stat(path, &st) == 0;
 }
 
+bool render_display_available(char* why, size_t n) {
+    const char* d = getenv("DISPLAY");
+    const char* w = getenv("WAYLAND_DISPLAY");
+    if (d && *d) return true;
+    if (w && *w) {
+        if (wayland_socket(w)) return true;
+        const char* dir = getenv("XDG_RUNTIME_DIR");
+        if (w[0] != '/' && !(dir && *dir))
+            snprintf(why, n, "no display (WAYLAND_DISPLAY=%s, but XDG_RUNTIME_DIR is unset)", w);
+        else
+            snprintf(why, n, "no display (WAYLAND_DISPLAY=%s: no socket %s%s%s)", w, w[0] == '/' ? "" : dir,
+                     w[0] == '/' ? "" : "/", w);
+        return false;
+    }
+    snprintf(why, n, "no display (DISPLAY and WAYLAND_DISPLAY unset)");
+    return false;
+}
+
 bool render_gl_open(render* r, char* err, size_t errsz) {
     // Prefer the offscreen driver for headless rendering, but let an explicit
     // SDL_VIDEODRIVER in the environment win (it overrides a default hint).

@@ -83,6 +83,10 @@ render* render_create(const render_config* cfg, char* err, size_t errsz);
 /// driver without a screen), as opposed to a window or GL context that would
 /// not start on a real display: the caller may then run without a window.
 #define RENDER_ERR_NO_SCREEN "cannot open a window"
+/// True when the environment names a display a window could open on: DISPLAY,
+/// or WAYLAND_DISPLAY with its socket present. Else false, with the reason in
+/// why ("no display (DISPLAY and WAYLAND_DISPLAY unset)", ...).
+bool render_display_available(char* why, size_t n);
 /// True when err, as render_create wrote it, says there is no screen.
 static inline bool render_err_no_screen(const char* err) {
     return !strncmp(err, "render: " RENDER_ERR_NO_SCREEN, 8 + sizeof RENDER_ERR_NO_SCREEN - 1);
