@@ -47,6 +47,17 @@ static inline void add_valve(hyd_builder* b, const char* name, const char* P, co
     hyd_add_valve(b, &v);
 }
 
+/// A fixed orifice from in to out of area A [m^2] (default discharge
+/// coefficient, hyd_default_orifice_def().cd).
+static inline void add_orifice(hyd_builder* b, const char* name, const char* in, const char* out, double A) {
+    hyd_orifice_def o = hyd_default_orifice_def();
+    o.name = name;
+    o.inlet = in;
+    o.outlet = out;
+    o.area = A;
+    hyd_add_orifice(b, &o);
+}
+
 /// A relief from in to out cracking at p_crack [Pa]; q_rated [m^3/s] <= 0
 /// keeps the default.
 static inline void add_relief(hyd_builder* b, const char* name, const char* in, const char* out, double p_crack,

@@ -449,12 +449,7 @@ static void test_fused_refuses(void) {
     add_tank(b, "tank", 0);
     add_volume(b, "line", 1e-3);
     add_pump(b, "pump", "tank", "line", 1e-4, 1e7);
-    hyd_orifice_def o = hyd_default_orifice_def();
-    o.name = "bleed";
-    o.inlet = "line";
-    o.outlet = "tank";
-    o.area = 1e-6;
-    hyd_add_orifice(b, &o);
+    add_orifice(b, "bleed", "line", "tank", 1e-6);
     hyd_model* m2 = hyd_compile(b, err, sizeof err);
     hyd_builder_free(b);
     CHECK(m2 != NULL, "compile: %s", err);
@@ -558,12 +553,8 @@ static void test_fastest_rate(void) {
     hyd_builder* b = hyd_builder_create();
     add_tank(b, "tank", 0);
     add_volume(b, "line", 1e-3);
-    hyd_orifice_def o = hyd_default_orifice_def();
-    o.name = "bleed";
-    o.inlet = "line";
-    o.outlet = "tank";
-    o.area = 1e-6;
-    hyd_add_orifice(b, &o);
+    const double A = 1e-6, cd = hyd_default_orifice_def().cd;
+    add_orifice(b, "bleed", "line", "tank", A);
     char err[256];
     hyd_model* m = hyd_compile(b, err, sizeof err);
     hyd_builder_free(b);
@@ -572,7 +563,7 @@ static void test_fastest_rate(void) {
     const hyd_fluid_def f = hyd_model_fluid(m);
     const double pT = hyd_default_tank_def().pressure;
     double g;
-    hyd_orifice_flow(&f, o.cd, o.area, 0.0, &g, NULL);
+    hyd_orifice_flow(&f, cd, A, 0.0, &g, NULL);
     const double expect = hyd_bulk_modulus(&f, f.bulk_modulus, pT, NULL) * g / 1e-3;
     CHECK_REL(hyd_model_fastest_rate(m, pT, 0.0), expect, 1e-3);
     hyd_model_free(m);
