@@ -6,6 +6,7 @@
 #include "sim.h"
 
 #include <math.h>
+#include <string.h>
 
 static void test_adaptive_within_one_percent(void) {
     CHECK(sim_have_cvode(), "this build has no CVODE reference");
@@ -88,8 +89,41 @@ static void test_domain_keeps_pressures_physical(void) {
     model_free(m);
 }
 
+// Below absolute zero (decision 6): a fixed-step W-method that dips there for
+// a step at a stiff event (ROS2 at 1 ms on `overload`: -57 kPa) finishes
+// with a note naming the state, the depth and the time; CVODE at rtol 1e-2 on
+// `ramp`, which leaves the physical range by far more (-192 kPa, then a
+// crane falling while commanded up), fails.
+static void test_dips_and_failures(void) {
+    if (!sim_have_cvode()) {
+        CHECK(0, "this build has no CVODE");
+        return;
+    }
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    scenario sc;
+    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/overload.json", &sc, err, sizeof err) == 0, "%s", err);
+    sim_opts o = sim_default_opts();
+    o.solver = HYD_ROS2;
+    o.h = 1e-3;
+    sim_result r;
+    CHECK(sim_run(m, &sc, &o, NULL, NULL, NULL, NULL, NULL, &r) == 0, "ros2 1 ms: %s", r.message);
+    CHECK(strstr(r.note, "dipped below absolute zero") && strstr(r.note, "kPa"), "note: '%s'", r.note);
+    printf("  ros2 1 ms on overload: %s\n", r.note);
+    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/ramp.json", &sc, err, sizeof err) == 0, "%s", err);
+    o = sim_default_opts();
+    o.cvode = true;
+    o.rtol = 1e-2;
+    CHECK(sim_run(m, &sc, &o, NULL, NULL, NULL, NULL, NULL, &r) == 1 && strstr(r.message, "below absolute zero"),
+          "cvode rtol 1e-2: status %d: %s", r.status, r.message);
+    model_free(m);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_adaptive_within_one_percent);
     RUN_TEST(test_domain_keeps_pressures_physical);
+    RUN_TEST(test_dips_and_failures);
     TEST_MAIN_END();
 }
