@@ -125,6 +125,11 @@ typedef struct hyd_solver_opts {
     /// states between rows nobody consumes (benchmarks).
     const int* out_states;
     int n_out_states;
+    /// Optional: called after every accepted step with the new (t, y), for a
+    /// caller that tracks something between output times (sim.c: the peak
+    /// pressures of a run summary). NULL (default): no call, no cost.
+    void (*on_step)(void* user, double t, const double* y);
+    void* on_step_user;
 } hyd_solver_opts;
 
 hyd_solver_opts hyd_default_solver_opts(void);

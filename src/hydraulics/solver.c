@@ -434,6 +434,7 @@ static int advance_fixed(hyd_solver* s, double* t, double* y, double t_end, long
         const int land = rem <= h0 * (1.0 + 1e-9);
         int rc = fixed_step(s, t, y, land ? rem : h0, land ? t_end : t0 + (double)k * h0);
         if (rc != HYD_OK) return rc;
+        if (s->o.on_step) s->o.on_step(s->o.on_step_user, *t, y);
     }
     return HYD_OK;
 }
@@ -665,6 +666,7 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
         s->st.steps++;
         s->j_steps++;
         s->last_h = h;
+        if (s->o.on_step) s->o.on_step(s->o.on_step_user, *t, y);
     }
     return HYD_OK;
 }

@@ -904,6 +904,15 @@ hyd_model* ode_world_circuit(ode_world* w) { return w->hm; }
 
 int ode_world_fused(const ode_world* w) { return w->hm && w->use_fused; }
 
+void ode_world_chamber_pressures(const ode_world* w, double pA[ODE_NACT], double pB[ODE_NACT]) {
+    for (int k = 0; k < ODE_NACT; ++k) {
+        const ow_act* c = &w->act[k];
+        const bool on = w->hm && c->cyl >= 0;
+        pA[k] = on ? w->y[c->iA] : 0.0;
+        pB[k] = on ? w->y[c->iB] : 0.0;
+    }
+}
+
 const char* ode_world_load_name(const ode_world* w, int i, double* mass) {
     if (i < 0 || i >= w->desc.nload) return NULL;
     if (mass) *mass = w->desc.load[i].mass;

@@ -125,6 +125,10 @@ hyd_model* ode_world_circuit(ode_world* w);
 /// (hyd_fused.h), 0 on the component loops (opts.general_circuit, or a
 /// circuit of another shape).
 int ode_world_fused(const ode_world* w);
+/// Chamber pressures pA, pB [Pa abs] of the actuators (ODE_LIFT, ODE_JIB,
+/// ODE_SLEW; 0 where there is none), straight from the hydraulic state:
+/// cheap enough for every step.
+void ode_world_chamber_pressures(const ode_world* w, double pA[ODE_NACT], double pB[ODE_NACT]);
 /// Non-fatal messages ODE has sent so far in this process (a degenerate
 /// contact LCP), and the last one's text in *last (may be NULL).
 long ode_world_messages(const char** last);

@@ -114,6 +114,10 @@ typedef struct run_ctx {
     // (reported as a note): dip_state < 0 while there was none.
     int dip_state;
     double dip_value, dip_t;
+    // Peak chamber pressures p1A, p1B, p2A, p2B [Pa abs] (lagrange: system
+    // state indices pidx), from every step and every row.
+    int pidx[4];
+    double peak[4];
     int npress;    ///< pressure states (emit checks only these)
     int press[LSIM_MAX_STATES];
 } run_ctx;
@@ -201,8 +205,19 @@ static int check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, do
 
 static int deliver(run_ctx* c, const double* row);
 
+static void track_peaks(run_ctx* c, const double* y) {
+    for (int k = 0; k < 4; ++k) c->peak[k] = fmax(c->peak[k], y[c->pidx[k]]);
+}
+
+// hyd_solver_opts.on_step: peaks between the rows too.
+static void on_step(void* user, double t, const double* y) {
+    (void)t;
+    track_peaks(user, y);
+}
+
 static int emit(void* user, double t, const double* y) {
     run_ctx* c = user;
+    track_peaks(c, y);
     // Segments share their end points: write each output time once.
     if (c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out) return 0;
     for (int k = 0; k < c->npress; ++k) {
@@ -347,6 +362,7 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     int ev = 0;
     double w0 = sim_wall_time();
     sim_ode_row(w, row);
+    for (int k = 0; k < 4; ++k) res->p_peak[k] = row[COL_P1A + k];
     deliver(c, row);
     ++c->rows;
     for (long i = 0; i < nstep && !c->stop; ++i) {
@@ -364,6 +380,13 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
             res->status = 1;
             snprintf(res->message, sizeof res->message, "numerical blow-up: %s", ode_world_error(w));
             break;
+        }
+        {
+            // Peaks at every ODE step, not only at the rows.
+            double pA[ODE_NACT], pB[ODE_NACT];
+            ode_world_chamber_pressures(w, pA, pB);
+            const double p[4] = {pA[0], pB[0], pA[1], pB[1]};
+            for (int k = 0; k < 4; ++k) res->p_peak[k] = fmax(res->p_peak[k], p[k]);
         }
         if ((i + 1) % nout && i + 1 != nstep) continue;
         sim_ode_row(w, row);
@@ -392,6 +415,7 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     res->rows = c->rows;
     res->t_end = c->t_last_row;
     ode_world_destroy(w);
+    res->peak_steps = true;
     const char* last;
     const long msgs = ode_world_messages(&last) - ode_msgs;
     if (!res->status && c->dip_state >= 0)
@@ -463,6 +487,12 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
         so.out_states = press;
         so.n_out_states = npress;
     }
+    // The run's context, filled below; its address goes to the solver now.
+    run_ctx c;
+    if (trace || row_fn) { // someone reads the summary: peaks from every step
+        so.on_step = on_step;
+        so.on_step_user = &c;
+    }
     // CVODE brings its own integrator; the in-house one is not created then.
     hyd_solver* s = o->cvode ? NULL : hyd_solver_create(&prob, o->solver, &so);
     if (!s && !o->cvode) {
@@ -480,9 +510,10 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     // (the breakpoints are rounded to this grid, so it must not pass t_end).
     if (oo.dt_out > t_end && t_end > 0) oo.dt_out = t_end;
     o = &oo;
-    run_ctx c = {.ls = &ls, .o = o, .row_fn = row_fn, .row_user = row_user, .trace = trace,
-                 .progress = progress, .progress_user = progress_user, .t_end = t_end, .bad_state = -1,
-                 .dip_state = -1};
+    c = (run_ctx){.ls = &ls, .o = o, .row_fn = row_fn, .row_user = row_user, .trace = trace,
+                  .progress = progress, .progress_user = progress_user, .t_end = t_end, .bad_state = -1,
+                  .dip_state = -1,
+                  .pidx = {ls.ip[0][0], ls.ip[0][1], ls.ip[1][0], ls.ip[1][1]}};
     memcpy(c.press, press, sizeof press);
     c.npress = npress;
     // Integrate between command breakpoints (rounded to the output grid) and
@@ -556,6 +587,8 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
             snprintf(res->message, sizeof res->message, "solver %s stopped near t = %.6g s: %s",
                      o->cvode ? "cvode" : hyd_method_name(o->solver), c.t_last_row, hyd_error_text(rc));
     }
+    memcpy(res->p_peak, c.peak, sizeof res->p_peak);
+    res->peak_steps = !o->cvode && (trace || row_fn);
     if (!res->status && c.dip_state >= 0)
         dip_note(res->note, sizeof res->note, state_name(&ls, c.dip_state, nb, sizeof nb), c.dip_value, c.dip_t);
     hyd_solver_destroy(s);

@@ -76,7 +76,10 @@ typedef int (*sim_row_fn)(void* user, const double* row);
 typedef struct sim_result {
     int status;          ///< 0 ok, 1 numerical failure, 2 stopped by callback
     char message[512];   ///< failure description: state name, time
-    char note[256];      ///< something the run noticed but went on with (ode: ODE solver messages), else ""
+    char note[256];
+    double p_peak[4];    ///< peak chamber pressures p1A, p1B, p2A, p2B [Pa abs]: over every step
+                         ///< when peak_steps, else over the output rows (CVODE)
+    bool peak_steps;     ///< p_peak saw every integration step (ode: every ODE step)      ///< something the run noticed but went on with (ode: ODE solver messages), else ""
     double t_end;        ///< simulated time reached [s]
     double wall;         ///< wall time of the integration [s]
     hyd_solver_stats stats;
