@@ -607,6 +607,12 @@ double ode_world_dt(const ode_world* w) { return w->opt.dt_ode; }
 world_kind ode_world_kind(const ode_world* w) { return w->kind; }
 long ode_world_hyd_steps(const ode_world* w) { return w->hyd_steps; }
 
+hyd_solver_stats ode_world_hyd_stats(const ode_world* w) {
+    hyd_solver_stats st = {0};
+    if (w->hs) st = *hyd_solver_get_stats(w->hs);
+    return st;
+}
+
 void ode_world_set_commands(ode_world* w, const double u_cmd[ODE_NACT]) {
     for (int k = 0; k < ODE_NACT; ++k) {
         double u = u_cmd[k];

@@ -175,6 +175,10 @@ void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, doubl
 void ode_world_swing_hook(ode_world* w, const double omega[3]);
 /// Per-step hydraulic sub-steps taken since create (for benchmarks).
 long ode_world_hyd_steps(const ode_world* w);
+/// The hydraulic solver's work counters (steps, rejections, f evaluations,
+/// Jacobians, factorisations) since the world was created; zeros without
+/// hydraulics.
+hyd_solver_stats ode_world_hyd_stats(const ode_world* w);
 
 #ifdef __cplusplus
 }

@@ -411,7 +411,8 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
         deliver(c, row);
     }
     res->wall = sim_wall_time() - w0;
-    res->stats.steps = ode_world_hyd_steps(w);
+    res->stats = ode_world_hyd_stats(w);
+    res->stats.steps = ode_world_hyd_steps(w); // fixed-step sub-steps are counted by the world
     res->rows = c->rows;
     res->t_end = c->t_last_row;
     ode_world_destroy(w);
