@@ -145,6 +145,16 @@ int cmd_compare(int argc, char** argv) {
         const int rc = app_check_sim("compare", &side[s], given);
         if (rc) return rc;
     }
+    // Rows are compared by index, so both runs must write them on one grid:
+    // a fixed step longer than --every writes one row per step (decision 7).
+    const double per_a = app_output_period(&side[0]), per_b = app_output_period(&side[1]);
+    if (fabs(per_a - per_b) > 1e-9 * fmax(per_a, per_b)) {
+        fprintf(stderr,
+                "cranesim compare: %s writes rows every %g ms and %s every %g ms: they cannot be compared row by "
+                "row; give --every %g (a multiple of both steps)\n",
+                label[0][0] ? label[0] : "A", per_a * 1e3, label[1][0] ? label[1] : "B", per_b * 1e3, fmax(per_a, per_b));
+        return EXIT_USAGE;
+    }
     model* m;
     scenario sc;
     int rc = app_load(&c, &m, &sc);

@@ -88,7 +88,9 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     const bool ode = o->mechanics == SIM_ODE;
     const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
     // The variant is the lagrange backend's; an ode run is named by its world.
-    if (ode) printf("cranesim run: %s, ode/%s", scen, o->world ? o->world : "validation");
+    // A world given as a file path reads "ode world FILE", a name "ode/NAME".
+    if (ode) printf("cranesim run: %s, ode%s%s", scen, o->world && strchr(o->world, '/') ? " world " : "/",
+                    o->world ? o->world : "validation");
     else printf("cranesim run: %s, lagrange/%s", scen, lagrange_variant_name(o->variant));
     printf(", solver %s", o->cvode ? "cvode" : hyd_method_name(o->solver));
     // Which circuit kernel ran (cranesim run --help, --kernel).
@@ -118,7 +120,8 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     } else {
         printf("  peak pressures at the output rows: p1A %.2f, p1B %.2f, p2A %.2f, p2B %.2f MPa (absolute)",
                pmax[0] * 1e-6, pmax[1] * 1e-6, pmax[2] * 1e-6, pmax[3] * 1e-6);
-        if (every > 1e-3 * (1 + 1e-9)) printf(", rows every %g ms", every * 1e3);
+        // The rows come every `every`, but never farther apart than the run.
+        if (every > 1e-3 * (1 + 1e-9)) printf(", rows every %g ms", fmin(every, r->t_end) * 1e3);
     }
     printf("\n  %ld rows -> %s\n", r->rows, out);
 }
@@ -157,6 +160,17 @@ int cmd_run(int argc, char** argv) {
     if (rc) return rc;
     app_note_unused("run", c.given, &c.sim, 1);
     app_note_load("run", &c, &c.sim, &sc);
+    {
+        // A fixed step so small that the run takes minutes: say so up front
+        // (a Krus step of the crane costs at least 0.25 us on this class of
+        // machine, docs/performance.md), rather than leave a silent terminal.
+        const double dur = c.sim.duration > 0 ? c.sim.duration : sc.duration;
+        const bool fixed = !c.sim.cvode && !hyd_method_is_adaptive(c.sim.solver);
+        const double steps = fixed ? dur / c.sim.h : 0.0;
+        if (steps > 1e8)
+            fprintf(stderr, "cranesim run: note: %.3g steps of %g s: at least %.0f s of wall time\n", steps, c.sim.h,
+                    steps * 0.25e-6);
+    }
     app_settle_unused(&c.sim);
 
     csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim)};

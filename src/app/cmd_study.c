@@ -27,7 +27,8 @@ static void study_help(FILE* f) {
             "usage: cranesim study [--scenario S] [--out-dir DIR] [--repeat N] [--quick] [options]\n"
             "\n"
             "Integrates the scenario (default ramp) with Krus and ROS2 at h = 0.1, 0.2, 0.5, 1 ms,\n"
-            "RK4, the adaptive ROS34PW2 and RODAS3 at rtol 1e-2, 2e-3, 1e-3, 1e-4, 1e-5, and\n"
+            "RK4 at 0.1 ms (refused: beyond its stability limit, the table says why) and 0.01 ms,\n"
+            "the adaptive ROS34PW2 and RODAS3 at rtol 1e-2, 2e-3, 1e-3, 1e-4, 1e-5, and\n"
             "SUNDIALS CVODE, and compares each with a CVODE reference at rtol 1e-10, on the\n"
             "lagrange model and the 1 ms output grid. Reports per configuration:\n"
             "max and RMS chamber-pressure error [MPa and %% of peak], max stroke error [mm],\n"
@@ -260,8 +261,11 @@ int cmd_study(int argc, char** argv) {
     const int nh = quick ? 2 : 4, nt = quick ? 2 : 5;
     for (int i = 0; i < nh; ++i) n = add_fixed(cfg, n, &c.sim, HYD_KRUS, quick ? hs[i * 3] : hs[i]);
     for (int i = 0; i < nh; ++i) n = add_fixed(cfg, n, &c.sim, HYD_ROS2, quick ? hs[i * 3] : hs[i]);
-    n = add_fixed(cfg, n, &c.sim, HYD_RK4, 1e-4);
-    if (!quick) n = add_fixed(cfg, n, &c.sim, HYD_RK4, 1e-5);
+    // RK4 at 0.1 ms is refused (beyond its stability interval on the hose
+    // modes, decision 6): the full study keeps the row, whose text says why
+    // stiffness matters; the quick one runs it only where it is stable.
+    if (!quick) n = add_fixed(cfg, n, &c.sim, HYD_RK4, 1e-4);
+    n = add_fixed(cfg, n, &c.sim, HYD_RK4, 1e-5);
     for (int i = 0; i < nt; ++i) n = add_adaptive(cfg, n, &c.sim, HYD_ROS34PW2, false, tols[i]);
     for (int i = 0; i < nt; ++i) n = add_adaptive(cfg, n, &c.sim, HYD_RODAS3, false, tols[i]);
     for (int i = 0; i < nt; ++i) n = add_adaptive(cfg, n, &c.sim, HYD_RODAS3, true, tols[i]);

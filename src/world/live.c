@@ -36,7 +36,7 @@ live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2]
         free(l);
         return NULL;
     }
-    if (lsim_check_pose(&l->ls, q0, err, errsz)) {
+    if (lsim_check_pose(&l->ls, q0, err, errsz) || sim_check_fixed_step(m->hyd, o, o->h, 0.0, err, errsz)) {
         lsim_free(&l->ls);
         free(l);
         return NULL;
@@ -73,6 +73,13 @@ live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], dou
     l->o = *o;
     l->ode = sim_ode_world_create(m, o, "sandbox", q0, slew0, m3, err, errsz);
     if (!l->ode) {
+        free(l);
+        return NULL;
+    }
+    // The hydraulic sub-step is min(--dt, ODE step), as sim_ode_world_create sets it.
+    const double dt = ode_world_dt(l->ode), h = o->h < dt ? o->h : dt;
+    if (sim_check_fixed_step(ode_world_circuit(l->ode), o, h, 0.0, err, errsz)) {
+        ode_world_destroy(l->ode);
         free(l);
         return NULL;
     }

@@ -172,17 +172,16 @@ static double stable_step(double lim, double dt_out) {
 // interval on the circuit's fastest mode (it would ring or freeze instead of
 // integrating), a step longer than the run, or more than 1e12 steps.
 // Returns 0, or 2 with the reason in res->message.
-static int check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, sim_result* res) {
+int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, char* err, size_t errsz) {
     if (o->cvode || hyd_method_is_adaptive(o->solver)) return 0;
-    if (h > t_end) {
-        snprintf(res->message, sizeof res->message, "--dt %g s is longer than the run (%g s)", h, t_end);
-        return res->status = 2;
+    if (t_end > 0 && h > t_end) {
+        snprintf(err, errsz, "--dt %g s is longer than the run (%g s)", h, t_end);
+        return 2;
     }
-    if (t_end / h > 1e12) {
-        snprintf(res->message, sizeof res->message,
-                 "--dt %g s over %g s is %.3g steps, more than 1e12: use a larger --dt or a shorter run", h, t_end,
-                 t_end / h);
-        return res->status = 2;
+    if (t_end > 0 && t_end / h > 1e12) {
+        snprintf(err, errsz, "--dt %g s over %g s is %.3g steps, more than 1e12: use a larger --dt or a shorter run",
+                 h, t_end, t_end / h);
+        return 2;
     }
     if (o->solver == HYD_RK4) {
         // RK4's stability interval on the negative real axis is [-2.785, 0].
@@ -193,14 +192,18 @@ static int check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, do
         // mechanics and the end stops are not in this J.
         const double rate = fmax(hyd_model_fastest_rate(hm, 25e6, 0.0), hyd_model_fastest_rate(hm, 25e6, 1.0));
         if (rate > 0.0 && h * rate > 2.785) {
-            snprintf(res->message, sizeof res->message,
+            snprintf(err, errsz,
                      "rk4 is unstable at h = %g s on this circuit: its fastest mode (%.3g 1/s, an open valve at "
                      "25 MPa) needs h < %.3g s at the least; use --dt %g or a stiff solver (krus, ros2, rodas3)",
                      h, rate, 2.785 / rate, stable_step(2.785 / rate, o->dt_out));
-            return res->status = 2;
+            return 2;
         }
     }
     return 0;
+}
+
+static int check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, sim_result* res) {
+    return res->status = sim_check_fixed_step(hm, o, h, t_end, res->message, sizeof res->message);
 }
 
 static int deliver(run_ctx* c, const double* row);

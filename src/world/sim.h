@@ -39,6 +39,13 @@ typedef struct sim_opts {
                          ///< of the split step (lsim_krus.c; for comparisons)
 } sim_opts;
 
+/// Refuse a fixed-step run the method cannot do, before it starts: RK4
+/// beyond its stability interval on the circuit hm's fastest mode, a step h
+/// [s] longer than the run t_end [s], or more than 1e12 steps (t_end <= 0:
+/// an open-ended run, only the stability test). Returns 0, or 2 with one
+/// line in err. Adaptive solvers and CVODE always pass.
+int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, char* err, size_t errsz);
+
 /// True when this build has the CVODE reference solver.
 bool sim_have_cvode(void);
 

@@ -147,6 +147,7 @@ static void test_bad_options_rejected_in_every_mode(void) {
         {"--mapping map_bogus_key.json", "bogus"},
         {"--every 0.01", "--every"},
         {"--load 500", "--load"},                                 // the sandbox's loads are world objects
+        {"--solver rk4", "rk4 is unstable"},                      // as run refuses it
         {"--record /nonexistent/dir/r.csv", "/nonexistent/dir"}, // checked before driving, not after
     };
     // Headless by option, headless for want of a display, and offscreen.
