@@ -41,6 +41,9 @@ int hyd_method_order(hyd_method m) {
 
 hyd_solver_opts hyd_default_solver_opts(void) {
     hyd_solver_opts o;
+    // Every field defined, also those added later (a missing on_step = NULL
+    // was called as garbage: caught by the sanitizer build).
+    memset(&o, 0, sizeof o);
     o.h = 1e-4;           // the paper's Krus step [s]
     o.rtol = 1e-3;
     o.atol = 1e-6;
