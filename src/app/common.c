@@ -470,6 +470,8 @@ void app_note_unused(const char* cmd, unsigned given, const sim_opts* o, int n) 
                 if (is_adaptive(r)) {
                     snprintf(buf, sizeof buf, "with the adaptive solver %s (fixed-step solvers only)", solver_name(r));
                     w = buf;
+                } else if (r->solver == HYD_RK4) {
+                    w = "with rk4 (an explicit method: no Jacobian)";
                 }
                 break;
             case APP_OPT_WORLD:
@@ -497,9 +499,16 @@ void app_note_load(const char* cmd, const app_common* c, const sim_opts* o, cons
     static const char path[] = "mechanics.load_mass=";
     for (int i = 0; i < c->nset; ++i)
         if (!strncmp(c->sets[i], path, sizeof path - 1)) set = c->sets[i];
+    char err[512];
+    // A scenario written for the tip load (overload, hold) run in the
+    // sandbox: its load_mass does not apply there either.
+    if (!set && sc->load_mass >= 0 && o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX)
+        fprintf(stderr,
+                "cranesim %s: note: scenario %s's load_mass (%g kg) has no effect: the sandbox world's loads are "
+                "world objects\n",
+                cmd, sc->name, sc->load_mass);
     if (!set) return;
     const char* v = set + sizeof path - 1;
-    char err[512];
     if (o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX)
         fprintf(stderr, "cranesim %s: note: --set %s has no effect: the sandbox world's loads are world objects\n", cmd,
                 set);

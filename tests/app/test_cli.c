@@ -239,7 +239,10 @@ static void test_sandbox_start_poses(void) {
     CHECK(run("run --quiet --mechanics ode --world sandbox --scenario ramp --duration 1 --out /dev/null", out,
               sizeof out) == 0,
           "ramp on the sandbox: %s", out);
-    CHECK(out[0] == 0, "no output with --quiet: %s", out);
+    // With --quiet only the note that ramp's 500 kg tip load does not apply
+    // to the sandbox (decision 29); no failure, no other line.
+    CHECK(count_lines(out) == 1 && strstr(out, "note: scenario ramp's load_mass (500 kg) has no effect"),
+          "with --quiet: %s", out);
     char a[1024];
     snprintf(a, sizeof a, "run --quiet --mechanics ode --world sandbox --scenario %s/scn_tip_low.json --out /dev/null",
              DATA);
@@ -513,6 +516,14 @@ static void test_run_summary(void) {
           "cvode --every 0.5: %s", out);
 }
 
+// Notes for what a run does not use (decision 29): the Jacobian options
+// with the explicit RK4.
+static void test_rk4_jacobian_note(void) {
+    static char out[8192];
+    int rc = run("run --quiet --solver rk4 --dt 5e-6 --jac-every 5 --duration 0.01 --out /dev/null", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "note: --jac-every has no effect with rk4") && count_lines(out) == 1, "%s", out);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_help_and_usage);
     RUN_TEST(test_bad_models);
@@ -523,6 +534,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_rk4_refused);
     RUN_TEST(test_ode_runs_are_deterministic);
     RUN_TEST(test_sandbox_start_poses);
+    RUN_TEST(test_rk4_jacobian_note);
     RUN_TEST(test_bad_world_and_compare_tolerance);
     RUN_TEST(test_help_topics);
     RUN_TEST(test_missing_values);
