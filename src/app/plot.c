@@ -23,10 +23,8 @@ static int write_file(const char* path, const void* data, size_t n, char* err, s
         snprintf(err, errsz, "cannot write %s: %s", path, strerror(errno));
         return -1;
     }
-    int e = 0;
-    if (fwrite(data, 1, n, f) != n) e = errno ? errno : EIO;
-    if (fflush(f) && !e) e = errno ? errno : EIO;
-    if (fclose(f) && !e) e = errno ? errno : EIO;
+    errno = 0;
+    const int e = app_fclose_checked(f, fwrite(data, 1, n, f) != n ? (errno ? errno : EIO) : 0);
     if (!e) return 0;
     snprintf(err, errsz, "cannot write %s: %s", path, strerror(e));
     struct stat st;
