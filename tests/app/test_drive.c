@@ -36,7 +36,8 @@ static int run_for(drive_session* s, double* wall, double seconds);
 // A session in the validation world (column on the ground at the origin,
 // booms on hinges, no truck), driven by the 2-DOF demo as `cranesim drive
 // --world validation` does.
-static drive_session* open_validation(bool scripted) {
+// record: the CSV to record to, or NULL.
+static drive_session* open_validation(bool scripted, const char* record) {
     app_common c = {.sim = sim_default_opts()};
     c.sim.mechanics = SIM_ODE;
     c.sim.world = "validation";
@@ -44,6 +45,7 @@ static drive_session* open_validation(bool scripted) {
     drive_opts o = drive_default_opts();
     o.offscreen = true;
     o.scripted = scripted;
+    o.record_path = record;
     char err[512];
     drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
     CHECK(s != NULL, "validation session: %s", err);
@@ -121,7 +123,7 @@ static void check_crane_drawn_in_one_piece(const world_snapshot* snap, const cra
 // alone (paper convention: q1 from the downward vertical, q2 relative to the
 // lifting arm, boom plane x-z): an independent check of the whole chain.
 static void test_validation_world_drawn_at_the_joints(void) {
-    drive_session* s = open_validation(true);
+    drive_session* s = open_validation(true, NULL);
     if (!s) return;
     double wall = 0;
     const crane_mech* me = &drive_session_model(s)->mech;
@@ -177,7 +179,7 @@ static bool has_chart(render* r, const char* label) {
 // slew rack; the validation world has none, so no empty p3A/x3/u3 traces.
 // The HUD names who drives: the scenario when scripted.
 static void test_charts_and_status_follow_the_world(void) {
-    drive_session* s = open_validation(true);
+    drive_session* s = open_validation(true, NULL);
     if (!s) return;
     render* r = drive_session_render_ctx(s);
     const int ncyl = drive_session_snapshot(s)->ncyl;
@@ -206,7 +208,7 @@ static void test_charts_and_status_follow_the_world(void) {
 // The real-time factor is simulated over wall time; over a few milliseconds
 // (a frame at t = 0) the ratio means nothing and the HUD must not show it.
 static void test_no_rate_over_an_instant(void) {
-    drive_session* s = open_validation(true);
+    drive_session* s = open_validation(true, NULL);
     if (!s) return;
     // 0.1 ms of wall time: the world still steps a whole 1 ms ODE step.
     CHECK(drive_session_tick(s, 1e-4) == 0, "tick");
@@ -224,17 +226,8 @@ static void test_no_rate_over_an_instant(void) {
 // A record that cannot be written is reported, with the error, and the rows
 // written before stay counted; one that can is complete.
 static void test_record_write_failure(void) {
-    app_common c = {.sim = sim_default_opts()};
-    c.sim.mechanics = SIM_ODE;
-    c.sim.world = "validation";
-    c.scenario_path = CRANESIM_ASSETS "/scenarios/drive_demo.json";
-    drive_opts o = drive_default_opts();
-    o.offscreen = true;
-    o.scripted = true;
-    o.record_path = "/dev/full"; // every write fails with ENOSPC
     char err[512] = "";
-    drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
-    CHECK(s != NULL, "session: %s", err);
+    drive_session* s = open_validation(true, "/dev/full"); // every write fails with ENOSPC
     if (!s) return;
     double wall = 0;
     run_for(s, &wall, 0.5);
@@ -243,9 +236,7 @@ static void test_record_write_failure(void) {
     CHECK(strstr(err, "cannot write /dev/full") && strstr(err, strerror(ENOSPC)), "message: %s", err);
     drive_session_destroy(s);
 
-    o.record_path = "drive_session_record.csv";
-    s = drive_session_create(&c, &o, err, sizeof err, NULL);
-    CHECK(s != NULL, "session: %s", err);
+    s = open_validation(true, "drive_session_record.csv");
     if (!s) return;
     for (int i = 1; i <= 120; ++i) drive_session_tick(s, i / 240.0); // 0.5 s of ticks
     CHECK(drive_session_finish_record(s, &rows, err, sizeof err) == 0, "record: %s", err);
