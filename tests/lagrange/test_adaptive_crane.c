@@ -3,6 +3,7 @@
 // tight tolerance: chamber pressures within 1 % of the peak pressure at
 // rtol = 1e-3, with far fewer steps than the fixed 0.1 ms step.
 #include "check.h"
+#include "crane_fixture.h"
 #include "sim.h"
 
 #include <math.h>
@@ -11,12 +12,9 @@
 static void test_adaptive_within_one_percent(void) {
     CHECK(sim_have_cvode(), "this build has no CVODE reference");
     if (!sim_have_cvode()) return;
-    char err[512];
-    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
-    CHECK(m != NULL, "%s", err);
-    if (!m) return;
     scenario sc;
-    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/ramp.json", &sc, err, sizeof err) == 0, "%s", err);
+    model* m = load_crane("ramp", &sc);
+    if (!m) return;
     sim_opts ro = sim_default_opts();
     ro.cvode = true;
     ro.rtol = 1e-10;
@@ -62,12 +60,9 @@ static void test_adaptive_within_one_percent(void) {
 // falls back to the chord. Both runs end normally, every output pressure
 // above absolute zero.
 static void test_domain_keeps_pressures_physical(void) {
-    char err[512];
-    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
-    CHECK(m != NULL, "%s", err);
-    if (!m) return;
     scenario sc;
-    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/overload.json", &sc, err, sizeof err) == 0, "%s", err);
+    model* m = load_crane("overload", &sc);
+    if (!m) return;
     const hyd_method methods[2] = {HYD_RODAS3, HYD_ROS34PW2};
     for (int j = 0; j < 2; ++j) {
         sim_opts o = sim_default_opts();
@@ -99,12 +94,9 @@ static void test_dips_and_failures(void) {
         CHECK(0, "this build has no CVODE");
         return;
     }
-    char err[512];
-    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
-    CHECK(m != NULL, "%s", err);
-    if (!m) return;
     scenario sc;
-    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/overload.json", &sc, err, sizeof err) == 0, "%s", err);
+    model* m = load_crane("overload", &sc);
+    if (!m) return;
     sim_opts o = sim_default_opts();
     o.solver = HYD_ROS2;
     o.h = 1e-3;
@@ -112,7 +104,7 @@ static void test_dips_and_failures(void) {
     CHECK(sim_run(m, &sc, &o, NULL, NULL, NULL, NULL, NULL, &r) == 0, "ros2 1 ms: %s", r.message);
     CHECK(strstr(r.note, "dipped below absolute zero") && strstr(r.note, "kPa"), "note: '%s'", r.note);
     printf("  ros2 1 ms on overload: %s\n", r.note);
-    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/ramp.json", &sc, err, sizeof err) == 0, "%s", err);
+    load_scenario("ramp", &sc);
     o = sim_default_opts();
     o.cvode = true;
     o.rtol = 1e-2;

@@ -3,18 +3,16 @@
 // physics by different means (Lagrange's equations vs constrained rigid
 // bodies), so their agreement checks both.
 #include "check.h"
+#include "crane_fixture.h"
 #include "sim.h"
 
 #include <math.h>
 #include <string.h>
 
 static void test_validation_world_matches_lagrange(void) {
-    char err[512];
-    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
-    CHECK(m != NULL, "%s", err);
-    if (!m) return;
     scenario sc;
-    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/ramp.json", &sc, err, sizeof err) == 0, "%s", err);
+    model* m = load_crane("ramp", &sc);
+    if (!m) return;
     sim_trace tr[2] = {{0}, {0}};
     for (int b = 0; b < 2; ++b) {
         sim_opts o = sim_default_opts();
@@ -60,12 +58,9 @@ static void test_validation_world_matches_lagrange(void) {
 // the lag's effect is monotone in the step up to the limit, and the limit
 // holds.
 static void test_ode_step_limit(void) {
-    char err[512];
-    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
-    CHECK(m != NULL, "%s", err);
-    if (!m) return;
     scenario sc;
-    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/step.json", &sc, err, sizeof err) == 0, "%s", err);
+    model* m = load_crane("step", &sc);
+    if (!m) return;
     sim_opts o = sim_default_opts();
     o.duration = 4.0;
     o.dt_out = 0.01;
@@ -105,12 +100,9 @@ static void test_ode_step_limit(void) {
 // rack travels r * 60 deg (r = the pinion radius) and its chambers carry the
 // driving pressure; the validation world has no slew and writes zeros.
 static void test_slew_columns(void) {
-    char err[512];
-    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
-    CHECK(m != NULL, "%s", err);
-    if (!m) return;
     scenario sc;
-    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/sandbox_pick_place.json", &sc, err, sizeof err) == 0, "%s", err);
+    model* m = load_crane("sandbox_pick_place", &sc);
+    if (!m) return;
     for (int wld = 0; wld < 2; ++wld) {
         sim_opts o = sim_default_opts();
         o.mechanics = SIM_ODE;

@@ -1,0 +1,33 @@
+// crane_fixture.h: the default crane model with one shipped scenario, for
+// the tests that run whole scenarios through sim_run.
+#ifndef TEST_CRANE_FIXTURE_H
+#define TEST_CRANE_FIXTURE_H
+
+#include "check.h"
+#include "sim.h"
+
+#include <stdio.h>
+
+/// assets/scenarios/<name>.json into *sc.
+static inline int load_scenario(const char* name, scenario* sc) {
+    char path[512], err[512];
+    snprintf(path, sizeof path, "%s/scenarios/%s.json", CRANESIM_ASSETS, name);
+    const int rc = scenario_load(path, sc, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    return rc;
+}
+
+/// The default model (assets/models/hiab031.json) and scenario `name`;
+/// NULL (the failure CHECKed) when either does not load.
+static inline model* load_crane(const char* name, scenario* sc) {
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (m && load_scenario(name, sc)) {
+        model_free(m);
+        return NULL;
+    }
+    return m;
+}
+
+#endif
