@@ -243,8 +243,18 @@ int hydEvalF(hyd_solver* s, double t, const double* y, double* dydt) {
     return s->p->f(s->p->user, t, y, dydt) == 0 ? HYD_OK : HYD_ERR_RHS;
 }
 
+// Typical size of a state for the finite-difference increment: below
+// atol / rtol the error test is absolute (atol + rtol |y| ~ atol), so that is
+// the size from which on a state is resolved at all. With rtol = 0 or
+// atol = 0 the tolerances say nothing about a scale: 1 (the unit floor of
+// the textbook increment). docs/solvers.md, "Finite-difference Jacobian".
+static double fd_typical(const hyd_solver_opts* o) {
+    const double typ = o->rtol > 0.0 ? o->atol / o->rtol : 0.0;
+    return typ > 0.0 && typ <= DBL_MAX ? typ : 1.0;
+}
+
 // J by the callback, or by forward differences with the per-column step
-// sqrt(eps) max(|y_j|, 1); only the diagonal blocks are kept.
+// sqrt(eps) max(|y_j|, atol / rtol); only the diagonal blocks are kept.
 static int eval_jacobian(hyd_solver* s, double t, const double* y, const double* f0,
                          double h) {
     const hyd_problem* p = s->p;
@@ -261,12 +271,20 @@ static int eval_jacobian(hyd_solver* s, double t, const double* y, const double*
             }
         }
     } else {
-        const double sq = sqrt(DBL_EPSILON);
+        // sqrt(eps) times the state's own size balances truncation (f'' d)
+        // against rounding (eps |f| / d). The old floor of 1 made d = 1.5e-8
+        // for a state of 1e-13 (ROBER's y2 at t = 1e11): a difference
+        // across 1e5 times the state, and results with 1 or 2 correct digits.
+        const double sq = sqrt(DBL_EPSILON), typ = fd_typical(&s->o);
         memcpy(s->fdy, y, (size_t)n * sizeof *y);
         for (int j = 0; j < n; ++j) {
             const double yj = y[j];
-            s->fdy[j] = yj + sq * fmax(fabs(yj), 1.0);
-            const double d = s->fdy[j] - yj; // the step actually represented
+            s->fdy[j] = yj + sq * fmax(fabs(yj), typ);
+            double d = s->fdy[j] - yj; // the step actually represented
+            if (!(d != 0.0)) { // a floor below the resolution of yj (or NaN): the unit floor
+                s->fdy[j] = yj + sq * fmax(fabs(yj), 1.0);
+                d = s->fdy[j] - yj;
+            }
             int rc = hydEvalF(s, t, s->fdy, s->fdf);
             s->fdy[j] = yj;
             if (rc != HYD_OK) return rc;

@@ -127,6 +127,52 @@ static void test_robertson(void) {
     }
 }
 
+// Correct significant digits of y against ref: min over the states of
+// -log10 |y_i - ref_i| / |ref_i|.
+static double digits(const double* y, const double* ref, int n) {
+    double d = 99.0;
+    for (int i = 0; i < n; ++i) {
+        const double e = fabs(y[i] - ref[i]) / fabs(ref[i]);
+        d = fmin(d, e > 0.0 ? -log10(e) : 17.0);
+    }
+    return isfinite(d) ? d : -99.0;
+}
+
+// A badly scaled problem with the finite-difference Jacobian: Robertson,
+// whose y2 is 9e-6 at t = 40 and 8e-14 at t = 1e11. A difference increment
+// that ignores a state's scale (sqrt(eps) max(|y_j|, 1) = 1.5e-8 for y2)
+// gave at t = 1e11, rtol 1e-7, atol 1e-20, 2.1 correct digits with ROS34PW2
+// and 1.1 with RODAS3 (which, being a classical Rosenbrock method, needs an
+// accurate J), and at t = 40, rtol 1e-8, atol 1e-14, 6.7 digits with RODAS3;
+// the increment scaled from atol / rtol gives 6.7, 7.3 and 8.2.
+// References: t = 40, Hairer & Wanner, Solving ODEs II, IV.1 (Table 1.1
+// digits as quoted in the SUNDIALS cvRoberts_dns example); t = 1e11, the
+// IVP test set (Mazzia & Magherini), problem ROBER, computed with RADAU5.
+static void test_robertson_fd_scaling(void) {
+    static const struct {
+        double t1, rtol, atol, min_digits;
+        double ref[3];
+    } cs[2] = {
+        {40.0, 1e-8, 1e-14, 7.5, {0.7158270687193, 9.185534764e-6, 0.2841637457}},
+        {1e11, 1e-7, 1e-20, 5.0, {0.2083340149701255e-07, 0.8333360770334713e-13, 0.9999999791665050}},
+    };
+    for (int c = 0; c < 2; ++c) {
+        for (int m = HYD_ROS34PW2; m <= HYD_RODAS3; ++m) {
+            hyd_problem p = {0};
+            p.n = 3, p.f = rober_f, p.jac = NULL, p.autonomous = 1;
+            double y[3] = {1.0, 0.0, 0.0};
+            hyd_solver_stats st;
+            int rc = run((hyd_method)m, &p, y, cs[c].t1, cs[c].rtol, cs[c].atol, &st);
+            CHECK(rc == HYD_OK, "%s rc %d", hyd_method_name(m), rc);
+            const double d = digits(y, cs[c].ref, 3);
+            CHECK(d >= cs[c].min_digits, "%s FD J, t = %g: %.2f correct digits, expected >= %.1f (y = %.10g %.10g %.10g)",
+                  hyd_method_name(m), cs[c].t1, d, cs[c].min_digits, y[0], y[1], y[2]);
+            printf("  robertson fd t=%-5g %-8s: %.2f digits, %ld steps\n", cs[c].t1, hyd_method_name(m), d,
+                   st.steps);
+        }
+    }
+}
+
 // HIRES at t = 321.8122. Reference: IVP test set (Mazzia & Magherini), hiressol,
 // computed with RADAU5 in quadruple precision.
 static void test_hires(void) {
@@ -200,6 +246,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_rodas3_order3);
     RUN_TEST(test_l_stability);
     RUN_TEST(test_robertson);
+    RUN_TEST(test_robertson_fd_scaling);
     RUN_TEST(test_hires);
     RUN_TEST(test_vdpol);
     RUN_TEST(test_hold_and_reuse);
