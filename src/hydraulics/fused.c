@@ -10,6 +10,9 @@
 
 #include "hyd_internal.h"
 
+#include <limits.h>
+#include <string.h>
+
 static void set_why(char* why, size_t n, const char* msg) {
     if (why && n) snprintf(why, n, "%s", msg);
 }
@@ -32,6 +35,21 @@ static void pack_node(const hyd_model* m, int node, hyd_fused_node* n) {
     n->nramp = 0;
     n->p_lo = -HUGE_VAL;
     n->p_hi = HUGE_VAL;
+    // The knee of the entrained-air law: the pressure where Be(p) reaches
+    // 90 % of the liquid modulus (2.6 MPa for the default hoses, 3.2 MPa
+    // for the oil-only nodes; Be is 1 % of it at 0.05 MPa). Bisection on
+    // log p over [100 Pa, 1 GPa]; no air: no knee.
+    n->p_knee = 0.0;
+    if (m->be_alpha > 0.0 && n->bel > 0.0) {
+        double lo = log(1e2), hi = log(1e9);
+        if (hyd_be_slow(m, n->bel, exp(lo), NULL) >= 0.9 * n->bel) return;
+        for (int i = 0; i < 60; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            if (hyd_be_slow(m, n->bel, exp(mid), NULL) < 0.9 * n->bel) lo = mid;
+            else hi = mid;
+        }
+        n->p_knee = exp(hi);
+    }
 }
 
 // The hose whose own node is `node`, or -1.
@@ -258,6 +276,90 @@ static inline double pump_in(const hyd_fused* f, double pPL, double* g) {
     const double s = hyd_smoothstep((pPL - f->p_in - f->pset) * f->inv_band, &ds);
     *g = -f->qmax * ds * f->inv_band;
     return f->qmax * (1.0 - s);
+}
+
+// ---------------------------------------------------------------- events --
+//
+// hyd_fused_events_update counts the moments at which the circuit gets
+// stiffer than a Jacobian taken before them describes. The fixed-step
+// W-methods (Krus, ROS2) tolerate a W that overestimates the stiffness of
+// a mode (|R| stays below 1) but not one that underestimates it by a few
+// times at h |lambda| > 2: there the stage equations amplify the mode. So
+// the events are the switches that stiffen: a relief or check valve
+// reaching its corner or passing beyond it, an end stop engaging or
+// pressing beyond its smoothing width, the pump line entering the band of
+// the pump's cut-off, a pressure rising into a higher octave below the knee
+// of its bulk-modulus law. Switches the other way are not counted: there the
+// older J overestimates. Counting both ways was tried: ROS2 at 1 ms on
+// `overload`, which finishes with J by age alone, then blew up at 5.74 s
+// (a J taken at the end stop's first touch, kept as it pressed in), and
+// Krus at 1 ms on `step` failed at 1.26 s instead of 3.63 s
+// (docs/solver_study.md).
+
+// Where a piecewise law stands: 0 before its corner, 1 on it (0 < t < 1),
+// 2 beyond it (t >= 1; also NaN).
+static inline unsigned char corner_level(double t) { return t <= 0.0 ? 0 : (t < 1.0 ? 1 : 2); }
+
+// The octave of a pressure below the knee of its node's bulk-modulus law
+// (the binary exponent: no log), or INT_MAX above it (and for NaN). Be(p)
+// grows about 3x per octave there (the default hose: 8.4 MPa at 0.05 MPa,
+// 27 at 0.1, 82 at 0.2, 283 at 0.5), and so does the stiffness of the
+// node's modes.
+static inline int low_octave(const hyd_fused_node* n, double p) {
+    if (!(p < n->p_knee)) return INT_MAX;
+    uint64_t b;
+    memcpy(&b, &p, sizeof b);
+    return p > 0.0 ? (int)(b >> 52) : INT_MIN; // at or below 0: lowest
+}
+
+// One node: its octave (slot *io of e->oct) and its ramps' levels (slots
+// from *il of e->lv). Returns 1 when either stiffened since the last call.
+static int node_events(hyd_fused_events* e, const hyd_fused_node* n, double p, int* io, int* il) {
+    int sw = 0;
+    const int o = low_octave(n, p);
+    if (o > e->oct[*io] && o != INT_MAX) sw = 1;
+    e->oct[(*io)++] = o;
+    if (n->p_lo < p && p < n->p_hi) { // every ramp closed: the common case
+        for (int i = 0; i < n->nramp; ++i) e->lv[(*il)++] = 0;
+        return sw;
+    }
+    for (int i = 0; i < n->nramp; ++i) {
+        const hyd_fused_ramp* r = &n->ramp[i];
+        const double d = r->into ? r->p_tank - p : p - r->p_tank;
+        const unsigned char lv = corner_level((d - r->pcr) * r->inv_w);
+        if (lv > e->lv[*il]) sw = 1;
+        e->lv[(*il)++] = lv;
+    }
+    return sw;
+}
+
+unsigned long hyd_fused_events_update(hyd_fused_events* e, const hyd_fused* f, const double* y,
+                                      const double* x, const double* cmd) {
+    int sw = 0, io = 0, il = 0;
+    for (int k = 0; k < f->nact; ++k) {
+        const hyd_fused_act* a = &f->act[k];
+        if (!(fabs(cmd[k] - e->cmd[k]) <= HYD_FUSED_CMD_EVENT)) sw = 1;
+        e->cmd[k] = cmd[k];
+        sw |= node_events(e, &a->hA, y[a->hA.s], &io, &il);
+        sw |= node_events(e, &a->hB, y[a->hB.s], &io, &il);
+        sw |= node_events(e, &a->cA, y[a->cA.s], &io, &il);
+        sw |= node_events(e, &a->cB, y[a->cB.s], &io, &il);
+        // End stops: penetration over the smoothing width ws (cylinder.c).
+        const double iw = 1.0 / a->ws;
+        const unsigned char lo = corner_level(-x[k] * iw), hi = corner_level((x[k] - a->s) * iw);
+        if (lo > e->stop[2 * k] || hi > e->stop[2 * k + 1]) sw = 1;
+        e->stop[2 * k] = lo, e->stop[2 * k + 1] = hi;
+    }
+    const double pPL = y[f->pl.s];
+    sw |= node_events(e, &f->pl, pPL, &io, &il);
+    // The pump's cut-off: a smoothstep over its band above pset, steep only
+    // inside the band (level 1).
+    const unsigned char lp = corner_level((pPL - f->p_in - f->pset) * f->inv_band);
+    if (lp == 1 && e->pump != 1) sw = 1;
+    e->pump = lp;
+    if (e->have && sw) ++e->count;
+    e->have = 1;
+    return e->count;
 }
 
 void hyd_fused_eval(const hyd_fused* f, const double* y, const double* x, const double* v,

@@ -21,6 +21,8 @@
 #ifndef HYD_FUSED_H
 #define HYD_FUSED_H
 
+#include <stdint.h>
+
 #include "hydraulics.h"
 
 #ifdef __cplusplus
@@ -49,6 +51,7 @@ typedef struct hyd_fused_node {
     /// Every ramp is closed while p_lo < p < p_hi [Pa abs] (checks crack
     /// below p_lo, reliefs above p_hi): the common case costs two compares.
     double p_lo, p_hi;
+    double p_knee;         ///< Be(p) < 0.9 bel below it [Pa abs] (0: no air, constant Be)
 } hyd_fused_node;
 
 typedef struct hyd_fused_act {
@@ -120,6 +123,37 @@ void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const
 void hyd_fused_jacobian(const hyd_fused* f, const double* y, const double* x, const double* v,
                         const double* cmd, double* ydot, double* F, double* J, int ldj,
                         hyd_fused_coupling* cpl);
+
+/// A valve command change between two calls of hyd_fused_events_update that
+/// counts as a command step [-]: 5 % of the full opening (a ramp of the
+/// shipped scenarios moves at most 1e-3 per 1 ms step, their steps 0.6 to
+/// 0.8).
+#define HYD_FUSED_CMD_EVENT 0.05
+
+/// An event counter for hyd_problem.events on a fused circuit: where each
+/// piecewise law stood at the previous call (see hyd_fused_events_update).
+typedef struct hyd_fused_events {
+    unsigned long count;   ///< switches seen so far
+    double cmd[HYD_FUSED_MAXACT]; ///< commands at the previous call [-]
+    int oct[4 * HYD_FUSED_MAXACT + 1]; ///< pressure octave per node below its knee (hoses, chambers, pump line)
+    unsigned char lv[(4 * HYD_FUSED_MAXACT + 1) * HYD_FUSED_MAXRAMP]; ///< ramp levels: 0 closed, 1 on the corner, 2 open
+    unsigned char stop[2 * HYD_FUSED_MAXACT]; ///< end stops (low, high): 0 free, 1 in the width, 2 engaged
+    unsigned char pump;    ///< the pump's cut-off: 0 below its band, 1 in it, 2 above
+    int have;              ///< the fields above are set
+} hyd_fused_events;
+
+/// Count a switch that stiffens the circuit since the previous call: a
+/// command cmd[k] (k < f->nact) moving by more than HYD_FUSED_CMD_EVENT (a
+/// NaN counts), a relief or check valve reaching or passing the corner of
+/// its opening law, an end stop engaging or pressing beyond its smoothing
+/// width, the pump line entering the pump's cut-off band, a node below the
+/// knee of its bulk-modulus law (p_knee) rising into a higher octave of
+/// pressure (Be, and with it the node's stiffness, grows about 3x per
+/// octave there). Switches back are not counted: a J from before them
+/// overestimates the stiffness, which the W-methods tolerate (fused.c).
+/// Returns the count. y in the caller's order, x the strokes [m].
+unsigned long hyd_fused_events_update(hyd_fused_events* e, const hyd_fused* f, const double* y,
+                                      const double* x, const double* cmd);
 
 #ifdef __cplusplus
 }

@@ -81,6 +81,17 @@ typedef struct hyd_problem {
     /// solution never gets there, a step too long for its error estimate
     /// can). NULL: every finite y is admissible.
     int (*outside)(void* user, const double* y);
+    /// Optional event counter for the Jacobian schedule. Called with the
+    /// state (t, y) at the start of a step, it returns a count that the
+    /// problem increases whenever f has switched since its previous call: a
+    /// command step, a relief or check valve passing a corner of its
+    /// opening law, an end stop engaging or releasing. When the count
+    /// differs from its value at the last J, that step takes a new J, as it
+    /// would at jac_every steps or jac_max_age: a J of one regime reused in
+    /// another can make W a poor, even unstable, approximation (Krus at
+    /// 1 ms on `step`, docs/solver_study.md). Only consulted while J is
+    /// reused (jac_every > 1). NULL: J by age only.
+    unsigned long (*events)(void* user, double t, const double* y);
 } hyd_problem;
 
 typedef enum hyd_method {
@@ -140,6 +151,7 @@ typedef struct hyd_solver_stats {
     long rejected;  ///< rejected steps (adaptive)
     long fevals;    ///< right-hand-side evaluations (including finite-difference ones)
     long jevals;    ///< Jacobian evaluations
+    long jevents;   ///< of them, taken early because hyd_problem.events reported a switch
     long lus;       ///< LU factorisations of W (a block-diagonal W counts once)
     long outside;   ///< trial steps rejected for leaving the domain (hyd_problem.outside; adaptive)
 } hyd_solver_stats;

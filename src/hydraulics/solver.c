@@ -243,6 +243,8 @@ int hydEvalF(hyd_solver* s, double t, const double* y, double* dydt) {
     return s->p->f(s->p->user, t, y, dydt) == 0 ? HYD_OK : HYD_ERR_RHS;
 }
 
+static void mark_jacobian(hyd_solver* s, double t);
+
 // Typical size of a state for the finite-difference increment: below
 // atol / rtol the error test is absolute (atol + rtol |y| ~ atol), so that is
 // the size from which on a state is resolved at all. With rtol = 0 or
@@ -309,26 +311,43 @@ static int eval_jacobian(hyd_solver* s, double t, const double* y, const double*
             for (int i = 0; i < n; ++i) s->ft[i] = (s->fdf[i] - f0[i]) * id;
         }
     }
-    s->st.jevals++;
-    s->j_valid = 1;
-    s->j_force = 0;
-    s->j_steps = 0;
-    s->j_t = t;
+    mark_jacobian(s, t);
     s->w_valid = 0;
     return HYD_OK;
 }
 
 // A new Jacobian is due: none yet, forced (reset, rejection), too many steps
-// or too much simulated time since the last one.
-static int jacobian_due(const hyd_solver* s, double t) {
+// or too much simulated time since the last one, or (hyd_problem.events)
+// f switched since it was taken. The event count of (t, y) is kept in
+// ev_now for mark_jacobian.
+static int jacobian_due(hyd_solver* s, double t, const double* y) {
     const hyd_solver_opts* o = &s->o;
-    return !s->j_valid || s->j_force || s->j_steps >= (o->jac_every > 1 ? o->jac_every : 1) ||
-           (o->jac_max_age > 0.0 && fabs(t - s->j_t) > o->jac_max_age);
+    const int every = o->jac_every > 1 ? o->jac_every : 1;
+    int due = !s->j_valid || s->j_force || s->j_steps >= every ||
+              (o->jac_max_age > 0.0 && fabs(t - s->j_t) > o->jac_max_age);
+    if (s->p->events && every > 1) {
+        s->ev_now = s->p->events(s->p->user, t, y);
+        if (!due && s->ev_now != s->j_events) {
+            due = 1;
+            s->st.jevents++;
+        }
+    }
+    return due;
+}
+
+// Bookkeeping of a new J taken at time t.
+static void mark_jacobian(hyd_solver* s, double t) {
+    s->st.jevals++;
+    s->j_valid = 1;
+    s->j_force = 0;
+    s->j_steps = 0;
+    s->j_t = t;
+    s->j_events = s->ev_now;
 }
 
 int hydPrepareW(hyd_solver* s, double t, const double* y, const double* f0, double gh) {
     const hyd_solver_opts* o = &s->o;
-    if (jacobian_due(s, t)) {
+    if (jacobian_due(s, t, y)) {
         if (s->sp_on) {
             // State scales for the sparse LU's pivot test (lu.c): the error
             // weights, so the test is blind to the states' units.
@@ -402,18 +421,12 @@ static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_ne
     int rc;
     if (s->p->wstep && (s->method == HYD_KRUS || s->method == HYD_ROS2)) {
         // The problem's own step kernel (hyd_problem.wstep).
-        const int need_j = jacobian_due(s, *t);
+        const int need_j = jacobian_due(s, *t, y);
         rc = s->p->wstep(s->p->user, *t, y, h, hydKrusGamma(s->method), need_j, s->ynew);
         if (rc < 0) return rc;
         s->st.fevals += 2;
         s->st.lus += rc;
-        if (need_j) {
-            s->st.jevals++;
-            s->j_valid = 1;
-            s->j_force = 0;
-            s->j_steps = 0;
-            s->j_t = *t;
-        }
+        if (need_j) mark_jacobian(s, *t);
     } else {
         const double* f0 = s->fc_f;
         rc = s->fc_valid ? current_f(s, *t, y, &f0) : hydEvalF(s, *t, y, s->fc_f);

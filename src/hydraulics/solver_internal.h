@@ -54,6 +54,8 @@ struct hyd_solver {
     int j_force;   ///< re-evaluate J at the next step (after a rejection or reset)
     long j_steps;  ///< accepted steps since J was evaluated
     double j_t;    ///< time J was evaluated at [s]
+    unsigned long j_events; ///< hyd_problem.events at the last J
+    unsigned long ev_now;   ///< its value at the current step (jacobian_due)
     int w_valid;   ///< w holds LU(I - w_gh J)
     double w_gh;   ///< gamma * h that w was factored with [s]
 

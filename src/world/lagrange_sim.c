@@ -24,6 +24,25 @@ static int hose_of_chamber(const hyd_model* hm, const double* J, int nh, int ic,
     return -1;
 }
 
+// The mount angle phi at which cylinder a has stroke x [m]: phi = acos of
+// the law of cosines (paper Eq. 5); the mounts keep phi in (0, pi), where
+// the stroke grows with phi. NaN when x is out of the mounts' reach.
+static double phi_of_stroke(const crane_actuator* a, double x) {
+    const double L = x + a->closed_length;
+    const double c = (a->a * a->a + a->b * a->b - L * L) / (2.0 * a->a * a->b);
+    return c >= -1.0 && c <= 1.0 ? acos(c) : NAN;
+}
+
+// Joint ranges in which lsim_events can skip the strokes (ev_phi).
+static void events_setup(lsim* s) {
+    for (int k = 0; k < 2; ++k) {
+        const crane_actuator* a = &s->mdl->mech.act[k];
+        const hyd_fused_act* fa = &s->fz.act[k];
+        s->ev_phi[k][0] = phi_of_stroke(a, fa->ws);
+        s->ev_phi[k][1] = phi_of_stroke(a, fa->s - fa->ws);
+    }
+}
+
 int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err, size_t errsz) {
     memset(s, 0, sizeof *s);
     s->mdl = m;
@@ -104,6 +123,8 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
     const int fv[2] = {m->valve[0], m->valve[1]}, fc[2] = {m->cyl[0], m->cyl[1]};
     s->have_fused = hyd_fused_build(hm, fv, fc, 2, &s->fz, s->fused_why, sizeof s->fused_why) == 0;
     if (s->have_fused) hyd_fused_map(&s->fz, s->hpos);
+    if (s->have_fused) events_setup(s);
+    s->fz_rev = hyd_model_revision(hm);
     s->use_fused = s->have_fused;
     s->w_layout = lsim_w_layout(s);
     s->use_w = s->w_layout;
@@ -144,6 +165,7 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
     p.jac = fz ? lsim_jac_fused : lsim_jac;
     p.dfdt = lsim_dfdt;
     p.user = s;
+    if (s->have_fused) p.events = lsim_events;
     if (blocks) {
         p.nblock = s->nblock;
         p.block_size = s->block;
@@ -198,6 +220,30 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt) {
     lagrange_accel(&lt, tau, qdd);
     lsim_mech_out(s, qd, qdd, dydt + iq);
     return 0;
+}
+
+unsigned long lsim_events(void* user, double t, const double* y) {
+    lsim* s = user;
+    double cmd[2], x[2];
+    // A live edit of the circuit (the drive panel, hyd_model_set): the
+    // packed thresholds are stale. (Such runs evaluate f by the general
+    // path; the events still come from the packed laws.)
+    if (hyd_model_revision(s->mdl->hyd) != s->fz_rev) {
+        const int fv[2] = {s->mdl->valve[0], s->mdl->valve[1]}, fc[2] = {s->mdl->cyl[0], s->mdl->cyl[1]};
+        s->fz_rev = hyd_model_revision(s->mdl->hyd);
+        s->have_fused = hyd_fused_build(s->mdl->hyd, fv, fc, 2, &s->fz, s->fused_why, sizeof s->fused_why) == 0;
+        if (s->have_fused) hyd_fused_map(&s->fz, s->hpos), events_setup(s);
+    }
+    if (!s->have_fused) return s->ev.count; // no packed laws: J by age only
+    commands(s, t, cmd);
+    // The stroke only near an end stop (a sincos and a square root); away
+    // from both, any stroke inside the range has the same levels.
+    for (int k = 0; k < 2; ++k) {
+        const crane_actuator* a = &s->mdl->mech.act[k];
+        const double phi = y[s->iq + k] + a->phi_offset;
+        x[k] = phi > s->ev_phi[k][0] && phi < s->ev_phi[k][1] ? 0.5 * s->fz.act[k].s : crane_stroke(a, y[s->iq + k]);
+    }
+    return hyd_fused_events_update(&s->ev, &s->fz, y, x, cmd);
 }
 
 int lsim_dfdt(void* user, double t, const double* y, double* dfdt) {

@@ -92,6 +92,12 @@ typedef struct lsim {
     // Split Krus/ROS2 step (lsim_krus.c) for the block-pattern fixed-step runs.
     bool use_split;        ///< lsim_problem(s, true) hands out lsim_wstep (default: w_layout)
     lsim_ks ks;
+    hyd_fused_events ev;   ///< event counter of lsim_events
+    unsigned fz_rev;       ///< hyd_model_revision that fz was packed at
+    /// Cylinder k is clear of both end stops and their smoothing widths
+    /// while ev_phi[k][0] < phi < ev_phi[k][1] (phi = q + phi_offset [rad];
+    /// NaN: no such range): lsim_events then needs no stroke.
+    double ev_phi[2][2];
 } lsim;
 
 /// Set up for model m. Returns 0, or -1 with a message.
@@ -130,6 +136,12 @@ void lsim_wsolve(void* user, double* x);
 int lsim_wstep(void* user, double t, const double* y, double h, double gamma, int new_jac,
                double* ynew);
 int lsim_rhs(void* user, double t, const double* y, double* dydt);
+/// hyd_problem.events (requires have_fused): counts the switches between
+/// successive calls (hyd_fused_events_update): a valve command step, a
+/// relief or check valve, an end stop or the pump's cut-off passing a
+/// corner of its law, a pressure below the bulk modulus' knee changing
+/// octave.
+unsigned long lsim_events(void* user, double t, const double* y);
 /// df/dt: time enters only through the valve commands of the scenario, so
 /// only the spool rows are non-zero: (du_cmd/dt) / tau_s.
 int lsim_dfdt(void* user, double t, const double* y, double* dfdt);

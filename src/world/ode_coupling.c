@@ -75,6 +75,16 @@ static int jac_fused(void* user, double t, const double* y, double* J) {
     return 0;
 }
 
+// hyd_problem.events on the fused path: switches of the circuit's regime or
+// of a command (hyd_fused_events_update), so the sub-steps' reused J is
+// renewed at them as in the lagrange runs.
+static unsigned long events_fused(void* user, double t, const double* y) {
+    ode_world* w = user;
+    double x[ODE_NACT], v[ODE_NACT], cmd[ODE_NACT];
+    fused_inputs(w, t, x, v, cmd);
+    return hyd_fused_events_update(&w->fz_ev, &w->fz, y, x, cmd);
+}
+
 // hyd_problem.outside: a node pressure below absolute zero (the adaptive
 // methods then retry with a shorter step; see lagrange_sim.c).
 static int outside(void* user, const double* y) {
@@ -92,7 +102,7 @@ static void fused_setup(ode_world* w) {
     w->use_fused = 0;
     w->hp.f = rhs;
     w->hp.jac = jac;
-    if (w->opt.general_circuit) return;
+    w->hp.events = NULL;
     int valve[ODE_NACT], cyl[ODE_NACT];
     w->nfz = 0;
     for (int k = 0; k < ODE_NACT; ++k) {
@@ -104,6 +114,10 @@ static void fused_setup(ode_world* w) {
     char why[128];
     if (hyd_fused_build(w->hm, valve, cyl, w->nfz, &w->fz, why, sizeof why)) return;
     w->fz_rev = hyd_model_revision(w->hm);
+    // The event counter reads the packed laws whichever kernel evaluates f,
+    // so both kernels follow the same Jacobian schedule.
+    w->hp.events = events_fused;
+    if (w->opt.general_circuit) return;
     w->use_fused = 1;
     w->hp.f = rhs_fused;
     w->hp.jac = jac_fused;
@@ -382,7 +396,7 @@ int ow_hyd_step(ode_world* w, double H) {
     w->step_t0 = w->th;
     // A live parameter edit (hyd_model_set) since the last step: the packed
     // constants are stale. (The solver reads f and jac through &w->hp.)
-    if (w->use_fused && hyd_model_revision(w->hm) != w->fz_rev) fused_setup(w);
+    if (w->hp.events && hyd_model_revision(w->hm) != w->fz_rev) fused_setup(w);
     // New strokes and rates: f at (th, y) is not what the solver cached.
     hyd_solver_inputs_changed(w->hs);
     double Fsum[ODE_NACT] = {0, 0, 0};

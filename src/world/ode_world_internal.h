@@ -153,6 +153,7 @@ struct ode_world {
     int use_fused, nfz;
     int fz_act[ODE_NACT];
     unsigned fz_rev;
+    hyd_fused_events fz_ev; ///< the fused path's event counter (hyd_problem.events)
 };
 
 // ode_world.c

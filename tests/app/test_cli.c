@@ -171,14 +171,17 @@ static void test_csv_contract(void) {
     CHECK(count_lines(csv) == 1 + 6, "want 6 rows at 100 Hz, got %d", count_lines(csv) - 1);
 }
 
-// Krus (A-stable, R(-inf) = -1) at 20 times its step rings on the valve
+// Krus (A-stable, R(-inf) = -1) at 80 times its step rings on the valve
 // steps until a pressure leaves the physical range: exit 1, a message naming
 // the state and the time, and the rows before the failure kept. (RK4 beyond
-// its stability limit is refused up front: test_rk4_refused.)
+// its stability limit is refused up front: test_rk4_refused.) At 2 ms (and
+// 5 ms) it failed too while its Jacobian was renewed by age alone; with the
+// renewal at events it runs through (1.2 % and 5.7 % of peak pressure RMS
+// from CVODE).
 static void test_blow_up_keeps_output(void) {
     static char out[8192];
     static char csv[1 << 20];
-    int rc = run("run --quiet --scenario step --solver krus --dt 2e-3 --out cli_blowup.csv", out, sizeof out);
+    int rc = run("run --quiet --scenario step --solver krus --dt 8e-3 --out cli_blowup.csv", out, sizeof out);
     CHECK(rc == 1, "exit %d, want 1: %s", rc, out);
     CHECK(strstr(out, "state ") && strstr(out, "t = "), "message should name state and time: %s", out);
     CHECK(strstr(out, "kept in cli_blowup.csv"), "message should say where the rows are: %s", out);

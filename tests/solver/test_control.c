@@ -316,6 +316,77 @@ static void test_wstep_hook(void) {
     }
 }
 
+// hyd_problem.events: a counter that moves takes a new J at that step, as
+// many times as it moves, on both step paths (generic and wstep), and a
+// counter that stands still changes nothing. The switch here is y1 rising
+// through 0.5 and 0.9 (conv_exact's sin t on [0, 1.5]), so the J times are
+// known by hand: age 3 from t = 0, plus the two crossings.
+typedef struct ev_state {
+    ws_state ws;           ///< for the wstep path
+    unsigned long count;
+    int level, calls;
+    double t_switch[4];
+    int nswitch;
+} ev_state;
+
+static unsigned long ev_count(void* user, double t, const double* y) {
+    ev_state* e = user;
+    e->calls++;
+    const int lv = (y[0] >= 0.5) + (y[0] >= 0.9);
+    if (lv != e->level) {
+        e->count++;
+        if (e->nswitch < 4) e->t_switch[e->nswitch++] = t;
+    }
+    e->level = lv;
+    return e->count;
+}
+
+static int ev_wstep(void* user, double t, const double* y, double h, double gamma, int new_jac, double* ynew) {
+    return ws_step(&((ev_state*)user)->ws, t, y, h, gamma, new_jac, ynew);
+}
+
+static void test_events_hook(void) {
+    for (int path = 0; path < 2; ++path) {
+        for (int on = 0; on < 2; ++on) {
+            ev_state e = {0};
+            hyd_problem p = {0};
+            p.n = 3, p.f = conv_f_bounded, p.jac = conv_jac, p.user = &e;
+            if (path) p.wstep = ev_wstep;
+            if (on) p.events = ev_count;
+            hyd_solver_opts o = hyd_default_solver_opts();
+            o.h = 1e-2;
+            o.jac_every = 1000; // J by events alone after the first
+            o.jac_max_age = 0.0;
+            hyd_solver* s = hyd_solver_create(&p, HYD_KRUS, &o);
+            double t = 0.0, y[3];
+            conv_exact(0.0, y);
+            CHECK(hyd_solver_advance(s, &t, y, 1.5) == HYD_OK, "path %d events %d", path, on);
+            const hyd_solver_stats* st = hyd_solver_get_stats(s);
+            // sin t crosses 0.5 near t = 0.524 and 0.9 near t = 1.120.
+            CHECK(st->jevals == (on ? 3 : 1), "path %d events %d: %ld J", path, on, st->jevals);
+            CHECK(st->jevents == (on ? 2 : 0), "path %d events %d: %ld J for events", path, on, st->jevents);
+            if (on) {
+                CHECK(e.nswitch == 2 && fabs(e.t_switch[0] - 0.53) < 0.011 && fabs(e.t_switch[1] - 1.13) < 0.011,
+                      "switches %d at %.3f, %.3f", e.nswitch, e.t_switch[0], e.t_switch[1]);
+                CHECK(e.calls == 150, "%d calls for 150 steps", e.calls);
+                if (path) CHECK(e.ws.new_jacs == 3, "wstep asked for %ld new J", e.ws.new_jacs);
+            }
+            hyd_solver_destroy(s);
+        }
+    }
+    // With a J every step the hook is not consulted.
+    ev_state e = {0};
+    hyd_problem p = {0};
+    p.n = 3, p.f = conv_f_bounded, p.jac = conv_jac, p.user = &e, p.events = ev_count;
+    hyd_solver_opts o = hyd_default_solver_opts();
+    o.h = 1e-2;
+    hyd_solver* s = hyd_solver_create(&p, HYD_KRUS, &o);
+    double t = 0.0, y[3];
+    conv_exact(0.0, y);
+    CHECK(hyd_solver_advance(s, &t, y, 0.1) == HYD_OK && e.calls == 0, "%d calls with jac_every 1", e.calls);
+    hyd_solver_destroy(s);
+}
+
 // y' = rate, with rate an input the solver cannot see. After the input
 // changes, hyd_solver_inputs_changed makes an adaptive method drop its cached
 // f(t, y): every method then integrates the new rate exactly (a constant
@@ -431,6 +502,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_out_states);
     RUN_TEST(test_wfactor_hook);
     RUN_TEST(test_wstep_hook);
+    RUN_TEST(test_events_hook);
     RUN_TEST(test_inputs_changed);
     RUN_TEST(test_nonfinite);
     RUN_TEST(test_reset);
