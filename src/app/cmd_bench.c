@@ -31,6 +31,9 @@ static void bench_help(FILE* f) {
             "  rodas3-1pct  adaptive RODAS3, rtol 1e-2 (the paper's 1 %% tolerance)\n"
             "  rodas3-2e-3  adaptive RODAS3, rtol 2e-3: the loosest tolerance whose max chamber-\n"
             "               pressure error on ramp stays below 1 %% of peak (0.98 %%, cranesim study)\n"
+            "  krus-length  Krus, h = 0.1 ms, the scenario for its duration T and for 4 T (the valves\n"
+            "               closed for the rest): ns per step of each and their ratio, which stays\n"
+            "               near 1 when the cost of a step does not grow with run length\n"
             "  sandbox-ode1ms    ode sandbox (pick and place), ODE step 1 ms, hydraulics Krus 0.1 ms\n"
             "  sandbox-ode0.1ms  the same with ODE step 0.1 ms\n"
             "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
@@ -86,6 +89,43 @@ static sim_opts bench_opts(const sim_opts* common, const bench_cfg* b) {
     return o;
 }
 
+// krus-length: the cost of a step against the length of the run. Spool
+// states used to decay into subnormal numbers some 20 s after their valve
+// closed and stay there, which made every later step 45 % dearer (280 ns
+// per step over 20 s of ramp, 355 over 80 s); hyd_problem.settle now sets
+// them to 0. Returns 0, or -1 after printing an error line.
+static int bench_length(const app_common* c, const model* m, const scenario* sc, int repeat) {
+    const bench_cfg b = {"krus-length", HYD_KRUS, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL};
+    sim_opts o = bench_opts(&c->sim, &b);
+    const double T = c->sim.duration > 0 ? c->sim.duration : sc->duration;
+    double ns[2], t_end[2];
+    long steps[2];
+    for (int k = 0; k < 2; ++k) {
+        o.duration = k ? 4.0 * T : T;
+        double walls[100];
+        sim_result r;
+        // Interleaved would be fairer on a noisy machine, but each length's
+        // runs are short (under a second): medians of back-to-back runs.
+        for (int i = 0; i < repeat; ++i) {
+            sim_run(m, sc, &o, NULL, NULL, NULL, NULL, NULL, &r);
+            walls[i] = r.wall;
+            if (r.status) {
+                printf("{\"config\":\"%s\",\"error\":\"%s\"}\n", b.name, r.message);
+                return -1;
+            }
+        }
+        steps[k] = r.stats.steps;
+        t_end[k] = r.t_end;
+        ns[k] = 1e9 * app_median(walls, repeat) / (double)(r.stats.steps ? r.stats.steps : 1);
+    }
+    printf("{\"config\":\"%s\",\"scenario\":\"%s\",\"solver\":\"krus\",\"h_s\":%g,\"repeat\":%d,"
+           "\"sim_time_short_s\":%.6g,\"steps_short\":%ld,\"ns_per_step_short\":%.1f,"
+           "\"sim_time_long_s\":%.6g,\"steps_long\":%ld,\"ns_per_step_long\":%.1f,\"ratio_long_short\":%.3f}\n",
+           b.name, sc->name, o.h, repeat, t_end[0], steps[0], ns[0], t_end[1], steps[1], ns[1], ns[1] / ns[0]);
+    fflush(stdout);
+    return 0;
+}
+
 int cmd_bench(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     int repeat = 3;
@@ -123,10 +163,14 @@ int cmd_bench(int argc, char** argv) {
         fprintf(stderr, "cranesim bench: unknown option '%s' (see cranesim bench --help)\n", argv[i]);
         return EXIT_USAGE;
     }
-    bool want_drive = nonly == 0;
+    bool want_drive = nonly == 0, want_length = nonly == 0;
     for (int j = 0; j < nonly; ++j) {
         if (!strcmp(only[j], "drive")) {
             want_drive = true;
+            continue;
+        }
+        if (!strcmp(only[j], "krus-length")) {
+            want_length = true;
             continue;
         }
         bool found = false;
@@ -201,6 +245,7 @@ int cmd_bench(int argc, char** argv) {
                r.stats.lus, 1e9 * wall / (double)(r.stats.steps ? r.stats.steps : 1));
         fflush(stdout);
     }
+    if (want_length && bench_length(&c, m, &sc, repeat)) code = EXIT_RUNTIME;
     model_free(m);
     if (want_drive) {
 #ifdef CRANESIM_HAVE_RENDER

@@ -124,6 +124,12 @@ void hyd_fused_jacobian(const hyd_fused* f, const double* y, const double* x, co
                         const double* cmd, double* ydot, double* F, double* J, int ldj,
                         hyd_fused_coupling* cpl);
 
+/// A spool opening that is no opening [-, of full stroke]: 1e-12 (an orifice
+/// area of 1e-12 A_max). A spool lag towards a command of 0 gets there 27.6
+/// time constants after the command (0.83 s at tau = 30 ms); the callers'
+/// hyd_problem.settle then set it to exactly 0.
+#define HYD_SPOOL_SETTLE 1e-12
+
 /// A valve command change between two calls of hyd_fused_events_update that
 /// counts as a command step [-]: 5 % of the full opening (a ramp of the
 /// shipped scenarios moves at most 1e-3 per 1 ms step, their steps 0.6 to

@@ -446,6 +446,7 @@ static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_ne
     s->st.steps++;
     s->j_steps++;
     s->last_h = h;
+    if (s->p->settle) s->p->settle(s->p->user, *t, y);
     return HYD_OK;
 }
 
@@ -696,6 +697,8 @@ static int advance_adaptive(hyd_solver* s, double* t, double* y, double t_end, l
         s->fnew = tmp;
         s->fc_t = t_new;
         s->fc_valid = 1;
+        // A settled state: f there is not the one just computed.
+        if (s->p->settle && s->p->settle(s->p->user, t_new, y)) s->fc_valid = 0;
         *t = t_new;
         s->st.steps++;
         s->j_steps++;

@@ -142,6 +142,9 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt);
 /// corner of its law, a pressure below the bulk modulus' knee changing
 /// octave.
 unsigned long lsim_events(void* user, double t, const double* y);
+/// hyd_problem.settle: a spool within HYD_SPOOL_SETTLE of 0 while its
+/// command is as close to 0 is set to exactly 0.
+int lsim_settle(void* user, double t, double* y);
 /// df/dt: time enters only through the valve commands of the scenario, so
 /// only the spool rows are non-zero: (du_cmd/dt) / tau_s.
 int lsim_dfdt(void* user, double t, const double* y, double* dfdt);
