@@ -134,6 +134,15 @@ const char* app_default_drive_scenario(sim_mechanics mech);
 int cmd_run(int argc, char** argv);
 int cmd_bench(int argc, char** argv);
 int cmd_compare(int argc, char** argv);
+/// compare's reference side (0: A, 1: B): the one run by CVODE, else the one
+/// with the shorter fixed step, else A (the first named).
+int app_compare_reference(const sim_opts* a, const sim_opts* b);
+/// compare's pressure figure: the largest RMS difference [Pa] of the four
+/// chamber pressures over the rows both traces have, the peak chamber
+/// pressure [Pa abs] of the reference trace (side ref), and the RMS as a
+/// percentage of that peak (0 when the peak is not positive).
+void app_compare_pressure(const sim_trace* a, const sim_trace* b, int ref, double* rms_pa, double* peak_pa,
+                          double* pct);
 int cmd_drive(int argc, char** argv);
 int cmd_study(int argc, char** argv);
 
