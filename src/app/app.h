@@ -155,6 +155,14 @@ int cmd_study(int argc, char** argv);
 /// partly written regular file.
 int app_png_render(const char* png, const char* geometry, void (*draw)(void* user), void* user, char* err,
                    size_t errsz);
+/// Axis ticks of the plots (pure; no PLplot): the step, 1, 2 or 5 times a
+/// power of ten, that puts at most max_ticks intervals on [lo, hi] (1 for an
+/// empty or non-finite range); the decimals a label needs at that step; and
+/// the label of tick value v, so that labels one step apart always differ.
+double app_tick_step(double lo, double hi, int max_ticks);
+int app_tick_decimals(double step);
+void app_tick_label(double v, double step, char* buf, size_t n);
+
 /// Plot a run's main time histories to a PNG (PLplot). Returns 0, or -1 with
 /// a message (also when cranesim was built without PLplot).
 int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz);

@@ -32,8 +32,52 @@ static int write_file(const char* path, const void* data, size_t n, char* err, s
     return -1;
 }
 
+// ---------------------------------------------------------- axis ticks --
+//
+// PLplot's own labels print a fixed number of significant digits, so an axis
+// whose range is small against its values repeats them ("3.906 3.906 3.906"
+// for a stroke between 3.9060 and 3.9064 m). The axes here take their tick
+// step from app_tick_step and print each label with as many decimals as the
+// step needs (app_tick_label), so neighbouring labels always differ.
+
+double app_tick_step(double lo, double hi, int max_ticks) {
+    const double span = fabs(hi - lo);
+    if (!(span > 0) || !isfinite(span) || max_ticks < 1) return 1.0;
+    const double raw = span / max_ticks;
+    double p10 = pow(10.0, floor(log10(raw)));
+    static const double lead[4] = {1.0, 2.0, 5.0, 10.0};
+    for (int k = 0; k < 4; ++k)
+        if (lead[k] * p10 >= raw * (1.0 - 1e-12)) return lead[k] * p10;
+    return 10.0 * p10;
+}
+
+int app_tick_decimals(double step) {
+    if (!(step > 0) || !isfinite(step)) return 0;
+    // Steps are 1, 2 or 5 times 10^k: -k decimals, none for k >= 0. The
+    // 1e-9 absorbs the rounding of log10 at exact powers of ten.
+    const int d = (int)ceil(-log10(step) - 1e-9);
+    return d < 0 ? 0 : (d > 15 ? 15 : d);
+}
+
+void app_tick_label(double v, double step, char* buf, size_t n) {
+    const int d = app_tick_decimals(step);
+    // A tick at zero computed as -1e-17 would print "-0.000".
+    if (fabs(v) < 0.5 * step * 1e-6) v = 0.0;
+    snprintf(buf, n, "%.*f", d, v);
+    if (!strncmp(buf, "-0", 2) && strspn(buf + 1, "0.") == strlen(buf + 1)) memmove(buf, buf + 1, strlen(buf));
+}
+
 #ifdef CRANESIM_HAVE_PLPLOT
 #include <plplot.h>
+
+// Major ticks per axis at most: a 700 px wide panel holds about seven labels.
+enum { MAX_TICKS = 6 };
+
+// plslabelfunc callback: data holds the x and y tick steps.
+static void tick_label_cb(PLINT axis, PLFLT value, char* label, PLINT length, PLPointer data) {
+    const double* step = data;
+    app_tick_label(value, axis == PL_Y_AXIS ? step[1] : step[0], label, (size_t)length);
+}
 
 // The memory stream PLplot writes the PNG into.
 typedef struct png_mem {
@@ -138,8 +182,28 @@ static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, c
         xhi += xp;
     }
     plcol0(15);
-    plenv(xlo, xhi, ylo - pad, yhi + pad, 0, 2);
-    pllab(xlabel, ylabel, title);
+    // plenv(..., 0, 2) with our own tick steps and labels: box, ticks,
+    // grid and zero axes, custom labels ("o").
+    static double step[2];
+    step[0] = app_tick_step(xlo, xhi, MAX_TICKS);
+    step[1] = app_tick_step(ylo - pad, yhi + pad, MAX_TICKS);
+    pladv(0);
+    plvsta();
+    plwind(xlo, xhi, ylo - pad, yhi + pad);
+    plslabelfunc(tick_label_cb, step);
+    plbox("abcgnsto", step[0], 0, "abcgnstvo", step[1], 0);
+    plslabelfunc(NULL, NULL);
+    pllab(xlabel, "", title);
+    // The y title clear of the widest tick label: pllab's offset, 5
+    // character heights, is too little for labels of 7 or more characters
+    // ("-0.4570"; a digit is about 0.75 of the character height wide here).
+    int wide = 0;
+    for (double v = ceil((ylo - pad) / step[1]) * step[1]; v <= yhi + pad; v += step[1]) {
+        char lb[64];
+        app_tick_label(v, step[1], lb, sizeof lb);
+        if ((int)strlen(lb) > wide) wide = (int)strlen(lb);
+    }
+    plmtex("l", fmax(5.0, 1.5 + 0.75 * wide), 0.5, 0.5, ylabel);
     static const int colours[] = {1, 3, 9, 8, 12, 13};
     for (int t = 0; t < 2; ++t) {
         if (!trs[t]) continue;
