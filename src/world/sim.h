@@ -45,6 +45,12 @@ typedef struct sim_opts {
 /// an open-ended run, only the stability test). Returns 0, or 2 with one
 /// line in err. Adaptive solvers and CVODE always pass.
 int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, char* err, size_t errsz);
+/// The advice of a numerical blow-up: a pressure state with value [Pa abs]
+/// found implausible at time t [s] of a run with an adaptive (or CVODE) or a
+/// fixed-step solver. "Try a smaller --dt" only where a shorter step is the
+/// likely cure: a fixed step, after steps were taken (t > 0), from a finite
+/// value; a smaller --rtol for adaptive runs; else a check of the model.
+const char* sim_blowup_hint(bool adaptive, double t, double value);
 
 /// True when this build has the CVODE reference solver.
 bool sim_have_cvode(void);
