@@ -91,9 +91,10 @@ static sim_opts bench_opts(const sim_opts* common, const bench_cfg* b) {
 
 // krus-length: the cost of a step against the length of the run. Spool
 // states used to decay into subnormal numbers some 20 s after their valve
-// closed and stay there, which made every later step 45 % dearer (280 ns
-// per step over 20 s of ramp, 355 over 80 s); hyd_problem.settle now sets
-// them to 0. Returns 0, or -1 after printing an error line.
+// closed and stay there, which made every later step dearer (issue 13: 280
+// ns per step over 20 s of ramp, 355 over 80 s; on this machine 384 against
+// 867); hyd_problem.settle now sets them to 0. Returns 0, or -1 after
+// printing an error line.
 static int bench_length(const app_common* c, const model* m, const scenario* sc, int repeat) {
     const bench_cfg b = {"krus-length", HYD_KRUS, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL};
     sim_opts o = bench_opts(&c->sim, &b);
