@@ -255,7 +255,7 @@ int cmd_study(int argc, char** argv) {
     int n = 0;
     const double hs[] = {1e-4, 2e-4, 5e-4, 1e-3};
     // 2e-3: the loosest tolerance at which RODAS3 keeps the ramp's chamber
-    // pressures within 1 % of peak (the SPEC's "1 % pressure accuracy").
+    // pressures within 1 % of peak (the "1 % pressure accuracy" of docs/solver_study.md).
     const double tols_all[] = {1e-2, 2e-3, 1e-3, 1e-4, 1e-5}, tols_quick[] = {1e-2, 1e-3};
     const double* tols = quick ? tols_quick : tols_all;
     const int nh = quick ? 2 : 4, nt = quick ? 2 : 5;

@@ -1,6 +1,6 @@
 // fluid.c: fluid properties and the effective bulk modulus Be(p).
 //
-// Be(p) follows the entrained-air law of SPEC 3.2, written in absolute
+// Be(p) follows the entrained-air law of docs/hydraulics.md, written in absolute
 // pressure P = p_a + p_gauge:
 //   r(P)  = (p_a / P)^(1/n)                  (free-air volume per unit air at p_a)
 //   Be(P) = Be_l (1 + alpha r) / (1 + alpha Be_l r / (n P))

@@ -1,4 +1,4 @@
-// krus.c: the 2-stage linearly implicit W-method of SPEC 3.3,
+// krus.c: the 2-stage linearly implicit W-method of docs/solvers.md,
 //   W k1 = h f(t, y)
 //   W k2 = h f(t + h, y + k1) + g21 h J k1
 //   y_new = y + (k1 + k2) / 2,            W = I - gamma h J,  g21 = -2 gamma

@@ -1,6 +1,6 @@
 // orifice.c: two-regime (laminar/turbulent) orifice, after Ellman and Piche.
 //
-// With K = cd A sqrt(2/rho) and x = dp / p_tr (our reading, SPEC 3.2):
+// With K = cd A sqrt(2/rho) and x = dp / p_tr (our reading; docs/hydraulics.md):
 //   |x| <  1:  Q = K sqrt(p_tr) x (5 - x^2) / 4
 //   |x| >= 1:  Q = K sign(dp) sqrt(|dp|)
 // equal in value and slope at |dp| = p_tr. p_tr = (rho/2)(Re_tr nu/(cd D_h))^2

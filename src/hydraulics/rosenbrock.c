@@ -1,8 +1,8 @@
-// rosenbrock.c: the adaptive 4-stage linearly implicit methods of SPEC 3.3,
+// rosenbrock.c: the adaptive 4-stage linearly implicit methods of docs/solvers.md,
 // ROS34PW2 (Rang & Angermann 2005, a W-method) and RODAS3 (Sandu et al. 1997,
 // stiffly accurate), both order 3 with an embedded order-2 solution.
 //
-// Original form, as in the SPEC:
+// Original form, as in the sources below:
 //   W k_i = h f(t + c_i h, y + sum_j a_ij k_j) + h J sum_j g_ij k_j + gs_i h^2 df/dt
 // with W = I - gamma h J. The products h J k_j are not formed: stage j's own
 // equation gives h J k_j = (k_j - r_j) / gamma, where r_j is its right-hand
@@ -34,7 +34,7 @@ static hyd_tableau make_tableau(int needs_dfdt, double gamma, const double a[4][
     return t;
 }
 
-// Coefficients exactly as printed in SPEC 3.3 (Rang & Angermann 2005, table
+// Coefficients exactly as published (Rang & Angermann 2005, table
 // "ROS34PW2"). Copied into each solver at create: no shared mutable state.
 static hyd_tableau ros34pw2(void) {
     static const double a[4][4] = {
@@ -56,7 +56,7 @@ static hyd_tableau ros34pw2(void) {
     return make_tableau(0, 0.43586652150845900, a, g, b, bh);
 }
 
-// RODAS3 (Sandu et al. 1997), as in SPEC 3.3. Not a W-method: it keeps order 3
+// RODAS3 (Sandu et al. 1997). Not a W-method: it keeps order 3
 // only with the exact J and the df/dt term.
 static hyd_tableau rodas3(void) {
     static const double a[4][4] = {

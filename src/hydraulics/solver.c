@@ -50,7 +50,7 @@ hyd_solver_opts hyd_default_solver_opts(void) {
     o.h_min = 1e-12;      // [s]
     o.h_max = HUGE_VAL;   // no cap; <= 0 also means no cap
     o.jac_every = 1;
-    o.jac_max_age = 0.01; // SPEC 3.3: older J diverged at larger h [s]; <= 0: no limit
+    o.jac_max_age = 0.01; // older J diverged at larger h [s]; <= 0: no limit
     o.max_steps = 100000000;
     o.h_hold = 0.0;       // no step hysteresis
     o.out_states = NULL;  // interpolate every state at output times

@@ -1,4 +1,4 @@
-// lagrange.h: the analytic 2-DOF crane (SPEC section 3.1, paper Eqs. 1-4).
+// lagrange.h: the analytic 2-DOF crane (paper Eqs. 1-4; derivation in docs/lagrange.md).
 //
 // H(q) q'' + C(q, q') + G(q) = tau, q1 from the downward vertical, q2 relative
 // to the lifting arm. Derivation in docs/lagrange.md.

@@ -1,11 +1,11 @@
 // lsim_krus.c: the split Krus / ROS2 step for the crane (hyd_problem.wstep).
 //
-// The same W-method as krus.c (SPEC 3.3),
+// The same W-method as krus.c (docs/solvers.md),
 //   W k1 = h f(t, y),  W k2 = h f(t + h, y + k1) - 2 (k1 - h f(t, y)),
 //   y_new = y + (k1 + k2) / 2,  W = I - gamma h J,
 // with the same block-diagonal J (spool, [hose, chamber] x 2 per actuator,
 // pump line, [q1, q2, q1', q2']), but with the mechanics evaluated once per
-// step, as SPEC section 7 asks for the 1000x target:
+// step, where most of a step's time went:
 //
 // - At the predicted midpoint q_m = q_n + (h/2) q'_n the kernel takes the
 //   sines and cosines (rotated on from the previous midpoint, see

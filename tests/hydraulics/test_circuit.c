@@ -568,7 +568,7 @@ static void test_fastest_rate(void) {
     CHECK_REL(hyd_model_fastest_rate(m, pT, 0.0), expect, 1e-3);
     hyd_model_free(m);
     // The crane: the hose/chamber pairs are its fastest modes, 1e4..1e5 1/s
-    // (SPEC 3.2: a calibration prototype found 4e4..9e4).
+    // (docs/hydraulics.md: a calibration prototype found 4e4..9e4).
     hyd_model* c = hyd_model_default_crane(err, sizeof err);
     if (!c) return;
     const double r = hyd_model_fastest_rate(c, 10e6, 0.0);

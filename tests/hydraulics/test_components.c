@@ -10,7 +10,7 @@
 
 static const double PI = 3.14159265358979323846;
 
-// p_tr straight from the SPEC formula, independent of orifice.c.
+// p_tr straight from the docs/hydraulics.md formula, independent of orifice.c.
 static double spec_p_tr(const hyd_fluid_def* f, double cd, double A) {
     const double Dh = sqrt(4.0 * A / PI);
     const double a = f->re_transition * f->viscosity / (cd * Dh);
@@ -68,7 +68,7 @@ static void test_orifice_limits(void) {
     CHECK(fabs(g0A) < 1e-3 * K / A * sqrt(1e5), "dQ/dA near A=0: %g", g0A);
 }
 
-// Be(p) as printed in SPEC 3.2 (gauge pressure pg).
+// Be(p) as printed in docs/hydraulics.md (gauge pressure pg).
 static double spec_be(const hyd_fluid_def* f, double bel, double pg) {
     const double n = f->polytropic_index, pa = f->p_atm, a = f->air_fraction;
     return bel * (1 + a * pow(pa / (pa + pg), 1 / n)) /

@@ -1,6 +1,6 @@
 // test_crane.c: the analytic crane with its full circuit, against physics:
 // Jacobian vs finite differences, static equilibrium, flow continuity,
-// pump-limited speed, the SPEC section 4 sanity targets, variants, scenarios.
+// pump-limited speed, the docs/model.md sanity targets, variants, scenarios.
 #include "check.h"
 #include "sim.h"
 
@@ -195,7 +195,7 @@ static void test_steady_speed_is_valve_flow_over_area(void) {
     model_free(m);
 }
 
-// SPEC section 4: with the default load, static holding pressures stay well
+// docs/model.md: with the default load, static holding pressures stay well
 // below the reliefs over the whole workspace, and 2000 kg can be held close in.
 static double holding_pressure(const model* m, double m3, double q1, double q2, int k) {
     const double q[2] = {q1, q2};

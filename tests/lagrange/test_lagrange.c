@@ -28,7 +28,7 @@ static int free_rhs(void* user, double t, const double* y, double* f) {
     return 0;
 }
 
-// Energy is conserved with tau = 0 in the full model (SPEC section 3.1). The
+// Energy is conserved with tau = 0 in the full model (docs/lagrange.md). The
 // crane swings through large angles (a double pendulum), so this exercises
 // the Coriolis terms: drop them and the drift is of order 1.
 static void test_energy_conservation(void) {
@@ -102,7 +102,7 @@ static void test_mass_matrix_from_kinetic_energy(void) {
     }
 }
 
-// The variants differ exactly by the terms the paper drops (SPEC 3.1).
+// The variants differ exactly by the terms the paper drops (docs/lagrange.md).
 static void test_variants_differ_by_dropped_terms(void) {
     crane_mech m = crane_default_mech();
     const double m3 = 500, g = m.gravity;
@@ -167,7 +167,7 @@ static void test_cylinder_kinematics(void) {
             if (st >= 0 && st <= 0.6) CHECK_NEAR(crane_joint_for_stroke(a, st), q, 1e-9);
         }
     }
-    // Default mounts: strokes cover the joint ranges of SPEC section 4.
+    // Default mounts: strokes cover the joint ranges of docs/model.md.
     CHECK_NEAR(crane_stroke(&m.act[0], 70 * M_PI / 180), 0.0, 2e-3);
     CHECK_NEAR(crane_stroke(&m.act[0], 160 * M_PI / 180), 0.7, 2e-3);
     CHECK_NEAR(crane_stroke(&m.act[1], -135 * M_PI / 180), 0.0, 2e-3);

@@ -2,7 +2,7 @@
 // evaluates the mechanics once per step, against
 // - an independent reference (CVODE at rtol 1e-10, else the generic RODAS3 at
 //   rtol 1e-9 on the exact f): the error falls by about 4 when h is halved
-//   (order 2, SPEC 3.3);
+//   (order 2, docs/solvers.md);
 // - the generic stage arithmetic with f in full at every stage (krus.c through
 //   the solver, sim_opts.whole_step): the two differ by far less than either
 //   differs from the reference.

@@ -1,5 +1,5 @@
 // bench_solver.c: per-step cost of Krus at h = 0.1 ms on a 15-state problem
-// shaped like the crane (SPEC 3.2/3.3): two actuators with spool, hose and
+// shaped like the crane (docs/hydraulics.md, docs/solvers.md): two actuators with spool, hose and
 // chamber pressures, a pump line, and two joints. Not a test (tests never time
 // anything); run by hand:  ./bench_solver [seconds_simulated]
 // Prints ns per step for each Jacobian strategy.

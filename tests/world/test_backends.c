@@ -1,5 +1,5 @@
 // test_backends.c: the ode validation world against lagrange `full` on the
-// ramp scenario (issue 4 / SPEC section 7): the two backends integrate the same
+// ramp scenario (issue 4; docs/performance.md): the two backends integrate the same
 // physics by different means (Lagrange's equations vs constrained rigid
 // bodies), so their agreement checks both.
 #include "check.h"

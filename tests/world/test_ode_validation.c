@@ -1,5 +1,5 @@
 // test_ode_validation.c: the ODE validation world against the analytic
-// mechanics of SPEC section 3.1 (equations written out here, independently of
+// mechanics of docs/lagrange.md (equations written out here, independently of
 // the ODE code): angle conventions, static equilibrium under the analytic
 // holding torque G(q), free motion against H q'' + C + G = 0, energy
 // conservation, and a hydraulic hold.
@@ -31,7 +31,7 @@ static ode_world* make(const model* m, const ode_world_opts* o) {
     return w;
 }
 
-// SPEC 3.1 terms for links with inertia and a tip point mass m3.
+// docs/lagrange.md terms for links with inertia and a tip point mass m3.
 typedef struct terms {
     double H[2][2], C[2], G[2];
 } terms;
@@ -157,7 +157,7 @@ static void test_equilibrium(void) {
     model_free(m);
 }
 
-// Free motion (tau = 0) from rest against the SPEC equations integrated with
+// Free motion (tau = 0) from rest against the docs/lagrange.md equations integrated with
 // RK4 at a fine step: the ODE bodies are the same mechanical system.
 static void test_free_motion_matches_spec(void) {
     model* m = load_model();
