@@ -279,7 +279,14 @@ hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz) {
     }
     char* text = NULL;
     long n = -1;
-    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0) {
+    // The same limit as the model loader (json_util.h, JSON_MAX_FILE_BYTES):
+    // parsing costs about 20 bytes of memory per byte of text.
+    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && n > (1L << 20)) {
+        fclose(fp);
+        jerr(&c, "", "too large (%ld bytes; input files are limited to %ld bytes)", n, 1L << 20);
+        return NULL;
+    }
+    if (n >= 0 && fseek(fp, 0, SEEK_SET) == 0) {
         text = malloc((size_t)n + 1);
         if (text && fread(text, 1, (size_t)n, fp) != (size_t)n) {
             free(text);

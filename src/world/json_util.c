@@ -80,24 +80,77 @@ static int check_numbers(const char* text, const char* path, char* err, size_t e
     return 0;
 }
 
+// One member of an object, for the duplicate search: its key and its place.
+typedef struct key_pos {
+    const char* key;
+    int pos;
+} key_pos;
+
+static int cmp_key_pos(const void* a, const void* b) {
+    const key_pos *x = a, *y = b;
+    int d = strcmp(x->key, y->key);
+    return d ? d : (x->pos > y->pos) - (x->pos < y->pos);
+}
+
+// The key of node's first member (in document order) that is given again
+// later in the same object, or NULL. Sorting the keys makes this O(n log n):
+// the pairwise scan it replaces took 17 minutes on an object of 800,000 keys.
+// Small objects (every object of a shipped file) keep the pairwise scan,
+// which needs no allocation. Sets *oom when the sort buffer cannot be had.
+static const char* first_duplicate(const cJSON* node, bool* oom) {
+    int n = 0;
+    for (const cJSON* it = node->child; it; it = it->next) ++n;
+    if (n <= 16) {
+        for (const cJSON* it = node->child; it; it = it->next)
+            for (const cJSON* later = it->next; later; later = later->next)
+                if (it->string && later->string && !strcmp(it->string, later->string)) return it->string;
+        return NULL;
+    }
+    key_pos* k = malloc((size_t)n * sizeof *k);
+    if (!k) {
+        *oom = true;
+        return NULL;
+    }
+    int m = 0, i = 0;
+    for (const cJSON* it = node->child; it; it = it->next, ++i)
+        if (it->string) k[m++] = (key_pos){it->string, i};
+    qsort(k, (size_t)m, sizeof *k, cmp_key_pos);
+    // Equal keys are now adjacent, each run in document order: the run whose
+    // first member comes earliest is the one the pairwise scan would report.
+    const char* dup = NULL;
+    int dup_pos = n;
+    for (int j = 1; j < m; ++j)
+        if (!strcmp(k[j - 1].key, k[j].key) && (j == 1 || strcmp(k[j - 2].key, k[j].key)) && k[j - 1].pos < dup_pos) {
+            dup = k[j - 1].key;
+            dup_pos = k[j - 1].pos;
+        }
+    free(k);
+    return dup;
+}
+
 // Reject an object member given twice: cJSON keeps both and every lookup
 // finds the first, so the second would be silently ignored.
 static int check_duplicates(const cJSON* node, const char* at, const char* path, char* err, size_t errsz) {
+    char p[256];
+    if (cJSON_IsObject(node)) {
+        bool oom = false;
+        const char* dup = first_duplicate(node, &oom);
+        if (oom) {
+            snprintf(err, errsz, "%s: out of memory", path);
+            return -1;
+        }
+        if (dup) {
+            json_path(p, sizeof p, at, dup);
+            snprintf(err, errsz, "%s: %s: given twice (duplicate field)", path, p);
+            return -1;
+        }
+    }
     int i = 0;
     for (const cJSON* it = node ? node->child : NULL; it; it = it->next, ++i) {
-        char p[256];
-        if (cJSON_IsObject(node)) {
-            for (const cJSON* later = it->next; later; later = later->next)
-                if (it->string && later->string && !strcmp(it->string, later->string)) {
-                    json_path(p, sizeof p, at, it->string);
-                    snprintf(err, errsz, "%s: %s: given twice (duplicate field)", path, p);
-                    return -1;
-                }
-            json_path(p, sizeof p, at, it->string ? it->string : "?");
-        } else {
-            json_path_index(p, sizeof p, at, i);
-        }
-        if ((cJSON_IsObject(it) || cJSON_IsArray(it)) && check_duplicates(it, p, path, err, errsz)) return -1;
+        if (!cJSON_IsObject(it) && !cJSON_IsArray(it)) continue;
+        if (cJSON_IsObject(node)) json_path(p, sizeof p, at, it->string ? it->string : "?");
+        else json_path_index(p, sizeof p, at, i);
+        if (check_duplicates(it, p, path, err, errsz)) return -1;
     }
     return 0;
 }
@@ -108,6 +161,13 @@ cJSON* json_load_file(const char* path, char* err, size_t errsz) {
         snprintf(err, errsz, "%s: not a regular file", path);
         return NULL;
     }
+    // Refused before reading: parsing costs about 20 bytes of memory per
+    // byte of text (a 59 MB scenario took 1.2 GB before it was refused).
+    if (stat(path, &st) == 0 && st.st_size > JSON_MAX_FILE_BYTES) {
+        snprintf(err, errsz, "%s: too large (%lld bytes; input files are limited to %ld bytes, docs/files.md)", path,
+                 (long long)st.st_size, (long)JSON_MAX_FILE_BYTES);
+        return NULL;
+    }
     FILE* f = fopen(path, "rb");
     if (!f) {
         snprintf(err, errsz, "%s: cannot open: %s", path, strerror(errno));
@@ -116,7 +176,7 @@ cJSON* json_load_file(const char* path, char* err, size_t errsz) {
     fseek(f, 0, SEEK_END);
     long n = ftell(f);
     fseek(f, 0, SEEK_SET);
-    if (n < 0 || n > (64L << 20)) {
+    if (n < 0 || n > JSON_MAX_FILE_BYTES) {
         fclose(f);
         snprintf(err, errsz, "%s: cannot read (size %ld bytes)", path, n);
         return NULL;
@@ -130,22 +190,27 @@ cJSON* json_load_file(const char* path, char* err, size_t errsz) {
     size_t got = fread(buf, 1, (size_t)n, f);
     fclose(f);
     buf[got] = 0;
+    cJSON* root = json_parse(buf, path, err, errsz);
+    free(buf);
+    return root;
+}
+
+cJSON* json_parse(const char* text, const char* name, char* err, size_t errsz) {
     const char* end = NULL;
-    cJSON* root = cJSON_ParseWithOpts(buf, &end, 1);
+    cJSON* root = cJSON_ParseWithOpts(text, &end, 1);
     if (!root) {
         // Report line and column of the parse failure: the one thing a user
         // needs to find a missing comma.
         const char* at = end ? end : cJSON_GetErrorPtr();
         int line = 1, col = 1;
-        for (const char* p = buf; at && p < at && *p; ++p) {
+        for (const char* p = text; at && p < at && *p; ++p) {
             if (*p == '\n') { ++line; col = 1; } else ++col;
         }
-        snprintf(err, errsz, "%s: line %d, column %d: invalid JSON", path, line, col);
-    } else if (check_numbers(buf, path, err, errsz) || check_duplicates(root, "", path, err, errsz)) {
+        snprintf(err, errsz, "%s: line %d, column %d: invalid JSON", name, line, col);
+    } else if (check_numbers(text, name, err, errsz) || check_duplicates(root, "", name, err, errsz)) {
         cJSON_Delete(root);
         root = NULL;
     }
-    free(buf);
     return root;
 }
 
@@ -229,7 +294,9 @@ int json_int(json_ctx* c, const cJSON* obj, const char* path, const char* key, b
     json_path(full, sizeof full, path, key);
     double x = json_num(c, obj, path, key, required, def, lo, hi);
     if (!c->failed && x != floor(x)) json_fail(c, full, "must be a whole number, got %g", x);
-    return (int)x;
+    // Converted only once it is known to fit: (int)2e67 is undefined
+    // behaviour (it gave INT_MIN here), so a failed field yields def.
+    return c->failed ? def : (int)x;
 }
 
 bool json_bool(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool def) {

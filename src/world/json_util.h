@@ -26,10 +26,18 @@ typedef struct json_ctx {
 void json_fail(json_ctx* c, const char* path, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-/// Read and parse a whole file. NULL with "file: line L, column C: message" on
+/// Largest input file accepted [bytes]: 1 MiB, over 100 times the largest
+/// shipped file (sandbox.json, 7.7 kB). Checked before reading.
+#define JSON_MAX_FILE_BYTES (1L << 20)
+
+/// Read and parse a whole file. A file over JSON_MAX_FILE_BYTES is refused
+/// before it is read: "file: too large (N bytes; ...)". NULL with "file: line L, column C: message" on
 /// a syntax error, also for a number JSON does not allow (00.1, 1.), and
 /// "file: field.path: given twice (duplicate field)" for a repeated member.
 cJSON* json_load_file(const char* path, char* err, size_t errsz);
+
+/// The checks of json_load_file on a text in memory (name is used in messages).
+cJSON* json_parse(const char* text, const char* name, char* err, size_t errsz);
 
 /// Join a parent path and a key ("a.b" + "c" -> "a.b.c"; "" + "c" -> "c").
 void json_path(char* out, size_t n, const char* parent, const char* key);

@@ -178,9 +178,10 @@ static void load_terrain(json_ctx* c, const cJSON* o, world_terrain* t) {
         double s[2];
         json_vec(c, o, "terrain", "samples", true, s, 2);
         for (int i = 0; i < 2 && !c->failed; ++i) {
+            // Range first, then the conversion: (int)1e300 is undefined.
             if (s[i] != floor(s[i]) || s[i] < 2 || s[i] > 1024)
                 json_fail(c, "terrain.samples", "must be whole numbers in [2, 1024], got %g", s[i]);
-            t->samples[i] = (int)s[i];
+            else t->samples[i] = (int)s[i];
         }
     }
     t->flat_radius = json_num(c, o, "terrain", "flat_radius", false, t->flat_radius, 0, 1e4);
