@@ -218,6 +218,73 @@ static int read_list(const jctx* c, hyd_builder* b, const cJSON* root, const cha
     return 0;
 }
 
+// ---------------------------------------------------------------------------
+// Notes
+// ---------------------------------------------------------------------------
+
+static hyd_note_fn note_fn = NULL;
+static void* note_user = NULL;
+
+void hyd_set_note_handler(hyd_note_fn fn, void* user) {
+    note_fn = fn;
+    note_user = user;
+}
+
+// Lines already printed by the default handler, so a model loaded three
+// times in one run notes each value once. A fixed table: beyond it notes
+// repeat rather than being lost.
+#define NOTE_SEEN 64
+static char* note_seen[NOTE_SEEN];
+static int note_nseen;
+
+void hyd_note(const char* line) {
+    if (note_fn) {
+        note_fn(line, note_user);
+        return;
+    }
+    for (int i = 0; i < note_nseen; ++i)
+        if (!strcmp(note_seen[i], line))
+            return;
+    if (note_nseen < NOTE_SEEN) {
+        size_t n = strlen(line) + 1;
+        char* c = malloc(n);
+        if (c) {
+            memcpy(c, line, n);
+            note_seen[note_nseen++] = c;
+        }
+    }
+    fprintf(stderr, "note: %s\n", line);
+}
+
+// A note per parameter outside its typical range: "file: path.field: v is
+// outside the typical range [lo, hi] unit".
+static void note_params(const jctx* c, const char* path, const void* def, const hyd_param_info* p,
+                        int np) {
+    for (int k = 0; k < np; ++k) {
+        char msg[200], line[400];
+        if (!hyd_param_typical(&p[k], *(const double*)((const char*)def + p[k].off), msg, sizeof msg))
+            continue;
+        const int pre = c->prefix && c->prefix[0];
+        snprintf(line, sizeof line, "%s: %s%s%s.%s: %s", c->file ? c->file : "<json>",
+                 pre ? c->prefix : "", pre ? "." : "", path, p[k].name, msg);
+        hyd_note(line);
+    }
+}
+
+static void note_model(const jctx* c, const hyd_model* m) {
+    int np;
+    const hyd_param_info* p = hyd_fluid_params(&np);
+    note_params(c, "fluid", &m->fluid, p, np);
+    for (int i = 0; i < m->nunode + m->ncomp; ++i) {
+        const hyd_elem* e = i < m->nunode ? &m->unode[i] : &m->comp[i - m->nunode];
+        char path[64];
+        snprintf(path, sizeof path, "%s[%d]", i < m->nunode ? "nodes" : "components",
+                 i < m->nunode ? i : i - m->nunode);
+        p = hyd_params_of(e->type, &np);
+        note_params(c, path, &e->def, p, np);
+    }
+}
+
 hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const char* prefix,
                                char* err, size_t errsz) {
     jctx c = {file, prefix ? prefix : "", err, errsz};
@@ -264,6 +331,8 @@ hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const cha
         else
             path[0] = 0;
         jerr(&c, path, "%s", e.msg);
+    } else {
+        note_model(&c, m);
     }
 done:
     hyd_builder_free(b);

@@ -1,6 +1,8 @@
 // json_util.c: see json_util.h.
 #include "json_util.h"
 
+#include "hydraulics.h"
+
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -273,10 +275,80 @@ double json_num(json_ctx* c, const cJSON* obj, const char* path, const char* key
         return def;
     }
     double x = v->valuedouble;
-    if (!isfinite(x)) json_fail(c, full, "must be finite");
+    if (!isfinite(x)) json_fail(c, full, "must be a finite number");
     else if (x < lo) json_fail(c, full, "must be >= %g, got %g", lo, x);
     else if (x > hi) json_fail(c, full, "must be <= %g, got %g", hi, x);
     return x;
+}
+
+void json_note(json_ctx* c, const char* path, const char* fmt, ...) {
+    if (c->nnotes >= JSON_MAX_NOTES) return;
+    char* out = c->notes[c->nnotes++];
+    const size_t n = sizeof c->notes[0];
+    int k = snprintf(out, n, "%s: %s: ", c->file ? c->file : "(input)", path && *path ? path : "(top level)");
+    if (k < 0 || (size_t)k >= n) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(out + k, n - (size_t)k, fmt, ap);
+    va_end(ap);
+}
+
+void json_flush_notes(json_ctx* c) {
+    if (!c->failed)
+        for (int i = 0; i < c->nnotes; ++i) hyd_note(c->notes[i]);
+    c->nnotes = 0;
+}
+
+// "[lo, hi] unit" as a user writes it ("[1, 1e5] kg").
+static void range_text(char* out, size_t n, double lo, double hi, const char* unit) {
+    char a[24], b[24];
+    hyd_fmt_num(a, sizeof a, lo);
+    hyd_fmt_num(b, sizeof b, hi);
+    snprintf(out, n, "[%s, %s]%s%s", a, b, unit && *unit ? " " : "", unit ? unit : "");
+}
+
+void json_range_check(json_ctx* c, const char* full, double v, const json_range* r) {
+    if (c->failed) return;
+    char got[24], rng[80];
+    hyd_fmt_num(got, sizeof got, v);
+    if (!isfinite(v)) {
+        json_fail(c, full, "must be a finite number");
+    } else if (r->lo > 0 && !(v > 0)) {
+        json_fail(c, full, "must be > 0, got %s", got);
+    } else if (v < r->lo || v > r->hi) {
+        range_text(rng, sizeof rng, r->lo, r->hi, r->unit);
+        json_fail(c, full, "must be in %s, got %s", rng, got);
+    } else if (v < r->tlo || v > r->thi) {
+        range_text(rng, sizeof rng, r->tlo, r->thi, r->unit);
+        json_note(c, full, "%s%s%s is outside the typical range %s", got, r->unit && *r->unit ? " " : "",
+                  r->unit ? r->unit : "", rng);
+    }
+}
+
+double json_num_r(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                  double def, const json_range* r) {
+    char full[256];
+    const cJSON* v = member(c, obj, path, key, required, full, sizeof full);
+    if (!v) return def;
+    if (!cJSON_IsNumber(v)) {
+        json_fail(c, full, "must be a number, got %s", type_name(v));
+        return def;
+    }
+    json_range_check(c, full, v->valuedouble, r);
+    return v->valuedouble;
+}
+
+void json_vec_r(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                double* out, int n, const json_range* r) {
+    char full[256];
+    json_path(full, sizeof full, path, key);
+    if (!required && !cJSON_GetObjectItemCaseSensitive(obj, key)) return;
+    json_vec(c, obj, path, key, required, out, n);
+    for (int i = 0; i < n && !c->failed; ++i) {
+        char p[272];
+        json_path_index(p, sizeof p, full, i);
+        json_range_check(c, p, out[i], r);
+    }
 }
 
 double json_pos(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
@@ -340,7 +412,8 @@ void json_vec(json_ctx* c, const cJSON* obj, const char* path, const char* key, 
         if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) {
             char p[272];
             json_path_index(p, sizeof p, full, i);
-            json_fail(c, p, "must be a finite number, got %s", type_name(e));
+            if (cJSON_IsNumber(e)) json_fail(c, p, "must be a finite number");
+            else json_fail(c, p, "must be a finite number, got %s", type_name(e));
             return;
         }
         out[i] = e->valuedouble;

@@ -15,11 +15,15 @@
 extern "C" {
 #endif
 
+#define JSON_MAX_NOTES 8
+
 typedef struct json_ctx {
     const char* file; ///< file name used in messages
     char* err;        ///< caller's buffer for the first error
     size_t errsz;
     bool failed;
+    int nnotes; ///< queued notes (json_note), sent by json_flush_notes
+    char notes[JSON_MAX_NOTES][200];
 } json_ctx;
 
 /// Record an error "file: path: message" (printf-style message). First one wins.
@@ -54,6 +58,32 @@ const cJSON* json_arr(json_ctx* c, const cJSON* obj, const char* path, const cha
 /// Absent and not required: returns def.
 double json_num(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
                 double def, double lo, double hi);
+/// Physically meaningful range of a value. Outside [lo, hi] (hard) the file
+/// is refused: "must be in [1, 1e5] kg, got 1e-300" ("must be > 0, got -3"
+/// for a non-positive value when lo > 0). Outside [tlo, thi] (typical) the
+/// load goes on with a note: "note: file: path: 6000 kg is outside the
+/// typical range [20, 5000] kg". unit is printed after the range ("" for none).
+typedef struct json_range {
+    double lo, hi;
+    double tlo, thi;
+    const char* unit;
+} json_range;
+
+/// Number checked against a json_range (notes are queued in the context and
+/// sent by json_flush_notes).
+double json_num_r(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                  double def, const json_range* r);
+/// Fixed-length number array, every element checked against r.
+void json_vec_r(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                double* out, int n, const json_range* r);
+/// Check a value already read (full: its whole path) against r.
+void json_range_check(json_ctx* c, const char* full, double v, const json_range* r);
+/// Queue a note "file: path: message" (at most JSON_MAX_NOTES per load).
+void json_note(json_ctx* c, const char* path, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+/// Send the queued notes (hyd_note: stderr by default) if the load succeeded;
+/// a refused file gets its error line only.
+void json_flush_notes(json_ctx* c);
+
 /// Number that must be > 0.
 double json_pos(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
                 double def);
