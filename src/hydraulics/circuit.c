@@ -172,25 +172,38 @@ const char* hyd_param_unit(hyd_type t, int k) {
     return (k >= 0 && k < n) ? p[k].unit : NULL;
 }
 
-// A number for a message, as a user would write it: 22, 0.005, 1e5, 2.5e9,
-// 1.01325e5 (%g would give 100000 and 2.5e+09). Six significant digits.
+// A number for a message, as a user would write it: 22, 0.005, 6000, 86400,
+// 1e5, 2.5e9, 101325 (%g would give 100000 and 2.5e+09): six significant
+// digits, in exponent form when that is at least two characters shorter.
 void hyd_fmt_num(char* out, size_t n, double v) {
     const double a = fabs(v);
-    if (!isfinite(v) || a == 0.0 || (a >= 1e-3 && a < 1e4)) {
+    if (!isfinite(v) || a == 0.0) {
         snprintf(out, n, "%g", v);
         return;
     }
-    char t[40];
-    snprintf(t, sizeof t, "%.5e", v); // d.ddddde[+-]XX
-    char* e = strchr(t, 'e');
+    char ex[40], pl[400];
+    snprintf(ex, sizeof ex, "%.5e", v); // d.ddddde[+-]XX, trimmed below
+    char* e = strchr(ex, 'e');
     char* m = e;
-    while (m > t && m[-1] == '0') --m;
-    if (m > t && m[-1] == '.') --m;
+    while (m > ex && m[-1] == '0') --m;
+    if (m > ex && m[-1] == '.') --m;
     const char* q = e + 1;
     const int neg = *q == '-';
     if (*q == '+' || *q == '-') ++q;
     while (*q == '0' && q[1]) ++q;
-    snprintf(out, n, "%.*se%s%s", (int)(m - t), t, neg ? "-" : "", q);
+    char exp_form[40];
+    snprintf(exp_form, sizeof exp_form, "%.*se%s%s", (int)(m - ex), ex, neg ? "-" : "", q);
+    // The plain form with the same six digits.
+    int dec = 5 - (int)floor(log10(a));
+    if (dec < 0) dec = 0;
+    if (dec > 300) dec = 300;
+    snprintf(pl, sizeof pl, "%.*f", dec, v);
+    if (strchr(pl, '.')) {
+        char* z = pl + strlen(pl);
+        while (z[-1] == '0') *--z = 0;
+        if (z[-1] == '.') z[-1] = 0;
+    }
+    snprintf(out, n, "%s", strlen(exp_form) + 2 <= strlen(pl) ? exp_form : pl);
 }
 
 // "[lo, hi] unit" for messages ("[1e5, 1e8] Pa"; no unit for "-").
@@ -681,7 +694,12 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
             m->tank_node[m->ntank++] = i;
     }
 
-    // Resolve ports by node name.
+    // Resolve ports by node name, counting the ports on each user node.
+    int* conn = calloc((size_t)(nnode > 0 ? nnode : 1), sizeof *conn);
+    if (!conn) {
+        hyd_model_free(m);
+        return set_err(e, -1, 0, "", "out of memory"), NULL;
+    }
     for (int i = 0; i < b->ncomp; ++i) {
         const hyd_elem* el = &b->comp[i];
         int np;
@@ -690,23 +708,41 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
         for (int k = 0; k < np; ++k) {
             char msg[200];
             if (!el->port[k]) {
+                free(conn);
                 hyd_model_free(m);
                 return set_err(e, 2, i, pi[k].name, "missing node name"), NULL;
             }
             node[k] = find_name(m->node_name, nnode, el->port[k]);
             if (node[k] < 0) {
                 snprintf(msg, sizeof msg, "unknown node '%s'", el->port[k]);
+                free(conn);
                 hyd_model_free(m);
                 return set_err(e, 2, i, pi[k].name, msg), NULL;
             }
             for (int j = 0; j < k; ++j)
                 if (node[j] == node[k]) {
                     snprintf(msg, sizeof msg, "same node '%s' as %s", el->port[k], pi[j].name);
+                    free(conn);
                     hyd_model_free(m);
                     return set_err(e, 2, i, pi[k].name, msg), NULL;
                 }
         }
+        for (int k = 0; k < np; ++k)
+            ++conn[node[k]];
         const int s = m->comp_sub[i];
+        // A valve's T port returns to the tank; on a cylinder chamber it
+        // would drain that chamber whenever the spool opens (a swapped port).
+        if (el->type == HYD_VALVE)
+            for (int c = 0; c < m->ncyl; ++c)
+                if (node[1] == m->cyl[c].nA || node[1] == m->cyl[c].nB) {
+                    char msg[200];
+                    snprintf(msg, sizeof msg,
+                             "'%s' is a cylinder chamber; T is the return to the tank (P, A or B meant?)",
+                             el->port[1]);
+                    free(conn);
+                    hyd_model_free(m);
+                    return set_err(e, 2, i, "T", msg), NULL;
+                }
         switch (el->type) {
         case HYD_PUMP: m->pump[s].in = node[0]; m->pump[s].out = node[1]; break;
         case HYD_RELIEF: m->relief[s].in = node[0]; m->relief[s].out = node[1]; break;
@@ -714,6 +750,7 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
         case HYD_ORIFICE: m->orifice[s].in = node[0]; m->orifice[s].out = node[1]; break;
         case HYD_HOSE:
             if (node[0] == m->hose[s].node) {
+                free(conn);
                 hyd_model_free(m);
                 return set_err(e, 2, i, "to", "a hose cannot end at its own node"), NULL;
             }
@@ -728,6 +765,19 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
         default: break;
         }
     }
+    // A user node that nothing connects to is a typo or a leftover (its
+    // pressure would be a state that never changes). One port is enough: a
+    // pump charging a closed volume is a proper circuit.
+    for (int i = 0; i < b->nnode; ++i)
+        if (!conn[i]) {
+            char msg[200];
+            snprintf(msg, sizeof msg, "'%s' is connected to no component (an isolated %s)", b->node[i].name,
+                     b->node[i].type == HYD_VOLUME ? "volume" : "tank");
+            free(conn);
+            hyd_model_free(m);
+            return set_err(e, 1, i, "name", msg), NULL;
+        }
+    free(conn);
     if (build_incidence(m)) {
         hyd_model_free(m);
         return set_err(e, -1, 0, "", "out of memory"), NULL;

@@ -59,7 +59,16 @@ static int check_numbers(const char* text, const char* path, char* err, size_t e
     for (const char* p = text; *p;) {
         if (*p == '"') { // skip the string, escapes included
             for (++p, ++col; *p && *p != '"'; ++p, ++col)
-                if (*p == '\\' && p[1]) ++p, ++col;
+                if (*p == '\\' && p[1]) {
+                    // cJSON ends the string at an escaped NUL: "lift\u0000_cyl"
+                    // would silently become "lift".
+                    if (!strncmp(p, "\\u0000", 6)) {
+                        snprintf(err, errsz, "%s: line %d, column %d: \\u0000 (a NUL character) is not allowed in a string",
+                                 path, line, col);
+                        return -1;
+                    }
+                    ++p, ++col;
+                }
             if (*p) ++p, ++col;
             continue;
         }
@@ -214,6 +223,26 @@ cJSON* json_parse(const char* text, const char* name, char* err, size_t errsz) {
         root = NULL;
     }
     return root;
+}
+
+const char* json_file_kind(const cJSON* root) {
+    if (!cJSON_IsObject(root)) return NULL;
+    if (cJSON_GetObjectItemCaseSensitive(root, "mechanics") || cJSON_GetObjectItemCaseSensitive(root, "hydraulics"))
+        return "model";
+    if (cJSON_GetObjectItemCaseSensitive(root, "type")) return "world";
+    if (cJSON_GetObjectItemCaseSensitive(root, "duration") || cJSON_GetObjectItemCaseSensitive(root, "commands"))
+        return "scenario";
+    return NULL;
+}
+
+bool json_wrong_kind(json_ctx* c, const cJSON* root, const char* want) {
+    const char* k = json_file_kind(root);
+    if (!k || !strcmp(k, want) || c->failed) return false;
+    c->failed = true;
+    if (c->err && c->errsz)
+        snprintf(c->err, c->errsz, "%s: this is a %s file (use --%s), not a %s", c->file ? c->file : "(input)", k, k,
+                 want);
+    return true;
 }
 
 void json_path(char* out, size_t n, const char* parent, const char* key) {
@@ -517,6 +546,25 @@ static bool value_numbers_ok(const char* v) {
     return check_numbers(v, "", e, sizeof e) == 0;
 }
 
+// Why segment seg names nothing below node (at: its path): an index past the
+// end of an array says so with the length, an unknown name says "no field".
+static void set_path_missing(const char* assignment, const cJSON* node, const char* at, const path_seg* seg,
+                             char* err, size_t errsz) {
+    const bool digits = seg->key[0] && strspn(seg->key, "0123456789") == strlen(seg->key);
+    if (cJSON_IsArray(node) && digits) {
+        const int n = cJSON_GetArraySize(node);
+        snprintf(err, errsz, "--set '%s': index %s out of range: %s has %d element%s (0..%d)", assignment, seg->key,
+                 at, n, n == 1 ? "" : "s", n - 1);
+    } else if (cJSON_IsArray(node)) {
+        snprintf(err, errsz, "--set '%s': no element named '%s' in %s", assignment, seg->key, at);
+    } else if (seg->index) {
+        snprintf(err, errsz, "--set '%s': %s is not an array (index [%s])", assignment, at, seg->key);
+    } else {
+        snprintf(err, errsz, "--set '%s': no field '%s' in the model%s%s", assignment, seg->key, at[0] ? " under " : "",
+                 at);
+    }
+}
+
 int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) {
     // Messages quote the whole argument: it is what the user typed.
     const char* eq = strchr(assignment, '=');
@@ -542,21 +590,20 @@ int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) 
         return -1;
     }
     cJSON* parent = root;
-    for (int i = 0; i < nseg - 1; ++i) {
-        parent = child_by_segment(parent, &segs[i]);
-        if (!parent) {
-            snprintf(err, errsz, "--set '%s': no field '%s%s%s' in the model", assignment, segs[i].index ? "[" : "",
-                     segs[i].key, segs[i].index ? "]" : "");
+    cJSON* old = NULL;
+    char at[256] = ""; // the path walked so far, for messages
+    for (int i = 0; i < nseg; ++i) {
+        cJSON* next = child_by_segment(parent, &segs[i]);
+        if (!next) {
+            set_path_missing(assignment, parent, at, &segs[i], err, errsz);
             return -1;
         }
+        const size_t L = strlen(at);
+        snprintf(at + L, sizeof at - L, segs[i].index ? "[%s]" : (L ? ".%s" : "%s"), segs[i].key);
+        if (i < nseg - 1) parent = next;
+        else old = next;
     }
     const path_seg* last = &segs[nseg - 1];
-    cJSON* old = child_by_segment(parent, last);
-    if (!old) {
-        snprintf(err, errsz, "--set '%s': no field '%s%s%s' in the model", assignment, last->index ? "[" : "",
-                 last->key, last->index ? "]" : "");
-        return -1;
-    }
     // The whole value must be one JSON value: "5 xyz", "5,6" or "5}" are
     // typos, not 5 (cJSON alone stops at the end of the first value).
     const char* vend = NULL;

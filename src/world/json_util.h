@@ -43,6 +43,15 @@ cJSON* json_load_file(const char* path, char* err, size_t errsz);
 /// The checks of json_load_file on a text in memory (name is used in messages).
 cJSON* json_parse(const char* text, const char* name, char* err, size_t errsz);
 
+/// What kind of cranesim file a document looks like, from the members only
+/// that kind has: "model" (mechanics, hydraulics), "world" (type),
+/// "scenario" (duration, commands), or NULL.
+const char* json_file_kind(const cJSON* root);
+/// If root looks like another kind of file than want ("model", "scenario",
+/// "world"), fail with "file: this is a scenario file (use --scenario), not a
+/// model" and return true: better than "duration: unknown field".
+bool json_wrong_kind(json_ctx* c, const cJSON* root, const char* want);
+
 /// Join a parent path and a key ("a.b" + "c" -> "a.b.c"; "" + "c" -> "c").
 void json_path(char* out, size_t n, const char* parent, const char* key);
 /// Parent path plus an index ("a.b" + 3 -> "a.b[3]").

@@ -102,6 +102,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     snprintf(m->file, sizeof m->file, "%s", file);
     json_ctx c = {.file = file, .err = err, .errsz = errsz};
     if (!cJSON_IsObject(root)) json_fail(&c, "", "a model must be a JSON object");
+    if (json_wrong_kind(&c, root, "model")) goto fail;
     static const char* const keys[] = {"name", "description", "mechanics", "hydraulics", NULL};
     json_only_keys(&c, root, "", keys);
     json_str(&c, root, "", "name", false, "crane", m->name, sizeof m->name);

@@ -59,6 +59,7 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
         json_fail(&c, "", "a scenario must be a JSON object");
         return -1;
     }
+    if (json_wrong_kind(&c, root, "scenario")) return -1;
     static const char* const keys[] = {"name", "description", "model", "duration", "load_mass",
                                        "initial", "commands", "hook", NULL};
     json_only_keys(&c, root, "", keys);

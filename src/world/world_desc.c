@@ -3,6 +3,11 @@
 
 #include "hydraulics.h"
 #include "json_util.h"
+#include "model.h"
+
+#include <dirent.h>
+#include <stdlib.h>
+#include <sys/stat.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -474,6 +479,7 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     static const char* const keys[] = {"name", "description", "type", "gravity", "ode", "terrain", "truck",
                                        "slew", "circuit", "rope", "hook", "loads", "obstacles",
                                        "meshes", NULL};
+    if (json_wrong_kind(&c, root, "world")) return -1;
     json_only_keys(&c, root, "", keys);
     json_str(&c, root, "", "type", true, "", kind, sizeof kind);
     if (c.failed) return -1;
@@ -551,8 +557,46 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     return 0;
 }
 
+static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
+
+// A world named on the command line (--world NAME is <assets>/worlds/NAME.json)
+// that does not exist: list the worlds there instead of "cannot open".
+static int missing_named_world(const char* path, char* err, size_t errsz) {
+    char folder[512];
+    snprintf(folder, sizeof folder, "%s/worlds/", model_assets_dir());
+    const size_t n = strlen(folder);
+    struct stat st;
+    if (strncmp(path, folder, n) || strchr(path + n, '/') || stat(path, &st) == 0) return 0;
+    char* names[64];
+    int k = 0;
+    DIR* d = opendir(folder);
+    for (struct dirent* e; d && k < 64 && (e = readdir(d));) {
+        const size_t L = strlen(e->d_name);
+        if (L > 5 && !strcmp(e->d_name + L - 5, ".json")) {
+            names[k] = malloc(L - 4);
+            if (!names[k]) break;
+            snprintf(names[k], L - 4, "%s", e->d_name);
+            ++k;
+        }
+    }
+    if (d) closedir(d);
+    qsort(names, (size_t)k, sizeof *names, cmp_str);
+    char list[512] = "";
+    for (int i = 0; i < k; ++i) {
+        const size_t L = strlen(list);
+        snprintf(list + L, sizeof list - L, "%s%s", i ? ", " : "", names[i]);
+        free(names[i]);
+    }
+    const char* base = path + n;
+    const size_t bl = strlen(base) > 5 ? strlen(base) - 5 : strlen(base);
+    snprintf(err, errsz, "--world %.*s: no such world (available: %s; or the path of a world file)", (int)bl, base,
+             k ? list : "none");
+    return 1;
+}
+
 int world_desc_load(const char* path, world_desc* w, char* err, size_t errsz) {
     memset(w, 0, sizeof *w);
+    if (missing_named_world(path, err, errsz)) return -1;
     cJSON* root = json_load_file(path, err, errsz);
     if (!root) return -1;
     const char* base = strrchr(path, '/');

@@ -183,6 +183,99 @@ static const bad_case range_cases[] = {
 
 static void test_hard_ranges(void) { run_cases(range_cases, (int)(sizeof range_cases / sizeof range_cases[0])); }
 
+#define SP "scenarios/sandbox_pick_place.json"
+
+// The corpus: one change each to a shipped file. Text replacements make what
+// a --set cannot (a wrong type, a repeated key, a number JSON forbids).
+static const bad_case corpus[] = {
+    // models
+    {MODEL, "m_joint_huge.json", M, NULL, "\"joint\": 0", "\"joint\": 2E67", "mechanics.actuators[0].joint", "<= 1"},
+    {MODEL, "m_gravity_neg.json", M, "mechanics.gravity=-9.81", NULL, NULL, "mechanics.gravity", "[0, 30] m/s^2"},
+    {MODEL, "m_column_zero.json", M, "mechanics.column.height=0", NULL, NULL, "mechanics.column.height", "must be > 0"},
+    {MODEL, "m_link_long.json", M, "mechanics.links[0].length=1e6", NULL, NULL, "mechanics.links[0].length", "[0.1, 30] m"},
+    {MODEL, "m_inertia_neg.json", M, "mechanics.links[1].inertia=-1", NULL, NULL, "mechanics.links[1].inertia", "> 0"},
+    {MODEL, "m_mount_far.json", M, "mechanics.actuators[0].base_mount=[1e9, 0]", NULL, NULL,
+     "mechanics.actuators[0].base_mount[0]", "[-10, 10] m"},
+    {MODEL, "m_closed_neg.json", M, "mechanics.actuators[1].closed_length=-0.9", NULL, NULL,
+     "mechanics.actuators[1].closed_length", "> 0"},
+    {MODEL, "m_rod_ge_bore.json", M, "hydraulics.components.lift_cyl.rod=0.2", NULL, NULL,
+     "hydraulics.components[5].rod", "must be < bore"},
+    {MODEL, "m_valve_t_chamber.json", M, NULL, "\"T\": \"tank\", \"A\": \"lift_hose_A\"",
+     "\"T\": \"lift_cyl.A\", \"A\": \"lift_hose_A\"", "hydraulics.components[2].T", "is a cylinder chamber"},
+    {MODEL, "m_isolated_node.json", M, NULL, "{\"name\": \"tank\", \"type\": \"tank\", \"pressure\": 100000},",
+     "{\"name\": \"tank\", \"type\": \"tank\", \"pressure\": 100000}, {\"name\": \"spare\", \"type\": \"volume\", "
+     "\"volume\": 0.001},",
+     "hydraulics.nodes[1]", "'spare' is connected to no component"},
+    {MODEL, "m_nul_name.json", M, NULL, "\"name\": \"lift_cyl\"", "\"name\": \"lift\\u0000_cyl\"", "\\u0000",
+     "not allowed in a string"},
+    {MODEL, "m_dup_key.json", M, NULL, "\"bore\": 0.1,", "\"bore\": 0.1, \"bore\": 0.2,", "hydraulics.components[5].bore",
+     "given twice"},
+    {MODEL, "m_mass_string.json", M, NULL, "\"mass\": 180.0", "\"mass\": \"heavy\"", "mechanics.links[0].mass",
+     "must be a number"},
+    {MODEL, "m_unknown_node.json", M, NULL, "\"to\": \"lift_cyl.A\"", "\"to\": \"lift_cyl.C\"",
+     "hydraulics.components[3].to", "unknown node"},
+    {MODEL, "m_leading_zero.json", M, NULL, "\"stroke\": 0.7", "\"stroke\": 00.7", "line", "invalid number"},
+    {MODEL, "m_length_inf.json", M, NULL, "\"length\": 2.3", "\"length\": 1e400", "mechanics.links[0].length",
+     "must be a finite number"},
+    {MODEL, "m_is_scenario.json", S, NULL, "\"name\"", "\"name\"", "this is a scenario file (use --scenario)", NULL},
+    {MODEL, "m_is_world.json", W, NULL, "\"name\"", "\"name\"", "this is a world file (use --world)", NULL},
+    {MODEL, "m_tau_zero.json", M, "hydraulics.components.lift_valve.tau=0", NULL, NULL, "hydraulics.components[2].tau",
+     "> 0"},
+    {MODEL, "m_air.json", M, "hydraulics.fluid.air_fraction=0.9", NULL, NULL, "hydraulics.fluid.air_fraction", "[0, 0.5]"},
+    {MODEL, "m_viscosity.json", M, "hydraulics.fluid.viscosity=1", NULL, NULL, "hydraulics.fluid.viscosity",
+     "[1e-7, 0.01] m^2/s"},
+    {MODEL, "m_typo.json", M, NULL, "\"load_mass\": 500.0", "\"load_mas\": 500.0", "mechanics.load_mas", "unknown field"},
+    // scenarios
+    {SCENARIO, "s_time_inf.json", S, NULL, "[16, -0.5]", "[1e400, -0.5]", "commands.lift[7]", "must be a finite number"},
+    {SCENARIO, "s_time_order.json", S, NULL, "[5, 0.6]", "[0.5, 0.6]", "commands.lift[3]", "must not decrease"},
+    {SCENARIO, "s_u_range.json", S, NULL, "[2, 0.6]", "[2, 1.6]", "commands.lift[2]", "[-1, 1]"},
+    {SCENARIO, "s_duration_neg.json", S, "duration=-1", NULL, NULL, "duration", "must be > 0"},
+    {SCENARIO, "s_duration_huge.json", S, "duration=1e9", NULL, NULL, "duration", "[0.001, 86400] s"},
+    {SCENARIO, "s_q1.json", S, "initial.q1_deg=400", NULL, NULL, "initial.q1_deg", "<= 360"},
+    {SCENARIO, "s_is_model.json", M, NULL, "\"name\"", "\"name\"", "this is a model file (use --model)", NULL},
+    {SCENARIO, "s_is_world.json", W, NULL, "\"name\"", "\"name\"", "this is a world file (use --world)", NULL},
+    {SCENARIO, "s_hook_inf.json", SP, NULL, "[24.0, \"release\"]", "[1e400, \"release\"]", "hook[1]",
+     "must be a finite number"},
+    {SCENARIO, "s_channel.json", S, NULL, "\"jib\":", "\"boom\":", "commands.boom", "unknown field"},
+    // worlds
+    {WORLD, "w_max_contacts.json", W, "ode.max_contacts=1e300", NULL, NULL, "ode.max_contacts", "<= 32"},
+    {WORLD, "w_rope_links.json", W, "rope.links=2E67", NULL, NULL, "rope.links", "<= 16"},
+    {WORLD, "w_samples.json", W, "terrain.samples=[1e300, 121]", NULL, NULL, "terrain.samples", "[2, 1024]"},
+    {WORLD, "w_hook_mass.json", W, "hook.mass=0", NULL, NULL, "hook.mass", "must be > 0"},
+    {WORLD, "w_load_far.json", W, "loads[1].position=[500, 0]", NULL, NULL, "loads[1].position", "must lie on the terrain"},
+    {WORLD, "w_obstacle_mass.json", W, "obstacles[2].mass=-5", NULL, NULL, "obstacles[2].mass", "[0, 1e6] kg"},
+    {WORLD, "w_is_scenario.json", S, NULL, "\"name\"", "\"name\"", "this is a scenario file (use --scenario)", NULL},
+    {WORLD, "w_validation_rope.json", WV, NULL, "\"type\": \"validation\",", "\"type\": \"validation\", \"rope\": {},",
+     "rope", "only a sandbox world"},
+    {WORLD, "w_circuit_bore.json", W, "circuit.components.slew_cyl.bore=1e300", NULL, NULL, "circuit.components[3].bore",
+     "[0.005, 1] m"},
+    {WORLD, "w_dup_name.json", W, "loads[1].name=load_200", NULL, NULL, "loads[1].name", "duplicate name"},
+    {WORLD, "w_gravity.json", WV, NULL, "\"type\": \"validation\",", "\"type\": \"validation\", \"gravity\": 1e400,",
+     "gravity", "must be a finite number"},
+};
+
+static void test_corpus(void) {
+    const int n = (int)(sizeof corpus / sizeof corpus[0]);
+    CHECK(n + (int)(sizeof range_cases / sizeof range_cases[0]) >= 40, "corpus too small: %d", n);
+    run_cases(corpus, n);
+}
+
+// Messages that are not about one file: a world name that does not exist
+// lists the worlds; an index past the end of an array gives the length.
+static void test_messages(void) {
+    int rc = run("run --quiet --mechanics ode --world nosuch --scenario hold --out /dev/null", out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "--world nosuch: no such world (available: sandbox, validation") &&
+              count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    rc = run("run --quiet --scenario hold --out /dev/null --set 'mechanics.links[5].mass=1'", out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "index 5 out of range: mechanics.links has 2 elements") &&
+              count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    rc = run("run --quiet --scenario hold --out /dev/null --set 'hydraulics.components.nosuch.bore=1'", out_buf,
+             sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "no element named 'nosuch' in hydraulics.components"), "exit %d: %s", rc, out_buf);
+}
+
 // --set gets the same ranges (it edits the document before loading), and
 // --load the tip-load range.
 static void test_set_and_load(void) {
@@ -242,6 +335,8 @@ static void test_shipped_quiet(void) {
 
 int main(int argc, char** argv) {
     RUN_TEST(test_hard_ranges);
+    RUN_TEST(test_corpus);
+    RUN_TEST(test_messages);
     RUN_TEST(test_set_and_load);
     RUN_TEST(test_typical_notes);
     RUN_TEST(test_shipped_quiet);
