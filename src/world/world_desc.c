@@ -159,6 +159,7 @@ static const json_range R_LOAD_SIZE = {0.01, 20, 0.1, 5, "m"};
 static const json_range R_OBST_SIZE = {0.01, 100, 0.1, 50, "m"};
 static const json_range R_OBST_MASS = {0, 1e6, 0, 2e4, "kg"};
 static const json_range R_HEIGHT = {-1, 1e3, -1, 100, "m"}; // z < 0: rest on the ground
+static const json_range R_CONTACT_CFM = {1e-10, 1, 1e-8, 1e-3, ""};
 static const json_range R_MESH_SCALE = {1e-4, 1e4, 1e-3, 1e3, ""};
 static const json_range R_MESH_OFFSET = {-100, 100, -20, 20, "m"};
 
@@ -208,7 +209,9 @@ static void load_ode(json_ctx* c, const cJSON* o, world_ode_params* p) {
     p->erp = json_num(c, o, "ode", "erp", false, p->erp, 0.0, 1.0);
     p->cfm = json_num(c, o, "ode", "cfm", false, p->cfm, 0.0, 1.0);
     p->contact_erp = json_num(c, o, "ode", "contact_erp", false, p->contact_erp, 0.0, 1.0);
-    p->contact_cfm = json_num(c, o, "ode", "contact_cfm", false, p->contact_cfm, 0.0, 1.0);
+    // A contact CFM of 0 makes the contact rows of bodies that start in
+    // touch singular: the fuzzer found ODE aborting (dxNormalize4) on it.
+    p->contact_cfm = json_num_r(c, o, "ode", "contact_cfm", false, p->contact_cfm, &R_CONTACT_CFM);
     p->surface_layer = json_num(c, o, "ode", "surface_layer", false, p->surface_layer, 0.0, 0.1);
     p->max_contacts = json_int(c, o, "ode", "max_contacts", false, p->max_contacts, 1, 32);
 }
@@ -462,6 +465,81 @@ static void check_on_terrain(json_ctx* c, const char* path, const double* pos, b
     }
 }
 
+// A body's box for the overlap check: centre, half sizes in its own frame,
+// heading, and its height interval [m].
+typedef struct ovl_box {
+    double x, y, hx, hy, yaw, z0, z1;
+} ovl_box;
+
+// Separating-axis test of two boxes that are only turned about z: the
+// footprints (rectangles) overlap by more than tol on every one of the four
+// edge normals, and the height intervals by more than tol.
+static bool boxes_overlap(const ovl_box* a, const ovl_box* b, double tol) {
+    if (a->z1 - tol <= b->z0 || b->z1 - tol <= a->z0) return false;
+    const ovl_box* bx[2] = {a, b};
+    for (int k = 0; k < 2; ++k)
+        for (int e = 0; e < 2; ++e) {
+            const double ang = bx[k]->yaw + (e ? M_PI / 2 : 0), ux = cos(ang), uy = sin(ang);
+            double r[2];
+            for (int j = 0; j < 2; ++j) {
+                const ovl_box* q = bx[j];
+                const double c = cos(q->yaw), sn = sin(q->yaw);
+                r[j] = q->hx * fabs(c * ux + sn * uy) + q->hy * fabs(-sn * ux + c * uy);
+            }
+            const double d = fabs((b->x - a->x) * ux + (b->y - a->y) * uy);
+            if (d >= r[0] + r[1] - tol) return false;
+        }
+    return true;
+}
+
+// Truck-frame box (centre px, py; half sizes; heights) placed in the world.
+static ovl_box truck_part(const world_truck* k, double px, double py, double hx, double hy, double z0, double z1) {
+    const double c = cos(k->yaw), s = sin(k->yaw);
+    return (ovl_box){k->position[0] + c * px - s * py, k->position[1] + s * px + c * py, hx, hy, k->yaw, z0, z1};
+}
+
+// No body may start inside another (the truck, its outriggers, loads and
+// obstacles): ODE meets a deep initial penetration with a huge contact
+// impulse, and the fuzzer found a fixed wall through the truck aborting ODE.
+// Bodies that touch (a stack of boxes) are fine: the tolerance is 1 cm.
+static void check_overlaps(json_ctx* c, const world_desc* w) {
+    enum { MAXB = 3 + WORLD_DESC_MAX_LOADS + WORLD_DESC_MAX_OBSTACLES };
+    ovl_box b[MAXB];
+    char name[MAXB][WORLD_DESC_NAME + 16], path[MAXB][64];
+    int n = 0;
+    const world_truck* k = &w->truck;
+    b[n] = truck_part(k, 0, 0, 0.5 * k->chassis[0], 0.5 * k->chassis[1], 0, k->bed_height + k->cab[2]);
+    snprintf(name[n], sizeof name[n], "the truck");
+    snprintf(path[n++], sizeof path[0], "truck");
+    if (k->outriggers)
+        for (int a = 0; a < 2; ++a) {
+            // Beam and pad on both sides as one strip across the truck.
+            const double hx = 0.5 * fmax(0.2, k->pad[0]), hy = 0.5 * (k->outrigger_span + k->pad[1]);
+            b[n] = truck_part(k, k->outrigger_x[a], 0, hx, hy, 0, k->bed_height);
+            snprintf(name[n], sizeof name[n], "the truck's outriggers");
+            snprintf(path[n++], sizeof path[0], "truck.outrigger_x[%d]", a);
+        }
+    for (int i = 0; i < w->nload + w->nobstacle; ++i) {
+        const bool ld = i < w->nload;
+        const double* p = ld ? w->load[i].position : w->obstacle[i - w->nload].position;
+        const double* sz = ld ? w->load[i].size : w->obstacle[i - w->nload].size;
+        b[n] = (ovl_box){p[0], p[1], 0.5 * sz[0], 0.5 * sz[1], ld ? w->load[i].yaw : w->obstacle[i - w->nload].yaw,
+                         p[2] - 0.5 * sz[2], p[2] + 0.5 * sz[2]};
+        snprintf(name[n], sizeof name[n], "%s \"%s\"", ld ? "load" : "obstacle",
+                 ld ? w->load[i].name : w->obstacle[i - w->nload].name);
+        if (ld) snprintf(path[n], sizeof path[0], "loads[%d].position", i);
+        else snprintf(path[n], sizeof path[0], "obstacles[%d].position", i - w->nload);
+        ++n;
+    }
+    const int ntruck = k->outriggers ? 3 : 1;
+    for (int i = ntruck; i < n; ++i)
+        for (int j = 0; j < i; ++j)
+            if (boxes_overlap(&b[i], &b[j], 0.01)) {
+                json_fail(c, path[i], "%s starts inside %s; bodies must not overlap at the start", name[i], name[j]);
+                return;
+            }
+}
+
 // Resolve "rest on the ground" positions (z < 0) now that the terrain is known.
 static void settle_on_ground(const world_desc* w, double* pos, const double* size) {
     if (pos[2] >= 0) return;
@@ -534,6 +612,7 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     if (!c.failed) {
         for (int i = 0; i < w->nload; ++i) settle_on_ground(w, w->load[i].position, w->load[i].size);
         for (int i = 0; i < w->nobstacle; ++i) settle_on_ground(w, w->obstacle[i].position, w->obstacle[i].size);
+        if (w->kind == WORLD_SANDBOX) check_overlaps(&c, w);
         // Names must be unique: the snapshot and the CSV address bodies by name.
         for (int i = 0; i < w->nload + w->nobstacle && !c.failed; ++i) {
             const char* a = i < w->nload ? w->load[i].name : w->obstacle[i - w->nload].name;

@@ -250,6 +250,13 @@ static const bad_case corpus[] = {
     {WORLD, "w_circuit_bore.json", W, "circuit.components.slew_cyl.bore=1e300", NULL, NULL, "circuit.components[3].bore",
      "[0.005, 1] m"},
     {WORLD, "w_dup_name.json", W, "loads[1].name=load_200", NULL, NULL, "loads[1].name", "duplicate name"},
+    // found by fuzz_world_build: a fixed wall through the truck with a contact
+    // CFM of 0 aborted ODE (dxNormalize4); each alone is now refused
+    {WORLD, "w_wall_in_truck.json", W, "obstacles[1].position=[0, -2]", NULL, NULL, "obstacles[1].position",
+     "obstacle \"wall_yard\" starts inside the truck"},
+    {WORLD, "w_contact_cfm0.json", W, "ode.contact_cfm=0", NULL, NULL, "ode.contact_cfm", "must be > 0"},
+    {WORLD, "w_load_in_load.json", W, "loads[1].position=[3.0, -3.3]", NULL, NULL, "loads[1].position",
+     "load \"load_500\" starts inside load \"load_200\""},
     {WORLD, "w_gravity.json", WV, NULL, "\"type\": \"validation\",", "\"type\": \"validation\", \"gravity\": 1e400,",
      "gravity", "must be a finite number"},
 };
