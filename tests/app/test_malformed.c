@@ -267,6 +267,28 @@ static void test_corpus(void) {
     run_cases(corpus, n);
 }
 
+// A file over the 1 MiB limit (docs/files.md, File limits) is refused before
+// it is read, in one line, and the output file stays as it was.
+static void test_oversize(void) {
+    char path[1024], out[1024], cmd[4096];
+    snprintf(path, sizeof path, "%s/s_oversize.json", dir());
+    snprintf(out, sizeof out, "%s/out.csv", dir());
+    FILE* f = fopen(path, "w");
+    fputs("{\"name\": \"big\", \"description\": \"", f);
+    for (long i = 0; i < (1L << 20); ++i) fputc('x', f);
+    fputs("\", \"duration\": 1, \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110}, \"commands\": {}}\n", f);
+    fclose(f);
+    write_all(out, SENTINEL);
+    snprintf(cmd, sizeof cmd, "run --quiet --scenario %s --out %s", path, out);
+    int rc = run(cmd, out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "s_oversize.json: too large (") && count_lines(out_buf) == 1, "exit %d: %s", rc,
+          out_buf);
+    char* now = read_all(out);
+    CHECK(now && !strcmp(now, SENTINEL), "the existing output file was changed");
+    free(now);
+    remove(path);
+}
+
 // Messages that are not about one file: a world name that does not exist
 // lists the worlds; an index past the end of an array gives the length.
 static void test_messages(void) {
@@ -344,6 +366,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_hard_ranges);
     RUN_TEST(test_corpus);
     RUN_TEST(test_messages);
+    RUN_TEST(test_oversize);
     RUN_TEST(test_set_and_load);
     RUN_TEST(test_typical_notes);
     RUN_TEST(test_shipped_quiet);
