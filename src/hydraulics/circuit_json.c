@@ -230,6 +230,12 @@ void hyd_set_note_handler(hyd_note_fn fn, void* user) {
     note_user = user;
 }
 
+hyd_note_fn hyd_get_note_handler(void** user) {
+    if (user)
+        *user = note_user;
+    return note_fn;
+}
+
 // Lines already printed by the default handler, so a model loaded three
 // times in one run notes each value once. A fixed table: beyond it notes
 // repeat rather than being lost.
@@ -282,6 +288,36 @@ static void note_model(const jctx* c, const hyd_model* m) {
                  i < m->nunode ? i : i - m->nunode);
         p = hyd_params_of(e->type, &np);
         note_params(c, path, &e->def, p, np);
+    }
+}
+
+void hyd_json_fragment_notes(const cJSON* fragment, const char* file, const char* prefix) {
+    jctx c = {file, prefix ? prefix : "", NULL, 0};
+    static const char* const lists[2] = {"nodes", "components"};
+    for (int l = 0; l < 2; ++l) {
+        const cJSON* a = cJSON_GetObjectItemCaseSensitive(fragment, lists[l]);
+        int i = 0;
+        for (const cJSON* e = cJSON_IsArray(a) ? a->child : NULL; e; e = e->next, ++i) {
+            const cJSON* jt = cJSON_GetObjectItemCaseSensitive(e, "type");
+            const int t = cJSON_IsString(jt) ? hyd_type_parse(jt->valuestring) : -1;
+            if (t < 0)
+                continue;
+            int np;
+            const hyd_param_info* p = hyd_params_of((hyd_type)t, &np);
+            char path[64];
+            snprintf(path, sizeof path, "%s[%d]", lists[l], i);
+            // One parameter at a time through a def of defaults: absent
+            // members keep their (typical) default and give no note.
+            for (int k = 0; k < np; ++k) {
+                const cJSON* v = cJSON_GetObjectItemCaseSensitive(e, p[k].name);
+                if (!cJSON_IsNumber(v))
+                    continue;
+                hyd_elem tmp;
+                memset(&tmp, 0, sizeof tmp);
+                *(double*)((char*)&tmp.def + p[k].off) = v->valuedouble;
+                note_params(&c, path, &tmp.def, &p[k], 1);
+            }
+        }
     }
 }
 

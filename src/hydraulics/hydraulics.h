@@ -375,8 +375,16 @@ hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz);
 /// process-wide and not thread-safe: set them before loading.
 typedef void (*hyd_note_fn)(const char* line, void* user);
 void hyd_set_note_handler(hyd_note_fn fn, void* user);
+/// The handler in use (NULL: the default) and its user pointer.
+hyd_note_fn hyd_get_note_handler(void** user);
 /// Send one note line to the handler.
 void hyd_note(const char* line);
+/// Notes for a circuit fragment that is not compiled on its own (a world's
+/// extra components, appended to the model's circuit): each numeric member
+/// of "nodes" and "components" outside its typical range, as
+/// "file: prefix.components[i].field: ...". Members the compiler would
+/// refuse are left to it.
+void hyd_json_fragment_notes(const struct cJSON* fragment, const char* file, const char* prefix);
 /// A number for a message as a user writes it: 22, 0.005, 1e5, 2.5e9 (6
 /// significant digits; %g would give 100000 and 2.5e+09).
 void hyd_fmt_num(char* out, size_t n, double v);

@@ -333,6 +333,19 @@ static void test_typical_notes(void) {
                                      "range [20, 5000] kg") &&
               count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
+    // A world's circuit component is noted under the world file's own path,
+    // not as a component of the model's merged circuit.
+    bad_case w = {WORLD, "w_note_bore.json", W, "circuit.components.slew_cyl.bore=0.025", NULL, NULL, "", NULL};
+    const char* wf = make_case(&w);
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd,
+             "run --quiet --mechanics ode --world %s --scenario sandbox_swing --duration 0.01 --out /dev/null", wf);
+    rc = run(cmd, out_buf, sizeof out_buf);
+    CHECK(rc == 0 &&
+              strstr(out_buf, "note: w_note_bore.json: circuit.components[3].bore: 0.025 is outside the typical range "
+                              "[0.03, 0.3] m") &&
+              count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
     rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --load 5000", out_buf, sizeof out_buf);
     CHECK(rc == 0 && strstr(out_buf, "note:") && strstr(out_buf, "--load 5000 kg") && count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
