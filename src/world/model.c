@@ -1,6 +1,7 @@
 // model.c: load and validate a crane model file.
 #include "model.h"
 
+#include "hydraulics.h"
 #include "json_util.h"
 
 #include <stdio.h>
@@ -68,6 +69,20 @@ static void load_link(json_ctx* c, const cJSON* arr, int i, crane_link* l) {
     l->inertia = json_num_r(c, o, p, "inertia", true, 0, &R_LINK_INERTIA);
     l->width = json_num_r(c, o, p, "width", false, 0.18, &R_LINK_SECTION);
     l->height = json_num_r(c, o, p, "height", false, 0.24, &R_LINK_SECTION);
+    // A boom's inertia about its centre of mass is near that of a uniform
+    // box, m (length^2 + height^2) / 12: a thin-walled section is at most
+    // about 1.3 times it, mass gathered at both ends 3 times, a point mass
+    // 0. Far outside [0.2, 4] times is more likely a slip (kg m^2 vs kg cm^2)
+    // than a design.
+    const double box = l->mass * (l->length * l->length + l->height * l->height) / 12.0;
+    if (!c->failed && (l->inertia < 0.2 * box || l->inertia > 4.0 * box)) {
+        char f2[80], v[24], b[24];
+        json_path(f2, sizeof f2, p, "inertia");
+        hyd_fmt_num(v, sizeof v, l->inertia);
+        hyd_fmt_num(b, sizeof b, box);
+        json_note(c, f2, "%s kg m^2 is outside the typical range [0.2, 4] times a uniform box of this mass and size "
+                         "(%s kg m^2)", v, b);
+    }
 }
 
 static void load_actuator(json_ctx* c, const cJSON* arr, int i, crane_actuator* a) {

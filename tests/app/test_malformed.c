@@ -331,6 +331,13 @@ static void test_typical_notes(void) {
              sizeof out_buf);
     CHECK(rc == 0 && strstr(out_buf, "note: hiab031.json: mechanics.links[0].mass: 6000 kg is outside the typical "
                                      "range [20, 5000] kg") &&
+              strstr(out_buf, "mechanics.links[0].inertia") && count_lines(out_buf) == 2, // 79 kg m^2 left as it was
+          "exit %d: %s", rc, out_buf);
+    // An inertia far from a box of the link's mass and size (kg cm^2 meant?).
+    rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links[0].inertia=7935",
+             out_buf, sizeof out_buf);
+    CHECK(rc == 0 && strstr(out_buf, "note: hiab031.json: mechanics.links[0].inertia: 7935 kg m^2 is outside the typical "
+                                     "range [0.2, 4] times a uniform box") &&
               count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
     // A world's circuit component is noted under the world file's own path,
