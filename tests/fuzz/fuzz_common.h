@@ -21,7 +21,7 @@ static void fuzz_silent_note(const char* line, void* user) {
 // The input as a parsed document, or NULL when the reader refuses it (a
 // refusal is a correct answer, not a finding). Inputs over the file limit
 // are skipped: json_load_file refuses them before parsing.
-static cJSON* fuzz_parse(const uint8_t* data, size_t size) {
+static inline cJSON* fuzz_parse(const uint8_t* data, size_t size) {
     hyd_set_note_handler(fuzz_silent_note, NULL);
     if (size > (size_t)JSON_MAX_FILE_BYTES) return NULL;
     char* text = malloc(size + 1);
