@@ -3,6 +3,7 @@
 // the size limit.
 #include "check.h"
 #include "json_util.h"
+#include "model.h"
 #include "world_desc.h"
 
 #include <stdio.h>
@@ -120,7 +121,38 @@ static void test_size_limit(void) {
     remove(p);
 }
 
+// Live changes (the drive panel's hyd_model_set) get the hard ranges of the
+// parameter tables too, and a refused value changes nothing.
+static void test_live_ranges(void) {
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    int rc = hyd_model_set(m->hyd, "main_relief.p_crack", 22, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, "main_relief.p_crack: must be in [1e5, 1e8] Pa, got 22"), "rc %d: %s", rc, err);
+    double v = 0;
+    CHECK(hyd_model_get(m->hyd, "main_relief.p_crack", &v) == 0 && v == 22e6, "p_crack now %g", v);
+    rc = hyd_model_set(m->hyd, "fluid.bulk_modulus", 1e20, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, "[1e7, 1e10] Pa"), "rc %d: %s", rc, err);
+    CHECK(hyd_model_set(m->hyd, "main_relief.p_crack", 21e6, err, sizeof err) == 0, "%s", err);
+    model_free(m);
+}
+
+// Numbers in messages as a user writes them.
+static void test_number_format(void) {
+    const double v[] = {22, 0.005, 6000, 86400, 1e5, 2.5e9, 101325, 1e-7, 3.2e-5, -9.81, 1e300, 0};
+    const char* want[] = {"22", "0.005", "6000", "86400", "1e5", "2.5e9", "101325", "1e-7", "3.2e-5", "-9.81",
+                          "1e300", "0"};
+    for (int i = 0; i < 12; ++i) {
+        char b[32];
+        hyd_fmt_num(b, sizeof b, v[i]);
+        CHECK(!strcmp(b, want[i]), "%g -> '%s', want '%s'", v[i], b, want[i]);
+    }
+}
+
 int main(int argc, char** argv) {
+    RUN_TEST(test_live_ranges);
+    RUN_TEST(test_number_format);
     RUN_TEST(test_int_out_of_range);
     RUN_TEST(test_world_ints);
     RUN_TEST(test_many_keys);
