@@ -199,10 +199,16 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
         c->sim.jac_every = (int)d;
         break;
     case APP_OPT_LOAD:
-        if (app_parse_double(v, &d) || d < 0 || d > 1e5) {
-            fprintf(stderr, "cranesim: --load: expected a mass in kg (0..100000), got '%s'\n", v);
+        // The model's tip-load range (crane_model.h): 100 t on this crane
+        // peaked at 1.05 GPa and still exited 0.
+        if (app_parse_double(v, &d) || !(d >= 0 && d <= CRANE_LOAD_MAX)) {
+            fprintf(stderr, "cranesim: --load: expected a mass in [0, %g] kg, got '%s'\n", CRANE_LOAD_MAX, v);
             return -1;
         }
+        if (d > CRANE_LOAD_TYPICAL)
+            fprintf(stderr, "cranesim: note: --load %g kg is outside the typical range [0, %g] kg (the port reliefs "
+                            "of a HIAB-031-class crane open near 3000 kg)\n",
+                    d, CRANE_LOAD_TYPICAL);
         c->sim.load_mass = d;
         break;
     case APP_OPT_WORLD: c->sim.world = v; break;

@@ -31,70 +31,79 @@ int hyd_type_parse(const char* name) {
     return -1;
 }
 
-#define P_(T, f, unit, rule, req) {#f, unit, offsetof(T, f), rule, req}
+// Each parameter has a hard range, outside which a circuit is refused (a
+// value there is a typo or a unit slip, and the integrator would meet it as
+// a blow-up or, worse, as a plausible wrong answer: p_crack = 22 Pa, meant as
+// MPa, let the boom sink onto its stop with exit 0), and a typical range for
+// crane-sized machines, outside which the loader prints a note. The ranges
+// and their reasons are documented in docs/hydraulics.md ("Parameter
+// ranges").
+#define P_(T, f, unit, rule, req, lo, hi, tlo, thi) {#f, unit, offsetof(T, f), rule, req, lo, hi, tlo, thi}
 
 static const hyd_param_info fluid_params[] = {
-    P_(hyd_fluid_def, density, "kg/m^3", HYD_R_POS, 0),
-    P_(hyd_fluid_def, viscosity, "m^2/s", HYD_R_POS, 0),
-    P_(hyd_fluid_def, bulk_modulus, "Pa", HYD_R_POS, 0),
-    P_(hyd_fluid_def, air_fraction, "-", HYD_R_FRAC, 0),
-    P_(hyd_fluid_def, polytropic_index, "-", HYD_R_POS, 0),
-    P_(hyd_fluid_def, p_atm, "Pa", HYD_R_POS, 0),
-    P_(hyd_fluid_def, re_transition, "-", HYD_R_POS, 0),
+    P_(hyd_fluid_def, density, "kg/m^3", HYD_R_POS, 0, 500, 2000, 800, 1100),
+    P_(hyd_fluid_def, viscosity, "m^2/s", HYD_R_POS, 0, 1e-7, 1e-2, 2e-6, 5e-4),
+    P_(hyd_fluid_def, bulk_modulus, "Pa", HYD_R_POS, 0, 1e7, 1e10, 5e8, 2.5e9),
+    P_(hyd_fluid_def, air_fraction, "-", HYD_R_FRAC, 0, 0, 0.5, 0, 0.02),
+    P_(hyd_fluid_def, polytropic_index, "-", HYD_R_POS, 0, 1, 2, 1, 1.4),
+    P_(hyd_fluid_def, p_atm, "Pa", HYD_R_POS, 0, 1e4, 2e5, 8e4, 1.1e5),
+    P_(hyd_fluid_def, re_transition, "-", HYD_R_POS, 0, 1, 1e5, 10, 2000),
 };
 static const hyd_param_info tank_params[] = {
-    P_(hyd_tank_def, pressure, "Pa", HYD_R_NONNEG, 0),
+    P_(hyd_tank_def, pressure, "Pa", HYD_R_NONNEG, 0, 0, 1e7, 5e4, 1e6),
 };
 static const hyd_param_info volume_params[] = {
-    P_(hyd_volume_def, volume, "m^3", HYD_R_POS, 1),
-    P_(hyd_volume_def, bulk_modulus, "Pa", HYD_R_NONNEG, 0),
-    P_(hyd_volume_def, p0, "Pa", HYD_R_NONNEG, 0),
+    P_(hyd_volume_def, volume, "m^3", HYD_R_POS, 1, 1e-9, 10, 1e-6, 0.1),
+    P_(hyd_volume_def, bulk_modulus, "Pa", HYD_R_ZERO_DEF, 0, 1e7, 1e10, 1e8, 2.5e9),
+    P_(hyd_volume_def, p0, "Pa", HYD_R_NONNEG, 0, 0, 1e8, 0, 5e7),
 };
 static const hyd_param_info pump_params[] = {
-    P_(hyd_pump_def, q_max, "m^3/s", HYD_R_POS, 1),
-    P_(hyd_pump_def, p_set, "Pa", HYD_R_POS, 1),
-    P_(hyd_pump_def, band, "Pa", HYD_R_POS, 0),
+    P_(hyd_pump_def, q_max, "m^3/s", HYD_R_POS, 1, 1e-7, 0.1, 1e-5, 5e-3),
+    P_(hyd_pump_def, p_set, "Pa", HYD_R_POS, 1, 1e5, 1e8, 5e6, 4.5e7),
+    P_(hyd_pump_def, band, "Pa", HYD_R_POS, 0, 1e3, 1e7, 1e4, 3e6),
 };
 static const hyd_param_info relief_params[] = {
-    P_(hyd_relief_def, p_crack, "Pa", HYD_R_POS, 1),
-    P_(hyd_relief_def, dp_override, "Pa", HYD_R_POS, 0),
-    P_(hyd_relief_def, q_rated, "m^3/s", HYD_R_POS, 0),
+    P_(hyd_relief_def, p_crack, "Pa", HYD_R_POS, 1, 1e5, 1e8, 5e6, 4.5e7),
+    P_(hyd_relief_def, dp_override, "Pa", HYD_R_POS, 0, 1e3, 1e7, 1e5, 5e6),
+    P_(hyd_relief_def, q_rated, "m^3/s", HYD_R_POS, 0, 1e-7, 0.1, 1e-5, 5e-3),
 };
 static const hyd_param_info check_params[] = {
-    P_(hyd_check_def, p_crack, "Pa", HYD_R_NONNEG, 0),
-    P_(hyd_check_def, dp_open, "Pa", HYD_R_POS, 0),
-    P_(hyd_check_def, q_rated, "m^3/s", HYD_R_POS, 0),
+    P_(hyd_check_def, p_crack, "Pa", HYD_R_NONNEG, 0, 0, 1e7, 0, 1e6),
+    P_(hyd_check_def, dp_open, "Pa", HYD_R_POS, 0, 1e2, 1e7, 5e3, 1e6),
+    P_(hyd_check_def, q_rated, "m^3/s", HYD_R_POS, 0, 1e-7, 0.1, 1e-5, 5e-3),
 };
 static const hyd_param_info orifice_params[] = {
-    P_(hyd_orifice_def, area, "m^2", HYD_R_POS, 1),
-    P_(hyd_orifice_def, cd, "-", HYD_R_FRAC, 0),
+    P_(hyd_orifice_def, area, "m^2", HYD_R_POS, 1, 1e-10, 0.1, 1e-8, 1e-3),
+    P_(hyd_orifice_def, cd, "-", HYD_R_FRAC, 0, 0, 1, 0.5, 0.8),
 };
 static const hyd_param_info hose_params[] = {
-    P_(hyd_hose_def, length, "m", HYD_R_POS, 1),
-    P_(hyd_hose_def, diameter, "m", HYD_R_POS, 1),
-    P_(hyd_hose_def, bulk_modulus, "Pa", HYD_R_NONNEG, 0),
-    P_(hyd_hose_def, p0, "Pa", HYD_R_NONNEG, 0),
+    P_(hyd_hose_def, length, "m", HYD_R_POS, 1, 0.01, 100, 0.2, 20),
+    P_(hyd_hose_def, diameter, "m", HYD_R_POS, 1, 1e-3, 0.2, 4e-3, 0.05),
+    P_(hyd_hose_def, bulk_modulus, "Pa", HYD_R_ZERO_DEF, 0, 1e7, 1e10, 1e8, 2.5e9),
+    P_(hyd_hose_def, p0, "Pa", HYD_R_NONNEG, 0, 0, 1e8, 0, 5e7),
 };
 static const hyd_param_info valve_params[] = {
-    P_(hyd_valve_def, q_nominal, "m^3/s", HYD_R_POS, 0),
-    P_(hyd_valve_def, dp_nominal, "Pa", HYD_R_POS, 0),
-    P_(hyd_valve_def, cd, "-", HYD_R_FRAC, 0),
-    P_(hyd_valve_def, tau, "s", HYD_R_POS, 0),
-    P_(hyd_valve_def, u0, "-", HYD_R_UNIT, 0),
+    P_(hyd_valve_def, q_nominal, "m^3/s", HYD_R_POS, 0, 1e-7, 0.1, 1e-5, 5e-3),
+    P_(hyd_valve_def, dp_nominal, "Pa", HYD_R_POS, 0, 1e4, 1e7, 2e5, 3.5e6),
+    // cd divides the rated flow into the largest opening: 0 would be infinite.
+    P_(hyd_valve_def, cd, "-", HYD_R_FRAC, 0, 0.1, 1, 0.5, 0.8),
+    P_(hyd_valve_def, tau, "s", HYD_R_POS, 0, 1e-4, 10, 5e-3, 0.2),
+    P_(hyd_valve_def, u0, "-", HYD_R_UNIT, 0, -1, 1, -1, 1),
 };
 static const hyd_param_info cylinder_params[] = {
-    P_(hyd_cylinder_def, bore, "m", HYD_R_POS, 1),
-    P_(hyd_cylinder_def, rod, "m", HYD_R_POS, 1),
-    P_(hyd_cylinder_def, stroke, "m", HYD_R_POS, 1),
-    P_(hyd_cylinder_def, dead_volume_a, "m^3", HYD_R_POS, 0),
-    P_(hyd_cylinder_def, dead_volume_b, "m^3", HYD_R_POS, 0),
-    P_(hyd_cylinder_def, leakage, "m^3/(s Pa)", HYD_R_NONNEG, 0),
-    P_(hyd_cylinder_def, friction, "N s/m", HYD_R_NONNEG, 0),
-    P_(hyd_cylinder_def, stop_stiffness, "N/m", HYD_R_POS, 0),
-    P_(hyd_cylinder_def, stop_damping, "N s/m", HYD_R_NONNEG, 0),
-    P_(hyd_cylinder_def, stop_width, "m", HYD_R_POS, 0),
-    P_(hyd_cylinder_def, p0_a, "Pa", HYD_R_NONNEG, 0),
-    P_(hyd_cylinder_def, p0_b, "Pa", HYD_R_NONNEG, 0),
+    P_(hyd_cylinder_def, bore, "m", HYD_R_POS, 1, 0.005, 1, 0.03, 0.3),
+    P_(hyd_cylinder_def, rod, "m", HYD_R_POS, 1, 0.002, 1, 0.015, 0.2),
+    P_(hyd_cylinder_def, stroke, "m", HYD_R_POS, 1, 0.01, 10, 0.1, 3),
+    P_(hyd_cylinder_def, dead_volume_a, "m^3", HYD_R_POS, 0, 1e-8, 0.1, 1e-6, 1e-3),
+    P_(hyd_cylinder_def, dead_volume_b, "m^3", HYD_R_POS, 0, 1e-8, 0.1, 1e-6, 1e-3),
+    // 1e-10 m^3/(s Pa) leaks 60 L/min at 10 bar: the piston seal is gone.
+    P_(hyd_cylinder_def, leakage, "m^3/(s Pa)", HYD_R_NONNEG, 0, 0, 1e-10, 0, 1e-11),
+    P_(hyd_cylinder_def, friction, "N s/m", HYD_R_NONNEG, 0, 0, 1e7, 0, 1e5),
+    P_(hyd_cylinder_def, stop_stiffness, "N/m", HYD_R_POS, 0, 1e5, 1e11, 1e7, 5e9),
+    P_(hyd_cylinder_def, stop_damping, "N s/m", HYD_R_NONNEG, 0, 0, 1e9, 0, 1e7),
+    P_(hyd_cylinder_def, stop_width, "m", HYD_R_POS, 0, 1e-5, 0.05, 1e-4, 1e-2),
+    P_(hyd_cylinder_def, p0_a, "Pa", HYD_R_NONNEG, 0, 0, 1e8, 0, 5e7),
+    P_(hyd_cylinder_def, p0_b, "Pa", HYD_R_NONNEG, 0, 0, 1e8, 0, 5e7),
 };
 #undef P_
 
@@ -163,21 +172,84 @@ const char* hyd_param_unit(hyd_type t, int k) {
     return (k >= 0 && k < n) ? p[k].unit : NULL;
 }
 
+// A number for a message, as a user would write it: 22, 0.005, 6000, 86400,
+// 1e5, 2.5e9, 101325 (%g would give 100000 and 2.5e+09): six significant
+// digits, in exponent form when that is at least two characters shorter.
+void hyd_fmt_num(char* out, size_t n, double v) {
+    const double a = fabs(v);
+    if (!isfinite(v) || a == 0.0) {
+        snprintf(out, n, "%g", v);
+        return;
+    }
+    char ex[40], pl[400];
+    snprintf(ex, sizeof ex, "%.5e", v); // d.ddddde[+-]XX, trimmed below
+    char* e = strchr(ex, 'e');
+    char* m = e;
+    while (m > ex && m[-1] == '0') --m;
+    if (m > ex && m[-1] == '.') --m;
+    const char* q = e + 1;
+    const int neg = *q == '-';
+    if (*q == '+' || *q == '-') ++q;
+    while (*q == '0' && q[1]) ++q;
+    char exp_form[40];
+    snprintf(exp_form, sizeof exp_form, "%.*se%s%s", (int)(m - ex), ex, neg ? "-" : "", q);
+    // The plain form with the same six digits.
+    int dec = 5 - (int)floor(log10(a));
+    if (dec < 0) dec = 0;
+    if (dec > 300) dec = 300;
+    snprintf(pl, sizeof pl, "%.*f", dec, v);
+    if (strchr(pl, '.')) {
+        char* z = pl + strlen(pl);
+        while (z[-1] == '0') *--z = 0;
+        if (z[-1] == '.') z[-1] = 0;
+    }
+    snprintf(out, n, "%s", strlen(exp_form) + 2 <= strlen(pl) ? exp_form : pl);
+}
+
+// "[lo, hi] unit" for messages ("[1e5, 1e8] Pa"; no unit for "-").
+static void range_text(char* out, size_t n, double lo, double hi, const char* unit) {
+    char a[24], b[24];
+    hyd_fmt_num(a, sizeof a, lo);
+    hyd_fmt_num(b, sizeof b, hi);
+    const int has_unit = unit && unit[0] && strcmp(unit, "-");
+    snprintf(out, n, "[%s, %s]%s%s", a, b, has_unit ? " " : "", has_unit ? unit : "");
+}
+
 int hyd_param_check(const hyd_param_info* p, double v, char* msg, size_t msgsz) {
     const char* need = NULL;
     if (!isfinite(v))
-        need = "must be finite";
+        need = "must be a finite number";
     else if (p->rule == HYD_R_POS && !(v > 0.0))
         need = "must be > 0";
-    else if (p->rule == HYD_R_NONNEG && !(v >= 0.0))
+    else if ((p->rule == HYD_R_NONNEG || p->rule == HYD_R_ZERO_DEF) && !(v >= 0.0))
         need = "must be >= 0";
     else if (p->rule == HYD_R_UNIT && !(v >= -1.0 && v <= 1.0))
         need = "must be in [-1, 1]";
     else if (p->rule == HYD_R_FRAC && !(v >= 0.0 && v <= 1.0))
         need = "must be in [0, 1]";
-    if (!need)
+    char got[24];
+    hyd_fmt_num(got, sizeof got, v);
+    if (need) {
+        snprintf(msg, msgsz, "%s, got %s", need, got);
+        return -1;
+    }
+    if (p->rule == HYD_R_ZERO_DEF && v == 0.0)
+        return 0; // 0: take the fluid's value
+    if (v >= p->lo && v <= p->hi)
         return 0;
-    snprintf(msg, msgsz, "%s, got %g", need, v);
+    char r[64];
+    range_text(r, sizeof r, p->lo, p->hi, p->unit);
+    snprintf(msg, msgsz, "must be %sin %s, got %s", p->rule == HYD_R_ZERO_DEF ? "0 (the fluid's) or " : "", r, got);
+    return -1;
+}
+
+int hyd_param_typical(const hyd_param_info* p, double v, char* msg, size_t msgsz) {
+    if ((p->rule == HYD_R_ZERO_DEF && v == 0.0) || (v >= p->tlo && v <= p->thi))
+        return 0;
+    char r[64], got[24];
+    range_text(r, sizeof r, p->tlo, p->thi, p->unit);
+    hyd_fmt_num(got, sizeof got, v);
+    snprintf(msg, msgsz, "%s is outside the typical range %s", got, r);
     return -1;
 }
 
@@ -622,7 +694,12 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
             m->tank_node[m->ntank++] = i;
     }
 
-    // Resolve ports by node name.
+    // Resolve ports by node name, counting the ports on each user node.
+    int* conn = calloc((size_t)(nnode > 0 ? nnode : 1), sizeof *conn);
+    if (!conn) {
+        hyd_model_free(m);
+        return set_err(e, -1, 0, "", "out of memory"), NULL;
+    }
     for (int i = 0; i < b->ncomp; ++i) {
         const hyd_elem* el = &b->comp[i];
         int np;
@@ -631,23 +708,41 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
         for (int k = 0; k < np; ++k) {
             char msg[200];
             if (!el->port[k]) {
+                free(conn);
                 hyd_model_free(m);
                 return set_err(e, 2, i, pi[k].name, "missing node name"), NULL;
             }
             node[k] = find_name(m->node_name, nnode, el->port[k]);
             if (node[k] < 0) {
                 snprintf(msg, sizeof msg, "unknown node '%s'", el->port[k]);
+                free(conn);
                 hyd_model_free(m);
                 return set_err(e, 2, i, pi[k].name, msg), NULL;
             }
             for (int j = 0; j < k; ++j)
                 if (node[j] == node[k]) {
                     snprintf(msg, sizeof msg, "same node '%s' as %s", el->port[k], pi[j].name);
+                    free(conn);
                     hyd_model_free(m);
                     return set_err(e, 2, i, pi[k].name, msg), NULL;
                 }
         }
+        for (int k = 0; k < np; ++k)
+            ++conn[node[k]];
         const int s = m->comp_sub[i];
+        // A valve's T port returns to the tank; on a cylinder chamber it
+        // would drain that chamber whenever the spool opens (a swapped port).
+        if (el->type == HYD_VALVE)
+            for (int c = 0; c < m->ncyl; ++c)
+                if (node[1] == m->cyl[c].nA || node[1] == m->cyl[c].nB) {
+                    char msg[200];
+                    snprintf(msg, sizeof msg,
+                             "'%s' is a cylinder chamber; T is the return to the tank (P, A or B meant?)",
+                             el->port[1]);
+                    free(conn);
+                    hyd_model_free(m);
+                    return set_err(e, 2, i, "T", msg), NULL;
+                }
         switch (el->type) {
         case HYD_PUMP: m->pump[s].in = node[0]; m->pump[s].out = node[1]; break;
         case HYD_RELIEF: m->relief[s].in = node[0]; m->relief[s].out = node[1]; break;
@@ -655,6 +750,7 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
         case HYD_ORIFICE: m->orifice[s].in = node[0]; m->orifice[s].out = node[1]; break;
         case HYD_HOSE:
             if (node[0] == m->hose[s].node) {
+                free(conn);
                 hyd_model_free(m);
                 return set_err(e, 2, i, "to", "a hose cannot end at its own node"), NULL;
             }
@@ -669,6 +765,19 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
         default: break;
         }
     }
+    // A user node that nothing connects to is a typo or a leftover (its
+    // pressure would be a state that never changes). One port is enough: a
+    // pump charging a closed volume is a proper circuit.
+    for (int i = 0; i < b->nnode; ++i)
+        if (!conn[i]) {
+            char msg[200];
+            snprintf(msg, sizeof msg, "'%s' is connected to no component (an isolated %s)", b->node[i].name,
+                     b->node[i].type == HYD_VOLUME ? "volume" : "tank");
+            free(conn);
+            hyd_model_free(m);
+            return set_err(e, 1, i, "name", msg), NULL;
+        }
+    free(conn);
     if (build_incidence(m)) {
         hyd_model_free(m);
         return set_err(e, -1, 0, "", "out of memory"), NULL;

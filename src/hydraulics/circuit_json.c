@@ -218,6 +218,109 @@ static int read_list(const jctx* c, hyd_builder* b, const cJSON* root, const cha
     return 0;
 }
 
+// ---------------------------------------------------------------------------
+// Notes
+// ---------------------------------------------------------------------------
+
+static hyd_note_fn note_fn = NULL;
+static void* note_user = NULL;
+
+void hyd_set_note_handler(hyd_note_fn fn, void* user) {
+    note_fn = fn;
+    note_user = user;
+}
+
+hyd_note_fn hyd_get_note_handler(void** user) {
+    if (user)
+        *user = note_user;
+    return note_fn;
+}
+
+// Lines already printed by the default handler, so a model loaded three
+// times in one run notes each value once. A fixed table: beyond it notes
+// repeat rather than being lost.
+#define NOTE_SEEN 64
+static char* note_seen[NOTE_SEEN];
+static int note_nseen;
+
+void hyd_note(const char* line) {
+    if (note_fn) {
+        note_fn(line, note_user);
+        return;
+    }
+    for (int i = 0; i < note_nseen; ++i)
+        if (!strcmp(note_seen[i], line))
+            return;
+    if (note_nseen < NOTE_SEEN) {
+        size_t n = strlen(line) + 1;
+        char* c = malloc(n);
+        if (c) {
+            memcpy(c, line, n);
+            note_seen[note_nseen++] = c;
+        }
+    }
+    fprintf(stderr, "note: %s\n", line);
+}
+
+// A note per parameter outside its typical range: "file: path.field: v is
+// outside the typical range [lo, hi] unit".
+static void note_params(const jctx* c, const char* path, const void* def, const hyd_param_info* p,
+                        int np) {
+    for (int k = 0; k < np; ++k) {
+        char msg[200], line[400];
+        if (!hyd_param_typical(&p[k], *(const double*)((const char*)def + p[k].off), msg, sizeof msg))
+            continue;
+        const int pre = c->prefix && c->prefix[0];
+        snprintf(line, sizeof line, "%s: %s%s%s.%s: %s", c->file ? c->file : "<json>",
+                 pre ? c->prefix : "", pre ? "." : "", path, p[k].name, msg);
+        hyd_note(line);
+    }
+}
+
+static void note_model(const jctx* c, const hyd_model* m) {
+    int np;
+    const hyd_param_info* p = hyd_fluid_params(&np);
+    note_params(c, "fluid", &m->fluid, p, np);
+    for (int i = 0; i < m->nunode + m->ncomp; ++i) {
+        const hyd_elem* e = i < m->nunode ? &m->unode[i] : &m->comp[i - m->nunode];
+        char path[64];
+        snprintf(path, sizeof path, "%s[%d]", i < m->nunode ? "nodes" : "components",
+                 i < m->nunode ? i : i - m->nunode);
+        p = hyd_params_of(e->type, &np);
+        note_params(c, path, &e->def, p, np);
+    }
+}
+
+void hyd_json_fragment_notes(const cJSON* fragment, const char* file, const char* prefix) {
+    jctx c = {file, prefix ? prefix : "", NULL, 0};
+    static const char* const lists[2] = {"nodes", "components"};
+    for (int l = 0; l < 2; ++l) {
+        const cJSON* a = cJSON_GetObjectItemCaseSensitive(fragment, lists[l]);
+        int i = 0;
+        for (const cJSON* e = cJSON_IsArray(a) ? a->child : NULL; e; e = e->next, ++i) {
+            const cJSON* jt = cJSON_GetObjectItemCaseSensitive(e, "type");
+            const int t = cJSON_IsString(jt) ? hyd_type_parse(jt->valuestring) : -1;
+            if (t < 0)
+                continue;
+            int np;
+            const hyd_param_info* p = hyd_params_of((hyd_type)t, &np);
+            char path[64];
+            snprintf(path, sizeof path, "%s[%d]", lists[l], i);
+            // One parameter at a time through a def of defaults: absent
+            // members keep their (typical) default and give no note.
+            for (int k = 0; k < np; ++k) {
+                const cJSON* v = cJSON_GetObjectItemCaseSensitive(e, p[k].name);
+                if (!cJSON_IsNumber(v))
+                    continue;
+                hyd_elem tmp;
+                memset(&tmp, 0, sizeof tmp);
+                *(double*)((char*)&tmp.def + p[k].off) = v->valuedouble;
+                note_params(&c, path, &tmp.def, &p[k], 1);
+            }
+        }
+    }
+}
+
 hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const char* prefix,
                                char* err, size_t errsz) {
     jctx c = {file, prefix ? prefix : "", err, errsz};
@@ -264,6 +367,8 @@ hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const cha
         else
             path[0] = 0;
         jerr(&c, path, "%s", e.msg);
+    } else {
+        note_model(&c, m);
     }
 done:
     hyd_builder_free(b);
@@ -279,7 +384,14 @@ hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz) {
     }
     char* text = NULL;
     long n = -1;
-    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0) {
+    // The same limit as the model loader (json_util.h, JSON_MAX_FILE_BYTES):
+    // parsing costs about 20 bytes of memory per byte of text.
+    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && n > (1L << 20)) {
+        fclose(fp);
+        jerr(&c, "", "too large (%ld bytes; input files are limited to %ld bytes)", n, 1L << 20);
+        return NULL;
+    }
+    if (n >= 0 && fseek(fp, 0, SEEK_SET) == 0) {
         text = malloc((size_t)n + 1);
         if (text && fread(text, 1, (size_t)n, fp) != (size_t)n) {
             free(text);

@@ -39,8 +39,10 @@ typedef struct hyd_elem {
     } def;
 } hyd_elem;
 
-/// Parameter checking rules.
-enum { HYD_R_POS = 0, HYD_R_NONNEG, HYD_R_ANY, HYD_R_UNIT, HYD_R_FRAC };
+/// Parameter checking rules (sign and closed ranges; the magnitude is the
+/// table's hard range). HYD_R_ZERO_DEF: 0 means "the fluid's value", any
+/// other value must be in the hard range.
+enum { HYD_R_POS = 0, HYD_R_NONNEG, HYD_R_ANY, HYD_R_UNIT, HYD_R_FRAC, HYD_R_ZERO_DEF };
 
 /// A port of a component type: its name and the offset of its const char*
 /// field inside the type's def struct.
@@ -55,6 +57,8 @@ typedef struct hyd_param_info {
     size_t off;   ///< byte offset of the double inside the type's def struct
     int rule;     ///< HYD_R_*
     int required; ///< must be given in JSON (C defaults leave it 0, which fails the rule)
+    double lo, hi;   ///< hard range [unit]: outside it the circuit is refused
+    double tlo, thi; ///< typical range [unit]: outside it the loader prints a note
 } hyd_param_info;
 
 /// Parameter and port tables of a type (circuit.c).
@@ -63,8 +67,12 @@ const hyd_port_info* hyd_ports_of(hyd_type t, int* count);
 /// Pointer to an element's def struct (the active union member).
 void* hyd_elem_def(hyd_elem* e);
 const void* hyd_elem_cdef(const hyd_elem* e);
-/// Check one value against a rule; returns 0 or writes a message and returns -1.
+/// Check one value against its rule and hard range; returns 0 or writes a
+/// message ("must be in [1e5, 1e8] Pa, got 22") and returns -1.
 int hyd_param_check(const hyd_param_info* p, double v, char* msg, size_t msgsz);
+/// 0 if v is in the typical range, else -1 with "v is outside the typical range [lo, hi] unit".
+int hyd_param_typical(const hyd_param_info* p, double v, char* msg, size_t msgsz);
+
 /// Fluid parameter table (name, unit, offset into hyd_fluid_def).
 const hyd_param_info* hyd_fluid_params(int* count);
 

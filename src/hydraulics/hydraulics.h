@@ -368,6 +368,26 @@ hyd_model* hyd_model_from_json(const struct cJSON* circuit, const char* file, co
 /// Load a circuit file: either the circuit object itself or a document with a
 /// "hydraulics" member holding it (prefix "hydraulics"). NULL on error.
 hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz);
+/// Notes (non-fatal remarks such as a value outside its typical range, one
+/// line each, without a newline) go to this handler. The default writes
+/// "note: <line>" to stderr, each distinct line once per process (a run loads
+/// its model and world more than once); NULL restores it. Handlers are
+/// process-wide and not thread-safe: set them before loading.
+typedef void (*hyd_note_fn)(const char* line, void* user);
+void hyd_set_note_handler(hyd_note_fn fn, void* user);
+/// The handler in use (NULL: the default) and its user pointer.
+hyd_note_fn hyd_get_note_handler(void** user);
+/// Send one note line to the handler.
+void hyd_note(const char* line);
+/// Notes for a circuit fragment that is not compiled on its own (a world's
+/// extra components, appended to the model's circuit): each numeric member
+/// of "nodes" and "components" outside its typical range, as
+/// "file: prefix.components[i].field: ...". Members the compiler would
+/// refuse are left to it.
+void hyd_json_fragment_notes(const struct cJSON* fragment, const char* file, const char* prefix);
+/// A number for a message as a user writes it: 22, 0.005, 1e5, 2.5e9 (6
+/// significant digits; %g would give 100000 and 2.5e+09).
+void hyd_fmt_num(char* out, size_t n, double v);
 /// The model's current definition (fluid, nodes, components with every
 /// parameter, including live changes) as a new cJSON object; the caller frees
 /// it with cJSON_Delete. NULL if out of memory.

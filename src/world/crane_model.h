@@ -18,6 +18,14 @@ extern "C" {
 
 #define CRANE_NAME 48
 
+/// Tip load [kg] (mechanics.load_mass, a scenario's load_mass, --load): at
+/// most CRANE_LOAD_MAX, a note above CRANE_LOAD_TYPICAL. 3000 kg already
+/// opens the port reliefs of the HIAB-031-class crane (the overload
+/// scenario); 10 t is beyond any crane of this size, and 100 t peaked at
+/// 1.05 GPa in a run that exited 0.
+#define CRANE_LOAD_MAX 1e4
+#define CRANE_LOAD_TYPICAL 3000.0
+
 /// One boom (rigid link).
 typedef struct crane_link {
     char name[CRANE_NAME];

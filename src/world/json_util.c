@@ -1,6 +1,8 @@
 // json_util.c: see json_util.h.
 #include "json_util.h"
 
+#include "hydraulics.h"
+
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -57,7 +59,16 @@ static int check_numbers(const char* text, const char* path, char* err, size_t e
     for (const char* p = text; *p;) {
         if (*p == '"') { // skip the string, escapes included
             for (++p, ++col; *p && *p != '"'; ++p, ++col)
-                if (*p == '\\' && p[1]) ++p, ++col;
+                if (*p == '\\' && p[1]) {
+                    // cJSON ends the string at an escaped NUL: "lift\u0000_cyl"
+                    // would silently become "lift".
+                    if (!strncmp(p, "\\u0000", 6)) {
+                        snprintf(err, errsz, "%s: line %d, column %d: \\u0000 (a NUL character) is not allowed in a string",
+                                 path, line, col);
+                        return -1;
+                    }
+                    ++p, ++col;
+                }
             if (*p) ++p, ++col;
             continue;
         }
@@ -80,24 +91,78 @@ static int check_numbers(const char* text, const char* path, char* err, size_t e
     return 0;
 }
 
+// One member of an object, for the duplicate search: its key and its place.
+typedef struct key_pos {
+    const char* key;
+    int pos;
+} key_pos;
+
+static int cmp_key_pos(const void* a, const void* b) {
+    const key_pos *x = a, *y = b;
+    int d = strcmp(x->key, y->key);
+    return d ? d : (x->pos > y->pos) - (x->pos < y->pos);
+}
+
+// The key of node's first member (in document order) that is given again
+// later in the same object, or NULL. Sorting the keys makes this O(n log n):
+// the pairwise scan it replaces took 17 minutes on an object of 800,000 keys.
+// Small objects (every object of a shipped file: the largest, sandbox.json's
+// truck, has 17 members) keep the pairwise scan, which needs no allocation.
+// Sets *oom when the sort buffer cannot be had.
+static const char* first_duplicate(const cJSON* node, bool* oom) {
+    int n = 0;
+    for (const cJSON* it = node->child; it; it = it->next) ++n;
+    if (n <= 32) {
+        for (const cJSON* it = node->child; it; it = it->next)
+            for (const cJSON* later = it->next; later; later = later->next)
+                if (it->string && later->string && !strcmp(it->string, later->string)) return it->string;
+        return NULL;
+    }
+    key_pos* k = malloc((size_t)n * sizeof *k);
+    if (!k) {
+        *oom = true;
+        return NULL;
+    }
+    int m = 0, i = 0;
+    for (const cJSON* it = node->child; it; it = it->next, ++i)
+        if (it->string) k[m++] = (key_pos){it->string, i};
+    qsort(k, (size_t)m, sizeof *k, cmp_key_pos);
+    // Equal keys are now adjacent, each run in document order: the run whose
+    // first member comes earliest is the one the pairwise scan would report.
+    const char* dup = NULL;
+    int dup_pos = n;
+    for (int j = 1; j < m; ++j)
+        if (!strcmp(k[j - 1].key, k[j].key) && (j == 1 || strcmp(k[j - 2].key, k[j].key)) && k[j - 1].pos < dup_pos) {
+            dup = k[j - 1].key;
+            dup_pos = k[j - 1].pos;
+        }
+    free(k);
+    return dup;
+}
+
 // Reject an object member given twice: cJSON keeps both and every lookup
 // finds the first, so the second would be silently ignored.
 static int check_duplicates(const cJSON* node, const char* at, const char* path, char* err, size_t errsz) {
+    char p[256];
+    if (cJSON_IsObject(node)) {
+        bool oom = false;
+        const char* dup = first_duplicate(node, &oom);
+        if (oom) {
+            snprintf(err, errsz, "%s: out of memory", path);
+            return -1;
+        }
+        if (dup) {
+            json_path(p, sizeof p, at, dup);
+            snprintf(err, errsz, "%s: %s: given twice (duplicate field)", path, p);
+            return -1;
+        }
+    }
     int i = 0;
     for (const cJSON* it = node ? node->child : NULL; it; it = it->next, ++i) {
-        char p[256];
-        if (cJSON_IsObject(node)) {
-            for (const cJSON* later = it->next; later; later = later->next)
-                if (it->string && later->string && !strcmp(it->string, later->string)) {
-                    json_path(p, sizeof p, at, it->string);
-                    snprintf(err, errsz, "%s: %s: given twice (duplicate field)", path, p);
-                    return -1;
-                }
-            json_path(p, sizeof p, at, it->string ? it->string : "?");
-        } else {
-            json_path_index(p, sizeof p, at, i);
-        }
-        if ((cJSON_IsObject(it) || cJSON_IsArray(it)) && check_duplicates(it, p, path, err, errsz)) return -1;
+        if (!cJSON_IsObject(it) && !cJSON_IsArray(it)) continue;
+        if (cJSON_IsObject(node)) json_path(p, sizeof p, at, it->string ? it->string : "?");
+        else json_path_index(p, sizeof p, at, i);
+        if (check_duplicates(it, p, path, err, errsz)) return -1;
     }
     return 0;
 }
@@ -108,6 +173,13 @@ cJSON* json_load_file(const char* path, char* err, size_t errsz) {
         snprintf(err, errsz, "%s: not a regular file", path);
         return NULL;
     }
+    // Refused before reading: parsing costs about 20 bytes of memory per
+    // byte of text (a 59 MB scenario took 1.2 GB before it was refused).
+    if (stat(path, &st) == 0 && st.st_size > JSON_MAX_FILE_BYTES) {
+        snprintf(err, errsz, "%s: too large (%lld bytes; input files are limited to %ld bytes, docs/files.md)", path,
+                 (long long)st.st_size, (long)JSON_MAX_FILE_BYTES);
+        return NULL;
+    }
     FILE* f = fopen(path, "rb");
     if (!f) {
         snprintf(err, errsz, "%s: cannot open: %s", path, strerror(errno));
@@ -116,7 +188,7 @@ cJSON* json_load_file(const char* path, char* err, size_t errsz) {
     fseek(f, 0, SEEK_END);
     long n = ftell(f);
     fseek(f, 0, SEEK_SET);
-    if (n < 0 || n > (64L << 20)) {
+    if (n < 0 || n > JSON_MAX_FILE_BYTES) {
         fclose(f);
         snprintf(err, errsz, "%s: cannot read (size %ld bytes)", path, n);
         return NULL;
@@ -130,23 +202,48 @@ cJSON* json_load_file(const char* path, char* err, size_t errsz) {
     size_t got = fread(buf, 1, (size_t)n, f);
     fclose(f);
     buf[got] = 0;
+    cJSON* root = json_parse(buf, path, err, errsz);
+    free(buf);
+    return root;
+}
+
+cJSON* json_parse(const char* text, const char* name, char* err, size_t errsz) {
     const char* end = NULL;
-    cJSON* root = cJSON_ParseWithOpts(buf, &end, 1);
+    cJSON* root = cJSON_ParseWithOpts(text, &end, 1);
     if (!root) {
         // Report line and column of the parse failure: the one thing a user
         // needs to find a missing comma.
         const char* at = end ? end : cJSON_GetErrorPtr();
         int line = 1, col = 1;
-        for (const char* p = buf; at && p < at && *p; ++p) {
+        for (const char* p = text; at && p < at && *p; ++p) {
             if (*p == '\n') { ++line; col = 1; } else ++col;
         }
-        snprintf(err, errsz, "%s: line %d, column %d: invalid JSON", path, line, col);
-    } else if (check_numbers(buf, path, err, errsz) || check_duplicates(root, "", path, err, errsz)) {
+        snprintf(err, errsz, "%s: line %d, column %d: invalid JSON", name, line, col);
+    } else if (check_numbers(text, name, err, errsz) || check_duplicates(root, "", name, err, errsz)) {
         cJSON_Delete(root);
         root = NULL;
     }
-    free(buf);
     return root;
+}
+
+const char* json_file_kind(const cJSON* root) {
+    if (!cJSON_IsObject(root)) return NULL;
+    if (cJSON_GetObjectItemCaseSensitive(root, "mechanics") || cJSON_GetObjectItemCaseSensitive(root, "hydraulics"))
+        return "model";
+    if (cJSON_GetObjectItemCaseSensitive(root, "type")) return "world";
+    if (cJSON_GetObjectItemCaseSensitive(root, "duration") || cJSON_GetObjectItemCaseSensitive(root, "commands"))
+        return "scenario";
+    return NULL;
+}
+
+bool json_wrong_kind(json_ctx* c, const cJSON* root, const char* want) {
+    const char* k = json_file_kind(root);
+    if (!k || !strcmp(k, want) || c->failed) return false;
+    c->failed = true;
+    if (c->err && c->errsz)
+        snprintf(c->err, c->errsz, "%s: this is a %s file (use --%s), not a %s", c->file ? c->file : "(input)", k, k,
+                 want);
+    return true;
 }
 
 void json_path(char* out, size_t n, const char* parent, const char* key) {
@@ -208,10 +305,80 @@ double json_num(json_ctx* c, const cJSON* obj, const char* path, const char* key
         return def;
     }
     double x = v->valuedouble;
-    if (!isfinite(x)) json_fail(c, full, "must be finite");
+    if (!isfinite(x)) json_fail(c, full, "must be a finite number");
     else if (x < lo) json_fail(c, full, "must be >= %g, got %g", lo, x);
     else if (x > hi) json_fail(c, full, "must be <= %g, got %g", hi, x);
     return x;
+}
+
+void json_note(json_ctx* c, const char* path, const char* fmt, ...) {
+    if (c->nnotes >= JSON_MAX_NOTES) return;
+    char* out = c->notes[c->nnotes++];
+    const size_t n = sizeof c->notes[0];
+    int k = snprintf(out, n, "%s: %s: ", c->file ? c->file : "(input)", path && *path ? path : "(top level)");
+    if (k < 0 || (size_t)k >= n) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(out + k, n - (size_t)k, fmt, ap);
+    va_end(ap);
+}
+
+void json_flush_notes(json_ctx* c) {
+    if (!c->failed)
+        for (int i = 0; i < c->nnotes; ++i) hyd_note(c->notes[i]);
+    c->nnotes = 0;
+}
+
+// "[lo, hi] unit" as a user writes it ("[1, 1e5] kg").
+static void range_text(char* out, size_t n, double lo, double hi, const char* unit) {
+    char a[24], b[24];
+    hyd_fmt_num(a, sizeof a, lo);
+    hyd_fmt_num(b, sizeof b, hi);
+    snprintf(out, n, "[%s, %s]%s%s", a, b, unit && *unit ? " " : "", unit ? unit : "");
+}
+
+void json_range_check(json_ctx* c, const char* full, double v, const json_range* r) {
+    if (c->failed) return;
+    char got[24], rng[80];
+    hyd_fmt_num(got, sizeof got, v);
+    if (!isfinite(v)) {
+        json_fail(c, full, "must be a finite number");
+    } else if (r->lo > 0 && !(v > 0)) {
+        json_fail(c, full, "must be > 0, got %s", got);
+    } else if (v < r->lo || v > r->hi) {
+        range_text(rng, sizeof rng, r->lo, r->hi, r->unit);
+        json_fail(c, full, "must be in %s, got %s", rng, got);
+    } else if (v < r->tlo || v > r->thi) {
+        range_text(rng, sizeof rng, r->tlo, r->thi, r->unit);
+        json_note(c, full, "%s%s%s is outside the typical range %s", got, r->unit && *r->unit ? " " : "",
+                  r->unit ? r->unit : "", rng);
+    }
+}
+
+double json_num_r(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                  double def, const json_range* r) {
+    char full[256];
+    const cJSON* v = member(c, obj, path, key, required, full, sizeof full);
+    if (!v) return def;
+    if (!cJSON_IsNumber(v)) {
+        json_fail(c, full, "must be a number, got %s", type_name(v));
+        return def;
+    }
+    json_range_check(c, full, v->valuedouble, r);
+    return v->valuedouble;
+}
+
+void json_vec_r(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                double* out, int n, const json_range* r) {
+    char full[256];
+    json_path(full, sizeof full, path, key);
+    if (!required && !cJSON_GetObjectItemCaseSensitive(obj, key)) return;
+    json_vec(c, obj, path, key, required, out, n);
+    for (int i = 0; i < n && !c->failed; ++i) {
+        char p[272];
+        json_path_index(p, sizeof p, full, i);
+        json_range_check(c, p, out[i], r);
+    }
 }
 
 double json_pos(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
@@ -229,7 +396,9 @@ int json_int(json_ctx* c, const cJSON* obj, const char* path, const char* key, b
     json_path(full, sizeof full, path, key);
     double x = json_num(c, obj, path, key, required, def, lo, hi);
     if (!c->failed && x != floor(x)) json_fail(c, full, "must be a whole number, got %g", x);
-    return (int)x;
+    // Converted only once it is known to fit: (int)2e67 is undefined
+    // behaviour (it gave INT_MIN here), so a failed field yields def.
+    return c->failed ? def : (int)x;
 }
 
 bool json_bool(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool def) {
@@ -273,7 +442,8 @@ void json_vec(json_ctx* c, const cJSON* obj, const char* path, const char* key, 
         if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) {
             char p[272];
             json_path_index(p, sizeof p, full, i);
-            json_fail(c, p, "must be a finite number, got %s", type_name(e));
+            if (cJSON_IsNumber(e)) json_fail(c, p, "must be a finite number");
+            else json_fail(c, p, "must be a finite number, got %s", type_name(e));
             return;
         }
         out[i] = e->valuedouble;
@@ -377,6 +547,25 @@ static bool value_numbers_ok(const char* v) {
     return check_numbers(v, "", e, sizeof e) == 0;
 }
 
+// Why segment seg names nothing below node (at: its path): an index past the
+// end of an array says so with the length, an unknown name says "no field".
+static void set_path_missing(const char* assignment, const cJSON* node, const char* at, const path_seg* seg,
+                             char* err, size_t errsz) {
+    const bool digits = seg->key[0] && strspn(seg->key, "0123456789") == strlen(seg->key);
+    if (cJSON_IsArray(node) && digits) {
+        const int n = cJSON_GetArraySize(node);
+        snprintf(err, errsz, "--set '%s': index %s out of range: %s has %d element%s (0..%d)", assignment, seg->key,
+                 at, n, n == 1 ? "" : "s", n - 1);
+    } else if (cJSON_IsArray(node)) {
+        snprintf(err, errsz, "--set '%s': no element named '%s' in %s", assignment, seg->key, at);
+    } else if (seg->index) {
+        snprintf(err, errsz, "--set '%s': %s is not an array (index [%s])", assignment, at, seg->key);
+    } else {
+        snprintf(err, errsz, "--set '%s': no field '%s' in the model%s%s", assignment, seg->key, at[0] ? " under " : "",
+                 at);
+    }
+}
+
 int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) {
     // Messages quote the whole argument: it is what the user typed.
     const char* eq = strchr(assignment, '=');
@@ -402,21 +591,20 @@ int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) 
         return -1;
     }
     cJSON* parent = root;
-    for (int i = 0; i < nseg - 1; ++i) {
-        parent = child_by_segment(parent, &segs[i]);
-        if (!parent) {
-            snprintf(err, errsz, "--set '%s': no field '%s%s%s' in the model", assignment, segs[i].index ? "[" : "",
-                     segs[i].key, segs[i].index ? "]" : "");
+    cJSON* old = NULL;
+    char at[256] = ""; // the path walked so far, for messages
+    for (int i = 0; i < nseg; ++i) {
+        cJSON* next = child_by_segment(parent, &segs[i]);
+        if (!next) {
+            set_path_missing(assignment, parent, at, &segs[i], err, errsz);
             return -1;
         }
+        const size_t L = strlen(at);
+        snprintf(at + L, sizeof at - L, segs[i].index ? "[%s]" : (L ? ".%s" : "%s"), segs[i].key);
+        if (i < nseg - 1) parent = next;
+        else old = next;
     }
     const path_seg* last = &segs[nseg - 1];
-    cJSON* old = child_by_segment(parent, last);
-    if (!old) {
-        snprintf(err, errsz, "--set '%s': no field '%s%s%s' in the model", assignment, last->index ? "[" : "",
-                 last->key, last->index ? "]" : "");
-        return -1;
-    }
     // The whole value must be one JSON value: "5 xyz", "5,6" or "5}" are
     // typos, not 5 (cJSON alone stops at the end of the first value).
     const char* vend = NULL;

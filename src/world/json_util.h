@@ -15,21 +15,42 @@
 extern "C" {
 #endif
 
+#define JSON_MAX_NOTES 8
+
 typedef struct json_ctx {
     const char* file; ///< file name used in messages
     char* err;        ///< caller's buffer for the first error
     size_t errsz;
     bool failed;
+    int nnotes; ///< queued notes (json_note), sent by json_flush_notes
+    char notes[JSON_MAX_NOTES][200];
 } json_ctx;
 
 /// Record an error "file: path: message" (printf-style message). First one wins.
 void json_fail(json_ctx* c, const char* path, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-/// Read and parse a whole file. NULL with "file: line L, column C: message" on
+/// Largest input file accepted [bytes]: 1 MiB, over 100 times the largest
+/// shipped file (sandbox.json, 7.7 kB). Checked before reading.
+#define JSON_MAX_FILE_BYTES (1L << 20)
+
+/// Read and parse a whole file. A file over JSON_MAX_FILE_BYTES is refused
+/// before it is read: "file: too large (N bytes; ...)". NULL with "file: line L, column C: message" on
 /// a syntax error, also for a number JSON does not allow (00.1, 1.), and
 /// "file: field.path: given twice (duplicate field)" for a repeated member.
 cJSON* json_load_file(const char* path, char* err, size_t errsz);
+
+/// The checks of json_load_file on a text in memory (name is used in messages).
+cJSON* json_parse(const char* text, const char* name, char* err, size_t errsz);
+
+/// What kind of cranesim file a document looks like, from the members only
+/// that kind has: "model" (mechanics, hydraulics), "world" (type),
+/// "scenario" (duration, commands), or NULL.
+const char* json_file_kind(const cJSON* root);
+/// If root looks like another kind of file than want ("model", "scenario",
+/// "world"), fail with "file: this is a scenario file (use --scenario), not a
+/// model" and return true: better than "duration: unknown field".
+bool json_wrong_kind(json_ctx* c, const cJSON* root, const char* want);
 
 /// Join a parent path and a key ("a.b" + "c" -> "a.b.c"; "" + "c" -> "c").
 void json_path(char* out, size_t n, const char* parent, const char* key);
@@ -46,6 +67,32 @@ const cJSON* json_arr(json_ctx* c, const cJSON* obj, const char* path, const cha
 /// Absent and not required: returns def.
 double json_num(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
                 double def, double lo, double hi);
+/// Physically meaningful range of a value. Outside [lo, hi] (hard) the file
+/// is refused: "must be in [1, 1e5] kg, got 1e-300" ("must be > 0, got -3"
+/// for a non-positive value when lo > 0). Outside [tlo, thi] (typical) the
+/// load goes on with a note: "note: file: path: 6000 kg is outside the
+/// typical range [20, 5000] kg". unit is printed after the range ("" for none).
+typedef struct json_range {
+    double lo, hi;
+    double tlo, thi;
+    const char* unit;
+} json_range;
+
+/// Number checked against a json_range (notes are queued in the context and
+/// sent by json_flush_notes).
+double json_num_r(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                  double def, const json_range* r);
+/// Fixed-length number array, every element checked against r.
+void json_vec_r(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                double* out, int n, const json_range* r);
+/// Check a value already read (full: its whole path) against r.
+void json_range_check(json_ctx* c, const char* full, double v, const json_range* r);
+/// Queue a note "file: path: message" (at most JSON_MAX_NOTES per load).
+void json_note(json_ctx* c, const char* path, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+/// Send the queued notes (hyd_note: stderr by default) if the load succeeded;
+/// a refused file gets its error line only.
+void json_flush_notes(json_ctx* c);
+
 /// Number that must be > 0.
 double json_pos(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
                 double def);

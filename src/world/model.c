@@ -1,6 +1,7 @@
 // model.c: load and validate a crane model file.
 #include "model.h"
 
+#include "hydraulics.h"
 #include "json_util.h"
 
 #include <stdio.h>
@@ -27,6 +28,23 @@ const char* model_default_path(void) {
     return path;
 }
 
+// Hard and typical ranges of the mechanical values (docs/model.md, "Value
+// ranges"). Hard: outside it a value is a typo or a unit slip that the
+// integrators meet as an abort or a plausible wrong answer (a link mass of
+// 1e-300 kg aborted ODE); typical: a crane of the HIAB 031 class and its
+// relatives up to a few tonnes of lifting capacity.
+static const json_range R_GRAVITY = {0, 30, 9.7, 9.9, "m/s^2"};
+static const json_range R_COLUMN_HEIGHT = {0.1, 10, 0.5, 4, "m"};
+static const json_range R_COLUMN_MASS = {1, 1e5, 50, 5000, "kg"};
+static const json_range R_LINK_LENGTH = {0.1, 30, 0.5, 10, "m"};
+static const json_range R_LINK_MASS = {1, 1e5, 20, 5000, "kg"};
+static const json_range R_LINK_COM = {0, 30, 0, 10, "m"};
+static const json_range R_LINK_INERTIA = {1e-3, 1e7, 1, 1e5, "kg m^2"};
+static const json_range R_LINK_SECTION = {0.01, 2, 0.05, 0.6, "m"};
+static const json_range R_LOAD = {0, CRANE_LOAD_MAX, 0, CRANE_LOAD_TYPICAL, "kg"};
+static const json_range R_MOUNT = {-10, 10, -3, 3, "m"};
+static const json_range R_CLOSED_LENGTH = {0.05, 20, 0.3, 5, "m"};
+
 static void load_link(json_ctx* c, const cJSON* arr, int i, crane_link* l) {
     char p[64];
     json_path_index(p, sizeof p, "mechanics.links", i);
@@ -38,9 +56,9 @@ static void load_link(json_ctx* c, const cJSON* arr, int i, crane_link* l) {
     static const char* const keys[] = {"name", "length", "mass", "com", "inertia", "width", "height", NULL};
     json_only_keys(c, o, p, keys);
     json_str(c, o, p, "name", false, i ? "end_arm" : "lifting_arm", l->name, sizeof l->name);
-    l->length = json_pos(c, o, p, "length", true, 0);
-    l->mass = json_pos(c, o, p, "mass", true, 0);
-    l->com = json_num(c, o, p, "com", true, 0, 0, 100);
+    l->length = json_num_r(c, o, p, "length", true, 0, &R_LINK_LENGTH);
+    l->mass = json_num_r(c, o, p, "mass", true, 0, &R_LINK_MASS);
+    l->com = json_num_r(c, o, p, "com", true, 0, &R_LINK_COM);
     // A centre of mass past the link's end is a typo (a point mass beyond the
     // tip belongs in load_mass), and a zero inertia is a body ODE cannot
     // integrate (its mass matrix must be positive definite).
@@ -48,9 +66,23 @@ static void load_link(json_ctx* c, const cJSON* arr, int i, crane_link* l) {
     json_path(f, sizeof f, p, "com");
     if (!c->failed && l->com > l->length)
         json_fail(c, f, "must lie on the link (0..length %g m), got %g m", l->length, l->com);
-    l->inertia = json_pos(c, o, p, "inertia", true, 0);
-    l->width = json_pos(c, o, p, "width", false, 0.18);
-    l->height = json_pos(c, o, p, "height", false, 0.24);
+    l->inertia = json_num_r(c, o, p, "inertia", true, 0, &R_LINK_INERTIA);
+    l->width = json_num_r(c, o, p, "width", false, 0.18, &R_LINK_SECTION);
+    l->height = json_num_r(c, o, p, "height", false, 0.24, &R_LINK_SECTION);
+    // A boom's inertia about its centre of mass is near that of a uniform
+    // box, m (length^2 + height^2) / 12: a thin-walled section is at most
+    // about 1.3 times it, mass gathered at both ends 3 times, a point mass
+    // 0. Far outside [0.2, 4] times is more likely a slip (kg m^2 vs kg cm^2)
+    // than a design.
+    const double box = l->mass * (l->length * l->length + l->height * l->height) / 12.0;
+    if (!c->failed && (l->inertia < 0.2 * box || l->inertia > 4.0 * box)) {
+        char f2[80], v[24], b[24];
+        json_path(f2, sizeof f2, p, "inertia");
+        hyd_fmt_num(v, sizeof v, l->inertia);
+        hyd_fmt_num(b, sizeof b, box);
+        json_note(c, f2, "%s kg m^2 is outside the typical range [0.2, 4] times a uniform box of this mass and size "
+                         "(%s kg m^2)", v, b);
+    }
 }
 
 static void load_actuator(json_ctx* c, const cJSON* arr, int i, crane_actuator* a) {
@@ -69,9 +101,9 @@ static void load_actuator(json_ctx* c, const cJSON* arr, int i, crane_actuator* 
     if (!c->failed && a->joint != i) json_fail(c, p, "actuator %d must act on joint %d", i, i);
     json_str(c, o, p, "cylinder", true, "", a->cylinder, sizeof a->cylinder);
     json_str(c, o, p, "valve", true, "", a->valve, sizeof a->valve);
-    json_vec(c, o, p, "base_mount", true, a->base_mount, 2);
-    json_vec(c, o, p, "rod_mount", true, a->rod_mount, 2);
-    a->closed_length = json_pos(c, o, p, "closed_length", true, 0);
+    json_vec_r(c, o, p, "base_mount", true, a->base_mount, 2, &R_MOUNT);
+    json_vec_r(c, o, p, "rod_mount", true, a->rod_mount, 2, &R_MOUNT);
+    a->closed_length = json_num_r(c, o, p, "closed_length", true, 0, &R_CLOSED_LENGTH);
 }
 
 model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
@@ -85,6 +117,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     snprintf(m->file, sizeof m->file, "%s", file);
     json_ctx c = {.file = file, .err = err, .errsz = errsz};
     if (!cJSON_IsObject(root)) json_fail(&c, "", "a model must be a JSON object");
+    if (json_wrong_kind(&c, root, "model")) goto fail;
     static const char* const keys[] = {"name", "description", "mechanics", "hydraulics", NULL};
     json_only_keys(&c, root, "", keys);
     json_str(&c, root, "", "name", false, "crane", m->name, sizeof m->name);
@@ -93,11 +126,11 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     const cJSON* mech = json_obj(&c, root, "", "mechanics", true);
     static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", NULL};
     json_only_keys(&c, mech, "mechanics", mkeys);
-    me->gravity = json_num(&c, mech, "mechanics", "gravity", false, 9.81, 0, 100);
+    me->gravity = json_num_r(&c, mech, "mechanics", "gravity", false, 9.81, &R_GRAVITY);
     const cJSON* col = json_obj(&c, mech, "mechanics", "column", true);
     json_only_keys(&c, col, "mechanics.column", (const char* const[]){"height", "mass", NULL});
-    me->column_height = json_pos(&c, col, "mechanics.column", "height", true, 0);
-    me->column_mass = json_pos(&c, col, "mechanics.column", "mass", false, 250);
+    me->column_height = json_num_r(&c, col, "mechanics.column", "height", true, 0, &R_COLUMN_HEIGHT);
+    me->column_mass = json_num_r(&c, col, "mechanics.column", "mass", false, 250, &R_COLUMN_MASS);
     const cJSON* links = json_arr(&c, mech, "mechanics", "links", true);
     if (links && cJSON_GetArraySize(links) != 2) json_fail(&c, "mechanics.links", "must list exactly 2 links");
     for (int i = 0; i < 2 && !c.failed; ++i) load_link(&c, links, i, &me->link[i]);
@@ -105,7 +138,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     // equal names would make the second unreachable.
     if (!c.failed && !strcmp(me->link[0].name, me->link[1].name))
         json_fail(&c, "mechanics.links[1].name", "\"%s\" is already the name of links[0]", me->link[1].name);
-    me->load_mass = json_num(&c, mech, "mechanics", "load_mass", true, 0, 0, 1e5);
+    me->load_mass = json_num_r(&c, mech, "mechanics", "load_mass", true, 0, &R_LOAD);
     const cJSON* acts = json_arr(&c, mech, "mechanics", "actuators", true);
     if (acts && cJSON_GetArraySize(acts) != 2)
         json_fail(&c, "mechanics.actuators", "must list exactly 2 actuators (lift, jib)");
@@ -113,6 +146,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     if (!c.failed && !strcmp(me->act[0].name, me->act[1].name))
         json_fail(&c, "mechanics.actuators[1].name", "\"%s\" is already the name of actuators[0]", me->act[1].name);
     if (c.failed) goto fail;
+    json_flush_notes(&c);
     crane_mech_derive(me);
 
     const cJSON* hyd = json_obj(&c, root, "", "hydraulics", true);

@@ -227,6 +227,11 @@ static void block_pattern(ode_world* w) {
     }
 }
 
+static void ow_silent_note(const char* line, void* user) {
+    (void)line;
+    (void)user;
+}
+
 int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz) {
     const char* mfile = w->opt.model_file;
     const int sandbox = w->kind == WORLD_SANDBOX;
@@ -235,8 +240,17 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
         snprintf(err, errsz, "%s: hydraulics: out of memory", mfile);
         return -1;
     }
+    // The merged circuit's notes would call the world's components
+    // hydraulics.components[18..] of the model: the model's were given when
+    // it was loaded, the world's are given below under the world file.
+    void* note_user;
+    const hyd_note_fn note_prev = hyd_get_note_handler(&note_user);
+    hyd_set_note_handler(ow_silent_note, NULL);
     w->hm = hyd_model_from_json(merged, mfile, "hydraulics", err, errsz);
+    hyd_set_note_handler(note_prev, note_user);
     cJSON_Delete(merged);
+    if (w->hm && sandbox && extra)
+        hyd_json_fragment_notes(extra, w->desc.file[0] ? w->desc.file : "world", "circuit");
     if (!w->hm) {
         // Blame the world file when the model's own circuit is fine: the
         // problem is then in the appended nodes/components.

@@ -1,6 +1,7 @@
 // scenario.c: scenario loading and command interpolation.
 #include "scenario.h"
 
+#include "crane_model.h"
 #include "json_util.h"
 
 #include <math.h>
@@ -11,6 +12,13 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
+
+// Ranges (docs/files.md, "Value ranges"): a day of simulated time is far
+// beyond any study (the longest shipped scenario is 60 s), and the tip load
+// shares the model's range.
+static const json_range R_DURATION = {1e-3, 86400, 1e-3, 3600, "s"};
+static const json_range R_TIME = {0, 86400, 0, 86400, "s"};
+static const json_range R_LOAD = {0, CRANE_LOAD_MAX, 0, CRANE_LOAD_TYPICAL, "kg"};
 
 const char* const scenario_cmd_name[SCENARIO_NCMD] = {"lift", "jib", "slew"};
 
@@ -32,7 +40,10 @@ static void load_signal(json_ctx* c, const cJSON* arr, const char* path, scenari
             return;
         }
         double t = cJSON_GetArrayItem(pt, 0)->valuedouble, u = cJSON_GetArrayItem(pt, 1)->valuedouble;
-        if (!isfinite(t) || t < 0) json_fail(c, p, "time must be >= 0, got %g", t);
+        // inf (a time of 1e400) is not a time at all; say so rather than
+        // "must be >= 0, got inf".
+        if (!isfinite(t) || !isfinite(u)) json_fail(c, p, "must be a finite number (a [t, u] pair)");
+        else if (t < 0 || t > R_TIME.hi) json_fail(c, p, "time must be in [0, %g] s, got %g", R_TIME.hi, t);
         else if (i > 0 && t < sig->t[i - 1]) json_fail(c, p, "times must not decrease (%g after %g)", t, sig->t[i - 1]);
         else if (!isfinite(u) || u < -1 || u > 1) json_fail(c, p, "command must be in [-1, 1], got %g", u);
         sig->t[i] = t;
@@ -48,14 +59,15 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
         json_fail(&c, "", "a scenario must be a JSON object");
         return -1;
     }
+    if (json_wrong_kind(&c, root, "scenario")) return -1;
     static const char* const keys[] = {"name", "description", "model", "duration", "load_mass",
                                        "initial", "commands", "hook", NULL};
     json_only_keys(&c, root, "", keys);
     json_str(&c, root, "", "name", false, "", s->name, sizeof s->name);
     json_str(&c, root, "", "description", false, "", s->description, sizeof s->description);
     json_str(&c, root, "", "model", false, "", s->model, sizeof s->model);
-    s->duration = json_pos(&c, root, "", "duration", true, 0);
-    s->load_mass = json_num(&c, root, "", "load_mass", false, -1.0, 0.0, 1e5);
+    s->duration = json_num_r(&c, root, "", "duration", true, 0, &R_DURATION);
+    s->load_mass = json_num_r(&c, root, "", "load_mass", false, -1.0, &R_LOAD);
 
     const cJSON* ini = json_obj(&c, root, "", "initial", true);
     static const char* const ikeys[] = {"q1_deg", "q2_deg", "slew_deg", NULL};
@@ -90,6 +102,10 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
                 json_fail(&c, p, "event must be \"attach\" or \"release\", got \"%s\"", k->valuestring);
                 break;
             }
+            if (!isfinite(t->valuedouble)) {
+                json_fail(&c, p, "time must be a finite number");
+                break;
+            }
             if (t->valuedouble < 0 || (i > 0 && t->valuedouble < s->event[i - 1].t)) {
                 json_fail(&c, p, "event times must be >= 0 and not decrease");
                 break;
@@ -99,6 +115,7 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
             s->nevent = i + 1;
         }
     }
+    json_flush_notes(&c);
     return c.failed ? -1 : 0;
 }
 

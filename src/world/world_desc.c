@@ -1,7 +1,13 @@
 // world_desc.c: world file loading (schema in docs/ode_world.md).
 #include "world_desc.h"
 
+#include "hydraulics.h"
 #include "json_util.h"
+#include "model.h"
+
+#include <dirent.h>
+#include <stdlib.h>
+#include <sys/stat.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -119,6 +125,44 @@ double world_desc_terrain_height(const world_desc* w, double x, double y) {
     return h;
 }
 
+// Hard and typical ranges of the world's values (docs/ode_world.md, "Value
+// ranges"). Hard: ODE aborts the process (dxNormalize, dCollideHeightfield)
+// on a truck of 1e308 kg, a load 1e308 m long or a truck 1e30 m away, and
+// values like that are typos; typical: a truck-mounted crane's yard.
+static const json_range R_GRAVITY = {0, 30, 9.7, 9.9, "m/s^2"};
+static const json_range R_TERRAIN_SIZE = {10, 1e4, 20, 2000, "m"};
+static const json_range R_FLAT_RADIUS = {0, 1e4, 5, 500, "m"};
+static const json_range R_FRICTION = {0, 10, 0.1, 1.5, ""};
+static const json_range R_HILL_XY = {-1e4, 1e4, -1e3, 1e3, "m"};
+static const json_range R_HILL_RADIUS = {0.1, 1e4, 1, 200, "m"};
+static const json_range R_HILL_HEIGHT = {-100, 100, -20, 20, "m"};
+static const json_range R_TRUCK_MASS = {100, 1e6, 2000, 6e4, "kg"};
+static const json_range R_TRUCK_SIZE = {0.05, 30, 0.2, 15, "m"};
+static const json_range R_TRUCK_X = {-20, 20, -10, 10, "m"};
+static const json_range R_BED_HEIGHT = {0.2, 5, 0.6, 2, "m"};
+static const json_range R_WHEEL_RADIUS = {0.1, 2, 0.2, 0.8, "m"};
+static const json_range R_WHEEL_WIDTH = {0.05, 2, 0.1, 0.6, "m"};
+static const json_range R_TRACK = {0.5, 5, 1.2, 2.6, "m"};
+static const json_range R_SPAN = {0.5, 20, 2, 10, "m"};
+static const json_range R_PAD = {0.01, 3, 0.05, 1, "m"};
+static const json_range R_PINION = {0.01, 1, 0.03, 0.3, "m"};
+static const json_range R_COLUMN_RADIUS = {0.02, 2, 0.05, 0.5, "m"};
+static const json_range R_SLEW_DAMPING = {0, 1e7, 0, 1e5, "N m s/rad"};
+static const json_range R_ROPE_LENGTH = {0.2, 50, 0.5, 10, "m"};
+static const json_range R_ROPE_RADIUS = {0.002, 0.2, 0.005, 0.05, "m"};
+static const json_range R_ROPE_MASS = {0.01, 100, 0.1, 10, "kg/m"};
+static const json_range R_HOOK_MASS = {0.5, 5000, 5, 500, "kg"};
+static const json_range R_HOOK_SIZE = {0.01, 2, 0.05, 1, "m"};
+static const json_range R_HOOK_REACH = {0.01, 5, 0.1, 2, "m"};
+static const json_range R_LOAD_MASS = {0.1, 1e5, 1, 5000, "kg"};
+static const json_range R_LOAD_SIZE = {0.01, 20, 0.1, 5, "m"};
+static const json_range R_OBST_SIZE = {0.01, 100, 0.1, 50, "m"};
+static const json_range R_OBST_MASS = {0, 1e6, 0, 2e4, "kg"};
+static const json_range R_HEIGHT = {-1, 1e3, -1, 100, "m"}; // z < 0: rest on the ground
+static const json_range R_CONTACT_CFM = {1e-10, 1, 1e-8, 1e-3, ""};
+static const json_range R_MESH_SCALE = {1e-4, 1e4, 1e-3, 1e3, ""};
+static const json_range R_MESH_OFFSET = {-100, 100, -20, 20, "m"};
+
 // Position [x, y] or [x, y, z]; a missing or negative z means "rest on the
 // ground" and is resolved after the terrain is known (z = -1 marks it).
 static void read_position(json_ctx* c, const cJSON* o, const char* path, double* p) {
@@ -143,13 +187,18 @@ static void read_position(json_ctx* c, const cJSON* o, const char* path, double*
 }
 
 static void read_size(json_ctx* c, const cJSON* o, const char* path, const char* key, bool required,
-                      double* v) {
+                      double* v, const json_range* r) {
     char full[256];
     json_path(full, sizeof full, path, key);
     if (!cJSON_GetObjectItemCaseSensitive(o, key) && !required) return;
     json_vec(c, o, path, key, required, v, 3);
     for (int i = 0; i < 3 && !c->failed; ++i)
         if (!(v[i] > 0)) json_fail(c, full, "all sizes must be > 0, got %g", v[i]);
+    for (int i = 0; i < 3 && !c->failed; ++i) {
+        char p[272];
+        json_path_index(p, sizeof p, full, i);
+        json_range_check(c, p, v[i], r);
+    }
 }
 
 static void load_ode(json_ctx* c, const cJSON* o, world_ode_params* p) {
@@ -160,7 +209,9 @@ static void load_ode(json_ctx* c, const cJSON* o, world_ode_params* p) {
     p->erp = json_num(c, o, "ode", "erp", false, p->erp, 0.0, 1.0);
     p->cfm = json_num(c, o, "ode", "cfm", false, p->cfm, 0.0, 1.0);
     p->contact_erp = json_num(c, o, "ode", "contact_erp", false, p->contact_erp, 0.0, 1.0);
-    p->contact_cfm = json_num(c, o, "ode", "contact_cfm", false, p->contact_cfm, 0.0, 1.0);
+    // A contact CFM of 0 makes the contact rows of bodies that start in
+    // touch singular: the fuzzer found ODE aborting (dxNormalize4) on it.
+    p->contact_cfm = json_num_r(c, o, "ode", "contact_cfm", false, p->contact_cfm, &R_CONTACT_CFM);
     p->surface_layer = json_num(c, o, "ode", "surface_layer", false, p->surface_layer, 0.0, 0.1);
     p->max_contacts = json_int(c, o, "ode", "max_contacts", false, p->max_contacts, 1, 32);
 }
@@ -173,18 +224,21 @@ static void load_terrain(json_ctx* c, const cJSON* o, world_terrain* t) {
         json_vec(c, o, "terrain", "size", true, t->size, 2);
         if (!c->failed && !(t->size[0] >= 10 && t->size[1] >= 10))
             json_fail(c, "terrain.size", "must be >= 10 m each way, got [%g, %g]", t->size[0], t->size[1]);
+        json_range_check(c, "terrain.size[0]", t->size[0], &R_TERRAIN_SIZE);
+        json_range_check(c, "terrain.size[1]", t->size[1], &R_TERRAIN_SIZE);
     }
     if (cJSON_GetObjectItemCaseSensitive(o, "samples")) {
         double s[2];
         json_vec(c, o, "terrain", "samples", true, s, 2);
         for (int i = 0; i < 2 && !c->failed; ++i) {
+            // Range first, then the conversion: (int)1e300 is undefined.
             if (s[i] != floor(s[i]) || s[i] < 2 || s[i] > 1024)
                 json_fail(c, "terrain.samples", "must be whole numbers in [2, 1024], got %g", s[i]);
-            t->samples[i] = (int)s[i];
+            else t->samples[i] = (int)s[i];
         }
     }
-    t->flat_radius = json_num(c, o, "terrain", "flat_radius", false, t->flat_radius, 0, 1e4);
-    t->friction = json_num(c, o, "terrain", "friction", false, t->friction, 0, 10);
+    t->flat_radius = json_num_r(c, o, "terrain", "flat_radius", false, t->flat_radius, &R_FLAT_RADIUS);
+    t->friction = json_num_r(c, o, "terrain", "friction", false, t->friction, &R_FRICTION);
     const cJSON* hills = json_arr(c, o, "terrain", "hills", false);
     if (!hills || c->failed) return;
     int n = cJSON_GetArraySize(hills);
@@ -202,10 +256,10 @@ static void load_terrain(json_ctx* c, const cJSON* o, world_terrain* t) {
         }
         json_only_keys(c, h, p, (const char* const[]){"x", "y", "radius", "height", NULL});
         world_hill* g = &t->hill[i];
-        g->x = json_num(c, h, p, "x", true, 0, -1e4, 1e4);
-        g->y = json_num(c, h, p, "y", true, 0, -1e4, 1e4);
-        g->radius = json_pos(c, h, p, "radius", true, 1);
-        g->height = json_num(c, h, p, "height", true, 0, -100, 100);
+        g->x = json_num_r(c, h, p, "x", true, 0, &R_HILL_XY);
+        g->y = json_num_r(c, h, p, "y", true, 0, &R_HILL_XY);
+        g->radius = json_num_r(c, h, p, "radius", true, 1, &R_HILL_RADIUS);
+        g->height = json_num_r(c, h, p, "height", true, 0, &R_HILL_HEIGHT);
         t->nhill = i + 1;
     }
 }
@@ -220,22 +274,21 @@ static void load_truck(json_ctx* c, const cJSON* o, world_truck* k) {
     json_only_keys(c, o, p, keys);
     if (cJSON_GetObjectItemCaseSensitive(o, "position")) json_vec(c, o, p, "position", true, k->position, 2);
     k->yaw = json_num(c, o, p, "yaw_deg", false, k->yaw / DEG, -360, 360) * DEG;
-    k->mass = json_pos(c, o, p, "mass", false, k->mass);
-    read_size(c, o, p, "chassis", false, k->chassis);
-    k->bed_height = json_pos(c, o, p, "bed_height", false, k->bed_height);
-    read_size(c, o, p, "cab", false, k->cab);
-    k->cab_x = json_num(c, o, p, "cab_x", false, k->cab_x, -50, 50);
-    k->wheel_radius = json_pos(c, o, p, "wheel_radius", false, k->wheel_radius);
-    k->wheel_width = json_pos(c, o, p, "wheel_width", false, k->wheel_width);
-    if (cJSON_GetObjectItemCaseSensitive(o, "wheel_x")) json_vec(c, o, p, "wheel_x", true, k->wheel_x, 2);
-    k->track = json_pos(c, o, p, "track", false, k->track);
+    k->mass = json_num_r(c, o, p, "mass", false, k->mass, &R_TRUCK_MASS);
+    read_size(c, o, p, "chassis", false, k->chassis, &R_TRUCK_SIZE);
+    k->bed_height = json_num_r(c, o, p, "bed_height", false, k->bed_height, &R_BED_HEIGHT);
+    read_size(c, o, p, "cab", false, k->cab, &R_TRUCK_SIZE);
+    k->cab_x = json_num_r(c, o, p, "cab_x", false, k->cab_x, &R_TRUCK_X);
+    k->wheel_radius = json_num_r(c, o, p, "wheel_radius", false, k->wheel_radius, &R_WHEEL_RADIUS);
+    k->wheel_width = json_num_r(c, o, p, "wheel_width", false, k->wheel_width, &R_WHEEL_WIDTH);
+    json_vec_r(c, o, p, "wheel_x", false, k->wheel_x, 2, &R_TRUCK_X);
+    k->track = json_num_r(c, o, p, "track", false, k->track, &R_TRACK);
     k->outriggers = json_bool(c, o, p, "outriggers", k->outriggers != 0);
-    if (cJSON_GetObjectItemCaseSensitive(o, "outrigger_x"))
-        json_vec(c, o, p, "outrigger_x", true, k->outrigger_x, 2);
-    k->outrigger_span = json_pos(c, o, p, "outrigger_span", false, k->outrigger_span);
-    read_size(c, o, p, "pad", false, k->pad);
-    k->column_x = json_num(c, o, p, "column_x", false, k->column_x, -50, 50);
-    k->friction = json_num(c, o, p, "friction", false, k->friction, 0, 10);
+    json_vec_r(c, o, p, "outrigger_x", false, k->outrigger_x, 2, &R_TRUCK_X);
+    k->outrigger_span = json_num_r(c, o, p, "outrigger_span", false, k->outrigger_span, &R_SPAN);
+    read_size(c, o, p, "pad", false, k->pad, &R_PAD);
+    k->column_x = json_num_r(c, o, p, "column_x", false, k->column_x, &R_TRUCK_X);
+    k->friction = json_num_r(c, o, p, "friction", false, k->friction, &R_FRICTION);
     if (c->failed) return;
     // The chassis sits on the wheels: the bed must be above the axles, or the
     // wheels would be inside the chassis box.
@@ -251,30 +304,30 @@ static void load_slew(json_ctx* c, const cJSON* o, world_slew* s) {
     if (!o) return;
     static const char* const keys[] = {"pinion_radius", "cylinder", "valve", "column_radius", "damping", NULL};
     json_only_keys(c, o, "slew", keys);
-    s->pinion_radius = json_pos(c, o, "slew", "pinion_radius", false, s->pinion_radius);
+    s->pinion_radius = json_num_r(c, o, "slew", "pinion_radius", false, s->pinion_radius, &R_PINION);
     json_str(c, o, "slew", "cylinder", false, s->cylinder, s->cylinder, sizeof s->cylinder);
     json_str(c, o, "slew", "valve", false, s->valve, s->valve, sizeof s->valve);
-    s->column_radius = json_pos(c, o, "slew", "column_radius", false, s->column_radius);
-    s->damping = json_num(c, o, "slew", "damping", false, s->damping, 0, 1e9);
+    s->column_radius = json_num_r(c, o, "slew", "column_radius", false, s->column_radius, &R_COLUMN_RADIUS);
+    s->damping = json_num_r(c, o, "slew", "damping", false, s->damping, &R_SLEW_DAMPING);
 }
 
 static void load_rope(json_ctx* c, const cJSON* o, world_rope* r) {
     if (!o) return;
     static const char* const keys[] = {"length", "links", "radius", "mass_per_m", NULL};
     json_only_keys(c, o, "rope", keys);
-    r->length = json_num(c, o, "rope", "length", false, r->length, 0.2, 50);
+    r->length = json_num_r(c, o, "rope", "length", false, r->length, &R_ROPE_LENGTH);
     r->links = json_int(c, o, "rope", "links", false, r->links, 1, WORLD_DESC_MAX_ROPE);
-    r->radius = json_num(c, o, "rope", "radius", false, r->radius, 0.002, 0.2);
-    r->mass_per_m = json_pos(c, o, "rope", "mass_per_m", false, r->mass_per_m);
+    r->radius = json_num_r(c, o, "rope", "radius", false, r->radius, &R_ROPE_RADIUS);
+    r->mass_per_m = json_num_r(c, o, "rope", "mass_per_m", false, r->mass_per_m, &R_ROPE_MASS);
 }
 
 static void load_hook(json_ctx* c, const cJSON* o, world_hook* h) {
     if (!o) return;
     static const char* const keys[] = {"mass", "size", "reach", NULL};
     json_only_keys(c, o, "hook", keys);
-    h->mass = json_pos(c, o, "hook", "mass", false, h->mass);
-    read_size(c, o, "hook", "size", false, h->size);
-    h->reach = json_pos(c, o, "hook", "reach", false, h->reach);
+    h->mass = json_num_r(c, o, "hook", "mass", false, h->mass, &R_HOOK_MASS);
+    read_size(c, o, "hook", "size", false, h->size, &R_HOOK_SIZE);
+    h->reach = json_num_r(c, o, "hook", "reach", false, h->reach, &R_HOOK_REACH);
 }
 
 static void load_loads(json_ctx* c, const cJSON* arr, world_desc* w) {
@@ -298,11 +351,11 @@ static void load_loads(json_ctx* c, const cJSON* arr, world_desc* w) {
         char def[WORLD_DESC_NAME];
         snprintf(def, sizeof def, "load_%d", i);
         json_str(c, o, p, "name", false, def, l->name, sizeof l->name);
-        l->mass = json_pos(c, o, p, "mass", true, 0);
-        read_size(c, o, p, "size", true, l->size);
+        l->mass = json_num_r(c, o, p, "mass", true, 0, &R_LOAD_MASS);
+        read_size(c, o, p, "size", true, l->size, &R_LOAD_SIZE);
         read_position(c, o, p, l->position);
         l->yaw = json_num(c, o, p, "yaw_deg", false, 0, -360, 360) * DEG;
-        l->friction = json_num(c, o, p, "friction", false, 0.6, 0, 10);
+        l->friction = json_num_r(c, o, p, "friction", false, 0.6, &R_FRICTION);
         w->nload = i + 1;
     }
 }
@@ -339,11 +392,11 @@ static void load_obstacles(json_ctx* c, const cJSON* arr, world_desc* w) {
                 json_fail(c, f, "must be \"wall\", \"box\" or \"building\", got \"%s\"", kind);
             }
         }
-        read_size(c, o, p, "size", true, b->size);
+        read_size(c, o, p, "size", true, b->size, &R_OBST_SIZE);
         read_position(c, o, p, b->position);
         b->yaw = json_num(c, o, p, "yaw_deg", false, 0, -360, 360) * DEG;
-        b->mass = json_num(c, o, p, "mass", false, 0, 0, 1e6);
-        b->friction = json_num(c, o, p, "friction", false, 0.6, 0, 10);
+        b->mass = json_num_r(c, o, p, "mass", false, 0, &R_OBST_MASS);
+        b->friction = json_num_r(c, o, p, "friction", false, 0.6, &R_FRICTION);
         w->nobstacle = i + 1;
     }
 }
@@ -363,7 +416,7 @@ static void load_meshes(json_ctx* c, const cJSON* o, world_desc* w) {
         json_only_keys(c, m, p, (const char* const[]){"file", "scale", "up", "offset", NULL});
         world_mesh* s = &w->mesh[i];
         json_str(c, m, p, "file", false, s->file, s->file, sizeof s->file);
-        s->scale = json_pos(c, m, p, "scale", false, s->scale);
+        s->scale = json_num_r(c, m, p, "scale", false, s->scale, &R_MESH_SCALE);
         char up[8];
         json_str(c, m, p, "up", false, s->up == 1 ? "y" : "z", up, sizeof up);
         if (!c->failed) {
@@ -376,7 +429,7 @@ static void load_meshes(json_ctx* c, const cJSON* o, world_desc* w) {
             }
         }
         if (cJSON_GetObjectItemCaseSensitive(m, "offset")) {
-            json_vec(c, m, p, "offset", true, s->offset, 3);
+            json_vec_r(c, m, p, "offset", true, s->offset, 3, &R_MESH_OFFSET);
             s->has_offset = 1;
         }
     }
@@ -392,6 +445,99 @@ static void load_circuit(json_ctx* c, const cJSON* o, world_desc* w) {
     if (c->failed) return;
     w->circuit = cJSON_Duplicate(o, 1);
     if (!w->circuit) json_fail(c, "circuit", "out of memory");
+}
+
+// A body must stand on the terrain (centred on the origin): ODE aborted on a
+// truck placed 1e30 m away, and off the heightfield there is no ground.
+static void check_on_terrain(json_ctx* c, const char* path, const double* pos, bool has_z, const world_terrain* t) {
+    if (c->failed) return;
+    const double hx = 0.5 * t->size[0], hy = 0.5 * t->size[1];
+    if (!(fabs(pos[0]) <= hx && fabs(pos[1]) <= hy)) {
+        char x[24], y[24];
+        hyd_fmt_num(x, sizeof x, pos[0]);
+        hyd_fmt_num(y, sizeof y, pos[1]);
+        json_fail(c, path, "must lie on the terrain (|x| <= %g m, |y| <= %g m; terrain.size), got [%s, %s]", hx, hy,
+                  x, y);
+    } else if (has_z && pos[2] >= 0) {
+        char p2[96];
+        snprintf(p2, sizeof p2, "%s[2]", path);
+        json_range_check(c, p2, pos[2], &R_HEIGHT);
+    }
+}
+
+// A body's box for the overlap check: centre, half sizes in its own frame,
+// heading, and its height interval [m].
+typedef struct ovl_box {
+    double x, y, hx, hy, yaw, z0, z1;
+} ovl_box;
+
+// Separating-axis test of two boxes that are only turned about z: the
+// footprints (rectangles) overlap by more than tol on every one of the four
+// edge normals, and the height intervals by more than tol.
+static bool boxes_overlap(const ovl_box* a, const ovl_box* b, double tol) {
+    if (a->z1 - tol <= b->z0 || b->z1 - tol <= a->z0) return false;
+    const ovl_box* bx[2] = {a, b};
+    for (int k = 0; k < 2; ++k)
+        for (int e = 0; e < 2; ++e) {
+            const double ang = bx[k]->yaw + (e ? M_PI / 2 : 0), ux = cos(ang), uy = sin(ang);
+            double r[2];
+            for (int j = 0; j < 2; ++j) {
+                const ovl_box* q = bx[j];
+                const double c = cos(q->yaw), sn = sin(q->yaw);
+                r[j] = q->hx * fabs(c * ux + sn * uy) + q->hy * fabs(-sn * ux + c * uy);
+            }
+            const double d = fabs((b->x - a->x) * ux + (b->y - a->y) * uy);
+            if (d >= r[0] + r[1] - tol) return false;
+        }
+    return true;
+}
+
+// Truck-frame box (centre px, py; half sizes; heights) placed in the world.
+static ovl_box truck_part(const world_truck* k, double px, double py, double hx, double hy, double z0, double z1) {
+    const double c = cos(k->yaw), s = sin(k->yaw);
+    return (ovl_box){k->position[0] + c * px - s * py, k->position[1] + s * px + c * py, hx, hy, k->yaw, z0, z1};
+}
+
+// No body may start inside another (the truck, its outriggers, loads and
+// obstacles): ODE meets a deep initial penetration with a huge contact
+// impulse, and the fuzzer found a fixed wall through the truck aborting ODE.
+// Bodies that touch (a stack of boxes) are fine: the tolerance is 1 cm.
+static void check_overlaps(json_ctx* c, const world_desc* w) {
+    enum { MAXB = 3 + WORLD_DESC_MAX_LOADS + WORLD_DESC_MAX_OBSTACLES };
+    ovl_box b[MAXB];
+    char name[MAXB][WORLD_DESC_NAME + 16], path[MAXB][64];
+    int n = 0;
+    const world_truck* k = &w->truck;
+    b[n] = truck_part(k, 0, 0, 0.5 * k->chassis[0], 0.5 * k->chassis[1], 0, k->bed_height + k->cab[2]);
+    snprintf(name[n], sizeof name[n], "the truck");
+    snprintf(path[n++], sizeof path[0], "truck");
+    if (k->outriggers)
+        for (int a = 0; a < 2; ++a) {
+            // Beam and pad on both sides as one strip across the truck.
+            const double hx = 0.5 * fmax(0.2, k->pad[0]), hy = 0.5 * (k->outrigger_span + k->pad[1]);
+            b[n] = truck_part(k, k->outrigger_x[a], 0, hx, hy, 0, k->bed_height);
+            snprintf(name[n], sizeof name[n], "the truck's outriggers");
+            snprintf(path[n++], sizeof path[0], "truck.outrigger_x[%d]", a);
+        }
+    for (int i = 0; i < w->nload + w->nobstacle; ++i) {
+        const bool ld = i < w->nload;
+        const double* p = ld ? w->load[i].position : w->obstacle[i - w->nload].position;
+        const double* sz = ld ? w->load[i].size : w->obstacle[i - w->nload].size;
+        b[n] = (ovl_box){p[0], p[1], 0.5 * sz[0], 0.5 * sz[1], ld ? w->load[i].yaw : w->obstacle[i - w->nload].yaw,
+                         p[2] - 0.5 * sz[2], p[2] + 0.5 * sz[2]};
+        snprintf(name[n], sizeof name[n], "%s \"%s\"", ld ? "load" : "obstacle",
+                 ld ? w->load[i].name : w->obstacle[i - w->nload].name);
+        if (ld) snprintf(path[n], sizeof path[0], "loads[%d].position", i);
+        else snprintf(path[n], sizeof path[0], "obstacles[%d].position", i - w->nload);
+        ++n;
+    }
+    const int ntruck = k->outriggers ? 3 : 1;
+    for (int i = ntruck; i < n; ++i)
+        for (int j = 0; j < i; ++j)
+            if (boxes_overlap(&b[i], &b[j], 0.01)) {
+                json_fail(c, path[i], "%s starts inside %s; bodies must not overlap at the start", name[i], name[j]);
+                return;
+            }
 }
 
 // Resolve "rest on the ground" positions (z < 0) now that the terrain is known.
@@ -411,6 +557,7 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     static const char* const keys[] = {"name", "description", "type", "gravity", "ode", "terrain", "truck",
                                        "slew", "circuit", "rope", "hook", "loads", "obstacles",
                                        "meshes", NULL};
+    if (json_wrong_kind(&c, root, "world")) return -1;
     json_only_keys(&c, root, "", keys);
     json_str(&c, root, "", "type", true, "", kind, sizeof kind);
     if (c.failed) return -1;
@@ -437,7 +584,8 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     }
     snprintf(w->file, sizeof w->file, "%s", file);
     json_str(&c, root, "", "name", false, w->name, w->name, sizeof w->name);
-    w->gravity = json_num(&c, root, "", "gravity", false, w->gravity, 0, 100);
+    if (cJSON_GetObjectItemCaseSensitive(root, "gravity"))
+        w->gravity = json_num_r(&c, root, "", "gravity", false, w->gravity, &R_GRAVITY);
     load_ode(&c, json_obj(&c, root, "", "ode", false), &w->ode);
     load_terrain(&c, json_obj(&c, root, "", "terrain", false), &w->terrain);
     load_truck(&c, json_obj(&c, root, "", "truck", false), &w->truck);
@@ -448,9 +596,23 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     load_obstacles(&c, json_arr(&c, root, "", "obstacles", false), w);
     load_meshes(&c, json_obj(&c, root, "", "meshes", false), w);
     load_circuit(&c, json_obj(&c, root, "", "circuit", false), w);
+    if (!c.failed && w->kind == WORLD_SANDBOX) {
+        check_on_terrain(&c, "truck.position", w->truck.position, false, &w->terrain);
+        for (int i = 0; i < w->nload && !c.failed; ++i) {
+            char p[64];
+            snprintf(p, sizeof p, "loads[%d].position", i);
+            check_on_terrain(&c, p, w->load[i].position, true, &w->terrain);
+        }
+        for (int i = 0; i < w->nobstacle && !c.failed; ++i) {
+            char p[64];
+            snprintf(p, sizeof p, "obstacles[%d].position", i);
+            check_on_terrain(&c, p, w->obstacle[i].position, true, &w->terrain);
+        }
+    }
     if (!c.failed) {
         for (int i = 0; i < w->nload; ++i) settle_on_ground(w, w->load[i].position, w->load[i].size);
         for (int i = 0; i < w->nobstacle; ++i) settle_on_ground(w, w->obstacle[i].position, w->obstacle[i].size);
+        if (w->kind == WORLD_SANDBOX) check_overlaps(&c, w);
         // Names must be unique: the snapshot and the CSV address bodies by name.
         for (int i = 0; i < w->nload + w->nobstacle && !c.failed; ++i) {
             const char* a = i < w->nload ? w->load[i].name : w->obstacle[i - w->nload].name;
@@ -466,6 +628,7 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
             }
         }
     }
+    json_flush_notes(&c);
     if (c.failed) {
         world_desc_free(w);
         return -1;
@@ -473,8 +636,46 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     return 0;
 }
 
+static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
+
+// A world named on the command line (--world NAME is <assets>/worlds/NAME.json)
+// that does not exist: list the worlds there instead of "cannot open".
+static int missing_named_world(const char* path, char* err, size_t errsz) {
+    char folder[512];
+    snprintf(folder, sizeof folder, "%s/worlds/", model_assets_dir());
+    const size_t n = strlen(folder);
+    struct stat st;
+    if (strncmp(path, folder, n) || strchr(path + n, '/') || stat(path, &st) == 0) return 0;
+    char* names[64];
+    int k = 0;
+    DIR* d = opendir(folder);
+    for (struct dirent* e; d && k < 64 && (e = readdir(d));) {
+        const size_t L = strlen(e->d_name);
+        if (L > 5 && !strcmp(e->d_name + L - 5, ".json")) {
+            names[k] = malloc(L - 4);
+            if (!names[k]) break;
+            snprintf(names[k], L - 4, "%s", e->d_name);
+            ++k;
+        }
+    }
+    if (d) closedir(d);
+    qsort(names, (size_t)k, sizeof *names, cmp_str);
+    char list[512] = "";
+    for (int i = 0; i < k; ++i) {
+        const size_t L = strlen(list);
+        snprintf(list + L, sizeof list - L, "%s%s", i ? ", " : "", names[i]);
+        free(names[i]);
+    }
+    const char* base = path + n;
+    const size_t bl = strlen(base) > 5 ? strlen(base) - 5 : strlen(base);
+    snprintf(err, errsz, "--world %.*s: no such world (available: %s; or the path of a world file)", (int)bl, base,
+             k ? list : "none");
+    return 1;
+}
+
 int world_desc_load(const char* path, world_desc* w, char* err, size_t errsz) {
     memset(w, 0, sizeof *w);
+    if (missing_named_world(path, err, errsz)) return -1;
     cJSON* root = json_load_file(path, err, errsz);
     if (!root) return -1;
     const char* base = strrchr(path, '/');

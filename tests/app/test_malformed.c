@@ -1,0 +1,394 @@
+// test_malformed.c: a corpus of malformed model, scenario and world files.
+// Each bad file is made at test time from a shipped file with one change
+// (a --set style path assignment, or one text replacement), run through
+// `cranesim run`, and must be refused with exit 2 and one line naming the
+// file and the field, leaving an existing output file byte for byte as it
+// was. Also: values outside the hard ranges of docs/files.md are refused
+// with the range and the unit; outside the typical range, a one-line note;
+// the shipped files give no note at all.
+#include "check.h"
+#include "json_util.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#define BIN CRANESIM_BINARY_DIR "/cranesim"
+#define ASSETS CRANESIM_ASSETS
+
+enum kind { MODEL, SCENARIO, WORLD };
+
+typedef struct bad_case {
+    enum kind kind;
+    const char* name;  ///< file name of the generated file
+    const char* base;  ///< shipped file it is made from (relative to assets/)
+    const char* set;   ///< "path=value" applied with json_set_path, or NULL
+    const char* from;  ///< text replaced in the shipped file (first occurrence), or NULL
+    const char* to;    ///< replacement
+    const char* field; ///< must appear in the message
+    const char* msg;   ///< must appear in the message too (NULL: no check)
+} bad_case;
+
+static char out_buf[16384];
+
+// Run cranesim with args (stderr merged into out). Returns the exit code.
+// CRANESIM_BIN runs another binary (an older build, to see the test fail).
+static int run(const char* args, char* out, size_t n) {
+    char cmd[8192];
+    const char* bin = getenv("CRANESIM_BIN");
+    snprintf(cmd, sizeof cmd, "%s %s 2>&1", bin && *bin ? bin : BIN, args);
+    FILE* p = popen(cmd, "r");
+    if (!p) return -1;
+    size_t got = fread(out, 1, n - 1, p);
+    out[got] = 0;
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static int count_lines(const char* s) {
+    int n = 0;
+    for (; *s; ++s) n += *s == '\n';
+    return n;
+}
+
+static char* read_all(const char* path) {
+    FILE* f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char* s = malloc((size_t)n + 1);
+    size_t got = fread(s, 1, (size_t)n, f);
+    s[got] = 0;
+    fclose(f);
+    return s;
+}
+
+static void write_all(const char* path, const char* text) {
+    FILE* f = fopen(path, "wb");
+    fputs(text, f);
+    fclose(f);
+}
+
+static const char* dir(void) {
+    static char d[512];
+    if (!d[0]) {
+        snprintf(d, sizeof d, "%s/tests/app/malformed", CRANESIM_BINARY_DIR);
+        mkdir(d, 0755);
+    }
+    return d;
+}
+
+// Make the bad file of case k; returns its path (static) or NULL.
+static const char* make_case(const bad_case* k) {
+    static char path[1024];
+    char base[1024];
+    snprintf(base, sizeof base, "%s/%s", ASSETS, k->base);
+    snprintf(path, sizeof path, "%s/%s", dir(), k->name);
+    char* text = read_all(base);
+    if (!text) return NULL;
+    if (k->set) {
+        char err[512];
+        cJSON* root = cJSON_Parse(text);
+        if (!root || json_set_path(root, k->set, err, sizeof err)) {
+            fprintf(stderr, "%s: cannot apply %s: %s\n", k->name, k->set, err);
+            cJSON_Delete(root);
+            free(text);
+            return NULL;
+        }
+        char* s = cJSON_Print(root);
+        write_all(path, s);
+        free(s);
+        cJSON_Delete(root);
+    } else {
+        char* at = strstr(text, k->from);
+        if (!at) {
+            fprintf(stderr, "%s: '%s' not in %s\n", k->name, k->from, k->base);
+            free(text);
+            return NULL;
+        }
+        size_t n = strlen(text) + strlen(k->to) + 1;
+        char* s = malloc(n);
+        snprintf(s, n, "%.*s%s%s", (int)(at - text), text, k->to, at + strlen(k->from));
+        write_all(path, s);
+        free(s);
+    }
+    free(text);
+    return path;
+}
+
+static const char SENTINEL[] = "t,x1\n0,0.5\nthis file must survive a refused run\n";
+
+static void command_for(const bad_case* k, const char* file, const char* out, char* cmd, size_t n) {
+    if (k->kind == MODEL)
+        snprintf(cmd, n, "run --quiet --model %s --scenario hold --duration 0.01 --out %s", file, out);
+    else if (k->kind == SCENARIO)
+        snprintf(cmd, n, "run --quiet --scenario %s --duration 0.01 --out %s", file, out);
+    else if (strstr(k->base, "sandbox"))
+        snprintf(cmd, n, "run --quiet --mechanics ode --world %s --scenario sandbox_swing --duration 0.01 --out %s",
+                 file, out);
+    else
+        snprintf(cmd, n, "run --quiet --mechanics ode --world %s --scenario hold --duration 0.01 --out %s", file, out);
+}
+
+static void run_cases(const bad_case* cases, int n) {
+    char out[1024];
+    snprintf(out, sizeof out, "%s/out.csv", dir());
+    for (int i = 0; i < n; ++i) {
+        const bad_case* k = &cases[i];
+        const char* file = make_case(k);
+        CHECK(file != NULL, "%s: could not be made", k->name);
+        if (!file) continue;
+        write_all(out, SENTINEL);
+        char cmd[4096];
+        command_for(k, file, out, cmd, sizeof cmd);
+        int rc = run(cmd, out_buf, sizeof out_buf);
+        CHECK(rc == 2, "%s: exit %d, want 2: %s", k->name, rc, out_buf);
+        CHECK(strstr(out_buf, k->name) != NULL, "%s: message does not name the file: %s", k->name, out_buf);
+        CHECK(strstr(out_buf, k->field) != NULL, "%s: message does not name %s: %s", k->name, k->field, out_buf);
+        CHECK(!k->msg || strstr(out_buf, k->msg), "%s: message lacks '%s': %s", k->name, k->msg, out_buf);
+        CHECK(count_lines(out_buf) == 1, "%s: want one line, got: %s", k->name, out_buf);
+        char* now = read_all(out);
+        CHECK(now && !strcmp(now, SENTINEL), "%s: the existing output file was changed", k->name);
+        free(now);
+    }
+}
+
+#define M "models/hiab031.json"
+#define S "scenarios/ramp.json"
+#define SB "scenarios/sandbox_swing.json"
+#define W "worlds/sandbox.json"
+#define WV "worlds/validation.json"
+
+// The cases of issue 13 that ran (or aborted in ODE) before the ranges.
+static const bad_case range_cases[] = {
+    {WORLD, "w_truck_mass.json", W, "truck.mass=1e308", NULL, NULL, "truck.mass", "must be in [100, 1e6] kg, got 1e308"},
+    {WORLD, "w_load_size.json", W, "loads[0].size=[1e308, 1, 1]", NULL, NULL, "loads[0].size[0]", "must be in [0.01, 20] m"},
+    {WORLD, "w_truck_far.json", W, "truck.position=[1e30, 0]", NULL, NULL, "truck.position", "must lie on the terrain"},
+    {WORLD, "w_column_radius.json", W, "slew.column_radius=5", NULL, NULL, "slew.column_radius", "[0.02, 2] m"},
+    {MODEL, "m_link_mass.json", M, "mechanics.links[1].mass=1e-300", NULL, NULL, "mechanics.links[1].mass",
+     "must be in [1, 1e5] kg, got 1e-300"},
+    {MODEL, "m_p_crack.json", M, "hydraulics.components.main_relief.p_crack=22", NULL, NULL,
+     "hydraulics.components[1].p_crack", "must be in [1e5, 1e8] Pa, got 22"},
+    {MODEL, "m_bulk_low.json", M, "hydraulics.fluid.bulk_modulus=1", NULL, NULL, "hydraulics.fluid.bulk_modulus",
+     "must be in [1e7, 1e10] Pa, got 1"},
+    {MODEL, "m_bulk_high.json", M, "hydraulics.fluid.bulk_modulus=1e20", NULL, NULL, "hydraulics.fluid.bulk_modulus",
+     "got 1e20"},
+    {MODEL, "m_bore_huge.json", M, "hydraulics.components.lift_cyl.bore=1e300", NULL, NULL,
+     "hydraulics.components[5].bore", "must be in [0.005, 1] m"},
+    {MODEL, "m_tip_load.json", M, "mechanics.load_mass=1e5", NULL, NULL, "mechanics.load_mass", "[0, 1e4] kg"},
+    {SCENARIO, "s_tip_load.json", S, "load_mass=1e5", NULL, NULL, "load_mass", "[0, 1e4] kg"},
+};
+
+static void test_hard_ranges(void) { run_cases(range_cases, (int)(sizeof range_cases / sizeof range_cases[0])); }
+
+#define SP "scenarios/sandbox_pick_place.json"
+
+// The corpus: one change each to a shipped file. Text replacements make what
+// a --set cannot (a wrong type, a repeated key, a number JSON forbids).
+static const bad_case corpus[] = {
+    // models
+    {MODEL, "m_joint_huge.json", M, NULL, "\"joint\": 0", "\"joint\": 2E67", "mechanics.actuators[0].joint", "<= 1"},
+    {MODEL, "m_gravity_neg.json", M, "mechanics.gravity=-9.81", NULL, NULL, "mechanics.gravity", "[0, 30] m/s^2"},
+    {MODEL, "m_column_zero.json", M, "mechanics.column.height=0", NULL, NULL, "mechanics.column.height", "must be > 0"},
+    {MODEL, "m_link_long.json", M, "mechanics.links[0].length=1e6", NULL, NULL, "mechanics.links[0].length", "[0.1, 30] m"},
+    {MODEL, "m_inertia_neg.json", M, "mechanics.links[1].inertia=-1", NULL, NULL, "mechanics.links[1].inertia", "> 0"},
+    {MODEL, "m_mount_far.json", M, "mechanics.actuators[0].base_mount=[1e9, 0]", NULL, NULL,
+     "mechanics.actuators[0].base_mount[0]", "[-10, 10] m"},
+    {MODEL, "m_closed_neg.json", M, "mechanics.actuators[1].closed_length=-0.9", NULL, NULL,
+     "mechanics.actuators[1].closed_length", "> 0"},
+    {MODEL, "m_rod_ge_bore.json", M, "hydraulics.components.lift_cyl.rod=0.2", NULL, NULL,
+     "hydraulics.components[5].rod", "must be < bore"},
+    {MODEL, "m_valve_t_chamber.json", M, NULL, "\"T\": \"tank\", \"A\": \"lift_hose_A\"",
+     "\"T\": \"lift_cyl.A\", \"A\": \"lift_hose_A\"", "hydraulics.components[2].T", "is a cylinder chamber"},
+    {MODEL, "m_isolated_node.json", M, NULL, "{\"name\": \"tank\", \"type\": \"tank\", \"pressure\": 100000},",
+     "{\"name\": \"tank\", \"type\": \"tank\", \"pressure\": 100000}, {\"name\": \"spare\", \"type\": \"volume\", "
+     "\"volume\": 0.001},",
+     "hydraulics.nodes[1]", "'spare' is connected to no component"},
+    {MODEL, "m_nul_name.json", M, NULL, "\"name\": \"lift_cyl\"", "\"name\": \"lift\\u0000_cyl\"", "\\u0000",
+     "not allowed in a string"},
+    {MODEL, "m_dup_key.json", M, NULL, "\"bore\": 0.1,", "\"bore\": 0.1, \"bore\": 0.2,", "hydraulics.components[5].bore",
+     "given twice"},
+    {MODEL, "m_mass_string.json", M, NULL, "\"mass\": 180.0", "\"mass\": \"heavy\"", "mechanics.links[0].mass",
+     "must be a number"},
+    {MODEL, "m_unknown_node.json", M, NULL, "\"to\": \"lift_cyl.A\"", "\"to\": \"lift_cyl.C\"",
+     "hydraulics.components[3].to", "unknown node"},
+    {MODEL, "m_leading_zero.json", M, NULL, "\"stroke\": 0.7", "\"stroke\": 00.7", "line", "invalid number"},
+    {MODEL, "m_length_inf.json", M, NULL, "\"length\": 2.3", "\"length\": 1e400", "mechanics.links[0].length",
+     "must be a finite number"},
+    {MODEL, "m_is_scenario.json", S, NULL, "\"name\"", "\"name\"", "this is a scenario file (use --scenario)", NULL},
+    {MODEL, "m_is_world.json", W, NULL, "\"name\"", "\"name\"", "this is a world file (use --world)", NULL},
+    {MODEL, "m_tau_zero.json", M, "hydraulics.components.lift_valve.tau=0", NULL, NULL, "hydraulics.components[2].tau",
+     "> 0"},
+    {MODEL, "m_air.json", M, "hydraulics.fluid.air_fraction=0.9", NULL, NULL, "hydraulics.fluid.air_fraction", "[0, 0.5]"},
+    {MODEL, "m_viscosity.json", M, "hydraulics.fluid.viscosity=1", NULL, NULL, "hydraulics.fluid.viscosity",
+     "[1e-7, 0.01] m^2/s"},
+    {MODEL, "m_typo.json", M, NULL, "\"load_mass\": 500.0", "\"load_mas\": 500.0", "mechanics.load_mas", "unknown field"},
+    // scenarios
+    {SCENARIO, "s_time_inf.json", S, NULL, "[16, -0.5]", "[1e400, -0.5]", "commands.lift[7]", "must be a finite number"},
+    {SCENARIO, "s_time_order.json", S, NULL, "[5, 0.6]", "[0.5, 0.6]", "commands.lift[3]", "must not decrease"},
+    {SCENARIO, "s_u_range.json", S, NULL, "[2, 0.6]", "[2, 1.6]", "commands.lift[2]", "[-1, 1]"},
+    {SCENARIO, "s_duration_neg.json", S, "duration=-1", NULL, NULL, "duration", "must be > 0"},
+    {SCENARIO, "s_duration_huge.json", S, "duration=1e9", NULL, NULL, "duration", "[0.001, 86400] s"},
+    {SCENARIO, "s_q1.json", S, "initial.q1_deg=400", NULL, NULL, "initial.q1_deg", "<= 360"},
+    {SCENARIO, "s_is_model.json", M, NULL, "\"name\"", "\"name\"", "this is a model file (use --model)", NULL},
+    {SCENARIO, "s_is_world.json", W, NULL, "\"name\"", "\"name\"", "this is a world file (use --world)", NULL},
+    {SCENARIO, "s_hook_inf.json", SP, NULL, "[24.0, \"release\"]", "[1e400, \"release\"]", "hook[1]",
+     "must be a finite number"},
+    {SCENARIO, "s_channel.json", S, NULL, "\"jib\":", "\"boom\":", "commands.boom", "unknown field"},
+    // worlds
+    {WORLD, "w_max_contacts.json", W, "ode.max_contacts=1e300", NULL, NULL, "ode.max_contacts", "<= 32"},
+    {WORLD, "w_rope_links.json", W, "rope.links=2E67", NULL, NULL, "rope.links", "<= 16"},
+    {WORLD, "w_samples.json", W, "terrain.samples=[1e300, 121]", NULL, NULL, "terrain.samples", "[2, 1024]"},
+    {WORLD, "w_hook_mass.json", W, "hook.mass=0", NULL, NULL, "hook.mass", "must be > 0"},
+    {WORLD, "w_load_far.json", W, "loads[1].position=[500, 0]", NULL, NULL, "loads[1].position", "must lie on the terrain"},
+    {WORLD, "w_obstacle_mass.json", W, "obstacles[2].mass=-5", NULL, NULL, "obstacles[2].mass", "[0, 1e6] kg"},
+    {WORLD, "w_is_scenario.json", S, NULL, "\"name\"", "\"name\"", "this is a scenario file (use --scenario)", NULL},
+    {WORLD, "w_validation_rope.json", WV, NULL, "\"type\": \"validation\",", "\"type\": \"validation\", \"rope\": {},",
+     "rope", "only a sandbox world"},
+    {WORLD, "w_circuit_bore.json", W, "circuit.components.slew_cyl.bore=1e300", NULL, NULL, "circuit.components[3].bore",
+     "[0.005, 1] m"},
+    {WORLD, "w_dup_name.json", W, "loads[1].name=load_200", NULL, NULL, "loads[1].name", "duplicate name"},
+    // found by fuzz_world_build: a fixed wall through the truck with a contact
+    // CFM of 0 aborted ODE (dxNormalize4); each alone is now refused
+    {WORLD, "w_wall_in_truck.json", W, "obstacles[1].position=[0, -2]", NULL, NULL, "obstacles[1].position",
+     "obstacle \"wall_yard\" starts inside the truck"},
+    {WORLD, "w_contact_cfm0.json", W, "ode.contact_cfm=0", NULL, NULL, "ode.contact_cfm", "must be > 0"},
+    {WORLD, "w_load_in_load.json", W, "loads[1].position=[3.0, -3.3]", NULL, NULL, "loads[1].position",
+     "load \"load_500\" starts inside load \"load_200\""},
+    {WORLD, "w_gravity.json", WV, NULL, "\"type\": \"validation\",", "\"type\": \"validation\", \"gravity\": 1e400,",
+     "gravity", "must be a finite number"},
+};
+
+static void test_corpus(void) {
+    const int n = (int)(sizeof corpus / sizeof corpus[0]);
+    CHECK(n + (int)(sizeof range_cases / sizeof range_cases[0]) >= 40, "corpus too small: %d", n);
+    run_cases(corpus, n);
+}
+
+// A file over the 1 MiB limit (docs/files.md, File limits) is refused before
+// it is read, in one line, and the output file stays as it was.
+static void test_oversize(void) {
+    char path[1024], out[1024], cmd[4096];
+    snprintf(path, sizeof path, "%s/s_oversize.json", dir());
+    snprintf(out, sizeof out, "%s/out.csv", dir());
+    FILE* f = fopen(path, "w");
+    fputs("{\"name\": \"big\", \"description\": \"", f);
+    for (long i = 0; i < (1L << 20); ++i) fputc('x', f);
+    fputs("\", \"duration\": 1, \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110}, \"commands\": {}}\n", f);
+    fclose(f);
+    write_all(out, SENTINEL);
+    snprintf(cmd, sizeof cmd, "run --quiet --scenario %s --out %s", path, out);
+    int rc = run(cmd, out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "s_oversize.json: too large (") && count_lines(out_buf) == 1, "exit %d: %s", rc,
+          out_buf);
+    char* now = read_all(out);
+    CHECK(now && !strcmp(now, SENTINEL), "the existing output file was changed");
+    free(now);
+    remove(path);
+}
+
+// Messages that are not about one file: a world name that does not exist
+// lists the worlds; an index past the end of an array gives the length.
+static void test_messages(void) {
+    int rc = run("run --quiet --mechanics ode --world nosuch --scenario hold --out /dev/null", out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "--world nosuch: no such world (available: sandbox, validation") &&
+              count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    rc = run("run --quiet --scenario hold --out /dev/null --set 'mechanics.links[5].mass=1'", out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "index 5 out of range: mechanics.links has 2 elements") &&
+              count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    rc = run("run --quiet --scenario hold --out /dev/null --set 'hydraulics.components.nosuch.bore=1'", out_buf,
+             sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "no element named 'nosuch' in hydraulics.components"), "exit %d: %s", rc, out_buf);
+}
+
+// --set gets the same ranges (it edits the document before loading), and
+// --load the tip-load range.
+static void test_set_and_load(void) {
+    int rc = run("run --quiet --scenario ramp --duration 0.01 --out /dev/null --set "
+                 "hydraulics.components.main_relief.p_crack=22",
+                 out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "hiab031.json: hydraulics.components[1].p_crack: must be in [1e5, 1e8] Pa, got 22") &&
+              strstr(out_buf, "(from --set"),
+          "exit %d: %s", rc, out_buf);
+    rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --load 1e5", out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "--load") && strstr(out_buf, "kg"), "--load 1e5: exit %d: %s", rc, out_buf);
+}
+
+// Outside the typical range: the run goes on (exit 0) with one note naming
+// file, field, range and unit.
+static void test_typical_notes(void) {
+    int rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set hydraulics.fluid.bulk_modulus=4e8",
+                 out_buf, sizeof out_buf);
+    CHECK(rc == 0 && strstr(out_buf, "note: hiab031.json: hydraulics.fluid.bulk_modulus: 4e8 is outside the typical "
+                                     "range [5e8, 2.5e9] Pa") &&
+              count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links[0].mass=6000", out_buf,
+             sizeof out_buf);
+    CHECK(rc == 0 && strstr(out_buf, "note: hiab031.json: mechanics.links[0].mass: 6000 kg is outside the typical "
+                                     "range [20, 5000] kg") &&
+              strstr(out_buf, "mechanics.links[0].inertia") && count_lines(out_buf) == 2, // 79 kg m^2 left as it was
+          "exit %d: %s", rc, out_buf);
+    // An inertia far from a box of the link's mass and size (kg cm^2 meant?).
+    rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links[0].inertia=7935",
+             out_buf, sizeof out_buf);
+    CHECK(rc == 0 && strstr(out_buf, "note: hiab031.json: mechanics.links[0].inertia: 7935 kg m^2 is outside the typical "
+                                     "range [0.2, 4] times a uniform box") &&
+              count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    // A world's circuit component is noted under the world file's own path,
+    // not as a component of the model's merged circuit.
+    bad_case w = {WORLD, "w_note_bore.json", W, "circuit.components.slew_cyl.bore=0.025", NULL, NULL, "", NULL};
+    const char* wf = make_case(&w);
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd,
+             "run --quiet --mechanics ode --world %s --scenario sandbox_swing --duration 0.01 --out /dev/null", wf);
+    rc = run(cmd, out_buf, sizeof out_buf);
+    CHECK(rc == 0 &&
+              strstr(out_buf, "note: w_note_bore.json: circuit.components[3].bore: 0.025 is outside the typical range "
+                              "[0.03, 0.3] m") &&
+              count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --load 5000", out_buf, sizeof out_buf);
+    CHECK(rc == 0 && strstr(out_buf, "note:") && strstr(out_buf, "--load 5000 kg") && count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+}
+
+// Every shipped file is inside the hard ranges and gives no note, in every
+// world it can run in.
+static void test_shipped_quiet(void) {
+    const char* lag[] = {"ramp", "step", "hold", "overload", "drive_demo"};
+    const char* sbx[] = {"sandbox_wall", "sandbox_swing", "sandbox_pick_place"};
+    for (int i = 0; i < 5; ++i) {
+        char a[512];
+        snprintf(a, sizeof a, "run --quiet --scenario %s --duration 0.01 --out /dev/null", lag[i]);
+        int rc = run(a, out_buf, sizeof out_buf);
+        CHECK(rc == 0 && !out_buf[0], "%s: exit %d: %s", lag[i], rc, out_buf);
+        snprintf(a, sizeof a, "run --quiet --mechanics ode --world validation --scenario %s --duration 0.01 --out /dev/null",
+                 lag[i]);
+        rc = run(a, out_buf, sizeof out_buf);
+        CHECK(rc == 0 && !out_buf[0], "%s (validation): exit %d: %s", lag[i], rc, out_buf);
+    }
+    for (int i = 0; i < 3; ++i) {
+        char a[512];
+        snprintf(a, sizeof a, "run --quiet --mechanics ode --world sandbox --scenario %s --duration 0.01 --out /dev/null",
+                 sbx[i]);
+        int rc = run(a, out_buf, sizeof out_buf);
+        CHECK(rc == 0 && !out_buf[0], "%s: exit %d: %s", sbx[i], rc, out_buf);
+    }
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_hard_ranges);
+    RUN_TEST(test_corpus);
+    RUN_TEST(test_messages);
+    RUN_TEST(test_oversize);
+    RUN_TEST(test_set_and_load);
+    RUN_TEST(test_typical_notes);
+    RUN_TEST(test_shipped_quiet);
+    TEST_MAIN_END();
+}
