@@ -320,24 +320,42 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     return y;
 }
 
-static void draw_warnings(render* r, const world_snapshot* s) {
-    render_hud* h = &r->hud;
-    char w[12][96];
+int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDER_WARN_LEN], int max) {
     int n = 0;
+    if (max > RENDER_WARN_MAX) max = RENDER_WARN_MAX;
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
-    if (s->main_relief_open) snprintf(w[n++], sizeof w[0], "MAIN RELIEF OPEN");
-    for (int i = 0; i < ncyl && n < 10; ++i) {
-        const char* nm = s->cyl[i].name[0] ? s->cyl[i].name : "cylinder";
-        if (s->cyl[i].relief_open) snprintf(w[n++], sizeof w[0], "RELIEF OPEN: %s", nm);
-        if (s->cyl[i].end_stop && n < 10) snprintf(w[n++], sizeof w[0], "END STOP: %s", nm);
+    // Each open relief by its circuit name, with the cylinder chamber it
+    // guards: "MAIN RELIEF OPEN" for every relief sent an operator slewing
+    // into a wall looking at the pump line. A snapshot without names (an
+    // older producer, the demo scene) keeps the flags.
+    int nrel = s->nrelief < WORLD_SNAP_MAX_RELIEFS ? s->nrelief : WORLD_SNAP_MAX_RELIEFS;
+    for (int k = 0; k < nrel && n < max - 2; ++k) {
+        const int c = s->relief_cyl[k];
+        if (c >= 0 && c < ncyl)
+            snprintf(w[n++], RENDER_WARN_LEN, "RELIEF OPEN: %s (%s %c)", s->relief[k],
+                     s->cyl[c].name[0] ? s->cyl[c].name : "cylinder", s->relief_port[k] ? 'B' : 'A');
+        else
+            snprintf(w[n++], RENDER_WARN_LEN, "RELIEF OPEN: %s", s->relief[k]);
     }
-    if (s->tipping && n < 11)
-        snprintf(w[n++], sizeof w[0], "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
-    if (s->collision && n < 11) snprintf(w[n++], sizeof w[0], "COLLISION");
+    if (nrel == 0 && s->main_relief_open && n < max - 2) snprintf(w[n++], RENDER_WARN_LEN, "MAIN RELIEF OPEN");
+    for (int i = 0; i < ncyl && n < max - 2; ++i) {
+        const char* nm = s->cyl[i].name[0] ? s->cyl[i].name : "cylinder";
+        if (nrel == 0 && s->cyl[i].relief_open) snprintf(w[n++], RENDER_WARN_LEN, "RELIEF OPEN: %s", nm);
+        if (s->cyl[i].end_stop && n < max - 2) snprintf(w[n++], RENDER_WARN_LEN, "END STOP: %s", nm);
+    }
+    if (s->tipping && n < max - 1)
+        snprintf(w[n++], RENDER_WARN_LEN, "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
+    if (s->collision && n < max - 1) snprintf(w[n++], RENDER_WARN_LEN, "COLLISION");
     // Real time: the app's missed deadlines, or a measured factor below 1.
     bool slow = r->missed_deadlines > 0 || (s->rt_factor > 0 && s->rt_factor < 0.97);
-    if (slow && n < 12)
-        snprintf(w[n++], sizeof w[0], "CANNOT KEEP UP WITH REAL TIME (%.2fx)", s->rt_factor);
+    if (slow && n < max) snprintf(w[n++], RENDER_WARN_LEN, "CANNOT KEEP UP WITH REAL TIME (%.2fx)", s->rt_factor);
+    return n;
+}
+
+static void draw_warnings(render* r, const world_snapshot* s) {
+    render_hud* h = &r->hud;
+    char w[RENDER_WARN_MAX][RENDER_WARN_LEN];
+    const int n = render_hud_warnings(r, s, w, RENDER_WARN_MAX);
     float y = 10;
     for (int i = 0; i < n; ++i) {
         float tw = render_hud_text_width(w[i], 2.0f);

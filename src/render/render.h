@@ -165,6 +165,14 @@ bool render_attach_panel(render* r, panel* p);
 void render_set_status(render* r, const char* text);
 /// The status line as last set.
 const char* render_get_status(const render* r);
+/// Longest warning line and most lines render_hud_warnings gives.
+#define RENDER_WARN_LEN 96
+#define RENDER_WARN_MAX 12
+/// The warnings the HUD draws (top centre, red) for snapshot s, as text, in
+/// the order drawn: open reliefs by name with the chamber they guard, end
+/// stops, tipping, collision, "cannot keep up with real time". Returns the
+/// number of lines (at most max, capped at RENDER_WARN_MAX).
+int render_hud_warnings(const render* r, const world_snapshot* s, char out[][RENDER_WARN_LEN], int max);
 /// The app reports missed real-time deadlines here; any count > 0 in the last
 /// second shows the "cannot keep up with real time" warning.
 void render_set_missed_deadlines(render* r, int missed_last_second);

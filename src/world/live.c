@@ -2,6 +2,7 @@
 #include "live.h"
 
 #include "ode_world.h"
+#include "snap_reliefs.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -272,5 +273,7 @@ void live_snapshot(live* l, world_snapshot* s) {
         c->end_stop = (o.end_stop >> k) & 1;
     }
     s->p_supply = o.p_pump;
-    s->main_relief_open = o.relief_open > 0;
+    // lsim_outputs evaluated the circuit at (t, y): its open flags are current.
+    const int cyl_hyd[WORLD_SNAP_MAX_CYLINDERS] = {l->ls.mdl->cyl[0], l->ls.mdl->cyl[1], -1, -1};
+    world_snap_reliefs(s, l->ls.mdl->hyd, l->ls.hd->comp_open, cyl_hyd);
 }
