@@ -57,6 +57,15 @@ struct drive_session {
     double wall_last, wall_next_frame;
     double wall_last_frame; ///< wall time the last timed frame started [s] (< 0: none yet)
     double sim_offset;   // simulated time = wall - sim_offset while running
+    // The world is rebuilt by a reset, a solver change or a parameter that
+    // cannot change in place; each build is a "piece" with its own clock
+    // (live_time from 0). The session's time is t_base + live_time: a reset
+    // starts it again at 0, a rebuild continues it.
+    double t_base;       // session time at which the current piece started [s]
+    double sim_done;     // simulated time of the earlier pieces [s]
+    double piece_wall0;  // wall time the current piece started [s]
+    double piece_paused; // wall time paused during the current piece [s]
+    int segment;         // pieces so far - 1: the record's `segment` column
     FILE* rec;
     char rec_path[256];
     long rec_rows;       // rows written to the open recording
@@ -150,7 +159,7 @@ static void build_params(drive_session* s) {
     add_hyd(s, "reliefs", "jib port B", "MPa", 1e6, 2, 40, "jib_relief_B", "p_crack");
     add_hyd(s, "oil", "bulk modulus", "GPa", 1e9, 0.2, 2.5, "fluid", "bulk_modulus");
     add_hyd(s, "oil", "density", "kg/m3", 1, 700, 1000, "fluid", "density");
-    add_param(s, PK_SOLVER, "solver", "method 0 Krus 1 ROS2", "-", 1, 0, 1, NULL, NULL,
+    add_param(s, PK_SOLVER, "solver", "method", "-", 1, 0, 1, NULL, NULL,
               s->c.sim.solver == HYD_ROS2 ? 1.0 : 0.0);
     add_param(s, PK_STEP, "solver", "step", "ms", 1e-3, 0.05, 1.0, NULL, NULL, s->c.sim.h);
 }
@@ -252,11 +261,25 @@ static void rebuild_world(drive_session* s, bool at_start) {
         snprintf(s->status, sizeof s->status, "rebuild failed: %s", s->err);
         return;
     }
+    // The real-time factor is the new piece's simulated time over its own
+    // wall time: dividing it by the wall time since the session started read
+    // "RT 0.42x" (and "cannot keep up") for ever after a reset. The totals
+    // (drive_stats) add the pieces up.
+    const double t_old = live_time(s->l);
+    s->sim_done += t_old;
+    s->t_base = at_start ? 0.0 : s->t_base + t_old;
+    s->piece_wall0 = s->wall_last;
+    s->piece_paused = 0.0;
+    ++s->segment;
     live_destroy(s->l);
     s->l = l;
     s->sim_offset = s->wall_last; // the new world's clock starts at 0 now
-    s->ev = 0;
-    render_chart_clear(s->r);
+    if (at_start) {
+        // A new run: the script and the charts start again. A rebuild keeps
+        // the session's time running, so charts and script continue.
+        s->ev = 0;
+        render_chart_clear(s->r);
+    }
 }
 
 // Strip-chart channel list: CSV column names (not t), comma-separated, 1 to 8
@@ -414,7 +437,16 @@ int drive_session_finish_record(drive_session* s, long* rows, char* err, size_t 
     return -1;
 }
 
-static void take_snapshot(drive_session* s) { live_snapshot(s->l, s->snap); }
+// The world's row, on the session's clock.
+static void session_row(drive_session* s, double* row) {
+    live_row(s->l, row);
+    row[COL_T] += s->t_base;
+}
+
+static void take_snapshot(drive_session* s) {
+    live_snapshot(s->l, s->snap);
+    s->snap->t += s->t_base;
+}
 
 drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz,
                                     int* code) {
@@ -550,11 +582,18 @@ void drive_session_destroy(drive_session* s) {
 static void render_snapshot(drive_session* s) {
     // Over less than 0.1 s of wall time the ratio means nothing (a frame at
     // t = 0 would read thousands); 0 is "unknown" (world_snapshot.h).
-    s->snap->rt_factor = s->st.wall_time >= DRIVE_MIN_RATE_S ? s->st.sim_time / s->st.wall_time : 0;
+    s->snap->rt_factor = drive_session_rt_factor(s);
     render_frame(s->r, s->snap);
     render_present(s->r);
     s->st.triangles = render_get_stats(s->r).triangles;
     ++s->st.frames;
+}
+
+double drive_session_rt_factor(const drive_session* s) {
+    // The current piece only, and only the time it ran: a pause holds the
+    // simulated time, so counting it would read "cannot keep up" too.
+    const double run = s->wall_last - s->piece_wall0 - s->piece_paused;
+    return run >= DRIVE_MIN_RATE_S ? live_time(s->l) / run : 0.0;
 }
 
 void drive_session_render(drive_session* s) {
@@ -625,10 +664,12 @@ int drive_session_tick(drive_session* s, double wall) {
     if (s->paused) {
         // Hold simulated time: the clock offset grows with the paused time.
         s->sim_offset += dt_wall;
+        s->piece_paused += dt_wall;
+        s->st.paused_time += dt_wall;
     } else {
         double u[3] = {cmd.lift, cmd.jib, cmd.slew};
         if (s->o.scripted) {
-            app_scripted_input(&s->sc, s->l, t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
+            app_scripted_input(&s->sc, s->l, s->t_base + t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
         } else if (cmd.hook_toggle) {
             live_hook(s->l, !live_attached(s->l));
         }
@@ -649,7 +690,7 @@ int drive_session_tick(drive_session* s, double wall) {
             return -1;
         }
     }
-    s->st.sim_time = live_time(s->l);
+    s->st.sim_time = s->sim_done + live_time(s->l);
     if (wall - s->missed_t0 >= 1.0) {
         render_set_missed_deadlines(s->r, s->missed_window);
         s->missed_window = 0;
@@ -662,7 +703,7 @@ int drive_session_tick(drive_session* s, double wall) {
     const bool frame = wall >= s->wall_next_frame && !render_busy(s->r);
     // One CSV row per tick at most, shared by the recording and the charts.
     double row[SIM_NCOL];
-    if (s->rec || (frame && s->nchart)) live_row(s->l, row);
+    if (s->rec || (frame && s->nchart)) session_row(s, row);
     if (s->rec) record_row(s, row);
     if (frame) {
         char status[640];
@@ -701,7 +742,7 @@ const model* drive_session_model(const drive_session* s) { return s->m; }
 render* drive_session_render_ctx(drive_session* s) { return s->r; }
 input* drive_session_input(drive_session* s) { return s->in; }
 panel* drive_session_panel(drive_session* s) { return s->pn; }
-void drive_session_row(drive_session* s, double* row) { live_row(s->l, row); }
+void drive_session_row(drive_session* s, double* row) { session_row(s, row); }
 
 // "%.1f fps" of n events over wall seconds, or "n/a" when the interval is too
 // short for a rate to mean anything (a screenshot at t = 0).
@@ -745,7 +786,7 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
             code = EXIT_RUNTIME;
             break;
         }
-        if (screenshot && !shot_done && live_time(s->l) >= screenshot_at) {
+        if (screenshot && !shot_done && s->t_base + live_time(s->l) >= screenshot_at) {
             drive_session_render(s);
             if (drive_session_screenshot(s, screenshot, err, sizeof err)) {
                 fprintf(stderr, "cranesim drive: %s\n", err);
@@ -762,9 +803,14 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     }
     const drive_stats* st = drive_session_stats(s);
     char fps[32], hz[32];
-    printf("  simulated %.2f s in %.2f s wall; %ld frames (%s fps), %ld command updates (%s Hz), missed %ld; "
+    // Simulated time over every piece (resets, rebuilds); paused wall time
+    // said, so the two figures can be compared.
+    char extra[96] = "";
+    if (st->paused_time > 0 || s->segment > 0)
+        snprintf(extra, sizeof extra, " (%.2f s of it paused; %d resets or rebuilds)", st->paused_time, s->segment);
+    printf("  simulated %.2f s in %.2f s wall%s; %ld frames (%s fps), %ld command updates (%s Hz), missed %ld; "
            "%ld triangles\n",
-           st->sim_time, st->wall_time, st->frames, rate_str(fps, sizeof fps, (double)st->frames, st->wall_time, "%.1f"),
+           st->sim_time, st->wall_time, extra, st->frames, rate_str(fps, sizeof fps, (double)st->frames, st->wall_time, "%.1f"),
            st->input_samples, rate_str(hz, sizeof hz, (double)st->input_samples, st->wall_time, "%.0f"), st->missed,
            st->triangles);
     long rows = 0;

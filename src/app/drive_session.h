@@ -54,8 +54,9 @@ typedef struct drive_stats {
     long frames;          ///< frames rendered
     long input_samples;   ///< valve-command updates applied
     long missed;          ///< ticks whose physics could not catch up with wall time
-    double sim_time;      ///< simulated time [s]
+    double sim_time;      ///< simulated time, summed over resets and rebuilds [s]
     double wall_time;     ///< wall time since start [s]
+    double paused_time;   ///< wall time spent paused [s]
     long triangles;       ///< triangles in the last frame
     double frame_ms[4096];///< recent frame intervals [ms] (ring buffer)
     int nframe_ms;
@@ -82,6 +83,10 @@ int drive_session_tick(drive_session* s, double wall);
 /// if there is one (returning when the driver has finished it), else sleep.
 void drive_session_idle(drive_session* s, double left);
 
+/// The real-time factor the HUD shows: simulated over running (not paused)
+/// wall time since the last reset or rebuild; 0 (unknown) before
+/// DRIVE_MIN_RATE_S of it.
+double drive_session_rt_factor(const drive_session* s);
 /// Force a rendered frame now (e.g. before a screenshot).
 void drive_session_render(drive_session* s);
 /// Save the last frame as PNG. Returns 0, or -1 with "cannot write FILE:

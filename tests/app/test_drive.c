@@ -525,6 +525,62 @@ static void test_open_relief_is_named(void) {
     drive_session_destroy(s);
 }
 
+
+// Tap a key: down on one tick, up on the next.
+static void tap_key(drive_session* s, double* wall, SDL_Scancode sc) {
+    push_key(sc, 1);
+    run_for(s, wall, 1.0 / 240.0);
+    push_key(sc, 0);
+    run_for(s, wall, 1.0 / 240.0);
+}
+
+// The real-time factor after a reset (R), a rebuild (a solver change) and a
+// pause is the simulation's own rate, 1.00 on a virtual clock that the loop
+// keeps up with: it divided the time since the reset by the wall time since
+// the start ("RT 0.33x" and "CANNOT KEEP UP" for ever). The session's totals
+// add the pieces up (the exit summary).
+static void test_rt_factor_after_reset_rebuild_and_pause(void) {
+    drive_session* s = open_validation(true, NULL);
+    if (!s) return;
+    double wall = 0;
+    char text[1024];
+    CHECK(run_for(s, &wall, 2.0) == 0, "loop: %s", drive_session_error(s));
+    tap_key(s, &wall, SDL_SCANCODE_R);
+    double row[SIM_NCOL];
+    drive_session_row(s, row);
+    CHECK(row[COL_T] < 0.05, "after R the run starts again: t = %.3f s", row[COL_T]);
+    CHECK(run_for(s, &wall, 1.0) == 0, "loop: %s", drive_session_error(s));
+    hud_warnings(s, text, sizeof text);
+    double rt = drive_session_snapshot(s)->rt_factor;
+    CHECK(rt > 0.97 && rt < 1.03, "RT after a reset: %.3f", rt);
+    CHECK(!strstr(text, "CANNOT KEEP UP"), "after a reset: '%s'", text);
+    // A solver change rebuilds the world; time goes on.
+    char msg[256];
+    CHECK(panel_set(drive_session_panel(s), "solver/method", 1, msg, sizeof msg) == PANEL_OK, "%s", msg);
+    const double t_before = drive_session_snapshot(s)->t;
+    CHECK(run_for(s, &wall, 1.0) == 0, "loop: %s", drive_session_error(s));
+    hud_warnings(s, text, sizeof text);
+    rt = drive_session_snapshot(s)->rt_factor;
+    CHECK(rt > 0.97 && rt < 1.03, "RT after a solver change: %.3f", rt);
+    CHECK(drive_session_snapshot(s)->t > t_before + 0.9, "time after the rebuild %.3f s, before %.3f s",
+          drive_session_snapshot(s)->t, t_before);
+    CHECK(!strstr(text, "CANNOT KEEP UP"), "after a solver change: '%s'", text);
+    // Paused for 1 s, then 1 s running: still 1.00.
+    tap_key(s, &wall, SDL_SCANCODE_P);
+    run_for(s, &wall, 1.0);
+    tap_key(s, &wall, SDL_SCANCODE_P);
+    run_for(s, &wall, 1.0);
+    hud_warnings(s, text, sizeof text);
+    rt = drive_session_snapshot(s)->rt_factor;
+    CHECK(rt > 0.97 && rt < 1.03, "RT after a pause: %.3f", rt);
+    CHECK(!strstr(text, "CANNOT KEEP UP"), "after a pause: '%s'", text);
+    // Totals: every piece's simulated time, against the wall time less the pause.
+    const drive_stats* st = drive_session_stats(s);
+    CHECK(fabs(st->sim_time - (st->wall_time - st->paused_time)) < 0.05 && fabs(st->paused_time - 1.0) < 0.02,
+          "summary: simulated %.3f s in %.3f s wall, %.3f s paused", st->sim_time, st->wall_time, st->paused_time);
+    drive_session_destroy(s);
+}
+
 int main(int argc, char** argv) {
     // Headless: SDL's offscreen video driver on Mesa's EGL (llvmpipe).
     setenv("SDL_VIDEODRIVER", "offscreen", 0);
@@ -540,6 +596,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_no_rate_over_an_instant);
     RUN_TEST(test_record_write_failure);
     RUN_TEST(test_open_relief_is_named);
+    RUN_TEST(test_rt_factor_after_reset_rebuild_and_pause);
     SDL_Quit();
     TEST_MAIN_END();
 }
