@@ -365,12 +365,40 @@ static void act_reset(void* user) {
     snprintf(s->status, sizeof s->status, "run reset");
 }
 
+int drive_save_name(char* path, size_t n) {
+    // "wx" (C11) creates the file only if no file of that name exists, so a
+    // name is taken atomically and nothing is ever overwritten; model_save
+    // then fills the empty file.
+    for (int k = 1; k <= 9999; ++k) {
+        snprintf(path, n, "cranesim_model_%d.json", k);
+        FILE* f = fopen(path, "wx");
+        if (f) {
+            fclose(f);
+            return 0;
+        }
+        if (errno != EEXIST) return -1;
+    }
+    errno = EEXIST;
+    return -1;
+}
+
 static void act_save(void* user) {
     drive_session* s = user;
-    char e[256];
-    const char* path = "cranesim_model_saved.json";
-    if (model_save(s->m, path, e, sizeof e)) snprintf(s->status, sizeof s->status, "save failed: %s", e);
-    else snprintf(s->status, sizeof s->status, "model saved to %s", path);
+    char e[320], path[256];
+    if (s->o.save_as) {
+        // The user named the file (--save-as): each save replaces it, and
+        // the status line says so.
+        snprintf(path, sizeof path, "%s", s->o.save_as);
+    } else if (drive_save_name(path, sizeof path)) {
+        snprintf(s->status, sizeof s->status, "save failed: cannot create %s: %s", path, strerror(errno));
+        return;
+    }
+    if (model_save(s->m, path, e, sizeof e)) {
+        snprintf(s->status, sizeof s->status, "save failed: %s", e);
+        if (!s->o.save_as) remove(path); // the empty file reserved for it
+    } else {
+        snprintf(s->status, sizeof s->status, "model saved to %s%s", path, s->o.save_as ? " (--save-as, replaced)" : "");
+    }
 }
 
 static void act_pause(void* user) {

@@ -40,6 +40,8 @@ typedef struct drive_opts {
     const char* charts;       ///< strip-chart channels: CSV column names, comma-separated
                               ///< ("p1A,p2A,x1,u1"); NULL: pressures, strokes, spools
     const char* world_name;   ///< the ode world's name for the banner ("validation"); NULL: "sandbox"
+    const char* save_as;      ///< "save model" writes (and replaces) this file; NULL: a new
+                              ///< cranesim_model_N.json each time (drive_save_name)
 } drive_opts;
 
 drive_opts drive_default_opts(void);
@@ -110,6 +112,11 @@ struct panel* drive_session_panel(drive_session* s);
 const model* drive_session_model(const drive_session* s);
 /// The row (CSV columns) at the current simulated time.
 void drive_session_row(drive_session* s, double* row);
+
+/// Take a new file name for "save model" in the working directory:
+/// cranesim_model_N.json with the smallest N >= 1 no file has, created empty
+/// so no other writer gets it. Returns 0, or -1 with errno.
+int drive_save_name(char* path, size_t n);
 
 /// Run the interactive loop on the real clock until quit (the `drive` command).
 /// Returns an exit code, or DRIVE_NO_WINDOW (nothing printed, the reason in

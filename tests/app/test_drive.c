@@ -12,6 +12,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 // sets: model overrides (--set path=value), nset of them.
 static drive_session* open_session_with(const char* const* sets, int nset) {
@@ -581,6 +582,80 @@ static void test_rt_factor_after_reset_rebuild_and_pause(void) {
     drive_session_destroy(s);
 }
 
+
+static bool file_is(const char* path, const char* text) {
+    char buf[64] = "";
+    FILE* f = fopen(path, "r");
+    if (!f) return false;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    return !strcmp(buf, text);
+}
+
+// "save model" wrote ./cranesim_model_saved.json over whatever was there.
+// Now each save takes a new name (cranesim_model_N.json, N past the files
+// that exist), says it in the status line, and never touches an existing
+// file; with --save-as it writes the named file.
+static void test_save_model_never_overwrites(void) {
+    char dir[] = "/tmp/cranesim_save_XXXXXX", cwd[1024];
+    CHECK(mkdtemp(dir) != NULL && getcwd(cwd, sizeof cwd) != NULL, "temp dir");
+    CHECK(chdir(dir) == 0, "chdir %s", dir);
+    FILE* f = fopen("cranesim_model_1.json", "w");
+    if (f) fputs("keep me", f), fclose(f);
+    f = fopen("cranesim_model_saved.json", "w");
+    if (f) fputs("keep me too", f), fclose(f);
+    drive_session* s = open_validation(true, NULL);
+    if (s) {
+        render* r = drive_session_render_ctx(s);
+        double wall = 0;
+        CHECK(panel_run_action(drive_session_panel(s), "save model"), "save action");
+        render_wait(drive_session_render_ctx(s), 1.0); // the next tick draws a frame with the status
+        run_for(s, &wall, 0.05);
+        CHECK(strstr(render_get_status(r), "model saved to cranesim_model_2.json") != NULL, "status: '%s'",
+              render_get_status(r));
+        CHECK(panel_run_action(drive_session_panel(s), "save model"), "save action");
+        render_wait(drive_session_render_ctx(s), 1.0); // the next tick draws a frame with the status
+        run_for(s, &wall, 0.05);
+        CHECK(strstr(render_get_status(r), "cranesim_model_3.json") != NULL, "status: '%s'", render_get_status(r));
+        CHECK(file_is("cranesim_model_1.json", "keep me") && file_is("cranesim_model_saved.json", "keep me too"),
+              "an existing file was overwritten");
+        // The saved file is the model: it loads back.
+        char err[512];
+        model* m = model_load("cranesim_model_2.json", NULL, 0, err, sizeof err);
+        CHECK(m != NULL, "saved model loads: %s", err);
+        model_free(m);
+        drive_session_destroy(s);
+    }
+    app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE;
+    c.sim.world = "validation";
+    c.scenario_path = CRANESIM_ASSETS "/scenarios/drive_demo.json";
+    drive_opts o = drive_default_opts();
+    o.offscreen = true;
+    o.save_as = "mine.json";
+    char err[512];
+    s = drive_session_create(&c, &o, err, sizeof err, NULL);
+    CHECK(s != NULL, "session: %s", err);
+    if (s) {
+        CHECK(panel_run_action(drive_session_panel(s), "save model"), "save action");
+        double wall = 0;
+        render_wait(drive_session_render_ctx(s), 1.0); // the next tick draws a frame with the status
+        run_for(s, &wall, 0.05);
+        const char* st = render_get_status(drive_session_render_ctx(s));
+        CHECK(strstr(st, "model saved to mine.json") != NULL, "status: '%s'", st);
+        model* m = model_load("mine.json", NULL, 0, err, sizeof err);
+        CHECK(m != NULL, "--save-as model loads: %s", err);
+        model_free(m);
+        CHECK(access("cranesim_model_4.json", F_OK) != 0, "--save-as also took a new name");
+        drive_session_destroy(s);
+    }
+    const char* names[] = {"cranesim_model_1.json", "cranesim_model_2.json", "cranesim_model_3.json",
+                           "cranesim_model_saved.json", "mine.json"};
+    for (int i = 0; i < 5; ++i) remove(names[i]);
+    CHECK(chdir(cwd) == 0 && rmdir(dir) == 0, "clean up %s", dir);
+}
+
 int main(int argc, char** argv) {
     // Headless: SDL's offscreen video driver on Mesa's EGL (llvmpipe).
     setenv("SDL_VIDEODRIVER", "offscreen", 0);
@@ -597,6 +672,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_record_write_failure);
     RUN_TEST(test_open_relief_is_named);
     RUN_TEST(test_rt_factor_after_reset_rebuild_and_pause);
+    RUN_TEST(test_save_model_never_overwrites);
     SDL_Quit();
     TEST_MAIN_END();
 }
