@@ -343,7 +343,7 @@ static void test_panel_draws_offscreen(void) {
     render_read_pixels(r, before, W, H);
     panel* pn = panel_create();
     double bore = 0.1;
-    panel_param_def d = {"bore", "lift cylinder", "m", &bore, 0.05, 0.2, 0.005};
+    panel_param_def d = {"bore", "lift cylinder", "m", &bore, 0.05, 0.2, 0.005, false};
     panel_add_param(pn, &d);
     CHECK(render_attach_panel(r, pn), "ImGui panel starts on the offscreen context");
     // ImGui needs a frame or two to lay out its window.
