@@ -24,7 +24,7 @@ typedef enum param_kind {
     PK_HYD,  ///< a circuit parameter: hyd_model_set on the live circuit, at once
     PK_MECH, ///< a mechanical parameter: live for lagrange, a rebuilt world for ode
     PK_LOAD, ///< the tip load (lagrange) [kg]
-    PK_SOLVER, ///< hydraulic integrator: 0 Krus, 1 ROS2 (a rebuilt world/solver at the current pose)
+    PK_SOLVER, ///< hydraulic integrator, an index into k_solver (a rebuilt world/solver at the current pose)
     PK_STEP,   ///< hydraulic step [s] (rebuilt likewise)
 } param_kind;
 
@@ -38,7 +38,13 @@ typedef struct drive_param {
     double min, max;   ///< display units
     char hyd_path[64]; ///< PK_HYD: "lift_cyl.bore", "fluid.bulk_modulus"
     char json[128];    ///< path in the model file, for saving
+    bool on_release;   ///< applied when the edit ends: it rebuilds the world
 } drive_param;
+
+// The solver choice of the panel: the in-house integrators drive can step.
+static const hyd_method k_solver[] = {HYD_KRUS, HYD_ROS2, HYD_RK4, HYD_ROS34PW2, HYD_RODAS3};
+static const char* const k_solver_name[] = {"Krus", "ROS2", "RK4", "ROS34PW2", "RODAS3"};
+#define NSOLVER ((int)(sizeof k_solver / sizeof k_solver[0]))
 
 struct drive_session {
     app_common c;
@@ -54,6 +60,8 @@ struct drive_session {
     int nparam;
     int pid[MAX_PARAMS]; // panel ids
     bool paused, rebuild;
+    char rebuild_why[160]; // the change that asked for the rebuild
+    sim_opts sim_live;     // the options the running world was built with
     double wall_last, wall_next_frame;
     double wall_last_frame; ///< wall time the last timed frame started [s] (< 0: none yet)
     double sim_offset;   // simulated time = wall - sim_offset while running
@@ -159,9 +167,25 @@ static void build_params(drive_session* s) {
     add_hyd(s, "reliefs", "jib port B", "MPa", 1e6, 2, 40, "jib_relief_B", "p_crack");
     add_hyd(s, "oil", "bulk modulus", "GPa", 1e9, 0.2, 2.5, "fluid", "bulk_modulus");
     add_hyd(s, "oil", "density", "kg/m3", 1, 700, 1000, "fluid", "density");
-    add_param(s, PK_SOLVER, "solver", "method", "-", 1, 0, 1, NULL, NULL,
-              s->c.sim.solver == HYD_ROS2 ? 1.0 : 0.0);
+    int method = 0;
+    for (int k = 0; k < NSOLVER; ++k)
+        if (k_solver[k] == s->c.sim.solver) method = k;
+    add_param(s, PK_SOLVER, "solver", "method", "", 1, 0, NSOLVER - 1, NULL, NULL, method);
     add_param(s, PK_STEP, "solver", "step", "ms", 1e-3, 0.05, 1.0, NULL, NULL, s->c.sim.h);
+    // What cannot change in place rebuilds the world (loads back at their
+    // start): applied once when the drag or the typing ends, not at every
+    // pixel. Masses and inertias change in place (live_set_link); in the ode
+    // world a length does not.
+    // A tip load in an ode world (the validation world's, merged into the end
+    // arm) moves the end arm's centre of mass with its mass: a rebuild too.
+    const bool ode = s->c.sim.mechanics == SIM_ODE;
+    const bool tip_load = ode && !live_load_name(s->l, 0, NULL) && sim_load_mass(s->m, &s->sc, &s->c.sim) > 0;
+    for (int i = 0; i < s->nparam; ++i) {
+        drive_param* p = &s->param[i];
+        const bool mech = p->kind == PK_MECH;
+        p->on_release = p->kind == PK_STEP || p->kind == PK_SOLVER || (mech && ode && strstr(p->json, ".length")) ||
+                        (mech && tip_load && strstr(p->json, "links[1].mass"));
+    }
 }
 
 // Keep the model document in step with a changed parameter, so "save model"
@@ -215,31 +239,39 @@ static void apply_param(drive_session* s, int i) {
             ln->length = si;
         }
         crane_mech_derive(me);
+        // In place where the backend can (the lagrange crane; an ode boom's
+        // mass and inertia), else one rebuild at the current pose.
+        if (live_set_link(s->l, k, ln)) {
+            s->rebuild = true;
+            snprintf(s->rebuild_why, sizeof s->rebuild_why, "%s/%s", p->group, p->label);
+        }
         char a[160], e2[200];
         snprintf(a, sizeof a, "mechanics.links[%d].com=%.10g", k, ln->com);
         json_set_path(s->m->json, a, e2, sizeof e2);
         snprintf(a, sizeof a, "mechanics.links[%d].inertia=%.10g", k, ln->inertia);
         json_set_path(s->m->json, a, e2, sizeof e2);
-        // Lagrange reads the model's mechanics every step; the ode world's
-        // bodies are built once, so it is rebuilt at the current pose.
-        if (s->c.sim.mechanics == SIM_ODE) s->rebuild = true;
         break;
     }
     case PK_LOAD:
         live_set_load(s->l, si);
         s->c.sim.load_mass = si;
         break;
-    case PK_SOLVER:
-        p->value = si < 0.5 ? 0.0 : 1.0; // a choice, not a continuum
-        s->c.sim.solver = p->value > 0.5 ? HYD_ROS2 : HYD_KRUS;
+    case PK_SOLVER: {
+        const int k = (int)p->value;
+        s->c.sim.solver = k_solver[k >= 0 && k < NSOLVER ? k : 0];
         s->rebuild = true;
-        break;
+        snprintf(s->rebuild_why, sizeof s->rebuild_why, "solver %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
+        sync_json(s, p);
+        snprintf(s->status, sizeof s->status, "solver/method = %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
+        return;
+    }
     case PK_STEP: {
         // The ode world needs the hydraulic step to divide its 1 ms step.
         double sub = s->c.sim.mechanics == SIM_ODE ? floor(s->c.sim.dt_ode / si + 0.5) : 0;
         s->c.sim.h = sub > 0 ? s->c.sim.dt_ode / sub : si;
         p->value = s->c.sim.h / p->scale;
         s->rebuild = true;
+        snprintf(s->rebuild_why, sizeof s->rebuild_why, "solver step %.4g ms", p->value);
         break;
     }
     }
@@ -258,9 +290,22 @@ static void rebuild_world(drive_session* s, bool at_start) {
     }
     live* l = make_live(s, q0, slew0);
     if (!l) {
-        snprintf(s->status, sizeof s->status, "rebuild failed: %s", s->err);
+        // The running world goes on with the options it was built with, and
+        // the panel shows them again.
+        snprintf(s->status, sizeof s->status, "rebuild failed (%s kept): %s",
+                 hyd_method_name(s->sim_live.solver), s->err);
+        s->c.sim.solver = s->sim_live.solver;
+        s->c.sim.h = s->sim_live.h;
+        for (int i = 0; i < s->nparam; ++i) {
+            drive_param* p = &s->param[i];
+            if (p->kind == PK_STEP) p->value = s->c.sim.h / p->scale;
+            if (p->kind == PK_SOLVER)
+                for (int k = 0; k < NSOLVER; ++k)
+                    if (k_solver[k] == s->c.sim.solver) p->value = k;
+        }
         return;
     }
+    s->sim_live = s->c.sim;
     // The real-time factor is the new piece's simulated time over its own
     // wall time: dividing it by the wall time since the session started read
     // "RT 0.42x" (and "cannot keep up") for ever after a reset. The totals
@@ -442,7 +487,11 @@ static int start_recording(drive_session* s, const char* path) {
         return -1;
     }
     errno = 0;
-    sim_csv_header(s->rec, s->ncol);
+    // The world's columns and `segment`: 0 from the start, one more at each
+    // reset or rebuild (a reset starts t at 0 again, a rebuild puts the
+    // loads back), so a reader can split the record where the world jumped.
+    for (int c = 0; c < s->ncol; ++c) fprintf(s->rec, "%s,", sim_col_name[c]);
+    fputs("segment\n", s->rec);
     if (ferror(s->rec)) {
         record_failed(s, errno);
         return -1;
@@ -452,7 +501,10 @@ static int start_recording(drive_session* s, const char* path) {
 
 static void record_row(drive_session* s, const double* row) {
     errno = 0;
-    sim_csv_row(s->rec, row, s->ncol);
+    double r[SIM_NCOL + 1];
+    memcpy(r, row, sizeof(double) * (size_t)s->ncol);
+    r[s->ncol] = s->segment;
+    sim_csv_row(s->rec, r, s->ncol + 1);
     if (ferror(s->rec)) record_failed(s, errno);
     else ++s->rec_rows;
 }
@@ -508,6 +560,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         return NULL;
     }
     s->l = make_live(s, s->sc.q0, s->sc.slew0);
+    s->sim_live = s->c.sim;
     if (!s->l) {
         // A world file or model the world cannot be built from.
         snprintf(err, errsz, "%s", s->err);
@@ -551,8 +604,10 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     build_params(s);
     for (int i = 0; i < s->nparam; ++i) {
         drive_param* p = &s->param[i];
-        panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0};
-        s->pid[i] = panel_add_param(s->pn, &d);
+        panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0, p->on_release};
+        s->pid[i] = p->kind == PK_SOLVER
+                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
+                        : panel_add_param(s->pn, &d);
     }
     panel_add_action(s->pn, "reset run", act_reset, s);
     panel_add_action(s->pn, "save model", act_save, s);
@@ -685,7 +740,16 @@ int drive_session_tick(drive_session* s, double wall) {
             if (s->pid[i] == id) apply_param(s, i);
     if (s->rebuild) {
         s->rebuild = false;
+        const double t_at = s->t_base + live_time(s->l);
+        const int seg = s->segment;
         rebuild_world(s, false);
+        // Say it: a rebuild puts the loads back and is a new segment of the
+        // record.
+        if (s->segment != seg)
+            snprintf(s->status, sizeof s->status, "%s: world rebuilt at t = %.2f s%s (record segment %d)",
+                     s->rebuild_why, t_at, s->c.sim.mechanics == SIM_ODE ? ", loads back at their start" : "",
+                     s->segment);
+        ++s->st.rebuilds;
     }
 
     double t = live_time(s->l);
@@ -737,8 +801,11 @@ int drive_session_tick(drive_session* s, double wall) {
         char status[640];
         // Who drives: the scenario, a named device, or the keyboard alone.
         const char* src = s->o.scripted ? "  [scripted]" : input_device_name(s->in) ? "" : "  [keyboard]";
-        snprintf(status, sizeof status, "%s%s%s%s%s", s->paused ? "PAUSED  " : "", s->rec ? "REC  " : "", s->status,
-                 src, panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]");
+        // While a value is typed the keys go to the panel, not the crane:
+        // say so where the operator looks.
+        const char* keys = panel_gui_wants_keyboard(s->pn) ? "  [keys: panel - Enter/Esc gives them back]" : "";
+        snprintf(status, sizeof status, "%s%s%s%s%s%s", s->paused ? "PAUSED  " : "", s->rec ? "REC  " : "", s->status,
+                 src, panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]", keys);
         render_set_status(s->r, status);
         take_snapshot(s);
         if (s->nchart)

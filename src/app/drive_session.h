@@ -59,6 +59,7 @@ typedef struct drive_stats {
     double sim_time;      ///< simulated time, summed over resets and rebuilds [s]
     double wall_time;     ///< wall time since start [s]
     double paused_time;   ///< wall time spent paused [s]
+    long rebuilds;        ///< world rebuilds for a parameter (not resets)
     long triangles;       ///< triangles in the last frame
     double frame_ms[4096];///< recent frame intervals [ms] (ring buffer)
     int nframe_ms;

@@ -123,6 +123,17 @@ void live_set_load(live* l, double m3) {
     hyd_solver_inputs_changed(l->solver); // f changed at the same (t, y)
 }
 
+int live_set_link(live* l, int k, const crane_link* ln) {
+    if (l->ode) return ode_world_set_link_mass(l->ode, k, ln) ? 1 : 0;
+    // The lagrange crane reads the model's links (ln is one of them, edited
+    // by the caller); the constants its fast kernels made from them at start
+    // are made again.
+    (void)ln;
+    lagrange_consts_init(&l->ls.mdl->mech, l->ls.variant, l->ls.m3, &l->ls.lk);
+    hyd_solver_inputs_changed(l->solver); // f changed at the same (t, y)
+    return 0;
+}
+
 int live_ncol(const live* l) { return l->ode ? SIM_NCOL : SIM_NCOL_BASE; }
 
 void live_set_commands(live* l, const double u[3]) {

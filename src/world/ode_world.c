@@ -909,6 +909,19 @@ void ode_world_lock_booms(ode_world* w, int lock) {
 
 hyd_model* ode_world_circuit(ode_world* w) { return w->hm; }
 
+int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln) {
+    if (k < 0 || k > 1 || !w->frame[k + 1].body) return -1;
+    const crane_link* old = &w->mech.link[k];
+    if (ln->length != old->length || ln->width != old->width || ln->height != old->height) return -1;
+    dMass m;
+    const double c = boom_mass(ln, k == 1 && w->kind == WORLD_VALIDATION ? w->m3 : 0.0, &m);
+    // The body origin is the combined centre of mass, -org from the joint.
+    if (fabs(c + w->frame[k + 1].org[0]) > 1e-9 * ln->length || !dMassCheck(&m)) return -1;
+    dBodySetMass(w->frame[k + 1].body, &m);
+    w->mech.link[k] = *ln;
+    return 0;
+}
+
 int ode_world_fused(const ode_world* w) { return w->hm && w->use_fused; }
 
 void ode_world_chamber_pressures(const ode_world* w, double pA[ODE_NACT], double pB[ODE_NACT]) {
