@@ -177,7 +177,7 @@ void render_set_status(render* r, const char* text);
 /// The status line as last set.
 const char* render_get_status(const render* r);
 /// Longest warning line and most lines render_hud_warnings gives.
-#define RENDER_WARN_LEN 96
+#define RENDER_WARN_LEN 128
 #define RENDER_WARN_MAX 12
 /// The warnings the HUD draws (top centre, red) for snapshot s, as text, in
 /// the order drawn: open reliefs by name with the chamber they guard, end
