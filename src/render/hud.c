@@ -196,7 +196,9 @@ static void pressure_color(double frac, float rgba[4]) {
 
 enum { BAR_W = 14, BAR_H = 96, BAR_GAP = 6, BAR_PAD = 4 };
 
-static void draw_pressure_bars(render* r, const world_snapshot* s) {
+// keep_out: the warnings' box at the top centre (x, y, w, h [px]; w = 0 for
+// none): a bar group there goes below it, not under it.
+static void draw_pressure_bars(render* r, const world_snapshot* s, const float keep_out[4]) {
     render_hud* h = &r->hud;
     const float empty[4] = {((RENDER_BAR_EMPTY_RGB >> 16) & 255) / 255.0f,
                             ((RENDER_BAR_EMPTY_RGB >> 8) & 255) / 255.0f,
@@ -218,6 +220,9 @@ static void draw_pressure_bars(render* r, const world_snapshot* s) {
         int gx = (int)px[0] - gw / 2, gy = (int)px[1] - 40 - gh;
         if (gx < 4) gx = 4;
         if (gy < 4) gy = 4;
+        if (keep_out[2] > 0 && gx < keep_out[0] + keep_out[2] && keep_out[0] < gx + gw &&
+            gy < keep_out[1] + keep_out[3])
+            gy = (int)(keep_out[1] + keep_out[3]) + 4;
         if (gx + gw > h->w - 4) gx = h->w - 4 - gw;
         if (gy + gh > h->h - 4) gy = h->h - 4 - gh;
         for (int pass = 0; pass < 4; ++pass)
@@ -352,10 +357,15 @@ int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDE
     return n;
 }
 
-static void draw_warnings(render* r, const world_snapshot* s) {
+// The warnings' box at the top centre (x, y, w, h [px]), w = 0 for none.
+static void warnings_box(const render* r, char w[][RENDER_WARN_LEN], int n, float box[4]) {
+    float tw = 0;
+    for (int i = 0; i < n; ++i) tw = fmaxf(tw, render_hud_text_width(w[i], 2.0f));
+    box[0] = 0.5f * ((float)r->hud.w - tw) - 8, box[1] = 5, box[2] = n ? tw + 16 : 0, box[3] = 30.0f * (float)n;
+}
+
+static void draw_warnings(render* r, char w[][RENDER_WARN_LEN], int n) {
     render_hud* h = &r->hud;
-    char w[RENDER_WARN_MAX][RENDER_WARN_LEN];
-    const int n = render_hud_warnings(r, s, w, RENDER_WARN_MAX);
     float y = 10;
     for (int i = 0; i < n; ++i) {
         float tw = render_hud_text_width(w[i], 2.0f);
@@ -368,9 +378,14 @@ static void draw_warnings(render* r, const world_snapshot* s) {
 
 void render_hud_draw_overlay(render* r, const world_snapshot* s) {
     render_hud* h = &r->hud;
-    draw_pressure_bars(r, s);
+    // Warnings first as text, so the pressure bars keep clear of them.
+    char w[RENDER_WARN_MAX][RENDER_WARN_LEN];
+    const int nw = render_hud_warnings(r, s, w, RENDER_WARN_MAX);
+    float box[4];
+    warnings_box(r, w, nw, box);
+    draw_pressure_bars(r, s, box);
     draw_readouts(r, s);
-    draw_warnings(r, s);
+    draw_warnings(r, w, nw);
     if (r->charts.n > 0) {
         float ch = 124.0f;
         render_charts_draw(h, &r->charts, 10, (float)h->h - ch - 10, (float)h->w - 20, ch);

@@ -498,6 +498,24 @@ static void test_open_relief_is_named(void) {
     CHECK(snap->ncyl == 3 && snap->cyl[2].relief_open && !snap->cyl[0].relief_open && !snap->cyl[1].relief_open,
           "per-cylinder relief flags lift %d jib %d slew %d", snap->cyl[0].relief_open, snap->cyl[1].relief_open,
           snap->ncyl > 2 ? snap->cyl[2].relief_open : -1);
+    // The pressure bars stay clear of the warnings stacked at the top centre
+    // (they were drawn under them, the jib's hidden by the relief line).
+    {
+        char w[RENDER_WARN_MAX][RENDER_WARN_LEN];
+        render* r = drive_session_render_ctx(s);
+        const int nw = render_hud_warnings(r, snap, w, RENDER_WARN_MAX);
+        int covered = 0;
+        for (int cyl = 0; cyl < snap->ncyl; ++cyl)
+            for (int ch = 0; ch < 2; ++ch) {
+                int rc[4];
+                // The widest line (35 characters at 2x stb_easy_font) spans
+                // about 640 +- 200 px; each line is 30 px high from y = 5.
+                if (render_hud_bar_rect(r, cyl, ch, rc) && rc[0] < 840 && rc[0] + rc[2] > 440 &&
+                    rc[1] - 14 < 5 + 30 * nw)
+                    ++covered;
+            }
+        CHECK(covered == 0, "%d pressure bars under the %d warning lines", covered, nw);
+    }
     push_key(SDL_SCANCODE_A, 0);
     drive_session_destroy(s);
 
