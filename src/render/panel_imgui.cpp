@@ -121,6 +121,8 @@ extern "C" bool panel_gui_event(panel* p, const SDL_Event* ev) {
     if (ev->type == SDL_MOUSEMOTION) p->mouse_x = (float)ev->motion.x, p->mouse_y = (float)ev->motion.y, p->have_mouse = true;
     if (ev->type == SDL_MOUSEBUTTONDOWN || ev->type == SDL_MOUSEBUTTONUP)
         p->mouse_x = (float)ev->button.x, p->mouse_y = (float)ev->button.y, p->have_mouse = true;
+    // A mouse that left the window is nowhere over the panel.
+    if (ev->type == SDL_WINDOWEVENT && ev->window.event == SDL_WINDOWEVENT_LEAVE) p->have_mouse = false;
     const ImGuiIO& io = ImGui::GetIO();
     switch (ev->type) {
     case SDL_MOUSEMOTION:
