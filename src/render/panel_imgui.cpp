@@ -117,7 +117,16 @@ extern "C" void panel_gui_shutdown(panel* p) {
 extern "C" bool panel_gui_event(panel* p, const SDL_Event* ev) {
     if (!p || !p->imgui_ctx || !p->visible) return false;
     ImGui::SetCurrentContext(ctx_of(p));
-    ImGui_ImplSDL2_ProcessEvent(ev);
+    const int sc = ev->type == SDL_KEYDOWN || ev->type == SDL_KEYUP ? (int)ev->key.keysym.scancode : -1;
+    if (ev->type == SDL_KEYUP && sc >= 0 && sc < 512 && p->down_since_frame[sc] && p->ndeferred_up < 16) {
+        // Pressed and released before ImGui saw it down: release it after
+        // the next frame (panel_gui_draw), or the Enter that ends typing
+        // is lost and the panel keeps the keyboard.
+        p->deferred_up[p->ndeferred_up++] = sc;
+    } else {
+        ImGui_ImplSDL2_ProcessEvent(ev);
+        if (ev->type == SDL_KEYDOWN && sc >= 0 && sc < 512) p->down_since_frame[sc] = 1;
+    }
     if (ev->type == SDL_MOUSEMOTION) p->mouse_x = (float)ev->motion.x, p->mouse_y = (float)ev->motion.y, p->have_mouse = true;
     if (ev->type == SDL_MOUSEBUTTONDOWN || ev->type == SDL_MOUSEBUTTONUP)
         p->mouse_x = (float)ev->button.x, p->mouse_y = (float)ev->button.y, p->have_mouse = true;
@@ -164,6 +173,18 @@ extern "C" void panel_gui_draw(panel* p) {
     ImGuiIO& io = ImGui::GetIO();
     if (io.MousePos.x == -FLT_MAX && p->have_mouse) io.MousePos = ImVec2(p->mouse_x, p->mouse_y);
     ImGui::NewFrame();
+    // This frame has seen the keys down; the releases held back go in now
+    // and count from the next frame.
+    std::memset(p->down_since_frame, 0, sizeof p->down_since_frame);
+    for (int k = 0; k < p->ndeferred_up; ++k) {
+        SDL_Event up;
+        std::memset(&up, 0, sizeof up);
+        up.type = SDL_KEYUP;
+        up.key.state = SDL_RELEASED;
+        up.key.keysym.scancode = (SDL_Scancode)p->deferred_up[k];
+        ImGui_ImplSDL2_ProcessEvent(&up);
+    }
+    p->ndeferred_up = 0;
     for (int i = 0; i < p->nparam; ++i) p->param[i].drawn = false;
     if (p->visible) {
         // The label column is as wide as the longest label.

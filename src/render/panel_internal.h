@@ -40,6 +40,11 @@ struct panel {
     bool visible;
     bool wants_keyboard;  ///< ImGui had the keyboard at the last frame
     bool have_mouse;      ///< mouse_x/y hold the last mouse event's position
+    /// Keys pressed since the last frame (SDL scancodes), and key-ups held
+    /// back for after it: ImGui 1.86 reads key states once per frame, so a
+    /// press and release between two frames would never reach it.
+    unsigned char down_since_frame[512];
+    int deferred_up[16], ndeferred_up;
     float mouse_x, mouse_y;
     void* imgui_ctx; ///< ImGuiContext*, owned by panel_imgui.cpp
 };
