@@ -77,6 +77,7 @@ struct drive_session {
     FILE* rec;
     char rec_path[256];
     long rec_rows;       // rows written to the open recording
+    int rec_seg0;        // s->segment when it started: its rows count segments from 0
     char rec_err[320];   // first recording failure ("cannot write FILE: ..."), "" if none
     int ncol;
     int ev;              // next scripted hook event
@@ -478,6 +479,7 @@ static void stop_recording(drive_session* s) {
 static int start_recording(drive_session* s, const char* path) {
     snprintf(s->rec_path, sizeof s->rec_path, "%s", path);
     s->rec_rows = 0;
+    s->rec_seg0 = s->segment;
     s->rec = fopen(path, "w");
     if (!s->rec) {
         // Remembered like a failed write: the session's end must not report
@@ -503,7 +505,7 @@ static void record_row(drive_session* s, const double* row) {
     errno = 0;
     double r[SIM_NCOL + 1];
     memcpy(r, row, sizeof(double) * (size_t)s->ncol);
-    r[s->ncol] = s->segment;
+    r[s->ncol] = s->segment - s->rec_seg0;
     sim_csv_row(s->rec, r, s->ncol + 1);
     if (ferror(s->rec)) record_failed(s, errno);
     else ++s->rec_rows;
@@ -745,11 +747,13 @@ int drive_session_tick(drive_session* s, double wall) {
         rebuild_world(s, false);
         // Say it: a rebuild puts the loads back and is a new segment of the
         // record.
-        if (s->segment != seg)
-            snprintf(s->status, sizeof s->status, "%s: world rebuilt at t = %.2f s%s (record segment %d)",
-                     s->rebuild_why, t_at, s->c.sim.mechanics == SIM_ODE ? ", loads back at their start" : "",
-                     s->segment);
-        ++s->st.rebuilds;
+        if (s->segment != seg) {
+            char seg_note[48] = "";
+            if (s->rec) snprintf(seg_note, sizeof seg_note, " (record segment %d)", s->segment - s->rec_seg0);
+            snprintf(s->status, sizeof s->status, "%s: world rebuilt at t = %.2f s%s%s", s->rebuild_why, t_at,
+                     s->c.sim.mechanics == SIM_ODE ? ", loads back at their start" : "", seg_note);
+            ++s->st.rebuilds;
+        }
     }
 
     double t = live_time(s->l);
