@@ -39,6 +39,7 @@ typedef struct drive_param {
     char hyd_path[64]; ///< PK_HYD: "lift_cyl.bore", "fluid.bulk_modulus"
     char json[128];    ///< path in the model file, for saving
     bool on_release;   ///< applied when the edit ends: it rebuilds the world
+    bool world_only;   ///< PK_HYD of the world's circuit, not the model's (not saved)
 } drive_param;
 
 // The solver choice of the panel: the in-house integrators drive can step.
@@ -129,8 +130,27 @@ static void add_hyd(drive_session* s, const char* group, const char* label, cons
         snprintf(hp, sizeof hp, "%s.%s", comp, field);
         snprintf(jp, sizeof jp, "hydraulics.components.%s.%s", comp, field);
     }
-    if (hyd_model_get(s->m->hyd, hp, &v)) return; // not in this circuit
-    add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, jp, v);
+    if (hyd_model_get(s->m->hyd, hp, &v) == 0) {
+        add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, jp, v);
+        return;
+    }
+    // A component of the world's own circuit (the sandbox's slew valve): it
+    // lives in the world file, not the model, so it is set on the running
+    // circuit only (and again after a rebuild); "save model" does not save it.
+    if (hyd_model_get(live_circuit(s->l), hp, &v) == 0) {
+        add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, NULL, v);
+        s->param[s->nparam - 1].world_only = true;
+    }
+}
+
+// Set the world-only circuit parameters on a new world's circuit, which
+// starts from the world file's values.
+static void reapply_world_params(drive_session* s) {
+    char e[256];
+    for (int i = 0; i < s->nparam; ++i) {
+        const drive_param* p = &s->param[i];
+        if (p->world_only) hyd_model_set(live_circuit(s->l), p->hyd_path, p->value * p->scale, e, sizeof e);
+    }
 }
 
 static void build_params(drive_session* s) {
@@ -166,6 +186,8 @@ static void build_params(drive_session* s) {
     add_hyd(s, "reliefs", "lift port B", "MPa", 1e6, 2, 40, "lift_relief_B", "p_crack");
     add_hyd(s, "reliefs", "jib port A", "MPa", 1e6, 2, 40, "jib_relief_A", "p_crack");
     add_hyd(s, "reliefs", "jib port B", "MPa", 1e6, 2, 40, "jib_relief_B", "p_crack");
+    add_hyd(s, "reliefs", "slew port A", "MPa", 1e6, 2, 40, "slew_relief_A", "p_crack");
+    add_hyd(s, "reliefs", "slew port B", "MPa", 1e6, 2, 40, "slew_relief_B", "p_crack");
     add_hyd(s, "oil", "bulk modulus", "GPa", 1e9, 0.2, 2.5, "fluid", "bulk_modulus");
     add_hyd(s, "oil", "density", "kg/m3", 1, 700, 1000, "fluid", "density");
     int method = 0;
@@ -215,10 +237,11 @@ static void apply_param(drive_session* s, int i) {
         // Both the world's own circuit and the model's (which a rebuilt world
         // or a saved file starts from).
         if (hyd_model_set(live_circuit(s->l), p->hyd_path, si, e, sizeof e) ||
-            hyd_model_set(s->m->hyd, p->hyd_path, si, e, sizeof e)) {
+            (!p->world_only && hyd_model_set(s->m->hyd, p->hyd_path, si, e, sizeof e))) {
             snprintf(s->status, sizeof s->status, "rejected: %s", e);
             double old;
-            if (!hyd_model_get(s->m->hyd, p->hyd_path, &old)) p->value = old / p->scale;
+            if (!hyd_model_get(p->world_only ? live_circuit(s->l) : s->m->hyd, p->hyd_path, &old))
+                p->value = old / p->scale;
             return;
         }
         break;
@@ -319,6 +342,7 @@ static void rebuild_world(drive_session* s, bool at_start) {
     ++s->segment;
     live_destroy(s->l);
     s->l = l;
+    reapply_world_params(s);
     s->sim_offset = s->wall_last; // the new world's clock starts at 0 now
     if (at_start) {
         // A new run: the script and the charts start again. A rebuild keeps

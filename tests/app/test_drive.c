@@ -1033,6 +1033,30 @@ static void test_presets_keep_out_of_the_truck(void) {
     drive_session_destroy(s);
 }
 
+
+// The sandbox's slew valve belongs to the world's circuit, not the model's:
+// the panel lacked it. Now it is there, acts on the running circuit, and
+// survives a reset (a new world from the world file).
+static void test_slew_valve_in_the_panel(void) {
+    drive_session* s = open_session();
+    if (!s) return;
+    panel* pn = drive_session_panel(s);
+    CHECK(panel_find(pn, "slew valve/rated flow") >= 0, "no slew valve in the panel");
+    char msg[256];
+    CHECK(panel_set(pn, "slew valve/rated flow", 12.0, msg, sizeof msg) == PANEL_OK, "%s", msg);
+    double wall = 0, v = 0;
+    run_for(s, &wall, 0.1);
+    CHECK(hyd_model_get(live_circuit(drive_session_live(s)), "slew_valve.q_nominal", &v) == 0 &&
+              fabs(v - 12.0 / 60000.0) < 1e-12,
+          "slew valve q_nominal %g m^3/s", v);
+    tap_key(s, &wall, SDL_SCANCODE_R);
+    v = 0;
+    CHECK(hyd_model_get(live_circuit(drive_session_live(s)), "slew_valve.q_nominal", &v) == 0 &&
+              fabs(v - 12.0 / 60000.0) < 1e-12,
+          "after a reset: slew valve q_nominal %g m^3/s", v);
+    drive_session_destroy(s);
+}
+
 int main(int argc, char** argv) {
     // Headless: SDL's offscreen video driver on Mesa's EGL (llvmpipe).
     setenv("SDL_VIDEODRIVER", "offscreen", 0);
@@ -1056,6 +1080,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_solver_is_a_choice);
     RUN_TEST(test_default_view_shows_hook_and_load);
     RUN_TEST(test_presets_keep_out_of_the_truck);
+    RUN_TEST(test_slew_valve_in_the_panel);
     SDL_Quit();
     TEST_MAIN_END();
 }
