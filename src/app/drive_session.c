@@ -775,7 +775,7 @@ int drive_session_tick(drive_session* s, double wall) {
             char seg_note[48] = "";
             if (s->rec) snprintf(seg_note, sizeof seg_note, " (record segment %d)", s->segment - s->rec_seg0);
             snprintf(s->status, sizeof s->status, "%s: world rebuilt at t = %.2f s%s%s", s->rebuild_why, t_at,
-                     s->c.sim.mechanics == SIM_ODE ? ", loads back at their start" : "", seg_note);
+                     live_load_name(s->l, 0, NULL) ? ", loads back at their start" : "", seg_note);
             ++s->st.rebuilds;
         }
     }
