@@ -48,6 +48,8 @@ static void drive_help(FILE* f) {
             "  --screenshot FILE   save a PNG of the view at --screenshot-at seconds and stop\n"
             "                      (offscreen when there is no display)\n"
             "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
+            "  --save-as FILE      window: the panel's \"save model\" writes FILE (default: a new\n"
+            "                      cranesim_model_N.json each time, never an existing file)\n"
             "  --size WxH          window size in pixels (default 1280x720)\n");
     app_common_help(f, true);
     // Keys last: they are what an operator looks up while the window is open.
@@ -242,6 +244,7 @@ int cmd_drive(int argc, char** argv) {
     const char* shot = NULL;
     const char* mapping = NULL;
     const char* charts = NULL;
+    const char* save_as = NULL;
     int width = 1280, height = 720;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -274,6 +277,10 @@ int cmd_drive(int argc, char** argv) {
         }
         if (!strcmp(argv[i], "--mapping") && i + 1 < argc) {
             mapping = argv[++i];
+            continue;
+        }
+        if (!strcmp(argv[i], "--save-as") && i + 1 < argc) {
+            save_as = argv[++i];
             continue;
         }
         if (!strcmp(argv[i], "--screenshot") && i + 1 < argc) {
@@ -310,7 +317,8 @@ int cmd_drive(int argc, char** argv) {
     // an option accepted in one mode and ignored in another would hide a
     // mistake until the other mode is used.
     if ((record && app_check_output("drive", "--record", record, NULL)) ||
-        (shot && app_check_output("drive", "--screenshot", shot, ".png")))
+        (shot && app_check_output("drive", "--screenshot", shot, ".png")) ||
+        (save_as && app_check_output("drive", "--save-as", save_as, ".json")))
         return EXIT_USAGE;
     // drive's ode world is the sandbox unless --world says otherwise (run's
     // is the validation world): name it, so the checks see the same world.
@@ -341,6 +349,7 @@ int cmd_drive(int argc, char** argv) {
     o.mapping_file = mapping;
     o.charts = charts;
     o.record_path = record;
+    o.save_as = save_as;
     o.world_name = c.sim.mechanics == SIM_ODE ? wname : NULL;
     int rc = drive_opts_check(&c, &o, err, sizeof err);
     if (rc) {
@@ -388,5 +397,7 @@ int cmd_drive(int argc, char** argv) {
     }
     if (!headless && display) snprintf(why, sizeof why, "this binary was built without the render module (CRANESIM_CORE_ONLY)");
 #endif
+    // The headless run has no parameter panel, so nothing to save.
+    if (save_as) fprintf(stderr, "cranesim drive: note: --save-as has no effect without the window (no parameter panel)\n");
     return drive_headless(&c, frame_rate, record ? record : "drive.csv", why, kind, wname);
 }

@@ -61,13 +61,14 @@ const char* app_value(int argc, char** argv, int* i) {
 // app_opt_name up to --kernel).
 static const struct {
     const char* cmd;
-    const char* opts[8];
+    const char* opts[10];
 } own_values[] = {
     {"run", {"--out", "--plot", NULL}},
     {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot", NULL}},
     {"study", {"--out-dir", "--repeat", NULL}},
     {"bench", {"--repeat", "--config", NULL}},
-    {"drive", {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", NULL}},
+    {"drive",
+     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", NULL}},
 };
 
 int app_check_values(const char* cmd, int argc, char** argv) {

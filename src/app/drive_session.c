@@ -24,7 +24,7 @@ typedef enum param_kind {
     PK_HYD,  ///< a circuit parameter: hyd_model_set on the live circuit, at once
     PK_MECH, ///< a mechanical parameter: live for lagrange, a rebuilt world for ode
     PK_LOAD, ///< the tip load (lagrange) [kg]
-    PK_SOLVER, ///< hydraulic integrator: 0 Krus, 1 ROS2 (a rebuilt world/solver at the current pose)
+    PK_SOLVER, ///< hydraulic integrator, an index into k_solver (a rebuilt world/solver at the current pose)
     PK_STEP,   ///< hydraulic step [s] (rebuilt likewise)
 } param_kind;
 
@@ -38,7 +38,14 @@ typedef struct drive_param {
     double min, max;   ///< display units
     char hyd_path[64]; ///< PK_HYD: "lift_cyl.bore", "fluid.bulk_modulus"
     char json[128];    ///< path in the model file, for saving
+    bool on_release;   ///< applied when the edit ends: it rebuilds the world
+    bool world_only;   ///< PK_HYD of the world's circuit, not the model's (not saved)
 } drive_param;
+
+// The solver choice of the panel: the in-house integrators drive can step.
+static const hyd_method k_solver[] = {HYD_KRUS, HYD_ROS2, HYD_RK4, HYD_ROS34PW2, HYD_RODAS3};
+static const char* const k_solver_name[] = {"Krus", "ROS2", "RK4", "ROS34PW2", "RODAS3"};
+#define NSOLVER ((int)(sizeof k_solver / sizeof k_solver[0]))
 
 struct drive_session {
     app_common c;
@@ -54,12 +61,24 @@ struct drive_session {
     int nparam;
     int pid[MAX_PARAMS]; // panel ids
     bool paused, rebuild;
+    char rebuild_why[160]; // the change that asked for the rebuild
+    sim_opts sim_live;     // the options the running world was built with
     double wall_last, wall_next_frame;
     double wall_last_frame; ///< wall time the last timed frame started [s] (< 0: none yet)
     double sim_offset;   // simulated time = wall - sim_offset while running
+    // The world is rebuilt by a reset, a solver change or a parameter that
+    // cannot change in place; each build is a "piece" with its own clock
+    // (live_time from 0). The session's time is t_base + live_time: a reset
+    // starts it again at 0, a rebuild continues it.
+    double t_base;       // session time at which the current piece started [s]
+    double sim_done;     // simulated time of the earlier pieces [s]
+    double piece_wall0;  // wall time the current piece started [s]
+    double piece_paused; // wall time paused during the current piece [s]
+    int segment;         // pieces so far - 1: the record's `segment` column
     FILE* rec;
     char rec_path[256];
     long rec_rows;       // rows written to the open recording
+    int rec_seg0;        // s->segment when it started: its rows count segments from 0
     char rec_err[320];   // first recording failure ("cannot write FILE: ..."), "" if none
     int ncol;
     int ev;              // next scripted hook event
@@ -111,8 +130,27 @@ static void add_hyd(drive_session* s, const char* group, const char* label, cons
         snprintf(hp, sizeof hp, "%s.%s", comp, field);
         snprintf(jp, sizeof jp, "hydraulics.components.%s.%s", comp, field);
     }
-    if (hyd_model_get(s->m->hyd, hp, &v)) return; // not in this circuit
-    add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, jp, v);
+    if (hyd_model_get(s->m->hyd, hp, &v) == 0) {
+        add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, jp, v);
+        return;
+    }
+    // A component of the world's own circuit (the sandbox's slew valve): it
+    // lives in the world file, not the model, so it is set on the running
+    // circuit only (and again after a rebuild); "save model" does not save it.
+    if (hyd_model_get(live_circuit(s->l), hp, &v) == 0) {
+        add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, NULL, v);
+        s->param[s->nparam - 1].world_only = true;
+    }
+}
+
+// Set the world-only circuit parameters on a new world's circuit, which
+// starts from the world file's values.
+static void reapply_world_params(drive_session* s) {
+    char e[256];
+    for (int i = 0; i < s->nparam; ++i) {
+        const drive_param* p = &s->param[i];
+        if (p->world_only) hyd_model_set(live_circuit(s->l), p->hyd_path, p->value * p->scale, e, sizeof e);
+    }
 }
 
 static void build_params(drive_session* s) {
@@ -148,11 +186,29 @@ static void build_params(drive_session* s) {
     add_hyd(s, "reliefs", "lift port B", "MPa", 1e6, 2, 40, "lift_relief_B", "p_crack");
     add_hyd(s, "reliefs", "jib port A", "MPa", 1e6, 2, 40, "jib_relief_A", "p_crack");
     add_hyd(s, "reliefs", "jib port B", "MPa", 1e6, 2, 40, "jib_relief_B", "p_crack");
+    add_hyd(s, "reliefs", "slew port A", "MPa", 1e6, 2, 40, "slew_relief_A", "p_crack");
+    add_hyd(s, "reliefs", "slew port B", "MPa", 1e6, 2, 40, "slew_relief_B", "p_crack");
     add_hyd(s, "oil", "bulk modulus", "GPa", 1e9, 0.2, 2.5, "fluid", "bulk_modulus");
     add_hyd(s, "oil", "density", "kg/m3", 1, 700, 1000, "fluid", "density");
-    add_param(s, PK_SOLVER, "solver", "method 0 Krus 1 ROS2", "-", 1, 0, 1, NULL, NULL,
-              s->c.sim.solver == HYD_ROS2 ? 1.0 : 0.0);
+    int method = 0;
+    for (int k = 0; k < NSOLVER; ++k)
+        if (k_solver[k] == s->c.sim.solver) method = k;
+    add_param(s, PK_SOLVER, "solver", "method", "", 1, 0, NSOLVER - 1, NULL, NULL, method);
     add_param(s, PK_STEP, "solver", "step", "ms", 1e-3, 0.05, 1.0, NULL, NULL, s->c.sim.h);
+    // What cannot change in place rebuilds the world (loads back at their
+    // start): applied once when the drag or the typing ends, not at every
+    // pixel. Masses and inertias change in place (live_set_link); in the ode
+    // world a length does not.
+    // A tip load in an ode world (the validation world's, merged into the end
+    // arm) moves the end arm's centre of mass with its mass: a rebuild too.
+    const bool ode = s->c.sim.mechanics == SIM_ODE;
+    const bool tip_load = ode && !live_load_name(s->l, 0, NULL) && sim_load_mass(s->m, &s->sc, &s->c.sim) > 0;
+    for (int i = 0; i < s->nparam; ++i) {
+        drive_param* p = &s->param[i];
+        const bool mech = p->kind == PK_MECH;
+        p->on_release = p->kind == PK_STEP || p->kind == PK_SOLVER || (mech && ode && strstr(p->json, ".length")) ||
+                        (mech && tip_load && strstr(p->json, "links[1].mass"));
+    }
 }
 
 // Keep the model document in step with a changed parameter, so "save model"
@@ -181,10 +237,11 @@ static void apply_param(drive_session* s, int i) {
         // Both the world's own circuit and the model's (which a rebuilt world
         // or a saved file starts from).
         if (hyd_model_set(live_circuit(s->l), p->hyd_path, si, e, sizeof e) ||
-            hyd_model_set(s->m->hyd, p->hyd_path, si, e, sizeof e)) {
+            (!p->world_only && hyd_model_set(s->m->hyd, p->hyd_path, si, e, sizeof e))) {
             snprintf(s->status, sizeof s->status, "rejected: %s", e);
             double old;
-            if (!hyd_model_get(s->m->hyd, p->hyd_path, &old)) p->value = old / p->scale;
+            if (!hyd_model_get(p->world_only ? live_circuit(s->l) : s->m->hyd, p->hyd_path, &old))
+                p->value = old / p->scale;
             return;
         }
         break;
@@ -206,31 +263,39 @@ static void apply_param(drive_session* s, int i) {
             ln->length = si;
         }
         crane_mech_derive(me);
+        // In place where the backend can (the lagrange crane; an ode boom's
+        // mass and inertia), else one rebuild at the current pose.
+        if (live_set_link(s->l, k, ln)) {
+            s->rebuild = true;
+            snprintf(s->rebuild_why, sizeof s->rebuild_why, "%s/%s", p->group, p->label);
+        }
         char a[160], e2[200];
         snprintf(a, sizeof a, "mechanics.links[%d].com=%.10g", k, ln->com);
         json_set_path(s->m->json, a, e2, sizeof e2);
         snprintf(a, sizeof a, "mechanics.links[%d].inertia=%.10g", k, ln->inertia);
         json_set_path(s->m->json, a, e2, sizeof e2);
-        // Lagrange reads the model's mechanics every step; the ode world's
-        // bodies are built once, so it is rebuilt at the current pose.
-        if (s->c.sim.mechanics == SIM_ODE) s->rebuild = true;
         break;
     }
     case PK_LOAD:
         live_set_load(s->l, si);
         s->c.sim.load_mass = si;
         break;
-    case PK_SOLVER:
-        p->value = si < 0.5 ? 0.0 : 1.0; // a choice, not a continuum
-        s->c.sim.solver = p->value > 0.5 ? HYD_ROS2 : HYD_KRUS;
+    case PK_SOLVER: {
+        const int k = (int)p->value;
+        s->c.sim.solver = k_solver[k >= 0 && k < NSOLVER ? k : 0];
         s->rebuild = true;
-        break;
+        snprintf(s->rebuild_why, sizeof s->rebuild_why, "solver %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
+        sync_json(s, p);
+        snprintf(s->status, sizeof s->status, "solver/method = %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
+        return;
+    }
     case PK_STEP: {
         // The ode world needs the hydraulic step to divide its 1 ms step.
         double sub = s->c.sim.mechanics == SIM_ODE ? floor(s->c.sim.dt_ode / si + 0.5) : 0;
         s->c.sim.h = sub > 0 ? s->c.sim.dt_ode / sub : si;
         p->value = s->c.sim.h / p->scale;
         s->rebuild = true;
+        snprintf(s->rebuild_why, sizeof s->rebuild_why, "solver step %.4g ms", p->value);
         break;
     }
     }
@@ -249,14 +314,42 @@ static void rebuild_world(drive_session* s, bool at_start) {
     }
     live* l = make_live(s, q0, slew0);
     if (!l) {
-        snprintf(s->status, sizeof s->status, "rebuild failed: %s", s->err);
+        // The running world goes on with the options it was built with, and
+        // the panel shows them again.
+        snprintf(s->status, sizeof s->status, "rebuild failed (%s kept): %s",
+                 hyd_method_name(s->sim_live.solver), s->err);
+        s->c.sim.solver = s->sim_live.solver;
+        s->c.sim.h = s->sim_live.h;
+        for (int i = 0; i < s->nparam; ++i) {
+            drive_param* p = &s->param[i];
+            if (p->kind == PK_STEP) p->value = s->c.sim.h / p->scale;
+            if (p->kind == PK_SOLVER)
+                for (int k = 0; k < NSOLVER; ++k)
+                    if (k_solver[k] == s->c.sim.solver) p->value = k;
+        }
         return;
     }
+    s->sim_live = s->c.sim;
+    // The real-time factor is the new piece's simulated time over its own
+    // wall time: dividing it by the wall time since the session started read
+    // "RT 0.42x" (and "cannot keep up") for ever after a reset. The totals
+    // (drive_stats) add the pieces up.
+    const double t_old = live_time(s->l);
+    s->sim_done += t_old;
+    s->t_base = at_start ? 0.0 : s->t_base + t_old;
+    s->piece_wall0 = s->wall_last;
+    s->piece_paused = 0.0;
+    ++s->segment;
     live_destroy(s->l);
     s->l = l;
+    reapply_world_params(s);
     s->sim_offset = s->wall_last; // the new world's clock starts at 0 now
-    s->ev = 0;
-    render_chart_clear(s->r);
+    if (at_start) {
+        // A new run: the script and the charts start again. A rebuild keeps
+        // the session's time running, so charts and script continue.
+        s->ev = 0;
+        render_chart_clear(s->r);
+    }
 }
 
 // Strip-chart channel list: CSV column names (not t), comma-separated, 1 to 8
@@ -342,12 +435,40 @@ static void act_reset(void* user) {
     snprintf(s->status, sizeof s->status, "run reset");
 }
 
+int drive_save_name(char* path, size_t n) {
+    // "wx" (C11) creates the file only if no file of that name exists, so a
+    // name is taken atomically and nothing is ever overwritten; model_save
+    // then fills the empty file.
+    for (int k = 1; k <= 9999; ++k) {
+        snprintf(path, n, "cranesim_model_%d.json", k);
+        FILE* f = fopen(path, "wx");
+        if (f) {
+            fclose(f);
+            return 0;
+        }
+        if (errno != EEXIST) return -1;
+    }
+    errno = EEXIST;
+    return -1;
+}
+
 static void act_save(void* user) {
     drive_session* s = user;
-    char e[256];
-    const char* path = "cranesim_model_saved.json";
-    if (model_save(s->m, path, e, sizeof e)) snprintf(s->status, sizeof s->status, "save failed: %s", e);
-    else snprintf(s->status, sizeof s->status, "model saved to %s", path);
+    char e[320], path[256];
+    if (s->o.save_as) {
+        // The user named the file (--save-as): each save replaces it, and
+        // the status line says so.
+        snprintf(path, sizeof path, "%s", s->o.save_as);
+    } else if (drive_save_name(path, sizeof path)) {
+        snprintf(s->status, sizeof s->status, "save failed: cannot create %s: %s", path, strerror(errno));
+        return;
+    }
+    if (model_save(s->m, path, e, sizeof e)) {
+        snprintf(s->status, sizeof s->status, "save failed: %s", e);
+        if (!s->o.save_as) remove(path); // the empty file reserved for it
+    } else {
+        snprintf(s->status, sizeof s->status, "model saved to %s%s", path, s->o.save_as ? " (--save-as, replaced)" : "");
+    }
 }
 
 static void act_pause(void* user) {
@@ -382,6 +503,7 @@ static void stop_recording(drive_session* s) {
 static int start_recording(drive_session* s, const char* path) {
     snprintf(s->rec_path, sizeof s->rec_path, "%s", path);
     s->rec_rows = 0;
+    s->rec_seg0 = s->segment;
     s->rec = fopen(path, "w");
     if (!s->rec) {
         // Remembered like a failed write: the session's end must not report
@@ -391,7 +513,11 @@ static int start_recording(drive_session* s, const char* path) {
         return -1;
     }
     errno = 0;
-    sim_csv_header(s->rec, s->ncol);
+    // The world's columns and `segment`: 0 from the start, one more at each
+    // reset or rebuild (a reset starts t at 0 again, a rebuild puts the
+    // loads back), so a reader can split the record where the world jumped.
+    for (int c = 0; c < s->ncol; ++c) fprintf(s->rec, "%s,", sim_col_name[c]);
+    fputs("segment\n", s->rec);
     if (ferror(s->rec)) {
         record_failed(s, errno);
         return -1;
@@ -401,7 +527,10 @@ static int start_recording(drive_session* s, const char* path) {
 
 static void record_row(drive_session* s, const double* row) {
     errno = 0;
-    sim_csv_row(s->rec, row, s->ncol);
+    double r[SIM_NCOL + 1];
+    memcpy(r, row, sizeof(double) * (size_t)s->ncol);
+    r[s->ncol] = s->segment - s->rec_seg0;
+    sim_csv_row(s->rec, r, s->ncol + 1);
     if (ferror(s->rec)) record_failed(s, errno);
     else ++s->rec_rows;
 }
@@ -414,7 +543,16 @@ int drive_session_finish_record(drive_session* s, long* rows, char* err, size_t 
     return -1;
 }
 
-static void take_snapshot(drive_session* s) { live_snapshot(s->l, s->snap); }
+// The world's row, on the session's clock.
+static void session_row(drive_session* s, double* row) {
+    live_row(s->l, row);
+    row[COL_T] += s->t_base;
+}
+
+static void take_snapshot(drive_session* s) {
+    live_snapshot(s->l, s->snap);
+    s->snap->t += s->t_base;
+}
 
 drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz,
                                     int* code) {
@@ -448,6 +586,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         return NULL;
     }
     s->l = make_live(s, s->sc.q0, s->sc.slew0);
+    s->sim_live = s->c.sim;
     if (!s->l) {
         // A world file or model the world cannot be built from.
         snprintf(err, errsz, "%s", s->err);
@@ -491,8 +630,10 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     build_params(s);
     for (int i = 0; i < s->nparam; ++i) {
         drive_param* p = &s->param[i];
-        panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0};
-        s->pid[i] = panel_add_param(s->pn, &d);
+        panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0, p->on_release};
+        s->pid[i] = p->kind == PK_SOLVER
+                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
+                        : panel_add_param(s->pn, &d);
     }
     panel_add_action(s->pn, "reset run", act_reset, s);
     panel_add_action(s->pn, "save model", act_save, s);
@@ -550,11 +691,18 @@ void drive_session_destroy(drive_session* s) {
 static void render_snapshot(drive_session* s) {
     // Over less than 0.1 s of wall time the ratio means nothing (a frame at
     // t = 0 would read thousands); 0 is "unknown" (world_snapshot.h).
-    s->snap->rt_factor = s->st.wall_time >= DRIVE_MIN_RATE_S ? s->st.sim_time / s->st.wall_time : 0;
+    s->snap->rt_factor = drive_session_rt_factor(s);
     render_frame(s->r, s->snap);
     render_present(s->r);
     s->st.triangles = render_get_stats(s->r).triangles;
     ++s->st.frames;
+}
+
+double drive_session_rt_factor(const drive_session* s) {
+    // The current piece only, and only the time it ran: a pause holds the
+    // simulated time, so counting it would read "cannot keep up" too.
+    const double run = s->wall_last - s->piece_wall0 - s->piece_paused;
+    return run >= DRIVE_MIN_RATE_S ? live_time(s->l) / run : 0.0;
 }
 
 void drive_session_render(drive_session* s) {
@@ -618,17 +766,30 @@ int drive_session_tick(drive_session* s, double wall) {
             if (s->pid[i] == id) apply_param(s, i);
     if (s->rebuild) {
         s->rebuild = false;
+        const double t_at = s->t_base + live_time(s->l);
+        const int seg = s->segment;
         rebuild_world(s, false);
+        // Say it: a rebuild puts the loads back and is a new segment of the
+        // record.
+        if (s->segment != seg) {
+            char seg_note[48] = "";
+            if (s->rec) snprintf(seg_note, sizeof seg_note, " (record segment %d)", s->segment - s->rec_seg0);
+            snprintf(s->status, sizeof s->status, "%s: world rebuilt at t = %.2f s%s%s", s->rebuild_why, t_at,
+                     live_load_name(s->l, 0, NULL) ? ", loads back at their start" : "", seg_note);
+            ++s->st.rebuilds;
+        }
     }
 
     double t = live_time(s->l);
     if (s->paused) {
         // Hold simulated time: the clock offset grows with the paused time.
         s->sim_offset += dt_wall;
+        s->piece_paused += dt_wall;
+        s->st.paused_time += dt_wall;
     } else {
         double u[3] = {cmd.lift, cmd.jib, cmd.slew};
         if (s->o.scripted) {
-            app_scripted_input(&s->sc, s->l, t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
+            app_scripted_input(&s->sc, s->l, s->t_base + t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
         } else if (cmd.hook_toggle) {
             live_hook(s->l, !live_attached(s->l));
         }
@@ -649,7 +810,7 @@ int drive_session_tick(drive_session* s, double wall) {
             return -1;
         }
     }
-    s->st.sim_time = live_time(s->l);
+    s->st.sim_time = s->sim_done + live_time(s->l);
     if (wall - s->missed_t0 >= 1.0) {
         render_set_missed_deadlines(s->r, s->missed_window);
         s->missed_window = 0;
@@ -662,14 +823,17 @@ int drive_session_tick(drive_session* s, double wall) {
     const bool frame = wall >= s->wall_next_frame && !render_busy(s->r);
     // One CSV row per tick at most, shared by the recording and the charts.
     double row[SIM_NCOL];
-    if (s->rec || (frame && s->nchart)) live_row(s->l, row);
+    if (s->rec || (frame && s->nchart)) session_row(s, row);
     if (s->rec) record_row(s, row);
     if (frame) {
         char status[640];
         // Who drives: the scenario, a named device, or the keyboard alone.
         const char* src = s->o.scripted ? "  [scripted]" : input_device_name(s->in) ? "" : "  [keyboard]";
-        snprintf(status, sizeof status, "%s%s%s%s%s", s->paused ? "PAUSED  " : "", s->rec ? "REC  " : "", s->status,
-                 src, panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]");
+        // While a value is typed the keys go to the panel, not the crane:
+        // say so where the operator looks.
+        const char* keys = panel_gui_wants_keyboard(s->pn) ? "  [keys: panel - Enter/Esc gives them back]" : "";
+        snprintf(status, sizeof status, "%s%s%s%s%s%s", s->paused ? "PAUSED  " : "", s->rec ? "REC  " : "", s->status,
+                 src, panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]", keys);
         render_set_status(s->r, status);
         take_snapshot(s);
         if (s->nchart)
@@ -701,7 +865,7 @@ const model* drive_session_model(const drive_session* s) { return s->m; }
 render* drive_session_render_ctx(drive_session* s) { return s->r; }
 input* drive_session_input(drive_session* s) { return s->in; }
 panel* drive_session_panel(drive_session* s) { return s->pn; }
-void drive_session_row(drive_session* s, double* row) { live_row(s->l, row); }
+void drive_session_row(drive_session* s, double* row) { session_row(s, row); }
 
 // "%.1f fps" of n events over wall seconds, or "n/a" when the interval is too
 // short for a rate to mean anything (a screenshot at t = 0).
@@ -745,7 +909,7 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
             code = EXIT_RUNTIME;
             break;
         }
-        if (screenshot && !shot_done && live_time(s->l) >= screenshot_at) {
+        if (screenshot && !shot_done && s->t_base + live_time(s->l) >= screenshot_at) {
             drive_session_render(s);
             if (drive_session_screenshot(s, screenshot, err, sizeof err)) {
                 fprintf(stderr, "cranesim drive: %s\n", err);
@@ -762,9 +926,14 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     }
     const drive_stats* st = drive_session_stats(s);
     char fps[32], hz[32];
-    printf("  simulated %.2f s in %.2f s wall; %ld frames (%s fps), %ld command updates (%s Hz), missed %ld; "
+    // Simulated time over every piece (resets, rebuilds); paused wall time
+    // said, so the two figures can be compared.
+    char extra[96] = "";
+    if (st->paused_time > 0 || s->segment > 0)
+        snprintf(extra, sizeof extra, " (%.2f s of it paused; %d resets or rebuilds)", st->paused_time, s->segment);
+    printf("  simulated %.2f s in %.2f s wall%s; %ld frames (%s fps), %ld command updates (%s Hz), missed %ld; "
            "%ld triangles\n",
-           st->sim_time, st->wall_time, st->frames, rate_str(fps, sizeof fps, (double)st->frames, st->wall_time, "%.1f"),
+           st->sim_time, st->wall_time, extra, st->frames, rate_str(fps, sizeof fps, (double)st->frames, st->wall_time, "%.1f"),
            st->input_samples, rate_str(hz, sizeof hz, (double)st->input_samples, st->wall_time, "%.0f"), st->missed,
            st->triangles);
     long rows = 0;

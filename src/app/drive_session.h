@@ -40,6 +40,8 @@ typedef struct drive_opts {
     const char* charts;       ///< strip-chart channels: CSV column names, comma-separated
                               ///< ("p1A,p2A,x1,u1"); NULL: pressures, strokes, spools
     const char* world_name;   ///< the ode world's name for the banner ("validation"); NULL: "sandbox"
+    const char* save_as;      ///< "save model" writes (and replaces) this file; NULL: a new
+                              ///< cranesim_model_N.json each time (drive_save_name)
 } drive_opts;
 
 drive_opts drive_default_opts(void);
@@ -54,8 +56,10 @@ typedef struct drive_stats {
     long frames;          ///< frames rendered
     long input_samples;   ///< valve-command updates applied
     long missed;          ///< ticks whose physics could not catch up with wall time
-    double sim_time;      ///< simulated time [s]
+    double sim_time;      ///< simulated time, summed over resets and rebuilds [s]
     double wall_time;     ///< wall time since start [s]
+    double paused_time;   ///< wall time spent paused [s]
+    long rebuilds;        ///< world rebuilds for a parameter (not resets)
     long triangles;       ///< triangles in the last frame
     double frame_ms[4096];///< recent frame intervals [ms] (ring buffer)
     int nframe_ms;
@@ -82,6 +86,10 @@ int drive_session_tick(drive_session* s, double wall);
 /// if there is one (returning when the driver has finished it), else sleep.
 void drive_session_idle(drive_session* s, double left);
 
+/// The real-time factor the HUD shows: simulated over running (not paused)
+/// wall time since the last reset or rebuild; 0 (unknown) before
+/// DRIVE_MIN_RATE_S of it.
+double drive_session_rt_factor(const drive_session* s);
 /// Force a rendered frame now (e.g. before a screenshot).
 void drive_session_render(drive_session* s);
 /// Save the last frame as PNG. Returns 0, or -1 with "cannot write FILE:
@@ -105,6 +113,11 @@ struct panel* drive_session_panel(drive_session* s);
 const model* drive_session_model(const drive_session* s);
 /// The row (CSV columns) at the current simulated time.
 void drive_session_row(drive_session* s, double* row);
+
+/// Take a new file name for "save model" in the working directory:
+/// cranesim_model_N.json with the smallest N >= 1 no file has, created empty
+/// so no other writer gets it. Returns 0, or -1 with errno.
+int drive_save_name(char* path, size_t n);
 
 /// Run the interactive loop on the real clock until quit (the `drive` command).
 /// Returns an exit code, or DRIVE_NO_WINDOW (nothing printed, the reason in

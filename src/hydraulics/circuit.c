@@ -933,6 +933,10 @@ void hyd_model_cylinder_states(const hyd_model* m, int c, int* iA, int* iB) {
 int hyd_model_valve_state(const hyd_model* m, int v) { return m->valve[v].adr; }
 int hyd_model_cylinder_comp(const hyd_model* m, int c) { return m->cyl[c].comp; }
 int hyd_model_valve_comp(const hyd_model* m, int v) { return m->valve[v].comp; }
+int hyd_model_relief_inlet(const hyd_model* m, int c) {
+    if (c < 0 || c >= m->ncomp || m->comp[c].type != HYD_RELIEF) return -1;
+    return m->relief[m->comp_sub[c]].in;
+}
 void hyd_model_cylinder_geometry(const hyd_model* m, int c, double* AA, double* AB, double* s) {
     *AA = m->cyl[c].AA;
     *AB = m->cyl[c].AB;

@@ -256,6 +256,9 @@ int hyd_model_cylinder_comp(const hyd_model* m, int cyl);
 int hyd_model_valve_comp(const hyd_model* m, int valve);
 /// Cylinder geometry: piston area A_A [m^2], annulus area A_B [m^2], stroke [m].
 void hyd_model_cylinder_geometry(const hyd_model* m, int cyl, double* AA, double* AB, double* s);
+/// Node a relief valve guards (its inlet), or -1 when comp is not a relief.
+/// The drive HUD names the cylinder chamber behind an open relief with it.
+int hyd_model_relief_inlet(const hyd_model* m, int comp);
 /// Fill y (nstate) with the initial state (p0 of each node, u0 of each valve).
 void hyd_model_initial_state(const hyd_model* m, double* y);
 /// The circuit's fastest mode [1/s]: the spectral radius of its Jacobian

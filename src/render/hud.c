@@ -196,7 +196,9 @@ static void pressure_color(double frac, float rgba[4]) {
 
 enum { BAR_W = 14, BAR_H = 96, BAR_GAP = 6, BAR_PAD = 4 };
 
-static void draw_pressure_bars(render* r, const world_snapshot* s) {
+// keep_out: the warnings' box at the top centre (x, y, w, h [px]; w = 0 for
+// none): a bar group there goes below it, not under it.
+static void draw_pressure_bars(render* r, const world_snapshot* s, const float keep_out[4]) {
     render_hud* h = &r->hud;
     const float empty[4] = {((RENDER_BAR_EMPTY_RGB >> 16) & 255) / 255.0f,
                             ((RENDER_BAR_EMPTY_RGB >> 8) & 255) / 255.0f,
@@ -218,6 +220,9 @@ static void draw_pressure_bars(render* r, const world_snapshot* s) {
         int gx = (int)px[0] - gw / 2, gy = (int)px[1] - 40 - gh;
         if (gx < 4) gx = 4;
         if (gy < 4) gy = 4;
+        if (keep_out[2] > 0 && gx < keep_out[0] + keep_out[2] && keep_out[0] < gx + gw &&
+            gy < keep_out[1] + keep_out[3])
+            gy = (int)(keep_out[1] + keep_out[3]) + 4;
         if (gx + gw > h->w - 4) gx = h->w - 4 - gw;
         if (gy + gh > h->h - 4) gy = h->h - 4 - gh;
         for (int pass = 0; pass < 4; ++pass)
@@ -320,24 +325,47 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     return y;
 }
 
-static void draw_warnings(render* r, const world_snapshot* s) {
-    render_hud* h = &r->hud;
-    char w[12][96];
+int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDER_WARN_LEN], int max) {
     int n = 0;
+    if (max > RENDER_WARN_MAX) max = RENDER_WARN_MAX;
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
-    if (s->main_relief_open) snprintf(w[n++], sizeof w[0], "MAIN RELIEF OPEN");
-    for (int i = 0; i < ncyl && n < 10; ++i) {
-        const char* nm = s->cyl[i].name[0] ? s->cyl[i].name : "cylinder";
-        if (s->cyl[i].relief_open) snprintf(w[n++], sizeof w[0], "RELIEF OPEN: %s", nm);
-        if (s->cyl[i].end_stop && n < 10) snprintf(w[n++], sizeof w[0], "END STOP: %s", nm);
+    // Each open relief by its circuit name, with the cylinder chamber it
+    // guards: "MAIN RELIEF OPEN" for every relief sent an operator slewing
+    // into a wall looking at the pump line. A snapshot without names (an
+    // older producer, the demo scene) keeps the flags.
+    int nrel = s->nrelief < WORLD_SNAP_MAX_RELIEFS ? s->nrelief : WORLD_SNAP_MAX_RELIEFS;
+    for (int k = 0; k < nrel && n < max - 2; ++k) {
+        const int c = s->relief_cyl[k];
+        if (c >= 0 && c < ncyl)
+            snprintf(w[n++], RENDER_WARN_LEN, "RELIEF OPEN: %s (%s %c)", s->relief[k],
+                     s->cyl[c].name[0] ? s->cyl[c].name : "cylinder", s->relief_port[k] ? 'B' : 'A');
+        else
+            snprintf(w[n++], RENDER_WARN_LEN, "RELIEF OPEN: %s", s->relief[k]);
     }
-    if (s->tipping && n < 11)
-        snprintf(w[n++], sizeof w[0], "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
-    if (s->collision && n < 11) snprintf(w[n++], sizeof w[0], "COLLISION");
+    if (nrel == 0 && s->main_relief_open && n < max - 2) snprintf(w[n++], RENDER_WARN_LEN, "MAIN RELIEF OPEN");
+    for (int i = 0; i < ncyl && n < max - 2; ++i) {
+        const char* nm = s->cyl[i].name[0] ? s->cyl[i].name : "cylinder";
+        if (nrel == 0 && s->cyl[i].relief_open) snprintf(w[n++], RENDER_WARN_LEN, "RELIEF OPEN: %s", nm);
+        if (s->cyl[i].end_stop && n < max - 2) snprintf(w[n++], RENDER_WARN_LEN, "END STOP: %s", nm);
+    }
+    if (s->tipping && n < max - 1)
+        snprintf(w[n++], RENDER_WARN_LEN, "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
+    if (s->collision && n < max - 1) snprintf(w[n++], RENDER_WARN_LEN, "COLLISION");
     // Real time: the app's missed deadlines, or a measured factor below 1.
     bool slow = r->missed_deadlines > 0 || (s->rt_factor > 0 && s->rt_factor < 0.97);
-    if (slow && n < 12)
-        snprintf(w[n++], sizeof w[0], "CANNOT KEEP UP WITH REAL TIME (%.2fx)", s->rt_factor);
+    if (slow && n < max) snprintf(w[n++], RENDER_WARN_LEN, "CANNOT KEEP UP WITH REAL TIME (%.2fx)", s->rt_factor);
+    return n;
+}
+
+// The warnings' box at the top centre (x, y, w, h [px]), w = 0 for none.
+static void warnings_box(const render* r, char w[][RENDER_WARN_LEN], int n, float box[4]) {
+    float tw = 0;
+    for (int i = 0; i < n; ++i) tw = fmaxf(tw, render_hud_text_width(w[i], 2.0f));
+    box[0] = 0.5f * ((float)r->hud.w - tw) - 8, box[1] = 5, box[2] = n ? tw + 16 : 0, box[3] = 30.0f * (float)n;
+}
+
+static void draw_warnings(render* r, char w[][RENDER_WARN_LEN], int n) {
+    render_hud* h = &r->hud;
     float y = 10;
     for (int i = 0; i < n; ++i) {
         float tw = render_hud_text_width(w[i], 2.0f);
@@ -350,9 +378,14 @@ static void draw_warnings(render* r, const world_snapshot* s) {
 
 void render_hud_draw_overlay(render* r, const world_snapshot* s) {
     render_hud* h = &r->hud;
-    draw_pressure_bars(r, s);
+    // Warnings first as text, so the pressure bars keep clear of them.
+    char w[RENDER_WARN_MAX][RENDER_WARN_LEN];
+    const int nw = render_hud_warnings(r, s, w, RENDER_WARN_MAX);
+    float box[4];
+    warnings_box(r, w, nw, box);
+    draw_pressure_bars(r, s, box);
     draw_readouts(r, s);
-    draw_warnings(r, s);
+    draw_warnings(r, w, nw);
     if (r->charts.n > 0) {
         float ch = 124.0f;
         render_charts_draw(h, &r->charts, 10, (float)h->h - ch - 10, (float)h->w - 20, ch);

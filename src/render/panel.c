@@ -44,7 +44,61 @@ int panel_add_param(panel* p, const panel_param_def* d) {
     q->min = d->min;
     q->max = d->max;
     q->step = d->step > 0 ? d->step : (d->max - d->min) / 100.0;
+    q->on_release = d->on_release;
     return p->nparam++;
+}
+
+int panel_add_choice(panel* p, const char* label, const char* group, double* value, const char* const* options,
+                     int n) {
+    if (!options || n < 1) return -1;
+    panel_param_def d = {label, group, "", value, 0, n - 1, 1, false};
+    int id = panel_add_param(p, &d);
+    if (id < 0) return -1;
+    p->param[id].choices = options;
+    p->param[id].nchoice = n;
+    return id;
+}
+
+int panel_choice_count(const panel* p, int id) {
+    return p && id >= 0 && id < p->nparam ? p->param[id].nchoice : 0;
+}
+
+const char* panel_choice_label(const panel* p, int id, int k) {
+    if (!p || id < 0 || id >= p->nparam || k < 0 || k >= p->param[id].nchoice) return NULL;
+    return p->param[id].choices[k];
+}
+
+bool panel_on_release(const panel* p, int id) {
+    return p && id >= 0 && id < p->nparam && p->param[id].on_release;
+}
+
+double panel_drag_speed(const panel* p, int id) {
+    if (!p || id < 0 || id >= p->nparam) return 0;
+    const panel_param* q = &p->param[id];
+    const double v = q->has_pending ? q->pending : *q->value;
+    double floor = PANEL_DRAG_FLOOR * (q->max - q->min);
+    if (PANEL_DRAG_REL * fabs(q->min) > floor) floor = PANEL_DRAG_REL * fabs(q->min);
+    const double rel = PANEL_DRAG_REL * fabs(v);
+    return rel > floor ? rel : floor;
+}
+
+panel_status panel_edit(panel* p, int id, double v, bool done) {
+    if (!p || id < 0 || id >= p->nparam) return panel_set_id(p, id, v, NULL, 0);
+    panel_param* q = &p->param[id];
+    if (q->on_release && !done) {
+        // Shown, not applied: the app sees one change when the edit ends.
+        q->pending = v;
+        q->has_pending = true;
+        return PANEL_OK;
+    }
+    q->has_pending = false;
+    return panel_set_id(p, id, v, NULL, 0);
+}
+
+bool panel_pending(const panel* p, int id, double* v) {
+    if (!p || id < 0 || id >= p->nparam || !p->param[id].has_pending) return false;
+    if (v) *v = p->param[id].pending;
+    return true;
 }
 
 int panel_add_action(panel* p, const char* label, panel_action_fn fn, void* user) {
@@ -110,6 +164,12 @@ panel_status panel_set_id(panel* p, int id, double value, char* msg, size_t msgs
         snprintf(text, sizeof text, "panel: %s/%s: value must be finite", q->group, q->label);
         say(p, msg, msgsz, text);
         return PANEL_NOT_FINITE;
+    }
+    if (q->nchoice && value != floor(value)) {
+        snprintf(text, sizeof text, "panel: %s/%s: %g is not one of the options 0..%d; unchanged", q->group,
+                 q->label, value, q->nchoice - 1);
+        say(p, msg, msgsz, text);
+        return PANEL_OUT_OF_RANGE;
     }
     if (value < q->min || value > q->max) {
         snprintf(text, sizeof text, "panel: %s/%s: %g %s is outside [%g, %g] %s; unchanged",

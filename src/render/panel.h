@@ -30,7 +30,18 @@ typedef struct panel_param_def {
     double* value;     ///< the app's variable, edited in place
     double min, max;   ///< accepted range, inclusive (same units as *value)
     double step;       ///< widget step, 0 = range/100
+    /// Changes reach the app only when the edit is finished (the drag is
+    /// released, Enter typed), not at every pixel: for a parameter whose
+    /// change is costly (it rebuilds the world). The window marks these.
+    bool on_release;
 } panel_param_def;
+
+/// Drag speed of the widgets: this fraction of the value per pixel (0.5 %),
+/// so a drag is as fine at 180 kg as at 1800 kg; near 0 at least
+/// PANEL_DRAG_REL of the range's lower end, or PANEL_DRAG_FLOOR of the range,
+/// per pixel (a value at 0 still moves).
+#define PANEL_DRAG_REL 0.005
+#define PANEL_DRAG_FLOOR 1e-4
 
 /// Result of panel_set().
 typedef enum panel_status {
@@ -50,6 +61,27 @@ void panel_destroy(panel* p);
 /// Register a parameter. Returns its id (>= 0), or -1 if the definition is
 /// invalid (no value pointer, min > max, duplicate group/label).
 int panel_add_param(panel* p, const panel_param_def* def);
+/// Register a choice among n named options (a combo box): *value holds the
+/// index 0..n-1 as a double; panel_set accepts only whole indices. The option
+/// names must outlive the panel. Returns its id (>= 0) or -1.
+int panel_add_choice(panel* p, const char* label, const char* group, double* value, const char* const* options,
+                     int n);
+/// Options of a choice (n = 0 for a plain parameter) and the name of option k.
+int panel_choice_count(const panel* p, int id);
+const char* panel_choice_label(const panel* p, int id, int k);
+/// Whether the parameter applies on release (panel_param_def.on_release).
+bool panel_on_release(const panel* p, int id);
+/// Value change per pixel of mouse drag at the parameter's current value.
+double panel_drag_speed(const panel* p, int id);
+/// What the window calls while the user edits a parameter: value v, and
+/// whether the edit is finished (drag released, Enter). A live parameter is
+/// set at once (panel_set_id); an on-release one only when done, its value in
+/// between held as pending (shown, not applied). Returns panel_set_id's
+/// status, or PANEL_OK while pending.
+panel_status panel_edit(panel* p, int id, double v, bool done);
+/// The pending (shown but not applied) value of an on-release parameter
+/// being edited; false if none.
+bool panel_pending(const panel* p, int id, double* v);
 /// Register a button. Returns its id (>= 0) or -1.
 int panel_add_action(panel* p, const char* label, panel_action_fn fn, void* user);
 
@@ -98,6 +130,12 @@ void panel_gui_draw(panel* p);
 void panel_gui_show(panel* p, bool show);
 /// Whether the window is shown.
 bool panel_gui_visible(const panel* p);
+/// Whether the window has the keyboard (a value is being typed): keys then
+/// go to it, not to the crane. Enter or Escape gives the keyboard back.
+bool panel_gui_wants_keyboard(const panel* p);
+/// Screen rectangle (x, y, w, h [px]) of parameter id's widget as last drawn;
+/// false if it was not drawn (hidden window, collapsed group).
+bool panel_gui_item_rect(const panel* p, int id, float rect[4]);
 
 #ifdef __cplusplus
 }

@@ -14,6 +14,13 @@ typedef struct panel_param {
     double* value;
     double min, max, step;
     bool changed;
+    bool on_release;            ///< applied only when an edit is finished
+    bool has_pending;           ///< an on-release edit in progress
+    double pending;             ///< its value, shown but not applied
+    const char* const* choices; ///< option names of a choice, or NULL
+    int nchoice;
+    bool drawn;                 ///< drawn in the last frame, at rect
+    float rect[4];              ///< x, y, w, h [px]
 } panel_param;
 
 typedef struct panel_action {
@@ -31,6 +38,14 @@ struct panel {
     void* on_change_user;
     char last_error[256];
     bool visible;
+    bool wants_keyboard;  ///< ImGui had the keyboard at the last frame
+    bool have_mouse;      ///< mouse_x/y hold the last mouse event's position
+    /// Keys pressed since the last frame (SDL scancodes), and key-ups held
+    /// back for after it: ImGui 1.86 reads key states once per frame, so a
+    /// press and release between two frames would never reach it.
+    unsigned char down_since_frame[512];
+    int deferred_up[16], ndeferred_up;
+    float mouse_x, mouse_y;
     void* imgui_ctx; ///< ImGuiContext*, owned by panel_imgui.cpp
 };
 

@@ -100,7 +100,10 @@ void render_frame(render* r, const world_snapshot* snap) {
         SDL_GL_GetDrawableSize(r->win, &w, &h);
         if (w != r->w || h != r->h) render_targets_resize(r, w, h);
     }
-    render_camera_update(&r->cam, snap, r->w, r->h);
+    // The strip charts cover the bottom 124 px plus margins (hud.c): the
+    // camera centres the picture on the rest.
+    const float inset = r->cfg.hud && r->charts.n > 0 ? 144.0f : 0.0f;
+    render_camera_update(&r->cam, snap, r->w, r->h, &r->meshes, inset);
 
     glBindFramebuffer(GL_FRAMEBUFFER, render_target_fbo(r));
     render_scene_draw(&r->scene, &r->meshes, &r->shadow, &r->cam, snap, r->w, r->h);
@@ -170,9 +173,31 @@ bool render_wait(render* r, double timeout_s) {
 
 void render_set_camera_preset(render* r, render_cam_preset p) {
     if (p < 0 || p >= RENDER_CAM_COUNT) return;
+    if (p == RENDER_CAM_ORBIT) {
+        // The preset is the default view again (F1 after the hook view's
+        // 7 m, or after zooming), keeping the operator's side.
+        const int side = r->cam.op_side;
+        render_camera_init(&r->cam);
+        r->cam.op_side = side;
+    }
     r->cam.preset = p;
     if (p == RENDER_CAM_FOLLOW_HOOK) r->cam.dist = 7.0f;
-    if (p == RENDER_CAM_ORBIT) r->cam.target_set = false;
+}
+
+void render_camera_eye(const render* r, double eye[3], double at[3]) {
+    const rm_vec3 e = r->cam.eye, a = r->cam.at;
+    eye[0] = e.x, eye[1] = e.y, eye[2] = e.z;
+    at[0] = a.x, at[1] = a.y, at[2] = a.z;
+}
+
+void render_get_orbit(const render* r, double* yaw, double* pitch, double* dist) {
+    if (yaw) *yaw = r->cam.yaw;
+    if (pitch) *pitch = r->cam.pitch;
+    if (dist) *dist = r->cam.dist;
+}
+
+bool render_body_bounds(render* r, const world_snap_body* b, double lo[3], double hi[3]) {
+    return render_body_local_bounds(&r->meshes, b, lo, hi);
 }
 
 render_cam_preset render_get_camera_preset(const render* r) {

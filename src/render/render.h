@@ -130,6 +130,17 @@ render_cam_preset render_get_camera_preset(const render* r);
 /// Orbit parameters for the free camera: target [m], yaw/pitch [rad], distance [m].
 void render_set_orbit(render* r, const double target[3], double yaw, double pitch, double dist);
 
+/// Where the camera of the last frame was [m, world] and what it looked at.
+void render_camera_eye(const render* r, double eye[3], double at[3]);
+/// The free orbit's yaw, pitch [rad] and distance [m] (any NULL skipped).
+void render_get_orbit(const render* r, double* yaw, double* pitch, double* dist);
+/// Distance factor per mouse-wheel notch (a touchpad's fractions scale it).
+#define RENDER_ZOOM_PER_NOTCH 0.94f
+/// Body b's drawn extent in its own frame [m] (mesh bounds as drawn, or the
+/// primitive); false for terrain. The cameras keep their eye out of these
+/// boxes for the truck, outriggers, wheels, loads and obstacles.
+bool render_body_bounds(render* r, const world_snap_body* b, double lo[3], double hi[3]);
+
 /// Project a world point [m] to pixel coordinates (x right, y down, origin top
 /// left) with the camera of the last frame. Returns false if it is behind the
 /// camera.
@@ -165,6 +176,14 @@ bool render_attach_panel(render* r, panel* p);
 void render_set_status(render* r, const char* text);
 /// The status line as last set.
 const char* render_get_status(const render* r);
+/// Longest warning line and most lines render_hud_warnings gives.
+#define RENDER_WARN_LEN 128
+#define RENDER_WARN_MAX 12
+/// The warnings the HUD draws (top centre, red) for snapshot s, as text, in
+/// the order drawn: open reliefs by name with the chamber they guard, end
+/// stops, tipping, collision, "cannot keep up with real time". Returns the
+/// number of lines (at most max, capped at RENDER_WARN_MAX).
+int render_hud_warnings(const render* r, const world_snapshot* s, char out[][RENDER_WARN_LEN], int max);
 /// The app reports missed real-time deadlines here; any count > 0 in the last
 /// second shows the "cannot keep up with real time" warning.
 void render_set_missed_deadlines(render* r, int missed_last_second);

@@ -76,9 +76,9 @@ int main(int argc, char** argv) {
     double bore = 0.1, load = 500;
     if (want_panel) {
         pn = panel_create();
-        panel_param_def d = {"bore", "lift cylinder", "m", &bore, 0.05, 0.2, 0.005};
+        panel_param_def d = {"bore", "lift cylinder", "m", &bore, 0.05, 0.2, 0.005, false};
         panel_add_param(pn, &d);
-        panel_param_def d2 = {"load mass", "scenario", "kg", &load, 0, 2000, 10};
+        panel_param_def d2 = {"load mass", "scenario", "kg", &load, 0, 2000, 10, false};
         panel_add_param(pn, &d2);
         panel_add_action(pn, "reset", noop, NULL);
         panel_add_action(pn, "pause", noop, NULL);

@@ -72,6 +72,9 @@ typedef struct render_mesh_cache {
 /// up: 1 = y-up, 2 or 0 = z-up. Returns NULL if it cannot be loaded, after
 /// one warning line on stderr naming the file (the first time only).
 const render_mesh* render_mesh_get(render_mesh_cache* c, const char* file, int up);
+/// Body b's drawn extent in its own frame [m]: its mesh's bounds (scaled and
+/// offset as drawn) or its primitive's. False for terrain or nothing known.
+bool render_body_local_bounds(render_mesh_cache* mc, const world_snap_body* b, double lo[3], double hi[3]);
 void render_mesh_cache_free(render_mesh_cache* c);
 
 // ---- camera (camera.c) ---------------------------------------------------
@@ -83,13 +86,18 @@ typedef struct render_camera {
     float fovy;             ///< vertical field of view [rad]
     bool dragging_orbit, dragging_pan;
     bool target_set; ///< orbit target chosen by user / set_orbit
+    int op_side;     ///< operator preset: +1 left of the truck, -1 right, 0 not chosen yet
     rm_vec3 eye, at; ///< resolved this frame
     float view[16], proj[16], viewproj[16];
 } render_camera;
 
 void render_camera_init(render_camera* c);
 /// Resolve the preset against the snapshot and build the matrices.
-void render_camera_update(render_camera* c, const world_snapshot* s, int w, int h);
+/// mc: the mesh cache (for the bodies' drawn boxes the eye keeps out of), or
+/// NULL; inset_bottom: pixels at the bottom covered by the strip charts.
+struct render_mesh_cache;
+void render_camera_update(render_camera* c, const world_snapshot* s, int w, int h, struct render_mesh_cache* mc,
+                          float inset_bottom);
 bool render_camera_event(render_camera* c, const SDL_Event* ev);
 
 // ---- shadow map (shadow.c) -----------------------------------------------

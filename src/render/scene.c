@@ -317,6 +317,39 @@ void render_body_point(const world_snap_body* b, const double p[3], double world
         world[r] = b->pos[r] + b->rot[r * 3 + 0] * q[0] + b->rot[r * 3 + 1] * q[1] + b->rot[r * 3 + 2] * q[2];
 }
 
+bool render_body_local_bounds(render_mesh_cache* mc, const world_snap_body* b, double lo[3], double hi[3]) {
+    if (b->shape == WORLD_SHAPE_TERRAIN || b->role == WORLD_ROLE_TERRAIN) return false;
+    const render_mesh* mesh = b->mesh[0] ? render_mesh_get(mc, b->mesh, b->mesh_up) : NULL;
+    if (mesh) {
+        // As drawn: s p + offset in the body frame (render_body_point).
+        const double s = b->mesh_scale > 0 ? b->mesh_scale : 1.0;
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = s * mesh->bmin[k] + b->mesh_offset[k];
+            hi[k] = s * mesh->bmax[k] + b->mesh_offset[k];
+        }
+        return true;
+    }
+    double e[3];
+    switch (b->shape) {
+    case WORLD_SHAPE_BOX:
+        e[0] = 0.5 * b->size[0], e[1] = 0.5 * b->size[1], e[2] = 0.5 * b->size[2];
+        break;
+    case WORLD_SHAPE_CYLINDER:
+        e[0] = e[1] = b->size[0], e[2] = 0.5 * b->size[1];
+        break;
+    case WORLD_SHAPE_CAPSULE:
+        e[0] = e[1] = b->size[0], e[2] = 0.5 * b->size[1] + b->size[0];
+        break;
+    case WORLD_SHAPE_SPHERE:
+        e[0] = e[1] = e[2] = b->size[0];
+        break;
+    default:
+        return false;
+    }
+    for (int k = 0; k < 3; ++k) lo[k] = -e[k], hi[k] = e[k];
+    return true;
+}
+
 static void add_body(render_scene* sc, render_mesh_cache* mc, const world_snap_body* b) {
     if (b->shape == WORLD_SHAPE_TERRAIN || b->role == WORLD_ROLE_TERRAIN) return;
     int first = sc->nitems;

@@ -2,6 +2,7 @@
 #include "live.h"
 
 #include "ode_world.h"
+#include "snap_reliefs.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -120,6 +121,17 @@ void live_set_load(live* l, double m3) {
     l->ls.m3 = m3;
     lagrange_consts_init(&l->ls.mdl->mech, l->ls.variant, m3, &l->ls.lk);
     hyd_solver_inputs_changed(l->solver); // f changed at the same (t, y)
+}
+
+int live_set_link(live* l, int k, const crane_link* ln) {
+    if (l->ode) return ode_world_set_link_mass(l->ode, k, ln) ? 1 : 0;
+    // The lagrange crane reads the model's links (ln is one of them, edited
+    // by the caller); the constants its fast kernels made from them at start
+    // are made again.
+    (void)ln;
+    lagrange_consts_init(&l->ls.mdl->mech, l->ls.variant, l->ls.m3, &l->ls.lk);
+    hyd_solver_inputs_changed(l->solver); // f changed at the same (t, y)
+    return 0;
 }
 
 int live_ncol(const live* l) { return l->ode ? SIM_NCOL : SIM_NCOL_BASE; }
@@ -272,5 +284,7 @@ void live_snapshot(live* l, world_snapshot* s) {
         c->end_stop = (o.end_stop >> k) & 1;
     }
     s->p_supply = o.p_pump;
-    s->main_relief_open = o.relief_open > 0;
+    // lsim_outputs evaluated the circuit at (t, y): its open flags are current.
+    const int cyl_hyd[WORLD_SNAP_MAX_CYLINDERS] = {l->ls.mdl->cyl[0], l->ls.mdl->cyl[1], -1, -1};
+    world_snap_reliefs(s, l->ls.mdl->hyd, l->ls.hd->comp_open, cyl_hyd);
 }

@@ -38,6 +38,13 @@ bool live_attached(const live* l);
 hyd_model* live_circuit(live* l);
 /// Set the tip load [kg] (lagrange; takes effect at the next step).
 void live_set_load(live* l, double m3);
+/// Boom k (0 lifting arm, 1 end arm) now has link ln (mass, com, inertia,
+/// length), applied in place at the next step where the backend can: the
+/// lagrange crane always (its constants are recomputed; ln is the model's
+/// link it reads), the ode world for a new mass and inertia about the same
+/// centre of mass (dBodySetMass). Returns 0 when applied, 1 when the world
+/// must be rebuilt for it (a new length, or a centre of mass that moves).
+int live_set_link(live* l, int k, const crane_link* ln);
 
 /// Columns live_row fills (base, or base plus world extras for ode).
 int live_ncol(const live* l);

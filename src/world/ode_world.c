@@ -1,6 +1,7 @@
 // ode_world.c: ODE world lifecycle, the crane (column, lifting arm, end arm,
 // hinges, cylinder mounts), the step loop, state and snapshot.
 #include "ode_world_internal.h"
+#include "snap_reliefs.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -878,15 +879,15 @@ void ode_world_snapshot(const ode_world* w, world_snapshot* s) {
     memcpy(s->tip, tp, sizeof tp);
     memcpy(s->hook, tp, sizeof tp);
     s->load_mass = w->kind == WORLD_VALIDATION ? w->m3 : 0;
-    if (w->hm) {
-        if (w->ipump >= 0) s->p_supply = w->y[w->ipump];
-        int nc = hyd_model_ncomp(w->hm);
-        for (int i = 0; i < nc; ++i)
-            // The public circuit API does not say which port a relief guards,
-            // so any open relief raises the one flag; per-cylinder flags stay 0.
-            if (hyd_model_comp_type(w->hm, i) == HYD_RELIEF && w->hd->comp_open[i]) s->main_relief_open = 1;
-    }
+    if (w->hm && w->ipump >= 0) s->p_supply = w->y[w->ipump];
     if (w->kind == WORLD_SANDBOX) ow_sandbox_snapshot(w, s);
+    if (w->hm) {
+        // Open reliefs by name, and on the cylinder whose chamber each
+        // guards: snapshot cylinders are lift, jib, then the sandbox's slew.
+        int cyl_hyd[WORLD_SNAP_MAX_CYLINDERS] = {w->act[0].cyl, w->act[1].cyl, -1, -1};
+        if (w->act[ODE_SLEW].present) cyl_hyd[2] = w->act[ODE_SLEW].cyl;
+        world_snap_reliefs(s, w->hm, w->hd->comp_open, cyl_hyd);
+    }
 }
 
 void ode_world_lock_booms(ode_world* w, int lock) {
@@ -907,6 +908,19 @@ void ode_world_lock_booms(ode_world* w, int lock) {
 }
 
 hyd_model* ode_world_circuit(ode_world* w) { return w->hm; }
+
+int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln) {
+    if (k < 0 || k > 1 || !w->frame[k + 1].body) return -1;
+    const crane_link* old = &w->mech.link[k];
+    if (ln->length != old->length || ln->width != old->width || ln->height != old->height) return -1;
+    dMass m;
+    const double c = boom_mass(ln, k == 1 && w->kind == WORLD_VALIDATION ? w->m3 : 0.0, &m);
+    // The body origin is the combined centre of mass, -org from the joint.
+    if (fabs(c + w->frame[k + 1].org[0]) > 1e-9 * ln->length || !dMassCheck(&m)) return -1;
+    dBodySetMass(w->frame[k + 1].body, &m);
+    w->mech.link[k] = *ln;
+    return 0;
+}
 
 int ode_world_fused(const ode_world* w) { return w->hm && w->use_fused; }
 

@@ -121,6 +121,11 @@ void ode_world_get_state(const ode_world* w, ode_world_state* s);
 /// The world's own compiled circuit (model plus world extras), for live
 /// parameter changes with hyd_model_set between steps; NULL without hydraulics.
 hyd_model* ode_world_circuit(ode_world* w);
+/// Give boom k (0 lifting arm, 1 end arm) link ln's mass and inertia in
+/// place (dBodySetMass), keeping its motion. Returns 0, or -1 (nothing
+/// changed) when that needs a rebuild: another length, section or centre of
+/// mass than the body was built with (its origin is its centre of mass).
+int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln);
 /// 1 when the hydraulic solver runs on the straight-line circuit kernel
 /// (hyd_fused.h), 0 on the component loops (opts.general_circuit, or a
 /// circuit of another shape).

@@ -17,6 +17,7 @@ extern "C" {
 #define WORLD_SNAP_MAX_CYLINDERS 4
 #define WORLD_SNAP_MAX_ROPE 32
 #define WORLD_SNAP_NAME 48
+#define WORLD_SNAP_MAX_RELIEFS 8
 
 /// Primitive shape used when a body has no mesh or its mesh failed to load.
 typedef enum world_shape {
@@ -72,7 +73,7 @@ typedef struct world_snap_cylinder {
     double force;          ///< cylinder force, + extends [N]
     double u;              ///< spool opening of its valve, -1..1
     double u_cmd;          ///< commanded opening, -1..1
-    uint8_t relief_open;   ///< a port relief is passing flow
+    uint8_t relief_open;   ///< a relief on one of its chambers is passing flow
     uint8_t end_stop;      ///< at an end stop
 } world_snap_cylinder;
 
@@ -103,7 +104,12 @@ typedef struct world_snapshot {
     uint8_t attached;       ///< a load is on the hook
     uint8_t tipping;        ///< truck tilt past the warning limit
     uint8_t collision;      ///< a crane part touches an obstacle
-    uint8_t main_relief_open;
+    uint8_t main_relief_open; ///< any relief valve passing flow (see relief[] for which)
+    int nrelief;              ///< relief valves passing flow, named in relief[] (0 if unknown)
+    char relief[WORLD_SNAP_MAX_RELIEFS][WORLD_SNAP_NAME]; ///< their circuit names ("slew_relief_A")
+    /// The snapshot cylinder each open relief guards (index into cyl[]), or -1
+    /// (a pump-line relief), and the chamber: 0 = A, 1 = B.
+    int relief_cyl[WORLD_SNAP_MAX_RELIEFS], relief_port[WORLD_SNAP_MAX_RELIEFS];
 } world_snapshot;
 
 #ifdef __cplusplus

@@ -149,6 +149,8 @@ static void test_bad_options_rejected_in_every_mode(void) {
         {"--load 500", "--load"},                                 // the sandbox's loads are world objects
         {"--solver rk4", "rk4 is unstable"},                      // as run refuses it
         {"--record /nonexistent/dir/r.csv", "/nonexistent/dir"}, // checked before driving, not after
+        {"--save-as /nonexistent/dir/m.json", "--save-as"},      // the panel's "save model" file
+        {"--save-as model.txt", "must end in .json"},
     };
     // Headless by option, headless for want of a display, and offscreen.
     static const char* const modes[] = {"--headless --duration 0.2", "--duration 0.2",

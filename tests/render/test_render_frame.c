@@ -182,6 +182,68 @@ static void test_camera_presets(void) {
     render_destroy(r);
 }
 
+// The default view keeps the hook and its load above the strip charts
+// (144 px at the bottom) when the crane works in front of the camera: the
+// load set down on the ground by stack_b at (6, -6) m, the hook 1 m up. The
+// view centred on column and tip, on the whole window, put the load behind
+// the charts (the load's centre at y = 569 px of 720; now 448, the hook 402).
+static void test_default_view_above_the_charts(void) {
+    render* r = make(true);
+    if (!r) return;
+    render_demo_params p = render_demo_default_params();
+    render_demo_scene(&snap, &p, terrain);
+    render_charts_default(r, snap.ncyl);
+    const double tip[3] = {5.6, -5.6, 2.2}, hook[3] = {5.6, -5.6, 1.0}, load[3] = {5.6, -5.6, 0.35};
+    memcpy(snap.tip, tip, sizeof tip);
+    memcpy(snap.hook, hook, sizeof hook);
+    for (int i = 0; i < snap.nbody; ++i)
+        if (snap.body[i].role == WORLD_ROLE_LOAD) {
+            memcpy(snap.body[i].pos, load, sizeof load);
+            break;
+        }
+    render_set_camera_preset(r, RENDER_CAM_ORBIT);
+    render_frame(r, &snap);
+    const double* pts[2] = {hook, load};
+    for (int k = 0; k < 2; ++k) {
+        double q[2];
+        CHECK(render_project(r, pts[k], q) && q[0] > 0 && q[0] < W && q[1] > 0 && q[1] < H - 144 - 10,
+              "%s at (%.0f, %.0f) px; the charts start at y = %d", k ? "load" : "hook", q[0], q[1], H - 144);
+    }
+    render_destroy(r);
+}
+
+// The wheel zooms RENDER_ZOOM_PER_NOTCH (6 %) per notch, a touchpad's
+// fraction of a notch by that fraction, and one event at most 3 notches. It
+// was 12 % per whole notch: 6 notches halved the distance.
+static void test_zoom_per_notch(void) {
+    render* r = make(true);
+    if (!r) return;
+    render_demo_params p = render_demo_default_params();
+    render_demo_scene(&snap, &p, terrain);
+    render_frame(r, &snap);
+    double d0, d1;
+    render_get_orbit(r, NULL, NULL, &d0);
+    SDL_Event ev;
+    memset(&ev, 0, sizeof ev);
+    ev.type = SDL_MOUSEWHEEL;
+    ev.wheel.y = 1;
+    ev.wheel.preciseY = 1.0f;
+    CHECK(render_handle_event(r, &ev), "wheel taken");
+    render_get_orbit(r, NULL, NULL, &d1);
+    CHECK_NEAR(d1 / d0, 0.94, 1e-5);
+    ev.wheel.y = 0;
+    ev.wheel.preciseY = 0.25f;
+    render_handle_event(r, &ev);
+    render_get_orbit(r, NULL, NULL, &d0);
+    CHECK_NEAR(d0 / d1, pow(0.94, 0.25), 1e-5);
+    ev.wheel.y = -40;
+    ev.wheel.preciseY = -40.0f;
+    render_handle_event(r, &ev);
+    render_get_orbit(r, NULL, NULL, &d1);
+    CHECK_NEAR(d1 / d0, pow(0.94, -3.0), 1e-4);
+    render_destroy(r);
+}
+
 static void test_missing_mesh_falls_back(void) {
     // A garbage file and a missing one: one warning line each, primitives drawn.
     char bad[512];
@@ -343,7 +405,7 @@ static void test_panel_draws_offscreen(void) {
     render_read_pixels(r, before, W, H);
     panel* pn = panel_create();
     double bore = 0.1;
-    panel_param_def d = {"bore", "lift cylinder", "m", &bore, 0.05, 0.2, 0.005};
+    panel_param_def d = {"bore", "lift cylinder", "m", &bore, 0.05, 0.2, 0.005, false};
     panel_add_param(pn, &d);
     CHECK(render_attach_panel(r, pn), "ImGui panel starts on the offscreen context");
     // ImGui needs a frame or two to lay out its window.
@@ -443,6 +505,8 @@ int main(int argc, char** argv) {
     RUN_TEST(test_crane_where_it_projects);
     RUN_TEST(test_pressure_bars_follow_pressure);
     RUN_TEST(test_camera_presets);
+    RUN_TEST(test_zoom_per_notch);
+    RUN_TEST(test_default_view_above_the_charts);
     RUN_TEST(test_missing_mesh_falls_back);
     RUN_TEST(test_cad_mesh_formats);
     RUN_TEST(test_warnings_shown);
