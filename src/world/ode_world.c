@@ -3,6 +3,7 @@
 #include "ode_world_internal.h"
 
 #include <math.h>
+#include <setjmp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,17 +16,26 @@
 // ODE keeps global tables (collider registry, thread-local data); it must be
 // initialised once before the first world and closed after the last. A
 // counter lets several worlds coexist (tests, compare runs). This is the one
-// piece of global mutable state the project allows (STYLE.md); worlds must be
-// created and destroyed from one thread.
+// piece of global mutable state the project allows; worlds must be created
+// and destroyed from one thread.
 // The ODE library's state: its users, and the non-fatal messages it sends
 // (dMessage: "LCP internal error, s <= 0" on a degenerate contact set),
 // which it would print to stderr itself, outside our one-line messages and
 // unrelated to the run. They are counted here and reported by the caller
 // (ode_world_messages).
+// ODE's errors and failed internal checks (dError, dDebug: an assertion such
+// as "!bSafeNormalize4Fault" in dxNormalize4 on a quaternion that a 1e-300 kg
+// link or a 1e308 kg truck has turned into NaN) call abort() by default, and
+// their handler must not return. Every entry point that runs ODE code arms a
+// trap (ow_trapped); the handler jumps back to it, the world is marked dead
+// and from then on only destroyed. The caller sees an ordinary runtime
+// failure (exit 1, rows kept) instead of SIGABRT.
 static struct {
     int users;
     long messages;
     char last[160];
+    jmp_buf* trap; ///< the armed entry point, or NULL
+    char fatal[200]; ///< text of the last ODE error
 } g_ode;
 
 static void ode_message(int num, const char* msg, va_list ap) {
@@ -34,15 +44,59 @@ static void ode_message(int num, const char* msg, va_list ap) {
     g_ode.messages++;
 }
 
+static void ode_fatal(int num, const char* msg, va_list ap) {
+    (void)num;
+    vsnprintf(g_ode.fatal, sizeof g_ode.fatal, msg, ap);
+    if (g_ode.trap) longjmp(*g_ode.trap, 1);
+    // No world call is running (cannot happen through this module's API):
+    // nothing to return to. exit, not abort, so the rows already written are
+    // flushed.
+    fprintf(stderr, "cranesim: ODE error outside a world call: %s\n", g_ode.fatal);
+    exit(1);
+}
+
 static void ode_acquire(void) {
     if (g_ode.users++ == 0) {
         dInitODE2(0);
         dSetMessageHandler(ode_message);
+        dSetErrorHandler(ode_fatal);
+        dSetDebugHandler(ode_fatal);
     }
 }
 
 static void ode_release(void) {
     if (--g_ode.users == 0) dCloseODE();
+}
+
+// Run fn(w, arg) with ODE's errors caught. Returns fn's result, or
+// OW_ODE_FAILED after an ODE error; then w is dead (w->err says why) and
+// only ode_world_destroy may touch it. Nothing in fn may rely on running to
+// its end (the jump skips the rest of fn and of ODE's own frames): fn only
+// steps or reads the world, which is then discarded whole.
+enum { OW_ODE_FAILED = -1000 };
+typedef int (*ow_fn)(ode_world* w, void* arg);
+static int ow_trapped(ode_world* w, const char* what, ow_fn fn, void* arg) {
+    jmp_buf jb;
+    jmp_buf* const prev = g_ode.trap;
+    if (setjmp(jb)) {
+        g_ode.trap = prev;
+        w->dead = 1;
+        w->failed = 1;
+        if (w->world_built)
+            snprintf(w->err, sizeof w->err,
+                     "ode world: ODE failed %s at t = %.6f s (%.150s): a mass, size or position far outside the "
+                     "physical range; the world was stopped",
+                     what, w->t, g_ode.fatal);
+        else
+            snprintf(w->err, sizeof w->err,
+                     "ode world: ODE failed %s (%.150s): a mass, size or position far outside the physical range",
+                     what, g_ode.fatal);
+        return OW_ODE_FAILED;
+    }
+    g_ode.trap = &jb;
+    const int rc = fn(w, arg);
+    g_ode.trap = prev;
+    return rc;
 }
 
 long ode_world_messages(const char** last) {
@@ -443,6 +497,57 @@ void ow_apply_forces(ode_world* w) {
 
 // ---- create / destroy ----
 
+typedef struct create_args {
+    const cJSON* hydraulics;
+    const world_desc* desc;
+    char* err;
+    size_t errsz;
+} create_args;
+
+// The ODE part of ode_world_create (run under ow_trapped): 0, or -1 with err set.
+static int build_world(ode_world* w, void* arg) {
+    const create_args* a = arg;
+    w->world = dWorldCreate();
+    // Each world queues its step jobs on its own self-threaded implementation,
+    // not on ODE's process-wide default: an ODE error jumps out of a step
+    // with jobs still queued (ow_trapped), and on the shared one those would
+    // be run by the next world's step and fail ODE's check at dCloseODE.
+    w->threading = dThreadingAllocateSelfThreadedImplementation();
+    if (w->threading)
+        dWorldSetStepThreadingImplementation(w->world, dThreadingImplementationGetFunctions(w->threading),
+                                             w->threading);
+    dWorldSetGravity(w->world, 0, 0, -w->g);
+    dWorldSetERP(w->world, w->desc.ode.erp);
+    dWorldSetCFM(w->world, w->desc.ode.cfm);
+    dWorldSetContactSurfaceLayer(w->world, w->desc.ode.surface_layer);
+    // No automatic disabling by default: a resting crane must react to the
+    // next command at once. Loads and obstacles opt in per body
+    // (ode_sandbox.c, allow_sleep).
+    dWorldSetAutoDisableFlag(w->world, 0);
+    w->dyn_space = dSimpleSpaceCreate(0);
+    w->static_space = dSimpleSpaceCreate(0);
+    w->contacts = dJointGroupCreate(0);
+
+    // The hydraulic circuit first: cylinder strokes are needed for the limits.
+    if (w->opt.hydraulics) {
+        if (ow_hyd_create(w, a->hydraulics, a->desc ? a->desc->circuit : NULL, a->err, a->errsz)) return -1;
+    } else {
+        // Without a circuit, strokes come from nowhere; hinge limits are off.
+        for (int k = 0; k < 2; ++k) w->act[k].stroke = 0;
+    }
+
+    if (w->kind == WORLD_VALIDATION) {
+        static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        double p[3] = {0, 0, w->mech.column_height};
+        if (ow_build_crane(w, p, I, 0, a->err, a->errsz)) return -1;
+    } else {
+        if (ow_build_sandbox(w, a->err, a->errsz)) return -1;
+    }
+    if (w->opt.hydraulics) ow_hyd_init_state(w);
+    ow_read_actuators(w);
+    return 0;
+}
+
 ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, const world_desc* desc,
                             const ode_world_opts* o, char* err, size_t errsz) {
     ode_world_opts opt = o ? *o : ode_world_default_opts();
@@ -483,50 +588,41 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
     w->ipump = -1;
     for (int k = 0; k < ODE_NACT; ++k) w->act[k].cyl = w->act[k].valve = -1;
 
-    w->world = dWorldCreate();
-    dWorldSetGravity(w->world, 0, 0, -w->g);
-    dWorldSetERP(w->world, w->desc.ode.erp);
-    dWorldSetCFM(w->world, w->desc.ode.cfm);
-    dWorldSetContactSurfaceLayer(w->world, w->desc.ode.surface_layer);
-    // No automatic disabling by default: a resting crane must react to the
-    // next command at once. Loads and obstacles opt in per body
-    // (ode_sandbox.c, allow_sleep).
-    dWorldSetAutoDisableFlag(w->world, 0);
-    w->dyn_space = dSimpleSpaceCreate(0);
-    w->static_space = dSimpleSpaceCreate(0);
-    w->contacts = dJointGroupCreate(0);
-
-    // The hydraulic circuit first: cylinder strokes are needed for the limits.
-    if (opt.hydraulics) {
-        if (ow_hyd_create(w, hydraulics, desc ? desc->circuit : NULL, err, errsz)) goto fail;
-    } else {
-        // Without a circuit, strokes come from nowhere; hinge limits are off.
-        for (int k = 0; k < 2; ++k) w->act[k].stroke = 0;
+    create_args ca = {hydraulics, desc, err, errsz};
+    const int rc = ow_trapped(w, "while building the world", build_world, &ca);
+    if (rc == OW_ODE_FAILED) snprintf(err, errsz, "%s", w->err);
+    if (rc) {
+        ode_world_destroy(w);
+        return NULL;
     }
-
-    if (w->kind == WORLD_VALIDATION) {
-        static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-        double p[3] = {0, 0, w->mech.column_height};
-        if (ow_build_crane(w, p, I, 0, err, errsz)) goto fail;
-    } else {
-        if (ow_build_sandbox(w, err, errsz)) goto fail;
-    }
-    if (opt.hydraulics) ow_hyd_init_state(w);
-    ow_read_actuators(w);
+    w->world_built = 1;
     return w;
-fail:
-    ode_world_destroy(w);
-    return NULL;
+}
+
+
+static int destroy_ode(ode_world* w, void* arg) {
+    (void)arg;
+    if (w->contacts) dJointGroupDestroy(w->contacts);
+    if (w->dyn_space) dSpaceDestroy(w->dyn_space);
+    if (w->static_space) dSpaceDestroy(w->static_space);
+    if (w->hfield) dGeomHeightfieldDataDestroy(w->hfield);
+    if (w->world) {
+        dWorldSetStepThreadingImplementation(w->world, NULL, NULL);
+        dWorldDestroy(w->world);
+    }
+    // A dead world's job queue may still hold the jobs of the step ODE left
+    // (freeing it fails ODE's check): it is abandoned with the world.
+    if (w->threading && !w->dead) dThreadingFreeImplementation(w->threading);
+    return 0;
 }
 
 void ode_world_destroy(ode_world* w) {
     if (!w) return;
     ow_hyd_destroy(w);
-    if (w->contacts) dJointGroupDestroy(w->contacts);
-    if (w->dyn_space) dSpaceDestroy(w->dyn_space);
-    if (w->static_space) dSpaceDestroy(w->static_space);
-    if (w->hfield) dGeomHeightfieldDataDestroy(w->hfield);
-    if (w->world) dWorldDestroy(w->world);
+    // A dead world's ODE objects may fail ODE's checks once more as they are
+    // torn down: then what is left of them is abandoned (a leak, once, at
+    // the end of a failed run) rather than aborting.
+    ow_trapped(w, "while destroying the world", destroy_ode, NULL);
     free(w->terrain);
     free(w);
     ode_release();
@@ -572,10 +668,8 @@ static int check_finite(ode_world* w) {
     return 0;
 }
 
-int ode_world_step(ode_world* w, double dt) {
-    if (w->failed) return -1;
-    long n = (long)floor(dt / w->opt.dt_ode + 0.5);
-    if (n < 1) n = 1;
+static int step_ode(ode_world* w, void* arg) {
+    const long n = *(const long*)arg;
     const double h = w->opt.dt_ode;
     for (long i = 0; i < n; ++i) {
         ow_read_actuators(w);
@@ -599,6 +693,16 @@ int ode_world_step(ode_world* w, double dt) {
         }
     }
     return 0;
+}
+
+int ode_world_step(ode_world* w, double dt) {
+    if (w->failed) return -1;
+    // Capped before the conversion: a dt of 1e300 s is not a step count a
+    // long can hold (undefined behaviour). 1e12 steps is already "never".
+    const double steps = floor(dt / w->opt.dt_ode + 0.5);
+    long n = steps > 1e12 ? (long)1e12 : (long)steps;
+    if (n < 1) n = 1;
+    return ow_trapped(w, "in a step", step_ode, &n) ? -1 : 0;
 }
 
 const char* ode_world_error(const ode_world* w) { return w->err; }
@@ -698,9 +802,22 @@ static void tip_point(const ode_world* w, double p[3], double v[3]) {
     if (v) ow_frame_point_vel(w, 2, tip, v);
 }
 
+static int get_state_ode(ode_world* w, void* arg);
+
 void ode_world_get_state(const ode_world* w, ode_world_state* s) {
     memset(s, 0, sizeof *s);
     s->t = w->t;
+    // A dead world's bodies are not asked again (ODE failed on them): the
+    // hydraulic states, which are ours, are all it reports.
+    if (w->dead || ow_trapped((ode_world*)w, "reading the state", get_state_ode, s)) {
+        ode_world_chamber_pressures(w, s->pA, s->pB);
+        s->t = w->t;
+        s->attached = -1;
+    }
+}
+
+static int get_state_ode(ode_world* w, void* arg) {
+    ode_world_state* s = arg;
     for (int k = 0; k < ODE_NACT; ++k) {
         const ow_act* c = &w->act[k];
         if (!c->present) continue;
@@ -751,6 +868,7 @@ void ode_world_get_state(const ode_world* w, ode_world_state* s) {
     s->max_depth = w->max_depth;
     s->max_depth_crane = w->max_depth_crane;
     s->attached = w->attached;
+    return 0;
 }
 
 int ode_world_nload(const ode_world* w) { return w->nload; }
@@ -783,7 +901,13 @@ int ode_world_obstacle_pos(const ode_world* w, const char* name, double pos[3]) 
     return -1;
 }
 
-int ode_world_hook(ode_world* w, int attach) { return w->kind == WORLD_SANDBOX ? ow_attach(w, attach) : -1; }
+static int hook_ode(ode_world* w, void* arg) { return ow_attach(w, *(const int*)arg); }
+
+int ode_world_hook(ode_world* w, int attach) {
+    if (w->kind != WORLD_SANDBOX || w->dead) return -1;
+    const int rc = ow_trapped(w, "attaching the hook", hook_ode, &attach);
+    return rc == OW_ODE_FAILED ? -1 : rc;
+}
 
 void ode_world_hold_crane(ode_world* w, int hold) {
     hold = hold != 0;
@@ -812,7 +936,20 @@ void ode_world_hold_crane(ode_world* w, int hold) {
 
 // ---- snapshot ----
 
+static int snapshot_ode(ode_world* w, void* arg);
+
 void ode_world_snapshot(const ode_world* w, world_snapshot* s) {
+    // A dead world is not drawn again: the snapshot keeps the last picture
+    // (the caller's), with the time of the failure.
+    if (w->dead) {
+        s->t = w->t;
+        return;
+    }
+    ow_trapped((ode_world*)w, "drawing the world", snapshot_ode, s);
+}
+
+static int snapshot_ode(ode_world* w, void* arg) {
+    world_snapshot* s = arg;
     memset(s, 0, sizeof *s);
     s->t = w->t;
     int n = 0;
@@ -887,6 +1024,7 @@ void ode_world_snapshot(const ode_world* w, world_snapshot* s) {
             if (hyd_model_comp_type(w->hm, i) == HYD_RELIEF && w->hd->comp_open[i]) s->main_relief_open = 1;
     }
     if (w->kind == WORLD_SANDBOX) ow_sandbox_snapshot(w, s);
+    return 0;
 }
 
 void ode_world_lock_booms(ode_world* w, int lock) {

@@ -82,9 +82,12 @@ struct ode_world {
     double t;            ///< [s]
     long nstep;          ///< ODE steps taken
     int failed;
-    char err[256];
+    int world_built;     ///< ode_world_create finished
+    int dead;            ///< ODE itself failed (ow_trapped): only ode_world_destroy may touch ODE
+    char err[384];
 
     dWorldID world;
+    dThreadingImplementationID threading; ///< the world's own (self-threaded) step jobs, see ow_trapped
     dSpaceID dyn_space;    ///< moving geoms
     dSpaceID static_space; ///< terrain and fixed obstacles
     dJointGroupID contacts;
