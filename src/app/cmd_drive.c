@@ -141,6 +141,14 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     int rc = app_load(c, &m, &sc);
     if (rc) return rc;
     double duration = c->sim.duration > 0 ? c->sim.duration : sc.duration;
+    // At most SIM_MAX_DURATION (the option is capped by app_parse_common, a
+    // scenario's here) at <= 1000 frames/s: at most 1e9 frames, counted in a long.
+    if (!(duration > 0) || duration > SIM_MAX_DURATION) {
+        fprintf(stderr, "cranesim drive: %s: duration: expected a simulated time in s, 0 < T <= 1e6, got %g\n",
+                sc.name, duration);
+        model_free(m);
+        return EXIT_USAGE;
+    }
     char err[320];
     double m3 = sim_load_mass(m, &sc, &c->sim);
     live* l = live_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
@@ -170,12 +178,12 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
            ode ? world_name : "lagrange 2-DOF (no world)", sc.name, frame_rate, hyd_method_name(c->sim.solver),
            c->sim.h * 1e3);
     const double frame = 1.0 / frame_rate;
-    const int nframes = (int)ceil(duration * frame_rate - 1e-9);
+    const long nframes = (long)ceil(duration * frame_rate - 1e-9);
     double w0 = sim_wall_time(), busy = 0, worst = 0;
     int missed = 0, code = 0, ev = 0, frames_done = 0;
     double row[SIM_NCOL];
     live_row(l, row);
-    for (int i = 0; i < nframes && !wr; ++i) {
+    for (long i = 0; i < nframes && !wr; ++i) {
         double ws = sim_wall_time();
         double t = live_time(l);
         // The operator's stick positions at the middle of this frame.
@@ -208,6 +216,11 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         sleep_until(w0 + (i + 1) * frame);
     }
     if (!c->quiet) app_progress_done();
+    if (!code) {
+        char note[320];
+        live_note(l, note, sizeof note);
+        if (note[0]) fprintf(stderr, "cranesim drive: note: %s\n", note);
+    }
     wr = app_fclose_checked(f, wr);
     if (wr) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(wr));

@@ -175,8 +175,19 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
     case APP_OPT_DT: if (positive(a, v, &c->sim.h)) return -1; break;
     case APP_OPT_RTOL: if (positive(a, v, &c->sim.rtol)) return -1; break;
     case APP_OPT_ATOL: if (positive(a, v, &c->sim.atol)) return -1; break;
-    case APP_OPT_DURATION: if (positive(a, v, &c->sim.duration)) return -1; break;
-    case APP_OPT_EVERY: if (positive(a, v, &c->sim.dt_out)) return -1; break;
+    case APP_OPT_DURATION:
+    case APP_OPT_EVERY:
+        // Capped before anything counts steps or rows in integers from them
+        // (1e300 s made the run count wrap and exit 0 having simulated nothing).
+        if (app_parse_double(v, &d) || !(d > 0) || d > SIM_MAX_DURATION) {
+            fprintf(stderr, "cranesim: %s: expected %s in s, 0 < %s <= 1e6 (11.6 days), got '%s'\n", a,
+                    k == APP_OPT_DURATION ? "a simulated time" : "an output period",
+                    k == APP_OPT_DURATION ? "T" : "DT", v);
+            return -1;
+        }
+        if (k == APP_OPT_DURATION) c->sim.duration = d;
+        else c->sim.dt_out = d;
+        break;
     case APP_OPT_SET:
         if (c->nset == APP_MAX_SET) {
             fprintf(stderr, "cranesim: at most %d --set options\n", APP_MAX_SET);

@@ -21,7 +21,9 @@ struct live {
     sim_opts o;
     double t;
     double y[LSIM_MAX_STATES];
-    char err[320];
+    char err[512];
+    sim_checks chk; ///< the run checks every driver applies (sim.h)
+    bool failed;    ///< a check or the solver failed: the crane stays stopped
 };
 
 live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
@@ -138,7 +140,7 @@ void live_set_commands(live* l, const double u[3]) {
     }
 }
 
-int live_advance(live* l, double dt) {
+static int advance(live* l, double dt) {
     if (l->ode) {
         if (ode_world_step(l->ode, dt) == 0) return 0;
         snprintf(l->err, sizeof l->err, "%s", ode_world_error(l->ode));
@@ -152,6 +154,29 @@ int live_advance(live* l, double dt) {
              rc, tb, i);
     return 1;
 }
+
+int live_advance(live* l, double dt) {
+    if (l->failed) return 1;
+    if (advance(l, dt)) {
+        l->failed = true;
+        return 1;
+    }
+    // The same checks as run's, on the row the loop records and shows: a
+    // drive that exits 0 while recording -26 MPa absolute is a wrong result
+    // passing as valid.
+    double row[SIM_NCOL];
+    live_row(l, row);
+    char what[200];
+    const int rc = sim_check_row(&l->chk, row, live_ncol(l), what, sizeof what);
+    if (!rc) return 0;
+    const bool adaptive = hyd_method_is_adaptive(l->o.solver);
+    snprintf(l->err, sizeof l->err, "numerical blow-up: %s (solver %s): %s", what, hyd_method_name(l->o.solver),
+             sim_check_hint(rc, row[COL_T], adaptive));
+    l->failed = true;
+    return 1;
+}
+
+void live_note(const live* l, char* note, size_t n) { sim_checks_note(&l->chk, note, n); }
 
 const char* live_error(const live* l) { return l->err; }
 double live_time(const live* l) { return l->ode ? ode_world_time(l->ode) : l->t; }

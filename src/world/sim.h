@@ -46,6 +46,40 @@ typedef struct sim_opts {
 /// line in err. Adaptive solvers and CVODE always pass.
 int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, char* err, size_t errsz);
 
+/// Longest simulated time and output period a run accepts [s]: 1e6 s (11.6
+/// days). Beyond, a step or row count no longer fits the integers that count
+/// them, and no run of a crane needs more.
+#define SIM_MAX_DURATION 1e6
+/// Refuse a run's duration t_end [s] or output period dt_out [s] outside
+/// (0, SIM_MAX_DURATION], or more than 1e12 rows. Returns 0, or 2 with one
+/// line in err naming the option (--duration, --every), the range and the unit.
+int sim_check_times(double t_end, double dt_out, char* err, size_t errsz);
+
+/// The checks every driver (run, compare, bench, study, drive) applies to the
+/// state it records, so no driver lets through what another refuses: every
+/// value finite, no absolute pressure more than 0.1 MPa below zero
+/// (decision 6). A shallower dip below zero is remembered for a note.
+typedef struct sim_checks {
+    bool dip;            ///< a dip below absolute zero was seen
+    char dip_name[96];   ///< its state or column
+    double dip_value;    ///< deepest value [Pa abs]
+    double dip_t;        ///< when [s]
+} sim_checks;
+void sim_checks_init(sim_checks* k);
+/// Check one value v of the state named name at time t [s]; pressure: an
+/// absolute pressure [Pa]. Returns 0, 1 when v is not finite, 2 when it is a
+/// pressure more than 0.1 MPa below absolute zero; then msg holds
+/// "state NAME ... at t = T s" (the caller adds the solver and the hint).
+int sim_check_value(sim_checks* k, const char* name, double v, bool pressure, double t, char* msg, size_t n);
+/// sim_check_value on every column of a CSV row of ncol columns (the
+/// chamber and pump pressures as pressures).
+int sim_check_row(sim_checks* k, const double* row, int ncol, char* msg, size_t n);
+/// The note for the deepest dip below absolute zero, or "" when there was none.
+void sim_checks_note(const sim_checks* k, char* note, size_t n);
+/// What to try after a failed check at time t [s] (rc from sim_check_value):
+/// a non-finite value at t = 0 is the model's, not the step's.
+const char* sim_check_hint(int rc, double t, bool adaptive);
+
 /// True when this build has the CVODE reference solver.
 bool sim_have_cvode(void);
 
