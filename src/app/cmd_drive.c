@@ -157,7 +157,9 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         model_free(m);
         return EXIT_USAGE;
     }
-    FILE* f = fopen(record, "w");
+    // Replaces a previous record only when the drive ends (app_out).
+    app_out rec;
+    FILE* f = app_out_open(&rec, record, "w");
     if (!f) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(errno));
         live_destroy(l);
@@ -221,7 +223,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         live_note(l, note, sizeof note);
         if (note[0]) fprintf(stderr, "cranesim drive: note: %s\n", note);
     }
-    wr = app_fclose_checked(f, wr);
+    wr = app_out_close(&rec, wr, true);
     if (wr) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(wr));
         code = EXIT_RUNTIME;

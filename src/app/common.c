@@ -1,9 +1,12 @@
 // common.c: option parsing and loading shared by the subcommands.
+// realpath (X/Open) for app_out_open.
+#define _XOPEN_SOURCE 700
 #include "app.h"
 #include "live.h"
 #include "world_desc.h"
 
 #include <ctype.h>
+#include <limits.h>
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -292,6 +295,77 @@ int app_fclose_checked(FILE* f, int first) {
     if (flagged && !e) e = EIO;
     return e;
 }
+
+FILE* app_out_open(app_out* o, const char* path, const char* mode) {
+    memset(o, 0, sizeof *o);
+    struct stat st;
+    const bool exists = stat(path, &st) == 0;
+    if (exists && !S_ISREG(st.st_mode)) { // a device or a pipe: in place
+        snprintf(o->path, sizeof o->path, "%s", path);
+        o->f = fopen(path, mode);
+        return o->f;
+    }
+    // Through a symlink to the file it names: renaming over the link itself
+    // would replace the link with a file.
+    char real[PATH_MAX];
+    const char* target = exists && realpath(path, real) ? real : path;
+    if (strlen(target) >= sizeof o->path) {
+        errno = ENAMETOOLONG;
+        return NULL;
+    }
+    snprintf(o->path, sizeof o->path, "%s", target);
+    const char* slash = strrchr(o->path, '/');
+    const int dl = slash ? (int)(slash - o->path + 1) : 0;
+    snprintf(o->tmp, sizeof o->tmp, "%.*s.%s.XXXXXX", dl, o->path, o->path + dl);
+    const int fd = mkstemp(o->tmp);
+    if (fd < 0) {
+        // A folder we may not create files in, holding a file we may write:
+        // write it in place, as before (app_check_output let it through).
+        const int e = errno;
+        o->tmp[0] = 0;
+        if (exists && access(o->path, W_OK) == 0) {
+            o->f = fopen(o->path, mode);
+            return o->f;
+        }
+        errno = e;
+        return NULL;
+    }
+    // mkstemp makes it 0600: give it the mode the old file had, or a new
+    // file's (0666 less the umask).
+    mode_t mode_bits;
+    if (exists) {
+        mode_bits = st.st_mode & 07777;
+    } else {
+        const mode_t um = umask(0);
+        umask(um);
+        mode_bits = 0666 & ~um;
+    }
+    if (fchmod(fd, mode_bits)) { /* the data matters more than the mode */
+    }
+    o->f = fdopen(fd, mode);
+    if (!o->f) {
+        const int e = errno;
+        close(fd);
+        unlink(o->tmp);
+        o->tmp[0] = 0;
+        errno = e;
+    }
+    return o->f;
+}
+
+int app_out_close(app_out* o, int first, bool keep) {
+    int e = first;
+    if (o->f) e = app_fclose_checked(o->f, first);
+    o->f = NULL;
+    if (o->tmp[0]) {
+        if (keep && !e && rename(o->tmp, o->path)) e = errno;
+        if (!keep || e) unlink(o->tmp);
+        o->tmp[0] = 0;
+    }
+    return e;
+}
+
+int app_out_commit_signal(const app_out* o) { return o->tmp[0] ? rename(o->tmp, o->path) : 0; }
 
 int app_check_output(const char* cmd, const char* opt, const char* path, const char* ext) {
     if (!*path) {
