@@ -450,11 +450,42 @@ static void boom_cyl_kinematics(const ode_world* w, const ow_act* c, double* x, 
 // [m/s].
 static void slew_kinematics(const ode_world* w, const ow_act* c, double* x, double* v) {
     const double r = w->desc.slew.pinion_radius;
-    *x = 0.5 * c->stroke + r * (dJointGetHingeAngle(w->slew_joint) + w->slew_off);
+    *x = 0.5 * c->stroke + r * ow_slew_angle(w);
     *v = r * dJointGetHingeAngleRate(w->slew_joint);
 }
 
+// The hinge angle's turn count relative to the last read (raw: now).
+static double slew_turns_at(const ode_world* w, double raw) {
+    const double d = raw - w->slew_raw;
+    return w->slew_turns + (d > M_PI ? -2 * M_PI : d < -M_PI ? 2 * M_PI : 0.0);
+}
+
+double ow_slew_angle(const ode_world* w) {
+    if (!w->slew_joint) return 0.0;
+    const double raw = dJointGetHingeAngle(w->slew_joint);
+    return raw + slew_turns_at(w, raw) + w->slew_off;
+}
+
+void ow_slew_stops(ode_world* w) {
+    // A stop this turn's (-pi, pi] cannot reach is left to the turn that
+    // can: ODE sees it once the angle has wrapped (the next read), and holds
+    // it from there. Set hi before lo so ODE never sees lo > hi.
+    const double lo = w->slew_lim[0] - w->slew_turns, hi = w->slew_lim[1] - w->slew_turns;
+    dJointSetHingeParam(w->slew_joint, dParamLoStop, -dInfinity);
+    dJointSetHingeParam(w->slew_joint, dParamHiStop, fabs(hi) < M_PI ? hi : dInfinity);
+    dJointSetHingeParam(w->slew_joint, dParamLoStop, fabs(lo) < M_PI ? lo : -dInfinity);
+}
+
 void ow_read_actuators(ode_world* w) {
+    if (w->slew_joint) {
+        const double raw = dJointGetHingeAngle(w->slew_joint);
+        const double turns = slew_turns_at(w, raw);
+        w->slew_raw = raw;
+        if (turns != w->slew_turns) {
+            w->slew_turns = turns;
+            ow_slew_stops(w);
+        }
+    }
     for (int k = 0; k < 2; ++k) {
         ow_act* c = &w->act[k];
         boom_cyl_kinematics(w, c, &c->x, &c->v);
@@ -843,7 +874,7 @@ static int get_state_ode(ode_world* w, void* arg) {
     s->qd[0] = dJointGetHingeAngleRate(w->j1);
     s->qd[1] = dJointGetHingeAngleRate(w->j2);
     if (w->slew_joint) {
-        s->slew = dJointGetHingeAngle(w->slew_joint) + w->slew_off;
+        s->slew = ow_slew_angle(w);
         s->slew_rate = dJointGetHingeAngleRate(w->slew_joint);
     }
     // Tip relative to joint 1 in the column's boom plane.
