@@ -44,6 +44,13 @@ live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2]
         return NULL;
     }
     lsim_initial_state(&l->ls, q0, 0.5e6, l->y);
+    double row0[SIM_NCOL];
+    live_row(l, row0);
+    if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, m3, err, errsz)) {
+        lsim_free(&l->ls);
+        free(l);
+        return NULL;
+    }
     // The drive panel edits circuit parameters in place (hyd_model_set), and
     // the fused kernel holds a packed copy of them: live runs keep the
     // general path, which reads the model on every call. Real time needs 1x,
@@ -80,7 +87,10 @@ live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], dou
     }
     // The hydraulic sub-step is min(--dt, ODE step), as sim_ode_world_create sets it.
     const double dt = ode_world_dt(l->ode), h = o->h < dt ? o->h : dt;
-    if (sim_check_fixed_step(ode_world_circuit(l->ode), o, h, 0.0, err, errsz)) {
+    double row0[SIM_NCOL];
+    sim_ode_row(l->ode, row0);
+    if (sim_check_fixed_step(ode_world_circuit(l->ode), o, h, 0.0, err, errsz) ||
+        sim_check_start(ode_world_circuit(l->ode), row0, SIM_NCOL, m3, err, errsz)) {
         ode_world_destroy(l->ode);
         free(l);
         return NULL;

@@ -191,6 +191,36 @@ const char* sim_check_hint(int rc, double t, bool adaptive) {
                     : "the step is too long for this transient: try a smaller --dt or an adaptive solver";
 }
 
+int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz) {
+    if (!hm) return 0;
+    double pmax = -1;
+    const char* which = NULL;
+    for (int i = 0; i < hyd_model_ncomp(hm); ++i) {
+        if (hyd_model_comp_type(hm, i) != HYD_RELIEF) continue;
+        char path[160];
+        double crack = 0, over = 0;
+        const char* name = hyd_model_comp_name(hm, i);
+        snprintf(path, sizeof path, "%s.p_crack", name);
+        if (hyd_model_get(hm, path, &crack)) continue;
+        snprintf(path, sizeof path, "%s.dp_override", name);
+        if (hyd_model_get(hm, path, &over)) over = 0;
+        if (crack + over > pmax) pmax = crack + over, which = name;
+    }
+    if (!which) return 0; // no relief: nothing bounds the pressure
+    static const int pcol[6] = {COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_P3A, COL_P3B};
+    for (int j = 0; j < 6; ++j) {
+        const int c = pcol[j];
+        if (c >= ncol || !(row[c] > pmax)) continue;
+        snprintf(err, errsz,
+                 "the start pose needs %s = %.4g MPa to hold the crane still with %g kg at the tip, above the "
+                 "circuit's highest relief setting (%s: %.4g MPa, p_crack + dp_override): the crane cannot hold "
+                 "this load here (a smaller --load or another start pose)",
+                 sim_col_name[c], row[c] * 1e-6, m3, which, pmax * 1e-6);
+        return 2;
+    }
+    return 0;
+}
+
 int sim_check_times(double t_end, double dt_out, char* err, size_t errsz) {
     if (!(t_end > 0) || t_end > SIM_MAX_DURATION) {
         snprintf(err, errsz, "--duration: expected a simulated time in s, 0 < T <= 1e6, got %g",
@@ -455,6 +485,11 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
             ode_world_destroy(w);
             return res->status = 2;
         }
+        if (sim_check_start(ode_world_circuit(w), row, SIM_NCOL, sim_load_mass(m, sc, o), res->message,
+                            sizeof res->message)) {
+            ode_world_destroy(w);
+            return res->status = 2;
+        }
     }
     deliver(c, row);
     ++c->rows;
@@ -549,6 +584,16 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
         return res->status = 2;
     }
     lsim_initial_state(&ls, sc->q0, 0.5e6, y);
+    {
+        lsim_out lo;
+        lsim_outputs(&ls, 0.0, y, &lo);
+        const double row0[SIM_NCOL_BASE] = {[COL_P1A] = lo.pA[0], [COL_P1B] = lo.pB[0], [COL_P2A] = lo.pA[1],
+                                            [COL_P2B] = lo.pB[1]};
+        if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, m3, res->message, sizeof res->message)) {
+            lsim_free(&ls);
+            return res->status = 2;
+        }
+    }
 
     const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
 #ifndef CRANESIM_HAVE_CVODE

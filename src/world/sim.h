@@ -80,6 +80,16 @@ void sim_checks_note(const sim_checks* k, char* note, size_t n);
 /// a non-finite value at t = 0 is the model's, not the step's.
 const char* sim_check_hint(int rc, double t, bool adaptive);
 
+/// Refuse a start state the circuit cannot hold: a chamber pressure of row
+/// (the CSV row at t = 0: p1A..p2B, and p3A, p3B when ncol has them) above
+/// the highest relief setting of circuit hm (p_crack + dp_override). The
+/// static start (decision 5) gives each chamber the pressure that holds the
+/// crane still; with a load too heavy for the pose that is more than any
+/// relief lets the circuit reach (100 t at the tip: 459 MPa), a state the
+/// reliefs cannot cap because it is set, not integrated. m3: the tip load
+/// [kg], for the message. Returns 0, or 2 with one line in err.
+int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz);
+
 /// True when this build has the CVODE reference solver.
 bool sim_have_cvode(void);
 
