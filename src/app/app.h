@@ -117,6 +117,16 @@ void app_note_load(const char* cmd, const app_common* c, const sim_opts* o, cons
 /// when the step is longer (decision 7); with ode a whole number of ODE steps.
 double app_output_period(const sim_opts* o);
 
+/// A scenario that slews the crane or works the hook (slew commands, an
+/// initial slew, hook events) is written for a world with a slewing column
+/// and a hook: the sandbox. Run elsewhere its slew and hook would be dropped.
+/// With may_switch, no --world and no --mechanics other than ode given, o
+/// becomes ode on the sandbox (one note on stderr, and *switched is set):
+/// the scenario runs in its world. Otherwise a run o cannot honour is refused: one line
+/// saying how to run it, EXIT_USAGE. Returns 0 when o runs it as written.
+int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
+                       bool* switched);
+
 /// Resolve a scenario argument: an existing file, or assets/scenarios/<name>.json.
 const char* app_scenario_path(const char* arg, char* buf, size_t n);
 

@@ -240,6 +240,14 @@ int cmd_run(int argc, char** argv) {
     scenario sc;
     rc = app_load(&c, &m, &sc);
     if (rc) return rc;
+    // A sandbox scenario runs in the sandbox unless the options say otherwise.
+    bool switched;
+    rc = app_scenario_world("run", &c.sim, c.given, &sc, true, &switched);
+    if (!rc && switched) rc = app_check_sim("run", &c.sim, c.given);
+    if (rc) {
+        model_free(m);
+        return rc;
+    }
     app_note_unused("run", c.given, &c.sim, 1);
     app_note_load("run", &c, &c.sim, &sc);
     {

@@ -606,6 +606,39 @@ void app_note_load(const char* cmd, const app_common* c, const sim_opts* o, cons
                 cmd, set, sc->name, sc->load_mass, v);
 }
 
+// What in a scenario needs the sandbox (NULL: nothing): the slew, the hook.
+static const char* sandbox_use(const scenario* sc) {
+    if (sc->nevent > 0) return "works the hook";
+    const scenario_signal* sl = &sc->cmd[2];
+    for (int i = 0; i < sl->n; ++i)
+        if (sl->u[i] != 0) return "slews the crane";
+    return sc->slew0 != 0 ? "starts slewed" : NULL;
+}
+
+int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
+                       bool* switched) {
+    if (switched) *switched = false;
+    const char* why = sandbox_use(sc);
+    if (!why) return 0;
+    char err[512];
+    if (o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX) return 0;
+    const char* name = sc->name[0] ? sc->name : "the scenario";
+    // No world chosen (--world), and no backend or the ode one: its world.
+    if (may_switch && !(given & APP_GIVEN(APP_OPT_WORLD)) &&
+        (!(given & APP_GIVEN(APP_OPT_MECHANICS)) || o->mechanics == SIM_ODE)) {
+        o->mechanics = SIM_ODE;
+        o->world = "sandbox";
+        if (switched) *switched = true;
+        fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs in its world, --mechanics ode --world sandbox\n",
+                cmd, name, why);
+        return 0;
+    }
+    fprintf(stderr,
+            "cranesim %s: scenario %s %s, which the %s has not: run it with --mechanics ode --world sandbox\n", cmd,
+            name, why, o->mechanics == SIM_ODE ? "validation world" : "lagrange 2-DOF crane");
+    return EXIT_USAGE;
+}
+
 const char* app_scenario_path(const char* arg, char* buf, size_t n) {
     // A path if it looks like one or is a readable file; else a name in the
     // assets (a folder called "step" in the working directory is not a file).

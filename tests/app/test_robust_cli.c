@@ -187,10 +187,49 @@ static void test_run_memory(void) {
     CHECK(ru.ru_maxrss < 48 * 1024, "peak RSS %ld KB of a run without --plot", ru.ru_maxrss);
 }
 
+// A sandbox scenario runs in the sandbox: `run --scenario sandbox_wall` used
+// to run the 2-DOF lagrange crane and drop the slew commands without a word.
+// Asked to run it where it cannot (lagrange, the validation world), run and
+// compare refuse and say how.
+static void test_scenario_world(void) {
+    static char out[8192], buf[1 << 20];
+    int rc = run("run --quiet --scenario sandbox_wall --duration 1.5 --every 0.5 --out world.csv", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "--mechanics ode --world sandbox"), "exit %d: %s", rc, out);
+    CHECK(read_file("world.csv", buf, sizeof buf) > 0 && strstr(buf, ",u3_cmd,"), "no slew columns: %.200s", buf);
+    // The last row: t = 1.5 s, where the scenario commands the slew valve
+    // to 0.25 (a ramp from 0 at 1 s to 0.5 at 2 s; the ode run takes the
+    // command at each 1 ms step's midpoint: 0.24975).
+    const char* last = buf + strlen(buf) - 1;
+    while (last > buf && last[-1] != '\n') --last;
+    double v[64];
+    int n = 0;
+    for (const char* p = last; n < 64 && *p && *p != '\n';) {
+        char* e;
+        v[n++] = strtod(p, &e);
+        p = *e == ',' ? e + 1 : e;
+        if (*e != ',') break;
+    }
+    CHECK(n > 38 && fabs(v[0] - 1.5) < 1e-9 && fabs(v[38] - 0.25) < 1e-3, "%d columns, t %g, u3_cmd %g", n, v[0],
+          n > 38 ? v[38] : NAN);
+    const char* const refused[] = {
+        "run --quiet --scenario sandbox_wall --mechanics lagrange --out world.csv",
+        "run --quiet --scenario sandbox_pick_place --mechanics ode --world validation --out world.csv",
+        "compare --quiet --scenario sandbox_wall --duration 0.1",
+    };
+    for (int i = 0; i < 3; ++i) {
+        write_file("world.csv", "old\n");
+        rc = run(refused[i], out, sizeof out);
+        CHECK(rc == 2 && strstr(out, "run it with --mechanics ode --world sandbox"), "%s: exit %d: %s", refused[i],
+              rc, out);
+        CHECK(read_file("world.csv", buf, sizeof buf) == 4, "%s: the old file changed", refused[i]);
+    }
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_run_memory);
     RUN_TEST(test_duration_caps);
     RUN_TEST(test_interrupted_run);
     RUN_TEST(test_failed_run_keeps_rows);
+    RUN_TEST(test_scenario_world);
     TEST_MAIN_END();
 }
