@@ -38,7 +38,7 @@ static void drive_help(FILE* f) {
             "options:\n"
             "  --headless          no window, even if a display is available\n"
             "  --duration T        seconds to drive (headless default: the scenario's; window: until Esc)\n"
-            "  --record FILE.csv   record every frame to CSV (headless default: drive.csv)\n"
+            "  --record FILE.csv   record every frame to CSV (default: no record)\n"
             "  --frame-rate F      headless: command updates per second (default 75, the paper's rate);\n"
             "                      window: frame-rate cap (default 65)\n"
             "  --scripted          window: drive by the scenario's commands instead of the devices\n"
@@ -157,10 +157,12 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         model_free(m);
         return EXIT_USAGE;
     }
-    // Replaces a previous record only when the drive ends (app_out).
-    app_out rec;
-    FILE* f = app_out_open(&rec, record, "w");
-    if (!f) {
+    // Replaces a previous record only when the drive ends (app_out). No
+    // --record, no file: a Quick-start drive leaves nothing in the folder it
+    // was started from.
+    app_out rec = {.f = NULL};
+    FILE* f = record ? app_out_open(&rec, record, "w") : NULL;
+    if (record && !f) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(errno));
         live_destroy(l);
         model_free(m);
@@ -173,8 +175,8 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     const bool loads = sandbox && live_load_name(l, 0, NULL) != NULL;
     drive_world dw = {.hook = sandbox};
     int wr = 0; // errno of the first failed write to the record
-    sim_csv_header(f, ncol);
-    if (ferror(f)) wr = errno ? errno : EIO;
+    if (f) sim_csv_header(f, ncol);
+    if (f && ferror(f)) wr = errno ? errno : EIO;
     printf("cranesim drive: %s: driving %s headless in real time for %.1f s\n", why, m->name, duration);
     printf("  world: %s; operator input: scripted (%s), %.0f commands/s; hydraulics %s at h = %g ms\n",
            ode ? world_name : "lagrange 2-DOF (no world)", sc.name, frame_rate, hyd_method_name(c->sim.solver),
@@ -197,14 +199,15 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         // steps whole ODE steps, so aim at the target, not at +frame).
         if (live_advance(l, (i + 1) * frame - live_time(l))) {
             if (!c->quiet) app_progress_done();
-            fprintf(stderr, "cranesim drive: %s; record kept in %s\n", live_error(l), record);
+            if (record) fprintf(stderr, "cranesim drive: %s; record kept in %s\n", live_error(l), record);
+            else fprintf(stderr, "cranesim drive: %s\n", live_error(l));
             code = EXIT_RUNTIME;
             break;
         }
         live_row(l, row);
         // A record that cannot be written stops the run: driving on would
         // only lose more of it.
-        if (!write_row(f, row, ncol)) {
+        if (f && !write_row(f, row, ncol)) {
             wr = errno ? errno : EIO;
             break;
         }
@@ -240,9 +243,12 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (sandbox) printf("; truck tilt %.2f deg", row[COL_TRUCK_TILT] * 180 / M_PI);
     if (!sandbox && m3 > 0) printf("; %.0f kg at the tip", m3);
     printf("\n");
-    if (!wr)
+    if (!wr && record)
         printf("  record -> %s (%d rows); for the 3D window run it on a machine with a display\n", record,
                frames_done);
+    else if (!wr)
+        printf("  no record (--record FILE.csv writes one); for the 3D window run it on a machine with a "
+               "display\n");
     live_destroy(l);
     model_free(m);
     return code;
@@ -403,5 +409,5 @@ int cmd_drive(int argc, char** argv) {
     }
     if (!headless && display) snprintf(why, sizeof why, "this binary was built without the render module (CRANESIM_CORE_ONLY)");
 #endif
-    return drive_headless(&c, frame_rate, record ? record : "drive.csv", why, kind, wname);
+    return drive_headless(&c, frame_rate, record, why, kind, wname);
 }

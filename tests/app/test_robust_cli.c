@@ -225,11 +225,23 @@ static void test_scenario_world(void) {
     }
 }
 
+// The Quick start's headless drive (scripts/run.sh) wrote drive.csv into the
+// folder it was started from, the checkout: without --record nothing is
+// written now, and the report says how to get a record.
+static void test_drive_writes_nothing_unasked(void) {
+    static char out[16384];
+    remove("drive.csv");
+    const int rc = run("drive --headless --quiet --duration 0.2", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "no record (--record FILE.csv"), "exit %d: %s", rc, out);
+    CHECK(access("drive.csv", F_OK) != 0, "drive wrote drive.csv unasked");
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_run_memory);
     RUN_TEST(test_duration_caps);
     RUN_TEST(test_interrupted_run);
     RUN_TEST(test_failed_run_keeps_rows);
     RUN_TEST(test_scenario_world);
+    RUN_TEST(test_drive_writes_nothing_unasked);
     TEST_MAIN_END();
 }
