@@ -69,7 +69,7 @@ static const struct {
     {"run", {"--out", "--plot", NULL}},
     {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot", NULL}},
     {"study", {"--out-dir", "--repeat", NULL}},
-    {"bench", {"--repeat", "--config", NULL}},
+    {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive", {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", NULL}},
 };
 

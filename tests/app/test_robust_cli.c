@@ -236,6 +236,24 @@ static void test_drive_writes_nothing_unasked(void) {
     CHECK(access("drive.csv", F_OK) != 0, "drive wrote drive.csv unasked");
 }
 
+// The soak benchmark (`bench --config soak`) runs and is repeatable: the same
+// seed gives the same run (its figures are in the JSON line, not checked
+// here: benchmarks are not tests).
+static void test_soak_runs(void) {
+    static char a[4096], b[4096];
+    int rc = run("bench --config soak --duration 2 --seed 7", a, sizeof a);
+    CHECK(rc == 0 && strstr(a, "\"config\":\"soak\"") && strstr(a, "\"exit_status\":0") &&
+              strstr(a, "\"nonfinite_values\":0") && strstr(a, "\"peak_rss_kb\":"),
+          "exit %d: %s", rc, a);
+    rc = run("bench --config soak --duration 2 --seed 7", b, sizeof b);
+    // Everything but the wall time and the RSS must agree.
+    const char* pa = strstr(a, "\"peak_pressure_mpa\"");
+    const char* pb = strstr(b, "\"peak_pressure_mpa\"");
+    const char* ea = pa ? strstr(pa, "\"peak_rss_kb\"") : NULL;
+    CHECK(rc == 0 && pa && pb && ea && !strncmp(pa, pb, (size_t)(ea - pa)), "two runs differ:\n%s%s", a, b);
+    CHECK(run("bench --config soak --seed 0", a, sizeof a) == 2 && strstr(a, "--seed"), "%s", a);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_run_memory);
     RUN_TEST(test_duration_caps);
@@ -243,5 +261,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_failed_run_keeps_rows);
     RUN_TEST(test_scenario_world);
     RUN_TEST(test_drive_writes_nothing_unasked);
+    RUN_TEST(test_soak_runs);
     TEST_MAIN_END();
 }
