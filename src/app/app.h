@@ -12,7 +12,7 @@
 
 #define APP_MAX_SET 64
 
-/// Exit codes (SPEC section 5).
+/// Exit codes (README, "Exit codes"); an interrupted run exits 128 + the signal.
 enum { EXIT_OK_ = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
 
 /// The common options, as bits of app_common.given (APP_GIVEN(APP_OPT_DT)):

@@ -22,12 +22,15 @@ static void run_help(FILE* f) {
             "  x3,v3,p3A,p3B,u3,u3_cmd,F3 (zeros in the validation world)\n"
             "\n"
             "options:\n"
-            "  --out FILE           CSV output (default run.csv); created when the run starts\n"
+            "  --out FILE           CSV output (default run.csv); written to a temporary file in its\n"
+            "                       folder and renamed over FILE when the run ends (also a failed or\n"
+            "                       interrupted one, with the rows so far): until then FILE is untouched\n"
             "  --plot FILE.png      also plot strokes, pressures, valve openings and tip path\n");
     app_common_help(f, true);
     fprintf(f,
             "\nexit codes: 0 ok, 1 runtime failure (a numerical blow-up keeps the rows so far; a failed\n"
-            "write), 2 bad input or usage (nothing is written)\n"
+            "write), 2 bad input or usage (nothing is written), 130 or 143 stopped by SIGINT (Ctrl-C) or\n"
+            "SIGTERM (the rows so far kept; a second signal kills at once)\n"
             "example: cranesim run --scenario ramp --out ramp.csv --plot ramp.png\n");
 }
 

@@ -144,7 +144,7 @@ void live_set_commands(live* l, const double u[3]) {
     for (int k = 0; k < 2; ++k) {
         double v = u[k] < -1 ? -1 : u[k] > 1 ? 1 : u[k];
         // A command change is a kink in the input: adaptive methods restart
-        // their step-size history there (SPEC section 3.3).
+        // their step-size history there (decision 8).
         if (v != l->ls.u_cmd[k] && hyd_method_is_adaptive(l->o.solver)) hyd_solver_reset(l->solver);
         l->ls.u_cmd[k] = v;
     }

@@ -98,7 +98,8 @@ double sim_load_mass(const model* m, const scenario* sc, const sim_opts* o);
 
 sim_opts sim_default_opts(void);
 
-/// CSV columns, in order. The first 17 are the SPEC section 5 contract.
+/// CSV columns, in order. The first 17 are the columns every backend has
+/// written from the start (README, "The CSV columns"): their order is fixed.
 enum {
     COL_T, COL_X1, COL_X2, COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_U1, COL_U2, COL_Q1, COL_Q2,
     COL_TIP_X, COL_TIP_Z, COL_F1, COL_F2, COL_U1_CMD, COL_U2_CMD,
