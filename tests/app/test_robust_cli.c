@@ -254,6 +254,24 @@ static void test_soak_runs(void) {
     CHECK(run("bench --config soak --seed 0", a, sizeof a) == 2 && strstr(a, "--seed"), "%s", a);
 }
 
+// Replacing through a temporary file must not turn a symlinked output into a
+// plain file, nor change the old file's permissions (a rename would do
+// both if app_out did not write next to the link's target with its mode).
+static void test_replace_keeps_link_and_mode(void) {
+    static char out[8192], buf[1 << 16];
+    remove("lnk.csv");
+    write_file("tgt.csv", "old\n");
+    chmod("tgt.csv", 0640);
+    CHECK(symlink("tgt.csv", "lnk.csv") == 0, "symlink");
+    const int rc = run("run --quiet --scenario hold --duration 0.01 --out lnk.csv", out, sizeof out);
+    CHECK(rc == 0, "exit %d: %s", rc, out);
+    struct stat st;
+    CHECK(lstat("lnk.csv", &st) == 0 && S_ISLNK(st.st_mode), "lnk.csv is no longer a symlink");
+    CHECK(stat("tgt.csv", &st) == 0 && (st.st_mode & 0777) == 0640, "mode now %o", (unsigned)(st.st_mode & 0777));
+    CHECK(read_file("tgt.csv", buf, sizeof buf) > 0 && whole_rows(buf) == 11, "target: %.60s", buf);
+    remove("lnk.csv");
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_run_memory);
     RUN_TEST(test_duration_caps);
@@ -262,5 +280,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_scenario_world);
     RUN_TEST(test_drive_writes_nothing_unasked);
     RUN_TEST(test_soak_runs);
+    RUN_TEST(test_replace_keeps_link_and_mode);
     TEST_MAIN_END();
 }
