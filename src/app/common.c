@@ -313,7 +313,7 @@ FILE* app_out_open(app_out* o, const char* path, const char* mode) {
         errno = ENAMETOOLONG;
         return NULL;
     }
-    snprintf(o->path, sizeof o->path, "%s", target);
+    memcpy(o->path, target, strlen(target) + 1); // fits: checked above
     const char* slash = strrchr(o->path, '/');
     const int dl = slash ? (int)(slash - o->path + 1) : 0;
     snprintf(o->tmp, sizeof o->tmp, "%.*s.%s.XXXXXX", dl, o->path, o->path + dl);
