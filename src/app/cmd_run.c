@@ -300,7 +300,7 @@ int cmd_run(int argc, char** argv) {
         // bad input, and nothing was written.
         fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
         code = EXIT_USAGE;
-    } else if (g_signal && res.status == 2) {
+    } else if (g_signal && res.status == 2 && sink.opened) {
         // Interrupted: 128 + the signal, as a shell reports a process the
         // signal ended, but with the rows in place (decision in docs).
         if (werr) fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));

@@ -626,6 +626,7 @@ static void set_rigid_vel(dBodyID b, const double tip[3], const double om[3]) {
 }
 
 void ode_world_swing_hook(ode_world* w, const double omega[3]) {
+    if (w->dead) return;
     if (w->kind != WORLD_SANDBOX) return;
     double tip[3], tl[3] = {w->mech.link[1].length, 0, 0};
     ow_frame_point(w, 2, tl, tip);

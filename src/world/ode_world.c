@@ -761,6 +761,7 @@ void ode_world_set_joint_torques(ode_world* w, const double tau[2]) {
 }
 
 void ode_world_set_joint_rates(ode_world* w, const double qd[2]) {
+    if (w->dead) return; // ODE failed on these bodies: not touched again
     // Rigid-body velocities of the booms for joint rates qd about the fixed
     // joint 1 (validation column at rest): omega along the hinge axis.
     double axis_l[3] = {0, -1, 0}, R[9], ax[3];
@@ -815,6 +816,7 @@ static double body_energy(dBodyID b, double g) {
 }
 
 double ode_world_energy(const ode_world* w) {
+    if (w->dead) return NAN;
     double e = 0;
     for (int f = 0; f < 3; ++f)
         if (w->frame[f].body) e += body_energy(w->frame[f].body, w->g);
@@ -941,6 +943,7 @@ int ode_world_hook(ode_world* w, int attach) {
 }
 
 void ode_world_hold_crane(ode_world* w, int hold) {
+    if (w->dead) return;
     hold = hold != 0;
     if (hold == w->held) return;
     w->held = hold;
@@ -1059,6 +1062,7 @@ static int snapshot_ode(ode_world* w, void* arg) {
 }
 
 void ode_world_lock_booms(ode_world* w, int lock) {
+    if (w->dead) return;
     dJointID j[2] = {w->j1, w->j2};
     for (int k = 0; k < 2; ++k) {
         // Set hi before lo (or lo before hi) so ODE never sees lo > hi.
