@@ -181,12 +181,14 @@ int live_advance(live* l, double dt) {
     if (!rc) return 0;
     const bool adaptive = hyd_method_is_adaptive(l->o.solver);
     snprintf(l->err, sizeof l->err, "numerical blow-up: %s (solver %s): %s", what, hyd_method_name(l->o.solver),
-             sim_check_hint(rc, row[COL_T], adaptive));
+             sim_blowup_hint(adaptive, row[COL_T], l->chk.bad_value));
     l->failed = true;
     return 1;
 }
 
-void live_note(const live* l, char* note, size_t n) { sim_checks_note(&l->chk, note, n); }
+void live_note(const live* l, char* note, size_t n) {
+    sim_checks_note(&l->chk, hyd_method_is_adaptive(l->o.solver), note, n);
+}
 
 const char* live_error(const live* l) { return l->err; }
 double live_time(const live* l) { return l->ode ? ode_world_time(l->ode) : l->t; }

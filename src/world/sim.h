@@ -64,21 +64,28 @@ typedef struct sim_checks {
     char dip_name[96];   ///< its state or column
     double dip_value;    ///< deepest value [Pa abs]
     double dip_t;        ///< when [s]
+    double bad_value;    ///< the value of the last failed check (for sim_blowup_hint)
 } sim_checks;
 void sim_checks_init(sim_checks* k);
 /// Check one value v of the state named name at time t [s]; pressure: an
 /// absolute pressure [Pa]. Returns 0, 1 when v is not finite, 2 when it is a
 /// pressure more than 0.1 MPa below absolute zero; then msg holds
-/// "state NAME ... at t = T s" (the caller adds the solver and the hint).
+/// "state NAME = VALUE ... at t = T s" (the caller adds the solver and
+/// sim_blowup_hint(adaptive, t, k->bad_value)).
 int sim_check_value(sim_checks* k, const char* name, double v, bool pressure, double t, char* msg, size_t n);
 /// sim_check_value on every column of a CSV row of ncol columns (the
 /// chamber and pump pressures as pressures).
 int sim_check_row(sim_checks* k, const double* row, int ncol, char* msg, size_t n);
-/// The note for the deepest dip below absolute zero, or "" when there was none.
-void sim_checks_note(const sim_checks* k, char* note, size_t n);
-/// What to try after a failed check at time t [s] (rc from sim_check_value):
-/// a non-finite value at t = 0 is the model's, not the step's.
-const char* sim_check_hint(int rc, double t, bool adaptive);
+/// The note for the deepest dip below absolute zero, or "" when there was
+/// none; adaptive: the run's steps were the solver's (the advice is then a
+/// smaller --rtol, not --dt).
+void sim_checks_note(const sim_checks* k, bool adaptive, char* note, size_t n);
+/// The advice of a failed check: a value [Pa abs, or any state's] found
+/// implausible at time t [s] of a run with an adaptive (or CVODE) or a
+/// fixed-step solver. "Try a smaller --dt" only where a shorter step is the
+/// likely cure: a fixed step, after steps were taken (t > 0), from a finite
+/// value; a smaller --rtol for adaptive runs; else a check of the model.
+const char* sim_blowup_hint(bool adaptive, double t, double value);
 
 /// Refuse a start state the circuit cannot hold: a chamber pressure of row
 /// (the CSV row at t = 0: p1A..p2B, and p3A, p3B when ncol has them) above

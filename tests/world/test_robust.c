@@ -62,10 +62,10 @@ static void test_checks(void) {
     row[COL_P1A] = -5e4;
     CHECK(sim_check_row(&k, row, SIM_NCOL_BASE, msg, sizeof msg) == 0, "%s", msg);
     char note[300];
-    sim_checks_note(&k, note, sizeof note);
+    sim_checks_note(&k, false, note, sizeof note);
     CHECK(k.dip && strstr(note, "p1A") && strstr(note, "-50 kPa"), "%s", note);
     // A non-finite value at the start is the model's, not the step's.
-    CHECK(strstr(sim_check_hint(1, 0.0, false), "--dt") == NULL, "%s", sim_check_hint(1, 0.0, false));
+    CHECK(strstr(sim_blowup_hint(false, 0.0, INFINITY), "--dt") == NULL, "%s", sim_blowup_hint(false, 0.0, INFINITY));
 }
 
 // drive steps through live_advance, which applies the same checks as run:
