@@ -302,8 +302,11 @@ int cmd_drive(int argc, char** argv) {
             continue;
         }
         if (!strcmp(argv[i], "--screenshot-at") && i + 1 < argc) {
-            if (app_parse_double(argv[++i], &shot_at) || shot_at < 0) {
-                fprintf(stderr, "cranesim drive: --screenshot-at: expected a time >= 0 s, got '%s'\n", argv[i]);
+            // Capped like --duration: a simulated time, compared and counted
+            // against the run's.
+            if (app_parse_double(argv[++i], &shot_at) || shot_at < 0 || shot_at > SIM_MAX_DURATION) {
+                fprintf(stderr, "cranesim drive: --screenshot-at: expected a time in s, 0 <= T <= 1e6, got '%s'\n",
+                        argv[i]);
                 return EXIT_USAGE;
             }
             continue;

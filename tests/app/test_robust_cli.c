@@ -54,12 +54,14 @@ static void test_duration_caps(void) {
         "run --quiet --every 1e300 --out cap.csv",
         "run --quiet --mechanics ode --duration 1e300 --out cap.csv",
         "drive --headless --quiet --duration 1e300 --record cap.csv",
+        "drive --headless --quiet --duration 0.1 --screenshot-at 1e300 --record cap.csv",
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         write_file("cap.csv", "old\n");
         const int rc = run(cases[i], out, sizeof out);
         CHECK(rc == 2, "%s: exit %d: %s", cases[i], rc, out);
-        CHECK(strstr(out, "1e6") && strstr(out, " s") && (strstr(out, "--duration") || strstr(out, "--every")),
+        CHECK(strstr(out, "1e6") && strstr(out, " s") &&
+                  (strstr(out, "--duration") || strstr(out, "--every") || strstr(out, "--screenshot-at")),
               "%s: %s", cases[i], out);
         CHECK(read_file("cap.csv", buf, sizeof buf) == 4 && !strcmp(buf, "old\n"), "%s: file now '%s'", cases[i],
               buf);
