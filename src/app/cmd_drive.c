@@ -16,6 +16,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -38,7 +39,8 @@ static void drive_help(FILE* f) {
             "options:\n"
             "  --headless          no window, even if a display is available\n"
             "  --duration T        seconds to drive (headless default: the scenario's; window: until Esc)\n"
-            "  --record FILE.csv   record every frame to CSV (default: no record)\n"
+            "  --record FILE.csv   record every frame to CSV (default: no record); headless, SIGINT or\n"
+            "                      SIGTERM stop the drive with the record kept (exit 130, 143)\n"
             "  --frame-rate F      headless: command updates per second (default 75, the paper's rate);\n"
             "                      window: frame-rate cap (default 65)\n"
             "  --scripted          window: drive by the scenario's commands instead of the devices\n"
@@ -130,7 +132,11 @@ static bool write_row(FILE* f, const double* row, int ncol) {
     return !ferror(f);
 }
 
-// Flush and close a record; 0, or errno of the first failure.
+// SIGINT or SIGTERM during the headless loop: it stops after the frame,
+// and the record (a temporary until the end, app_out) is put in place.
+static volatile sig_atomic_t g_signal;
+
+static void on_signal(int sig) { g_signal = sig; }
 
 static int drive_headless(app_common* c, double frame_rate, const char* record, const char* why, int kind,
                           const char* world_name) {
@@ -187,7 +193,15 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     int missed = 0, code = 0, ev = 0, frames_done = 0;
     double row[SIM_NCOL];
     live_row(l, row);
-    for (long i = 0; i < nframes && !wr; ++i) {
+    // As in run: the first signal stops the loop, a second kills at once.
+    struct sigaction sa, old_int, old_term;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sa.sa_flags = SA_RESETHAND;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int);
+    sigaction(SIGTERM, &sa, &old_term);
+    for (long i = 0; i < nframes && !wr && !g_signal; ++i) {
         double ws = sim_wall_time();
         double t = live_time(l);
         // The operator's stick positions at the middle of this frame.
@@ -221,6 +235,13 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         sleep_until(w0 + (i + 1) * frame);
     }
     if (!c->quiet) app_progress_done();
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
+    if (g_signal && !code) {
+        fprintf(stderr, "cranesim drive: interrupted (%s) at t = %.6g s%s%s\n", g_signal == SIGINT ? "SIGINT" : "SIGTERM",
+                live_time(l), record ? "; record kept in " : "", record ? record : "");
+        code = 128 + g_signal;
+    }
     if (!code) {
         char note[320];
         live_note(l, note, sizeof note);

@@ -83,6 +83,12 @@ static void find_temp(const char* name, char* out, size_t n) {
     if (d) closedir(d);
 }
 
+// Remove temporaries an earlier, killed test run may have left.
+static void remove_temps(const char* name) {
+    char tmp[256];
+    for (find_temp(name, tmp, sizeof tmp); tmp[0]; find_temp(name, tmp, sizeof tmp)) remove(tmp);
+}
+
 // Start `cranesim run ... --out name` as a child (stderr to errfile) and
 // wait until its CSV has rows in the temporary file; returns the pid.
 static pid_t start_run(const char* name, const char* errfile) {
@@ -134,6 +140,7 @@ static void test_interrupted_run(void) {
     static char buf[1 << 24], err[4096];
     for (int k = 0; k < 2; ++k) {
         write_file("intr.csv", "old\n");
+        remove_temps("intr.csv");
         const pid_t pid = start_run("intr.csv", "intr.err");
         CHECK(pid > 0, "fork");
         if (pid <= 0) return;
@@ -274,6 +281,41 @@ static void test_replace_keeps_link_and_mode(void) {
     remove("lnk.csv");
 }
 
+// The headless drive writes its record through a temporary file too: a
+// signal must put the record in place (whole lines), not leave the
+// temporary behind.
+static void test_interrupted_drive(void) {
+    static char buf[1 << 20], err[4096];
+    write_file("drv.csv", "old\n");
+    remove_temps("drv.csv");
+    pid_t pid = fork();
+    if (pid == 0) {
+        FILE* e = freopen("drv.err", "w", stderr);
+        FILE* o = freopen("/dev/null", "w", stdout);
+        (void)e, (void)o;
+        execl(BIN, BIN, "drive", "--headless", "--quiet", "--duration", "60", "--record", "drv.csv", (char*)NULL);
+        _exit(127);
+    }
+    CHECK(pid > 0, "fork");
+    if (pid <= 0) return;
+    char tmp[256];
+    struct stat st;
+    for (int i = 0; i < 2000; ++i) { // waiting for rows, not timing (real time: ~0.5 s)
+        find_temp("drv.csv", tmp, sizeof tmp);
+        if (tmp[0] && stat(tmp, &st) == 0 && st.st_size > 0) break;
+        nanosleep(&(struct timespec){0, 10000000L}, NULL);
+    }
+    kill(pid, SIGTERM);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 143, "status %#x", status);
+    read_file("drv.err", err, sizeof err);
+    CHECK(strstr(err, "interrupted (SIGTERM) at t = ") && strstr(err, "record kept in drv.csv"), "%s", err);
+    CHECK(read_file("drv.csv", buf, sizeof buf) > 0 && whole_rows(buf) >= 1, "record: %.60s", buf);
+    find_temp("drv.csv", tmp, sizeof tmp);
+    CHECK(tmp[0] == 0, "temporary %s left behind", tmp);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_run_memory);
     RUN_TEST(test_duration_caps);
@@ -283,5 +325,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_drive_writes_nothing_unasked);
     RUN_TEST(test_soak_runs);
     RUN_TEST(test_replace_keeps_link_and_mode);
+    RUN_TEST(test_interrupted_drive);
     TEST_MAIN_END();
 }
