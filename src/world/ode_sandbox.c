@@ -390,14 +390,14 @@ int ow_build_sandbox(ode_world* w, char* err, size_t errsz) {
     w->slew_turns = 0;
     w->slew_lim[0] = -dInfinity;
     w->slew_lim[1] = dInfinity;
-    if (s->present && s->stroke > 0 && smax < M_PI) {
+    if (s->present && s->stroke > 0) {
         // The rack's end stops as hinge limits (docs/ode_world.md, "End
-        // stops"), on the continuous hinge angle; ow_slew_stops gives ODE
-        // the part of them its (-pi, pi] angle can reach. (Given to ODE as
-        // they are, the +171.9 deg stop from slew0 = -60 deg was 4.05 rad,
-        // which ODE never reaches: at +120 deg the angle wrapped, the rack
-        // stroke jumped by -2 pi r = -0.63 m and a phantom 5.9e7 N end-stop
-        // force followed.)
+        // stops"), on the continuous hinge angle, however long the rack;
+        // ow_slew_stops gives ODE the part of them its (-pi, pi] angle can
+        // reach. (Given to ODE as they are, the +171.9 deg stop from slew0 =
+        // -60 deg was 4.05 rad, which ODE never reaches: at +120 deg the
+        // angle wrapped, the rack stroke jumped by -2 pi r = -0.63 m and a
+        // phantom 5.9e7 N end-stop force followed.)
         w->slew_lim[0] = -smax - w->opt.slew0;
         w->slew_lim[1] = smax - w->opt.slew0;
         dJointSetHingeParam(w->slew_joint, dParamBounce, 0.0);

@@ -469,11 +469,20 @@ double ow_slew_angle(const ode_world* w) {
 void ow_slew_stops(ode_world* w) {
     // A stop this turn's (-pi, pi] cannot reach is left to the turn that
     // can: ODE sees it once the angle has wrapped (the next read), and holds
-    // it from there. Set hi before lo so ODE never sees lo > hi.
-    const double lo = w->slew_lim[0] - w->slew_turns, hi = w->slew_lim[1] - w->slew_turns;
+    // it from there. A rack of more than a turn puts both stops in one turn
+    // with lo > hi: the angle is then above lo or below hi, and only that
+    // stop is reachable before the next wrap. Set hi before lo so ODE never
+    // sees lo > hi.
+    double lo = w->slew_lim[0] - w->slew_turns, hi = w->slew_lim[1] - w->slew_turns;
+    if (!(fabs(lo) < M_PI)) lo = -dInfinity;
+    if (!(fabs(hi) < M_PI)) hi = dInfinity;
+    if (lo > -dInfinity && hi < dInfinity && lo >= hi) {
+        if (w->slew_raw >= lo) hi = dInfinity;
+        else lo = -dInfinity;
+    }
     dJointSetHingeParam(w->slew_joint, dParamLoStop, -dInfinity);
-    dJointSetHingeParam(w->slew_joint, dParamHiStop, fabs(hi) < M_PI ? hi : dInfinity);
-    dJointSetHingeParam(w->slew_joint, dParamLoStop, fabs(lo) < M_PI ? lo : -dInfinity);
+    dJointSetHingeParam(w->slew_joint, dParamHiStop, hi);
+    dJointSetHingeParam(w->slew_joint, dParamLoStop, lo);
 }
 
 void ow_read_actuators(ode_world* w) {
