@@ -12,7 +12,7 @@
 
 #define APP_MAX_SET 64
 
-/// Exit codes (SPEC section 5).
+/// Exit codes (README, "Exit codes"); an interrupted run exits 128 + the signal.
 enum { EXIT_OK_ = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
 
 /// The common options, as bits of app_common.given (APP_GIVEN(APP_OPT_DT)):
@@ -68,6 +68,30 @@ int app_check_output(const char* cmd, const char* opt, const char* path, const c
 /// to tell (a failed write's errno is gone once later calls ran: callers
 /// that want it pass it as first).
 int app_fclose_checked(FILE* f, int first);
+/// An output file that replaces an existing one only when the command is
+/// done with it: a regular file (existing or new) is written to a temporary
+/// file in the same folder, ".NAME.XXXXXX", that app_out_close renames over
+/// the final name (through a symlink to its target), so the previous file
+/// is intact until then, and a run killed outright (SIGKILL) leaves it
+/// untouched. A device or a pipe (/dev/stdout, /dev/null) is written in place.
+typedef struct app_out {
+    char path[1024]; ///< the final name
+    char tmp[1100];  ///< the temporary file, "" when writing in place
+    FILE* f;
+} app_out;
+/// Open path for writing ("w" or "wb"). Returns the stream, or NULL with errno set.
+FILE* app_out_open(app_out* o, const char* path, const char* mode);
+/// Flush and close the stream; then, when keep and nothing failed, rename the
+/// temporary file over the final name, else remove it (the final name keeps
+/// its old contents: a half-written file from a full disk is not kept).
+/// first: the errno of a write the caller already saw fail, 0 if none.
+/// Returns 0, or the errno of the first failure. Safe on an unopened o.
+int app_out_close(app_out* o, int first, bool keep);
+/// Rename the temporary file over the final name from a signal handler
+/// (async-signal-safe: rename only; the caller has written whole lines with
+/// write(2) or flushed). Returns 0 or -1.
+int app_out_commit_signal(const app_out* o);
+
 /// Create directory dir and its parents (mkdir -p) and check it is a writable
 /// directory. Returns 0, or -1 after one line on stderr naming opt and dir.
 int app_make_dir(const char* cmd, const char* opt, const char* dir);
@@ -92,6 +116,16 @@ void app_note_load(const char* cmd, const app_common* c, const sim_opts* o, cons
 /// The period a run writes rows at [s]: --every, or one row per fixed step
 /// when the step is longer (decision 7); with ode a whole number of ODE steps.
 double app_output_period(const sim_opts* o);
+
+/// A scenario that slews the crane or works the hook (slew commands, an
+/// initial slew, hook events) is written for a world with a slewing column
+/// and a hook: the sandbox. Run elsewhere its slew and hook would be dropped.
+/// With may_switch, no --world and no --mechanics other than ode given, o
+/// becomes ode on the sandbox (one note on stderr, and *switched is set):
+/// the scenario runs in its world. Otherwise a run o cannot honour is refused: one line
+/// saying how to run it, EXIT_USAGE. Returns 0 when o runs it as written.
+int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
+                       bool* switched);
 
 /// Resolve a scenario argument: an existing file, or assets/scenarios/<name>.json.
 const char* app_scenario_path(const char* arg, char* buf, size_t n);

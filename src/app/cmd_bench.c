@@ -4,17 +4,24 @@
 // reported: this machine is shared and noisy, so medians and ratios are the
 // honest figures. Benchmarks measure; tests never time anything.
 #include "app.h"
+#include "live.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
 #endif
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 static void bench_help(FILE* f) {
     fprintf(f,
-            "usage: cranesim bench [--scenario S] [--duration T] [--repeat N] [--config NAME] [--model M]\n"
+            "usage: cranesim bench [--scenario S] [--duration T] [--repeat N] [--config NAME] [--seed N] [--model M]\n"
             "                      [--kernel split|fused|general]\n"
             "\n"
             "Prints one JSON object per line and configuration: scenario, mechanics, variant,\n"
@@ -36,6 +43,10 @@ static void bench_help(FILE* f) {
             "               near 1 when the cost of a step does not grow with run length\n"
             "  sandbox-ode1ms    ode sandbox (pick and place), ODE step 1 ms, hydraulics Krus 0.1 ms\n"
             "  sandbox-ode0.1ms  the same with ODE step 0.1 ms\n"
+            "  soak         not in the default set: --duration seconds (default 600) of seeded random\n"
+            "               piecewise-linear commands on lift, jib and slew plus hook toggles in the\n"
+            "               sandbox, as fast as it runs, with drive's run checks: exit status,\n"
+            "               non-finite values, the failure if any, peak RSS (--seed N, default 1)\n"
             "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
             "               operator, for --duration seconds of wall time (default 60): fps,\n"
             "               frame times, missed real-time deadlines, command rate\n"
@@ -45,6 +56,7 @@ static void bench_help(FILE* f) {
             "  --duration T   simulated seconds per run (default: the scenario's)\n"
             "  --repeat N     runs per configuration, median reported (default 3)\n"
             "  --config NAME  only this configuration (repeatable)\n"
+            "  --seed N       soak: the random input's seed (default 1)\n"
             "  --kernel K     lagrange kernel (see cranesim run --help; default split)\n");
 }
 
@@ -74,6 +86,115 @@ static const bench_cfg configs[] = {
     {"sandbox-ode1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-3, "sandbox_pick_place"},
     {"sandbox-ode0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-4, "sandbox_pick_place"},
 };
+
+// ---- soak: random operator input in the sandbox ----
+
+// xorshift64*: a fixed, portable sequence per seed (the soak must be
+// repeatable: the same seed gives the same run, bit for bit).
+static double soak_rand(uint64_t* s) {
+    *s ^= *s >> 12;
+    *s ^= *s << 25;
+    *s ^= *s >> 27;
+    return (double)((*s * 2685821657736338717ull) >> 11) * 0x1.0p-53; // [0, 1)
+}
+
+// One function's command: linear from (t0, u0) to (t1, u1), then a new
+// random segment of 0.5..4 s towards a random opening (a third of them 0:
+// an operator lets go of the stick often).
+typedef struct soak_ramp {
+    double t0, t1, u0, u1;
+} soak_ramp;
+
+static double soak_command(soak_ramp* r, uint64_t* rng, double t) {
+    while (t >= r->t1) {
+        r->t0 = r->t1;
+        r->u0 = r->u1;
+        r->t1 = r->t0 + 0.5 + 3.5 * soak_rand(rng);
+        const double a = soak_rand(rng);
+        r->u1 = a < 1.0 / 3 ? 0.0 : 2.0 * soak_rand(rng) - 1.0;
+    }
+    return r->u0 + (r->u1 - r->u0) * (t - r->t0) / (r->t1 - r->t0);
+}
+
+// The soak: `duration` simulated seconds of random legal input in the
+// sandbox, stepped in 10 ms frames through live (drive's path, with the run
+// checks of sim.h), every row checked for non-finite values. One JSON line.
+// Returns 0, or EXIT_RUNTIME when the run failed.
+static int bench_soak(app_common* c, double duration, uint64_t seed) {
+    app_common sc_c = *c;
+    sc_c.scenario_path = "sandbox_pick_place"; // its start pose
+    model* m;
+    scenario sc;
+    if (app_load(&sc_c, &m, &sc)) return EXIT_USAGE;
+    sim_opts o = c->sim;
+    o.mechanics = SIM_ODE;
+    o.world = "sandbox";
+    o.solver = HYD_KRUS;
+    o.cvode = false;
+    char err[512];
+    live* l = live_create(m, &o, sc.q0, sc.slew0, -1, err, sizeof err);
+    if (!l) {
+        printf("{\"config\":\"soak\",\"error\":\"%s\"}\n", err);
+        model_free(m);
+        return EXIT_RUNTIME;
+    }
+    uint64_t rng = seed ? seed : 1;
+    soak_ramp ramp[3];
+    memset(ramp, 0, sizeof ramp);
+    double next_hook = 5.0 + 15.0 * soak_rand(&rng);
+    int attach = 1, hooks = 0, picks = 0;
+    long rows = 0, nonfinite = 0;
+    double pmax = 0, slew_lo = INFINITY, slew_hi = -INFINITY;
+    const double frame = 0.01;
+    const long nframes = (long)ceil(duration / frame - 1e-9);
+    int status = 0;
+    double row[SIM_NCOL];
+    const double w0 = sim_wall_time();
+    for (long i = 0; i < nframes; ++i) {
+        const double tm = (i + 0.5) * frame;
+        const double u[3] = {soak_command(&ramp[0], &rng, tm), soak_command(&ramp[1], &rng, tm),
+                             soak_command(&ramp[2], &rng, tm)};
+        live_set_commands(l, u);
+        if (tm >= next_hook) {
+            const int got = live_hook(l, attach);
+            ++hooks;
+            picks += attach && got >= 0;
+            attach = !attach;
+            next_hook = tm + 5.0 + 15.0 * soak_rand(&rng);
+        }
+        if (live_advance(l, (i + 1) * frame - live_time(l))) {
+            status = 1;
+            break;
+        }
+        live_row(l, row);
+        ++rows;
+        for (int k = 0; k < SIM_NCOL; ++k) nonfinite += !isfinite(row[k]);
+        for (int k = COL_P1A; k <= COL_P2B; ++k) pmax = fmax(pmax, row[k]);
+        pmax = fmax(pmax, fmax(row[COL_P3A], row[COL_P3B]));
+        slew_lo = fmin(slew_lo, row[COL_SLEW]);
+        slew_hi = fmax(slew_hi, row[COL_SLEW]);
+    }
+    const double wall = sim_wall_time() - w0;
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    // The failure text without quotes or backslashes (it goes into JSON).
+    char msg[600] = "";
+    if (status) {
+        snprintf(msg, sizeof msg, "%s", live_error(l));
+        for (char* p = msg; *p; ++p)
+            if (*p == '"' || *p == '\\' || (unsigned char)*p < 0x20) *p = '\'';
+    }
+    printf("{\"config\":\"soak\",\"world\":\"sandbox\",\"seed\":%llu,\"sim_time_s\":%.3f,\"duration_s\":%g,"
+           "\"wall_s\":%.3f,\"exit_status\":%d,\"rows\":%ld,\"nonfinite_values\":%ld,\"peak_pressure_mpa\":%.3f,"
+           "\"slew_range_deg\":[%.1f,%.1f],\"hook_toggles\":%d,\"loads_picked\":%d,\"peak_rss_kb\":%ld,"
+           "\"failure\":\"%s\"}\n",
+           (unsigned long long)seed, live_time(l), duration, wall, status, rows, nonfinite, pmax * 1e-6,
+           slew_lo * 180 / M_PI, slew_hi * 180 / M_PI, hooks, picks, ru.ru_maxrss, msg);
+    fflush(stdout);
+    live_destroy(l);
+    model_free(m);
+    return status ? EXIT_RUNTIME : 0;
+}
 
 // The run options of configuration b on top of the command line's.
 static sim_opts bench_opts(const sim_opts* common, const bench_cfg* b) {
@@ -130,6 +251,7 @@ static int bench_length(const app_common* c, const model* m, const scenario* sc,
 int cmd_bench(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     int repeat = 3;
+    uint64_t seed = 1;
     const char* only[16];
     int nonly = 0;
     for (int i = 0; i < argc; ++i) {
@@ -151,6 +273,17 @@ int cmd_bench(int argc, char** argv) {
             repeat = (int)d;
             continue;
         }
+        if (!strcmp(argv[i], "--seed")) {
+            const char* v = app_value(argc, argv, &i);
+            double d;
+            if (!v) return EXIT_USAGE;
+            if (app_parse_double(v, &d) || d < 1 || d > 9007199254740992.0 || d != floor(d)) {
+                fprintf(stderr, "cranesim bench: --seed: expected a whole number 1..2^53, got '%s'\n", v);
+                return EXIT_USAGE;
+            }
+            seed = (uint64_t)d;
+            continue;
+        }
         if (!strcmp(argv[i], "--config")) {
             const char* v = app_value(argc, argv, &i);
             if (!v) return EXIT_USAGE;
@@ -164,7 +297,7 @@ int cmd_bench(int argc, char** argv) {
         fprintf(stderr, "cranesim bench: unknown option '%s' (see cranesim bench --help)\n", argv[i]);
         return EXIT_USAGE;
     }
-    bool want_drive = nonly == 0, want_length = nonly == 0;
+    bool want_drive = nonly == 0, want_length = nonly == 0, want_soak = false;
     for (int j = 0; j < nonly; ++j) {
         if (!strcmp(only[j], "drive")) {
             want_drive = true;
@@ -172,6 +305,10 @@ int cmd_bench(int argc, char** argv) {
         }
         if (!strcmp(only[j], "krus-length")) {
             want_length = true;
+            continue;
+        }
+        if (!strcmp(only[j], "soak")) {
+            want_soak = true;
             continue;
         }
         bool found = false;
@@ -248,6 +385,10 @@ int cmd_bench(int argc, char** argv) {
     }
     if (want_length && bench_length(&c, m, &sc, repeat)) code = EXIT_RUNTIME;
     model_free(m);
+    if (want_soak) {
+        const int scode = bench_soak(&c, c.sim.duration > 0 ? c.sim.duration : 600.0, seed);
+        if (scode) code = scode;
+    }
     if (want_drive) {
 #ifdef CRANESIM_HAVE_RENDER
         app_common dc = c;

@@ -180,6 +180,13 @@ int cmd_compare(int argc, char** argv) {
     model* m;
     scenario sc;
     int rc = app_load(&c, &m, &sc);
+    // Both sides must run the scenario as written (no silent switch: the
+    // comparison names its backends).
+    for (int s = 0; s < 2 && !rc; ++s) rc = app_scenario_world("compare", &side[s], c.given, &sc, false, NULL);
+    if (rc && m) {
+        model_free(m);
+        return rc;
+    }
     if (rc) return rc;
     app_note_unused("compare", c.given, side, 2);
     app_note_load("compare", &c, &side[0], &sc);

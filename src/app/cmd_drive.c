@@ -16,6 +16,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -38,7 +39,8 @@ static void drive_help(FILE* f) {
             "options:\n"
             "  --headless          no window, even if a display is available\n"
             "  --duration T        seconds to drive (headless default: the scenario's; window: until Esc)\n"
-            "  --record FILE.csv   record every frame to CSV (headless default: drive.csv)\n"
+            "  --record FILE.csv   record every frame to CSV (default: no record); headless, SIGINT or\n"
+            "                      SIGTERM stop the drive with the record kept (exit 130, 143)\n"
             "  --frame-rate F      headless: command updates per second (default 75, the paper's rate);\n"
             "                      window: frame-rate cap (default 65)\n"
             "  --scripted          window: drive by the scenario's commands instead of the devices\n"
@@ -132,7 +134,11 @@ static bool write_row(FILE* f, const double* row, int ncol) {
     return !ferror(f);
 }
 
-// Flush and close a record; 0, or errno of the first failure.
+// SIGINT or SIGTERM during the headless loop: it stops after the frame,
+// and the record (a temporary until the end, app_out) is put in place.
+static volatile sig_atomic_t g_signal;
+
+static void on_signal(int sig) { g_signal = sig; }
 
 static int drive_headless(app_common* c, double frame_rate, const char* record, const char* why, int kind,
                           const char* world_name) {
@@ -143,6 +149,14 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     int rc = app_load(c, &m, &sc);
     if (rc) return rc;
     double duration = c->sim.duration > 0 ? c->sim.duration : sc.duration;
+    // At most SIM_MAX_DURATION (the option is capped by app_parse_common, a
+    // scenario's here) at <= 1000 frames/s: at most 1e9 frames, counted in a long.
+    if (!(duration > 0) || duration > SIM_MAX_DURATION) {
+        fprintf(stderr, "cranesim drive: %s: duration: expected a simulated time in s, 0 < T <= 1e6, got %g\n",
+                sc.name, duration);
+        model_free(m);
+        return EXIT_USAGE;
+    }
     char err[320];
     double m3 = sim_load_mass(m, &sc, &c->sim);
     live* l = live_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
@@ -151,8 +165,12 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         model_free(m);
         return EXIT_USAGE;
     }
-    FILE* f = fopen(record, "w");
-    if (!f) {
+    // Replaces a previous record only when the drive ends (app_out). No
+    // --record, no file: a Quick-start drive leaves nothing in the folder it
+    // was started from.
+    app_out rec = {.f = NULL};
+    FILE* f = record ? app_out_open(&rec, record, "w") : NULL;
+    if (record && !f) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(errno));
         live_destroy(l);
         model_free(m);
@@ -165,19 +183,27 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     const bool loads = sandbox && live_load_name(l, 0, NULL) != NULL;
     drive_world dw = {.hook = sandbox};
     int wr = 0; // errno of the first failed write to the record
-    sim_csv_header(f, ncol);
-    if (ferror(f)) wr = errno ? errno : EIO;
+    if (f) sim_csv_header(f, ncol);
+    if (f && ferror(f)) wr = errno ? errno : EIO;
     printf("cranesim drive: %s: driving %s headless in real time for %.1f s\n", why, m->name, duration);
     printf("  world: %s; operator input: scripted (%s), %.0f commands/s; hydraulics %s at h = %g ms\n",
            ode ? world_name : "lagrange 2-DOF (no world)", sc.name, frame_rate, hyd_method_name(c->sim.solver),
            c->sim.h * 1e3);
     const double frame = 1.0 / frame_rate;
-    const int nframes = (int)ceil(duration * frame_rate - 1e-9);
+    const long nframes = (long)ceil(duration * frame_rate - 1e-9);
     double w0 = sim_wall_time(), busy = 0, worst = 0;
     int missed = 0, code = 0, ev = 0, frames_done = 0;
     double row[SIM_NCOL];
     live_row(l, row);
-    for (int i = 0; i < nframes && !wr; ++i) {
+    // As in run: the first signal stops the loop, a second kills at once.
+    struct sigaction sa, old_int, old_term;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sa.sa_flags = SA_RESETHAND;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int);
+    sigaction(SIGTERM, &sa, &old_term);
+    for (long i = 0; i < nframes && !wr && !g_signal; ++i) {
         double ws = sim_wall_time();
         double t = live_time(l);
         // The operator's stick positions at the middle of this frame.
@@ -189,14 +215,15 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         // steps whole ODE steps, so aim at the target, not at +frame).
         if (live_advance(l, (i + 1) * frame - live_time(l))) {
             if (!c->quiet) app_progress_done();
-            fprintf(stderr, "cranesim drive: %s; record kept in %s\n", live_error(l), record);
+            if (record) fprintf(stderr, "cranesim drive: %s; record kept in %s\n", live_error(l), record);
+            else fprintf(stderr, "cranesim drive: %s\n", live_error(l));
             code = EXIT_RUNTIME;
             break;
         }
         live_row(l, row);
         // A record that cannot be written stops the run: driving on would
         // only lose more of it.
-        if (!write_row(f, row, ncol)) {
+        if (f && !write_row(f, row, ncol)) {
             wr = errno ? errno : EIO;
             break;
         }
@@ -210,7 +237,19 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         sleep_until(w0 + (i + 1) * frame);
     }
     if (!c->quiet) app_progress_done();
-    wr = app_fclose_checked(f, wr);
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
+    if (g_signal && !code) {
+        fprintf(stderr, "cranesim drive: interrupted (%s) at t = %.6g s%s%s\n", g_signal == SIGINT ? "SIGINT" : "SIGTERM",
+                live_time(l), record ? "; record kept in " : "", record ? record : "");
+        code = 128 + g_signal;
+    }
+    if (!code) {
+        char note[320];
+        live_note(l, note, sizeof note);
+        if (note[0]) fprintf(stderr, "cranesim drive: note: %s\n", note);
+    }
+    wr = app_out_close(&rec, wr, true);
     if (wr) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(wr));
         code = EXIT_RUNTIME;
@@ -227,9 +266,12 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (sandbox) printf("; truck tilt %.2f deg", row[COL_TRUCK_TILT] * 180 / M_PI);
     if (!sandbox && m3 > 0) printf("; %.0f kg at the tip", m3);
     printf("\n");
-    if (!wr)
+    if (!wr && record)
         printf("  record -> %s (%d rows); for the 3D window run it on a machine with a display\n", record,
                frames_done);
+    else if (!wr)
+        printf("  no record (--record FILE.csv writes one); for the 3D window run it on a machine with a "
+               "display\n");
     live_destroy(l);
     model_free(m);
     return code;
@@ -288,8 +330,11 @@ int cmd_drive(int argc, char** argv) {
             continue;
         }
         if (!strcmp(argv[i], "--screenshot-at") && i + 1 < argc) {
-            if (app_parse_double(argv[++i], &shot_at) || shot_at < 0) {
-                fprintf(stderr, "cranesim drive: --screenshot-at: expected a time >= 0 s, got '%s'\n", argv[i]);
+            // Capped like --duration: a simulated time, compared and counted
+            // against the run's.
+            if (app_parse_double(argv[++i], &shot_at) || shot_at < 0 || shot_at > SIM_MAX_DURATION) {
+                fprintf(stderr, "cranesim drive: --screenshot-at: expected a time in s, 0 <= T <= 1e6, got '%s'\n",
+                        argv[i]);
                 return EXIT_USAGE;
             }
             continue;
@@ -399,5 +444,5 @@ int cmd_drive(int argc, char** argv) {
 #endif
     // The headless run has no parameter panel, so nothing to save.
     if (save_as) fprintf(stderr, "cranesim drive: note: --save-as has no effect without the window (no parameter panel)\n");
-    return drive_headless(&c, frame_rate, record ? record : "drive.csv", why, kind, wname);
+    return drive_headless(&c, frame_rate, record, why, kind, wname);
 }

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -21,31 +22,118 @@ static void run_help(FILE* f) {
             "  x3,v3,p3A,p3B,u3,u3_cmd,F3 (zeros in the validation world)\n"
             "\n"
             "options:\n"
-            "  --out FILE           CSV output (default run.csv); created when the run starts\n"
+            "  --out FILE           CSV output (default run.csv); written to a temporary file in its\n"
+            "                       folder and renamed over FILE when the run ends (also a failed or\n"
+            "                       interrupted one, with the rows so far): until then FILE is untouched\n"
             "  --plot FILE.png      also plot strokes, pressures, valve openings and tip path\n");
     app_common_help(f, true);
     fprintf(f,
             "\nexit codes: 0 ok, 1 runtime failure (a numerical blow-up keeps the rows so far; a failed\n"
-            "write), 2 bad input or usage (nothing is written)\n"
+            "write), 2 bad input or usage (nothing is written), 130 or 143 stopped by SIGINT (Ctrl-C) or\n"
+            "SIGTERM (the rows so far kept; a second signal kills at once)\n"
             "example: cranesim run --scenario ramp --out ramp.csv --plot ramp.png\n");
 }
 
+// SIGINT or SIGTERM during the run: the signal number, seen by the row
+// sink, which stops the run after the row it is writing (whole lines).
+static volatile sig_atomic_t g_signal;
+
+static void on_signal(int sig) { g_signal = sig; }
+
+// The rows the plot needs, decimated to a bounded number: a run of up to
+// PLOT_FULL rows (every shipped scenario at 1 kHz) keeps every row; a longer
+// one keeps, for each bucket of `stride` rows, two rows holding each
+// column's minimum and maximum over the bucket (at the bucket's first and
+// last time), so a one-row pressure spike still reaches the plot. Without
+// --plot nothing is kept (a 600 s sandbox run held 203 MB of rows).
+enum { PLOT_FULL = 100000 };
+typedef struct plot_keep {
+    sim_trace* tr; ///< NULL: no plot
+    long stride;   ///< rows per bucket (1: every row)
+    long inb;      ///< rows in the current bucket
+    double lo[SIM_NCOL], hi[SIM_NCOL], t0, t1;
+    bool oom;
+} plot_keep;
+
+static void keep_push(plot_keep* k, const double* row) {
+    sim_trace* tr = k->tr;
+    if (tr->nrow == tr->cap) {
+        const int cap = tr->cap ? 2 * tr->cap : 4096;
+        double* v = realloc(tr->v, (size_t)cap * SIM_NCOL * sizeof(double));
+        if (!v) {
+            k->oom = true;
+            return;
+        }
+        tr->v = v;
+        tr->cap = cap;
+    }
+    memcpy(tr->v + (size_t)tr->nrow * SIM_NCOL, row, SIM_NCOL * sizeof(double));
+    ++tr->nrow;
+}
+
+static void keep_flush(plot_keep* k) {
+    if (!k->tr || k->inb == 0) return;
+    if (k->inb == 1) {
+        keep_push(k, k->lo);
+    } else {
+        k->lo[COL_T] = k->t0;
+        k->hi[COL_T] = k->t1;
+        keep_push(k, k->lo);
+        keep_push(k, k->hi);
+    }
+    k->inb = 0;
+}
+
+static void keep_row(plot_keep* k, const double* row, int ncol) {
+    if (!k->tr || k->oom) return;
+    double full[SIM_NCOL] = {0};
+    memcpy(full, row, (size_t)ncol * sizeof(double));
+    if (k->stride <= 1) {
+        keep_push(k, full);
+        return;
+    }
+    if (k->inb == 0) {
+        memcpy(k->lo, full, sizeof full);
+        memcpy(k->hi, full, sizeof full);
+        k->t0 = full[COL_T];
+    } else {
+        for (int c = 0; c < SIM_NCOL; ++c) {
+            k->lo[c] = fmin(k->lo[c], full[c]);
+            k->hi[c] = fmax(k->hi[c], full[c]);
+        }
+    }
+    k->t1 = full[COL_T];
+    if (++k->inb == k->stride) keep_flush(k);
+}
+
+// The summary's extremes, from every row.
+typedef struct row_stats {
+    double pmax[4], xmin[2], xmax[2];
+} row_stats;
+
 typedef struct csv_sink {
     const char* path;
+    app_out out;
     FILE* f;     ///< opened at the first row
     long rows;
     int ncol;
     int err;     ///< errno of the first failed open or write, 0 if none
-    bool opened; ///< the file was created (or truncated)
+    bool opened; ///< the file was created (as a temporary, renamed at the end)
+    plot_keep keep;
+    row_stats st;
+    double t_last; ///< time of the last row written [s]
 } csv_sink;
 
 // The CSV is opened at the first row (t = 0, before any step): a run refused
 // while it sets up (a bad world, a start pose, an option sim_run rejects)
-// then creates or truncates nothing. A failed write stops the run.
+// then creates nothing. It is written to a temporary file in the same
+// folder, renamed over --out when the run ends (app_out): the previous file
+// stays whole until the run has rows to replace it with. A failed write
+// stops the run, and so does SIGINT or SIGTERM (after a whole row).
 static int csv_row(void* user, const double* row) {
     csv_sink* s = user;
     if (!s->f) {
-        s->f = fopen(s->path, "w");
+        s->f = app_out_open(&s->out, s->path, "w");
         if (!s->f) {
             s->err = errno;
             return 1;
@@ -55,36 +143,33 @@ static int csv_row(void* user, const double* row) {
     }
     errno = 0;
     sim_csv_row(s->f, row, s->ncol);
-    // Flush about once a simulated second at 1 kHz, so a crash or a kill
-    // keeps nearly everything already computed.
-    if (++s->rows % 1000 == 0) fflush(s->f);
+    ++s->rows;
+    s->t_last = row[COL_T];
     if (ferror(s->f)) {
         s->err = errno ? errno : EIO;
         return 1;
     }
-    return 0;
+    for (int k = 0; k < 4; ++k) s->st.pmax[k] = fmax(s->st.pmax[k], row[COL_P1A + k]);
+    for (int k = 0; k < 2; ++k) {
+        s->st.xmin[k] = fmin(s->st.xmin[k], row[COL_X1 + k]);
+        s->st.xmax[k] = fmax(s->st.xmax[k], row[COL_X1 + k]);
+    }
+    keep_row(&s->keep, row, s->ncol);
+    return g_signal != 0;
 }
 
-// Close the CSV; 0, or the errno of the first failure (a full disk often
-// shows only when the last buffer is flushed).
+// Close the CSV and put it in place; 0, or the errno of the first failure
+// (a full disk often shows only when the last buffer is flushed).
 static int csv_close(csv_sink* s) {
     if (!s->f) return s->err;
-    s->err = app_fclose_checked(s->f, s->err);
+    s->err = app_out_close(&s->out, s->err, true);
     s->f = NULL;
     return s->err;
 }
 
-static void print_summary(const char* scen, const sim_opts* o, const sim_result* r, const sim_trace* tr,
+static void print_summary(const char* scen, const sim_opts* o, const sim_result* r, const row_stats* st,
                           const char* out) {
-    double pmax[4] = {0}, xmin[2] = {1e9, 1e9}, xmax[2] = {-1e9, -1e9};
-    for (int i = 0; i < tr->nrow; ++i) {
-        const double* v = tr->v + (size_t)i * SIM_NCOL;
-        for (int k = 0; k < 4; ++k) pmax[k] = fmax(pmax[k], v[COL_P1A + k]);
-        for (int k = 0; k < 2; ++k) {
-            xmin[k] = fmin(xmin[k], v[COL_X1 + k]);
-            xmax[k] = fmax(xmax[k], v[COL_X1 + k]);
-        }
-    }
+    const double *pmax = st->pmax, *xmin = st->xmin, *xmax = st->xmax;
     const bool ode = o->mechanics == SIM_ODE;
     const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
     // The variant is the lagrange backend's; an ode run is named by its world.
@@ -158,6 +243,14 @@ int cmd_run(int argc, char** argv) {
     scenario sc;
     rc = app_load(&c, &m, &sc);
     if (rc) return rc;
+    // A sandbox scenario runs in the sandbox unless the options say otherwise.
+    bool switched;
+    rc = app_scenario_world("run", &c.sim, c.given, &sc, true, &switched);
+    if (!rc && switched) rc = app_check_sim("run", &c.sim, c.given);
+    if (rc) {
+        model_free(m);
+        return rc;
+    }
     app_note_unused("run", c.given, &c.sim, 1);
     app_note_load("run", &c, &c.sim, &sc);
     {
@@ -173,19 +266,48 @@ int cmd_run(int argc, char** argv) {
     }
     app_settle_unused(&c.sim);
 
-    csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim)};
+    csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim),
+                     .st = {.xmin = {INFINITY, INFINITY}, .xmax = {-INFINITY, -INFINITY}}};
     sim_trace tr = {0};
+    if (plot) {
+        sink.keep.tr = &tr;
+        // Rows the run will write: one per output period, plus the first.
+        const double dur = c.sim.duration > 0 ? c.sim.duration : sc.duration;
+        const double rows = dur / app_output_period(&c.sim) + 1.0;
+        sink.keep.stride = rows > PLOT_FULL ? (long)ceil(rows / (PLOT_FULL / 2)) : 1;
+    }
     sim_result res;
-    sim_run(m, &sc, &c.sim, csv_row, &sink, &tr, c.quiet ? NULL : app_progress, NULL, &res);
+    // SIGINT (Ctrl-C) or SIGTERM: the run stops after the row being written
+    // and the CSV is closed and put in place with every row so far; a second
+    // signal kills at once (SA_RESETHAND).
+    struct sigaction sa, old_int, old_term;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sa.sa_flags = SA_RESETHAND;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int);
+    sigaction(SIGTERM, &sa, &old_term);
+    sim_run(m, &sc, &c.sim, csv_row, &sink, NULL, c.quiet ? NULL : app_progress, NULL, &res);
+    keep_flush(&sink.keep);
     if (!c.quiet) app_progress_done();
-    if (res.note[0]) fprintf(stderr, "cranesim run: note: %s\n", res.note);
+    if (res.note[0] && !g_signal) fprintf(stderr, "cranesim run: note: %s\n", res.note);
     const int werr = csv_close(&sink);
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
     int code = EXIT_OK_;
     if (werr && !sink.opened) {
         // The path passed app_check_output, yet could not be created: still
         // bad input, and nothing was written.
         fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
         code = EXIT_USAGE;
+    } else if (g_signal && res.status == 2 && sink.opened) {
+        // Interrupted: 128 + the signal, as a shell reports a process the
+        // signal ended, but with the rows in place (decision in docs).
+        if (werr) fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
+        else
+            fprintf(stderr, "cranesim run: interrupted (%s) at t = %.6g s; %ld rows kept in %s\n",
+                    g_signal == SIGINT ? "SIGINT" : "SIGTERM", sink.t_last, sink.rows, out);
+        code = 128 + g_signal;
     } else if (res.status == 1) {
         fprintf(stderr, "cranesim run: %s; %ld rows up to t = %.6g s kept in %s\n", res.message, res.rows,
                 res.t_end, out);
@@ -199,8 +321,13 @@ int cmd_run(int argc, char** argv) {
         fprintf(stderr, "cranesim run: %s\n", res.message);
         code = sink.rows ? EXIT_RUNTIME : EXIT_USAGE;
     }
-    if (code == EXIT_OK_ && !c.quiet) print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &tr, out);
-    if (plot && tr.nrow > 1 && code != EXIT_USAGE) {
+    if (sink.keep.oom && code == EXIT_OK_) {
+        fprintf(stderr, "cranesim run: plot: out of memory for the plotted rows\n");
+        code = EXIT_RUNTIME;
+    }
+    if (code == EXIT_OK_ && !c.quiet)
+        print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, out);
+    if (plot && tr.nrow > 1 && code != EXIT_USAGE && !g_signal) {
         char err[512], title[160];
         if (c.sim.mechanics == SIM_ODE)
             snprintf(title, sizeof title, "%s: ode/%s, %s", sc.name, c.sim.world ? c.sim.world : "validation",

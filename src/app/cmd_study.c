@@ -157,8 +157,8 @@ static int plot_wp(const study_cfg* c, int n, double ppeak, const char* title, c
 #endif
 
 // Close a result file, reporting a failed write: "cannot write FILE: reason".
-static int close_checked(FILE* f, const char* path) {
-    const int e = app_fclose_checked(f, 0);
+static int close_checked(app_out* o, const char* path) {
+    const int e = app_out_close(o, 0, true);
     if (e) fprintf(stderr, "cranesim study: cannot write %s: %s\n", path, strerror(e));
     return e ? -1 : 0;
 }
@@ -307,11 +307,13 @@ int cmd_study(int argc, char** argv) {
         sim_trace_free(&tr);
     }
 
-    FILE* md = fopen(path_md, "w");
-    FILE* js = md ? fopen(path_js, "w") : NULL;
+    // Each replaces the previous study's file only once written in full.
+    app_out out_md, out_js;
+    FILE* md = app_out_open(&out_md, path_md, "w");
+    FILE* js = md ? app_out_open(&out_js, path_js, "w") : NULL;
     if (!md || !js) {
         fprintf(stderr, "cranesim study: cannot write %s: %s\n", md ? path_js : path_md, strerror(errno));
-        if (md) fclose(md);
+        if (md) app_out_close(&out_md, 0, false);
         model_free(m);
         sim_trace_free(&ref);
         return EXIT_RUNTIME;
@@ -345,8 +347,8 @@ int cmd_study(int argc, char** argv) {
                 s->st.fevals, s->st.jevals, s->st.lus, s->wall);
     }
     int code = 0;
-    if (close_checked(md, path_md)) code = EXIT_RUNTIME;
-    if (close_checked(js, path_js)) code = EXIT_RUNTIME;
+    if (close_checked(&out_md, path_md)) code = EXIT_RUNTIME;
+    if (close_checked(&out_js, path_js)) code = EXIT_RUNTIME;
 #ifdef CRANESIM_HAVE_PLPLOT
     char title[160], err[512];
     snprintf(title, sizeof title, "Work-precision, scenario %s (reference CVODE rtol 1e-10)", sc.name);

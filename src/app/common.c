@@ -1,9 +1,12 @@
 // common.c: option parsing and loading shared by the subcommands.
+// realpath (X/Open) for app_out_open.
+#define _XOPEN_SOURCE 700
 #include "app.h"
 #include "live.h"
 #include "world_desc.h"
 
 #include <ctype.h>
+#include <limits.h>
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -66,7 +69,7 @@ static const struct {
     {"run", {"--out", "--plot", NULL}},
     {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot", NULL}},
     {"study", {"--out-dir", "--repeat", NULL}},
-    {"bench", {"--repeat", "--config", NULL}},
+    {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
      {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", NULL}},
 };
@@ -176,8 +179,19 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
     case APP_OPT_DT: if (positive(a, v, &c->sim.h)) return -1; break;
     case APP_OPT_RTOL: if (positive(a, v, &c->sim.rtol)) return -1; break;
     case APP_OPT_ATOL: if (positive(a, v, &c->sim.atol)) return -1; break;
-    case APP_OPT_DURATION: if (positive(a, v, &c->sim.duration)) return -1; break;
-    case APP_OPT_EVERY: if (positive(a, v, &c->sim.dt_out)) return -1; break;
+    case APP_OPT_DURATION:
+    case APP_OPT_EVERY:
+        // Capped before anything counts steps or rows in integers from them
+        // (1e300 s made the run count wrap and exit 0 having simulated nothing).
+        if (app_parse_double(v, &d) || !(d > 0) || d > SIM_MAX_DURATION) {
+            fprintf(stderr, "cranesim: %s: expected %s in s, 0 < %s <= 1e6 (11.6 days), got '%s'\n", a,
+                    k == APP_OPT_DURATION ? "a simulated time" : "an output period",
+                    k == APP_OPT_DURATION ? "T" : "DT", v);
+            return -1;
+        }
+        if (k == APP_OPT_DURATION) c->sim.duration = d;
+        else c->sim.dt_out = d;
+        break;
     case APP_OPT_SET:
         if (c->nset == APP_MAX_SET) {
             fprintf(stderr, "cranesim: at most %d --set options\n", APP_MAX_SET);
@@ -288,6 +302,77 @@ int app_fclose_checked(FILE* f, int first) {
     if (flagged && !e) e = EIO;
     return e;
 }
+
+FILE* app_out_open(app_out* o, const char* path, const char* mode) {
+    memset(o, 0, sizeof *o);
+    struct stat st;
+    const bool exists = stat(path, &st) == 0;
+    if (exists && !S_ISREG(st.st_mode)) { // a device or a pipe: in place
+        snprintf(o->path, sizeof o->path, "%s", path);
+        o->f = fopen(path, mode);
+        return o->f;
+    }
+    // Through a symlink to the file it names: renaming over the link itself
+    // would replace the link with a file.
+    char real[PATH_MAX];
+    const char* target = exists && realpath(path, real) ? real : path;
+    if (strlen(target) >= sizeof o->path) {
+        errno = ENAMETOOLONG;
+        return NULL;
+    }
+    memcpy(o->path, target, strlen(target) + 1); // fits: checked above
+    const char* slash = strrchr(o->path, '/');
+    const int dl = slash ? (int)(slash - o->path + 1) : 0;
+    snprintf(o->tmp, sizeof o->tmp, "%.*s.%s.XXXXXX", dl, o->path, o->path + dl);
+    const int fd = mkstemp(o->tmp);
+    if (fd < 0) {
+        // A folder we may not create files in, holding a file we may write:
+        // write it in place, as before (app_check_output let it through).
+        const int e = errno;
+        o->tmp[0] = 0;
+        if (exists && access(o->path, W_OK) == 0) {
+            o->f = fopen(o->path, mode);
+            return o->f;
+        }
+        errno = e;
+        return NULL;
+    }
+    // mkstemp makes it 0600: give it the mode the old file had, or a new
+    // file's (0666 less the umask).
+    mode_t mode_bits;
+    if (exists) {
+        mode_bits = st.st_mode & 07777;
+    } else {
+        const mode_t um = umask(0);
+        umask(um);
+        mode_bits = 0666 & ~um;
+    }
+    if (fchmod(fd, mode_bits)) { /* the data matters more than the mode */
+    }
+    o->f = fdopen(fd, mode);
+    if (!o->f) {
+        const int e = errno;
+        close(fd);
+        unlink(o->tmp);
+        o->tmp[0] = 0;
+        errno = e;
+    }
+    return o->f;
+}
+
+int app_out_close(app_out* o, int first, bool keep) {
+    int e = first;
+    if (o->f) e = app_fclose_checked(o->f, first);
+    o->f = NULL;
+    if (o->tmp[0]) {
+        if (keep && !e && rename(o->tmp, o->path)) e = errno;
+        if (!keep || e) unlink(o->tmp);
+        o->tmp[0] = 0;
+    }
+    return e;
+}
+
+int app_out_commit_signal(const app_out* o) { return o->tmp[0] ? rename(o->tmp, o->path) : 0; }
 
 int app_check_output(const char* cmd, const char* opt, const char* path, const char* ext) {
     if (!*path) {
@@ -526,6 +611,48 @@ void app_note_load(const char* cmd, const app_common* c, const sim_opts* o, cons
         fprintf(stderr,
                 "cranesim %s: note: --set %s has no effect: scenario %s sets its own load (%g kg); use --load %s\n",
                 cmd, set, sc->name, sc->load_mass, v);
+}
+
+// What in a scenario needs the sandbox (NULL: nothing): the slew, the hook.
+static const char* sandbox_use(const scenario* sc) {
+    if (sc->nevent > 0) return "works the hook";
+    const scenario_signal* sl = &sc->cmd[2];
+    for (int i = 0; i < sl->n; ++i)
+        if (sl->u[i] != 0) return "slews the crane";
+    return sc->slew0 != 0 ? "starts slewed" : NULL;
+}
+
+int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
+                       bool* switched) {
+    if (switched) *switched = false;
+    const char* why = sandbox_use(sc);
+    if (!why) return 0;
+    char err[512];
+    if (o->mechanics == SIM_ODE) {
+        const int kind = world_kind_of(o, err, sizeof err);
+        if (kind == WORLD_SANDBOX) return 0;
+        // A world file that does not load is the first thing wrong: say that,
+        // not that the scenario needs another world.
+        if (kind < 0) {
+            fprintf(stderr, "cranesim %s: %s\n", cmd, err);
+            return EXIT_USAGE;
+        }
+    }
+    const char* name = sc->name[0] ? sc->name : "the scenario";
+    // No world chosen (--world), and no backend or the ode one: its world.
+    if (may_switch && !(given & APP_GIVEN(APP_OPT_WORLD)) &&
+        (!(given & APP_GIVEN(APP_OPT_MECHANICS)) || o->mechanics == SIM_ODE)) {
+        o->mechanics = SIM_ODE;
+        o->world = "sandbox";
+        if (switched) *switched = true;
+        fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs in its world, --mechanics ode --world sandbox\n",
+                cmd, name, why);
+        return 0;
+    }
+    fprintf(stderr,
+            "cranesim %s: scenario %s %s, which the %s has not: run it with --mechanics ode --world sandbox\n", cmd,
+            name, why, o->mechanics == SIM_ODE ? "validation world" : "lagrange 2-DOF crane");
+    return EXIT_USAGE;
 }
 
 const char* app_scenario_path(const char* arg, char* buf, size_t n) {

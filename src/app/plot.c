@@ -15,20 +15,20 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-// Write n bytes to path; on failure "cannot write FILE: reason" in err, and a
-// partly written regular file is removed (it would pass for a plot).
+// Write n bytes to path, replacing it only once all are written (app_out);
+// on failure "cannot write FILE: reason" in err, and the previous file is
+// left as it was (a partly written one would pass for a plot).
 static int write_file(const char* path, const void* data, size_t n, char* err, size_t errsz) {
-    FILE* f = fopen(path, "wb");
+    app_out out;
+    FILE* f = app_out_open(&out, path, "wb");
     if (!f) {
         snprintf(err, errsz, "cannot write %s: %s", path, strerror(errno));
         return -1;
     }
     errno = 0;
-    const int e = app_fclose_checked(f, fwrite(data, 1, n, f) != n ? (errno ? errno : EIO) : 0);
+    const int e = app_out_close(&out, fwrite(data, 1, n, f) != n ? (errno ? errno : EIO) : 0, true);
     if (!e) return 0;
     snprintf(err, errsz, "cannot write %s: %s", path, strerror(e));
-    struct stat st;
-    if (stat(path, &st) == 0 && S_ISREG(st.st_mode)) remove(path);
     return -1;
 }
 

@@ -22,7 +22,9 @@ struct live {
     sim_opts o;
     double t;
     double y[LSIM_MAX_STATES];
-    char err[320];
+    char err[512];
+    sim_checks chk; ///< the run checks every driver applies (sim.h)
+    bool failed;    ///< a check or the solver failed: the crane stays stopped
 };
 
 live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
@@ -43,6 +45,13 @@ live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2]
         return NULL;
     }
     lsim_initial_state(&l->ls, q0, 0.5e6, l->y);
+    double row0[SIM_NCOL];
+    live_row(l, row0);
+    if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, m3, err, errsz)) {
+        lsim_free(&l->ls);
+        free(l);
+        return NULL;
+    }
     // The drive panel edits circuit parameters in place (hyd_model_set), and
     // the fused kernel holds a packed copy of them: live runs keep the
     // general path, which reads the model on every call. Real time needs 1x,
@@ -79,7 +88,10 @@ live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], dou
     }
     // The hydraulic sub-step is min(--dt, ODE step), as sim_ode_world_create sets it.
     const double dt = ode_world_dt(l->ode), h = o->h < dt ? o->h : dt;
-    if (sim_check_fixed_step(ode_world_circuit(l->ode), o, h, 0.0, err, errsz)) {
+    double row0[SIM_NCOL];
+    sim_ode_row(l->ode, row0);
+    if (sim_check_fixed_step(ode_world_circuit(l->ode), o, h, 0.0, err, errsz) ||
+        sim_check_start(ode_world_circuit(l->ode), row0, SIM_NCOL, m3, err, errsz)) {
         ode_world_destroy(l->ode);
         free(l);
         return NULL;
@@ -144,13 +156,13 @@ void live_set_commands(live* l, const double u[3]) {
     for (int k = 0; k < 2; ++k) {
         double v = u[k] < -1 ? -1 : u[k] > 1 ? 1 : u[k];
         // A command change is a kink in the input: adaptive methods restart
-        // their step-size history there (SPEC section 3.3).
+        // their step-size history there (decision 8).
         if (v != l->ls.u_cmd[k] && hyd_method_is_adaptive(l->o.solver)) hyd_solver_reset(l->solver);
         l->ls.u_cmd[k] = v;
     }
 }
 
-int live_advance(live* l, double dt) {
+static int advance(live* l, double dt) {
     if (l->ode) {
         if (ode_world_step(l->ode, dt) == 0) return 0;
         snprintf(l->err, sizeof l->err, "%s", ode_world_error(l->ode));
@@ -163,6 +175,31 @@ int live_advance(live* l, double dt) {
     snprintf(l->err, sizeof l->err, "solver %s failed (code %d) at t = %.6g s, state %d", hyd_method_name(l->o.solver),
              rc, tb, i);
     return 1;
+}
+
+int live_advance(live* l, double dt) {
+    if (l->failed) return 1;
+    if (advance(l, dt)) {
+        l->failed = true;
+        return 1;
+    }
+    // The same checks as run's, on the row the loop records and shows: a
+    // drive that exits 0 while recording -26 MPa absolute is a wrong result
+    // passing as valid.
+    double row[SIM_NCOL];
+    live_row(l, row);
+    char what[200];
+    const int rc = sim_check_row(&l->chk, row, live_ncol(l), what, sizeof what);
+    if (!rc) return 0;
+    const bool adaptive = hyd_method_is_adaptive(l->o.solver);
+    snprintf(l->err, sizeof l->err, "numerical blow-up: %s (solver %s): %s", what, hyd_method_name(l->o.solver),
+             sim_blowup_hint(adaptive, row[COL_T], l->chk.bad_value));
+    l->failed = true;
+    return 1;
+}
+
+void live_note(const live* l, char* note, size_t n) {
+    sim_checks_note(&l->chk, hyd_method_is_adaptive(l->o.solver), note, n);
 }
 
 const char* live_error(const live* l) { return l->err; }

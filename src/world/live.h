@@ -53,9 +53,14 @@ void live_destroy(live* l);
 /// Valve commands lift, jib, slew in [-1, 1] (slew ignored by lagrange).
 void live_set_commands(live* l, const double u[3]);
 
-/// Advance dt [s] of simulated time. Returns 0, or 1 on a numerical failure
-/// (message from live_error).
+/// Advance dt [s] of simulated time, then apply the run checks of sim.h
+/// (sim_check_row) to the state reached. Returns 0, or 1 on a numerical
+/// failure or a failed check (message from live_error); then the crane stays
+/// stopped and every further call returns 1.
 int live_advance(live* l, double dt);
+/// The note for a dip below absolute zero the checks saw (sim_checks_note),
+/// or "".
+void live_note(const live* l, char* note, size_t n);
 const char* live_error(const live* l);
 
 double live_time(const live* l);

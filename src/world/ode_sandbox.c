@@ -383,13 +383,26 @@ int ow_build_sandbox(ode_world* w, char* err, size_t errsz) {
     dJointAttach(w->slew_joint, w->frame[0].body, w->truck);
     dJointSetHingeAnchor(w->slew_joint, base[0], base[1], base[2]);
     dJointSetHingeAxis(w->slew_joint, R[2], R[5], R[8]);
+    // ODE's hinge angle is 0 at slew0 and wraps at +-pi; the slew is that
+    // angle plus slew0 plus the turns counted by ow_read_actuators.
     w->slew_off = w->opt.slew0;
-    if (s->present && s->stroke > 0 && smax < M_PI) {
-        // The rack's end stops as hinge limits (docs/ode_world.md, "End stops").
-        dJointSetHingeParam(w->slew_joint, dParamLoStop, -smax - w->opt.slew0);
-        dJointSetHingeParam(w->slew_joint, dParamHiStop, smax - w->opt.slew0);
+    w->slew_raw = 0;
+    w->slew_turns = 0;
+    w->slew_lim[0] = -dInfinity;
+    w->slew_lim[1] = dInfinity;
+    if (s->present && s->stroke > 0) {
+        // The rack's end stops as hinge limits (docs/ode_world.md, "End
+        // stops"), on the continuous hinge angle, however long the rack;
+        // ow_slew_stops gives ODE the part of them its (-pi, pi] angle can
+        // reach. (Given to ODE as they are, the +171.9 deg stop from slew0 =
+        // -60 deg was 4.05 rad, which ODE never reaches: at +120 deg the
+        // angle wrapped, the rack stroke jumped by -2 pi r = -0.63 m and a
+        // phantom 5.9e7 N end-stop force followed.)
+        w->slew_lim[0] = -smax - w->opt.slew0;
+        w->slew_lim[1] = smax - w->opt.slew0;
         dJointSetHingeParam(w->slew_joint, dParamBounce, 0.0);
     }
+    ow_slew_stops(w);
     build_rope(w);
     build_loads(w);
     build_obstacles(w);
@@ -567,7 +580,7 @@ void ow_sandbox_snapshot(const ode_world* w, world_snapshot* s) {
     ow_hook_point(w, s->hook, NULL);
     s->attached = w->attached >= 0;
     s->load_mass = w->attached >= 0 ? w->desc.load[w->attached].mass : 0;
-    s->slew = dJointGetHingeAngle(w->slew_joint) + w->slew_off;
+    s->slew = ow_slew_angle(w);
     s->truck_tilt = ow_truck_tilt(w);
     s->tipping = s->truck_tilt > 5.0 * M_PI / 180.0;
     s->collision = (uint8_t)w->crane_contact;
@@ -613,6 +626,7 @@ static void set_rigid_vel(dBodyID b, const double tip[3], const double om[3]) {
 }
 
 void ode_world_swing_hook(ode_world* w, const double omega[3]) {
+    if (w->dead) return;
     if (w->kind != WORLD_SANDBOX) return;
     double tip[3], tl[3] = {w->mech.link[1].length, 0, 0};
     ow_frame_point(w, 2, tl, tip);

@@ -4,6 +4,7 @@
 #include "snap_reliefs.h"
 
 #include <math.h>
+#include <setjmp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,17 +17,26 @@
 // ODE keeps global tables (collider registry, thread-local data); it must be
 // initialised once before the first world and closed after the last. A
 // counter lets several worlds coexist (tests, compare runs). This is the one
-// piece of global mutable state the project allows (STYLE.md); worlds must be
-// created and destroyed from one thread.
+// piece of global mutable state the project allows; worlds must be created
+// and destroyed from one thread.
 // The ODE library's state: its users, and the non-fatal messages it sends
 // (dMessage: "LCP internal error, s <= 0" on a degenerate contact set),
 // which it would print to stderr itself, outside our one-line messages and
 // unrelated to the run. They are counted here and reported by the caller
 // (ode_world_messages).
+// ODE's errors and failed internal checks (dError, dDebug: an assertion such
+// as "!bSafeNormalize4Fault" in dxNormalize4 on a quaternion that a 1e-300 kg
+// link or a 1e308 kg truck has turned into NaN) call abort() by default, and
+// their handler must not return. Every entry point that runs ODE code arms a
+// trap (ow_trapped); the handler jumps back to it, the world is marked dead
+// and from then on only destroyed. The caller sees an ordinary runtime
+// failure (exit 1, rows kept) instead of SIGABRT.
 static struct {
     int users;
     long messages;
     char last[160];
+    jmp_buf* trap; ///< the armed entry point, or NULL
+    char fatal[200]; ///< text of the last ODE error
 } g_ode;
 
 static void ode_message(int num, const char* msg, va_list ap) {
@@ -35,15 +45,59 @@ static void ode_message(int num, const char* msg, va_list ap) {
     g_ode.messages++;
 }
 
+static void ode_fatal(int num, const char* msg, va_list ap) {
+    (void)num;
+    vsnprintf(g_ode.fatal, sizeof g_ode.fatal, msg, ap);
+    if (g_ode.trap) longjmp(*g_ode.trap, 1);
+    // No world call is running (cannot happen through this module's API):
+    // nothing to return to. exit, not abort, so the rows already written are
+    // flushed.
+    fprintf(stderr, "cranesim: ODE error outside a world call: %s\n", g_ode.fatal);
+    exit(1);
+}
+
 static void ode_acquire(void) {
     if (g_ode.users++ == 0) {
         dInitODE2(0);
         dSetMessageHandler(ode_message);
+        dSetErrorHandler(ode_fatal);
+        dSetDebugHandler(ode_fatal);
     }
 }
 
 static void ode_release(void) {
     if (--g_ode.users == 0) dCloseODE();
+}
+
+// Run fn(w, arg) with ODE's errors caught. Returns fn's result, or
+// OW_ODE_FAILED after an ODE error; then w is dead (w->err says why) and
+// only ode_world_destroy may touch it. Nothing in fn may rely on running to
+// its end (the jump skips the rest of fn and of ODE's own frames): fn only
+// steps or reads the world, which is then discarded whole.
+enum { OW_ODE_FAILED = -1000 };
+typedef int (*ow_fn)(ode_world* w, void* arg);
+static int ow_trapped(ode_world* w, const char* what, ow_fn fn, void* arg) {
+    jmp_buf jb;
+    jmp_buf* const prev = g_ode.trap;
+    if (setjmp(jb)) {
+        g_ode.trap = prev;
+        w->dead = 1;
+        w->failed = 1;
+        if (w->world_built)
+            snprintf(w->err, sizeof w->err,
+                     "ode world: ODE failed %s at t = %.6f s (%.150s): a mass, size or position far outside the "
+                     "physical range; the world was stopped",
+                     what, w->t, g_ode.fatal);
+        else
+            snprintf(w->err, sizeof w->err,
+                     "ode world: ODE failed %s (%.150s): a mass, size or position far outside the physical range",
+                     what, g_ode.fatal);
+        return OW_ODE_FAILED;
+    }
+    g_ode.trap = &jb;
+    const int rc = fn(w, arg);
+    g_ode.trap = prev;
+    return rc;
 }
 
 long ode_world_messages(const char** last) {
@@ -397,11 +451,51 @@ static void boom_cyl_kinematics(const ode_world* w, const ow_act* c, double* x, 
 // [m/s].
 static void slew_kinematics(const ode_world* w, const ow_act* c, double* x, double* v) {
     const double r = w->desc.slew.pinion_radius;
-    *x = 0.5 * c->stroke + r * (dJointGetHingeAngle(w->slew_joint) + w->slew_off);
+    *x = 0.5 * c->stroke + r * ow_slew_angle(w);
     *v = r * dJointGetHingeAngleRate(w->slew_joint);
 }
 
+// The hinge angle's turn count relative to the last read (raw: now).
+static double slew_turns_at(const ode_world* w, double raw) {
+    const double d = raw - w->slew_raw;
+    return w->slew_turns + (d > M_PI ? -2 * M_PI : d < -M_PI ? 2 * M_PI : 0.0);
+}
+
+double ow_slew_angle(const ode_world* w) {
+    if (!w->slew_joint) return 0.0;
+    const double raw = dJointGetHingeAngle(w->slew_joint);
+    return raw + slew_turns_at(w, raw) + w->slew_off;
+}
+
+void ow_slew_stops(ode_world* w) {
+    // A stop this turn's (-pi, pi] cannot reach is left to the turn that
+    // can: ODE sees it once the angle has wrapped (the next read), and holds
+    // it from there. A rack of more than a turn puts both stops in one turn
+    // with lo > hi: the angle is then above lo or below hi, and only that
+    // stop is reachable before the next wrap. Set hi before lo so ODE never
+    // sees lo > hi.
+    double lo = w->slew_lim[0] - w->slew_turns, hi = w->slew_lim[1] - w->slew_turns;
+    if (!(fabs(lo) < M_PI)) lo = -dInfinity;
+    if (!(fabs(hi) < M_PI)) hi = dInfinity;
+    if (lo > -dInfinity && hi < dInfinity && lo >= hi) {
+        if (w->slew_raw >= lo) hi = dInfinity;
+        else lo = -dInfinity;
+    }
+    dJointSetHingeParam(w->slew_joint, dParamLoStop, -dInfinity);
+    dJointSetHingeParam(w->slew_joint, dParamHiStop, hi);
+    dJointSetHingeParam(w->slew_joint, dParamLoStop, lo);
+}
+
 void ow_read_actuators(ode_world* w) {
+    if (w->slew_joint) {
+        const double raw = dJointGetHingeAngle(w->slew_joint);
+        const double turns = slew_turns_at(w, raw);
+        w->slew_raw = raw;
+        if (turns != w->slew_turns) {
+            w->slew_turns = turns;
+            ow_slew_stops(w);
+        }
+    }
     for (int k = 0; k < 2; ++k) {
         ow_act* c = &w->act[k];
         boom_cyl_kinematics(w, c, &c->x, &c->v);
@@ -444,6 +538,57 @@ void ow_apply_forces(ode_world* w) {
 
 // ---- create / destroy ----
 
+typedef struct create_args {
+    const cJSON* hydraulics;
+    const world_desc* desc;
+    char* err;
+    size_t errsz;
+} create_args;
+
+// The ODE part of ode_world_create (run under ow_trapped): 0, or -1 with err set.
+static int build_world(ode_world* w, void* arg) {
+    const create_args* a = arg;
+    w->world = dWorldCreate();
+    // Each world queues its step jobs on its own self-threaded implementation,
+    // not on ODE's process-wide default: an ODE error jumps out of a step
+    // with jobs still queued (ow_trapped), and on the shared one those would
+    // be run by the next world's step and fail ODE's check at dCloseODE.
+    w->threading = dThreadingAllocateSelfThreadedImplementation();
+    if (w->threading)
+        dWorldSetStepThreadingImplementation(w->world, dThreadingImplementationGetFunctions(w->threading),
+                                             w->threading);
+    dWorldSetGravity(w->world, 0, 0, -w->g);
+    dWorldSetERP(w->world, w->desc.ode.erp);
+    dWorldSetCFM(w->world, w->desc.ode.cfm);
+    dWorldSetContactSurfaceLayer(w->world, w->desc.ode.surface_layer);
+    // No automatic disabling by default: a resting crane must react to the
+    // next command at once. Loads and obstacles opt in per body
+    // (ode_sandbox.c, allow_sleep).
+    dWorldSetAutoDisableFlag(w->world, 0);
+    w->dyn_space = dSimpleSpaceCreate(0);
+    w->static_space = dSimpleSpaceCreate(0);
+    w->contacts = dJointGroupCreate(0);
+
+    // The hydraulic circuit first: cylinder strokes are needed for the limits.
+    if (w->opt.hydraulics) {
+        if (ow_hyd_create(w, a->hydraulics, a->desc ? a->desc->circuit : NULL, a->err, a->errsz)) return -1;
+    } else {
+        // Without a circuit, strokes come from nowhere; hinge limits are off.
+        for (int k = 0; k < 2; ++k) w->act[k].stroke = 0;
+    }
+
+    if (w->kind == WORLD_VALIDATION) {
+        static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        double p[3] = {0, 0, w->mech.column_height};
+        if (ow_build_crane(w, p, I, 0, a->err, a->errsz)) return -1;
+    } else {
+        if (ow_build_sandbox(w, a->err, a->errsz)) return -1;
+    }
+    if (w->opt.hydraulics) ow_hyd_init_state(w);
+    ow_read_actuators(w);
+    return 0;
+}
+
 ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, const world_desc* desc,
                             const ode_world_opts* o, char* err, size_t errsz) {
     ode_world_opts opt = o ? *o : ode_world_default_opts();
@@ -484,50 +629,41 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
     w->ipump = -1;
     for (int k = 0; k < ODE_NACT; ++k) w->act[k].cyl = w->act[k].valve = -1;
 
-    w->world = dWorldCreate();
-    dWorldSetGravity(w->world, 0, 0, -w->g);
-    dWorldSetERP(w->world, w->desc.ode.erp);
-    dWorldSetCFM(w->world, w->desc.ode.cfm);
-    dWorldSetContactSurfaceLayer(w->world, w->desc.ode.surface_layer);
-    // No automatic disabling by default: a resting crane must react to the
-    // next command at once. Loads and obstacles opt in per body
-    // (ode_sandbox.c, allow_sleep).
-    dWorldSetAutoDisableFlag(w->world, 0);
-    w->dyn_space = dSimpleSpaceCreate(0);
-    w->static_space = dSimpleSpaceCreate(0);
-    w->contacts = dJointGroupCreate(0);
-
-    // The hydraulic circuit first: cylinder strokes are needed for the limits.
-    if (opt.hydraulics) {
-        if (ow_hyd_create(w, hydraulics, desc ? desc->circuit : NULL, err, errsz)) goto fail;
-    } else {
-        // Without a circuit, strokes come from nowhere; hinge limits are off.
-        for (int k = 0; k < 2; ++k) w->act[k].stroke = 0;
+    create_args ca = {hydraulics, desc, err, errsz};
+    const int rc = ow_trapped(w, "while building the world", build_world, &ca);
+    if (rc == OW_ODE_FAILED) snprintf(err, errsz, "%s", w->err);
+    if (rc) {
+        ode_world_destroy(w);
+        return NULL;
     }
-
-    if (w->kind == WORLD_VALIDATION) {
-        static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-        double p[3] = {0, 0, w->mech.column_height};
-        if (ow_build_crane(w, p, I, 0, err, errsz)) goto fail;
-    } else {
-        if (ow_build_sandbox(w, err, errsz)) goto fail;
-    }
-    if (opt.hydraulics) ow_hyd_init_state(w);
-    ow_read_actuators(w);
+    w->world_built = 1;
     return w;
-fail:
-    ode_world_destroy(w);
-    return NULL;
+}
+
+
+static int destroy_ode(ode_world* w, void* arg) {
+    (void)arg;
+    if (w->contacts) dJointGroupDestroy(w->contacts);
+    if (w->dyn_space) dSpaceDestroy(w->dyn_space);
+    if (w->static_space) dSpaceDestroy(w->static_space);
+    if (w->hfield) dGeomHeightfieldDataDestroy(w->hfield);
+    if (w->world) {
+        dWorldSetStepThreadingImplementation(w->world, NULL, NULL);
+        dWorldDestroy(w->world);
+    }
+    // A dead world's job queue may still hold the jobs of the step ODE left
+    // (freeing it fails ODE's check): it is abandoned with the world.
+    if (w->threading && !w->dead) dThreadingFreeImplementation(w->threading);
+    return 0;
 }
 
 void ode_world_destroy(ode_world* w) {
     if (!w) return;
     ow_hyd_destroy(w);
-    if (w->contacts) dJointGroupDestroy(w->contacts);
-    if (w->dyn_space) dSpaceDestroy(w->dyn_space);
-    if (w->static_space) dSpaceDestroy(w->static_space);
-    if (w->hfield) dGeomHeightfieldDataDestroy(w->hfield);
-    if (w->world) dWorldDestroy(w->world);
+    // A dead world's ODE objects may fail ODE's checks once more as they are
+    // torn down: then what is left of them is abandoned (a leak, once, at
+    // the end of a failed run) rather than aborting.
+    ow_trapped(w, "while destroying the world", destroy_ode, NULL);
     free(w->terrain);
     free(w);
     ode_release();
@@ -573,10 +709,8 @@ static int check_finite(ode_world* w) {
     return 0;
 }
 
-int ode_world_step(ode_world* w, double dt) {
-    if (w->failed) return -1;
-    long n = (long)floor(dt / w->opt.dt_ode + 0.5);
-    if (n < 1) n = 1;
+static int step_ode(ode_world* w, void* arg) {
+    const long n = *(const long*)arg;
     const double h = w->opt.dt_ode;
     for (long i = 0; i < n; ++i) {
         ow_read_actuators(w);
@@ -600,6 +734,16 @@ int ode_world_step(ode_world* w, double dt) {
         }
     }
     return 0;
+}
+
+int ode_world_step(ode_world* w, double dt) {
+    if (w->failed) return -1;
+    // Capped before the conversion: a dt of 1e300 s is not a step count a
+    // long can hold (undefined behaviour). 1e12 steps is already "never".
+    const double steps = floor(dt / w->opt.dt_ode + 0.5);
+    long n = steps > 1e12 ? (long)1e12 : (long)steps;
+    if (n < 1) n = 1;
+    return ow_trapped(w, "in a step", step_ode, &n) ? -1 : 0;
 }
 
 const char* ode_world_error(const ode_world* w) { return w->err; }
@@ -627,6 +771,7 @@ void ode_world_set_joint_torques(ode_world* w, const double tau[2]) {
 }
 
 void ode_world_set_joint_rates(ode_world* w, const double qd[2]) {
+    if (w->dead) return; // ODE failed on these bodies: not touched again
     // Rigid-body velocities of the booms for joint rates qd about the fixed
     // joint 1 (validation column at rest): omega along the hinge axis.
     double axis_l[3] = {0, -1, 0}, R[9], ax[3];
@@ -681,6 +826,7 @@ static double body_energy(dBodyID b, double g) {
 }
 
 double ode_world_energy(const ode_world* w) {
+    if (w->dead) return NAN;
     double e = 0;
     for (int f = 0; f < 3; ++f)
         if (w->frame[f].body) e += body_energy(w->frame[f].body, w->g);
@@ -699,9 +845,22 @@ static void tip_point(const ode_world* w, double p[3], double v[3]) {
     if (v) ow_frame_point_vel(w, 2, tip, v);
 }
 
+static int get_state_ode(ode_world* w, void* arg);
+
 void ode_world_get_state(const ode_world* w, ode_world_state* s) {
     memset(s, 0, sizeof *s);
     s->t = w->t;
+    // A dead world's bodies are not asked again (ODE failed on them): the
+    // hydraulic states, which are ours, are all it reports.
+    if (w->dead || ow_trapped((ode_world*)w, "reading the state", get_state_ode, s)) {
+        ode_world_chamber_pressures(w, s->pA, s->pB);
+        s->t = w->t;
+        s->attached = -1;
+    }
+}
+
+static int get_state_ode(ode_world* w, void* arg) {
+    ode_world_state* s = arg;
     for (int k = 0; k < ODE_NACT; ++k) {
         const ow_act* c = &w->act[k];
         if (!c->present) continue;
@@ -727,7 +886,7 @@ void ode_world_get_state(const ode_world* w, ode_world_state* s) {
     s->qd[0] = dJointGetHingeAngleRate(w->j1);
     s->qd[1] = dJointGetHingeAngleRate(w->j2);
     if (w->slew_joint) {
-        s->slew = dJointGetHingeAngle(w->slew_joint) + w->slew_off;
+        s->slew = ow_slew_angle(w);
         s->slew_rate = dJointGetHingeAngleRate(w->slew_joint);
     }
     // Tip relative to joint 1 in the column's boom plane.
@@ -752,6 +911,7 @@ void ode_world_get_state(const ode_world* w, ode_world_state* s) {
     s->max_depth = w->max_depth;
     s->max_depth_crane = w->max_depth_crane;
     s->attached = w->attached;
+    return 0;
 }
 
 int ode_world_nload(const ode_world* w) { return w->nload; }
@@ -784,9 +944,16 @@ int ode_world_obstacle_pos(const ode_world* w, const char* name, double pos[3]) 
     return -1;
 }
 
-int ode_world_hook(ode_world* w, int attach) { return w->kind == WORLD_SANDBOX ? ow_attach(w, attach) : -1; }
+static int hook_ode(ode_world* w, void* arg) { return ow_attach(w, *(const int*)arg); }
+
+int ode_world_hook(ode_world* w, int attach) {
+    if (w->kind != WORLD_SANDBOX || w->dead) return -1;
+    const int rc = ow_trapped(w, "attaching the hook", hook_ode, &attach);
+    return rc == OW_ODE_FAILED ? -1 : rc;
+}
 
 void ode_world_hold_crane(ode_world* w, int hold) {
+    if (w->dead) return;
     hold = hold != 0;
     if (hold == w->held) return;
     w->held = hold;
@@ -813,7 +980,20 @@ void ode_world_hold_crane(ode_world* w, int hold) {
 
 // ---- snapshot ----
 
+static int snapshot_ode(ode_world* w, void* arg);
+
 void ode_world_snapshot(const ode_world* w, world_snapshot* s) {
+    // A dead world is not drawn again: the snapshot keeps the last picture
+    // (the caller's), with the time of the failure.
+    if (w->dead) {
+        s->t = w->t;
+        return;
+    }
+    ow_trapped((ode_world*)w, "drawing the world", snapshot_ode, s);
+}
+
+static int snapshot_ode(ode_world* w, void* arg) {
+    world_snapshot* s = arg;
     memset(s, 0, sizeof *s);
     s->t = w->t;
     int n = 0;
@@ -888,9 +1068,11 @@ void ode_world_snapshot(const ode_world* w, world_snapshot* s) {
         if (w->act[ODE_SLEW].present) cyl_hyd[2] = w->act[ODE_SLEW].cyl;
         world_snap_reliefs(s, w->hm, w->hd->comp_open, cyl_hyd);
     }
+    return 0;
 }
 
 void ode_world_lock_booms(ode_world* w, int lock) {
+    if (w->dead) return;
     dJointID j[2] = {w->j1, w->j2};
     for (int k = 0; k < 2; ++k) {
         // Set hi before lo (or lo before hi) so ODE never sees lo > hi.

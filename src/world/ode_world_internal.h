@@ -82,9 +82,12 @@ struct ode_world {
     double t;            ///< [s]
     long nstep;          ///< ODE steps taken
     int failed;
-    char err[256];
+    int world_built;     ///< ode_world_create finished
+    int dead;            ///< ODE itself failed (ow_trapped): only ode_world_destroy may touch ODE
+    char err[384];
 
     dWorldID world;
+    dThreadingImplementationID threading; ///< the world's own (self-threaded) step jobs, see ow_trapped
     dSpaceID dyn_space;    ///< moving geoms
     dSpaceID static_space; ///< terrain and fixed obstacles
     dJointGroupID contacts;
@@ -95,7 +98,15 @@ struct ode_world {
     dJointID slew_joint, j1, j2, column_fix;
     double qoff[2];      ///< q = hinge angle + qoff [rad]
     double lim[2][2];    ///< stroke-derived hinge stops lo, hi [rad] (+-dInfinity if none)
-    double slew_off;     ///< slew = hinge angle + slew_off [rad]
+    // The slew angle [rad], continuous: ODE's hinge angle wraps at +-pi, so
+    // slew = hinge angle + slew_turns + slew_off, with slew_turns (a multiple
+    // of 2 pi) moved whenever the hinge angle jumps by more than pi between
+    // two reads (ow_read_actuators, every ODE step; a step turns the column
+    // far less than pi).
+    double slew_off;     ///< slew at hinge angle 0 (slew0) [rad]
+    double slew_turns;
+    double slew_raw;     ///< hinge angle at the last read [rad]
+    double slew_lim[2];  ///< the rack's end stops on the continuous hinge angle [rad] (+-dInfinity: none)
     double tau_extra[2]; ///< test torques [N m]
     ow_act act[ODE_NACT];
 
@@ -169,6 +180,10 @@ void ow_mat_vec(const double A[9], const double v[3], double out[3]);
 int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9], dBodyID base,
                    char* err, size_t errsz);
 void ow_read_actuators(ode_world* w);
+/// The slew angle [rad], continuous through +-pi (0 without a slew hinge).
+double ow_slew_angle(const ode_world* w);
+/// Give ODE the slew stops (slew_lim) as hinge angles of the current turn.
+void ow_slew_stops(ode_world* w);
 void ow_apply_forces(ode_world* w);
 
 // ode_sandbox.c

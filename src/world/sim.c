@@ -108,12 +108,12 @@ typedef struct run_ctx {
     double t_end, t_last_row, wall_next;
     long rows;
     int stop;
-    int bad_state; ///< state index found implausible by emit, or -1
-    double bad_value, bad_t;
-    // The deepest dip below absolute zero that stayed above P_IMPLAUSIBLE
-    // (reported as a note): dip_state < 0 while there was none.
-    int dip_state;
-    double dip_value, dip_t;
+    // The run checks (sim_check_value): what failed, its text and time; the
+    // dips below zero.
+    sim_checks chk;
+    double bad_t;
+    char bad[200];
+    bool all_states; ///< emit sees every state (else only the pressures are interpolated)
     // Peak chamber pressures p1A, p1B, p2A, p2B [Pa abs] (lagrange: system
     // state indices pidx), from every step and every row.
     int pidx[4];
@@ -135,43 +135,120 @@ typedef struct run_ctx {
 // (hyd_problem.outside).
 static const double P_IMPLAUSIBLE = -1e5;
 
-// The note for a dip below absolute zero that was not a failure. With an
-// adaptive solver (CVODE has no domain hook: -1.5 kPa on `step` at rtol
-// 5e-3, none at 1e-3) the step is not the user's to shorten.
-static void dip_note(char* note, size_t n, const char* state, double p, double t, bool adaptive) {
-    snprintf(note, n, "%s dipped below absolute zero, to %.3g kPa, at t = %.6g s: %s", state, p * 1e-3, t,
+void sim_checks_init(sim_checks* k) { memset(k, 0, sizeof *k); }
+
+int sim_check_value(sim_checks* k, const char* name, double v, bool pressure, double t, char* msg, size_t n) {
+    // Finite first: +inf passes any lower bound, and the first row of a
+    // model with an absurd value can hold it before any step ran.
+    if (!isfinite(v)) {
+        k->bad_value = v;
+        snprintf(msg, n, "state %s = %s (not a finite number) at t = %.6g s", name,
+                 isnan(v) ? "nan" : v > 0 ? "inf" : "-inf", t);
+        return 1;
+    }
+    if (!pressure) return 0;
+    if (v <= P_IMPLAUSIBLE) {
+        k->bad_value = v;
+        snprintf(msg, n, "state %s = %.4g Pa (more than 0.1 MPa below absolute zero) at t = %.6g s", name, v, t);
+        return 2;
+    }
+    if (v < 0.0 && (!k->dip || v < k->dip_value)) {
+        k->dip = true;
+        snprintf(k->dip_name, sizeof k->dip_name, "%s", name);
+        k->dip_value = v;
+        k->dip_t = t;
+    }
+    return 0;
+}
+
+static bool col_is_pressure(int c) {
+    return c == COL_P1A || c == COL_P1B || c == COL_P2A || c == COL_P2B || c == COL_P_PUMP || c == COL_P3A ||
+           c == COL_P3B;
+}
+
+int sim_check_row(sim_checks* k, const double* row, int ncol, char* msg, size_t n) {
+    for (int c = 0; c < ncol; ++c) {
+        const int rc = sim_check_value(k, sim_col_name[c], row[c], col_is_pressure(c), row[COL_T], msg, n);
+        if (rc) return rc;
+    }
+    return 0;
+}
+
+void sim_checks_note(const sim_checks* k, bool adaptive, char* note, size_t n) {
+    if (!k->dip) {
+        if (n) note[0] = 0;
+        return;
+    }
+    // With an adaptive solver (CVODE has no domain hook: -1.5 kPa on `step`
+    // at rtol 5e-3, none at 1e-3) the step is not the user's to shorten.
+    snprintf(note, n, "%s dipped below absolute zero, to %.3g kPa, at t = %.6g s: %s", k->dip_name,
+             k->dip_value * 1e-3, k->dip_t,
              adaptive ? "the tolerance let the integration overshoot at a stiff event (a smaller --rtol avoids it)"
                       : "the fixed step rings at a stiff event (a smaller --dt or an adaptive solver avoids it)");
 }
 
-// Remember the deepest dip below zero that is not a failure.
-static void note_dip(run_ctx* c, int state, double p, double t) {
-    if (p < 0.0 && (c->dip_state < 0 || p < c->dip_value)) c->dip_state = state, c->dip_value = p, c->dip_t = t;
-}
-
-// What to try after a pressure state's value went implausible at time t
-// (sim.h). A
-// smaller step (or tolerance) is the likely cure only after steps from an
+// A smaller step (or tolerance) is the likely cure only after steps from an
 // admissible state went wrong: not in the initial state (t = 0, no step
 // taken: a bore of 1e300 gave NaN pressures there, and the advice to
-// shorten a step never taken), and not for a value that is no number at
-// all (the per-step check catches a NaN that a step produces, so one here
-// comes from the model's values). With an adaptive solver the steps are
-// its own: the tolerance is the user's lever. (Spools never get here: their
-// lag is linear and every method is stable on it.)
+// shorten a step never taken), and not for a value that is no number at all
+// (the per-step check catches a NaN that a step produces, so one here comes
+// from the model's values). With an adaptive solver the steps are its own:
+// the tolerance is the user's lever.
 const char* sim_blowup_hint(bool adaptive, double t, double value) {
-    if (!(t > 0.0)) return "the initial state is already outside the physical range (no step was taken): check the model's values";
+    if (!(t > 0.0))
+        return "the initial state is already outside the physical range (no step was taken): check the model's values";
     if (!isfinite(value)) return "a component law gave no finite number: check the model's values";
     return adaptive ? "the tolerance is too loose for this transient: try a smaller --rtol"
                     : "the step is too long for this transient: try a smaller --dt or an adaptive solver";
 }
 
-// "= -3.46e+05 Pa (more than 0.1 MPa below absolute zero)", or for a value
-// that is no number "= nan", into buf.
-static const char* bad_value_text(double v, char* buf, size_t n) {
-    if (isfinite(v)) snprintf(buf, n, "= %.4g Pa (more than 0.1 MPa below absolute zero)", v);
-    else snprintf(buf, n, "= %s (not a finite number)", isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf"));
-    return buf;
+int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz) {
+    if (!hm) return 0;
+    double pmax = -1;
+    const char* which = NULL;
+    for (int i = 0; i < hyd_model_ncomp(hm); ++i) {
+        if (hyd_model_comp_type(hm, i) != HYD_RELIEF) continue;
+        char path[160];
+        double crack = 0, over = 0;
+        const char* name = hyd_model_comp_name(hm, i);
+        snprintf(path, sizeof path, "%s.p_crack", name);
+        if (hyd_model_get(hm, path, &crack)) continue;
+        snprintf(path, sizeof path, "%s.dp_override", name);
+        if (hyd_model_get(hm, path, &over)) over = 0;
+        if (crack + over > pmax) pmax = crack + over, which = name;
+    }
+    if (!which) return 0; // no relief: nothing bounds the pressure
+    static const int pcol[6] = {COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_P3A, COL_P3B};
+    for (int j = 0; j < 6; ++j) {
+        const int c = pcol[j];
+        if (c >= ncol || !(row[c] > pmax)) continue;
+        snprintf(err, errsz,
+                 "the start pose needs %s = %.4g MPa to hold the crane still with %g kg at the tip, above the "
+                 "circuit's highest relief setting (%s: %.4g MPa, p_crack + dp_override): the crane cannot hold "
+                 "this load here (a smaller --load or another start pose)",
+                 sim_col_name[c], row[c] * 1e-6, m3, which, pmax * 1e-6);
+        return 2;
+    }
+    return 0;
+}
+
+int sim_check_times(double t_end, double dt_out, char* err, size_t errsz) {
+    if (!(t_end > 0) || t_end > SIM_MAX_DURATION) {
+        snprintf(err, errsz, "--duration: expected a simulated time in s, 0 < T <= 1e6, got %g",
+                 t_end);
+        return 2;
+    }
+    if (!(dt_out > 0) || dt_out > SIM_MAX_DURATION) {
+        snprintf(err, errsz, "--every: expected an output period in s, 0 < DT <= 1e6, got %g",
+                 dt_out);
+        return 2;
+    }
+    if (t_end / dt_out > 1e12) {
+        snprintf(err, errsz, "--every %g s over %g s is %.3g rows, more than 1e12: use a larger --every", dt_out,
+                 t_end, t_end / dt_out);
+        return 2;
+    }
+    return 0;
 }
 
 // A step to suggest below a stability limit lim [s]: the largest of
@@ -238,20 +315,31 @@ static void on_step(void* user, double t, const double* y) {
     track_peaks(user, y);
 }
 
+static const char* state_name(const lsim* ls, int i, char* buf, size_t n);
+
+// A failed run check: remember what and when, and stop the integration.
+static int check_failed(run_ctx* c, double t) {
+    c->bad_t = t;
+    return (c->stop = 3);
+}
+
 static int emit(void* user, double t, const double* y) {
     run_ctx* c = user;
     track_peaks(c, y);
     // Segments share their end points: write each output time once.
     if (c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out) return 0;
-    for (int k = 0; k < c->npress; ++k) {
-        const int i = c->press[k];
-        if (!(y[i] > P_IMPLAUSIBLE)) {
-            c->bad_state = i;
-            c->bad_value = y[i];
-            c->bad_t = t;
-            return (c->stop = 3);
-        }
-        note_dip(c, i, y[i], t);
+    char nb[96];
+    // Every state (when the solver interpolated them all), the pressures as
+    // pressures; benchmarks see only the pressure states.
+    for (int i = 0; i < c->ls->n; ++i) {
+        const bool p = i < c->ls->nh && c->ls->is_pressure[i];
+        if (!p && !c->all_states) continue;
+        // The common case first, without naming the state (this runs at
+        // every output time, also in benchmarks).
+        if (isfinite(y[i]) && (!p || y[i] >= 0.0)) continue;
+        const int rc = sim_check_value(&c->chk, state_name(c->ls, i, nb, sizeof nb), y[i], p, t, c->bad,
+                                       sizeof c->bad);
+        if (rc) return check_failed(c, t);
     }
     c->t_last_row = t;
     ++c->rows;
@@ -263,6 +351,13 @@ static int emit(void* user, double t, const double* y) {
         t, o.x[0], o.x[1], o.pA[0], o.pB[0], o.pA[1], o.pB[1], o.u[0], o.u[1], o.q[0], o.q[1],
         o.tip[0], o.tip[1], o.F[0], o.F[1], o.u_cmd[0], o.u_cmd[1],
         o.v[0], o.v[1], o.p_pump, o.relief_open, o.end_stop};
+    // The derived columns too (a force or a tip position can overflow while
+    // the states are finite).
+    const int rc = sim_check_row(&c->chk, row, SIM_NCOL_BASE, c->bad, sizeof c->bad);
+    if (rc) {
+        --c->rows;
+        return check_failed(c, t);
+    }
     return deliver(c, row);
 }
 
@@ -370,7 +465,6 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     if (!w) return res->status = 2;
     res->fused = ode_world_fused(w);
     const long ode_msgs = ode_world_messages(NULL);
-    const bool slew = ode_world_kind(w) == WORLD_SANDBOX;
     const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
     if (check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res)) {
         ode_world_destroy(w);
@@ -378,14 +472,39 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     }
 
     const double dt = ode_world_dt(w);
+    // Counted in longs: refused before a conversion could overflow (the
+    // output period is at most the run, sim_check_times).
+    if (c->t_end / dt > 1e12) {
+        snprintf(res->message, sizeof res->message,
+                 "--dt-ode %g s over %g s is %.3g steps, more than 1e12: use a larger --dt-ode or a shorter run", dt,
+                 c->t_end, c->t_end / dt);
+        ode_world_destroy(w);
+        return res->status = 2;
+    }
     const long nstep = (long)floor(c->t_end / dt + 0.5);
-    long nout = (long)floor(o->dt_out / dt + 0.5);
+    long nout = (long)floor(fmin(o->dt_out, c->t_end) / dt + 0.5);
     if (nout < 1) nout = 1;
     double row[SIM_NCOL];
     int ev = 0;
     double w0 = sim_wall_time();
     sim_ode_row(w, row);
     for (int k = 0; k < 4; ++k) res->p_peak[k] = row[COL_P1A + k];
+    {
+        // The start state too: a model value that overflows shows at t = 0.
+        char what[200];
+        const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
+        if (rc) {
+            snprintf(res->message, sizeof res->message, "%s: %s", what,
+                     sim_blowup_hint(hyd_method_is_adaptive(o->solver), 0.0, c->chk.bad_value));
+            ode_world_destroy(w);
+            return res->status = 2;
+        }
+        if (sim_check_start(ode_world_circuit(w), row, SIM_NCOL, sim_load_mass(m, sc, o), res->message,
+                            sizeof res->message)) {
+            ode_world_destroy(w);
+            return res->status = 2;
+        }
+    }
     deliver(c, row);
     ++c->rows;
     for (long i = 0; i < nstep && !c->stop; ++i) {
@@ -414,18 +533,14 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
         if ((i + 1) % nout && i + 1 != nstep) continue;
         sim_ode_row(w, row);
         row[COL_T] = (double)(i + 1) * dt; // exact grid times, no accumulated round-off
-        // The boom chambers, and the slew's where the world has one.
-        static const int pcol[6] = {COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_P3A, COL_P3B};
-        for (int j = 0; j < (slew ? 6 : 4); ++j) {
-            const int k = pcol[j];
-            note_dip(c, k, row[k], row[COL_T]);
-            if (!(row[k] > P_IMPLAUSIBLE)) {
+        {
+            char what[200];
+            const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
+            if (rc) {
                 res->status = 1;
-                char vb[64];
-                snprintf(res->message, sizeof res->message,
-                         "numerical blow-up: state %s %s at t = %.6g s (solver %s, h = %g s, ODE step %g s): %s",
-                         sim_col_name[k], bad_value_text(row[k], vb, sizeof vb), row[COL_T], hyd_method_name(o->solver),
-                         o->h < dt ? o->h : dt, dt, sim_blowup_hint(hyd_method_is_adaptive(o->solver), row[COL_T], row[k]));
+                snprintf(res->message, sizeof res->message, "numerical blow-up: %s (solver %s, h = %g s, ODE step %g s): %s",
+                         what, hyd_method_name(o->solver), o->h < dt ? o->h : dt, dt,
+                         sim_blowup_hint(hyd_method_is_adaptive(o->solver), row[COL_T], c->chk.bad_value));
             }
         }
         if (res->status) break;
@@ -442,9 +557,8 @@ static int run_ode(const model* m, const scenario* sc, const sim_opts* o, run_ct
     res->peak_steps = true;
     const char* last;
     const long msgs = ode_world_messages(&last) - ode_msgs;
-    if (!res->status && c->dip_state >= 0)
-        dip_note(res->note, sizeof res->note, sim_col_name[c->dip_state], c->dip_value, c->dip_t,
-                 hyd_method_is_adaptive(o->solver));
+    if (!res->status && c->chk.dip)
+        sim_checks_note(&c->chk, hyd_method_is_adaptive(o->solver), res->note, sizeof res->note);
     else if (msgs > 0)
         snprintf(res->note, sizeof res->note,
                  "ODE reported %ld solver message%s during the run (last: %.120s): a degenerate contact set, which "
@@ -463,9 +577,12 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     if (o->mechanics == SIM_ODE) {
         run_ctx c = {.o = o, .row_fn = row_fn, .row_user = row_user, .trace = trace, .progress = progress,
                      .progress_user = progress_user, .t_end = o->duration > 0 ? o->duration : sc->duration,
-                     .bad_state = -1, .dip_state = -1};
+                     .all_states = true};
+        if (sim_check_times(c.t_end, o->dt_out, res->message, sizeof res->message)) return res->status = 2;
         return run_ode(m, sc, o, &c, res);
     }
+    if (sim_check_times(o->duration > 0 ? o->duration : sc->duration, o->dt_out, res->message, sizeof res->message))
+        return res->status = 2;
     lsim ls;
     double m3 = sim_load_mass(m, sc, o);
     if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = 2;
@@ -481,6 +598,16 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
         return res->status = 2;
     }
     lsim_initial_state(&ls, sc->q0, 0.5e6, y);
+    {
+        lsim_out lo;
+        lsim_outputs(&ls, 0.0, y, &lo);
+        const double row0[SIM_NCOL_BASE] = {[COL_P1A] = lo.pA[0], [COL_P1B] = lo.pB[0], [COL_P2A] = lo.pA[1],
+                                            [COL_P2B] = lo.pB[1]};
+        if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, m3, res->message, sizeof res->message)) {
+            lsim_free(&ls);
+            return res->status = 2;
+        }
+    }
 
     const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
 #ifndef CRANESIM_HAVE_CVODE
@@ -536,8 +663,8 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     if (oo.dt_out > t_end && t_end > 0) oo.dt_out = t_end;
     o = &oo;
     c = (run_ctx){.ls = &ls, .o = o, .row_fn = row_fn, .row_user = row_user, .trace = trace,
-                  .progress = progress, .progress_user = progress_user, .t_end = t_end, .bad_state = -1,
-                  .dip_state = -1,
+                  .progress = progress, .progress_user = progress_user, .t_end = t_end,
+                  .all_states = so.out_states == NULL,
                   .pidx = {ls.ip[0][0], ls.ip[0][1], ls.ip[1][0], ls.ip[1][1]}};
     memcpy(c.press, press, sizeof press);
     c.npress = npress;
@@ -580,16 +707,21 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     res->t_end = c.t_last_row;
     char nb[96];
     if (c.stop == 3) {
-        res->status = 1;
+        // A failed check at t = 0 is the model's start state (no step ran):
+        // refused like bad input, nothing written.
+        res->status = c.bad_t > 0 ? 1 : 2;
         // The step for fixed-step methods, the last step tried for ours, the
         // tolerance for CVODE (whose steps are its own).
         char how[48];
         if (o->cvode) snprintf(how, sizeof how, "rtol %g", o->rtol);
         else snprintf(how, sizeof how, "h = %g s", adaptive && s ? hyd_solver_last_h(s) : o->h);
-        char vb[64];
-        snprintf(res->message, sizeof res->message, "numerical blow-up: state %s %s at t = %.6g s (solver %s, %s): %s",
-                 state_name(&ls, c.bad_state, nb, sizeof nb), bad_value_text(c.bad_value, vb, sizeof vb), c.bad_t,
-                 o->cvode ? "cvode" : hyd_method_name(o->solver), how, sim_blowup_hint(adaptive, c.bad_t, c.bad_value));
+        if (res->status == 2)
+            snprintf(res->message, sizeof res->message, "%s: %s", c.bad,
+                     sim_blowup_hint(adaptive, 0.0, c.chk.bad_value));
+        else
+            snprintf(res->message, sizeof res->message, "numerical blow-up: %s (solver %s, %s): %s", c.bad,
+                     o->cvode ? "cvode" : hyd_method_name(o->solver), how,
+                     sim_blowup_hint(adaptive, c.bad_t, c.chk.bad_value));
     } else if (c.stop) {
         res->status = 2;
         snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c.t_last_row);
@@ -613,9 +745,7 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
     }
     memcpy(res->p_peak, c.peak, sizeof res->p_peak);
     res->peak_steps = !o->cvode && (trace || row_fn);
-    if (!res->status && c.dip_state >= 0)
-        dip_note(res->note, sizeof res->note, state_name(&ls, c.dip_state, nb, sizeof nb), c.dip_value, c.dip_t,
-                 adaptive);
+    if (!res->status) sim_checks_note(&c.chk, adaptive, res->note, sizeof res->note);
     hyd_solver_destroy(s);
     lsim_free(&ls);
     return res->status;

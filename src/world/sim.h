@@ -52,6 +52,57 @@ int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, doubl
 /// value; a smaller --rtol for adaptive runs; else a check of the model.
 const char* sim_blowup_hint(bool adaptive, double t, double value);
 
+/// Longest simulated time and output period a run accepts [s]: 1e6 s (11.6
+/// days). Beyond, a step or row count no longer fits the integers that count
+/// them, and no run of a crane needs more.
+#define SIM_MAX_DURATION 1e6
+/// Refuse a run's duration t_end [s] or output period dt_out [s] outside
+/// (0, SIM_MAX_DURATION], or more than 1e12 rows. Returns 0, or 2 with one
+/// line in err naming the option (--duration, --every), the range and the unit.
+int sim_check_times(double t_end, double dt_out, char* err, size_t errsz);
+
+/// The checks every driver (run, compare, bench, study, drive) applies to the
+/// state it records, so no driver lets through what another refuses: every
+/// value finite, no absolute pressure more than 0.1 MPa below zero
+/// (decision 6). A shallower dip below zero is remembered for a note.
+typedef struct sim_checks {
+    bool dip;            ///< a dip below absolute zero was seen
+    char dip_name[96];   ///< its state or column
+    double dip_value;    ///< deepest value [Pa abs]
+    double dip_t;        ///< when [s]
+    double bad_value;    ///< the value of the last failed check (for sim_blowup_hint)
+} sim_checks;
+void sim_checks_init(sim_checks* k);
+/// Check one value v of the state named name at time t [s]; pressure: an
+/// absolute pressure [Pa]. Returns 0, 1 when v is not finite, 2 when it is a
+/// pressure more than 0.1 MPa below absolute zero; then msg holds
+/// "state NAME = VALUE ... at t = T s" (the caller adds the solver and
+/// sim_blowup_hint(adaptive, t, k->bad_value)).
+int sim_check_value(sim_checks* k, const char* name, double v, bool pressure, double t, char* msg, size_t n);
+/// sim_check_value on every column of a CSV row of ncol columns (the
+/// chamber and pump pressures as pressures).
+int sim_check_row(sim_checks* k, const double* row, int ncol, char* msg, size_t n);
+/// The note for the deepest dip below absolute zero, or "" when there was
+/// none; adaptive: the run's steps were the solver's (the advice is then a
+/// smaller --rtol, not --dt).
+void sim_checks_note(const sim_checks* k, bool adaptive, char* note, size_t n);
+/// The advice of a failed check: a value [Pa abs, or any state's] found
+/// implausible at time t [s] of a run with an adaptive (or CVODE) or a
+/// fixed-step solver. "Try a smaller --dt" only where a shorter step is the
+/// likely cure: a fixed step, after steps were taken (t > 0), from a finite
+/// value; a smaller --rtol for adaptive runs; else a check of the model.
+const char* sim_blowup_hint(bool adaptive, double t, double value);
+
+/// Refuse a start state the circuit cannot hold: a chamber pressure of row
+/// (the CSV row at t = 0: p1A..p2B, and p3A, p3B when ncol has them) above
+/// the highest relief setting of circuit hm (p_crack + dp_override). The
+/// static start (decision 5) gives each chamber the pressure that holds the
+/// crane still; with a load too heavy for the pose that is more than any
+/// relief lets the circuit reach (100 t at the tip: 459 MPa), a state the
+/// reliefs cannot cap because it is set, not integrated. m3: the tip load
+/// [kg], for the message. Returns 0, or 2 with one line in err.
+int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz);
+
 /// True when this build has the CVODE reference solver.
 bool sim_have_cvode(void);
 
@@ -60,7 +111,8 @@ double sim_load_mass(const model* m, const scenario* sc, const sim_opts* o);
 
 sim_opts sim_default_opts(void);
 
-/// CSV columns, in order. The first 17 are the SPEC section 5 contract.
+/// CSV columns, in order. The first 17 are the columns every backend has
+/// written from the start (README, "The CSV columns"): their order is fixed.
 enum {
     COL_T, COL_X1, COL_X2, COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_U1, COL_U2, COL_Q1, COL_Q2,
     COL_TIP_X, COL_TIP_Z, COL_F1, COL_F2, COL_U1_CMD, COL_U2_CMD,
