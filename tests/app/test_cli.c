@@ -1,47 +1,31 @@
 // test_cli.c: the cranesim command line as a user meets it: exit codes, one-line
 // errors naming file and field, CSV contract, no lost output on a blow-up.
 #include "check.h"
+#include "cli_util.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
 
-#define BIN CRANESIM_BINARY_DIR "/cranesim"
 #define DATA CRANESIM_TESTDATA
 
-// Run cranesim with args (stderr merged into out). Returns the exit code.
-static int run(const char* args, char* out, size_t n) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", BIN, args);
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t got = fread(out, 1, n - 1, p);
-    out[got] = 0;
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
-static int count_lines(const char* s) {
-    int n = 0;
-    for (; *s; ++s) n += *s == '\n';
-    return n;
-}
 
 static void test_help_and_usage(void) {
     static char out[16384];
-    CHECK(run("help", out, sizeof out) == 0, "help: %s", out);
+    CHECK(cli_run("help", out, sizeof out) == 0, "help: %s", out);
     CHECK(strstr(out, "drive") && strstr(out, "run") && strstr(out, "compare") && strstr(out, "bench"), "%s", out);
     const char* const cmds[] = {"run", "bench", "compare", "drive"};
     for (int i = 0; i < 4; ++i) {
         char a[64];
         snprintf(a, sizeof a, "%s --help", cmds[i]);
-        CHECK(run(a, out, sizeof out) == 0 && strstr(out, "usage: cranesim"), "%s: %s", a, out);
+        CHECK(cli_run(a, out, sizeof out) == 0 && strstr(out, "usage: cranesim"), "%s: %s", a, out);
     }
-    CHECK(run("", out, sizeof out) == 2, "no command should exit 2");
-    CHECK(run("fly", out, sizeof out) == 2 && strstr(out, "unknown command"), "%s", out);
-    CHECK(run("run --bogus", out, sizeof out) == 2 && strstr(out, "--bogus"), "%s", out);
-    CHECK(run("run --dt -1", out, sizeof out) == 2 && strstr(out, "--dt"), "%s", out);
-    CHECK(run("run --solver euler", out, sizeof out) == 2 && strstr(out, "euler"), "%s", out);
+    CHECK(cli_run("", out, sizeof out) == 2, "no command should exit 2");
+    CHECK(cli_run("fly", out, sizeof out) == 2 && strstr(out, "unknown command"), "%s", out);
+    CHECK(cli_run("run --bogus", out, sizeof out) == 2 && strstr(out, "--bogus"), "%s", out);
+    CHECK(cli_run("run --dt -1", out, sizeof out) == 2 && strstr(out, "--dt"), "%s", out);
+    CHECK(cli_run("run --solver euler", out, sizeof out) == 2 && strstr(out, "euler"), "%s", out);
 }
 
 typedef struct bad_case {
@@ -75,12 +59,12 @@ static void test_bad_models(void) {
         char a[1024];
         snprintf(a, sizeof a, "run --quiet --model %s/%s --scenario hold --duration 0.01 --out /dev/null", DATA,
                  cases[i].file);
-        int rc = run(a, out, sizeof out);
+        int rc = cli_run(a, out, sizeof out);
         CHECK(rc == 2, "%s: exit %d, want 2: %s", cases[i].file, rc, out);
         CHECK(strstr(out, cases[i].file) != NULL, "%s: message does not name the file: %s", cases[i].file, out);
         CHECK(strstr(out, cases[i].field) != NULL, "%s: message does not name %s: %s", cases[i].file,
               cases[i].field, out);
-        CHECK(count_lines(out) == 1, "%s: want one line, got: %s", cases[i].file, out);
+        CHECK(cli_count_lines(out) == 1, "%s: want one line, got: %s", cases[i].file, out);
     }
 }
 
@@ -96,11 +80,11 @@ static void test_bad_scenarios(void) {
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char a[1024];
         snprintf(a, sizeof a, "run --quiet --scenario %s/%s --out /dev/null", DATA, cases[i].file);
-        int rc = run(a, out, sizeof out);
+        int rc = cli_run(a, out, sizeof out);
         CHECK(rc == 2, "%s: exit %d, want 2: %s", cases[i].file, rc, out);
         CHECK(strstr(out, cases[i].file) && strstr(out, cases[i].field), "%s: want file and %s in: %s",
               cases[i].file, cases[i].field, out);
-        CHECK(count_lines(out) == 1, "%s: want one line: %s", cases[i].file, out);
+        CHECK(cli_count_lines(out) == 1, "%s: want one line: %s", cases[i].file, out);
     }
 }
 
@@ -112,8 +96,8 @@ static void test_bad_set(void) {
     for (int i = 0; i < 4; ++i) {
         char a[512];
         snprintf(a, sizeof a, "run --quiet --scenario hold --duration 0.01 --out /dev/null --set %s", bad[i]);
-        int rc = run(a, out, sizeof out);
-        CHECK(rc == 2 && strstr(out, want[i]) && count_lines(out) == 1, "--set %s: exit %d: %s", bad[i], rc, out);
+        int rc = cli_run(a, out, sizeof out);
+        CHECK(rc == 2 && strstr(out, want[i]) && cli_count_lines(out) == 1, "--set %s: exit %d: %s", bad[i], rc, out);
     }
     // Trailing junk after the value and malformed paths are errors that quote
     // the whole --set argument (each of these used to run with gravity 5 or 1).
@@ -127,48 +111,40 @@ static void test_bad_set(void) {
         char a[512], quoted[128];
         snprintf(a, sizeof a, "run --quiet --scenario hold --duration 0.01 --out /dev/null --set '%s'", junk[i]);
         snprintf(quoted, sizeof quoted, "--set '%s'", junk[i]);
-        int rc = run(a, out, sizeof out);
-        CHECK(rc == 2 && strstr(out, quoted) && count_lines(out) == 1, "--set '%s': exit %d, want 2 naming it: %s",
+        int rc = cli_run(a, out, sizeof out);
+        CHECK(rc == 2 && strstr(out, quoted) && cli_count_lines(out) == 1, "--set '%s': exit %d, want 2 naming it: %s",
               junk[i], rc, out);
     }
     // A range error found by the loader says which --set caused it.
-    CHECK(run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set hydraulics.components.lift_cyl.bore=-0.1",
+    CHECK(cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set hydraulics.components.lift_cyl.bore=-0.1",
               out, sizeof out) == 2 &&
               strstr(out, "components[5].bore") && strstr(out, "--set 'hydraulics.components.lift_cyl.bore=-0.1'"),
           "range error should name the --set: %s", out);
     // Well-formed paths still work: a named array element, an index.
-    CHECK(run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links.end_arm.mass=150 "
+    CHECK(cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links.end_arm.mass=150 "
               "--set 'mechanics.links[0].mass=200' --set mechanics.gravity=9.8",
               out, sizeof out) == 0,
           "good paths: %s", out);
     // A good --set takes effect: a heavier load needs more lift pressure.
     char a[512];
     snprintf(a, sizeof a, "run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.load_mass=800");
-    CHECK(run(a, out, sizeof out) == 0, "good --set failed: %s", out);
+    CHECK(cli_run(a, out, sizeof out) == 0, "good --set failed: %s", out);
 }
 
-static int read_file(const char* path, char* buf, size_t n) {
-    FILE* f = fopen(path, "r");
-    if (!f) return -1;
-    size_t got = fread(buf, 1, n - 1, f);
-    buf[got] = 0;
-    fclose(f);
-    return (int)got;
-}
 
 static void test_csv_contract(void) {
     static char out[8192];
     static char csv[1 << 16];
-    CHECK(run("run --quiet --scenario ramp --duration 0.05 --out cli_ramp.csv", out, sizeof out) == 0, "%s", out);
-    CHECK(read_file("cli_ramp.csv", csv, sizeof csv) > 0, "no csv");
+    CHECK(cli_run("run --quiet --scenario ramp --duration 0.05 --out cli_ramp.csv", out, sizeof out) == 0, "%s", out);
+    CHECK(cli_read_file("cli_ramp.csv", csv, sizeof csv) > 0, "no csv");
     const char* contract = "t,x1,x2,p1A,p1B,p2A,p2B,u1,u2,q1,q2,tip_x,tip_z,F1,F2,u1_cmd,u2_cmd";
     CHECK(strncmp(csv, contract, strlen(contract)) == 0, "header: %.120s", csv);
-    CHECK(count_lines(csv) == 1 + 51, "want header + 51 rows at 1 kHz over 0.05 s, got %d lines", count_lines(csv));
+    CHECK(cli_count_lines(csv) == 1 + 51, "want header + 51 rows at 1 kHz over 0.05 s, got %d lines", cli_count_lines(csv));
     // --every sets the output period.
-    CHECK(run("run --quiet --scenario ramp --duration 0.05 --every 0.01 --out cli_ramp10.csv", out, sizeof out) == 0,
+    CHECK(cli_run("run --quiet --scenario ramp --duration 0.05 --every 0.01 --out cli_ramp10.csv", out, sizeof out) == 0,
           "%s", out);
-    read_file("cli_ramp10.csv", csv, sizeof csv);
-    CHECK(count_lines(csv) == 1 + 6, "want 6 rows at 100 Hz, got %d", count_lines(csv) - 1);
+    cli_read_file("cli_ramp10.csv", csv, sizeof csv);
+    CHECK(cli_count_lines(csv) == 1 + 6, "want 6 rows at 100 Hz, got %d", cli_count_lines(csv) - 1);
 }
 
 // Krus (A-stable, R(-inf) = -1) at 80 times its step rings on the valve
@@ -181,12 +157,12 @@ static void test_csv_contract(void) {
 static void test_blow_up_keeps_output(void) {
     static char out[8192];
     static char csv[1 << 20];
-    int rc = run("run --quiet --scenario step --solver krus --dt 8e-3 --out cli_blowup.csv", out, sizeof out);
+    int rc = cli_run("run --quiet --scenario step --solver krus --dt 8e-3 --out cli_blowup.csv", out, sizeof out);
     CHECK(rc == 1, "exit %d, want 1: %s", rc, out);
     CHECK(strstr(out, "state ") && strstr(out, "t = "), "message should name state and time: %s", out);
     CHECK(strstr(out, "kept in cli_blowup.csv"), "message should say where the rows are: %s", out);
-    int n = read_file("cli_blowup.csv", csv, sizeof csv);
-    CHECK(n > 0 && count_lines(csv) >= 2, "rows lost: %d lines", count_lines(csv));
+    int n = cli_read_file("cli_blowup.csv", csv, sizeof csv);
+    CHECK(n > 0 && cli_count_lines(csv) >= 2, "rows lost: %d lines", cli_count_lines(csv));
     CHECK(strstr(csv, "nan") == NULL && strstr(csv, "inf") == NULL, "non-finite values written");
 }
 
@@ -211,11 +187,11 @@ static int files_equal(const char* a, const char* b) {
 static void test_rk4_refused(void) {
     static char out[8192];
     remove("cli_rk4.csv");
-    int rc = run("run --quiet --scenario step --solver rk4 --duration 0.2 --out cli_rk4.csv", out, sizeof out);
+    int rc = cli_run("run --quiet --scenario step --solver rk4 --duration 0.2 --out cli_rk4.csv", out, sizeof out);
     CHECK(rc == 2, "exit %d, want 2: %s", rc, out);
-    CHECK(strstr(out, "rk4 is unstable at h = 0.0001 s") && strstr(out, "needs h <") && count_lines(out) == 1,
+    CHECK(strstr(out, "rk4 is unstable at h = 0.0001 s") && strstr(out, "needs h <") && cli_count_lines(out) == 1,
           "message: %s", out);
-    rc = run("run --quiet --scenario step --solver rk4 --dt 1e-5 --duration 0.2 --out cli_rk4.csv", out, sizeof out);
+    rc = cli_run("run --quiet --scenario step --solver rk4 --dt 1e-5 --duration 0.2 --out cli_rk4.csv", out, sizeof out);
     CHECK(rc == 0, "rk4 at 10 us: exit %d: %s", rc, out);
     remove("cli_rk4.csv");
 }
@@ -225,12 +201,12 @@ static void test_ode_runs_are_deterministic(void) {
     const char* args = "run --quiet --mechanics ode --world sandbox --scenario sandbox_pick_place --duration 6";
     char a[512];
     snprintf(a, sizeof a, "%s --out cli_det1.csv", args);
-    CHECK(run(a, out, sizeof out) == 0, "%s", out);
+    CHECK(cli_run(a, out, sizeof out) == 0, "%s", out);
     snprintf(a, sizeof a, "%s --out cli_det2.csv", args);
-    CHECK(run(a, out, sizeof out) == 0, "%s", out);
+    CHECK(cli_run(a, out, sizeof out) == 0, "%s", out);
     CHECK(files_equal("cli_det1.csv", "cli_det2.csv"), "two identical runs wrote different CSV");
     static char csv[4096];
-    read_file("cli_det1.csv", csv, sizeof csv);
+    cli_read_file("cli_det1.csv", csv, sizeof csv);
     CHECK(strstr(csv, ",hook_x,hook_y,hook_z,") && strstr(csv, "truck_tilt"), "ode extras missing: %.300s", csv);
 }
 
@@ -239,39 +215,39 @@ static void test_ode_runs_are_deterministic(void) {
 // A pose with no room at all is bad input: one line naming the pose, exit 2.
 static void test_sandbox_start_poses(void) {
     static char out[8192];
-    CHECK(run("run --quiet --mechanics ode --world sandbox --scenario ramp --duration 1 --out /dev/null", out,
+    CHECK(cli_run("run --quiet --mechanics ode --world sandbox --scenario ramp --duration 1 --out /dev/null", out,
               sizeof out) == 0,
           "ramp on the sandbox: %s", out);
     // With --quiet only the note that ramp's 500 kg tip load does not apply
     // to the sandbox (decision 29); no failure, no other line.
-    CHECK(count_lines(out) == 1 && strstr(out, "note: scenario ramp's load_mass (500 kg) has no effect"),
+    CHECK(cli_count_lines(out) == 1 && strstr(out, "note: scenario ramp's load_mass (500 kg) has no effect"),
           "with --quiet: %s", out);
     char a[1024];
     snprintf(a, sizeof a, "run --quiet --mechanics ode --world sandbox --scenario %s/scn_tip_low.json --out /dev/null",
              DATA);
-    CHECK(run(a, out, sizeof out) == 2, "want exit 2: %s", out);
-    CHECK(strstr(out, "q1 = 80.0 deg, q2 = -110.0 deg leaves no room for the rope") && count_lines(out) == 1,
+    CHECK(cli_run(a, out, sizeof out) == 2, "want exit 2: %s", out);
+    CHECK(strstr(out, "q1 = 80.0 deg, q2 = -110.0 deg leaves no room for the rope") && cli_count_lines(out) == 1,
           "want one line naming the pose: %s", out);
 }
 
 static void test_bad_world_and_compare_tolerance(void) {
     static char out[8192];
-    int rc = run("run --quiet --mechanics ode --world " DATA "/missing_world.json --scenario ramp --out /dev/null", out,
+    int rc = cli_run("run --quiet --mechanics ode --world " DATA "/missing_world.json --scenario ramp --out /dev/null", out,
                  sizeof out);
-    CHECK(rc == 2 && strstr(out, "missing_world.json") && count_lines(out) == 1, "exit %d: %s", rc, out);
-    rc = run("run --quiet --mechanics ode --scenario ramp --solver cvode --out /dev/null", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "missing_world.json") && cli_count_lines(out) == 1, "exit %d: %s", rc, out);
+    rc = cli_run("run --quiet --mechanics ode --scenario ramp --solver cvode --out /dev/null", out, sizeof out);
     CHECK(rc == 2 && strstr(out, "ode"), "cvode in ode mode: exit %d: %s", rc, out);
     // compare fails (exit 1) when a difference exceeds the given tolerance.
-    rc = run("compare --quiet --scenario hold --duration 1 --solvers krus,ros2 --dts 1e-4,1e-3 --tol-pressure 1e-9",
+    rc = cli_run("compare --quiet --scenario hold --duration 1 --solvers krus,ros2 --dts 1e-4,1e-3 --tol-pressure 1e-9",
              out, sizeof out);
     CHECK(rc == 1 && strstr(out, "FAIL"), "compare beyond tolerance: exit %d: %s", rc, out);
     // --solvers overrides a common --solver cvode on both sides (both ran
     // CVODE, labelled krus and ros2, and agreed).
-    rc = run("compare --quiet --scenario hold --duration 1 --solver cvode --solvers krus,ros2 --dts 1e-4,1e-3 "
+    rc = cli_run("compare --quiet --scenario hold --duration 1 --solver cvode --solvers krus,ros2 --dts 1e-4,1e-3 "
              "--tol-pressure 1e-9",
              out, sizeof out);
     CHECK(rc == 1 && strstr(out, "FAIL"), "--solvers after --solver cvode: exit %d: %s", rc, out);
-    rc = run("compare --quiet --scenario ramp --duration 4 --tol-stroke 0.5 --tol-pressure 1", out, sizeof out);
+    rc = cli_run("compare --quiet --scenario ramp --duration 4 --tol-stroke 0.5 --tol-pressure 1", out, sizeof out);
     CHECK(rc == 0 && strstr(out, "x1") && strstr(out, "p2B"), "lagrange vs ode within tolerance: exit %d: %s", rc,
           out);
 }
@@ -290,17 +266,17 @@ static void test_help_topics(void) {
         char a[64], want[64];
         snprintf(a, sizeof a, "help %s", cmds[i]);
         snprintf(want, sizeof want, "usage: cranesim %s", cmds[i]);
-        CHECK(run(a, out, sizeof out) == 0 && strstr(out, want), "%s: %.200s", a, out);
+        CHECK(cli_run(a, out, sizeof out) == 0 && strstr(out, want), "%s: %.200s", a, out);
     }
-    CHECK(run("help fly", out, sizeof out) == 2 && strstr(out, "fly"), "help fly: %s", out);
+    CHECK(cli_run("help fly", out, sizeof out) == 2 && strstr(out, "fly"), "help fly: %s", out);
     // The top-level example used to set a load the scenario overrides.
-    CHECK(run("help", out, sizeof out) == 0 && !strstr(out, "--set mechanics.load_mass") && strstr(out, "--load"),
+    CHECK(cli_run("help", out, sizeof out) == 0 && !strstr(out, "--set mechanics.load_mass") && strstr(out, "--load"),
           "help examples: %s", out);
     // cvode is a solver, for lagrange only.
-    CHECK(run("run --help", out, sizeof out) == 0 && strstr(out, "cvode (SUNDIALS BDF; --mechanics lagrange only)"),
+    CHECK(cli_run("run --help", out, sizeof out) == 0 && strstr(out, "cvode (SUNDIALS BDF; --mechanics lagrange only)"),
           "run --help: %s", out);
     // study lists each option once and none it cannot use.
-    CHECK(run("study --help", out, sizeof out) == 0, "study --help: %s", out);
+    CHECK(cli_run("study --help", out, sizeof out) == 0, "study --help: %s", out);
     int nscen = 0;
     for (const char* p = out; (p = strstr(p, "\n  --scenario")); ++p) ++nscen;
     CHECK(nscen == 1, "study --help lists --scenario %d times: %s", nscen, out);
@@ -321,11 +297,11 @@ static void test_missing_values(void) {
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char want[64];
         snprintf(want, sizeof want, "option %s needs a value", cases[i][1]);
-        int rc = run(cases[i][0], out, sizeof out);
-        CHECK(rc == 2 && strstr(out, want) && count_lines(out) == 1, "%s: exit %d: %s", cases[i][0], rc, out);
+        int rc = cli_run(cases[i][0], out, sizeof out);
+        CHECK(rc == 2 && strstr(out, want) && cli_count_lines(out) == 1, "%s: exit %d: %s", cases[i][0], rc, out);
     }
     remove("--quiet");
-    int rc = run("run --scenario hold --duration 0.01 --out --quiet", out, sizeof out);
+    int rc = cli_run("run --scenario hold --duration 0.01 --out --quiet", out, sizeof out);
     CHECK(rc == 2 && strstr(out, "option --out needs a value"), "--out --quiet: exit %d: %s", rc, out);
     CHECK(!exists("--quiet"), "a file named --quiet was created");
     remove("--quiet");
@@ -341,10 +317,10 @@ static void test_strict_numbers(void) {
         char a[256], opt[32];
         snprintf(a, sizeof a, "run --quiet --scenario hold --duration 0.01 --out /dev/null %s", bad[i]);
         snprintf(opt, sizeof opt, "%.*s", (int)strcspn(bad[i], " "), bad[i]);
-        int rc = run(a, out, sizeof out);
-        CHECK(rc == 2 && strstr(out, opt) && count_lines(out) == 1, "%s: exit %d: %s", bad[i], rc, out);
+        int rc = cli_run(a, out, sizeof out);
+        CHECK(rc == 2 && strstr(out, opt) && cli_count_lines(out) == 1, "%s: exit %d: %s", bad[i], rc, out);
     }
-    CHECK(run("run --quiet --scenario hold --duration 0.01 --out /dev/null --jac-every 1000000 --dt 1e-4", out,
+    CHECK(cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null --jac-every 1000000 --dt 1e-4", out,
               sizeof out) == 0,
           "--jac-every 1000000: %s", out);
 }
@@ -353,14 +329,14 @@ static void test_strict_numbers(void) {
 static void test_rejected_run_writes_nothing(void) {
     static char out[8192];
     remove("cli_rej.csv");
-    int rc = run("run --quiet --mechanics ode --solver cvode --out cli_rej.csv", out, sizeof out);
-    CHECK(rc == 2 && strstr(out, "cvode") && count_lines(out) == 1, "ode + cvode: exit %d: %s", rc, out);
+    int rc = cli_run("run --quiet --mechanics ode --solver cvode --out cli_rej.csv", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "cvode") && cli_count_lines(out) == 1, "ode + cvode: exit %d: %s", rc, out);
     CHECK(!exists("cli_rej.csv"), "ode + cvode left cli_rej.csv behind");
     // Refused inside the run's setup (the sandbox has no room for the rope).
     char a[1024];
     snprintf(a, sizeof a, "run --quiet --mechanics ode --world sandbox --scenario %s/scn_tip_low.json --out cli_rej.csv",
              DATA);
-    rc = run(a, out, sizeof out);
+    rc = cli_run(a, out, sizeof out);
     CHECK(rc == 2 && !exists("cli_rej.csv"), "start pose refused: exit %d, file %s: %s", rc,
           exists("cli_rej.csv") ? "created" : "absent", out);
     // An existing file keeps its content.
@@ -369,9 +345,9 @@ static void test_rejected_run_writes_nothing(void) {
     if (!f) return;
     fputs("keep\n", f);
     fclose(f);
-    rc = run("run --quiet --mechanics ode --world sandbox --scenario ramp --dt 3e-4 --out cli_keep.csv", out, sizeof out);
+    rc = cli_run("run --quiet --mechanics ode --world sandbox --scenario ramp --dt 3e-4 --out cli_keep.csv", out, sizeof out);
     static char csv[64];
-    CHECK(rc == 2 && read_file("cli_keep.csv", csv, sizeof csv) == 5 && !strcmp(csv, "keep\n"),
+    CHECK(rc == 2 && cli_read_file("cli_keep.csv", csv, sizeof csv) == 5 && !strcmp(csv, "keep\n"),
           "refused run touched cli_keep.csv: exit %d, now '%s': %s", rc, csv, out);
     remove("cli_rej.csv");
     remove("cli_keep.csv");
@@ -381,30 +357,30 @@ static void test_rejected_run_writes_nothing(void) {
 static void test_write_failures(void) {
     static char out[8192];
     remove("cli_plot.png");
-    int rc = run("run --quiet --scenario hold --duration 0.05 --out /dev/null --plot cli_plot.png", out, sizeof out);
+    int rc = cli_run("run --quiet --scenario hold --duration 0.05 --out /dev/null --plot cli_plot.png", out, sizeof out);
     const int have_plplot = !strstr(out, "without PLplot");
     if (have_plplot) {
         static char png[16];
-        CHECK(rc == 0 && read_file("cli_plot.png", png, sizeof png) > 8 && !memcmp(png, "\x89PNG\r\n\x1a\n", 8),
+        CHECK(rc == 0 && cli_read_file("cli_plot.png", png, sizeof png) > 8 && !memcmp(png, "\x89PNG\r\n\x1a\n", 8),
               "plot to a file: exit %d: %s", rc, out);
-        rc = run("run --scenario hold --duration 0.05 --out /dev/null --plot /dev/full", out, sizeof out);
+        rc = cli_run("run --scenario hold --duration 0.05 --out /dev/null --plot /dev/full", out, sizeof out);
         CHECK(rc == 1 && strstr(out, "cannot write /dev/full: No space left on device") && !strstr(out, "plot ->"),
               "run --plot /dev/full: exit %d: %s", rc, out);
-        rc = run("compare --quiet --scenario hold --duration 0.05 --solvers krus,ros2 --plot /dev/full", out,
+        rc = cli_run("compare --quiet --scenario hold --duration 0.05 --solvers krus,ros2 --plot /dev/full", out,
                  sizeof out);
         CHECK(rc == 1 && strstr(out, "cannot write /dev/full: No space left on device") && !strstr(out, "plot ->"),
               "compare --plot /dev/full: exit %d: %s", rc, out);
     }
-    rc = run("run --quiet --scenario hold --duration 1 --out /dev/full", out, sizeof out);
+    rc = cli_run("run --quiet --scenario hold --duration 1 --out /dev/full", out, sizeof out);
     CHECK(rc == 1 && strstr(out, "cannot write /dev/full: No space left on device"), "run --out /dev/full: exit %d: %s",
           rc, out);
     // PNG data in a .jpg is refused before the run, and nothing is created.
     remove("cli_plot.jpg");
-    rc = run("run --quiet --scenario hold --duration 0.05 --out /dev/null --plot cli_plot.jpg", out, sizeof out);
-    CHECK(rc == 2 && strstr(out, "--plot cli_plot.jpg") && count_lines(out) == 1 && !exists("cli_plot.jpg"),
+    rc = cli_run("run --quiet --scenario hold --duration 0.05 --out /dev/null --plot cli_plot.jpg", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--plot cli_plot.jpg") && cli_count_lines(out) == 1 && !exists("cli_plot.jpg"),
           "--plot .jpg: exit %d: %s", rc, out);
-    rc = run("run --quiet --scenario hold --duration 0.05 --out no_such_dir/x.csv", out, sizeof out);
-    CHECK(rc == 2 && strstr(out, "--out no_such_dir/x.csv") && count_lines(out) == 1, "--out in a missing folder: %s",
+    rc = cli_run("run --quiet --scenario hold --duration 0.05 --out no_such_dir/x.csv", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--out no_such_dir/x.csv") && cli_count_lines(out) == 1, "--out in a missing folder: %s",
           out);
     remove("cli_plot.png");
 }
@@ -413,23 +389,23 @@ static void test_write_failures(void) {
 // it cannot honour up front.
 static void test_study_usage(void) {
     static char out[16384];
-    int rc = run("study --quick --repeat 1 --duration 0.05 --mechanics ode", out, sizeof out);
+    int rc = cli_run("study --quick --repeat 1 --duration 0.05 --mechanics ode", out, sizeof out);
     CHECK(rc == 2 && strstr(out, "--mechanics ode") && !strstr(out, "reference:") && !strstr(out, "reference run failed"), "--mechanics ode: exit %d: %s", rc,
           out);
-    rc = run("study --quick --repeat 1 --duration 0.05 --solver krus", out, sizeof out);
-    CHECK(rc == 2 && strstr(out, "--solver") && count_lines(out) == 1, "--solver: exit %d: %s", rc, out);
-    rc = run("study --quick --repeat 1 --duration 0.05 --out-dir ''", out, sizeof out);
-    CHECK(rc == 2 && strstr(out, "--out-dir") && count_lines(out) == 1, "empty --out-dir: exit %d: %s", rc, out);
+    rc = cli_run("study --quick --repeat 1 --duration 0.05 --solver krus", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--solver") && cli_count_lines(out) == 1, "--solver: exit %d: %s", rc, out);
+    rc = cli_run("study --quick --repeat 1 --duration 0.05 --out-dir ''", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--out-dir") && cli_count_lines(out) == 1, "empty --out-dir: exit %d: %s", rc, out);
     // A file where the folder should be: refused before the reference run.
     FILE* f = fopen("cli_study_file", "w");
     if (f) fclose(f);
-    rc = run("study --quick --repeat 1 --duration 0.05 --out-dir cli_study_file", out, sizeof out);
+    rc = cli_run("study --quick --repeat 1 --duration 0.05 --out-dir cli_study_file", out, sizeof out);
     CHECK(rc == 2 && strstr(out, "--out-dir cli_study_file") && !strstr(out, "reference:") && !strstr(out, "reference run failed"),
           "--out-dir naming a file: exit %d: %s", rc, out);
     remove("cli_study_file");
     // A nested folder is made with its parents.
     remove("cli_study/sub/deeper/study.md");
-    rc = run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study/sub/deeper", out, sizeof out);
+    rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study/sub/deeper", out, sizeof out);
     if (rc == 2 && strstr(out, "needs the CVODE reference")) {
         // Only a build without SUNDIALS gets here (the study cannot run at
         // all); the checks above still ran. Said, not counted as a pass.
@@ -444,35 +420,35 @@ static void test_study_usage(void) {
 // of steps (else steps are silently shortened); adaptive solvers take any.
 static void test_every_multiple_of_step(void) {
     static char out[8192];
-    int rc = run("run --quiet --scenario ramp --duration 0.01 --every 0.00015 --dt 1e-4 --out /dev/null", out,
+    int rc = cli_run("run --quiet --scenario ramp --duration 0.01 --every 0.00015 --dt 1e-4 --out /dev/null", out,
                  sizeof out);
-    CHECK(rc == 2 && strstr(out, "--every 0.00015") && strstr(out, "0.0001 or 0.0002") && count_lines(out) == 1,
+    CHECK(rc == 2 && strstr(out, "--every 0.00015") && strstr(out, "0.0001 or 0.0002") && cli_count_lines(out) == 1,
           "--every 0.00015 --dt 1e-4: exit %d: %s", rc, out);
-    rc = run("run --quiet --scenario ramp --duration 0.05 --every 0.0015 --mechanics ode --out /dev/null", out,
+    rc = cli_run("run --quiet --scenario ramp --duration 0.05 --every 0.0015 --mechanics ode --out /dev/null", out,
              sizeof out);
-    CHECK(rc == 2 && strstr(out, "ODE step") && count_lines(out) == 1, "ode --every 0.0015: exit %d: %s", rc, out);
-    rc = run("run --quiet --scenario ramp --duration 0.01 --every 0.00015 --solver rodas3 --out /dev/null", out,
+    CHECK(rc == 2 && strstr(out, "ODE step") && cli_count_lines(out) == 1, "ode --every 0.0015: exit %d: %s", rc, out);
+    rc = cli_run("run --quiet --scenario ramp --duration 0.01 --every 0.00015 --solver rodas3 --out /dev/null", out,
              sizeof out);
     CHECK(rc == 0, "adaptive solvers take any --every: exit %d: %s", rc, out);
     // A whole multiple: 0.01 s at 0.2 ms is 50 periods, 51 rows.
     static char csv[1 << 16];
-    rc = run("run --quiet --scenario ramp --duration 0.01 --every 0.0002 --dt 1e-4 --out cli_every.csv", out,
+    rc = cli_run("run --quiet --scenario ramp --duration 0.01 --every 0.0002 --dt 1e-4 --out cli_every.csv", out,
              sizeof out);
-    CHECK(rc == 0 && read_file("cli_every.csv", csv, sizeof csv) > 0 && count_lines(csv) == 1 + 51,
-          "--every 0.0002: exit %d, %d lines: %s", rc, count_lines(csv), out);
+    CHECK(rc == 0 && cli_read_file("cli_every.csv", csv, sizeof csv) > 0 && cli_count_lines(csv) == 1 + 51,
+          "--every 0.0002: exit %d, %d lines: %s", rc, cli_count_lines(csv), out);
 }
 
 // Options that cannot act say so in one line; --load on the sandbox is refused.
 static void test_notes_on_unused_options(void) {
     static char out[8192];
-    int rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.load_mass=2000", out,
+    int rc = cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.load_mass=2000", out,
                  sizeof out);
     CHECK(rc == 0 && strstr(out, "note: --set mechanics.load_mass=2000 has no effect") && strstr(out, "--load 2000") &&
-              count_lines(out) == 1,
+              cli_count_lines(out) == 1,
           "load_mass overridden by the scenario: exit %d: %s", rc, out);
-    rc = run("run --quiet --scenario ramp --duration 0.01 --mechanics ode --world sandbox --load 100 --out /dev/null",
+    rc = cli_run("run --quiet --scenario ramp --duration 0.01 --mechanics ode --world sandbox --load 100 --out /dev/null",
              out, sizeof out);
-    CHECK(rc == 2 && strstr(out, "--load") && strstr(out, "sandbox") && count_lines(out) == 1,
+    CHECK(rc == 2 && strstr(out, "--load") && strstr(out, "sandbox") && cli_count_lines(out) == 1,
           "--load on the sandbox: exit %d: %s", rc, out);
     const char* const cases[][2] = {
         {"--solver rodas3 --dt 1e-3", "note: --dt has no effect"},
@@ -486,10 +462,10 @@ static void test_notes_on_unused_options(void) {
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char a[256];
         snprintf(a, sizeof a, "run --quiet --scenario ramp --duration 0.01 --out /dev/null %s", cases[i][0]);
-        rc = run(a, out, sizeof out);
-        CHECK(rc == 0 && strstr(out, cases[i][1]) && count_lines(out) == 1, "%s: exit %d: %s", cases[i][0], rc, out);
+        rc = cli_run(a, out, sizeof out);
+        CHECK(rc == 0 && strstr(out, cases[i][1]) && cli_count_lines(out) == 1, "%s: exit %d: %s", cases[i][0], rc, out);
     }
-    rc = run("bench --config krus-1ms --repeat 1 --duration 0.01 --solver rodas3", out, sizeof out);
+    rc = cli_run("bench --config krus-1ms --repeat 1 --duration 0.01 --solver rodas3", out, sizeof out);
     CHECK(rc == 0 && strstr(out, "note: --solver has no effect") && strstr(out, "\"solver\":\"krus\""),
           "bench --solver: exit %d: %s", rc, out);
 }
@@ -498,23 +474,23 @@ static void test_notes_on_unused_options(void) {
 // world rather than a lagrange variant, where the peaks come from.
 static void test_run_summary(void) {
     static char out[8192];
-    int rc = run("run --scenario ramp --duration 0.1 --mechanics ode --dt 2e-3 --out /dev/null", out, sizeof out);
+    int rc = cli_run("run --scenario ramp --duration 0.1 --mechanics ode --dt 2e-3 --out /dev/null", out, sizeof out);
     CHECK(rc == 0 && strstr(out, "ode/validation") && strstr(out, "h = 1 ms") && strstr(out, "reduced"),
           "ode --dt 2e-3: %s", out);
-    rc = run("run --scenario ramp --duration 0.01 --mechanics ode --dt-ode 1e-5 --out /dev/null", out, sizeof out);
+    rc = cli_run("run --scenario ramp --duration 0.01 --mechanics ode --dt-ode 1e-5 --out /dev/null", out, sizeof out);
     CHECK(rc == 0 && strstr(out, "h = 0.01 ms") && !strstr(out, "h = 0.1 ms"), "ode --dt-ode 1e-5: %s", out);
     // Peaks over every step, whatever the row period: the same line at 1 ms
     // and at 500 ms rows on `step` (whose peaks fall between coarse rows:
     // the rows alone gave 4.44 instead of 11.46 MPa for p1A). CVODE's steps
     // are its own: its peaks are the rows', and the line says so.
     static char first[8192];
-    rc = run("run --scenario step --duration 3 --out /dev/null", first, sizeof first);
+    rc = cli_run("run --scenario step --duration 3 --out /dev/null", first, sizeof first);
     const char* a = strstr(first, "peak pressures:");
-    rc |= run("run --scenario step --duration 3 --every 0.5 --out /dev/null", out, sizeof out);
+    rc |= cli_run("run --scenario step --duration 3 --every 0.5 --out /dev/null", out, sizeof out);
     const char* b = strstr(out, "peak pressures:");
     CHECK(rc == 0 && a && b && strstr(a, "over every step") && !strncmp(a, b, strcspn(a, "\n")),
           "peaks depend on the rows:\n%s\n%s", first, out);
-    rc = run("run --scenario ramp --duration 1 --every 0.5 --solver cvode --out /dev/null", out, sizeof out);
+    rc = cli_run("run --scenario ramp --duration 1 --every 0.5 --solver cvode --out /dev/null", out, sizeof out);
     CHECK(rc == 0 && strstr(out, "peak pressures at the output rows") && strstr(out, "rows every 500 ms"),
           "cvode --every 0.5: %s", out);
 }
@@ -523,8 +499,8 @@ static void test_run_summary(void) {
 // with the explicit RK4.
 static void test_rk4_jacobian_note(void) {
     static char out[8192];
-    int rc = run("run --quiet --solver rk4 --dt 5e-6 --jac-every 5 --duration 0.01 --out /dev/null", out, sizeof out);
-    CHECK(rc == 0 && strstr(out, "note: --jac-every has no effect with rk4") && count_lines(out) == 1, "%s", out);
+    int rc = cli_run("run --quiet --solver rk4 --dt 5e-6 --jac-every 5 --duration 0.01 --out /dev/null", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "note: --jac-every has no effect with rk4") && cli_count_lines(out) == 1, "%s", out);
 }
 
 int main(int argc, char** argv) {

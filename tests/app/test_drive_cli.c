@@ -6,6 +6,7 @@
 // surfaceless EGL, so offscreen views work without a GPU.
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
+#include "cli_util.h"
 
 #include <errno.h>
 #include <stdbool.h>
@@ -15,32 +16,21 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#define BIN CRANESIM_BINARY_DIR "/cranesim"
 
 static char out[65536];
 
 // Run `env ENV cranesim drive ARGS` with stderr merged into out. Returns the
 // exit code (-1 if it did not exit normally).
 static int drive(const char* env, const char* args) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "env %s %s drive %s 2>&1", env, BIN, args);
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t got = fread(out, 1, sizeof out - 1, p);
-    out[got] = 0;
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    char a[4096];
+    snprintf(a, sizeof a, "drive %s", args);
+    return cli_run_env(env, a, out, sizeof out);
 }
 
 // No display at all (the QA machine's case) and the offscreen driver for
 // screenshots.
 #define NO_DISPLAY "-u DISPLAY -u WAYLAND_DISPLAY SDL_VIDEODRIVER=offscreen"
 
-static int count_lines(const char* s) {
-    int n = 0;
-    for (; *s; ++s) n += *s == '\n';
-    return n;
-}
 
 static int file_lines(const char* path) {
     FILE* f = fopen(path, "r");
@@ -163,7 +153,7 @@ static void test_bad_options_rejected_in_every_mode(void) {
             CHECK(rc == 2, "drive %s: exit %d, want 2: %s", a, rc, out);
             CHECK(strstr(out, cases[i].names) != NULL, "drive %s: message does not name %s: %s", a, cases[i].names,
                   out);
-            CHECK(count_lines(out) == 1, "drive %s: want one line, got: %s", a, out);
+            CHECK(cli_count_lines(out) == 1, "drive %s: want one line, got: %s", a, out);
         }
 }
 

@@ -7,6 +7,7 @@
 // with the range and the unit; outside the typical range, a one-line note;
 // the shipped files give no note at all.
 #include "check.h"
+#include "cli_util.h"
 #include "json_util.h"
 
 #include <stdlib.h>
@@ -14,7 +15,6 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
-#define BIN CRANESIM_BINARY_DIR "/cranesim"
 #define ASSETS CRANESIM_ASSETS
 
 enum kind { MODEL, SCENARIO, WORLD };
@@ -32,25 +32,7 @@ typedef struct bad_case {
 
 static char out_buf[16384];
 
-// Run cranesim with args (stderr merged into out). Returns the exit code.
-// CRANESIM_BIN runs another binary (an older build, to see the test fail).
-static int run(const char* args, char* out, size_t n) {
-    char cmd[8192];
-    const char* bin = getenv("CRANESIM_BIN");
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", bin && *bin ? bin : BIN, args);
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t got = fread(out, 1, n - 1, p);
-    out[got] = 0;
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
-static int count_lines(const char* s) {
-    int n = 0;
-    for (; *s; ++s) n += *s == '\n';
-    return n;
-}
 
 static char* read_all(const char* path) {
     FILE* f = fopen(path, "rb");
@@ -143,12 +125,12 @@ static void run_cases(const bad_case* cases, int n) {
         write_all(out, SENTINEL);
         char cmd[4096];
         command_for(k, file, out, cmd, sizeof cmd);
-        int rc = run(cmd, out_buf, sizeof out_buf);
+        int rc = cli_run(cmd, out_buf, sizeof out_buf);
         CHECK(rc == 2, "%s: exit %d, want 2: %s", k->name, rc, out_buf);
         CHECK(strstr(out_buf, k->name) != NULL, "%s: message does not name the file: %s", k->name, out_buf);
         CHECK(strstr(out_buf, k->field) != NULL, "%s: message does not name %s: %s", k->name, k->field, out_buf);
         CHECK(!k->msg || strstr(out_buf, k->msg), "%s: message lacks '%s': %s", k->name, k->msg, out_buf);
-        CHECK(count_lines(out_buf) == 1, "%s: want one line, got: %s", k->name, out_buf);
+        CHECK(cli_count_lines(out_buf) == 1, "%s: want one line, got: %s", k->name, out_buf);
         char* now = read_all(out);
         CHECK(now && !strcmp(now, SENTINEL), "%s: the existing output file was changed", k->name);
         free(now);
@@ -280,8 +262,8 @@ static void test_oversize(void) {
     fclose(f);
     write_all(out, SENTINEL);
     snprintf(cmd, sizeof cmd, "run --quiet --scenario %s --out %s", path, out);
-    int rc = run(cmd, out_buf, sizeof out_buf);
-    CHECK(rc == 2 && strstr(out_buf, "s_oversize.json: too large (") && count_lines(out_buf) == 1, "exit %d: %s", rc,
+    int rc = cli_run(cmd, out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "s_oversize.json: too large (") && cli_count_lines(out_buf) == 1, "exit %d: %s", rc,
           out_buf);
     char* now = read_all(out);
     CHECK(now && !strcmp(now, SENTINEL), "the existing output file was changed");
@@ -292,15 +274,15 @@ static void test_oversize(void) {
 // Messages that are not about one file: a world name that does not exist
 // lists the worlds; an index past the end of an array gives the length.
 static void test_messages(void) {
-    int rc = run("run --quiet --mechanics ode --world nosuch --scenario hold --out /dev/null", out_buf, sizeof out_buf);
+    int rc = cli_run("run --quiet --mechanics ode --world nosuch --scenario hold --out /dev/null", out_buf, sizeof out_buf);
     CHECK(rc == 2 && strstr(out_buf, "--world nosuch: no such world (available: sandbox, validation") &&
-              count_lines(out_buf) == 1,
+              cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
-    rc = run("run --quiet --scenario hold --out /dev/null --set 'mechanics.links[5].mass=1'", out_buf, sizeof out_buf);
+    rc = cli_run("run --quiet --scenario hold --out /dev/null --set 'mechanics.links[5].mass=1'", out_buf, sizeof out_buf);
     CHECK(rc == 2 && strstr(out_buf, "index 5 out of range: mechanics.links has 2 elements") &&
-              count_lines(out_buf) == 1,
+              cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
-    rc = run("run --quiet --scenario hold --out /dev/null --set 'hydraulics.components.nosuch.bore=1'", out_buf,
+    rc = cli_run("run --quiet --scenario hold --out /dev/null --set 'hydraulics.components.nosuch.bore=1'", out_buf,
              sizeof out_buf);
     CHECK(rc == 2 && strstr(out_buf, "no element named 'nosuch' in hydraulics.components"), "exit %d: %s", rc, out_buf);
 }
@@ -308,37 +290,37 @@ static void test_messages(void) {
 // --set gets the same ranges (it edits the document before loading), and
 // --load the tip-load range.
 static void test_set_and_load(void) {
-    int rc = run("run --quiet --scenario ramp --duration 0.01 --out /dev/null --set "
+    int rc = cli_run("run --quiet --scenario ramp --duration 0.01 --out /dev/null --set "
                  "hydraulics.components.main_relief.p_crack=22",
                  out_buf, sizeof out_buf);
     CHECK(rc == 2 && strstr(out_buf, "hiab031.json: hydraulics.components[1].p_crack: must be in [1e5, 1e8] Pa, got 22") &&
               strstr(out_buf, "(from --set"),
           "exit %d: %s", rc, out_buf);
-    rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --load 1e5", out_buf, sizeof out_buf);
+    rc = cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null --load 1e5", out_buf, sizeof out_buf);
     CHECK(rc == 2 && strstr(out_buf, "--load") && strstr(out_buf, "kg"), "--load 1e5: exit %d: %s", rc, out_buf);
 }
 
 // Outside the typical range: the run goes on (exit 0) with one note naming
 // file, field, range and unit.
 static void test_typical_notes(void) {
-    int rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set hydraulics.fluid.bulk_modulus=4e8",
+    int rc = cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set hydraulics.fluid.bulk_modulus=4e8",
                  out_buf, sizeof out_buf);
     CHECK(rc == 0 && strstr(out_buf, "note: hiab031.json: hydraulics.fluid.bulk_modulus: 4e8 is outside the typical "
                                      "range [5e8, 2.5e9] Pa") &&
-              count_lines(out_buf) == 1,
+              cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
-    rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links[0].mass=15", out_buf,
+    rc = cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links[0].mass=15", out_buf,
              sizeof out_buf);
     CHECK(rc == 0 && strstr(out_buf, "note: hiab031.json: mechanics.links[0].mass: 15 kg is outside the typical "
                                      "range [20, 5000] kg") &&
-              strstr(out_buf, "mechanics.links[0].inertia") && count_lines(out_buf) == 2, // 79 kg m^2 left as it was
+              strstr(out_buf, "mechanics.links[0].inertia") && cli_count_lines(out_buf) == 2, // 79 kg m^2 left as it was
           "exit %d: %s", rc, out_buf);
     // An inertia far from a box of the link's mass and size (kg cm^2 meant?).
-    rc = run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links[0].inertia=7935",
+    rc = cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set mechanics.links[0].inertia=7935",
              out_buf, sizeof out_buf);
     CHECK(rc == 0 && strstr(out_buf, "note: hiab031.json: mechanics.links[0].inertia: 7935 kg m^2 is outside the typical "
                                      "range [0.2, 4] times a uniform box") &&
-              count_lines(out_buf) == 1,
+              cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
     // A world's circuit component is noted under the world file's own path,
     // not as a component of the model's merged circuit.
@@ -347,14 +329,14 @@ static void test_typical_notes(void) {
     char cmd[2048];
     snprintf(cmd, sizeof cmd,
              "run --quiet --mechanics ode --world %s --scenario sandbox_swing --duration 0.01 --out /dev/null", wf);
-    rc = run(cmd, out_buf, sizeof out_buf);
+    rc = cli_run(cmd, out_buf, sizeof out_buf);
     CHECK(rc == 0 &&
               strstr(out_buf, "note: w_note_bore.json: circuit.components[3].bore: 0.025 is outside the typical range "
                               "[0.03, 0.3] m") &&
-              count_lines(out_buf) == 1,
+              cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
-    rc = run("run --quiet --scenario ramp --duration 0.01 --out /dev/null --load 4000", out_buf, sizeof out_buf);
-    CHECK(rc == 0 && strstr(out_buf, "note:") && strstr(out_buf, "--load 4000 kg") && count_lines(out_buf) == 1,
+    rc = cli_run("run --quiet --scenario ramp --duration 0.01 --out /dev/null --load 4000", out_buf, sizeof out_buf);
+    CHECK(rc == 0 && strstr(out_buf, "note:") && strstr(out_buf, "--load 4000 kg") && cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
 }
 
@@ -366,18 +348,18 @@ static void test_shipped_quiet(void) {
     for (int i = 0; i < 5; ++i) {
         char a[512];
         snprintf(a, sizeof a, "run --quiet --scenario %s --duration 0.01 --out /dev/null", lag[i]);
-        int rc = run(a, out_buf, sizeof out_buf);
+        int rc = cli_run(a, out_buf, sizeof out_buf);
         CHECK(rc == 0 && !out_buf[0], "%s: exit %d: %s", lag[i], rc, out_buf);
         snprintf(a, sizeof a, "run --quiet --mechanics ode --world validation --scenario %s --duration 0.01 --out /dev/null",
                  lag[i]);
-        rc = run(a, out_buf, sizeof out_buf);
+        rc = cli_run(a, out_buf, sizeof out_buf);
         CHECK(rc == 0 && !out_buf[0], "%s (validation): exit %d: %s", lag[i], rc, out_buf);
     }
     for (int i = 0; i < 3; ++i) {
         char a[512];
         snprintf(a, sizeof a, "run --quiet --mechanics ode --world sandbox --scenario %s --duration 0.01 --out /dev/null",
                  sbx[i]);
-        int rc = run(a, out_buf, sizeof out_buf);
+        int rc = cli_run(a, out_buf, sizeof out_buf);
         CHECK(rc == 0 && !out_buf[0], "%s: exit %d: %s", sbx[i], rc, out_buf);
     }
 }

@@ -2,6 +2,7 @@
 // capped durations, output files replaced only by a run that wrote rows,
 // interrupted runs, a scenario run in its own world.
 #include "check.h"
+#include "cli_util.h"
 
 #include <dirent.h>
 #include <signal.h>
@@ -13,36 +14,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#define BIN CRANESIM_BINARY_DIR "/cranesim"
 
-// Run cranesim with args (stderr merged into out). Returns the exit code.
-static int run(const char* args, char* out, size_t n) {
-    char cmd[2048];
-    snprintf(cmd, sizeof cmd, "%s %s 2>&1", BIN, args);
-    FILE* p = popen(cmd, "r");
-    if (!p) return -1;
-    size_t got = fread(out, 1, n - 1, p);
-    out[got] = 0;
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
-static void write_file(const char* path, const char* text) {
-    FILE* f = fopen(path, "w");
-    if (!f) return;
-    fputs(text, f);
-    fclose(f);
-}
 
-// The whole file in buf (NUL-terminated); its length, or -1.
-static long read_file(const char* path, char* buf, size_t n) {
-    FILE* f = fopen(path, "r");
-    if (!f) return -1;
-    size_t got = fread(buf, 1, n - 1, f);
-    buf[got] = 0;
-    fclose(f);
-    return (long)got;
-}
 
 // Durations and output periods beyond 1e6 s are refused up front (exit 2,
 // range and unit named, the old file untouched): before, --duration 1e300
@@ -57,17 +31,17 @@ static void test_duration_caps(void) {
         "drive --headless --quiet --duration 0.1 --screenshot-at 1e300 --record cap.csv",
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-        write_file("cap.csv", "old\n");
-        const int rc = run(cases[i], out, sizeof out);
+        cli_write_file("cap.csv", "old\n");
+        const int rc = cli_run(cases[i], out, sizeof out);
         CHECK(rc == 2, "%s: exit %d: %s", cases[i], rc, out);
         CHECK(strstr(out, "1e6") && strstr(out, " s") &&
                   (strstr(out, "--duration") || strstr(out, "--every") || strstr(out, "--screenshot-at")),
               "%s: %s", cases[i], out);
-        CHECK(read_file("cap.csv", buf, sizeof buf) == 4 && !strcmp(buf, "old\n"), "%s: file now '%s'", cases[i],
+        CHECK(cli_read_file("cap.csv", buf, sizeof buf) == 4 && !strcmp(buf, "old\n"), "%s: file now '%s'", cases[i],
               buf);
     }
     // An output period finer than a row per picosecond of the run.
-    const int rc = run("run --quiet --solver rodas3 --every 1e-300 --out cap.csv", out, sizeof out);
+    const int rc = cli_run("run --quiet --solver rodas3 --every 1e-300 --out cap.csv", out, sizeof out);
     CHECK(rc == 2 && strstr(out, "--every"), "exit %d: %s", rc, out);
 }
 
@@ -96,7 +70,7 @@ static pid_t start_run(const char* name, const char* errfile) {
     if (pid == 0) {
         FILE* e = freopen(errfile, "w", stderr);
         (void)e;
-        execl(BIN, BIN, "run", "--quiet", "--scenario", "ramp", "--duration", "5000", "--out", name, (char*)NULL);
+        execl(cli_bin(), cli_bin(), "run", "--quiet", "--scenario", "ramp", "--duration", "5000", "--out", name, (char*)NULL);
         _exit(127);
     }
     // Waiting, not timing: the run writes its first rows within milliseconds;
@@ -139,7 +113,7 @@ static void test_interrupted_run(void) {
     static const int sigs[2] = {SIGINT, SIGTERM};
     static char buf[1 << 24], err[4096];
     for (int k = 0; k < 2; ++k) {
-        write_file("intr.csv", "old\n");
+        cli_write_file("intr.csv", "old\n");
         remove_temps("intr.csv");
         const pid_t pid = start_run("intr.csv", "intr.err");
         CHECK(pid > 0, "fork");
@@ -147,16 +121,16 @@ static void test_interrupted_run(void) {
         char tmp[256];
         find_temp("intr.csv", tmp, sizeof tmp);
         CHECK(tmp[0] != 0, "no temporary CSV while the run writes rows");
-        CHECK(read_file("intr.csv", buf, sizeof buf) == 4 && !strcmp(buf, "old\n"),
+        CHECK(cli_read_file("intr.csv", buf, sizeof buf) == 4 && !strcmp(buf, "old\n"),
               "the previous CSV changed while the run was under way: '%.40s'", buf);
         kill(pid, sigs[k]);
         int st = 0;
         waitpid(pid, &st, 0);
         CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 128 + sigs[k], "signal %d: status %#x (want exit %d)", sigs[k], st,
               128 + sigs[k]);
-        read_file("intr.err", err, sizeof err);
+        cli_read_file("intr.err", err, sizeof err);
         CHECK(strstr(err, "interrupted") && strstr(err, "at t = ") && strstr(err, "rows kept in intr.csv"), "%s", err);
-        const long got = read_file("intr.csv", buf, sizeof buf);
+        const long got = cli_read_file("intr.csv", buf, sizeof buf);
         const long rows = got > 0 ? whole_rows(buf) : -1;
         CHECK(rows > 1, "signal %d: the CSV is not whole lines with a header (%ld bytes)", sigs[k], got);
         // The message's row count is the file's.
@@ -172,15 +146,15 @@ static void test_interrupted_run(void) {
 // a refused one (exit 2) leaves the previous file as it was.
 static void test_failed_run_keeps_rows(void) {
     static char out[8192], buf[1 << 20];
-    write_file("fail.csv", "old\n");
-    int rc = run("run --quiet --scenario hold --duration 0.05 --set nonsense=1 --out fail.csv", out, sizeof out);
-    CHECK(rc == 2 && read_file("fail.csv", buf, sizeof buf) == 4, "refused run: exit %d, file '%.20s'", rc, buf);
+    cli_write_file("fail.csv", "old\n");
+    int rc = cli_run("run --quiet --scenario hold --duration 0.05 --set nonsense=1 --out fail.csv", out, sizeof out);
+    CHECK(rc == 2 && cli_read_file("fail.csv", buf, sizeof buf) == 4, "refused run: exit %d, file '%.20s'", rc, buf);
     // 10 ms hydraulic steps in the ode world: the pump line goes far below
     // absolute zero in the first step (test_robust.c, test_live_checks).
-    rc = run("run --quiet --mechanics ode --scenario step --dt-ode 0.01 --dt 0.01 --every 0.01 --out fail.csv", out,
+    rc = cli_run("run --quiet --mechanics ode --scenario step --dt-ode 0.01 --dt 0.01 --every 0.01 --out fail.csv", out,
              sizeof out);
     CHECK(rc == 1 && strstr(out, "kept in fail.csv"), "exit %d: %s", rc, out);
-    CHECK(read_file("fail.csv", buf, sizeof buf) > 0 && whole_rows(buf) == 1, "failed run's rows: '%.80s'", buf);
+    CHECK(cli_read_file("fail.csv", buf, sizeof buf) > 0 && whole_rows(buf) == 1, "failed run's rows: '%.80s'", buf);
 }
 
 // `run` without --plot keeps no rows in memory: 200,001 rows at 0.1 ms on
@@ -189,7 +163,7 @@ static void test_failed_run_keeps_rows(void) {
 // model, stdio). The bound is the child's peak resident set.
 static void test_run_memory(void) {
     static char out[8192];
-    const int rc = run("run --quiet --scenario ramp --every 1e-4 --out /dev/null", out, sizeof out);
+    const int rc = cli_run("run --quiet --scenario ramp --every 1e-4 --out /dev/null", out, sizeof out);
     CHECK(rc == 0, "exit %d: %s", rc, out);
     struct rusage ru;
     getrusage(RUSAGE_CHILDREN, &ru);
@@ -202,9 +176,9 @@ static void test_run_memory(void) {
 // compare refuse and say how.
 static void test_scenario_world(void) {
     static char out[8192], buf[1 << 20];
-    int rc = run("run --quiet --scenario sandbox_wall --duration 1.5 --every 0.5 --out world.csv", out, sizeof out);
+    int rc = cli_run("run --quiet --scenario sandbox_wall --duration 1.5 --every 0.5 --out world.csv", out, sizeof out);
     CHECK(rc == 0 && strstr(out, "--mechanics ode --world sandbox"), "exit %d: %s", rc, out);
-    CHECK(read_file("world.csv", buf, sizeof buf) > 0 && strstr(buf, ",u3_cmd,"), "no slew columns: %.200s", buf);
+    CHECK(cli_read_file("world.csv", buf, sizeof buf) > 0 && strstr(buf, ",u3_cmd,"), "no slew columns: %.200s", buf);
     // The last row: t = 1.5 s, where the scenario commands the slew valve
     // to 0.25 (a ramp from 0 at 1 s to 0.5 at 2 s; the ode run takes the
     // command at each 1 ms step's midpoint: 0.24975).
@@ -226,11 +200,11 @@ static void test_scenario_world(void) {
         "compare --quiet --scenario sandbox_wall --duration 0.1",
     };
     for (int i = 0; i < 3; ++i) {
-        write_file("world.csv", "old\n");
-        rc = run(refused[i], out, sizeof out);
+        cli_write_file("world.csv", "old\n");
+        rc = cli_run(refused[i], out, sizeof out);
         CHECK(rc == 2 && strstr(out, "run it with --mechanics ode --world sandbox"), "%s: exit %d: %s", refused[i],
               rc, out);
-        CHECK(read_file("world.csv", buf, sizeof buf) == 4, "%s: the old file changed", refused[i]);
+        CHECK(cli_read_file("world.csv", buf, sizeof buf) == 4, "%s: the old file changed", refused[i]);
     }
 }
 
@@ -240,7 +214,7 @@ static void test_scenario_world(void) {
 static void test_drive_writes_nothing_unasked(void) {
     static char out[16384];
     remove("drive.csv");
-    const int rc = run("drive --headless --quiet --duration 0.2", out, sizeof out);
+    const int rc = cli_run("drive --headless --quiet --duration 0.2", out, sizeof out);
     CHECK(rc == 0 && strstr(out, "no record (--record FILE.csv"), "exit %d: %s", rc, out);
     CHECK(access("drive.csv", F_OK) != 0, "drive wrote drive.csv unasked");
 }
@@ -250,17 +224,17 @@ static void test_drive_writes_nothing_unasked(void) {
 // here: benchmarks are not tests).
 static void test_soak_runs(void) {
     static char a[4096], b[4096];
-    int rc = run("bench --config soak --duration 2 --seed 7", a, sizeof a);
+    int rc = cli_run("bench --config soak --duration 2 --seed 7", a, sizeof a);
     CHECK(rc == 0 && strstr(a, "\"config\":\"soak\"") && strstr(a, "\"exit_status\":0") &&
               strstr(a, "\"nonfinite_values\":0") && strstr(a, "\"peak_rss_kb\":"),
           "exit %d: %s", rc, a);
-    rc = run("bench --config soak --duration 2 --seed 7", b, sizeof b);
+    rc = cli_run("bench --config soak --duration 2 --seed 7", b, sizeof b);
     // Everything but the wall time and the RSS must agree.
     const char* pa = strstr(a, "\"peak_pressure_mpa\"");
     const char* pb = strstr(b, "\"peak_pressure_mpa\"");
     const char* ea = pa ? strstr(pa, "\"peak_rss_kb\"") : NULL;
     CHECK(rc == 0 && pa && pb && ea && !strncmp(pa, pb, (size_t)(ea - pa)), "two runs differ:\n%s%s", a, b);
-    CHECK(run("bench --config soak --seed 0", a, sizeof a) == 2 && strstr(a, "--seed"), "%s", a);
+    CHECK(cli_run("bench --config soak --seed 0", a, sizeof a) == 2 && strstr(a, "--seed"), "%s", a);
 }
 
 // Replacing through a temporary file must not turn a symlinked output into a
@@ -269,15 +243,15 @@ static void test_soak_runs(void) {
 static void test_replace_keeps_link_and_mode(void) {
     static char out[8192], buf[1 << 16];
     remove("lnk.csv");
-    write_file("tgt.csv", "old\n");
+    cli_write_file("tgt.csv", "old\n");
     chmod("tgt.csv", 0640);
     CHECK(symlink("tgt.csv", "lnk.csv") == 0, "symlink");
-    const int rc = run("run --quiet --scenario hold --duration 0.01 --out lnk.csv", out, sizeof out);
+    const int rc = cli_run("run --quiet --scenario hold --duration 0.01 --out lnk.csv", out, sizeof out);
     CHECK(rc == 0, "exit %d: %s", rc, out);
     struct stat st;
     CHECK(lstat("lnk.csv", &st) == 0 && S_ISLNK(st.st_mode), "lnk.csv is no longer a symlink");
     CHECK(stat("tgt.csv", &st) == 0 && (st.st_mode & 0777) == 0640, "mode now %o", (unsigned)(st.st_mode & 0777));
-    CHECK(read_file("tgt.csv", buf, sizeof buf) > 0 && whole_rows(buf) == 11, "target: %.60s", buf);
+    CHECK(cli_read_file("tgt.csv", buf, sizeof buf) > 0 && whole_rows(buf) == 11, "target: %.60s", buf);
     remove("lnk.csv");
 }
 
@@ -286,14 +260,14 @@ static void test_replace_keeps_link_and_mode(void) {
 // temporary behind.
 static void test_interrupted_drive(void) {
     static char buf[1 << 20], err[4096];
-    write_file("drv.csv", "old\n");
+    cli_write_file("drv.csv", "old\n");
     remove_temps("drv.csv");
     pid_t pid = fork();
     if (pid == 0) {
         FILE* e = freopen("drv.err", "w", stderr);
         FILE* o = freopen("/dev/null", "w", stdout);
         (void)e, (void)o;
-        execl(BIN, BIN, "drive", "--headless", "--quiet", "--duration", "60", "--record", "drv.csv", (char*)NULL);
+        execl(cli_bin(), cli_bin(), "drive", "--headless", "--quiet", "--duration", "60", "--record", "drv.csv", (char*)NULL);
         _exit(127);
     }
     CHECK(pid > 0, "fork");
@@ -309,9 +283,9 @@ static void test_interrupted_drive(void) {
     int status = 0;
     waitpid(pid, &status, 0);
     CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 143, "status %#x", status);
-    read_file("drv.err", err, sizeof err);
+    cli_read_file("drv.err", err, sizeof err);
     CHECK(strstr(err, "interrupted (SIGTERM) at t = ") && strstr(err, "record kept in drv.csv"), "%s", err);
-    CHECK(read_file("drv.csv", buf, sizeof buf) > 0 && whole_rows(buf) >= 1, "record: %.60s", buf);
+    CHECK(cli_read_file("drv.csv", buf, sizeof buf) > 0 && whole_rows(buf) >= 1, "record: %.60s", buf);
     find_temp("drv.csv", tmp, sizeof tmp);
     CHECK(tmp[0] == 0, "temporary %s left behind", tmp);
 }
