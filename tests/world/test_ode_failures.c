@@ -17,30 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define PI 3.14159265358979323846
-
-static model* g_model;
-
-static const cJSON* hyd_json(void) { return cJSON_GetObjectItemCaseSensitive(g_model->json, "hydraulics"); }
-
-static ode_world* make(const crane_mech* me, const world_desc* d, char* err, size_t errsz) {
-    ode_world_opts o = ode_world_default_opts();
-    o.model_file = "hiab031.json";
-    if (d && d->kind == WORLD_SANDBOX) { // the pick-and-place start pose
-        o.q0[0] = 117.3 * PI / 180, o.q0[1] = -65.8 * PI / 180;
-        o.slew0 = -60 * PI / 180;
-    }
-    return ode_world_create(me, hyd_json(), d, &o, err, errsz);
-}
-
-static int load_sandbox(world_desc* d) {
-    char err[512];
-    if (world_desc_load(CRANESIM_ASSETS "/worlds/sandbox.json", d, err, sizeof err)) {
-        fprintf(stderr, "%s\n", err);
-        return -1;
-    }
-    return 0;
-}
+#include "world_fixture.h"
 
 // The end arm's state after n ODE steps of the validation world at rest
 // (valves closed): a fingerprint to compare runs by.
