@@ -4,6 +4,7 @@
 #define APP_H
 
 #include <stdbool.h>
+#include <signal.h>
 #include <stdio.h>
 
 #include "model.h"
@@ -68,6 +69,20 @@ int app_check_output(const char* cmd, const char* opt, const char* path, const c
 /// to tell (a failed write's errno is gone once later calls ran: callers
 /// that want it pass it as first).
 int app_fclose_checked(FILE* f, int first);
+
+/// SIGINT and SIGTERM caught for a long loop that stops cleanly (run, the
+/// headless drive): the first signal sets app_signal_caught() and the loop
+/// ends after the row or frame it is on; a second one kills at once
+/// (SA_RESETHAND). app_signals_restore puts the previous handlers back.
+typedef struct app_signals {
+    struct sigaction old_int, old_term;
+} app_signals;
+void app_signals_catch(app_signals* s);
+void app_signals_restore(const app_signals* s);
+/// The signal caught since app_signals_catch (SIGINT, SIGTERM), or 0.
+int app_signal_caught(void);
+/// "SIGINT" or "SIGTERM".
+const char* app_signal_name(int sig);
 /// An output file that replaces an existing one only when the command is
 /// done with it: a regular file (existing or new) is written to a temporary
 /// file in the same folder, ".NAME.XXXXXX", that app_out_close renames over

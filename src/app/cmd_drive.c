@@ -134,11 +134,6 @@ static bool write_row(FILE* f, const double* row, int ncol) {
     return !ferror(f);
 }
 
-// SIGINT or SIGTERM during the headless loop: it stops after the frame,
-// and the record (a temporary until the end, app_out) is put in place.
-static volatile sig_atomic_t g_signal;
-
-static void on_signal(int sig) { g_signal = sig; }
 
 static int drive_headless(app_common* c, double frame_rate, const char* record, const char* why, int kind,
                           const char* world_name) {
@@ -196,14 +191,9 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     double row[SIM_NCOL];
     live_row(l, row);
     // As in run: the first signal stops the loop, a second kills at once.
-    struct sigaction sa, old_int, old_term;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sa.sa_flags = SA_RESETHAND;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int);
-    sigaction(SIGTERM, &sa, &old_term);
-    for (long i = 0; i < nframes && !wr && !g_signal; ++i) {
+    app_signals sig;
+    app_signals_catch(&sig);
+    for (long i = 0; i < nframes && !wr && !app_signal_caught(); ++i) {
         double ws = sim_wall_time();
         double t = live_time(l);
         // The operator's stick positions at the middle of this frame.
@@ -237,12 +227,11 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         sleep_until(w0 + (i + 1) * frame);
     }
     if (!c->quiet) app_progress_done();
-    sigaction(SIGINT, &old_int, NULL);
-    sigaction(SIGTERM, &old_term, NULL);
-    if (g_signal && !code) {
-        fprintf(stderr, "cranesim drive: interrupted (%s) at t = %.6g s%s%s\n", g_signal == SIGINT ? "SIGINT" : "SIGTERM",
+    app_signals_restore(&sig);
+    if (app_signal_caught() && !code) {
+        fprintf(stderr, "cranesim drive: interrupted (%s) at t = %.6g s%s%s\n", app_signal_name(app_signal_caught()),
                 live_time(l), record ? "; record kept in " : "", record ? record : "");
-        code = 128 + g_signal;
+        code = 128 + app_signal_caught();
     }
     if (!code) {
         char note[320];

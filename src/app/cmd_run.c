@@ -34,11 +34,6 @@ static void run_help(FILE* f) {
             "example: cranesim run --scenario ramp --out ramp.csv --plot ramp.png\n");
 }
 
-// SIGINT or SIGTERM during the run: the signal number, seen by the row
-// sink, which stops the run after the row it is writing (whole lines).
-static volatile sig_atomic_t g_signal;
-
-static void on_signal(int sig) { g_signal = sig; }
 
 // The rows the plot needs, decimated to a bounded number: a run of up to
 // PLOT_FULL rows (every shipped scenario at 1 kHz) keeps every row; a longer
@@ -155,7 +150,7 @@ static int csv_row(void* user, const double* row) {
         s->st.xmax[k] = fmax(s->st.xmax[k], row[COL_X1 + k]);
     }
     keep_row(&s->keep, row, s->ncol);
-    return g_signal != 0;
+    return app_signal_caught() != 0;
 }
 
 // Close the CSV and put it in place; 0, or the errno of the first failure
@@ -280,34 +275,28 @@ int cmd_run(int argc, char** argv) {
     // SIGINT (Ctrl-C) or SIGTERM: the run stops after the row being written
     // and the CSV is closed and put in place with every row so far; a second
     // signal kills at once (SA_RESETHAND).
-    struct sigaction sa, old_int, old_term;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sa.sa_flags = SA_RESETHAND;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int);
-    sigaction(SIGTERM, &sa, &old_term);
+    app_signals sig;
+    app_signals_catch(&sig);
     sim_run(m, &sc, &c.sim, csv_row, &sink, NULL, c.quiet ? NULL : app_progress, NULL, &res);
     keep_flush(&sink.keep);
     if (!c.quiet) app_progress_done();
-    if (res.note[0] && !g_signal) fprintf(stderr, "cranesim run: note: %s\n", res.note);
+    if (res.note[0] && !app_signal_caught()) fprintf(stderr, "cranesim run: note: %s\n", res.note);
     const int werr = csv_close(&sink);
-    sigaction(SIGINT, &old_int, NULL);
-    sigaction(SIGTERM, &old_term, NULL);
+    app_signals_restore(&sig);
     int code = EXIT_OK_;
     if (werr && !sink.opened) {
         // The path passed app_check_output, yet could not be created: still
         // bad input, and nothing was written.
         fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
         code = EXIT_USAGE;
-    } else if (g_signal && res.status == 2 && sink.opened) {
+    } else if (app_signal_caught() && res.status == 2 && sink.opened) {
         // Interrupted: 128 + the signal, as a shell reports a process the
         // signal ended, but with the rows in place (decision in docs).
         if (werr) fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
         else
             fprintf(stderr, "cranesim run: interrupted (%s) at t = %.6g s; %ld rows kept in %s\n",
-                    g_signal == SIGINT ? "SIGINT" : "SIGTERM", sink.t_last, sink.rows, out);
-        code = 128 + g_signal;
+                    app_signal_name(app_signal_caught()), sink.t_last, sink.rows, out);
+        code = 128 + app_signal_caught();
     } else if (res.status == 1) {
         fprintf(stderr, "cranesim run: %s; %ld rows up to t = %.6g s kept in %s\n", res.message, res.rows,
                 res.t_end, out);
@@ -327,7 +316,7 @@ int cmd_run(int argc, char** argv) {
     }
     if (code == EXIT_OK_ && !c.quiet)
         print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, out);
-    if (plot && tr.nrow > 1 && code != EXIT_USAGE && !g_signal) {
+    if (plot && tr.nrow > 1 && code != EXIT_USAGE && !app_signal_caught()) {
         char err[512], title[160];
         if (c.sim.mechanics == SIM_ODE)
             snprintf(title, sizeof title, "%s: ode/%s, %s", sc.name, c.sim.world ? c.sim.world : "validation",
