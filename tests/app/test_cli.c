@@ -2,9 +2,11 @@
 // errors naming file and field, CSV contract, no lost output on a blow-up.
 #include "check.h"
 #include "cli_util.h"
+#include "fixture_edit.h"
 
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #define DATA CRANESIM_TESTDATA
@@ -33,38 +35,54 @@ typedef struct bad_case {
     const char* field; // must appear in the message
 } bad_case;
 
+// A bad model: the shipped one with one change (fixture_edit.h), written
+// under the case's file name, which the message must name.
+typedef struct bad_model {
+    const char* file;
+    const char* field;    ///< must appear in the message
+    const char* set;      ///< "path=value", or NULL: a text edit
+    const char *from, *to; ///< the text edit (first occurrence)
+} bad_model;
+
 static void test_bad_models(void) {
-    static const bad_case cases[] = {
-        {"bad_bore.json", "bore"},
-        {"missing_links.json", "mechanics.links"},
-        {"typo_key.json", "load_mas"},
-        {"unknown_cylinder.json", "actuators[1].cylinder"},
-        {"rod_ge_bore.json", "rod"},
-        {"mass_string.json", "links[0].mass"},
-        {"bad_mount.json", "actuators[0]"},
-        {"bad_port.json", "components[2].A"},
-        {"syntax_error.json", "line"},
+    static const bad_model cases[] = {
+        {"bad_bore.json", "bore", "hydraulics.components.jib_cyl.bore=-0.08", NULL, NULL},
+        {"missing_links.json", "mechanics.links", "-mechanics.links", NULL, NULL},
+        {"typo_key.json", "load_mas", NULL, "\"load_mass\"", "\"load_mas\""},
+        {"unknown_cylinder.json", "actuators[1].cylinder", "mechanics.actuators[1].cylinder=\"jib_cylinder\"", NULL,
+         NULL},
+        {"rod_ge_bore.json", "rod", "hydraulics.components.jib_cyl.rod=0.09", NULL, NULL},
+        {"mass_string.json", "links[0].mass", NULL, "\"mass\": 180.0", "\"mass\": \"heavy\""},
+        {"bad_mount.json", "actuators[0]", "mechanics.actuators[0].closed_length=3.5", NULL, NULL},
+        {"bad_port.json", "components[2].A", "hydraulics.components[2].A=\"nowhere\"", NULL, NULL},
+        {"syntax_error.json", "line", NULL, "\"gravity\": 9.81,", "\"gravity\": 9.81"},
         // Strict reading (docs/files.md): a field given twice, a number JSON
         // does not allow, a centre of mass past the link, a massless
         // rotation, two actuators on one cylinder or with one name.
-        {"dup_key.json", "components[5].bore"},
-        {"leading_zero.json", "00.1"},
-        {"com_beyond_link.json", "links[0].com"},
-        {"zero_inertia.json", "links[1].inertia"},
-        {"two_on_one_cylinder.json", "actuators[1].cylinder"},
-        {"dup_actuator_name.json", "actuators[1].name"},
+        {"dup_key.json", "components[5].bore", NULL, "\"bore\": 0.1,", "\"bore\": 0.1, \"bore\": 0.2,"},
+        {"leading_zero.json", "00.1", NULL, "\"bore\": 0.1,", "\"bore\": 00.1,"},
+        {"com_beyond_link.json", "links[0].com", "mechanics.links[0].com=10.0", NULL, NULL},
+        {"zero_inertia.json", "links[1].inertia", "mechanics.links[1].inertia=0", NULL, NULL},
+        {"two_on_one_cylinder.json", "actuators[1].cylinder", "mechanics.actuators[0].cylinder=\"jib_cyl\"", NULL,
+         NULL},
+        {"dup_actuator_name.json", "actuators[1].name", "mechanics.actuators[1].name=\"lift\"", NULL, NULL},
     };
     static char out[8192];
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/tests/app/bad_models", CRANESIM_BINARY_DIR);
+    mkdir(dir, 0755);
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-        char a[1024];
-        snprintf(a, sizeof a, "run --quiet --model %s/%s --scenario hold --duration 0.01 --out /dev/null", DATA,
-                 cases[i].file);
+        const bad_model* k = &cases[i];
+        char path[1200], a[2048];
+        snprintf(path, sizeof path, "%s/%s", dir, k->file);
+        CHECK(fixture_edit(CRANESIM_ASSETS "/models/hiab031.json", path, k->set, k->from, k->to) == 0,
+              "%s: the edit does not apply to the shipped model", k->file);
+        snprintf(a, sizeof a, "run --quiet --model %s --scenario hold --duration 0.01 --out /dev/null", path);
         int rc = cli_run(a, out, sizeof out);
-        CHECK(rc == 2, "%s: exit %d, want 2: %s", cases[i].file, rc, out);
-        CHECK(strstr(out, cases[i].file) != NULL, "%s: message does not name the file: %s", cases[i].file, out);
-        CHECK(strstr(out, cases[i].field) != NULL, "%s: message does not name %s: %s", cases[i].file,
-              cases[i].field, out);
-        CHECK(cli_count_lines(out) == 1, "%s: want one line, got: %s", cases[i].file, out);
+        CHECK(rc == 2, "%s: exit %d, want 2: %s", k->file, rc, out);
+        CHECK(strstr(out, k->file) != NULL, "%s: message does not name the file: %s", k->file, out);
+        CHECK(strstr(out, k->field) != NULL, "%s: message does not name %s: %s", k->file, k->field, out);
+        CHECK(cli_count_lines(out) == 1, "%s: want one line, got: %s", k->file, out);
     }
 }
 

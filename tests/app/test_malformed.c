@@ -8,6 +8,7 @@
 // the shipped files give no note at all.
 #include "check.h"
 #include "cli_util.h"
+#include "fixture_edit.h"
 #include "json_util.h"
 
 #include <stdlib.h>
@@ -34,25 +35,6 @@ static char out_buf[16384];
 
 
 
-static char* read_all(const char* path) {
-    FILE* f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char* s = malloc((size_t)n + 1);
-    size_t got = fread(s, 1, (size_t)n, f);
-    s[got] = 0;
-    fclose(f);
-    return s;
-}
-
-static void write_all(const char* path, const char* text) {
-    FILE* f = fopen(path, "wb");
-    fputs(text, f);
-    fclose(f);
-}
-
 static const char* dir(void) {
     static char d[512];
     if (!d[0]) {
@@ -68,36 +50,7 @@ static const char* make_case(const bad_case* k) {
     char base[1024];
     snprintf(base, sizeof base, "%s/%s", ASSETS, k->base);
     snprintf(path, sizeof path, "%s/%s", dir(), k->name);
-    char* text = read_all(base);
-    if (!text) return NULL;
-    if (k->set) {
-        char err[512];
-        cJSON* root = cJSON_Parse(text);
-        if (!root || json_set_path(root, k->set, err, sizeof err)) {
-            fprintf(stderr, "%s: cannot apply %s: %s\n", k->name, k->set, err);
-            cJSON_Delete(root);
-            free(text);
-            return NULL;
-        }
-        char* s = cJSON_Print(root);
-        write_all(path, s);
-        free(s);
-        cJSON_Delete(root);
-    } else {
-        char* at = strstr(text, k->from);
-        if (!at) {
-            fprintf(stderr, "%s: '%s' not in %s\n", k->name, k->from, k->base);
-            free(text);
-            return NULL;
-        }
-        size_t n = strlen(text) + strlen(k->to) + 1;
-        char* s = malloc(n);
-        snprintf(s, n, "%.*s%s%s", (int)(at - text), text, k->to, at + strlen(k->from));
-        write_all(path, s);
-        free(s);
-    }
-    free(text);
-    return path;
+    return fixture_edit(base, path, k->set, k->from, k->to) ? NULL : path;
 }
 
 static const char SENTINEL[] = "t,x1\n0,0.5\nthis file must survive a refused run\n";
@@ -122,7 +75,7 @@ static void run_cases(const bad_case* cases, int n) {
         const char* file = make_case(k);
         CHECK(file != NULL, "%s: could not be made", k->name);
         if (!file) continue;
-        write_all(out, SENTINEL);
+        cli_write_file(out, SENTINEL);
         char cmd[4096];
         command_for(k, file, out, cmd, sizeof cmd);
         int rc = cli_run(cmd, out_buf, sizeof out_buf);
@@ -131,7 +84,7 @@ static void run_cases(const bad_case* cases, int n) {
         CHECK(strstr(out_buf, k->field) != NULL, "%s: message does not name %s: %s", k->name, k->field, out_buf);
         CHECK(!k->msg || strstr(out_buf, k->msg), "%s: message lacks '%s': %s", k->name, k->msg, out_buf);
         CHECK(cli_count_lines(out_buf) == 1, "%s: want one line, got: %s", k->name, out_buf);
-        char* now = read_all(out);
+        char* now = fixture_read_all(out);
         CHECK(now && !strcmp(now, SENTINEL), "%s: the existing output file was changed", k->name);
         free(now);
     }
@@ -260,12 +213,12 @@ static void test_oversize(void) {
     for (long i = 0; i < (1L << 20); ++i) fputc('x', f);
     fputs("\", \"duration\": 1, \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110}, \"commands\": {}}\n", f);
     fclose(f);
-    write_all(out, SENTINEL);
+    cli_write_file(out, SENTINEL);
     snprintf(cmd, sizeof cmd, "run --quiet --scenario %s --out %s", path, out);
     int rc = cli_run(cmd, out_buf, sizeof out_buf);
     CHECK(rc == 2 && strstr(out_buf, "s_oversize.json: too large (") && cli_count_lines(out_buf) == 1, "exit %d: %s", rc,
           out_buf);
-    char* now = read_all(out);
+    char* now = fixture_read_all(out);
     CHECK(now && !strcmp(now, SENTINEL), "the existing output file was changed");
     free(now);
     remove(path);
