@@ -95,6 +95,18 @@ panel_status panel_edit(panel* p, int id, double v, bool done) {
     return panel_set_id(p, id, v, NULL, 0);
 }
 
+panel_status panel_edit_typed(panel* p, int id, double v, bool done) {
+    if (!p || id < 0 || id >= p->nparam) return panel_set_id(p, id, v, NULL, 0);
+    panel_param* q = &p->param[id];
+    if (!done) {
+        q->pending = v;
+        q->has_pending = true;
+        return PANEL_OK;
+    }
+    q->has_pending = false;
+    return panel_set_id(p, id, v, NULL, 0);
+}
+
 bool panel_pending(const panel* p, int id, double* v) {
     if (!p || id < 0 || id >= p->nparam || !p->param[id].has_pending) return false;
     if (v) *v = p->param[id].pending;

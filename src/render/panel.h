@@ -79,6 +79,11 @@ double panel_drag_speed(const panel* p, int id);
 /// between held as pending (shown, not applied). Returns panel_set_id's
 /// status, or PANEL_OK while pending.
 panel_status panel_edit(panel* p, int id, double v, bool done);
+/// The same for a value being typed (Ctrl+click, then digits): every
+/// parameter, live or not, is held pending until the edit is done (Enter,
+/// or the field losing focus), so the half-typed "9" of "900" never reaches
+/// the crane; Escape drops it.
+panel_status panel_edit_typed(panel* p, int id, double v, bool done);
 /// The pending (shown but not applied) value of an on-release parameter
 /// being edited; false if none.
 bool panel_pending(const panel* p, int id, double* v);

@@ -72,7 +72,15 @@ void draw_group(panel* p, const char* group, float label_w) {
             const bool changed = ImGui::DragScalar("##value", ImGuiDataType_Double, &v, speed, &q->min, &q->max, fmt,
                                                    ImGuiSliderFlags_AlwaysClamp);
             const bool done = ImGui::IsItemDeactivatedAfterEdit();
-            if (changed || done) panel_edit(p, i, v, done);
+            // Active with no mouse button down: the value is being typed
+            // (Ctrl+click or double-click opened the text field), and each
+            // keystroke is a "change": typing 900 passed 9 (clamped to the
+            // minimum) to the crane on the way.
+            const bool typing = ImGui::IsItemActive() && !ImGui::GetIO().MouseDown[0];
+            if (changed || done) {
+                if (typing) panel_edit_typed(p, i, v, done);
+                else panel_edit(p, i, v, done);
+            }
             // An edit given up (Escape while typing) leaves nothing pending.
             if (!done && !ImGui::IsItemActive()) q->has_pending = false;
         }

@@ -141,6 +141,27 @@ static void test_on_release_applies_once(void) {
     panel_destroy(p);
 }
 
+// A typed value reaches the app only when the edit is done, for live
+// parameters too: Ctrl+click, "9" on the way to "900" set a 150 kg end arm
+// to 20 kg (the clamp) while the valves were closed.
+static void test_typed_value_applies_on_enter(void) {
+    panel* p = panel_create();
+    double mass = 150;
+    panel_param_def d = {"end arm mass", "booms", "kg", &mass, 20, 5000, 0, false};
+    int im = panel_add_param(p, &d);
+    seen s = {0, -1, 0};
+    panel_on_change(p, on_change, &s);
+    panel_edit_typed(p, im, 20, false); // "9", clamped
+    panel_edit_typed(p, im, 90, false);
+    double v = 0;
+    CHECK(s.calls == 0 && mass == 150 && panel_pending(p, im, &v) && v == 90,
+          "while typing: %d calls, mass %g, pending %g", s.calls, mass, v);
+    CHECK(panel_edit_typed(p, im, 900, true) == PANEL_OK && s.calls == 1 && mass == 900 &&
+              !panel_pending(p, im, NULL),
+          "on Enter: %d calls, mass %g", s.calls, mass);
+    panel_destroy(p);
+}
+
 // A choice takes whole option indices only and names its options.
 static void test_choice(void) {
     panel* p = panel_create();
@@ -161,6 +182,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_groups_and_actions);
     RUN_TEST(test_drag_speed_is_relative);
     RUN_TEST(test_on_release_applies_once);
+    RUN_TEST(test_typed_value_applies_on_enter);
     RUN_TEST(test_choice);
     TEST_MAIN_END();
 }
