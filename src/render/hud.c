@@ -273,7 +273,12 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
     const int nrows = 14;
     float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
+    // The status line ("[keys: panel - Enter/Esc gives them back]") is the
+    // widest text; the box grows to hold it rather than cut it at its edge.
+    if (r->status[0]) w = fmaxf(w, render_hud_text_width(r->status, sc) + 12);
     render_hud_rect(h, x - 6, y - 6, w, lh * (float)nrows + 10, k_panel);
+    h->readouts_rect[0] = x - 6, h->readouts_rect[1] = y - 6, h->readouts_rect[2] = w,
+    h->readouts_rect[3] = lh * (float)nrows + 10;
     char buf[160], rt[32];
     // rt_factor 0 means unknown (world_snapshot.h), e.g. over the first
     // instants, where a ratio of two tiny times means nothing.

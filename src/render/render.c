@@ -229,6 +229,12 @@ bool render_hud_bar_rect(const render* r, int cyl, int chamber, int rect[4]) {
     return true;
 }
 
+bool render_hud_readouts_rect(const render* r, float rect[4]) {
+    if (!(r->hud.readouts_rect[2] > 0)) return false;
+    memcpy(rect, r->hud.readouts_rect, 4 * sizeof(float));
+    return true;
+}
+
 void render_size(const render* r, int* w, int* h) {
     if (w) *w = r->w;
     if (h) *h = r->h;

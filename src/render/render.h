@@ -160,6 +160,9 @@ void render_body_point(const world_snap_body* b, const double p[3], double world
 /// RENDER_BAR_EMPTY_RGB.
 bool render_hud_bar_rect(const render* r, int cyl, int chamber, int rect[4]);
 #define RENDER_BAR_EMPTY_RGB 0x141418
+/// Screen rectangle (x, y, w, h [px], origin top left) of the readouts box
+/// at the top left as drawn in the last frame; false before the first HUD.
+bool render_hud_readouts_rect(const render* r, float rect[4]);
 
 /// Current framebuffer size [px].
 void render_size(const render* r, int* w, int* h);

@@ -10,6 +10,7 @@
 #include "check.h"
 #include "panel.h"
 #include "render.h"
+#include "render_internal.h" // render_hud_text_width: the HUD font's metrics
 
 enum { W = 1280, H = 720 };
 
@@ -132,6 +133,23 @@ static int bar_fill(render* r, int cyl, int chamber) {
             if (rgb != RENDER_BAR_EMPTY_RGB) ++n;
         }
     return n;
+}
+
+// The readouts box holds the status line, the widest text it shows: the
+// panel's "[keys: panel - ...]" ran past its edge and was cut off.
+static void test_status_line_inside_readouts(void) {
+    render* r = make(true);
+    if (!r) return;
+    render_demo_params p = render_demo_default_params();
+    render_demo_scene(&snap, &p, terrain);
+    const char* st = "REC   [keyboard]  [keys: panel - Enter/Esc gives them back]  1 resets or rebuilds";
+    render_set_status(r, st);
+    render_frame(r, &snap);
+    float rc[4] = {0};
+    CHECK(render_hud_readouts_rect(r, rc), "readouts drawn");
+    const float need = render_hud_text_width(st, 1.5f);
+    CHECK(rc[0] + rc[2] >= 10 + need, "box ends at %.0f px, the status line at %.0f px", rc[0] + rc[2], 10 + need);
+    render_destroy(r);
 }
 
 static void test_pressure_bars_follow_pressure(void) {
@@ -504,6 +522,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_frame_not_blank_and_png);
     RUN_TEST(test_crane_where_it_projects);
     RUN_TEST(test_pressure_bars_follow_pressure);
+    RUN_TEST(test_status_line_inside_readouts);
     RUN_TEST(test_camera_presets);
     RUN_TEST(test_zoom_per_notch);
     RUN_TEST(test_default_view_above_the_charts);
