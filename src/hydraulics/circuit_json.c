@@ -2,7 +2,7 @@
 // library so the core stays libm-only.
 //
 // The loader walks the document, turning every field into the same definition
-// structs the C API uses (via the parameter and port tables in circuit.c),
+// structs the C API uses (via each type's descriptor, component_table.c),
 // then compiles. Value and cross-field rules live once, in the compiler;
 // errors it reports (element index + field) are mapped back to JSON paths
 // here. Unknown keys are rejected so a typo never silently falls back to a
@@ -110,37 +110,6 @@ static int read_params(const jctx* c, const cJSON* o, const char* path, void* de
     return 0;
 }
 
-// Default def of a type, as raw bytes in the element union.
-static void default_def(hyd_type t, hyd_elem* e) {
-    switch (t) {
-    case HYD_TANK: e->def.tank = hyd_default_tank_def(); break;
-    case HYD_VOLUME: e->def.volume = hyd_default_volume_def(); break;
-    case HYD_PUMP: e->def.pump = hyd_default_pump_def(); break;
-    case HYD_RELIEF: e->def.relief = hyd_default_relief_def(); break;
-    case HYD_CHECK: e->def.check = hyd_default_check_def(); break;
-    case HYD_ORIFICE: e->def.orifice = hyd_default_orifice_def(); break;
-    case HYD_HOSE: e->def.hose = hyd_default_hose_def(); break;
-    case HYD_VALVE: e->def.valve = hyd_default_valve_def(); break;
-    case HYD_CYLINDER: e->def.cylinder = hyd_default_cylinder_def(); break;
-    default: break;
-    }
-}
-
-static int add_elem(hyd_builder* b, hyd_elem* e) {
-    switch (e->type) {
-    case HYD_TANK: return hyd_add_tank(b, &e->def.tank);
-    case HYD_VOLUME: return hyd_add_volume(b, &e->def.volume);
-    case HYD_PUMP: return hyd_add_pump(b, &e->def.pump);
-    case HYD_RELIEF: return hyd_add_relief(b, &e->def.relief);
-    case HYD_CHECK: return hyd_add_check(b, &e->def.check);
-    case HYD_ORIFICE: return hyd_add_orifice(b, &e->def.orifice);
-    case HYD_HOSE: return hyd_add_hose(b, &e->def.hose);
-    case HYD_VALVE: return hyd_add_valve(b, &e->def.valve);
-    case HYD_CYLINDER: return hyd_add_cylinder(b, &e->def.cylinder);
-    default: return -1;
-    }
-}
-
 // One entry of "nodes" (nodes = 1) or "components" (nodes = 0).
 static int read_elem(const jctx* c, hyd_builder* b, const cJSON* o, const char* list, int i,
                      int nodes) {
@@ -172,17 +141,25 @@ static int read_elem(const jctx* c, hyd_builder* b, const cJSON* o, const char* 
         return -1;
     }
     const int t = hyd_type_parse(jt->valuestring);
-    const int is_node_type = t == HYD_TANK || t == HYD_VOLUME;
-    if (t < 0 || is_node_type != nodes) {
+    const hyd_component* desc = t >= 0 ? hyd_component_of((hyd_type)t) : NULL;
+    if (!desc || desc->is_node != nodes) {
+        // The known types of this list, in table order.
+        char known[200] = "";
+        size_t len = 0;
+        for (int k = 0; k < HYD_TYPE_COUNT; ++k) {
+            const hyd_component* d = hyd_component_of((hyd_type)k);
+            if (d && d->is_node == nodes)
+                len += (size_t)snprintf(known + len, len < sizeof known ? sizeof known - len : 0,
+                                        "%s%s", len ? ", " : "", d->name);
+        }
         jerr(c, fpath, "unknown %s type '%s' (known: %s)", nodes ? "node" : "component",
-             jt->valuestring,
-             nodes ? "tank, volume" : "pump, relief, check, orifice, hose, valve, cylinder");
+             jt->valuestring, known);
         return -1;
     }
     hyd_elem e;
     memset(&e, 0, sizeof e);
     e.type = (hyd_type)t;
-    default_def(e.type, &e);
+    desc->defaults(&e.def);
     int np, nports;
     const hyd_param_info* p = hyd_params_of(e.type, &np);
     const hyd_port_info* ports = hyd_ports_of(e.type, &nports);
@@ -193,7 +170,7 @@ static int read_elem(const jctx* c, hyd_builder* b, const cJSON* o, const char* 
     *(const char**)base = jn->valuestring;
     for (int k = 0; k < nports; ++k)
         *(const char**)(base + ports[k].off) = port_names[k];
-    if (add_elem(b, &e) < 0) {
+    if (hyd_add(b, e.type, &e.def) < 0) {
         jerr(c, path, "out of memory");
         return -1;
     }

@@ -196,6 +196,9 @@ int hyd_add_orifice(hyd_builder* b, const hyd_orifice_def* def);
 int hyd_add_hose(hyd_builder* b, const hyd_hose_def* def);
 int hyd_add_valve(hyd_builder* b, const hyd_valve_def* def);
 int hyd_add_cylinder(hyd_builder* b, const hyd_cylinder_def* def);
+/// Add an element of type t from its def struct (def points to the
+/// hyd_<type>_def of t); the same as the typed hyd_add_* functions.
+int hyd_add(hyd_builder* b, hyd_type t, const void* def);
 
 /// Where a build error was found (used by the JSON loader to name JSON paths).
 typedef struct hyd_build_error {
@@ -214,7 +217,7 @@ hyd_model* hyd_compile(const hyd_builder* b, char* err, size_t errsz);
 hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e);
 void hyd_model_free(hyd_model* m);
 
-/// The default two-actuator crane circuit of SPEC section 4 (components named
+/// The default two-actuator crane circuit of docs/model.md (components named
 /// as in tests/hydraulics/data/crane_circuit.json: "lift_valve", "lift_cyl",
 /// "jib_valve", "jib_cyl", ...). 11 states.
 hyd_model* hyd_model_default_crane(char* err, size_t errsz);
