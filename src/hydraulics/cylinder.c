@@ -11,7 +11,7 @@
 //   S = delta^2/(2w) for delta < w, delta - w/2 beyond (spring with C1 onset)
 //   W = smoothstep(delta/w)                         (damper fades in, C1)
 // so F is C1 in x and x': no kink for the Jacobian or finite differences.
-#include "hyd_internal.h"
+#include "hyd_cylinder.h"
 
 #include <math.h>
 
@@ -68,27 +68,22 @@ static void cylinders_eval(const hyd_model* m, hyd_data* d, const void* rec, int
         const double x = d->cyl_x[i], v = d->cyl_v[i];
         const double pA = d->node_p[c->nA], pB = d->node_p[c->nB];
 
-        const double VA = c->VA0 + c->AA * x, VB = c->VB0 + c->AB * (c->s - x);
-        const double VAmin = HYD_VMIN_FRAC * c->VA0, VBmin = HYD_VMIN_FRAC * c->VB0;
-        d->node_V[c->nA] = VA > VAmin ? VA : VAmin;
-        d->node_V[c->nB] = VB > VBmin ? VB : VBmin;
+        double VA, VB, dVA, dVB;
+        hyd_cyl_volumes(c->VA0, c->VB0, c->AA, c->AB, c->s, x, &VA, &VB, &dVA, &dVB);
+        d->node_V[c->nA] = VA;
+        d->node_V[c->nB] = VB;
         d->node_dV[c->nA] = c->AA * v;
         d->node_dV[c->nB] = -c->AB * v;
 
-        const double leak = c->CL * (pA - pB);
+        const double leak = hyd_cyl_leak(c->CL, pA, pB);
         d->comp_q[2 * c->comp] = leak;
         hyd_flow2(m, d, G, c->comp, c->nA, c->nB, leak, c->CL, -c->CL);
 
-        // Retracted stop pushes out (+), extended stop pushes in (-).
-        double fdl, fvl, fdh, fvh;
-        const double flo = hyd_stop_force(c->ks, c->cs, c->ws, -x, -v, &fdl, &fvl);
-        const double fhi = hyd_stop_force(c->ks, c->cs, c->ws, x - c->s, v, &fdh, &fvh);
-        d->cyl_F[i] = pA * c->AA - pB * c->AB - c->bv * v + flo - fhi;
+        // dF/dx and dF/dv (used by hyd_jacobian; cheap enough to always write).
+        d->cyl_F[i] = hyd_cyl_force(c->AA, c->AB, c->bv, c->ks, c->cs, c->ws, c->s, pA, pB, x, v,
+                                    &d->dFdx[i], &d->dFdv[i]);
         d->cyl_stop[i] = (x > c->s) - (x < 0.0);
         d->comp_open[c->comp] = d->cyl_stop[i] != 0;
-        // dF/dx and dF/dv (used by hyd_jacobian; cheap enough to always write).
-        d->dFdx[i] = -fdl - fdh;
-        d->dFdv[i] = -c->bv - fvl - fvh;
     }
 }
 
@@ -105,8 +100,8 @@ static void cylinders_jacobian(const hyd_model* m, hyd_data* d, const void* rec,
         const double netA = d->node_q[c->nA] - d->node_dV[c->nA];
         const double netB = d->node_q[c->nB] - d->node_dV[c->nB];
         // The volume floor makes V constant in x once reached.
-        const double dVA = (c->VA0 + c->AA * x > HYD_VMIN_FRAC * c->VA0) ? c->AA : 0.0;
-        const double dVB = (c->VB0 + c->AB * (c->s - x) > HYD_VMIN_FRAC * c->VB0) ? -c->AB : 0.0;
+        double VAf, VBf, dVA, dVB;
+        hyd_cyl_volumes(c->VA0, c->VB0, c->AA, c->AB, c->s, x, &VAf, &VBf, &dVA, &dVB);
         d->dydx[i * n + c->sA] = -cA / VA * dVA * netA;
         d->dydx[i * n + c->sB] = -cB / VB * dVB * netB;
         d->dydv[i * n + c->sA] = -cA * c->AA;

@@ -5,6 +5,7 @@
 // node "to" by a laminar Hagen-Poiseuille resistance
 //   Q = G (p_hose - p_to),  G = pi d^4 / (128 mu L),  mu = rho nu.
 // Hose and chamber then form each actuator's fastest (stiff) modes.
+#include "hyd_hose.h"
 #include "hyd_internal.h"
 
 hyd_hose_def hyd_default_hose_def(void) {
@@ -35,7 +36,7 @@ static void hoses_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, 
     (void)y, (void)ydot, (void)map;
     for (int i = 0; i < n; ++i) {
         const hyd_hose_c* c = (const hyd_hose_c*)rec + i;
-        const double q = c->G * (d->node_p[c->node] - d->node_p[c->to]);
+        const double q = hyd_hose_q(c->G, d->node_p[c->node], d->node_p[c->to]);
         d->comp_q[2 * c->comp] = q;
         hyd_flow2(m, d, G, c->comp, c->node, c->to, q, c->G, -c->G);
     }

@@ -303,27 +303,6 @@ int hyd_elem_copy(hyd_elem* dst, const hyd_elem* src);
 void hyd_elem_free(hyd_elem* e);
 char* hyd_strdup(const char* s);
 
-/// Orifice law on precomputed constants: Q [m^3/s], *g = dQ/ddp, *gA = dQ/dA
-/// (see orifice.c). Inline: it runs twice per valve per evaluation, and the
-/// caller's unused partials then cost nothing.
-static inline double hyd_orifice_q(const hyd_orif_k* k, double A, double dp, double* g, double* gA) {
-    const double x = dp * A * k->invP0;
-    if (fabs(x) < 1.0) {
-        const double sA = sqrt(A);
-        const double G = k->kl * A * sA;
-        const double x2 = x * x;
-        const double lam = 1.0 - 0.2 * x2;
-        *g = G * (1.0 - 0.6 * x2);
-        // dQ/dA = dG/dA dp (1 - x^2/5) - G dp (2x/5) dx/dA, dx/dA = dp / P0
-        *gA = 1.5 * k->kl * sA * dp * lam - G * dp * 0.4 * x * dp * k->invP0;
-        return G * dp * lam;
-    }
-    const double s = sqrt(fabs(dp));
-    *g = 0.5 * k->k * A / s;
-    *gA = k->k * copysign(s, dp);
-    return k->k * A * copysign(s, dp);
-}
-
 // ---------------------------------------------------------------------------
 // Kernels: each type's eval hook loops over all its records, adds flows into
 // d->node_q and, when G is non-NULL, flow partials into G, an (n+1) x (n+1)
@@ -453,46 +432,6 @@ static inline double hyd_smoothstep(double t, double* ds) {
     }
     *ds = 6.0 * t * (1.0 - t);
     return t * t * (3.0 - 2.0 * t);
-}
-
-/// Relief/check opening law on t = d / w (see relief.c): 0, t^2, then 2t - 1;
-/// *dr = d ramp / d d (so it includes 1/w).
-static inline double hyd_open_ramp_t(double t, double inv_w, double* dr) {
-    if (t <= 0.0) {
-        *dr = 0.0;
-        return 0.0;
-    }
-    if (t < 1.0) {
-        *dr = 2.0 * t * inv_w;
-        return t * t;
-    }
-    *dr = 2.0 * inv_w;
-    return 2.0 * t - 1.0;
-}
-
-/// Cylinder end stop (see cylinder.c) of stiffness ks [N/m], damping cs
-/// [N s/m] and smoothing width ws [m]: force magnitude for penetration delta
-/// and its rate ddelta, with partials d|F|/ddelta (*fd) and d|F|/dddelta (*fv).
-static inline double hyd_stop_force(double ks, double cs, double ws, double delta, double ddelta, double* fd,
-                                    double* fv) {
-    if (delta <= 0.0) {
-        *fd = 0.0;
-        *fv = 0.0;
-        return 0.0;
-    }
-    const double t = delta / ws;
-    double S, dS, dW;
-    if (t < 1.0) {
-        S = 0.5 * delta * t;
-        dS = t;
-    } else {
-        S = delta - 0.5 * ws;
-        dS = 1.0;
-    }
-    const double W = hyd_smoothstep(t, &dW);
-    *fd = ks * dS + cs * dW / ws * ddelta;
-    *fv = cs * W;
-    return ks * S + cs * W * ddelta;
 }
 
 

@@ -9,7 +9,7 @@
 //   G = 5 K / (4 sqrt(p_tr)) = kl A^1.5,   Q = G dp (1 - x^2/5),
 // and x = dp A / P0, so A -> 0 gives Q -> 0 and dQ/ddp -> 0 with no division
 // by A: a closed valve edge needs no special case.
-#include "hyd_internal.h"
+#include "hyd_orifice.h"
 
 #include <math.h>
 

@@ -4,7 +4,7 @@
 // then q_max (1 - smoothstep((dp - p_set)/band)): C1, zero at p_set + band.
 // The cubic corner keeps dQ/dp bounded (-1.5 q_max / band at mid-band), so
 // the pump-line mode stays finite for the stiff solvers.
-#include "hyd_internal.h"
+#include "hyd_pump.h"
 
 hyd_pump_def hyd_default_pump_def(void) {
     hyd_pump_def d = {0};
@@ -27,12 +27,9 @@ static void pumps_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, 
     for (int i = 0; i < n; ++i) {
         const hyd_pump_c* c = (const hyd_pump_c*)rec + i;
         const double dp = d->node_p[c->out] - d->node_p[c->in];
-        const double t = (dp - c->pset) * c->inv_band;
-        double ds;
-        const double s = hyd_smoothstep(t, &ds);
-        const double q = c->qmax * (1.0 - s);
         // q flows in -> out and depends on p_out - p_in.
-        const double g = -c->qmax * ds * c->inv_band; // dq/d(dp)
+        double g, t; // dq/d(dp), and where dp stands in the band
+        const double q = hyd_pump_q(c->qmax, c->pset, c->inv_band, dp, &g, &t);
         d->comp_q[2 * c->comp] = q;
         d->comp_open[c->comp] = t > 0.0;
         hyd_flow2(m, d, G, c->comp, c->in, c->out, q, -g, g);

@@ -5,7 +5,7 @@
 // Value and slope match at d = 0 and d = w, so the Jacobian stays bounded when
 // the valve cracks; beyond w it behaves as a linear (laminar-like) resistance
 // with the slope of the corner's end, 2 q_rated / w.
-#include "hyd_internal.h"
+#include "hyd_ramp.h"
 
 hyd_relief_def hyd_default_relief_def(void) {
     hyd_relief_def d = {0};
@@ -39,18 +39,15 @@ void hyd_ramps_eval(const hyd_model* m, hyd_data* d, double* G, const hyd_ramp_c
     double* restrict fl = d->flow_;
     for (int i = 0; i < nv; ++i) {
         const hyd_ramp_c* c = &v[i];
-        const double t = (p[c->in] - p[c->out] - c->pcr) * c->inv_w;
-        if (t <= 0.0) { // (a NaN takes the full path and propagates)
+        double g, t;
+        const double q = hyd_ramp_q(c->pcr, c->inv_w, c->qr, p[c->in] - p[c->out], &g, &t);
+        if (t <= 0.0) { // closed: +0 flows (a NaN takes the full path and propagates)
             cq[2 * c->comp] = 0.0;
             open[c->comp] = 0;
             fl[4 * c->comp] = 0.0;
             fl[4 * c->comp + 1] = 0.0;
             continue;
         }
-        double dr;
-        const double r = hyd_open_ramp_t(t, c->inv_w, &dr);
-        const double q = c->qr * r;
-        const double g = c->qr * dr;
         cq[2 * c->comp] = q;
         open[c->comp] = q > 0.0;
         fl[4 * c->comp] = -q;

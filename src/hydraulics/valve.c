@@ -8,7 +8,7 @@
 // about 0.4 Pa for the default valve). Only the two open edges are evaluated;
 // port nodes are chosen by the sign of u. Because the orifice's laminar flow
 // scales as A^1.5, Q(u) is C1 through u = 0 even though |u| is not.
-#include "hyd_internal.h"
+#include "hyd_valve.h"
 
 #include <math.h>
 
@@ -42,20 +42,18 @@ static inline void valves_kernel(const hyd_model* m, hyd_data* d, const hyd_valv
         const hyd_valve_c* c = &rec[i];
         const int at = map ? map[c->adr] : c->adr;
         const double u = y[at];
-        const double raw = d->valve_cmd[i];
-        const double cmd = raw > 1.0 ? 1.0 : (raw < -1.0 ? -1.0 : raw);
         if (ydot)
-            ydot[at] = (cmd - u) * c->inv_tau;
+            ydot[at] = hyd_spool_rate(d->valve_cmd[i], u, c->inv_tau);
 
-        const int pos = u >= 0.0;
-        const double sgn = pos ? 1.0 : -1.0;
-        const double A = c->Amax * fabs(u);
         // Edge 1 feeds the work port from P; edge 2 drains the other one to T.
+        hyd_valve_flow e;
+        hyd_valve_edges(&c->ok, c->Amax, u, d->node_p[c->P], d->node_p[c->T], d->node_p[c->A],
+                        d->node_p[c->B], &e);
+        const int pos = e.pos;
+        const double sgn = pos ? 1.0 : -1.0;
         const int feed = pos ? c->A : c->B;
         const int drain = pos ? c->B : c->A;
-        double g1, g1A, g2, g2A;
-        const double q1 = hyd_orifice_q(&c->ok, A, d->node_p[c->P] - d->node_p[feed], &g1, &g1A);
-        const double q2 = hyd_orifice_q(&c->ok, A, d->node_p[drain] - d->node_p[c->T], &g2, &g2A);
+        const double q1 = e.q1, q2 = e.q2, g1 = e.g1, g2 = e.g2, g1A = e.g1A, g2A = e.g2A;
         const double qA = pos ? q1 : -q2; // into port A
         const double qB = pos ? q2 : -q1; // out of port B
         double* fl = d->flow_ + 4 * c->comp;
