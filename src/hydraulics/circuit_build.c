@@ -185,6 +185,7 @@ void hyd_model_free(hyd_model* m) {
     free(m->node_owner);
     free(m->comp_node0);
     free(m->comp_slot);
+    free(m->comp_state0);
     free(m->comp_sub);
     free(m->vol_ptr);
     free(m->vol_flow);
@@ -303,7 +304,7 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
              HYD_ALLOC(m->node_bec, nnode) && HYD_ALLOC(m->node_owner, nnode) &&
              HYD_ALLOC(m->node_p0, nnode) && HYD_ALLOC(m->vol_node, nnode) &&
              HYD_ALLOC(m->tank_node, nnode) && HYD_ALLOC(m->comp_node0, b->ncomp) &&
-             HYD_ALLOC(m->comp_slot, HYD_MAXSLOT * b->ncomp) &&
+             HYD_ALLOC(m->comp_slot, HYD_MAXSLOT * b->ncomp) && HYD_ALLOC(m->comp_state0, b->ncomp) &&
              HYD_ALLOC(m->comp_sub, b->ncomp) && HYD_ALLOC(m->state_name, nstate) &&
              HYD_ALLOC(m->y0, nstate);
     for (int t = 0; t < HYD_TYPE_COUNT && ok; ++t) {
@@ -329,9 +330,7 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
 
     // Nodes and states in the documented order: user nodes, then owned
     // nodes in component order; volume pressures, then component states.
-    int* state0 = calloc((size_t)(b->ncomp > 0 ? b->ncomp : 1), sizeof *state0);
-    if (!state0)
-        return fail(m, NULL, e, -1, 0, "", "out of memory");
+    int* state0 = m->comp_state0;
     int in = 0, is = 0;
     int nsub[HYD_TYPE_COUNT] = {0};
     for (int i = 0; i < b->nnode + b->ncomp; ++i) {
@@ -358,10 +357,10 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
     }
     for (int i = 0; i < nnode; ++i)
         if (!m->node_name[i])
-            return fail(m, state0, e, -1, 0, "", "out of memory");
+            return fail(m, NULL, e, -1, 0, "", "out of memory");
     for (int i = 0; i < nstate; ++i)
         if (!m->state_name[i])
-            return fail(m, state0, e, -1, 0, "", "out of memory");
+            return fail(m, NULL, e, -1, 0, "", "out of memory");
     for (int i = 0; i < nnode; ++i) {
         m->node_sidx[i] = m->node_state[i] >= 0 ? m->node_state[i] : nstate;
         if (m->node_state[i] >= 0)
@@ -374,7 +373,7 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
     // bind each record to its nodes and states.
     int* conn = calloc((size_t)(nnode > 0 ? nnode : 1), sizeof *conn);
     if (!conn)
-        return fail(m, state0, e, -1, 0, "", "out of memory");
+        return fail(m, NULL, e, -1, 0, "", "out of memory");
     for (int i = 0; i < b->ncomp; ++i) {
         const hyd_elem* el = &b->comp[i];
         const hyd_component* d = hyd_component_of(el->type);
@@ -385,19 +384,19 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
         for (int k = 0; k < np; ++k) {
             if (!el->port[k]) {
                 free(conn);
-                return fail(m, state0, e, 2, i, pi[k].name, "missing node name");
+                return fail(m, NULL, e, 2, i, pi[k].name, "missing node name");
             }
             node[k] = find_name(m->node_name, nnode, el->port[k]);
             if (node[k] < 0) {
                 snprintf(msg, sizeof msg, "unknown node '%s'", el->port[k]);
                 free(conn);
-                return fail(m, state0, e, 2, i, pi[k].name, msg);
+                return fail(m, NULL, e, 2, i, pi[k].name, msg);
             }
             for (int j = 0; j < k; ++j)
                 if (node[j] == node[k]) {
                     snprintf(msg, sizeof msg, "same node '%s' as %s", el->port[k], pi[j].name);
                     free(conn);
-                    return fail(m, state0, e, 2, i, pi[k].name, msg);
+                    return fail(m, NULL, e, 2, i, pi[k].name, msg);
                 }
         }
         for (int k = 0; k < np; ++k)
@@ -412,7 +411,7 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
             if (d->check_ports(m, (const char* const*)el->port, node, own, field, sizeof field, msg,
                                sizeof msg)) {
                 free(conn);
-                return fail(m, state0, e, 2, i, field, msg);
+                return fail(m, NULL, e, 2, i, field, msg);
             }
         }
         if (d->bind)
@@ -422,7 +421,6 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
         for (int j = 0; j < HYD_MAXSLOT; ++j)
             slot[j] = j < d->nnode ? own[j] : (j - d->nnode < np ? node[j - d->nnode] : -1);
     }
-    free(state0);
     // A user node that nothing connects to is a typo or a leftover (its
     // pressure would be a state that never changes). One port is enough: a
     // pump charging a closed volume is a proper circuit.

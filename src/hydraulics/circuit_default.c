@@ -98,3 +98,50 @@ hyd_model* hyd_model_default_crane(char* err, size_t errsz) {
     hyd_builder_free(b);
     return m;
 }
+
+hyd_model* hyd_model_synthetic(int nact, char* err, size_t errsz) {
+    if (nact < 1 || nact > 64) {
+        if (err && errsz)
+            snprintf(err, errsz, "actuators: must be in [1, 64], got %d", nact);
+        return NULL;
+    }
+    hyd_builder* b = hyd_builder_create();
+    if (!b) {
+        if (err && errsz)
+            snprintf(err, errsz, "out of memory");
+        return NULL;
+    }
+    hyd_tank_def t = hyd_default_tank_def();
+    t.name = "tank";
+    hyd_add_tank(b, &t);
+    hyd_volume_def pl = hyd_default_volume_def();
+    pl.name = "pump_line";
+    pl.volume = 1e-3;
+    hyd_add_volume(b, &pl);
+    // A pump and main relief sized as the crane's, per actuator (35 L/min each).
+    hyd_pump_def p = hyd_default_pump_def();
+    p.name = "pump";
+    p.inlet = "tank";
+    p.outlet = "pump_line";
+    p.q_max = nact * 35.0 / 60000.0 < 0.1 ? nact * 35.0 / 60000.0 : 0.1;
+    p.p_set = 20e6;
+    hyd_add_pump(b, &p);
+    hyd_relief_def r = hyd_default_relief_def();
+    r.name = "main_relief";
+    r.inlet = "pump_line";
+    r.outlet = "tank";
+    r.p_crack = 22e6;
+    hyd_add_relief(b, &r);
+    for (int k = 0; k < nact; ++k) {
+        char pre[16];
+        snprintf(pre, sizeof pre, "act%d", k + 1);
+        // Alternate the crane's two cylinder sizes.
+        if (k % 2)
+            add_actuator(b, pre, 0.080, 0.045, 0.6);
+        else
+            add_actuator(b, pre, 0.100, 0.060, 0.7);
+    }
+    hyd_model* m = hyd_compile(b, err, errsz);
+    hyd_builder_free(b);
+    return m;
+}

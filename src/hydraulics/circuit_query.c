@@ -78,3 +78,104 @@ void hyd_model_initial_state(const hyd_model* m, double* y) {
 }
 hyd_fluid_def hyd_model_fluid(const hyd_model* m) { return m->fluid; }
 
+
+// ---------------------------------------------------------------------------
+// Structure
+// ---------------------------------------------------------------------------
+
+int hyd_model_state_node(const hyd_model* m, int i) {
+    if (i < 0 || i >= m->nstate)
+        return -1;
+    for (int k = 0; k < m->nvol; ++k)
+        if (m->node_state[m->vol_node[k]] == i)
+            return m->vol_node[k];
+    return -1;
+}
+
+hyd_state_kind hyd_model_state_kind(const hyd_model* m, int i) {
+    if (i < 0 || i >= m->nstate)
+        return HYD_STATE_OTHER;
+    if (hyd_model_state_node(m, i) >= 0)
+        return HYD_STATE_PRESSURE;
+    // A non-pressure state belongs to the last component whose states start
+    // at or before it (states are consecutive per component).
+    int owner = -1;
+    for (int c = 0; c < m->ncomp; ++c)
+        if (m->comp_state0[c] <= i && hyd_component_of(m->comp[c].type)->nstate)
+            owner = c;
+    return owner >= 0 && m->comp[owner].type == HYD_VALVE ? HYD_STATE_SPOOL : HYD_STATE_OTHER;
+}
+
+hyd_node_role hyd_model_node_role(const hyd_model* m, int i) {
+    if (i < 0 || i >= m->nnode)
+        return HYD_NODE_LINE;
+    if (m->node_state[i] < 0)
+        return HYD_NODE_TANK;
+    for (int k = 0; k < m->npump; ++k)
+        if (m->pump[k].out == i)
+            return HYD_NODE_SUPPLY;
+    return HYD_NODE_LINE;
+}
+
+int hyd_model_supply_node(const hyd_model* m) {
+    for (int i = 0; i < m->nnode; ++i)
+        if (hyd_model_node_role(m, i) == HYD_NODE_SUPPLY)
+            return i;
+    return -1;
+}
+
+int hyd_model_node_owner(const hyd_model* m, int i) {
+    return (i >= 0 && i < m->nnode) ? m->node_owner[i] : -1;
+}
+
+int hyd_model_comp_node(const hyd_model* m, int c, int k) {
+    if (c < 0 || c >= m->ncomp)
+        return -1;
+    const hyd_component* d = hyd_component_of(m->comp[c].type);
+    return (k >= 0 && k < d->nnode) ? m->comp_node0[c] + k : -1;
+}
+
+int hyd_model_port_node(const hyd_model* m, int c, int k) {
+    if (c < 0 || c >= m->ncomp)
+        return -1;
+    const hyd_component* d = hyd_component_of(m->comp[c].type);
+    // Flow slots are the owned nodes, then the ports (circuit_build.c).
+    return (k >= 0 && k < d->nport) ? m->comp_slot[HYD_MAXSLOT * c + d->nnode + k] : -1;
+}
+
+int hyd_model_feed_hose(const hyd_model* m, int node) {
+    for (int h = 0; h < m->nhose; ++h)
+        if (m->hose[h].to == node)
+            return m->hose[h].comp;
+    return -1;
+}
+
+void hyd_model_jacobian_pattern(const hyd_model* m, unsigned char* P) {
+    const int n = m->nstate;
+    memset(P, 0, (size_t)n * (size_t)n);
+    for (int k = 0; k < m->nvol; ++k) {
+        const int s = m->node_state[m->vol_node[k]];
+        P[(size_t)s * n + s] = 1; // Be(p) / V depends on p
+    }
+    for (int c = 0; c < m->ncomp; ++c) {
+        const hyd_component* d = hyd_component_of(m->comp[c].type);
+        const int* slot = m->comp_slot + HYD_MAXSLOT * c;
+        // The component's own non-pressure states: after its nodes' pressures.
+        int s0 = m->comp_state0[c];
+        const int ns = d->nstate;
+        for (int k = 0; k < d->nnode; ++k)
+            s0 += m->node_state[m->comp_node0[c] + k] >= 0;
+        for (int a = 0; a < HYD_MAXSLOT; ++a) {
+            if (slot[a] < 0 || m->node_state[slot[a]] < 0)
+                continue;
+            const int sa = m->node_state[slot[a]];
+            for (int b = 0; b < HYD_MAXSLOT; ++b)
+                if (slot[b] >= 0 && m->node_state[slot[b]] >= 0)
+                    P[(size_t)sa * n + m->node_state[slot[b]]] = 1;
+            for (int k = 0; k < ns; ++k)
+                P[(size_t)sa * n + s0 + k] = 1;
+        }
+        for (int k = 0; k < ns; ++k)
+            P[(size_t)(s0 + k) * n + s0 + k] = 1; // a lag on its own state
+    }
+}

@@ -65,7 +65,9 @@ static void cylinders_eval(const hyd_model* m, hyd_data* d, const void* rec, int
     (void)y, (void)ydot, (void)map;
     for (int i = 0; i < n; ++i) {
         const hyd_cyl_c* c = (const hyd_cyl_c*)rec + i;
-        const double x = d->cyl_x[i], v = d->cyl_v[i];
+        // The cylinder's own index (rec may be a subset of the model's cylinders).
+        const int k = m->comp_sub[c->comp];
+        const double x = d->cyl_x[k], v = d->cyl_v[k];
         const double pA = d->node_p[c->nA], pB = d->node_p[c->nB];
 
         double VA, VB, dVA, dVB;
@@ -80,10 +82,10 @@ static void cylinders_eval(const hyd_model* m, hyd_data* d, const void* rec, int
         hyd_flow2(m, d, G, c->comp, c->nA, c->nB, leak, c->CL, -c->CL);
 
         // dF/dx and dF/dv (used by hyd_jacobian; cheap enough to always write).
-        d->cyl_F[i] = hyd_cyl_force(c->AA, c->AB, c->bv, c->ks, c->cs, c->ws, c->s, pA, pB, x, v,
-                                    &d->dFdx[i], &d->dFdv[i]);
-        d->cyl_stop[i] = (x > c->s) - (x < 0.0);
-        d->comp_open[c->comp] = d->cyl_stop[i] != 0;
+        d->cyl_F[k] = hyd_cyl_force(c->AA, c->AB, c->bv, c->ks, c->cs, c->ws, c->s, pA, pB, x, v,
+                                    &d->dFdx[k], &d->dFdv[k]);
+        d->cyl_stop[k] = (x > c->s) - (x < 0.0);
+        d->comp_open[c->comp] = d->cyl_stop[k] != 0;
     }
 }
 
@@ -92,8 +94,9 @@ static void cylinders_jacobian(const hyd_model* m, hyd_data* d, const void* rec,
                                int ldj) {
     (void)Jb, (void)ldj;
     const int n = m->nstate;
-    for (int i = 0; i < nc; ++i) {
-        const hyd_cyl_c* c = (const hyd_cyl_c*)rec + i;
+    for (int ii = 0; ii < nc; ++ii) {
+        const hyd_cyl_c* c = (const hyd_cyl_c*)rec + ii;
+        const int i = m->comp_sub[c->comp]; // its index among the model's cylinders
         const double x = d->cyl_x[i];
         const double VA = d->node_V[c->nA], VB = d->node_V[c->nB];
         const double cA = d->node_be[c->nA] / VA, cB = d->node_be[c->nB] / VB;

@@ -254,6 +254,7 @@ struct hyd_model {
     int nrec[HYD_TYPE_COUNT];
     int* node_owner; ///< (nnode) component that owns the node, or -1 for a user node
     int* comp_node0; ///< (ncomp) first owned node of each component (owned nodes are consecutive)
+    int* comp_state0; ///< (ncomp) first state of each component (its states are consecutive)
     int* comp_slot;  ///< (ncomp x HYD_MAXSLOT) node at each flow slot, -1 unused
     /// Typed views of rec[] for the kernels and queries that know their type.
     int npump, nrelief, ncheck, norifice, nhose, nvalve, ncyl;

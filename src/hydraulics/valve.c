@@ -42,8 +42,9 @@ static inline void valves_kernel(const hyd_model* m, hyd_data* d, const hyd_valv
         const hyd_valve_c* c = &rec[i];
         const int at = map ? map[c->adr] : c->adr;
         const double u = y[at];
+        // The valve's own index (rec may be a subset of the model's valves).
         if (ydot)
-            ydot[at] = hyd_spool_rate(d->valve_cmd[i], u, c->inv_tau);
+            ydot[at] = hyd_spool_rate(d->valve_cmd[m->comp_sub[c->comp]], u, c->inv_tau);
 
         // Edge 1 feeds the work port from P; edge 2 drains the other one to T.
         hyd_valve_flow e;
