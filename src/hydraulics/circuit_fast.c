@@ -164,8 +164,8 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
         take_records(k);
     const int nnode = m->nnode;
     double* p = d->node_p;
-    for (int i = 0; i < nnode; ++i)
-        p[i] = m->node_state[i] >= 0 ? y[m->node_state[i]] : m->node_pfix[i];
+    for (int i = 0; i < m->ntank; ++i) p[m->tank_node[i]] = m->node_pfix[m->tank_node[i]];
+    for (int i = 0; i < m->nvol; ++i) p[m->vol_node[i]] = y[m->node_state[m->vol_node[i]]];
     memcpy(d->node_V, m->node_V0, (size_t)nnode * sizeof(double));
     memset(d->node_dV, 0, (size_t)nnode * sizeof(double));
     memset(k->net, 0, (size_t)nnode * sizeof(double));
@@ -212,8 +212,9 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
         d->cyl_stop[ic] = (x > c->s) - (x < 0.0);
     }
 
-    // 4. Be/V per pressure node.
-    for (int kk = 0; kk < m->nvol; ++kk) {
+    // 4. Be/V per pressure node, before the flows when their partials are
+    // scaled by it (the plain evaluation takes it in step 6).
+    for (int kk = 0; kk < m->nvol && J; ++kk) {
         const int node = m->vol_node[kk];
         double be;
         k->c[node] = hyd_node_c(m, m->node_bel[node], m->node_bec[node], p[node], d->node_V[node],
@@ -283,8 +284,16 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
         const int s = m->node_state[node];
         d->node_q[node] = k->net[node];
         const double net = k->net[node] - d->node_dV[node];
-        ydot[s] = k->c[node] * net;
-        if (J) J[(size_t)s * ldj + s] += k->dbe[node] / d->node_V[node] * net;
+        if (J) {
+            ydot[s] = k->c[node] * net;
+            J[(size_t)s * ldj + s] += k->dbe[node] / d->node_V[node] * net;
+        } else {
+            double be;
+            const double c = hyd_node_c(m, m->node_bel[node], m->node_bec[node], p[node],
+                                        d->node_V[node], &be, NULL);
+            d->node_be[node] = be;
+            ydot[s] = c * net;
+        }
     }
     if (G) {
         // The fallback components' partials, scaled by their rows' c.
