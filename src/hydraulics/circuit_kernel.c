@@ -97,6 +97,18 @@ int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int na
     f->nact = nact;
     if (nact < 1 || nact > HYD_FUSED_MAXACT) return set_why(why, whysz, "too many actuators"), -1;
     if (m->norifice) return set_why(why, whysz, "the circuit has fixed orifices"), -1;
+    // Only the types below are packed: any other component would be left
+    // out of the sum and give plausible wrong numbers, so it is refused.
+    for (int c = 0; c < m->ncomp; ++c) {
+        const hyd_type t = m->comp[c].type;
+        if (t != HYD_PUMP && t != HYD_RELIEF && t != HYD_CHECK && t != HYD_HOSE && t != HYD_VALVE &&
+            t != HYD_CYLINDER) {
+            if (why && whysz)
+                snprintf(why, whysz, "component '%s' (%s): the one-pass kernel has no place for this type",
+                         m->comp[c].name, hyd_type_name(t));
+            return -1;
+        }
+    }
     if (m->npump != 1) return set_why(why, whysz, "the circuit needs exactly one pump"), -1;
     if (m->nvalve != nact || m->ncyl != nact || m->nhose != 2 * nact)
         return set_why(why, whysz, "not one valve, two hoses and one cylinder per actuator"), -1;
