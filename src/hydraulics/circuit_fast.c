@@ -44,6 +44,8 @@ struct hyd_fast {
     double* dbe;         ///< (nnode) dBe/dp [-]
     double* net;         ///< (nnode) net inflow [m^3/s]
     double* f;           ///< (nstate) rates when the Jacobian's caller wants none
+    int* smap;           ///< (nstate) circuit state i lives at y[smap[i]] (hyd_fast_map)
+    int* ns;             ///< (nnode) a node's state in the caller's order, -1 for a tank
 };
 
 unsigned hyd_fast_types(void) {
@@ -68,6 +70,10 @@ static void take_records(hyd_fast* k) {
             k->fb_comp[k->nfb_comp++] = c;
         }
     }
+    // The copies' own state indices in the caller's order (the model's
+    // records, which the reference hooks read, stay in circuit order).
+    hyd_valve_c* va = k->rec[HYD_VALVE];
+    for (int i = 0; i < k->nrec[HYD_VALVE]; ++i) va[i].adr = k->smap[va[i].adr];
     k->rev = m->revision;
 }
 
@@ -83,6 +89,8 @@ void hyd_fast_free(hyd_fast* k) {
     free(k->dbe);
     free(k->net);
     free(k->f);
+    free(k->smap);
+    free(k->ns);
     free(k);
 }
 
@@ -115,7 +123,8 @@ hyd_fast* hyd_fast_create(const hyd_model* m, unsigned types, int fallback, char
             }
         }
         ok = ok && HYD_ALLOC(k->fb_comp, m->ncomp) && HYD_ALLOC(k->c, m->nnode) &&
-             HYD_ALLOC(k->dbe, m->nnode) && HYD_ALLOC(k->net, m->nnode) && HYD_ALLOC(k->f, m->nstate);
+             HYD_ALLOC(k->dbe, m->nnode) && HYD_ALLOC(k->net, m->nnode) && HYD_ALLOC(k->f, m->nstate) &&
+             HYD_ALLOC(k->smap, m->nstate) && HYD_ALLOC(k->ns, m->nnode);
     }
     if (!ok) {
         hyd_fast_free(k);
@@ -123,8 +132,20 @@ hyd_fast* hyd_fast_create(const hyd_model* m, unsigned types, int fallback, char
             snprintf(why, whysz, "out of memory");
         return NULL;
     }
+    for (int i = 0; i < m->nstate; ++i) k->smap[i] = i;
+    memcpy(k->ns, m->node_state, (size_t)m->nnode * sizeof *k->ns);
     take_records(k);
     return k;
+}
+
+int hyd_fast_map(hyd_fast* k, const int* map) {
+    const hyd_model* m = k->m;
+    if (k->nfb_comp) return -1; // the reference loops work in circuit order
+    for (int i = 0; i < m->nstate; ++i) k->smap[i] = map ? map[i] : i;
+    for (int i = 0; i < m->nnode; ++i)
+        k->ns[i] = m->node_state[i] >= 0 ? k->smap[m->node_state[i]] : -1;
+    take_records(k);
+    return 0;
 }
 
 int hyd_fast_nfallback(const hyd_fast* k) { return k->nfb_comp; }
@@ -137,7 +158,7 @@ FAST_INLINE void flow(const hyd_fast* k, double* J, int ldj, int a, int b, doubl
     k->net[a] -= q;
     k->net[b] += q;
     if (J) {
-        const int* ns = k->m->node_state;
+        const int* ns = k->ns;
         const int sa = ns[a], sb = ns[b];
         if (sa >= 0) {
             double* r = J + (size_t)sa * ldj;
@@ -154,7 +175,7 @@ FAST_INLINE void flow(const hyd_fast* k, double* J, int ldj, int a, int b, doubl
 
 // J[row of node a][col] += c_a g (nothing for a tank).
 FAST_INLINE void jcol(const hyd_fast* k, double* J, int ldj, int a, int col, double g) {
-    const int sa = k->m->node_state[a];
+    const int sa = k->ns[a];
     if (sa >= 0) J[(size_t)sa * ldj + col] += k->c[a] * g;
 }
 
@@ -165,14 +186,22 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
     const int nnode = m->nnode;
     double* p = d->node_p;
     for (int i = 0; i < m->ntank; ++i) p[m->tank_node[i]] = m->node_pfix[m->tank_node[i]];
-    for (int i = 0; i < m->nvol; ++i) p[m->vol_node[i]] = y[m->node_state[m->vol_node[i]]];
+    for (int i = 0; i < m->nvol; ++i) p[m->vol_node[i]] = y[k->ns[m->vol_node[i]]];
     memcpy(d->node_V, m->node_V0, (size_t)nnode * sizeof(double));
     memset(d->node_dV, 0, (size_t)nnode * sizeof(double));
     memset(k->net, 0, (size_t)nnode * sizeof(double));
     const int n = m->nstate;
-    if (J)
-        for (int i = 0; i < n; ++i)
-            memset(J + (size_t)i * ldj, 0, (size_t)n * sizeof *J);
+    if (J) {
+        int ident = 1;
+        for (int i = 0; i < n && ident; ++i) ident = k->smap[i] == i;
+        for (int i = 0; i < n; ++i) {
+            double* r = J + (size_t)k->smap[i] * ldj;
+            if (ident)
+                memset(r, 0, (size_t)n * sizeof *J);
+            else
+                for (int j = 0; j < n; ++j) r[k->smap[j]] = 0.0;
+        }
+    }
 
     // 2. Reference loops for the components without a fast loop.
     double* G = NULL;
@@ -281,7 +310,7 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
     // 6. Pressure rates.
     for (int kk = 0; kk < m->nvol; ++kk) {
         const int node = m->vol_node[kk];
-        const int s = m->node_state[node];
+        const int s = k->ns[node];
         d->node_q[node] = k->net[node];
         const double net = k->net[node] - d->node_dV[node];
         if (J) {

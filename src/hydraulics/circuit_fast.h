@@ -33,6 +33,12 @@ unsigned hyd_fast_types(void);
 /// model's records again after a hyd_model_set (its revision).
 hyd_fast* hyd_fast_create(const hyd_model* m, unsigned types, int fallback, char* why, size_t whysz);
 void hyd_fast_free(hyd_fast* k);
+/// Renumber states: circuit state i lives at y[map[i]] (and its rate at
+/// ydot[map[i]], its Jacobian row and column at map[i] of the caller's J)
+/// from now on; map NULL is the circuit's own order. The coupling partials
+/// stay in circuit order. Returns 0, or -1 when components fall back to the
+/// reference loops (which work in circuit order only).
+int hyd_fast_map(hyd_fast* k, const int* map);
 /// Components evaluated by their reference loop.
 int hyd_fast_nfallback(const hyd_fast* k);
 

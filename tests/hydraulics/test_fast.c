@@ -272,6 +272,51 @@ static void test_live_change(void) {
     hyd_model_free(m);
 }
 
+// In a caller's state order (hyd_fast_map) the same numbers, bit for bit,
+// at the mapped places: a state vector of 3 n entries with the circuit's
+// states scattered in reverse.
+static void test_mapped(void) {
+    char err[256], why[256];
+    hyd_model* m = hyd_model_synthetic(3, err, sizeof err);
+    if (!m) return;
+    const int n = hyd_model_nstate(m), N = 3 * n;
+    hyd_fast* k = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+    hyd_fast* km = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+    int* map = malloc((size_t)n * sizeof *map);
+    double *y = calloc((size_t)n, sizeof *y), *f = calloc((size_t)n, sizeof *f);
+    double *J = calloc((size_t)n * n, sizeof *J), *Y = calloc((size_t)N, sizeof *Y);
+    double *F = calloc((size_t)N, sizeof *F), *JM = calloc((size_t)N * N, sizeof *JM);
+    hyd_data* d = hyd_data_create(m);
+    if (!k || !km || !map || !y || !f || !J || !Y || !F || !JM || !d) return;
+    for (int i = 0; i < n; ++i) map[i] = N - 1 - 2 * i;
+    CHECK(hyd_fast_map(km, map) == 0, "map refused");
+    int bad = 0, outside = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        random_state(m, d, y);
+        for (int i = 0; i < n; ++i) Y[map[i]] = y[i];
+        for (int i = 0; i < N * N; ++i) JM[i] = 7.0;
+        hyd_fast_jacobian(k, d, y, f, J, n);
+        hyd_fast_jacobian(km, d, Y, F, JM, N);
+        for (int i = 0; i < n; ++i) {
+            bad += memcmp(&F[map[i]], &f[i], sizeof *f) != 0;
+            for (int j = 0; j < n; ++j) bad += memcmp(&JM[map[i] * N + map[j]], &J[i * n + j], sizeof *J) != 0;
+        }
+        int in_block = 0;
+        for (int i = 0; i < N * N; ++i) in_block += JM[i] != 7.0;
+        outside += in_block > n * n;
+    }
+    CHECK(bad == 0, "%d mapped values differ", bad);
+    CHECK(outside == 0, "entries written outside the mapped block in %d trials", outside);
+    hyd_fast* kf = hyd_fast_create(m, hyd_fast_types() & ~(1u << HYD_HOSE), 1, why, sizeof why);
+    CHECK(kf && hyd_fast_map(kf, map) == -1, "map accepted with fallback components");
+    hyd_fast_free(kf);
+    hyd_data_free(d);
+    free(JM), free(F), free(Y), free(J), free(f), free(y), free(map);
+    hyd_fast_free(km);
+    hyd_fast_free(k);
+    hyd_model_free(m);
+}
+
 static void test_structure(void) {
     char err[256];
     hyd_model* m = hyd_model_default_crane(err, sizeof err);
@@ -339,5 +384,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_synthetic);
     RUN_TEST(test_unsupported);
     RUN_TEST(test_live_change);
+    RUN_TEST(test_mapped);
     TEST_MAIN_END();
 }
