@@ -4,10 +4,10 @@
 // reported: this machine is shared and noisy, so medians and ratios are the
 // honest figures. Benchmarks measure; tests never time anything.
 #include "app.h"
+#include "circuit_fast.h"
 #include "live.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
-#include "circuit_fast.h"
 #endif
 
 #include <math.h>
