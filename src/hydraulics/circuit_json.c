@@ -298,9 +298,34 @@ void hyd_json_fragment_notes(const cJSON* fragment, const char* file, const char
     }
 }
 
-hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const char* prefix,
-                               char* err, size_t errsz) {
-    jctx c = {file, prefix ? prefix : "", err, errsz};
+// Nodes and components of an appended fragment (optional lists).
+static int read_extra(const jctx* c, hyd_builder* b, const cJSON* extra) {
+    if (!cJSON_IsObject(extra)) {
+        jerr(c, "", "must be an object, got %s", jtype(extra));
+        return -1;
+    }
+    for (const cJSON* it = extra->child; it; it = it->next)
+        if (it->string[0] != '_' && strcmp(it->string, "nodes") && strcmp(it->string, "components")) {
+            jerr(c, it->string, "unknown field (known: nodes, components)");
+            return -1;
+        }
+    static const char* const lists[2] = {"nodes", "components"};
+    for (int l = 0; l < 2; ++l)
+        if (cJSON_GetObjectItemCaseSensitive(extra, lists[l]) && read_list(c, b, extra, lists[l], l == 0))
+            return -1;
+    return 0;
+}
+
+static int list_size(const cJSON* o, const char* key) {
+    const cJSON* a = o ? cJSON_GetObjectItemCaseSensitive(o, key) : NULL;
+    return cJSON_IsArray(a) ? cJSON_GetArraySize(a) : 0;
+}
+
+// The circuit, with the fragment extra (NULL: none) appended; errors and
+// notes in the fragment are reported against cx with the fragment's own
+// indices.
+static hyd_model* from_json(const cJSON* circuit, const jctx* cc, const cJSON* extra, const jctx* cx) {
+    const jctx c = *cc;
     if (!cJSON_IsObject(circuit)) {
         jerr(&c, "", "circuit must be an object, got %s", circuit ? jtype(circuit) : "nothing");
         return NULL;
@@ -332,24 +357,53 @@ hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const cha
     }
     if (read_list(&c, b, circuit, "nodes", 1) || read_list(&c, b, circuit, "components", 0))
         goto done;
+    const int nbase[2] = {list_size(circuit, "nodes"), list_size(circuit, "components")};
+    if (extra && read_extra(cx, b, extra))
+        goto done;
     hyd_build_error e;
     m = hyd_compile_ex(b, &e);
     if (!m) {
         char path[160];
+        const jctx* at = &c;
+        int index = e.index;
+        if (extra && (e.where == 1 || e.where == 2) && e.index >= nbase[e.where - 1]) {
+            at = cx;
+            index -= nbase[e.where - 1];
+        }
         if (e.where == 0)
             snprintf(path, sizeof path, "fluid.%s", e.field);
         else if (e.where == 1 || e.where == 2)
             snprintf(path, sizeof path, "%s[%d].%s", e.where == 1 ? "nodes" : "components",
-                     e.index, e.field);
+                     index, e.field);
         else
             path[0] = 0;
-        jerr(&c, path, "%s", e.msg);
+        // The message goes to the caller's buffer whichever part it names.
+        jctx out = *at;
+        out.err = c.err, out.errsz = c.errsz;
+        jerr(&out, path, "%s", e.msg);
+    } else if (extra) {
+        // The base circuit's notes were given when it was loaded on its own.
+        hyd_json_fragment_notes(extra, cx->file, cx->prefix);
     } else {
         note_model(&c, m);
     }
 done:
     hyd_builder_free(b);
     return m;
+}
+
+hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const char* prefix,
+                               char* err, size_t errsz) {
+    const jctx c = {file, prefix ? prefix : "", err, errsz};
+    return from_json(circuit, &c, NULL, NULL);
+}
+
+hyd_model* hyd_model_from_json_extra(const cJSON* circuit, const char* file, const char* prefix,
+                                     const cJSON* extra, const char* extra_file,
+                                     const char* extra_prefix, char* err, size_t errsz) {
+    const jctx c = {file, prefix ? prefix : "", err, errsz};
+    const jctx cx = {extra_file, extra_prefix ? extra_prefix : "", err, errsz};
+    return from_json(circuit, &c, extra, &cx);
 }
 
 hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz) {

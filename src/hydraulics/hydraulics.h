@@ -424,6 +424,15 @@ struct cJSON;
 /// or "" when the circuit is the whole document). NULL on error, with err set.
 hyd_model* hyd_model_from_json(const struct cJSON* circuit, const char* file, const char* prefix,
                                char* err, size_t errsz);
+/// hyd_model_from_json with a fragment appended: the "nodes" and
+/// "components" of extra (each optional) after the circuit's own, compiled
+/// as one circuit (a world's extra circuit on a model's). An error in the
+/// fragment names extra_file, extra_prefix and the fragment's own index
+/// ("sandbox.json: circuit.components[3].bore: ..."); notes are given for the
+/// fragment only (the circuit's own were given when it was loaded alone).
+hyd_model* hyd_model_from_json_extra(const struct cJSON* circuit, const char* file, const char* prefix,
+                                     const struct cJSON* extra, const char* extra_file,
+                                     const char* extra_prefix, char* err, size_t errsz);
 /// Load a circuit file: either the circuit object itself or a document with a
 /// "hydraulics" member holding it (prefix "hydraulics"). NULL on error.
 hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz);
