@@ -4,6 +4,7 @@
 // reported: this machine is shared and noisy, so medians and ratios are the
 // honest figures. Benchmarks measure; tests never time anything.
 #include "app.h"
+#include "circuit_fast.h"
 #include "live.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
@@ -47,6 +48,8 @@ static void bench_help(FILE* f) {
             "               piecewise-linear commands on lift, jib and slew plus hook toggles in the\n"
             "               sandbox, as fast as it runs, with drive's run checks: exit status,\n"
             "               non-finite values, the failure if any, peak RSS (--seed N, default 1)\n"
+            "  circuit-sizes  not in the default set: one circuit evaluation (fast kernel, reference)\n"
+            "               on synthetic circuits of 1, 2, 4, 8, 16 actuators, ns per eval and per state\n"
             "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
             "               operator, for --duration seconds of wall time (default 60): fps,\n"
             "               frame times, missed real-time deadlines, command rate\n"
@@ -248,6 +251,76 @@ static int bench_length(const app_common* c, const model* m, const scenario* sc,
     return 0;
 }
 
+// circuit-sizes: the cost of one circuit evaluation on synthetic circuits of
+// 1, 2, 4, 8 and 16 actuators (hyd_model_synthetic), through the fast kernel
+// (circuit_fast.h) and the reference loops, in ns per evaluation and per
+// state. A kernel whose cost per state stays flat across sizes scales with
+// the circuit; the last line gives the ratio of the largest to the smallest.
+static int bench_circuit_sizes(int repeat) {
+    static const int sizes[5] = {1, 2, 4, 8, 16};
+    double per_state[5] = {0};
+    for (int s = 0; s < 5; ++s) {
+        char err[256];
+        hyd_model* m = hyd_model_synthetic(sizes[s], err, sizeof err);
+        hyd_fast* k = m ? hyd_fast_create(m, hyd_fast_types(), 0, err, sizeof err) : NULL;
+        hyd_data* d = m ? hyd_data_create(m) : NULL;
+        const int n = m ? hyd_model_nstate(m) : 0;
+        double* y = calloc((size_t)(n > 0 ? n : 1), sizeof *y);
+        double* f = calloc((size_t)(n > 0 ? n : 1), sizeof *f);
+        if (!k || !d || !y || !f) {
+            printf("{\"config\":\"circuit-sizes\",\"error\":\"%s\"}\n", m ? err : "synthetic circuit");
+            hyd_fast_free(k), hyd_data_free(d), hyd_model_free(m), free(y), free(f);
+            return EXIT_RUNTIME;
+        }
+        // A working point: pressures 5..15 MPa, spools half open both ways,
+        // strokes at mid-stroke and moving (no relief open, no end stop).
+        hyd_model_initial_state(m, y);
+        for (int i = 0; i < n; ++i)
+            y[i] = hyd_model_state_kind(m, i) == HYD_STATE_SPOOL ? (i % 2 ? 0.5 : -0.5) : 5e6 + 1e6 * (i % 11);
+        for (int c = 0; c < hyd_model_ncylinder(m); ++c) {
+            double AA, AB, st;
+            hyd_model_cylinder_geometry(m, c, &AA, &AB, &st);
+            d->cyl_x[c] = 0.5 * st, d->cyl_v[c] = 0.05;
+        }
+        for (int v = 0; v < hyd_model_nvalve(m); ++v) d->valve_cmd[v] = 0.5;
+        // About 2e6 state evaluations per run, whatever the size.
+        const long iters = 2000000L / n;
+        double tf[16], tr[16];
+        const int reps = repeat < 1 ? 1 : (repeat > 16 ? 16 : repeat);
+        double sink = 0.0;
+        for (int r = 0; r < reps; ++r) {
+            double w0 = sim_wall_time();
+            for (long it = 0; it < iters; ++it) {
+                hyd_fast_eval(k, d, y, f);
+                sink += f[0];
+            }
+            tf[r] = (sim_wall_time() - w0) / (double)iters;
+            w0 = sim_wall_time();
+            for (long it = 0; it < iters; ++it) {
+                hyd_eval(m, d, 0.0, y, f);
+                sink += f[0];
+            }
+            tr[r] = (sim_wall_time() - w0) / (double)iters;
+        }
+        for (int a = 1; a < reps; ++a) // insertion sort, for the medians
+            for (int b = a; b > 0 && tf[b] < tf[b - 1]; --b) { double t = tf[b]; tf[b] = tf[b - 1]; tf[b - 1] = t; }
+        for (int a = 1; a < reps; ++a)
+            for (int b = a; b > 0 && tr[b] < tr[b - 1]; --b) { double t = tr[b]; tr[b] = tr[b - 1]; tr[b - 1] = t; }
+        const double fast = tf[reps / 2] * 1e9, ref = tr[reps / 2] * 1e9;
+        per_state[s] = fast / n;
+        printf("{\"config\":\"circuit-sizes\",\"actuators\":%d,\"states\":%d,\"repeat\":%d,"
+               "\"fast_ns_per_eval\":%.1f,\"fast_ns_per_state\":%.2f,\"reference_ns_per_eval\":%.1f,"
+               "\"reference_ns_per_state\":%.2f,\"check\":%g}\n",
+               sizes[s], n, reps, fast, fast / n, ref, ref / n, sink != sink ? 1.0 : 0.0);
+        hyd_fast_free(k), hyd_data_free(d), hyd_model_free(m), free(y), free(f);
+    }
+    double lo = per_state[0], hi = per_state[0];
+    for (int s = 1; s < 5; ++s) lo = fmin(lo, per_state[s]), hi = fmax(hi, per_state[s]);
+    printf("{\"config\":\"circuit-sizes\",\"fast_ns_per_state_max_over_min\":%.3f}\n", hi / lo);
+    fflush(stdout);
+    return 0;
+}
+
 int cmd_bench(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     int repeat = 3;
@@ -311,6 +384,7 @@ int cmd_bench(int argc, char** argv) {
             want_soak = true;
             continue;
         }
+        if (!strcmp(only[j], "circuit-sizes")) { if (bench_circuit_sizes(repeat)) return EXIT_RUNTIME; continue; }
         bool found = false;
         for (size_t k = 0; k < sizeof configs / sizeof configs[0]; ++k) found |= !strcmp(only[j], configs[k].name);
         if (!found) {

@@ -2,7 +2,7 @@
 // library so the core stays libm-only.
 //
 // The loader walks the document, turning every field into the same definition
-// structs the C API uses (via the parameter and port tables in circuit.c),
+// structs the C API uses (via each type's descriptor, component_table.c),
 // then compiles. Value and cross-field rules live once, in the compiler;
 // errors it reports (element index + field) are mapped back to JSON paths
 // here. Unknown keys are rejected so a typo never silently falls back to a
@@ -110,37 +110,6 @@ static int read_params(const jctx* c, const cJSON* o, const char* path, void* de
     return 0;
 }
 
-// Default def of a type, as raw bytes in the element union.
-static void default_def(hyd_type t, hyd_elem* e) {
-    switch (t) {
-    case HYD_TANK: e->def.tank = hyd_default_tank_def(); break;
-    case HYD_VOLUME: e->def.volume = hyd_default_volume_def(); break;
-    case HYD_PUMP: e->def.pump = hyd_default_pump_def(); break;
-    case HYD_RELIEF: e->def.relief = hyd_default_relief_def(); break;
-    case HYD_CHECK: e->def.check = hyd_default_check_def(); break;
-    case HYD_ORIFICE: e->def.orifice = hyd_default_orifice_def(); break;
-    case HYD_HOSE: e->def.hose = hyd_default_hose_def(); break;
-    case HYD_VALVE: e->def.valve = hyd_default_valve_def(); break;
-    case HYD_CYLINDER: e->def.cylinder = hyd_default_cylinder_def(); break;
-    default: break;
-    }
-}
-
-static int add_elem(hyd_builder* b, hyd_elem* e) {
-    switch (e->type) {
-    case HYD_TANK: return hyd_add_tank(b, &e->def.tank);
-    case HYD_VOLUME: return hyd_add_volume(b, &e->def.volume);
-    case HYD_PUMP: return hyd_add_pump(b, &e->def.pump);
-    case HYD_RELIEF: return hyd_add_relief(b, &e->def.relief);
-    case HYD_CHECK: return hyd_add_check(b, &e->def.check);
-    case HYD_ORIFICE: return hyd_add_orifice(b, &e->def.orifice);
-    case HYD_HOSE: return hyd_add_hose(b, &e->def.hose);
-    case HYD_VALVE: return hyd_add_valve(b, &e->def.valve);
-    case HYD_CYLINDER: return hyd_add_cylinder(b, &e->def.cylinder);
-    default: return -1;
-    }
-}
-
 // One entry of "nodes" (nodes = 1) or "components" (nodes = 0).
 static int read_elem(const jctx* c, hyd_builder* b, const cJSON* o, const char* list, int i,
                      int nodes) {
@@ -172,17 +141,25 @@ static int read_elem(const jctx* c, hyd_builder* b, const cJSON* o, const char* 
         return -1;
     }
     const int t = hyd_type_parse(jt->valuestring);
-    const int is_node_type = t == HYD_TANK || t == HYD_VOLUME;
-    if (t < 0 || is_node_type != nodes) {
+    const hyd_component* desc = t >= 0 ? hyd_component_of((hyd_type)t) : NULL;
+    if (!desc || desc->is_node != nodes) {
+        // The known types of this list, in table order.
+        char known[200] = "";
+        size_t len = 0;
+        for (int k = 0; k < HYD_TYPE_COUNT; ++k) {
+            const hyd_component* d = hyd_component_of((hyd_type)k);
+            if (d && d->is_node == nodes)
+                len += (size_t)snprintf(known + len, len < sizeof known ? sizeof known - len : 0,
+                                        "%s%s", len ? ", " : "", d->name);
+        }
         jerr(c, fpath, "unknown %s type '%s' (known: %s)", nodes ? "node" : "component",
-             jt->valuestring,
-             nodes ? "tank, volume" : "pump, relief, check, orifice, hose, valve, cylinder");
+             jt->valuestring, known);
         return -1;
     }
     hyd_elem e;
     memset(&e, 0, sizeof e);
     e.type = (hyd_type)t;
-    default_def(e.type, &e);
+    desc->defaults(&e.def);
     int np, nports;
     const hyd_param_info* p = hyd_params_of(e.type, &np);
     const hyd_port_info* ports = hyd_ports_of(e.type, &nports);
@@ -193,7 +170,7 @@ static int read_elem(const jctx* c, hyd_builder* b, const cJSON* o, const char* 
     *(const char**)base = jn->valuestring;
     for (int k = 0; k < nports; ++k)
         *(const char**)(base + ports[k].off) = port_names[k];
-    if (add_elem(b, &e) < 0) {
+    if (hyd_add(b, e.type, &e.def) < 0) {
         jerr(c, path, "out of memory");
         return -1;
     }
@@ -321,9 +298,34 @@ void hyd_json_fragment_notes(const cJSON* fragment, const char* file, const char
     }
 }
 
-hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const char* prefix,
-                               char* err, size_t errsz) {
-    jctx c = {file, prefix ? prefix : "", err, errsz};
+// Nodes and components of an appended fragment (optional lists).
+static int read_extra(const jctx* c, hyd_builder* b, const cJSON* extra) {
+    if (!cJSON_IsObject(extra)) {
+        jerr(c, "", "must be an object, got %s", jtype(extra));
+        return -1;
+    }
+    for (const cJSON* it = extra->child; it; it = it->next)
+        if (it->string[0] != '_' && strcmp(it->string, "nodes") && strcmp(it->string, "components")) {
+            jerr(c, it->string, "unknown field (known: nodes, components)");
+            return -1;
+        }
+    static const char* const lists[2] = {"nodes", "components"};
+    for (int l = 0; l < 2; ++l)
+        if (cJSON_GetObjectItemCaseSensitive(extra, lists[l]) && read_list(c, b, extra, lists[l], l == 0))
+            return -1;
+    return 0;
+}
+
+static int list_size(const cJSON* o, const char* key) {
+    const cJSON* a = o ? cJSON_GetObjectItemCaseSensitive(o, key) : NULL;
+    return cJSON_IsArray(a) ? cJSON_GetArraySize(a) : 0;
+}
+
+// The circuit, with the fragment extra (NULL: none) appended; errors and
+// notes in the fragment are reported against cx with the fragment's own
+// indices.
+static hyd_model* from_json(const cJSON* circuit, const jctx* cc, const cJSON* extra, const jctx* cx) {
+    const jctx c = *cc;
     if (!cJSON_IsObject(circuit)) {
         jerr(&c, "", "circuit must be an object, got %s", circuit ? jtype(circuit) : "nothing");
         return NULL;
@@ -355,24 +357,53 @@ hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const cha
     }
     if (read_list(&c, b, circuit, "nodes", 1) || read_list(&c, b, circuit, "components", 0))
         goto done;
+    const int nbase[2] = {list_size(circuit, "nodes"), list_size(circuit, "components")};
+    if (extra && read_extra(cx, b, extra))
+        goto done;
     hyd_build_error e;
     m = hyd_compile_ex(b, &e);
     if (!m) {
         char path[160];
+        const jctx* at = &c;
+        int index = e.index;
+        if (extra && (e.where == 1 || e.where == 2) && e.index >= nbase[e.where - 1]) {
+            at = cx;
+            index -= nbase[e.where - 1];
+        }
         if (e.where == 0)
             snprintf(path, sizeof path, "fluid.%s", e.field);
         else if (e.where == 1 || e.where == 2)
             snprintf(path, sizeof path, "%s[%d].%s", e.where == 1 ? "nodes" : "components",
-                     e.index, e.field);
+                     index, e.field);
         else
             path[0] = 0;
-        jerr(&c, path, "%s", e.msg);
+        // The message goes to the caller's buffer whichever part it names.
+        jctx out = *at;
+        out.err = c.err, out.errsz = c.errsz;
+        jerr(&out, path, "%s", e.msg);
+    } else if (extra) {
+        // The base circuit's notes were given when it was loaded on its own.
+        hyd_json_fragment_notes(extra, cx->file, cx->prefix);
     } else {
         note_model(&c, m);
     }
 done:
     hyd_builder_free(b);
     return m;
+}
+
+hyd_model* hyd_model_from_json(const cJSON* circuit, const char* file, const char* prefix,
+                               char* err, size_t errsz) {
+    const jctx c = {file, prefix ? prefix : "", err, errsz};
+    return from_json(circuit, &c, NULL, NULL);
+}
+
+hyd_model* hyd_model_from_json_extra(const cJSON* circuit, const char* file, const char* prefix,
+                                     const cJSON* extra, const char* extra_file,
+                                     const char* extra_prefix, char* err, size_t errsz) {
+    const jctx c = {file, prefix ? prefix : "", err, errsz};
+    const jctx cx = {extra_file, extra_prefix ? extra_prefix : "", err, errsz};
+    return from_json(circuit, &c, extra, &cx);
 }
 
 hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz) {

@@ -19,6 +19,10 @@
 /// piston driven far into a stop cannot make V <= 0 (cylinder.c).
 #define HYD_VMIN_FRAC 0.05
 
+/// Room for the largest def struct in an element (hyd_elem.def.raw). Each
+/// component file asserts its def fits, so a new component needs no edit here.
+#define HYD_DEF_MAX 192
+
 /// A node or component as the user defined it (names owned by the holder).
 /// Kept in the model so live parameter changes and JSON export see the same
 /// values that the derived arrays were computed from.
@@ -36,6 +40,8 @@ typedef struct hyd_elem {
         hyd_hose_def hose;
         hyd_valve_def valve;
         hyd_cylinder_def cylinder;
+        double align_;
+        unsigned char raw[HYD_DEF_MAX]; ///< any type's def, by its descriptor's def_size
     } def;
 } hyd_elem;
 
@@ -61,7 +67,80 @@ typedef struct hyd_param_info {
     double tlo, thi; ///< typical range [unit]: outside it the loader prints a note
 } hyd_param_info;
 
-/// Parameter and port tables of a type (circuit.c).
+/// Table entries: HYD_PARAM(def type, field, unit, rule, required, hard lo, hi,
+/// typical lo, hi); HYD_PORT(def type, field); HYD_COUNT(array).
+#define HYD_PARAM(T, f, unit, rule, req, lo, hi, tlo, thi) {#f, unit, offsetof(T, f), rule, req, lo, hi, tlo, thi}
+#define HYD_PORT(T, f) {#f, offsetof(T, f)}
+#define HYD_COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
+/// A def struct must fit the element's storage (hyd_elem.def.raw).
+#define HYD_DEF_FITS(T) _Static_assert(sizeof(T) <= HYD_DEF_MAX, #T " is larger than HYD_DEF_MAX")
+
+/// A node an element owns: a tank or volume owns itself, a hose its volume,
+/// a cylinder its two chambers.
+typedef struct hyd_owned_node {
+    const char* suffix; ///< node name "<element>.<suffix>", or NULL: the element's own name
+    const char* state;  ///< its pressure state "<element>.<state>", or NULL: a fixed-pressure node
+} hyd_owned_node;
+
+/// Flow slots per component: hyd_data.flow_ holds this many "flow into the
+/// node at slot k" entries per component; slots are the owned nodes, then
+/// the ports, in table order.
+#define HYD_MAXSLOT 4
+
+/// One element type, as data: everything the builder, the compiler, the JSON
+/// loader, live parameters and the reference evaluation need to know about it.
+/// Each component file defines one (hyd_<type>_component) and component_table.c
+/// lists them by hyd_type. Hooks that a type does not need are NULL.
+typedef struct hyd_component {
+    hyd_type type;
+    const char* name;  ///< type name in JSON ("pump")
+    int is_node;       ///< 1: listed under "nodes" (tank, volume); 0: under "components"
+    size_t def_size;   ///< sizeof its hyd_<type>_def (every def starts with const char* name)
+    const hyd_param_info* params;
+    int nparam;
+    const hyd_port_info* ports; ///< ports (const char* fields of the def naming nodes)
+    int nport;
+    const hyd_owned_node* nodes; ///< nodes it creates, in node order
+    int nnode;
+    const char* const* states; ///< states other than its nodes' pressures ("spool"), after them
+    int nstate;
+    size_t rec_size;   ///< its packed record in hyd_model.rec[type] (0: none, for user nodes)
+    /// Fill def with the documented defaults (name and ports NULL).
+    void (*defaults)(void* def);
+    /// Cross-field value rules a parameter table cannot express (rod < bore):
+    /// 0, or -1 with the offending field and a message.
+    int (*validate)(const void* def, char* field, size_t fsz, char* msg, size_t msz);
+    /// Port rules that need the compiled nodes (a valve's T on a cylinder
+    /// chamber, a hose ending at its own node): 0 or -1 with field and message.
+    int (*check_ports)(const hyd_model* m, const char* const* port_name, const int* port,
+                       const int* own, char* field, size_t fsz, char* msg, size_t msz);
+    /// Write the node and state indices into the packed record: comp is the
+    /// component index, port[k] the node of port k, own[k] the k-th owned
+    /// node, state[k] the k-th state (owned-node pressures, then states[]).
+    void (*bind)(void* rec, int comp, const int* port, const int* own, const int* state);
+    /// Derived values: the record's constants from def and the fluid, and the
+    /// fixed volume, liquid modulus, initial and fixed pressure of each owned
+    /// node (node0: the first owned node; they are consecutive). rec is NULL
+    /// when rec_size is 0.
+    void (*derive)(hyd_model* m, const void* def, void* rec, int node0);
+    /// Initial values of its non-pressure states (states[]), written to y0.
+    void (*initial)(const void* def, const void* rec, double* y0);
+    /// Reference evaluation over all n records of the type: flows into the
+    /// flow slots (hyd_flow2), outputs into d, flow partials into G when non-NULL
+    /// (see the kernels below), and the derivatives of its own states into
+    /// ydot (state i at ydot[map ? map[i] : i]; map is non-NULL only without G).
+    void (*eval)(const hyd_model* m, hyd_data* d, const void* rec, int n, const double* y,
+                 double* ydot, double* G, const int* map);
+    /// After the node rows of the Jacobian are written: the rows of its own
+    /// states in the n x n block Jb (leading dimension ldj; NULL: none asked)
+    /// and the coupling partials in d.
+    void (*jacobian)(const hyd_model* m, hyd_data* d, const void* rec, int n, double* Jb, int ldj);
+} hyd_component;
+
+/// The table (component_table.c): the descriptor of type t, or NULL.
+const hyd_component* hyd_component_of(hyd_type t);
+
+/// Parameter and port tables of a type (from its descriptor).
 const hyd_param_info* hyd_params_of(hyd_type t, int* count);
 const hyd_port_info* hyd_ports_of(hyd_type t, int* count);
 /// Pointer to an element's def struct (the active union member).
@@ -122,6 +201,9 @@ typedef struct hyd_cyl_c {
     double AA, AB, s, VA0, VB0, CL, bv, ks, cs, ws;
 } hyd_cyl_c;
 
+/// calloc of n (at least 1) elements into p; true on success.
+#define HYD_ALLOC(p, n) ((p) = calloc((size_t)((n) > 0 ? (n) : 1), sizeof *(p)), (p) != NULL)
+
 /// Segments per octave of the air-ratio table (a power of two).
 #define HYD_AIR_SEG 128
 /// Octaves covered: absolute pressures in [1, 2^HYD_AIR_OCT) Pa (the law is
@@ -166,6 +248,15 @@ struct hyd_model {
     int* vol_node;  ///< (nvol) state-carrying nodes, in state order of appearance
     int* tank_node; ///< (ntank)
 
+    /// Packed records per type (hyd_component.rec_size each), in component
+    /// order; comp_sub gives a component's index among its type's records.
+    void* rec[HYD_TYPE_COUNT];
+    int nrec[HYD_TYPE_COUNT];
+    int* node_owner; ///< (nnode) component that owns the node, or -1 for a user node
+    int* comp_node0; ///< (ncomp) first owned node of each component (owned nodes are consecutive)
+    int* comp_state0; ///< (ncomp) first state of each component (its states are consecutive)
+    int* comp_slot;  ///< (ncomp x HYD_MAXSLOT) node at each flow slot, -1 unused
+    /// Typed views of rec[] for the kernels and queries that know their type.
     int npump, nrelief, ncheck, norifice, nhose, nvalve, ncyl;
     hyd_pump_c* pump;
     hyd_ramp_c* relief;
@@ -195,59 +286,33 @@ struct hyd_model {
 /// parameter change). Returns 0, or -1 with e filled if a value is invalid.
 int hyd_model_derive(hyd_model* m, hyd_build_error* e);
 
-// Component derivations (each in its own file).
-void hyd_pump_derive(const hyd_pump_def* d, hyd_pump_c* c);
-void hyd_relief_derive(const hyd_relief_def* d, hyd_ramp_c* c);
-void hyd_check_derive(const hyd_check_def* d, hyd_ramp_c* c);
+// Component helpers used by more than one file.
 hyd_orif_k hyd_orifice_constants(const hyd_fluid_def* f, double cd);
-void hyd_hose_derive(const hyd_fluid_def* f, const hyd_hose_def* d, hyd_hose_c* c);
 double hyd_hose_volume(const hyd_hose_def* d);
-void hyd_valve_derive(const hyd_fluid_def* f, const hyd_valve_def* d, hyd_valve_c* c);
-void hyd_cylinder_derive(const hyd_cylinder_def* d, hyd_cyl_c* c);
-/// Cross-field checks a table cannot express; return 0 or fill field/msg.
-int hyd_cylinder_validate(const hyd_cylinder_def* d, char* field, size_t fsz, char* msg,
-                          size_t msz);
+/// Relief and check valves share their record, binding and evaluation (relief.c).
+void hyd_ramp_bind(void* rec, int comp, const int* port, const int* own, const int* state);
+void hyd_ramps_component_eval(const hyd_model* m, hyd_data* d, const void* rec, int n,
+                              const double* y, double* ydot, double* G, const int* map);
 
-/// Orifice law on precomputed constants: Q [m^3/s], *g = dQ/ddp, *gA = dQ/dA
-/// (see orifice.c). Inline: it runs twice per valve per evaluation, and the
-/// caller's unused partials then cost nothing.
-static inline double hyd_orifice_q(const hyd_orif_k* k, double A, double dp, double* g, double* gA) {
-    const double x = dp * A * k->invP0;
-    if (fabs(x) < 1.0) {
-        const double sA = sqrt(A);
-        const double G = k->kl * A * sA;
-        const double x2 = x * x;
-        const double lam = 1.0 - 0.2 * x2;
-        *g = G * (1.0 - 0.6 * x2);
-        // dQ/dA = dG/dA dp (1 - x^2/5) - G dp (2x/5) dx/dA, dx/dA = dp / P0
-        *gA = 1.5 * k->kl * sA * dp * lam - G * dp * 0.4 * x * dp * k->invP0;
-        return G * dp * lam;
-    }
-    const double s = sqrt(fabs(dp));
-    *g = 0.5 * k->k * A / s;
-    *gA = k->k * copysign(s, dp);
-    return k->k * A * copysign(s, dp);
-}
+/// Fluid value rules (table and cross-field); element value rules (table and
+/// the type's validate hook). 0, or -1 with e filled (circuit_params.c).
+int hyd_validate_fluid(const hyd_fluid_def* f, hyd_build_error* e);
+int hyd_validate_values(const hyd_elem* el, int where, int index, hyd_build_error* e);
+int hyd_set_err(hyd_build_error* e, int where, int index, const char* field, const char* msg);
+/// Copy an element (name and port strings duplicated); free its strings.
+int hyd_elem_copy(hyd_elem* dst, const hyd_elem* src);
+void hyd_elem_free(hyd_elem* e);
+char* hyd_strdup(const char* s);
 
 // ---------------------------------------------------------------------------
-// Kernels: each loops over all components of its type, adds flows into
+// Kernels: each type's eval hook loops over all its records, adds flows into
 // d->node_q and, when G is non-NULL, flow partials into G, an (n+1) x (n+1)
 // row-major matrix indexed by state (tank nodes map to the dummy index n),
 // so a kernel needs no branch on node kind.
 // ---------------------------------------------------------------------------
 
-void hyd_cylinders_eval(const hyd_model* m, hyd_data* d, double* G);
-void hyd_pumps_eval(const hyd_model* m, hyd_data* d, double* G);
-void hyd_reliefs_eval(const hyd_model* m, hyd_data* d, double* G);
-void hyd_checks_eval(const hyd_model* m, hyd_data* d, double* G);
 /// Relief and check kernel on an array of ramp records (relief.c).
 void hyd_ramps_eval(const hyd_model* m, hyd_data* d, double* G, const hyd_ramp_c* v, int nv);
-void hyd_orifices_eval(const hyd_model* m, hyd_data* d, double* G);
-void hyd_hoses_eval(const hyd_model* m, hyd_data* d, double* G);
-void hyd_valves_eval(const hyd_model* m, hyd_data* d, const double* y, double* ydot, double* G);
-/// hyd_valves_eval without G, circuit state i at y[map[i]] (hyd_eval_mapped).
-void hyd_valves_eval_mapped(const hyd_model* m, hyd_data* d, const double* y, double* ydot,
-                            const int* map);
 /// The plain evaluation with circuit state i written to ydot[map[i]].
 void hyd_volumes_eval_mapped(const hyd_model* m, hyd_data* d, double* ydot, const int* map);
 /// Pressure derivative of every volume node; with J non-NULL also the node
@@ -284,7 +349,7 @@ static inline double hyd_air_ratio(const hyd_air_tab* t, double P) {
 /// Numerator and denominator of the law at absolute pressure P for a node with
 /// liquid modulus bel and air weight bec = alpha bel / n:
 ///   Be = N / D,  N = bel (1 + alpha r) P,  D = P + bec r
-/// (the SPEC form multiplied through by P, so Be costs one division, which the
+/// (the law of docs/hydraulics.md multiplied through by P, so Be costs one division, which the
 /// caller can share with 1/V). Returns 0 when P is off the fast path; the
 /// caller then uses hyd_be_slow.
 static inline int hyd_be_nd(const hyd_model* m, double bel, double bec, double P, double* N,
@@ -368,46 +433,6 @@ static inline double hyd_smoothstep(double t, double* ds) {
     }
     *ds = 6.0 * t * (1.0 - t);
     return t * t * (3.0 - 2.0 * t);
-}
-
-/// Relief/check opening law on t = d / w (see relief.c): 0, t^2, then 2t - 1;
-/// *dr = d ramp / d d (so it includes 1/w).
-static inline double hyd_open_ramp_t(double t, double inv_w, double* dr) {
-    if (t <= 0.0) {
-        *dr = 0.0;
-        return 0.0;
-    }
-    if (t < 1.0) {
-        *dr = 2.0 * t * inv_w;
-        return t * t;
-    }
-    *dr = 2.0 * inv_w;
-    return 2.0 * t - 1.0;
-}
-
-/// Cylinder end stop (see cylinder.c) of stiffness ks [N/m], damping cs
-/// [N s/m] and smoothing width ws [m]: force magnitude for penetration delta
-/// and its rate ddelta, with partials d|F|/ddelta (*fd) and d|F|/dddelta (*fv).
-static inline double hyd_stop_force(double ks, double cs, double ws, double delta, double ddelta, double* fd,
-                                    double* fv) {
-    if (delta <= 0.0) {
-        *fd = 0.0;
-        *fv = 0.0;
-        return 0.0;
-    }
-    const double t = delta / ws;
-    double S, dS, dW;
-    if (t < 1.0) {
-        S = 0.5 * delta * t;
-        dS = t;
-    } else {
-        S = delta - 0.5 * ws;
-        dS = 1.0;
-    }
-    const double W = hyd_smoothstep(t, &dW);
-    *fd = ks * dS + cs * dW / ws * ddelta;
-    *fv = cs * W;
-    return ks * S + cs * W * ddelta;
 }
 
 

@@ -196,6 +196,9 @@ int hyd_add_orifice(hyd_builder* b, const hyd_orifice_def* def);
 int hyd_add_hose(hyd_builder* b, const hyd_hose_def* def);
 int hyd_add_valve(hyd_builder* b, const hyd_valve_def* def);
 int hyd_add_cylinder(hyd_builder* b, const hyd_cylinder_def* def);
+/// Add an element of type t from its def struct (def points to the
+/// hyd_<type>_def of t); the same as the typed hyd_add_* functions.
+int hyd_add(hyd_builder* b, hyd_type t, const void* def);
 
 /// Where a build error was found (used by the JSON loader to name JSON paths).
 typedef struct hyd_build_error {
@@ -214,10 +217,16 @@ hyd_model* hyd_compile(const hyd_builder* b, char* err, size_t errsz);
 hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e);
 void hyd_model_free(hyd_model* m);
 
-/// The default two-actuator crane circuit of SPEC section 4 (components named
+/// The default two-actuator crane circuit of docs/model.md (components named
 /// as in tests/hydraulics/data/crane_circuit.json: "lift_valve", "lift_cyl",
 /// "jib_valve", "jib_cyl", ...). 11 states.
 hyd_model* hyd_model_default_crane(char* err, size_t errsz);
+/// A synthetic circuit with nact in [1, 64] actuators for tests and benches:
+/// tank, pump line, a pump (35 L/min per actuator) and main relief, then per
+/// actuator k = 1..nact "act<k>_valve", two hoses "act<k>_hose_A/B", the
+/// cylinder "act<k>_cyl" (the lift cylinder's size for odd k, the jib's for
+/// even k), port reliefs and anti-cavitation checks on both chambers.
+hyd_model* hyd_model_synthetic(int nact, char* err, size_t errsz);
 
 // ---------------------------------------------------------------------------
 // Model queries (cheap; not for the hot loop)
@@ -269,6 +278,53 @@ void hyd_model_initial_state(const hyd_model* m, double* y);
 double hyd_model_fastest_rate(const hyd_model* m, double p, double u);
 /// The fluid the model was compiled with.
 hyd_fluid_def hyd_model_fluid(const hyd_model* m);
+
+// ---------------------------------------------------------------------------
+// Structure queries: what the circuit is made of, so that callers need not
+// guess it from names (".p" suffixes, "pump_line", hoses found by name).
+// ---------------------------------------------------------------------------
+
+/// What a state is.
+typedef enum hyd_state_kind {
+    HYD_STATE_PRESSURE = 0, ///< a node's pressure [Pa abs] (volumes, hoses, chambers)
+    HYD_STATE_SPOOL,        ///< a valve's spool position [-]
+    HYD_STATE_OTHER         ///< any other state a component owns
+} hyd_state_kind;
+/// Kind of state i (HYD_STATE_OTHER when i is out of range).
+hyd_state_kind hyd_model_state_kind(const hyd_model* m, int i);
+/// Node whose pressure state i is, or -1 when state i is not a pressure.
+int hyd_model_state_node(const hyd_model* m, int i);
+
+/// What a node does in the circuit.
+typedef enum hyd_node_role {
+    HYD_NODE_LINE = 0, ///< any other pressure node (a line, a hose, a chamber)
+    HYD_NODE_TANK,     ///< fixed pressure (a tank node; no state)
+    HYD_NODE_SUPPLY,   ///< a pump delivers into it (the pump line)
+    HYD_NODE_LS        ///< a load-sensing line (no component creates one yet)
+} hyd_node_role;
+/// Role of node i (HYD_NODE_LINE when i is out of range).
+hyd_node_role hyd_model_node_role(const hyd_model* m, int i);
+/// The first node with role HYD_NODE_SUPPLY, or -1 when no pump feeds a node.
+int hyd_model_supply_node(const hyd_model* m);
+/// Component that owns node i (a hose's volume, a cylinder's chambers), or -1
+/// for a node declared under "nodes" (tank, volume).
+int hyd_model_node_owner(const hyd_model* m, int i);
+/// The k-th node component comp owns (hose: 0 its volume; cylinder: 0 chamber
+/// A, 1 chamber B), or -1.
+int hyd_model_comp_node(const hyd_model* m, int comp, int k);
+/// The node at port k of component comp (in the order of its JSON ports:
+/// pump/relief/check/orifice inlet, outlet; hose to; valve P, T, A, B), or -1.
+int hyd_model_port_node(const hyd_model* m, int comp, int k);
+/// The hose whose far end ("to") is node i (a cylinder chamber), as a
+/// component index, or -1. Its own pressure state is
+/// hyd_model_node_state(m, hyd_model_comp_node(m, hose, 0)).
+int hyd_model_feed_hose(const hyd_model* m, int node);
+/// Structural pattern of d ydot / d y: pattern[i * n + j] = 1 where the entry
+/// can be non-zero at some state, else 0 (n = nstate; the caller's array of
+/// n * n bytes). A node's pressure rate depends on its own pressure and on
+/// the pressures and states of every component connected to it; a spool
+/// rate on its spool only. hyd_jacobian never writes a non-zero outside it.
+void hyd_model_jacobian_pattern(const hyd_model* m, unsigned char* pattern);
 
 // ---------------------------------------------------------------------------
 // Live parameters. A path is "<element>.<field>" ("lift_cyl.bore",
@@ -368,6 +424,15 @@ struct cJSON;
 /// or "" when the circuit is the whole document). NULL on error, with err set.
 hyd_model* hyd_model_from_json(const struct cJSON* circuit, const char* file, const char* prefix,
                                char* err, size_t errsz);
+/// hyd_model_from_json with a fragment appended: the "nodes" and
+/// "components" of extra (each optional) after the circuit's own, compiled
+/// as one circuit (a world's extra circuit on a model's). An error in the
+/// fragment names extra_file, extra_prefix and the fragment's own index
+/// ("sandbox.json: circuit.components[3].bore: ..."); notes are given for the
+/// fragment only (the circuit's own were given when it was loaded alone).
+hyd_model* hyd_model_from_json_extra(const struct cJSON* circuit, const char* file, const char* prefix,
+                                     const struct cJSON* extra, const char* extra_file,
+                                     const char* extra_prefix, char* err, size_t errsz);
 /// Load a circuit file: either the circuit object itself or a document with a
 /// "hydraulics" member holding it (prefix "hydraulics"). NULL on error.
 hyd_model* hyd_model_load_json(const char* path, char* err, size_t errsz);

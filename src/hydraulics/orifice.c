@@ -9,7 +9,7 @@
 //   G = 5 K / (4 sqrt(p_tr)) = kl A^1.5,   Q = G dp (1 - x^2/5),
 // and x = dp A / P0, so A -> 0 gives Q -> 0 and dQ/ddp -> 0 with no division
 // by A: a closed valve edge needs no special case.
-#include "hyd_internal.h"
+#include "hyd_orifice.h"
 
 #include <math.h>
 
@@ -46,12 +46,45 @@ double hyd_orifice_p_tr(const hyd_fluid_def* f, double cd, double A) {
 }
 
 // Fixed orifices between two nodes.
-void hyd_orifices_eval(const hyd_model* m, hyd_data* d, double* G) {
-    for (int i = 0; i < m->norifice; ++i) {
-        const hyd_orifice_c* c = &m->orifice[i];
+static void orifices_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, const double* y,
+                          double* ydot, double* G, const int* map) {
+    (void)y, (void)ydot, (void)map;
+    for (int i = 0; i < n; ++i) {
+        const hyd_orifice_c* c = (const hyd_orifice_c*)rec + i;
         double g, gA;
         const double q = hyd_orifice_q(&c->ok, c->A, d->node_p[c->in] - d->node_p[c->out], &g, &gA);
         d->comp_q[2 * c->comp] = q;
         hyd_flow2(m, d, G, c->comp, c->in, c->out, q, g, -g);
     }
 }
+
+static void orifice_derive(hyd_model* m, const void* def, void* rec, int node0) {
+    (void)node0;
+    const hyd_orifice_def* d = def;
+    hyd_orifice_c* c = rec;
+    c->A = d->area;
+    c->ok = hyd_orifice_constants(&m->fluid, d->cd);
+}
+
+static void orifice_bind(void* rec, int comp, const int* port, const int* own, const int* state) {
+    (void)own, (void)state;
+    hyd_orifice_c* c = rec;
+    c->comp = comp, c->in = port[0], c->out = port[1];
+}
+
+static const hyd_param_info orifice_params[] = {
+    HYD_PARAM(hyd_orifice_def, area, "m^2", HYD_R_POS, 1, 1e-10, 0.1, 1e-8, 1e-3),
+    HYD_PARAM(hyd_orifice_def, cd, "-", HYD_R_FRAC, 0, 0, 1, 0.5, 0.8),
+};
+static const hyd_port_info orifice_ports[] = {HYD_PORT(hyd_orifice_def, inlet), HYD_PORT(hyd_orifice_def, outlet)};
+
+static void orifice_defaults(void* def) { *(hyd_orifice_def*)def = hyd_default_orifice_def(); }
+
+HYD_DEF_FITS(hyd_orifice_def);
+const hyd_component hyd_orifice_component = {
+    .type = HYD_ORIFICE, .name = "orifice", .def_size = sizeof(hyd_orifice_def),
+    .params = orifice_params, .nparam = HYD_COUNT(orifice_params),
+    .ports = orifice_ports, .nport = HYD_COUNT(orifice_ports),
+    .rec_size = sizeof(hyd_orifice_c),
+    .defaults = orifice_defaults, .bind = orifice_bind, .derive = orifice_derive, .eval = orifices_eval,
+};

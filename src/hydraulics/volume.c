@@ -1,22 +1,43 @@
-// volume.c: pressure nodes (fixed volumes, tanks, and the pressure equation
-// shared by hoses and cylinder chambers).
+// volume.c: volume nodes, and the pressure equation of every node with a
+// pressure state (volumes, hoses, cylinder chambers).
 //
 //   dp/dt = Be(p) / V * (sum Q_in - dV/dt)
 // V and dV/dt come from the node's fixed volume plus whatever a cylinder wrote
 // for its chambers; sum Q_in is gathered here from the components' per-port flow slots.
 #include "hyd_internal.h"
 
-hyd_tank_def hyd_default_tank_def(void) {
-    hyd_tank_def d = {0};
-    d.pressure = 1e5;
-    return d;
-}
-
 hyd_volume_def hyd_default_volume_def(void) {
     hyd_volume_def d = {0};
     d.p0 = 1e5;
     return d;
 }
+
+static void volume_derive(hyd_model* m, const void* def, void* rec, int node0) {
+    (void)rec;
+    const hyd_volume_def* v = def;
+    m->node_pfix[node0] = 0.0;
+    m->node_p0[node0] = v->p0;
+    m->node_V0[node0] = v->volume;
+    m->node_bel[node0] = v->bulk_modulus > 0.0 ? v->bulk_modulus : m->fluid.bulk_modulus;
+}
+
+static const hyd_param_info volume_params[] = {
+    HYD_PARAM(hyd_volume_def, volume, "m^3", HYD_R_POS, 1, 1e-9, 10, 1e-6, 0.1),
+    HYD_PARAM(hyd_volume_def, bulk_modulus, "Pa", HYD_R_ZERO_DEF, 0, 1e7, 1e10, 1e8, 2.5e9),
+    HYD_PARAM(hyd_volume_def, p0, "Pa", HYD_R_NONNEG, 0, 0, 1e8, 0, 5e7),
+};
+// A volume is its own node, with state "<name>.p".
+static const hyd_owned_node volume_nodes[] = {{NULL, "p"}};
+
+static void volume_defaults(void* def) { *(hyd_volume_def*)def = hyd_default_volume_def(); }
+
+HYD_DEF_FITS(hyd_volume_def);
+const hyd_component hyd_volume_component = {
+    .type = HYD_VOLUME, .name = "volume", .is_node = 1, .def_size = sizeof(hyd_volume_def),
+    .params = volume_params, .nparam = HYD_COUNT(volume_params),
+    .nodes = volume_nodes, .nnode = HYD_COUNT(volume_nodes),
+    .defaults = volume_defaults, .derive = volume_derive,
+};
 
 // The plain evaluation (no Jacobian), the hot path of every f evaluation:
 // the same arithmetic as the loop below, in a loop of its own so that the

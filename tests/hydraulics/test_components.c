@@ -316,6 +316,42 @@ static void test_valve_rating(void) {
     hyd_model_free(m);
 }
 
+// The component table is consistent, so a new entry that breaks a rule the
+// compiler relies on fails here rather than in a run: each descriptor sits
+// at its own type, names are unique, its def fits the element, its slots
+// fit HYD_MAXSLOT, parameter offsets lie inside the def after the name and
+// ports, and the defaults pass their own rules (required fields excepted).
+static void test_component_table(void) {
+    for (int t = 0; t < HYD_TYPE_COUNT; ++t) {
+        const hyd_component* c = hyd_component_of((hyd_type)t);
+        CHECK(c != NULL, "type %d has no descriptor", t);
+        if (!c) continue;
+        CHECK(c->type == (hyd_type)t && hyd_type_parse(c->name) == t, "%s: type %d", c->name, (int)c->type);
+        CHECK(c->def_size <= HYD_DEF_MAX && c->defaults != NULL && c->derive != NULL, "%s: def", c->name);
+        CHECK(c->nport <= HYD_MAXPORT && c->nnode + c->nport <= HYD_MAXSLOT, "%s: slots", c->name);
+        CHECK(c->is_node ? (c->nport == 0 && c->rec_size == 0 && c->nnode == 1)
+                         : (c->rec_size > 0 && c->eval != NULL && c->bind != NULL),
+              "%s: node or component", c->name);
+        const size_t data0 = sizeof(const char*) * (size_t)(1 + c->nport);
+        unsigned char def[HYD_DEF_MAX];
+        c->defaults(def);
+        for (int k = 0; k < c->nparam; ++k) {
+            const hyd_param_info* p = &c->params[k];
+            CHECK(p->off >= data0 && p->off + sizeof(double) <= c->def_size, "%s.%s: offset", c->name, p->name);
+            CHECK(p->lo <= p->tlo && p->tlo <= p->thi && p->thi <= p->hi, "%s.%s: ranges", c->name, p->name);
+            for (int j = 0; j < k; ++j) CHECK(strcmp(p->name, c->params[j].name), "%s.%s twice", c->name, p->name);
+            for (int j = 0; j < c->nport; ++j) CHECK(strcmp(p->name, c->ports[j].name), "%s.%s: port and parameter", c->name, p->name);
+            double v;
+            memcpy(&v, def + p->off, sizeof v);
+            char msg[200];
+            if (!p->required) CHECK(hyd_param_check(p, v, msg, sizeof msg) == 0, "%s.%s default: %s", c->name, p->name, msg);
+        }
+        for (int j = 0; j < c->nport; ++j)
+            CHECK(c->ports[j].off >= sizeof(const char*) && c->ports[j].off < data0, "%s.%s: port offset", c->name,
+                  c->ports[j].name);
+    }
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_orifice_limits);
     RUN_TEST(test_bulk_modulus);
@@ -324,5 +360,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_pump);
     RUN_TEST(test_blocked_cylinder_force);
     RUN_TEST(test_valve_rating);
+    RUN_TEST(test_component_table);
     TEST_MAIN_END();
 }

@@ -80,9 +80,48 @@ static void test_from_parsed_object(void) {
     CHECK(m == NULL && strstr(err, "does_not_exist.json: cannot open file"), "%s", err);
 }
 
+// A fragment appended to a circuit (a world's extra circuit on a model's):
+// one circuit, errors in the fragment named by its own file and index.
+static void quiet(const char* line, void* user) { (void)line, (void)user; }
+
+static void test_extra_fragment(void) {
+    const char* base = "{\"nodes\": [{\"name\": \"tank\", \"type\": \"tank\"},"
+                       " {\"name\": \"line\", \"type\": \"volume\", \"volume\": 1e-3}],"
+                       " \"components\": [{\"name\": \"pump\", \"type\": \"pump\", \"inlet\": \"tank\","
+                       " \"outlet\": \"line\", \"q_max\": 1e-4, \"p_set\": 1e7}]}";
+    const char* good = "{\"components\": [{\"name\": \"bleed\", \"type\": \"orifice\", \"inlet\": \"line\","
+                       " \"outlet\": \"tank\", \"area\": 1e-6}]}";
+    const char* bad = "{\"nodes\": [], \"components\": [{\"name\": \"bleed\", \"type\": \"orifice\","
+                      " \"inlet\": \"line\", \"outlet\": \"tank\", \"area\": 1e-6},"
+                      " {\"name\": \"bleed2\", \"type\": \"orifice\", \"inlet\": \"line\", \"outlet\": \"tank\","
+                      " \"area\": -1}]}";
+    const char* badkey = "{\"component\": []}";
+    cJSON *jb = cJSON_Parse(base), *jg = cJSON_Parse(good), *jx = cJSON_Parse(bad), *jk = cJSON_Parse(badkey);
+    char err[256] = "";
+    hyd_set_note_handler(quiet, NULL);
+    hyd_model* m = hyd_model_from_json_extra(jb, "model.json", "hydraulics", jg, "world.json", "circuit", err,
+                                             sizeof err);
+    CHECK(m != NULL, "%s", err);
+    CHECK(m && hyd_model_ncomp(m) == 2 && hyd_model_find(m, "bleed") == 1, "fragment not appended");
+    hyd_model_free(m);
+    m = hyd_model_from_json_extra(jb, "model.json", "hydraulics", jx, "world.json", "circuit", err, sizeof err);
+    CHECK(m == NULL && !strcmp(err, "world.json: circuit.components[1].area: must be > 0, got -1"), "%s", err);
+    m = hyd_model_from_json_extra(jb, "model.json", "hydraulics", jk, "world.json", "circuit", err, sizeof err);
+    CHECK(m == NULL && !strcmp(err, "world.json: circuit.component: unknown field (known: nodes, components)"),
+          "%s", err);
+    // An error in the base circuit still names the model.
+    cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(jb, "components"), 0),
+                                     "q_max")->valuedouble = -2;
+    m = hyd_model_from_json_extra(jb, "model.json", "hydraulics", jg, "world.json", "circuit", err, sizeof err);
+    CHECK(m == NULL && !strcmp(err, "model.json: hydraulics.components[0].q_max: must be > 0, got -2"), "%s", err);
+    hyd_set_note_handler(NULL, NULL);
+    cJSON_Delete(jb), cJSON_Delete(jg), cJSON_Delete(jx), cJSON_Delete(jk);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_valid_files);
     RUN_TEST(test_malformed_files);
     RUN_TEST(test_from_parsed_object);
+    RUN_TEST(test_extra_fragment);
     TEST_MAIN_END();
 }

@@ -1,14 +1,21 @@
-// fused.c: the standard actuator circuit in one pass (see hyd_fused.h).
+// circuit_kernel.c: the one-pass circuit kernel, the standard actuator
+// circuit in one pass (see circuit_kernel.h).
 //
-// Every law here is the component's own: hyd_orifice_q (orifice.c),
-// hyd_open_ramp_t (relief.c), hyd_stop_force (cylinder.c), hyd_be_nd /
-// hyd_be_slow (fluid.c), the pump's smoothstep (pump.c). What changes is the
-// bookkeeping: flows stay in registers and each node's net inflow is summed
+// Every law here is the component's own, from its header: hyd_pump_q
+// (hyd_pump.h), hyd_ramp_q (hyd_ramp.h), hyd_valve_edges and hyd_spool_rate
+// (hyd_valve.h), hyd_hose_q (hyd_hose.h), hyd_cyl_volumes, hyd_cyl_leak and
+// hyd_cyl_force (hyd_cylinder.h), hyd_node_c / hyd_be_slow (fluid.c). The
+// reference loops call the same functions. What changes is the bookkeeping: flows stay in registers and each node's net inflow is summed
 // where it is known, instead of through per-port slots and a CSR gather.
 // Summation order differs from volume.c, so results agree to rounding.
-#include "hyd_fused.h"
+#include "circuit_kernel.h"
 
+#include "hyd_cylinder.h"
+#include "hyd_hose.h"
 #include "hyd_internal.h"
+#include "hyd_pump.h"
+#include "hyd_ramp.h"
+#include "hyd_valve.h"
 
 #include <limits.h>
 #include <string.h>
@@ -90,6 +97,18 @@ int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int na
     f->nact = nact;
     if (nact < 1 || nact > HYD_FUSED_MAXACT) return set_why(why, whysz, "too many actuators"), -1;
     if (m->norifice) return set_why(why, whysz, "the circuit has fixed orifices"), -1;
+    // Only the types below are packed: any other component would be left
+    // out of the sum and give plausible wrong numbers, so it is refused.
+    for (int c = 0; c < m->ncomp; ++c) {
+        const hyd_type t = m->comp[c].type;
+        if (t != HYD_PUMP && t != HYD_RELIEF && t != HYD_CHECK && t != HYD_HOSE && t != HYD_VALVE &&
+            t != HYD_CYLINDER) {
+            if (why && whysz)
+                snprintf(why, whysz, "component '%s' (%s): the one-pass kernel has no place for this type",
+                         m->comp[c].name, hyd_type_name(t));
+            return -1;
+        }
+    }
     if (m->npump != 1) return set_why(why, whysz, "the circuit needs exactly one pump"), -1;
     if (m->nvalve != nact || m->ncyl != nact || m->nhose != 2 * nact)
         return set_why(why, whysz, "not one valve, two hoses and one cylinder per actuator"), -1;
@@ -192,12 +211,11 @@ FUSED_INLINE double ramps_in(const hyd_fused_node* n, double p, double* g) {
     for (int i = 0; i < n->nramp; ++i) {
         const hyd_fused_ramp* r = &n->ramp[i];
         const double d = r->into ? r->p_tank - p : p - r->p_tank;
-        const double t = (d - r->pcr) * r->inv_w;
+        double gr, t;
+        const double o = hyd_ramp_q(r->pcr, r->inv_w, r->qr, d, &gr, &t);
         if (t <= 0.0) continue;
-        double dr;
-        const double o = r->qr * hyd_open_ramp_t(t, r->inv_w, &dr);
         q += r->into ? o : -o;
-        gs -= r->qr * dr;
+        gs -= gr;
     }
     *g = gs;
     return q;
@@ -219,34 +237,30 @@ typedef struct act_out {
     double g1, du1, g2, du2;     ///< valve edges: dq/ddp, dq/du
     int pos;
     double gA, gB, ghA, ghB;     ///< ramp partials of chamber A, B, hose A, B
-    double fdl, fvl, fdh, fvh;   ///< end-stop partials
+    double dFdx, dFdv;           ///< force partials [N/m], [N s/m]
     double dVA, dVB;             ///< dV/dx of the chambers (0 once the volume floor holds V, cylinder.c)
 } act_out;
 
 FUSED_INLINE void actuator(const hyd_fused_act* a, const double* y, double pPL, double x, double v,
                             double cmd, double* ydot_u, act_out* o, int partials) {
     const double u = y[a->su];
-    const double c = cmd > 1.0 ? 1.0 : (cmd < -1.0 ? -1.0 : cmd);
-    *ydot_u = (c - u) * a->inv_tau;
+    *ydot_u = hyd_spool_rate(cmd, u, a->inv_tau);
     const double phA = y[a->hA.s], phB = y[a->hB.s], pA = y[a->cA.s], pB = y[a->cB.s];
 
-    // Valve (valve.c): edge 1 feeds a work port from P, edge 2 drains the other to T.
-    const int pos = u >= 0.0;
-    const double A = a->Amax * fabs(u);
+    // Valve: edge 1 feeds a work port from P, edge 2 drains the other to T.
     const hyd_orif_k ok = {a->ok, 0.0, a->oinvP0, a->okl};
-    double g1, g1A, g2, g2A;
-    const double q1 = hyd_orifice_q(&ok, A, pPL - (pos ? phA : phB), &g1, &g1A);
-    const double q2 = hyd_orifice_q(&ok, A, (pos ? phB : phA) - a->pT, &g2, &g2A);
+    hyd_valve_flow e;
+    hyd_valve_edges(&ok, a->Amax, u, pPL, a->pT, phA, phB, &e);
+    const int pos = e.pos;
+    const double q1 = e.q1, q2 = e.q2;
     o->q_pl = q1;
     const double inA = pos ? q1 : -q2, inB = pos ? -q2 : q1;
 
-    // Hoses (hose.c), leakage and volumes (cylinder.c).
-    const double qhA = a->GA * (phA - pA), qhB = a->GB * (phB - pB);
-    const double leak = a->CL * (pA - pB);
-    const double VA = a->VA0 + a->AA * x, VB = a->VB0 + a->AB * (a->s - x);
-    const double VAmin = HYD_VMIN_FRAC * a->VA0, VBmin = HYD_VMIN_FRAC * a->VB0;
-    o->VA = VA > VAmin ? VA : VAmin;
-    o->VB = VB > VBmin ? VB : VBmin;
+    // Hoses, leakage and volumes.
+    const double qhA = hyd_hose_q(a->GA, phA, pA), qhB = hyd_hose_q(a->GB, phB, pB);
+    const double leak = hyd_cyl_leak(a->CL, pA, pB);
+    double dVA, dVB;
+    hyd_cyl_volumes(a->VA0, a->VB0, a->AA, a->AB, a->s, x, &o->VA, &o->VB, &dVA, &dVB);
 
     double gA, gB, ghA, ghB;
     o->nhA = inA - qhA + ramps_in(&a->hA, phA, &ghA);
@@ -254,28 +268,23 @@ FUSED_INLINE void actuator(const hyd_fused_act* a, const double* y, double pPL, 
     o->nA = qhA - leak + ramps_in(&a->cA, pA, &gA) - a->AA * v;
     o->nB = qhB + leak + ramps_in(&a->cB, pB, &gB) + a->AB * v;
 
-    // Force with the end stops (cylinder.c).
-    double fdl, fvl, fdh, fvh;
-    const double flo = hyd_stop_force(a->ks, a->cs, a->ws, -x, -v, &fdl, &fvl);
-    const double fhi = hyd_stop_force(a->ks, a->cs, a->ws, x - a->s, v, &fdh, &fvh);
-    o->F = pA * a->AA - pB * a->AB - a->bv * v + flo - fhi;
+    // Force with the end stops.
+    double dFdx, dFdv;
+    o->F = hyd_cyl_force(a->AA, a->AB, a->bv, a->ks, a->cs, a->ws, a->s, pA, pB, x, v, &dFdx, &dFdv);
     if (partials) {
         const double sgn = pos ? 1.0 : -1.0;
-        o->g1 = g1, o->g2 = g2, o->pos = pos;
-        o->du1 = g1A * a->Amax * sgn;
-        o->du2 = g2A * a->Amax * sgn;
+        o->g1 = e.g1, o->g2 = e.g2, o->pos = pos;
+        o->du1 = e.g1A * a->Amax * sgn;
+        o->du2 = e.g2A * a->Amax * sgn;
         o->gA = gA, o->gB = gB, o->ghA = ghA, o->ghB = ghB;
-        o->fdl = fdl, o->fvl = fvl, o->fdh = fdh, o->fvh = fvh;
-        o->dVA = VA > VAmin ? a->AA : 0.0;
-        o->dVB = VB > VBmin ? -a->AB : 0.0;
+        o->dFdx = dFdx, o->dFdv = dFdv;
+        o->dVA = dVA, o->dVB = dVB;
     }
 }
 
 static inline double pump_in(const hyd_fused* f, double pPL, double* g) {
-    double ds;
-    const double s = hyd_smoothstep((pPL - f->p_in - f->pset) * f->inv_band, &ds);
-    *g = -f->qmax * ds * f->inv_band;
-    return f->qmax * (1.0 - s);
+    double t;
+    return hyd_pump_q(f->qmax, f->pset, f->inv_band, pPL - f->p_in, g, &t);
 }
 
 // ---------------------------------------------------------------- events --
@@ -448,8 +457,8 @@ void hyd_fused_jacobian(const hyd_fused* f, const double* y, const double* x, co
         cp->dB_dx = -cB / o.VB * o.dVB * o.nB;
         cp->dA_dv = -cA * a->AA;
         cp->dB_dv = cB * a->AB;
-        cp->dF_dx = -o.fdl - o.fdh;
-        cp->dF_dv = -a->bv - o.fvl - o.fvh;
+        cp->dF_dx = o.dFdx;
+        cp->dF_dv = o.dFdv;
     }
     qpl += ramps_in(&f->pl, pPL, &gr);
     g_pl_pl += gr;

@@ -1,0 +1,66 @@
+// hyd_cylinder.h: the cylinder's laws (cylinder.c has the equations),
+// written once for the reference loop (cylinder.c) and the one-pass kernel
+// (circuit_kernel.c).
+#ifndef HYD_CYLINDER_H
+#define HYD_CYLINDER_H
+
+#include "hyd_internal.h"
+
+/// Cylinder end stop (see cylinder.c) of stiffness ks [N/m], damping cs
+/// [N s/m] and smoothing width ws [m]: force magnitude for penetration delta
+/// and its rate ddelta, with partials d|F|/ddelta (*fd) and d|F|/dddelta (*fv).
+static inline double hyd_stop_force(double ks, double cs, double ws, double delta, double ddelta, double* fd,
+                                    double* fv) {
+    if (delta <= 0.0) {
+        *fd = 0.0;
+        *fv = 0.0;
+        return 0.0;
+    }
+    const double t = delta / ws;
+    double S, dS, dW;
+    if (t < 1.0) {
+        S = 0.5 * delta * t;
+        dS = t;
+    } else {
+        S = delta - 0.5 * ws;
+        dS = 1.0;
+    }
+    const double W = hyd_smoothstep(t, &dW);
+    *fd = ks * dS + cs * dW / ws * ddelta;
+    *fv = cs * W;
+    return ks * S + cs * W * ddelta;
+}
+
+/// Chamber volumes [m^3] at stroke x [m]: V_A = V_A0 + A_A x, V_B = V_B0 +
+/// A_B (s - x), each floored at HYD_VMIN_FRAC of its dead volume; *dVA, *dVB
+/// = dV/dx [m^2] (0 once the floor holds V).
+static inline void hyd_cyl_volumes(double VA0, double VB0, double AA, double AB, double s, double x,
+                                   double* VA, double* VB, double* dVA, double* dVB) {
+    const double va = VA0 + AA * x, vb = VB0 + AB * (s - x);
+    const double vamin = HYD_VMIN_FRAC * VA0, vbmin = HYD_VMIN_FRAC * VB0;
+    *VA = va > vamin ? va : vamin;
+    *VB = vb > vbmin ? vb : vbmin;
+    *dVA = va > vamin ? AA : 0.0;
+    *dVB = vb > vbmin ? -AB : 0.0;
+}
+
+/// Internal leakage A -> B [m^3/s] with coefficient CL [m^3/(s Pa)].
+static inline double hyd_cyl_leak(double CL, double pA, double pB) { return CL * (pA - pB); }
+
+/// Rod force F [N] (+ extends): pA A_A - pB A_B - b_v x' plus the end stops
+/// (stiffness ks [N/m], damping cs [N s/m], width ws [m]) below 0 and beyond
+/// the stroke s [m]. *dFdx [N/m] and *dFdv [N s/m] are its partials (dF/dpA =
+/// A_A and dF/dpB = -A_B need none).
+static inline double hyd_cyl_force(double AA, double AB, double bv, double ks, double cs, double ws,
+                                   double s, double pA, double pB, double x, double v, double* dFdx,
+                                   double* dFdv) {
+    // Retracted stop pushes out (+), extended stop pushes in (-).
+    double fdl, fvl, fdh, fvh;
+    const double flo = hyd_stop_force(ks, cs, ws, -x, -v, &fdl, &fvl);
+    const double fhi = hyd_stop_force(ks, cs, ws, x - s, v, &fdh, &fvh);
+    *dFdx = -fdl - fdh;
+    *dFdv = -bv - fvl - fvh;
+    return pA * AA - pB * AB - bv * v + flo - fhi;
+}
+
+#endif

@@ -1,0 +1,389 @@
+// test_fast.c: the fast kernel for any circuit (circuit_fast.h) against the
+// reference loops (hyd_eval, hyd_jacobian), on every circuit that ships
+// (assets/models, the world circuits merged as the ode world merges them,
+// tests/hydraulics/data) and on synthetic circuits of 1, 2, 4 and 8
+// actuators; a type without a fast loop either falls back or is refused;
+// and the structure queries (state kinds, node roles, Jacobian pattern).
+#include "check.h"
+#include "circuit_fast.h"
+#include "hydraulics.h"
+
+#include <cjson/cJSON.h>
+#include <dirent.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TRIALS 3000
+#define TOL 1e-12
+
+static double urand(double a, double b) { return a + (b - a) * rand() / (double)RAND_MAX; }
+
+// A random state that visits every regime: pressures from near vacuum (Be
+// near 0, checks open) to beyond the reliefs' corners, spools closed, nearly
+// closed or open, strokes in and beyond both end stops.
+static void random_state(const hyd_model* m, hyd_data* d, double* y) {
+    const int n = hyd_model_nstate(m);
+    for (int i = 0; i < n; ++i) {
+        if (hyd_model_state_kind(m, i) == HYD_STATE_SPOOL) {
+            const int um = rand() % 3;
+            y[i] = um == 0 ? urand(-1, 1) : um == 1 ? urand(-1e-3, 1e-3) : urand(-1e-6, 1e-6);
+            continue;
+        }
+        switch (rand() % 6) {
+        case 0: y[i] = urand(1e3, 6e4); break;
+        case 1: y[i] = urand(150.0, 2e3); break;
+        case 2: y[i] = 1e5 + 20e6 + urand(-0.1e6, 0.6e6); break;
+        case 3: y[i] = 1e5 + 25e6 + urand(-2e4, 1.2e6); break;
+        default: y[i] = urand(0.2e6, 24e6); break;
+        }
+    }
+    for (int c = 0; c < hyd_model_ncylinder(m); ++c) {
+        double AA, AB, s;
+        hyd_model_cylinder_geometry(m, c, &AA, &AB, &s);
+        const int sm = rand() % 3;
+        d->cyl_x[c] = sm == 0 ? urand(-2.5e-3, 2.5e-3) : sm == 1 ? s + urand(-2.5e-3, 2.5e-3) : urand(0, s);
+        d->cyl_v[c] = urand(-0.3, 0.3);
+    }
+    for (int v = 0; v < hyd_model_nvalve(m); ++v) d->valve_cmd[v] = urand(-1.2, 1.2);
+}
+
+// |a - b| within TOL of the larger magnitude (both 0 passes), and of a
+// scale for entries that are sums of cancelling terms.
+static int agree(double a, double b, double scale) {
+    if (!isfinite(a) || !isfinite(b)) return a == b || (isnan(a) && isnan(b));
+    const double mag = fmax(fmax(fabs(a), fabs(b)), scale);
+    return fabs(a - b) <= TOL * mag;
+}
+
+// Fast against reference on TRIALS random states; returns the mismatches.
+static int compare(const char* what, const hyd_model* m, hyd_fast* k) {
+    const int n = hyd_model_nstate(m);
+    hyd_data* dr = hyd_data_create(m);
+    hyd_data* df = hyd_data_create(m);
+    double* y = calloc((size_t)n, sizeof *y);
+    double* fr = calloc((size_t)n, sizeof *fr);
+    double* ff = calloc((size_t)n, sizeof *ff);
+    double* Jr = calloc((size_t)n * n, sizeof *Jr);
+    double* Jf = calloc((size_t)n * n, sizeof *Jf);
+    int bad = 0;
+    for (int trial = 0; trial < TRIALS && dr && df && y && fr && ff && Jr && Jf; ++trial) {
+        random_state(m, dr, y);
+        memcpy(df->cyl_x, dr->cyl_x, (size_t)hyd_model_ncylinder(m) * sizeof(double));
+        memcpy(df->cyl_v, dr->cyl_v, (size_t)hyd_model_ncylinder(m) * sizeof(double));
+        memcpy(df->valve_cmd, dr->valve_cmd, (size_t)hyd_model_nvalve(m) * sizeof(double));
+        hyd_eval(m, dr, 0.0, y, fr);
+        hyd_fast_eval(k, df, y, ff);
+        for (int i = 0; i < n; ++i) {
+            // A pressure rate is c times a sum of flows: its scale is c times
+            // the largest flow magnitude of the circuit.
+            const int node = hyd_model_state_node(m, i);
+            double qs = 0.0;
+            if (node >= 0) {
+                for (int c = 0; c < 2 * hyd_model_ncomp(m); ++c) qs = fmax(qs, fabs(dr->comp_q[c]));
+                qs = fmax(qs, fabs(dr->node_dV[node]));
+                qs *= dr->node_be[node] / dr->node_V[node];
+            }
+            if (!agree(ff[i], fr[i], qs)) {
+                if (bad < 5)
+                    fprintf(stderr, "%s trial %d: f[%s] fast %.17g ref %.17g\n", what, trial,
+                            hyd_model_state_name(m, i), ff[i], fr[i]);
+                ++bad;
+            }
+        }
+        for (int c = 0; c < hyd_model_ncylinder(m); ++c)
+            if (!agree(df->cyl_F[c], dr->cyl_F[c], 0.0)) ++bad;
+        hyd_jacobian(m, dr, 0.0, y, NULL, Jr, n, 0, 0);
+        for (int i = 0; i < n * n; ++i) Jf[i] = 12345.0; // every entry must be written
+        hyd_fast_jacobian(k, df, y, NULL, Jf, n);
+        for (int i = 0; i < n; ++i) {
+            double rowmax = 0.0;
+            for (int j = 0; j < n; ++j) rowmax = fmax(rowmax, fabs(Jr[i * n + j]));
+            for (int j = 0; j < n; ++j)
+                if (!agree(Jf[i * n + j], Jr[i * n + j], i == j ? rowmax : 0.0)) {
+                    if (bad < 5)
+                        fprintf(stderr, "%s trial %d: J[%s][%s] fast %.17g ref %.17g\n", what, trial,
+                                hyd_model_state_name(m, i), hyd_model_state_name(m, j), Jf[i * n + j],
+                                Jr[i * n + j]);
+                    ++bad;
+                }
+        }
+        for (int i = 0; i < hyd_model_ncylinder(m) * n; ++i)
+            if (!agree(df->dydx[i], dr->dydx[i], 0.0) || !agree(df->dydv[i], dr->dydv[i], 0.0) ||
+                !agree(df->dFdy[i], dr->dFdy[i], 0.0))
+                ++bad;
+    }
+    CHECK(bad == 0, "%s: %d values of the fast kernel differ from the reference", what, bad);
+    free(Jf);
+    free(Jr);
+    free(ff);
+    free(fr);
+    free(y);
+    hyd_data_free(df);
+    hyd_data_free(dr);
+    return bad;
+}
+
+static void check_circuit(const char* what, const hyd_model* m) {
+    char why[256] = "";
+    hyd_fast* k = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+    CHECK(k != NULL, "%s: fast kernel refused: %s", what, why);
+    if (!k) return;
+    CHECK(hyd_fast_nfallback(k) == 0, "%s: %d components fell back", what, hyd_fast_nfallback(k));
+    compare(what, m, k);
+    hyd_fast_free(k);
+}
+
+static cJSON* read_json(const char* path) {
+    FILE* f = fopen(path, "rb");
+    if (!f) return NULL;
+    static char buf[1 << 20];
+    const size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    return cJSON_Parse(buf);
+}
+
+// Every JSON file in dir that holds a circuit that compiles.
+static int check_dir(const char* dir) {
+    DIR* dp = opendir(dir);
+    CHECK(dp != NULL, "cannot open %s", dir);
+    if (!dp) return 0;
+    int count = 0;
+    struct dirent* e;
+    while ((e = readdir(dp))) {
+        const size_t L = strlen(e->d_name);
+        if (L < 6 || strcmp(e->d_name + L - 5, ".json")) continue;
+        char path[1024], err[512];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        hyd_set_note_handler(NULL, NULL);
+        hyd_model* m = hyd_model_load_json(path, err, sizeof err);
+        if (!m) continue; // a bad-circuit fixture
+        check_circuit(path, m);
+        hyd_model_free(m);
+        ++count;
+    }
+    closedir(dp);
+    return count;
+}
+
+static void quiet(const char* line, void* user) { (void)line, (void)user; }
+
+// Each shipped model's circuit with each world's extra circuit appended, as
+// the ode world merges them (nodes and components appended in order).
+static void test_world_circuits(void) {
+    const char* models[] = {HYD_ASSETS "/models/hiab031.json"};
+    const char* worlds[] = {HYD_ASSETS "/worlds/sandbox.json", HYD_ASSETS "/worlds/validation.json"};
+    int merged = 0;
+    for (size_t a = 0; a < sizeof models / sizeof *models; ++a)
+        for (size_t w = 0; w < sizeof worlds / sizeof *worlds; ++w) {
+            cJSON* mj = read_json(models[a]);
+            cJSON* wj = read_json(worlds[w]);
+            CHECK(mj && wj, "cannot read %s or %s", models[a], worlds[w]);
+            const cJSON* extra = wj ? cJSON_GetObjectItemCaseSensitive(wj, "circuit") : NULL;
+            cJSON* h = mj ? cJSON_GetObjectItemCaseSensitive(mj, "hydraulics") : NULL;
+            if (h && extra) {
+                static const char* const lists[2] = {"nodes", "components"};
+                for (int l = 0; l < 2; ++l) {
+                    const cJSON* add = cJSON_GetObjectItemCaseSensitive(extra, lists[l]);
+                    cJSON* dst = cJSON_GetObjectItemCaseSensitive(h, lists[l]);
+                    const cJSON* it;
+                    cJSON_ArrayForEach(it, add) cJSON_AddItemToArray(dst, cJSON_Duplicate(it, 1));
+                }
+                char err[512];
+                hyd_set_note_handler(quiet, NULL);
+                hyd_model* m = hyd_model_from_json(h, worlds[w], "hydraulics", err, sizeof err);
+                hyd_set_note_handler(NULL, NULL);
+                CHECK(m != NULL, "merged circuit of %s: %s", worlds[w], err);
+                if (m) {
+                    char what[600];
+                    snprintf(what, sizeof what, "%s + %s", models[a], worlds[w]);
+                    check_circuit(what, m);
+                    hyd_model_free(m);
+                    ++merged;
+                }
+            }
+            cJSON_Delete(mj);
+            cJSON_Delete(wj);
+        }
+    CHECK(merged >= 1, "no world circuit merged");
+}
+
+static void test_shipped(void) {
+    CHECK(check_dir(HYD_ASSETS "/models") >= 1, "no shipped model circuit");
+    CHECK(check_dir(HYD_TESTDATA) >= 2, "fewer than 2 valid test circuits");
+    char err[256];
+    hyd_model* m = hyd_model_default_crane(err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (m) check_circuit("default crane", m), hyd_model_free(m);
+}
+
+static void test_synthetic(void) {
+    const int sizes[] = {1, 2, 4, 8};
+    for (int s = 0; s < 4; ++s) {
+        char err[256], what[64];
+        hyd_model* m = hyd_model_synthetic(sizes[s], err, sizeof err);
+        CHECK(m != NULL, "synthetic %d: %s", sizes[s], err);
+        if (!m) continue;
+        CHECK(hyd_model_ncylinder(m) == sizes[s] && hyd_model_nstate(m) == 1 + 5 * sizes[s],
+              "synthetic %d: %d cylinders, %d states", sizes[s], hyd_model_ncylinder(m), hyd_model_nstate(m));
+        snprintf(what, sizeof what, "synthetic %d actuators", sizes[s]);
+        check_circuit(what, m);
+        hyd_model_free(m);
+    }
+}
+
+// A circuit with a type the kernel does not take (here: told so by the mask)
+// is refused with a message naming the component, or evaluated correctly by
+// the reference loop of that type.
+static void test_unsupported(void) {
+    char err[256], why[256] = "";
+    hyd_model* m = hyd_model_default_crane(err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    const unsigned types[3] = {hyd_fast_types() & ~(1u << HYD_VALVE), hyd_fast_types() & ~(1u << HYD_CYLINDER),
+                               hyd_fast_types() & ~(1u << HYD_RELIEF | 1u << HYD_HOSE)};
+    for (int t = 0; t < 3; ++t) {
+        hyd_fast* k = hyd_fast_create(m, types[t], 0, why, sizeof why);
+        CHECK(k == NULL, "mask %u: accepted without fallback", types[t]);
+        CHECK(strstr(why, "component '") && strstr(why, "no loop for this type"), "message: %s", why);
+        hyd_fast_free(k);
+        k = hyd_fast_create(m, types[t], 1, why, sizeof why);
+        CHECK(k != NULL && hyd_fast_nfallback(k) > 0, "mask %u: no fallback", types[t]);
+        if (k) compare("fallback", m, k);
+        hyd_fast_free(k);
+    }
+    hyd_fast* k = hyd_fast_create(m, hyd_fast_types() & ~(1u << HYD_VALVE), 0, why, sizeof why);
+    CHECK(!k && strstr(why, "'lift_valve' (valve)"), "message: %s", why);
+    hyd_fast_free(k);
+    hyd_model_free(m);
+}
+
+// A parameter change reaches the kernel's record copies.
+static void test_live_change(void) {
+    char err[256], why[256];
+    hyd_model* m = hyd_model_default_crane(err, sizeof err);
+    if (!m) return;
+    hyd_fast* k = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+    CHECK(hyd_model_set(m, "lift_cyl.bore", 0.12, err, sizeof err) == 0, "%s", err);
+    CHECK(hyd_model_set(m, "jib_hose_A.length", 5.0, err, sizeof err) == 0, "%s", err);
+    if (k) compare("after hyd_model_set", m, k);
+    hyd_fast_free(k);
+    hyd_model_free(m);
+}
+
+// In a caller's state order (hyd_fast_map) the same numbers, bit for bit,
+// at the mapped places: a state vector of 3 n entries with the circuit's
+// states scattered in reverse.
+static void test_mapped(void) {
+    char err[256], why[256];
+    hyd_model* m = hyd_model_synthetic(3, err, sizeof err);
+    if (!m) return;
+    const int n = hyd_model_nstate(m), N = 3 * n;
+    hyd_fast* k = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+    hyd_fast* km = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+    int* map = malloc((size_t)n * sizeof *map);
+    double *y = calloc((size_t)n, sizeof *y), *f = calloc((size_t)n, sizeof *f);
+    double *J = calloc((size_t)n * n, sizeof *J), *Y = calloc((size_t)N, sizeof *Y);
+    double *F = calloc((size_t)N, sizeof *F), *JM = calloc((size_t)N * N, sizeof *JM);
+    hyd_data* d = hyd_data_create(m);
+    if (!k || !km || !map || !y || !f || !J || !Y || !F || !JM || !d) return;
+    for (int i = 0; i < n; ++i) map[i] = N - 1 - 2 * i;
+    CHECK(hyd_fast_map(km, map) == 0, "map refused");
+    int bad = 0, outside = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        random_state(m, d, y);
+        for (int i = 0; i < n; ++i) Y[map[i]] = y[i];
+        for (int i = 0; i < N * N; ++i) JM[i] = 7.0;
+        hyd_fast_jacobian(k, d, y, f, J, n);
+        hyd_fast_jacobian(km, d, Y, F, JM, N);
+        for (int i = 0; i < n; ++i) {
+            bad += memcmp(&F[map[i]], &f[i], sizeof *f) != 0;
+            for (int j = 0; j < n; ++j) bad += memcmp(&JM[map[i] * N + map[j]], &J[i * n + j], sizeof *J) != 0;
+        }
+        int in_block = 0;
+        for (int i = 0; i < N * N; ++i) in_block += JM[i] != 7.0;
+        outside += in_block > n * n;
+    }
+    CHECK(bad == 0, "%d mapped values differ", bad);
+    CHECK(outside == 0, "entries written outside the mapped block in %d trials", outside);
+    hyd_fast* kf = hyd_fast_create(m, hyd_fast_types() & ~(1u << HYD_HOSE), 1, why, sizeof why);
+    CHECK(kf && hyd_fast_map(kf, map) == -1, "map accepted with fallback components");
+    hyd_fast_free(kf);
+    hyd_data_free(d);
+    free(JM), free(F), free(Y), free(J), free(f), free(y), free(map);
+    hyd_fast_free(km);
+    hyd_fast_free(k);
+    hyd_model_free(m);
+}
+
+static void test_structure(void) {
+    char err[256];
+    hyd_model* m = hyd_model_default_crane(err, sizeof err);
+    if (!m) return;
+    const int n = hyd_model_nstate(m);
+    for (int i = 0; i < n; ++i) {
+        const char* nm = hyd_model_state_name(m, i);
+        const hyd_state_kind k = hyd_model_state_kind(m, i);
+        const int spool = strstr(nm, ".spool") != NULL;
+        CHECK(k == (spool ? HYD_STATE_SPOOL : HYD_STATE_PRESSURE), "kind of %s: %d", nm, (int)k);
+        CHECK((hyd_model_state_node(m, i) < 0) == spool, "node of %s", nm);
+        if (!spool) CHECK(hyd_model_node_state(m, hyd_model_state_node(m, i)) == i, "node state of %s", nm);
+    }
+    const int pl = hyd_model_find_node(m, "pump_line"), tank = hyd_model_find_node(m, "tank");
+    CHECK(hyd_model_supply_node(m) == pl, "supply node %d, pump line %d", hyd_model_supply_node(m), pl);
+    CHECK(hyd_model_node_role(m, pl) == HYD_NODE_SUPPLY && hyd_model_node_role(m, tank) == HYD_NODE_TANK &&
+              hyd_model_node_role(m, hyd_model_find_node(m, "lift_cyl.A")) == HYD_NODE_LINE,
+          "node roles");
+    const int cyl = hyd_model_find(m, "jib_cyl");
+    const int chB = hyd_model_comp_node(m, cyl, 1);
+    CHECK(chB == hyd_model_find_node(m, "jib_cyl.B") && hyd_model_node_owner(m, chB) == cyl, "chamber B");
+    const int hose = hyd_model_feed_hose(m, chB);
+    CHECK(hose == hyd_model_find(m, "jib_hose_B"), "feed hose of jib_cyl.B: %d", hose);
+    CHECK(hyd_model_node_state(m, hyd_model_comp_node(m, hose, 0)) == hyd_model_find_state(m, "jib_hose_B.p"),
+          "hose state");
+    const int valve = hyd_model_find(m, "lift_valve");
+    CHECK(hyd_model_port_node(m, valve, 0) == pl && hyd_model_port_node(m, valve, 1) == tank &&
+              hyd_model_port_node(m, valve, 2) == hyd_model_find_node(m, "lift_hose_A"),
+          "valve ports");
+    CHECK(hyd_model_port_node(m, valve, 4) == -1 && hyd_model_comp_node(m, valve, 0) == -1 &&
+              hyd_model_node_owner(m, pl) == -1,
+          "out of range");
+
+    // No Jacobian entry outside the pattern, at random states; and the
+    // pattern is not full (the point of a block pattern).
+    unsigned char* P = malloc((size_t)n * n);
+    double* y = calloc((size_t)n, sizeof *y);
+    double* J = calloc((size_t)n * n, sizeof *J);
+    hyd_data* d = hyd_data_create(m);
+    int outside = 0, nnz = 0;
+    hyd_model_jacobian_pattern(m, P);
+    for (int i = 0; i < n * n; ++i) nnz += P[i];
+    for (int trial = 0; trial < 300; ++trial) {
+        random_state(m, d, y);
+        hyd_jacobian(m, d, 0.0, y, NULL, J, n, 0, 0);
+        for (int i = 0; i < n * n; ++i) outside += J[i] != 0.0 && !P[i];
+    }
+    CHECK(outside == 0, "%d Jacobian entries outside the pattern", outside);
+    CHECK(nnz > n && nnz < n * n / 2, "pattern has %d of %d entries", nnz, n * n);
+    CHECK(P[hyd_model_find_state(m, "lift_valve.spool") * n + hyd_model_find_state(m, "pump_line.p")] == 0 &&
+              P[hyd_model_find_state(m, "pump_line.p") * n + hyd_model_find_state(m, "lift_valve.spool")] == 1,
+          "spool row and column");
+    hyd_data_free(d);
+    free(J);
+    free(y);
+    free(P);
+    hyd_model_free(m);
+}
+
+int main(int argc, char** argv) {
+    srand(14);
+    RUN_TEST(test_structure);
+    RUN_TEST(test_shipped);
+    RUN_TEST(test_world_circuits);
+    RUN_TEST(test_synthetic);
+    RUN_TEST(test_unsupported);
+    RUN_TEST(test_live_change);
+    RUN_TEST(test_mapped);
+    TEST_MAIN_END();
+}
