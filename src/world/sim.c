@@ -347,10 +347,8 @@ static int emit(void* user, double t, const double* y) {
     if (!c->trace && !c->row_fn && !c->progress) return 0;
     lsim_out o;
     lsim_outputs(c->ls, t, y, &o);
-    double row[SIM_NCOL] = {
-        t, o.x[0], o.x[1], o.pA[0], o.pB[0], o.pA[1], o.pB[1], o.u[0], o.u[1], o.q[0], o.q[1],
-        o.tip[0], o.tip[1], o.F[0], o.F[1], o.u_cmd[0], o.u_cmd[1],
-        o.v[0], o.v[1], o.p_pump, o.relief_open, o.end_stop};
+    double row[SIM_NCOL];
+    sim_lagrange_row(t, &o, row);
     // The derived columns too (a force or a tip position can overflow while
     // the states are finite).
     const int rc = sim_check_row(&c->chk, row, SIM_NCOL_BASE, c->bad, sizeof c->bad);
@@ -381,6 +379,14 @@ static const char* state_name(const lsim* ls, int i, char* buf, size_t n) {
     if (i >= ls->iq) return mech[i - ls->iq];
     snprintf(buf, n, "%s", hyd_model_state_name(ls->mdl->hyd, ls->perm[i]));
     return buf;
+}
+
+void sim_lagrange_row(double t, const lsim_out* o, double* row) {
+    const double v[SIM_NCOL] = {
+        t, o->x[0], o->x[1], o->pA[0], o->pB[0], o->pA[1], o->pB[1], o->u[0], o->u[1], o->q[0], o->q[1],
+        o->tip[0], o->tip[1], o->F[0], o->F[1], o->u_cmd[0], o->u_cmd[1],
+        o->v[0], o->v[1], o->p_pump, o->relief_open, o->end_stop};
+    memcpy(row, v, sizeof v);
 }
 
 // One CSV row from the ode world's state.

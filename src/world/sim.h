@@ -171,6 +171,9 @@ void sim_csv_row(FILE* f, const double* row, int ncol);
 /// assets/worlds/<name>.json ("validation", "sandbox").
 const char* sim_world_path(const char* arg, char* buf, size_t n);
 
+/// One row (all SIM_NCOL columns; the world extras 0) from the lagrange
+/// crane's outputs o at time t [s]: the one place its rows are assembled.
+void sim_lagrange_row(double t, const lsim_out* o, double* row);
 struct ode_world;
 /// One row (all SIM_NCOL columns) from an ode world's current state.
 void sim_ode_row(struct ode_world* w, double* row);

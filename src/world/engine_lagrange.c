@@ -1,7 +1,8 @@
-// live.c: the lagrange crane stepped by a real-time loop.
-#include "live.h"
+// engine_lagrange.c: the lagrange crane (lagrange_sim.h: the analytic
+// 2-DOF crane and its full circuit as one ODE system) behind engine.h,
+// stepped by an outside loop with commands set between steps.
+#include "engine_impl.h"
 
-#include "ode_world.h"
 #include "snap_reliefs.h"
 
 #include <math.h>
@@ -14,27 +15,28 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-struct live {
-    ode_world* ode; ///< the ode backend, or NULL for lagrange
+typedef struct eng_lagrange {
+    engine base;
     lsim ls;
     hyd_problem prob;
     hyd_solver* solver;
-    sim_opts o;
     double t;
     double y[LSIM_MAX_STATES];
-    char err[512];
-    sim_checks chk; ///< the run checks every driver applies (sim.h)
-    bool failed;    ///< a check or the solver failed: the crane stays stopped
-};
+} eng_lagrange;
 
-live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
-                           size_t errsz) {
-    live* l = calloc(1, sizeof *l);
+static void lag_row(engine* e, double row[SIM_NCOL]);
+static void lag_destroy(engine* e);
+static const engine_ops lagrange_ops;
+
+engine* engine_lagrange_create(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
+                               size_t errsz) {
+    eng_lagrange* l = calloc(1, sizeof *l);
     if (!l) {
         snprintf(err, errsz, "out of memory");
         return NULL;
     }
-    l->o = *o;
+    l->base.ops = &lagrange_ops;
+    l->base.o = *o;
     if (lsim_init(&l->ls, m, o->variant, m3, err, errsz)) {
         free(l);
         return NULL;
@@ -46,7 +48,7 @@ live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2]
     }
     lsim_initial_state(&l->ls, q0, 0.5e6, l->y);
     double row0[SIM_NCOL];
-    live_row(l, row0);
+    lag_row(&l->base, row0);
     if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, m3, err, errsz)) {
         lsim_free(&l->ls);
         free(l);
@@ -67,155 +69,70 @@ live* live_create_lagrange(const model* m, const sim_opts* o, const double q0[2]
     l->solver = hyd_solver_create(&l->prob, o->solver, &so);
     if (!l->solver) {
         snprintf(err, errsz, "cannot create the %s solver", hyd_method_name(o->solver));
-        live_destroy(l);
+        lag_destroy(&l->base);
         return NULL;
     }
-    return l;
+    return &l->base;
 }
 
-live* live_create_ode(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
-                      size_t errsz) {
-    live* l = calloc(1, sizeof *l);
-    if (!l) {
-        snprintf(err, errsz, "out of memory");
-        return NULL;
-    }
-    l->o = *o;
-    l->ode = sim_ode_world_create(m, o, "sandbox", q0, slew0, m3, err, errsz);
-    if (!l->ode) {
-        free(l);
-        return NULL;
-    }
-    // The hydraulic sub-step is min(--dt, ODE step), as sim_ode_world_create sets it.
-    const double dt = ode_world_dt(l->ode), h = o->h < dt ? o->h : dt;
-    double row0[SIM_NCOL];
-    sim_ode_row(l->ode, row0);
-    if (sim_check_fixed_step(ode_world_circuit(l->ode), o, h, 0.0, err, errsz) ||
-        sim_check_start(ode_world_circuit(l->ode), row0, SIM_NCOL, m3, err, errsz)) {
-        ode_world_destroy(l->ode);
-        free(l);
-        return NULL;
-    }
-    return l;
-}
-
-live* live_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
-                  size_t errsz) {
-    return o->mechanics == SIM_ODE ? live_create_ode(m, o, q0, slew0, m3, err, errsz)
-                                   : live_create_lagrange(m, o, q0, m3, err, errsz);
-}
-
-void live_destroy(live* l) {
-    if (!l) return;
-    if (l->ode) ode_world_destroy(l->ode);
+static void lag_destroy(engine* e) {
+    eng_lagrange* l = (eng_lagrange*)e;
     hyd_solver_destroy(l->solver);
-    if (!l->ode) lsim_free(&l->ls);
+    lsim_free(&l->ls);
     free(l);
 }
 
-int live_hook(live* l, int attach) { return l->ode ? ode_world_hook(l->ode, attach) : -1; }
+static hyd_model* lag_circuit(engine* e) { return ((eng_lagrange*)e)->ls.mdl->hyd; }
 
-const char* live_load_name(const live* l, int i, double* mass) {
-    return l->ode ? ode_world_load_name(l->ode, i, mass) : NULL;
-}
-
-bool live_attached(const live* l) {
-    if (!l->ode) return false;
-    ode_world_state st;
-    ode_world_get_state(l->ode, &st);
-    return st.attached >= 0;
-}
-
-hyd_model* live_circuit(live* l) { return l->ode ? ode_world_circuit(l->ode) : l->ls.mdl->hyd; }
-
-void live_set_load(live* l, double m3) {
-    if (l->ode || l->ls.m3 == m3) return;
+static void lag_set_load(engine* e, double m3) {
+    eng_lagrange* l = (eng_lagrange*)e;
+    if (l->ls.m3 == m3) return;
     l->ls.m3 = m3;
     lagrange_consts_init(&l->ls.mdl->mech, l->ls.variant, m3, &l->ls.lk);
     hyd_solver_inputs_changed(l->solver); // f changed at the same (t, y)
 }
 
-int live_set_link(live* l, int k, const crane_link* ln) {
-    if (l->ode) return ode_world_set_link_mass(l->ode, k, ln) ? 1 : 0;
+static int lag_set_link(engine* e, int k, const crane_link* ln) {
+    eng_lagrange* l = (eng_lagrange*)e;
     // The lagrange crane reads the model's links (ln is one of them, edited
     // by the caller); the constants its fast kernels made from them at start
     // are made again.
+    (void)k;
     (void)ln;
     lagrange_consts_init(&l->ls.mdl->mech, l->ls.variant, l->ls.m3, &l->ls.lk);
     hyd_solver_inputs_changed(l->solver); // f changed at the same (t, y)
     return 0;
 }
 
-int live_ncol(const live* l) { return l->ode ? SIM_NCOL : SIM_NCOL_BASE; }
-
-void live_set_commands(live* l, const double u[3]) {
-    if (l->ode) {
-        ode_world_set_commands(l->ode, u);
-        return;
-    }
+static void lag_set_commands(engine* e, const double u[3]) {
+    eng_lagrange* l = (eng_lagrange*)e;
     for (int k = 0; k < 2; ++k) {
         double v = u[k] < -1 ? -1 : u[k] > 1 ? 1 : u[k];
         // A command change is a kink in the input: adaptive methods restart
         // their step-size history there (decision 8).
-        if (v != l->ls.u_cmd[k] && hyd_method_is_adaptive(l->o.solver)) hyd_solver_reset(l->solver);
+        if (v != l->ls.u_cmd[k] && hyd_method_is_adaptive(e->o.solver)) hyd_solver_reset(l->solver);
         l->ls.u_cmd[k] = v;
     }
 }
 
-static int advance(live* l, double dt) {
-    if (l->ode) {
-        if (ode_world_step(l->ode, dt) == 0) return 0;
-        snprintf(l->err, sizeof l->err, "%s", ode_world_error(l->ode));
-        return 1;
-    }
+static int lag_step(engine* e, double dt) {
+    eng_lagrange* l = (eng_lagrange*)e;
     int rc = hyd_solver_advance(l->solver, &l->t, l->y, l->t + dt);
     if (rc == HYD_OK) return 0;
     double tb = l->t;
     int i = hyd_solver_bad_state(l->solver, &tb);
-    snprintf(l->err, sizeof l->err, "solver %s failed (code %d) at t = %.6g s, state %d", hyd_method_name(l->o.solver),
+    snprintf(e->err, sizeof e->err, "solver %s failed (code %d) at t = %.6g s, state %d", hyd_method_name(e->o.solver),
              rc, tb, i);
     return 1;
 }
 
-int live_advance(live* l, double dt) {
-    if (l->failed) return 1;
-    if (advance(l, dt)) {
-        l->failed = true;
-        return 1;
-    }
-    // The same checks as run's, on the row the loop records and shows: a
-    // drive that exits 0 while recording -26 MPa absolute is a wrong result
-    // passing as valid.
-    double row[SIM_NCOL];
-    live_row(l, row);
-    char what[200];
-    const int rc = sim_check_row(&l->chk, row, live_ncol(l), what, sizeof what);
-    if (!rc) return 0;
-    const bool adaptive = hyd_method_is_adaptive(l->o.solver);
-    snprintf(l->err, sizeof l->err, "numerical blow-up: %s (solver %s): %s", what, hyd_method_name(l->o.solver),
-             sim_blowup_hint(adaptive, row[COL_T], l->chk.bad_value));
-    l->failed = true;
-    return 1;
-}
+static double lag_time(const engine* e) { return ((const eng_lagrange*)e)->t; }
 
-void live_note(const live* l, char* note, size_t n) {
-    sim_checks_note(&l->chk, hyd_method_is_adaptive(l->o.solver), note, n);
-}
-
-const char* live_error(const live* l) { return l->err; }
-double live_time(const live* l) { return l->ode ? ode_world_time(l->ode) : l->t; }
-void live_row(live* l, double row[SIM_NCOL]) {
-    if (l->ode) {
-        sim_ode_row(l->ode, row);
-        return;
-    }
+static void lag_row(engine* e, double row[SIM_NCOL]) {
+    eng_lagrange* l = (eng_lagrange*)e;
     lsim_out o;
     lsim_outputs(&l->ls, l->t, l->y, &o);
-    double v[SIM_NCOL] = {
-        l->t, o.x[0], o.x[1], o.pA[0], o.pB[0], o.pA[1], o.pB[1], o.u[0], o.u[1], o.q[0], o.q[1],
-        o.tip[0], o.tip[1], o.F[0], o.F[1], o.u_cmd[0], o.u_cmd[1],
-        o.v[0], o.v[1], o.p_pump, o.relief_open, o.end_stop};
-    memcpy(row, v, sizeof v);
+    sim_lagrange_row(l->t, &o, row);
 }
 
 // Planar crane placed in the world: boom plane = x-z, joint 1 at the column
@@ -247,11 +164,8 @@ static void add_body(world_snapshot* s, const char* name, world_role role, world
     b->mesh_up = 2;
 }
 
-void live_snapshot(live* l, world_snapshot* s) {
-    if (l->ode) {
-        ode_world_snapshot(l->ode, s);
-        return;
-    }
+static void lag_snapshot(engine* e, world_snapshot* s) {
+    eng_lagrange* l = (eng_lagrange*)e;
     lsim_out o;
     lsim_outputs(&l->ls, l->t, l->y, &o);
     const crane_mech* me = &l->ls.mdl->mech;
@@ -325,3 +239,18 @@ void live_snapshot(live* l, world_snapshot* s) {
     const int cyl_hyd[WORLD_SNAP_MAX_CYLINDERS] = {l->ls.mdl->cyl[0], l->ls.mdl->cyl[1], -1, -1};
     world_snap_reliefs(s, l->ls.mdl->hyd, l->ls.hd->comp_open, cyl_hyd);
 }
+
+static const engine_ops lagrange_ops = {
+    .name = "lagrange",
+    .ncol = SIM_NCOL_BASE,
+    .destroy = lag_destroy,
+    .set_commands = lag_set_commands,
+    .hook = NULL, // no world, no hook
+    .circuit = lag_circuit,
+    .set_load = lag_set_load,
+    .set_link = lag_set_link,
+    .step = lag_step,
+    .time = lag_time,
+    .row = lag_row,
+    .snapshot = lag_snapshot,
+};

@@ -1,0 +1,86 @@
+// engine.h: one crane engine, whatever the backend: the lagrange crane
+// (engine_lagrange.c, on lagrange_sim) or the ODE world (engine_ode.c, on
+// ode_world). Drivers (drive, the window's tick, the soak bench) create one
+// from the model and the options, set commands, advance it on the simulated
+// clock, read its row and its snapshot, and never ask which backend runs:
+// what differs is behind engine_ops (engine_impl.h).
+#ifndef ENGINE_H
+#define ENGINE_H
+
+#include "sim.h"
+#include "world_snapshot.h"
+
+#include <stdbool.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct engine engine;
+
+/// The engine o->mechanics names, at joint angles q0 [rad], slew angle
+/// slew0 [rad] (ode only) and tip load m3 [kg] (lagrange, and the ode
+/// validation world; the sandbox picks loads up with the hook). The ode world
+/// is o->world, else the sandbox. NULL with one line in err: the start the
+/// run checks refuse (an unreachable pose, a step the method cannot take, a
+/// load the reliefs cannot hold), or the world file at fault.
+engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
+                      size_t errsz);
+void engine_destroy(engine* e);
+/// "lagrange" or "ode".
+const char* engine_backend_name(const engine* e);
+
+/// Valve commands lift, jib, slew in [-1, 1] (clamped; slew ignored where
+/// the crane does not slew), held until changed.
+void engine_set_commands(engine* e, const double u[3]);
+/// Hook: 1 attach the nearest load in reach, 0 release. Returns the load
+/// index attached, or -1 (also where the world has no hook).
+int engine_hook(engine* e, int attach);
+/// Name and mass [kg] of load i of the world, or NULL.
+const char* engine_load_name(const engine* e, int i, double* mass);
+/// True while a load hangs on the hook.
+bool engine_attached(const engine* e);
+/// The circuit the running engine uses (the model's for lagrange, the
+/// world's own copy for ode): hyd_model_set on it takes effect at the next step.
+hyd_model* engine_circuit(engine* e);
+/// Set the tip load [kg] where the engine carries it as a parameter
+/// (lagrange; takes effect at the next step).
+void engine_set_load(engine* e, double m3);
+/// Boom k (0 lifting arm, 1 end arm) now has link ln (mass, com, inertia,
+/// length), applied in place at the next step where the engine can: the
+/// lagrange crane always (its constants are recomputed; ln is the model's
+/// link it reads), the ode world for a new mass and inertia about the same
+/// centre of mass. Returns 0 when applied, 1 when the engine must be
+/// rebuilt for it (a new length, or a centre of mass that moves).
+int engine_set_link(engine* e, int k, const crane_link* ln);
+
+/// Columns engine_row fills (base, or base plus the world extras for ode).
+int engine_ncol(const engine* e);
+
+/// Called for each row engine_advance_to produces; non-zero stops it.
+typedef int (*engine_row_fn)(void* user, const double* row);
+/// Advance to simulated time t_to [s] (the ode world takes whole ODE steps:
+/// it ends on the step nearest t_to), then apply the run checks of sim.h
+/// (sim_check_row) to the state reached and hand its row to row_fn (may be
+/// NULL). Returns 0; 1 on a numerical failure or a failed check (message
+/// from engine_error), after which the engine stays stopped and every
+/// further call returns 1; 2 when row_fn asked to stop.
+int engine_advance_to(engine* e, double t_to, engine_row_fn row_fn, void* user);
+/// Advance by dt [s], as engine_advance_to without a row callback.
+int engine_advance(engine* e, double dt);
+/// The note for a dip below absolute zero the checks saw (sim_checks_note),
+/// or "".
+void engine_note(const engine* e, char* note, size_t n);
+const char* engine_error(const engine* e);
+
+/// Simulated time [s].
+double engine_time(const engine* e);
+/// The CSV row at the current time (sim.h columns; engine_ncol of them are set).
+void engine_row(engine* e, double row[SIM_NCOL]);
+/// Fill a snapshot for the renderer.
+void engine_snapshot(engine* e, world_snapshot* s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
