@@ -152,14 +152,6 @@ int app_load_msg(const app_common* c, model** m, scenario* sc, char* err, size_t
 /// app_load_msg, printing the message as "cranesim: ..." on stderr.
 int app_load(const app_common* c, model** m, scenario* sc);
 
-typedef struct engine engine;
-/// The scripted operator (a scenario's command tables and hook events) at
-/// simulated time tm: the stick positions into u[3], and every hook event
-/// due by tm, from *ev on, applied to l (*ev advances). on_hook (may be
-/// NULL) hears each: attach or release, and engine_hook's answer.
-void app_scripted_input(const scenario* sc, engine* l, double tm, int* ev, double u[3],
-                        void (*on_hook)(void* user, engine* l, int attach, int got), void* user);
-
 /// Progress bar on stderr, only when stderr is a terminal.
 void app_progress(void* user, double t, double t_end);
 void app_progress_done(void);

@@ -199,7 +199,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         // The operator's stick positions at the middle of this frame.
         const double tm = t + 0.5 * frame;
         double u[3];
-        app_scripted_input(&sc, l, tm, &ev, u, report_hook, &dw);
+        engine_play(l, &sc, tm, &ev, u, report_hook, &dw);
         engine_set_commands(l, u);
         // Advance to the frame's end on the simulated clock (the ode world
         // steps whole ODE steps, so aim at the target, not at +frame).

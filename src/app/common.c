@@ -704,16 +704,6 @@ int app_load_msg(const app_common* c, model** m, scenario* sc, char* err, size_t
     return 0;
 }
 
-void app_scripted_input(const scenario* sc, engine* l, double tm, int* ev, double u[3],
-                        void (*on_hook)(void* user, engine* l, int attach, int got), void* user) {
-    for (int k = 0; k < 3; ++k) u[k] = scenario_command(sc, k, tm);
-    for (; *ev < sc->nevent && sc->event[*ev].t <= tm; ++*ev) {
-        const int attach = sc->event[*ev].kind == SCENARIO_ATTACH;
-        const int got = engine_hook(l, attach);
-        if (on_hook) on_hook(user, l, attach, got);
-    }
-}
-
 void app_progress(void* user, double t, double t_end) {
     (void)user;
     if (!isatty(2)) return;

@@ -789,7 +789,7 @@ int drive_session_tick(drive_session* s, double wall) {
     } else {
         double u[3] = {cmd.lift, cmd.jib, cmd.slew};
         if (s->o.scripted) {
-            app_scripted_input(&s->sc, s->l, s->t_base + t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
+            engine_play(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
         } else if (cmd.hook_toggle) {
             engine_hook(s->l, !engine_attached(s->l));
         }

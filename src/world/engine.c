@@ -4,10 +4,33 @@
 
 #include <stdio.h>
 
+typedef struct play_ctx {
+    engine* e;
+    engine_hook_fn on_hook;
+    void* user;
+} play_ctx;
+
+static int play_hook(void* user, int attach) {
+    play_ctx* pc = user;
+    const int got = engine_hook(pc->e, attach);
+    if (pc->on_hook) pc->on_hook(pc->user, pc->e, attach, got);
+    return got;
+}
+
 engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
                       size_t errsz) {
     return o->mechanics == SIM_ODE ? engine_ode_create(m, o, q0, slew0, m3, err, errsz)
                                    : engine_lagrange_create(m, o, q0, m3, err, errsz);
+}
+
+int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
+    return o->mechanics == SIM_ODE ? engine_ode_run(m, sc, o, k, res) : engine_lagrange_run(m, sc, o, k, res);
+}
+
+void engine_play(engine* e, const scenario* sc, double tm, int* ev, double u[3], engine_hook_fn on_hook,
+                 void* user) {
+    play_ctx pc = {e, on_hook, user};
+    scenario_play(sc, tm, ev, u, play_hook, &pc);
 }
 
 void engine_destroy(engine* e) {

@@ -3,10 +3,12 @@
 // ode_world). Drivers (drive, the window's tick, the soak bench) create one
 // from the model and the options, set commands, advance it on the simulated
 // clock, read its row and its snapshot, and never ask which backend runs:
-// what differs is behind engine_ops (engine_impl.h).
+// what differs is behind engine_ops (engine_impl.h). Scripted runs (run,
+// compare, study, bench) go through engine_run, which plays a scenario.
 #ifndef ENGINE_H
 #define ENGINE_H
 
+#include "scenario.h"
 #include "sim.h"
 #include "world_snapshot.h"
 
@@ -68,10 +70,35 @@ typedef int (*engine_row_fn)(void* user, const double* row);
 int engine_advance_to(engine* e, double t_to, engine_row_fn row_fn, void* user);
 /// Advance by dt [s], as engine_advance_to without a row callback.
 int engine_advance(engine* e, double dt);
+
+/// Where a scripted run's rows go (engine_run).
+typedef struct engine_sink {
+    engine_row_fn row; ///< each output row (may be NULL); non-zero stops the run
+    void* user;
+    bool rows;         ///< someone consumes rows: else (benchmarks) the output evaluation is skipped
+    bool summary;      ///< someone reads the summary: peaks over every step, not only the rows
+    double t_end;      ///< the run's end [s] (> 0; checked by the caller, sim_check_times)
+} engine_sink;
+/// A scripted run from t = 0 to k->t_end: the engine o->mechanics names,
+/// built for scenario sc (its start pose, load and world), plays the
+/// scenario and hands a row every o->dt_out to k. The run checks and their
+/// messages are sim.h's; res as sim_run's (status 0, 1 numerical failure,
+/// 2 refused or stopped).
+int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
 /// The note for a dip below absolute zero the checks saw (sim_checks_note),
 /// or "".
 void engine_note(const engine* e, char* note, size_t n);
 const char* engine_error(const engine* e);
+
+/// Hears a hook event the scripted operator applied: attach or release,
+/// and engine_hook's answer.
+typedef void (*engine_hook_fn)(void* user, engine* e, int attach, int got);
+/// The scripted operator (scenario_play) at simulated time tm [s]: the
+/// stick positions into u[3] (the caller sets them), and every hook event
+/// due by tm, from *ev on, applied to e (*ev advances); on_hook (may be
+/// NULL) hears each.
+void engine_play(engine* e, const scenario* sc, double tm, int* ev, double u[3], engine_hook_fn on_hook,
+                 void* user);
 
 /// Simulated time [s].
 double engine_time(const engine* e);

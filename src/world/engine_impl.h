@@ -40,4 +40,9 @@ engine* engine_lagrange_create(const model* m, const sim_opts* o, const double q
 engine* engine_ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           char* err, size_t errsz);
 
+/// The backends' scripted runs (engine_run picks one by o->mechanics).
+int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
+                        sim_result* res);
+int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
+
 #endif

@@ -4,6 +4,9 @@
 #include "engine_impl.h"
 
 #include "snap_reliefs.h"
+#ifdef CRANESIM_HAVE_CVODE
+#include "hyd_cvode.h"
+#endif
 
 #include <math.h>
 #include <stddef.h>
@@ -134,6 +137,275 @@ static void lag_row(engine* e, double row[SIM_NCOL]) {
     lsim_outputs(&l->ls, l->t, l->y, &o);
     sim_lagrange_row(l->t, &o, row);
 }
+
+// ---- Scripted runs (sim_run) ----
+
+typedef struct run_ctx {
+    lsim* ls;
+    const sim_opts* o;
+    const engine_sink* sink;
+    double t_end, t_last_row;
+    long rows;
+    int stop;
+    // The run checks (sim_check_value): what failed, its text and time; the
+    // dips below zero.
+    sim_checks chk;
+    double bad_t;
+    char bad[200];
+    bool all_states; ///< emit sees every state (else only the pressures are interpolated)
+    // Peak chamber pressures p1A, p1B, p2A, p2B [Pa abs] (lagrange: system
+    // state indices pidx), from every step and every row.
+    int pidx[4];
+    double peak[4];
+    int npress;    ///< pressure states (emit checks only these)
+    int press[LSIM_MAX_STATES];
+} run_ctx;
+
+static int check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, sim_result* res) {
+    return res->status = sim_check_fixed_step(hm, o, h, t_end, res->message, sizeof res->message);
+}
+
+// Hand a finished row to the driver's sink.
+static int deliver(run_ctx* c, const double* row) {
+    if (c->sink->row && c->sink->row(c->sink->user, row)) return (c->stop = 2);
+    return 0;
+}
+
+static void track_peaks(run_ctx* c, const double* y) {
+    for (int k = 0; k < 4; ++k) c->peak[k] = fmax(c->peak[k], y[c->pidx[k]]);
+}
+
+// hyd_solver_opts.on_step: peaks between the rows too.
+static void on_step(void* user, double t, const double* y) {
+    (void)t;
+    track_peaks(user, y);
+}
+
+static const char* state_name(const lsim* ls, int i, char* buf, size_t n);
+
+// A failed run check: remember what and when, and stop the integration.
+static int check_failed(run_ctx* c, double t) {
+    c->bad_t = t;
+    return (c->stop = 3);
+}
+
+static int emit(void* user, double t, const double* y) {
+    run_ctx* c = user;
+    track_peaks(c, y);
+    // Segments share their end points: write each output time once.
+    if (c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out) return 0;
+    char nb[96];
+    // Every state (when the solver interpolated them all), the pressures as
+    // pressures; benchmarks see only the pressure states.
+    for (int i = 0; i < c->ls->n; ++i) {
+        const bool p = i < c->ls->nh && c->ls->is_pressure[i];
+        if (!p && !c->all_states) continue;
+        // The common case first, without naming the state (this runs at
+        // every output time, also in benchmarks).
+        if (isfinite(y[i]) && (!p || y[i] >= 0.0)) continue;
+        const int rc = sim_check_value(&c->chk, state_name(c->ls, i, nb, sizeof nb), y[i], p, t, c->bad,
+                                       sizeof c->bad);
+        if (rc) return check_failed(c, t);
+    }
+    c->t_last_row = t;
+    ++c->rows;
+    // Benchmarks consume nothing: skip the output evaluation entirely.
+    if (!c->sink->rows) return 0;
+    lsim_out o;
+    lsim_outputs(c->ls, t, y, &o);
+    double row[SIM_NCOL];
+    sim_lagrange_row(t, &o, row);
+    // The derived columns too (a force or a tip position can overflow while
+    // the states are finite).
+    const int rc = sim_check_row(&c->chk, row, SIM_NCOL_BASE, c->bad, sizeof c->bad);
+    if (rc) {
+        --c->rows;
+        return check_failed(c, t);
+    }
+    return deliver(c, row);
+}
+
+static const char* state_name(const lsim* ls, int i, char* buf, size_t n) {
+    static const char* const mech[4] = {"q1", "q2", "q1_dot", "q2_dot"};
+    if (i >= ls->iq) return mech[i - ls->iq];
+    snprintf(buf, n, "%s", hyd_model_state_name(ls->mdl->hyd, ls->perm[i]));
+    return buf;
+}
+
+// A scripted run (engine_run): the scenario's commands read continuously
+// inside f (lsim.scn), the fused kernel and the split step where they
+// apply, integrated between the command breakpoints with rows at the
+// output times.
+int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
+                        sim_result* res) {
+    lsim ls;
+    double m3 = sim_load_mass(m, sc, o);
+    if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = 2;
+    ls.scn = sc;
+    ls.use_fused = ls.have_fused && !o->general_kernel;
+    ls.use_w = ls.w_layout && !o->general_kernel; // the crane-specialised W too (lsim_w.c)
+    ls.use_split = ls.w_layout && !o->general_kernel && !o->whole_step;
+    res->fused = ls.use_fused;
+    double y[LSIM_MAX_STATES];
+    if (lsim_check_pose(&ls, sc->q0, res->message, sizeof res->message) ||
+        check_fixed_step(m->hyd, o, o->h, o->duration > 0 ? o->duration : sc->duration, res)) {
+        lsim_free(&ls);
+        return res->status = 2;
+    }
+    lsim_initial_state(&ls, sc->q0, 0.5e6, y);
+    {
+        lsim_out lo;
+        lsim_outputs(&ls, 0.0, y, &lo);
+        const double row0[SIM_NCOL_BASE] = {[COL_P1A] = lo.pA[0], [COL_P1B] = lo.pB[0], [COL_P2A] = lo.pA[1],
+                                            [COL_P2B] = lo.pB[1]};
+        if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, m3, res->message, sizeof res->message)) {
+            lsim_free(&ls);
+            return res->status = 2;
+        }
+    }
+
+    const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
+#ifndef CRANESIM_HAVE_CVODE
+    if (o->cvode) {
+        snprintf(res->message, sizeof res->message, "this build has no CVODE (install libsundials-dev)");
+        lsim_free(&ls);
+        return res->status = 2;
+    }
+#endif
+    hyd_problem prob = lsim_problem(&ls, !adaptive && !o->dense_jac);
+    res->split = prob.wstep && (o->solver == HYD_KRUS || o->solver == HYD_ROS2) && !o->cvode;
+    hyd_solver_opts so = hyd_default_solver_opts();
+    so.h = adaptive ? 0.0 : o->h;
+    so.rtol = o->rtol;
+    so.atol = o->atol;
+    so.h_max = 0.5;
+    so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    // A fixed-step run ends by construction (check_fixed_step bounds it to
+    // 1e12 steps): no per-call budget, which at 1e8 stopped a 1 ns step at
+    // 0.1 s. The adaptive budget guards against a controller that stalls.
+    if (!adaptive) so.max_steps = 0;
+    // emit checks the pressure states at every output; when no row is
+    // consumed (benchmarks) that is all it reads, so an adaptive solver
+    // interpolates only those.
+    int press[LSIM_MAX_STATES], npress = 0;
+    for (int i = 0; i < ls.nh; ++i)
+        if (ls.is_pressure[i]) press[npress++] = i;
+    if (!k->rows) {
+        so.out_states = press;
+        so.n_out_states = npress;
+    }
+    // The run's context, filled below; its address goes to the solver now.
+    run_ctx c;
+    if (k->summary) { // someone reads the summary: peaks from every step
+        so.on_step = on_step;
+        so.on_step_user = &c;
+    }
+    // CVODE brings its own integrator; the in-house one is not created then.
+    hyd_solver* s = o->cvode ? NULL : hyd_solver_create(&prob, o->solver, &so);
+    if (!s && !o->cvode) {
+        snprintf(res->message, sizeof res->message, "cannot create the %s solver", hyd_method_name(o->solver));
+        lsim_free(&ls);
+        return res->status = 2;
+    }
+
+    const double t_end = o->duration > 0 ? o->duration : sc->duration;
+    // A fixed step longer than the output period outputs once per step
+    // (fixed-step methods land on every output time).
+    sim_opts oo = *o;
+    if (!adaptive && oo.h > oo.dt_out) oo.dt_out = oo.h;
+    // An output period longer than the run: rows at the start and the end
+    // (the breakpoints are rounded to this grid, so it must not pass t_end).
+    if (oo.dt_out > t_end && t_end > 0) oo.dt_out = t_end;
+    o = &oo;
+    c = (run_ctx){.ls = &ls, .o = o, .sink = k, .t_end = t_end,
+                  .all_states = so.out_states == NULL,
+                  .pidx = {ls.ip[0][0], ls.ip[0][1], ls.ip[1][0], ls.ip[1][1]}};
+    memcpy(c.press, press, sizeof press);
+    c.npress = npress;
+    // Integrate between command breakpoints (rounded to the output grid) and
+    // reset the solver at each: a kink in a valve command is a discontinuity
+    // in f' that an adaptive controller should not have to discover.
+    double bp[2 * SCENARIO_MAX_POINTS * SCENARIO_NCMD + SCENARIO_MAX_EVENTS + 2];
+    int nbp = scenario_breakpoints(sc, bp, (int)(sizeof bp / sizeof bp[0]) - 1);
+    double t = 0.0;
+    hyd_solver_stats cv = {0};
+    double w0 = sim_wall_time();
+    int rc = HYD_OK;
+    emit(&c, 0.0, y);
+    for (int i = 0; i <= nbp && rc == HYD_OK && !c.stop && t < t_end; ++i) {
+        double tb = i < nbp ? ceil(bp[i] / o->dt_out - 1e-9) * o->dt_out : t_end;
+        if (tb > t_end) tb = t_end;
+        if (tb <= t + 1e-12) continue;
+        if (s) hyd_solver_reset(s);
+#ifdef CRANESIM_HAVE_CVODE
+        if (o->cvode) {
+            hyd_cvode_opts co = hyd_cvode_default_opts();
+            co.rtol = o->rtol;
+            co.atol = o->atol;
+            co.h_max = 0.5;
+            hyd_solver_stats cs = {0};
+            rc = hyd_cvode_integrate(&prob, &co, t, y, tb, o->dt_out, emit, &c, &cs);
+            cv.steps += cs.steps;
+            cv.rejected += cs.rejected;
+            cv.fevals += cs.fevals;
+            cv.jevals += cs.jevals;
+            cv.lus += cs.lus;
+        } else
+#endif
+            rc = hyd_solver_integrate(s, t, y, tb, o->dt_out, emit, &c);
+        if (rc == HYD_OK && !c.stop) t = tb;
+    }
+    res->wall = sim_wall_time() - w0;
+    res->stats = o->cvode ? cv : *hyd_solver_get_stats(s);
+    res->rows = c.rows;
+    res->t_end = c.t_last_row;
+    char nb[96];
+    if (c.stop == 3) {
+        // A failed check at t = 0 is the model's start state (no step ran):
+        // refused like bad input, nothing written.
+        res->status = c.bad_t > 0 ? 1 : 2;
+        // The step for fixed-step methods, the last step tried for ours, the
+        // tolerance for CVODE (whose steps are its own).
+        char how[48];
+        if (o->cvode) snprintf(how, sizeof how, "rtol %g", o->rtol);
+        else snprintf(how, sizeof how, "h = %g s", adaptive && s ? hyd_solver_last_h(s) : o->h);
+        if (res->status == 2)
+            snprintf(res->message, sizeof res->message, "%s: %s", c.bad,
+                     sim_blowup_hint(adaptive, 0.0, c.chk.bad_value));
+        else
+            snprintf(res->message, sizeof res->message, "numerical blow-up: %s (solver %s, %s): %s", c.bad,
+                     o->cvode ? "cvode" : hyd_method_name(o->solver), how,
+                     sim_blowup_hint(adaptive, c.bad_t, c.chk.bad_value));
+    } else if (c.stop) {
+        res->status = 2;
+        snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c.t_last_row);
+    } else if (rc != HYD_OK) {
+        res->status = 1;
+        double tb = c.t_last_row;
+        int bi = s ? hyd_solver_bad_state(s, &tb) : -1;
+        if (rc == HYD_ERR_NONFINITE && bi >= 0)
+            snprintf(res->message, sizeof res->message,
+                     "numerical blow-up: state %s became non-finite at t = %.6g s (solver %s, h = %g s)",
+                     state_name(&ls, bi, nb, sizeof nb), tb, hyd_method_name(o->solver),
+                     adaptive && s ? hyd_solver_last_h(s) : o->h);
+        else if (rc == HYD_ERR_DOMAIN && bi >= 0)
+            snprintf(res->message, sizeof res->message,
+                     "numerical failure: every step the %s controller tried took state %s below absolute zero at "
+                     "t = %.6g s, down to the smallest step",
+                     hyd_method_name(o->solver), state_name(&ls, bi, nb, sizeof nb), tb);
+        else
+            snprintf(res->message, sizeof res->message, "solver %s stopped near t = %.6g s: %s",
+                     o->cvode ? "cvode" : hyd_method_name(o->solver), c.t_last_row, hyd_error_text(rc));
+    }
+    memcpy(res->p_peak, c.peak, sizeof res->p_peak);
+    res->peak_steps = !o->cvode && k->summary;
+    if (!res->status) sim_checks_note(&c.chk, adaptive, res->note, sizeof res->note);
+    hyd_solver_destroy(s);
+    lsim_free(&ls);
+    return res->status;
+}
+
+// ---- The renderer's picture ----
 
 // Planar crane placed in the world: boom plane = x-z, joint 1 at the column
 // top above the origin. Rotation about y by the elevation angle.

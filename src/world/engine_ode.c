@@ -5,6 +5,7 @@
 
 #include "ode_world.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -77,6 +78,142 @@ static int ode_step(engine* e, double dt) {
 static double ode_time(const engine* e) { return ode_world_time(W(e)); }
 static void ode_row(engine* e, double row[SIM_NCOL]) { sim_ode_row(W(e), row); }
 static void ode_snapshot(engine* e, world_snapshot* s) { ode_world_snapshot(W(e), s); }
+
+// ---- Scripted runs (sim_run) ----
+
+typedef struct run_ctx {
+    const engine_sink* sink;
+    double t_end, t_last_row;
+    long rows;
+    int stop;
+    sim_checks chk; ///< the run checks (sim_check_row) and the dips below zero
+} run_ctx;
+
+// Hand a finished row to the driver's sink.
+static int deliver(run_ctx* c, const double* row) {
+    if (c->sink->row && c->sink->row(c->sink->user, row)) return (c->stop = 2);
+    return 0;
+}
+
+static int play_hook(void* user, int attach) { return ode_world_hook(user, attach); }
+
+// A scripted run (engine_run): the scenario played at each ODE step's
+// midpoint (scenario_play), rows every dt_out on the step grid.
+int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
+    run_ctx cc = {.sink = k, .t_end = k->t_end}, *c = &cc;
+    if (o->cvode) {
+        snprintf(res->message, sizeof res->message,
+                 "--mechanics ode steps the hydraulics inside each ODE step: use krus, ros2, rk4, ros34pw2 or rodas3");
+        return res->status = 2;
+    }
+    ode_world* w = sim_ode_world_create(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
+                                        sizeof res->message);
+    if (!w) return res->status = 2;
+    res->fused = ode_world_fused(w);
+    const long ode_msgs = ode_world_messages(NULL);
+    const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
+    if ((res->status = sim_check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res->message,
+                                            sizeof res->message))) {
+        ode_world_destroy(w);
+        return res->status;
+    }
+
+    const double dt = ode_world_dt(w);
+    // Counted in longs: refused before a conversion could overflow (the
+    // output period is at most the run, sim_check_times).
+    if (c->t_end / dt > 1e12) {
+        snprintf(res->message, sizeof res->message,
+                 "--dt-ode %g s over %g s is %.3g steps, more than 1e12: use a larger --dt-ode or a shorter run", dt,
+                 c->t_end, c->t_end / dt);
+        ode_world_destroy(w);
+        return res->status = 2;
+    }
+    const long nstep = (long)floor(c->t_end / dt + 0.5);
+    long nout = (long)floor(fmin(o->dt_out, c->t_end) / dt + 0.5);
+    if (nout < 1) nout = 1;
+    double row[SIM_NCOL];
+    int ev = 0;
+    double w0 = sim_wall_time();
+    sim_ode_row(w, row);
+    for (int k = 0; k < 4; ++k) res->p_peak[k] = row[COL_P1A + k];
+    {
+        // The start state too: a model value that overflows shows at t = 0.
+        char what[200];
+        const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
+        if (rc) {
+            snprintf(res->message, sizeof res->message, "%s: %s", what,
+                     sim_blowup_hint(hyd_method_is_adaptive(o->solver), 0.0, c->chk.bad_value));
+            ode_world_destroy(w);
+            return res->status = 2;
+        }
+        if (sim_check_start(ode_world_circuit(w), row, SIM_NCOL, sim_load_mass(m, sc, o), res->message,
+                            sizeof res->message)) {
+            ode_world_destroy(w);
+            return res->status = 2;
+        }
+    }
+    deliver(c, row);
+    ++c->rows;
+    for (long i = 0; i < nstep && !c->stop; ++i) {
+        const double t = (double)i * dt;
+        // Commands at the step's midpoint: second-order accurate for ramps,
+        // and steps land within half an ODE step of their time.
+        const double tm = t + 0.5 * dt;
+        double u[3];
+        scenario_play(sc, tm, &ev, u, play_hook, w);
+        ode_world_set_commands(w, u);
+        if (ode_world_step(w, dt)) {
+            res->status = 1;
+            snprintf(res->message, sizeof res->message, "numerical blow-up: %s", ode_world_error(w));
+            break;
+        }
+        {
+            // Peaks at every ODE step, not only at the rows.
+            double pA[ODE_NACT], pB[ODE_NACT];
+            ode_world_chamber_pressures(w, pA, pB);
+            const double p[4] = {pA[0], pB[0], pA[1], pB[1]};
+            for (int k = 0; k < 4; ++k) res->p_peak[k] = fmax(res->p_peak[k], p[k]);
+        }
+        if ((i + 1) % nout && i + 1 != nstep) continue;
+        sim_ode_row(w, row);
+        row[COL_T] = (double)(i + 1) * dt; // exact grid times, no accumulated round-off
+        {
+            char what[200];
+            const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
+            if (rc) {
+                res->status = 1;
+                snprintf(res->message, sizeof res->message, "numerical blow-up: %s (solver %s, h = %g s, ODE step %g s): %s",
+                         what, hyd_method_name(o->solver), o->h < dt ? o->h : dt, dt,
+                         sim_blowup_hint(hyd_method_is_adaptive(o->solver), row[COL_T], c->chk.bad_value));
+            }
+        }
+        if (res->status) break;
+        c->t_last_row = row[COL_T];
+        ++c->rows;
+        deliver(c, row);
+    }
+    res->wall = sim_wall_time() - w0;
+    res->stats = ode_world_hyd_stats(w);
+    res->stats.steps = ode_world_hyd_steps(w); // fixed-step sub-steps are counted by the world
+    res->rows = c->rows;
+    res->t_end = c->t_last_row;
+    ode_world_destroy(w);
+    res->peak_steps = true;
+    const char* last;
+    const long msgs = ode_world_messages(&last) - ode_msgs;
+    if (!res->status && c->chk.dip)
+        sim_checks_note(&c->chk, hyd_method_is_adaptive(o->solver), res->note, sizeof res->note);
+    else if (msgs > 0)
+        snprintf(res->note, sizeof res->note,
+                 "ODE reported %ld solver message%s during the run (last: %.120s): a degenerate contact set, which "
+                 "ODE stepped through",
+                 msgs, msgs > 1 ? "s" : "", last);
+    if (c->stop && !res->status) {
+        res->status = 2;
+        snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c->t_last_row);
+    }
+    return res->status;
+}
 
 static const engine_ops ode_ops = {
     .name = "ode",
