@@ -16,6 +16,11 @@
 /// Exit codes (README, "Exit codes"); an interrupted run exits 128 + the signal.
 enum { EXIT_OK_ = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
 
+/// The exit code of a world-library status (sim_status): SIM_FAILED is a
+/// runtime failure (1); SIM_REFUSED is bad input (2), unless rows were
+/// already written (rows > 0: then the run failed on its way, 1).
+int app_exit_code(int status, long rows);
+
 /// The common options, as bits of app_common.given (APP_GIVEN(APP_OPT_DT)):
 /// which ones the user gave, so a command can tell a choice from a default,
 /// note an option that has no effect and reject one it cannot honour.

@@ -704,6 +704,12 @@ int app_load_msg(const app_common* c, model** m, scenario* sc, char* err, size_t
     return 0;
 }
 
+int app_exit_code(int status, long rows) {
+    if (status == SIM_OK) return EXIT_OK_;
+    if (status == SIM_FAILED || rows > 0) return EXIT_RUNTIME;
+    return EXIT_USAGE;
+}
+
 void app_progress(void* user, double t, double t_end) {
     (void)user;
     if (!isatty(2)) return;

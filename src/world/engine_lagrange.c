@@ -240,7 +240,7 @@ int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, c
                         sim_result* res) {
     lsim ls;
     double m3 = sim_load_mass(m, sc, o);
-    if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = 2;
+    if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     ls.scn = sc;
     ls.use_fused = ls.have_fused && !o->general_kernel;
     ls.use_w = ls.w_layout && !o->general_kernel; // the crane-specialised W too (lsim_w.c)
@@ -250,7 +250,7 @@ int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, c
     if (lsim_check_pose(&ls, sc->q0, res->message, sizeof res->message) ||
         check_fixed_step(m->hyd, o, o->h, o->duration > 0 ? o->duration : sc->duration, res)) {
         lsim_free(&ls);
-        return res->status = 2;
+        return res->status = SIM_REFUSED;
     }
     lsim_initial_state(&ls, sc->q0, 0.5e6, y);
     {
@@ -260,7 +260,7 @@ int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, c
                                             [COL_P2B] = lo.pB[1]};
         if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, m3, res->message, sizeof res->message)) {
             lsim_free(&ls);
-            return res->status = 2;
+            return res->status = SIM_REFUSED;
         }
     }
 
@@ -269,7 +269,7 @@ int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, c
     if (o->cvode) {
         snprintf(res->message, sizeof res->message, "this build has no CVODE (install libsundials-dev)");
         lsim_free(&ls);
-        return res->status = 2;
+        return res->status = SIM_REFUSED;
     }
 #endif
     hyd_problem prob = lsim_problem(&ls, !adaptive && !o->dense_jac);
@@ -305,7 +305,7 @@ int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, c
     if (!s && !o->cvode) {
         snprintf(res->message, sizeof res->message, "cannot create the %s solver", hyd_method_name(o->solver));
         lsim_free(&ls);
-        return res->status = 2;
+        return res->status = SIM_REFUSED;
     }
 
     const double t_end = o->duration > 0 ? o->duration : sc->duration;
@@ -363,13 +363,13 @@ int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, c
     if (c.stop == 3) {
         // A failed check at t = 0 is the model's start state (no step ran):
         // refused like bad input, nothing written.
-        res->status = c.bad_t > 0 ? 1 : 2;
+        res->status = c.bad_t > 0 ? SIM_FAILED : SIM_REFUSED;
         // The step for fixed-step methods, the last step tried for ours, the
         // tolerance for CVODE (whose steps are its own).
         char how[48];
         if (o->cvode) snprintf(how, sizeof how, "rtol %g", o->rtol);
         else snprintf(how, sizeof how, "h = %g s", adaptive && s ? hyd_solver_last_h(s) : o->h);
-        if (res->status == 2)
+        if (res->status == SIM_REFUSED)
             snprintf(res->message, sizeof res->message, "%s: %s", c.bad,
                      sim_blowup_hint(adaptive, 0.0, c.chk.bad_value));
         else
@@ -377,10 +377,10 @@ int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, c
                      o->cvode ? "cvode" : hyd_method_name(o->solver), how,
                      sim_blowup_hint(adaptive, c.bad_t, c.chk.bad_value));
     } else if (c.stop) {
-        res->status = 2;
+        res->status = SIM_REFUSED;
         snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c.t_last_row);
     } else if (rc != HYD_OK) {
-        res->status = 1;
+        res->status = SIM_FAILED;
         double tb = c.t_last_row;
         int bi = s ? hyd_solver_bad_state(s, &tb) : -1;
         if (rc == HYD_ERR_NONFINITE && bi >= 0)

@@ -104,11 +104,11 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     if (o->cvode) {
         snprintf(res->message, sizeof res->message,
                  "--mechanics ode steps the hydraulics inside each ODE step: use krus, ros2, rk4, ros34pw2 or rodas3");
-        return res->status = 2;
+        return res->status = SIM_REFUSED;
     }
     ode_world* w = sim_ode_world_create(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
                                         sizeof res->message);
-    if (!w) return res->status = 2;
+    if (!w) return res->status = SIM_REFUSED;
     res->fused = ode_world_fused(w);
     const long ode_msgs = ode_world_messages(NULL);
     const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
@@ -126,7 +126,7 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
                  "--dt-ode %g s over %g s is %.3g steps, more than 1e12: use a larger --dt-ode or a shorter run", dt,
                  c->t_end, c->t_end / dt);
         ode_world_destroy(w);
-        return res->status = 2;
+        return res->status = SIM_REFUSED;
     }
     const long nstep = (long)floor(c->t_end / dt + 0.5);
     long nout = (long)floor(fmin(o->dt_out, c->t_end) / dt + 0.5);
@@ -144,12 +144,12 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             snprintf(res->message, sizeof res->message, "%s: %s", what,
                      sim_blowup_hint(hyd_method_is_adaptive(o->solver), 0.0, c->chk.bad_value));
             ode_world_destroy(w);
-            return res->status = 2;
+            return res->status = SIM_REFUSED;
         }
         if (sim_check_start(ode_world_circuit(w), row, SIM_NCOL, sim_load_mass(m, sc, o), res->message,
                             sizeof res->message)) {
             ode_world_destroy(w);
-            return res->status = 2;
+            return res->status = SIM_REFUSED;
         }
     }
     deliver(c, row);
@@ -163,7 +163,7 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         scenario_play(sc, tm, &ev, u, play_hook, w);
         ode_world_set_commands(w, u);
         if (ode_world_step(w, dt)) {
-            res->status = 1;
+            res->status = SIM_FAILED;
             snprintf(res->message, sizeof res->message, "numerical blow-up: %s", ode_world_error(w));
             break;
         }
@@ -181,7 +181,7 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             char what[200];
             const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
             if (rc) {
-                res->status = 1;
+                res->status = SIM_FAILED;
                 snprintf(res->message, sizeof res->message, "numerical blow-up: %s (solver %s, h = %g s, ODE step %g s): %s",
                          what, hyd_method_name(o->solver), o->h < dt ? o->h : dt, dt,
                          sim_blowup_hint(hyd_method_is_adaptive(o->solver), row[COL_T], c->chk.bad_value));
@@ -209,7 +209,7 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
                  "ODE stepped through",
                  msgs, msgs > 1 ? "s" : "", last);
     if (c->stop && !res->status) {
-        res->status = 2;
+        res->status = SIM_REFUSED;
         snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c->t_last_row);
     }
     return res->status;

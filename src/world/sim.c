@@ -200,7 +200,7 @@ int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3,
                  "circuit's highest relief setting (%s: %.4g MPa, p_crack + dp_override): the crane cannot hold "
                  "this load here (a smaller --load or another start pose)",
                  sim_col_name[c], row[c] * 1e-6, m3, which, pmax * 1e-6);
-        return 2;
+        return SIM_REFUSED;
     }
     return 0;
 }
@@ -209,17 +209,17 @@ int sim_check_times(double t_end, double dt_out, char* err, size_t errsz) {
     if (!(t_end > 0) || t_end > SIM_MAX_DURATION) {
         snprintf(err, errsz, "--duration: expected a simulated time in s, 0 < T <= 1e6, got %g",
                  t_end);
-        return 2;
+        return SIM_REFUSED;
     }
     if (!(dt_out > 0) || dt_out > SIM_MAX_DURATION) {
         snprintf(err, errsz, "--every: expected an output period in s, 0 < DT <= 1e6, got %g",
                  dt_out);
-        return 2;
+        return SIM_REFUSED;
     }
     if (t_end / dt_out > 1e12) {
         snprintf(err, errsz, "--every %g s over %g s is %.3g rows, more than 1e12: use a larger --every", dt_out,
                  t_end, t_end / dt_out);
-        return 2;
+        return SIM_REFUSED;
     }
     return 0;
 }
@@ -246,12 +246,12 @@ int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, doubl
     if (o->cvode || hyd_method_is_adaptive(o->solver)) return 0;
     if (t_end > 0 && h > t_end) {
         snprintf(err, errsz, "--dt %g s is longer than the run (%g s)", h, t_end);
-        return 2;
+        return SIM_REFUSED;
     }
     if (t_end > 0 && t_end / h > 1e12) {
         snprintf(err, errsz, "--dt %g s over %g s is %.3g steps, more than 1e12: use a larger --dt or a shorter run",
                  h, t_end, t_end / h);
-        return 2;
+        return SIM_REFUSED;
     }
     if (o->solver == HYD_RK4) {
         // RK4's stability interval on the negative real axis is [-2.785, 0].
@@ -266,7 +266,7 @@ int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, doubl
                      "rk4 is unstable at h = %g s on this circuit: its fastest mode (%.3g 1/s, an open valve at "
                      "25 MPa) needs h < %.3g s at the least; use --dt %g or a stiff solver (krus, ros2, rodas3)",
                      h, rate, 2.785 / rate, stable_step(2.785 / rate, o->dt_out));
-            return 2;
+            return SIM_REFUSED;
         }
     }
     return 0;
@@ -381,7 +381,7 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
             sim_trace* trace, sim_progress_fn progress, void* progress_user, sim_result* res) {
     memset(res, 0, sizeof *res);
     const double t_end = o->duration > 0 ? o->duration : sc->duration;
-    if (sim_check_times(t_end, o->dt_out, res->message, sizeof res->message)) return res->status = 2;
+    if (sim_check_times(t_end, o->dt_out, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     run_out out = {.row_fn = row_fn, .row_user = row_user, .trace = trace, .progress = progress,
                    .progress_user = progress_user, .t_end = t_end};
     const engine_sink k = {.row = deliver, .user = &out, .rows = trace || row_fn || progress,

@@ -17,6 +17,16 @@ extern "C" {
 
 typedef enum sim_mechanics { SIM_LAGRANGE = 0, SIM_ODE } sim_mechanics;
 
+/// What a run or a check of the world library reports, with its text in a
+/// message buffer. The library does not choose exit codes: src/app maps these
+/// (app_exit_code).
+typedef enum sim_status {
+    SIM_OK = 0,      ///< done
+    SIM_FAILED = 1,  ///< a numerical failure during the run (the rows so far are valid)
+    SIM_REFUSED = 2, ///< refused before it started (bad input, an impossible setting), or stopped by
+                     ///< the row callback
+} sim_status;
+
 typedef struct sim_opts {
     sim_mechanics mechanics;
     lagrange_variant variant;
@@ -42,7 +52,7 @@ typedef struct sim_opts {
 /// Refuse a fixed-step run the method cannot do, before it starts: RK4
 /// beyond its stability interval on the circuit hm's fastest mode, a step h
 /// [s] longer than the run t_end [s], or more than 1e12 steps (t_end <= 0:
-/// an open-ended run, only the stability test). Returns 0, or 2 with one
+/// an open-ended run, only the stability test). Returns SIM_OK, or SIM_REFUSED with one
 /// line in err. Adaptive solvers and CVODE always pass.
 int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, char* err, size_t errsz);
 /// The advice of a numerical blow-up: a pressure state with value [Pa abs]
@@ -57,7 +67,7 @@ const char* sim_blowup_hint(bool adaptive, double t, double value);
 /// them, and no run of a crane needs more.
 #define SIM_MAX_DURATION 1e6
 /// Refuse a run's duration t_end [s] or output period dt_out [s] outside
-/// (0, SIM_MAX_DURATION], or more than 1e12 rows. Returns 0, or 2 with one
+/// (0, SIM_MAX_DURATION], or more than 1e12 rows. Returns SIM_OK, or SIM_REFUSED with one
 /// line in err naming the option (--duration, --every), the range and the unit.
 int sim_check_times(double t_end, double dt_out, char* err, size_t errsz);
 
@@ -100,7 +110,7 @@ const char* sim_blowup_hint(bool adaptive, double t, double value);
 /// crane still; with a load too heavy for the pose that is more than any
 /// relief lets the circuit reach (100 t at the tip: 459 MPa), a state the
 /// reliefs cannot cap because it is set, not integrated. m3: the tip load
-/// [kg], for the message. Returns 0, or 2 with one line in err.
+/// [kg], for the message. Returns SIM_OK, or SIM_REFUSED with one line in err.
 int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz);
 
 /// True when this build has the CVODE reference solver.
@@ -139,7 +149,7 @@ void sim_trace_free(sim_trace* tr);
 typedef int (*sim_row_fn)(void* user, const double* row);
 
 typedef struct sim_result {
-    int status;          ///< 0 ok, 1 numerical failure, 2 stopped by callback
+    int status;          ///< a sim_status: SIM_OK, SIM_FAILED, SIM_REFUSED (also: stopped by the callback)
     char message[512];   ///< failure description: state name, time
     char note[256];
     double p_peak[4];    ///< peak chamber pressures p1A, p1B, p2A, p2B [Pa abs]: over every step
