@@ -392,7 +392,7 @@ int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t
     }
     if (o->charts) {
         int col[8];
-        if (parse_charts(o->charts, c->sim.mechanics == SIM_ODE ? SIM_NCOL : SIM_NCOL_BASE, col, err, errsz) < 0)
+        if (parse_charts(o->charts, sim_ncol(&c->sim), col, err, errsz) < 0)
             return EXIT_USAGE;
     }
     if (o->mapping_file) {

@@ -53,7 +53,17 @@ void engine_set_load(engine* e, double m3) {
 }
 
 int engine_set_link(engine* e, int k, const crane_link* ln) { return e->ops->set_link(e, k, ln); }
-int engine_ncol(const engine* e) { return e->ops->ncol; }
+int engine_ncol(const engine* e) { return e->ops->nchannel; }
+
+const sim_channel* engine_channels(const engine* e, int* n) {
+    *n = e->ops->nchannel;
+    return sim_channels;
+}
+
+const sim_channel* engine_channels_for(const sim_opts* o, int* n) {
+    *n = (o->mechanics == SIM_ODE ? &engine_ode_ops : &engine_lagrange_ops)->nchannel;
+    return sim_channels;
+}
 double engine_time(const engine* e) { return e->ops->time(e); }
 void engine_row(engine* e, double row[SIM_NCOL]) { e->ops->row(e, row); }
 void engine_snapshot(engine* e, world_snapshot* s) { e->ops->snapshot(e, s); }
@@ -76,7 +86,7 @@ static int advance(engine* e, double dt, engine_row_fn row_fn, void* user) {
     double row[SIM_NCOL];
     e->ops->row(e, row);
     char what[200];
-    const int rc = sim_check_row(&e->chk, row, e->ops->ncol, what, sizeof what);
+    const int rc = sim_check_row(&e->chk, row, e->ops->nchannel, what, sizeof what);
     if (rc) {
         const bool adaptive = hyd_method_is_adaptive(e->o.solver);
         snprintf(e->err, sizeof e->err, "numerical blow-up: %s (solver %s): %s", what, hyd_method_name(e->o.solver),

@@ -56,7 +56,14 @@ void engine_set_load(engine* e, double m3);
 /// rebuilt for it (a new length, or a centre of mass that moves).
 int engine_set_link(engine* e, int k, const crane_link* ln);
 
-/// Columns engine_row fills (base, or base plus the world extras for ode).
+/// The output channels the engine publishes, by name, unit and kind: the
+/// first *n entries of sim_channels (the base list; the ode world adds its
+/// extras), which are the columns engine_row fills.
+const sim_channel* engine_channels(const engine* e, int* n);
+/// The channels of the engine o->mechanics names, before one exists (a run
+/// writes its CSV header from them).
+const sim_channel* engine_channels_for(const sim_opts* o, int* n);
+/// The number of engine_channels.
 int engine_ncol(const engine* e);
 
 /// Called for each row engine_advance_to produces; non-zero stops it.

@@ -8,7 +8,7 @@
 
 typedef struct engine_ops {
     const char* name; ///< "lagrange", "ode"
-    int ncol;         ///< columns its rows fill
+    int nchannel;     ///< the channels it publishes: sim_channels[0 .. nchannel), the columns its rows fill
     void (*destroy)(engine* e);
     void (*set_commands)(engine* e, const double u[3]);
     /// NULL: the backend has no hook (engine_hook returns -1, no loads).
@@ -33,6 +33,8 @@ struct engine {
     sim_checks chk; ///< the run checks every driver applies (sim.h)
     bool failed;    ///< a check or the step failed: the engine stays stopped
 };
+
+extern const engine_ops engine_lagrange_ops, engine_ode_ops;
 
 /// The backends' constructors (engine_create picks one by o->mechanics).
 engine* engine_lagrange_create(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,

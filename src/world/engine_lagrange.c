@@ -29,7 +29,6 @@ typedef struct eng_lagrange {
 
 static void lag_row(engine* e, double row[SIM_NCOL]);
 static void lag_destroy(engine* e);
-static const engine_ops lagrange_ops;
 
 engine* engine_lagrange_create(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
                                size_t errsz) {
@@ -38,7 +37,7 @@ engine* engine_lagrange_create(const model* m, const sim_opts* o, const double q
         snprintf(err, errsz, "out of memory");
         return NULL;
     }
-    l->base.ops = &lagrange_ops;
+    l->base.ops = &engine_lagrange_ops;
     l->base.o = *o;
     if (lsim_init(&l->ls, m, o->variant, m3, err, errsz)) {
         free(l);
@@ -512,9 +511,9 @@ static void lag_snapshot(engine* e, world_snapshot* s) {
     world_snap_reliefs(s, l->ls.mdl->hyd, l->ls.hd->comp_open, cyl_hyd);
 }
 
-static const engine_ops lagrange_ops = {
+const engine_ops engine_lagrange_ops = {
     .name = "lagrange",
-    .ncol = SIM_NCOL_BASE,
+    .nchannel = SIM_NCOL_BASE, // the base list: no world
     .destroy = lag_destroy,
     .set_commands = lag_set_commands,
     .hook = NULL, // no world, no hook

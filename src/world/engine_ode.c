@@ -14,7 +14,6 @@ typedef struct eng_ode {
     ode_world* w;
 } eng_ode;
 
-static const engine_ops ode_ops;
 
 static ode_world* W(const engine* e) { return ((const eng_ode*)e)->w; }
 
@@ -25,7 +24,7 @@ engine* engine_ode_create(const model* m, const sim_opts* o, const double q0[2],
         snprintf(err, errsz, "out of memory");
         return NULL;
     }
-    l->base.ops = &ode_ops;
+    l->base.ops = &engine_ode_ops;
     l->base.o = *o;
     l->w = sim_ode_world_create(m, o, "sandbox", q0, slew0, m3, err, errsz);
     if (!l->w) {
@@ -215,9 +214,9 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     return res->status;
 }
 
-static const engine_ops ode_ops = {
+const engine_ops engine_ode_ops = {
     .name = "ode",
-    .ncol = SIM_NCOL,
+    .nchannel = SIM_NCOL, // the base list and the world extras
     .destroy = ode_destroy,
     .set_commands = ode_set_commands,
     .hook = ode_hook,

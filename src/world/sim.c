@@ -10,17 +10,15 @@
 #include "engine_impl.h"
 #include "ode_world.h"
 
-const char* const sim_col_name[SIM_NCOL] = {
-    "t", "x1", "x2", "p1A", "p1B", "p2A", "p2B", "u1", "u2", "q1", "q2",
-    "tip_x", "tip_z", "F1", "F2", "u1_cmd", "u2_cmd",
-    "v1", "v2", "p_pump", "relief_open", "end_stop",
-    "slew", "hook_x", "hook_y", "hook_z", "load_x", "load_y", "load_z", "attached", "truck_tilt", "contacts",
-    "max_depth", "x3", "v3", "p3A", "p3B", "u3", "u3_cmd", "F3"};
-const char* const sim_col_unit[SIM_NCOL] = {
-    "s", "m", "m", "Pa", "Pa", "Pa", "Pa", "-", "-", "rad", "rad",
-    "m", "m", "N", "N", "-", "-",
-    "m/s", "m/s", "Pa", "count", "bits",
-    "rad", "m", "m", "m", "m", "m", "m", "index", "rad", "count", "m", "m", "m/s", "Pa", "Pa", "-", "-", "N"};
+#define CH_ENTRY_(id, name, unit, kind) {name, unit, kind},
+#define CH_NAME_(id, name, unit, kind) name,
+#define CH_UNIT_(id, name, unit, kind) unit,
+const sim_channel sim_channels[SIM_NCOL] = {SIM_CHANNELS_BASE(CH_ENTRY_) SIM_CHANNELS_WORLD(CH_ENTRY_)};
+const char* const sim_col_name[SIM_NCOL] = {SIM_CHANNELS_BASE(CH_NAME_) SIM_CHANNELS_WORLD(CH_NAME_)};
+const char* const sim_col_unit[SIM_NCOL] = {SIM_CHANNELS_BASE(CH_UNIT_) SIM_CHANNELS_WORLD(CH_UNIT_)};
+// The README's fixed order of the first columns, and the world extras right after the base.
+_Static_assert(COL_U2_CMD == 16 && COL_END_STOP == 21 && COL_SLEW == SIM_NCOL_BASE && COL_F3 == SIM_NCOL - 1,
+               "the channel list lost its documented order");
 
 sim_opts sim_default_opts(void) {
     sim_opts o;
@@ -75,10 +73,14 @@ static int trace_push(sim_trace* tr, const double* row) {
     return 0;
 }
 
-int sim_ncol(const sim_opts* o) { return o->mechanics == SIM_ODE ? SIM_NCOL : SIM_NCOL_BASE; }
+int sim_ncol(const sim_opts* o) {
+    int n;
+    engine_channels_for(o, &n);
+    return n;
+}
 
 void sim_csv_header(FILE* f, int ncol) {
-    for (int c = 0; c < ncol; ++c) fprintf(f, "%s%s", c ? "," : "", sim_col_name[c]);
+    for (int c = 0; c < ncol; ++c) fprintf(f, "%s%s", c ? "," : "", sim_channels[c].name);
     fputc('\n', f);
 }
 
@@ -134,10 +136,7 @@ int sim_check_value(sim_checks* k, const char* name, double v, bool pressure, do
     return 0;
 }
 
-static bool col_is_pressure(int c) {
-    return c == COL_P1A || c == COL_P1B || c == COL_P2A || c == COL_P2B || c == COL_P_PUMP || c == COL_P3A ||
-           c == COL_P3B;
-}
+static bool col_is_pressure(int c) { return sim_channels[c].kind == SIM_CH_PRESSURE; }
 
 int sim_check_row(sim_checks* k, const double* row, int ncol, char* msg, size_t n) {
     for (int c = 0; c < ncol; ++c) {

@@ -121,20 +121,80 @@ double sim_load_mass(const model* m, const scenario* sc, const sim_opts* o);
 
 sim_opts sim_default_opts(void);
 
-/// CSV columns, in order. The first 17 are the columns every backend has
-/// written from the start (README, "The CSV columns"): their order is fixed.
+/// The output channels: one list (name, unit, kind) from which the CSV
+/// columns, their header, sim_col_name and sim_col_unit, the run checks'
+/// pressure columns and the channels an engine publishes (engine_channels)
+/// are all made. The first 17 are the columns every backend has written
+/// from the start (README, "The CSV columns"): their order is fixed. A new
+/// channel is one X(...) line in the list its backends write.
+typedef enum sim_channel_kind {
+    SIM_CH_OTHER = 0,
+    SIM_CH_PRESSURE, ///< an absolute pressure [Pa]: the run checks refuse one below -0.1 MPa
+} sim_channel_kind;
+typedef struct sim_channel {
+    const char* name; ///< CSV column name
+    const char* unit; ///< SI unit, "-" for none, "count", "bits", "index"
+    sim_channel_kind kind;
+} sim_channel;
+
+/// Every backend's channels.
+#define SIM_CHANNELS_BASE(X) \
+    X(T, "t", "s", SIM_CH_OTHER) \
+    X(X1, "x1", "m", SIM_CH_OTHER) \
+    X(X2, "x2", "m", SIM_CH_OTHER) \
+    X(P1A, "p1A", "Pa", SIM_CH_PRESSURE) \
+    X(P1B, "p1B", "Pa", SIM_CH_PRESSURE) \
+    X(P2A, "p2A", "Pa", SIM_CH_PRESSURE) \
+    X(P2B, "p2B", "Pa", SIM_CH_PRESSURE) \
+    X(U1, "u1", "-", SIM_CH_OTHER) \
+    X(U2, "u2", "-", SIM_CH_OTHER) \
+    X(Q1, "q1", "rad", SIM_CH_OTHER) \
+    X(Q2, "q2", "rad", SIM_CH_OTHER) \
+    X(TIP_X, "tip_x", "m", SIM_CH_OTHER) \
+    X(TIP_Z, "tip_z", "m", SIM_CH_OTHER) \
+    X(F1, "F1", "N", SIM_CH_OTHER) \
+    X(F2, "F2", "N", SIM_CH_OTHER) \
+    X(U1_CMD, "u1_cmd", "-", SIM_CH_OTHER) \
+    X(U2_CMD, "u2_cmd", "-", SIM_CH_OTHER) \
+    X(V1, "v1", "m/s", SIM_CH_OTHER) \
+    X(V2, "v2", "m/s", SIM_CH_OTHER) \
+    X(P_PUMP, "p_pump", "Pa", SIM_CH_PRESSURE) \
+    X(RELIEF_OPEN, "relief_open", "count", SIM_CH_OTHER) \
+    X(END_STOP, "end_stop", "bits", SIM_CH_OTHER)
+/// World extras, written by the ode backend only.
+#define SIM_CHANNELS_WORLD(X) \
+    X(SLEW, "slew", "rad", SIM_CH_OTHER) \
+    X(HOOK_X, "hook_x", "m", SIM_CH_OTHER) \
+    X(HOOK_Y, "hook_y", "m", SIM_CH_OTHER) \
+    X(HOOK_Z, "hook_z", "m", SIM_CH_OTHER) \
+    X(LOAD_X, "load_x", "m", SIM_CH_OTHER) \
+    X(LOAD_Y, "load_y", "m", SIM_CH_OTHER) \
+    X(LOAD_Z, "load_z", "m", SIM_CH_OTHER) \
+    X(ATTACHED, "attached", "index", SIM_CH_OTHER) \
+    X(TRUCK_TILT, "truck_tilt", "rad", SIM_CH_OTHER) \
+    X(CONTACTS, "contacts", "count", SIM_CH_OTHER) \
+    X(MAX_DEPTH, "max_depth", "m", SIM_CH_OTHER) \
+    /* The slew function's actuator (sandbox; zeros in the validation world). */ \
+    X(X3, "x3", "m", SIM_CH_OTHER) \
+    X(V3, "v3", "m/s", SIM_CH_OTHER) \
+    X(P3A, "p3A", "Pa", SIM_CH_PRESSURE) \
+    X(P3B, "p3B", "Pa", SIM_CH_PRESSURE) \
+    X(U3, "u3", "-", SIM_CH_OTHER) \
+    X(U3_CMD, "u3_cmd", "-", SIM_CH_OTHER) \
+    X(F3, "F3", "N", SIM_CH_OTHER)
+
+#define SIM_COL_ENUM_(id, name, unit, kind) COL_##id,
+/// CSV column indices, in the order of the list.
 enum {
-    COL_T, COL_X1, COL_X2, COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_U1, COL_U2, COL_Q1, COL_Q2,
-    COL_TIP_X, COL_TIP_Z, COL_F1, COL_F2, COL_U1_CMD, COL_U2_CMD,
-    COL_V1, COL_V2, COL_P_PUMP, COL_RELIEF_OPEN, COL_END_STOP,
+    SIM_CHANNELS_BASE(SIM_COL_ENUM_)
     SIM_NCOL_BASE, ///< columns every backend writes
-    // World extras, written by the ode backend only.
-    COL_SLEW = SIM_NCOL_BASE, COL_HOOK_X, COL_HOOK_Y, COL_HOOK_Z, COL_LOAD_X, COL_LOAD_Y, COL_LOAD_Z,
-    COL_ATTACHED, COL_TRUCK_TILT, COL_CONTACTS, COL_MAX_DEPTH,
-    // The slew function's actuator (sandbox; zeros in the validation world).
-    COL_X3, COL_V3, COL_P3A, COL_P3B, COL_U3, COL_U3_CMD, COL_F3,
+    SIM_COL_WORLD_ = SIM_NCOL_BASE - 1, // the world extras follow the base columns directly
+    SIM_CHANNELS_WORLD(SIM_COL_ENUM_)
     SIM_NCOL
 };
+#undef SIM_COL_ENUM_
+/// The list, indexed by column (COL_T .. SIM_NCOL - 1).
+extern const sim_channel sim_channels[SIM_NCOL];
 extern const char* const sim_col_name[SIM_NCOL];
 extern const char* const sim_col_unit[SIM_NCOL];
 
