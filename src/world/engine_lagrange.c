@@ -242,7 +242,7 @@ int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, c
     if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     ls.scn = sc;
     ls.use_fused = ls.have_fused && !o->general_kernel;
-    ls.use_w = ls.w_layout && !o->general_kernel; // the crane-specialised W too (lsim_w.c)
+    ls.use_w = ls.w_layout && !o->general_kernel; // the crane-specialised W too (lagrange_schur_w.c)
     ls.use_split = ls.w_layout && !o->general_kernel && !o->whole_step;
     res->fused = ls.use_fused;
     double y[LSIM_MAX_STATES];

@@ -46,7 +46,7 @@ typedef struct sim_opts {
                          ///< the fused kernel applies (hyd_fused.h; for comparisons)
     bool whole_step;     ///< lagrange, Krus/ROS2 with the block pattern: the generic
                          ///< stage arithmetic with f in full at every stage, instead
-                         ///< of the split step (lsim_krus.c; for comparisons)
+                         ///< of the split step (lagrange_split_step.c; for comparisons)
 } sim_opts;
 
 /// Refuse a fixed-step run the method cannot do, before it starts: RK4
@@ -220,7 +220,7 @@ typedef struct sim_result {
     hyd_solver_stats stats;
     long rows;
     bool fused;          ///< the run used the fused circuit kernel (lagrange or ode)
-    bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lsim_krus.c)
+    bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lagrange_split_step.c)
 } sim_result;
 
 /// Run the scenario. Rows go to row_fn (may be NULL) and to trace (may be
