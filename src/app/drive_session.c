@@ -163,7 +163,7 @@ static void build_params(drive_session* s) {
               me->link[0].length);
     add_param(s, PK_MECH, "booms", "end arm length", "m", 1, 1.0, 5.0, NULL, "mechanics.links[1].length",
               me->link[1].length);
-    if (s->c.sim.mechanics == SIM_LAGRANGE)
+    if (engine_can_set_load(s->l))
         add_param(s, PK_LOAD, "load", "tip load", "kg", 1, 0, 5000, NULL, "mechanics.load_mass",
                   sim_load_mass(s->m, &s->sc, &s->c.sim));
     static const char* const cyl[2] = {"lift_cyl", "jib_cyl"};
@@ -197,16 +197,18 @@ static void build_params(drive_session* s) {
     add_param(s, PK_STEP, "solver", "step", "ms", 1e-3, 0.05, 1.0, NULL, NULL, s->c.sim.h);
     // What cannot change in place rebuilds the world (loads back at their
     // start): applied once when the drag or the typing ends, not at every
-    // pixel. Masses and inertias change in place (engine_set_link); in the ode
-    // world a length does not.
-    // A tip load in an ode world (the validation world's, merged into the end
-    // arm) moves the end arm's centre of mass with its mass: a rebuild too.
-    const bool ode = s->c.sim.mechanics == SIM_ODE;
-    const bool tip_load = ode && !engine_load_name(s->l, 0, NULL) && sim_load_mass(s->m, &s->sc, &s->c.sim) > 0;
+    // pixel. Masses and inertias change in place (engine_set_link); a length
+    // only where the engine can resize a boom (not the ode world's bodies).
+    // A tip load merged into the end arm (the ode validation world's: no
+    // load parameter, no load bodies) moves the end arm's centre of mass
+    // with its mass: a rebuild too.
+    const bool resize = engine_can_resize_links(s->l);
+    const bool tip_load = !engine_can_set_load(s->l) && !engine_load_name(s->l, 0, NULL) &&
+                          sim_load_mass(s->m, &s->sc, &s->c.sim) > 0;
     for (int i = 0; i < s->nparam; ++i) {
         drive_param* p = &s->param[i];
         const bool mech = p->kind == PK_MECH;
-        p->on_release = p->kind == PK_STEP || p->kind == PK_SOLVER || (mech && ode && strstr(p->json, ".length")) ||
+        p->on_release = p->kind == PK_STEP || p->kind == PK_SOLVER || (mech && !resize && strstr(p->json, ".length")) ||
                         (mech && tip_load && strstr(p->json, "links[1].mass"));
     }
 }
@@ -306,7 +308,7 @@ static void apply_param(drive_session* s, int i) {
 static void rebuild_world(drive_session* s, bool at_start) {
     double row[SIM_NCOL];
     engine_row(s->l, row);
-    double q0[2] = {row[COL_Q1], row[COL_Q2]}, slew0 = s->c.sim.mechanics == SIM_ODE ? row[COL_SLEW] : 0;
+    double q0[2] = {row[COL_Q1], row[COL_Q2]}, slew0 = row[COL_SLEW]; // 0 where the crane does not slew
     if (at_start) {
         q0[0] = s->sc.q0[0];
         q0[1] = s->sc.q0[1];

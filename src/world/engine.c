@@ -52,6 +52,9 @@ void engine_set_load(engine* e, double m3) {
     if (e->ops->set_load) e->ops->set_load(e, m3);
 }
 
+bool engine_can_set_load(const engine* e) { return e->ops->set_load != NULL; }
+bool engine_can_resize_links(const engine* e) { return e->ops->resize_links; }
+
 int engine_set_link(engine* e, int k, const crane_link* ln) { return e->ops->set_link(e, k, ln); }
 int engine_ncol(const engine* e) { return e->ops->nchannel; }
 

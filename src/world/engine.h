@@ -48,6 +48,12 @@ hyd_model* engine_circuit(engine* e);
 /// Set the tip load [kg] where the engine carries it as a parameter
 /// (lagrange; takes effect at the next step).
 void engine_set_load(engine* e, double m3);
+/// True when the tip load is a parameter engine_set_load changes (else the
+/// world's loads are bodies, or the load is merged into the end arm).
+bool engine_can_set_load(const engine* e);
+/// True when engine_set_link applies a new boom length in place (else the
+/// engine must be rebuilt for one).
+bool engine_can_resize_links(const engine* e);
 /// Boom k (0 lifting arm, 1 end arm) now has link ln (mass, com, inertia,
 /// length), applied in place at the next step where the engine can: the
 /// lagrange crane always (its constants are recomputed; ln is the model's

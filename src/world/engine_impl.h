@@ -19,6 +19,7 @@ typedef struct engine_ops {
     /// NULL: the tip load is not a parameter of this backend.
     void (*set_load)(engine* e, double m3);
     int (*set_link)(engine* e, int k, const crane_link* ln);
+    bool resize_links; ///< set_link applies a new boom length in place
     /// Advance dt [s]; 0, or 1 with the reason in e->err.
     int (*step)(engine* e, double dt);
     double (*time)(const engine* e);

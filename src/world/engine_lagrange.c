@@ -520,6 +520,7 @@ const engine_ops engine_lagrange_ops = {
     .circuit = lag_circuit,
     .set_load = lag_set_load,
     .set_link = lag_set_link,
+    .resize_links = true, // the constants are made again from the model's links
     .step = lag_step,
     .time = lag_time,
     .row = lag_row,

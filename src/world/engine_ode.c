@@ -225,6 +225,7 @@ const engine_ops engine_ode_ops = {
     .circuit = ode_circuit,
     .set_load = NULL, // the world's loads are bodies, picked up with the hook
     .set_link = ode_set_link,
+    .resize_links = false, // a body's geometry is fixed when it is built
     .step = ode_step,
     .time = ode_time,
     .row = ode_row,
