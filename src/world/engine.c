@@ -91,9 +91,10 @@ static int advance(engine* e, double dt, engine_row_fn row_fn, void* user) {
     char what[200];
     const int rc = sim_check_row(&e->chk, row, e->ops->nchannel, what, sizeof what);
     if (rc) {
-        const bool adaptive = hyd_method_is_adaptive(e->o.solver);
-        snprintf(e->err, sizeof e->err, "numerical blow-up: %s (solver %s): %s", what, hyd_method_name(e->o.solver),
-                 sim_blowup_hint(adaptive, row[COL_T], e->chk.bad_value));
+        char how[64];
+        snprintf(how, sizeof how, "solver %s", hyd_method_name(e->o.solver));
+        sim_check_message(e->err, sizeof e->err, what, how, hyd_method_is_adaptive(e->o.solver), row[COL_T],
+                          e->chk.bad_value);
         e->failed = true;
         return 1;
     }

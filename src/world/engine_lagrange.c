@@ -365,16 +365,12 @@ int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, c
         res->status = c.bad_t > 0 ? SIM_FAILED : SIM_REFUSED;
         // The step for fixed-step methods, the last step tried for ours, the
         // tolerance for CVODE (whose steps are its own).
-        char how[48];
-        if (o->cvode) snprintf(how, sizeof how, "rtol %g", o->rtol);
-        else snprintf(how, sizeof how, "h = %g s", adaptive && s ? hyd_solver_last_h(s) : o->h);
-        if (res->status == SIM_REFUSED)
-            snprintf(res->message, sizeof res->message, "%s: %s", c.bad,
-                     sim_blowup_hint(adaptive, 0.0, c.chk.bad_value));
-        else
-            snprintf(res->message, sizeof res->message, "numerical blow-up: %s (solver %s, %s): %s", c.bad,
-                     o->cvode ? "cvode" : hyd_method_name(o->solver), how,
-                     sim_blowup_hint(adaptive, c.bad_t, c.chk.bad_value));
+        char how[96];
+        if (o->cvode) snprintf(how, sizeof how, "solver cvode, rtol %g", o->rtol);
+        else snprintf(how, sizeof how, "solver %s, h = %g s", hyd_method_name(o->solver),
+                      adaptive && s ? hyd_solver_last_h(s) : o->h);
+        sim_check_message(res->message, sizeof res->message, c.bad, res->status == SIM_REFUSED ? NULL : how,
+                          adaptive, c.bad_t, c.chk.bad_value);
     } else if (c.stop) {
         res->status = SIM_REFUSED;
         snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c.t_last_row);

@@ -140,8 +140,8 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         char what[200];
         const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
         if (rc) {
-            snprintf(res->message, sizeof res->message, "%s: %s", what,
-                     sim_blowup_hint(hyd_method_is_adaptive(o->solver), 0.0, c->chk.bad_value));
+            sim_check_message(res->message, sizeof res->message, what, NULL, hyd_method_is_adaptive(o->solver),
+                              0.0, c->chk.bad_value);
             ode_world_destroy(w);
             return res->status = SIM_REFUSED;
         }
@@ -181,9 +181,11 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
             if (rc) {
                 res->status = SIM_FAILED;
-                snprintf(res->message, sizeof res->message, "numerical blow-up: %s (solver %s, h = %g s, ODE step %g s): %s",
-                         what, hyd_method_name(o->solver), o->h < dt ? o->h : dt, dt,
-                         sim_blowup_hint(hyd_method_is_adaptive(o->solver), row[COL_T], c->chk.bad_value));
+                char how[96];
+                snprintf(how, sizeof how, "solver %s, h = %g s, ODE step %g s", hyd_method_name(o->solver),
+                         o->h < dt ? o->h : dt, dt);
+                sim_check_message(res->message, sizeof res->message, what, how, hyd_method_is_adaptive(o->solver),
+                                  row[COL_T], c->chk.bad_value);
             }
         }
         if (res->status) break;

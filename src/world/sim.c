@@ -174,6 +174,12 @@ const char* sim_blowup_hint(bool adaptive, double t, double value) {
                     : "the step is too long for this transient: try a smaller --dt or an adaptive solver";
 }
 
+void sim_check_message(char* out, size_t n, const char* what, const char* how, bool adaptive, double t,
+                       double bad) {
+    if (!how) snprintf(out, n, "%s: %s", what, sim_blowup_hint(adaptive, 0.0, bad));
+    else snprintf(out, n, "numerical blow-up: %s (%s): %s", what, how, sim_blowup_hint(adaptive, t, bad));
+}
+
 int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz) {
     if (!hm) return 0;
     double pmax = -1;

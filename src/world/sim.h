@@ -103,6 +103,15 @@ void sim_checks_note(const sim_checks* k, bool adaptive, char* note, size_t n);
 /// value; a smaller --rtol for adaptive runs; else a check of the model.
 const char* sim_blowup_hint(bool adaptive, double t, double value);
 
+/// The one message of a failed run check (sim_check_value, sim_check_row):
+/// what failed, where the run stood (how: "solver krus, h = 0.0001 s", the
+/// solver and its step as the driver knows them) and the advice of
+/// sim_blowup_hint for a failure at time t [s] of value bad [state units].
+/// With how == NULL the failure is in the start state (nothing was
+/// integrated): "WHAT: ADVICE"; else "numerical blow-up: WHAT (HOW): ADVICE".
+void sim_check_message(char* out, size_t n, const char* what, const char* how, bool adaptive, double t,
+                       double bad);
+
 /// Refuse a start state the circuit cannot hold: a chamber pressure of row
 /// (the CSV row at t = 0: p1A..p2B, and p3A, p3B when ncol has them) above
 /// the highest relief setting of circuit hm (p_crack + dp_override). The
