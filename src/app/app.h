@@ -33,6 +33,10 @@ enum app_opt {
 #define APP_GIVEN(opt) (1u << (opt))
 /// Option names by app_opt ("--model", ...).
 extern const char* const app_opt_name[APP_OPT_COUNT];
+/// Tell the world library the option that sets each of its run settings
+/// (sim_name_params), so its messages name "--dt", not "h". main() calls it
+/// first.
+void app_name_params(void);
 
 /// Options common to the subcommands that run a model.
 typedef struct app_common {

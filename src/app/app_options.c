@@ -45,6 +45,17 @@ const char* const app_opt_name[APP_OPT_COUNT] = {
     "--model", "--scenario", "--mechanics", "--variant", "--solver", "--dt", "--rtol", "--atol", "--duration",
     "--every", "--set", "--jac-every", "--load", "--world", "--dt-ode", "--kernel", "--dense-jac", "--quiet"};
 
+void app_name_params(void) {
+    static const char* names[SIM_PARAM_COUNT];
+    names[SIM_PARAM_DT] = app_opt_name[APP_OPT_DT];
+    names[SIM_PARAM_DT_ODE] = app_opt_name[APP_OPT_DT_ODE];
+    names[SIM_PARAM_DURATION] = app_opt_name[APP_OPT_DURATION];
+    names[SIM_PARAM_EVERY] = app_opt_name[APP_OPT_EVERY];
+    names[SIM_PARAM_LOAD] = app_opt_name[APP_OPT_LOAD];
+    names[SIM_PARAM_MECHANICS] = app_opt_name[APP_OPT_MECHANICS];
+    sim_name_params(names);
+}
+
 // A value that is itself an option name ("--out --quiet") is a missing
 // value: a file called "--quiet" is never what was meant.
 static bool missing_value(int argc, char** argv, int i) {

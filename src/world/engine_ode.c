@@ -102,7 +102,8 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     run_ctx cc = {.sink = k, .t_end = k->t_end}, *c = &cc;
     if (o->cvode) {
         snprintf(res->message, sizeof res->message,
-                 "--mechanics ode steps the hydraulics inside each ODE step: use krus, ros2, rk4, ros34pw2 or rodas3");
+                 "%s ode steps the hydraulics inside each ODE step: use krus, ros2, rk4, ros34pw2 or rodas3",
+                 sim_param_name(SIM_PARAM_MECHANICS));
         return res->status = SIM_REFUSED;
     }
     ode_world* w = sim_ode_world_create(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
@@ -122,8 +123,8 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     // output period is at most the run, sim_check_times).
     if (c->t_end / dt > 1e12) {
         snprintf(res->message, sizeof res->message,
-                 "--dt-ode %g s over %g s is %.3g steps, more than 1e12: use a larger --dt-ode or a shorter run", dt,
-                 c->t_end, c->t_end / dt);
+                 "%s %g s over %g s is %.3g steps, more than 1e12: use a larger %s or a shorter run",
+                 sim_param_name(SIM_PARAM_DT_ODE), dt, c->t_end, c->t_end / dt, sim_param_name(SIM_PARAM_DT_ODE));
         ode_world_destroy(w);
         return res->status = SIM_REFUSED;
     }

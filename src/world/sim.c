@@ -110,6 +110,17 @@ const char* sim_world_path(const char* arg, char* buf, size_t n) {
 // (hyd_problem.outside).
 static const double P_IMPLAUSIBLE = -1e5;
 
+static const char* const k_param_field[SIM_PARAM_COUNT] = {"h", "dt_ode", "duration", "dt_out", "load_mass",
+                                                           "mechanics"};
+static const char* const* g_param_names;
+
+void sim_name_params(const char* const names[SIM_PARAM_COUNT]) { g_param_names = names; }
+
+const char* sim_param_name(sim_param p) {
+    const char* n = g_param_names ? g_param_names[p] : NULL;
+    return n ? n : k_param_field[p];
+}
+
 void sim_checks_init(sim_checks* k) { memset(k, 0, sizeof *k); }
 
 int sim_check_value(sim_checks* k, const char* name, double v, bool pressure, double t, char* msg, size_t n) {
@@ -203,8 +214,8 @@ int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3,
         snprintf(err, errsz,
                  "the start pose needs %s = %.4g MPa to hold the crane still with %g kg at the tip, above the "
                  "circuit's highest relief setting (%s: %.4g MPa, p_crack + dp_override): the crane cannot hold "
-                 "this load here (a smaller --load or another start pose)",
-                 sim_col_name[c], row[c] * 1e-6, m3, which, pmax * 1e-6);
+                 "this load here (a smaller %s or another start pose)",
+                 sim_col_name[c], row[c] * 1e-6, m3, which, pmax * 1e-6, sim_param_name(SIM_PARAM_LOAD));
         return SIM_REFUSED;
     }
     return 0;
@@ -212,18 +223,18 @@ int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3,
 
 int sim_check_times(double t_end, double dt_out, char* err, size_t errsz) {
     if (!(t_end > 0) || t_end > SIM_MAX_DURATION) {
-        snprintf(err, errsz, "--duration: expected a simulated time in s, 0 < T <= 1e6, got %g",
-                 t_end);
+        snprintf(err, errsz, "%s: expected a simulated time in s, 0 < T <= 1e6, got %g",
+                 sim_param_name(SIM_PARAM_DURATION), t_end);
         return SIM_REFUSED;
     }
     if (!(dt_out > 0) || dt_out > SIM_MAX_DURATION) {
-        snprintf(err, errsz, "--every: expected an output period in s, 0 < DT <= 1e6, got %g",
-                 dt_out);
+        snprintf(err, errsz, "%s: expected an output period in s, 0 < DT <= 1e6, got %g",
+                 sim_param_name(SIM_PARAM_EVERY), dt_out);
         return SIM_REFUSED;
     }
     if (t_end / dt_out > 1e12) {
-        snprintf(err, errsz, "--every %g s over %g s is %.3g rows, more than 1e12: use a larger --every", dt_out,
-                 t_end, t_end / dt_out);
+        snprintf(err, errsz, "%s %g s over %g s is %.3g rows, more than 1e12: use a larger %s",
+                 sim_param_name(SIM_PARAM_EVERY), dt_out, t_end, t_end / dt_out, sim_param_name(SIM_PARAM_EVERY));
         return SIM_REFUSED;
     }
     return 0;
@@ -250,12 +261,12 @@ static double stable_step(double lim, double dt_out) {
 int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, char* err, size_t errsz) {
     if (o->cvode || hyd_method_is_adaptive(o->solver)) return 0;
     if (t_end > 0 && h > t_end) {
-        snprintf(err, errsz, "--dt %g s is longer than the run (%g s)", h, t_end);
+        snprintf(err, errsz, "%s %g s is longer than the run (%g s)", sim_param_name(SIM_PARAM_DT), h, t_end);
         return SIM_REFUSED;
     }
     if (t_end > 0 && t_end / h > 1e12) {
-        snprintf(err, errsz, "--dt %g s over %g s is %.3g steps, more than 1e12: use a larger --dt or a shorter run",
-                 h, t_end, t_end / h);
+        snprintf(err, errsz, "%s %g s over %g s is %.3g steps, more than 1e12: use a larger %s or a shorter run",
+                 sim_param_name(SIM_PARAM_DT), h, t_end, t_end / h, sim_param_name(SIM_PARAM_DT));
         return SIM_REFUSED;
     }
     if (o->solver == HYD_RK4) {
@@ -269,8 +280,8 @@ int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, doubl
         if (rate > 0.0 && h * rate > 2.785) {
             snprintf(err, errsz,
                      "rk4 is unstable at h = %g s on this circuit: its fastest mode (%.3g 1/s, an open valve at "
-                     "25 MPa) needs h < %.3g s at the least; use --dt %g or a stiff solver (krus, ros2, rodas3)",
-                     h, rate, 2.785 / rate, stable_step(2.785 / rate, o->dt_out));
+                     "25 MPa) needs h < %.3g s at the least; use %s %g or a stiff solver (krus, ros2, rodas3)",
+                     h, rate, 2.785 / rate, sim_param_name(SIM_PARAM_DT), stable_step(2.785 / rate, o->dt_out));
             return SIM_REFUSED;
         }
     }
@@ -322,9 +333,9 @@ ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* d
     // chamber as a success. Beyond 10 ms the result is not worth having.
     if (wo.dt_ode > 0.01 + 1e-12) {
         snprintf(err, errsz,
-                 "--dt-ode %g s is too long: the cylinder forces lag the bodies by one ODE step, which beyond "
+                 "%s %g s is too long: the cylinder forces lag the bodies by one ODE step, which beyond "
                  "0.01 s distorts the pressures by more than 15 %% and then goes unstable (docs/ode_world.md)",
-                 wo.dt_ode);
+                 sim_param_name(SIM_PARAM_DT_ODE), wo.dt_ode);
         world_desc_free(&wd);
         return NULL;
     }
@@ -334,7 +345,8 @@ ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* d
     const double ratio = wo.dt_ode / wo.dt_hyd;
     if (fabs(ratio - floor(ratio + 0.5)) > 1e-6) {
         // ode_world_create checks this too; here it is said in the options' words.
-        snprintf(err, errsz, "--dt %g s must divide the ODE step %g s (hydraulic sub-steps)", wo.dt_hyd, wo.dt_ode);
+        snprintf(err, errsz, "%s %g s must divide the ODE step %g s (hydraulic sub-steps)",
+                 sim_param_name(SIM_PARAM_DT), wo.dt_hyd, wo.dt_ode);
         world_desc_free(&wd);
         return NULL;
     }

@@ -49,6 +49,25 @@ typedef struct sim_opts {
                          ///< of the split step (lagrange_split_step.c; for comparisons)
 } sim_opts;
 
+/// The run settings a world-library message names. The library does not
+/// know how a program lets its user set them: the program names them once
+/// (sim_name_params; cranesim names its options, "--dt"), else a message
+/// names the sim_opts field ("h", "dt_ode", ...).
+typedef enum sim_param {
+    SIM_PARAM_DT,        ///< sim_opts.h, the fixed (or hydraulic sub-) step [s]
+    SIM_PARAM_DT_ODE,    ///< sim_opts.dt_ode [s]
+    SIM_PARAM_DURATION,  ///< sim_opts.duration [s]
+    SIM_PARAM_EVERY,     ///< sim_opts.dt_out [s]
+    SIM_PARAM_LOAD,      ///< sim_opts.load_mass [kg]
+    SIM_PARAM_MECHANICS, ///< sim_opts.mechanics
+    SIM_PARAM_COUNT
+} sim_param;
+/// Name the settings for every later message (names[p] may be NULL: the
+/// field's name). The table is copied by pointer: it must outlive the runs.
+void sim_name_params(const char* const names[SIM_PARAM_COUNT]);
+/// The name messages use for setting p.
+const char* sim_param_name(sim_param p);
+
 /// Refuse a fixed-step run the method cannot do, before it starts: RK4
 /// beyond its stability interval on the circuit hm's fastest mode, a step h
 /// [s] longer than the run t_end [s], or more than 1e12 steps (t_end <= 0:
@@ -68,7 +87,7 @@ const char* sim_blowup_hint(bool adaptive, double t, double value);
 #define SIM_MAX_DURATION 1e6
 /// Refuse a run's duration t_end [s] or output period dt_out [s] outside
 /// (0, SIM_MAX_DURATION], or more than 1e12 rows. Returns SIM_OK, or SIM_REFUSED with one
-/// line in err naming the option (--duration, --every), the range and the unit.
+/// line in err naming the setting (sim_param_name), the range and the unit.
 int sim_check_times(double t_end, double dt_out, char* err, size_t errsz);
 
 /// The checks every driver (run, compare, bench, study, drive) applies to the
