@@ -53,6 +53,7 @@ void app_name_params(void) {
     names[SIM_PARAM_EVERY] = app_opt_name[APP_OPT_EVERY];
     names[SIM_PARAM_LOAD] = app_opt_name[APP_OPT_LOAD];
     names[SIM_PARAM_MECHANICS] = app_opt_name[APP_OPT_MECHANICS];
+    names[SIM_PARAM_RTOL] = app_opt_name[APP_OPT_RTOL];
     sim_name_params(names);
 }
 

@@ -110,8 +110,8 @@ const char* sim_world_path(const char* arg, char* buf, size_t n) {
 // (hyd_problem.outside).
 static const double P_IMPLAUSIBLE = -1e5;
 
-static const char* const k_param_field[SIM_PARAM_COUNT] = {"h", "dt_ode", "duration", "dt_out", "load_mass",
-                                                           "mechanics"};
+static const char* const k_param_field[SIM_PARAM_COUNT] = {"h",         "dt_ode",    "duration", "dt_out",
+                                                           "load_mass", "mechanics", "rtol"};
 static const char* const* g_param_names;
 
 void sim_name_params(const char* const names[SIM_PARAM_COUNT]) { g_param_names = names; }
@@ -164,10 +164,16 @@ void sim_checks_note(const sim_checks* k, bool adaptive, char* note, size_t n) {
     }
     // With an adaptive solver (CVODE has no domain hook: -1.5 kPa on `step`
     // at rtol 5e-3, none at 1e-3) the step is not the user's to shorten.
+    char why[160];
+    if (adaptive)
+        snprintf(why, sizeof why,
+                 "the tolerance let the integration overshoot at a stiff event (a smaller %s avoids it)",
+                 sim_param_name(SIM_PARAM_RTOL));
+    else
+        snprintf(why, sizeof why, "the fixed step rings at a stiff event (a smaller %s or an adaptive solver avoids it)",
+                 sim_param_name(SIM_PARAM_DT));
     snprintf(note, n, "%s dipped below absolute zero, to %.3g kPa, at t = %.6g s: %s", k->dip_name,
-             k->dip_value * 1e-3, k->dip_t,
-             adaptive ? "the tolerance let the integration overshoot at a stiff event (a smaller --rtol avoids it)"
-                      : "the fixed step rings at a stiff event (a smaller --dt or an adaptive solver avoids it)");
+             k->dip_value * 1e-3, k->dip_t, why);
 }
 
 // A smaller step (or tolerance) is the likely cure only after steps from an
@@ -181,8 +187,14 @@ const char* sim_blowup_hint(bool adaptive, double t, double value) {
     if (!(t > 0.0))
         return "the initial state is already outside the physical range (no step was taken): check the model's values";
     if (!isfinite(value)) return "a component law gave no finite number: check the model's values";
-    return adaptive ? "the tolerance is too loose for this transient: try a smaller --rtol"
-                    : "the step is too long for this transient: try a smaller --dt or an adaptive solver";
+    static char hint[160];
+    if (adaptive)
+        snprintf(hint, sizeof hint, "the tolerance is too loose for this transient: try a smaller %s",
+                 sim_param_name(SIM_PARAM_RTOL));
+    else
+        snprintf(hint, sizeof hint, "the step is too long for this transient: try a smaller %s or an adaptive solver",
+                 sim_param_name(SIM_PARAM_DT));
+    return hint;
 }
 
 void sim_check_message(char* out, size_t n, const char* what, const char* how, bool adaptive, double t,

@@ -60,6 +60,7 @@ typedef enum sim_param {
     SIM_PARAM_EVERY,     ///< sim_opts.dt_out [s]
     SIM_PARAM_LOAD,      ///< sim_opts.load_mass [kg]
     SIM_PARAM_MECHANICS, ///< sim_opts.mechanics
+    SIM_PARAM_RTOL,      ///< sim_opts.rtol [-]
     SIM_PARAM_COUNT
 } sim_param;
 /// Name the settings for every later message (names[p] may be NULL: the
@@ -79,6 +80,8 @@ int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, doubl
 /// fixed-step solver. "Try a smaller --dt" only where a shorter step is the
 /// likely cure: a fixed step, after steps were taken (t > 0), from a finite
 /// value; a smaller --rtol for adaptive runs; else a check of the model.
+/// The settings are named by sim_param_name; the text lives until the next
+/// call.
 const char* sim_blowup_hint(bool adaptive, double t, double value);
 
 /// Longest simulated time and output period a run accepts [s]: 1e6 s (11.6

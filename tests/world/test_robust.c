@@ -206,6 +206,9 @@ static void test_start_beyond_reliefs(void) {
 }
 
 int main(int argc, char** argv) {
+    // The advice names the settings as cranesim's options do (app_name_params).
+    static const char* const cli[SIM_PARAM_COUNT] = {[SIM_PARAM_DT] = "--dt", [SIM_PARAM_RTOL] = "--rtol"};
+    sim_name_params(cli);
     char err[512];
     g_model = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
     if (!g_model) {
