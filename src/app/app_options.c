@@ -54,6 +54,8 @@ void app_name_params(void) {
     names[SIM_PARAM_LOAD] = app_opt_name[APP_OPT_LOAD];
     names[SIM_PARAM_MECHANICS] = app_opt_name[APP_OPT_MECHANICS];
     names[SIM_PARAM_RTOL] = app_opt_name[APP_OPT_RTOL];
+    names[SIM_PARAM_SET] = app_opt_name[APP_OPT_SET];
+    names[SIM_PARAM_WORLD] = app_opt_name[APP_OPT_WORLD];
     sim_name_params(names);
 }
 

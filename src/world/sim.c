@@ -111,7 +111,8 @@ const char* sim_world_path(const char* arg, char* buf, size_t n) {
 static const double P_IMPLAUSIBLE = -1e5;
 
 static const char* const k_param_field[SIM_PARAM_COUNT] = {"h",         "dt_ode",    "duration", "dt_out",
-                                                           "load_mass", "mechanics", "rtol"};
+                                                           "load_mass", "mechanics", "rtol",     "set",
+                                                           "world"};
 static const char* const* g_param_names;
 
 void sim_name_params(const char* const names[SIM_PARAM_COUNT]) { g_param_names = names; }

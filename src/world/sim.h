@@ -9,6 +9,7 @@
 #include "hyd_solver.h"
 #include "lagrange_sim.h"
 #include "model.h"
+#include "param_names.h"
 #include "scenario.h"
 
 #ifdef __cplusplus
@@ -49,25 +50,7 @@ typedef struct sim_opts {
                          ///< of the split step (lagrange_split_step.c; for comparisons)
 } sim_opts;
 
-/// The run settings a world-library message names. The library does not
-/// know how a program lets its user set them: the program names them once
-/// (sim_name_params; cranesim names its options, "--dt"), else a message
-/// names the sim_opts field ("h", "dt_ode", ...).
-typedef enum sim_param {
-    SIM_PARAM_DT,        ///< sim_opts.h, the fixed (or hydraulic sub-) step [s]
-    SIM_PARAM_DT_ODE,    ///< sim_opts.dt_ode [s]
-    SIM_PARAM_DURATION,  ///< sim_opts.duration [s]
-    SIM_PARAM_EVERY,     ///< sim_opts.dt_out [s]
-    SIM_PARAM_LOAD,      ///< sim_opts.load_mass [kg]
-    SIM_PARAM_MECHANICS, ///< sim_opts.mechanics
-    SIM_PARAM_RTOL,      ///< sim_opts.rtol [-]
-    SIM_PARAM_COUNT
-} sim_param;
-/// Name the settings for every later message (names[p] may be NULL: the
-/// field's name). The table is copied by pointer: it must outlive the runs.
-void sim_name_params(const char* const names[SIM_PARAM_COUNT]);
-/// The name messages use for setting p.
-const char* sim_param_name(sim_param p);
+// The settings its messages name: sim_param, sim_name_params, sim_param_name (param_names.h).
 
 /// Refuse a fixed-step run the method cannot do, before it starts: RK4
 /// beyond its stability interval on the circuit hm's fastest mode, a step h
