@@ -17,14 +17,18 @@ static int play_hook(void* user, int attach) {
     return got;
 }
 
+// The backend o->mechanics names: the one place that chooses by it.
+static const engine_ops* backend(const sim_opts* o) {
+    return o->mechanics == SIM_ODE ? &engine_ode_ops : &engine_lagrange_ops;
+}
+
 engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
                       size_t errsz) {
-    return o->mechanics == SIM_ODE ? engine_ode_create(m, o, q0, slew0, m3, err, errsz)
-                                   : engine_lagrange_create(m, o, q0, m3, err, errsz);
+    return backend(o)->create(m, o, q0, slew0, m3, err, errsz);
 }
 
 int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
-    return o->mechanics == SIM_ODE ? engine_ode_run(m, sc, o, k, res) : engine_lagrange_run(m, sc, o, k, res);
+    return backend(o)->run(m, sc, o, k, res);
 }
 
 void engine_play(engine* e, const scenario* sc, double tm, int* ev, double u[3], engine_hook_fn on_hook,
@@ -64,7 +68,7 @@ const sim_channel* engine_channels(const engine* e, int* n) {
 }
 
 const sim_channel* engine_channels_for(const sim_opts* o, int* n) {
-    *n = (o->mechanics == SIM_ODE ? &engine_ode_ops : &engine_lagrange_ops)->nchannel;
+    *n = backend(o)->nchannel;
     return sim_channels;
 }
 double engine_time(const engine* e) { return e->ops->time(e); }

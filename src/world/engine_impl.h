@@ -8,6 +8,11 @@
 
 typedef struct engine_ops {
     const char* name; ///< "lagrange", "ode"
+    /// A stepped engine at q0 [rad], slew0 [rad] (where the crane slews), tip load m3 [kg].
+    engine* (*create)(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
+                      size_t errsz);
+    /// A scripted run of scenario sc (engine_run).
+    int (*run)(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
     int nchannel;     ///< the channels it publishes: sim_channels[0 .. nchannel), the columns its rows fill
     void (*destroy)(engine* e);
     void (*set_commands)(engine* e, const double u[3]);
@@ -36,16 +41,5 @@ struct engine {
 };
 
 extern const engine_ops engine_lagrange_ops, engine_ode_ops;
-
-/// The backends' constructors (engine_create picks one by o->mechanics).
-engine* engine_lagrange_create(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
-                               size_t errsz);
-engine* engine_ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
-                          char* err, size_t errsz);
-
-/// The backends' scripted runs (engine_run picks one by o->mechanics).
-int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
-                        sim_result* res);
-int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
 
 #endif

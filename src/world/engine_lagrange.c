@@ -30,8 +30,9 @@ typedef struct eng_lagrange {
 static void lag_row(engine* e, double row[SIM_NCOL]);
 static void lag_destroy(engine* e);
 
-engine* engine_lagrange_create(const model* m, const sim_opts* o, const double q0[2], double m3, char* err,
-                               size_t errsz) {
+static engine* lag_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
+                          char* err, size_t errsz) {
+    (void)slew0; // the planar crane does not slew
     eng_lagrange* l = calloc(1, sizeof *l);
     if (!l) {
         snprintf(err, errsz, "out of memory");
@@ -235,8 +236,7 @@ static const char* state_name(const lsim* ls, int i, char* buf, size_t n) {
 // inside f (lsim.scn), the fused kernel and the split step where they
 // apply, integrated between the command breakpoints with rows at the
 // output times.
-int engine_lagrange_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
-                        sim_result* res) {
+static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
     lsim ls;
     double m3 = sim_load_mass(m, sc, o);
     if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
@@ -509,6 +509,8 @@ static void lag_snapshot(engine* e, world_snapshot* s) {
 
 const engine_ops engine_lagrange_ops = {
     .name = "lagrange",
+    .create = lag_create,
+    .run = lag_run,
     .nchannel = SIM_NCOL_BASE, // the base list: no world
     .destroy = lag_destroy,
     .set_commands = lag_set_commands,

@@ -17,7 +17,7 @@ typedef struct eng_ode {
 
 static ode_world* W(const engine* e) { return ((const eng_ode*)e)->w; }
 
-engine* engine_ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
+static engine* ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           char* err, size_t errsz) {
     eng_ode* l = calloc(1, sizeof *l);
     if (!l) {
@@ -98,7 +98,7 @@ static int play_hook(void* user, int attach) { return ode_world_hook(user, attac
 
 // A scripted run (engine_run): the scenario played at each ODE step's
 // midpoint (scenario_play), rows every dt_out on the step grid.
-int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
+static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
     run_ctx cc = {.sink = k, .t_end = k->t_end}, *c = &cc;
     if (o->cvode) {
         snprintf(res->message, sizeof res->message,
@@ -219,6 +219,8 @@ int engine_ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
 
 const engine_ops engine_ode_ops = {
     .name = "ode",
+    .create = ode_create,
+    .run = ode_run,
     .nchannel = SIM_NCOL, // the base list and the world extras
     .destroy = ode_destroy,
     .set_commands = ode_set_commands,
