@@ -16,6 +16,11 @@
 /// Exit codes (README, "Exit codes"); an interrupted run exits 128 + the signal.
 enum { EXIT_OK_ = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
 
+/// The exit code of a world-library status (sim_status): SIM_FAILED is a
+/// runtime failure (1); SIM_REFUSED is bad input (2), unless rows were
+/// already written (rows > 0: then the run failed on its way, 1).
+int app_exit_code(int status, long rows);
+
 /// The common options, as bits of app_common.given (APP_GIVEN(APP_OPT_DT)):
 /// which ones the user gave, so a command can tell a choice from a default,
 /// note an option that has no effect and reject one it cannot honour.
@@ -28,6 +33,10 @@ enum app_opt {
 #define APP_GIVEN(opt) (1u << (opt))
 /// Option names by app_opt ("--model", ...).
 extern const char* const app_opt_name[APP_OPT_COUNT];
+/// Tell the world library the option that sets each of its run settings
+/// (sim_name_params), so its messages name "--dt", not "h". main() calls it
+/// first.
+void app_name_params(void);
 
 /// Options common to the subcommands that run a model.
 typedef struct app_common {
@@ -151,14 +160,6 @@ const char* app_scenario_path(const char* arg, char* buf, size_t n);
 int app_load_msg(const app_common* c, model** m, scenario* sc, char* err, size_t errsz);
 /// app_load_msg, printing the message as "cranesim: ..." on stderr.
 int app_load(const app_common* c, model** m, scenario* sc);
-
-typedef struct live live;
-/// The scripted operator (a scenario's command tables and hook events) at
-/// simulated time tm: the stick positions into u[3], and every hook event
-/// due by tm, from *ev on, applied to l (*ev advances). on_hook (may be
-/// NULL) hears each: attach or release, and live_hook's answer.
-void app_scripted_input(const scenario* sc, live* l, double tm, int* ev, double u[3],
-                        void (*on_hook)(void* user, live* l, int attach, int got), void* user);
 
 /// Progress bar on stderr, only when stderr is a terminal.
 void app_progress(void* user, double t, double t_end);

@@ -5,7 +5,7 @@
 // honest figures. Benchmarks measure; tests never time anything.
 #include "app.h"
 #include "circuit_fast.h"
-#include "live.h"
+#include "engine.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
 #endif
@@ -120,7 +120,7 @@ static double soak_command(soak_ramp* r, uint64_t* rng, double t) {
 }
 
 // The soak: `duration` simulated seconds of random legal input in the
-// sandbox, stepped in 10 ms frames through live (drive's path, with the run
+// sandbox, stepped in 10 ms frames through the engine (drive's path, with the run
 // checks of sim.h), every row checked for non-finite values. One JSON line.
 // Returns 0, or EXIT_RUNTIME when the run failed.
 static int bench_soak(app_common* c, double duration, uint64_t seed) {
@@ -135,7 +135,7 @@ static int bench_soak(app_common* c, double duration, uint64_t seed) {
     o.solver = HYD_KRUS;
     o.cvode = false;
     char err[512];
-    live* l = live_create(m, &o, sc.q0, sc.slew0, -1, err, sizeof err);
+    engine* l = engine_create(m, &o, sc.q0, sc.slew0, -1, err, sizeof err);
     if (!l) {
         printf("{\"config\":\"soak\",\"error\":\"%s\"}\n", err);
         model_free(m);
@@ -157,19 +157,19 @@ static int bench_soak(app_common* c, double duration, uint64_t seed) {
         const double tm = (i + 0.5) * frame;
         const double u[3] = {soak_command(&ramp[0], &rng, tm), soak_command(&ramp[1], &rng, tm),
                              soak_command(&ramp[2], &rng, tm)};
-        live_set_commands(l, u);
+        engine_set_commands(l, u);
         if (tm >= next_hook) {
-            const int got = live_hook(l, attach);
+            const int got = engine_hook(l, attach);
             ++hooks;
             picks += attach && got >= 0;
             attach = !attach;
             next_hook = tm + 5.0 + 15.0 * soak_rand(&rng);
         }
-        if (live_advance(l, (i + 1) * frame - live_time(l))) {
+        if (engine_advance(l, (i + 1) * frame - engine_time(l))) {
             status = 1;
             break;
         }
-        live_row(l, row);
+        engine_row(l, row);
         ++rows;
         for (int k = 0; k < SIM_NCOL; ++k) nonfinite += !isfinite(row[k]);
         for (int k = COL_P1A; k <= COL_P2B; ++k) pmax = fmax(pmax, row[k]);
@@ -183,7 +183,7 @@ static int bench_soak(app_common* c, double duration, uint64_t seed) {
     // The failure text without quotes or backslashes (it goes into JSON).
     char msg[600] = "";
     if (status) {
-        snprintf(msg, sizeof msg, "%s", live_error(l));
+        snprintf(msg, sizeof msg, "%s", engine_error(l));
         for (char* p = msg; *p; ++p)
             if (*p == '"' || *p == '\\' || (unsigned char)*p < 0x20) *p = '\'';
     }
@@ -191,10 +191,10 @@ static int bench_soak(app_common* c, double duration, uint64_t seed) {
            "\"wall_s\":%.3f,\"exit_status\":%d,\"rows\":%ld,\"nonfinite_values\":%ld,\"peak_pressure_mpa\":%.3f,"
            "\"slew_range_deg\":[%.1f,%.1f],\"hook_toggles\":%d,\"loads_picked\":%d,\"peak_rss_kb\":%ld,"
            "\"failure\":\"%s\"}\n",
-           (unsigned long long)seed, live_time(l), duration, wall, status, rows, nonfinite, pmax * 1e-6,
+           (unsigned long long)seed, engine_time(l), duration, wall, status, rows, nonfinite, pmax * 1e-6,
            slew_lo * 180 / M_PI, slew_hi * 180 / M_PI, hooks, picks, ru.ru_maxrss, msg);
     fflush(stdout);
-    live_destroy(l);
+    engine_destroy(l);
     model_free(m);
     return status ? EXIT_RUNTIME : 0;
 }

@@ -204,7 +204,7 @@ int cmd_compare(int argc, char** argv) {
             sim_trace_free(&tr[0]);
             sim_trace_free(&tr[1]);
             model_free(m);
-            return res[s].status == 1 ? EXIT_RUNTIME : EXIT_USAGE;
+            return app_exit_code(res[s].status, 0);
         }
     }
     // Percentages are of the reference's peak: the side whose pressures are

@@ -7,7 +7,7 @@
 // capacity, missed frame deadlines, and where the record went. Every option
 // is checked before any of that, whichever mode follows.
 #include "app.h"
-#include "live.h"
+#include "engine.h"
 #include "world_desc.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
@@ -112,7 +112,7 @@ typedef struct drive_world {
 } drive_world;
 
 // Say what the scripted operator's hook did.
-static void report_hook(void* user, live* l, int attach, int got) {
+static void report_hook(void* user, engine* l, int attach, int got) {
     drive_world* dw = user;
     if (!dw->hook) {
         if (!dw->noted) printf("  (the scenario's hook events are ignored: this world has no hook)\n");
@@ -120,8 +120,8 @@ static void report_hook(void* user, live* l, int attach, int got) {
         return;
     }
     double mass = 0;
-    const char* name = got >= 0 ? live_load_name(l, got, &mass) : NULL;
-    const double t = live_time(l);
+    const char* name = got >= 0 ? engine_load_name(l, got, &mass) : NULL;
+    const double t = engine_time(l);
     if (attach && name) printf("  t = %5.2f s: hook picked up %s (%.0f kg)\n", t, name, mass);
     else if (attach) printf("  t = %5.2f s: hook found no load in reach\n", t);
     else printf("  t = %5.2f s: hook released the load\n", t);
@@ -154,7 +154,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     }
     char err[320];
     double m3 = sim_load_mass(m, &sc, &c->sim);
-    live* l = live_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
+    engine* l = engine_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
     if (!l) {
         fprintf(stderr, "cranesim drive: %s\n", err);
         model_free(m);
@@ -167,15 +167,15 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     FILE* f = record ? app_out_open(&rec, record, "w") : NULL;
     if (record && !f) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(errno));
-        live_destroy(l);
+        engine_destroy(l);
         model_free(m);
         return EXIT_USAGE;
     }
-    const int ncol = live_ncol(l);
+    const int ncol = engine_ncol(l);
     // The sandbox has the truck, the slew and the hook; loads only if its
     // file has some. The validation world and the lagrange view have none.
     const bool sandbox = ode && kind == WORLD_SANDBOX;
-    const bool loads = sandbox && live_load_name(l, 0, NULL) != NULL;
+    const bool loads = sandbox && engine_load_name(l, 0, NULL) != NULL;
     drive_world dw = {.hook = sandbox};
     int wr = 0; // errno of the first failed write to the record
     if (f) sim_csv_header(f, ncol);
@@ -189,28 +189,28 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     double w0 = sim_wall_time(), busy = 0, worst = 0;
     int missed = 0, code = 0, ev = 0, frames_done = 0;
     double row[SIM_NCOL];
-    live_row(l, row);
+    engine_row(l, row);
     // As in run: the first signal stops the loop, a second kills at once.
     app_signals sig;
     app_signals_catch(&sig);
     for (long i = 0; i < nframes && !wr && !app_signal_caught(); ++i) {
         double ws = sim_wall_time();
-        double t = live_time(l);
+        double t = engine_time(l);
         // The operator's stick positions at the middle of this frame.
         const double tm = t + 0.5 * frame;
         double u[3];
-        app_scripted_input(&sc, l, tm, &ev, u, report_hook, &dw);
-        live_set_commands(l, u);
+        engine_play(l, &sc, tm, &ev, u, report_hook, &dw);
+        engine_set_commands(l, u);
         // Advance to the frame's end on the simulated clock (the ode world
         // steps whole ODE steps, so aim at the target, not at +frame).
-        if (live_advance(l, (i + 1) * frame - live_time(l))) {
+        if (engine_advance(l, (i + 1) * frame - engine_time(l))) {
             if (!c->quiet) app_progress_done();
-            if (record) fprintf(stderr, "cranesim drive: %s; record kept in %s\n", live_error(l), record);
-            else fprintf(stderr, "cranesim drive: %s\n", live_error(l));
+            if (record) fprintf(stderr, "cranesim drive: %s; record kept in %s\n", engine_error(l), record);
+            else fprintf(stderr, "cranesim drive: %s\n", engine_error(l));
             code = EXIT_RUNTIME;
             break;
         }
-        live_row(l, row);
+        engine_row(l, row);
         // A record that cannot be written stops the run: driving on would
         // only lose more of it.
         if (f && !write_row(f, row, ncol)) {
@@ -223,19 +223,19 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         worst = fmax(worst, we - ws);
         // A deadline is missed when the frame's work ends after its slot.
         if (we > w0 + (i + 1) * frame) ++missed;
-        if (!c->quiet) app_progress(NULL, live_time(l), duration);
+        if (!c->quiet) app_progress(NULL, engine_time(l), duration);
         sleep_until(w0 + (i + 1) * frame);
     }
     if (!c->quiet) app_progress_done();
     app_signals_restore(&sig);
     if (app_signal_caught() && !code) {
         fprintf(stderr, "cranesim drive: interrupted (%s) at t = %.6g s%s%s\n", app_signal_name(app_signal_caught()),
-                live_time(l), record ? "; record kept in " : "", record ? record : "");
+                engine_time(l), record ? "; record kept in " : "", record ? record : "");
         code = 128 + app_signal_caught();
     }
     if (!code) {
         char note[320];
-        live_note(l, note, sizeof note);
+        engine_note(l, note, sizeof note);
         if (note[0]) fprintf(stderr, "cranesim drive: note: %s\n", note);
     }
     wr = app_out_close(&rec, wr, true);
@@ -245,7 +245,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     }
     double wall = sim_wall_time() - w0;
     printf("  simulated %.2f s in %.2f s wall; physics busy %.1f %% of the time: capacity %.0fx real time\n",
-           live_time(l), wall, wall > 0 ? 100 * busy / wall : 0.0, busy > 0 ? live_time(l) / busy : 0.0);
+           engine_time(l), wall, wall > 0 ? 100 * busy / wall : 0.0, busy > 0 ? engine_time(l) / busy : 0.0);
     printf("  frames: %d of %.1f ms, worst frame %.2f ms, missed deadlines %d\n", frames_done, frame * 1e3,
            worst * 1e3, missed);
     printf("  final: lift stroke %.0f mm, jib stroke %.0f mm, tip at reach %.2f m, height %.2f m", row[COL_X1] * 1e3,
@@ -261,7 +261,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     else if (!wr)
         printf("  no record (--record FILE.csv writes one); for the 3D window run it on a machine with a "
                "display\n");
-    live_destroy(l);
+    engine_destroy(l);
     model_free(m);
     return code;
 }

@@ -289,7 +289,7 @@ int cmd_run(int argc, char** argv) {
         // bad input, and nothing was written.
         fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
         code = EXIT_USAGE;
-    } else if (app_signal_caught() && res.status == 2 && sink.opened) {
+    } else if (app_signal_caught() && res.status == SIM_REFUSED && sink.opened) {
         // Interrupted: 128 + the signal, as a shell reports a process the
         // signal ended, but with the rows in place (decision in docs).
         if (werr) fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
@@ -297,7 +297,7 @@ int cmd_run(int argc, char** argv) {
             fprintf(stderr, "cranesim run: interrupted (%s) at t = %.6g s; %ld rows kept in %s\n",
                     app_signal_name(app_signal_caught()), sink.t_last, sink.rows, out);
         code = 128 + app_signal_caught();
-    } else if (res.status == 1) {
+    } else if (res.status == SIM_FAILED) {
         fprintf(stderr, "cranesim run: %s; %ld rows up to t = %.6g s kept in %s\n", res.message, res.rows,
                 res.t_end, out);
         if (werr) fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
@@ -305,10 +305,10 @@ int cmd_run(int argc, char** argv) {
     } else if (werr) {
         fprintf(stderr, "cranesim run: cannot write %s: %s\n", out, strerror(werr));
         code = EXIT_RUNTIME;
-    } else if (res.status == 2) {
+    } else if (res.status == SIM_REFUSED) {
         // Refused while setting up: no row was written, so no file exists.
         fprintf(stderr, "cranesim run: %s\n", res.message);
-        code = sink.rows ? EXIT_RUNTIME : EXIT_USAGE;
+        code = app_exit_code(res.status, sink.rows);
     }
     if (sink.keep.oom && code == EXIT_OK_) {
         fprintf(stderr, "cranesim run: plot: out of memory for the plotted rows\n");

@@ -52,7 +52,7 @@ struct drive_session {
     drive_opts o;
     model* m;
     scenario sc;
-    live* l;
+    engine* l;
     render* r;
     input* in;
     panel* pn;
@@ -68,7 +68,7 @@ struct drive_session {
     double sim_offset;   // simulated time = wall - sim_offset while running
     // The world is rebuilt by a reset, a solver change or a parameter that
     // cannot change in place; each build is a "piece" with its own clock
-    // (live_time from 0). The session's time is t_base + live_time: a reset
+    // (engine_time from 0). The session's time is t_base + engine_time: a reset
     // starts it again at 0, a rebuild continues it.
     double t_base;       // session time at which the current piece started [s]
     double sim_done;     // simulated time of the earlier pieces [s]
@@ -137,7 +137,7 @@ static void add_hyd(drive_session* s, const char* group, const char* label, cons
     // A component of the world's own circuit (the sandbox's slew valve): it
     // lives in the world file, not the model, so it is set on the running
     // circuit only (and again after a rebuild); "save model" does not save it.
-    if (hyd_model_get(live_circuit(s->l), hp, &v) == 0) {
+    if (hyd_model_get(engine_circuit(s->l), hp, &v) == 0) {
         add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, NULL, v);
         s->param[s->nparam - 1].world_only = true;
     }
@@ -149,7 +149,7 @@ static void reapply_world_params(drive_session* s) {
     char e[256];
     for (int i = 0; i < s->nparam; ++i) {
         const drive_param* p = &s->param[i];
-        if (p->world_only) hyd_model_set(live_circuit(s->l), p->hyd_path, p->value * p->scale, e, sizeof e);
+        if (p->world_only) hyd_model_set(engine_circuit(s->l), p->hyd_path, p->value * p->scale, e, sizeof e);
     }
 }
 
@@ -163,7 +163,7 @@ static void build_params(drive_session* s) {
               me->link[0].length);
     add_param(s, PK_MECH, "booms", "end arm length", "m", 1, 1.0, 5.0, NULL, "mechanics.links[1].length",
               me->link[1].length);
-    if (s->c.sim.mechanics == SIM_LAGRANGE)
+    if (engine_can_set_load(s->l))
         add_param(s, PK_LOAD, "load", "tip load", "kg", 1, 0, 5000, NULL, "mechanics.load_mass",
                   sim_load_mass(s->m, &s->sc, &s->c.sim));
     static const char* const cyl[2] = {"lift_cyl", "jib_cyl"};
@@ -197,16 +197,18 @@ static void build_params(drive_session* s) {
     add_param(s, PK_STEP, "solver", "step", "ms", 1e-3, 0.05, 1.0, NULL, NULL, s->c.sim.h);
     // What cannot change in place rebuilds the world (loads back at their
     // start): applied once when the drag or the typing ends, not at every
-    // pixel. Masses and inertias change in place (live_set_link); in the ode
-    // world a length does not.
-    // A tip load in an ode world (the validation world's, merged into the end
-    // arm) moves the end arm's centre of mass with its mass: a rebuild too.
-    const bool ode = s->c.sim.mechanics == SIM_ODE;
-    const bool tip_load = ode && !live_load_name(s->l, 0, NULL) && sim_load_mass(s->m, &s->sc, &s->c.sim) > 0;
+    // pixel. Masses and inertias change in place (engine_set_link); a length
+    // only where the engine can resize a boom (not the ode world's bodies).
+    // A tip load merged into the end arm (the ode validation world's: no
+    // load parameter, no load bodies) moves the end arm's centre of mass
+    // with its mass: a rebuild too.
+    const bool resize = engine_can_resize_links(s->l);
+    const bool tip_load = !engine_can_set_load(s->l) && !engine_load_name(s->l, 0, NULL) &&
+                          sim_load_mass(s->m, &s->sc, &s->c.sim) > 0;
     for (int i = 0; i < s->nparam; ++i) {
         drive_param* p = &s->param[i];
         const bool mech = p->kind == PK_MECH;
-        p->on_release = p->kind == PK_STEP || p->kind == PK_SOLVER || (mech && ode && strstr(p->json, ".length")) ||
+        p->on_release = p->kind == PK_STEP || p->kind == PK_SOLVER || (mech && !resize && strstr(p->json, ".length")) ||
                         (mech && tip_load && strstr(p->json, "links[1].mass"));
     }
 }
@@ -220,9 +222,9 @@ static void sync_json(drive_session* s, const drive_param* p) {
     json_set_path(s->m->json, a, e, sizeof e);
 }
 
-static live* make_live(drive_session* s, const double q0[2], double slew0) {
+static engine* make_engine(drive_session* s, const double q0[2], double slew0) {
     char err[400];
-    live* l = live_create(s->m, &s->c.sim, q0, slew0, sim_load_mass(s->m, &s->sc, &s->c.sim), err, sizeof err);
+    engine* l = engine_create(s->m, &s->c.sim, q0, slew0, sim_load_mass(s->m, &s->sc, &s->c.sim), err, sizeof err);
     if (!l) snprintf(s->err, sizeof s->err, "%s", err);
     return l;
 }
@@ -236,11 +238,11 @@ static void apply_param(drive_session* s, int i) {
     case PK_HYD:
         // Both the world's own circuit and the model's (which a rebuilt world
         // or a saved file starts from).
-        if (hyd_model_set(live_circuit(s->l), p->hyd_path, si, e, sizeof e) ||
+        if (hyd_model_set(engine_circuit(s->l), p->hyd_path, si, e, sizeof e) ||
             (!p->world_only && hyd_model_set(s->m->hyd, p->hyd_path, si, e, sizeof e))) {
             snprintf(s->status, sizeof s->status, "rejected: %s", e);
             double old;
-            if (!hyd_model_get(p->world_only ? live_circuit(s->l) : s->m->hyd, p->hyd_path, &old))
+            if (!hyd_model_get(p->world_only ? engine_circuit(s->l) : s->m->hyd, p->hyd_path, &old))
                 p->value = old / p->scale;
             return;
         }
@@ -265,7 +267,7 @@ static void apply_param(drive_session* s, int i) {
         crane_mech_derive(me);
         // In place where the backend can (the lagrange crane; an ode boom's
         // mass and inertia), else one rebuild at the current pose.
-        if (live_set_link(s->l, k, ln)) {
+        if (engine_set_link(s->l, k, ln)) {
             s->rebuild = true;
             snprintf(s->rebuild_why, sizeof s->rebuild_why, "%s/%s", p->group, p->label);
         }
@@ -277,7 +279,7 @@ static void apply_param(drive_session* s, int i) {
         break;
     }
     case PK_LOAD:
-        live_set_load(s->l, si);
+        engine_set_load(s->l, si);
         s->c.sim.load_mass = si;
         break;
     case PK_SOLVER: {
@@ -305,14 +307,14 @@ static void apply_param(drive_session* s, int i) {
 
 static void rebuild_world(drive_session* s, bool at_start) {
     double row[SIM_NCOL];
-    live_row(s->l, row);
-    double q0[2] = {row[COL_Q1], row[COL_Q2]}, slew0 = s->c.sim.mechanics == SIM_ODE ? row[COL_SLEW] : 0;
+    engine_row(s->l, row);
+    double q0[2] = {row[COL_Q1], row[COL_Q2]}, slew0 = row[COL_SLEW]; // 0 where the crane does not slew
     if (at_start) {
         q0[0] = s->sc.q0[0];
         q0[1] = s->sc.q0[1];
         slew0 = s->sc.slew0;
     }
-    live* l = make_live(s, q0, slew0);
+    engine* l = make_engine(s, q0, slew0);
     if (!l) {
         // The running world goes on with the options it was built with, and
         // the panel shows them again.
@@ -334,13 +336,13 @@ static void rebuild_world(drive_session* s, bool at_start) {
     // wall time: dividing it by the wall time since the session started read
     // "RT 0.42x" (and "cannot keep up") for ever after a reset. The totals
     // (drive_stats) add the pieces up.
-    const double t_old = live_time(s->l);
+    const double t_old = engine_time(s->l);
     s->sim_done += t_old;
     s->t_base = at_start ? 0.0 : s->t_base + t_old;
     s->piece_wall0 = s->wall_last;
     s->piece_paused = 0.0;
     ++s->segment;
-    live_destroy(s->l);
+    engine_destroy(s->l);
     s->l = l;
     reapply_world_params(s);
     s->sim_offset = s->wall_last; // the new world's clock starts at 0 now
@@ -384,7 +386,7 @@ static int parse_charts(const char* list, int ncol, int col[8], char* err, size_
 
 int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t errsz) {
     if (c->sim.cvode) {
-        // live.c steps the hydraulics with the in-house solvers only; run
+        // engine_lagrange.c steps the hydraulics with the in-house solvers only; run
         // says the same for the ode world (sim.c).
         snprintf(err, errsz, "--solver cvode: drive steps the hydraulics in real time with the in-house solvers: use "
                              "krus, ros2, rk4, ros34pw2 or rodas3");
@@ -392,7 +394,7 @@ int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t
     }
     if (o->charts) {
         int col[8];
-        if (parse_charts(o->charts, c->sim.mechanics == SIM_ODE ? SIM_NCOL : SIM_NCOL_BASE, col, err, errsz) < 0)
+        if (parse_charts(o->charts, sim_ncol(&c->sim), col, err, errsz) < 0)
             return EXIT_USAGE;
     }
     if (o->mapping_file) {
@@ -545,12 +547,12 @@ int drive_session_finish_record(drive_session* s, long* rows, char* err, size_t 
 
 // The world's row, on the session's clock.
 static void session_row(drive_session* s, double* row) {
-    live_row(s->l, row);
+    engine_row(s->l, row);
     row[COL_T] += s->t_base;
 }
 
 static void take_snapshot(drive_session* s) {
-    live_snapshot(s->l, s->snap);
+    engine_snapshot(s->l, s->snap);
     s->snap->t += s->t_base;
 }
 
@@ -585,7 +587,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         *code = EXIT_USAGE;
         return NULL;
     }
-    s->l = make_live(s, s->sc.q0, s->sc.slew0);
+    s->l = make_engine(s, s->sc.q0, s->sc.slew0);
     s->sim_live = s->c.sim;
     if (!s->l) {
         // A world file or model the world cannot be built from.
@@ -594,7 +596,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         *code = EXIT_USAGE;
         return NULL;
     }
-    s->ncol = live_ncol(s->l);
+    s->ncol = engine_ncol(s->l);
     // Keep reading the sticks when the 3D window is not focused (the operator
     // may click a plot or a terminal; and an offscreen view never has focus).
     SDL_SetHint(SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, "1");
@@ -681,7 +683,7 @@ void drive_session_destroy(drive_session* s) {
     }
     if (s->in) input_destroy(s->in);
     if (s->r) render_destroy(s->r);
-    live_destroy(s->l);
+    engine_destroy(s->l);
     model_free(s->m);
     free(s->snap);
     free(s);
@@ -702,7 +704,7 @@ double drive_session_rt_factor(const drive_session* s) {
     // The current piece only, and only the time it ran: a pause holds the
     // simulated time, so counting it would read "cannot keep up" too.
     const double run = s->wall_last - s->piece_wall0 - s->piece_paused;
-    return run >= DRIVE_MIN_RATE_S ? live_time(s->l) / run : 0.0;
+    return run >= DRIVE_MIN_RATE_S ? engine_time(s->l) / run : 0.0;
 }
 
 void drive_session_render(drive_session* s) {
@@ -766,7 +768,7 @@ int drive_session_tick(drive_session* s, double wall) {
             if (s->pid[i] == id) apply_param(s, i);
     if (s->rebuild) {
         s->rebuild = false;
-        const double t_at = s->t_base + live_time(s->l);
+        const double t_at = s->t_base + engine_time(s->l);
         const int seg = s->segment;
         rebuild_world(s, false);
         // Say it: a rebuild puts the loads back and is a new segment of the
@@ -775,12 +777,12 @@ int drive_session_tick(drive_session* s, double wall) {
             char seg_note[48] = "";
             if (s->rec) snprintf(seg_note, sizeof seg_note, " (record segment %d)", s->segment - s->rec_seg0);
             snprintf(s->status, sizeof s->status, "%s: world rebuilt at t = %.2f s%s%s", s->rebuild_why, t_at,
-                     live_load_name(s->l, 0, NULL) ? ", loads back at their start" : "", seg_note);
+                     engine_load_name(s->l, 0, NULL) ? ", loads back at their start" : "", seg_note);
             ++s->st.rebuilds;
         }
     }
 
-    double t = live_time(s->l);
+    double t = engine_time(s->l);
     if (s->paused) {
         // Hold simulated time: the clock offset grows with the paused time.
         s->sim_offset += dt_wall;
@@ -789,11 +791,11 @@ int drive_session_tick(drive_session* s, double wall) {
     } else {
         double u[3] = {cmd.lift, cmd.jib, cmd.slew};
         if (s->o.scripted) {
-            app_scripted_input(&s->sc, s->l, s->t_base + t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
+            engine_play(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
         } else if (cmd.hook_toggle) {
-            live_hook(s->l, !live_attached(s->l));
+            engine_hook(s->l, !engine_attached(s->l));
         }
-        live_set_commands(s->l, u);
+        engine_set_commands(s->l, u);
         ++s->st.input_samples;
         // Keep simulated time on wall time. More than 0.1 s behind means the
         // machine cannot keep up: count it and let the clock slip rather than
@@ -805,12 +807,12 @@ int drive_session_tick(drive_session* s, double wall) {
             s->sim_offset += target - t - 0.1;
             target = t + 0.1;
         }
-        if (target > t && live_advance(s->l, target - t)) {
-            snprintf(s->err, sizeof s->err, "%s", live_error(s->l));
+        if (target > t && engine_advance(s->l, target - t)) {
+            snprintf(s->err, sizeof s->err, "%s", engine_error(s->l));
             return -1;
         }
     }
-    s->st.sim_time = s->sim_done + live_time(s->l);
+    s->st.sim_time = s->sim_done + engine_time(s->l);
     if (wall - s->missed_t0 >= 1.0) {
         render_set_missed_deadlines(s->r, s->missed_window);
         s->missed_window = 0;
@@ -860,7 +862,7 @@ void drive_session_idle(drive_session* s, double left) {
 
 const char* drive_session_error(const drive_session* s) { return s->err; }
 const drive_stats* drive_session_stats(const drive_session* s) { return &s->st; }
-live* drive_session_live(drive_session* s) { return s->l; }
+engine* drive_session_engine(drive_session* s) { return s->l; }
 const model* drive_session_model(const drive_session* s) { return s->m; }
 render* drive_session_render_ctx(drive_session* s) { return s->r; }
 input* drive_session_input(drive_session* s) { return s->in; }
@@ -909,7 +911,7 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
             code = EXIT_RUNTIME;
             break;
         }
-        if (screenshot && !shot_done && s->t_base + live_time(s->l) >= screenshot_at) {
+        if (screenshot && !shot_done && s->t_base + engine_time(s->l) >= screenshot_at) {
             drive_session_render(s);
             if (drive_session_screenshot(s, screenshot, err, sizeof err)) {
                 fprintf(stderr, "cranesim drive: %s\n", err);

@@ -13,7 +13,7 @@
 #include <stddef.h>
 
 #include "app.h"
-#include "live.h"
+#include "engine.h"
 
 struct render;
 struct input;
@@ -105,7 +105,7 @@ int drive_session_finish_record(drive_session* s, long* rows, char* err, size_t 
 
 const char* drive_session_error(const drive_session* s);
 const drive_stats* drive_session_stats(const drive_session* s);
-live* drive_session_live(drive_session* s);
+engine* drive_session_engine(drive_session* s);
 struct render* drive_session_render_ctx(drive_session* s);
 struct input* drive_session_input(drive_session* s);
 struct panel* drive_session_panel(drive_session* s);

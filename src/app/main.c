@@ -45,6 +45,7 @@ static int (*find_command(const char* name))(int, char**) {
 }
 
 int main(int argc, char** argv) {
+    app_name_params();
     if (argc < 2) {
         usage(stderr);
         return EXIT_USAGE;

@@ -1,5 +1,6 @@
 // json_util.c: see json_util.h.
 #include "json_util.h"
+#include "param_names.h"
 
 #include "hydraulics.h"
 
@@ -554,14 +555,14 @@ static void set_path_missing(const char* assignment, const cJSON* node, const ch
     const bool digits = seg->key[0] && strspn(seg->key, "0123456789") == strlen(seg->key);
     if (cJSON_IsArray(node) && digits) {
         const int n = cJSON_GetArraySize(node);
-        snprintf(err, errsz, "--set '%s': index %s out of range: %s has %d element%s (0..%d)", assignment, seg->key,
+        snprintf(err, errsz, "%s '%s': index %s out of range: %s has %d element%s (0..%d)", sim_param_name(SIM_PARAM_SET), assignment, seg->key,
                  at, n, n == 1 ? "" : "s", n - 1);
     } else if (cJSON_IsArray(node)) {
-        snprintf(err, errsz, "--set '%s': no element named '%s' in %s", assignment, seg->key, at);
+        snprintf(err, errsz, "%s '%s': no element named '%s' in %s", sim_param_name(SIM_PARAM_SET), assignment, seg->key, at);
     } else if (seg->index) {
-        snprintf(err, errsz, "--set '%s': %s is not an array (index [%s])", assignment, at, seg->key);
+        snprintf(err, errsz, "%s '%s': %s is not an array (index [%s])", sim_param_name(SIM_PARAM_SET), assignment, at, seg->key);
     } else {
-        snprintf(err, errsz, "--set '%s': no field '%s' in the model%s%s", assignment, seg->key, at[0] ? " under " : "",
+        snprintf(err, errsz, "%s '%s': no field '%s' in the model%s%s", sim_param_name(SIM_PARAM_SET), assignment, seg->key, at[0] ? " under " : "",
                  at);
     }
 }
@@ -570,13 +571,13 @@ int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) 
     // Messages quote the whole argument: it is what the user typed.
     const char* eq = strchr(assignment, '=');
     if (!eq || eq == assignment) {
-        snprintf(err, errsz, "--set '%s': expected PATH=VALUE", assignment);
+        snprintf(err, errsz, "%s '%s': expected PATH=VALUE", sim_param_name(SIM_PARAM_SET), assignment);
         return -1;
     }
     char path[256];
     size_t plen = (size_t)(eq - assignment);
     if (plen >= sizeof path) {
-        snprintf(err, errsz, "--set '%.40s...': path too long", assignment);
+        snprintf(err, errsz, "%s '%.40s...': path too long", sim_param_name(SIM_PARAM_SET), assignment);
         return -1;
     }
     memcpy(path, assignment, plen);
@@ -587,7 +588,7 @@ int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) 
     char why[96];
     const int nseg = parse_set_path(path, segs, 32, why, sizeof why);
     if (nseg < 0) {
-        snprintf(err, errsz, "--set '%s': malformed path '%s': %s", assignment, path, why);
+        snprintf(err, errsz, "%s '%s': malformed path '%s': %s", sim_param_name(SIM_PARAM_SET), assignment, path, why);
         return -1;
     }
     cJSON* parent = root;
@@ -614,9 +615,9 @@ int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) 
         bool word = *value != 0;
         for (const char* q = value; *q; ++q) word = word && (isalnum((unsigned char)*q) || strchr("_-./:", *q));
         if (!word) {
-            snprintf(err, errsz, "--set '%s': cannot parse the value '%s' (a number, true/false, \"text\", "
+            snprintf(err, errsz, "%s '%s': cannot parse the value '%s' (a number, true/false, \"text\", "
                                  "[array] or a bare word)",
-                     assignment, value);
+                     sim_param_name(SIM_PARAM_SET), assignment, value);
             return -1;
         }
         nv = cJSON_CreateString(value);
@@ -626,7 +627,7 @@ int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) 
     if ((cJSON_IsNumber(old) && !cJSON_IsNumber(nv)) || (cJSON_IsBool(old) && !cJSON_IsBool(nv)) ||
         (cJSON_IsString(old) && !cJSON_IsString(nv)) || (cJSON_IsObject(old) && !cJSON_IsObject(nv)) ||
         (cJSON_IsArray(old) && !cJSON_IsArray(nv))) {
-        snprintf(err, errsz, "--set '%s': %s must be %s, got '%s'", assignment, path, type_name(old), value);
+        snprintf(err, errsz, "%s '%s': %s must be %s, got '%s'", sim_param_name(SIM_PARAM_SET), assignment, path, type_name(old), value);
         cJSON_Delete(nv);
         return -1;
     }

@@ -21,7 +21,7 @@ extern "C" {
 #define LSIM_MAX_STATES 64
 #define LSIM_MAX_BLOCKS 64
 
-/// Factors of W = I - gh J by block elimination (lsim_w.c): per actuator
+/// Factors of W = I - gh J by block elimination (lagrange_schur_w.c): per actuator
 /// the LU of its 5x5 interior block A_k, A_k^-1 B_k and C_k, and the LU of
 /// the 5x5 Schur complement on [pump line, q1, q2, q1', q2'].
 typedef struct lsim_w {
@@ -35,7 +35,7 @@ typedef struct lsim_w {
     int ps[5];
 } lsim_w;
 
-/// State of the split Krus/ROS2 step kernel (lsim_krus.c): the diagonal
+/// State of the split Krus/ROS2 step kernel (lagrange_split_step.c): the diagonal
 /// blocks of the last J, W^-1 of each block for the current gamma h, and the
 /// last valve commands.
 typedef struct lsim_ks {
@@ -85,11 +85,11 @@ typedef struct lsim {
     bool have_fused;       ///< the circuit has the standard shape
     bool use_fused;        ///< lsim_problem hands out the fused f and J (default: have_fused)
     char fused_why[96];    ///< why not, when !have_fused
-    // Structured W (lsim_w.c) for the dense-pattern solvers.
-    bool w_layout;         ///< the state layout lsim_w.c needs (standard circuit, 2 actuators)
+    // Structured W (lagrange_schur_w.c) for the dense-pattern solvers.
+    bool w_layout;         ///< the state layout lagrange_schur_w.c needs (standard circuit, 2 actuators)
     bool use_w;            ///< lsim_problem hands out wfactor/wsolve (default: w_layout)
     lsim_w w;
-    // Split Krus/ROS2 step (lsim_krus.c) for the block-pattern fixed-step runs.
+    // Split Krus/ROS2 step (lagrange_split_step.c) for the block-pattern fixed-step runs.
     bool use_split;        ///< lsim_problem(s, true) hands out lsim_wstep (default: w_layout)
     lsim_ks ks;
     hyd_fused_events ev;   ///< event counter of lsim_events
@@ -121,15 +121,15 @@ void lsim_initial_state(lsim* s, const double q0[2], double p_low, double* y);
 /// put a boom through its end stop at t = 0).
 int lsim_check_pose(const lsim* s, const double q0[2], char* err, size_t errsz);
 
-/// True when s has the layout of lsim_w.c: 15 states, actuator k at
+/// True when s has the layout of lagrange_schur_w.c: 15 states, actuator k at
 /// 5k..5k+4 = [spool, hose A, chamber A, hose B, chamber B], then the pump
 /// line and q1, q2, q1', q2'.
 bool lsim_w_layout(const lsim* s);
-/// hyd_problem.wfactor / wsolve for that layout (see lsim_w.c).
+/// hyd_problem.wfactor / wsolve for that layout (see lagrange_schur_w.c).
 int lsim_wfactor(void* user, const double* J, double gh);
 void lsim_wsolve(void* user, double* x);
 
-/// hyd_problem.wstep for Krus and ROS2 with the block pattern (lsim_krus.c):
+/// hyd_problem.wstep for Krus and ROS2 with the block pattern (lagrange_split_step.c):
 /// the mechanics (sines, cylinder kinematics, mass matrix) evaluated once per
 /// step at the predicted midpoint and carried to both stages to first order.
 /// Requires w_layout.

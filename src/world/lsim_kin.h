@@ -1,6 +1,6 @@
 // lsim_kin.h: cylinder kinematics of the 2-DOF crane and the mechanics rows
 // of f, shared by the right-hand sides (lagrange_sim.c) and the split step
-// kernel (lsim_krus.c). Internal to src/world.
+// kernel (lagrange_split_step.c). Internal to src/world.
 #ifndef LSIM_KIN_H
 #define LSIM_KIN_H
 

@@ -1,5 +1,6 @@
 // model.c: load and validate a crane model file.
 #include "model.h"
+#include "param_names.h"
 
 #include "hydraulics.h"
 #include "json_util.h"
@@ -230,7 +231,7 @@ model* model_load(const char* path, const char* const* sets, int nset, char* err
     const int k = first_bad_set(path, base, sets, nset);
     if (k >= 0) {
         const size_t L = strlen(err);
-        snprintf(err + L, errsz - L, " (from --set '%s')", sets[k]);
+        snprintf(err + L, errsz - L, " (from %s '%s')", sim_param_name(SIM_PARAM_SET), sets[k]);
     }
     return NULL;
 }

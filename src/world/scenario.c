@@ -187,3 +187,10 @@ int scenario_breakpoints(const scenario* s, double* t, int cap) {
         if (m == 0 || t[i] > t[m - 1]) t[m++] = t[i];
     return m;
 }
+
+void scenario_play(const scenario* s, double tm, int* ev, double u[SCENARIO_NCMD], scenario_hook_fn hook,
+                   void* user) {
+    for (int k = 0; k < SCENARIO_NCMD; ++k) u[k] = scenario_command(s, k, tm);
+    for (; *ev < s->nevent && s->event[*ev].t <= tm; ++*ev)
+        if (hook) hook(user, s->event[*ev].kind == SCENARIO_ATTACH);
+}

@@ -77,6 +77,16 @@ double scenario_command_rate(const scenario* s, int k, double t);
 /// increasing order without duplicates. Returns the count (<= cap).
 int scenario_breakpoints(const scenario* s, double* t, int cap);
 
+/// Hook events go to hook(user, attach: 1 attach, 0 release); it returns
+/// the load attached or -1.
+typedef int (*scenario_hook_fn)(void* user, int attach);
+/// The scripted operator, the one player of a scenario step by step (run
+/// on the ode world at each ODE step, drive at each frame): the commands at
+/// time tm [s] into u[3], and every event due by tm (t <= tm), from *ev on,
+/// to hook (may be NULL); *ev advances past them.
+void scenario_play(const scenario* s, double tm, int* ev, double u[SCENARIO_NCMD], scenario_hook_fn hook,
+                   void* user);
+
 #ifdef __cplusplus
 }
 #endif

@@ -9,6 +9,7 @@
 #include "hyd_solver.h"
 #include "lagrange_sim.h"
 #include "model.h"
+#include "param_names.h"
 #include "scenario.h"
 
 #ifdef __cplusplus
@@ -16,6 +17,16 @@ extern "C" {
 #endif
 
 typedef enum sim_mechanics { SIM_LAGRANGE = 0, SIM_ODE } sim_mechanics;
+
+/// What a run or a check of the world library reports, with its text in a
+/// message buffer. The library does not choose exit codes: src/app maps these
+/// (app_exit_code).
+typedef enum sim_status {
+    SIM_OK = 0,      ///< done
+    SIM_FAILED = 1,  ///< a numerical failure during the run (the rows so far are valid)
+    SIM_REFUSED = 2, ///< refused before it started (bad input, an impossible setting), or stopped by
+                     ///< the row callback
+} sim_status;
 
 typedef struct sim_opts {
     sim_mechanics mechanics;
@@ -36,13 +47,15 @@ typedef struct sim_opts {
                          ///< the fused kernel applies (hyd_fused.h; for comparisons)
     bool whole_step;     ///< lagrange, Krus/ROS2 with the block pattern: the generic
                          ///< stage arithmetic with f in full at every stage, instead
-                         ///< of the split step (lsim_krus.c; for comparisons)
+                         ///< of the split step (lagrange_split_step.c; for comparisons)
 } sim_opts;
+
+// The settings its messages name: sim_param, sim_name_params, sim_param_name (param_names.h).
 
 /// Refuse a fixed-step run the method cannot do, before it starts: RK4
 /// beyond its stability interval on the circuit hm's fastest mode, a step h
 /// [s] longer than the run t_end [s], or more than 1e12 steps (t_end <= 0:
-/// an open-ended run, only the stability test). Returns 0, or 2 with one
+/// an open-ended run, only the stability test). Returns SIM_OK, or SIM_REFUSED with one
 /// line in err. Adaptive solvers and CVODE always pass.
 int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, char* err, size_t errsz);
 /// The advice of a numerical blow-up: a pressure state with value [Pa abs]
@@ -50,6 +63,8 @@ int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, doubl
 /// fixed-step solver. "Try a smaller --dt" only where a shorter step is the
 /// likely cure: a fixed step, after steps were taken (t > 0), from a finite
 /// value; a smaller --rtol for adaptive runs; else a check of the model.
+/// The settings are named by sim_param_name; the text lives until the next
+/// call.
 const char* sim_blowup_hint(bool adaptive, double t, double value);
 
 /// Longest simulated time and output period a run accepts [s]: 1e6 s (11.6
@@ -57,8 +72,8 @@ const char* sim_blowup_hint(bool adaptive, double t, double value);
 /// them, and no run of a crane needs more.
 #define SIM_MAX_DURATION 1e6
 /// Refuse a run's duration t_end [s] or output period dt_out [s] outside
-/// (0, SIM_MAX_DURATION], or more than 1e12 rows. Returns 0, or 2 with one
-/// line in err naming the option (--duration, --every), the range and the unit.
+/// (0, SIM_MAX_DURATION], or more than 1e12 rows. Returns SIM_OK, or SIM_REFUSED with one
+/// line in err naming the setting (sim_param_name), the range and the unit.
 int sim_check_times(double t_end, double dt_out, char* err, size_t errsz);
 
 /// The checks every driver (run, compare, bench, study, drive) applies to the
@@ -93,6 +108,15 @@ void sim_checks_note(const sim_checks* k, bool adaptive, char* note, size_t n);
 /// value; a smaller --rtol for adaptive runs; else a check of the model.
 const char* sim_blowup_hint(bool adaptive, double t, double value);
 
+/// The one message of a failed run check (sim_check_value, sim_check_row):
+/// what failed, where the run stood (how: "solver krus, h = 0.0001 s", the
+/// solver and its step as the driver knows them) and the advice of
+/// sim_blowup_hint for a failure at time t [s] of value bad [state units].
+/// With how == NULL the failure is in the start state (nothing was
+/// integrated): "WHAT: ADVICE"; else "numerical blow-up: WHAT (HOW): ADVICE".
+void sim_check_message(char* out, size_t n, const char* what, const char* how, bool adaptive, double t,
+                       double bad);
+
 /// Refuse a start state the circuit cannot hold: a chamber pressure of row
 /// (the CSV row at t = 0: p1A..p2B, and p3A, p3B when ncol has them) above
 /// the highest relief setting of circuit hm (p_crack + dp_override). The
@@ -100,7 +124,7 @@ const char* sim_blowup_hint(bool adaptive, double t, double value);
 /// crane still; with a load too heavy for the pose that is more than any
 /// relief lets the circuit reach (100 t at the tip: 459 MPa), a state the
 /// reliefs cannot cap because it is set, not integrated. m3: the tip load
-/// [kg], for the message. Returns 0, or 2 with one line in err.
+/// [kg], for the message. Returns SIM_OK, or SIM_REFUSED with one line in err.
 int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz);
 
 /// True when this build has the CVODE reference solver.
@@ -111,20 +135,80 @@ double sim_load_mass(const model* m, const scenario* sc, const sim_opts* o);
 
 sim_opts sim_default_opts(void);
 
-/// CSV columns, in order. The first 17 are the columns every backend has
-/// written from the start (README, "The CSV columns"): their order is fixed.
+/// The output channels: one list (name, unit, kind) from which the CSV
+/// columns, their header, sim_col_name and sim_col_unit, the run checks'
+/// pressure columns and the channels an engine publishes (engine_channels)
+/// are all made. The first 17 are the columns every backend has written
+/// from the start (README, "The CSV columns"): their order is fixed. A new
+/// channel is one X(...) line in the list its backends write.
+typedef enum sim_channel_kind {
+    SIM_CH_OTHER = 0,
+    SIM_CH_PRESSURE, ///< an absolute pressure [Pa]: the run checks refuse one below -0.1 MPa
+} sim_channel_kind;
+typedef struct sim_channel {
+    const char* name; ///< CSV column name
+    const char* unit; ///< SI unit, "-" for none, "count", "bits", "index"
+    sim_channel_kind kind;
+} sim_channel;
+
+/// Every backend's channels.
+#define SIM_CHANNELS_BASE(X) \
+    X(T, "t", "s", SIM_CH_OTHER) \
+    X(X1, "x1", "m", SIM_CH_OTHER) \
+    X(X2, "x2", "m", SIM_CH_OTHER) \
+    X(P1A, "p1A", "Pa", SIM_CH_PRESSURE) \
+    X(P1B, "p1B", "Pa", SIM_CH_PRESSURE) \
+    X(P2A, "p2A", "Pa", SIM_CH_PRESSURE) \
+    X(P2B, "p2B", "Pa", SIM_CH_PRESSURE) \
+    X(U1, "u1", "-", SIM_CH_OTHER) \
+    X(U2, "u2", "-", SIM_CH_OTHER) \
+    X(Q1, "q1", "rad", SIM_CH_OTHER) \
+    X(Q2, "q2", "rad", SIM_CH_OTHER) \
+    X(TIP_X, "tip_x", "m", SIM_CH_OTHER) \
+    X(TIP_Z, "tip_z", "m", SIM_CH_OTHER) \
+    X(F1, "F1", "N", SIM_CH_OTHER) \
+    X(F2, "F2", "N", SIM_CH_OTHER) \
+    X(U1_CMD, "u1_cmd", "-", SIM_CH_OTHER) \
+    X(U2_CMD, "u2_cmd", "-", SIM_CH_OTHER) \
+    X(V1, "v1", "m/s", SIM_CH_OTHER) \
+    X(V2, "v2", "m/s", SIM_CH_OTHER) \
+    X(P_PUMP, "p_pump", "Pa", SIM_CH_PRESSURE) \
+    X(RELIEF_OPEN, "relief_open", "count", SIM_CH_OTHER) \
+    X(END_STOP, "end_stop", "bits", SIM_CH_OTHER)
+/// World extras, written by the ode backend only.
+#define SIM_CHANNELS_WORLD(X) \
+    X(SLEW, "slew", "rad", SIM_CH_OTHER) \
+    X(HOOK_X, "hook_x", "m", SIM_CH_OTHER) \
+    X(HOOK_Y, "hook_y", "m", SIM_CH_OTHER) \
+    X(HOOK_Z, "hook_z", "m", SIM_CH_OTHER) \
+    X(LOAD_X, "load_x", "m", SIM_CH_OTHER) \
+    X(LOAD_Y, "load_y", "m", SIM_CH_OTHER) \
+    X(LOAD_Z, "load_z", "m", SIM_CH_OTHER) \
+    X(ATTACHED, "attached", "index", SIM_CH_OTHER) \
+    X(TRUCK_TILT, "truck_tilt", "rad", SIM_CH_OTHER) \
+    X(CONTACTS, "contacts", "count", SIM_CH_OTHER) \
+    X(MAX_DEPTH, "max_depth", "m", SIM_CH_OTHER) \
+    /* The slew function's actuator (sandbox; zeros in the validation world). */ \
+    X(X3, "x3", "m", SIM_CH_OTHER) \
+    X(V3, "v3", "m/s", SIM_CH_OTHER) \
+    X(P3A, "p3A", "Pa", SIM_CH_PRESSURE) \
+    X(P3B, "p3B", "Pa", SIM_CH_PRESSURE) \
+    X(U3, "u3", "-", SIM_CH_OTHER) \
+    X(U3_CMD, "u3_cmd", "-", SIM_CH_OTHER) \
+    X(F3, "F3", "N", SIM_CH_OTHER)
+
+#define SIM_COL_ENUM_(id, name, unit, kind) COL_##id,
+/// CSV column indices, in the order of the list.
 enum {
-    COL_T, COL_X1, COL_X2, COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_U1, COL_U2, COL_Q1, COL_Q2,
-    COL_TIP_X, COL_TIP_Z, COL_F1, COL_F2, COL_U1_CMD, COL_U2_CMD,
-    COL_V1, COL_V2, COL_P_PUMP, COL_RELIEF_OPEN, COL_END_STOP,
+    SIM_CHANNELS_BASE(SIM_COL_ENUM_)
     SIM_NCOL_BASE, ///< columns every backend writes
-    // World extras, written by the ode backend only.
-    COL_SLEW = SIM_NCOL_BASE, COL_HOOK_X, COL_HOOK_Y, COL_HOOK_Z, COL_LOAD_X, COL_LOAD_Y, COL_LOAD_Z,
-    COL_ATTACHED, COL_TRUCK_TILT, COL_CONTACTS, COL_MAX_DEPTH,
-    // The slew function's actuator (sandbox; zeros in the validation world).
-    COL_X3, COL_V3, COL_P3A, COL_P3B, COL_U3, COL_U3_CMD, COL_F3,
+    SIM_COL_WORLD_ = SIM_NCOL_BASE - 1, // the world extras follow the base columns directly
+    SIM_CHANNELS_WORLD(SIM_COL_ENUM_)
     SIM_NCOL
 };
+#undef SIM_COL_ENUM_
+/// The list, indexed by column (COL_T .. SIM_NCOL - 1).
+extern const sim_channel sim_channels[SIM_NCOL];
 extern const char* const sim_col_name[SIM_NCOL];
 extern const char* const sim_col_unit[SIM_NCOL];
 
@@ -139,7 +223,7 @@ void sim_trace_free(sim_trace* tr);
 typedef int (*sim_row_fn)(void* user, const double* row);
 
 typedef struct sim_result {
-    int status;          ///< 0 ok, 1 numerical failure, 2 stopped by callback
+    int status;          ///< a sim_status: SIM_OK, SIM_FAILED, SIM_REFUSED (also: stopped by the callback)
     char message[512];   ///< failure description: state name, time
     char note[256];
     double p_peak[4];    ///< peak chamber pressures p1A, p1B, p2A, p2B [Pa abs]: over every step
@@ -150,7 +234,7 @@ typedef struct sim_result {
     hyd_solver_stats stats;
     long rows;
     bool fused;          ///< the run used the fused circuit kernel (lagrange or ode)
-    bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lsim_krus.c)
+    bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lagrange_split_step.c)
 } sim_result;
 
 /// Run the scenario. Rows go to row_fn (may be NULL) and to trace (may be
@@ -171,6 +255,9 @@ void sim_csv_row(FILE* f, const double* row, int ncol);
 /// assets/worlds/<name>.json ("validation", "sandbox").
 const char* sim_world_path(const char* arg, char* buf, size_t n);
 
+/// One row (all SIM_NCOL columns; the world extras 0) from the lagrange
+/// crane's outputs o at time t [s]: the one place its rows are assembled.
+void sim_lagrange_row(double t, const lsim_out* o, double* row);
 struct ode_world;
 /// One row (all SIM_NCOL columns) from an ode world's current state.
 void sim_ode_row(struct ode_world* w, double* row);

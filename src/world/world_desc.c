@@ -1,5 +1,6 @@
 // world_desc.c: world file loading (schema in docs/ode_world.md).
 #include "world_desc.h"
+#include "param_names.h"
 
 #include "hydraulics.h"
 #include "json_util.h"
@@ -668,8 +669,8 @@ static int missing_named_world(const char* path, char* err, size_t errsz) {
     }
     const char* base = path + n;
     const size_t bl = strlen(base) > 5 ? strlen(base) - 5 : strlen(base);
-    snprintf(err, errsz, "--world %.*s: no such world (available: %s; or the path of a world file)", (int)bl, base,
-             k ? list : "none");
+    snprintf(err, errsz, "%s %.*s: no such world (available: %s; or the path of a world file)",
+             sim_param_name(SIM_PARAM_WORLD), (int)bl, base, k ? list : "none");
     return 1;
 }
 

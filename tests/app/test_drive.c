@@ -316,7 +316,7 @@ static void test_default_scene_frame(void) {
     CHECK(var > 100, "frame looks blank: green variance %.1f", var);
     // Find the lifting arm in the snapshot and look at its projected centre.
     world_snapshot* snap = calloc(1, sizeof *snap);
-    live_snapshot(drive_session_live(s), snap);
+    engine_snapshot(drive_session_engine(s), snap);
     int found = 0;
     for (int b = 0; b < snap->nbody; ++b) {
         if (snap->body[b].role != WORLD_ROLE_BOOM1) continue;
@@ -416,7 +416,7 @@ static void test_panel_change_takes_effect(void) {
     // setting; open a valve so the pump line drains down to it.
     run_for(s, &wall, 1.0 / 240.0);
     double v;
-    CHECK(hyd_model_get(live_circuit(drive_session_live(s)), "pump.p_set", &v) == 0 && fabs(v - 12e6) < 1,
+    CHECK(hyd_model_get(engine_circuit(drive_session_engine(s)), "pump.p_set", &v) == 0 && fabs(v - 12e6) < 1,
           "circuit p_set = %g", v);
     push_key(SDL_SCANCODE_UP, 1);
     run_for(s, &wall, 1.5);
@@ -1046,12 +1046,12 @@ static void test_slew_valve_in_the_panel(void) {
     CHECK(panel_set(pn, "slew valve/rated flow", 12.0, msg, sizeof msg) == PANEL_OK, "%s", msg);
     double wall = 0, v = 0;
     run_for(s, &wall, 0.1);
-    CHECK(hyd_model_get(live_circuit(drive_session_live(s)), "slew_valve.q_nominal", &v) == 0 &&
+    CHECK(hyd_model_get(engine_circuit(drive_session_engine(s)), "slew_valve.q_nominal", &v) == 0 &&
               fabs(v - 12.0 / 60000.0) < 1e-12,
           "slew valve q_nominal %g m^3/s", v);
     tap_key(s, &wall, SDL_SCANCODE_R);
     v = 0;
-    CHECK(hyd_model_get(live_circuit(drive_session_live(s)), "slew_valve.q_nominal", &v) == 0 &&
+    CHECK(hyd_model_get(engine_circuit(drive_session_engine(s)), "slew_valve.q_nominal", &v) == 0 &&
               fabs(v - 12.0 / 60000.0) < 1e-12,
           "after a reset: slew valve q_nominal %g m^3/s", v);
     drive_session_destroy(s);

@@ -412,7 +412,7 @@ static double backward_error(const double* W, int n, const double* x, const doub
     return worst;
 }
 
-// The block-eliminated W of lsim_w.c against LU with partial pivoting of the
+// The block-eliminated W of lagrange_schur_w.c against LU with partial pivoting of the
 // whole W (hyd_lu_factor, an independent code path), for random crane states
 // (as above) and gh from 1e-7 s to 0.2 s. Where that LU factors W (its
 // unit-blind singularity test refuses about a third of these extreme random

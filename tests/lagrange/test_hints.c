@@ -58,6 +58,9 @@ static void test_cvode_dip_note(void) {
 }
 
 int main(int argc, char** argv) {
+    // The advice names the settings as cranesim's options do (app_name_params).
+    static const char* const cli[SIM_PARAM_COUNT] = {[SIM_PARAM_DT] = "--dt", [SIM_PARAM_RTOL] = "--rtol"};
+    sim_name_params(cli);
     RUN_TEST(test_hint_rule);
     RUN_TEST(test_cvode_dip_note);
     TEST_MAIN_END();

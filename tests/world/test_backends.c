@@ -89,8 +89,16 @@ static void test_ode_step_limit(void) {
     sim_opts bad = o;
     bad.mechanics = SIM_ODE;
     bad.dt_ode = 0.02;
+    // The library names the setting as the program does (cranesim: its
+    // option, app_name_params), else by the sim_opts field.
+    CHECK(sim_run(m, &sc, &bad, NULL, NULL, NULL, NULL, NULL, &r) == 2 && strstr(r.message, "dt_ode 0.02 s is too long") &&
+              !strstr(r.message, "--"),
+          "unnamed: status %d: %s", r.status, r.message);
+    static const char* const cli[SIM_PARAM_COUNT] = {[SIM_PARAM_DT_ODE] = "--dt-ode"};
+    sim_name_params(cli);
     CHECK(sim_run(m, &sc, &bad, NULL, NULL, NULL, NULL, NULL, &r) == 2 && strstr(r.message, "--dt-ode 0.02 s is too long"),
           "status %d: %s", r.status, r.message);
+    sim_name_params(NULL);
     sim_trace_free(&ref);
     model_free(m);
 }

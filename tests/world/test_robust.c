@@ -4,7 +4,7 @@
 // loaders' ranges refuse them up front; this is the safety net behind).
 #include "check.h"
 
-#include "live.h"
+#include "engine.h"
 
 #include "model.h"
 #include "ode_world.h"
@@ -45,7 +45,7 @@ static void test_checks(void) {
     CHECK(strstr(sim_blowup_hint(false, 0.0, INFINITY), "--dt") == NULL, "%s", sim_blowup_hint(false, 0.0, INFINITY));
 }
 
-// drive steps through live_advance, which applies the same checks as run:
+// drive steps through engine_advance, which applies the same checks as run:
 // the validation world with 10 ms hydraulic steps on `step` takes the pump
 // line to about -12 MPa in its first step (run refuses it too); before, drive
 // recorded that and exited 0.
@@ -61,20 +61,20 @@ static void test_live_checks(void) {
     o.world = "validation";
     o.dt_ode = 0.01;
     o.h = 0.01;
-    live* l = live_create(g_model, &o, sc.q0, sc.slew0, sim_load_mass(g_model, &sc, &o), err, sizeof err);
+    engine* l = engine_create(g_model, &o, sc.q0, sc.slew0, sim_load_mass(g_model, &sc, &o), err, sizeof err);
     CHECK(l != NULL, "%s", err);
     if (!l) return;
     int rc = 0;
     for (int i = 0; i < 100 && rc == 0; ++i) {
-        const double tm = live_time(l) + 0.005;
+        const double tm = engine_time(l) + 0.005;
         const double u[3] = {scenario_command(&sc, 0, tm), scenario_command(&sc, 1, tm), 0};
-        live_set_commands(l, u);
-        rc = live_advance(l, 0.01);
+        engine_set_commands(l, u);
+        rc = engine_advance(l, 0.01);
     }
-    CHECK(rc == 1 && strstr(live_error(l), "below absolute zero") && strstr(live_error(l), "t = "), "rc %d: %s", rc,
-          live_error(l));
-    CHECK(live_advance(l, 0.01) == 1, "a failed live crane stays stopped");
-    live_destroy(l);
+    CHECK(rc == 1 && strstr(engine_error(l), "below absolute zero") && strstr(engine_error(l), "t = "), "rc %d: %s", rc,
+          engine_error(l));
+    CHECK(engine_advance(l, 0.01) == 1, "a failed live crane stays stopped");
+    engine_destroy(l);
 }
 
 // The slew angle of the column in the truck's frame [rad], wrapped, from the
@@ -196,9 +196,9 @@ static void test_start_beyond_reliefs(void) {
         sim_run(g_model, &sc, &o, NULL, NULL, NULL, NULL, NULL, &r);
         CHECK(r.status == 2 && r.rows == 0 && strstr(r.message, "cannot hold") && strstr(r.message, "p1A"),
               "backend %d: status %d, %ld rows: %s", b, r.status, r.rows, r.message);
-        live* l = live_create(g_model, &o, sc.q0, sc.slew0, o.load_mass, err, sizeof err);
+        engine* l = engine_create(g_model, &o, sc.q0, sc.slew0, o.load_mass, err, sizeof err);
         CHECK(l == NULL && strstr(err, "cannot hold"), "live backend %d: %s", b, l ? "created" : err);
-        live_destroy(l);
+        engine_destroy(l);
         o.load_mass = 1000; // the validation load of `hold`
         sim_run(g_model, &sc, &o, NULL, NULL, NULL, NULL, NULL, &r);
         CHECK(r.status == 0, "backend %d, 1000 kg: %s", b, r.message);
@@ -206,6 +206,9 @@ static void test_start_beyond_reliefs(void) {
 }
 
 int main(int argc, char** argv) {
+    // The advice names the settings as cranesim's options do (app_name_params).
+    static const char* const cli[SIM_PARAM_COUNT] = {[SIM_PARAM_DT] = "--dt", [SIM_PARAM_RTOL] = "--rtol"};
+    sim_name_params(cli);
     char err[512];
     g_model = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
     if (!g_model) {

@@ -1,4 +1,4 @@
-// lsim_w.c: W = I - gh J for the crane's standard layout, by block
+// lagrange_schur_w.c: W = I - gh J for the crane's standard layout, by block
 // elimination onto a 5x5 Schur complement (hyd_problem.wfactor/wsolve).
 //
 // Layout (lsim_w_layout checks it): actuator k owns the interior states

@@ -1,4 +1,4 @@
-// lsim_krus.c: the split Krus / ROS2 step for the crane (hyd_problem.wstep).
+// lagrange_split_step.c: the split Krus / ROS2 step for the crane (hyd_problem.wstep).
 //
 // The same W-method as krus.c (docs/solvers.md),
 //   W k1 = h f(t, y),  W k2 = h f(t + h, y + k1) - 2 (k1 - h f(t, y)),

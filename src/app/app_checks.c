@@ -1,0 +1,226 @@
+// app_checks.c: what a run is refused or told before it starts (options it
+// cannot honour, options with no effect, the world a scenario needs), and the
+// exit code of a world-library status.
+#include "app.h"
+#include "engine.h"
+#include "world_desc.h"
+
+#include <ctype.h>
+#include <limits.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static bool is_adaptive(const sim_opts* o) { return o->cvode || hyd_method_is_adaptive(o->solver); }
+static const char* solver_name(const sim_opts* o) { return o->cvode ? "cvode" : hyd_method_name(o->solver); }
+
+// The kind of the ode world o runs on (WORLD_VALIDATION, WORLD_SANDBOX), or
+// -1 with the loader's message in err.
+static int world_kind_of(const sim_opts* o, char* err, size_t errsz) {
+    char buf[512];
+    world_desc wd;
+    if (world_desc_load(sim_world_path(o->world, buf, sizeof buf), &wd, err, errsz)) return -1;
+    const int kind = (int)wd.kind;
+    world_desc_free(&wd);
+    return kind;
+}
+
+// |a / b - round(a / b)| within 1e-9 relative: a is a whole multiple of b.
+static bool whole_multiple(double a, double b) {
+    const double r = a / b;
+    return fabs(r - floor(r + 0.5)) <= 1e-9 * r;
+}
+
+double app_output_period(const sim_opts* o) {
+    if (o->mechanics == SIM_ODE) {
+        const double n = floor(o->dt_out / o->dt_ode + 0.5);
+        return (n < 1 ? 1 : n) * o->dt_ode;
+    }
+    if (!is_adaptive(o) && o->h > o->dt_out) return o->h;
+    return o->dt_out;
+}
+
+int app_check_sim(const char* cmd, const sim_opts* o, unsigned given) {
+    if (o->cvode && !sim_have_cvode()) {
+        fprintf(stderr, "cranesim %s: --solver cvode: this build has no CVODE (install libsundials-dev and rebuild)\n",
+                cmd);
+        return EXIT_USAGE;
+    }
+    if (o->cvode && o->mechanics == SIM_ODE) {
+        fprintf(stderr,
+                "cranesim %s: --solver cvode works with --mechanics lagrange only (the ode world steps its hydraulics "
+                "inside each ODE step): use krus, ros2, rk4, ros34pw2 or rodas3\n",
+                cmd);
+        return EXIT_USAGE;
+    }
+    // Fixed steps land on every output time: an output period that is not a
+    // whole number of steps would shorten steps (more steps, more LUs and
+    // different results than the --dt asked for); the ode world writes rows
+    // at whole ODE steps only. A step longer than the period gives one row
+    // per step (decision 7).
+    const bool ode = o->mechanics == SIM_ODE;
+    const double step = ode ? o->dt_ode : o->h;
+    if ((ode || !is_adaptive(o)) && o->dt_out > step && !whole_multiple(o->dt_out, step)) {
+        const double lo = floor(o->dt_out / step) * step, hi = lo + step;
+        const bool given_every = given & APP_GIVEN(APP_OPT_EVERY);
+        fprintf(stderr,
+                "cranesim %s: %s %g s is not a whole multiple of %s %g s (%s): use --every %g or %g%s\n", cmd,
+                given_every ? "--every" : "the default output period --every", o->dt_out,
+                ode ? "the ODE step --dt-ode" : "the fixed step --dt", step,
+                ode ? "rows come at whole ODE steps" : "the solver would shorten steps to land on the output times",
+                lo, hi, given_every ? "" : ode ? ", or a --dt-ode that divides it" : ", or a --dt that divides it");
+        return EXIT_USAGE;
+    }
+    if (ode && (given & APP_GIVEN(APP_OPT_LOAD))) {
+        char err[512];
+        const int kind = world_kind_of(o, err, sizeof err);
+        if (kind < 0) {
+            fprintf(stderr, "cranesim %s: %s\n", cmd, err);
+            return EXIT_USAGE;
+        }
+        if (kind == WORLD_SANDBOX) {
+            fprintf(stderr,
+                    "cranesim %s: --load: the sandbox world's loads are objects of the world file (loads[].mass); "
+                    "--load sets the tip load of lagrange and the validation world\n",
+                    cmd);
+            return EXIT_USAGE;
+        }
+    }
+    return 0;
+}
+
+void app_settle_unused(sim_opts* o) {
+    if (o->mechanics == SIM_ODE && is_adaptive(o)) o->h = o->dt_ode;
+}
+
+void app_note_unused(const char* cmd, unsigned given, const sim_opts* o, int n) {
+    // Each rule: the option, and why a run does not use it (NULL: it does).
+    for (int opt = 0; opt < APP_OPT_COUNT; ++opt) {
+        if (!(given & APP_GIVEN(opt))) continue;
+        const char* why = NULL;
+        char buf[160];
+        for (int s = 0; s < n; ++s) {
+            const sim_opts* r = &o[s];
+            const char* w = NULL;
+            switch (opt) {
+            case APP_OPT_DT:
+                if (is_adaptive(r)) {
+                    snprintf(buf, sizeof buf, "with the adaptive solver %s (steps from --rtol/--atol)", solver_name(r));
+                    w = buf;
+                }
+                break;
+            case APP_OPT_RTOL:
+            case APP_OPT_ATOL:
+                if (!is_adaptive(r)) {
+                    snprintf(buf, sizeof buf, "with the fixed-step solver %s (steps of --dt)", solver_name(r));
+                    w = buf;
+                }
+                break;
+            case APP_OPT_JAC_EVERY:
+            case APP_OPT_DENSE_JAC:
+                if (is_adaptive(r)) {
+                    snprintf(buf, sizeof buf, "with the adaptive solver %s (fixed-step solvers only)", solver_name(r));
+                    w = buf;
+                } else if (r->solver == HYD_RK4) {
+                    w = "with rk4 (an explicit method: no Jacobian)";
+                }
+                break;
+            case APP_OPT_WORLD:
+            case APP_OPT_DT_ODE:
+                if (r->mechanics == SIM_LAGRANGE) w = "with --mechanics lagrange (ode only)";
+                break;
+            case APP_OPT_VARIANT:
+                if (r->mechanics == SIM_ODE) w = "with --mechanics ode (the Lagrange equations are lagrange's)";
+                break;
+            default: break;
+            }
+            if (!w) { // this run uses the option
+                why = NULL;
+                break;
+            }
+            why = w;
+        }
+        if (why) fprintf(stderr, "cranesim %s: note: %s has no effect %s%s\n", cmd, app_opt_name[opt], why,
+                         n > 1 ? " in both runs" : "");
+    }
+}
+
+void app_note_load(const char* cmd, const app_common* c, const sim_opts* o, const scenario* sc) {
+    const char* set = NULL;
+    static const char path[] = "mechanics.load_mass=";
+    for (int i = 0; i < c->nset; ++i)
+        if (!strncmp(c->sets[i], path, sizeof path - 1)) set = c->sets[i];
+    char err[512];
+    // A scenario written for the tip load (overload, hold) run in the
+    // sandbox: its load_mass does not apply there either.
+    if (!set && sc->load_mass >= 0 && o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX)
+        fprintf(stderr,
+                "cranesim %s: note: scenario %s's load_mass (%g kg) has no effect: the sandbox world's loads are "
+                "world objects\n",
+                cmd, sc->name, sc->load_mass);
+    if (!set) return;
+    const char* v = set + sizeof path - 1;
+    if (o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX)
+        fprintf(stderr, "cranesim %s: note: --set %s has no effect: the sandbox world's loads are world objects\n", cmd,
+                set);
+    else if (o->load_mass >= 0)
+        fprintf(stderr, "cranesim %s: note: --set %s has no effect: --load %g kg sets the tip load\n", cmd, set,
+                o->load_mass);
+    else if (sc->load_mass >= 0)
+        fprintf(stderr,
+                "cranesim %s: note: --set %s has no effect: scenario %s sets its own load (%g kg); use --load %s\n",
+                cmd, set, sc->name, sc->load_mass, v);
+}
+
+// What in a scenario needs the sandbox (NULL: nothing): the slew, the hook.
+static const char* sandbox_use(const scenario* sc) {
+    if (sc->nevent > 0) return "works the hook";
+    const scenario_signal* sl = &sc->cmd[2];
+    for (int i = 0; i < sl->n; ++i)
+        if (sl->u[i] != 0) return "slews the crane";
+    return sc->slew0 != 0 ? "starts slewed" : NULL;
+}
+
+int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
+                       bool* switched) {
+    if (switched) *switched = false;
+    const char* why = sandbox_use(sc);
+    if (!why) return 0;
+    char err[512];
+    if (o->mechanics == SIM_ODE) {
+        const int kind = world_kind_of(o, err, sizeof err);
+        if (kind == WORLD_SANDBOX) return 0;
+        // A world file that does not load is the first thing wrong: say that,
+        // not that the scenario needs another world.
+        if (kind < 0) {
+            fprintf(stderr, "cranesim %s: %s\n", cmd, err);
+            return EXIT_USAGE;
+        }
+    }
+    const char* name = sc->name[0] ? sc->name : "the scenario";
+    // No world chosen (--world), and no backend or the ode one: its world.
+    if (may_switch && !(given & APP_GIVEN(APP_OPT_WORLD)) &&
+        (!(given & APP_GIVEN(APP_OPT_MECHANICS)) || o->mechanics == SIM_ODE)) {
+        o->mechanics = SIM_ODE;
+        o->world = "sandbox";
+        if (switched) *switched = true;
+        fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs in its world, --mechanics ode --world sandbox\n",
+                cmd, name, why);
+        return 0;
+    }
+    fprintf(stderr,
+            "cranesim %s: scenario %s %s, which the %s has not: run it with --mechanics ode --world sandbox\n", cmd,
+            name, why, o->mechanics == SIM_ODE ? "validation world" : "lagrange 2-DOF crane");
+    return EXIT_USAGE;
+}
+
+int app_exit_code(int status, long rows) {
+    if (status == SIM_OK) return EXIT_OK_;
+    if (status == SIM_FAILED || rows > 0) return EXIT_RUNTIME;
+    return EXIT_USAGE;
+}

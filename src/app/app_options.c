@@ -1,0 +1,294 @@
+// app_options.c: the command line: the options common to the subcommands
+// (parsing, values, help) and their value words (mechanics, variant, solver).
+#include "app.h"
+#include "engine.h"
+#include "world_desc.h"
+
+#include <ctype.h>
+#include <limits.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+int app_parse_double(const char* s, double* v) {
+    // Decimal or scientific notation only: strtod also takes hex ("0x10" is
+    // 16), "inf", "nan" and leading blanks, none of which a user means as a
+    // step, a tolerance or a mass.
+    const char* p = s;
+    if (*p == '+' || *p == '-') ++p;
+    bool digits = false;
+    for (; isdigit((unsigned char)*p); ++p) digits = true;
+    if (*p == '.')
+        for (++p; isdigit((unsigned char)*p); ++p) digits = true;
+    if (!digits) return -1;
+    if (*p == 'e' || *p == 'E') {
+        ++p;
+        if (*p == '+' || *p == '-') ++p;
+        if (!isdigit((unsigned char)*p)) return -1;
+        while (isdigit((unsigned char)*p)) ++p;
+    }
+    if (*p) return -1;
+    char* end;
+    errno = 0;
+    double x = strtod(s, &end);
+    if (errno || *end || !isfinite(x)) return -1;
+    *v = x;
+    return 0;
+}
+
+const char* const app_opt_name[APP_OPT_COUNT] = {
+    "--model", "--scenario", "--mechanics", "--variant", "--solver", "--dt", "--rtol", "--atol", "--duration",
+    "--every", "--set", "--jac-every", "--load", "--world", "--dt-ode", "--kernel", "--dense-jac", "--quiet"};
+
+void app_name_params(void) {
+    static const char* names[SIM_PARAM_COUNT];
+    names[SIM_PARAM_DT] = app_opt_name[APP_OPT_DT];
+    names[SIM_PARAM_DT_ODE] = app_opt_name[APP_OPT_DT_ODE];
+    names[SIM_PARAM_DURATION] = app_opt_name[APP_OPT_DURATION];
+    names[SIM_PARAM_EVERY] = app_opt_name[APP_OPT_EVERY];
+    names[SIM_PARAM_LOAD] = app_opt_name[APP_OPT_LOAD];
+    names[SIM_PARAM_MECHANICS] = app_opt_name[APP_OPT_MECHANICS];
+    names[SIM_PARAM_RTOL] = app_opt_name[APP_OPT_RTOL];
+    names[SIM_PARAM_SET] = app_opt_name[APP_OPT_SET];
+    names[SIM_PARAM_WORLD] = app_opt_name[APP_OPT_WORLD];
+    sim_name_params(names);
+}
+
+// A value that is itself an option name ("--out --quiet") is a missing
+// value: a file called "--quiet" is never what was meant.
+static bool missing_value(int argc, char** argv, int i) {
+    return i + 1 >= argc || !strncmp(argv[i + 1], "--", 2);
+}
+
+const char* app_value(int argc, char** argv, int* i) {
+    if (missing_value(argc, argv, *i)) {
+        fprintf(stderr, "cranesim: option %s needs a value (see --help)\n", argv[*i]);
+        return NULL;
+    }
+    return argv[++*i];
+}
+
+// Each command's own options that take a value (the common ones are
+// app_opt_name up to --kernel).
+static const struct {
+    const char* cmd;
+    const char* opts[10];
+} own_values[] = {
+    {"run", {"--out", "--plot", NULL}},
+    {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot", NULL}},
+    {"study", {"--out-dir", "--repeat", NULL}},
+    {"bench", {"--repeat", "--config", "--seed", NULL}},
+    {"drive",
+     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", NULL}},
+};
+
+int app_check_values(const char* cmd, int argc, char** argv) {
+    const char* const* own = NULL;
+    for (size_t k = 0; k < sizeof own_values / sizeof own_values[0]; ++k)
+        if (!strcmp(cmd, own_values[k].cmd)) own = own_values[k].opts;
+    for (int i = 0; i < argc; ++i) {
+        const char* a = argv[i];
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) return 0; // the command prints its help
+        bool takes = false;
+        for (int k = 0; k <= APP_OPT_KERNEL && !takes; ++k) takes = !strcmp(a, app_opt_name[k]);
+        for (int k = 0; own && own[k] && !takes; ++k) takes = !strcmp(a, own[k]);
+        if (!takes) continue;
+        if (missing_value(argc, argv, i)) {
+            fprintf(stderr, "cranesim %s: option %s needs a value (see cranesim %s --help)\n", cmd, a, cmd);
+            return EXIT_USAGE;
+        }
+        ++i;
+    }
+    return 0;
+}
+
+static int positive(const char* opt, const char* s, double* v) {
+    if (app_parse_double(s, v) || !(*v > 0)) {
+        fprintf(stderr, "cranesim: %s: expected a positive number, got '%s'\n", opt, s);
+        return -1;
+    }
+    return 0;
+}
+
+const char* app_default_drive_scenario(sim_mechanics mech) {
+    return mech == SIM_ODE ? "sandbox_pick_place" : "drive_demo";
+}
+
+int app_set_mechanics(sim_opts* o, const char* opt, const char* v) {
+    if (!strcmp(v, "lagrange")) o->mechanics = SIM_LAGRANGE;
+    else if (!strcmp(v, "ode")) o->mechanics = SIM_ODE;
+    else {
+        fprintf(stderr, "cranesim: %s: expected lagrange or ode, got '%s'\n", opt, v);
+        return -1;
+    }
+    return 0;
+}
+
+int app_set_variant(sim_opts* o, const char* opt, const char* v) {
+    const int var = lagrange_variant_parse(v);
+    if (var < 0) {
+        fprintf(stderr, "cranesim: %s: expected full, paper or paper-typo, got '%s'\n", opt, v);
+        return -1;
+    }
+    o->variant = (lagrange_variant)var;
+    return 0;
+}
+
+int app_set_solver(sim_opts* o, const char* opt, const char* v) {
+    o->cvode = !strcmp(v, "cvode");
+    if (o->cvode) return 0;
+    const int m = hyd_method_parse(v);
+    if (m < 0) {
+        fprintf(stderr, "cranesim: %s: expected krus, ros2, rk4, ros34pw2, rodas3 or cvode, got '%s'\n", opt, v);
+        return -1;
+    }
+    o->solver = (hyd_method)m;
+    return 0;
+}
+
+int app_parse_common(app_common* c, int argc, char** argv, int* i) {
+    const char* a = argv[*i];
+    if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+        c->quiet = true;
+        c->given |= APP_GIVEN(APP_OPT_QUIET);
+        return 1;
+    }
+    if (!strcmp(a, "--dense-jac")) {
+        c->sim.dense_jac = true;
+        c->given |= APP_GIVEN(APP_OPT_DENSE_JAC);
+        return 1;
+    }
+    int k = -1;
+    for (int j = 0; j <= APP_OPT_KERNEL; ++j)
+        if (!strcmp(a, app_opt_name[j])) k = j;
+    if (k < 0) return 0;
+    const char* v = app_value(argc, argv, i);
+    if (!v) return -1;
+    c->given |= APP_GIVEN(k);
+    double d;
+    switch ((enum app_opt)k) {
+    case APP_OPT_MODEL: c->model_path = v; break;
+    case APP_OPT_SCENARIO: c->scenario_path = v; break;
+    case APP_OPT_MECHANICS: if (app_set_mechanics(&c->sim, a, v)) return -1; break;
+    case APP_OPT_VARIANT: if (app_set_variant(&c->sim, a, v)) return -1; break;
+    case APP_OPT_SOLVER: if (app_set_solver(&c->sim, a, v)) return -1; break;
+    case APP_OPT_DT: if (positive(a, v, &c->sim.h)) return -1; break;
+    case APP_OPT_RTOL: if (positive(a, v, &c->sim.rtol)) return -1; break;
+    case APP_OPT_ATOL: if (positive(a, v, &c->sim.atol)) return -1; break;
+    case APP_OPT_DURATION:
+    case APP_OPT_EVERY:
+        // Capped before anything counts steps or rows in integers from them
+        // (1e300 s made the run count wrap and exit 0 having simulated nothing).
+        if (app_parse_double(v, &d) || !(d > 0) || d > SIM_MAX_DURATION) {
+            fprintf(stderr, "cranesim: %s: expected %s in s, 0 < %s <= 1e6 (11.6 days), got '%s'\n", a,
+                    k == APP_OPT_DURATION ? "a simulated time" : "an output period",
+                    k == APP_OPT_DURATION ? "T" : "DT", v);
+            return -1;
+        }
+        if (k == APP_OPT_DURATION) c->sim.duration = d;
+        else c->sim.dt_out = d;
+        break;
+    case APP_OPT_SET:
+        if (c->nset == APP_MAX_SET) {
+            fprintf(stderr, "cranesim: at most %d --set options\n", APP_MAX_SET);
+            return -1;
+        }
+        if (!strchr(v, '=')) {
+            fprintf(stderr, "cranesim: --set '%s': expected PATH=VALUE\n", v);
+            return -1;
+        }
+        c->sets[c->nset++] = v;
+        break;
+    case APP_OPT_JAC_EVERY:
+        // Range-checked before the conversion: (int)4294967296.0 is undefined
+        // and wrapped to 0 on this machine. A million steps (100 s at 0.1 ms)
+        // is already "never" for any run we make.
+        if (app_parse_double(v, &d) || d < 1 || d > 1e6 || d != floor(d)) {
+            fprintf(stderr, "cranesim: --jac-every: expected a whole number of steps 1..1000000, got '%s'\n", v);
+            return -1;
+        }
+        c->sim.jac_every = (int)d;
+        break;
+    case APP_OPT_LOAD:
+        // The model's tip-load range (crane_model.h): 100 t on this crane
+        // peaked at 1.05 GPa and still exited 0.
+        if (app_parse_double(v, &d) || !(d >= 0 && d <= CRANE_LOAD_MAX)) {
+            fprintf(stderr, "cranesim: --load: expected a mass in [0, %g] kg, got '%s'\n", CRANE_LOAD_MAX, v);
+            return -1;
+        }
+        if (d > CRANE_LOAD_TYPICAL)
+            fprintf(stderr, "cranesim: note: --load %g kg is outside the typical range [0, %g] kg (the port reliefs "
+                            "of a HIAB-031-class crane open near 3000 kg)\n",
+                    d, CRANE_LOAD_TYPICAL);
+        c->sim.load_mass = d;
+        break;
+    case APP_OPT_WORLD: c->sim.world = v; break;
+    case APP_OPT_DT_ODE: if (positive(a, v, &c->sim.dt_ode)) return -1; break;
+    case APP_OPT_KERNEL:
+        if (strcmp(v, "split") && strcmp(v, "fused") && strcmp(v, "general")) {
+            fprintf(stderr, "cranesim: --kernel: expected split, fused or general, got '%s'\n", v);
+            return -1;
+        }
+        c->sim.general_kernel = !strcmp(v, "general");
+        c->sim.whole_step = !strcmp(v, "fused");
+        break;
+    default: break;
+    }
+    return 1;
+}
+
+// The common options' help, one entry per option (some span lines).
+static const struct {
+    int opt;
+    const char* text;
+} common_help[] = {
+    {APP_OPT_MODEL, "  --model FILE         crane model JSON (default: assets/models/hiab031.json)\n"},
+    {APP_OPT_SCENARIO, "  --scenario S         scenario JSON file, or a name in assets/scenarios (default ramp)\n"},
+    {APP_OPT_SET, "  --set PATH=VALUE     override any model value (repeatable), e.g.\n"
+                  "                       --set mechanics.links[0].mass=200 or\n"
+                  "                       --set hydraulics.components.lift_cyl.bore=0.11\n"},
+    {APP_OPT_LOAD, "  --load KG            tip load [kg] (default: the scenario's, else the model's;\n"
+                   "                       a --set of mechanics.load_mass counts only when neither sets one);\n"
+                   "                       not with the sandbox world, whose loads are world objects\n"},
+    {APP_OPT_MECHANICS, "  --mechanics M        lagrange (analytic 2-DOF, default) or ode\n"},
+    {APP_OPT_VARIANT, "  --variant V          lagrange equations: full (default), paper, paper-typo\n"},
+    {APP_OPT_WORLD, "  --world W            ode: world file or name: validation (default for run), sandbox\n"},
+    {APP_OPT_DT_ODE, "  --dt-ode H           ode: rigid-body step [s] (default 1e-3); the hydraulics sub-step\n"
+                     "                       there is min(--dt, --dt-ode) and must divide it\n"},
+    {APP_OPT_SOLVER, "  --solver S           fixed step: krus (default), ros2, rk4; adaptive: ros34pw2,\n"
+                     "                       rodas3, cvode (SUNDIALS BDF; --mechanics lagrange only)\n"},
+    {APP_OPT_DT, "  --dt H               fixed step [s] (default 1e-4)\n"},
+    {APP_OPT_RTOL, "  --rtol R, --atol A   adaptive tolerances (default 1e-3, 1e-6)\n"},
+    {APP_OPT_JAC_EVERY, "  --jac-every N        fixed-step: new Jacobian every N steps (1..1000000, default 10)\n"},
+    {APP_OPT_DENSE_JAC, "  --dense-jac          fixed-step: dense Jacobian instead of the block pattern\n"},
+    {APP_OPT_KERNEL, "  --kernel K           lagrange, when the circuit has the standard shape:\n"
+                     "                       split (default): one-pass circuit, block-eliminated W, and\n"
+                     "                         for krus/ros2 the mechanics once per step (docs/lagrange.md);\n"
+                     "                       fused: the same, but f in full at every Krus/ROS2 stage;\n"
+                     "                       general: the component loops and the solver's own sparse LU;\n"
+                     "                       with --mechanics ode, split and fused both mean the one-pass\n"
+                     "                         circuit in the hydraulic sub-steps, general the loops\n"},
+    {APP_OPT_DURATION, "  --duration T         simulated time [s] (default: the scenario's)\n"},
+    {APP_OPT_EVERY, "  --every DT           output period [s] (default 1e-3, i.e. 1 kHz); with a fixed-step\n"
+                    "                       solver a whole multiple of --dt (a longer --dt: one row per step),\n"
+                    "                       with ode a whole multiple of --dt-ode\n"},
+    {APP_OPT_QUIET, "  --quiet              no progress bar or summary (notes and errors still go to stderr)\n"},
+};
+
+void app_options_help(FILE* f, unsigned which) {
+    for (size_t k = 0; k < sizeof common_help / sizeof common_help[0]; ++k)
+        if (which & APP_GIVEN(common_help[k].opt)) fputs(common_help[k].text, f);
+}
+
+void app_common_help(FILE* f, bool with_solver) {
+    unsigned all = APP_GIVEN(APP_OPT_COUNT) - 1u;
+    const unsigned solver = APP_GIVEN(APP_OPT_SOLVER) | APP_GIVEN(APP_OPT_DT) | APP_GIVEN(APP_OPT_RTOL) |
+                            APP_GIVEN(APP_OPT_JAC_EVERY) | APP_GIVEN(APP_OPT_DENSE_JAC) |
+                            APP_GIVEN(APP_OPT_KERNEL) | APP_GIVEN(APP_OPT_DURATION) | APP_GIVEN(APP_OPT_EVERY);
+    app_options_help(f, with_solver ? all : all & ~solver);
+}

@@ -1,0 +1,178 @@
+// app_output.c: output files: checked before a run, written to a temporary
+// file and renamed over the final name when done (app_out), folders made.
+// realpath (X/Open) for app_out_open.
+#define _XOPEN_SOURCE 700
+#include "app.h"
+#include "engine.h"
+#include "world_desc.h"
+
+#include <ctype.h>
+#include <limits.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+int app_fclose_checked(FILE* f, int first) {
+    int e = first;
+    const int flagged = ferror(f);
+    errno = 0;
+    if (fflush(f) != 0 && !e) e = errno ? errno : EIO;
+    errno = 0;
+    if (fclose(f) != 0 && !e) e = errno ? errno : EIO;
+    if (flagged && !e) e = EIO;
+    return e;
+}
+
+FILE* app_out_open(app_out* o, const char* path, const char* mode) {
+    memset(o, 0, sizeof *o);
+    struct stat st;
+    const bool exists = stat(path, &st) == 0;
+    if (exists && !S_ISREG(st.st_mode)) { // a device or a pipe: in place
+        snprintf(o->path, sizeof o->path, "%s", path);
+        o->f = fopen(path, mode);
+        return o->f;
+    }
+    // Through a symlink to the file it names: renaming over the link itself
+    // would replace the link with a file.
+    char real[PATH_MAX];
+    const char* target = exists && realpath(path, real) ? real : path;
+    if (strlen(target) >= sizeof o->path) {
+        errno = ENAMETOOLONG;
+        return NULL;
+    }
+    memcpy(o->path, target, strlen(target) + 1); // fits: checked above
+    const char* slash = strrchr(o->path, '/');
+    const int dl = slash ? (int)(slash - o->path + 1) : 0;
+    snprintf(o->tmp, sizeof o->tmp, "%.*s.%s.XXXXXX", dl, o->path, o->path + dl);
+    const int fd = mkstemp(o->tmp);
+    if (fd < 0) {
+        // A folder we may not create files in, holding a file we may write:
+        // write it in place, as before (app_check_output let it through).
+        const int e = errno;
+        o->tmp[0] = 0;
+        if (exists && access(o->path, W_OK) == 0) {
+            o->f = fopen(o->path, mode);
+            return o->f;
+        }
+        errno = e;
+        return NULL;
+    }
+    // mkstemp makes it 0600: give it the mode the old file had, or a new
+    // file's (0666 less the umask).
+    mode_t mode_bits;
+    if (exists) {
+        mode_bits = st.st_mode & 07777;
+    } else {
+        const mode_t um = umask(0);
+        umask(um);
+        mode_bits = 0666 & ~um;
+    }
+    if (fchmod(fd, mode_bits)) { /* the data matters more than the mode */
+    }
+    o->f = fdopen(fd, mode);
+    if (!o->f) {
+        const int e = errno;
+        close(fd);
+        unlink(o->tmp);
+        o->tmp[0] = 0;
+        errno = e;
+    }
+    return o->f;
+}
+
+int app_out_close(app_out* o, int first, bool keep) {
+    int e = first;
+    if (o->f) e = app_fclose_checked(o->f, first);
+    o->f = NULL;
+    if (o->tmp[0]) {
+        if (keep && !e && rename(o->tmp, o->path)) e = errno;
+        if (!keep || e) unlink(o->tmp);
+        o->tmp[0] = 0;
+    }
+    return e;
+}
+
+int app_out_commit_signal(const app_out* o) { return o->tmp[0] ? rename(o->tmp, o->path) : 0; }
+
+int app_check_output(const char* cmd, const char* opt, const char* path, const char* ext) {
+    if (!*path) {
+        fprintf(stderr, "cranesim %s: %s: empty file name\n", cmd, opt);
+        return -1;
+    }
+    struct stat st;
+    const bool exists = stat(path, &st) == 0;
+    if (exists && S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "cranesim %s: %s %s: is a directory\n", cmd, opt, path);
+        return -1;
+    }
+    // A device or a pipe (/dev/stdout, /dev/null) takes whatever is written;
+    // a file named x.jpg holding PNG data would mislead every viewer.
+    const size_t L = strlen(path), le = ext ? strlen(ext) : 0;
+    if (ext && !(exists && !S_ISREG(st.st_mode)) && (L <= le || strcasecmp(path + L - le, ext))) {
+        fprintf(stderr, "cranesim %s: %s %s: the file is written as %s, so its name must end in %s\n", cmd, opt,
+                path, ext + 1, ext);
+        return -1;
+    }
+    if (exists) {
+        if (access(path, W_OK)) {
+            fprintf(stderr, "cranesim %s: %s %s: cannot write: %s\n", cmd, opt, path, strerror(errno));
+            return -1;
+        }
+        return 0;
+    }
+    char dir[1024];
+    const char* slash = strrchr(path, '/');
+    if (!slash) snprintf(dir, sizeof dir, ".");
+    else if (slash == path) snprintf(dir, sizeof dir, "/");
+    else snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    if (stat(dir, &st) || !S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "cranesim %s: %s %s: no directory %s\n", cmd, opt, path, dir);
+        return -1;
+    }
+    if (access(dir, W_OK | X_OK)) {
+        fprintf(stderr, "cranesim %s: %s %s: cannot create a file in %s: %s\n", cmd, opt, path, dir,
+                strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+int app_make_dir(const char* cmd, const char* opt, const char* dir) {
+    char buf[1024];
+    if (!*dir) {
+        fprintf(stderr, "cranesim %s: %s: empty directory name\n", cmd, opt);
+        return -1;
+    }
+    if (strlen(dir) >= sizeof buf) {
+        fprintf(stderr, "cranesim %s: %s: directory name too long\n", cmd, opt);
+        return -1;
+    }
+    snprintf(buf, sizeof buf, "%s", dir);
+    // mkdir -p: each prefix ending before a '/', then the whole path.
+    for (char* p = buf + 1;; ++p) {
+        if (*p && *p != '/') continue;
+        const char keep = *p;
+        *p = 0;
+        struct stat st;
+        if (mkdir(buf, 0755) && errno != EEXIST) {
+            fprintf(stderr, "cranesim %s: %s %s: cannot create %s: %s\n", cmd, opt, dir, buf, strerror(errno));
+            return -1;
+        }
+        if (stat(buf, &st) || !S_ISDIR(st.st_mode)) {
+            fprintf(stderr, "cranesim %s: %s %s: %s exists and is not a directory\n", cmd, opt, dir, buf);
+            return -1;
+        }
+        *p = keep;
+        if (!keep) break;
+    }
+    if (access(dir, W_OK | X_OK)) {
+        fprintf(stderr, "cranesim %s: %s %s: cannot write into it: %s\n", cmd, opt, dir, strerror(errno));
+        return -1;
+    }
+    return 0;
+}

@@ -1,0 +1,126 @@
+// engine.h: one crane engine, whatever the backend: the lagrange crane
+// (engine_lagrange.c, on lagrange_sim) or the ODE world (engine_ode.c, on
+// ode_world). Drivers (drive, the window's tick, the soak bench) create one
+// from the model and the options, set commands, advance it on the simulated
+// clock, read its row and its snapshot, and never ask which backend runs:
+// what differs is behind engine_ops (engine_impl.h). Scripted runs (run,
+// compare, study, bench) go through engine_run, which plays a scenario.
+#ifndef ENGINE_H
+#define ENGINE_H
+
+#include "scenario.h"
+#include "sim.h"
+#include "world_snapshot.h"
+
+#include <stdbool.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct engine engine;
+
+/// The engine o->mechanics names, at joint angles q0 [rad], slew angle
+/// slew0 [rad] (ode only) and tip load m3 [kg] (lagrange, and the ode
+/// validation world; the sandbox picks loads up with the hook). The ode world
+/// is o->world, else the sandbox. NULL with one line in err: the start the
+/// run checks refuse (an unreachable pose, a step the method cannot take, a
+/// load the reliefs cannot hold), or the world file at fault.
+engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
+                      size_t errsz);
+void engine_destroy(engine* e);
+/// "lagrange" or "ode".
+const char* engine_backend_name(const engine* e);
+
+/// Valve commands lift, jib, slew in [-1, 1] (clamped; slew ignored where
+/// the crane does not slew), held until changed.
+void engine_set_commands(engine* e, const double u[3]);
+/// Hook: 1 attach the nearest load in reach, 0 release. Returns the load
+/// index attached, or -1 (also where the world has no hook).
+int engine_hook(engine* e, int attach);
+/// Name and mass [kg] of load i of the world, or NULL.
+const char* engine_load_name(const engine* e, int i, double* mass);
+/// True while a load hangs on the hook.
+bool engine_attached(const engine* e);
+/// The circuit the running engine uses (the model's for lagrange, the
+/// world's own copy for ode): hyd_model_set on it takes effect at the next step.
+hyd_model* engine_circuit(engine* e);
+/// Set the tip load [kg] where the engine carries it as a parameter
+/// (lagrange; takes effect at the next step).
+void engine_set_load(engine* e, double m3);
+/// True when the tip load is a parameter engine_set_load changes (else the
+/// world's loads are bodies, or the load is merged into the end arm).
+bool engine_can_set_load(const engine* e);
+/// True when engine_set_link applies a new boom length in place (else the
+/// engine must be rebuilt for one).
+bool engine_can_resize_links(const engine* e);
+/// Boom k (0 lifting arm, 1 end arm) now has link ln (mass, com, inertia,
+/// length), applied in place at the next step where the engine can: the
+/// lagrange crane always (its constants are recomputed; ln is the model's
+/// link it reads), the ode world for a new mass and inertia about the same
+/// centre of mass. Returns 0 when applied, 1 when the engine must be
+/// rebuilt for it (a new length, or a centre of mass that moves).
+int engine_set_link(engine* e, int k, const crane_link* ln);
+
+/// The output channels the engine publishes, by name, unit and kind: the
+/// first *n entries of sim_channels (the base list; the ode world adds its
+/// extras), which are the columns engine_row fills.
+const sim_channel* engine_channels(const engine* e, int* n);
+/// The channels of the engine o->mechanics names, before one exists (a run
+/// writes its CSV header from them).
+const sim_channel* engine_channels_for(const sim_opts* o, int* n);
+/// The number of engine_channels.
+int engine_ncol(const engine* e);
+
+/// Called for each row engine_advance_to produces; non-zero stops it.
+typedef int (*engine_row_fn)(void* user, const double* row);
+/// Advance to simulated time t_to [s] (the ode world takes whole ODE steps:
+/// it ends on the step nearest t_to), then apply the run checks of sim.h
+/// (sim_check_row) to the state reached and hand its row to row_fn (may be
+/// NULL). Returns 0; 1 on a numerical failure or a failed check (message
+/// from engine_error), after which the engine stays stopped and every
+/// further call returns 1; 2 when row_fn asked to stop.
+int engine_advance_to(engine* e, double t_to, engine_row_fn row_fn, void* user);
+/// Advance by dt [s], as engine_advance_to without a row callback.
+int engine_advance(engine* e, double dt);
+
+/// Where a scripted run's rows go (engine_run).
+typedef struct engine_sink {
+    engine_row_fn row; ///< each output row (may be NULL); non-zero stops the run
+    void* user;
+    bool rows;         ///< someone consumes rows: else (benchmarks) the output evaluation is skipped
+    bool summary;      ///< someone reads the summary: peaks over every step, not only the rows
+    double t_end;      ///< the run's end [s] (> 0; checked by the caller, sim_check_times)
+} engine_sink;
+/// A scripted run from t = 0 to k->t_end: the engine o->mechanics names,
+/// built for scenario sc (its start pose, load and world), plays the
+/// scenario and hands a row every o->dt_out to k. The run checks and their
+/// messages are sim.h's; res as sim_run's (status 0, 1 numerical failure,
+/// 2 refused or stopped).
+int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
+/// The note for a dip below absolute zero the checks saw (sim_checks_note),
+/// or "".
+void engine_note(const engine* e, char* note, size_t n);
+const char* engine_error(const engine* e);
+
+/// Hears a hook event the scripted operator applied: attach or release,
+/// and engine_hook's answer.
+typedef void (*engine_hook_fn)(void* user, engine* e, int attach, int got);
+/// The scripted operator (scenario_play) at simulated time tm [s]: the
+/// stick positions into u[3] (the caller sets them), and every hook event
+/// due by tm, from *ev on, applied to e (*ev advances); on_hook (may be
+/// NULL) hears each.
+void engine_play(engine* e, const scenario* sc, double tm, int* ev, double u[3], engine_hook_fn on_hook,
+                 void* user);
+
+/// Simulated time [s].
+double engine_time(const engine* e);
+/// The CSV row at the current time (sim.h columns; engine_ncol of them are set).
+void engine_row(engine* e, double row[SIM_NCOL]);
+/// Fill a snapshot for the renderer.
+void engine_snapshot(engine* e, world_snapshot* s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

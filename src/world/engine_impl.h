@@ -1,0 +1,45 @@
+// engine_impl.h: what a backend supplies to engine.h. A backend's engine
+// struct starts with a struct engine (the part engine.c owns: options,
+// checks, failure state) and points it at its engine_ops.
+#ifndef ENGINE_IMPL_H
+#define ENGINE_IMPL_H
+
+#include "engine.h"
+
+typedef struct engine_ops {
+    const char* name; ///< "lagrange", "ode"
+    /// A stepped engine at q0 [rad], slew0 [rad] (where the crane slews), tip load m3 [kg].
+    engine* (*create)(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
+                      size_t errsz);
+    /// A scripted run of scenario sc (engine_run).
+    int (*run)(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
+    int nchannel;     ///< the channels it publishes: sim_channels[0 .. nchannel), the columns its rows fill
+    void (*destroy)(engine* e);
+    void (*set_commands)(engine* e, const double u[3]);
+    /// NULL: the backend has no hook (engine_hook returns -1, no loads).
+    int (*hook)(engine* e, int attach);
+    const char* (*load_name)(const engine* e, int i, double* mass);
+    bool (*attached)(const engine* e);
+    hyd_model* (*circuit)(engine* e);
+    /// NULL: the tip load is not a parameter of this backend.
+    void (*set_load)(engine* e, double m3);
+    int (*set_link)(engine* e, int k, const crane_link* ln);
+    bool resize_links; ///< set_link applies a new boom length in place
+    /// Advance dt [s]; 0, or 1 with the reason in e->err.
+    int (*step)(engine* e, double dt);
+    double (*time)(const engine* e);
+    void (*row)(engine* e, double row[SIM_NCOL]);
+    void (*snapshot)(engine* e, world_snapshot* s);
+} engine_ops;
+
+struct engine {
+    const engine_ops* ops;
+    sim_opts o;
+    char err[512];
+    sim_checks chk; ///< the run checks every driver applies (sim.h)
+    bool failed;    ///< a check or the step failed: the engine stays stopped
+};
+
+extern const engine_ops engine_lagrange_ops, engine_ode_ops;
+
+#endif

@@ -1,0 +1,238 @@
+// engine_ode.c: the ODE world (ode_world.h: truck, slewing column, booms,
+// rope, hook, loads, terrain; the circuit sub-stepped inside each ODE step)
+// behind engine.h.
+#include "engine_impl.h"
+
+#include "ode_world.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+typedef struct eng_ode {
+    engine base;
+    ode_world* w;
+} eng_ode;
+
+
+static ode_world* W(const engine* e) { return ((const eng_ode*)e)->w; }
+
+static engine* ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
+                          char* err, size_t errsz) {
+    eng_ode* l = calloc(1, sizeof *l);
+    if (!l) {
+        snprintf(err, errsz, "out of memory");
+        return NULL;
+    }
+    l->base.ops = &engine_ode_ops;
+    l->base.o = *o;
+    l->w = sim_ode_world_create(m, o, "sandbox", q0, slew0, m3, err, errsz);
+    if (!l->w) {
+        free(l);
+        return NULL;
+    }
+    // The hydraulic sub-step is min(--dt, ODE step), as sim_ode_world_create sets it.
+    const double dt = ode_world_dt(l->w), h = o->h < dt ? o->h : dt;
+    double row0[SIM_NCOL];
+    sim_ode_row(l->w, row0);
+    if (sim_check_fixed_step(ode_world_circuit(l->w), o, h, 0.0, err, errsz) ||
+        sim_check_start(ode_world_circuit(l->w), row0, SIM_NCOL, m3, err, errsz)) {
+        ode_world_destroy(l->w);
+        free(l);
+        return NULL;
+    }
+    return &l->base;
+}
+
+static void ode_destroy(engine* e) {
+    ode_world_destroy(W(e));
+    free(e);
+}
+
+static void ode_set_commands(engine* e, const double u[3]) { ode_world_set_commands(W(e), u); }
+static int ode_hook(engine* e, int attach) { return ode_world_hook(W(e), attach); }
+
+static const char* ode_load_name(const engine* e, int i, double* mass) {
+    return ode_world_load_name(W(e), i, mass);
+}
+
+static bool ode_attached(const engine* e) {
+    ode_world_state st;
+    ode_world_get_state(W(e), &st);
+    return st.attached >= 0;
+}
+
+static hyd_model* ode_circuit(engine* e) { return ode_world_circuit(W(e)); }
+
+static int ode_set_link(engine* e, int k, const crane_link* ln) {
+    return ode_world_set_link_mass(W(e), k, ln) ? 1 : 0;
+}
+
+static int ode_step(engine* e, double dt) {
+    if (ode_world_step(W(e), dt) == 0) return 0;
+    snprintf(e->err, sizeof e->err, "%s", ode_world_error(W(e)));
+    return 1;
+}
+
+static double ode_time(const engine* e) { return ode_world_time(W(e)); }
+static void ode_row(engine* e, double row[SIM_NCOL]) { sim_ode_row(W(e), row); }
+static void ode_snapshot(engine* e, world_snapshot* s) { ode_world_snapshot(W(e), s); }
+
+// ---- Scripted runs (sim_run) ----
+
+typedef struct run_ctx {
+    const engine_sink* sink;
+    double t_end, t_last_row;
+    long rows;
+    int stop;
+    sim_checks chk; ///< the run checks (sim_check_row) and the dips below zero
+} run_ctx;
+
+// Hand a finished row to the driver's sink.
+static int deliver(run_ctx* c, const double* row) {
+    if (c->sink->row && c->sink->row(c->sink->user, row)) return (c->stop = 2);
+    return 0;
+}
+
+static int play_hook(void* user, int attach) { return ode_world_hook(user, attach); }
+
+// A scripted run (engine_run): the scenario played at each ODE step's
+// midpoint (scenario_play), rows every dt_out on the step grid.
+static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
+    run_ctx cc = {.sink = k, .t_end = k->t_end}, *c = &cc;
+    if (o->cvode) {
+        snprintf(res->message, sizeof res->message,
+                 "%s ode steps the hydraulics inside each ODE step: use krus, ros2, rk4, ros34pw2 or rodas3",
+                 sim_param_name(SIM_PARAM_MECHANICS));
+        return res->status = SIM_REFUSED;
+    }
+    ode_world* w = sim_ode_world_create(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
+                                        sizeof res->message);
+    if (!w) return res->status = SIM_REFUSED;
+    res->fused = ode_world_fused(w);
+    const long ode_msgs = ode_world_messages(NULL);
+    const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
+    if ((res->status = sim_check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res->message,
+                                            sizeof res->message))) {
+        ode_world_destroy(w);
+        return res->status;
+    }
+
+    const double dt = ode_world_dt(w);
+    // Counted in longs: refused before a conversion could overflow (the
+    // output period is at most the run, sim_check_times).
+    if (c->t_end / dt > 1e12) {
+        snprintf(res->message, sizeof res->message,
+                 "%s %g s over %g s is %.3g steps, more than 1e12: use a larger %s or a shorter run",
+                 sim_param_name(SIM_PARAM_DT_ODE), dt, c->t_end, c->t_end / dt, sim_param_name(SIM_PARAM_DT_ODE));
+        ode_world_destroy(w);
+        return res->status = SIM_REFUSED;
+    }
+    const long nstep = (long)floor(c->t_end / dt + 0.5);
+    long nout = (long)floor(fmin(o->dt_out, c->t_end) / dt + 0.5);
+    if (nout < 1) nout = 1;
+    double row[SIM_NCOL];
+    int ev = 0;
+    double w0 = sim_wall_time();
+    sim_ode_row(w, row);
+    for (int k = 0; k < 4; ++k) res->p_peak[k] = row[COL_P1A + k];
+    {
+        // The start state too: a model value that overflows shows at t = 0.
+        char what[200];
+        const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
+        if (rc) {
+            sim_check_message(res->message, sizeof res->message, what, NULL, hyd_method_is_adaptive(o->solver),
+                              0.0, c->chk.bad_value);
+            ode_world_destroy(w);
+            return res->status = SIM_REFUSED;
+        }
+        if (sim_check_start(ode_world_circuit(w), row, SIM_NCOL, sim_load_mass(m, sc, o), res->message,
+                            sizeof res->message)) {
+            ode_world_destroy(w);
+            return res->status = SIM_REFUSED;
+        }
+    }
+    deliver(c, row);
+    ++c->rows;
+    for (long i = 0; i < nstep && !c->stop; ++i) {
+        const double t = (double)i * dt;
+        // Commands at the step's midpoint: second-order accurate for ramps,
+        // and steps land within half an ODE step of their time.
+        const double tm = t + 0.5 * dt;
+        double u[3];
+        scenario_play(sc, tm, &ev, u, play_hook, w);
+        ode_world_set_commands(w, u);
+        if (ode_world_step(w, dt)) {
+            res->status = SIM_FAILED;
+            snprintf(res->message, sizeof res->message, "numerical blow-up: %s", ode_world_error(w));
+            break;
+        }
+        {
+            // Peaks at every ODE step, not only at the rows.
+            double pA[ODE_NACT], pB[ODE_NACT];
+            ode_world_chamber_pressures(w, pA, pB);
+            const double p[4] = {pA[0], pB[0], pA[1], pB[1]};
+            for (int k = 0; k < 4; ++k) res->p_peak[k] = fmax(res->p_peak[k], p[k]);
+        }
+        if ((i + 1) % nout && i + 1 != nstep) continue;
+        sim_ode_row(w, row);
+        row[COL_T] = (double)(i + 1) * dt; // exact grid times, no accumulated round-off
+        {
+            char what[200];
+            const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
+            if (rc) {
+                res->status = SIM_FAILED;
+                char how[96];
+                snprintf(how, sizeof how, "solver %s, h = %g s, ODE step %g s", hyd_method_name(o->solver),
+                         o->h < dt ? o->h : dt, dt);
+                sim_check_message(res->message, sizeof res->message, what, how, hyd_method_is_adaptive(o->solver),
+                                  row[COL_T], c->chk.bad_value);
+            }
+        }
+        if (res->status) break;
+        c->t_last_row = row[COL_T];
+        ++c->rows;
+        deliver(c, row);
+    }
+    res->wall = sim_wall_time() - w0;
+    res->stats = ode_world_hyd_stats(w);
+    res->stats.steps = ode_world_hyd_steps(w); // fixed-step sub-steps are counted by the world
+    res->rows = c->rows;
+    res->t_end = c->t_last_row;
+    ode_world_destroy(w);
+    res->peak_steps = true;
+    const char* last;
+    const long msgs = ode_world_messages(&last) - ode_msgs;
+    if (!res->status && c->chk.dip)
+        sim_checks_note(&c->chk, hyd_method_is_adaptive(o->solver), res->note, sizeof res->note);
+    else if (msgs > 0)
+        snprintf(res->note, sizeof res->note,
+                 "ODE reported %ld solver message%s during the run (last: %.120s): a degenerate contact set, which "
+                 "ODE stepped through",
+                 msgs, msgs > 1 ? "s" : "", last);
+    if (c->stop && !res->status) {
+        res->status = SIM_REFUSED;
+        snprintf(res->message, sizeof res->message, "stopped at t = %.6g s", c->t_last_row);
+    }
+    return res->status;
+}
+
+const engine_ops engine_ode_ops = {
+    .name = "ode",
+    .create = ode_create,
+    .run = ode_run,
+    .nchannel = SIM_NCOL, // the base list and the world extras
+    .destroy = ode_destroy,
+    .set_commands = ode_set_commands,
+    .hook = ode_hook,
+    .load_name = ode_load_name,
+    .attached = ode_attached,
+    .circuit = ode_circuit,
+    .set_load = NULL, // the world's loads are bodies, picked up with the hook
+    .set_link = ode_set_link,
+    .resize_links = false, // a body's geometry is fixed when it is built
+    .step = ode_step,
+    .time = ode_time,
+    .row = ode_row,
+    .snapshot = ode_snapshot,
+};

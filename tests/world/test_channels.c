@@ -1,0 +1,82 @@
+// test_channels.c: the output channels are one list (sim.h, SIM_CHANNELS_*)
+// that each engine publishes, and the CSV header, sim_col_name and
+// sim_col_unit are made from it: the header each backend writes is the one
+// the README documents (these are the headers main wrote before the list).
+#include "check.h"
+#include "crane_fixture.h"
+#include "engine.h"
+#include "sim.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static const char* const k_header_lagrange =
+    "t,x1,x2,p1A,p1B,p2A,p2B,u1,u2,q1,q2,tip_x,tip_z,F1,F2,u1_cmd,u2_cmd,v1,v2,p_pump,relief_open,end_stop\n";
+static const char* const k_header_ode =
+    "t,x1,x2,p1A,p1B,p2A,p2B,u1,u2,q1,q2,tip_x,tip_z,F1,F2,u1_cmd,u2_cmd,v1,v2,p_pump,relief_open,end_stop,"
+    "slew,hook_x,hook_y,hook_z,load_x,load_y,load_z,attached,truck_tilt,contacts,max_depth,x3,v3,p3A,p3B,u3,"
+    "u3_cmd,F3\n";
+
+// The header sim_csv_header writes for ncol columns.
+static void header(int ncol, char* buf, size_t n) {
+    FILE* f = fmemopen(buf, n, "w");
+    sim_csv_header(f, ncol);
+    fclose(f);
+}
+
+static void test_headers_unchanged(void) {
+    char buf[2048];
+    sim_opts o = sim_default_opts();
+    header(sim_ncol(&o), buf, sizeof buf);
+    CHECK(strcmp(buf, k_header_lagrange) == 0, "lagrange header: %s", buf);
+    o.mechanics = SIM_ODE;
+    header(sim_ncol(&o), buf, sizeof buf);
+    CHECK(strcmp(buf, k_header_ode) == 0, "ode header: %s", buf);
+}
+
+static void test_one_list(void) {
+    int npress = 0;
+    for (int c = 0; c < SIM_NCOL; ++c) {
+        CHECK(sim_col_name[c] == sim_channels[c].name || !strcmp(sim_col_name[c], sim_channels[c].name),
+              "column %d: name %s vs %s", c, sim_col_name[c], sim_channels[c].name);
+        CHECK(!strcmp(sim_col_unit[c], sim_channels[c].unit), "column %d: unit", c);
+        const bool p = sim_channels[c].kind == SIM_CH_PRESSURE;
+        npress += p;
+        // Pressures are exactly the columns in Pa: the run checks read the kind.
+        CHECK(p == !strcmp(sim_channels[c].unit, "Pa"), "column %s: kind %d, unit %s", sim_channels[c].name,
+              sim_channels[c].kind, sim_channels[c].unit);
+    }
+    CHECK(npress == 7, "%d pressure channels", npress);
+    CHECK(!strcmp(sim_col_unit[COL_F3], "N") && !strcmp(sim_col_name[COL_SLEW], "slew"), "indices");
+}
+
+// Each engine publishes its channels; a run's CSV has as many columns.
+static void test_engines_publish(void) {
+    scenario sc;
+    model* m = load_crane("ramp", &sc);
+    if (!m) return;
+    for (int b = 0; b < 2; ++b) {
+        sim_opts o = sim_default_opts();
+        o.mechanics = b ? SIM_ODE : SIM_LAGRANGE;
+        o.world = CRANESIM_ASSETS "/worlds/validation.json";
+        char err[512];
+        engine* e = engine_create(m, &o, sc.q0, sc.slew0, sim_load_mass(m, &sc, &o), err, sizeof err);
+        CHECK(e != NULL, "%s", err);
+        if (!e) continue;
+        int n = 0, nf = 0;
+        const sim_channel* ch = engine_channels(e, &n);
+        const sim_channel* cf = engine_channels_for(&o, &nf);
+        CHECK(ch == sim_channels && cf == sim_channels && n == nf && n == sim_ncol(&o) && n == engine_ncol(e),
+              "%s: %d channels, %d before, %d columns", engine_backend_name(e), n, nf, sim_ncol(&o));
+        CHECK(n == (b ? SIM_NCOL : SIM_NCOL_BASE), "%s: %d channels", engine_backend_name(e), n);
+        engine_destroy(e);
+    }
+    model_free(m);
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_headers_unchanged);
+    RUN_TEST(test_one_list);
+    RUN_TEST(test_engines_publish);
+    TEST_MAIN_END();
+}
