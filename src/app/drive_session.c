@@ -63,6 +63,7 @@ struct drive_session {
     bool paused, rebuild;
     char rebuild_why[160]; // the change that asked for the rebuild
     sim_opts sim_live;     // the options the running world was built with
+    crane_mech mech_live;  // the mechanics the running world has (built with, or set in place since)
     double wall_last, wall_next_frame;
     double wall_last_frame; ///< wall time the last timed frame started [s] (< 0: none yet)
     double sim_offset;   // simulated time = wall - sim_offset while running
@@ -222,6 +223,27 @@ static void sync_json(drive_session* s, const drive_param* p) {
     json_set_path(s->m->json, a, e, sizeof e);
 }
 
+// A panel's mechanical value from the mechanics: the field its JSON path
+// names ("mechanics.links[1].length").
+static double mech_value(const crane_mech* me, const char* json) {
+    const crane_link* ln = &me->link[strstr(json, "links[1]") ? 1 : 0];
+    return strstr(json, ".length") ? ln->length : ln->mass;
+}
+
+// The model document's links as the mechanics have them (after a revert).
+static void sync_mech_json(drive_session* s) {
+    static const char* const field[] = {"mass", "length", "com", "inertia"};
+    for (int k = 0; k < 2; ++k) {
+        const crane_link* ln = &s->m->mech.link[k];
+        const double v[] = {ln->mass, ln->length, ln->com, ln->inertia};
+        for (int j = 0; j < 4; ++j) {
+            char a[160], e[200];
+            snprintf(a, sizeof a, "mechanics.links[%d].%s=%.10g", k, field[j], v[j]);
+            json_set_path(s->m->json, a, e, sizeof e);
+        }
+    }
+}
+
 static engine* make_engine(drive_session* s, const double q0[2], double slew0) {
     char err[400];
     engine* l = engine_create(s->m, &s->c.sim, q0, slew0, sim_load_mass(s->m, &s->sc, &s->c.sim), err, sizeof err);
@@ -270,6 +292,8 @@ static void apply_param(drive_session* s, int i) {
         if (engine_set_link(s->l, k, ln)) {
             s->rebuild = true;
             snprintf(s->rebuild_why, sizeof s->rebuild_why, "%s/%s", p->group, p->label);
+        } else {
+            s->mech_live.link[k] = *ln; // the running world has it now
         }
         char a[160], e2[200];
         snprintf(a, sizeof a, "mechanics.links[%d].com=%.10g", k, ln->com);
@@ -318,12 +342,21 @@ static void rebuild_world(drive_session* s, bool at_start) {
     if (!l) {
         // The running world goes on with the options it was built with, and
         // the panel shows them again.
-        snprintf(s->status, sizeof s->status, "rebuild failed (%s kept): %s",
+        snprintf(s->status, sizeof s->status, "rebuild failed (%s and the running world kept): %s",
                  hyd_method_name(s->sim_live.solver), s->err);
+        // The HUD's status line holds about 120 characters; the whole reason
+        // goes to the terminal too.
+        fprintf(stderr, "cranesim drive: %s\n", s->status);
         s->c.sim.solver = s->sim_live.solver;
         s->c.sim.h = s->sim_live.h;
+        // The mechanics too: a length the world could not be built with must
+        // not stay in the model (and the panel, and "save model") to come in
+        // unasked with the next rebuild.
+        s->m->mech = s->mech_live;
+        sync_mech_json(s);
         for (int i = 0; i < s->nparam; ++i) {
             drive_param* p = &s->param[i];
+            if (p->kind == PK_MECH) p->value = mech_value(&s->m->mech, p->json) / p->scale;
             if (p->kind == PK_STEP) p->value = s->c.sim.h / p->scale;
             if (p->kind == PK_SOLVER)
                 for (int k = 0; k < NSOLVER; ++k)
@@ -332,6 +365,7 @@ static void rebuild_world(drive_session* s, bool at_start) {
         return;
     }
     s->sim_live = s->c.sim;
+    s->mech_live = s->m->mech;
     // The real-time factor is the new piece's simulated time over its own
     // wall time: dividing it by the wall time since the session started read
     // "RT 0.42x" (and "cannot keep up") for ever after a reset. The totals
@@ -589,6 +623,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     }
     s->l = make_engine(s, s->sc.q0, s->sc.slew0);
     s->sim_live = s->c.sim;
+    s->mech_live = s->m->mech;
     if (!s->l) {
         // A world file or model the world cannot be built from.
         snprintf(err, errsz, "%s", s->err);

@@ -887,6 +887,45 @@ static void test_length_rebuilds_once_on_release(void) {
           seg_prev, back);
 }
 
+// A rebuild that fails leaves the running world as it was, and the panel
+// and the model say so: a longer lifting arm with the lift on its end stop
+// cannot be built at that pose; the model kept the new length, the panel
+// showed it, and the next rebuild (a solver change) brought it in unasked.
+static void test_failed_rebuild_keeps_the_running_world(void) {
+    drive_session* s = open_session();
+    if (!s) return;
+    double wall = 0;
+    run_for(s, &wall, 0.5);
+    push_key(SDL_SCANCODE_UP, 1);
+    run_for(s, &wall, 9.0);
+    push_key(SDL_SCANCODE_UP, 0);
+    run_for(s, &wall, 0.5);
+    panel* pn = drive_session_panel(s);
+    const int id = panel_find(pn, "booms/lifting arm length");
+    const double L0 = drive_session_model(s)->mech.link[0].length;
+    panel_edit(pn, id, L0 + 0.33, true);
+    run_for(s, &wall, 1.0 / 240.0);
+    render_wait(drive_session_render_ctx(s), 1.0);
+    run_for(s, &wall, 0.5);
+    const char* st = render_get_status(drive_session_render_ctx(s));
+    CHECK(strstr(st, "rebuild failed"), "lift at x1 = %.4f m: the longer arm was built: '%s'", lift_stroke(s), st);
+    CHECK(drive_session_model(s)->mech.link[0].length == L0 && panel_get(pn, id) == L0,
+          "after the failed rebuild: model %g m, panel %g m, want %g", drive_session_model(s)->mech.link[0].length,
+          panel_get(pn, id), L0);
+    double before[SIM_NCOL], after[SIM_NCOL];
+    drive_session_row(s, before);
+    const int is = panel_find(pn, "solver/method");
+    panel_edit(pn, is, 1, true); // ROS2: one rebuild at the current pose
+    run_for(s, &wall, 1.0 / 240.0);
+    render_wait(drive_session_render_ctx(s), 1.0);
+    run_for(s, &wall, 0.5);
+    drive_session_row(s, after);
+    CHECK(drive_session_model(s)->mech.link[0].length == L0 && fabs(after[COL_TIP_X] - before[COL_TIP_X]) < 0.01,
+          "the solver's rebuild: arm %g m, tip_x %.3f -> %.3f m", drive_session_model(s)->mech.link[0].length,
+          before[COL_TIP_X], after[COL_TIP_X]);
+    drive_session_destroy(s);
+}
+
 // The solver is a choice of names, not a slider: five options, half an
 // index is refused, and a choice that cannot run here (RK4 at the 0.1 ms
 // step is unstable for this circuit) keeps the running solver and says why.
@@ -1078,6 +1117,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_boom_mass_drag_in_place);
     RUN_TEST(test_length_rebuilds_once_on_release);
     RUN_TEST(test_solver_is_a_choice);
+    RUN_TEST(test_failed_rebuild_keeps_the_running_world);
     RUN_TEST(test_default_view_shows_hook_and_load);
     RUN_TEST(test_presets_keep_out_of_the_truck);
     RUN_TEST(test_slew_valve_in_the_panel);
