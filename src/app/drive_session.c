@@ -342,7 +342,7 @@ static void rebuild_world(drive_session* s, bool at_start) {
     if (!l) {
         // The running world goes on with the options it was built with, and
         // the panel shows them again.
-        snprintf(s->status, sizeof s->status, "rebuild failed (%s and the running world kept): %s",
+        snprintf(s->status, sizeof s->status, "rebuild failed (%s kept): %s",
                  hyd_method_name(s->sim_live.solver), s->err);
         // The HUD's status line holds about 120 characters; the whole reason
         // goes to the terminal too.
