@@ -196,10 +196,28 @@ static void build_rope(ode_world* w) {
     w->nrope = n;
     w->rope_len = l;
     w->rope_mass = ml;
+    // A taut chain of links zig-zags about its line with omega^2 <= T l / I
+    // (T tension [N], l link length [m], I the link's inertia about a
+    // transverse axis [kg m^2]; every transverse mode, the kinetic energy
+    // taken from the links' rotation alone). ODE treats that tension
+    // stiffness explicitly, stable for omega H < 2 at the ODE step H. With a
+    // capsule's own I = m l^2 / 12 (1.35e-3 kg m^2 for the sandbox's 0.18 kg
+    // links) that limit is T = 4 I / (l H^2) = 18 kN at 1 ms: a hook caught
+    // under the truck's chassis, pulled by the lift, came apart at 20-25 kN
+    // (the links flying at up to 100 m/s, the rope stretched to 1.9 m) and
+    // its jolts drove a chamber below absolute zero. So the transverse
+    // inertia is raised to OW_ROPE_DESIGN_TENSION l H^2: omega H <= 1 at that
+    // tension, stable up to four times it. The axial inertia and the mass
+    // stay the link's; the hook's swing changes by less than 0.1 % (the
+    // links' rotation holds 0.12 of the chain's 73 kg m^2 about the tip).
+    dMass m0;
+    dMassSetCapsuleTotal(&m0, ml, 3, r->radius, l);
+    const double H = w->opt.dt_ode, I_min = OW_ROPE_DESIGN_TENSION * l * H * H;
+    w->rope_inertia = m0.I[0] > I_min ? m0.I[0] : I_min;
     dBodyID prev = w->frame[2].body;
     for (int i = 0; i < n; ++i) {
-        dMass m;
-        dMassSetCapsuleTotal(&m, ml, 3, r->radius, l);
+        dMass m = m0;
+        m.I[0] = m.I[5] = w->rope_inertia; // about the link's x and y; z is its axis
         dBodyID b = dBodyCreate(w->world);
         dBodySetMass(b, &m);
         dBodySetPosition(b, tip[0], tip[1], tip[2] - (i + 0.5) * l);
@@ -634,12 +652,13 @@ void ode_world_swing_hook(ode_world* w, const double omega[3]) {
     set_rigid_vel(w->hook, tip, omega);
 }
 
-void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, double* link_mass, double* hook_mass,
-                         double* hook_com, double* hook_inertia) {
+void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, double* link_mass, double* link_inertia,
+                         double* hook_mass, double* hook_com, double* hook_inertia) {
     const world_hook* h = &w->desc.hook;
     *nlink = w->nrope;
     *link_len = w->rope_len;
     *link_mass = w->rope_mass;
+    *link_inertia = w->rope_inertia;
     *hook_mass = h->mass;
     *hook_com = 0.5 * h->size[2];
     *hook_inertia = h->mass * (h->size[0] * h->size[0] + h->size[2] * h->size[2]) / 12.0;

@@ -169,10 +169,12 @@ void ode_world_lock_booms(ode_world* w, int lock);
 double ode_world_energy(const ode_world* w);
 /// Set the joint rates q1', q2' [rad/s] (rigidly moving the distal bodies), for tests.
 void ode_world_set_joint_rates(ode_world* w, const double qd[2]);
-/// Rope model for analytic checks: number of rope links, link length [m] and
-/// mass [kg], hook mass [kg], hook pin-to-COM distance [m] and hook inertia
-/// about its COM about the body y axis [kg m^2].
-void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, double* link_mass,
+/// Rope model for analytic checks: number of rope links, link length [m],
+/// mass [kg] and inertia about a transverse axis through its centre [kg m^2]
+/// (raised above the capsule's own for the ODE step, see build_rope), hook
+/// mass [kg], hook pin-to-COM distance [m] and hook inertia about its COM
+/// about the body y axis [kg m^2].
+void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, double* link_mass, double* link_inertia,
                          double* hook_mass, double* hook_com, double* hook_inertia);
 /// Set rope links and hook moving as one rigid body rotating with angular
 /// velocity omega [rad/s] (world axes) about the end-arm tip pin: starts a

@@ -16,6 +16,12 @@
 #define OW_MAX_VIS WORLD_SNAP_MAX_BODIES
 #define OW_MAX_CONTACT_JOINTS 4096
 #define OW_MAX_HYD 96
+/// Rope tension [N] up to which the rope's links are given the transverse
+/// inertia that keeps their zig-zag modes at omega H <= 1 (build_rope). The
+/// sandbox's hook caught under the chassis and pulled by the lift loads it
+/// to 45 kN; the chain then holds up to 4e5 N, twice the lift cylinder's
+/// push at its port relief (7.85e-3 m^2 x 26 MPa = 204 kN).
+#define OW_ROPE_DESIGN_TENSION 1e5
 
 /// Collision categories (bits); which pairs collide is a table in ode_sandbox.c.
 enum {
@@ -117,6 +123,7 @@ struct ode_world {
     dBodyID rope[WORLD_DESC_MAX_ROPE];
     double rope_len;     ///< one link [m]
     double rope_mass;    ///< one link [kg]
+    double rope_inertia; ///< one link about a transverse axis through its centre [kg m^2] (see build_rope)
     dBodyID hook;
     dJointID hook_joint; ///< pre-created ball joint for attaching a load
     int attached;        ///< load index or -1

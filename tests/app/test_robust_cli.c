@@ -226,7 +226,7 @@ static void test_soak_runs(void) {
     static char a[4096], b[4096];
     int rc = cli_run("bench --config soak --duration 2 --seed 7", a, sizeof a);
     CHECK(rc == 0 && strstr(a, "\"config\":\"soak\"") && strstr(a, "\"exit_status\":0") &&
-              strstr(a, "\"nonfinite_values\":0") && strstr(a, "\"peak_rss_kb\":"),
+              strstr(a, "\"nonfinite_values\":0") && strstr(a, "\"ode_messages\":") && strstr(a, "\"peak_rss_kb\":"),
           "exit %d: %s", rc, a);
     rc = cli_run("bench --config soak --duration 2 --seed 7", b, sizeof b);
     // Everything but the wall time and the RSS must agree.
