@@ -71,7 +71,7 @@ typedef struct hyd_problem {
     /// Returns the number of W factorisations it did (>= 0, for the stats), or
     /// a negative HYD_ERR_* code. The solver counts two f evaluations per
     /// step. For problems that can share work between the two stages (the
-    /// crane: lsim_krus.c). NULL: the generic stage arithmetic (krus.c).
+    /// crane: lagrange_split_step.c). NULL: the generic stage arithmetic (krus.c).
     int (*wstep)(void* user, double t, const double* y, double h, double gamma, int new_jac,
                  double* ynew);
     /// Optional domain of the states: returns 0 when y is admissible, else

@@ -15,7 +15,7 @@ static crane_link make_link(const char* name, double length, double mass, double
     snprintf(l.name, sizeof l.name, "%s", name);
     l.length = length;
     l.mass = mass;
-    l.com = 0.5 * length;             // uniform beam estimate (SPEC section 4)
+    l.com = 0.5 * length;             // uniform beam estimate (docs/model.md)
     l.inertia = mass * length * length / 12.0;
     l.width = w;
     l.height = h;
@@ -124,7 +124,7 @@ int crane_mech_check(const crane_mech* m, const double stroke[2], char* err, int
             return -1;
         }
         // phi must stay in (15, 165) deg over the whole stroke so the lever arm
-        // a b sin(phi) / x never collapses (SPEC section 3.1).
+        // a b sin(phi) / x never collapses (docs/lagrange.md).
         double lo = a->closed_length, hi = a->closed_length + stroke[k];
         double xmin = fabs(a->a - a->b), xmax = a->a + a->b;
         if (lo <= xmin || hi >= xmax) {

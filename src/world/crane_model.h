@@ -66,7 +66,7 @@ typedef struct crane_mech {
     crane_actuator act[2];
 } crane_mech;
 
-/// Fill with the built-in HIAB-031-class defaults (SPEC section 4).
+/// Fill with the built-in HIAB-031-class defaults (docs/model.md).
 crane_mech crane_default_mech(void);
 
 /// Compute the derived fields (a, b, phi_offset) from the mount points.

@@ -569,7 +569,7 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     }
     world_desc_default(w, (world_kind)k);
     if (k == WORLD_VALIDATION) {
-        // The validation world is the lagrange crane in ODE (SPEC 6): no
+        // The validation world is the lagrange crane in ODE (docs/ode_world.md): no
         // terrain, truck, rope or loads. A sandbox section there would be
         // silently ignored, so it is an error.
         static const char* const vkeys[] = {"name", "description", "type", "gravity", "ode", NULL};
