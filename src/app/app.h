@@ -148,6 +148,11 @@ double app_output_period(const sim_opts* o);
 /// becomes ode on the sandbox (one note on stderr, and *switched is set):
 /// the scenario runs in its world. Otherwise a run o cannot honour is refused: one line
 /// saying how to run it, EXIT_USAGE. Returns 0 when o runs it as written.
+/// drive's counterpart: the scenario is a scripted operator there, so a
+/// slew it commands in a world without one (lagrange, the validation world)
+/// is not refused but said, once, on stderr. world_kind: the ode world's
+/// kind, or -1 for lagrange. (Hook events are said as they happen.)
+void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind);
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
                        bool* switched);
 

@@ -186,6 +186,26 @@ static const char* sandbox_use(const scenario* sc) {
     return sc->slew0 != 0 ? "starts slewed" : NULL;
 }
 
+void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind) {
+    if (world_kind == WORLD_SANDBOX) return;
+    const char* why = sandbox_use(sc);
+    if (!why || !strcmp(why, "works the hook")) {
+        // Hook events alone are said when they come; a slew is looked for
+        // in the commands too (a scenario can do both).
+        const scenario_signal* sl = &sc->cmd[2];
+        why = NULL;
+        for (int i = 0; i < sl->n && !why; ++i)
+            if (sl->u[i] != 0) why = "slews the crane";
+        if (!why && sc->slew0 != 0) why = "starts slewed";
+        if (!why) return;
+    }
+    fprintf(stderr,
+            "cranesim %s: note: scenario %s %s, which the %s has not: its slew is ignored (the sandbox has one: "
+            "--mechanics ode --world sandbox)\n",
+            cmd, sc->name[0] ? sc->name : "the scenario", why,
+            world_kind < 0 ? "lagrange 2-DOF crane" : "validation world");
+}
+
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
                        bool* switched) {
     if (switched) *switched = false;

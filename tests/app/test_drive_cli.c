@@ -213,6 +213,17 @@ static void test_validation_world_report(void) {
     for (int i = 0; i < 4; ++i) CHECK(!strstr(out, absent[i]), "validation report mentions '%s': %s", absent[i], out);
     CHECK(strstr(out, "record -> validation.csv"), "%s", out);
 
+    // A scenario that slews, driven where nothing slews: said once, not
+    // dropped silently (the slew commands of sandbox_wall and sandbox_swing).
+    rc = drive(NO_DISPLAY, "--headless --mechanics lagrange --scenario sandbox_wall --duration 0.3");
+    CHECK(rc == 0 && occurrences(out, "slews the crane, which the lagrange 2-DOF crane has not: its slew is ignored") == 1,
+          "exit %d: %s", rc, out);
+    rc = drive(NO_DISPLAY, "--headless --world validation --scenario sandbox_swing --duration 0.3");
+    CHECK(rc == 0 && occurrences(out, "which the validation world has not: its slew is ignored") == 1, "exit %d: %s",
+          rc, out);
+    rc = drive(NO_DISPLAY, "--headless --scenario sandbox_swing --duration 0.3");
+    CHECK(rc == 0 && !strstr(out, "slew is ignored"), "in the sandbox: exit %d: %s", rc, out);
+
     // A scenario with hook events: said once that there is no hook.
     rc = drive(NO_DISPLAY, "--headless --world validation --scenario sandbox_pick_place --duration 1 "
                            "--record validation.csv");
