@@ -36,7 +36,8 @@ static engine* ode_create(const model* m, const sim_opts* o, const double q0[2],
     double row0[SIM_NCOL];
     sim_ode_row(l->w, row0);
     if (sim_check_fixed_step(ode_world_circuit(l->w), o, h, 0.0, err, errsz) ||
-        sim_check_start(ode_world_circuit(l->w), row0, SIM_NCOL, m3, err, errsz)) {
+        sim_check_start(ode_world_circuit(l->w), row0, SIM_NCOL,
+                        ode_world_kind(l->w) == WORLD_SANDBOX ? -1.0 : m3, err, errsz)) {
         ode_world_destroy(l->w);
         free(l);
         return NULL;
@@ -146,8 +147,10 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             ode_world_destroy(w);
             return res->status = SIM_REFUSED;
         }
-        if (sim_check_start(ode_world_circuit(w), row, SIM_NCOL, sim_load_mass(m, sc, o), res->message,
-                            sizeof res->message)) {
+        // In the sandbox the tip carries the world's hook and rope, not a
+        // tip load (-1: sim_check_start words it so).
+        const double m3 = ode_world_kind(w) == WORLD_SANDBOX ? -1.0 : sim_load_mass(m, sc, o);
+        if (sim_check_start(ode_world_circuit(w), row, SIM_NCOL, m3, res->message, sizeof res->message)) {
             ode_world_destroy(w);
             return res->status = SIM_REFUSED;
         }

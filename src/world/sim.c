@@ -224,11 +224,19 @@ int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3,
     for (int j = 0; j < 6; ++j) {
         const int c = pcol[j];
         if (c >= ncol || !(row[c] > pmax)) continue;
-        snprintf(err, errsz,
-                 "the start pose needs %s = %.4g MPa to hold the crane still with %g kg at the tip, above the "
-                 "circuit's highest relief setting (%s: %.4g MPa, p_crack + dp_override): the crane cannot hold "
-                 "this load here (a smaller %s or another start pose)",
-                 sim_col_name[c], row[c] * 1e-6, m3, which, pmax * 1e-6, sim_param_name(SIM_PARAM_LOAD));
+        if (m3 < 0) // the sandbox: the world's hook and rope hang at the tip
+            snprintf(err, errsz,
+                     "the start pose needs %s = %.4g MPa to hold the crane still with the world's hook and rope at "
+                     "the tip, above the circuit's highest relief setting (%s: %.4g MPa, p_crack + dp_override): "
+                     "the crane cannot hold them here (a lighter hook or rope in the world file, or another start "
+                     "pose)",
+                     sim_col_name[c], row[c] * 1e-6, which, pmax * 1e-6);
+        else
+            snprintf(err, errsz,
+                     "the start pose needs %s = %.4g MPa to hold the crane still with %g kg at the tip, above the "
+                     "circuit's highest relief setting (%s: %.4g MPa, p_crack + dp_override): the crane cannot hold "
+                     "this load here (a smaller %s or another start pose)",
+                     sim_col_name[c], row[c] * 1e-6, m3, which, pmax * 1e-6, sim_param_name(SIM_PARAM_LOAD));
         return SIM_REFUSED;
     }
     return 0;

@@ -124,7 +124,8 @@ void sim_check_message(char* out, size_t n, const char* what, const char* how, b
 /// crane still; with a load too heavy for the pose that is more than any
 /// relief lets the circuit reach (100 t at the tip: 459 MPa), a state the
 /// reliefs cannot cap because it is set, not integrated. m3: the tip load
-/// [kg], for the message. Returns SIM_OK, or SIM_REFUSED with one line in err.
+/// [kg], for the message; < 0 in the sandbox, where the world's hook and
+/// rope hang at the tip. Returns SIM_OK, or SIM_REFUSED with one line in err.
 int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz);
 
 /// True when this build has the CVODE reference solver.

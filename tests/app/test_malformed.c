@@ -253,6 +253,22 @@ static void test_set_and_load(void) {
     CHECK(rc == 2 && strstr(out_buf, "--load") && strstr(out_buf, "kg"), "--load 1e5: exit %d: %s", rc, out_buf);
 }
 
+// A sandbox start the reliefs cannot hold is the world's hook, not a tip
+// load: the refusal says so and does not suggest --load, which the sandbox
+// refuses (it said "with 500 kg at the tip ... a smaller --load").
+static void test_sandbox_start_names_the_hook(void) {
+    bad_case w = {WORLD, "w_hook_5t.json", "worlds/sandbox.json", "hook.mass=5000", NULL, NULL, "", NULL};
+    const char* wf = make_case(&w);
+    CHECK(wf != NULL, "cannot make %s", w.name);
+    if (!wf) return;
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "run --quiet --mechanics ode --world %s --scenario sandbox_swing --out /dev/null", wf);
+    int rc = cli_run(cmd, out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "the world's hook and rope at the tip") && !strstr(out_buf, "--load") &&
+              !strstr(out_buf, "kg at the tip"),
+          "exit %d: %s", rc, out_buf);
+}
+
 // Outside the typical range: the run goes on (exit 0) with one note naming
 // file, field, range and unit.
 static void test_typical_notes(void) {
@@ -324,6 +340,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_oversize);
     RUN_TEST(test_set_and_load);
     RUN_TEST(test_typical_notes);
+    RUN_TEST(test_sandbox_start_names_the_hook);
     RUN_TEST(test_shipped_quiet);
     TEST_MAIN_END();
 }
