@@ -79,6 +79,8 @@ struct drive_session {
     FILE* rec;
     char rec_path[256];
     long rec_rows;       // rows written to the open recording
+    double rec_t_last;   // time of the last row written [s] (with rec_seg_last)
+    int rec_seg_last;
     int rec_seg0;        // s->segment when it started: its rows count segments from 0
     char rec_err[320];   // first recording failure ("cannot write FILE: ..."), "" if none
     int ncol;
@@ -562,6 +564,13 @@ static int start_recording(drive_session* s, const char* path) {
 }
 
 static void record_row(drive_session* s, const double* row) {
+    // One row per simulated instant: paused (or a tick too short to step)
+    // the time stands still, and a row per tick repeated it (196 rows at the
+    // same t over a 4 s pause). A reset starts a new segment, whose time may
+    // begin again at 0.
+    if (s->rec_rows > 0 && s->segment == s->rec_seg_last && !(row[COL_T] > s->rec_t_last)) return;
+    s->rec_t_last = row[COL_T];
+    s->rec_seg_last = s->segment;
     errno = 0;
     double r[SIM_NCOL + 1];
     memcpy(r, row, sizeof(double) * (size_t)s->ncol);
