@@ -52,8 +52,17 @@ static void drive_help(FILE* f) {
             "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
             "  --save-as FILE      window: the panel's \"save model\" writes FILE (default: a new\n"
             "                      cranesim_model_N.json each time, never an existing file)\n"
-            "  --size WxH          window size in pixels (default 1280x720)\n");
-    app_common_help(f, true);
+            "  --size WxH          window size in pixels (default 1280x720)\n"
+            "  --scenario S         the scripted operator: a scenario JSON file or a name in\n"
+            "                       assets/scenarios (default sandbox_pick_place in the sandbox,\n"
+            "                       drive_demo otherwise)\n"
+            "  --mechanics M        ode (default: the 3D world) or lagrange (analytic 2-DOF)\n"
+            "  --world W            ode: world file or name: sandbox (default), validation\n");
+    // The common options less those whose drive defaults differ (above)
+    // and --duration (drive's own, above) and --every (not for drive).
+    const unsigned all = APP_GIVEN(APP_OPT_COUNT) - 1u;
+    app_options_help(f, all & ~(APP_GIVEN(APP_OPT_SCENARIO) | APP_GIVEN(APP_OPT_MECHANICS) | APP_GIVEN(APP_OPT_WORLD) |
+                                APP_GIVEN(APP_OPT_DURATION) | APP_GIVEN(APP_OPT_EVERY)));
     // Keys last: they are what an operator looks up while the window is open.
     fprintf(f,
             "(--solver cvode and --every do not apply to drive: it steps in real time and records one\n"

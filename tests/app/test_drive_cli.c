@@ -213,6 +213,14 @@ static void test_validation_world_report(void) {
     for (int i = 0; i < 4; ++i) CHECK(!strstr(out, absent[i]), "validation report mentions '%s': %s", absent[i], out);
     CHECK(strstr(out, "record -> validation.csv"), "%s", out);
 
+    // --help gives drive's own defaults (the sandbox and its operator), not
+    // run's (lagrange, ramp), and each option once.
+    rc = drive("", "--help");
+    CHECK(rc == 0 && strstr(out, "sandbox (default)") && strstr(out, "default sandbox_pick_place") &&
+              !strstr(out, "(default ramp)") && !strstr(out, "lagrange (analytic 2-DOF, default)") &&
+              occurrences(out, "  --duration") == 1,
+          "drive --help: %s", out);
+
     // A scenario that slews, driven where nothing slews: said once, not
     // dropped silently (the slew commands of sandbox_wall and sandbox_swing).
     rc = drive(NO_DISPLAY, "--headless --mechanics lagrange --scenario sandbox_wall --duration 0.3");
