@@ -255,8 +255,9 @@ int cmd_run(int argc, char** argv) {
         const double dur = c.sim.duration > 0 ? c.sim.duration : sc.duration;
         const bool fixed = !c.sim.cvode && !hyd_method_is_adaptive(c.sim.solver);
         const double steps = fixed ? dur / c.sim.h : 0.0;
-        if (steps > 1e8)
-            fprintf(stderr, "cranesim run: note: %.3g steps of %g s: at least %.0f s of wall time\n", steps, c.sim.h,
+        // Beyond 1e12 steps the run is refused below, with its own line.
+        if (steps > 1e8 && steps <= 1e12)
+            fprintf(stderr, "cranesim run: note: %.3g steps of %g s: at least %.3g s of wall time\n", steps, c.sim.h,
                     steps * 0.25e-6);
     }
     app_settle_unused(&c.sim);

@@ -281,13 +281,16 @@ static double stable_step(double lim, double dt_out) {
 // Returns 0, or 2 with the reason in res->message.
 int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, char* err, size_t errsz) {
     if (o->cvode || hyd_method_is_adaptive(o->solver)) return 0;
+    // The step h is the hydraulic one: in the ode world min(dt, dt_ode),
+    // so name the setting it came from.
+    const int which = h < o->h ? SIM_PARAM_DT_ODE : SIM_PARAM_DT;
     if (t_end > 0 && h > t_end) {
-        snprintf(err, errsz, "%s %g s is longer than the run (%g s)", sim_param_name(SIM_PARAM_DT), h, t_end);
+        snprintf(err, errsz, "%s %g s is longer than the run (%g s)", sim_param_name(which), h, t_end);
         return SIM_REFUSED;
     }
     if (t_end > 0 && t_end / h > 1e12) {
         snprintf(err, errsz, "%s %g s over %g s is %.3g steps, more than 1e12: use a larger %s or a shorter run",
-                 sim_param_name(SIM_PARAM_DT), h, t_end, t_end / h, sim_param_name(SIM_PARAM_DT));
+                 sim_param_name(which), h, t_end, t_end / h, sim_param_name(which));
         return SIM_REFUSED;
     }
     if (o->solver == HYD_RK4) {
