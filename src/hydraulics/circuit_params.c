@@ -98,9 +98,12 @@ int hyd_param_check(const hyd_param_info* p, double v, char* msg, size_t msgsz) 
         need = "must be > 0";
     else if ((p->rule == HYD_R_NONNEG || p->rule == HYD_R_ZERO_DEF) && !(v >= 0.0))
         need = "must be >= 0";
-    else if (p->rule == HYD_R_UNIT && !(v >= -1.0 && v <= 1.0))
+    // A bounded rule whose hard range is narrower says the hard range (below):
+    // "cd = 5: must be in [0, 1]" and then "cd = 0: must be in [0.1, 1]" named
+    // two different ranges for one value.
+    else if (p->rule == HYD_R_UNIT && !(v >= -1.0 && v <= 1.0) && !(p->lo >= -1.0 && p->hi <= 1.0))
         need = "must be in [-1, 1]";
-    else if (p->rule == HYD_R_FRAC && !(v >= 0.0 && v <= 1.0))
+    else if (p->rule == HYD_R_FRAC && !(v >= 0.0 && v <= 1.0) && !(p->lo >= 0.0 && p->hi <= 1.0))
         need = "must be in [0, 1]";
     char got[24];
     hyd_fmt_num(got, sizeof got, v);

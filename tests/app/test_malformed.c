@@ -253,6 +253,15 @@ static void test_set_and_load(void) {
     CHECK(rc == 2 && strstr(out_buf, "--load") && strstr(out_buf, "kg"), "--load 1e5: exit %d: %s", rc, out_buf);
 }
 
+// One value, one range: a discharge coefficient of 5 and of 0 both name the
+// hard range [0.1, 1] (5 named the rule's [0, 1] before).
+static void test_one_range_per_value(void) {
+    int rc = cli_run("run --quiet --set hydraulics.components.lift_valve.cd=5 --out /dev/null", out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "must be in [0.1, 1], got 5"), "exit %d: %s", rc, out_buf);
+    rc = cli_run("run --quiet --set hydraulics.components.lift_valve.cd=0 --out /dev/null", out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "must be in [0.1, 1], got 0"), "exit %d: %s", rc, out_buf);
+}
+
 // A sandbox start the reliefs cannot hold is the world's hook, not a tip
 // load: the refusal says so and does not suggest --load, which the sandbox
 // refuses (it said "with 500 kg at the tip ... a smaller --load").
@@ -341,6 +350,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_set_and_load);
     RUN_TEST(test_typical_notes);
     RUN_TEST(test_sandbox_start_names_the_hook);
+    RUN_TEST(test_one_range_per_value);
     RUN_TEST(test_shipped_quiet);
     TEST_MAIN_END();
 }
