@@ -63,7 +63,10 @@ static void add_actuator(hyd_builder* b, const char* pre, double bore, double ro
     }
 }
 
-hyd_model* hyd_model_default_crane(char* err, size_t errsz) {
+// The supply both circuits share: tank, a 1 L pump line, a pressure-
+// compensated pump of q_max [m^3/s] set to 20 MPa, a 22 MPa main relief.
+// NULL (and "out of memory" in err) if no builder could be had.
+static hyd_builder* supply(double q_max, char* err, size_t errsz) {
     hyd_builder* b = hyd_builder_create();
     if (!b) {
         if (err && errsz)
@@ -77,12 +80,11 @@ hyd_model* hyd_model_default_crane(char* err, size_t errsz) {
     pl.name = "pump_line";
     pl.volume = 1e-3;
     hyd_add_volume(b, &pl);
-
     hyd_pump_def p = hyd_default_pump_def();
     p.name = "pump";
     p.inlet = "tank";
     p.outlet = "pump_line";
-    p.q_max = 35.0 / 60000.0;
+    p.q_max = q_max;
     p.p_set = 20e6;
     hyd_add_pump(b, &p);
     hyd_relief_def r = hyd_default_relief_def();
@@ -91,7 +93,12 @@ hyd_model* hyd_model_default_crane(char* err, size_t errsz) {
     r.outlet = "tank";
     r.p_crack = 22e6;
     hyd_add_relief(b, &r);
+    return b;
+}
 
+hyd_model* hyd_model_default_crane(char* err, size_t errsz) {
+    hyd_builder* b = supply(35.0 / 60000.0, err, errsz);
+    if (!b) return NULL;
     add_actuator(b, "lift", 0.100, 0.060, 0.7);
     add_actuator(b, "jib", 0.080, 0.045, 0.6);
     hyd_model* m = hyd_compile(b, err, errsz);
@@ -105,33 +112,10 @@ hyd_model* hyd_model_synthetic(int nact, char* err, size_t errsz) {
             snprintf(err, errsz, "actuators: must be in [1, 64], got %d", nact);
         return NULL;
     }
-    hyd_builder* b = hyd_builder_create();
-    if (!b) {
-        if (err && errsz)
-            snprintf(err, errsz, "out of memory");
-        return NULL;
-    }
-    hyd_tank_def t = hyd_default_tank_def();
-    t.name = "tank";
-    hyd_add_tank(b, &t);
-    hyd_volume_def pl = hyd_default_volume_def();
-    pl.name = "pump_line";
-    pl.volume = 1e-3;
-    hyd_add_volume(b, &pl);
-    // A pump and main relief sized as the crane's, per actuator (35 L/min each).
-    hyd_pump_def p = hyd_default_pump_def();
-    p.name = "pump";
-    p.inlet = "tank";
-    p.outlet = "pump_line";
-    p.q_max = nact * 35.0 / 60000.0 < 0.1 ? nact * 35.0 / 60000.0 : 0.1;
-    p.p_set = 20e6;
-    hyd_add_pump(b, &p);
-    hyd_relief_def r = hyd_default_relief_def();
-    r.name = "main_relief";
-    r.inlet = "pump_line";
-    r.outlet = "tank";
-    r.p_crack = 22e6;
-    hyd_add_relief(b, &r);
+    // The crane's pump per actuator (35 L/min each), at most 0.1 m^3/s.
+    const double q = nact * 35.0 / 60000.0;
+    hyd_builder* b = supply(q < 0.1 ? q : 0.1, err, errsz);
+    if (!b) return NULL;
     for (int k = 0; k < nact; ++k) {
         char pre[16];
         snprintf(pre, sizeof pre, "act%d", k + 1);

@@ -82,7 +82,7 @@ void hyd_fmt_num(char* out, size_t n, double v) {
 }
 
 // "[lo, hi] unit" for messages ("[1e5, 1e8] Pa"; no unit for "-").
-static void range_text(char* out, size_t n, double lo, double hi, const char* unit) {
+void hyd_fmt_range(char* out, size_t n, double lo, double hi, const char* unit) {
     char a[24], b[24];
     hyd_fmt_num(a, sizeof a, lo);
     hyd_fmt_num(b, sizeof b, hi);
@@ -116,7 +116,7 @@ int hyd_param_check(const hyd_param_info* p, double v, char* msg, size_t msgsz) 
     if (v >= p->lo && v <= p->hi)
         return 0;
     char r[64];
-    range_text(r, sizeof r, p->lo, p->hi, p->unit);
+    hyd_fmt_range(r, sizeof r, p->lo, p->hi, p->unit);
     snprintf(msg, msgsz, "must be %sin %s, got %s", p->rule == HYD_R_ZERO_DEF ? "0 (the fluid's) or " : "", r, got);
     return -1;
 }
@@ -125,7 +125,7 @@ int hyd_param_typical(const hyd_param_info* p, double v, char* msg, size_t msgsz
     if ((p->rule == HYD_R_ZERO_DEF && v == 0.0) || (v >= p->tlo && v <= p->thi))
         return 0;
     char r[64], got[24];
-    range_text(r, sizeof r, p->tlo, p->thi, p->unit);
+    hyd_fmt_range(r, sizeof r, p->tlo, p->thi, p->unit);
     hyd_fmt_num(got, sizeof got, v);
     snprintf(msg, msgsz, "%s is outside the typical range %s", got, r);
     return -1;

@@ -456,6 +456,8 @@ void hyd_json_fragment_notes(const struct cJSON* fragment, const char* file, con
 /// A number for a message as a user writes it: 22, 0.005, 1e5, 2.5e9 (6
 /// significant digits; %g would give 100000 and 2.5e+09).
 void hyd_fmt_num(char* out, size_t n, double v);
+/// A range for a message: "[1e5, 1e8] Pa" (no unit for NULL, "" or "-").
+void hyd_fmt_range(char* out, size_t n, double lo, double hi, const char* unit);
 /// The model's current definition (fluid, nodes, components with every
 /// parameter, including live changes) as a new cJSON object; the caller frees
 /// it with cJSON_Delete. NULL if out of memory.

@@ -296,15 +296,23 @@ const cJSON* json_arr(json_ctx* c, const cJSON* obj, const char* path, const cha
     return v;
 }
 
+// The member key of obj that must be a number: NULL when absent (and not
+// required) or not a number (the failure recorded); its full path in full.
+static const cJSON* number_member(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
+                                  char* full, size_t n) {
+    const cJSON* v = member(c, obj, path, key, required, full, n);
+    if (v && !cJSON_IsNumber(v)) {
+        json_fail(c, full, "must be a number, got %s", type_name(v));
+        return NULL;
+    }
+    return v;
+}
+
 double json_num(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
                 double def, double lo, double hi) {
     char full[256];
-    const cJSON* v = member(c, obj, path, key, required, full, sizeof full);
+    const cJSON* v = number_member(c, obj, path, key, required, full, sizeof full);
     if (!v) return def;
-    if (!cJSON_IsNumber(v)) {
-        json_fail(c, full, "must be a number, got %s", type_name(v));
-        return def;
-    }
     double x = v->valuedouble;
     if (!isfinite(x)) json_fail(c, full, "must be a finite number");
     else if (x < lo) json_fail(c, full, "must be >= %g, got %g", lo, x);
@@ -330,14 +338,6 @@ void json_flush_notes(json_ctx* c) {
     c->nnotes = 0;
 }
 
-// "[lo, hi] unit" as a user writes it ("[1, 1e5] kg").
-static void range_text(char* out, size_t n, double lo, double hi, const char* unit) {
-    char a[24], b[24];
-    hyd_fmt_num(a, sizeof a, lo);
-    hyd_fmt_num(b, sizeof b, hi);
-    snprintf(out, n, "[%s, %s]%s%s", a, b, unit && *unit ? " " : "", unit ? unit : "");
-}
-
 void json_range_check(json_ctx* c, const char* full, double v, const json_range* r) {
     if (c->failed) return;
     char got[24], rng[80];
@@ -347,10 +347,10 @@ void json_range_check(json_ctx* c, const char* full, double v, const json_range*
     } else if (r->lo > 0 && !(v > 0)) {
         json_fail(c, full, "must be > 0, got %s", got);
     } else if (v < r->lo || v > r->hi) {
-        range_text(rng, sizeof rng, r->lo, r->hi, r->unit);
+        hyd_fmt_range(rng, sizeof rng, r->lo, r->hi, r->unit);
         json_fail(c, full, "must be in %s, got %s", rng, got);
     } else if (v < r->tlo || v > r->thi) {
-        range_text(rng, sizeof rng, r->tlo, r->thi, r->unit);
+        hyd_fmt_range(rng, sizeof rng, r->tlo, r->thi, r->unit);
         json_note(c, full, "%s%s%s is outside the typical range %s", got, r->unit && *r->unit ? " " : "",
                   r->unit ? r->unit : "", rng);
     }
@@ -359,12 +359,8 @@ void json_range_check(json_ctx* c, const char* full, double v, const json_range*
 double json_num_r(json_ctx* c, const cJSON* obj, const char* path, const char* key, bool required,
                   double def, const json_range* r) {
     char full[256];
-    const cJSON* v = member(c, obj, path, key, required, full, sizeof full);
+    const cJSON* v = number_member(c, obj, path, key, required, full, sizeof full);
     if (!v) return def;
-    if (!cJSON_IsNumber(v)) {
-        json_fail(c, full, "must be a number, got %s", type_name(v));
-        return def;
-    }
     json_range_check(c, full, v->valuedouble, r);
     return v->valuedouble;
 }
