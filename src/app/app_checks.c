@@ -177,28 +177,20 @@ void app_note_load(const char* cmd, const app_common* c, const sim_opts* o, cons
                 cmd, set, sc->name, sc->load_mass, v);
 }
 
-// What in a scenario needs the sandbox (NULL: nothing): the slew, the hook.
-static const char* sandbox_use(const scenario* sc) {
-    if (sc->nevent > 0) return "works the hook";
+// What in a scenario needs a slewing column (NULL: nothing).
+static const char* slew_use(const scenario* sc) {
     const scenario_signal* sl = &sc->cmd[2];
     for (int i = 0; i < sl->n; ++i)
         if (sl->u[i] != 0) return "slews the crane";
     return sc->slew0 != 0 ? "starts slewed" : NULL;
 }
 
+// What in a scenario needs the sandbox (NULL: nothing): the hook, the slew.
+static const char* sandbox_use(const scenario* sc) { return sc->nevent > 0 ? "works the hook" : slew_use(sc); }
+
 void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind) {
-    if (world_kind == WORLD_SANDBOX) return;
-    const char* why = sandbox_use(sc);
-    if (!why || !strcmp(why, "works the hook")) {
-        // Hook events alone are said when they come; a slew is looked for
-        // in the commands too (a scenario can do both).
-        const scenario_signal* sl = &sc->cmd[2];
-        why = NULL;
-        for (int i = 0; i < sl->n && !why; ++i)
-            if (sl->u[i] != 0) why = "slews the crane";
-        if (!why && sc->slew0 != 0) why = "starts slewed";
-        if (!why) return;
-    }
+    const char* why = world_kind == WORLD_SANDBOX ? NULL : slew_use(sc);
+    if (!why) return;
     fprintf(stderr,
             "cranesim %s: note: scenario %s %s, which the %s has not: its slew is ignored (the sandbox has one: "
             "--mechanics ode --world sandbox)\n",
