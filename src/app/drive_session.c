@@ -297,11 +297,7 @@ static void apply_param(drive_session* s, int i) {
         } else {
             s->mech_live.link[k] = *ln; // the running world has it now
         }
-        char a[160], e2[200];
-        snprintf(a, sizeof a, "mechanics.links[%d].com=%.10g", k, ln->com);
-        json_set_path(s->m->json, a, e2, sizeof e2);
-        snprintf(a, sizeof a, "mechanics.links[%d].inertia=%.10g", k, ln->inertia);
-        json_set_path(s->m->json, a, e2, sizeof e2);
+        sync_mech_json(s);
         break;
     }
     case PK_LOAD:
