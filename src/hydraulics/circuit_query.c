@@ -114,7 +114,20 @@ hyd_node_role hyd_model_node_role(const hyd_model* m, int i) {
     for (int k = 0; k < m->npump; ++k)
         if (m->pump[k].out == i)
             return HYD_NODE_SUPPLY;
-    return HYD_NODE_LINE;
+    // Roles other types give the nodes at their ports (descriptor port_roles).
+    hyd_node_role r = HYD_NODE_LINE;
+    for (int c = 0; c < m->ncomp; ++c) {
+        const hyd_component* d = hyd_component_of(m->comp[c].type);
+        if (!d->port_roles)
+            continue;
+        for (int k = 0; k < d->nport; ++k)
+            if (d->port_roles[k] != HYD_NODE_LINE && hyd_model_port_node(m, c, k) == i) {
+                if (d->port_roles[k] == HYD_NODE_SUPPLY)
+                    return HYD_NODE_SUPPLY;
+                r = d->port_roles[k];
+            }
+    }
+    return r;
 }
 
 int hyd_model_supply_node(const hyd_model* m) {

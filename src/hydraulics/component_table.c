@@ -5,7 +5,7 @@
 
 extern const hyd_component hyd_tank_component, hyd_volume_component, hyd_pump_component,
     hyd_relief_component, hyd_check_component, hyd_orifice_component, hyd_hose_component,
-    hyd_valve_component, hyd_cylinder_component;
+    hyd_valve_component, hyd_cylinder_component, hyd_ls_pump_component;
 
 // Designated by type, so the order of lines cannot disagree with hyd_type.
 static const hyd_component* const table[HYD_TYPE_COUNT] = {
@@ -18,6 +18,7 @@ static const hyd_component* const table[HYD_TYPE_COUNT] = {
     [HYD_HOSE] = &hyd_hose_component,
     [HYD_VALVE] = &hyd_valve_component,
     [HYD_CYLINDER] = &hyd_cylinder_component,
+    [HYD_LS_PUMP] = &hyd_ls_pump_component,
 };
 
 const hyd_component* hyd_component_of(hyd_type t) {

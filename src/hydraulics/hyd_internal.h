@@ -105,6 +105,10 @@ typedef struct hyd_component {
     const char* const* states; ///< states other than its nodes' pressures ("spool"), after them
     int nstate;
     size_t rec_size;   ///< its packed record in hyd_model.rec[type] (0: none, for user nodes)
+    /// Role its port k gives the node there (hyd_model_node_role): NULL, or
+    /// nport entries, HYD_NODE_LINE for "no role" (a LS pump's outlet is a
+    /// supply node, its "ls" port a load-sensing line).
+    const hyd_node_role* port_roles;
     /// Fill def with the documented defaults (name and ports NULL).
     void (*defaults)(void* def);
     /// Cross-field value rules a parameter table cannot express (rod < bore):
@@ -419,6 +423,18 @@ static inline void hyd_flow2(const hyd_model* m, hyd_data* d, double* G, int c, 
     d->flow_[4 * c + 1] = q;
     if (G)
         hyd_jac_flow(m, G, a, b, ga, gb);
+}
+
+/// A component's own (non-pressure) state s whose rate depends on pressures
+/// or on other states: its eval hook writes d ydot_s / d y into row s of G
+/// (rows of non-pressure states are not used by the node rows, volume.c),
+/// and its jacobian hook copies that row into the block with this (G is
+/// d->scratch_ in both the reference and the fast kernel's fallback; the
+/// tank column n is dropped).
+static inline void hyd_state_row_from_G(const hyd_model* m, const hyd_data* d, int s, double* Jb,
+                                        int ldj) {
+    const int n = m->nstate;
+    memcpy(Jb + (size_t)s * ldj, d->scratch_ + (size_t)s * (n + 1), (size_t)n * sizeof(double));
 }
 
 /// C1 smoothstep s(t) = 3t^2 - 2t^3 on [0,1], 0 below, 1 above; *ds = ds/dt.

@@ -34,6 +34,7 @@ typedef enum hyd_type {
     HYD_HOSE,     ///< hose volume node plus a laminar resistance to node "to"
     HYD_VALVE,    ///< 4/3 closed-centre proportional valve, ports P, T, A, B
     HYD_CYLINDER, ///< double-acting cylinder with chambers "<name>.A", "<name>.B"
+    HYD_LS_PUMP,  ///< load-sensing variable pump, inlet -> outlet, LS port "ls"
     HYD_TYPE_COUNT
 } hyd_type;
 
@@ -160,6 +161,23 @@ typedef struct hyd_cylinder_def {
     double p0_b;           ///< initial chamber B pressure [Pa abs]; default 1e5
 } hyd_cylinder_def;
 
+/// Load-sensing variable pump: displacement state "<name>.disp" eps in [0, 1],
+/// delivery eps q_max; the displacement follows, with time constant tau, the
+/// setting that holds p_out - p_ls at margin, cut back above p_cutoff.
+typedef struct hyd_ls_pump_def {
+    const char* name;
+    const char* inlet;  ///< suction node (usually the tank)
+    const char* outlet; ///< delivery node (the pump line)
+    const char* ls;     ///< load-sensing line node (sensed only, no flow)
+    double q_max;       ///< REQUIRED flow at full displacement and the shaft speed [m^3/s]
+    double margin;      ///< LS margin p_out - p_ls held by the controller [Pa]; default 2e6
+    double band;        ///< LS controller band around the margin [Pa]; default 5e4
+    double p_cutoff;    ///< pressure cut-off, outlet - inlet, where the flow starts to fall [Pa]; default 22e6
+    double cutoff_band; ///< pressure rise from cut-off start to zero flow [Pa]; default 0.5e6
+    double tau;         ///< displacement time constant (stroke time) [s]; default 0.08
+    double eps0;        ///< initial displacement [-]; default 0
+} hyd_ls_pump_def;
+
 hyd_fluid_def hyd_default_fluid_def(void);
 hyd_tank_def hyd_default_tank_def(void);
 hyd_volume_def hyd_default_volume_def(void);
@@ -170,6 +188,7 @@ hyd_orifice_def hyd_default_orifice_def(void);
 hyd_hose_def hyd_default_hose_def(void);
 hyd_valve_def hyd_default_valve_def(void);
 hyd_cylinder_def hyd_default_cylinder_def(void);
+hyd_ls_pump_def hyd_default_ls_pump_def(void);
 
 // ---------------------------------------------------------------------------
 // Building and compiling
@@ -300,7 +319,7 @@ typedef enum hyd_node_role {
     HYD_NODE_LINE = 0, ///< any other pressure node (a line, a hose, a chamber)
     HYD_NODE_TANK,     ///< fixed pressure (a tank node; no state)
     HYD_NODE_SUPPLY,   ///< a pump delivers into it (the pump line)
-    HYD_NODE_LS        ///< a load-sensing line (no component creates one yet)
+    HYD_NODE_LS        ///< a load-sensing line (the "ls" port of a LS pump)
 } hyd_node_role;
 /// Role of node i (HYD_NODE_LINE when i is out of range).
 hyd_node_role hyd_model_node_role(const hyd_model* m, int i);

@@ -1,0 +1,142 @@
+// ls_pump.c: load-sensing variable displacement pump.
+//
+// State eps in [0, 1], the displacement fraction; delivery q = eps q_max
+// (q_max: full displacement at the shaft speed), inlet -> outlet. The
+// displacement controller is a first-order lag towards the setting the
+// LS spool and the cut-off spool ask for:
+//   tau eps' = eps_t - eps,   eps_t = e_ls e_co
+//   e_ls = 1 - smoothstep((p_out - p_ls - margin) / band + 1/2)
+//   e_co = 1 - smoothstep((p_out - p_in - p_cutoff) / cutoff_band)
+// e_ls is 1 while the margin is not reached and 0 once it is exceeded by
+// band/2, so at any steady flow between 0 and q_max the controller holds
+// p_out - p_ls within margin +- band/2. e_co takes the flow away above the
+// cut-off, whatever the LS signal asks (a product: either spool alone can
+// destroke the pump; where both are inside their bands it is C1 as well).
+// tau is the stroke time constant; eps_t in [0, 1] keeps eps in [0, 1]
+// without a limiter. The LS port draws no flow: the LS line's own bleed
+// orifice (a fixed orifice to tank) empties it.
+#include "hyd_internal.h"
+
+typedef struct hyd_ls_pump_c {
+    int in, out, ls, adr, comp;
+    double qmax, margin, inv_band, pcut, inv_cband, inv_tau;
+} hyd_ls_pump_c;
+
+hyd_ls_pump_def hyd_default_ls_pump_def(void) {
+    hyd_ls_pump_def d = {0};
+    d.margin = 2e6;
+    d.band = 5e4;
+    d.p_cutoff = 22e6;
+    d.cutoff_band = 0.5e6;
+    d.tau = 0.08;
+    d.eps0 = 0.0;
+    return d;
+}
+
+static void ls_pump_derive(hyd_model* m, const void* def, void* rec, int node0) {
+    (void)m, (void)node0;
+    const hyd_ls_pump_def* d = def;
+    hyd_ls_pump_c* c = rec;
+    c->qmax = d->q_max;
+    c->margin = d->margin;
+    c->inv_band = 1.0 / d->band;
+    c->pcut = d->p_cutoff;
+    c->inv_cband = 1.0 / d->cutoff_band;
+    c->inv_tau = 1.0 / d->tau;
+}
+
+static void ls_pumps_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, const double* y,
+                          double* ydot, double* G, const int* map) {
+    const int ld = m->nstate + 1;
+    for (int i = 0; i < n; ++i) {
+        const hyd_ls_pump_c* c = (const hyd_ls_pump_c*)rec + i;
+        const int at = map ? map[c->adr] : c->adr;
+        const double eps = y[at];
+        const double pin = d->node_p[c->in], pout = d->node_p[c->out], pls = d->node_p[c->ls];
+        double ds1, ds2;
+        const double e_ls = 1.0 - hyd_smoothstep((pout - pls - c->margin) * c->inv_band + 0.5, &ds1);
+        const double e_co = 1.0 - hyd_smoothstep((pout - pin - c->pcut) * c->inv_cband, &ds2);
+        const double target = e_ls * e_co;
+        if (ydot)
+            ydot[at] = (target - eps) * c->inv_tau;
+        const double q = eps * c->qmax;
+        d->comp_q[2 * c->comp] = q;
+        d->comp_open[c->comp] = target < 1.0;
+        double* fl = d->flow_ + HYD_MAXSLOT * c->comp;
+        fl[0] = -q, fl[1] = q, fl[2] = 0.0;
+        if (G) {
+            const int si = m->node_sidx[c->in], so = m->node_sidx[c->out], sl = m->node_sidx[c->ls];
+            // Flow column: dq/deps = q_max.
+            G[si * ld + c->adr] -= c->qmax;
+            G[so * ld + c->adr] += c->qmax;
+            // Displacement row (hyd_state_row_from_G): d eps' / d p and d eps.
+            const double a1 = -ds1 * c->inv_band * e_co; // d e_ls e_co / d(p_out - p_ls)
+            const double a2 = -ds2 * c->inv_cband * e_ls; // d e_ls e_co / d(p_out - p_in)
+            double* row = G + (size_t)c->adr * ld;
+            row[so] += (a1 + a2) * c->inv_tau;
+            row[sl] -= a1 * c->inv_tau;
+            row[si] -= a2 * c->inv_tau;
+            row[c->adr] -= c->inv_tau;
+        }
+    }
+}
+
+static void ls_pumps_jacobian(const hyd_model* m, hyd_data* d, const void* rec, int n, double* Jb,
+                              int ldj) {
+    if (!Jb)
+        return;
+    for (int i = 0; i < n; ++i)
+        hyd_state_row_from_G(m, d, ((const hyd_ls_pump_c*)rec)[i].adr, Jb, ldj);
+}
+
+// A pump that senses its own outlet would hold p_out - p_out = margin: never.
+static int ls_pump_check_ports(const hyd_model* m, const char* const* port_name, const int* port,
+                               const int* own, char* field, size_t fsz, char* msg, size_t msz) {
+    (void)m, (void)own;
+    if (port[2] == port[1]) {
+        snprintf(field, fsz, "ls");
+        snprintf(msg, msz, "'%s' is the pump's own outlet; ls must be the load-sensing line", port_name[2]);
+        return -1;
+    }
+    return 0;
+}
+
+static void ls_pump_bind(void* rec, int comp, const int* port, const int* own, const int* state) {
+    (void)own;
+    hyd_ls_pump_c* c = rec;
+    c->comp = comp, c->in = port[0], c->out = port[1], c->ls = port[2];
+    c->adr = state[0];
+}
+
+static void ls_pump_initial(const void* def, const void* rec, double* y0) {
+    y0[((const hyd_ls_pump_c*)rec)->adr] = ((const hyd_ls_pump_def*)def)->eps0;
+}
+
+static const hyd_param_info ls_pump_params[] = {
+    HYD_PARAM(hyd_ls_pump_def, q_max, "m^3/s", HYD_R_POS, 1, 1e-7, 0.1, 1e-5, 5e-3),
+    HYD_PARAM(hyd_ls_pump_def, margin, "Pa", HYD_R_POS, 0, 1e5, 1e7, 1e6, 3e6),
+    HYD_PARAM(hyd_ls_pump_def, band, "Pa", HYD_R_POS, 0, 1e3, 2e6, 1e4, 3e5),
+    HYD_PARAM(hyd_ls_pump_def, p_cutoff, "Pa", HYD_R_POS, 0, 1e6, 1e8, 1e7, 4.5e7),
+    HYD_PARAM(hyd_ls_pump_def, cutoff_band, "Pa", HYD_R_POS, 0, 1e3, 1e7, 1e5, 3e6),
+    HYD_PARAM(hyd_ls_pump_def, tau, "s", HYD_R_POS, 0, 1e-3, 10, 0.05, 0.15),
+    HYD_PARAM(hyd_ls_pump_def, eps0, "-", HYD_R_FRAC, 0, 0, 1, 0, 1),
+};
+static const hyd_port_info ls_pump_ports[] = {HYD_PORT(hyd_ls_pump_def, inlet),
+                                              HYD_PORT(hyd_ls_pump_def, outlet),
+                                              HYD_PORT(hyd_ls_pump_def, ls)};
+static const hyd_node_role ls_pump_roles[] = {HYD_NODE_LINE, HYD_NODE_SUPPLY, HYD_NODE_LS};
+static const char* const ls_pump_states[] = {"disp"};
+
+static void ls_pump_defaults(void* def) { *(hyd_ls_pump_def*)def = hyd_default_ls_pump_def(); }
+
+HYD_DEF_FITS(hyd_ls_pump_def);
+const hyd_component hyd_ls_pump_component = {
+    .type = HYD_LS_PUMP, .name = "ls_pump", .def_size = sizeof(hyd_ls_pump_def),
+    .params = ls_pump_params, .nparam = HYD_COUNT(ls_pump_params),
+    .ports = ls_pump_ports, .nport = HYD_COUNT(ls_pump_ports),
+    .states = ls_pump_states, .nstate = HYD_COUNT(ls_pump_states),
+    .rec_size = sizeof(hyd_ls_pump_c), .port_roles = ls_pump_roles,
+    .defaults = ls_pump_defaults, .check_ports = ls_pump_check_ports, .bind = ls_pump_bind,
+    .derive = ls_pump_derive, .initial = ls_pump_initial, .eval = ls_pumps_eval,
+    .jacobian = ls_pumps_jacobian,
+};
