@@ -5,7 +5,9 @@
 
 extern const hyd_component hyd_tank_component, hyd_volume_component, hyd_pump_component,
     hyd_relief_component, hyd_check_component, hyd_orifice_component, hyd_hose_component,
-    hyd_valve_component, hyd_cylinder_component, hyd_ls_pump_component;
+    hyd_valve_component, hyd_cylinder_component, hyd_ls_pump_component,
+    hyd_shuttle_component, hyd_compensator_component, hyd_counterbalance_component,
+    hyd_accumulator_component;
 
 // Designated by type, so the order of lines cannot disagree with hyd_type.
 static const hyd_component* const table[HYD_TYPE_COUNT] = {
@@ -19,6 +21,10 @@ static const hyd_component* const table[HYD_TYPE_COUNT] = {
     [HYD_VALVE] = &hyd_valve_component,
     [HYD_CYLINDER] = &hyd_cylinder_component,
     [HYD_LS_PUMP] = &hyd_ls_pump_component,
+    [HYD_SHUTTLE] = &hyd_shuttle_component,
+    [HYD_COMPENSATOR] = &hyd_compensator_component,
+    [HYD_COUNTERBALANCE] = &hyd_counterbalance_component,
+    [HYD_ACCUMULATOR] = &hyd_accumulator_component,
 };
 
 const hyd_component* hyd_component_of(hyd_type t) {

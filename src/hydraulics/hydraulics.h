@@ -35,6 +35,10 @@ typedef enum hyd_type {
     HYD_VALVE,    ///< 4/3 closed-centre proportional valve, ports P, T, A, B
     HYD_CYLINDER, ///< double-acting cylinder with chambers "<name>.A", "<name>.B"
     HYD_LS_PUMP,  ///< load-sensing variable pump, inlet -> outlet, LS port "ls"
+    HYD_SHUTTLE,  ///< LS shuttle: smooth max of ports a, b into node "out"
+    HYD_COMPENSATOR, ///< section pressure compensator, inlet -> outlet (valve P), senses load, ref
+    HYD_COUNTERBALANCE, ///< counterbalance valve: check valve -> load, pilot-assisted relief load -> valve
+    HYD_ACCUMULATOR, ///< gas-charged accumulator on node "port", oil volume state "<name>.oil"
     HYD_TYPE_COUNT
 } hyd_type;
 
@@ -178,6 +182,68 @@ typedef struct hyd_ls_pump_def {
     double eps0;        ///< initial displacement [-]; default 0
 } hyd_ls_pump_def;
 
+/// LS shuttle (signal network): flow G (smax(p_a, p_b) - p_out) into node out,
+/// drawn from a and b; smax is max with a C1 corner of half-width "width".
+typedef struct hyd_shuttle_def {
+    const char* name;
+    const char* a;       ///< first sensed node (a work port or an upstream shuttle)
+    const char* b;       ///< second sensed node
+    const char* out;     ///< LS line node (declare it as a volume)
+    double conductance;  ///< laminar conductance of the signal path [m^3/(s Pa)]; default 2e-11
+    double width;        ///< half-width of the max-select corner [Pa]; default 1e5
+} hyd_shuttle_def;
+
+/// Section pressure compensator: an orifice inlet -> outlet of area x area,
+/// x in [0, 1] set so that the meter-in drop p_outlet - p_load of the valve
+/// it feeds is setting (mode 0, pre-compensated) or p_inlet - p_ref - setting
+/// (mode 1, post-compensated / flow sharing; ref = the highest LS pressure).
+typedef struct hyd_compensator_def {
+    const char* name;
+    const char* inlet;  ///< pump line
+    const char* outlet; ///< the valve's P port node (declare it as a volume)
+    const char* load;   ///< the section's load pressure (work port or section LS node), sensed
+    const char* ref;    ///< the highest LS pressure (the LS line), sensed (mode 1)
+    double area;        ///< REQUIRED full opening [m^2]
+    double cd;          ///< discharge coefficient [-]; default 0.65
+    double setting;     ///< spring setting [Pa]; default 1e6 (pre), see mode
+    double band;        ///< drop error from open to closed [Pa]; default 5e4
+    double mode;        ///< 0: pre-compensated, 1: post-compensated (flow sharing); default 1
+} hyd_compensator_def;
+
+/// Counterbalance (over-centre) valve between a valve-side node and a load
+/// (cylinder) node. Free flow valve -> load through a check valve; out of the
+/// load through a relief whose spool (state "<name>.spool", x in [0, 1])
+/// follows, with time constant tau, the opening asked by
+/// (p_load - p_valve) + pilot_ratio (p_pilot - p_valve) - p_setting.
+typedef struct hyd_counterbalance_def {
+    const char* name;
+    const char* valve;  ///< valve-side node (the hose to the directional valve)
+    const char* load;   ///< the cylinder chamber it holds
+    const char* pilot;  ///< pilot node (the opposite line)
+    double p_setting;   ///< REQUIRED relief setting [Pa] (typically 1.3 x the load-holding pressure)
+    double pilot_ratio; ///< pilot area ratio R [-]; default 3
+    double band;        ///< opening signal from crack to full open [Pa]; default 1e6
+    double area;        ///< relief full opening [m^2]; default 2e-5
+    double cd;          ///< discharge coefficient [-]; default 0.65
+    double tau;         ///< spool time constant [s]; default 0.01
+    double check_crack; ///< check valve cracking pressure [Pa]; default 0.05e6
+    double check_open;  ///< check valve pressure from crack to rated flow [Pa]; default 0.2e6
+    double check_q;     ///< check valve rated flow [m^3/s]; default 1.6667e-3 (100 L/min)
+} hyd_counterbalance_def;
+
+/// Gas-charged accumulator: gas p V_g^n = p0 V0^n, oil volume V = V0 - V_g
+/// (state "<name>.oil" [m^3]), fed from node "port" through a laminar
+/// conductance.
+typedef struct hyd_accumulator_def {
+    const char* name;
+    const char* port;   ///< the node it is mounted on
+    double p0;          ///< REQUIRED precharge pressure [Pa abs]
+    double V0;          ///< REQUIRED gas volume at precharge (the size) [m^3]
+    double n;           ///< polytropic index [-]: 1 isothermal, 1.4 adiabatic; default 1.4
+    double conductance; ///< laminar conductance of the connection [m^3/(s Pa)]; default 1e-9
+    double p_init;      ///< initial gas pressure [Pa abs]; 0 (default): the precharge (empty)
+} hyd_accumulator_def;
+
 hyd_fluid_def hyd_default_fluid_def(void);
 hyd_tank_def hyd_default_tank_def(void);
 hyd_volume_def hyd_default_volume_def(void);
@@ -189,6 +255,10 @@ hyd_hose_def hyd_default_hose_def(void);
 hyd_valve_def hyd_default_valve_def(void);
 hyd_cylinder_def hyd_default_cylinder_def(void);
 hyd_ls_pump_def hyd_default_ls_pump_def(void);
+hyd_shuttle_def hyd_default_shuttle_def(void);
+hyd_compensator_def hyd_default_compensator_def(void);
+hyd_counterbalance_def hyd_default_counterbalance_def(void);
+hyd_accumulator_def hyd_default_accumulator_def(void);
 
 // ---------------------------------------------------------------------------
 // Building and compiling
