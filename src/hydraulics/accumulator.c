@@ -114,7 +114,7 @@ const hyd_component hyd_accumulator_component = {
     .params = acc_params, .nparam = HYD_COUNT(acc_params),
     .ports = acc_ports, .nport = HYD_COUNT(acc_ports),
     .states = acc_states, .nstate = HYD_COUNT(acc_states),
-    .rec_size = sizeof(hyd_acc_c),
+    .rec_size = sizeof(hyd_acc_c), .states_sense_ports = 1,
     .defaults = acc_defaults, .bind = acc_bind, .derive = acc_derive, .initial = acc_initial,
     .eval = accs_eval, .jacobian = accs_jacobian,
 };

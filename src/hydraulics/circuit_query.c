@@ -190,5 +190,13 @@ void hyd_model_jacobian_pattern(const hyd_model* m, unsigned char* P) {
         }
         for (int k = 0; k < ns; ++k)
             P[(size_t)(s0 + k) * n + s0 + k] = 1; // a lag on its own state
+        if (d->states_sense_ports)
+            for (int k = 0; k < ns; ++k) {
+                for (int a = 0; a < HYD_MAXSLOT; ++a)
+                    if (slot[a] >= 0 && m->node_state[slot[a]] >= 0)
+                        P[(size_t)(s0 + k) * n + m->node_state[slot[a]]] = 1;
+                for (int j = 0; j < ns; ++j)
+                    P[(size_t)(s0 + k) * n + s0 + j] = 1;
+            }
     }
 }

@@ -135,7 +135,7 @@ const hyd_component hyd_counterbalance_component = {
     .params = cb_params, .nparam = HYD_COUNT(cb_params),
     .ports = cb_ports, .nport = HYD_COUNT(cb_ports),
     .states = cb_states, .nstate = HYD_COUNT(cb_states),
-    .rec_size = sizeof(hyd_cb_c),
+    .rec_size = sizeof(hyd_cb_c), .states_sense_ports = 1,
     .defaults = cb_defaults, .bind = cb_bind, .derive = cb_derive, .initial = cb_initial,
     .eval = cbs_eval, .jacobian = cbs_jacobian,
 };

@@ -109,6 +109,12 @@ typedef struct hyd_component {
     /// nport entries, HYD_NODE_LINE for "no role" (a LS pump's outlet is a
     /// supply node, its "ls" port a load-sensing line).
     const hyd_node_role* port_roles;
+    /// 1: the rates of its own states depend on the pressures at its flow
+    /// slots (a lag whose set point is a pressure: LS pump displacement,
+    /// counterbalance spool, accumulator oil volume), so its state rows
+    /// are not diagonal (hyd_model_jacobian_pattern). 0: a lag on its own
+    /// state only (the valve spool).
+    int states_sense_ports;
     /// Fill def with the documented defaults (name and ports NULL).
     void (*defaults)(void* def);
     /// Cross-field value rules a parameter table cannot express (rod < bore):

@@ -412,7 +412,9 @@ int hyd_model_feed_hose(const hyd_model* m, int node);
 /// can be non-zero at some state, else 0 (n = nstate; the caller's array of
 /// n * n bytes). A node's pressure rate depends on its own pressure and on
 /// the pressures and states of every component connected to it; a spool
-/// rate on its spool only. hyd_jacobian never writes a non-zero outside it.
+/// rate on its spool only; the displacement, spool or oil volume of a LS
+/// pump, counterbalance valve or accumulator on the pressures at its ports
+/// too. hyd_jacobian never writes a non-zero outside it.
 void hyd_model_jacobian_pattern(const hyd_model* m, unsigned char* pattern);
 
 // ---------------------------------------------------------------------------

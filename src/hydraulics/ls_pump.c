@@ -135,7 +135,7 @@ const hyd_component hyd_ls_pump_component = {
     .params = ls_pump_params, .nparam = HYD_COUNT(ls_pump_params),
     .ports = ls_pump_ports, .nport = HYD_COUNT(ls_pump_ports),
     .states = ls_pump_states, .nstate = HYD_COUNT(ls_pump_states),
-    .rec_size = sizeof(hyd_ls_pump_c), .port_roles = ls_pump_roles,
+    .rec_size = sizeof(hyd_ls_pump_c), .states_sense_ports = 1, .port_roles = ls_pump_roles,
     .defaults = ls_pump_defaults, .check_ports = ls_pump_check_ports, .bind = ls_pump_bind,
     .derive = ls_pump_derive, .initial = ls_pump_initial, .eval = ls_pumps_eval,
     .jacobian = ls_pumps_jacobian,

@@ -74,6 +74,12 @@ static double jac_check(const hyd_model* m, const double* y0, double rel, const 
                   hyd_model_state_name(m, i), hyd_model_state_name(m, j), J[i * n + j], Jn[i * n + j]);
         }
     }
+    // The structural pattern holds every non-zero.
+    unsigned char P[MAXN * MAXN];
+    hyd_model_jacobian_pattern(m, P);
+    for (int i = 0; i < n * n; ++i)
+        CHECK(J[i] == 0.0 || P[i], "%s: J[%s][%s] = %g outside the pattern", what, hyd_model_state_name(m, i / n),
+              hyd_model_state_name(m, i % n), J[i]);
     // The fast kernel evaluates these types through their reference loops.
     char why[200];
     hyd_fast* k = hyd_fast_create(m, ~0u, 1, why, sizeof why);
