@@ -118,6 +118,28 @@ static const bad_case range_cases[] = {
 
 static void test_hard_ranges(void) { run_cases(range_cases, (int)(sizeof range_cases / sizeof range_cases[0])); }
 
+#define ML "models/hiab031_ls.json"
+
+// Malformed load-sensing components in the LS crane model.
+static const bad_case ls_cases[] = {
+    {MODEL, "m_ls_no_port.json", ML, NULL, "\"ls\": \"ls_line\",", "", "hydraulics.components[0].ls",
+     "missing required port"},
+    {MODEL, "m_ls_margin.json", ML, "hydraulics.components.pump.margin=-2e6", NULL, NULL,
+     "hydraulics.components[0].margin", "must be > 0, got -2e6"},
+    {MODEL, "m_ls_pilot.json", ML, "hydraulics.components.lift_cbv.pilot_ratio=0", NULL, NULL,
+     "hydraulics.components[10].pilot_ratio", "must be > 0, got 0"},
+    {MODEL, "m_ls_mode.json", ML, "hydraulics.components.lift_comp.mode=2", NULL, NULL,
+     "hydraulics.components[4].mode", NULL},
+};
+
+static void test_ls_components(void) {
+    run_cases(ls_cases, (int)(sizeof ls_cases / sizeof ls_cases[0]));
+    // The model itself loads and runs without a note.
+    int rc = cli_run("run --quiet --model " ASSETS "/" ML " --scenario ramp --duration 0.01 --out /dev/null", out_buf,
+                     sizeof out_buf);
+    CHECK(rc == 0 && !out_buf[0], "hiab031_ls: exit %d: %s", rc, out_buf);
+}
+
 #define SP "scenarios/sandbox_pick_place.json"
 
 // The corpus: one change each to a shipped file. Text replacements make what
@@ -344,6 +366,7 @@ static void test_shipped_quiet(void) {
 
 int main(int argc, char** argv) {
     RUN_TEST(test_hard_ranges);
+    RUN_TEST(test_ls_components);
     RUN_TEST(test_corpus);
     RUN_TEST(test_messages);
     RUN_TEST(test_oversize);
