@@ -99,6 +99,24 @@ static double phi_n(const hyd_model* m, int n, double p, int N) {
 
 static double phi(const hyd_model* m, int n, double p) { return phi_n(m, n, p, 512); }
 
+double hyd_node_phi(const hyd_model* m, int node, double p) {
+    if (node < 0 || node >= m->nnode || m->node_state[node] < 0) return 0.0;
+    return phi(m, node, p);
+}
+
+// phi(p1) - phi(p0) by one Simpson panel in p: for the small pressure change
+// of one step the error is O((p1 - p0)^5), so a caller can follow phi along
+// a trajectory at three table evaluations of Be per step.
+double hyd_node_phi_increment(const hyd_model* m, int node, double p0, double p1) {
+    if (node < 0 || node >= m->nnode || m->node_state[node] < 0) return 0.0;
+    const double pm = 0.5 * (p0 + p1);
+    double b0, bm, b1;
+    hyd_node_c(m, m->node_bel[node], m->node_bec[node], p0, 1.0, &b0, NULL);
+    hyd_node_c(m, m->node_bel[node], m->node_bec[node], pm, 1.0, &bm, NULL);
+    hyd_node_c(m, m->node_bel[node], m->node_bec[node], p1, 1.0, &b1, NULL);
+    return (p1 - p0) / 6.0 * (p0 / b0 + 4.0 * pm / bm + p1 / b1);
+}
+
 double hyd_node_stored_energy(const hyd_model* m, int node, double p, double V) {
     if (node < 0 || node >= m->nnode || m->node_state[node] < 0) return 0.0;
     return V * phi(m, node, p);

@@ -519,6 +519,10 @@ double hyd_stored_energy(const hyd_model* m, const double* p, const double* V);
 /// sum phi dV/dt, so d(hyd_stored_energy)/dt = hyd_stored_power -
 /// hyd_expansion_power along any trajectory (docs/energy.md).
 double hyd_expansion_power(const hyd_model* m, const hyd_data* d);
+/// phi(p) of node [J/m^3] (0 for a tank); and phi(p1) - phi(p0) for a
+/// small step (one Simpson panel: cheap enough to follow phi at every step).
+double hyd_node_phi(const hyd_model* m, int node, double p);
+double hyd_node_phi_increment(const hyd_model* m, int node, double p0, double p1);
 /// One node's term V phi(p) of hyd_stored_energy [J] (0 for a tank).
 double hyd_node_stored_energy(const hyd_model* m, int node, double p, double V);
 

@@ -19,6 +19,7 @@ struct sim_energy {
     double es0, es1, em0, em1;
     int finished;
     double *p1, *V1; ///< (nnode) node pressures and volumes at the last sample
+    double* phi;     ///< (nnode) phi(p1) of nodes whose volume has moved (NAN: not followed yet)
     FILE* csv;
     double csv_dt, csv_next;
 };
@@ -63,7 +64,8 @@ static void unbind(sim_energy* e) {
     free(e->ydot);
     free(e->p1);
     free(e->V1);
-    e->d = NULL, e->ydot = e->p1 = e->V1 = NULL;
+    free(e->phi);
+    e->d = NULL, e->ydot = e->p1 = e->V1 = e->phi = NULL;
     e->m = NULL;
 }
 
@@ -82,7 +84,9 @@ int sim_energy_bind(sim_energy* e, const hyd_model* m) {
     e->E = calloc(cap, sizeof *e->E);
     e->p1 = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->p1);
     e->V1 = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->V1);
-    if (!e->d || !e->ydot || !e->name || !e->group || !e->comp || !e->P || !e->Pprev || !e->E || !e->p1 || !e->V1) {
+    e->phi = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->phi);
+    if (!e->d || !e->ydot || !e->name || !e->group || !e->comp || !e->P || !e->Pprev || !e->E || !e->p1 || !e->V1 ||
+        !e->phi) {
         unbind(e);
         return -1;
     }
@@ -107,6 +111,7 @@ int sim_energy_bind(sim_energy* e, const hyd_model* m) {
     add_col(e, -1, SIM_EG_TANK, "tank");
     add_col(e, -1, SIM_EG_STORED, "stored");
     add_col(e, -1, SIM_EG_EXPANSION, "expansion");
+    for (int n = 0; n < nn; ++n) e->phi[n] = NAN;
     if (e->csv) {
         fprintf(e->csv, "t");
         for (int i = 0; i < e->ncol; ++i) fprintf(e->csv, ",%s", e->name[i]);
@@ -129,9 +134,8 @@ sim_energy_group sim_energy_col_group(const sim_energy* e, int i) { return (sim_
 double sim_energy_col_energy(const sim_energy* e, int i) { return e->E[i]; }
 
 // Every column's power taken from the fluid at the last evaluation [W].
-static void powers(sim_energy* e) {
+static void powers(sim_energy* e, const hyd_data* d) {
     const hyd_model* m = e->m;
-    const hyd_data* d = e->d;
     for (int i = 0; i < e->ncol; ++i) {
         const int c = e->comp[i];
         switch (e->group[i]) {
@@ -145,7 +149,24 @@ static void powers(sim_energy* e) {
         case SIM_EG_WORK: e->P[i] = hyd_comp_piston_power(m, d, c); break;
         case SIM_EG_TANK: e->P[i] = -hyd_boundary_power(m, d); break;
         case SIM_EG_STORED: e->P[i] = hyd_stored_power(m, d); break;
-        case SIM_EG_EXPANSION: e->P[i] = hyd_expansion_power(m, d); break;
+        case SIM_EG_EXPANSION: {
+            // hyd_expansion_power, with phi followed along the run (one
+            // Simpson panel per step) instead of integrated afresh.
+            double P = 0.0;
+            for (int n = 0; n < hyd_model_nnode(m); ++n) {
+                const double dV = d->node_dV[n];
+                if (hyd_model_node_state(m, n) < 0) continue;
+                if (isnan(e->phi[n])) {
+                    if (dV == 0.0) continue;
+                    e->phi[n] = hyd_node_phi(m, n, d->node_p[n]);
+                } else if (e->n > 0) {
+                    e->phi[n] += hyd_node_phi_increment(m, n, e->p1[n], d->node_p[n]);
+                }
+                P -= dV * e->phi[n];
+            }
+            e->P[i] = P;
+            break;
+        }
         default: e->P[i] = hyd_comp_power(m, d, c); break;
         }
     }
@@ -164,13 +185,18 @@ void sim_energy_csv(sim_energy* e, FILE* f, double dt) {
 }
 
 void sim_energy_sample(sim_energy* e, double t, const double* y, double e_mech) {
+    if (!e->m) return;
+    hyd_eval(e->m, e->d, t, y, e->ydot);
+    sim_energy_sample_data(e, t, e->d, e_mech);
+}
+
+void sim_energy_sample_data(sim_energy* e, double t, const hyd_data* d, double e_mech) {
     const hyd_model* m = e->m;
     if (!m) return;
-    hyd_eval(m, e->d, t, y, e->ydot);
-    powers(e);
+    powers(e, d);
     if (e->n == 0) {
         e->t0 = t;
-        e->es0 = hyd_stored_energy(m, e->d->node_p, e->d->node_V);
+        e->es0 = hyd_stored_energy(m, d->node_p, d->node_V);
         e->em0 = e_mech;
     } else {
         const double h = t - e->tprev;
@@ -178,8 +204,8 @@ void sim_energy_sample(sim_energy* e, double t, const double* y, double e_mech) 
     }
     memcpy(e->Pprev, e->P, (size_t)e->ncol * sizeof *e->P);
     const int nn = hyd_model_nnode(m);
-    memcpy(e->p1, e->d->node_p, (size_t)nn * sizeof *e->p1);
-    memcpy(e->V1, e->d->node_V, (size_t)nn * sizeof *e->V1);
+    memcpy(e->p1, d->node_p, (size_t)nn * sizeof *e->p1);
+    memcpy(e->V1, d->node_V, (size_t)nn * sizeof *e->V1);
     e->em1 = e_mech;
     e->tprev = t;
     ++e->n;

@@ -55,6 +55,9 @@ hyd_data* sim_energy_data(sim_energy* e);
 /// inputs in sim_energy_data, and add the powers since the last sample
 /// (trapezoidal rule). e_mech: the mechanics' energy [J] at t (NAN: none).
 void sim_energy_sample(sim_energy* e, double t, const double* y, double e_mech);
+/// The same from a hyd_data the caller's own evaluation of the circuit at
+/// (t, state) filled (every output: flows, node pressures, volumes).
+void sim_energy_sample_data(sim_energy* e, double t, const hyd_data* d, double e_mech);
 /// Write the powers to f [W] (header at bind, a row at the first sample and
 /// then one per dt [s] on the grid); f stays the caller's. Call before the run.
 void sim_energy_csv(sim_energy* e, FILE* f, double dt);
