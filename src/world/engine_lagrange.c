@@ -183,9 +183,10 @@ static void track_peaks(run_ctx* c, const double* y) {
 // ls->hd the balance reads; then the crane's energy.
 static void energy_sample(run_ctx* c, double t, const double* y) {
     lsim* ls = c->ls;
-    // A step at least every ENERGY_DT apart (the ode world's default step):
-    // the balance closes to 1e-5 of the energy in on ramp and overload
-    // either way, and sampling every 0.1 ms step tripled the run's cost.
+    // The next sample is the first step at least 1 ms on (the ode world's
+    // default step): the balance closes to 1e-4 of the energy in on ramp
+    // and overload either way, and sampling every 0.1 ms step made the run
+    // 2.5 times as slow (docs/energy.md).
     enum { ENERGY_PER_S = 1000 };
     c->energy_next = t + (1.0 - 1e-6) / ENERGY_PER_S;
     lsim_out lo;

@@ -178,8 +178,9 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             snprintf(res->message, sizeof res->message, "numerical blow-up: %s", ode_world_error(w));
             break;
         }
-        // The balance at every ODE step (the hydraulic sub-steps inside it
-        // see the same held rates, so the step ends are exact sample points).
+        // The balance at every ODE step, from the circuit's state at its end
+        // with the inputs its hydraulic sub-steps integrated (rates held
+        // over the step).
         if (en)
             sim_energy_sample(en, (double)(i + 1) * dt, ode_world_circuit_inputs(w, sim_energy_data(en)),
                               ode_world_energy(w));
