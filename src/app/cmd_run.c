@@ -232,11 +232,14 @@ static void print_energy(const sim_energy_balance* b) {
                b->mech * 1e-3, (b->work - b->mech) * 1e-3);
 }
 
-// FILE.png -> FILE_energy.png (the bar chart next to the run's plot).
-static void energy_png(const char* plot, char* buf, size_t n) {
+// FILE.png -> FILE_energy.png (the bar chart next to the run's plot);
+// false for a plot that is not a .png file name (a device or a pipe such
+// as /dev/stdout, which app_check_output lets through): no chart then.
+static bool energy_png(const char* plot, char* buf, size_t n) {
     const size_t len = strlen(plot);
-    const bool png = len >= 4 && !strcmp(plot + len - 4, ".png");
-    snprintf(buf, n, "%.*s_energy.png", (int)(png ? len - 4 : len), plot);
+    if (len < 4 || strcmp(plot + len - 4, ".png")) return false;
+    snprintf(buf, n, "%.*s_energy.png", (int)(len - 4), plot);
+    return true;
 }
 
 // The losses per component over the run [kJ], largest first (valve edges
@@ -442,8 +445,7 @@ int cmd_run(int argc, char** argv) {
             printf("  plot -> %s\n", plot);
         }
         char epng[1100];
-        energy_png(plot, epng, sizeof epng);
-        if (eb.samples > 1 && code == EXIT_OK_) {
+        if (energy_png(plot, epng, sizeof epng) && eb.samples > 1 && code == EXIT_OK_) {
             snprintf(title + strlen(title), sizeof title - strlen(title), ": losses per component");
             if (plot_energy(en, title, epng, err, sizeof err)) {
                 fprintf(stderr, "cranesim run: plot: %s\n", err);
