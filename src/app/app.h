@@ -221,6 +221,9 @@ void app_tick_label(double v, double step, char* buf, size_t n);
 /// Plot a run's main time histories to a PNG (PLplot). Returns 0, or -1 with
 /// a message (also when cranesim was built without PLplot).
 int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz);
+/// A bar chart of n energies kj [kJ] named names (one bar each, in order) to a PNG.
+int app_plot_energy(const char* const* names, const double* kj, int n, const char* title, const char* png, char* err,
+                    size_t errsz);
 /// Overlay two runs (a: solid, b: dashed) to a PNG.
 int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb,
                      const char* title, const char* png, char* err, size_t errsz);

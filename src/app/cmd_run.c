@@ -1,5 +1,6 @@
 // cmd_run.c: `cranesim run`: a headless run of a scenario to CSV (and a plot).
 #include "app.h"
+#include "energy_acc.h"
 
 #include <errno.h>
 #include <math.h>
@@ -25,7 +26,14 @@ static void run_help(FILE* f) {
             "  --out FILE           CSV output (default run.csv); written to a temporary file in its\n"
             "                       folder and renamed over FILE when the run ends (also a failed or\n"
             "                       interrupted one, with the rows so far): until then FILE is untouched\n"
-            "  --plot FILE.png      also plot strokes, pressures, valve openings and tip path\n");
+            "  --plot FILE.png      also plot strokes, pressures, valve openings and tip path, and\n"
+            "                       the energy per component as a bar chart to FILE_energy.png\n"
+            "  --energy FILE.csv    per-component hydraulic power [W] at the output period: t, then\n"
+            "                       per pump, valve edge (.meter_in, .meter_out), relief, check,\n"
+            "                       orifice, hose, cylinder (.leak, .work), then tank, stored and\n"
+            "                       expansion; power taken from the fluid is positive (a pump's is\n"
+            "                       negative) and all columns but expansion sum to zero (docs/energy.md)\n"
+            "The summary prints the energy balance of the run in kJ (docs/energy.md).\n");
     app_common_help(f, true);
     fprintf(f,
             "\nexit codes: 0 ok, 1 runtime failure (a numerical blow-up keeps the rows so far; a failed\n"
@@ -206,10 +214,77 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     printf("\n  %ld rows -> %s\n", r->rows, out);
 }
 
+// The energy balance (docs/energy.md): what came in, where it went, and
+// how much of it the accounting misses.
+static void print_energy(const sim_energy_balance* b) {
+    printf("  energy: in %.3f kJ (pump %.3f, tanks %.3f); losses %.3f kJ (valves %.3f meter-in + %.3f meter-out, "
+           "relief %.3f, check %.3f, orifice %.3f, hose %.3f, cylinder leakage %.3f",
+           b->in * 1e-3, b->pump * 1e-3, b->tank * 1e-3, b->loss * 1e-3, b->group[SIM_EG_VALVE_IN] * 1e-3,
+           b->group[SIM_EG_VALVE_OUT] * 1e-3, b->group[SIM_EG_RELIEF] * 1e-3, b->group[SIM_EG_CHECK] * 1e-3,
+           b->group[SIM_EG_ORIFICE] * 1e-3, b->group[SIM_EG_HOSE] * 1e-3, b->group[SIM_EG_LEAK] * 1e-3);
+    if (b->group[SIM_EG_OTHER] != 0.0) printf(", other %.3f", b->group[SIM_EG_OTHER] * 1e-3);
+    printf(")\n  energy: released by displaced fluid %.3f kJ; work on mechanics %.3f kJ; stored in the fluid %+.3f "
+           "kJ; residual %.3f %%\n",
+           b->expansion * 1e-3, b->work * 1e-3, b->stored * 1e-3, b->residual_pct);
+    if (isfinite(b->mech))
+        printf("  energy: mechanics (kinetic + potential) %+.3f kJ, so %.3f kJ of the work went to friction, end "
+               "stops and joints\n",
+               b->mech * 1e-3, (b->work - b->mech) * 1e-3);
+}
+
+// FILE.png -> FILE_energy.png (the bar chart next to the run's plot);
+// false for a plot that is not a .png file name (a device or a pipe such
+// as /dev/stdout, which app_check_output lets through): no chart then.
+static bool energy_png(const char* plot, char* buf, size_t n) {
+    const size_t len = strlen(plot);
+    if (len < 4 || strcmp(plot + len - 4, ".png")) return false;
+    snprintf(buf, n, "%.*s_energy.png", (int)(len - 4), plot);
+    return true;
+}
+
+// The losses per component over the run [kJ], largest first (valve edges
+// and a cylinder's leakage are summed per component).
+static int plot_energy(const sim_energy* en, const char* title, const char* png, char* err, size_t errsz) {
+    enum { MAXBAR = 64 };
+    static char names[MAXBAR][72];
+    const char* np[MAXBAR];
+    double kj[MAXBAR];
+    int n = 0;
+    for (int i = 0; i < sim_energy_ncol(en); ++i) {
+        const sim_energy_group g = sim_energy_col_group(en, i);
+        if (g < SIM_EG_VALVE_IN || g > SIM_EG_OTHER) continue;
+        char base[72];
+        snprintf(base, sizeof base, "%s", sim_energy_col_name(en, i));
+        char* dot = g == SIM_EG_VALVE_IN || g == SIM_EG_VALVE_OUT || g == SIM_EG_LEAK ? strrchr(base, '.') : NULL;
+        if (dot) *dot = 0;
+        int k = 0;
+        while (k < n && strcmp(names[k], base)) ++k;
+        if (k == n) {
+            if (n == MAXBAR) continue;
+            snprintf(names[n], sizeof names[n], "%s", base);
+            kj[n++] = 0.0;
+        }
+        kj[k] += 1e-3 * sim_energy_col_energy(en, i);
+    }
+    for (int i = 1; i < n; ++i) // insertion sort, largest first
+        for (int j = i; j > 0 && kj[j] > kj[j - 1]; --j) {
+            char t[72];
+            memcpy(t, names[j], sizeof t);
+            memcpy(names[j], names[j - 1], sizeof t);
+            memcpy(names[j - 1], t, sizeof t);
+            const double v = kj[j];
+            kj[j] = kj[j - 1];
+            kj[j - 1] = v;
+        }
+    for (int i = 0; i < n; ++i) np[i] = names[i];
+    return app_plot_energy(np, kj, n, title, png, err, errsz);
+}
+
 int cmd_run(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     const char* out = "run.csv";
     const char* plot = NULL;
+    const char* energy_csv = NULL;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             run_help(stdout);
@@ -226,11 +301,17 @@ int cmd_run(int argc, char** argv) {
             else plot = v;
             continue;
         }
+        if (!strcmp(argv[i], "--energy")) {
+            energy_csv = app_value(argc, argv, &i);
+            if (!energy_csv) return EXIT_USAGE;
+            continue;
+        }
         fprintf(stderr, "cranesim run: unknown option '%s' (see cranesim run --help)\n", argv[i]);
         return EXIT_USAGE;
     }
     // Everything that can be checked is checked before a file is touched.
-    if (app_check_output("run", "--out", out, NULL) || (plot && app_check_output("run", "--plot", plot, ".png")))
+    if (app_check_output("run", "--out", out, NULL) || (plot && app_check_output("run", "--plot", plot, ".png")) ||
+        (energy_csv && app_check_output("run", "--energy", energy_csv, NULL)))
         return EXIT_USAGE;
     int rc = app_check_sim("run", &c.sim, c.given);
     if (rc) return rc;
@@ -273,16 +354,39 @@ int cmd_run(int argc, char** argv) {
         sink.keep.stride = rows > PLOT_FULL ? (long)ceil(rows / (PLOT_FULL / 2)) : 1;
     }
     sim_result res;
+    // The energy balance for the summary, the --energy CSV and the bar chart
+    // (docs/energy.md says what it costs).
+    sim_energy* en = sim_energy_create();
+    app_out eout = {0};
+    FILE* ef = NULL;
+    if (!en) {
+        fprintf(stderr, "cranesim run: out of memory\n");
+        model_free(m);
+        return EXIT_RUNTIME;
+    }
+    if (energy_csv) {
+        ef = app_out_open(&eout, energy_csv, "w");
+        if (!ef) {
+            fprintf(stderr, "cranesim run: cannot write %s: %s\n", energy_csv, strerror(errno));
+            sim_energy_free(en);
+            model_free(m);
+            return EXIT_USAGE;
+        }
+        sim_energy_csv(en, ef, app_output_period(&c.sim));
+    }
     // SIGINT (Ctrl-C) or SIGTERM: the run stops after the row being written
     // and the CSV is closed and put in place with every row so far; a second
     // signal kills at once (SA_RESETHAND).
     app_signals sig;
     app_signals_catch(&sig);
-    sim_run(m, &sc, &c.sim, csv_row, &sink, NULL, c.quiet ? NULL : app_progress, NULL, &res);
+    sim_run_energy(m, &sc, &c.sim, csv_row, &sink, NULL, c.quiet ? NULL : app_progress, NULL, en, &res);
     keep_flush(&sink.keep);
     if (!c.quiet) app_progress_done();
     if (res.note[0] && !app_signal_caught()) fprintf(stderr, "cranesim run: note: %s\n", res.note);
     const int werr = csv_close(&sink);
+    // The energy CSV is kept when the run's CSV is (a run refused at its
+    // start leaves neither).
+    int eerr = ef ? app_out_close(&eout, ferror(ef) ? EIO : 0, sink.opened) : 0;
     app_signals_restore(&sig);
     int code = EXIT_OK_;
     if (werr && !sink.opened) {
@@ -311,12 +415,21 @@ int cmd_run(int argc, char** argv) {
         fprintf(stderr, "cranesim run: %s\n", res.message);
         code = app_exit_code(res.status, sink.rows);
     }
+    if (eerr && code == EXIT_OK_) {
+        fprintf(stderr, "cranesim run: cannot write %s: %s\n", energy_csv, strerror(eerr));
+        code = EXIT_RUNTIME;
+    }
     if (sink.keep.oom && code == EXIT_OK_) {
         fprintf(stderr, "cranesim run: plot: out of memory for the plotted rows\n");
         code = EXIT_RUNTIME;
     }
-    if (code == EXIT_OK_ && !c.quiet)
+    sim_energy_balance eb;
+    sim_energy_result(en, &eb);
+    if (code == EXIT_OK_ && !c.quiet) {
         print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, out);
+        if (eb.samples > 1) print_energy(&eb);
+        if (energy_csv) printf("  energy -> %s\n", energy_csv);
+    }
     if (plot && tr.nrow > 1 && code != EXIT_USAGE && !app_signal_caught()) {
         char err[512], title[160];
         if (c.sim.mechanics == SIM_ODE)
@@ -331,7 +444,18 @@ int cmd_run(int argc, char** argv) {
         } else if (!c.quiet) {
             printf("  plot -> %s\n", plot);
         }
+        char epng[1100];
+        if (energy_png(plot, epng, sizeof epng) && eb.samples > 1 && code == EXIT_OK_) {
+            snprintf(title + strlen(title), sizeof title - strlen(title), ": losses per component");
+            if (plot_energy(en, title, epng, err, sizeof err)) {
+                fprintf(stderr, "cranesim run: plot: %s\n", err);
+                code = EXIT_RUNTIME;
+            } else if (!c.quiet) {
+                printf("  energy plot -> %s\n", epng);
+            }
+        }
     }
+    sim_energy_free(en);
     sim_trace_free(&tr);
     model_free(m);
     return code;

@@ -277,6 +277,46 @@ int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, con
                      const char* png, char* err, size_t errsz) {
     return plot_traces(a, la, b, lb, title, png, err, errsz);
 }
+
+typedef struct bars_plot {
+    const char* const* names;
+    const double* kj;
+    int n;
+    const char* title;
+} bars_plot;
+
+// Horizontal bars, one per component, longest loss at the top.
+static void draw_bars(void* user) {
+    const bars_plot* p = user;
+    plstar(1, 1);
+    plschr(0, 0.8);
+    double hi = 0.0;
+    for (int i = 0; i < p->n; ++i) hi = fmax(hi, p->kj[i]);
+    if (!(hi > 0.0)) hi = 1.0;
+    pladv(0);
+    plvpor(0.28, 0.95, 0.1, 0.9);
+    plwind(0.0, 1.05 * hi, 0.0, (PLFLT)p->n);
+    plcol0(15);
+    plbox("bcgnst", 0.0, 0, "bc", 0.0, 0);
+    pllab("energy [kJ]", "", p->title);
+    for (int i = 0; i < p->n; ++i) {
+        const PLFLT y0 = (PLFLT)(p->n - 1 - i) + 0.15, y1 = y0 + 0.7;
+        PLFLT xs[4] = {0.0, p->kj[i], p->kj[i], 0.0}, ys[4] = {y0, y0, y1, y1};
+        plcol0(9);
+        plfill(4, xs, ys);
+        plcol0(15);
+        plline(4, xs, ys);
+        char lab[120];
+        snprintf(lab, sizeof lab, "%s  %.3g ", p->names[i], p->kj[i]);
+        plmtex("lv", 0.5, 0.5 * (y0 + y1) / (PLFLT)p->n, 1.0, lab);
+    }
+}
+
+int app_plot_energy(const char* const* names, const double* kj, int n, const char* title, const char* png, char* err,
+                    size_t errsz) {
+    bars_plot p = {names, kj, n, title};
+    return app_png_render(png, "1000x700", draw_bars, &p, err, errsz);
+}
 #else
 int app_png_render(const char* png, const char* geometry, void (*draw)(void* user), void* user, char* err,
                    size_t errsz) {
@@ -286,6 +326,12 @@ int app_png_render(const char* png, const char* geometry, void (*draw)(void* use
 }
 int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz) {
     (void)tr, (void)title, (void)png;
+    snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
+    return -1;
+}
+int app_plot_energy(const char* const* names, const double* kj, int n, const char* title, const char* png, char* err,
+                    size_t errsz) {
+    (void)names, (void)kj, (void)n, (void)title, (void)png;
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
     return -1;
 }

@@ -575,6 +575,48 @@ double hyd_orifice_p_tr(const hyd_fluid_def* f, double cd, double A);
 /// (d/w)^2 for 0 < d < w, 1 + 2 (d - w)/w beyond. *dr = dr/dd [1/Pa].
 double hyd_open_ramp(double d, double w, double* dr);
 
+// ---------------------------------------------------------------------------
+// Energy (energy.c; docs/energy.md). From the outputs of the last hyd_eval /
+// hyd_jacobian in d. Signs: power taken from the fluid is positive, so a
+// pump's is negative (it delivers). At every evaluation
+//   sum_c hyd_comp_power + sum_c hyd_comp_piston_power + hyd_stored_power
+//     = hyd_boundary_power
+// exactly (each term from the same flows), for any circuit.
+// ---------------------------------------------------------------------------
+
+/// Hydraulic power component comp takes from the fluid at its ports and owned
+/// nodes [W]: - sum over its flow slots of p_node * (flow into that node).
+double hyd_comp_power(const hyd_model* m, const hyd_data* d, int comp);
+/// Power comp takes through the moving volume of the nodes it owns [W]:
+/// sum p dV/dt (a cylinder's piston work on the mechanics; 0 otherwise).
+double hyd_comp_piston_power(const hyd_model* m, const hyd_data* d, int comp);
+/// A valve's loss per metering edge [W]: e[0] meter-in (P to the fed work
+/// port), e[1] meter-out (the other work port to T); e[0] + e[1] =
+/// hyd_comp_power. Returns 2, or 0 when comp is not a valve.
+int hyd_valve_edge_power(const hyd_model* m, const hyd_data* d, int comp, double e[2]);
+/// Power the fixed-pressure nodes (tanks) deliver into the circuit [W]:
+/// - sum p_t Q_t, Q_t the net flow into tank t.
+double hyd_boundary_power(const hyd_model* m, const hyd_data* d);
+/// Rate of compression energy stored in the fluid [W]: sum over pressure
+/// nodes of p V/Be dp/dt = p (Q_in - dV/dt).
+double hyd_stored_power(const hyd_model* m, const hyd_data* d);
+/// Compression energy stored in the fluid [J], a state function of the node
+/// pressures p and volumes V (nnode each, as hyd_data node_p, node_V):
+/// sum V phi(p), phi(p) = integral from p_atm to p of s / Be(s) ds.
+double hyd_stored_energy(const hyd_model* m, const double* p, const double* V);
+/// The compression energy that leaves with the fluid a moving volume
+/// displaces [W]: - sum phi(p) dV/dt over nodes whose volume moves. The
+/// volume-flow node equation makes hyd_stored_power = d(sum V phi)/dt -
+/// sum phi dV/dt, so d(hyd_stored_energy)/dt = hyd_stored_power -
+/// hyd_expansion_power along any trajectory (docs/energy.md).
+double hyd_expansion_power(const hyd_model* m, const hyd_data* d);
+/// phi(p) of node [J/m^3] (0 for a tank); and phi(p1) - phi(p0) for a
+/// small step (one Simpson panel: cheap enough to follow phi at every step).
+double hyd_node_phi(const hyd_model* m, int node, double p);
+double hyd_node_phi_increment(const hyd_model* m, int node, double p0, double p1);
+/// One node's term V phi(p) of hyd_stored_energy [J] (0 for a tank).
+double hyd_node_stored_energy(const hyd_model* m, int node, double p, double V);
+
 #ifdef __cplusplus
 }
 #endif

@@ -91,6 +91,9 @@ typedef struct engine_sink {
     bool rows;         ///< someone consumes rows: else (benchmarks) the output evaluation is skipped
     bool summary;      ///< someone reads the summary: peaks over every step, not only the rows
     double t_end;      ///< the run's end [s] (> 0; checked by the caller, sim_check_times)
+    /// NULL, or the energy balance to accumulate at every integration step
+    /// (energy_acc.h; at the rows with CVODE, whose steps are its own).
+    struct sim_energy* energy;
 } engine_sink;
 /// A scripted run from t = 0 to k->t_end: the engine o->mechanics names,
 /// built for scenario sc (its start pose, load and world), plays the

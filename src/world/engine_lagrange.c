@@ -2,6 +2,7 @@
 // 2-DOF crane and its full circuit as one ODE system) behind engine.h,
 // stepped by an outside loop with commands set between steps.
 #include "engine_impl.h"
+#include "energy_acc.h"
 
 #include "snap_reliefs.h"
 #ifdef CRANESIM_HAVE_CVODE
@@ -159,6 +160,8 @@ typedef struct run_ctx {
     double peak[4];
     int npress;    ///< pressure states (emit checks only these)
     int press[LSIM_MAX_STATES];
+    struct sim_energy* energy; ///< NULL, or the balance accumulated at the steps
+    double energy_next;        ///< the next step at or after this time [s] is sampled
 } run_ctx;
 
 static int check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, sim_result* res) {
@@ -175,10 +178,28 @@ static void track_peaks(run_ctx* c, const double* y) {
     for (int k = 0; k < 4; ++k) c->peak[k] = fmax(c->peak[k], y[c->pidx[k]]);
 }
 
-// hyd_solver_opts.on_step: peaks between the rows too.
+// One sample of the energy balance at (t, y): lsim_outputs evaluates the
+// circuit at (t, y) through the general path, which fills every output of
+// ls->hd the balance reads; then the crane's energy.
+static void energy_sample(run_ctx* c, double t, const double* y) {
+    lsim* ls = c->ls;
+    // The next sample is the first step at least 1 ms on (the ode world's
+    // default step): the balance closes to 1e-4 of the energy in on ramp
+    // and overload either way, and sampling every 0.1 ms step made the run
+    // 2.5 times as slow (docs/energy.md).
+    enum { ENERGY_PER_S = 1000 };
+    c->energy_next = t + (1.0 - 1e-6) / ENERGY_PER_S;
+    lsim_out lo;
+    lsim_outputs(ls, t, y, &lo);
+    const double q[2] = {y[ls->iq], y[ls->iq + 1]}, qd[2] = {y[ls->iq + 2], y[ls->iq + 3]};
+    sim_energy_sample_data(c->energy, t, ls->hd, lagrange_energy(&ls->mdl->mech, ls->m3, q, qd));
+}
+
+// hyd_solver_opts.on_step: peaks between the rows too, and the energy balance.
 static void on_step(void* user, double t, const double* y) {
-    (void)t;
-    track_peaks(user, y);
+    run_ctx* c = user;
+    if (c->sink->summary) track_peaks(c, y);
+    if (c->energy && t >= c->energy_next) energy_sample(c, t, y);
 }
 
 static const char* state_name(const lsim* ls, int i, char* buf, size_t n);
@@ -192,6 +213,9 @@ static int check_failed(run_ctx* c, double t) {
 static int emit(void* user, double t, const double* y) {
     run_ctx* c = user;
     track_peaks(c, y);
+    // CVODE's steps are its own: the balance is sampled at the rows.
+    if (c->energy && c->o->cvode && !(c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out))
+        energy_sample(c, t, y);
     // Segments share their end points: write each output time once.
     if (c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out) return 0;
     char nb[96];
@@ -295,7 +319,12 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     }
     // The run's context, filled below; its address goes to the solver now.
     run_ctx c;
-    if (k->summary) { // someone reads the summary: peaks from every step
+    if (k->energy && sim_energy_bind(k->energy, m->hyd)) {
+        snprintf(res->message, sizeof res->message, "out of memory for the energy balance");
+        lsim_free(&ls);
+        return res->status = SIM_REFUSED;
+    }
+    if (k->summary || k->energy) { // someone reads the summary: peaks from every step
         so.on_step = on_step;
         so.on_step_user = &c;
     }
@@ -316,7 +345,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     // (the breakpoints are rounded to this grid, so it must not pass t_end).
     if (oo.dt_out > t_end && t_end > 0) oo.dt_out = t_end;
     o = &oo;
-    c = (run_ctx){.ls = &ls, .o = o, .sink = k, .t_end = t_end,
+    c = (run_ctx){.ls = &ls, .o = o, .sink = k, .t_end = t_end, .energy = k->energy,
                   .all_states = so.out_states == NULL,
                   .pidx = {ls.ip[0][0], ls.ip[0][1], ls.ip[1][0], ls.ip[1][1]}};
     memcpy(c.press, press, sizeof press);
@@ -330,6 +359,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     hyd_solver_stats cv = {0};
     double w0 = sim_wall_time();
     int rc = HYD_OK;
+    if (c.energy && !o->cvode) energy_sample(&c, 0.0, y);
     emit(&c, 0.0, y);
     for (int i = 0; i <= nbp && rc == HYD_OK && !c.stop && t < t_end; ++i) {
         double tb = i < nbp ? ceil(bp[i] / o->dt_out - 1e-9) * o->dt_out : t_end;
@@ -354,6 +384,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
             rc = hyd_solver_integrate(s, t, y, tb, o->dt_out, emit, &c);
         if (rc == HYD_OK && !c.stop) t = tb;
     }
+    if (c.energy && !o->cvode) energy_sample(&c, t, y); // the end state (a repeat adds nothing)
     res->wall = sim_wall_time() - w0;
     res->stats = o->cvode ? cv : *hyd_solver_get_stats(s);
     res->rows = c.rows;
@@ -395,6 +426,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     memcpy(res->p_peak, c.peak, sizeof res->p_peak);
     res->peak_steps = !o->cvode && k->summary;
     if (!res->status) sim_checks_note(&c.chk, adaptive, res->note, sizeof res->note);
+    if (k->energy) sim_energy_finish(k->energy);
     hyd_solver_destroy(s);
     lsim_free(&ls);
     return res->status;

@@ -2,6 +2,7 @@
 // rope, hook, loads, terrain; the circuit sub-stepped inside each ODE step)
 // behind engine.h.
 #include "engine_impl.h"
+#include "energy_acc.h"
 
 #include "ode_world.h"
 
@@ -155,6 +156,13 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             return res->status = SIM_REFUSED;
         }
     }
+    sim_energy* en = k->energy && ode_world_circuit(w) ? k->energy : NULL;
+    if (en && sim_energy_bind(en, ode_world_circuit(w))) {
+        snprintf(res->message, sizeof res->message, "out of memory for the energy balance");
+        ode_world_destroy(w);
+        return res->status = SIM_REFUSED;
+    }
+    if (en) sim_energy_sample(en, 0.0, ode_world_circuit_inputs(w, sim_energy_data(en)), ode_world_energy(w));
     deliver(c, row);
     ++c->rows;
     for (long i = 0; i < nstep && !c->stop; ++i) {
@@ -170,6 +178,12 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             snprintf(res->message, sizeof res->message, "numerical blow-up: %s", ode_world_error(w));
             break;
         }
+        // The balance at every ODE step, from the circuit's state at its end
+        // with the inputs its hydraulic sub-steps integrated (rates held
+        // over the step).
+        if (en)
+            sim_energy_sample(en, (double)(i + 1) * dt, ode_world_circuit_inputs(w, sim_energy_data(en)),
+                              ode_world_energy(w));
         {
             // Peaks at every ODE step, not only at the rows.
             double pA[ODE_NACT], pB[ODE_NACT];
@@ -202,6 +216,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     res->stats.steps = ode_world_hyd_steps(w); // fixed-step sub-steps are counted by the world
     res->rows = c->rows;
     res->t_end = c->t_last_row;
+    if (en) sim_energy_finish(en);
     ode_world_destroy(w);
     res->peak_steps = true;
     const char* last;

@@ -480,3 +480,21 @@ int ow_hyd_step(ode_world* w, double H) {
     }
     return 0;
 }
+
+// The circuit's inputs at the end of the last hydraulic step, as the
+// hydraulics saw them (strokes extrapolated over the step at its rate, the
+// rate held; before the first step, the actuators as read at creation),
+// written into d; returns the circuit state (NULL without a circuit). For
+// the energy balance: the same inputs the hydraulic steps integrated.
+const double* ode_world_circuit_inputs(const ode_world* w, hyd_data* d) {
+    if (!w->hm) return NULL;
+    const double tau = w->th - w->step_t0;
+    for (int k = 0; k < ODE_NACT; ++k) {
+        const ow_act* c = &w->act[k];
+        if (c->cyl < 0) continue;
+        d->cyl_x[c->cyl] = w->nstep > 0 ? w->x0[k] + w->v0[k] * tau : c->x;
+        d->cyl_v[c->cyl] = w->nstep > 0 ? w->v0[k] : c->v;
+        if (c->valve >= 0) d->valve_cmd[c->valve] = w->u_cmd[k];
+    }
+    return w->y;
+}

@@ -182,6 +182,10 @@ void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, doubl
 void ode_world_swing_hook(ode_world* w, const double omega[3]);
 /// Per-step hydraulic sub-steps taken since create (for benchmarks).
 long ode_world_hyd_steps(const ode_world* w);
+/// The circuit's inputs (strokes, rates, commands) at the end of the last
+/// hydraulic step, as the hydraulics integrated them, written into d (data
+/// of ode_world_circuit); returns its state vector, or NULL without a circuit.
+const double* ode_world_circuit_inputs(const ode_world* w, hyd_data* d);
 /// The hydraulic solver's work counters (steps, rejections, f evaluations,
 /// Jacobians, factorisations) since the world was created; zeros without
 /// hydraulics.

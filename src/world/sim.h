@@ -244,6 +244,14 @@ typedef void (*sim_progress_fn)(void* user, double t, double t_end);
 int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
             sim_trace* trace, sim_progress_fn progress, void* progress_user, sim_result* res);
 
+struct sim_energy;
+/// sim_run that also accumulates the energy balance into energy
+/// (energy_acc.h; NULL: none, which is sim_run). energy must have been made
+/// for the circuit the run uses (model_circuit_for).
+int sim_run_energy(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
+                   sim_trace* trace, sim_progress_fn progress, void* progress_user, struct sim_energy* energy,
+                   sim_result* res);
+
 /// Number of CSV columns a run with these options writes (base, or base plus
 /// the world extras for the ode backend).
 int sim_ncol(const sim_opts* o);

@@ -1,0 +1,96 @@
+// energy_acc.h: the energy balance of a run (docs/energy.md): per-component
+// hydraulic power from the circuit (hydraulics.h, energy.c), integrated over
+// every integration step by the trapezoidal rule, the fluid's stored energy
+// as a state function at the start and the end, and the mechanics' energy
+// (kinetic + potential) from the backend. Optionally a CSV of the powers at
+// the row period.
+#ifndef ENERGY_ACC_H
+#define ENERGY_ACC_H
+
+#include "hydraulics.h"
+
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Groups of the columns (what a loss is, for the summary).
+typedef enum sim_energy_group {
+    SIM_EG_SUPPLY = 0, ///< pumps (power taken < 0: they deliver)
+    SIM_EG_VALVE_IN,   ///< valve meter-in edges
+    SIM_EG_VALVE_OUT,  ///< valve meter-out edges
+    SIM_EG_RELIEF,
+    SIM_EG_CHECK,
+    SIM_EG_ORIFICE,
+    SIM_EG_HOSE,
+    SIM_EG_LEAK,       ///< cylinder internal leakage
+    SIM_EG_OTHER,      ///< any other component type (its whole P_c)
+    SIM_EG_WORK,       ///< piston work on the mechanics
+    SIM_EG_TANK,       ///< taken by the tanks (boundary flow work p_t Q_t)
+    SIM_EG_STORED,     ///< rate of compression energy in the fluid, p V/Be dp/dt
+    SIM_EG_EXPANSION,  ///< compression energy leaving with displaced fluid (hyd_expansion_power)
+    SIM_EG_COUNT
+} sim_energy_group;
+
+/// Name of a group ("valve meter-in", "relief", ...).
+const char* sim_energy_group_name(sim_energy_group g);
+
+typedef struct sim_energy sim_energy;
+
+/// An empty accumulator; the run binds it to the circuit it integrates
+/// (the ode world uses its own copy). NULL if out of memory.
+sim_energy* sim_energy_create(void);
+void sim_energy_free(sim_energy* e);
+/// Make the columns for circuit m, which must live until sim_energy_finish.
+/// 0, or -1 (out of memory, or already bound: one run per accumulator).
+int sim_energy_bind(sim_energy* e, const hyd_model* m);
+/// The end of the run: the stored energy of the last sample is evaluated and
+/// the circuit is let go (the results and columns stay).
+void sim_energy_finish(sim_energy* e);
+/// The data whose inputs (cyl_x, cyl_v, valve_cmd) the caller sets before
+/// each sim_energy_sample.
+hyd_data* sim_energy_data(sim_energy* e);
+/// Evaluate the circuit at time t [s], state y (circuit order) with the
+/// inputs in sim_energy_data, and add the powers since the last sample
+/// (trapezoidal rule). e_mech: the mechanics' energy [J] at t (NAN: none).
+void sim_energy_sample(sim_energy* e, double t, const double* y, double e_mech);
+/// The same from a hyd_data the caller's own evaluation of the circuit at
+/// (t, state) filled (every output: flows, node pressures, volumes).
+void sim_energy_sample_data(sim_energy* e, double t, const hyd_data* d, double e_mech);
+/// Write the powers to f [W] (header at bind, a row at the first sample and
+/// then one per dt [s] on the grid); f stays the caller's. Call before the run.
+void sim_energy_csv(sim_energy* e, FILE* f, double dt);
+
+/// Columns: per component (a valve two, meter-in and meter-out; a cylinder
+/// two, leak and work), then "tank", "stored" and "expansion". All but the
+/// last sum to zero at every sample (the identity of hydraulics.h).
+int sim_energy_ncol(const sim_energy* e);
+const char* sim_energy_col_name(const sim_energy* e, int i);
+sim_energy_group sim_energy_col_group(const sim_energy* e, int i);
+/// Energy taken from the fluid by column i over the run [J].
+double sim_energy_col_energy(const sim_energy* e, int i);
+
+/// The balance over the run [J].
+typedef struct sim_energy_balance {
+    double pump;       ///< delivered by the pumps
+    double tank;       ///< delivered by the tanks (boundary flow work; < 0 when they take more back)
+    double in;         ///< pump + tank
+    double group[SIM_EG_COUNT]; ///< taken by each group (SUPPLY is -pump, TANK -tank)
+    double loss;       ///< sum of the loss groups (valves .. other)
+    double expansion;  ///< compression energy released by fluid the chambers displaced
+    double work;       ///< piston work on the mechanics
+    double stored;     ///< change of the fluid's compression energy, from the end states (state function)
+    double stored_rate;///< the same from the integrated rate (for comparison)
+    double residual;   ///< in - loss - expansion - work - stored
+    double residual_pct; ///< 100 residual / in
+    double mech;       ///< change of the mechanics' energy (kinetic + potential); NAN when unknown
+    double t0, t1;     ///< the samples' first and last time [s]
+    long samples;
+} sim_energy_balance;
+void sim_energy_result(const sim_energy* e, sim_energy_balance* b);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,64 @@
+// test_energy_cli.c: `run --energy FILE.csv` (docs/energy.md): the header,
+// one row per output row, and in every row the identity of the power terms:
+// all columns but t and expansion sum to zero.
+#include "check.h"
+#include "cli_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void test_energy_csv_rows_sum_to_zero(void) {
+    static char out[16384];
+    const char* csv = CRANESIM_BINARY_DIR "/test_energy_cli.csv";
+    const char* ecsv = CRANESIM_BINARY_DIR "/test_energy_cli_e.csv";
+    char args[1024];
+    snprintf(args, sizeof args, "run --scenario overload --duration 6 --every 0.01 --out %s --energy %s", csv, ecsv);
+    int rc = cli_run(args, out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "energy: in ") && strstr(out, "residual "), "rc %d: %s", rc, out);
+    const char* r = strstr(out, "residual ");
+    CHECK(r && fabs(atof(r + 9)) < 1.0, "%s", r ? r : out);
+    static char buf[1 << 21];
+    CHECK(cli_read_file(ecsv, buf, sizeof buf) > 0, "no %s", ecsv);
+    CHECK(!strncmp(buf, "t,pump,", 7), "header: %.200s", buf);
+    // Which column is expansion (the last).
+    char* line = strtok(buf, "\n");
+    int ncol = 1;
+    for (const char* p = line; *p; ++p) ncol += *p == ',';
+    CHECK(strstr(line, ",tank,stored,expansion") != NULL, "header: %.300s", line);
+    int rows = 0, bad = 0;
+    double worst = 0.0, pump_max = 0.0;
+    while ((line = strtok(NULL, "\n"))) {
+        double sum = 0.0, scale = 0.0, v;
+        char* p = line;
+        for (int k = 0; k < ncol; ++k) {
+            v = strtod(p, &p);
+            if (*p == ',') ++p;
+            if (k == 0 || k == ncol - 1) continue; // t, expansion
+            if (k == 1) pump_max = fmax(pump_max, -v);
+            sum += v;
+            scale += fabs(v);
+        }
+        ++rows;
+        worst = fmax(worst, fabs(sum) / (scale + 1.0));
+        bad += fabs(sum) > 1e-6 * scale + 1e-6;
+    }
+    CHECK(rows == 601, "%d rows, expected 601 (0 .. 6 s every 10 ms)", rows);
+    CHECK(pump_max > 1e3, "the pump delivered at most %g W", pump_max);
+    CHECK(bad == 0, "%d rows do not sum to zero (worst %.3g relative)", bad, worst);
+    remove(csv);
+    remove(ecsv);
+}
+
+static void test_energy_bad_path(void) {
+    static char out[4096];
+    int rc = cli_run("run --scenario ramp --out /dev/null --energy /nonexistent-dir/e.csv", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--energy") && cli_count_lines(out) == 1, "rc %d: %s", rc, out);
+}
+
+int main(void) {
+    test_energy_csv_rows_sum_to_zero();
+    test_energy_bad_path();
+    printf("%d checks, %d failed\n", check_count_, check_failures_);
+    return check_failures_ != 0;
+}
