@@ -603,7 +603,7 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
         snprintf(err, errsz, "ode world: dt_ode = %g s must be a whole multiple of dt_hyd = %g s", opt.dt_ode, opt.dt_hyd);
         return NULL;
     }
-    if (opt.hydraulics && !hydraulics) {
+    if (opt.hydraulics && !hydraulics && !opt.circuit) {
         snprintf(err, errsz, "%s: hydraulics: missing (required by the ode world)", opt.model_file);
         return NULL;
     }

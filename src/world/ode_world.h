@@ -59,6 +59,10 @@ typedef struct ode_world_opts {
     int general_circuit;  ///< 1: the circuit's component loops (hyd_eval) for the hydraulic
                           ///< solver even when the straight-line kernel applies (hyd_fused.h);
                           ///< 0 (default): that kernel when the circuit has its shape
+    hyd_model* circuit;   ///< the model's compiled circuit (borrowed, not freed): used as the
+                          ///< world's own when the world adds no circuit of its own, so a run
+                          ///< and its panel share one hyd_model; NULL (default) compiles the
+                          ///< "hydraulics" section
 } ode_world_opts;
 
 ode_world_opts ode_world_default_opts(void);

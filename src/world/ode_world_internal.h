@@ -148,7 +148,8 @@ struct ode_world {
     int crane_contact;
 
     // Hydraulics (ode_coupling.c).
-    hyd_model* hm;       ///< compiled circuit (owned), NULL without hydraulics
+    hyd_model* hm;       ///< compiled circuit, NULL without hydraulics
+    int own_hm;          ///< 1: hm compiled here (freed with the world); 0: opts.circuit, borrowed
     hyd_data* hd;
     hyd_solver* hs;
     hyd_problem hp;

@@ -386,6 +386,7 @@ ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* d
     wo.load_mass = m3;
     wo.p_low = 0.5e6; // as the lagrange backend, so both start from the same state
     wo.model_file = m->file;
+    wo.circuit = m->hyd; // the run's one circuit unless the world adds to it
     const cJSON* hyd = cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics");
     ode_world* w = ode_world_create(&m->mech, hyd, &wd, &wo, err, errsz);
     world_desc_free(&wd);
