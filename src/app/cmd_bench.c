@@ -460,7 +460,7 @@ int cmd_bench(int argc, char** argv) {
                o.mechanics == SIM_ODE ? o.dt_ode : 0.0, lagrange_variant_name(o.variant), hyd_method_name(o.solver),
                hyd_method_is_adaptive(o.solver) ? 0.0 : o.h, hyd_method_is_adaptive(o.solver) ? o.rtol : 0.0,
                hyd_method_is_adaptive(o.solver) ? "dense" : (o.dense_jac ? "dense" : "blocks"),
-               r.split ? "split" : r.fused ? "fused" : "general", r.t_end, wall,
+               r.split ? "split" : r.fused ? "fused" : r.fast ? "fast" : "general", r.t_end, wall,
                repeat, r.t_end / wall, r.stats.steps, r.stats.rejected, r.stats.fevals, r.stats.jevals,
                r.stats.lus, 1e9 * wall / (double)(r.stats.steps ? r.stats.steps : 1));
         fflush(stdout);

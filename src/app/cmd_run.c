@@ -174,7 +174,7 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     else printf("cranesim run: %s, lagrange/%s", scen, lagrange_variant_name(o->variant));
     printf(", solver %s", o->cvode ? "cvode" : hyd_method_name(o->solver));
     // Which circuit kernel ran (cranesim run --help, --kernel).
-    const char* kern = r->split ? ", split step" : r->fused ? ", fused kernel" : ", general kernel";
+    const char* kern = r->split ? ", split step" : r->fused ? ", fused kernel" : r->fast ? ", fast kernel" : ", general kernel";
     if (adaptive) printf(" (rtol %g, atol %g%s)\n", o->rtol, o->atol, kern);
     else if (ode && o->h > o->dt_ode) // the ode world sub-steps at min(--dt, --dt-ode)
         printf(" (h = %g ms: --dt %g ms reduced to the ODE step%s)\n", o->dt_ode * 1e3, o->h * 1e3, kern);

@@ -241,9 +241,10 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     double m3 = sim_load_mass(m, sc, o);
     if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     ls.scn = sc;
-    ls.use_fused = ls.have_fused && !o->general_kernel;
-    ls.use_w = ls.w_layout && !o->general_kernel; // the crane-specialised W too (lagrange_schur_w.c)
-    ls.use_split = ls.w_layout && !o->general_kernel && !o->whole_step;
+    const bool reference = o->kernel == SIM_KERNEL_GENERAL;
+    ls.use_fused = ls.have_fused && !reference;
+    ls.use_w = ls.w_layout && !reference; // the crane-specialised W too (lagrange_schur_w.c)
+    ls.use_split = ls.w_layout && o->kernel == SIM_KERNEL_SPLIT;
     res->fused = ls.use_fused;
     double y[LSIM_MAX_STATES];
     if (lsim_check_pose(&ls, sc->q0, res->message, sizeof res->message) ||

@@ -111,6 +111,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
                                         sizeof res->message);
     if (!w) return res->status = SIM_REFUSED;
     res->fused = ode_world_fused(w);
+    res->fast = ode_world_fast(w);
     const long ode_msgs = ode_world_messages(NULL);
     const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
     if ((res->status = sim_check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res->message,

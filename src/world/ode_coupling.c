@@ -44,6 +44,22 @@ static int jac(void* user, double t, const double* y, double* J) {
     return 0;
 }
 
+// The fast kernel for any circuit (circuit_fast.h): the same laws as the
+// component loops in type-sorted loops, the inputs as set_inputs writes them.
+static int rhs_fast(void* user, double t, const double* y, double* dydt) {
+    ode_world* w = user;
+    set_inputs(w, t);
+    hyd_fast_eval(w->fk, w->hd, y, dydt);
+    return 0;
+}
+
+static int jac_fast(void* user, double t, const double* y, double* J) {
+    ode_world* w = user;
+    set_inputs(w, t);
+    hyd_fast_jacobian(w->fk, w->hd, y, NULL, J, w->nh);
+    return 0;
+}
+
 // The straight-line kernel: the same laws in one pass (hyd_fused.h), about a
 // third of hyd_eval's instructions on the sandbox circuit. Its inputs per
 // lane are what set_inputs writes into hd.
@@ -115,10 +131,11 @@ static int outside(void* user, const double* y) {
     return 0;
 }
 
-// (Re)pack the straight-line kernel for the present parameters, or fall
-// back to the general path when the circuit does not have its shape.
+// (Re)pack the straight-line kernel for the present parameters, or take
+// the fast kernel when the circuit does not have its shape.
 static void fused_setup(ode_world* w) {
     w->use_fused = 0;
+    w->use_fast = 0;
     w->hp.f = rhs;
     w->hp.jac = jac;
     w->hp.events = NULL;
@@ -130,8 +147,19 @@ static void fused_setup(ode_world* w) {
         cyl[w->nfz] = w->act[k].cyl;
         w->fz_act[w->nfz++] = k;
     }
-    char why[128];
-    if (hyd_fused_build(w->hm, valve, cyl, w->nfz, &w->fz, why, sizeof why)) return;
+    char why[160];
+    if (hyd_fused_build(w->hm, valve, cyl, w->nfz, &w->fz, why, sizeof why)) {
+        // Not the standard shape: the fast kernel, unless the reference loops
+        // are asked for. A component type it has no loop for is evaluated by
+        // that type's loop (fallback), so it takes every circuit.
+        if (w->opt.general_circuit) return;
+        if (!w->fk) w->fk = hyd_fast_create(w->hm, hyd_fast_types(), 1, why, sizeof why);
+        if (!w->fk) return; // out of memory: the reference loops, still correct
+        w->use_fast = 1;
+        w->hp.f = rhs_fast;
+        w->hp.jac = jac_fast;
+        return;
+    }
     w->fz_rev = hyd_model_revision(w->hm);
     // The event counter reads the packed laws whichever kernel evaluates f,
     // so both kernels follow the same Jacobian schedule.
@@ -285,6 +313,8 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
 void ow_hyd_destroy(ode_world* w) {
     if (w->hs) hyd_solver_destroy(w->hs);
     if (w->hd) hyd_data_free(w->hd);
+    if (w->fk) hyd_fast_free(w->fk);
+    w->fk = NULL;
     if (w->hm && w->own_hm) hyd_model_free(w->hm);
     w->hs = NULL;
     w->hd = NULL;

@@ -134,6 +134,9 @@ int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln);
 /// (hyd_fused.h), 0 on the component loops (opts.general_circuit, or a
 /// circuit of another shape).
 int ode_world_fused(const ode_world* w);
+/// 1 when the hydraulic sub-steps evaluate the circuit with the fast kernel
+/// (circuit_fast.h: a circuit without the one-pass kernel's shape), 0 otherwise.
+int ode_world_fast(const ode_world* w);
 /// Chamber pressures pA, pB [Pa abs] of the actuators (ODE_LIFT, ODE_JIB,
 /// ODE_SLEW; 0 where there is none), straight from the hydraulic state:
 /// cheap enough for every step.

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "hydraulics.h"
+#include "circuit_fast.h"
 #include "hyd_fused.h"
 #include "hyd_solver.h"
 #include "ode_world.h"
@@ -173,6 +174,11 @@ struct ode_world {
     int fz_act[ODE_NACT];
     unsigned fz_rev;
     hyd_fused_events fz_ev; ///< the fused path's event counter (hyd_problem.events)
+    // The fast kernel (circuit_fast.h) for any other circuit, unless
+    // opts.general_circuit asks for the reference loops. It follows live
+    // edits by itself (the circuit's revision).
+    hyd_fast* fk;
+    int use_fast;
 };
 
 // ode_world.c

@@ -379,7 +379,7 @@ ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* d
     wo.rtol = o->rtol;
     wo.atol = o->atol;
     wo.dense_jac = o->dense_jac;
-    wo.general_circuit = o->general_kernel;
+    wo.general_circuit = o->kernel == SIM_KERNEL_GENERAL;
     wo.q0[0] = q0[0];
     wo.q0[1] = q0[1];
     wo.slew0 = slew0;
