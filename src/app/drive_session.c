@@ -316,9 +316,12 @@ static void apply_param(drive_session* s, int i) {
         return;
     }
     case PK_STEP: {
-        // The ode world needs the hydraulic step to divide its 1 ms step.
-        double sub = s->c.sim.mechanics == SIM_ODE ? floor(s->c.sim.dt_ode / si + 0.5) : 0;
-        s->c.sim.h = sub > 0 ? s->c.sim.dt_ode / sub : si;
+        // A backend that sub-steps the hydraulics in a rigid-body step (the
+        // ode world's 1 ms) needs the hydraulic step to divide it.
+        engine_desc d;
+        engine_describe(&s->c.sim, &d);
+        double sub = d.dt_outer > 0 ? floor(d.dt_outer / si + 0.5) : 0;
+        s->c.sim.h = sub > 0 ? d.dt_outer / sub : si;
         p->value = s->c.sim.h / p->scale;
         s->rebuild = true;
         snprintf(s->rebuild_why, sizeof s->rebuild_why, "solver step %.4g ms", p->value);

@@ -508,7 +508,23 @@ static void lag_snapshot(engine* e, world_snapshot* s) {
     world_snap_reliefs(s, l->ls.mdl->hyd, l->ls.hd->comp_open, cyl_hyd);
 }
 
+// A lagrange run is named by its variant of the equations; no world.
+static void lag_describe(const sim_opts* o, engine_desc* d) {
+    d->world = "";
+    snprintf(d->label, sizeof d->label, "lagrange/%s", lagrange_variant_name(o->variant));
+    snprintf(d->title, sizeof d->title, "%s", lagrange_variant_name(o->variant));
+    d->step_name = "step";
+}
+
+static void lag_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n) {
+    (void)o;
+    snprintf(buf, n, "%ld steps, %ld rejected, %ld f evals, %ld LU", r->stats.steps, r->stats.rejected,
+             r->stats.fevals, r->stats.lus);
+}
+
 const engine_ops engine_lagrange_ops = {
+    .describe = lag_describe,
+    .describe_work = lag_describe_work,
     .name = "lagrange",
     .create = lag_create,
     .run = lag_run,
