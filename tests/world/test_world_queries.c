@@ -259,10 +259,45 @@ static void test_fast_kernel_on_ode(void) {
     model_free(m0);
 }
 
+// The drivers' report fields come from the backend: the words cranesim run
+// printed when it chose them itself (docs/README examples).
+static void test_describe(void) {
+    sim_opts o = sim_default_opts();
+    engine_desc d;
+    engine_describe(&o, &d);
+    CHECK(!strcmp(d.backend, "lagrange") && !strcmp(d.label, "lagrange/full") && !strcmp(d.title, "full") &&
+              !strcmp(d.world, "") && d.dt_outer == 0 && !d.h_reduced && !strcmp(d.step_name, "step"),
+          "lagrange: %s %s %s '%s' %g %d %s", d.backend, d.label, d.title, d.world, d.dt_outer, d.h_reduced,
+          d.step_name);
+    sim_result r;
+    memset(&r, 0, sizeof r);
+    r.stats.steps = 200000, r.stats.rejected = 3, r.stats.fevals = 400000, r.stats.lus = 20065;
+    char work[200];
+    engine_describe_work(&o, &r, work, sizeof work);
+    CHECK(!strcmp(work, "200000 steps, 3 rejected, 400000 f evals, 20065 LU"), "%s", work);
+    o.mechanics = SIM_ODE;
+    engine_describe(&o, &d);
+    CHECK(!strcmp(d.backend, "ode") && !strcmp(d.label, "ode/validation") && !strcmp(d.title, "ode/validation") &&
+              !strcmp(d.world, "validation") && d.dt_outer == 1e-3 && !d.h_reduced && !strcmp(d.step_name, "ODE step"),
+          "ode: %s %s %s %s %g %d %s", d.backend, d.label, d.title, d.world, d.dt_outer, d.h_reduced, d.step_name);
+    engine_describe_work(&o, &r, work, sizeof work);
+    CHECK(!strcmp(work, "ODE step 1 ms, 200000 hydraulic sub-steps"), "%s", work);
+    o.world = "/tmp/w.json";
+    o.h = 2e-3; // longer than the ODE step: cut to it
+    engine_describe(&o, &d);
+    CHECK(!strcmp(d.label, "ode world /tmp/w.json") && !strcmp(d.title, "ode//tmp/w.json") && d.h_reduced, "%s %s %d",
+          d.label, d.title, d.h_reduced);
+    o.solver = HYD_RODAS3; // adaptive: its own steps, no fixed step to cut
+    engine_describe(&o, &d);
+    engine_describe_work(&o, &r, work, sizeof work);
+    CHECK(!d.h_reduced && !strcmp(work, "ODE step 1 ms, 200000 hydraulic steps"), "%d %s", d.h_reduced, work);
+}
+
 int main(void) {
     test_renamed_pump_line();
     test_one_circuit();
     test_world_circuit_errors();
     test_fast_kernel_on_ode();
+    test_describe();
     TEST_MAIN_END();
 }
