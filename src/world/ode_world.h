@@ -98,8 +98,10 @@ typedef struct ode_world_state {
 
 /// Build a world. mech: crane mechanics (copied). hydraulics: the model's
 /// "hydraulics" JSON section (read, not kept); may be NULL when
-/// o->hydraulics == 0. The world's circuit extras are appended to it before
-/// compiling. Returns NULL with one line "file: field: problem" in err.
+/// o->hydraulics == 0 or when o->circuit is given and the world adds no
+/// circuit. The world's circuit extras are compiled with it as one circuit
+/// (an error in them names the world file); without extras the world runs on
+/// o->circuit when given. Returns NULL with one line "file: field: problem" in err.
 ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, const world_desc* w,
                             const ode_world_opts* o, char* err, size_t errsz);
 void ode_world_destroy(ode_world* w);
@@ -122,8 +124,9 @@ void ode_world_snapshot(const ode_world* w, world_snapshot* s);
 /// Current state for CSV and tests.
 void ode_world_get_state(const ode_world* w, ode_world_state* s);
 
-/// The world's own compiled circuit (model plus world extras), for live
-/// parameter changes with hyd_model_set between steps; NULL without hydraulics.
+/// The run's compiled circuit (model plus world extras, or opts.circuit
+/// itself), for live parameter changes with hyd_model_set between steps;
+/// NULL without hydraulics.
 hyd_model* ode_world_circuit(ode_world* w);
 /// Give boom k (0 lifting arm, 1 end arm) link ln's mass and inertia in
 /// place (dBodySetMass), keeping its motion. Returns 0, or -1 (nothing
