@@ -230,12 +230,14 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
     case APP_OPT_WORLD: c->sim.world = v; break;
     case APP_OPT_DT_ODE: if (positive(a, v, &c->sim.dt_ode)) return -1; break;
     case APP_OPT_KERNEL:
-        if (strcmp(v, "split") && strcmp(v, "fused") && strcmp(v, "general")) {
+        // "fast" and "reference" name the two ends of the one choice.
+        if (!strcmp(v, "split") || !strcmp(v, "fast")) c->sim.kernel = SIM_KERNEL_SPLIT;
+        else if (!strcmp(v, "fused")) c->sim.kernel = SIM_KERNEL_FUSED;
+        else if (!strcmp(v, "general") || !strcmp(v, "reference")) c->sim.kernel = SIM_KERNEL_GENERAL;
+        else {
             fprintf(stderr, "cranesim: --kernel: expected split, fused or general, got '%s'\n", v);
             return -1;
         }
-        c->sim.general_kernel = !strcmp(v, "general");
-        c->sim.whole_step = !strcmp(v, "fused");
         break;
     default: break;
     }
@@ -272,7 +274,9 @@ static const struct {
                      "                       fused: the same, but f in full at every Krus/ROS2 stage;\n"
                      "                       general: the component loops and the solver's own sparse LU;\n"
                      "                       with --mechanics ode, split and fused both mean the one-pass\n"
-                     "                         circuit in the hydraulic sub-steps, general the loops\n"},
+                     "                         circuit in the hydraulic sub-steps (the fast kernel for a\n"
+                     "                         circuit without its shape), general the loops;\n"
+                     "                       fast = split, reference = general\n"},
     {APP_OPT_DURATION, "  --duration T         simulated time [s] (default: the scenario's)\n"},
     {APP_OPT_EVERY, "  --every DT           output period [s] (default 1e-3, i.e. 1 kHz); with a fixed-step\n"
                     "                       solver a whole multiple of --dt (a longer --dt: one row per step),\n"

@@ -451,16 +451,18 @@ int cmd_bench(int argc, char** argv) {
             continue;
         }
         const double wall = app_median(walls, repeat);
+        engine_desc d; // the backend's own name, world and outer step
+        engine_describe(&o, &d);
         printf("{\"config\":\"%s\",\"scenario\":\"%s\",\"mechanics\":\"%s\",\"world\":\"%s\","
                "\"dt_ode_s\":%g,\"variant\":\"%s\","
                "\"solver\":\"%s\",\"h_s\":%g,\"rtol\":%g,\"jacobian\":\"%s\",\"kernel\":\"%s\",\"sim_time_s\":%.6g,"
                "\"wall_s_median\":%.6g,\"repeat\":%d,\"rt_factor\":%.1f,\"steps\":%ld,\"rejected\":%ld,"
                "\"fevals\":%ld,\"jevals\":%ld,\"lus\":%ld,\"ns_per_step\":%.1f}\n",
-               b->name, use->name, o.mechanics == SIM_ODE ? "ode" : "lagrange", o.mechanics == SIM_ODE ? o.world : "",
-               o.mechanics == SIM_ODE ? o.dt_ode : 0.0, lagrange_variant_name(o.variant), hyd_method_name(o.solver),
+               b->name, use->name, d.backend, d.world, d.dt_outer, lagrange_variant_name(o.variant),
+               hyd_method_name(o.solver),
                hyd_method_is_adaptive(o.solver) ? 0.0 : o.h, hyd_method_is_adaptive(o.solver) ? o.rtol : 0.0,
                hyd_method_is_adaptive(o.solver) ? "dense" : (o.dense_jac ? "dense" : "blocks"),
-               r.split ? "split" : r.fused ? "fused" : "general", r.t_end, wall,
+               r.split ? "split" : r.fused ? "fused" : r.fast ? "fast" : "general", r.t_end, wall,
                repeat, r.t_end / wall, r.stats.steps, r.stats.rejected, r.stats.fevals, r.stats.jevals,
                r.stats.lus, 1e9 * wall / (double)(r.stats.steps ? r.stats.steps : 1));
         fflush(stdout);

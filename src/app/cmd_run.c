@@ -1,6 +1,7 @@
 // cmd_run.c: `cranesim run`: a headless run of a scenario to CSV (and a plot).
 #include "app.h"
 #include "energy_acc.h"
+#include "engine.h"
 
 #include <errno.h>
 #include <math.h>
@@ -173,28 +174,22 @@ static int csv_close(csv_sink* s) {
 static void print_summary(const char* scen, const sim_opts* o, const sim_result* r, const row_stats* st,
                           const char* out) {
     const double *pmax = st->pmax, *xmin = st->xmin, *xmax = st->xmax;
-    const bool ode = o->mechanics == SIM_ODE;
     const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
-    // The variant is the lagrange backend's; an ode run is named by its world.
-    // A world given as a file path reads "ode world FILE", a name "ode/NAME".
-    if (ode) printf("cranesim run: %s, ode%s%s", scen, o->world && strchr(o->world, '/') ? " world " : "/",
-                    o->world ? o->world : "validation");
-    else printf("cranesim run: %s, lagrange/%s", scen, lagrange_variant_name(o->variant));
+    // The backend names the run and its work (engine_describe).
+    engine_desc d;
+    engine_describe(o, &d);
+    printf("cranesim run: %s, %s", scen, d.label);
     printf(", solver %s", o->cvode ? "cvode" : hyd_method_name(o->solver));
     // Which circuit kernel ran (cranesim run --help, --kernel).
-    const char* kern = r->split ? ", split step" : r->fused ? ", fused kernel" : ", general kernel";
+    const char* kern = r->split ? ", split step" : r->fused ? ", fused kernel" : r->fast ? ", fast kernel" : ", general kernel";
     if (adaptive) printf(" (rtol %g, atol %g%s)\n", o->rtol, o->atol, kern);
-    else if (ode && o->h > o->dt_ode) // the ode world sub-steps at min(--dt, --dt-ode)
-        printf(" (h = %g ms: --dt %g ms reduced to the ODE step%s)\n", o->dt_ode * 1e3, o->h * 1e3, kern);
+    else if (d.h_reduced) // sub-stepped at min(--dt, the outer step)
+        printf(" (h = %g ms: --dt %g ms reduced to the ODE step%s)\n", d.dt_outer * 1e3, o->h * 1e3, kern);
     else printf(" (h = %g ms%s)\n", o->h * 1e3, kern);
-    if (ode)
-        printf("  simulated %.3f s in %.3f s wall: %.0fx real time; ODE step %g ms, %ld hydraulic %s\n", r->t_end,
-               r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, o->dt_ode * 1e3, r->stats.steps,
-               adaptive ? "steps" : "sub-steps");
-    else
-        printf("  simulated %.3f s in %.3f s wall: %.0fx real time; %ld steps, %ld rejected, %ld f evals, %ld LU\n",
-               r->t_end, r->wall, r->wall > 0 ? r->t_end / r->wall : 0.0, r->stats.steps, r->stats.rejected,
-               r->stats.fevals, r->stats.lus);
+    char work[200];
+    engine_describe_work(o, r, work, sizeof work);
+    printf("  simulated %.3f s in %.3f s wall: %.0fx real time; %s\n", r->t_end, r->wall,
+           r->wall > 0 ? r->t_end / r->wall : 0.0, work);
     printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
            1e3 * xmax[1]);
     // The peaks over every integration step when sim.c tracked them (between
@@ -203,8 +198,7 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     const double every = app_output_period(o);
     if (r->peak_steps) {
         printf("  peak pressures: p1A %.2f, p1B %.2f, p2A %.2f, p2B %.2f MPa (absolute, over every %s)",
-               r->p_peak[0] * 1e-6, r->p_peak[1] * 1e-6, r->p_peak[2] * 1e-6, r->p_peak[3] * 1e-6,
-               o->mechanics == SIM_ODE ? "ODE step" : "step");
+               r->p_peak[0] * 1e-6, r->p_peak[1] * 1e-6, r->p_peak[2] * 1e-6, r->p_peak[3] * 1e-6, d.step_name);
     } else {
         printf("  peak pressures at the output rows: p1A %.2f, p1B %.2f, p2A %.2f, p2B %.2f MPa (absolute)",
                pmax[0] * 1e-6, pmax[1] * 1e-6, pmax[2] * 1e-6, pmax[3] * 1e-6);
@@ -431,13 +425,11 @@ int cmd_run(int argc, char** argv) {
         if (energy_csv) printf("  energy -> %s\n", energy_csv);
     }
     if (plot && tr.nrow > 1 && code != EXIT_USAGE && !app_signal_caught()) {
-        char err[512], title[160];
-        if (c.sim.mechanics == SIM_ODE)
-            snprintf(title, sizeof title, "%s: ode/%s, %s", sc.name, c.sim.world ? c.sim.world : "validation",
-                     c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
-        else
-            snprintf(title, sizeof title, "%s: %s, %s", sc.name, lagrange_variant_name(c.sim.variant),
-                     c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
+        char err[512], title[256];
+        engine_desc d;
+        engine_describe(&c.sim, &d);
+        snprintf(title, sizeof title, "%s: %s, %s", sc.name, d.title,
+                 c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
         if (app_plot_run(&tr, title, plot, err, sizeof err)) {
             fprintf(stderr, "cranesim run: plot: %s\n", err);
             if (code == EXIT_OK_) code = EXIT_RUNTIME;

@@ -134,6 +134,9 @@ static void add_hyd(drive_session* s, const char* group, const char* label, cons
         snprintf(jp, sizeof jp, "hydraulics.components.%s.%s", comp, field);
     }
     if (hyd_model_get(s->m->hyd, hp, &v) == 0) {
+        // The value the run's circuit has now (the model's may lag it while a
+        // world that adds components runs: apply_param sets the run's only).
+        if (engine_circuit(s->l)) hyd_model_get(engine_circuit(s->l), hp, &v);
         add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, jp, v);
         return;
     }
@@ -260,14 +263,13 @@ static void apply_param(drive_session* s, int i) {
     char e[256];
     switch (p->kind) {
     case PK_HYD:
-        // Both the world's own circuit and the model's (which a rebuilt world
-        // or a saved file starts from).
-        if (hyd_model_set(engine_circuit(s->l), p->hyd_path, si, e, sizeof e) ||
-            (!p->world_only && hyd_model_set(s->m->hyd, p->hyd_path, si, e, sizeof e))) {
+        // Once, on the run's circuit: the model's own unless the world adds
+        // components to it (then a rebuilt world compiles the model document,
+        // which sync_json below updates; a saved file is that document).
+        if (hyd_model_set(engine_circuit(s->l), p->hyd_path, si, e, sizeof e)) {
             snprintf(s->status, sizeof s->status, "rejected: %s", e);
             double old;
-            if (!hyd_model_get(p->world_only ? engine_circuit(s->l) : s->m->hyd, p->hyd_path, &old))
-                p->value = old / p->scale;
+            if (!hyd_model_get(engine_circuit(s->l), p->hyd_path, &old)) p->value = old / p->scale;
             return;
         }
         break;
@@ -314,9 +316,12 @@ static void apply_param(drive_session* s, int i) {
         return;
     }
     case PK_STEP: {
-        // The ode world needs the hydraulic step to divide its 1 ms step.
-        double sub = s->c.sim.mechanics == SIM_ODE ? floor(s->c.sim.dt_ode / si + 0.5) : 0;
-        s->c.sim.h = sub > 0 ? s->c.sim.dt_ode / sub : si;
+        // A backend that sub-steps the hydraulics in a rigid-body step (the
+        // ode world's 1 ms) needs the hydraulic step to divide it.
+        engine_desc d;
+        engine_describe(&s->c.sim, &d);
+        double sub = d.dt_outer > 0 ? floor(d.dt_outer / si + 0.5) : 0;
+        s->c.sim.h = sub > 0 ? d.dt_outer / sub : si;
         p->value = s->c.sim.h / p->scale;
         s->rebuild = true;
         snprintf(s->rebuild_why, sizeof s->rebuild_why, "solver step %.4g ms", p->value);

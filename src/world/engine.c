@@ -3,6 +3,7 @@
 #include "engine_impl.h"
 
 #include <stdio.h>
+#include <string.h>
 
 typedef struct play_ctx {
     engine* e;
@@ -42,6 +43,16 @@ void engine_destroy(engine* e) {
 }
 
 const char* engine_backend_name(const engine* e) { return e->ops->name; }
+
+void engine_describe(const sim_opts* o, engine_desc* d) {
+    memset(d, 0, sizeof *d);
+    d->backend = backend(o)->name;
+    backend(o)->describe(o, d);
+}
+
+void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n) {
+    backend(o)->describe_work(o, r, buf, n);
+}
 void engine_set_commands(engine* e, const double u[3]) { e->ops->set_commands(e, u); }
 int engine_hook(engine* e, int attach) { return e->ops->hook ? e->ops->hook(e, attach) : -1; }
 

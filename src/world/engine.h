@@ -32,6 +32,25 @@ void engine_destroy(engine* e);
 /// "lagrange" or "ode".
 const char* engine_backend_name(const engine* e);
 
+/// What the backend o->mechanics chooses says about a run with options o,
+/// for the drivers' reports: they print these fields instead of asking which
+/// backend runs.
+typedef struct engine_desc {
+    const char* backend;   ///< "lagrange", "ode"
+    const char* world;     ///< the world the options name ("validation" when none); "" without a world
+    char label[320];       ///< the run in summaries: "ode/validation", "ode world FILE" (a path), "lagrange/full"
+    char title[160];       ///< the run in plot titles: "ode/validation", "full"
+    double dt_outer;       ///< the rigid-body step the hydraulics are sub-stepped in [s] (the
+                           ///< options' value); 0: no such step
+    bool h_reduced;        ///< the fixed hydraulic step asked for is longer than dt_outer, which is used
+    const char* step_name; ///< what a peak over every step is taken over: "ODE step", "step"
+} engine_desc;
+void engine_describe(const sim_opts* o, engine_desc* d);
+/// The work a finished run r did, as its summary says it after "real time; ":
+/// "ODE step 1 ms, 30000 hydraulic sub-steps" or "200000 steps, 0 rejected,
+/// 400000 f evals, 20065 LU".
+void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n);
+
 /// Valve commands lift, jib, slew in [-1, 1] (clamped; slew ignored where
 /// the crane does not slew), held until changed.
 void engine_set_commands(engine* e, const double u[3]);

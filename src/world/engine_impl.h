@@ -13,6 +13,9 @@ typedef struct engine_ops {
                       size_t errsz);
     /// A scripted run of scenario sc (engine_run).
     int (*run)(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
+    /// The report fields of a run with options o (engine_describe), and its work.
+    void (*describe)(const sim_opts* o, engine_desc* d);
+    void (*describe_work)(const sim_opts* o, const sim_result* r, char* buf, size_t n);
     int nchannel;     ///< the channels it publishes: sim_channels[0 .. nchannel), the columns its rows fill
     void (*destroy)(engine* e);
     void (*set_commands)(engine* e, const double u[3]);

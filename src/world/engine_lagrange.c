@@ -265,9 +265,10 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     double m3 = sim_load_mass(m, sc, o);
     if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     ls.scn = sc;
-    ls.use_fused = ls.have_fused && !o->general_kernel;
-    ls.use_w = ls.w_layout && !o->general_kernel; // the crane-specialised W too (lagrange_schur_w.c)
-    ls.use_split = ls.w_layout && !o->general_kernel && !o->whole_step;
+    const bool reference = o->kernel == SIM_KERNEL_GENERAL;
+    ls.use_fused = ls.have_fused && !reference;
+    ls.use_w = ls.w_layout && !reference; // the crane-specialised W too (lagrange_schur_w.c)
+    ls.use_split = ls.w_layout && o->kernel == SIM_KERNEL_SPLIT;
     res->fused = ls.use_fused;
     double y[LSIM_MAX_STATES];
     if (lsim_check_pose(&ls, sc->q0, res->message, sizeof res->message) ||
@@ -539,7 +540,23 @@ static void lag_snapshot(engine* e, world_snapshot* s) {
     world_snap_reliefs(s, l->ls.mdl->hyd, l->ls.hd->comp_open, cyl_hyd);
 }
 
+// A lagrange run is named by its variant of the equations; no world.
+static void lag_describe(const sim_opts* o, engine_desc* d) {
+    d->world = "";
+    snprintf(d->label, sizeof d->label, "lagrange/%s", lagrange_variant_name(o->variant));
+    snprintf(d->title, sizeof d->title, "%s", lagrange_variant_name(o->variant));
+    d->step_name = "step";
+}
+
+static void lag_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n) {
+    (void)o;
+    snprintf(buf, n, "%ld steps, %ld rejected, %ld f evals, %ld LU", r->stats.steps, r->stats.rejected,
+             r->stats.fevals, r->stats.lus);
+}
+
 const engine_ops engine_lagrange_ops = {
+    .describe = lag_describe,
+    .describe_work = lag_describe_work,
     .name = "lagrange",
     .create = lag_create,
     .run = lag_run,

@@ -9,6 +9,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 typedef struct eng_ode {
     engine base;
@@ -112,6 +113,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
                                         sizeof res->message);
     if (!w) return res->status = SIM_REFUSED;
     res->fused = ode_world_fused(w);
+    res->fast = ode_world_fast(w);
     const long ode_msgs = ode_world_messages(NULL);
     const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
     if ((res->status = sim_check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res->message,
@@ -235,7 +237,27 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     return res->status;
 }
 
+// An ode run is named by its world: a world given as a file path reads
+// "ode world FILE", a name "ode/NAME". The hydraulics are sub-stepped at
+// min(h, ODE step) (sim_ode_world_create).
+static void ode_describe(const sim_opts* o, engine_desc* d) {
+    d->world = o->world ? o->world : "validation";
+    snprintf(d->label, sizeof d->label, "ode%s%s", o->world && strchr(o->world, '/') ? " world " : "/", d->world);
+    snprintf(d->title, sizeof d->title, "ode/%s", d->world);
+    d->dt_outer = o->dt_ode;
+    d->h_reduced = !o->cvode && !hyd_method_is_adaptive(o->solver) && o->h > o->dt_ode;
+    d->step_name = "ODE step";
+}
+
+static void ode_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n) {
+    const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
+    snprintf(buf, n, "ODE step %g ms, %ld hydraulic %s", o->dt_ode * 1e3, r->stats.steps,
+             adaptive ? "steps" : "sub-steps");
+}
+
 const engine_ops engine_ode_ops = {
+    .describe = ode_describe,
+    .describe_work = ode_describe_work,
     .name = "ode",
     .create = ode_create,
     .run = ode_run,

@@ -8,20 +8,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-// Find the hose state feeding chamber state ic: the state j whose pressure
-// enters d(p_c)/dt through a laminar hose. Looks at the Jacobian pattern at a
-// nominal state, so it works for any circuit naming.
-static int hose_of_chamber(const hyd_model* hm, const double* J, int nh, int ic, int other) {
-    for (int j = 0; j < nh; ++j) {
-        if (j == ic || j == other || J[ic * nh + j] == 0.0) continue;
-        char comp[96];
-        snprintf(comp, sizeof comp, "%s", hyd_model_state_name(hm, j));
-        char* dot = strrchr(comp, '.');
-        if (dot) *dot = 0;
-        int c = hyd_model_find(hm, comp);
-        if (c >= 0 && hyd_model_comp_type(hm, c) == HYD_HOSE) return j;
-    }
-    return -1;
+// The pressure state of the hose feeding chamber state ic, or -1 when no
+// hose ends at that chamber (the circuit's own connection, not its names).
+static int hose_of_chamber(const hyd_model* hm, int ic) {
+    const int hose = hyd_model_feed_hose(hm, hyd_model_state_node(hm, ic));
+    return hose < 0 ? -1 : hyd_model_node_state(hm, hyd_model_comp_node(hm, hose, 0));
 }
 
 // The mount angle phi at which cylinder a has stroke x [m]: phi = acos of
@@ -65,18 +56,6 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
         return -1;
     }
 
-    // Jacobian pattern at a nominal state: mid-stroke, 5 MPa everywhere.
-    double y0[LSIM_MAX_STATES];
-    hyd_model_initial_state(hm, y0);
-    for (int i = 0; i < s->nh; ++i)
-        if (strstr(hyd_model_state_name(hm, i), ".p")) y0[i] = 5e6;
-    for (int k = 0; k < hyd_model_ncylinder(hm); ++k) {
-        double AA, AB, st;
-        hyd_model_cylinder_geometry(hm, k, &AA, &AB, &st);
-        s->hd->cyl_x[k] = 0.5 * st;
-    }
-    hyd_jacobian(hm, s->hd, 0.0, y0, NULL, s->jh_, s->nh, 0, 0);
-
     // Order: per actuator [spool] [hose A, pA] [hose B, pB]; then the rest.
     bool used[LSIM_MAX_STATES] = {false};
     int n = 0;
@@ -84,8 +63,8 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
         int iA, iB;
         hyd_model_cylinder_states(hm, m->cyl[k], &iA, &iB);
         int iu = hyd_model_valve_state(hm, m->valve[k]);
-        int hA = hose_of_chamber(hm, s->jh_, s->nh, iA, iB);
-        int hB = hose_of_chamber(hm, s->jh_, s->nh, iB, iA);
+        int hA = hose_of_chamber(hm, iA);
+        int hB = hose_of_chamber(hm, iB);
         s->iu[k] = n;
         s->perm[n++] = iu;
         s->block[s->nblock++] = 1;
@@ -131,10 +110,7 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
     s->use_split = s->w_layout;
     s->ks.cmd_t = NAN;
     lagrange_consts_init(&m->mech, v, m3, &s->lk);
-    for (int i = 0; i < s->nh; ++i) {
-        const char* nm = strrchr(hyd_model_state_name(hm, s->perm[i]), '.');
-        s->is_pressure[i] = nm && nm[1] == 'p';
-    }
+    for (int i = 0; i < s->nh; ++i) s->is_pressure[i] = hyd_model_state_kind(hm, s->perm[i]) == HYD_STATE_PRESSURE;
     return 0;
 }
 
@@ -511,6 +487,6 @@ void lsim_outputs(lsim* s, double t, const double* y, lsim_out* o) {
     const hyd_model* hm = s->mdl->hyd;
     for (int c = 0; c < hyd_model_ncomp(hm); ++c)
         if (hyd_model_comp_type(hm, c) == HYD_RELIEF && d->comp_open[c]) ++o->relief_open;
-    const int pl = hyd_model_find_node(hm, "pump_line");
+    const int pl = hyd_model_supply_node(hm); // the pump's delivery node, whatever its name
     if (pl >= 0) o->p_pump = d->node_p[pl];
 }

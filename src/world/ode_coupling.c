@@ -44,6 +44,22 @@ static int jac(void* user, double t, const double* y, double* J) {
     return 0;
 }
 
+// The fast kernel for any circuit (circuit_fast.h): the same laws as the
+// component loops in type-sorted loops, the inputs as set_inputs writes them.
+static int rhs_fast(void* user, double t, const double* y, double* dydt) {
+    ode_world* w = user;
+    set_inputs(w, t);
+    hyd_fast_eval(w->fk, w->hd, y, dydt);
+    return 0;
+}
+
+static int jac_fast(void* user, double t, const double* y, double* J) {
+    ode_world* w = user;
+    set_inputs(w, t);
+    hyd_fast_jacobian(w->fk, w->hd, y, NULL, J, w->nh);
+    return 0;
+}
+
 // The straight-line kernel: the same laws in one pass (hyd_fused.h), about a
 // third of hyd_eval's instructions on the sandbox circuit. Its inputs per
 // lane are what set_inputs writes into hd.
@@ -115,10 +131,11 @@ static int outside(void* user, const double* y) {
     return 0;
 }
 
-// (Re)pack the straight-line kernel for the present parameters, or fall
-// back to the general path when the circuit does not have its shape.
+// (Re)pack the straight-line kernel for the present parameters, or take
+// the fast kernel when the circuit does not have its shape.
 static void fused_setup(ode_world* w) {
     w->use_fused = 0;
+    w->use_fast = 0;
     w->hp.f = rhs;
     w->hp.jac = jac;
     w->hp.events = NULL;
@@ -130,8 +147,19 @@ static void fused_setup(ode_world* w) {
         cyl[w->nfz] = w->act[k].cyl;
         w->fz_act[w->nfz++] = k;
     }
-    char why[128];
-    if (hyd_fused_build(w->hm, valve, cyl, w->nfz, &w->fz, why, sizeof why)) return;
+    char why[160];
+    if (hyd_fused_build(w->hm, valve, cyl, w->nfz, &w->fz, why, sizeof why)) {
+        // Not the standard shape: the fast kernel, unless the reference loops
+        // are asked for. A component type it has no loop for is evaluated by
+        // that type's loop (fallback), so it takes every circuit.
+        if (w->opt.general_circuit) return;
+        if (!w->fk) w->fk = hyd_fast_create(w->hm, hyd_fast_types(), 1, why, sizeof why);
+        if (!w->fk) return; // out of memory: the reference loops, still correct
+        w->use_fast = 1;
+        w->hp.f = rhs_fast;
+        w->hp.jac = jac_fast;
+        return;
+    }
     w->fz_rev = hyd_model_revision(w->hm);
     // The event counter reads the packed laws whichever kernel evaluates f,
     // so both kernels follow the same Jacobian schedule.
@@ -140,33 +168,6 @@ static void fused_setup(ode_world* w) {
     w->use_fused = 1;
     w->hp.f = rhs_fused;
     w->hp.jac = jac_fused;
-}
-
-// Append the world's extra nodes and components to a copy of the model's
-// circuit (cJSON-level merge, so the circuit loader checks everything once).
-static cJSON* merge_circuit(const cJSON* hydraulics, const cJSON* extra) {
-    cJSON* m = cJSON_Duplicate(hydraulics, 1);
-    if (!m || !extra) return m;
-    static const char* const lists[2] = {"nodes", "components"};
-    for (int l = 0; l < 2; ++l) {
-        const cJSON* add = cJSON_GetObjectItemCaseSensitive(extra, lists[l]);
-        if (!add) continue;
-        cJSON* dst = cJSON_GetObjectItemCaseSensitive(m, lists[l]);
-        if (!dst) {
-            dst = cJSON_AddArrayToObject(m, lists[l]);
-            if (!dst) goto oom;
-        }
-        const cJSON* it;
-        cJSON_ArrayForEach(it, add) {
-            cJSON* d = cJSON_Duplicate(it, 1);
-            if (!d) goto oom;
-            cJSON_AddItemToArray(dst, d);
-        }
-    }
-    return m;
-oom:
-    cJSON_Delete(m);
-    return NULL;
 }
 
 static int bind_actuator(ode_world* w, int k, const char* cyl, const char* valve, const char* file,
@@ -201,10 +202,8 @@ static void block_pattern(ode_world* w) {
     w->nblock = 0;
     if (!J) return; // dense W then: slower, still correct
     hyd_model_initial_state(w->hm, y);
-    for (int i = 0; i < n; ++i) {
-        const char* nm = strrchr(hyd_model_state_name(w->hm, i), '.');
-        if (nm && nm[1] == 'p') y[i] = 5e6;
-    }
+    for (int i = 0; i < n; ++i)
+        if (hyd_model_state_kind(w->hm, i) == HYD_STATE_PRESSURE) y[i] = 5e6;
     for (int k = 0; k < ODE_NACT; ++k)
         if (w->act[k].cyl >= 0) w->hd->cyl_x[w->act[k].cyl] = 0.5 * w->act[k].stroke;
     hyd_jacobian(w->hm, w->hd, 0.0, y, NULL, J, n, 0, 0);
@@ -227,60 +226,27 @@ static void block_pattern(ode_world* w) {
     }
 }
 
-static void ow_silent_note(const char* line, void* user) {
-    (void)line;
-    (void)user;
-}
-
+// The run's one compiled circuit. A world that adds components (the
+// sandbox's slew) compiles the model's circuit with them appended, so an
+// error in the world's part names the world file and its own index; else
+// the model's compiled circuit is used as it is (opts.circuit), and the
+// panel's edits reach the world and the model at once.
 int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz) {
     const char* mfile = w->opt.model_file;
     const int sandbox = w->kind == WORLD_SANDBOX;
-    cJSON* merged = merge_circuit(hydraulics, sandbox ? extra : NULL);
-    if (!merged) {
-        snprintf(err, errsz, "%s: hydraulics: out of memory", mfile);
+    if (!sandbox) extra = NULL;
+    if (!extra && w->opt.circuit) {
+        w->hm = w->opt.circuit;
+        w->own_hm = 0;
+    } else if (!hydraulics) {
+        snprintf(err, errsz, "%s: hydraulics: missing (required by the ode world)", mfile);
         return -1;
-    }
-    // The merged circuit's notes would call the world's components
-    // hydraulics.components[18..] of the model: the model's were given when
-    // it was loaded, the world's are given below under the world file.
-    void* note_user;
-    const hyd_note_fn note_prev = hyd_get_note_handler(&note_user);
-    hyd_set_note_handler(ow_silent_note, NULL);
-    w->hm = hyd_model_from_json(merged, mfile, "hydraulics", err, errsz);
-    hyd_set_note_handler(note_prev, note_user);
-    cJSON_Delete(merged);
-    if (w->hm && sandbox && extra)
-        hyd_json_fragment_notes(extra, w->desc.file[0] ? w->desc.file : "world", "circuit");
-    if (!w->hm) {
-        // Blame the world file when the model's own circuit is fine: the
-        // problem is then in the appended nodes/components.
-        if (sandbox && extra) {
-            char e2[256];
-            hyd_model* alone = hyd_model_from_json(hydraulics, mfile, "hydraulics", e2, sizeof e2);
-            if (alone) {
-                hyd_model_free(alone);
-                // Re-address "hydraulics.<list>[i].field: problem" to the
-                // world file's own list index when i is past the model's items.
-                char inner[256];
-                snprintf(inner, sizeof inner, "%s", err);
-                const char* wf = w->desc.file[0] ? w->desc.file : "world";
-                static const char* const lists[2] = {"nodes", "components"};
-                int done = 0;
-                for (int l = 0; l < 2 && !done; ++l) {
-                    char key[48];
-                    snprintf(key, sizeof key, "hydraulics.%s[", lists[l]);
-                    const char* at = strstr(inner, key);
-                    const cJSON* ml = cJSON_GetObjectItemCaseSensitive(hydraulics, lists[l]);
-                    int nmodel = ml ? cJSON_GetArraySize(ml) : 0, idx = -1, used = 0;
-                    if (at && sscanf(at + strlen(key), "%d]%n", &idx, &used) == 1 && used > 0 && idx >= nmodel) {
-                        snprintf(err, errsz, "%s: circuit.%s[%d]%s", wf, lists[l], idx - nmodel, at + strlen(key) + used);
-                        done = 1;
-                    }
-                }
-                if (!done) snprintf(err, errsz, "%s: circuit: merged with the model's circuit: %s", wf, inner);
-            }
-        }
-        return -1;
+    } else {
+        w->hm = extra ? hyd_model_from_json_extra(hydraulics, mfile, "hydraulics", extra,
+                                                  w->desc.file[0] ? w->desc.file : "world", "circuit", err, errsz)
+                      : hyd_model_from_json(hydraulics, mfile, "hydraulics", err, errsz);
+        w->own_hm = 1;
+        if (!w->hm) return -1;
     }
     w->nh = hyd_model_nstate(w->hm);
     if (w->nh > OW_MAX_HYD) {
@@ -310,9 +276,8 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
         }
         w->act[ODE_SLEW].present = 1;
     }
-    w->ipump = -1;
-    int pl = hyd_model_find_node(w->hm, "pump_line");
-    if (pl >= 0) w->ipump = hyd_model_node_state(w->hm, pl);
+    // The pump's delivery node, whatever the circuit calls it.
+    w->ipump = hyd_model_node_state(w->hm, hyd_model_supply_node(w->hm));
 
     w->hd = hyd_data_create(w->hm);
     if (!w->hd) {
@@ -348,23 +313,19 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
 void ow_hyd_destroy(ode_world* w) {
     if (w->hs) hyd_solver_destroy(w->hs);
     if (w->hd) hyd_data_free(w->hd);
-    if (w->hm) hyd_model_free(w->hm);
+    if (w->fk) hyd_fast_free(w->fk);
+    w->fk = NULL;
+    if (w->hm && w->own_hm) hyd_model_free(w->hm);
     w->hs = NULL;
     w->hd = NULL;
     w->hm = NULL;
 }
 
-// The hose feeding a chamber: the pressure state, other than the chambers
-// themselves, that the chamber's pressure rate depends on (found from the
-// Jacobian's pattern, so it works for any naming).
-static int hose_of(ode_world* w, const double* J, int ic, int iother) {
-    for (int j = 0; j < w->nh; ++j) {
-        if (j == ic || j == iother || J[ic * w->nh + j] == 0) continue;
-        const char* nm = hyd_model_state_name(w->hm, j);
-        size_t L = strlen(nm);
-        if (L > 2 && !strcmp(nm + L - 2, ".p")) return j;
-    }
-    return -1;
+// The pressure state of the hose feeding chamber state ic, or -1 when no
+// hose ends at that chamber (the circuit's own connection, not its names).
+static int hose_of(const ode_world* w, int ic) {
+    const int hose = hyd_model_feed_hose(w->hm, hyd_model_state_node(w->hm, ic));
+    return hose < 0 ? -1 : hyd_model_node_state(w->hm, hyd_model_comp_node(w->hm, hose, 0));
 }
 
 // Initial hydraulic state: the model's, then (init_hold) each boom cylinder's
@@ -381,9 +342,6 @@ void ow_hyd_init_state(ode_world* w) {
         w->hd->cyl_x[w->act[k].cyl] = w->act[k].x;
         w->hd->cyl_v[w->act[k].cyl] = 0;
     }
-    double J[OW_MAX_HYD * OW_MAX_HYD];
-    hyd_jacobian(w->hm, w->hd, 0.0, w->y, NULL, J, w->nh, 0, 0);
-
     // Static gravity torques at the joints from the masses beyond each joint
     // (lagrange's G(q) for the validation world; with rope and hook hanging
     // at the tip in the sandbox).
@@ -404,7 +362,7 @@ void ow_hyd_init_state(ode_world* w) {
         else pB = (p * c->AA - F) / c->AB;
         w->y[c->iA] = pA;
         w->y[c->iB] = pB;
-        int hA = hose_of(w, J, c->iA, c->iB), hB = hose_of(w, J, c->iB, c->iA);
+        int hA = hose_of(w, c->iA), hB = hose_of(w, c->iB);
         if (hA >= 0) w->y[hA] = pA;
         if (hB >= 0) w->y[hB] = pB;
         c->F = F;
@@ -416,7 +374,7 @@ void ow_hyd_init_state(ode_world* w) {
         double p = w->opt.p_low;
         w->y[s->iA] = p;
         w->y[s->iB] = p * s->AA / s->AB;
-        int hA = hose_of(w, J, s->iA, s->iB), hB = hose_of(w, J, s->iB, s->iA);
+        int hA = hose_of(w, s->iA), hB = hose_of(w, s->iB);
         if (hA >= 0) w->y[hA] = w->y[s->iA];
         if (hB >= 0) w->y[hB] = w->y[s->iB];
     }

@@ -603,7 +603,7 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
         snprintf(err, errsz, "ode world: dt_ode = %g s must be a whole multiple of dt_hyd = %g s", opt.dt_ode, opt.dt_hyd);
         return NULL;
     }
-    if (opt.hydraulics && !hydraulics) {
+    if (opt.hydraulics && !hydraulics && !opt.circuit) {
         snprintf(err, errsz, "%s: hydraulics: missing (required by the ode world)", opt.model_file);
         return NULL;
     }
@@ -1105,6 +1105,7 @@ int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln) {
 }
 
 int ode_world_fused(const ode_world* w) { return w->hm && w->use_fused; }
+int ode_world_fast(const ode_world* w) { return w->hm && w->use_fast; }
 
 void ode_world_chamber_pressures(const ode_world* w, double pA[ODE_NACT], double pB[ODE_NACT]) {
     for (int k = 0; k < ODE_NACT; ++k) {

@@ -59,6 +59,10 @@ typedef struct ode_world_opts {
     int general_circuit;  ///< 1: the circuit's component loops (hyd_eval) for the hydraulic
                           ///< solver even when the straight-line kernel applies (hyd_fused.h);
                           ///< 0 (default): that kernel when the circuit has its shape
+    hyd_model* circuit;   ///< the model's compiled circuit (borrowed, not freed): used as the
+                          ///< world's own when the world adds no circuit of its own, so a run
+                          ///< and its panel share one hyd_model; NULL (default) compiles the
+                          ///< "hydraulics" section
 } ode_world_opts;
 
 ode_world_opts ode_world_default_opts(void);
@@ -94,8 +98,10 @@ typedef struct ode_world_state {
 
 /// Build a world. mech: crane mechanics (copied). hydraulics: the model's
 /// "hydraulics" JSON section (read, not kept); may be NULL when
-/// o->hydraulics == 0. The world's circuit extras are appended to it before
-/// compiling. Returns NULL with one line "file: field: problem" in err.
+/// o->hydraulics == 0 or when o->circuit is given and the world adds no
+/// circuit. The world's circuit extras are compiled with it as one circuit
+/// (an error in them names the world file); without extras the world runs on
+/// o->circuit when given. Returns NULL with one line "file: field: problem" in err.
 ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, const world_desc* w,
                             const ode_world_opts* o, char* err, size_t errsz);
 void ode_world_destroy(ode_world* w);
@@ -118,8 +124,9 @@ void ode_world_snapshot(const ode_world* w, world_snapshot* s);
 /// Current state for CSV and tests.
 void ode_world_get_state(const ode_world* w, ode_world_state* s);
 
-/// The world's own compiled circuit (model plus world extras), for live
-/// parameter changes with hyd_model_set between steps; NULL without hydraulics.
+/// The run's compiled circuit (model plus world extras, or opts.circuit
+/// itself), for live parameter changes with hyd_model_set between steps;
+/// NULL without hydraulics.
 hyd_model* ode_world_circuit(ode_world* w);
 /// Give boom k (0 lifting arm, 1 end arm) link ln's mass and inertia in
 /// place (dBodySetMass), keeping its motion. Returns 0, or -1 (nothing
@@ -130,6 +137,9 @@ int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln);
 /// (hyd_fused.h), 0 on the component loops (opts.general_circuit, or a
 /// circuit of another shape).
 int ode_world_fused(const ode_world* w);
+/// 1 when the hydraulic sub-steps evaluate the circuit with the fast kernel
+/// (circuit_fast.h: a circuit without the one-pass kernel's shape), 0 otherwise.
+int ode_world_fast(const ode_world* w);
 /// Chamber pressures pA, pB [Pa abs] of the actuators (ODE_LIFT, ODE_JIB,
 /// ODE_SLEW; 0 where there is none), straight from the hydraulic state:
 /// cheap enough for every step.

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "hydraulics.h"
+#include "circuit_fast.h"
 #include "hyd_fused.h"
 #include "hyd_solver.h"
 #include "ode_world.h"
@@ -148,7 +149,8 @@ struct ode_world {
     int crane_contact;
 
     // Hydraulics (ode_coupling.c).
-    hyd_model* hm;       ///< compiled circuit (owned), NULL without hydraulics
+    hyd_model* hm;       ///< compiled circuit, NULL without hydraulics
+    int own_hm;          ///< 1: hm compiled here (freed with the world); 0: opts.circuit, borrowed
     hyd_data* hd;
     hyd_solver* hs;
     hyd_problem hp;
@@ -172,6 +174,11 @@ struct ode_world {
     int fz_act[ODE_NACT];
     unsigned fz_rev;
     hyd_fused_events fz_ev; ///< the fused path's event counter (hyd_problem.events)
+    // The fast kernel (circuit_fast.h) for any other circuit, unless
+    // opts.general_circuit asks for the reference loops. It follows live
+    // edits by itself (the circuit's revision).
+    hyd_fast* fk;
+    int use_fast;
 };
 
 // ode_world.c

@@ -379,13 +379,14 @@ ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* d
     wo.rtol = o->rtol;
     wo.atol = o->atol;
     wo.dense_jac = o->dense_jac;
-    wo.general_circuit = o->general_kernel;
+    wo.general_circuit = o->kernel == SIM_KERNEL_GENERAL;
     wo.q0[0] = q0[0];
     wo.q0[1] = q0[1];
     wo.slew0 = slew0;
     wo.load_mass = m3;
     wo.p_low = 0.5e6; // as the lagrange backend, so both start from the same state
     wo.model_file = m->file;
+    wo.circuit = m->hyd; // the run's one circuit unless the world adds to it
     const cJSON* hyd = cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics");
     ode_world* w = ode_world_create(&m->mech, hyd, &wd, &wo, err, errsz);
     world_desc_free(&wd);

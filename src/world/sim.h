@@ -28,6 +28,18 @@ typedef enum sim_status {
                      ///< the row callback
 } sim_status;
 
+/// The one choice of circuit evaluation (--kernel). Fast paths are taken
+/// where the circuit allows them and reported in sim_result (fused, split,
+/// fast); the reference is the component loops (hyd_eval, hyd_jacobian).
+typedef enum sim_kernel {
+    SIM_KERNEL_SPLIT = 0, ///< fastest: lagrange the one-pass circuit, block-eliminated W and (Krus,
+                          ///< ROS2) the split step; ode the one-pass circuit, or the fast kernel for
+                          ///< any other circuit (circuit_fast.h)
+    SIM_KERNEL_FUSED,     ///< the same, but lagrange's Krus/ROS2 evaluate f in full at every stage
+                          ///< (the generic stage arithmetic; for comparisons)
+    SIM_KERNEL_GENERAL    ///< the reference: the component loops and the solver's own sparse LU
+} sim_kernel;
+
 typedef struct sim_opts {
     sim_mechanics mechanics;
     lagrange_variant variant;
@@ -43,11 +55,7 @@ typedef struct sim_opts {
     double dt_ode;     ///< ode: rigid-body step [s] (default 1e-3; hydraulics sub-step at h)
     bool cvode;        ///< integrate with SUNDIALS CVODE (BDF) instead of `solver`
                        ///< (the outside reference; rtol/atol apply)
-    bool general_kernel; ///< lagrange and ode: the general circuit evaluation even when
-                         ///< the fused kernel applies (hyd_fused.h; for comparisons)
-    bool whole_step;     ///< lagrange, Krus/ROS2 with the block pattern: the generic
-                         ///< stage arithmetic with f in full at every stage, instead
-                         ///< of the split step (lagrange_split_step.c; for comparisons)
+    sim_kernel kernel;   ///< how the circuit is evaluated (default SIM_KERNEL_SPLIT, the fastest)
 } sim_opts;
 
 // The settings its messages name: sim_param, sim_name_params, sim_param_name (param_names.h).
@@ -236,6 +244,8 @@ typedef struct sim_result {
     long rows;
     bool fused;          ///< the run used the fused circuit kernel (lagrange or ode)
     bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lagrange_split_step.c)
+    bool fast;           ///< ode: the fast kernel for any circuit (circuit_fast.h), the circuit
+                         ///< not having the fused kernel's shape
 } sim_result;
 
 /// Run the scenario. Rows go to row_fn (may be NULL) and to trace (may be

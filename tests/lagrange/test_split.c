@@ -4,7 +4,7 @@
 //   rtol 1e-9 on the exact f): the error falls by about 4 when h is halved
 //   (order 2, docs/solvers.md);
 // - the generic stage arithmetic with f in full at every stage (krus.c through
-//   the solver, sim_opts.whole_step): the two differ by far less than either
+//   the solver, sim_opts.kernel = SIM_KERNEL_FUSED): the two differ by far less than either
 //   differs from the reference.
 #include "check.h"
 #include "sim.h"
@@ -125,7 +125,7 @@ static void test_split_matches_whole_step(void) {
         sim_opts o = sim_default_opts();
         o.h = hs[i];
         run(m, &sc, o, &a, &ra);
-        o.whole_step = true;
+        o.kernel = SIM_KERNEL_FUSED;
         run(m, &sc, o, &b, &rb);
         CHECK(ra.split && !rb.split, "kernels: split %d, whole %d", ra.split, rb.split);
         const double d = max_dp(&a, &b), e = max_dp(&b, &ref);
