@@ -71,36 +71,39 @@ static void draw_heat(void* user) {
     const heat_plot* p = user;
     plinit();
     plschr(0, 0.9);
-    // plimage wants z[ix][iy]; the grid's rows have the second parameter fastest.
-    PLFLT** z = malloc((size_t)p->nx * sizeof(PLFLT*));
     double lo = INFINITY, hi = -INFINITY;
-    for (long i = 0; z && i < p->nx; ++i) {
-        z[i] = (PLFLT*)(p->z + (size_t)i * (size_t)p->ny);
-        for (long j = 0; j < p->ny; ++j)
-            if (isfinite(z[i][j])) {
-                lo = fmin(lo, z[i][j]);
-                hi = fmax(hi, z[i][j]);
-            }
-    }
+    for (long k = 0; k < p->nx * p->ny; ++k)
+        if (isfinite(p->z[k])) {
+            lo = fmin(lo, p->z[k]);
+            hi = fmax(hi, p->z[k]);
+        }
     if (!(hi > lo)) {
         lo = isfinite(lo) ? lo - 1 : 0;
         hi = lo + 2;
     }
-    // Cell centres at the grid values: the image spans half a cell beyond.
+    // One cell per design, centred on its grid values.
     const double dx = p->nx > 1 ? (p->x1 - p->x0) / (double)(p->nx - 1) : fabs(p->x0) * 0.1 + 1e-9;
     const double dy = p->ny > 1 ? (p->y1 - p->y0) / (double)(p->ny - 1) : fabs(p->y0) * 0.1 + 1e-9;
-    const double xa = p->x0 - dx / 2, xb = p->x1 + dx / 2, ya = p->y0 - dy / 2, yb = p->y1 + dy / 2;
     plcol0(15);
-    plenv(xa, xb, ya, yb, 0, 0);
+    plenv(p->x0 - dx / 2, p->x1 + dx / 2, p->y0 - dy / 2, p->y1 + dy / 2, 0, 0);
     pllab(p->xlab, p->ylab, p->title);
     plspal1("cmap1_blue_red.pal", 1);
-    if (z) plimage((const PLFLT* const*)z, (PLINT)p->nx, (PLINT)p->ny, xa, xb, ya, yb, lo, hi, xa, xb, ya, yb);
+    for (long i = 0; i < p->nx; ++i)
+        for (long j = 0; j < p->ny; ++j) {
+            // The grid's rows have the second parameter fastest.
+            const double z = p->z[(size_t)i * (size_t)p->ny + (size_t)j];
+            if (!isfinite(z)) continue; // a failed design stays blank
+            const double xc = p->x0 + dx * (double)i, yc = p->y0 + dy * (double)j;
+            PLFLT xs[4] = {xc - dx / 2, xc + dx / 2, xc + dx / 2, xc - dx / 2};
+            PLFLT ys[4] = {yc - dy / 2, yc - dy / 2, yc + dy / 2, yc + dy / 2};
+            plcol1((z - lo) / (hi - lo));
+            plfill(4, xs, ys);
+        }
     // The colour scale: the metric's range, low (blue) to high (red).
     char lab[160];
-    snprintf(lab, sizeof lab, "colour: %.4g (blue) .. %.4g (red); blank: failed", lo, hi);
+    snprintf(lab, sizeof lab, "blue %.5g .. red %.5g; blank: failed design", lo, hi);
     plcol0(15);
-    plmtex("b", 5.0, 0.5, 0.5, lab);
-    free(z);
+    plmtex("t", 0.5, 0.5, 0.5, lab);
 }
 
 int app_plot_heat(const char* png, const char* title, const char* xlab, const char* ylab, const double* z,
