@@ -447,12 +447,20 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
     }
     pthread_t* tid = calloc((size_t)threads, sizeof(pthread_t));
     if (!tid) return EXIT_RUNTIME;
-    s->active = 0;
+    // Counted before each start: a worker can finish before pthread_create returns.
+    int started = 0;
     for (int t = 0; t < threads; ++t) {
-        if (pthread_create(&tid[t], NULL, worker, s)) break;
+        pthread_mutex_lock(&s->mu);
         ++s->active;
+        pthread_mutex_unlock(&s->mu);
+        if (pthread_create(&tid[t], NULL, worker, s)) {
+            pthread_mutex_lock(&s->mu);
+            --s->active;
+            pthread_mutex_unlock(&s->mu);
+            break;
+        }
+        ++started;
     }
-    const int started = s->active;
     if (started == 0) {
         fprintf(stderr, "cranesim sweep: cannot start a thread\n");
         free(tid);
