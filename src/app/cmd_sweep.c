@@ -573,6 +573,8 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
 static int sweep_plots(const sweep* s, const sweep_out* o, const char* plot) {
     const size_t L = strlen(plot);
     const bool one = L > 4 && !strcmp(plot + L - 4, ".png");
+    int dirlen = (int)L; // the folder without its trailing slashes
+    while (dirlen > 1 && plot[dirlen - 1] == '/') --dirlen;
     const size_t w = (size_t)(s->npar + s->nmet);
     double* x = malloc((size_t)s->ndesign * sizeof(double));
     double* y = malloc((size_t)s->ndesign * sizeof(double));
@@ -595,7 +597,7 @@ static int sweep_plots(const sweep* s, const sweep_out* o, const char* plot) {
             if (!z) break;
             for (long i = 0; i < s->ndesign; ++i) z[i] = o->plotv[(size_t)i * w + 2 + (size_t)mk];
             if (one) snprintf(png, sizeof png, "%s", plot);
-            else snprintf(png, sizeof png, "%s/%s_heat.png", plot, mn);
+            else snprintf(png, sizeof png, "%.*s/%s_heat.png", dirlen, plot, mn);
             snprintf(title, sizeof title, "%s: %s", s->sc.name, ylab);
             if (app_plot_heat(png, title, s->par[0].path, s->par[1].path, z, nx, ny, s->par[0].lo, s->par[0].hi,
                               s->par[1].lo, s->par[1].hi, err, sizeof err)) {
@@ -619,7 +621,7 @@ static int sweep_plots(const sweep* s, const sweep_out* o, const char* plot) {
                 }
             }
             if (one) snprintf(png, sizeof png, "%s", plot);
-            else snprintf(png, sizeof png, "%s/%s_vs_%s.png", plot, mn, s->par[pk].path);
+            else snprintf(png, sizeof png, "%.*s/%s_vs_%s.png", dirlen, plot, mn, s->par[pk].path);
             snprintf(title, sizeof title, "%s: %s against %s", s->sc.name, mn, s->par[pk].path);
             if (app_plot_sweep(png, title, s->par[pk].path, ylab, x, y, n, err, sizeof err)) {
                 fprintf(stderr, "cranesim sweep: plot: %s\n", err);
@@ -835,7 +837,9 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
                 printf("cranesim sweep: %s, %ld designs (%s) on %ld thread%s%s in %.2f s -> %s\n", s.sc.name,
                        s.ndesign, shape, threads, threads == 1 ? "" : "s", nrank > 1 ? " per rank" : "", wall, out);
                 if (nrank > 1) printf("  %d MPI ranks\n", nrank);
-                if (nfail) printf("  %ld designs failed (exit and error in their rows)\n", nfail);
+                if (nfail)
+                    printf("  %ld design%s failed (exit and error in %s rows)\n", nfail, nfail == 1 ? "" : "s",
+                           nfail == 1 ? "its" : "their");
             }
             if (s.fail_fast && (nfail || o.written < s.ndesign)) {
                 fprintf(stderr, "cranesim sweep: --fail-fast: stopped at a failing design; %ld of %ld rows in %s\n",

@@ -165,7 +165,8 @@ static void test_sweep_threads_same_file(void) {
 }
 
 // A design the model refuses (a bore <= 0) is a row with exit 2 and the
-// model's message; the others run and the sweep exits 0. --fail-fast stops
+// model's message, one that blows up a row with exit 1; the others run and
+// the sweep exits 0. --fail-fast stops
 // with exit 1.
 static void test_sweep_failing_design_is_a_row(void) {
     static char a[1 << 15];
@@ -179,6 +180,15 @@ static void test_sweep_failing_design_is_a_row(void) {
     CHECK(strstr(a, "\n0,-0.10000000000000001,,2,\"") && strstr(a, "must be > 0"), "%s", a);
     CHECK(strstr(a, "\n1,0,,2,\""), "%s", a);
     CHECK(strstr(a, "\n2,0.10000000000000001,") && strstr(a, ",0,\n"), "%s", a);
+    // A blow-up: ROS2 at 5 ms is stable on the soft oil (0.1 GPa) and not on
+    // the stiff one (1 GPa) of the step scenario's valve steps: exit 1, the
+    // run's message, no metrics; the sweep still exits 0.
+    CHECK(cli_run("sweep --scenario step --duration 2 --solver ros2 --dt 5e-3 --metrics peak_p1A "
+                  "--param hydraulics.fluid.bulk_modulus=1e8:1e9:2 --out sweep_blowup.csv",
+                  out, sizeof out) == 0,
+          "%s", out);
+    CHECK(cli_read_file("sweep_blowup.csv", a, sizeof a) > 0 && cli_count_lines(a) == 3, "%s", a);
+    CHECK(strstr(a, "\n0,100000000,") && strstr(a, ",0,\n1,1000000000,,1,\"numerical blow-up"), "%s", a);
     snprintf(args, sizeof args, "%s --threads 1 --fail-fast --out sweep_ff.csv", base);
     CHECK(cli_run(args, out, sizeof out) == 1 && strstr(out, "--fail-fast"), "%s", out);
     CHECK(cli_read_file("sweep_ff.csv", a, sizeof a) > 0 && cli_count_lines(a) == 2, "%s", a);
