@@ -44,11 +44,18 @@ static void sweep_help(FILE* f) {
             "  --lhs N              a Latin hypercube of N designs instead of the grid\n"
             "  --seed K             its random seed (default 1; same seed, same designs)\n"
             "  --metrics LIST       the metrics to tabulate, comma separated (default: every metric\n"
-            "                       the run has); names and units: ",
+            "                       the run has; p3A, p3B, slew and tilt: ode only):",
             SW_MAXPAR);
-    char names[512];
-    metric_names(names, sizeof names);
-    fprintf(f, "%s\n", names);
+    // Each name with its unit, wrapped under the option's text.
+    int col = 999;
+    for (int id = 0; id < MET_COUNT; ++id) {
+        char tok[96];
+        snprintf(tok, sizeof tok, " %s [%s]%s", metric_name((metric_id)id), metric_unit((metric_id)id),
+                 id + 1 < MET_COUNT ? "," : "");
+        if (col + (int)strlen(tok) > 92) col = fprintf(f, "\n                      ");
+        col += fprintf(f, "%s", tok);
+    }
+    fprintf(f, "\n");
     fprintf(f,
             "  --threads T          designs run at once (default: every core; 1 per rank under MPI;\n"
             "                       ode designs run one at a time per process)\n"
@@ -408,7 +415,7 @@ static void out_flush(sweep* s, sweep_out* o) {
     }
 }
 
-static void progress(const sweep* s, long done, double t0) {
+static void progress(const sweep* s, long done, long failed, double t0) {
     if (!isatty(2)) return;
     const double el = sim_wall_time() - t0;
     const int width = 30;
@@ -417,7 +424,7 @@ static void progress(const sweep* s, long done, double t0) {
     char eta[32] = "";
     if (done > 0 && done < s->ndesign) snprintf(eta, sizeof eta, ", ETA %.0f s", el * (1.0 / f - 1.0));
     fprintf(stderr, "\r  [%.*s%*s] %ld/%ld designs (%ld failed), %.0f s%s   ", n,
-            "##############################", width - n, "", done, s->ndesign, s->failed, el, eta);
+            "##############################", width - n, "", done, s->ndesign, failed, el, eta);
     fflush(stderr);
 }
 
@@ -548,8 +555,9 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
 #endif
         pthread_mutex_lock(&s->mu);
         out_flush(s, o);
+        const long failed = s->failed;
         pthread_mutex_unlock(&s->mu);
-        if (!s->c.quiet) progress(s, done, t0);
+        if (!s->c.quiet) progress(s, done, failed, t0);
         if (local_done && remote_left <= 0) break;
     }
     free(batch);
