@@ -19,6 +19,7 @@
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -57,7 +58,8 @@ static void bench_help(FILE* f) {
             "               on synthetic circuits of 1, 2, 4, 8, 16 actuators, ns per eval and per state\n"
             "  sweep        not in the default set: cranesim sweep of 64 designs of the scenario (lift\n"
             "               bore 80..120 mm) on 1 and 2 threads: designs per minute and their ratio;\n"
-            "               then the peak RSS of sweeps of 100 and 10,000 designs of 0.05 s\n"
+            "               with MPI also on 1 and 2 ranks (mpiexec); then the peak RSS of sweeps of\n"
+            "               100 and 10,000 designs of 0.05 s\n"
             "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
             "               operator, for --duration seconds of wall time (default 60): fps,\n"
             "               frame times, missed real-time deadlines, command rate\n"
@@ -105,11 +107,11 @@ static const bench_cfg configs[] = {
 // not this process's) and CPU time [s] (user + system: on a loaded machine
 // wall / CPU says how much of the cores the sweep got). Returns the child's
 // exit code, or -1.
-static int bench_child(char* const* args, double* wall, long* rss_kb, double* cpu) {
+static int bench_spawn(const char* prog, char* const* args, double* wall, long* rss_kb, double* cpu) {
     const double t0 = sim_wall_time();
     pid_t pid;
     extern char** environ;
-    if (posix_spawn(&pid, "/proc/self/exe", NULL, NULL, args, environ)) return -1;
+    if (posix_spawnp(&pid, prog, NULL, NULL, args, environ)) return -1;
     int st;
     struct rusage ru;
     if (wait4(pid, &st, 0, &ru) != pid) return -1;
@@ -118,6 +120,9 @@ static int bench_child(char* const* args, double* wall, long* rss_kb, double* cp
     *cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
            1e-6 * (double)ru.ru_stime.tv_usec;
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+static int bench_child(char* const* args, double* wall, long* rss_kb, double* cpu) {
+    return bench_spawn("/proc/self/exe", args, wall, rss_kb, cpu);
 }
 
 // 64 designs of the scenario (lift bore 80..120 mm) on 1 and 2 threads:
@@ -149,6 +154,41 @@ static int bench_sweep(const app_common* c) {
         fflush(stdout);
     }
     printf("{\"config\":\"sweep\",\"designs_per_min_2_over_1\":%.3f}\n", dpm[1] / dpm[0]);
+#ifdef CRANESIM_HAVE_MPI
+    // The same 64 designs on 1 and 2 MPI ranks of one thread each (mpiexec
+    // from PATH; as root Open MPI wants its consent).
+    char self[1024];
+    const ssize_t L = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (L > 0) {
+        self[L] = 0;
+        if (geteuid() == 0) {
+            setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+            setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+        }
+        double rpm[2] = {0, 0};
+        for (int r = 1; r <= 2; ++r) {
+            char np[8];
+            snprintf(np, sizeof np, "%d", r);
+            char* args[] = {"mpiexec", "--oversubscribe", "-np", np, self, "sweep", "--scenario", (char*)scen,
+                            "--param", "hydraulics.components.lift_cyl.bore=0.08:0.12:64", "--threads", "1", "--out",
+                            "/dev/null", "--quiet", dur[0] ? "--duration" : NULL, dur, NULL};
+            double wall, cpu;
+            long rss;
+            const int rc = bench_spawn("mpiexec", args, &wall, &rss, &cpu);
+            if (rc) {
+                printf("{\"config\":\"sweep-mpi\",\"ranks\":%d,\"error\":\"mpiexec exited %d\"}\n", r, rc);
+                break;
+            }
+            rpm[r - 1] = 64 * 60.0 / wall;
+            printf("{\"config\":\"sweep-mpi\",\"scenario\":\"%s\",\"designs\":64,\"ranks\":%d,\"wall_s\":%.3f,"
+                   "\"designs_per_min\":%.1f,\"cpu_s\":%.3f,\"cpu_per_wall\":%.2f}\n",
+                   scen, r, wall, rpm[r - 1], cpu, cpu / wall);
+            fflush(stdout);
+        }
+        if (rpm[0] > 0 && rpm[1] > 0)
+            printf("{\"config\":\"sweep-mpi\",\"designs_per_min_2_over_1\":%.3f}\n", rpm[1] / rpm[0]);
+    }
+#endif
     long rss_n[2] = {0, 0};
     const char* counts[2] = {"100", "10000"};
     for (int k = 0; k < 2; ++k) {
