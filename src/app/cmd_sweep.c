@@ -429,7 +429,11 @@ static void progress(const sweep* s, long done, long failed, double t0) {
 }
 
 #ifdef CRANESIM_HAVE_MPI
-enum { TAG_ROW = 1, TAG_DONE = 2 };
+// Ranks > 0 send TAG_ROW (a design's index and row) and, when their designs
+// are done, TAG_DONE; rank 0 sends TAG_STOP (--fail-fast met a failure
+// anywhere) and, once every rank is done, TAG_END, which each rank waits
+// for, so no message is left unreceived at MPI_Finalize.
+enum { TAG_ROW = 1, TAG_DONE = 2, TAG_STOP = 3, TAG_END = 4 };
 #endif
 
 static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out_path, sweep_out* o) {
@@ -476,7 +480,8 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
     const double t0 = sim_wall_time();
     long done = 0;
     int remote_left = nrank - 1; // ranks that have not said they are done
-    (void)remote_left;
+    bool stop_sent = false;
+    (void)stop_sent;
     long* batch = malloc((size_t)s->ndesign * sizeof(long));
     if (!batch) abort();
     for (;;) {
@@ -514,8 +519,21 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
                 free(msg);
                 free(line);
             }
+            for (int flag = 1; flag;) {
+                MPI_Iprobe(0, TAG_STOP, MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE);
+                if (!flag) break;
+                MPI_Recv(NULL, 0, MPI_CHAR, 0, TAG_STOP, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                pthread_mutex_lock(&s->mu);
+                s->stop = true;
+                pthread_mutex_unlock(&s->mu);
+            }
             if (local_done) {
                 MPI_Send(NULL, 0, MPI_CHAR, 0, TAG_DONE, MPI_COMM_WORLD);
+                for (;;) { // a late TAG_STOP, then TAG_END
+                    MPI_Status st;
+                    MPI_Recv(NULL, 0, MPI_CHAR, 0, MPI_ANY_TAG, MPI_COMM_WORLD, &st);
+                    if (st.MPI_TAG == TAG_END) break;
+                }
                 break;
             }
             continue;
@@ -551,6 +569,16 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
                 }
                 free(msg);
             }
+            pthread_mutex_lock(&s->mu);
+            const bool stop_now = s->fail_fast && s->failed > 0;
+            if (stop_now) s->stop = true;
+            pthread_mutex_unlock(&s->mu);
+            if (stop_now && !stop_sent) {
+                for (int r = 1; r < nrank; ++r) MPI_Send(NULL, 0, MPI_CHAR, r, TAG_STOP, MPI_COMM_WORLD);
+                stop_sent = true;
+            }
+            if (local_done && remote_left <= 0)
+                for (int r = 1; r < nrank; ++r) MPI_Send(NULL, 0, MPI_CHAR, r, TAG_END, MPI_COMM_WORLD);
         }
 #endif
         pthread_mutex_lock(&s->mu);
