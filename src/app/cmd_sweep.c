@@ -187,10 +187,6 @@ static void sb_printf(sbuf* b, const char* fmt, ...) {
     }
 }
 
-typedef struct design_run {
-    run_metrics met;
-} design_run;
-
 static int design_row(void* user, const double* row) {
     metrics_row(user, row);
     return app_signal_caught() != 0;
@@ -480,8 +476,9 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
     const double t0 = sim_wall_time();
     long done = 0;
     int remote_left = nrank - 1; // ranks that have not said they are done
+#ifdef CRANESIM_HAVE_MPI
     bool stop_sent = false;
-    (void)stop_sent;
+#endif
     long* batch = malloc((size_t)s->ndesign * sizeof(long));
     if (!batch) abort();
     for (;;) {
