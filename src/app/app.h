@@ -200,6 +200,7 @@ void app_compare_pressure(const sim_trace* a, const sim_trace* b, int ref, doubl
                           double* pct);
 int cmd_drive(int argc, char** argv);
 int cmd_study(int argc, char** argv);
+int cmd_sweep(int argc, char** argv);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it
@@ -224,6 +225,13 @@ int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* 
 /// A bar chart of n energies kj [kJ] named names (one bar each, in order) to a PNG.
 int app_plot_energy(const char* const* names, const double* kj, int n, const char* title, const char* png, char* err,
                     size_t errsz);
+/// The sweep's plots: metric y against parameter x over n designs, and a
+/// heat map of z (nx x ny, the second parameter fastest, NaN: no value) over
+/// the grid [x0, x1] x [y0, y1]. Return 0, or -1 with a message.
+int app_plot_sweep(const char* png, const char* title, const char* xlab, const char* ylab, const double* x,
+                   const double* y, long n, char* err, size_t errsz);
+int app_plot_heat(const char* png, const char* title, const char* xlab, const char* ylab, const double* z,
+                  long nx, long ny, double x0, double x1, double y0, double y1, char* err, size_t errsz);
 /// Overlay two runs (a: solid, b: dashed) to a PNG.
 int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb,
                      const char* title, const char* png, char* err, size_t errsz);

@@ -79,7 +79,8 @@ static const struct {
     const char* cmd;
     const char* opts[10];
 } own_values[] = {
-    {"run", {"--out", "--plot", NULL}},
+    {"run", {"--out", "--plot", "--metrics", NULL}},
+    {"sweep", {"--param", "--lhs", "--seed", "--metrics", "--threads", "--out", "--plot", NULL}},
     {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot", NULL}},
     {"study", {"--out-dir", "--repeat", NULL}},
     {"bench", {"--repeat", "--config", "--seed", NULL}},

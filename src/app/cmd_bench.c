@@ -3,6 +3,7 @@
 // Each configuration is run `--repeat` times and the median wall time is
 // reported: this machine is shared and noisy, so medians and ratios are the
 // honest figures. Benchmarks measure; tests never time anything.
+#define _DEFAULT_SOURCE // wait4
 #include "app.h"
 #include "circuit_fast.h"
 #include "engine.h"
@@ -15,7 +16,10 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <spawn.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -52,6 +56,10 @@ static void bench_help(FILE* f) {
             "               (--seed N, default 1)\n"
             "  circuit-sizes  not in the default set: one circuit evaluation (fast kernel, reference)\n"
             "               on synthetic circuits of 1, 2, 4, 8, 16 actuators, ns per eval and per state\n"
+            "  sweep        not in the default set: cranesim sweep of 64 designs of the scenario (lift\n"
+            "               bore 80..120 mm) on 1 and 2 threads: designs per minute and their ratio;\n"
+            "               with MPI also on 1 and 2 ranks (mpiexec); then the peak RSS of sweeps of\n"
+            "               100 and 10,000 designs of 0.05 s\n"
             "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
             "               operator, for --duration seconds of wall time (default 60): fps,\n"
             "               frame times, missed real-time deadlines, command rate\n"
@@ -91,6 +99,118 @@ static const bench_cfg configs[] = {
     {"sandbox-ode1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-3, "sandbox_pick_place"},
     {"sandbox-ode0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-4, "sandbox_pick_place"},
 };
+
+// ---- sweep: designs per minute on 1 and 2 threads, and memory ----
+
+// Run `cranesim ARGS` (this binary, a child process) and report its wall
+// time [s], peak resident set [kB] (wait4's ru_maxrss: the child's own,
+// not this process's) and CPU time [s] (user + system: on a loaded machine
+// wall / CPU says how much of the cores the sweep got). Returns the child's
+// exit code, or -1.
+static int bench_spawn(const char* prog, char* const* args, double* wall, long* rss_kb, double* cpu) {
+    const double t0 = sim_wall_time();
+    pid_t pid;
+    extern char** environ;
+    if (posix_spawnp(&pid, prog, NULL, NULL, args, environ)) return -1;
+    int st;
+    struct rusage ru;
+    if (wait4(pid, &st, 0, &ru) != pid) return -1;
+    *wall = sim_wall_time() - t0;
+    *rss_kb = ru.ru_maxrss;
+    *cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
+           1e-6 * (double)ru.ru_stime.tv_usec;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+static int bench_child(char* const* args, double* wall, long* rss_kb, double* cpu) {
+    return bench_spawn("/proc/self/exe", args, wall, rss_kb, cpu);
+}
+
+// 64 designs of the scenario (lift bore 80..120 mm) on 1 and 2 threads:
+// designs per minute and their ratio; then the peak RSS of a sweep of 100
+// and of 10,000 designs of 0.05 s, which must not grow with the count (the
+// rows are written as they finish, each design's model freed).
+static int bench_sweep(const app_common* c) {
+    const char* scen = c->scenario_path ? c->scenario_path : "ramp";
+    char dur[32] = "";
+    if (c->sim.duration > 0) snprintf(dur, sizeof dur, "%.17g", c->sim.duration);
+    double dpm[2] = {0, 0};
+    for (int t = 1; t <= 2; ++t) {
+        char th[8];
+        snprintf(th, sizeof th, "%d", t);
+        char* args[] = {"cranesim", "sweep", "--scenario", (char*)scen, "--param",
+                        "hydraulics.components.lift_cyl.bore=0.08:0.12:64", "--threads", th, "--out", "/dev/null",
+                        "--quiet", dur[0] ? "--duration" : NULL, dur, NULL};
+        double wall, cpu;
+        long rss;
+        const int rc = bench_child(args, &wall, &rss, &cpu);
+        if (rc) {
+            printf("{\"config\":\"sweep\",\"threads\":%d,\"error\":\"cranesim sweep exited %d\"}\n", t, rc);
+            return EXIT_RUNTIME;
+        }
+        dpm[t - 1] = 64 * 60.0 / wall;
+        printf("{\"config\":\"sweep\",\"scenario\":\"%s\",\"designs\":64,\"threads\":%d,\"wall_s\":%.3f,"
+               "\"designs_per_min\":%.1f,\"cpu_s\":%.3f,\"cpu_per_wall\":%.2f,\"peak_rss_kb\":%ld}\n",
+               scen, t, wall, dpm[t - 1], cpu, cpu / wall, rss);
+        fflush(stdout);
+    }
+    printf("{\"config\":\"sweep\",\"designs_per_min_2_over_1\":%.3f}\n", dpm[1] / dpm[0]);
+#ifdef CRANESIM_HAVE_MPI
+    // The same 64 designs on 1 and 2 MPI ranks of one thread each (mpiexec
+    // from PATH; as root Open MPI wants its consent).
+    char self[1024];
+    const ssize_t L = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (L > 0) {
+        self[L] = 0;
+        if (geteuid() == 0) {
+            setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+            setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+        }
+        double rpm[2] = {0, 0};
+        for (int r = 1; r <= 2; ++r) {
+            char np[8];
+            snprintf(np, sizeof np, "%d", r);
+            char* args[] = {"mpiexec", "--oversubscribe", "-np", np, self, "sweep", "--scenario", (char*)scen,
+                            "--param", "hydraulics.components.lift_cyl.bore=0.08:0.12:64", "--threads", "1", "--out",
+                            "/dev/null", "--quiet", dur[0] ? "--duration" : NULL, dur, NULL};
+            double wall, cpu;
+            long rss;
+            const int rc = bench_spawn("mpiexec", args, &wall, &rss, &cpu);
+            if (rc) {
+                printf("{\"config\":\"sweep-mpi\",\"ranks\":%d,\"error\":\"mpiexec exited %d\"}\n", r, rc);
+                break;
+            }
+            rpm[r - 1] = 64 * 60.0 / wall;
+            printf("{\"config\":\"sweep-mpi\",\"scenario\":\"%s\",\"designs\":64,\"ranks\":%d,\"wall_s\":%.3f,"
+                   "\"designs_per_min\":%.1f,\"cpu_s\":%.3f,\"cpu_per_wall\":%.2f}\n",
+                   scen, r, wall, rpm[r - 1], cpu, cpu / wall);
+            fflush(stdout);
+        }
+        if (rpm[0] > 0 && rpm[1] > 0)
+            printf("{\"config\":\"sweep-mpi\",\"designs_per_min_2_over_1\":%.3f}\n", rpm[1] / rpm[0]);
+    }
+#endif
+    long rss_n[2] = {0, 0};
+    const char* counts[2] = {"100", "10000"};
+    for (int k = 0; k < 2; ++k) {
+        char par[128];
+        snprintf(par, sizeof par, "hydraulics.components.lift_cyl.bore=0.08:0.12:%s", counts[k]);
+        char* args[] = {"cranesim", "sweep", "--scenario", (char*)scen, "--duration", "0.05", "--param", par,
+                        "--out", "/dev/null", "--quiet", NULL};
+        double wall, cpu;
+        const int rc = bench_child(args, &wall, &rss_n[k], &cpu);
+        if (rc) {
+            printf("{\"config\":\"sweep-rss\",\"designs\":%s,\"error\":\"cranesim sweep exited %d\"}\n", counts[k],
+                   rc);
+            return EXIT_RUNTIME;
+        }
+        printf("{\"config\":\"sweep-rss\",\"scenario\":\"%s\",\"designs\":%s,\"duration_s\":0.05,\"wall_s\":%.3f,"
+               "\"peak_rss_kb\":%ld}\n",
+               scen, counts[k], wall, rss_n[k]);
+        fflush(stdout);
+    }
+    printf("{\"config\":\"sweep-rss\",\"peak_rss_10000_over_100\":%.3f}\n", (double)rss_n[1] / (double)rss_n[0]);
+    return 0;
+}
 
 // ---- soak: random operator input in the sandbox ----
 
@@ -390,6 +510,10 @@ int cmd_bench(int argc, char** argv) {
         }
         if (!strcmp(only[j], "soak")) {
             want_soak = true;
+            continue;
+        }
+        if (!strcmp(only[j], "sweep")) {
+            if (bench_sweep(&c)) return EXIT_RUNTIME;
             continue;
         }
         if (!strcmp(only[j], "circuit-sizes")) { if (bench_circuit_sizes(repeat)) return EXIT_RUNTIME; continue; }

@@ -2,6 +2,7 @@
 #include "app.h"
 #include "energy_acc.h"
 #include "engine.h"
+#include "metrics.h"
 
 #include <errno.h>
 #include <math.h>
@@ -29,6 +30,8 @@ static void run_help(FILE* f) {
             "                       interrupted one, with the rows so far): until then FILE is untouched\n"
             "  --plot FILE.png      also plot strokes, pressures, valve openings and tip path, and\n"
             "                       the energy per component as a bar chart to FILE_energy.png\n"
+            "  --metrics FILE.json  also write the run's metrics (peak pressures, relief time, end-stop\n"
+            "                       hits, ...; docs/sweep.md), replaced as --out is\n"
             "  --energy FILE.csv    per-component hydraulic power [W] at the output period: t, then\n"
             "                       per pump, valve edge (.meter_in, .meter_out), relief, check,\n"
             "                       orifice, hose, cylinder (.leak, .work), then tank, stored and\n"
@@ -125,6 +128,7 @@ typedef struct csv_sink {
     bool opened; ///< the file was created (as a temporary, renamed at the end)
     plot_keep keep;
     row_stats st;
+    run_metrics met;
     double t_last; ///< time of the last row written [s]
 } csv_sink;
 
@@ -159,6 +163,7 @@ static int csv_row(void* user, const double* row) {
         s->st.xmax[k] = fmax(s->st.xmax[k], row[COL_X1 + k]);
     }
     keep_row(&s->keep, row, s->ncol);
+    metrics_row(&s->met, row);
     return app_signal_caught() != 0;
 }
 
@@ -172,7 +177,7 @@ static int csv_close(csv_sink* s) {
 }
 
 static void print_summary(const char* scen, const sim_opts* o, const sim_result* r, const row_stats* st,
-                          const char* out) {
+                          const run_metrics* met, const char* out) {
     const double *pmax = st->pmax, *xmin = st->xmin, *xmax = st->xmax;
     const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
     // The backend names the run and its work (engine_describe).
@@ -205,7 +210,9 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
         // The rows come every `every`, but never farther apart than the run.
         if (every > 1e-3 * (1 + 1e-9)) printf(", rows every %g ms", fmin(every, r->t_end) * 1e3);
     }
-    printf("\n  %ld rows -> %s\n", r->rows, out);
+    printf("\n");
+    metrics_print(met, stdout);
+    printf("  %ld rows -> %s\n", r->rows, out);
 }
 
 // The energy balance (docs/energy.md): what came in, where it went, and
@@ -279,6 +286,7 @@ int cmd_run(int argc, char** argv) {
     const char* out = "run.csv";
     const char* plot = NULL;
     const char* energy_csv = NULL;
+    const char* metrics_out = NULL;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             run_help(stdout);
@@ -300,12 +308,17 @@ int cmd_run(int argc, char** argv) {
             if (!energy_csv) return EXIT_USAGE;
             continue;
         }
+        if (!strcmp(argv[i], "--metrics")) {
+            if (!(metrics_out = app_value(argc, argv, &i))) return EXIT_USAGE;
+            continue;
+        }
         fprintf(stderr, "cranesim run: unknown option '%s' (see cranesim run --help)\n", argv[i]);
         return EXIT_USAGE;
     }
     // Everything that can be checked is checked before a file is touched.
     if (app_check_output("run", "--out", out, NULL) || (plot && app_check_output("run", "--plot", plot, ".png")) ||
-        (energy_csv && app_check_output("run", "--energy", energy_csv, NULL)))
+        (energy_csv && app_check_output("run", "--energy", energy_csv, NULL)) ||
+        (metrics_out && app_check_output("run", "--metrics", metrics_out, ".json")))
         return EXIT_USAGE;
     int rc = app_check_sim("run", &c.sim, c.given);
     if (rc) return rc;
@@ -339,6 +352,7 @@ int cmd_run(int argc, char** argv) {
 
     csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim),
                      .st = {.xmin = {INFINITY, INFINITY}, .xmax = {-INFINITY, -INFINITY}}};
+    metrics_init(&sink.met, sink.ncol);
     sim_trace tr = {0};
     if (plot) {
         sink.keep.tr = &tr;
@@ -375,6 +389,7 @@ int cmd_run(int argc, char** argv) {
     app_signals_catch(&sig);
     sim_run_energy(m, &sc, &c.sim, csv_row, &sink, NULL, c.quiet ? NULL : app_progress, NULL, en, &res);
     keep_flush(&sink.keep);
+    metrics_finish(&sink.met, &res);
     if (!c.quiet) app_progress_done();
     if (res.note[0] && !app_signal_caught()) fprintf(stderr, "cranesim run: note: %s\n", res.note);
     const int werr = csv_close(&sink);
@@ -420,9 +435,23 @@ int cmd_run(int argc, char** argv) {
     sim_energy_balance eb;
     sim_energy_result(en, &eb);
     if (code == EXIT_OK_ && !c.quiet) {
-        print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, out);
+        print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, &sink.met, out);
         if (eb.samples > 1) print_energy(&eb);
         if (energy_csv) printf("  energy -> %s\n", energy_csv);
+    }
+    // The metrics of the rows written (also of a failed or interrupted run's).
+    if (metrics_out && sink.rows > 0 && code != EXIT_USAGE) {
+        app_out mo;
+        FILE* f = app_out_open(&mo, metrics_out, "w");
+        int e = f ? 0 : errno;
+        if (f && metrics_write_json(&sink.met, f)) e = errno ? errno : EIO;
+        if (f) e = app_out_close(&mo, e, true);
+        if (e) {
+            fprintf(stderr, "cranesim run: cannot write %s: %s\n", metrics_out, strerror(e));
+            if (code == EXIT_OK_) code = EXIT_RUNTIME;
+        } else if (!c.quiet && code == EXIT_OK_) {
+            printf("  metrics -> %s\n", metrics_out);
+        }
     }
     if (plot && tr.nrow > 1 && code != EXIT_USAGE && !app_signal_caught()) {
         char err[512], title[256];

@@ -20,6 +20,8 @@ static void usage(FILE* f) {
             "  compare   run one scenario two ways (backends or solvers); error metrics, overlay plots\n"
             "  bench     real-time factors as JSON lines\n"
             "  study     solver study: every integrator against a CVODE reference, work-precision plot\n"
+            "  sweep     one scenario on many designs (a grid or a Latin hypercube over model values),\n"
+            "            in parallel (threads, MPI ranks): a results table and plots\n"
             "  help      this text; cranesim help <command>: that command's help\n"
             "\n"
             "examples:\n"
@@ -36,6 +38,7 @@ static const struct {
     int (*fn)(int argc, char** argv);
 } commands[] = {
     {"run", cmd_run}, {"bench", cmd_bench}, {"compare", cmd_compare}, {"drive", cmd_drive}, {"study", cmd_study},
+    {"sweep", cmd_sweep},
 };
 
 static int (*find_command(const char* name))(int, char**) {

@@ -188,7 +188,8 @@ const char* sim_blowup_hint(bool adaptive, double t, double value) {
     if (!(t > 0.0))
         return "the initial state is already outside the physical range (no step was taken): check the model's values";
     if (!isfinite(value)) return "a component law gave no finite number: check the model's values";
-    static char hint[160];
+    // Per thread: sweeps run designs on several threads at once.
+    static _Thread_local char hint[160];
     if (adaptive)
         snprintf(hint, sizeof hint, "the tolerance is too loose for this transient: try a smaller %s",
                  sim_param_name(SIM_PARAM_RTOL));

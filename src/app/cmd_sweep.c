@@ -1,0 +1,923 @@
+// cmd_sweep.c: `cranesim sweep`: one scenario run on many designs (a full
+// grid or a Latin hypercube over model paths), the designs in parallel on
+// threads (and on MPI ranks when built with MPI and started by mpirun or
+// srun), one results row per design in design-index order.
+#define _DEFAULT_SOURCE // strsep
+#include "app.h"
+#include "json_util.h"
+#include "metrics.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#ifdef CRANESIM_HAVE_MPI
+#include <mpi.h>
+#endif
+
+enum { SW_MAXPAR = 8, SW_MAXDESIGN = 10000000 };
+
+static void sweep_help(FILE* f) {
+    fprintf(f,
+            "usage: cranesim sweep [--scenario S] [--model M] --param PATH=LO:HI:N [--param ...]\n"
+            "                      [--lhs N [--seed K]] [--metrics m1,m2] [--threads T] [--fail-fast]\n"
+            "                      [--out sweep.csv] [--plot DIR|FILE.png] [options]\n"
+            "\n"
+            "Runs the scenario once per design and writes one CSV row per design, in design-index\n"
+            "order: index, the parameter values, the metrics, exit (0 ok, 1 failed: a numerical\n"
+            "blow-up, 2 refused: a value the model or the run does not accept) and the error text.\n"
+            "A failing design is a row, not the end of the sweep. Designs run in parallel on\n"
+            "threads; under mpirun or srun (a build with MPI) they are spread over the ranks and\n"
+            "rank 0 writes the same file. docs/sweep.md has the details and a Slurm script.\n"
+            "\n"
+            "options:\n"
+            "  --param PATH=LO:HI:N a model path (the --set syntax, a number) from LO to HI in N\n"
+            "                       equal steps (a full grid over every --param, the last one\n"
+            "                       varying fastest); with --lhs: PATH=LO:HI (up to %d)\n"
+            "  --lhs N              a Latin hypercube of N designs instead of the grid\n"
+            "  --seed K             its random seed (default 1; same seed, same designs)\n"
+            "  --metrics LIST       the metrics to tabulate, comma separated (default: every metric\n"
+            "                       the run has; p3A, p3B, slew and tilt: ode only):",
+            SW_MAXPAR);
+    // Each name with its unit, wrapped under the option's text.
+    int col = 999;
+    for (int id = 0; id < MET_COUNT; ++id) {
+        char tok[96];
+        snprintf(tok, sizeof tok, " %s [%s]%s", metric_name((metric_id)id), metric_unit((metric_id)id),
+                 id + 1 < MET_COUNT ? "," : "");
+        if (col + (int)strlen(tok) > 92) col = fprintf(f, "\n                      ");
+        col += fprintf(f, "%s", tok);
+    }
+    fprintf(f, "\n");
+    fprintf(f,
+            "  --threads T          designs run at once (default: every core; 1 per rank under MPI;\n"
+            "                       ode designs run one at a time per process)\n"
+            "  --fail-fast          stop at the first failing design (exit 1)\n"
+            "  --out FILE           results CSV (default sweep.csv), replaced when the sweep ends\n"
+            "  --plot DIR|FILE.png  plots: each metric against each parameter, and a heat map of\n"
+            "                       each metric for a two-parameter grid (a .png name: the first)\n");
+    app_common_help(f, true);
+    fprintf(f,
+            "\nexit codes: 0 done (also with failing designs), 1 --fail-fast stopped or a failed write,\n"
+            "2 bad input (nothing is written), 130 or 143 interrupted (the rows finished so far kept)\n"
+            "example: cranesim sweep --scenario ramp --param hydraulics.components.lift_cyl.bore=0.08:0.12:5\n");
+}
+
+typedef struct sweep_param {
+    char path[256];
+    double lo, hi;
+    long n;
+} sweep_param;
+
+typedef struct sweep {
+    app_common c;
+    model* base;
+    scenario sc;
+    sweep_param par[SW_MAXPAR];
+    int npar;
+    long ndesign;
+    long lhs;           ///< > 0: Latin hypercube of this many designs
+    double* lhs_v;      ///< npar x ndesign values of the hypercube
+    int met[MET_COUNT]; ///< the metrics tabulated
+    int nmet;
+    int ncol;
+    bool fail_fast;
+    bool ode;
+    // Dispatch and results (under mu).
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    long next, stride;  ///< next design of this process, and the step (the MPI ranks interleave)
+    char** line;        ///< finished rows by design index, NULL until done (or once written)
+    long* fin;          ///< queue of designs finished here, not yet handed to the writer
+    long nfin;
+    int active;         ///< worker threads still running
+    bool stop;          ///< --fail-fast hit or a signal: no more designs
+    long failed;
+} sweep;
+
+// The ODE library and the ode world's error trap are process-wide: one ode
+// design at a time per process (threads still overlap loading and writing).
+static pthread_mutex_t g_ode_mu = PTHREAD_MUTEX_INITIALIZER;
+
+// The design values drop the model's range notes ("outside the typical
+// range"): thousands of designs would repeat them, and the row has the value.
+static void quiet_note(const char* line, void* user) {
+    (void)line;
+    (void)user;
+}
+
+static double design_value(const sweep* s, long i, int k) {
+    const sweep_param* p = &s->par[k];
+    if (s->lhs > 0) return s->lhs_v[(size_t)k * (size_t)s->ndesign + (size_t)i];
+    long stride = 1;
+    for (int j = s->npar - 1; j > k; --j) stride *= s->par[j].n;
+    const long j = (i / stride) % p->n;
+    if (p->n == 1) return p->lo;
+    if (j == p->n - 1) return p->hi;
+    return p->lo + (p->hi - p->lo) * ((double)j / (double)(p->n - 1));
+}
+
+// A 64-bit generator the same on every machine (splitmix64), so a seed
+// gives the same hypercube everywhere.
+static uint64_t mix_next(uint64_t* s) {
+    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+static double mix_unit(uint64_t* s) { return (double)(mix_next(s) >> 11) * 0x1.0p-53; }
+
+// Latin hypercube: each parameter's range cut into N equal strata, each
+// stratum used by exactly one design, at a uniform point inside it; the
+// strata of different parameters paired by independent random permutations.
+static int make_lhs(sweep* s, uint64_t seed) {
+    const size_t n = (size_t)s->ndesign;
+    s->lhs_v = malloc((size_t)s->npar * n * sizeof(double));
+    long* perm = malloc(n * sizeof(long));
+    if (!s->lhs_v || !perm) {
+        free(perm);
+        return -1;
+    }
+    uint64_t st = seed;
+    for (int k = 0; k < s->npar; ++k) {
+        for (size_t i = 0; i < n; ++i) perm[i] = (long)i;
+        for (size_t i = n - 1; i > 0; --i) {
+            const size_t j = (size_t)(mix_next(&st) % (uint64_t)(i + 1));
+            const long t = perm[i];
+            perm[i] = perm[j];
+            perm[j] = t;
+        }
+        const sweep_param* p = &s->par[k];
+        for (size_t i = 0; i < n; ++i)
+            s->lhs_v[(size_t)k * n + i] = p->lo + (p->hi - p->lo) * (((double)perm[i] + mix_unit(&st)) / (double)n);
+    }
+    free(perm);
+    return 0;
+}
+
+// A growing text buffer for one row.
+typedef struct sbuf {
+    char* p;
+    size_t n, cap;
+} sbuf;
+static void sb_printf(sbuf* b, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+static void sb_printf(sbuf* b, const char* fmt, ...) {
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        const size_t room = b->cap - b->n;
+        const int k = b->p ? vsnprintf(b->p + b->n, room, fmt, ap) : -1;
+        va_end(ap);
+        if (k >= 0 && (size_t)k < room) {
+            b->n += (size_t)k;
+            return;
+        }
+        const size_t cap = b->cap ? 2 * b->cap + (k > 0 ? (size_t)k : 0) : 512;
+        char* p = realloc(b->p, cap);
+        if (!p) abort(); // a few hundred bytes: nothing sensible is left to do
+        b->p = p;
+        b->cap = cap;
+    }
+}
+
+static int design_row(void* user, const double* row) {
+    metrics_row(user, row);
+    return app_signal_caught() != 0;
+}
+
+// Run design i; its CSV row (malloc'd, with the newline), or NULL when a
+// signal cut it short (it is then not a finished design). *failed: exit != 0.
+static char* run_design(const sweep* s, long i, bool* failed) {
+    double v[SW_MAXPAR];
+    for (int k = 0; k < s->npar; ++k) v[k] = design_value(s, i, k);
+    char err[1024] = "";
+    int code = 0;
+    run_metrics met;
+    metrics_init(&met, s->ncol);
+    cJSON* doc = cJSON_Duplicate(s->base->json, 1);
+    if (!doc) {
+        snprintf(err, sizeof err, "out of memory");
+        code = EXIT_RUNTIME;
+    }
+    for (int k = 0; k < s->npar && !code; ++k) {
+        char asg[320];
+        snprintf(asg, sizeof asg, "%s=%.17g", s->par[k].path, v[k]);
+        if (json_set_path(doc, asg, err, sizeof err)) code = EXIT_USAGE;
+    }
+    model* m = NULL;
+    if (!code) {
+        m = model_from_json(doc, s->base->file, err, sizeof err);
+        doc = NULL; // the model owns it now, also on failure
+        if (!m) code = EXIT_USAGE;
+    }
+    cJSON_Delete(doc);
+    if (m) {
+        sim_result res;
+        if (s->ode) pthread_mutex_lock(&g_ode_mu);
+        sim_run(m, &s->sc, &s->c.sim, design_row, &met, NULL, NULL, NULL, &res);
+        if (s->ode) pthread_mutex_unlock(&g_ode_mu);
+        model_free(m);
+        if (res.status == SIM_REFUSED && app_signal_caught()) return NULL;
+        metrics_finish(&met, &res);
+        if (res.status != SIM_OK) {
+            code = res.status == SIM_FAILED ? EXIT_RUNTIME : EXIT_USAGE;
+            snprintf(err, sizeof err, "%s", res.message);
+        }
+    }
+    sbuf b = {0};
+    sb_printf(&b, "%ld", i);
+    for (int k = 0; k < s->npar; ++k) sb_printf(&b, ",%.17g", v[k]);
+    // A failed design's metrics are left empty: those of a run cut short
+    // by a blow-up are not the design's.
+    for (int k = 0; k < s->nmet; ++k) {
+        if (code) sb_printf(&b, ",");
+        else sb_printf(&b, ",%.17g", met.value[s->met[k]]);
+    }
+    sb_printf(&b, ",%d,", code);
+    if (code) {
+        // The error as one quoted CSV field (quotes doubled, no newlines).
+        sb_printf(&b, "\"");
+        for (const char* p = err; *p; ++p) {
+            if (*p == '"') sb_printf(&b, "\"\"");
+            else sb_printf(&b, "%c", *p == '\n' || *p == '\r' ? ' ' : *p);
+        }
+        sb_printf(&b, "\"");
+    }
+    sb_printf(&b, "\n");
+    *failed = code != 0;
+    return b.p;
+}
+
+// The exit field of a row (after index, the parameters and the metrics).
+static int line_exit(const sweep* s, const char* line) {
+    const char* p = line;
+    for (int k = 0; k < 1 + s->npar + s->nmet && p; ++k) {
+        p = strchr(p, ',');
+        if (p) ++p;
+    }
+    return p ? atoi(p) : 0;
+}
+
+static void* worker(void* arg) {
+    sweep* s = arg;
+    for (;;) {
+        pthread_mutex_lock(&s->mu);
+        if (s->stop || app_signal_caught() || s->next >= s->ndesign) {
+            --s->active;
+            pthread_cond_broadcast(&s->cv);
+            pthread_mutex_unlock(&s->mu);
+            return NULL;
+        }
+        const long i = s->next;
+        s->next += s->stride;
+        pthread_mutex_unlock(&s->mu);
+        bool failed = false;
+        char* line = run_design(s, i, &failed);
+        pthread_mutex_lock(&s->mu);
+        if (line) {
+            s->line[i] = line;
+            s->fin[s->nfin++] = i;
+            if (failed) {
+                ++s->failed;
+                if (s->fail_fast) s->stop = true;
+            }
+        }
+        pthread_cond_broadcast(&s->cv);
+        pthread_mutex_unlock(&s->mu);
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Parsing
+// ---------------------------------------------------------------------------
+
+// "PATH=LO:HI:N" (grid) or "PATH=LO:HI" (--lhs). 0, or -1 after one line.
+static int parse_param(const char* arg, bool want_n, sweep_param* p) {
+    const char* eq = strrchr(arg, '=');
+    if (!eq || eq == arg || (size_t)(eq - arg) >= sizeof p->path) {
+        fprintf(stderr, "cranesim sweep: --param '%s': expected PATH=LO:HI%s\n", arg, want_n ? ":N" : "");
+        return -1;
+    }
+    snprintf(p->path, sizeof p->path, "%.*s", (int)(eq - arg), arg);
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", eq + 1);
+    char* f[4];
+    int nf = 0;
+    for (char *q = buf, *tok; nf < 4 && (tok = strsep(&q, ":"));) f[nf++] = tok;
+    if (nf != (want_n ? 3 : 2) || app_parse_double(f[0], &p->lo) || app_parse_double(f[1], &p->hi) ||
+        !isfinite(p->lo) || !isfinite(p->hi)) {
+        if (nf == 3 && !want_n)
+            fprintf(stderr, "cranesim sweep: --param '%s': with --lhs give PATH=LO:HI (--lhs sets the count)\n",
+                    arg);
+        else
+            fprintf(stderr, "cranesim sweep: --param '%s': expected PATH=LO:HI%s with finite numbers\n", arg,
+                    want_n ? ":N" : "");
+        return -1;
+    }
+    if (p->lo > p->hi) {
+        fprintf(stderr, "cranesim sweep: --param '%s': LO %g is above HI %g\n", arg, p->lo, p->hi);
+        return -1;
+    }
+    p->n = 1;
+    if (want_n) {
+        char* end;
+        errno = 0;
+        const long n = strtol(f[2], &end, 10);
+        if (!*f[2] || *end || errno || n < 1 || n > SW_MAXDESIGN) {
+            fprintf(stderr, "cranesim sweep: --param '%s': N must be a whole number in [1, %d], got '%s'\n", arg,
+                    SW_MAXDESIGN, f[2]);
+            return -1;
+        }
+        if (n == 1 && p->lo != p->hi) {
+            fprintf(stderr, "cranesim sweep: --param '%s': N = 1 needs LO = HI (one value)\n", arg);
+            return -1;
+        }
+        p->n = n;
+    }
+    return 0;
+}
+
+static int parse_metrics(sweep* s, const char* list) {
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", list);
+    s->nmet = 0;
+    for (char *q = buf, *tok; (tok = strsep(&q, ","));) {
+        const int id = metric_find(tok);
+        if (id < 0) {
+            char names[512];
+            metric_names(names, sizeof names);
+            fprintf(stderr, "cranesim sweep: --metrics: unknown metric '%s' (metrics: %s)\n", tok, names);
+            return -1;
+        }
+        if (!metrics_present((metric_id)id, s->ncol)) {
+            fprintf(stderr, "cranesim sweep: --metrics: this run has no %s (the ode world's channels)\n", tok);
+            return -1;
+        }
+        for (int k = 0; k < s->nmet; ++k)
+            if (s->met[k] == id) {
+                fprintf(stderr, "cranesim sweep: --metrics: '%s' given twice\n", tok);
+                return -1;
+            }
+        if (s->nmet == MET_COUNT) return -1;
+        s->met[s->nmet++] = id;
+    }
+    return 0;
+}
+
+// ---------------------------------------------------------------------------
+// The run
+// ---------------------------------------------------------------------------
+
+typedef struct sweep_out {
+    app_out out;
+    FILE* f;
+    int err;
+    long written, next_write;
+    double* plotv;     ///< ndesign x (npar + nmet) when plotting, NaN for none
+} sweep_out;
+
+static void out_line(sweep* s, sweep_out* o, long i, char* line) {
+    if (o->f && !o->err) {
+        if (fputs(line, o->f) < 0) o->err = errno ? errno : EIO;
+    }
+    if (o->plotv) {
+        // The values back from the row, exactly (17 digits round-trip).
+        const size_t w = (size_t)(s->npar + s->nmet);
+        double* v = o->plotv + (size_t)i * w;
+        const char* p = strchr(line, ',');
+        for (size_t k = 0; k < w && p; ++k) {
+            char* end;
+            v[k] = p[1] == ',' ? NAN : strtod(p + 1, &end);
+            p = strchr(p + 1, ',');
+        }
+    }
+    ++o->written;
+    free(line);
+}
+
+// Write the finished rows in index order as far as they go without a gap.
+static void out_flush(sweep* s, sweep_out* o) {
+    while (o->next_write < s->ndesign && s->line[o->next_write]) {
+        out_line(s, o, o->next_write, s->line[o->next_write]);
+        s->line[o->next_write] = NULL;
+        ++o->next_write;
+    }
+}
+
+static void progress(const sweep* s, long done, long failed, double t0) {
+    if (!isatty(2)) return;
+    const double el = sim_wall_time() - t0;
+    const int width = 30;
+    const double f = s->ndesign ? (double)done / (double)s->ndesign : 1.0;
+    const int n = (int)(f * width + 0.5);
+    char eta[32] = "";
+    if (done > 0 && done < s->ndesign) snprintf(eta, sizeof eta, ", ETA %.0f s", el * (1.0 / f - 1.0));
+    fprintf(stderr, "\r  [%.*s%*s] %ld/%ld designs (%ld failed), %.0f s%s   ", n,
+            "##############################", width - n, "", done, s->ndesign, failed, el, eta);
+    fflush(stderr);
+}
+
+#ifdef CRANESIM_HAVE_MPI
+// Ranks > 0 send TAG_ROW (a design's index and row) and, when their designs
+// are done, TAG_DONE; rank 0 sends TAG_STOP (--fail-fast met a failure
+// anywhere) and, once every rank is done, TAG_END, which each rank waits
+// for, so no message is left unreceived at MPI_Finalize.
+enum { TAG_ROW = 1, TAG_DONE = 2, TAG_STOP = 3, TAG_END = 4 };
+#endif
+
+static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out_path, sweep_out* o) {
+    s->next = rank;
+    s->stride = nrank;
+    s->line = calloc((size_t)s->ndesign, sizeof(char*));
+    s->fin = malloc((size_t)s->ndesign * sizeof(long));
+    if (!s->line || !s->fin) {
+        fprintf(stderr, "cranesim sweep: out of memory for %ld designs\n", s->ndesign);
+        return EXIT_RUNTIME;
+    }
+    if (rank == 0) {
+        o->f = app_out_open(&o->out, out_path, "w");
+        if (!o->f) {
+            fprintf(stderr, "cranesim sweep: cannot write %s: %s\n", out_path, strerror(errno));
+            return EXIT_USAGE;
+        }
+        fprintf(o->f, "index");
+        for (int k = 0; k < s->npar; ++k) fprintf(o->f, ",%s", s->par[k].path);
+        for (int k = 0; k < s->nmet; ++k) fprintf(o->f, ",%s", metric_name((metric_id)s->met[k]));
+        fprintf(o->f, ",exit,error\n");
+    }
+    pthread_t* tid = calloc((size_t)threads, sizeof(pthread_t));
+    if (!tid) return EXIT_RUNTIME;
+    // Counted before each start: a worker can finish before pthread_create returns.
+    int started = 0;
+    for (int t = 0; t < threads; ++t) {
+        pthread_mutex_lock(&s->mu);
+        ++s->active;
+        pthread_mutex_unlock(&s->mu);
+        if (pthread_create(&tid[t], NULL, worker, s)) {
+            pthread_mutex_lock(&s->mu);
+            --s->active;
+            pthread_mutex_unlock(&s->mu);
+            break;
+        }
+        ++started;
+    }
+    if (started == 0) {
+        fprintf(stderr, "cranesim sweep: cannot start a thread\n");
+        free(tid);
+        return EXIT_RUNTIME;
+    }
+    const double t0 = sim_wall_time();
+    long done = 0;
+    int remote_left = nrank - 1; // ranks that have not said they are done
+#ifdef CRANESIM_HAVE_MPI
+    bool stop_sent = false;
+#endif
+    long* batch = malloc((size_t)s->ndesign * sizeof(long));
+    if (!batch) abort();
+    for (;;) {
+        pthread_mutex_lock(&s->mu);
+        if (s->nfin == 0 && s->active > 0) {
+            struct timespec ts;
+            clock_gettime(CLOCK_REALTIME, &ts);
+            ts.tv_nsec += 20 * 1000000L; // also the MPI polling period
+            if (ts.tv_nsec >= 1000000000L) {
+                ts.tv_nsec -= 1000000000L;
+                ++ts.tv_sec;
+            }
+            pthread_cond_timedwait(&s->cv, &s->mu, &ts);
+        }
+        const long nb = s->nfin;
+        memcpy(batch, s->fin, (size_t)nb * sizeof(long));
+        s->nfin = 0;
+        const bool local_done = s->active == 0;
+        pthread_mutex_unlock(&s->mu);
+        done += nb;
+#ifdef CRANESIM_HAVE_MPI
+        if (rank > 0) {
+            for (long k = 0; k < nb; ++k) {
+                const long i = batch[k];
+                pthread_mutex_lock(&s->mu);
+                char* line = s->line[i];
+                s->line[i] = NULL;
+                pthread_mutex_unlock(&s->mu);
+                const size_t L = strlen(line) + 1;
+                char* msg = malloc(sizeof(long) + L);
+                if (!msg) abort();
+                memcpy(msg, &i, sizeof(long));
+                memcpy(msg + sizeof(long), line, L);
+                MPI_Send(msg, (int)(sizeof(long) + L), MPI_CHAR, 0, TAG_ROW, MPI_COMM_WORLD);
+                free(msg);
+                free(line);
+            }
+            for (int flag = 1; flag;) {
+                MPI_Iprobe(0, TAG_STOP, MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE);
+                if (!flag) break;
+                MPI_Recv(NULL, 0, MPI_CHAR, 0, TAG_STOP, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                pthread_mutex_lock(&s->mu);
+                s->stop = true;
+                pthread_mutex_unlock(&s->mu);
+            }
+            if (local_done) {
+                MPI_Send(NULL, 0, MPI_CHAR, 0, TAG_DONE, MPI_COMM_WORLD);
+                for (;;) { // a late TAG_STOP, then TAG_END
+                    MPI_Status st;
+                    MPI_Recv(NULL, 0, MPI_CHAR, 0, MPI_ANY_TAG, MPI_COMM_WORLD, &st);
+                    if (st.MPI_TAG == TAG_END) break;
+                }
+                break;
+            }
+            continue;
+        }
+        if (nrank > 1) {
+            for (int flag = 1; flag;) {
+                MPI_Status st;
+                MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &st);
+                if (!flag) break;
+                int cnt = 0;
+                MPI_Get_count(&st, MPI_CHAR, &cnt);
+                char* msg = malloc((size_t)cnt + 1);
+                if (!msg) abort();
+                MPI_Recv(msg, cnt, MPI_CHAR, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                if (st.MPI_TAG == TAG_DONE) {
+                    --remote_left;
+                } else {
+                    long i;
+                    memcpy(&i, msg, sizeof(long));
+                    const size_t L = (size_t)cnt - sizeof(long);
+                    char* line = malloc(L);
+                    if (!line) abort();
+                    memcpy(line, msg + sizeof(long), L);
+                    if (i >= 0 && i < s->ndesign && !s->line[i]) {
+                        pthread_mutex_lock(&s->mu);
+                        s->line[i] = line;
+                        if (line_exit(s, line)) ++s->failed;
+                        pthread_mutex_unlock(&s->mu);
+                        ++done;
+                    } else {
+                        free(line);
+                    }
+                }
+                free(msg);
+            }
+            pthread_mutex_lock(&s->mu);
+            const bool stop_now = s->fail_fast && s->failed > 0;
+            if (stop_now) s->stop = true;
+            pthread_mutex_unlock(&s->mu);
+            if (stop_now && !stop_sent) {
+                for (int r = 1; r < nrank; ++r) MPI_Send(NULL, 0, MPI_CHAR, r, TAG_STOP, MPI_COMM_WORLD);
+                stop_sent = true;
+            }
+            if (local_done && remote_left <= 0)
+                for (int r = 1; r < nrank; ++r) MPI_Send(NULL, 0, MPI_CHAR, r, TAG_END, MPI_COMM_WORLD);
+        }
+#endif
+        pthread_mutex_lock(&s->mu);
+        out_flush(s, o);
+        const long failed = s->failed;
+        pthread_mutex_unlock(&s->mu);
+        if (!s->c.quiet) progress(s, done, failed, t0);
+        if (local_done && remote_left <= 0) break;
+    }
+    free(batch);
+    for (int t = 0; t < started; ++t) pthread_join(tid[t], NULL);
+    free(tid);
+    if (rank > 0) return 0;
+    // After a signal or --fail-fast: the finished rows beyond a gap, still in index order.
+    for (long i = o->next_write; i < s->ndesign; ++i)
+        if (s->line[i]) {
+            out_line(s, o, i, s->line[i]);
+            s->line[i] = NULL;
+        }
+    if (!s->c.quiet && isatty(2)) fprintf(stderr, "\r%*s\r", 78, "");
+    return 0;
+}
+
+// ---------------------------------------------------------------------------
+// Plots
+// ---------------------------------------------------------------------------
+
+static int sweep_plots(const sweep* s, const sweep_out* o, const char* plot) {
+    const size_t L = strlen(plot);
+    const bool one = L > 4 && !strcmp(plot + L - 4, ".png");
+    int dirlen = (int)L; // the folder without its trailing slashes
+    while (dirlen > 1 && plot[dirlen - 1] == '/') --dirlen;
+    const size_t w = (size_t)(s->npar + s->nmet);
+    double* x = malloc((size_t)s->ndesign * sizeof(double));
+    double* y = malloc((size_t)s->ndesign * sizeof(double));
+    if (!x || !y) {
+        free(x);
+        free(y);
+        return -1;
+    }
+    int rc = 0;
+    int nplot = 0;
+    char err[512], png[1400], title[400];
+    for (int mk = 0; mk < s->nmet && !rc && !(one && nplot); ++mk) {
+        const char* mn = metric_name((metric_id)s->met[mk]);
+        char ylab[96];
+        snprintf(ylab, sizeof ylab, "%s [%s]", mn, metric_unit((metric_id)s->met[mk]));
+        if (s->npar == 2 && s->lhs == 0) {
+            // Heat map over the grid (row-major: the second parameter fastest).
+            const long nx = s->par[0].n, ny = s->par[1].n;
+            double* z = malloc((size_t)nx * (size_t)ny * sizeof(double));
+            if (!z) break;
+            for (long i = 0; i < s->ndesign; ++i) z[i] = o->plotv[(size_t)i * w + 2 + (size_t)mk];
+            if (one) snprintf(png, sizeof png, "%s", plot);
+            else snprintf(png, sizeof png, "%.*s/%s_heat.png", dirlen, plot, mn);
+            snprintf(title, sizeof title, "%s: %s", s->sc.name, ylab);
+            if (app_plot_heat(png, title, s->par[0].path, s->par[1].path, z, nx, ny, s->par[0].lo, s->par[0].hi,
+                              s->par[1].lo, s->par[1].hi, err, sizeof err)) {
+                fprintf(stderr, "cranesim sweep: plot: %s\n", err);
+                rc = -1;
+            } else {
+                ++nplot;
+                if (!s->c.quiet) printf("  plot -> %s\n", png);
+            }
+            free(z);
+            if (one) break;
+        }
+        for (int pk = 0; pk < s->npar && !rc && !(one && nplot); ++pk) {
+            long n = 0;
+            for (long i = 0; i < s->ndesign; ++i) {
+                const double* v = o->plotv + (size_t)i * w;
+                if (isfinite(v[pk]) && isfinite(v[s->npar + mk])) {
+                    x[n] = v[pk];
+                    y[n] = v[s->npar + mk];
+                    ++n;
+                }
+            }
+            if (one) snprintf(png, sizeof png, "%s", plot);
+            else snprintf(png, sizeof png, "%.*s/%s_vs_%s.png", dirlen, plot, mn, s->par[pk].path);
+            snprintf(title, sizeof title, "%s: %s against %s", s->sc.name, mn, s->par[pk].path);
+            if (app_plot_sweep(png, title, s->par[pk].path, ylab, x, y, n, err, sizeof err)) {
+                fprintf(stderr, "cranesim sweep: plot: %s\n", err);
+                rc = -1;
+            } else {
+                ++nplot;
+                if (!s->c.quiet) printf("  plot -> %s\n", png);
+            }
+        }
+    }
+    free(x);
+    free(y);
+    return rc;
+}
+
+// ---------------------------------------------------------------------------
+// The command
+// ---------------------------------------------------------------------------
+
+static int sweep_main(int argc, char** argv, int rank, int nrank) {
+    sweep s;
+    memset(&s, 0, sizeof s);
+    s.c.sim = sim_default_opts();
+    const char* out = "sweep.csv";
+    const char* plot = NULL;
+    const char* metrics = NULL;
+    const char* params[SW_MAXPAR];
+    int nparam = 0;
+    long lhs = 0, threads = 0;
+    uint64_t seed = 1;
+    for (int i = 0; i < argc; ++i) {
+        const char* a = argv[i];
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            if (rank == 0) sweep_help(stdout);
+            return 0;
+        }
+        int rc = app_parse_common(&s.c, argc, argv, &i);
+        if (rc < 0) return EXIT_USAGE;
+        if (rc > 0) continue;
+        if (!strcmp(a, "--fail-fast")) {
+            s.fail_fast = true;
+            continue;
+        }
+        const bool known = !strcmp(a, "--param") || !strcmp(a, "--lhs") || !strcmp(a, "--seed") ||
+                           !strcmp(a, "--metrics") || !strcmp(a, "--threads") || !strcmp(a, "--out") ||
+                           !strcmp(a, "--plot");
+        if (!known) {
+            fprintf(stderr, "cranesim sweep: unknown option '%s' (see cranesim sweep --help)\n", a);
+            return EXIT_USAGE;
+        }
+        const char* v = app_value(argc, argv, &i);
+        if (!v) return EXIT_USAGE;
+        if (!strcmp(a, "--param")) {
+            if (nparam == SW_MAXPAR) {
+                fprintf(stderr, "cranesim sweep: at most %d --param\n", SW_MAXPAR);
+                return EXIT_USAGE;
+            }
+            params[nparam++] = v;
+        } else if (!strcmp(a, "--out")) {
+            out = v;
+        } else if (!strcmp(a, "--plot")) {
+            plot = v;
+        } else if (!strcmp(a, "--metrics")) {
+            metrics = v;
+        } else {
+            char* end;
+            errno = 0;
+            const long long n = strtoll(v, &end, 10);
+            const long long hi = !strcmp(a, "--seed") ? LLONG_MAX : !strcmp(a, "--threads") ? 1024 : SW_MAXDESIGN;
+            const long long lo = !strcmp(a, "--seed") ? 0 : 1;
+            if (!*v || *end || errno || n < lo || n > hi) {
+                fprintf(stderr, "cranesim sweep: %s must be a whole number in [%lld, %lld], got '%s'\n", a, lo, hi,
+                        v);
+                return EXIT_USAGE;
+            }
+            if (!strcmp(a, "--seed")) seed = (uint64_t)n;
+            else if (!strcmp(a, "--lhs")) lhs = (long)n;
+            else threads = (long)n;
+        }
+    }
+    if (nparam == 0) {
+        fprintf(stderr, "cranesim sweep: give at least one --param PATH=LO:HI:N (see cranesim sweep --help)\n");
+        return EXIT_USAGE;
+    }
+    s.npar = nparam;
+    s.lhs = lhs;
+    double nd = 1;
+    for (int k = 0; k < nparam; ++k) {
+        if (parse_param(params[k], lhs == 0, &s.par[k])) return EXIT_USAGE;
+        for (int j = 0; j < k; ++j)
+            if (!strcmp(s.par[j].path, s.par[k].path)) {
+                fprintf(stderr, "cranesim sweep: --param %s given twice\n", s.par[k].path);
+                return EXIT_USAGE;
+            }
+        nd *= (double)s.par[k].n;
+    }
+    if (lhs > 0) nd = (double)lhs;
+    if (nd > SW_MAXDESIGN) {
+        fprintf(stderr, "cranesim sweep: %.0f designs: at most %d\n", nd, SW_MAXDESIGN);
+        return EXIT_USAGE;
+    }
+    s.ndesign = (long)nd;
+    if (app_check_output("sweep", "--out", out, NULL)) return EXIT_USAGE;
+    if (plot) {
+        const size_t L = strlen(plot);
+        if (L > 4 && !strcmp(plot + L - 4, ".png")) {
+            if (app_check_output("sweep", "--plot", plot, ".png")) return EXIT_USAGE;
+        }
+    }
+    int rc = app_check_sim("sweep", &s.c.sim, s.c.given);
+    if (rc) return rc;
+    // The base design: the model with the --set changes; each design copies it.
+    rc = app_load(&s.c, &s.base, &s.sc);
+    if (rc) return rc;
+    bool switched;
+    rc = app_scenario_world("sweep", &s.c.sim, s.c.given, &s.sc, true, &switched);
+    if (!rc && switched) rc = app_check_sim("sweep", &s.c.sim, s.c.given);
+    if (rc) {
+        model_free(s.base);
+        return rc;
+    }
+    s.ode = s.c.sim.mechanics == SIM_ODE;
+    s.ncol = sim_ncol(&s.c.sim);
+    // Every path must name a number in the model: a typo is bad input, not
+    // a sweep of refused designs. (Its values are checked per design.)
+    for (int k = 0; k < nparam && !rc; ++k) {
+        cJSON* doc = cJSON_Duplicate(s.base->json, 1);
+        char asg[320], err[1024];
+        snprintf(asg, sizeof asg, "%s=%.17g", s.par[k].path, s.par[k].lo);
+        if (!doc || json_set_path(doc, asg, err, sizeof err)) {
+            fprintf(stderr, "cranesim sweep: --param %s: %s\n", s.par[k].path, doc ? err : "out of memory");
+            rc = EXIT_USAGE;
+        }
+        cJSON_Delete(doc);
+    }
+    if (!rc && metrics) rc = parse_metrics(&s, metrics) ? EXIT_USAGE : 0;
+    else if (!rc)
+        for (int id = 0; id < MET_COUNT; ++id)
+            if (metrics_present((metric_id)id, s.ncol)) s.met[s.nmet++] = id;
+    if (!rc && plot && !(strlen(plot) > 4 && !strcmp(plot + strlen(plot) - 4, ".png")) && rank == 0)
+        rc = app_make_dir("sweep", "--plot", plot) ? EXIT_USAGE : 0;
+    if (!rc && lhs > 0 && make_lhs(&s, seed)) {
+        fprintf(stderr, "cranesim sweep: out of memory for %ld designs\n", s.ndesign);
+        rc = EXIT_RUNTIME;
+    }
+    if (rc) {
+        model_free(s.base);
+        free(s.lhs_v);
+        return rc;
+    }
+    app_note_unused("sweep", s.c.given, &s.c.sim, 1);
+    {
+        // A swept load mass the scenario's or --load overrides: the note run gives for --set.
+        app_common cn = s.c;
+        char asg[SW_MAXPAR][320];
+        for (int k = 0; k < nparam && cn.nset < APP_MAX_SET; ++k) {
+            snprintf(asg[k], sizeof asg[k], "%s=%.17g", s.par[k].path, s.par[k].lo);
+            cn.sets[cn.nset++] = asg[k];
+        }
+        if (rank == 0) app_note_load("sweep", &cn, &s.c.sim, &s.sc);
+    }
+    app_settle_unused(&s.c.sim);
+    if (threads == 0) {
+        // Every core; under MPI one thread per rank (mpirun places one rank per core).
+        const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+        threads = nrank > 1 ? 1 : cores > 0 ? cores : 1;
+    }
+    const long mine = (s.ndesign - rank + nrank - 1) / nrank; // designs of this rank
+    if (threads > mine) threads = mine > 0 ? mine : 1;
+    pthread_mutex_init(&s.mu, NULL);
+    pthread_cond_init(&s.cv, NULL);
+    void* note_user;
+    hyd_note_fn old_note = hyd_get_note_handler(&note_user);
+    hyd_set_note_handler(quiet_note, NULL);
+    sweep_out o = {0};
+    if (plot && rank == 0) {
+        const size_t w = (size_t)(s.npar + s.nmet);
+        o.plotv = malloc((size_t)s.ndesign * w * sizeof(double));
+        if (o.plotv)
+            for (size_t k = 0; k < (size_t)s.ndesign * w; ++k) o.plotv[k] = NAN;
+    }
+    app_signals sig;
+    app_signals_catch(&sig);
+    const double t0 = sim_wall_time();
+    rc = sweep_run(&s, (int)threads, rank, nrank, out, &o);
+    const double wall = sim_wall_time() - t0;
+    int code = rc;
+    if (rank == 0 && o.f) {
+        const int e = app_out_close(&o.out, o.err, true);
+        if (e) {
+            fprintf(stderr, "cranesim sweep: cannot write %s: %s\n", out, strerror(e));
+            if (!code) code = EXIT_RUNTIME;
+        }
+    }
+    app_signals_restore(&sig);
+    hyd_set_note_handler(old_note, note_user);
+    if (rank == 0 && !code) {
+        const int sg = app_signal_caught();
+        if (sg) {
+            fprintf(stderr, "cranesim sweep: interrupted (%s); %ld of %ld designs kept in %s\n",
+                    app_signal_name(sg), o.written, s.ndesign, out);
+            code = 128 + sg;
+        } else {
+            const long nfail = s.failed; // with MPI: every rank's, from the rows
+            if (!s.c.quiet) {
+                char shape[128] = "";
+                if (lhs > 0) snprintf(shape, sizeof shape, "Latin hypercube, seed %llu", (unsigned long long)seed);
+                else
+                    for (int k = 0; k < s.npar; ++k) {
+                        const size_t n = strlen(shape);
+                        snprintf(shape + n, sizeof shape - n, "%s%ld", k ? " x " : "grid ", s.par[k].n);
+                    }
+                printf("cranesim sweep: %s, %ld designs (%s) on %ld thread%s%s in %.2f s -> %s\n", s.sc.name,
+                       s.ndesign, shape, threads, threads == 1 ? "" : "s", nrank > 1 ? " per rank" : "", wall, out);
+                if (nrank > 1) printf("  %d MPI ranks\n", nrank);
+                if (nfail)
+                    printf("  %ld design%s failed (exit and error in %s rows)\n", nfail, nfail == 1 ? "" : "s",
+                           nfail == 1 ? "its" : "their");
+            }
+            if (s.fail_fast && (nfail || o.written < s.ndesign)) {
+                fprintf(stderr, "cranesim sweep: --fail-fast: stopped at a failing design; %ld of %ld rows in %s\n",
+                        o.written, s.ndesign, out);
+                code = EXIT_RUNTIME;
+            }
+            if (plot && o.plotv && sweep_plots(&s, &o, plot) && !code) code = EXIT_RUNTIME;
+        }
+    }
+    for (long i = 0; s.line && i < s.ndesign; ++i) free(s.line[i]);
+    free(s.line);
+    free(s.fin);
+    free(o.plotv);
+    free(s.lhs_v);
+    pthread_mutex_destroy(&s.mu);
+    pthread_cond_destroy(&s.cv);
+    model_free(s.base);
+    return code;
+}
+
+int cmd_sweep(int argc, char** argv) {
+    int rank = 0, nrank = 1;
+#ifdef CRANESIM_HAVE_MPI
+    // MPI only when a launcher started this process (mpirun, srun): a plain
+    // `cranesim sweep` stays a local run.
+    const bool launched = getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMIX_RANK") || getenv("PMI_RANK");
+    if (launched) {
+        int prov;
+        MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &prov);
+        MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+        MPI_Comm_size(MPI_COMM_WORLD, &nrank);
+    }
+#endif
+    // Every rank checks the input the same way; only rank 0 says what is wrong.
+    if (rank > 0 && (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr))) return EXIT_RUNTIME;
+    int rc = sweep_main(argc, argv, rank, nrank);
+#ifdef CRANESIM_HAVE_MPI
+    if (launched) {
+        // Ranks agree on the outcome: the worst exit code.
+        int worst = rc;
+        MPI_Allreduce(&rc, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+        MPI_Finalize();
+        rc = rank == 0 ? rc : 0;
+        (void)worst;
+    }
+#endif
+    return rc;
+}

@@ -1,0 +1,125 @@
+// plot_sweep.c: the sweep's plots with PLplot: a metric against a
+// parameter (one point per design) and a heat map of a metric over a
+// two-parameter grid. Rendered through app_png_render (checked writes).
+#include "app.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef CRANESIM_HAVE_PLPLOT
+#include <plplot.h>
+
+typedef struct scatter_plot {
+    const char *title, *xlab, *ylab;
+    const double *x, *y;
+    long n;
+} scatter_plot;
+
+static void range(const double* v, long n, double* lo, double* hi) {
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (long i = 0; i < n; ++i) {
+        *lo = fmin(*lo, v[i]);
+        *hi = fmax(*hi, v[i]);
+    }
+    if (!(*hi > *lo)) { // one value, or none: a window around it
+        const double c = isfinite(*lo) ? *lo : 0.0;
+        const double d = fabs(c) * 0.05 + 1e-9;
+        *lo = c - d;
+        *hi = c + d;
+    } else {
+        const double pad = 0.05 * (*hi - *lo);
+        *lo -= pad;
+        *hi += pad;
+    }
+}
+
+static void draw_scatter(void* user) {
+    const scatter_plot* p = user;
+    plinit();
+    plschr(0, 0.9);
+    double xlo, xhi, ylo, yhi;
+    range(p->x, p->n, &xlo, &xhi);
+    range(p->y, p->n, &ylo, &yhi);
+    plcol0(15);
+    plenv(xlo, xhi, ylo, yhi, 0, 2);
+    pllab(p->xlab, p->ylab, p->title);
+    // Points in design order, joined when the parameter only grows (a grid
+    // over one parameter), else points only (a hypercube, several parameters).
+    bool sorted = true;
+    for (long i = 1; i < p->n && sorted; ++i) sorted = p->x[i] > p->x[i - 1];
+    plcol0(1);
+    if (sorted && p->n > 1) plline((PLINT)p->n, p->x, p->y);
+    plpoin((PLINT)p->n, p->x, p->y, 17);
+}
+
+int app_plot_sweep(const char* png, const char* title, const char* xlab, const char* ylab, const double* x,
+                   const double* y, long n, char* err, size_t errsz) {
+    scatter_plot p = {title, xlab, ylab, x, y, n};
+    return app_png_render(png, "1000x700", draw_scatter, &p, err, errsz);
+}
+
+typedef struct heat_plot {
+    const char *title, *xlab, *ylab;
+    const double* z;
+    long nx, ny;
+    double x0, x1, y0, y1;
+} heat_plot;
+
+static void draw_heat(void* user) {
+    const heat_plot* p = user;
+    plinit();
+    plschr(0, 0.9);
+    double lo = INFINITY, hi = -INFINITY;
+    for (long k = 0; k < p->nx * p->ny; ++k)
+        if (isfinite(p->z[k])) {
+            lo = fmin(lo, p->z[k]);
+            hi = fmax(hi, p->z[k]);
+        }
+    if (!(hi > lo)) {
+        lo = isfinite(lo) ? lo - 1 : 0;
+        hi = lo + 2;
+    }
+    // One cell per design, centred on its grid values.
+    const double dx = p->nx > 1 ? (p->x1 - p->x0) / (double)(p->nx - 1) : fabs(p->x0) * 0.1 + 1e-9;
+    const double dy = p->ny > 1 ? (p->y1 - p->y0) / (double)(p->ny - 1) : fabs(p->y0) * 0.1 + 1e-9;
+    plcol0(15);
+    plenv(p->x0 - dx / 2, p->x1 + dx / 2, p->y0 - dy / 2, p->y1 + dy / 2, 0, 0);
+    pllab(p->xlab, p->ylab, p->title);
+    plspal1("cmap1_blue_red.pal", 1);
+    for (long i = 0; i < p->nx; ++i)
+        for (long j = 0; j < p->ny; ++j) {
+            // The grid's rows have the second parameter fastest.
+            const double z = p->z[(size_t)i * (size_t)p->ny + (size_t)j];
+            if (!isfinite(z)) continue; // a failed design stays blank
+            const double xc = p->x0 + dx * (double)i, yc = p->y0 + dy * (double)j;
+            PLFLT xs[4] = {xc - dx / 2, xc + dx / 2, xc + dx / 2, xc - dx / 2};
+            PLFLT ys[4] = {yc - dy / 2, yc - dy / 2, yc + dy / 2, yc + dy / 2};
+            plcol1((z - lo) / (hi - lo));
+            plfill(4, xs, ys);
+        }
+    // The colour scale: the metric's range, low (blue) to high (red).
+    char lab[160];
+    snprintf(lab, sizeof lab, "blue %.5g .. red %.5g; blank: failed design", lo, hi);
+    plcol0(15);
+    plmtex("t", 0.5, 0.5, 0.5, lab);
+}
+
+int app_plot_heat(const char* png, const char* title, const char* xlab, const char* ylab, const double* z,
+                  long nx, long ny, double x0, double x1, double y0, double y1, char* err, size_t errsz) {
+    heat_plot p = {title, xlab, ylab, z, nx, ny, x0, x1, y0, y1};
+    return app_png_render(png, "1000x800", draw_heat, &p, err, errsz);
+}
+#else
+int app_plot_sweep(const char* png, const char* title, const char* xlab, const char* ylab, const double* x,
+                   const double* y, long n, char* err, size_t errsz) {
+    (void)title, (void)xlab, (void)ylab, (void)x, (void)y, (void)n;
+    return app_png_render(png, "", NULL, NULL, err, errsz);
+}
+int app_plot_heat(const char* png, const char* title, const char* xlab, const char* ylab, const double* z,
+                  long nx, long ny, double x0, double x1, double y0, double y1, char* err, size_t errsz) {
+    (void)title, (void)xlab, (void)ylab, (void)z, (void)nx, (void)ny, (void)x0, (void)x1, (void)y0, (void)y1;
+    return app_png_render(png, "", NULL, NULL, err, errsz);
+}
+#endif

@@ -1,0 +1,107 @@
+// metrics.c: a run's metrics from its rows (metrics.h).
+#include "metrics.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct metric_def {
+    const char* name;
+    const char* unit;
+    int col;      ///< the channel it is made from
+} metric_def;
+
+static const metric_def k_metric[MET_COUNT] = {
+    [MET_PEAK_P1A] = {"peak_p1A", "Pa", COL_P1A},
+    [MET_PEAK_P1B] = {"peak_p1B", "Pa", COL_P1B},
+    [MET_PEAK_P2A] = {"peak_p2A", "Pa", COL_P2A},
+    [MET_PEAK_P2B] = {"peak_p2B", "Pa", COL_P2B},
+    [MET_PEAK_P3A] = {"peak_p3A", "Pa", COL_P3A},
+    [MET_PEAK_P3B] = {"peak_p3B", "Pa", COL_P3B},
+    [MET_PEAK_P_PUMP] = {"peak_p_pump", "Pa", COL_P_PUMP},
+    [MET_RELIEF_TIME] = {"relief_open_time", "s", COL_RELIEF_OPEN},
+    [MET_STOP_LIFT] = {"end_stop_hits_lift", "count", COL_END_STOP},
+    [MET_STOP_JIB] = {"end_stop_hits_jib", "count", COL_END_STOP},
+    // The slew actuator is bit 2 of end_stop; only the ode world has one,
+    // so the metric is there only when the run has the slew channels.
+    [MET_STOP_SLEW] = {"end_stop_hits_slew", "count", COL_X3},
+    [MET_MAX_TILT] = {"max_truck_tilt", "rad", COL_TRUCK_TILT},
+};
+
+bool metrics_present(metric_id id, int ncol) { return id >= 0 && id < MET_COUNT && k_metric[id].col < ncol; }
+const char* metric_name(metric_id id) { return k_metric[id].name; }
+const char* metric_unit(metric_id id) { return k_metric[id].unit; }
+
+int metric_find(const char* name) {
+    for (int i = 0; i < MET_COUNT; ++i)
+        if (!strcmp(name, k_metric[i].name)) return i;
+    return -1;
+}
+
+void metric_names(char* buf, size_t n) {
+    size_t k = 0;
+    buf[0] = 0;
+    for (int i = 0; i < MET_COUNT && k < n; ++i)
+        k += (size_t)snprintf(buf + k, n - k, "%s%s", i ? ", " : "", k_metric[i].name);
+}
+
+void metrics_init(run_metrics* m, int ncol) {
+    memset(m, 0, sizeof *m);
+    m->ncol = ncol;
+    for (int i = 0; i < MET_COUNT; ++i) {
+        m->present[i] = metrics_present((metric_id)i, ncol);
+        m->value[i] = i <= MET_PEAK_P_PUMP ? -INFINITY : 0.0;
+    }
+}
+
+void metrics_row(run_metrics* m, const double* row) {
+    for (int i = 0; i <= MET_PEAK_P_PUMP; ++i)
+        if (m->present[i]) m->value[i] = fmax(m->value[i], row[k_metric[i].col]);
+    const int stops = (int)row[COL_END_STOP];
+    if (m->rows > 0) {
+        if (row[COL_RELIEF_OPEN] > 0) m->value[MET_RELIEF_TIME] += row[COL_T] - m->t_prev;
+    }
+    const int rising = stops & ~(m->rows > 0 ? m->stop_prev : 0);
+    for (int k = 0; k < 3; ++k)
+        if (m->present[MET_STOP_LIFT + k] && (rising >> k & 1)) m->value[MET_STOP_LIFT + k] += 1;
+    if (m->present[MET_MAX_TILT]) m->value[MET_MAX_TILT] = fmax(m->value[MET_MAX_TILT], fabs(row[COL_TRUCK_TILT]));
+    m->stop_prev = stops;
+    m->t_prev = row[COL_T];
+    ++m->rows;
+}
+
+void metrics_finish(run_metrics* m, const sim_result* r) {
+    if (!r->peak_steps) return;
+    for (int k = 0; k < 4; ++k) {
+        // A run stopped before its first step has no step peak (0).
+        if (r->p_peak[k] >= m->value[MET_PEAK_P1A + k]) {
+            m->value[MET_PEAK_P1A + k] = r->p_peak[k];
+            m->per_step[MET_PEAK_P1A + k] = true;
+        }
+    }
+}
+
+void metrics_print(const run_metrics* m, FILE* f) {
+    if (m->rows == 0) return;
+    fprintf(f, "  metrics: relief open %.3f s; end-stop hits lift %.0f, jib %.0f", m->value[MET_RELIEF_TIME],
+            m->value[MET_STOP_LIFT], m->value[MET_STOP_JIB]);
+    if (m->present[MET_STOP_SLEW]) fprintf(f, ", slew %.0f", m->value[MET_STOP_SLEW]);
+    fprintf(f, "; peak pump %.2f MPa", m->value[MET_PEAK_P_PUMP] * 1e-6);
+    if (m->present[MET_PEAK_P3A])
+        fprintf(f, ", slew p3A %.2f, p3B %.2f MPa", m->value[MET_PEAK_P3A] * 1e-6, m->value[MET_PEAK_P3B] * 1e-6);
+    if (m->present[MET_MAX_TILT]) fprintf(f, "; max truck tilt %.3f deg", m->value[MET_MAX_TILT] * 57.29577951308232);
+    fprintf(f, "\n");
+}
+
+int metrics_write_json(const run_metrics* m, FILE* f) {
+    fprintf(f, "{\n  \"rows\": %ld,\n  \"metrics\": {", m->rows);
+    bool first = true;
+    for (int i = 0; i < MET_COUNT; ++i) {
+        if (!m->present[i] || m->rows == 0) continue;
+        const bool peak = i <= MET_PEAK_P_PUMP;
+        fprintf(f, "%s\n    \"%s\": {\"value\": %.17g, \"unit\": \"%s\", \"over\": \"%s\"}", first ? "" : ",",
+                k_metric[i].name, m->value[i], k_metric[i].unit, peak && m->per_step[i] ? "steps" : "rows");
+        first = false;
+    }
+    fprintf(f, "\n  }\n}\n");
+    return ferror(f) ? -1 : 0;
+}

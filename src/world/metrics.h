@@ -1,0 +1,75 @@
+// metrics.h: the metrics of one run (peak pressures, relief time, end-stop
+// hits, truck tilt), accumulated from its rows through the one channel list
+// (sim_channels), whatever the backend. `cranesim run` prints them in its
+// summary and writes them with --metrics; `cranesim sweep` tabulates them.
+#ifndef METRICS_H
+#define METRICS_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "sim.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// The metrics a run can have, by id. Which ones a run has depends only on
+/// its channel count (metrics_present): a metric whose channels the backend
+/// does not write is absent, not zero.
+typedef enum metric_id {
+    MET_PEAK_P1A, MET_PEAK_P1B, MET_PEAK_P2A, MET_PEAK_P2B, ///< [Pa abs], over every step when the run tracked them
+    MET_PEAK_P3A, MET_PEAK_P3B,                             ///< slew chambers [Pa abs], over the rows (ode)
+    MET_PEAK_P_PUMP,                                        ///< [Pa abs], over the rows
+    MET_RELIEF_TIME,     ///< time with any relief valve passing flow [s], at row resolution
+    MET_STOP_LIFT, MET_STOP_JIB, MET_STOP_SLEW, ///< end-stop hits (entries into a stop) [count]
+    MET_MAX_TILT,        ///< largest truck tilt from vertical [rad] (ode)
+    // Energy in and losses come from the energy accounting: one id each
+    // here, their unit and name in metrics.c's table, their value set by
+    // that module into run_metrics.value[] with present[] raised.
+    MET_COUNT
+} metric_id;
+
+typedef struct run_metrics {
+    int ncol;                   ///< the run's channel count
+    double value[MET_COUNT];    ///< in the unit of metric_unit
+    bool present[MET_COUNT];
+    bool per_step[MET_COUNT];   ///< a peak over every integration step (else over the rows)
+    long rows;
+    double t_prev;              ///< the previous row's time [s]
+    int stop_prev;              ///< the previous row's end_stop bits
+} run_metrics;
+
+/// Start the metrics of a run that writes ncol channels (sim_ncol).
+void metrics_init(run_metrics* m, int ncol);
+/// Add one output row (ncol values). Relief time: the interval since the
+/// previous row counts when this row has a relief open. End-stop hits: a
+/// bit of end_stop that is set in this row and was clear in the previous one
+/// (a run that starts at a stop counts one).
+void metrics_row(run_metrics* m, const double* row);
+/// After the run: the chamber peaks over every step from r when it tracked
+/// them (r->peak_steps) and they are higher than the rows' (they always are
+/// when every step is a row, and equal).
+void metrics_finish(run_metrics* m, const sim_result* r);
+
+/// Which metrics a run of ncol channels has (before it runs: for a table's header).
+bool metrics_present(metric_id id, int ncol);
+/// The name used in --metrics lists, the JSON file and the sweep's CSV
+/// ("peak_p1A"), and the unit ("Pa", "s", "count", "rad").
+const char* metric_name(metric_id id);
+const char* metric_unit(metric_id id);
+/// The id of a name, or -1.
+int metric_find(const char* name);
+/// The names, comma separated, for messages.
+void metric_names(char* buf, size_t n);
+
+/// The summary's block: a few lines, each starting with two spaces.
+void metrics_print(const run_metrics* m, FILE* f);
+/// The JSON document: {"metrics": {"NAME": {"value": V, "unit": U, "over": "steps"|"rows"}, ...}}
+/// (absent metrics left out; numbers with 17 significant digits). Returns 0, or -1 on a write error.
+int metrics_write_json(const run_metrics* m, FILE* f);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

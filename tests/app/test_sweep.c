@@ -1,0 +1,265 @@
+// test_sweep.c: run metrics (`run --metrics`) against the same quantities
+// computed here from the run's CSV, and `cranesim sweep`: deterministic
+// results files, failing designs as rows, bad input refused with nothing
+// written. Runs the real binary (cli_util.h).
+#include "check.h"
+#include "cli_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static char out[1 << 16];
+
+// The value of metric name in a metrics JSON text, or NAN.
+static double json_metric(const char* text, const char* name) {
+    char key[96];
+    snprintf(key, sizeof key, "\"%s\": {\"value\": ", name);
+    const char* p = strstr(text, key);
+    return p ? strtod(p + strlen(key), NULL) : NAN;
+}
+
+// The index of column name in a CSV header line, or -1.
+static int csv_col(const char* header, const char* name) {
+    int k = 0;
+    const size_t n = strlen(name);
+    for (const char* p = header; *p; ++k) {
+        const char* e = strpbrk(p, ",\n");
+        const size_t L = e ? (size_t)(e - p) : strlen(p);
+        if (L == n && !strncmp(p, name, n)) return k;
+        if (!e || *e == '\n') break;
+        p = e + 1;
+    }
+    return -1;
+}
+
+// Field k of a CSV line as a number.
+static double csv_field(const char* line, int k) {
+    const char* p = line;
+    for (int i = 0; i < k && p; ++i) {
+        p = strchr(p, ',');
+        if (p) ++p;
+    }
+    return p ? strtod(p, NULL) : NAN;
+}
+
+// The overload scenario drives the lift into its port relief and against
+// its end stop. With a row at every step (--every = --dt) the peaks over
+// every step are the rows' peaks (at the CSV's 9 digits); the relief time and the end-stop hits
+// follow from the relief_open and end_stop columns. Each is computed here
+// from the CSV alone and must equal the metrics file.
+static void test_metrics_match_csv(void) {
+    const char* csv = "metrics_overload.csv";
+    const char* js = "metrics_overload.json";
+    char args[512];
+    snprintf(args, sizeof args, "run --scenario overload --every 1e-4 --out %s --metrics %s", csv, js);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    CHECK(strstr(out, "metrics: relief open") != NULL, "summary has no metrics block: %s", out);
+    static char json[8192];
+    CHECK(cli_read_file(js, json, sizeof json) > 0, "no %s", js);
+    FILE* f = fopen(csv, "r");
+    CHECK(f != NULL, "no %s", csv);
+    if (!f) return;
+    static char line[8192];
+    if (!fgets(line, sizeof line, f)) line[0] = 0;
+    const char* pn[] = {"p1A", "p1B", "p2A", "p2B", "p_pump"};
+    int pc[5];
+    for (int k = 0; k < 5; ++k) pc[k] = csv_col(line, pn[k]);
+    const int ct = csv_col(line, "t"), cr = csv_col(line, "relief_open"), cs = csv_col(line, "end_stop");
+    CHECK(ct == 0 && cr > 0 && cs > 0 && pc[0] > 0 && pc[4] > 0, "columns: %s", line);
+    double peak[5] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    double relief = 0, tprev = 0;
+    long hits[2] = {0, 0}, rows = 0;
+    int prev = 0;
+    while (fgets(line, sizeof line, f)) {
+        for (int k = 0; k < 5; ++k) peak[k] = fmax(peak[k], csv_field(line, pc[k]));
+        const double t = csv_field(line, ct);
+        const int stop = (int)csv_field(line, cs);
+        if (rows > 0 && csv_field(line, cr) > 0) relief += t - tprev;
+        for (int b = 0; b < 2; ++b)
+            if ((stop >> b & 1) && !(rows > 0 && (prev >> b & 1))) ++hits[b];
+        prev = stop;
+        tprev = t;
+        ++rows;
+    }
+    fclose(f);
+    CHECK(rows == 120001, "rows %ld", rows);
+    for (int k = 0; k < 5; ++k) {
+        char name[32];
+        snprintf(name, sizeof name, "peak_%s", pn[k]);
+        // The CSV holds 9 significant digits (sim_csv_row): equal at that precision.
+        char a9[40], b9[40];
+        snprintf(a9, sizeof a9, "%.9g", json_metric(json, name));
+        snprintf(b9, sizeof b9, "%.9g", peak[k]);
+        CHECK(!strcmp(a9, b9), "%s: metrics %s, CSV %s", name, a9, b9);
+    }
+    // The scenario's own description: the lift relief caps p1A from 2.1 s on.
+    CHECK(relief > 1.0, "relief time %g s", relief);
+    CHECK_NEAR(json_metric(json, "relief_open_time"), relief, 1e-9);
+    CHECK(hits[0] >= 1, "lift end-stop hits %ld", hits[0]);
+    CHECK(json_metric(json, "end_stop_hits_lift") == (double)hits[0], "lift hits %g vs %ld",
+          json_metric(json, "end_stop_hits_lift"), hits[0]);
+    CHECK(json_metric(json, "end_stop_hits_jib") == (double)hits[1], "jib hits %g vs %ld",
+          json_metric(json, "end_stop_hits_jib"), hits[1]);
+    // Units on every value; the lagrange backend has no truck.
+    CHECK(strstr(json, "\"peak_p1A\": {\"value\"") && strstr(json, "\"unit\": \"Pa\"") &&
+              strstr(json, "\"unit\": \"s\"") && strstr(json, "\"unit\": \"count\""),
+          "%s", json);
+    CHECK(!strstr(json, "max_truck_tilt") && !strstr(json, "peak_p3A"), "absent metrics written: %s", json);
+    // Rows every 1 ms (10 steps): the chamber peaks are still those of every
+    // step, so at least the rows' and said to be over the steps.
+    snprintf(args, sizeof args, "run --scenario overload --out %s --metrics %s -q", csv, js);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    CHECK(cli_read_file(js, json, sizeof json) > 0, "no %s", js);
+    CHECK(strstr(json, "\"peak_p1A\": {\"value\": ") && strstr(json, "\"unit\": \"Pa\", \"over\": \"steps\"}"),
+          "%s", json);
+    f = fopen(csv, "r");
+    double coarse = -INFINITY;
+    while (f && fgets(line, sizeof line, f))
+        if (line[0] != 't') coarse = fmax(coarse, csv_field(line, pc[0]));
+    if (f) fclose(f);
+    CHECK(json_metric(json, "peak_p1A") >= coarse && coarse > 1e7, "step peak %.17g below the rows' %.17g",
+          json_metric(json, "peak_p1A"), coarse);
+}
+
+static const char* k_grid = "sweep --scenario ramp --duration 2 --param hydraulics.components.lift_cyl.bore=0.08:0.12:3 "
+                            "--param hydraulics.components.jib_cyl.bore=0.07:0.09:2";
+
+// The same grid on 1 and 2 threads: the same file byte for byte, one row
+// per design in index order, and a design's metrics those of `cranesim run`
+// with its values set.
+static void test_sweep_threads_same_file(void) {
+    char args[1024];
+    static char a[1 << 15], b[1 << 15], json[8192];
+    snprintf(args, sizeof args, "%s --threads 1 --out sweep_t1.csv", k_grid);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    snprintf(args, sizeof args, "%s --threads 2 --out sweep_t2.csv", k_grid);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    CHECK(cli_read_file("sweep_t1.csv", a, sizeof a) > 0 && cli_read_file("sweep_t2.csv", b, sizeof b) > 0,
+          "missing results");
+    CHECK(!strcmp(a, b), "1 and 2 threads differ:\n%s\n--\n%s", a, b);
+    CHECK(cli_count_lines(a) == 7, "rows: %s", a);
+    const char* l = a;
+    for (int i = 0; i < 6 && l; ++i) {
+        l = strchr(l, '\n');
+        if (l) ++l;
+        CHECK(l && atoi(l) == i && csv_field(l, csv_col(a, "exit")) == 0, "row %d: %s", i, l ? l : "");
+    }
+    // Design 3: lift bore 0.10 (second of three), jib bore 0.09 (second of two).
+    CHECK(cli_run("run --scenario ramp --duration 2 --set hydraulics.components.lift_cyl.bore=0.1 --set "
+                  "hydraulics.components.jib_cyl.bore=0.09 --out sweep_d3.csv --metrics sweep_d3.json -q",
+                  out, sizeof out) == 0,
+          "%s", out);
+    CHECK(cli_read_file("sweep_d3.json", json, sizeof json) > 0, "no sweep_d3.json");
+    const char* r3 = a;
+    for (int i = 0; i < 4 && r3; ++i) {
+        r3 = strchr(r3, '\n');
+        if (r3) ++r3;
+    }
+    CHECK(r3 && csv_field(r3, 1) == 0.1 && csv_field(r3, 2) == 0.09, "design 3: %s", r3 ? r3 : "");
+    const char* mets[] = {"peak_p1A", "peak_p2B", "peak_p_pump", "relief_open_time", "end_stop_hits_lift"};
+    for (int k = 0; k < 5 && r3; ++k)
+        CHECK(csv_field(r3, csv_col(a, mets[k])) == json_metric(json, mets[k]), "%s: sweep %.17g, run %.17g",
+              mets[k], csv_field(r3, csv_col(a, mets[k])), json_metric(json, mets[k]));
+}
+
+// A design the model refuses (a bore <= 0) is a row with exit 2 and the
+// model's message, one that blows up a row with exit 1; the others run and
+// the sweep exits 0. --fail-fast stops
+// with exit 1.
+static void test_sweep_failing_design_is_a_row(void) {
+    static char a[1 << 15];
+    const char* base = "sweep --scenario ramp --duration 1 --param hydraulics.components.lift_cyl.bore=-0.1:0.1:3 "
+                       "--metrics peak_p1A --threads 2";
+    char args[1024];
+    snprintf(args, sizeof args, "%s --out sweep_fail.csv", base);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    CHECK(cli_read_file("sweep_fail.csv", a, sizeof a) > 0, "no file");
+    CHECK(cli_count_lines(a) == 4, "%s", a);
+    CHECK(strstr(a, "\n0,-0.10000000000000001,,2,\"") && strstr(a, "must be > 0"), "%s", a);
+    CHECK(strstr(a, "\n1,0,,2,\""), "%s", a);
+    CHECK(strstr(a, "\n2,0.10000000000000001,") && strstr(a, ",0,\n"), "%s", a);
+    // A blow-up: ROS2 at 5 ms is stable on the soft oil (0.1 GPa) and not on
+    // the stiff one (1 GPa) of the step scenario's valve steps: exit 1, the
+    // run's message, no metrics; the sweep still exits 0.
+    CHECK(cli_run("sweep --scenario step --duration 2 --solver ros2 --dt 5e-3 --metrics peak_p1A "
+                  "--param hydraulics.fluid.bulk_modulus=1e8:1e9:2 --out sweep_blowup.csv",
+                  out, sizeof out) == 0,
+          "%s", out);
+    CHECK(cli_read_file("sweep_blowup.csv", a, sizeof a) > 0 && cli_count_lines(a) == 3, "%s", a);
+    CHECK(strstr(a, "\n0,100000000,") && strstr(a, ",0,\n1,1000000000,,1,\"numerical blow-up"), "%s", a);
+    snprintf(args, sizeof args, "%s --threads 1 --fail-fast --out sweep_ff.csv", base);
+    CHECK(cli_run(args, out, sizeof out) == 1 && strstr(out, "--fail-fast"), "%s", out);
+    CHECK(cli_read_file("sweep_ff.csv", a, sizeof a) > 0 && cli_count_lines(a) == 2, "%s", a);
+}
+
+// Bad input: one line naming the problem, exit 2, no results file.
+static void test_sweep_bad_input(void) {
+    static const struct {
+        const char* args;
+        const char* says;
+    } cases[] = {
+        {"--param hydraulics.components.lift_cyl.boar=0.08:0.12:3", "boar"},
+        {"--param hydraulics.components.nope.bore=0.08:0.12:3", "nope"},
+        {"--param hydraulics.components.lift_cyl.bore=0.12:0.08:3", "above HI"},
+        {"--param hydraulics.components.lift_cyl.bore=0.08:0.12:0", "N must be"},
+        {"--param hydraulics.components.lift_cyl.bore=0.08:0.12", "PATH=LO:HI:N"},
+        {"--param hydraulics.components.lift_cyl.bore=0.08:0.12:3 --metrics peak_p1A,wobble", "wobble"},
+        {"--param hydraulics.components.lift_cyl.bore=0.08:0.12:3 --metrics peak_p3A", "peak_p3A"},
+        {"--param hydraulics.components.lift_cyl.bore=0.08:0.12:3 --threads 0", "--threads"},
+        {"--lhs 4 --param hydraulics.components.lift_cyl.bore=0.08:0.12:3", "--lhs"},
+        {"--param hydraulics.components.name=1:2:2", "name"},
+        {"", "--param"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        unlink("sweep_bad.csv");
+        char args[1024];
+        snprintf(args, sizeof args, "sweep --scenario ramp --duration 1 %s --out sweep_bad.csv", cases[k].args);
+        const int rc = cli_run(args, out, sizeof out);
+        CHECK(rc == 2 && strstr(out, cases[k].says) && cli_count_lines(out) == 1, "%s: rc %d: %s", cases[k].args,
+              rc, out);
+        CHECK(access("sweep_bad.csv", F_OK) != 0, "%s: a results file was written", cases[k].args);
+    }
+}
+
+// A Latin hypercube: each parameter's N strata used once each, and the
+// same seed gives the same file.
+static void test_sweep_lhs_strata(void) {
+    static char a[1 << 15], b[1 << 15];
+    const char* base = "sweep --scenario ramp --duration 0.5 --lhs 8 --seed 7 --metrics peak_p1A "
+                       "--param hydraulics.components.lift_cyl.bore=0.08:0.12 "
+                       "--param hydraulics.components.jib_cyl.bore=0.06:0.1";
+    char args[1024];
+    snprintf(args, sizeof args, "%s --threads 2 --out sweep_lhs1.csv", base);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    snprintf(args, sizeof args, "%s --threads 1 --out sweep_lhs2.csv", base);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    CHECK(cli_read_file("sweep_lhs1.csv", a, sizeof a) > 0 && cli_read_file("sweep_lhs2.csv", b, sizeof b) > 0,
+          "no file");
+    CHECK(!strcmp(a, b), "same seed, different files");
+    const double lo[2] = {0.08, 0.06}, hi[2] = {0.12, 0.1};
+    for (int p = 0; p < 2; ++p) {
+        int used[8] = {0};
+        const char* l = a;
+        for (int i = 0; i < 8 && l; ++i) {
+            l = strchr(l, '\n');
+            if (!l) break;
+            ++l;
+            const double v = csv_field(l, 1 + p);
+            const int s = (int)floor((v - lo[p]) / (hi[p] - lo[p]) * 8);
+            CHECK(s >= 0 && s < 8, "value %g outside [%g, %g]", v, lo[p], hi[p]);
+            if (s >= 0 && s < 8) ++used[s];
+        }
+        for (int s = 0; s < 8; ++s) CHECK(used[s] == 1, "parameter %d stratum %d used %d times", p, s, used[s]);
+    }
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_metrics_match_csv);
+    RUN_TEST(test_sweep_threads_same_file);
+    RUN_TEST(test_sweep_failing_design_is_a_row);
+    RUN_TEST(test_sweep_bad_input);
+    RUN_TEST(test_sweep_lhs_strata);
+    TEST_MAIN_END();
+}
