@@ -22,22 +22,23 @@
 // How a panel parameter reaches the simulation.
 typedef enum param_kind {
     PK_HYD,  ///< a circuit parameter: hyd_model_set on the live circuit, at once
-    PK_MECH, ///< a mechanical parameter: live for lagrange, a rebuilt world for ode
-    PK_LOAD, ///< the tip load (lagrange) [kg]
+    PK_MECH, ///< a mechanical parameter: live where the engine can set it, else a rebuilt world
+    PK_LOAD, ///< the tip load, where the engine can set it live [kg]
     PK_SOLVER, ///< hydraulic integrator, an index into k_solver (a rebuilt world/solver at the current pose)
     PK_STEP,   ///< hydraulic step [s] (rebuilt likewise)
 } param_kind;
 
-#define MAX_PARAMS 40
-
+// One panel entry, generated from the parameter tables (build_params).
 typedef struct drive_param {
     param_kind kind;
-    char group[32], label[32], unit[12];
+    char group[64], label[48], unit[16];
     double value;      ///< shown value, display units (edited by the panel)
     double scale;      ///< SI value = value * scale
-    double min, max;   ///< display units
-    char hyd_path[64]; ///< PK_HYD: "lift_cyl.bore", "fluid.bulk_modulus"
-    char json[128];    ///< path in the model file, for saving
+    double min, max;   ///< hard range, display units: a typed value outside it is refused
+    double tmin, tmax; ///< typical range, display units: what a drag covers
+    char hyd_path[96]; ///< PK_HYD: "lift_cyl.bore", "fluid.bulk_modulus"
+    char json[160];    ///< path in the model file, for saving
+    int mech;          ///< PK_MECH, PK_LOAD: entry of the mechanics table (model_param_info)
     bool on_release;   ///< applied when the edit ends: it rebuilds the world
     bool world_only;   ///< PK_HYD of the world's circuit, not the model's (not saved)
 } drive_param;
@@ -57,9 +58,13 @@ struct drive_session {
     input* in;
     panel* pn;
     world_snapshot* snap; // large: heap
-    drive_param param[MAX_PARAMS];
-    int nparam;
-    int pid[MAX_PARAMS]; // panel ids
+    drive_param* param;  // the panel's entries (build_params)
+    int nparam, capparam;
+    int* pid;            // their panel ids
+    struct {
+        int i;
+        double v;
+    } * changed;         // (capparam) the entries a tick changes, and their new values
     bool paused, rebuild;
     char rebuild_why[160]; // the change that asked for the rebuild
     sim_opts sim_live;     // the options the running world was built with
@@ -105,44 +110,92 @@ drive_opts drive_default_opts(void) {
     return o;
 }
 
-static void add_param(drive_session* s, param_kind k, const char* group, const char* label, const char* unit,
-                      double scale, double min, double max, const char* hyd_path, const char* json, double si) {
-    if (s->nparam == MAX_PARAMS) return;
+// Display units: what an operator reads (MPa, L/min, mm) for the SI unit a
+// table gives, one scale per unit (SI value = shown value * scale).
+static const struct {
+    const char *si, *shown;
+    double scale;
+} k_units[] = {
+    {"Pa", "MPa", 1e6},         {"m^3/s", "L/min", 1.0 / 60000.0}, {"m", "mm", 1e-3},
+    {"m^3", "L", 1e-3},         {"m^2", "mm^2", 1e-6},              {"s", "ms", 1e-3},
+    {"N s/m", "kN s/m", 1e3},   {"N/m", "kN/m", 1e3},
+};
+
+static double display_unit(const char* si, char* shown, size_t n) {
+    for (size_t k = 0; k < sizeof k_units / sizeof k_units[0]; ++k)
+        if (!strcmp(si, k_units[k].si)) {
+            snprintf(shown, n, "%s", k_units[k].shown);
+            return k_units[k].scale;
+        }
+    snprintf(shown, n, "%s", strcmp(si, "-") ? si : "");
+    return 1.0;
+}
+
+static drive_param* new_param(drive_session* s) {
+    if (s->nparam == s->capparam) {
+        const int nc = s->capparam ? 2 * s->capparam : 64;
+        drive_param* np = realloc(s->param, (size_t)nc * sizeof *np);
+        int* ni = realloc(s->pid, (size_t)nc * sizeof *ni);
+        if (ni) s->pid = ni;
+        void* nch = realloc(s->changed, (size_t)nc * sizeof *s->changed);
+        if (nch) s->changed = nch;
+        if (!np || !ni || !nch) {
+            if (np) s->param = np;
+            return NULL;
+        }
+        s->param = np;
+        s->capparam = nc;
+    }
     drive_param* p = &s->param[s->nparam++];
+    memset(p, 0, sizeof *p);
+    p->mech = -1;
+    return p;
+}
+
+// An entry with SI unit si, hard range [lo, hi] and typical range [tlo,
+// thi] in that unit, at SI value v.
+static drive_param* add_param(drive_session* s, param_kind k, const char* group, const char* label, const char* si,
+                              double lo, double hi, double tlo, double thi, double v) {
+    drive_param* p = new_param(s);
+    if (!p) return NULL;
     p->kind = k;
     snprintf(p->group, sizeof p->group, "%s", group);
     snprintf(p->label, sizeof p->label, "%s", label);
-    snprintf(p->unit, sizeof p->unit, "%s", unit);
-    p->scale = scale;
-    p->min = min;
-    p->max = max;
-    snprintf(p->hyd_path, sizeof p->hyd_path, "%s", hyd_path ? hyd_path : "");
-    snprintf(p->json, sizeof p->json, "%s", json ? json : "");
-    p->value = si / scale;
+    p->scale = display_unit(si, p->unit, sizeof p->unit);
+    p->min = lo / p->scale;
+    p->max = hi / p->scale;
+    p->tmin = tlo / p->scale;
+    p->tmax = thi / p->scale;
+    p->value = v / p->scale;
+    // A value outside the hard range (a world file's, or one loaded with a
+    // note) must still be shown: the range stretches to it.
+    if (p->value < p->min) p->min = p->value;
+    if (p->value > p->max) p->max = p->value;
+    return p;
 }
 
-// A circuit parameter whose current value is read from the model.
-static void add_hyd(drive_session* s, const char* group, const char* label, const char* unit, double scale,
-                    double min, double max, const char* comp, const char* field) {
-    char hp[64], jp[128];
-    double v;
-    if (!strcmp(comp, "fluid")) {
-        snprintf(hp, sizeof hp, "fluid.%s", field);
-        snprintf(jp, sizeof jp, "hydraulics.fluid.%s", field);
-    } else {
-        snprintf(hp, sizeof hp, "%s.%s", comp, field);
-        snprintf(jp, sizeof jp, "hydraulics.components.%s.%s", comp, field);
-    }
-    if (hyd_model_get(s->m->hyd, hp, &v) == 0) {
-        add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, jp, v);
-        return;
-    }
-    // A component of the world's own circuit (the sandbox's slew valve): it
-    // lives in the world file, not the model, so it is set on the running
-    // circuit only (and again after a rebuild); "save model" does not save it.
-    if (hyd_model_get(engine_circuit(s->l), hp, &v) == 0) {
-        add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, NULL, v);
-        s->param[s->nparam - 1].world_only = true;
+// Every parameter of one circuit element (its type's table), read from the
+// running circuit. An element of the model's circuit is saved under its path
+// in the model file; one of the world's own circuit (the sandbox's slew
+// valve) lives in the world file: set on the running circuit only (and again
+// after a rebuild), not saved.
+static void add_element(drive_session* s, const hyd_model* live, const char* name, hyd_type t) {
+    char group[64];
+    snprintf(group, sizeof group, "%s (%s)", name, hyd_type_name(t));
+    const int is_node = t == HYD_TANK || t == HYD_VOLUME;
+    for (int k = 0; k < hyd_param_count(t); ++k) {
+        double lo, hi, tlo, thi, v;
+        char hp[96];
+        snprintf(hp, sizeof hp, "%s.%s", name, hyd_param_name(t, k));
+        if (hyd_param_range(t, k, &lo, &hi, &tlo, &thi) || hyd_model_get(live, hp, &v)) continue;
+        drive_param* p = add_param(s, PK_HYD, group, hyd_param_name(t, k), hyd_param_unit(t, k), lo, hi, tlo, thi, v);
+        if (!p) return;
+        snprintf(p->hyd_path, sizeof p->hyd_path, "%s", hp);
+        double mv;
+        if (hyd_model_get(s->m->hyd, hp, &mv) == 0)
+            snprintf(p->json, sizeof p->json, "hydraulics.%s.%s", is_node ? "nodes" : "components", hp);
+        else
+            p->world_only = true;
     }
 }
 
@@ -156,93 +209,111 @@ static void reapply_world_params(drive_session* s) {
     }
 }
 
+// The group header of a mechanics table entry: the link's or actuator's name.
+static void mech_group(const crane_mech* me, const model_param* mp, char* out, size_t n) {
+    int k = 0;
+    if (sscanf(mp->group, "links[%d]", &k) == 1 && k >= 0 && k < 2)
+        snprintf(out, n, "%s (link)", me->link[k].name);
+    else if (sscanf(mp->group, "actuators[%d]", &k) == 1 && k >= 0 && k < 2)
+        snprintf(out, n, "%s (actuator)", me->act[k].name);
+    else
+        snprintf(out, n, "%s", mp->group);
+}
+
+// The panel's list, generated from the tables: every element of the running
+// circuit with its type's parameters, the fluid, the mechanics table and the
+// run's own settings (solver). No component name is known here.
 static void build_params(drive_session* s) {
-    const crane_mech* me = &s->m->mech;
-    add_param(s, PK_MECH, "booms", "lifting arm mass", "kg", 1, 20, 2000, NULL, "mechanics.links[0].mass",
-              me->link[0].mass);
-    add_param(s, PK_MECH, "booms", "end arm mass", "kg", 1, 20, 2000, NULL, "mechanics.links[1].mass",
-              me->link[1].mass);
-    add_param(s, PK_MECH, "booms", "lifting arm length", "m", 1, 1.0, 5.0, NULL, "mechanics.links[0].length",
-              me->link[0].length);
-    add_param(s, PK_MECH, "booms", "end arm length", "m", 1, 1.0, 5.0, NULL, "mechanics.links[1].length",
-              me->link[1].length);
-    if (engine_can_set_load(s->l))
-        add_param(s, PK_LOAD, "load", "tip load", "kg", 1, 0, 5000, NULL, "mechanics.load_mass",
-                  sim_load_mass(s->m, &s->sc, &s->c.sim));
-    static const char* const cyl[2] = {"lift_cyl", "jib_cyl"};
-    static const char* const grp[2] = {"lift cylinder", "jib cylinder"};
-    for (int k = 0; k < 2; ++k) {
-        add_hyd(s, grp[k], "bore", "mm", 1e-3, 40, 200, cyl[k], "bore");
-        add_hyd(s, grp[k], "rod", "mm", 1e-3, 20, 150, cyl[k], "rod");
-        add_hyd(s, grp[k], "friction", "kN s/m", 1e3, 0, 100, cyl[k], "friction");
+    s->nparam = 0;
+    const hyd_model* live = engine_circuit(s->l);
+    for (int i = 0; i < hyd_model_nelement(live); ++i) {
+        hyd_type t;
+        const char* name = hyd_model_element(live, i, &t);
+        add_element(s, live, name, t);
     }
-    static const char* const val[3] = {"lift_valve", "jib_valve", "slew_valve"};
-    static const char* const vgrp[3] = {"lift valve", "jib valve", "slew valve"};
-    for (int k = 0; k < 3; ++k) {
-        add_hyd(s, vgrp[k], "rated flow", "L/min", 1.0 / 60000.0, 5, 200, val[k], "q_nominal");
-        add_hyd(s, vgrp[k], "spool time constant", "ms", 1e-3, 1, 500, val[k], "tau");
+    for (int k = 0; k < hyd_fluid_param_count(); ++k) {
+        double lo, hi, tlo, thi, v;
+        char hp[96];
+        snprintf(hp, sizeof hp, "fluid.%s", hyd_fluid_param_name(k));
+        if (hyd_fluid_param_range(k, &lo, &hi, &tlo, &thi) || hyd_model_get(live, hp, &v)) continue;
+        drive_param* p = add_param(s, PK_HYD, "fluid", hyd_fluid_param_name(k), hyd_fluid_param_unit(k), lo, hi, tlo,
+                                   thi, v);
+        if (!p) return;
+        snprintf(p->hyd_path, sizeof p->hyd_path, "%s", hp);
+        snprintf(p->json, sizeof p->json, "hydraulics.%s", hp);
     }
-    add_hyd(s, "supply", "pump pressure", "MPa", 1e6, 2, 35, "pump", "p_set");
-    add_hyd(s, "supply", "pump max flow", "L/min", 1.0 / 60000.0, 5, 200, "pump", "q_max");
-    add_hyd(s, "reliefs", "main relief", "MPa", 1e6, 2, 40, "main_relief", "p_crack");
-    add_hyd(s, "reliefs", "lift port A", "MPa", 1e6, 2, 40, "lift_relief_A", "p_crack");
-    add_hyd(s, "reliefs", "lift port B", "MPa", 1e6, 2, 40, "lift_relief_B", "p_crack");
-    add_hyd(s, "reliefs", "jib port A", "MPa", 1e6, 2, 40, "jib_relief_A", "p_crack");
-    add_hyd(s, "reliefs", "jib port B", "MPa", 1e6, 2, 40, "jib_relief_B", "p_crack");
-    add_hyd(s, "reliefs", "slew port A", "MPa", 1e6, 2, 40, "slew_relief_A", "p_crack");
-    add_hyd(s, "reliefs", "slew port B", "MPa", 1e6, 2, 40, "slew_relief_B", "p_crack");
-    add_hyd(s, "oil", "bulk modulus", "GPa", 1e9, 0.2, 2.5, "fluid", "bulk_modulus");
-    add_hyd(s, "oil", "density", "kg/m3", 1, 700, 1000, "fluid", "density");
+    crane_mech* me = &s->m->mech;
+    for (int k = 0; k < model_param_count(); ++k) {
+        model_param mp;
+        model_param_info(k, &mp);
+        char group[64];
+        mech_group(me, &mp, group, sizeof group);
+        const bool load = !strcmp(mp.path, "mechanics.load_mass");
+        // The tip load drives with the scenario's or --load's value where the
+        // engine takes it live; elsewhere it is the model's field.
+        const double v = load && engine_can_set_load(s->l) ? sim_load_mass(s->m, &s->sc, &s->c.sim)
+                                                           : *model_param_ptr(me, k);
+        drive_param* p = add_param(s, load && engine_can_set_load(s->l) ? PK_LOAD : PK_MECH, group, mp.name, mp.unit,
+                                   mp.lo, mp.hi, mp.tlo, mp.thi, v);
+        if (!p) return;
+        p->mech = k;
+        snprintf(p->json, sizeof p->json, "%s", mp.path);
+    }
     int method = 0;
     for (int k = 0; k < NSOLVER; ++k)
         if (k_solver[k] == s->c.sim.solver) method = k;
-    add_param(s, PK_SOLVER, "solver", "method", "", 1, 0, NSOLVER - 1, NULL, NULL, method);
-    add_param(s, PK_STEP, "solver", "step", "ms", 1e-3, 0.05, 1.0, NULL, NULL, s->c.sim.h);
+    drive_param* p = add_param(s, PK_SOLVER, "solver", "method", "-", 0, NSOLVER - 1, 0, NSOLVER - 1, method);
+    if (p) p->scale = 1, p->unit[0] = 0;
+    add_param(s, PK_STEP, "solver", "step", "s", 0.05e-3, 1e-3, 0.05e-3, 1e-3, s->c.sim.h);
     // What cannot change in place rebuilds the world (loads back at their
     // start): applied once when the drag or the typing ends, not at every
-    // pixel. Masses and inertias change in place (engine_set_link); a length
-    // only where the engine can resize a boom (not the ode world's bodies).
-    // A tip load merged into the end arm (the ode validation world's: no
-    // load parameter, no load bodies) moves the end arm's centre of mass
-    // with its mass: a rebuild too.
+    // pixel. A link's mass, inertia and centre of mass go to engine_set_link
+    // (in place where the engine can); a length only where the engine can
+    // resize a boom (not the ode world's bodies). A tip load merged into the
+    // end arm (the ode validation world's: no load parameter, no load bodies)
+    // moves the end arm's centre of mass with its mass: a rebuild too. Every
+    // other mechanical value (gravity, column, mounts, sections) rebuilds.
     const bool resize = engine_can_resize_links(s->l);
     const bool tip_load = !engine_can_set_load(s->l) && !engine_load_name(s->l, 0, NULL) &&
                           sim_load_mass(s->m, &s->sc, &s->c.sim) > 0;
     for (int i = 0; i < s->nparam; ++i) {
-        drive_param* p = &s->param[i];
-        const bool mech = p->kind == PK_MECH;
-        p->on_release = p->kind == PK_STEP || p->kind == PK_SOLVER || (mech && !resize && strstr(p->json, ".length")) ||
-                        (mech && tip_load && strstr(p->json, "links[1].mass"));
+        drive_param* q = &s->param[i];
+        if (q->kind == PK_STEP || q->kind == PK_SOLVER) q->on_release = true;
+        if (q->kind != PK_MECH) continue;
+        const bool link = !strncmp(q->json, "mechanics.links[", 16);
+        const bool live_field = link && (strstr(q->json, ".mass") || strstr(q->json, ".inertia") ||
+                                         strstr(q->json, ".com") || (resize && strstr(q->json, ".length")));
+        q->on_release = !live_field || (tip_load && strstr(q->json, "links[1].mass"));
     }
 }
 
 // Keep the model document in step with a changed parameter, so "save model"
 // writes what is being driven.
 static void sync_json(drive_session* s, const drive_param* p) {
-    if (!p->json[0]) return;
-    char a[200], e[200];
+    if (!p->json[0] || p->kind == PK_SOLVER || p->kind == PK_STEP) return;
+    char a[240], e[200];
     snprintf(a, sizeof a, "%s=%.10g", p->json, p->value * p->scale);
     json_set_path(s->m->json, a, e, sizeof e);
 }
 
-// A panel's mechanical value from the mechanics: the field its JSON path
-// names ("mechanics.links[1].length").
-static double mech_value(const crane_mech* me, const char* json) {
-    const crane_link* ln = &me->link[strstr(json, "links[1]") ? 1 : 0];
-    return strstr(json, ".length") ? ln->length : ln->mass;
+// The model document's mechanics as the model has them (after an edit that
+// scaled other fields, or a revert).
+static void sync_mech_json(drive_session* s) {
+    for (int k = 0; k < model_param_count(); ++k) {
+        model_param mp;
+        model_param_info(k, &mp);
+        char a[240], e[200];
+        snprintf(a, sizeof a, "%s=%.10g", mp.path, *model_param_ptr(&s->m->mech, k));
+        json_set_path(s->m->json, a, e, sizeof e);
+    }
 }
 
-// The model document's links as the mechanics have them (after a revert).
-static void sync_mech_json(drive_session* s) {
-    static const char* const field[] = {"mass", "length", "com", "inertia"};
-    for (int k = 0; k < 2; ++k) {
-        const crane_link* ln = &s->m->mech.link[k];
-        const double v[] = {ln->mass, ln->length, ln->com, ln->inertia};
-        for (int j = 0; j < 4; ++j) {
-            char a[160], e[200];
-            snprintf(a, sizeof a, "mechanics.links[%d].%s=%.10g", k, field[j], v[j]);
-            json_set_path(s->m->json, a, e, sizeof e);
-        }
+// Panel values of the mechanics from the model (after an edit moved other
+// fields with it, or a revert).
+static void refresh_mech_params(drive_session* s) {
+    for (int i = 0; i < s->nparam; ++i) {
+        drive_param* p = &s->param[i];
+        if (p->kind == PK_MECH) p->value = *model_param_ptr(&s->m->mech, p->mech) / p->scale;
     }
 }
 
@@ -272,32 +343,40 @@ static void apply_param(drive_session* s, int i) {
         }
         break;
     case PK_MECH: {
-        // Only the edited link changes, and it keeps its own mass
-        // distribution: a new mass scales its inertia, a new length scales
-        // its centre of mass and (squared) its inertia. The model file's com
-        // and inertia follow, so "save model" saves what is being driven.
         crane_mech* me = &s->m->mech;
-        const int k = strstr(p->json, "links[1]") ? 1 : 0;
-        crane_link* ln = &me->link[k];
-        if (strstr(p->json, ".mass") && ln->mass > 0) {
-            ln->inertia *= si / ln->mass;
-            ln->mass = si;
-        } else if (strstr(p->json, ".length") && ln->length > 0) {
-            const double r = si / ln->length;
-            ln->com *= r;
-            ln->inertia *= r * r;
-            ln->length = si;
-        }
-        crane_mech_derive(me);
-        // In place where the backend can (the lagrange crane; an ode boom's
-        // mass and inertia), else one rebuild at the current pose.
-        if (engine_set_link(s->l, k, ln)) {
+        double* f = model_param_ptr(me, p->mech);
+        int k = -1;
+        if (sscanf(p->json, "mechanics.links[%d]", &k) == 1 && k >= 0 && k < 2) {
+            // Only the edited link changes, and it keeps its own mass
+            // distribution: a new mass scales its inertia, a new length
+            // scales its centre of mass and (squared) its inertia.
+            crane_link* ln = &me->link[k];
+            if (f == &ln->mass && ln->mass > 0) ln->inertia *= si / ln->mass;
+            if (f == &ln->length && ln->length > 0) {
+                const double r = si / ln->length;
+                ln->com *= r;
+                ln->inertia *= r * r;
+            }
+            *f = si;
+            crane_mech_derive(me);
+            // In place where the backend can (the lagrange crane; an ode
+            // boom's mass and inertia), else one rebuild at the current pose.
+            if (f == &ln->width || f == &ln->height || engine_set_link(s->l, k, ln)) {
+                s->rebuild = true;
+                snprintf(s->rebuild_why, sizeof s->rebuild_why, "%s/%s", p->group, p->label);
+            } else {
+                s->mech_live.link[k] = *ln; // the running world has it now
+            }
+        } else {
+            *f = si;
+            crane_mech_derive(me);
             s->rebuild = true;
             snprintf(s->rebuild_why, sizeof s->rebuild_why, "%s/%s", p->group, p->label);
-        } else {
-            s->mech_live.link[k] = *ln; // the running world has it now
         }
+        // The model file's fields that moved with it follow, so "save
+        // model" saves what is being driven; the panel shows them.
         sync_mech_json(s);
+        refresh_mech_params(s);
         break;
     }
     case PK_LOAD:
@@ -309,7 +388,6 @@ static void apply_param(drive_session* s, int i) {
         s->c.sim.solver = k_solver[k >= 0 && k < NSOLVER ? k : 0];
         s->rebuild = true;
         snprintf(s->rebuild_why, sizeof s->rebuild_why, "solver %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
-        sync_json(s, p);
         snprintf(s->status, sizeof s->status, "solver/method = %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
         return;
     }
@@ -352,9 +430,9 @@ static void rebuild_world(drive_session* s, bool at_start) {
         // unasked with the next rebuild.
         s->m->mech = s->mech_live;
         sync_mech_json(s);
+        refresh_mech_params(s);
         for (int i = 0; i < s->nparam; ++i) {
             drive_param* p = &s->param[i];
-            if (p->kind == PK_MECH) p->value = mech_value(&s->m->mech, p->json) / p->scale;
             if (p->kind == PK_STEP) p->value = s->c.sim.h / p->scale;
             if (p->kind == PK_SOLVER)
                 for (int k = 0; k < NSOLVER; ++k)
@@ -676,6 +754,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         s->pid[i] = p->kind == PK_SOLVER
                         ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
                         : panel_add_param(s->pn, &d);
+        if (p->kind != PK_SOLVER) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
     }
     panel_add_action(s->pn, "reset run", act_reset, s);
     panel_add_action(s->pn, "save model", act_save, s);
@@ -725,6 +804,9 @@ void drive_session_destroy(drive_session* s) {
     if (s->r) render_destroy(s->r);
     engine_destroy(s->l);
     model_free(s->m);
+    free(s->param);
+    free(s->pid);
+    free(s->changed);
     free(s->snap);
     free(s);
 }
@@ -803,9 +885,20 @@ int drive_session_tick(drive_session* s, double wall) {
         if (render_save_png(s->r, path, e, sizeof e)) snprintf(s->status, sizeof s->status, "screenshot failed: %s", e);
         else snprintf(s->status, sizeof s->status, "saved %s", path);
     }
+    // Every change of this tick first, then applied one by one: applying one
+    // refreshes the mechanics entries it moves (a length scales its link's
+    // centre of mass), which must not undo another entry's new value.
+    int nchanged = 0;
     for (int id; (id = panel_next_changed(s->pn)) >= 0;)
         for (int i = 0; i < s->nparam; ++i)
-            if (s->pid[i] == id) apply_param(s, i);
+            if (s->pid[i] == id) {
+                s->changed[nchanged].i = i;
+                s->changed[nchanged++].v = s->param[i].value;
+            }
+    for (int k = 0; k < nchanged; ++k) {
+        s->param[s->changed[k].i].value = s->changed[k].v;
+        apply_param(s, s->changed[k].i);
+    }
     if (s->rebuild) {
         s->rebuild = false;
         const double t_at = s->t_base + engine_time(s->l);
