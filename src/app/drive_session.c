@@ -10,6 +10,7 @@
 
 #include <SDL2/SDL.h>
 
+#include "channels.h"
 #include "input.h"
 #include "json_util.h"
 #include "panel.h"
@@ -66,6 +67,8 @@ struct drive_session {
         double v;
     } * changed;         // (capparam) the entries a tick changes, and their new values
     bool paused, rebuild;
+    bool load_pending;     // "load model" was pressed: load s->load_path at the next tick
+    char load_path[256];   // the panel's model file box
     char rebuild_why[160]; // the change that asked for the rebuild
     sim_opts sim_live;     // the options the running world was built with
     crane_mech mech_live;  // the mechanics the running world has (built with, or set in place since)
@@ -90,8 +93,11 @@ struct drive_session {
     char rec_err[320];   // first recording failure ("cannot write FILE: ..."), "" if none
     int ncol;
     int ev;              // next scripted hook event
+    chan_list* chans;    // the engine's channels: its row, then its circuit's (channels.h)
+    double* chan_v;      // (chan_list_count) their values at the last charted frame
+    bool chart_circuit;  // a chart shows a circuit channel: evaluate them per frame
     int nchart;          // user-chosen strip-chart channels (0: the default set)
-    int chart_col[8];    // their CSV columns
+    int chart_col[8];    // their channels (index into chans)
     int chart_id[8];     // their render chart ids
     int missed_window;   // missed ticks in the current second
     double missed_t0;
@@ -454,6 +460,13 @@ static void rebuild_world(drive_session* s, bool at_start) {
     ++s->segment;
     engine_destroy(s->l);
     s->l = l;
+    // The same circuit, so the same channels in the same order (the charts
+    // keep their indices); the list reads the new engine.
+    chan_list* cl = chan_list_create(l);
+    if (cl) {
+        chan_list_free(s->chans);
+        s->chans = cl;
+    }
     reapply_world_params(s);
     s->sim_offset = s->wall_last; // the new world's clock starts at 0 now
     if (at_start) {
@@ -464,10 +477,13 @@ static void rebuild_world(drive_session* s, bool at_start) {
     }
 }
 
-// Strip-chart channel list: CSV column names (not t), comma-separated, 1 to 8
-// of them, among the first ncol columns. Fills col[] and returns the count,
-// or -1 with a one-line message.
-static int parse_charts(const char* list, int ncol, int col[8], char* err, size_t errsz) {
+// Strip-chart channel list: channel names (not t), comma-separated, 1 to 8
+// of them: the engine's columns (among the first ncol) and, when cl is not
+// NULL, its circuit's channels ("lift_cyl.A.p"). Without cl a name with a
+// dot is taken as a circuit channel, checked when the session has its
+// circuit. Fills col[] (indices into cl, or columns; -1 for a deferred name)
+// and returns the count, or -1 with a one-line message.
+static int parse_charts(const char* list, int ncol, const chan_list* cl, int col[8], char* err, size_t errsz) {
     int n = 0;
     for (const char* p = list;; ++p) {
         const char* e = strchr(p, ',');
@@ -477,11 +493,17 @@ static int parse_charts(const char* list, int ncol, int col[8], char* err, size_
             return -1;
         }
         int c = -1;
-        for (int k = 1; k < ncol; ++k)
-            if (strlen(sim_col_name[k]) == len && !strncmp(p, sim_col_name[k], len)) c = k;
-        if (c < 0) {
-            snprintf(err, errsz, "--charts: no column '%.*s'%s (see cranesim run --help for the names)", (int)len, p,
-                     ncol < SIM_NCOL ? " in the lagrange view" : "");
+        const int nch = cl ? chan_list_count(cl) : ncol;
+        for (int k = 1; k < nch; ++k) {
+            const char* nm = cl ? chan_list_channel(cl, k)->name : sim_col_name[k];
+            if (k >= ncol && k < chan_list_nrow(cl)) continue; // a world column the engine does not write
+            if (strlen(nm) == len && !strncmp(p, nm, len)) c = k;
+        }
+        const bool deferred = !cl && memchr(p, '.', len);
+        if (c < 0 && !deferred) {
+            snprintf(err, errsz, "--charts: no %s '%.*s'%s (see cranesim run --help for the names)",
+                     memchr(p, '.', len) ? "circuit channel" : "column", (int)len, p,
+                     ncol < SIM_NCOL && !memchr(p, '.', len) ? " in the lagrange view" : "");
             return -1;
         }
         if (n == 8) {
@@ -504,7 +526,7 @@ int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t
     }
     if (o->charts) {
         int col[8];
-        if (parse_charts(o->charts, sim_ncol(&c->sim), col, err, errsz) < 0)
+        if (parse_charts(o->charts, sim_ncol(&c->sim), NULL, col, err, errsz) < 0)
             return EXIT_USAGE;
     }
     if (o->mapping_file) {
@@ -521,17 +543,20 @@ static int setup_charts(drive_session* s, const char* list, char* err, size_t er
                                         {0.5f, 0.9f, 0.4f, 1},   {0.8f, 0.5f, 0.95f, 1},  {0.95f, 0.6f, 0.2f, 1},
                                         {0.6f, 0.9f, 0.9f, 1},   {0.9f, 0.9f, 0.9f, 1}};
     int cols[8];
-    const int n = parse_charts(list, s->ncol, cols, err, errsz);
+    const int n = parse_charts(list, s->ncol, s->chans, cols, err, errsz);
     if (n < 0) return -1;
     for (int i = 0; i < n; ++i) {
         const int col = cols[i];
-        const char* u = sim_col_unit[col];
-        render_chart_def d = {.label = sim_col_name[col], .unit = u, .scale = 1, .ymin = -1, .ymax = 1, .group = 5};
+        const sim_channel* ch = chan_list_channel(s->chans, col);
+        const char* u = ch->unit;
+        render_chart_def d = {.label = ch->name, .unit = u, .scale = 1, .ymin = -1, .ymax = 1, .group = 5};
         if (!strcmp(u, "Pa")) d.unit = "MPa", d.scale = 1e-6, d.ymin = 0, d.ymax = 30, d.group = 0;
         else if (!strcmp(u, "m")) d.unit = "mm", d.scale = 1e3, d.ymin = -5000, d.ymax = 5000, d.group = 1;
         else if (!strcmp(u, "-")) d.unit = "%", d.scale = 100, d.ymin = -100, d.ymax = 100, d.group = 2;
         else if (!strcmp(u, "rad")) d.unit = "deg", d.scale = 180 / M_PI, d.ymin = -180, d.ymax = 180, d.group = 3;
         else if (!strcmp(u, "N")) d.unit = "kN", d.scale = 1e-3, d.ymin = -200, d.ymax = 200, d.group = 4;
+        else if (!strcmp(u, "m^3/s")) d.unit = "L/min", d.scale = 60000, d.ymin = -50, d.ymax = 50, d.group = 6;
+        if (col >= chan_list_nrow(s->chans)) s->chart_circuit = true;
         if (col == COL_X1 || col == COL_X2) d.ymin = 0, d.ymax = 700;
         memcpy(d.rgba, colours[s->nchart], sizeof d.rgba);
         s->chart_col[s->nchart] = col;
@@ -539,6 +564,95 @@ static int setup_charts(drive_session* s, const char* list, char* err, size_t er
         ++s->nchart;
     }
     return 0;
+}
+
+static void act_load(void* user) {
+    drive_session* s = user;
+    s->load_pending = true; // at the next tick: not from inside the panel's own drawing
+}
+
+static void act_reset(void* user);
+static void act_save(void* user);
+static void act_pause(void* user);
+
+// The panel for the model and engine as they are: generated entries, the
+// model file box and the actions. Replaces the old panel (a loaded model has
+// other components); the window stays shown or hidden as it was.
+static int setup_panel(drive_session* s) {
+    const bool shown = s->pn ? panel_gui_visible(s->pn) : false;
+    char filter[64] = "";
+    if (s->pn) {
+        snprintf(filter, sizeof filter, "%s", panel_filter(s->pn));
+        render_attach_panel(s->r, NULL);
+        panel_destroy(s->pn);
+    }
+    s->pn = panel_create();
+    if (!s->pn) return -1;
+    build_params(s);
+    for (int i = 0; i < s->nparam; ++i) {
+        drive_param* p = &s->param[i];
+        panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0, p->on_release};
+        s->pid[i] = p->kind == PK_SOLVER
+                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
+                        : panel_add_param(s->pn, &d);
+        if (p->kind != PK_SOLVER) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
+    }
+    panel_add_text(s->pn, "model file", s->load_path, sizeof s->load_path);
+    panel_add_action(s->pn, "reset run", act_reset, s);
+    panel_add_action(s->pn, "save model", act_save, s);
+    panel_add_action(s->pn, "pause / resume", act_pause, s);
+    panel_add_action(s->pn, "load model", act_load, s);
+    panel_set_filter(s->pn, filter);
+    render_attach_panel(s->r, s->pn);
+    panel_gui_show(s->pn, shown);
+    return 0;
+}
+
+// Charts on channels by name again, in a list that may have changed (a
+// loaded model): a channel the new circuit lacks is left empty.
+static void rebind_charts(drive_session* s) {
+    s->chart_circuit = false;
+    for (int i = 0; i < s->nchart; ++i) {
+        s->chart_col[i] = chan_list_find(s->chans, render_chart_label(s->r, s->chart_id[i]));
+        if (s->chart_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
+    }
+    free(s->chan_v);
+    s->chan_v = calloc((size_t)chan_list_count(s->chans), sizeof *s->chan_v);
+}
+
+static void rebuild_world(drive_session* s, bool at_start);
+
+// Load the panel's model file and drive on with it in the same world, from
+// the current pose: a new engine, a new panel. A file that does not load, or
+// a model the world cannot be built with, leaves the running model as it
+// is, with the one-line reason in the panel and the status line.
+static void load_model(drive_session* s) {
+    char e[400];
+    model* nm = model_load(s->load_path[0] ? s->load_path : NULL, NULL, 0, e, sizeof e);
+    if (!nm) {
+        snprintf(s->status, sizeof s->status, "load failed (model kept): %s", e);
+        panel_set_message(s->pn, s->status);
+        fprintf(stderr, "cranesim drive: %s\n", s->status);
+        return;
+    }
+    model* old = s->m;
+    const int seg = s->segment;
+    s->m = nm;
+    rebuild_world(s, false);
+    if (s->segment == seg) {
+        // rebuild_world said why in the status line; the old engine runs on.
+        s->m = old;
+        model_free(nm);
+        snprintf(s->status, sizeof s->status, "load failed (model kept): %s", s->err);
+        panel_set_message(s->pn, s->status);
+        return;
+    }
+    model_free(old);
+    ++s->st.rebuilds;
+    rebind_charts(s);
+    setup_panel(s);
+    snprintf(s->status, sizeof s->status, "loaded %s (%s)", nm->file, nm->name);
+    panel_set_message(s->pn, s->status);
 }
 
 static void act_reset(void* user) {
@@ -715,6 +829,13 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         return NULL;
     }
     s->ncol = engine_ncol(s->l);
+    s->chans = chan_list_create(s->l);
+    s->chan_v = s->chans ? calloc((size_t)chan_list_count(s->chans), sizeof *s->chan_v) : NULL;
+    if (!s->chans || !s->chan_v) {
+        snprintf(err, errsz, "out of memory");
+        drive_session_destroy(s);
+        return NULL;
+    }
     // Keep reading the sticks when the 3D window is not focused (the operator
     // may click a plot or a terminal; and an offscreen view never has focus).
     SDL_SetHint(SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, "1");
@@ -746,24 +867,15 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         return NULL;
     }
     s->in = input_create(&map);
-    s->pn = panel_create();
-    build_params(s);
-    for (int i = 0; i < s->nparam; ++i) {
-        drive_param* p = &s->param[i];
-        panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0, p->on_release};
-        s->pid[i] = p->kind == PK_SOLVER
-                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
-                        : panel_add_param(s->pn, &d);
-        if (p->kind != PK_SOLVER) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
-    }
-    panel_add_action(s->pn, "reset run", act_reset, s);
-    panel_add_action(s->pn, "save model", act_save, s);
-    panel_add_action(s->pn, "pause / resume", act_pause, s);
-    render_attach_panel(s->r, s->pn);
+    snprintf(s->load_path, sizeof s->load_path, "%s", s->m->file);
     // The panel starts hidden (Tab shows it): on llvmpipe it costs ~4 fps at
     // 1280x720 (56 vs 60 fps, cranesim bench --config drive), and the scene
     // is what an operator watches while driving.
-    panel_gui_show(s->pn, false);
+    if (setup_panel(s)) {
+        snprintf(err, errsz, "out of memory");
+        drive_session_destroy(s);
+        return NULL;
+    }
     take_snapshot(s);
     if (o->charts) {
         if (setup_charts(s, o->charts, err, errsz)) {
@@ -804,6 +916,8 @@ void drive_session_destroy(drive_session* s) {
     if (s->r) render_destroy(s->r);
     engine_destroy(s->l);
     model_free(s->m);
+    chan_list_free(s->chans);
+    free(s->chan_v);
     free(s->param);
     free(s->pid);
     free(s->changed);
@@ -899,6 +1013,10 @@ int drive_session_tick(drive_session* s, double wall) {
         s->param[s->changed[k].i].value = s->changed[k].v;
         apply_param(s, s->changed[k].i);
     }
+    if (s->load_pending) {
+        s->load_pending = false;
+        load_model(s);
+    }
     if (s->rebuild) {
         s->rebuild = false;
         const double t_at = s->t_base + engine_time(s->l);
@@ -959,6 +1077,10 @@ int drive_session_tick(drive_session* s, double wall) {
     // One CSV row per tick at most, shared by the recording and the charts.
     double row[SIM_NCOL];
     if (s->rec || (frame && s->nchart)) session_row(s, row);
+    if (frame && s->nchart) {
+        memcpy(s->chan_v, row, sizeof *row * (size_t)chan_list_nrow(s->chans));
+        if (s->chart_circuit) chan_list_values(s->chans, s->l, s->chan_v, true);
+    }
     if (s->rec) record_row(s, row);
     if (frame) {
         char status[640];
@@ -972,7 +1094,8 @@ int drive_session_tick(drive_session* s, double wall) {
         render_set_status(s->r, status);
         take_snapshot(s);
         if (s->nchart)
-            for (int i = 0; i < s->nchart; ++i) render_chart_push(s->r, s->chart_id[i], row[COL_T], row[s->chart_col[i]]);
+            for (int i = 0; i < s->nchart; ++i)
+                render_chart_push(s->r, s->chart_id[i], row[COL_T], s->chan_v[s->chart_col[i]]);
         else
             render_charts_sample(s->r, s->snap);
         render_snapshot(s);
@@ -1001,6 +1124,7 @@ render* drive_session_render_ctx(drive_session* s) { return s->r; }
 input* drive_session_input(drive_session* s) { return s->in; }
 panel* drive_session_panel(drive_session* s) { return s->pn; }
 void drive_session_row(drive_session* s, double* row) { session_row(s, row); }
+const chan_list* drive_session_channels(const drive_session* s) { return s->chans; }
 
 // "%.1f fps" of n events over wall seconds, or "n/a" when the interval is too
 // short for a rate to mean anything (a screenshot at t = 0).

@@ -111,6 +111,10 @@ struct input* drive_session_input(drive_session* s);
 struct panel* drive_session_panel(drive_session* s);
 /// The model being driven (edited in place by the panel; "save model" writes it).
 const model* drive_session_model(const drive_session* s);
+struct chan_list;
+/// The channels the session can chart (--charts names): the engine's
+/// columns, then its circuit's (channels.h).
+const struct chan_list* drive_session_channels(const drive_session* s);
 /// The row (CSV columns) at the current simulated time.
 void drive_session_row(drive_session* s, double* row);
 
