@@ -96,6 +96,11 @@ struct drive_session {
     chan_list* chans;    // the engine's channels: its row, then its circuit's (channels.h)
     double* chan_v;      // (chan_list_count) their values at the last charted frame
     bool chart_circuit;  // a chart shows a circuit channel: evaluate them per frame
+    int nreadout;        // HUD readouts (--readouts)
+    int readout_col[8];  // their channels (index into chans)
+    double readout_scale[8]; // shown = value / scale
+    char readout_unit[8][16];
+    char readout_name[8][96];
     int nchart;          // user-chosen strip-chart channels (0: the default set)
     int chart_col[8];    // their channels (index into chans)
     int chart_id[8];     // their render chart ids
@@ -483,13 +488,14 @@ static void rebuild_world(drive_session* s, bool at_start) {
 // dot is taken as a circuit channel, checked when the session has its
 // circuit. Fills col[] (indices into cl, or columns; -1 for a deferred name)
 // and returns the count, or -1 with a one-line message.
-static int parse_charts(const char* list, int ncol, const chan_list* cl, int col[8], char* err, size_t errsz) {
+static int parse_charts(const char* opt, const char* list, int ncol, const chan_list* cl, int col[8], char* err,
+                        size_t errsz) {
     int n = 0;
     for (const char* p = list;; ++p) {
         const char* e = strchr(p, ',');
         size_t len = e ? (size_t)(e - p) : strlen(p);
         if (len == 0) {
-            snprintf(err, errsz, "--charts: expected column names separated by commas, got '%s'", list);
+            snprintf(err, errsz, "%s: expected column names separated by commas, got '%s'", opt, list);
             return -1;
         }
         int c = -1;
@@ -501,13 +507,13 @@ static int parse_charts(const char* list, int ncol, const chan_list* cl, int col
         }
         const bool deferred = !cl && memchr(p, '.', len);
         if (c < 0 && !deferred) {
-            snprintf(err, errsz, "--charts: no %s '%.*s'%s (see cranesim run --help for the names)",
+            snprintf(err, errsz, "%s: no %s '%.*s'%s (see cranesim run --help for the names)", opt,
                      memchr(p, '.', len) ? "circuit channel" : "column", (int)len, p,
                      ncol < SIM_NCOL && !memchr(p, '.', len) ? " in the lagrange view" : "");
             return -1;
         }
         if (n == 8) {
-            snprintf(err, errsz, "--charts: at most 8 channels, got more in '%s'", list);
+            snprintf(err, errsz, "%s: at most 8 channels, got more in '%s'", opt, list);
             return -1;
         }
         col[n++] = c;
@@ -526,7 +532,12 @@ int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t
     }
     if (o->charts) {
         int col[8];
-        if (parse_charts(o->charts, sim_ncol(&c->sim), NULL, col, err, errsz) < 0)
+        if (parse_charts("--charts", o->charts, sim_ncol(&c->sim), NULL, col, err, errsz) < 0)
+            return EXIT_USAGE;
+    }
+    if (o->readouts) {
+        int col[8];
+        if (parse_charts("--readouts", o->readouts, sim_ncol(&c->sim), NULL, col, err, errsz) < 0)
             return EXIT_USAGE;
     }
     if (o->mapping_file) {
@@ -543,7 +554,7 @@ static int setup_charts(drive_session* s, const char* list, char* err, size_t er
                                         {0.5f, 0.9f, 0.4f, 1},   {0.8f, 0.5f, 0.95f, 1},  {0.95f, 0.6f, 0.2f, 1},
                                         {0.6f, 0.9f, 0.9f, 1},   {0.9f, 0.9f, 0.9f, 1}};
     int cols[8];
-    const int n = parse_charts(list, s->ncol, s->chans, cols, err, errsz);
+    const int n = parse_charts("--charts", list, s->ncol, s->chans, cols, err, errsz);
     if (n < 0) return -1;
     for (int i = 0; i < n; ++i) {
         const int col = cols[i];
@@ -615,6 +626,10 @@ static void rebind_charts(drive_session* s) {
     for (int i = 0; i < s->nchart; ++i) {
         s->chart_col[i] = chan_list_find(s->chans, render_chart_label(s->r, s->chart_id[i]));
         if (s->chart_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
+    }
+    for (int i = 0; i < s->nreadout; ++i) {
+        s->readout_col[i] = chan_list_find(s->chans, s->readout_name[i]);
+        if (s->readout_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
     }
     free(s->chan_v);
     s->chan_v = calloc((size_t)chan_list_count(s->chans), sizeof *s->chan_v);
@@ -889,6 +904,20 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         // view have only the two boom cylinders.
         render_charts_default(s->r, s->snap->ncyl);
     }
+    if (o->readouts) {
+        s->nreadout = parse_charts("--readouts", o->readouts, s->ncol, s->chans, s->readout_col, err, errsz);
+        if (s->nreadout < 0) {
+            drive_session_destroy(s);
+            *code = EXIT_USAGE;
+            return NULL;
+        }
+        for (int i = 0; i < s->nreadout; ++i) {
+            const sim_channel* ch = chan_list_channel(s->chans, s->readout_col[i]);
+            snprintf(s->readout_name[i], sizeof s->readout_name[i], "%s", ch->name);
+            s->readout_scale[i] = display_unit(ch->unit, s->readout_unit[i], sizeof s->readout_unit[i]);
+            if (s->readout_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
+        }
+    }
     if (o->record_path && start_recording(s, o->record_path)) {
         snprintf(err, errsz, "%s", s->status);
         drive_session_destroy(s);
@@ -1076,8 +1105,8 @@ int drive_session_tick(drive_session* s, double wall) {
     const bool frame = wall >= s->wall_next_frame && !render_busy(s->r);
     // One CSV row per tick at most, shared by the recording and the charts.
     double row[SIM_NCOL];
-    if (s->rec || (frame && s->nchart)) session_row(s, row);
-    if (frame && s->nchart) {
+    if (s->rec || (frame && (s->nchart || s->nreadout))) session_row(s, row);
+    if (frame && (s->nchart || s->nreadout)) {
         memcpy(s->chan_v, row, sizeof *row * (size_t)chan_list_nrow(s->chans));
         if (s->chart_circuit) chan_list_values(s->chans, s->l, s->chan_v, true);
     }
@@ -1093,10 +1122,20 @@ int drive_session_tick(drive_session* s, double wall) {
                  src, panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]", keys);
         render_set_status(s->r, status);
         take_snapshot(s);
-        if (s->nchart)
+        if (s->nreadout) {
+            render_readout rd[8];
+            for (int i = 0; i < s->nreadout; ++i) {
+                const int k = s->readout_col[i];
+                // A channel a loaded model lacks reads NaN.
+                rd[i] = (render_readout){s->readout_name[i], s->readout_unit[i],
+                                         k >= 0 ? s->chan_v[k] / s->readout_scale[i] : NAN};
+            }
+            render_set_readouts(s->r, rd, s->nreadout);
+        }
+        if (s->nchart) {
             for (int i = 0; i < s->nchart; ++i)
-                render_chart_push(s->r, s->chart_id[i], row[COL_T], s->chan_v[s->chart_col[i]]);
-        else
+                if (s->chart_col[i] >= 0) render_chart_push(s->r, s->chart_id[i], row[COL_T], s->chan_v[s->chart_col[i]]);
+        } else
             render_charts_sample(s->r, s->snap);
         render_snapshot(s);
         // Interval between frame starts; the first frame has none.

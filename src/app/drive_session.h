@@ -39,6 +39,7 @@ typedef struct drive_opts {
     bool hud;                 ///< draw the HUD (default true)
     const char* charts;       ///< strip-chart channels: CSV column names, comma-separated
                               ///< ("p1A,p2A,x1,u1"); NULL: pressures, strokes, spools
+    const char* readouts;     ///< HUD readouts: channel names as charts, comma-separated; NULL: none
     const char* world_name;   ///< the ode world's name for the banner ("validation"); NULL: "sandbox"
     const char* save_as;      ///< "save model" writes (and replaces) this file; NULL: a new
                               ///< cranesim_model_N.json each time (drive_save_name)

@@ -299,6 +299,58 @@ static void test_circuit_channels(void) {
     drive_session_destroy(b);
 }
 
+// HUD readouts of named channels (--readouts): names and units from the
+// channel list, values in display units; the readout box grows a line each.
+static void test_hud_readouts(void) {
+    drive_session* plain = open_ok(SIM_ODE, NULL, NULL);
+    if (!plain) return;
+    double wall = 0;
+    run_for(plain, &wall, 0.3);
+    drive_session_render(plain);
+    float r0[4];
+    CHECK(render_hud_readouts_rect(drive_session_render_ctx(plain), r0), "no readouts box");
+    drive_session_destroy(plain);
+    app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE;
+    drive_opts o = drive_default_opts();
+    o.offscreen = true;
+    o.width = 640;
+    o.height = 360;
+    o.readouts = "lift_cyl.A.p,pump.q";
+    char err[512];
+    drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
+    CHECK(s != NULL, "session: %s", err);
+    if (!s) return;
+    wall = 0;
+    run_for(s, &wall, 0.3);
+    // Paused, the frames show the state that stands still.
+    panel_run_action(drive_session_panel(s), "pause / resume");
+    render* r = drive_session_render_ctx(s);
+    run_for(s, &wall, 0.05);
+    // A frame is drawn only when the driver has finished the last one.
+    render_wait(r, 5.0);
+    run_for(s, &wall, 0.05);
+    float r1[4];
+    CHECK(render_hud_readouts_rect(r, r1) && fabs(r1[3] - r0[3] - 2 * 14.0f) < 1e-3f, "box %g px, without %g px",
+          r1[3], r0[3]);
+    double v = 0;
+    const char* unit = NULL;
+    const char* name = render_get_readout(r, 0, &v, &unit);
+    // The chamber pressure in MPa, as the state gives it in Pa.
+    chan_list* cl = chan_list_create(drive_session_engine(s));
+    double* cv = calloc((size_t)chan_list_count(cl), sizeof *cv);
+    chan_list_values(cl, drive_session_engine(s), cv, false);
+    const int k = chan_list_find(cl, "lift_cyl.A.p");
+    CHECK(name && !strcmp(name, "lift_cyl.A.p") && !strcmp(unit, "MPa") && fabs(v - cv[k] * 1e-6) < 1e-9 * fabs(v),
+          "readout %s = %g %s, channel %g Pa (p1A %g Pa)", name ? name : "-", v, unit ? unit : "", cv[k], cv[COL_P1A]);
+    name = render_get_readout(r, 1, &v, &unit);
+    CHECK(name && !strcmp(name, "pump.q") && !strcmp(unit, "L/min"), "readout 1 %s %s", name ? name : "-",
+          unit ? unit : "");
+    free(cv);
+    chan_list_free(cl);
+    drive_session_destroy(s);
+}
+
 int main(int argc, char** argv) {
     setenv("SDL_VIDEODRIVER", "offscreen", 0);
     setenv("EGL_PLATFORM", "surfaceless", 0);
@@ -308,5 +360,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_bore_edit_changes_the_force);
     RUN_TEST(test_load_model_from_the_panel);
     RUN_TEST(test_circuit_channels);
+    RUN_TEST(test_hud_readouts);
     TEST_MAIN_END();
 }
