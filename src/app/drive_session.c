@@ -507,9 +507,12 @@ static int parse_charts(const char* opt, const char* list, int ncol, const chan_
         }
         const bool deferred = !cl && memchr(p, '.', len);
         if (c < 0 && !deferred) {
-            snprintf(err, errsz, "%s: no %s '%.*s'%s (see cranesim run --help for the names)", opt,
-                     memchr(p, '.', len) ? "circuit channel" : "column", (int)len, p,
-                     ncol < SIM_NCOL && !memchr(p, '.', len) ? " in the lagrange view" : "");
+            // A circuit channel is named after the model's nodes and
+            // components (docs/render.md), a column is in run --help.
+            const bool circ = memchr(p, '.', len) != NULL;
+            snprintf(err, errsz, "%s: no %s '%.*s'%s (see %s for the names)", opt, circ ? "circuit channel" : "column",
+                     (int)len, p, ncol < SIM_NCOL && !circ ? " in the lagrange view" : "",
+                     circ ? "the model's node and component names, docs/render.md" : "cranesim run --help");
             return -1;
         }
         if (n == 8) {
