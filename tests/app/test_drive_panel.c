@@ -184,6 +184,7 @@ static void test_renamed_components_get_a_full_panel(void) {
           "renamed components missing");
     CHECK(panel_find(pn, "lift_cyl (cylinder)/bore") < 0, "an old name in the panel");
     drive_session_destroy(s);
+    remove(path);
 }
 
 // Lift bore 100 -> 120 mm in the panel: the lift force the engine computes
