@@ -46,7 +46,11 @@ static void drive_help(FILE* f) {
             "  --scripted          window: drive by the scenario's commands instead of the devices\n"
             "  --mapping FILE      joystick axis mapping (JSON, see docs/render.md)\n"
             "  --charts LIST       strip-chart channels, CSV column names (up to 8), e.g.\n"
-            "                      p1A,p1B,x1,u1,F1 (default: pressures, strokes, spools)\n"
+            "                      p1A,p1B,x1,u1,F1 (default: pressures, strokes, spools), or the\n"
+            "                      circuit's channels: NODE.p, VALVE.spool, VALVE.qA/.qB, COMPONENT.q\n"
+            "                      (lift_cyl.A.p, pump_line.p, lift_valve.qA, pump.q; docs/render.md)\n"
+            "  --readouts LIST     window: HUD readouts of these channels (names as --charts, up to 8),\n"
+            "                      in display units (MPa, L/min, mm), under the fixed ones\n"
             "  --screenshot FILE   save a PNG of the view at --screenshot-at seconds and stop\n"
             "                      (offscreen when there is no display)\n"
             "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
@@ -285,6 +289,7 @@ int cmd_drive(int argc, char** argv) {
     const char* shot = NULL;
     const char* mapping = NULL;
     const char* charts = NULL;
+    const char* readouts = NULL;
     const char* save_as = NULL;
     int width = 1280, height = 720;
     for (int i = 0; i < argc; ++i) {
@@ -314,6 +319,10 @@ int cmd_drive(int argc, char** argv) {
         }
         if (!strcmp(argv[i], "--charts") && i + 1 < argc) {
             charts = argv[++i];
+            continue;
+        }
+        if (!strcmp(argv[i], "--readouts") && i + 1 < argc) {
+            readouts = argv[++i];
             continue;
         }
         if (!strcmp(argv[i], "--mapping") && i + 1 < argc) {
@@ -392,6 +401,7 @@ int cmd_drive(int argc, char** argv) {
     if (rate_given) o.fps_cap = frame_rate;
     o.mapping_file = mapping;
     o.charts = charts;
+    o.readouts = readouts;
     o.record_path = record;
     o.save_as = save_as;
     o.world_name = c.sim.mechanics == SIM_ODE ? wname : NULL;
@@ -429,7 +439,7 @@ int cmd_drive(int argc, char** argv) {
 #else
     (void)scripted, (void)width, (void)height, (void)shot_at, (void)rate_given;
     // Without the render module these options have nothing to act on.
-    const char* needs = shot ? "--screenshot" : mapping ? "--mapping" : charts ? "--charts" : NULL;
+    const char* needs = shot ? "--screenshot" : mapping ? "--mapping" : charts ? "--charts" : readouts ? "--readouts" : NULL;
     if (needs) {
         fprintf(stderr, "cranesim drive: %s needs the render module (built without SDL2/GL)\n", needs);
         return EXIT_USAGE;

@@ -10,6 +10,7 @@
 
 #include <SDL2/SDL.h>
 
+#include "channels.h"
 #include "input.h"
 #include "json_util.h"
 #include "panel.h"
@@ -22,22 +23,23 @@
 // How a panel parameter reaches the simulation.
 typedef enum param_kind {
     PK_HYD,  ///< a circuit parameter: hyd_model_set on the live circuit, at once
-    PK_MECH, ///< a mechanical parameter: live for lagrange, a rebuilt world for ode
-    PK_LOAD, ///< the tip load (lagrange) [kg]
+    PK_MECH, ///< a mechanical parameter: live where the engine can set it, else a rebuilt world
+    PK_LOAD, ///< the tip load, where the engine can set it live [kg]
     PK_SOLVER, ///< hydraulic integrator, an index into k_solver (a rebuilt world/solver at the current pose)
     PK_STEP,   ///< hydraulic step [s] (rebuilt likewise)
 } param_kind;
 
-#define MAX_PARAMS 40
-
+// One panel entry, generated from the parameter tables (build_params).
 typedef struct drive_param {
     param_kind kind;
-    char group[32], label[32], unit[12];
+    char group[64], label[48], unit[16];
     double value;      ///< shown value, display units (edited by the panel)
     double scale;      ///< SI value = value * scale
-    double min, max;   ///< display units
-    char hyd_path[64]; ///< PK_HYD: "lift_cyl.bore", "fluid.bulk_modulus"
-    char json[128];    ///< path in the model file, for saving
+    double min, max;   ///< hard range, display units: a typed value outside it is refused
+    double tmin, tmax; ///< typical range, display units: what a drag covers
+    char hyd_path[96]; ///< PK_HYD: "lift_cyl.bore", "fluid.bulk_modulus"
+    char json[160];    ///< path in the model file, for saving
+    int mech;          ///< PK_MECH, PK_LOAD: entry of the mechanics table (model_param_info)
     bool on_release;   ///< applied when the edit ends: it rebuilds the world
     bool world_only;   ///< PK_HYD of the world's circuit, not the model's (not saved)
 } drive_param;
@@ -57,10 +59,16 @@ struct drive_session {
     input* in;
     panel* pn;
     world_snapshot* snap; // large: heap
-    drive_param param[MAX_PARAMS];
-    int nparam;
-    int pid[MAX_PARAMS]; // panel ids
+    drive_param* param;  // the panel's entries (build_params)
+    int nparam, capparam;
+    int* pid;            // their panel ids
+    struct {
+        int i;
+        double v;
+    } * changed;         // (capparam) the entries a tick changes, and their new values
     bool paused, rebuild;
+    bool load_pending;     // "load model" was pressed: load s->load_path at the next tick
+    char load_path[256];   // the panel's model file box
     char rebuild_why[160]; // the change that asked for the rebuild
     sim_opts sim_live;     // the options the running world was built with
     crane_mech mech_live;  // the mechanics the running world has (built with, or set in place since)
@@ -85,8 +93,16 @@ struct drive_session {
     char rec_err[320];   // first recording failure ("cannot write FILE: ..."), "" if none
     int ncol;
     int ev;              // next scripted hook event
+    chan_list* chans;    // the engine's channels: its row, then its circuit's (channels.h)
+    double* chan_v;      // (chan_list_count) their values at the last charted frame
+    bool chart_circuit;  // a chart shows a circuit channel: evaluate them per frame
+    int nreadout;        // HUD readouts (--readouts)
+    int readout_col[8];  // their channels (index into chans)
+    double readout_scale[8]; // shown = value / scale
+    char readout_unit[8][16];
+    char readout_name[8][96];
     int nchart;          // user-chosen strip-chart channels (0: the default set)
-    int chart_col[8];    // their CSV columns
+    int chart_col[8];    // their channels (index into chans)
     int chart_id[8];     // their render chart ids
     int missed_window;   // missed ticks in the current second
     double missed_t0;
@@ -105,47 +121,92 @@ drive_opts drive_default_opts(void) {
     return o;
 }
 
-static void add_param(drive_session* s, param_kind k, const char* group, const char* label, const char* unit,
-                      double scale, double min, double max, const char* hyd_path, const char* json, double si) {
-    if (s->nparam == MAX_PARAMS) return;
+// Display units: what an operator reads (MPa, L/min, mm) for the SI unit a
+// table gives, one scale per unit (SI value = shown value * scale).
+static const struct {
+    const char *si, *shown;
+    double scale;
+} k_units[] = {
+    {"Pa", "MPa", 1e6},         {"m^3/s", "L/min", 1.0 / 60000.0}, {"m", "mm", 1e-3},
+    {"m^3", "L", 1e-3},         {"m^2", "mm^2", 1e-6},              {"s", "ms", 1e-3},
+    {"N s/m", "kN s/m", 1e3},   {"N/m", "kN/m", 1e3},
+};
+
+static double display_unit(const char* si, char* shown, size_t n) {
+    for (size_t k = 0; k < sizeof k_units / sizeof k_units[0]; ++k)
+        if (!strcmp(si, k_units[k].si)) {
+            snprintf(shown, n, "%s", k_units[k].shown);
+            return k_units[k].scale;
+        }
+    snprintf(shown, n, "%s", strcmp(si, "-") ? si : "");
+    return 1.0;
+}
+
+static drive_param* new_param(drive_session* s) {
+    if (s->nparam == s->capparam) {
+        const int nc = s->capparam ? 2 * s->capparam : 64;
+        drive_param* np = realloc(s->param, (size_t)nc * sizeof *np);
+        int* ni = realloc(s->pid, (size_t)nc * sizeof *ni);
+        if (ni) s->pid = ni;
+        void* nch = realloc(s->changed, (size_t)nc * sizeof *s->changed);
+        if (nch) s->changed = nch;
+        if (!np || !ni || !nch) {
+            if (np) s->param = np;
+            return NULL;
+        }
+        s->param = np;
+        s->capparam = nc;
+    }
     drive_param* p = &s->param[s->nparam++];
+    memset(p, 0, sizeof *p);
+    p->mech = -1;
+    return p;
+}
+
+// An entry with SI unit si, hard range [lo, hi] and typical range [tlo,
+// thi] in that unit, at SI value v.
+static drive_param* add_param(drive_session* s, param_kind k, const char* group, const char* label, const char* si,
+                              double lo, double hi, double tlo, double thi, double v) {
+    drive_param* p = new_param(s);
+    if (!p) return NULL;
     p->kind = k;
     snprintf(p->group, sizeof p->group, "%s", group);
     snprintf(p->label, sizeof p->label, "%s", label);
-    snprintf(p->unit, sizeof p->unit, "%s", unit);
-    p->scale = scale;
-    p->min = min;
-    p->max = max;
-    snprintf(p->hyd_path, sizeof p->hyd_path, "%s", hyd_path ? hyd_path : "");
-    snprintf(p->json, sizeof p->json, "%s", json ? json : "");
-    p->value = si / scale;
+    p->scale = display_unit(si, p->unit, sizeof p->unit);
+    p->min = lo / p->scale;
+    p->max = hi / p->scale;
+    p->tmin = tlo / p->scale;
+    p->tmax = thi / p->scale;
+    p->value = v / p->scale;
+    // A value outside the hard range (a world file's, or one loaded with a
+    // note) must still be shown: the range stretches to it.
+    if (p->value < p->min) p->min = p->value;
+    if (p->value > p->max) p->max = p->value;
+    return p;
 }
 
-// A circuit parameter whose current value is read from the model.
-static void add_hyd(drive_session* s, const char* group, const char* label, const char* unit, double scale,
-                    double min, double max, const char* comp, const char* field) {
-    char hp[64], jp[128];
-    double v;
-    if (!strcmp(comp, "fluid")) {
-        snprintf(hp, sizeof hp, "fluid.%s", field);
-        snprintf(jp, sizeof jp, "hydraulics.fluid.%s", field);
-    } else {
-        snprintf(hp, sizeof hp, "%s.%s", comp, field);
-        snprintf(jp, sizeof jp, "hydraulics.components.%s.%s", comp, field);
-    }
-    if (hyd_model_get(s->m->hyd, hp, &v) == 0) {
-        // The value the run's circuit has now (the model's may lag it while a
-        // world that adds components runs: apply_param sets the run's only).
-        if (engine_circuit(s->l)) hyd_model_get(engine_circuit(s->l), hp, &v);
-        add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, jp, v);
-        return;
-    }
-    // A component of the world's own circuit (the sandbox's slew valve): it
-    // lives in the world file, not the model, so it is set on the running
-    // circuit only (and again after a rebuild); "save model" does not save it.
-    if (hyd_model_get(engine_circuit(s->l), hp, &v) == 0) {
-        add_param(s, PK_HYD, group, label, unit, scale, min, max, hp, NULL, v);
-        s->param[s->nparam - 1].world_only = true;
+// Every parameter of one circuit element (its type's table), read from the
+// running circuit. An element of the model's circuit is saved under its path
+// in the model file; one of the world's own circuit (the sandbox's slew
+// valve) lives in the world file: set on the running circuit only (and again
+// after a rebuild), not saved.
+static void add_element(drive_session* s, const hyd_model* live, const char* name, hyd_type t) {
+    char group[64];
+    snprintf(group, sizeof group, "%s (%s)", name, hyd_type_name(t));
+    const int is_node = t == HYD_TANK || t == HYD_VOLUME;
+    for (int k = 0; k < hyd_param_count(t); ++k) {
+        double lo, hi, tlo, thi, v;
+        char hp[96];
+        snprintf(hp, sizeof hp, "%s.%s", name, hyd_param_name(t, k));
+        if (hyd_param_range(t, k, &lo, &hi, &tlo, &thi) || hyd_model_get(live, hp, &v)) continue;
+        drive_param* p = add_param(s, PK_HYD, group, hyd_param_name(t, k), hyd_param_unit(t, k), lo, hi, tlo, thi, v);
+        if (!p) return;
+        snprintf(p->hyd_path, sizeof p->hyd_path, "%s", hp);
+        double mv;
+        if (hyd_model_get(s->m->hyd, hp, &mv) == 0)
+            snprintf(p->json, sizeof p->json, "hydraulics.%s.%s", is_node ? "nodes" : "components", hp);
+        else
+            p->world_only = true;
     }
 }
 
@@ -159,93 +220,111 @@ static void reapply_world_params(drive_session* s) {
     }
 }
 
+// The group header of a mechanics table entry: the link's or actuator's name.
+static void mech_group(const crane_mech* me, const model_param* mp, char* out, size_t n) {
+    int k = 0;
+    if (sscanf(mp->group, "links[%d]", &k) == 1 && k >= 0 && k < 2)
+        snprintf(out, n, "%s (link)", me->link[k].name);
+    else if (sscanf(mp->group, "actuators[%d]", &k) == 1 && k >= 0 && k < 2)
+        snprintf(out, n, "%s (actuator)", me->act[k].name);
+    else
+        snprintf(out, n, "%s", mp->group);
+}
+
+// The panel's list, generated from the tables: every element of the running
+// circuit with its type's parameters, the fluid, the mechanics table and the
+// run's own settings (solver). No component name is known here.
 static void build_params(drive_session* s) {
-    const crane_mech* me = &s->m->mech;
-    add_param(s, PK_MECH, "booms", "lifting arm mass", "kg", 1, 20, 2000, NULL, "mechanics.links[0].mass",
-              me->link[0].mass);
-    add_param(s, PK_MECH, "booms", "end arm mass", "kg", 1, 20, 2000, NULL, "mechanics.links[1].mass",
-              me->link[1].mass);
-    add_param(s, PK_MECH, "booms", "lifting arm length", "m", 1, 1.0, 5.0, NULL, "mechanics.links[0].length",
-              me->link[0].length);
-    add_param(s, PK_MECH, "booms", "end arm length", "m", 1, 1.0, 5.0, NULL, "mechanics.links[1].length",
-              me->link[1].length);
-    if (engine_can_set_load(s->l))
-        add_param(s, PK_LOAD, "load", "tip load", "kg", 1, 0, 5000, NULL, "mechanics.load_mass",
-                  sim_load_mass(s->m, &s->sc, &s->c.sim));
-    static const char* const cyl[2] = {"lift_cyl", "jib_cyl"};
-    static const char* const grp[2] = {"lift cylinder", "jib cylinder"};
-    for (int k = 0; k < 2; ++k) {
-        add_hyd(s, grp[k], "bore", "mm", 1e-3, 40, 200, cyl[k], "bore");
-        add_hyd(s, grp[k], "rod", "mm", 1e-3, 20, 150, cyl[k], "rod");
-        add_hyd(s, grp[k], "friction", "kN s/m", 1e3, 0, 100, cyl[k], "friction");
+    s->nparam = 0;
+    const hyd_model* live = engine_circuit(s->l);
+    for (int i = 0; i < hyd_model_nelement(live); ++i) {
+        hyd_type t;
+        const char* name = hyd_model_element(live, i, &t);
+        add_element(s, live, name, t);
     }
-    static const char* const val[3] = {"lift_valve", "jib_valve", "slew_valve"};
-    static const char* const vgrp[3] = {"lift valve", "jib valve", "slew valve"};
-    for (int k = 0; k < 3; ++k) {
-        add_hyd(s, vgrp[k], "rated flow", "L/min", 1.0 / 60000.0, 5, 200, val[k], "q_nominal");
-        add_hyd(s, vgrp[k], "spool time constant", "ms", 1e-3, 1, 500, val[k], "tau");
+    for (int k = 0; k < hyd_fluid_param_count(); ++k) {
+        double lo, hi, tlo, thi, v;
+        char hp[96];
+        snprintf(hp, sizeof hp, "fluid.%s", hyd_fluid_param_name(k));
+        if (hyd_fluid_param_range(k, &lo, &hi, &tlo, &thi) || hyd_model_get(live, hp, &v)) continue;
+        drive_param* p = add_param(s, PK_HYD, "fluid", hyd_fluid_param_name(k), hyd_fluid_param_unit(k), lo, hi, tlo,
+                                   thi, v);
+        if (!p) return;
+        snprintf(p->hyd_path, sizeof p->hyd_path, "%s", hp);
+        snprintf(p->json, sizeof p->json, "hydraulics.%s", hp);
     }
-    add_hyd(s, "supply", "pump pressure", "MPa", 1e6, 2, 35, "pump", "p_set");
-    add_hyd(s, "supply", "pump max flow", "L/min", 1.0 / 60000.0, 5, 200, "pump", "q_max");
-    add_hyd(s, "reliefs", "main relief", "MPa", 1e6, 2, 40, "main_relief", "p_crack");
-    add_hyd(s, "reliefs", "lift port A", "MPa", 1e6, 2, 40, "lift_relief_A", "p_crack");
-    add_hyd(s, "reliefs", "lift port B", "MPa", 1e6, 2, 40, "lift_relief_B", "p_crack");
-    add_hyd(s, "reliefs", "jib port A", "MPa", 1e6, 2, 40, "jib_relief_A", "p_crack");
-    add_hyd(s, "reliefs", "jib port B", "MPa", 1e6, 2, 40, "jib_relief_B", "p_crack");
-    add_hyd(s, "reliefs", "slew port A", "MPa", 1e6, 2, 40, "slew_relief_A", "p_crack");
-    add_hyd(s, "reliefs", "slew port B", "MPa", 1e6, 2, 40, "slew_relief_B", "p_crack");
-    add_hyd(s, "oil", "bulk modulus", "GPa", 1e9, 0.2, 2.5, "fluid", "bulk_modulus");
-    add_hyd(s, "oil", "density", "kg/m3", 1, 700, 1000, "fluid", "density");
+    crane_mech* me = &s->m->mech;
+    for (int k = 0; k < model_param_count(); ++k) {
+        model_param mp;
+        model_param_info(k, &mp);
+        char group[64];
+        mech_group(me, &mp, group, sizeof group);
+        const bool load = !strcmp(mp.path, "mechanics.load_mass");
+        // The tip load drives with the scenario's or --load's value where the
+        // engine takes it live; elsewhere it is the model's field.
+        const double v = load && engine_can_set_load(s->l) ? sim_load_mass(s->m, &s->sc, &s->c.sim)
+                                                           : *model_param_ptr(me, k);
+        drive_param* p = add_param(s, load && engine_can_set_load(s->l) ? PK_LOAD : PK_MECH, group, mp.name, mp.unit,
+                                   mp.lo, mp.hi, mp.tlo, mp.thi, v);
+        if (!p) return;
+        p->mech = k;
+        snprintf(p->json, sizeof p->json, "%s", mp.path);
+    }
     int method = 0;
     for (int k = 0; k < NSOLVER; ++k)
         if (k_solver[k] == s->c.sim.solver) method = k;
-    add_param(s, PK_SOLVER, "solver", "method", "", 1, 0, NSOLVER - 1, NULL, NULL, method);
-    add_param(s, PK_STEP, "solver", "step", "ms", 1e-3, 0.05, 1.0, NULL, NULL, s->c.sim.h);
+    drive_param* p = add_param(s, PK_SOLVER, "solver", "method", "-", 0, NSOLVER - 1, 0, NSOLVER - 1, method);
+    if (p) p->scale = 1, p->unit[0] = 0;
+    add_param(s, PK_STEP, "solver", "step", "s", 0.05e-3, 1e-3, 0.05e-3, 1e-3, s->c.sim.h);
     // What cannot change in place rebuilds the world (loads back at their
     // start): applied once when the drag or the typing ends, not at every
-    // pixel. Masses and inertias change in place (engine_set_link); a length
-    // only where the engine can resize a boom (not the ode world's bodies).
-    // A tip load merged into the end arm (the ode validation world's: no
-    // load parameter, no load bodies) moves the end arm's centre of mass
-    // with its mass: a rebuild too.
+    // pixel. A link's mass, inertia and centre of mass go to engine_set_link
+    // (in place where the engine can); a length only where the engine can
+    // resize a boom (not the ode world's bodies). A tip load merged into the
+    // end arm (the ode validation world's: no load parameter, no load bodies)
+    // moves the end arm's centre of mass with its mass: a rebuild too. Every
+    // other mechanical value (gravity, column, mounts, sections) rebuilds.
     const bool resize = engine_can_resize_links(s->l);
     const bool tip_load = !engine_can_set_load(s->l) && !engine_load_name(s->l, 0, NULL) &&
                           sim_load_mass(s->m, &s->sc, &s->c.sim) > 0;
     for (int i = 0; i < s->nparam; ++i) {
-        drive_param* p = &s->param[i];
-        const bool mech = p->kind == PK_MECH;
-        p->on_release = p->kind == PK_STEP || p->kind == PK_SOLVER || (mech && !resize && strstr(p->json, ".length")) ||
-                        (mech && tip_load && strstr(p->json, "links[1].mass"));
+        drive_param* q = &s->param[i];
+        if (q->kind == PK_STEP || q->kind == PK_SOLVER) q->on_release = true;
+        if (q->kind != PK_MECH) continue;
+        const bool link = !strncmp(q->json, "mechanics.links[", 16);
+        const bool live_field = link && (strstr(q->json, ".mass") || strstr(q->json, ".inertia") ||
+                                         strstr(q->json, ".com") || (resize && strstr(q->json, ".length")));
+        q->on_release = !live_field || (tip_load && strstr(q->json, "links[1].mass"));
     }
 }
 
 // Keep the model document in step with a changed parameter, so "save model"
 // writes what is being driven.
 static void sync_json(drive_session* s, const drive_param* p) {
-    if (!p->json[0]) return;
-    char a[200], e[200];
+    if (!p->json[0] || p->kind == PK_SOLVER || p->kind == PK_STEP) return;
+    char a[240], e[200];
     snprintf(a, sizeof a, "%s=%.10g", p->json, p->value * p->scale);
     json_set_path(s->m->json, a, e, sizeof e);
 }
 
-// A panel's mechanical value from the mechanics: the field its JSON path
-// names ("mechanics.links[1].length").
-static double mech_value(const crane_mech* me, const char* json) {
-    const crane_link* ln = &me->link[strstr(json, "links[1]") ? 1 : 0];
-    return strstr(json, ".length") ? ln->length : ln->mass;
+// The model document's mechanics as the model has them (after an edit that
+// scaled other fields, or a revert).
+static void sync_mech_json(drive_session* s) {
+    for (int k = 0; k < model_param_count(); ++k) {
+        model_param mp;
+        model_param_info(k, &mp);
+        char a[240], e[200];
+        snprintf(a, sizeof a, "%s=%.10g", mp.path, *model_param_ptr(&s->m->mech, k));
+        json_set_path(s->m->json, a, e, sizeof e);
+    }
 }
 
-// The model document's links as the mechanics have them (after a revert).
-static void sync_mech_json(drive_session* s) {
-    static const char* const field[] = {"mass", "length", "com", "inertia"};
-    for (int k = 0; k < 2; ++k) {
-        const crane_link* ln = &s->m->mech.link[k];
-        const double v[] = {ln->mass, ln->length, ln->com, ln->inertia};
-        for (int j = 0; j < 4; ++j) {
-            char a[160], e[200];
-            snprintf(a, sizeof a, "mechanics.links[%d].%s=%.10g", k, field[j], v[j]);
-            json_set_path(s->m->json, a, e, sizeof e);
-        }
+// Panel values of the mechanics from the model (after an edit moved other
+// fields with it, or a revert).
+static void refresh_mech_params(drive_session* s) {
+    for (int i = 0; i < s->nparam; ++i) {
+        drive_param* p = &s->param[i];
+        if (p->kind == PK_MECH) p->value = *model_param_ptr(&s->m->mech, p->mech) / p->scale;
     }
 }
 
@@ -274,32 +353,40 @@ static void apply_param(drive_session* s, int i) {
         }
         break;
     case PK_MECH: {
-        // Only the edited link changes, and it keeps its own mass
-        // distribution: a new mass scales its inertia, a new length scales
-        // its centre of mass and (squared) its inertia. The model file's com
-        // and inertia follow, so "save model" saves what is being driven.
         crane_mech* me = &s->m->mech;
-        const int k = strstr(p->json, "links[1]") ? 1 : 0;
-        crane_link* ln = &me->link[k];
-        if (strstr(p->json, ".mass") && ln->mass > 0) {
-            ln->inertia *= si / ln->mass;
-            ln->mass = si;
-        } else if (strstr(p->json, ".length") && ln->length > 0) {
-            const double r = si / ln->length;
-            ln->com *= r;
-            ln->inertia *= r * r;
-            ln->length = si;
-        }
-        crane_mech_derive(me);
-        // In place where the backend can (the lagrange crane; an ode boom's
-        // mass and inertia), else one rebuild at the current pose.
-        if (engine_set_link(s->l, k, ln)) {
+        double* f = model_param_ptr(me, p->mech);
+        int k = -1;
+        if (sscanf(p->json, "mechanics.links[%d]", &k) == 1 && k >= 0 && k < 2) {
+            // Only the edited link changes, and it keeps its own mass
+            // distribution: a new mass scales its inertia, a new length
+            // scales its centre of mass and (squared) its inertia.
+            crane_link* ln = &me->link[k];
+            if (f == &ln->mass && ln->mass > 0) ln->inertia *= si / ln->mass;
+            if (f == &ln->length && ln->length > 0) {
+                const double r = si / ln->length;
+                ln->com *= r;
+                ln->inertia *= r * r;
+            }
+            *f = si;
+            crane_mech_derive(me);
+            // In place where the backend can (the lagrange crane; an ode
+            // boom's mass and inertia), else one rebuild at the current pose.
+            if (f == &ln->width || f == &ln->height || engine_set_link(s->l, k, ln)) {
+                s->rebuild = true;
+                snprintf(s->rebuild_why, sizeof s->rebuild_why, "%s/%s", p->group, p->label);
+            } else {
+                s->mech_live.link[k] = *ln; // the running world has it now
+            }
+        } else {
+            *f = si;
+            crane_mech_derive(me);
             s->rebuild = true;
             snprintf(s->rebuild_why, sizeof s->rebuild_why, "%s/%s", p->group, p->label);
-        } else {
-            s->mech_live.link[k] = *ln; // the running world has it now
         }
+        // The model file's fields that moved with it follow, so "save
+        // model" saves what is being driven; the panel shows them.
         sync_mech_json(s);
+        refresh_mech_params(s);
         break;
     }
     case PK_LOAD:
@@ -311,7 +398,6 @@ static void apply_param(drive_session* s, int i) {
         s->c.sim.solver = k_solver[k >= 0 && k < NSOLVER ? k : 0];
         s->rebuild = true;
         snprintf(s->rebuild_why, sizeof s->rebuild_why, "solver %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
-        sync_json(s, p);
         snprintf(s->status, sizeof s->status, "solver/method = %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
         return;
     }
@@ -357,9 +443,9 @@ static void rebuild_world(drive_session* s, bool at_start) {
         // unasked with the next rebuild.
         s->m->mech = s->mech_live;
         sync_mech_json(s);
+        refresh_mech_params(s);
         for (int i = 0; i < s->nparam; ++i) {
             drive_param* p = &s->param[i];
-            if (p->kind == PK_MECH) p->value = mech_value(&s->m->mech, p->json) / p->scale;
             if (p->kind == PK_STEP) p->value = s->c.sim.h / p->scale;
             if (p->kind == PK_SOLVER)
                 for (int k = 0; k < NSOLVER; ++k)
@@ -381,6 +467,13 @@ static void rebuild_world(drive_session* s, bool at_start) {
     ++s->segment;
     engine_destroy(s->l);
     s->l = l;
+    // The same circuit, so the same channels in the same order (the charts
+    // keep their indices); the list reads the new engine.
+    chan_list* cl = chan_list_create(l);
+    if (cl) {
+        chan_list_free(s->chans);
+        s->chans = cl;
+    }
     reapply_world_params(s);
     s->sim_offset = s->wall_last; // the new world's clock starts at 0 now
     if (at_start) {
@@ -391,28 +484,41 @@ static void rebuild_world(drive_session* s, bool at_start) {
     }
 }
 
-// Strip-chart channel list: CSV column names (not t), comma-separated, 1 to 8
-// of them, among the first ncol columns. Fills col[] and returns the count,
-// or -1 with a one-line message.
-static int parse_charts(const char* list, int ncol, int col[8], char* err, size_t errsz) {
+// Strip-chart channel list: channel names (not t), comma-separated, 1 to 8
+// of them: the engine's columns (among the first ncol) and, when cl is not
+// NULL, its circuit's channels ("lift_cyl.A.p"). Without cl a name with a
+// dot is taken as a circuit channel, checked when the session has its
+// circuit. Fills col[] (indices into cl, or columns; -1 for a deferred name)
+// and returns the count, or -1 with a one-line message.
+static int parse_charts(const char* opt, const char* list, int ncol, const chan_list* cl, int col[8], char* err,
+                        size_t errsz) {
     int n = 0;
     for (const char* p = list;; ++p) {
         const char* e = strchr(p, ',');
         size_t len = e ? (size_t)(e - p) : strlen(p);
         if (len == 0) {
-            snprintf(err, errsz, "--charts: expected column names separated by commas, got '%s'", list);
+            snprintf(err, errsz, "%s: expected column names separated by commas, got '%s'", opt, list);
             return -1;
         }
         int c = -1;
-        for (int k = 1; k < ncol; ++k)
-            if (strlen(sim_col_name[k]) == len && !strncmp(p, sim_col_name[k], len)) c = k;
-        if (c < 0) {
-            snprintf(err, errsz, "--charts: no column '%.*s'%s (see cranesim run --help for the names)", (int)len, p,
-                     ncol < SIM_NCOL ? " in the lagrange view" : "");
+        const int nch = cl ? chan_list_count(cl) : ncol;
+        for (int k = 1; k < nch; ++k) {
+            const char* nm = cl ? chan_list_channel(cl, k)->name : sim_col_name[k];
+            if (k >= ncol && k < chan_list_nrow(cl)) continue; // a world column the engine does not write
+            if (strlen(nm) == len && !strncmp(p, nm, len)) c = k;
+        }
+        const bool deferred = !cl && memchr(p, '.', len);
+        if (c < 0 && !deferred) {
+            // A circuit channel is named after the model's nodes and
+            // components (docs/render.md), a column is in run --help.
+            const bool circ = memchr(p, '.', len) != NULL;
+            snprintf(err, errsz, "%s: no %s '%.*s'%s (see %s for the names)", opt, circ ? "circuit channel" : "column",
+                     (int)len, p, ncol < SIM_NCOL && !circ ? " in the lagrange view" : "",
+                     circ ? "the model's node and component names, docs/render.md" : "cranesim run --help");
             return -1;
         }
         if (n == 8) {
-            snprintf(err, errsz, "--charts: at most 8 channels, got more in '%s'", list);
+            snprintf(err, errsz, "%s: at most 8 channels, got more in '%s'", opt, list);
             return -1;
         }
         col[n++] = c;
@@ -431,7 +537,12 @@ int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t
     }
     if (o->charts) {
         int col[8];
-        if (parse_charts(o->charts, sim_ncol(&c->sim), col, err, errsz) < 0)
+        if (parse_charts("--charts", o->charts, sim_ncol(&c->sim), NULL, col, err, errsz) < 0)
+            return EXIT_USAGE;
+    }
+    if (o->readouts) {
+        int col[8];
+        if (parse_charts("--readouts", o->readouts, sim_ncol(&c->sim), NULL, col, err, errsz) < 0)
             return EXIT_USAGE;
     }
     if (o->mapping_file) {
@@ -448,17 +559,20 @@ static int setup_charts(drive_session* s, const char* list, char* err, size_t er
                                         {0.5f, 0.9f, 0.4f, 1},   {0.8f, 0.5f, 0.95f, 1},  {0.95f, 0.6f, 0.2f, 1},
                                         {0.6f, 0.9f, 0.9f, 1},   {0.9f, 0.9f, 0.9f, 1}};
     int cols[8];
-    const int n = parse_charts(list, s->ncol, cols, err, errsz);
+    const int n = parse_charts("--charts", list, s->ncol, s->chans, cols, err, errsz);
     if (n < 0) return -1;
     for (int i = 0; i < n; ++i) {
         const int col = cols[i];
-        const char* u = sim_col_unit[col];
-        render_chart_def d = {.label = sim_col_name[col], .unit = u, .scale = 1, .ymin = -1, .ymax = 1, .group = 5};
+        const sim_channel* ch = chan_list_channel(s->chans, col);
+        const char* u = ch->unit;
+        render_chart_def d = {.label = ch->name, .unit = u, .scale = 1, .ymin = -1, .ymax = 1, .group = 5};
         if (!strcmp(u, "Pa")) d.unit = "MPa", d.scale = 1e-6, d.ymin = 0, d.ymax = 30, d.group = 0;
         else if (!strcmp(u, "m")) d.unit = "mm", d.scale = 1e3, d.ymin = -5000, d.ymax = 5000, d.group = 1;
         else if (!strcmp(u, "-")) d.unit = "%", d.scale = 100, d.ymin = -100, d.ymax = 100, d.group = 2;
         else if (!strcmp(u, "rad")) d.unit = "deg", d.scale = 180 / M_PI, d.ymin = -180, d.ymax = 180, d.group = 3;
         else if (!strcmp(u, "N")) d.unit = "kN", d.scale = 1e-3, d.ymin = -200, d.ymax = 200, d.group = 4;
+        else if (!strcmp(u, "m^3/s")) d.unit = "L/min", d.scale = 60000, d.ymin = -50, d.ymax = 50, d.group = 6;
+        if (col >= chan_list_nrow(s->chans)) s->chart_circuit = true;
         if (col == COL_X1 || col == COL_X2) d.ymin = 0, d.ymax = 700;
         memcpy(d.rgba, colours[s->nchart], sizeof d.rgba);
         s->chart_col[s->nchart] = col;
@@ -466,6 +580,99 @@ static int setup_charts(drive_session* s, const char* list, char* err, size_t er
         ++s->nchart;
     }
     return 0;
+}
+
+static void act_load(void* user) {
+    drive_session* s = user;
+    s->load_pending = true; // at the next tick: not from inside the panel's own drawing
+}
+
+static void act_reset(void* user);
+static void act_save(void* user);
+static void act_pause(void* user);
+
+// The panel for the model and engine as they are: generated entries, the
+// model file box and the actions. Replaces the old panel (a loaded model has
+// other components); the window stays shown or hidden as it was.
+static int setup_panel(drive_session* s) {
+    const bool shown = s->pn ? panel_gui_visible(s->pn) : false;
+    char filter[64] = "";
+    if (s->pn) {
+        snprintf(filter, sizeof filter, "%s", panel_filter(s->pn));
+        render_attach_panel(s->r, NULL);
+        panel_destroy(s->pn);
+    }
+    s->pn = panel_create();
+    if (!s->pn) return -1;
+    build_params(s);
+    for (int i = 0; i < s->nparam; ++i) {
+        drive_param* p = &s->param[i];
+        panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0, p->on_release};
+        s->pid[i] = p->kind == PK_SOLVER
+                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
+                        : panel_add_param(s->pn, &d);
+        if (p->kind != PK_SOLVER) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
+    }
+    panel_add_text(s->pn, "model file", s->load_path, sizeof s->load_path);
+    panel_add_action(s->pn, "reset run", act_reset, s);
+    panel_add_action(s->pn, "save model", act_save, s);
+    panel_add_action(s->pn, "pause / resume", act_pause, s);
+    panel_add_action(s->pn, "load model", act_load, s);
+    panel_set_filter(s->pn, filter);
+    render_attach_panel(s->r, s->pn);
+    panel_gui_show(s->pn, shown);
+    return 0;
+}
+
+// Charts on channels by name again, in a list that may have changed (a
+// loaded model): a channel the new circuit lacks is left empty.
+static void rebind_charts(drive_session* s) {
+    s->chart_circuit = false;
+    for (int i = 0; i < s->nchart; ++i) {
+        s->chart_col[i] = chan_list_find(s->chans, render_chart_label(s->r, s->chart_id[i]));
+        if (s->chart_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
+    }
+    for (int i = 0; i < s->nreadout; ++i) {
+        s->readout_col[i] = chan_list_find(s->chans, s->readout_name[i]);
+        if (s->readout_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
+    }
+    free(s->chan_v);
+    s->chan_v = calloc((size_t)chan_list_count(s->chans), sizeof *s->chan_v);
+}
+
+static void rebuild_world(drive_session* s, bool at_start);
+
+// Load the panel's model file and drive on with it in the same world, from
+// the current pose: a new engine, a new panel. A file that does not load, or
+// a model the world cannot be built with, leaves the running model as it
+// is, with the one-line reason in the panel and the status line.
+static void load_model(drive_session* s) {
+    char e[400];
+    model* nm = model_load(s->load_path[0] ? s->load_path : NULL, NULL, 0, e, sizeof e);
+    if (!nm) {
+        snprintf(s->status, sizeof s->status, "load failed (model kept): %s", e);
+        panel_set_message(s->pn, s->status);
+        fprintf(stderr, "cranesim drive: %s\n", s->status);
+        return;
+    }
+    model* old = s->m;
+    const int seg = s->segment;
+    s->m = nm;
+    rebuild_world(s, false);
+    if (s->segment == seg) {
+        // rebuild_world said why in the status line; the old engine runs on.
+        s->m = old;
+        model_free(nm);
+        snprintf(s->status, sizeof s->status, "load failed (model kept): %s", s->err);
+        panel_set_message(s->pn, s->status);
+        return;
+    }
+    model_free(old);
+    ++s->st.rebuilds;
+    rebind_charts(s);
+    setup_panel(s);
+    snprintf(s->status, sizeof s->status, "loaded %s (%s)", nm->file, nm->name);
+    panel_set_message(s->pn, s->status);
 }
 
 static void act_reset(void* user) {
@@ -642,6 +849,13 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         return NULL;
     }
     s->ncol = engine_ncol(s->l);
+    s->chans = chan_list_create(s->l);
+    s->chan_v = s->chans ? calloc((size_t)chan_list_count(s->chans), sizeof *s->chan_v) : NULL;
+    if (!s->chans || !s->chan_v) {
+        snprintf(err, errsz, "out of memory");
+        drive_session_destroy(s);
+        return NULL;
+    }
     // Keep reading the sticks when the 3D window is not focused (the operator
     // may click a plot or a terminal; and an offscreen view never has focus).
     SDL_SetHint(SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, "1");
@@ -673,23 +887,15 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         return NULL;
     }
     s->in = input_create(&map);
-    s->pn = panel_create();
-    build_params(s);
-    for (int i = 0; i < s->nparam; ++i) {
-        drive_param* p = &s->param[i];
-        panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0, p->on_release};
-        s->pid[i] = p->kind == PK_SOLVER
-                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
-                        : panel_add_param(s->pn, &d);
-    }
-    panel_add_action(s->pn, "reset run", act_reset, s);
-    panel_add_action(s->pn, "save model", act_save, s);
-    panel_add_action(s->pn, "pause / resume", act_pause, s);
-    render_attach_panel(s->r, s->pn);
+    snprintf(s->load_path, sizeof s->load_path, "%s", s->m->file);
     // The panel starts hidden (Tab shows it): on llvmpipe it costs ~4 fps at
     // 1280x720 (56 vs 60 fps, cranesim bench --config drive), and the scene
     // is what an operator watches while driving.
-    panel_gui_show(s->pn, false);
+    if (setup_panel(s)) {
+        snprintf(err, errsz, "out of memory");
+        drive_session_destroy(s);
+        return NULL;
+    }
     take_snapshot(s);
     if (o->charts) {
         if (setup_charts(s, o->charts, err, errsz)) {
@@ -702,6 +908,20 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         // slew rack is the third; the validation world and the lagrange
         // view have only the two boom cylinders.
         render_charts_default(s->r, s->snap->ncyl);
+    }
+    if (o->readouts) {
+        s->nreadout = parse_charts("--readouts", o->readouts, s->ncol, s->chans, s->readout_col, err, errsz);
+        if (s->nreadout < 0) {
+            drive_session_destroy(s);
+            *code = EXIT_USAGE;
+            return NULL;
+        }
+        for (int i = 0; i < s->nreadout; ++i) {
+            const sim_channel* ch = chan_list_channel(s->chans, s->readout_col[i]);
+            snprintf(s->readout_name[i], sizeof s->readout_name[i], "%s", ch->name);
+            s->readout_scale[i] = display_unit(ch->unit, s->readout_unit[i], sizeof s->readout_unit[i]);
+            if (s->readout_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
+        }
     }
     if (o->record_path && start_recording(s, o->record_path)) {
         snprintf(err, errsz, "%s", s->status);
@@ -730,6 +950,11 @@ void drive_session_destroy(drive_session* s) {
     if (s->r) render_destroy(s->r);
     engine_destroy(s->l);
     model_free(s->m);
+    chan_list_free(s->chans);
+    free(s->chan_v);
+    free(s->param);
+    free(s->pid);
+    free(s->changed);
     free(s->snap);
     free(s);
 }
@@ -808,9 +1033,24 @@ int drive_session_tick(drive_session* s, double wall) {
         if (render_save_png(s->r, path, e, sizeof e)) snprintf(s->status, sizeof s->status, "screenshot failed: %s", e);
         else snprintf(s->status, sizeof s->status, "saved %s", path);
     }
+    // Every change of this tick first, then applied one by one: applying one
+    // refreshes the mechanics entries it moves (a length scales its link's
+    // centre of mass), which must not undo another entry's new value.
+    int nchanged = 0;
     for (int id; (id = panel_next_changed(s->pn)) >= 0;)
         for (int i = 0; i < s->nparam; ++i)
-            if (s->pid[i] == id) apply_param(s, i);
+            if (s->pid[i] == id) {
+                s->changed[nchanged].i = i;
+                s->changed[nchanged++].v = s->param[i].value;
+            }
+    for (int k = 0; k < nchanged; ++k) {
+        s->param[s->changed[k].i].value = s->changed[k].v;
+        apply_param(s, s->changed[k].i);
+    }
+    if (s->load_pending) {
+        s->load_pending = false;
+        load_model(s);
+    }
     if (s->rebuild) {
         s->rebuild = false;
         const double t_at = s->t_base + engine_time(s->l);
@@ -870,7 +1110,11 @@ int drive_session_tick(drive_session* s, double wall) {
     const bool frame = wall >= s->wall_next_frame && !render_busy(s->r);
     // One CSV row per tick at most, shared by the recording and the charts.
     double row[SIM_NCOL];
-    if (s->rec || (frame && s->nchart)) session_row(s, row);
+    if (s->rec || (frame && (s->nchart || s->nreadout))) session_row(s, row);
+    if (frame && (s->nchart || s->nreadout)) {
+        memcpy(s->chan_v, row, sizeof *row * (size_t)chan_list_nrow(s->chans));
+        if (s->chart_circuit) chan_list_values(s->chans, s->l, s->chan_v, true);
+    }
     if (s->rec) record_row(s, row);
     if (frame) {
         char status[640];
@@ -883,9 +1127,20 @@ int drive_session_tick(drive_session* s, double wall) {
                  src, panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]", keys);
         render_set_status(s->r, status);
         take_snapshot(s);
-        if (s->nchart)
-            for (int i = 0; i < s->nchart; ++i) render_chart_push(s->r, s->chart_id[i], row[COL_T], row[s->chart_col[i]]);
-        else
+        if (s->nreadout) {
+            render_readout rd[8];
+            for (int i = 0; i < s->nreadout; ++i) {
+                const int k = s->readout_col[i];
+                // A channel a loaded model lacks reads NaN.
+                rd[i] = (render_readout){s->readout_name[i], s->readout_unit[i],
+                                         k >= 0 ? s->chan_v[k] / s->readout_scale[i] : NAN};
+            }
+            render_set_readouts(s->r, rd, s->nreadout);
+        }
+        if (s->nchart) {
+            for (int i = 0; i < s->nchart; ++i)
+                if (s->chart_col[i] >= 0) render_chart_push(s->r, s->chart_id[i], row[COL_T], s->chan_v[s->chart_col[i]]);
+        } else
             render_charts_sample(s->r, s->snap);
         render_snapshot(s);
         // Interval between frame starts; the first frame has none.
@@ -913,6 +1168,7 @@ render* drive_session_render_ctx(drive_session* s) { return s->r; }
 input* drive_session_input(drive_session* s) { return s->in; }
 panel* drive_session_panel(drive_session* s) { return s->pn; }
 void drive_session_row(drive_session* s, double* row) { session_row(s, row); }
+const chan_list* drive_session_channels(const drive_session* s) { return s->chans; }
 
 // "%.1f fps" of n events over wall seconds, or "n/a" when the interval is too
 // short for a rate to mean anything (a screenshot at t = 0).

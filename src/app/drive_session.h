@@ -39,6 +39,7 @@ typedef struct drive_opts {
     bool hud;                 ///< draw the HUD (default true)
     const char* charts;       ///< strip-chart channels: CSV column names, comma-separated
                               ///< ("p1A,p2A,x1,u1"); NULL: pressures, strokes, spools
+    const char* readouts;     ///< HUD readouts: channel names as charts, comma-separated; NULL: none
     const char* world_name;   ///< the ode world's name for the banner ("validation"); NULL: "sandbox"
     const char* save_as;      ///< "save model" writes (and replaces) this file; NULL: a new
                               ///< cranesim_model_N.json each time (drive_save_name)
@@ -111,6 +112,10 @@ struct input* drive_session_input(drive_session* s);
 struct panel* drive_session_panel(drive_session* s);
 /// The model being driven (edited in place by the panel; "save model" writes it).
 const model* drive_session_model(const drive_session* s);
+struct chan_list;
+/// The channels the session can chart (--charts names): the engine's
+/// columns, then its circuit's (channels.h).
+const struct chan_list* drive_session_channels(const drive_session* s);
 /// The row (CSV columns) at the current simulated time.
 void drive_session_row(drive_session* s, double* row);
 

@@ -200,3 +200,53 @@ void hyd_model_jacobian_pattern(const hyd_model* m, unsigned char* P) {
             }
     }
 }
+
+// ---- parameter tables, for generated parameter lists (the live panel) -----
+
+static int range_of(const hyd_param_info* p, int n, int k, double* lo, double* hi, double* tlo, double* thi) {
+    if (!p || k < 0 || k >= n) return -1;
+    if (lo) *lo = p[k].lo;
+    if (hi) *hi = p[k].hi;
+    if (tlo) *tlo = p[k].tlo;
+    if (thi) *thi = p[k].thi;
+    return 0;
+}
+
+int hyd_param_range(hyd_type t, int k, double* lo, double* hi, double* tlo, double* thi) {
+    int n;
+    const hyd_param_info* p = hyd_params_of(t, &n);
+    return range_of(p, n, k, lo, hi, tlo, thi);
+}
+
+int hyd_fluid_param_count(void) {
+    int n;
+    hyd_fluid_params(&n);
+    return n;
+}
+
+const char* hyd_fluid_param_name(int k) {
+    int n;
+    const hyd_param_info* p = hyd_fluid_params(&n);
+    return k >= 0 && k < n ? p[k].name : NULL;
+}
+
+const char* hyd_fluid_param_unit(int k) {
+    int n;
+    const hyd_param_info* p = hyd_fluid_params(&n);
+    return k >= 0 && k < n ? p[k].unit : NULL;
+}
+
+int hyd_fluid_param_range(int k, double* lo, double* hi, double* tlo, double* thi) {
+    int n;
+    const hyd_param_info* p = hyd_fluid_params(&n);
+    return range_of(p, n, k, lo, hi, tlo, thi);
+}
+
+int hyd_model_nelement(const hyd_model* m) { return m->nunode + m->ncomp; }
+
+const char* hyd_model_element(const hyd_model* m, int i, hyd_type* type) {
+    if (i < 0 || i >= m->nunode + m->ncomp) return NULL;
+    const hyd_elem* e = i < m->nunode ? &m->unode[i] : &m->comp[i - m->nunode];
+    if (type) *type = e->type;
+    return e->name;
+}

@@ -435,6 +435,20 @@ int hyd_model_get(const hyd_model* m, const char* path, double* value);
 int hyd_param_count(hyd_type t);
 const char* hyd_param_name(hyd_type t, int k);
 const char* hyd_param_unit(hyd_type t, int k);
+/// Hard range [lo, hi] (outside it a circuit is refused) and typical range
+/// [tlo, thi] (outside it the loader notes it) of parameter k of type t, in
+/// its unit (hyd_param_unit). Returns 0, or -1 when there is no such parameter.
+int hyd_param_range(hyd_type t, int k, double* lo, double* hi, double* tlo, double* thi);
+/// The fluid's parameters ("fluid.<name>"), likewise.
+int hyd_fluid_param_count(void);
+const char* hyd_fluid_param_name(int k);
+const char* hyd_fluid_param_unit(int k);
+int hyd_fluid_param_range(int k, double* lo, double* hi, double* tlo, double* thi);
+/// Elements with parameters: the declared nodes (tank, volume) first, then
+/// the components, in file order. hyd_model_element gives element i's name
+/// (the "<element>" of a parameter path) and type, or NULL when i is out of range.
+int hyd_model_nelement(const hyd_model* m);
+const char* hyd_model_element(const hyd_model* m, int i, hyd_type* type);
 
 // ---------------------------------------------------------------------------
 // Data: inputs, outputs, scratch. One per thread of use; the model may be shared.

@@ -271,7 +271,7 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     render_hud* h = &r->hud;
     const float sc = 1.5f, lh = 14.0f, col0 = 96.0f, colw = 84.0f;
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
-    const int nrows = 14;
+    const int nrows = 14 + r->nreadout;
     float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
     // The status line ("[keys: panel - Enter/Esc gives them back]") is the
     // widest text; the box grows to hold it rather than cut it at its edge.
@@ -323,6 +323,13 @@ static float draw_readouts(render* r, const world_snapshot* s) {
              s->truck_tilt * 180.0 / M_PI, s->p_supply * 1e-6);
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh;
+    // The app's channel readouts (render_set_readouts): name, value, unit
+    // as its channel list gives them.
+    for (int i = 0; i < r->nreadout; ++i) {
+        snprintf(buf, sizeof buf, "%s %.4g %s", r->readout[i].name, r->readout[i].value, r->readout[i].unit);
+        render_hud_text(h, x, y, sc, k_white, buf);
+        y += lh;
+    }
     if (r->status[0]) {
         render_hud_text(h, x, y, sc, k_amber, r->status);
         y += lh;

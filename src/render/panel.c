@@ -44,6 +44,9 @@ int panel_add_param(panel* p, const panel_param_def* d) {
     q->min = d->min;
     q->max = d->max;
     q->step = d->step > 0 ? d->step : (d->max - d->min) / 100.0;
+    q->smin = d->min;
+    q->smax = d->max;
+
     q->on_release = d->on_release;
     return p->nparam++;
 }
@@ -76,8 +79,8 @@ double panel_drag_speed(const panel* p, int id) {
     if (!p || id < 0 || id >= p->nparam) return 0;
     const panel_param* q = &p->param[id];
     const double v = q->has_pending ? q->pending : *q->value;
-    double floor = PANEL_DRAG_FLOOR * (q->max - q->min);
-    if (PANEL_DRAG_REL * fabs(q->min) > floor) floor = PANEL_DRAG_REL * fabs(q->min);
+    double floor = PANEL_DRAG_FLOOR * (q->smax - q->smin); // the slider range: a hard range spans decades
+    if (PANEL_DRAG_REL * fabs(q->smin) > floor) floor = PANEL_DRAG_REL * fabs(q->smin);
     const double rel = PANEL_DRAG_REL * fabs(v);
     return rel > floor ? rel : floor;
 }
@@ -280,3 +283,70 @@ const char* panel_action_label(const panel* p, int id) {
 const char* panel_last_error(const panel* p) {
     return p ? p->last_error : "";
 }
+
+void panel_set_slider_range(panel* p, int id, double min, double max) {
+    if (!p || id < 0 || id >= p->nparam || !(min < max)) return;
+    panel_param* q = &p->param[id];
+    q->smin = min > q->min ? min : q->min;
+    q->smax = max < q->max ? max : q->max;
+    if (!(q->smin < q->smax)) q->smin = q->min, q->smax = q->max;
+}
+
+void panel_slider_range(const panel* p, int id, double* min, double* max) {
+    if (!p || id < 0 || id >= p->nparam) return;
+    if (min) *min = p->param[id].smin;
+    if (max) *max = p->param[id].smax;
+}
+
+int panel_add_text(panel* p, const char* label, char* buf, size_t n) {
+    const int cap = (int)(sizeof p->text / sizeof p->text[0]);
+    if (!p || !label || !buf || n == 0 || p->ntext == cap) return -1;
+    panel_text* t = &p->text[p->ntext];
+    snprintf(t->label, sizeof t->label, "%s", label);
+    t->buf = buf;
+    t->n = n;
+    return p->ntext++;
+}
+
+int panel_text_count(const panel* p) { return p ? p->ntext : 0; }
+
+const char* panel_text_label(const panel* p, int id) {
+    return p && id >= 0 && id < p->ntext ? p->text[id].label : NULL;
+}
+
+bool panel_set_text(panel* p, const char* label, const char* text) {
+    for (int i = 0; p && label && i < p->ntext; ++i)
+        if (strcmp(p->text[i].label, label) == 0) {
+            snprintf(p->text[i].buf, p->text[i].n, "%s", text ? text : "");
+            return true;
+        }
+    return false;
+}
+
+void panel_set_filter(panel* p, const char* text) {
+    if (p) snprintf(p->filter, sizeof p->filter, "%s", text ? text : "");
+}
+
+const char* panel_filter(const panel* p) { return p ? p->filter : ""; }
+
+// Case-insensitive substring test (ASCII: the names are identifiers).
+static bool contains(const char* hay, const char* needle) {
+    const size_t n = strlen(needle);
+    for (const char* h = hay; *h; ++h) {
+        size_t k = 0;
+        while (k < n && h[k] && (h[k] | 0x20) == (needle[k] | 0x20)) ++k;
+        if (k == n) return true;
+    }
+    return n == 0;
+}
+
+bool panel_matches(const panel* p, int id) {
+    if (!p || id < 0 || id >= p->nparam) return false;
+    return !p->filter[0] || contains(p->param[id].group, p->filter) || contains(p->param[id].label, p->filter);
+}
+
+void panel_set_message(panel* p, const char* text) {
+    if (p) snprintf(p->message, sizeof p->message, "%s", text ? text : "");
+}
+
+const char* panel_message(const panel* p) { return p ? p->message : ""; }

@@ -38,7 +38,7 @@ typedef struct panel_param_def {
 
 /// Drag speed of the widgets: this fraction of the value per pixel (0.5 %),
 /// so a drag is as fine at 180 kg as at 1800 kg; near 0 at least
-/// PANEL_DRAG_REL of the range's lower end, or PANEL_DRAG_FLOOR of the range,
+/// PANEL_DRAG_REL of the slider range's lower end, or PANEL_DRAG_FLOOR of it,
 /// per pixel (a value at 0 still moves).
 #define PANEL_DRAG_REL 0.005
 #define PANEL_DRAG_FLOOR 1e-4
@@ -119,6 +119,28 @@ void panel_range(const panel* p, int id, double* min, double* max, double* step)
 int panel_action_count(const panel* p);
 const char* panel_action_label(const panel* p, int id);
 bool panel_run_action_id(panel* p, int id);
+/// Range a drag covers (e.g. a parameter's typical range, within [min, max]),
+/// within which the widget keeps a dragged value; a typed value may leave
+/// it and is checked against [min, max] only. By default [min, max].
+void panel_set_slider_range(panel* p, int id, double min, double max);
+void panel_slider_range(const panel* p, int id, double* min, double* max);
+/// Register a one-line text field (a file path) of n bytes at buf, shown
+/// above the parameters; the app reads buf when one of its actions runs.
+/// Returns its id (>= 0) or -1.
+int panel_add_text(panel* p, const char* label, char* buf, size_t n);
+int panel_text_count(const panel* p);
+const char* panel_text_label(const panel* p, int id);
+/// Set a text field by label (what typing into it does); false if absent.
+bool panel_set_text(panel* p, const char* label, const char* text);
+/// The filter box: parameters whose group or label contains it (ignoring
+/// case) are shown; "" shows all.
+void panel_set_filter(panel* p, const char* text);
+const char* panel_filter(const panel* p);
+/// Whether parameter id passes the filter.
+bool panel_matches(const panel* p, int id);
+/// A message shown under the actions (a failed load), "" for none.
+void panel_set_message(panel* p, const char* text);
+const char* panel_message(const panel* p);
 /// Last rejection message (shown in the GUI), "" if none.
 const char* panel_last_error(const panel* p);
 

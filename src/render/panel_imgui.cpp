@@ -44,7 +44,7 @@ void shown_label(const panel_param* q, char* out, size_t n) {
 void draw_group(panel* p, const char* group, float label_w) {
     for (int i = 0; i < p->nparam; ++i) {
         panel_param* q = &p->param[i];
-        if (std::strcmp(q->group, group) != 0) continue;
+        if (std::strcmp(q->group, group) != 0 || !panel_matches(p, i)) continue;
         char label[80];
         shown_label(q, label, sizeof label);
         ImGui::PushID(i);
@@ -69,8 +69,12 @@ void draw_group(panel* p, const char* group, float label_w) {
             // fraction of the value per pixel. A slider mapped the whole
             // range onto its width: 10 kg per pixel on a 180 kg boom.
             const float speed = (float)panel_drag_speed(p, i);
-            const bool changed = ImGui::DragScalar("##value", ImGuiDataType_Double, &v, speed, &q->min, &q->max, fmt,
-                                                   ImGuiSliderFlags_AlwaysClamp);
+            // A drag stays in the slider range (the typical range, widened
+            // to the current value); a typed value may go beyond it, and
+            // panel_set_id checks it against the hard range [min, max]
+            // (no AlwaysClamp: ImGui would clamp typed values too).
+            double lo = q->smin < v ? q->smin : v, hi = q->smax > v ? q->smax : v;
+            const bool changed = ImGui::DragScalar("##value", ImGuiDataType_Double, &v, speed, &lo, &hi, fmt, 0);
             const bool done = ImGui::IsItemDeactivatedAfterEdit();
             // Active with no mouse button down: the value is being typed
             // (Ctrl+click or double-click opened the text field), and each
@@ -218,6 +222,19 @@ extern "C" void panel_gui_draw(panel* p) {
             if (a) ImGui::SameLine();
             if (ImGui::Button(p->action[a].label)) panel_run_action_id(p, a);
         }
+        for (int t = 0; t < p->ntext; ++t) {
+            ImGui::PushID(1000 + t);
+            ImGui::SetNextItemWidth(-1.0f);
+            ImGui::InputTextWithHint("##text", p->text[t].label, p->text[t].buf, p->text[t].n);
+            ImGui::PopID();
+        }
+        ImGui::SetNextItemWidth(-1.0f);
+        ImGui::InputTextWithHint("##filter", "filter (component or parameter)", p->filter, sizeof p->filter);
+        if (p->message[0]) {
+            ImGui::PushTextWrapPos(0.0f);
+            ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.2f, 1.0f), "%s", p->message);
+            ImGui::PopTextWrapPos();
+        }
         // Who has the keyboard: while a value is typed the crane's keys go
         // here; Enter or Escape gives them back (below).
         ImGui::PushTextWrapPos(0.0f);
@@ -232,6 +249,10 @@ extern "C" void panel_gui_draw(panel* p) {
             for (int j = 0; j < i && first; ++j)
                 first = std::strcmp(p->param[j].group, p->param[i].group) != 0;
             if (!first) continue;
+            bool any = false;
+            for (int j = i; j < p->nparam && !any; ++j)
+                any = std::strcmp(p->param[j].group, p->param[i].group) == 0 && panel_matches(p, j);
+            if (!any) continue;
             if (ImGui::CollapsingHeader(p->param[i].group, ImGuiTreeNodeFlags_DefaultOpen))
                 draw_group(p, p->param[i].group, label_w);
         }

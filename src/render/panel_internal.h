@@ -13,6 +13,7 @@ typedef struct panel_param {
     char label[64], group[64], unit[16];
     double* value;
     double min, max, step;
+    double smin, smax;          ///< range a drag covers
     bool changed;
     bool on_release;            ///< applied only when an edit is finished
     bool has_pending;           ///< an on-release edit in progress
@@ -22,6 +23,12 @@ typedef struct panel_param {
     bool drawn;                 ///< drawn in the last frame, at rect
     float rect[4];              ///< x, y, w, h [px]
 } panel_param;
+
+typedef struct panel_text {
+    char label[64];
+    char* buf;
+    size_t n;
+} panel_text;
 
 typedef struct panel_action {
     char label[64];
@@ -34,6 +41,10 @@ struct panel {
     int nparam, capparam;
     panel_action* action;
     int naction, capaction;
+    panel_text text[4];
+    int ntext;
+    char filter[64];
+    char message[512];
     panel_change_fn on_change;
     void* on_change_user;
     char last_error[256];

@@ -263,6 +263,23 @@ void render_set_status(render* r, const char* text) {
 
 const char* render_get_status(const render* r) { return r->status; }
 
+const char* render_get_readout(const render* r, int k, double* value, const char** unit) {
+    if (k < 0 || k >= r->nreadout) return NULL;
+    if (value) *value = r->readout[k].value;
+    if (unit) *unit = r->readout[k].unit;
+    return r->readout[k].name;
+}
+
+void render_set_readouts(render* r, const render_readout* v, int n) {
+    r->nreadout = 0;
+    for (int i = 0; i < n && i < RENDER_MAX_READOUTS; ++i) {
+        snprintf(r->readout[i].name, sizeof r->readout[i].name, "%s", v[i].name ? v[i].name : "");
+        snprintf(r->readout[i].unit, sizeof r->readout[i].unit, "%s", v[i].unit ? v[i].unit : "");
+        r->readout[i].value = v[i].value;
+        ++r->nreadout;
+    }
+}
+
 void render_set_missed_deadlines(render* r, int missed) {
     r->missed_deadlines = missed;
 }

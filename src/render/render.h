@@ -177,6 +177,19 @@ bool render_attach_panel(render* r, panel* p);
 
 /// Short status line shown under the readouts (e.g. "PAUSED", "recording").
 void render_set_status(render* r, const char* text);
+/// Extra HUD readouts, one line each under the fixed ones: a channel's name,
+/// its value and unit as the caller shows them (display units). The app
+/// takes names and units from its channel list; n <= RENDER_MAX_READOUTS
+/// (more are dropped), 0 for none (the default).
+#define RENDER_MAX_READOUTS 8
+typedef struct render_readout {
+    const char* name;
+    const char* unit;
+    double value;
+} render_readout;
+void render_set_readouts(render* r, const render_readout* v, int n);
+/// Readout k as last set: its name (NULL when k is out of range), value and unit.
+const char* render_get_readout(const render* r, int k, double* value, const char** unit);
 /// The status line as last set.
 const char* render_get_status(const render* r);
 /// Longest warning line and most lines render_hud_warnings gives.

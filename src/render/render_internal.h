@@ -229,6 +229,11 @@ struct render {
     panel* panel;
     bool panel_gui;
     char status[128];
+    struct {
+        char name[64], unit[16];
+        double value;
+    } readout[RENDER_MAX_READOUTS]; ///< render_set_readouts
+    int nreadout;
     int missed_deadlines;
     bool have_frame;
     double frame_dt_avg; ///< smoothed wall time between frames [s]; the HUD shows 1 / it

@@ -73,6 +73,12 @@ bool engine_can_resize_links(const engine* e) { return e->ops->resize_links; }
 int engine_set_link(engine* e, int k, const crane_link* ln) { return e->ops->set_link(e, k, ln); }
 int engine_ncol(const engine* e) { return e->ops->nchannel; }
 
+void engine_circuit_state(engine* e, double* y, const hyd_data** in) {
+    const hyd_data* d = NULL;
+    e->ops->circuit_state(e, y, &d);
+    if (in) *in = d;
+}
+
 const sim_channel* engine_channels(const engine* e, int* n) {
     *n = e->ops->nchannel;
     return sim_channels;

@@ -88,6 +88,10 @@ const sim_channel* engine_channels(const engine* e, int* n);
 /// The channels of the engine o->mechanics names, before one exists (a run
 /// writes its CSV header from them).
 const sim_channel* engine_channels_for(const sim_opts* o, int* n);
+/// The circuit's state now, in the circuit's order (hyd_model_nstate of
+/// engine_circuit entries), into y; *in (may be NULL): the hydraulic data
+/// the engine last evaluated with (strokes, rates, valve commands).
+void engine_circuit_state(engine* e, double* y, const hyd_data** in);
 /// The number of engine_channels.
 int engine_ncol(const engine* e);
 

@@ -24,6 +24,10 @@ typedef struct engine_ops {
     const char* (*load_name)(const engine* e, int i, double* mass);
     bool (*attached)(const engine* e);
     hyd_model* (*circuit)(engine* e);
+    /// The circuit's state now, in its own order (hyd_model_nstate of
+    /// circuit()), into y; *in: the hydraulic data the engine last
+    /// evaluated with (its cylinder strokes, rates and valve commands).
+    void (*circuit_state)(engine* e, double* y, const hyd_data** in);
     /// NULL: the tip load is not a parameter of this backend.
     void (*set_load)(engine* e, double m3);
     int (*set_link)(engine* e, int k, const crane_link* ln);

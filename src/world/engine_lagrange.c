@@ -88,6 +88,13 @@ static void lag_destroy(engine* e) {
 
 static hyd_model* lag_circuit(engine* e) { return ((eng_lagrange*)e)->ls.mdl->hyd; }
 
+// The system state holds the circuit's states permuted (lsim.hpos).
+static void lag_circuit_state(engine* e, double* y, const hyd_data** in) {
+    eng_lagrange* l = (eng_lagrange*)e;
+    for (int j = 0; j < l->ls.nh; ++j) y[j] = l->y[l->ls.hpos[j]];
+    *in = l->ls.hd;
+}
+
 static void lag_set_load(engine* e, double m3) {
     eng_lagrange* l = (eng_lagrange*)e;
     if (l->ls.m3 == m3) return;
@@ -565,6 +572,7 @@ const engine_ops engine_lagrange_ops = {
     .set_commands = lag_set_commands,
     .hook = NULL, // no world, no hook
     .circuit = lag_circuit,
+    .circuit_state = lag_circuit_state,
     .set_load = lag_set_load,
     .set_link = lag_set_link,
     .resize_links = true, // the constants are made again from the model's links

@@ -66,6 +66,7 @@ static bool ode_attached(const engine* e) {
 }
 
 static hyd_model* ode_circuit(engine* e) { return ode_world_circuit(W(e)); }
+static void ode_circuit_state(engine* e, double* y, const hyd_data** in) { ode_world_circuit_state(W(e), y, in); }
 
 static int ode_set_link(engine* e, int k, const crane_link* ln) {
     return ode_world_set_link_mass(W(e), k, ln) ? 1 : 0;
@@ -268,6 +269,7 @@ const engine_ops engine_ode_ops = {
     .load_name = ode_load_name,
     .attached = ode_attached,
     .circuit = ode_circuit,
+    .circuit_state = ode_circuit_state,
     .set_load = NULL, // the world's loads are bodies, picked up with the hook
     .set_link = ode_set_link,
     .resize_links = false, // a body's geometry is fixed when it is built

@@ -262,3 +262,63 @@ int model_save(const model* m, const char* path, char* err, size_t errsz) {
     if (bad) snprintf(err, errsz, "%s: write failed", path);
     return bad ? -1 : 0;
 }
+
+// ---- the mechanics parameter table (generated parameter lists) ------------
+
+// Every scalar the mechanics section holds, with the ranges the loader
+// checks it against (the R_* above), so a panel or a sweep can list them
+// without knowing the file's layout.
+#define MP_(path, group, name, field, r) {path, group, name, offsetof(crane_mech, field), &r}
+typedef struct mech_entry {
+    const char* path, *group, *name;
+    size_t off;
+    const json_range* r;
+} mech_entry;
+static const mech_entry k_mech[] = {
+    MP_("mechanics.gravity", "mechanics", "gravity", gravity, R_GRAVITY),
+    MP_("mechanics.column.height", "mechanics", "column height", column_height, R_COLUMN_HEIGHT),
+    MP_("mechanics.column.mass", "mechanics", "column mass", column_mass, R_COLUMN_MASS),
+    MP_("mechanics.load_mass", "mechanics", "tip load", load_mass, R_LOAD),
+#define MP_LINK_(i)                                                                           \
+    MP_("mechanics.links[" #i "].length", "links[" #i "]", "length", link[i].length, R_LINK_LENGTH), \
+    MP_("mechanics.links[" #i "].mass", "links[" #i "]", "mass", link[i].mass, R_LINK_MASS),         \
+    MP_("mechanics.links[" #i "].com", "links[" #i "]", "com", link[i].com, R_LINK_COM),             \
+    MP_("mechanics.links[" #i "].inertia", "links[" #i "]", "inertia", link[i].inertia, R_LINK_INERTIA), \
+    MP_("mechanics.links[" #i "].width", "links[" #i "]", "width", link[i].width, R_LINK_SECTION),   \
+    MP_("mechanics.links[" #i "].height", "links[" #i "]", "height", link[i].height, R_LINK_SECTION)
+    MP_LINK_(0),
+    MP_LINK_(1),
+#define MP_ACT_(i)                                                                                              \
+    MP_("mechanics.actuators[" #i "].base_mount[0]", "actuators[" #i "]", "base mount x", act[i].base_mount[0], R_MOUNT), \
+    MP_("mechanics.actuators[" #i "].base_mount[1]", "actuators[" #i "]", "base mount z", act[i].base_mount[1], R_MOUNT), \
+    MP_("mechanics.actuators[" #i "].rod_mount[0]", "actuators[" #i "]", "rod mount x", act[i].rod_mount[0], R_MOUNT),   \
+    MP_("mechanics.actuators[" #i "].rod_mount[1]", "actuators[" #i "]", "rod mount z", act[i].rod_mount[1], R_MOUNT),   \
+    MP_("mechanics.actuators[" #i "].closed_length", "actuators[" #i "]", "closed length", act[i].closed_length,         \
+        R_CLOSED_LENGTH)
+    MP_ACT_(0),
+    MP_ACT_(1),
+};
+#undef MP_LINK_
+#undef MP_ACT_
+#undef MP_
+
+int model_param_count(void) { return (int)(sizeof k_mech / sizeof k_mech[0]); }
+
+int model_param_info(int k, model_param* out) {
+    if (k < 0 || k >= model_param_count()) return -1;
+    const mech_entry* e = &k_mech[k];
+    out->path = e->path;
+    out->group = e->group;
+    out->name = e->name;
+    out->unit = e->r->unit;
+    out->lo = e->r->lo;
+    out->hi = e->r->hi;
+    out->tlo = e->r->tlo;
+    out->thi = e->r->thi;
+    return 0;
+}
+
+double* model_param_ptr(crane_mech* me, int k) {
+    if (k < 0 || k >= model_param_count()) return NULL;
+    return (double*)((char*)me + k_mech[k].off);
+}

@@ -39,6 +39,21 @@ void model_free(model* m);
 /// Write the model's JSON (with overrides applied) to path. Returns 0 or -1.
 int model_save(const model* m, const char* path, char* err, size_t errsz);
 
+/// One scalar of the mechanics section, as the loader checks it.
+typedef struct model_param {
+    const char* path;  ///< its path in the model file ("mechanics.links[1].mass")
+    const char* group; ///< "mechanics", "links[0]", "links[1]", "actuators[0]", "actuators[1]"
+    const char* name;  ///< "mass", "base mount x", ...
+    const char* unit;  ///< SI unit ("kg", "m", "kg m^2", "m/s^2")
+    double lo, hi;     ///< hard range: outside it a file is refused [unit]
+    double tlo, thi;   ///< typical range: outside it the loader notes it [unit]
+} model_param;
+/// The mechanics parameter table: model_param_count() entries.
+int model_param_count(void);
+/// Entry k into *out; 0, or -1 when k is out of range.
+int model_param_info(int k, model_param* out);
+/// The field entry k names in me, or NULL when k is out of range.
+double* model_param_ptr(crane_mech* me, int k);
 /// The default model file: $CRANESIM_ASSETS/models/hiab031.json, else the
 /// source tree's assets folder compiled in, else ./assets/models/hiab031.json.
 const char* model_default_path(void);

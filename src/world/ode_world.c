@@ -1091,6 +1091,11 @@ void ode_world_lock_booms(ode_world* w, int lock) {
 
 hyd_model* ode_world_circuit(ode_world* w) { return w->hm; }
 
+void ode_world_circuit_state(const ode_world* w, double* y, const hyd_data** in) {
+    for (int i = 0; i < w->nh; ++i) y[i] = w->y[i];
+    *in = w->hd;
+}
+
 int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln) {
     if (k < 0 || k > 1 || !w->frame[k + 1].body) return -1;
     const crane_link* old = &w->mech.link[k];

@@ -128,6 +128,10 @@ void ode_world_get_state(const ode_world* w, ode_world_state* s);
 /// itself), for live parameter changes with hyd_model_set between steps;
 /// NULL without hydraulics.
 hyd_model* ode_world_circuit(ode_world* w);
+/// Its state now (hyd_model_nstate entries) into y, and the hydraulic data
+/// of its last evaluation (strokes, rates, commands) in *in (NULL without
+/// hydraulics): what the engine publishes as circuit channels.
+void ode_world_circuit_state(const ode_world* w, double* y, const hyd_data** in);
 /// Give boom k (0 lifting arm, 1 end arm) link ln's mass and inertia in
 /// place (dBodySetMass), keeping its motion. Returns 0, or -1 (nothing
 /// changed) when that needs a rebuild: another length, section or centre of

@@ -411,7 +411,7 @@ static void test_panel_change_takes_effect(void) {
     drive_session_row(s, row);
     CHECK(row[COL_P_PUMP] > 19e6, "pump line starts at %.2f MPa", row[COL_P_PUMP] * 1e-6);
     char msg[256];
-    CHECK(panel_set(drive_session_panel(s), "supply/pump pressure", 12.0, msg, sizeof msg) == PANEL_OK, "%s", msg);
+    CHECK(panel_set(drive_session_panel(s), "pump (pump)/p_set", 12.0, msg, sizeof msg) == PANEL_OK, "%s", msg);
     // The next tick applies it. The pump then stops delivering above its new
     // setting; open a valve so the pump line drains down to it.
     run_for(s, &wall, 1.0 / 240.0);
@@ -425,9 +425,9 @@ static void test_panel_change_takes_effect(void) {
     CHECK(row[COL_P_PUMP] < 13.0e6, "pump line %.2f MPa after lowering the setting to 12 MPa",
           row[COL_P_PUMP] * 1e-6);
     // Out of range is refused with a message, and nothing changes.
-    CHECK(panel_set(drive_session_panel(s), "supply/pump pressure", 99.0, msg, sizeof msg) == PANEL_OUT_OF_RANGE,
+    CHECK(panel_set(drive_session_panel(s), "pump (pump)/p_set", 150.0, msg, sizeof msg) == PANEL_OUT_OF_RANGE,
           "out of range accepted");
-    CHECK(strstr(msg, "pump pressure") != NULL, "message: %s", msg);
+    CHECK(strstr(msg, "p_set") != NULL, "message: %s", msg);
     drive_session_destroy(s);
 }
 
@@ -443,9 +443,9 @@ static void test_panel_boom_edit(void) {
     const model* m = drive_session_model(s);
     const crane_link l0 = m->mech.link[0], l1 = m->mech.link[1];
     char msg[256];
-    CHECK(panel_set(drive_session_panel(s), "booms/end arm mass", 2.0 * l1.mass, msg, sizeof msg) == PANEL_OK, "%s",
+    CHECK(panel_set(drive_session_panel(s), "end_arm (link)/mass", 2.0 * l1.mass, msg, sizeof msg) == PANEL_OK, "%s",
           msg);
-    CHECK(panel_set(drive_session_panel(s), "booms/lifting arm length", 1.1 * l0.length, msg, sizeof msg) == PANEL_OK,
+    CHECK(panel_set(drive_session_panel(s), "lifting_arm (link)/length", 1.1e3 * l0.length, msg, sizeof msg) == PANEL_OK,
           "%s", msg);
     double wall = 0;
     run_for(s, &wall, 2.0 / 240.0); // the ticks apply the changes
@@ -701,9 +701,12 @@ static void test_panel_gives_the_keyboard_back(void) {
     render* r = drive_session_render_ctx(s);
     double wall = 0;
     tap_key(s, &wall, SDL_SCANCODE_TAB); // show the panel
+    // The whole model's list is longer than the window: the filter box
+    // brings the end arm up, as an operator would.
+    panel_set_filter(pn, "end_arm");
     tick_and_draw(s, &wall);
     tick_and_draw(s, &wall);
-    const int id = panel_find(pn, "booms/end arm mass");
+    const int id = panel_find(pn, "end_arm (link)/mass");
     float rect[4];
     CHECK(panel_gui_item_rect(pn, id, rect), "end arm mass widget drawn");
     // The mouse over the widget (SDL's own state, which the ImGui backend
@@ -804,7 +807,7 @@ static void test_boom_mass_drag_in_place(void) {
         CHECK(run_for(s, &wall, 2.0) == 0, "loop: %s", drive_session_error(s));
         drive_session_row(s, row);
         const double p0 = row[COL_P1A], t0 = row[COL_T];
-        const int id = panel_find(drive_session_panel(s), "booms/lifting arm mass");
+        const int id = panel_find(drive_session_panel(s), "lifting_arm (link)/mass");
         const double m0 = panel_get(drive_session_panel(s), id);
         const double m1 = drag(s, &wall, id, 50);
         CHECK(fabs(m1 / m0 - pow(1.0 + PANEL_DRAG_REL, 50)) < 1e-9 && m1 < 1.3 * m0, "%s: 50 px took %.1f to %.1f kg",
@@ -837,7 +840,7 @@ static void test_length_rebuilds_once_on_release(void) {
     double wall = 0;
     run_for(s, &wall, 1.0);
     panel* pn = drive_session_panel(s);
-    const int id = panel_find(pn, "booms/lifting arm length");
+    const int id = panel_find(pn, "lifting_arm (link)/length");
     CHECK(panel_on_release(pn, id), "length applies on release in the ode world");
     const double L0 = drive_session_model(s)->mech.link[0].length;
     // Half the drag, not released: nothing applied yet.
@@ -854,13 +857,13 @@ static void test_length_rebuilds_once_on_release(void) {
           drive_session_stats(s)->rebuilds);
     panel_edit(pn, id, v, true);
     run_for(s, &wall, 1.0 / 240.0);
-    CHECK(fabs(drive_session_model(s)->mech.link[0].length - v) < 1e-12 && drive_session_stats(s)->rebuilds == 1,
+    CHECK(fabs(drive_session_model(s)->mech.link[0].length - v * 1e-3) < 1e-12 && drive_session_stats(s)->rebuilds == 1,
           "after release: %g m, %ld rebuilds", drive_session_model(s)->mech.link[0].length,
           drive_session_stats(s)->rebuilds);
     render_wait(drive_session_render_ctx(s), 1.0);
     run_for(s, &wall, 0.5);
     const char* st = render_get_status(drive_session_render_ctx(s));
-    CHECK(strstr(st, "world rebuilt at t = ") && strstr(st, "lifting arm length"), "status: '%s'", st);
+    CHECK(strstr(st, "world rebuilt at t = ") && strstr(st, "lifting_arm (link)/length"), "status: '%s'", st);
     char err[320];
     long rows = 0;
     CHECK(drive_session_finish_record(s, &rows, err, sizeof err) == 0, "record: %s", err);
@@ -901,15 +904,15 @@ static void test_failed_rebuild_keeps_the_running_world(void) {
     push_key(SDL_SCANCODE_UP, 0);
     run_for(s, &wall, 0.5);
     panel* pn = drive_session_panel(s);
-    const int id = panel_find(pn, "booms/lifting arm length");
+    const int id = panel_find(pn, "lifting_arm (link)/length");
     const double L0 = drive_session_model(s)->mech.link[0].length;
-    panel_edit(pn, id, L0 + 0.33, true);
+    panel_edit(pn, id, (L0 + 0.33) / 1e-3, true); // the panel shows mm
     run_for(s, &wall, 1.0 / 240.0);
     render_wait(drive_session_render_ctx(s), 1.0);
     run_for(s, &wall, 0.5);
     const char* st = render_get_status(drive_session_render_ctx(s));
     CHECK(strstr(st, "rebuild failed"), "lift at x1 = %.4f m: the longer arm was built: '%s'", lift_stroke(s), st);
-    CHECK(drive_session_model(s)->mech.link[0].length == L0 && panel_get(pn, id) == L0,
+    CHECK(drive_session_model(s)->mech.link[0].length == L0 && panel_get(pn, id) == L0 / 1e-3,
           "after the failed rebuild: model %g m, panel %g m, want %g", drive_session_model(s)->mech.link[0].length,
           panel_get(pn, id), L0);
     double before[SIM_NCOL], after[SIM_NCOL];
@@ -1114,9 +1117,9 @@ static void test_slew_valve_in_the_panel(void) {
     drive_session* s = open_session();
     if (!s) return;
     panel* pn = drive_session_panel(s);
-    CHECK(panel_find(pn, "slew valve/rated flow") >= 0, "no slew valve in the panel");
+    CHECK(panel_find(pn, "slew_valve (valve)/q_nominal") >= 0, "no slew valve in the panel");
     char msg[256];
-    CHECK(panel_set(pn, "slew valve/rated flow", 12.0, msg, sizeof msg) == PANEL_OK, "%s", msg);
+    CHECK(panel_set(pn, "slew_valve (valve)/q_nominal", 12.0, msg, sizeof msg) == PANEL_OK, "%s", msg);
     double wall = 0, v = 0;
     run_for(s, &wall, 0.1);
     CHECK(hyd_model_get(engine_circuit(drive_session_engine(s)), "slew_valve.q_nominal", &v) == 0 &&
