@@ -194,6 +194,9 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     printf("  world: %s; operator input: scripted (%s), %.0f commands/s; hydraulics %s at h = %g ms\n",
            ode ? world_name : "lagrange 2-DOF (no world)", sc.name, frame_rate, hyd_method_name(c->sim.solver),
            c->sim.h * 1e3);
+    if (sc.nfault)
+        printf("  (the scenario's %d fault event%s not played by drive: use run or compare)\n", sc.nfault,
+               sc.nfault > 1 ? "s are" : " is");
     const double frame = 1.0 / frame_rate;
     const long nframes = (long)ceil(duration * frame_rate - 1e-9);
     double w0 = sim_wall_time(), busy = 0, worst = 0;
