@@ -163,6 +163,15 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         return EXIT_USAGE;
     }
     char err[320];
+    if (sc.nfault) { // bursts need their orifices in the circuit (engine_fault_model)
+        model* fm = engine_fault_model(m, &sc, err, sizeof err);
+        model_free(m);
+        if (!fm) {
+            fprintf(stderr, "cranesim drive: %s\n", err);
+            return EXIT_USAGE;
+        }
+        m = fm;
+    }
     double m3 = sim_load_mass(m, &sc, &c->sim);
     engine* l = engine_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
     if (!l) {
@@ -194,9 +203,6 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     printf("  world: %s; operator input: scripted (%s), %.0f commands/s; hydraulics %s at h = %g ms\n",
            ode ? world_name : "lagrange 2-DOF (no world)", sc.name, frame_rate, hyd_method_name(c->sim.solver),
            c->sim.h * 1e3);
-    if (sc.nfault)
-        printf("  (the scenario's %d fault event%s not played by drive: use run or compare)\n", sc.nfault,
-               sc.nfault > 1 ? "s are" : " is");
     const double frame = 1.0 / frame_rate;
     const long nframes = (long)ceil(duration * frame_rate - 1e-9);
     double w0 = sim_wall_time(), busy = 0, worst = 0;

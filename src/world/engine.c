@@ -43,7 +43,7 @@ static void burst_name(char* out, size_t n, int i) { snprintf(out, n, "fault%d_b
 
 // The model with a closed orifice to the tank at each node a burst names
 // (so model files stay clean), or NULL with "file: faults[i].at: problem".
-static model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t errsz) {
+model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t errsz) {
     const hyd_model* hm = m->hyd;
     const char* tank = NULL;
     for (int i = 0; i < hyd_model_nnode(hm) && !tank; ++i)
@@ -164,6 +164,13 @@ void engine_play(engine* e, const scenario* sc, double tm, int* ev, double u[3],
                  void* user) {
     play_ctx pc = {e, on_hook, user};
     scenario_play(sc, tm, ev, u, play_hook, &pc);
+    // Faults act on the engine's circuit at the same time as the commands
+    // (bursts only if the engine was made from engine_fault_model's model).
+    if (sc->nfault) {
+        hyd_model* hm = engine_circuit(e);
+        if (!e->faults_ready) engine_faults_init(&e->faults, hm), e->faults_ready = true;
+        engine_faults_apply(&e->faults, hm, sc, tm);
+    }
 }
 
 void engine_destroy(engine* e) {
