@@ -167,6 +167,15 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         return EXIT_USAGE;
     }
     char err[320];
+    if (sc.nfault) { // bursts need their orifices in the circuit (engine_fault_model)
+        model* fm = engine_fault_model(m, &sc, err, sizeof err);
+        model_free(m);
+        if (!fm) {
+            fprintf(stderr, "cranesim drive: %s\n", err);
+            return EXIT_USAGE;
+        }
+        m = fm;
+    }
     double m3 = sim_load_mass(m, &sc, &c->sim);
     engine* l = engine_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
     if (!l) {

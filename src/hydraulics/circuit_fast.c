@@ -238,6 +238,9 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
         d->node_dV[c->nB] = -c->AB * v;
         d->cyl_F[ic] = hyd_cyl_force(c->AA, c->AB, c->bv, c->ks, c->cs, c->ws, c->s,
                                      p[c->nA], p[c->nB], x, v, &d->dFdx[ic], &d->dFdv[ic]);
+        double dseal;
+        d->cyl_F[ic] -= hyd_cyl_seal(c->Fc, c->Fs, c->vst, c->vsm, v, &dseal);
+        d->dFdv[ic] -= dseal;
         d->cyl_stop[ic] = (x > c->s) - (x < 0.0);
     }
 

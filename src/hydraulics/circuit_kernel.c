@@ -151,6 +151,7 @@ int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int na
         a->GB = m->hose[hb].G;
         a->AA = c->AA, a->AB = c->AB, a->s = c->s, a->VA0 = c->VA0, a->VB0 = c->VB0;
         a->CL = c->CL, a->bv = c->bv, a->ks = c->ks, a->cs = c->cs, a->ws = c->ws;
+        a->Fc = c->Fc, a->Fs = c->Fs, a->vst = c->vst, a->vsm = c->vsm;
         const int nodes[4] = {v->A, v->B, c->nA, c->nB};
         hyd_fused_node* recs[4] = {&a->hA, &a->hB, &a->cA, &a->cB};
         for (int j = 0; j < 4; ++j) {
@@ -271,6 +272,9 @@ FUSED_INLINE void actuator(const hyd_fused_act* a, const double* y, double pPL, 
     // Force with the end stops.
     double dFdx, dFdv;
     o->F = hyd_cyl_force(a->AA, a->AB, a->bv, a->ks, a->cs, a->ws, a->s, pA, pB, x, v, &dFdx, &dFdv);
+    double dseal;
+    o->F -= hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, v, &dseal);
+    dFdv -= dseal;
     if (partials) {
         const double sgn = pos ? 1.0 : -1.0;
         o->g1 = e.g1, o->g2 = e.g2, o->pos = pos;
@@ -655,6 +659,13 @@ void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const
     const v2 Fv = _mm_sub_pd(_mm_add_pd(_mm_sub_pd(_mm_sub_pd(_mm_mul_pd(pc[0], AA), _mm_mul_pd(pc[1], AB)),
                                                    _mm_mul_pd(ld(L->bv), vs)), z), z);
     _mm_storeu_pd(F, Fv);
+    // Seal friction lane by lane, after the store as the scalar kernel
+    // subtracts it after hyd_cyl_force (+0.0 when a cylinder has none).
+    for (int k2 = 0; k2 < 2; ++k2) {
+        const hyd_fused_act* a = &f->act[k2];
+        double dseal;
+        F[k2] -= hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, v[k2], &dseal);
+    }
 
     st_at(ydot, L->s_node[0], _mm_mul_pd(node_c2(m, L->bel[0], L->bec[0], ph[0], ld(L->hV0[0]), y, L->s_node[0]), nhA));
     st_at(ydot, L->s_node[1], _mm_mul_pd(node_c2(m, L->bel[1], L->bec[1], ph[1], ld(L->hV0[1]), y, L->s_node[1]), nhB));

@@ -64,6 +64,7 @@ typedef struct hyd_fused_act {
     double pT;             ///< valve tank pressure [Pa abs]
     double GA, GB;         ///< hose conductances [m^3/(s Pa)]
     double AA, AB, s, VA0, VB0, CL, bv, ks, cs, ws; ///< cylinder (hyd_cyl_c)
+    double Fc, Fs, vst, vsm;                        ///< seal friction (hyd_cyl_seal)
 } hyd_fused_act;
 
 /// Coupling partials of one actuator for the mechanics (hyd_fused_jacobian).

@@ -3,7 +3,8 @@
 //   A_A = pi D^2/4, A_B = pi (D^2 - d^2)/4
 //   V_A = V_A0 + A_A x,  V_B = V_B0 + A_B (s - x)   (dV_A/dt = A_A x', dV_B/dt = -A_B x')
 //   leakage A -> B: C_L (pA - pB)
-//   F = pA A_A - pB A_B - b_v x' + F_stop(x, x')
+//   F = pA A_A - pB A_B - b_v x' + F_stop(x, x') - F_seal(x')
+//   F_seal = (F_c + F_s exp(-(x'/v_st)^2)) tanh(x'/v_sm)   (seal friction)
 // The chambers are nodes owned by the cylinder; the pressure equation itself
 // is in volume.c. The end stop is a spring-damper that acts only beyond the
 // stroke, with penetration depth delta (-x below 0, x - s above s):
@@ -11,6 +12,12 @@
 //   S = delta^2/(2w) for delta < w, delta - w/2 beyond (spring with C1 onset)
 //   W = smoothstep(delta/w)                         (damper fades in, C1)
 // so F is C1 in x and x': no kink for the Jacobian or finite differences.
+// The seal friction is the Coulomb + Stribeck law of lumped friction models
+// (Olsson et al. 1998, the static part of the LuGre model without its bristle
+// state) with sign(x') replaced by tanh(x'/v_sm): smooth (C-infinity) through
+// zero velocity, so a held cylinder creeps at about v_sm atanh(F/F_break)
+// instead of sticking exactly. Its slope at rest, (F_c + F_s)/v_sm, is a
+// stiff viscous term the coupled Jacobian carries through dF/dx'.
 #include "hyd_cylinder.h"
 
 #include <math.h>
@@ -26,6 +33,12 @@ hyd_cylinder_def hyd_default_cylinder_def(void) {
     d.stop_width = 1e-3;
     d.p0_a = 1e5;
     d.p0_b = 1e5;
+    // Seal friction off by default (old circuits keep their numbers); the
+    // velocities are the usual Stribeck and regularisation widths.
+    d.coulomb = 0.0;
+    d.stribeck = 0.0;
+    d.v_stribeck = 0.01;
+    d.v_smooth = 1e-3;
     return d;
 }
 
@@ -52,6 +65,10 @@ static void cylinder_derive(hyd_model* m, const void* def, void* rec, int node0)
     c->ks = d->stop_stiffness;
     c->cs = d->stop_damping;
     c->ws = d->stop_width;
+    c->Fc = d->coulomb;
+    c->Fs = d->stribeck;
+    c->vst = d->v_stribeck;
+    c->vsm = d->v_smooth;
     // The chamber volume is written by the cylinder kernel each call.
     m->node_V0[node0] = m->node_V0[node0 + 1] = 0.0;
     m->node_bel[node0] = m->node_bel[node0 + 1] = m->fluid.bulk_modulus;
@@ -84,6 +101,9 @@ static void cylinders_eval(const hyd_model* m, hyd_data* d, const void* rec, int
         // dF/dx and dF/dv (used by hyd_jacobian; cheap enough to always write).
         d->cyl_F[k] = hyd_cyl_force(c->AA, c->AB, c->bv, c->ks, c->cs, c->ws, c->s, pA, pB, x, v,
                                     &d->dFdx[k], &d->dFdv[k]);
+        double dseal;
+        d->cyl_F[k] -= hyd_cyl_seal(c->Fc, c->Fs, c->vst, c->vsm, v, &dseal);
+        d->dFdv[k] -= dseal;
         d->cyl_stop[k] = (x > c->s) - (x < 0.0);
         d->comp_open[c->comp] = d->cyl_stop[k] != 0;
     }
@@ -134,6 +154,12 @@ static const hyd_param_info cylinder_params[] = {
     HYD_PARAM(hyd_cylinder_def, stop_width, "m", HYD_R_POS, 0, 1e-5, 0.05, 1e-4, 1e-2),
     HYD_PARAM(hyd_cylinder_def, p0_a, "Pa", HYD_R_NONNEG, 0, 0, 1e8, 0, 5e7),
     HYD_PARAM(hyd_cylinder_def, p0_b, "Pa", HYD_R_NONNEG, 0, 0, 1e8, 0, 5e7),
+    // Seal friction: typical Coulomb forces are 0.5-5 % of a crane cylinder's
+    // maximum force (a few kN for 100-200 kN cylinders); 1 MN is no seal.
+    HYD_PARAM(hyd_cylinder_def, coulomb, "N", HYD_R_NONNEG, 0, 0, 1e6, 0, 2e4),
+    HYD_PARAM(hyd_cylinder_def, stribeck, "N", HYD_R_NONNEG, 0, 0, 1e6, 0, 2e4),
+    HYD_PARAM(hyd_cylinder_def, v_stribeck, "m/s", HYD_R_POS, 0, 1e-5, 1, 1e-3, 0.1),
+    HYD_PARAM(hyd_cylinder_def, v_smooth, "m/s", HYD_R_POS, 0, 1e-7, 0.1, 1e-5, 1e-2),
 };
 // Chambers "<name>.A" (piston side) and "<name>.B", states "<name>.pA", "<name>.pB".
 static const hyd_owned_node cylinder_nodes[] = {{"A", "pA"}, {"B", "pB"}};

@@ -6,6 +6,8 @@
 
 #include "hyd_internal.h"
 
+#include <math.h>
+
 /// Cylinder end stop (see cylinder.c) of stiffness ks [N/m], damping cs
 /// [N s/m] and smoothing width ws [m]: force magnitude for penetration delta
 /// and its rate ddelta, with partials d|F|/ddelta (*fd) and d|F|/dddelta (*fv).
@@ -61,6 +63,24 @@ static inline double hyd_cyl_force(double AA, double AB, double bv, double ks, d
     *dFdx = -fdl - fdh;
     *dFdv = -bv - fvl - fvh;
     return pA * AA - pB * AB - bv * v + flo - fhi;
+}
+
+/// Seal friction [N] (Coulomb + Stribeck, opposing x'), smooth through zero:
+///   F_seal = (F_c + F_s exp(-(v/v_st)^2)) tanh(v/v_sm)
+/// F_c Coulomb [N], F_s breakaway excess [N] (static force F_c + F_s),
+/// v_st Stribeck velocity [m/s], v_sm regularisation width [m/s]. *dFdv [N s/m]
+/// is dF_seal/dv. With F_c = F_s = 0 it returns +0.0 and *dFdv = 0, so
+/// subtracting it leaves a force bit for bit (x - +0.0 == x for every x).
+static inline double hyd_cyl_seal(double Fc, double Fs, double vst, double vsm, double v, double* dFdv) {
+    if (Fc == 0.0 && Fs == 0.0) {
+        *dFdv = 0.0;
+        return 0.0;
+    }
+    const double r = v / vst, e = Fs * exp(-r * r), th = tanh(v / vsm);
+    const double mag = Fc + e;
+    // d/dv: mag (1 - th^2)/v_sm + th dmag/dv, dmag/dv = -2 r e / v_st.
+    *dFdv = mag * (1.0 - th * th) / vsm - 2.0 * r / vst * e * th;
+    return mag * th;
 }
 
 #endif

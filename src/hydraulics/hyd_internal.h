@@ -209,6 +209,7 @@ typedef struct hyd_valve_c {
 typedef struct hyd_cyl_c {
     int nA, nB, sA, sB, comp; ///< chamber nodes and their state indices
     double AA, AB, s, VA0, VB0, CL, bv, ks, cs, ws;
+    double Fc, Fs, vst, vsm; ///< seal friction: Coulomb, breakaway excess [N], Stribeck, smoothing [m/s]
 } hyd_cyl_c;
 
 /// calloc of n (at least 1) elements into p; true on success.

@@ -163,6 +163,10 @@ typedef struct hyd_cylinder_def {
     double stop_width;     ///< end-stop onset depth delta [m] (C1 smoothing); default 1e-3
     double p0_a;           ///< initial chamber A pressure [Pa abs]; default 1e5
     double p0_b;           ///< initial chamber B pressure [Pa abs]; default 1e5
+    double coulomb;        ///< seal Coulomb friction F_c [N]; default 0 (off)
+    double stribeck;       ///< seal breakaway excess F_s [N] (static force F_c + F_s); default 0
+    double v_stribeck;     ///< Stribeck velocity v_st [m/s]; default 0.01
+    double v_smooth;       ///< friction regularisation width v_sm [m/s] (tanh); default 1e-3
 } hyd_cylinder_def;
 
 /// Load-sensing variable pump: displacement state "<name>.disp" eps in [0, 1],

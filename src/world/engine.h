@@ -124,6 +124,11 @@ typedef struct engine_sink {
 /// messages are sim.h's; res as sim_run's (status 0, 1 numerical failure,
 /// 2 refused or stopped).
 int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
+/// The model a scenario with fault events runs on: a copy of m with a
+/// closed orifice to the tank at each node a hose burst names (engine_run
+/// makes it itself; a stepped driver passes it to engine_create). NULL with
+/// "file: faults[i].at: problem" in err.
+model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t errsz);
 /// The note for a dip below absolute zero the checks saw (sim_checks_note),
 /// or "".
 void engine_note(const engine* e, char* note, size_t n);

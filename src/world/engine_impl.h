@@ -39,14 +39,31 @@ typedef struct engine_ops {
     void (*snapshot)(engine* e, world_snapshot* s);
 } engine_ops;
 
+/// Fault events of a scenario (scenario.h) applied to a running circuit:
+/// each backend's scripted run calls engine_faults_apply at every step or
+/// breakpoint with the circuit it integrates. The bursts' orifices were
+/// added, closed, by engine_run (engine_fault_model).
+typedef struct engine_faults {
+    int pump;      ///< the pump component, or -1
+    double qmax0;  ///< its flow before any stop [m^3/s]
+} engine_faults;
+void engine_faults_init(engine_faults* f, const hyd_model* hm);
+/// Sets the burst areas and the pump's flow for time t [s]; only values
+/// that change are set (each set re-derives the circuit). Returns 1 if any
+/// changed.
+int engine_faults_apply(const engine_faults* f, hyd_model* hm, const scenario* sc, double t);
+
 struct engine {
     const engine_ops* ops;
     sim_opts o;
     char err[512];
     sim_checks chk; ///< the run checks every driver applies (sim.h)
     bool failed;    ///< a check or the step failed: the engine stays stopped
+    engine_faults faults; ///< for engine_play's fault events (faults_ready once initialised)
+    bool faults_ready;
 };
 
 extern const engine_ops engine_lagrange_ops, engine_ode_ops;
+
 
 #endif

@@ -363,6 +363,8 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     // in f' that an adaptive controller should not have to discover.
     double bp[2 * SCENARIO_MAX_POINTS * SCENARIO_NCMD + SCENARIO_MAX_EVENTS + 2];
     int nbp = scenario_breakpoints(sc, bp, (int)(sizeof bp / sizeof bp[0]) - 1);
+    engine_faults ef;
+    engine_faults_init(&ef, m->hyd);
     double t = 0.0;
     hyd_solver_stats cv = {0};
     double w0 = sim_wall_time();
@@ -373,6 +375,9 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
         double tb = i < nbp ? ceil(bp[i] / o->dt_out - 1e-9) * o->dt_out : t_end;
         if (tb > t_end) tb = t_end;
         if (tb <= t + 1e-12) continue;
+        // Faults (a burst opening, a pump stop's ramp) hold over a segment:
+        // their value at its midpoint, the breakpoints bound them.
+        engine_faults_apply(&ef, m->hyd, sc, 0.5 * (t + tb));
         if (s) hyd_solver_reset(s);
 #ifdef CRANESIM_HAVE_CVODE
         if (o->cvode) {

@@ -138,6 +138,8 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     if (nout < 1) nout = 1;
     double row[SIM_NCOL];
     int ev = 0;
+    engine_faults ef;
+    engine_faults_init(&ef, ode_world_circuit(w));
     double w0 = sim_wall_time();
     sim_ode_row(w, row);
     for (int k = 0; k < 4; ++k) res->p_peak[k] = row[COL_P1A + k];
@@ -175,6 +177,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         const double tm = t + 0.5 * dt;
         double u[3];
         scenario_play(sc, tm, &ev, u, play_hook, w);
+        engine_faults_apply(&ef, ode_world_circuit(w), sc, tm);
         ode_world_set_commands(w, u);
         if (ode_world_step(w, dt)) {
             res->status = SIM_FAILED;

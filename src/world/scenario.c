@@ -19,6 +19,68 @@
 static const json_range R_DURATION = {1e-3, 86400, 1e-3, 3600, "s"};
 static const json_range R_TIME = {0, 86400, 0, 86400, "s"};
 static const json_range R_LOAD = {0, CRANE_LOAD_MAX, 0, CRANE_LOAD_TYPICAL, "kg"};
+// A burst: from a pinhole (1e-8 m^2, 0.1 mm across) to a 110 mm bore
+// (1e-2 m^2); a 1/2" hose torn off is about 1.3e-4 m^2.
+static const json_range R_BURST_AREA = {1e-8, 1e-2, 1e-7, 5e-4, "m^2"};
+static const json_range R_BURST_CD = {0.1, 1, 0.5, 0.8, "-"};
+// Pump stop: a drive motor winding down takes 0.05-1 s; 0 is a step.
+static const json_range R_STOP_RAMP = {0, 10, 0, 2, "s"};
+
+static void load_faults(json_ctx* c, const cJSON* arr, scenario* s) {
+    if (!arr || c->failed) return;
+    const int n = cJSON_GetArraySize(arr);
+    if (n > SCENARIO_MAX_FAULTS) {
+        json_fail(c, "faults", "at most %d faults, got %d", SCENARIO_MAX_FAULTS, n);
+        return;
+    }
+    for (int i = 0; i < n && !c->failed; ++i) {
+        const cJSON* e = cJSON_GetArrayItem(arr, i);
+        char p[64];
+        json_path_index(p, sizeof p, "faults", i);
+        if (!cJSON_IsObject(e)) {
+            json_fail(c, p, "must be an object {\"t\": s, \"kind\": \"hose_burst\" | \"pump_stop\", ...}");
+            return;
+        }
+        scenario_fault* f = &s->fault[i];
+        char kind[32];
+        json_str(c, e, p, "kind", true, "", kind, sizeof kind);
+        if (c->failed) return;
+        char pk[96];
+        json_path(pk, sizeof pk, p, "kind");
+        if (!strcmp(kind, "hose_burst")) {
+            f->kind = SCENARIO_HOSE_BURST;
+            json_only_keys(c, e, p, (const char* const[]){"t", "kind", "at", "area", "cd", NULL});
+            json_str(c, e, p, "at", true, "", f->at, sizeof f->at);
+            if (!c->failed && !f->at[0]) {
+                char pa[96];
+                json_path(pa, sizeof pa, p, "at");
+                json_fail(c, pa, "must name a circuit node (a hose, or \"<cylinder>.A\" / \".B\")");
+            }
+            f->area = json_num_r(c, e, p, "area", true, 0, &R_BURST_AREA);
+            f->cd = json_num_r(c, e, p, "cd", false, 0.65, &R_BURST_CD);
+        } else if (!strcmp(kind, "pump_stop")) {
+            f->kind = SCENARIO_PUMP_STOP;
+            json_only_keys(c, e, p, (const char* const[]){"t", "kind", "ramp", NULL});
+            f->ramp = json_num_r(c, e, p, "ramp", false, 0.05, &R_STOP_RAMP);
+        } else {
+            json_fail(c, pk, "must be \"hose_burst\" or \"pump_stop\", got \"%s\"", kind);
+            return;
+        }
+        f->t = json_num_r(c, e, p, "t", true, 0, &R_TIME);
+        if (!c->failed && i > 0 && f->t < s->fault[i - 1].t) {
+            char pt[96];
+            json_path(pt, sizeof pt, p, "t");
+            json_fail(c, pt, "fault times must not decrease (%g after %g)", f->t, s->fault[i - 1].t);
+        }
+        for (int j = 0; j < i && !c->failed; ++j)
+            if (f->kind == SCENARIO_HOSE_BURST && s->fault[j].kind == SCENARIO_HOSE_BURST && !strcmp(f->at, s->fault[j].at)) {
+                char pa[96];
+                json_path(pa, sizeof pa, p, "at");
+                json_fail(c, pa, "node '%s' already bursts in faults[%d]", f->at, j);
+            }
+        if (!c->failed) s->nfault = i + 1;
+    }
+}
 
 const char* const scenario_cmd_name[SCENARIO_NCMD] = {"lift", "jib", "slew"};
 
@@ -61,7 +123,7 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
     }
     if (json_wrong_kind(&c, root, "scenario")) return -1;
     static const char* const keys[] = {"name", "description", "model", "duration", "load_mass",
-                                       "initial", "commands", "hook", NULL};
+                                       "initial", "commands", "hook", "faults", NULL};
     json_only_keys(&c, root, "", keys);
     json_str(&c, root, "", "name", false, "", s->name, sizeof s->name);
     json_str(&c, root, "", "description", false, "", s->description, sizeof s->description);
@@ -115,6 +177,8 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
             s->nevent = i + 1;
         }
     }
+    load_faults(&c, json_arr(&c, root, "", "faults", false), s);
+    snprintf(s->file, sizeof s->file, "%s", file ? file : "");
     json_flush_notes(&c);
     return c.failed ? -1 : 0;
 }
@@ -181,6 +245,13 @@ int scenario_breakpoints(const scenario* s, double* t, int cap) {
     for (int k = 0; k < SCENARIO_NCMD; ++k)
         for (int i = 0; i < s->cmd[k].n && n < cap; ++i) t[n++] = s->cmd[k].t[i];
     for (int i = 0; i < s->nevent && n < cap; ++i) t[n++] = s->event[i].t;
+    // Faults change the circuit: a run reapplies them at each breakpoint
+    // (engine_faults_apply), so a pump stop's ramp gets 8 of them.
+    for (int i = 0; i < s->nfault && n < cap; ++i) {
+        t[n++] = s->fault[i].t;
+        if (s->fault[i].kind == SCENARIO_PUMP_STOP && s->fault[i].ramp > 0)
+            for (int j = 1; j <= 8 && n < cap; ++j) t[n++] = s->fault[i].t + s->fault[i].ramp * j / 8.0;
+    }
     qsort(t, (size_t)n, sizeof *t, cmp_double);
     int m = 0;
     for (int i = 0; i < n; ++i)

@@ -29,6 +29,21 @@ typedef struct scenario_event {
     scenario_event_kind kind;
 } scenario_event;
 
+#define SCENARIO_MAX_FAULTS 8
+
+/// Fault events (docs/files.md, "faults"): a hose burst opens an orifice to
+/// the tank at a circuit node; a pump stop ramps the pump's flow to zero.
+typedef enum scenario_fault_kind { SCENARIO_HOSE_BURST = 1, SCENARIO_PUMP_STOP = 2 } scenario_fault_kind;
+
+typedef struct scenario_fault {
+    double t;                  ///< [s] when it starts
+    scenario_fault_kind kind;
+    char at[64];               ///< hose burst: the node (a hose or "<cylinder>.A"/".B")
+    double area;               ///< hose burst: opening area of the break [m^2]
+    double cd;                 ///< hose burst: discharge coefficient [-]
+    double ramp;               ///< pump stop: time for the flow to fall to zero [s]
+} scenario_fault;
+
 typedef struct scenario {
     char name[64];
     char description[256];
@@ -40,6 +55,9 @@ typedef struct scenario {
     scenario_signal cmd[SCENARIO_NCMD]; ///< lift, jib, slew
     int nevent;
     scenario_event event[SCENARIO_MAX_EVENTS];
+    int nfault;
+    scenario_fault fault[SCENARIO_MAX_FAULTS];
+    char file[128];            ///< file name it was loaded from, for messages
 } scenario;
 
 /// Names of the command channels: "lift", "jib", "slew".

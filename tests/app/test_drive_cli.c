@@ -285,6 +285,39 @@ static void test_drive_record_is_the_run(void) {
     remove("drv_same_drive.csv");
 }
 
+// The same with fault events: hose_burst (the lift chamber bursts at 2 s)
+// on the validation world. The drive plays the faults through engine_play,
+// the run through the ode backend's loop: the same rows, and the boom sinks
+// in both (the burst reached the drive's circuit).
+static void test_drive_plays_faults(void) {
+    static char run_csv[1 << 21], drv_csv[1 << 21];
+    remove("drv_fault_run.csv");
+    remove("drv_fault_drive.csv");
+    CHECK(cli_run("run --quiet --mechanics ode --world validation --scenario hose_burst --duration 3 "
+                  "--out drv_fault_run.csv",
+                  out, sizeof out) == 0,
+          "run: %s", out);
+    CHECK(drive(NULL, "--headless --quiet --mechanics ode --world validation --scenario hose_burst --duration 3 "
+                      "--frame-rate 1000 --record drv_fault_drive.csv") == 0,
+          "drive: %s", out);
+    const long nr = cli_read_file("drv_fault_run.csv", run_csv, sizeof run_csv);
+    const long nd = cli_read_file("drv_fault_drive.csv", drv_csv, sizeof drv_csv);
+    CHECK(nr > 0 && nd > 0, "files: run %ld, drive %ld bytes", nr, nd);
+    if (nr <= 0 || nd <= 0) return;
+    const char* r = strchr(run_csv, '\n');
+    const char* d = strchr(drv_csv, '\n');
+    if (r) r = strchr(r + 1, '\n'); // the run's t = 0 row
+    CHECK(r && d && strcmp(r + 1, d + 1) == 0, "the drive's record is not the run's CSV");
+    // Last row: lift stroke x1 (column 2) below its 418.1 mm before the burst.
+    long i = nd - 2; // before the final newline
+    while (i > 0 && drv_csv[i] != '\n') --i;
+    const char* last = drv_csv + i;
+    double t = 0, x1 = 1;
+    CHECK(last && sscanf(last + 1, "%lf,%lf", &t, &x1) == 2 && x1 < 0.40, "the boom did not sink: t %g x1 %g", t, x1);
+    remove("drv_fault_run.csv");
+    remove("drv_fault_drive.csv");
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_dead_display_runs_headless);
     RUN_TEST(test_dead_wayland_runs_headless);
@@ -294,5 +327,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_validation_world_report);
     RUN_TEST(test_help_keys_last);
     RUN_TEST(test_drive_record_is_the_run);
+    RUN_TEST(test_drive_plays_faults);
     TEST_MAIN_END();
 }

@@ -93,6 +93,7 @@ static void run_cases(const bad_case* cases, int n) {
 #define M "models/hiab031.json"
 #define S "scenarios/ramp.json"
 #define SB "scenarios/sandbox_swing.json"
+#define SF "scenarios/hose_burst.json"
 #define W "worlds/sandbox.json"
 #define WV "worlds/validation.json"
 
@@ -194,6 +195,20 @@ static const bad_case corpus[] = {
     {SCENARIO, "s_hook_inf.json", SP, NULL, "[24.0, \"release\"]", "[1e400, \"release\"]", "hook[1]",
      "must be a finite number"},
     {SCENARIO, "s_channel.json", S, NULL, "\"jib\":", "\"boom\":", "commands.boom", "unknown field"},
+    // fault events (scenarios/hose_burst.json)
+    {SCENARIO, "s_fault_kind.json", SF, NULL, "\"kind\": \"hose_burst\"", "\"kind\": \"hose_leak\"", "faults[0].kind",
+     "must be \"hose_burst\" or \"pump_stop\""},
+    {SCENARIO, "s_fault_at.json", SF, NULL, "\"at\": \"lift_cyl.A\", ", "", "faults[0].at", NULL},
+    {SCENARIO, "s_fault_node.json", SF, NULL, "\"lift_cyl.A\"", "\"lift_cyl.C\"", "faults[0].at", "no node 'lift_cyl.C'"},
+    {SCENARIO, "s_fault_tank.json", SF, NULL, "\"lift_cyl.A\"", "\"tank\"", "faults[0].at", "cannot open at the tank"},
+    {SCENARIO, "s_fault_area.json", SF, NULL, "\"area\": 2e-6", "\"area\": 5", "faults[0].area", "m^2"},
+    {SCENARIO, "s_fault_key.json", SF, NULL, "\"area\": 2e-6", "\"areas\": 2e-6", "faults[0].areas", "unknown field"},
+    {SCENARIO, "s_fault_ramp.json", SF, NULL, "\"area\": 2e-6}", "\"area\": 2e-6}, {\"t\": 3, \"kind\": \"pump_stop\", \"ramp\": -1}",
+     "faults[1].ramp", "[0, 10] s"},
+    {SCENARIO, "s_fault_order.json", SF, NULL, "\"area\": 2e-6}", "\"area\": 2e-6}, {\"t\": 1, \"kind\": \"pump_stop\"}",
+     "faults[1].t", "must not decrease"},
+    {SCENARIO, "s_fault_obj.json", SF, NULL, "{\"t\": 2.0, \"kind\": \"hose_burst\", \"at\": \"lift_cyl.A\", \"area\": 2e-6}", "[2, \"burst\"]",
+     "faults[0]", "must be an object"},
     // worlds
     {WORLD, "w_max_contacts.json", W, "ode.max_contacts=1e300", NULL, NULL, "ode.max_contacts", "<= 32"},
     {WORLD, "w_rope_links.json", W, "rope.links=2E67", NULL, NULL, "rope.links", "<= 16"},

@@ -577,12 +577,99 @@ static void test_fastest_rate(void) {
     hyd_model_free(c);
 }
 
+// Seal friction: dF/dx' of the reference evaluation against central
+// differences, across its regimes (sticking |v| < v_sm, the Stribeck dip
+// around v_st, sliding), and the one-pass kernels (scalar and two-lane) give
+// the reference force to rounding and the same dF/dx'.
+static void test_seal_partials(void) {
+    char err[256];
+    hyd_model* m = hyd_model_default_crane(err, sizeof err);
+    if (!m) return;
+    static const char* const set[] = {"lift_cyl.coulomb", "lift_cyl.stribeck", "jib_cyl.coulomb", "jib_cyl.stribeck"};
+    static const double val[] = {3000.0, 1500.0, 2000.0, 1000.0};
+    for (int i = 0; i < 4; ++i) CHECK(hyd_model_set(m, set[i], val[i], err, sizeof err) == 0, "%s", err);
+    hyd_data* d = hyd_data_create(m);
+    const int n = hyd_model_nstate(m);
+    int valve[2], cyl[2];
+    for (int k = 0; k < 2; ++k) {
+        cyl[k] = hyd_model_cylinder(m, k ? "jib_cyl" : "lift_cyl");
+        valve[k] = hyd_model_valve(m, k ? "jib_valve" : "lift_valve");
+    }
+    hyd_fused f;
+    char why[128] = "";
+    CHECK(hyd_fused_build(m, valve, cyl, 2, &f, why, sizeof why) == 0, "refused: %s", why);
+    double y[NMAX], yd[NMAX], J[NMAX * NMAX];
+    srand(777);
+    int bad_fd = 0, bad_k = 0, bad_2 = 0;
+    double worst = 0.0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        random_state(m, d, y);
+        for (int k = 0; k < 2; ++k) {
+            const int r = rand() % 3; // v_sm = 1 mm/s, v_st = 10 mm/s
+            d->cyl_v[cyl[k]] = r == 0 ? urand(-3e-3, 3e-3) : r == 1 ? urand(-0.03, 0.03) : urand(-0.3, 0.3);
+            d->cyl_x[cyl[k]] = urand(0.05, 0.5); // off the end stops: the seal term alone
+        }
+        hyd_jacobian(m, d, 0, y, yd, J, n, 0, 0);
+        double F[2], dFdv[2], x[2], v[2], cmd[2];
+        for (int k = 0; k < 2; ++k) {
+            F[k] = d->cyl_F[cyl[k]], dFdv[k] = d->dFdv[cyl[k]];
+            x[k] = d->cyl_x[cyl[k]], v[k] = d->cyl_v[cyl[k]], cmd[k] = d->valve_cmd[valve[k]];
+        }
+        for (int k = 0; k < 2; ++k) {
+            double* in = &d->cyl_v[cyl[k]];
+            const double v0 = *in, h = 1e-7;
+            *in = v0 + h;
+            hyd_eval(m, d, 0, y, yd);
+            const double Fp = d->cyl_F[cyl[k]];
+            *in = v0 - h;
+            hyd_eval(m, d, 0, y, yd);
+            const double Fm = d->cyl_F[cyl[k]];
+            *in = v0;
+            const double fd = (Fp - Fm) / (2 * h);
+            const double err_fd = fabs(fd - dFdv[k]) / (1e-5 * fabs(dFdv[k]) + 1e-14 * (fabs(F[k]) + 1e6) / h);
+            worst = fmax(worst, err_fd);
+            if (err_fd > 1.0 && bad_fd++ < 5)
+                CHECK(0, "trial %d cyl %d v = %g: dF/dv = %.10g, fd %.10g", trial, k, v0, dFdv[k], fd);
+        }
+        double ydf[NMAX], Ff[2], yd2[NMAX], F2[2], ydj[NMAX], Jf[NMAX * NMAX];
+        hyd_fused_eval(&f, y, x, v, cmd, ydf, Ff);
+        hyd_fused_eval2(&f, y, x, v, cmd, yd2, F2);
+        hyd_fused_coupling cp[2];
+        hyd_fused_jacobian(&f, y, x, v, cmd, ydj, Ff, Jf, n, cp);
+        for (int k = 0; k < 2; ++k) {
+            bad_k += !(fabs(Ff[k] - F[k]) <= 1e-12 * (fabs(F[k]) + 1e6));
+            bad_k += !(fabs(cp[k].dF_dv - dFdv[k]) <= 1e-12 * fabs(dFdv[k]));
+            bad_2 += !(F2[k] == Ff[k]);
+        }
+    }
+    // The seal force itself, by hand: F depends on x' only through -b_v x',
+    // the seal and the end stops (off here), so F(v) - F(-v) = -2 b_v v -
+    // 2 (F_c + F_s exp(-(v/v_st)^2)) tanh(v/v_sm). At v = v_st = 10 mm/s on
+    // the lift cylinder: -2 (5e3 0.01) - 2 (3000 + 1500/e) tanh(10) = -7203.6 N.
+    random_state(m, d, y);
+    d->cyl_x[cyl[0]] = 0.3;
+    d->cyl_v[cyl[0]] = 0.01;
+    hyd_eval(m, d, 0, y, yd);
+    const double Fplus = d->cyl_F[cyl[0]];
+    d->cyl_v[cyl[0]] = -0.01;
+    hyd_eval(m, d, 0, y, yd);
+    const double Fminus = d->cyl_F[cyl[0]];
+    CHECK_NEAR(Fplus - Fminus, -2 * 5e3 * 0.01 - 2 * (3000 + 1500 * exp(-1.0)) * tanh(10.0), 1e-6 * 1e6);
+    printf("  seal dF/dv: worst |fd - analytic| / tolerance %.3g\n", worst);
+    CHECK(bad_fd == 0, "%d seal partials disagree with central differences", bad_fd);
+    CHECK(bad_k == 0, "%d one-pass forces or dF/dv differ from the reference", bad_k);
+    CHECK(bad_2 == 0, "%d two-lane forces differ from the scalar kernel", bad_2);
+    hyd_data_free(d);
+    hyd_model_free(m);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_layout);
     RUN_TEST(test_jacobian_fd);
     RUN_TEST(test_flow_continuity);
     RUN_TEST(test_eval_mapped);
     RUN_TEST(test_fused);
+    RUN_TEST(test_seal_partials);
     RUN_TEST(test_fused_refuses);
     RUN_TEST(test_live_parameters);
     RUN_TEST(test_json_matches_default);

@@ -316,11 +316,75 @@ static void test_anti_cavitation(void) {
     }
 }
 
+// Seal friction holds a piston that is pushed below its breakaway force.
+// Both chambers drain to the tank through 1e-3 m^2 orifices, so the oil
+// holds no load: the only force against the push is the seal. Net push
+// (hand calculation): the tank pressure on the rod annulus, 1e5 Pa (A_A -
+// A_B) = 282.7 N outwards, against F_load. Breakaway F_b = F_c + F_s =
+// 4500 N. At a net 0.5 F_b inwards the tanh law lets it creep at
+// v = v_sm atanh(0.5) = 5.49e-5 m/s (viscous 5e3 N s/m adds 0.27 N, nothing):
+// it moves 55 um in 1 s, against 1.1 m (a = 2250 N / 500 kg, end stop at
+// 0.35 m) without seal friction. At 1.2 F_b it breaks away: a >= (1.2 F_b -
+// F_c - F_s) / M = 1.8 m/s^2 at first, at most (1.2 F_b - F_c) / M = 4.8 m/s^2
+// once sliding: 36..96 mm in 0.2 s.
+static void test_seal_breakaway(void) {
+    const double AA = PI * 0.01 / 4, AB = PI * (0.01 - 0.0036) / 4;
+    const double Fc = 3000.0, Fs = 1500.0, vsm = 1e-4, Fb = Fc + Fs;
+    const double Fhyd = 1e5 * (AA - AB);
+    for (int friction = 0; friction < 2; ++friction) {
+        for (int over = 0; over < 2; ++over) {
+            hyd_builder* b = hyd_builder_create();
+            add_tank(b, "tank", 0);
+            hyd_cylinder_def c = cyl_def();
+            c.p0_a = c.p0_b = 1e5;
+            if (friction) c.coulomb = Fc, c.stribeck = Fs, c.v_smooth = vsm;
+            hyd_add_cylinder(b, &c);
+            for (int k = 0; k < 2; ++k) {
+                hyd_orifice_def o = hyd_default_orifice_def();
+                o.name = k ? "drain_B" : "drain_A";
+                o.inlet = k ? "cyl.B" : "cyl.A";
+                o.outlet = "tank";
+                o.area = 1e-3;
+                hyd_add_orifice(b, &o);
+            }
+            rig r;
+            if (rig_open(&r, b)) return;
+            r.mech = 1;
+            r.M = 500.0;
+            const double push = (over ? 1.2 : 0.5) * Fb;
+            r.Fload = Fhyd + push; // net force -push (inwards)
+            double y[4];
+            hyd_model_initial_state(r.m, y);
+            const double x0 = 0.35;
+            y[r.n] = x0;
+            y[r.n + 1] = 0.0;
+            const double T = over ? 0.2 : 1.0;
+            rig_run(&r, HYD_ROS2, 1e-5, y, T);
+            const double moved = x0 - y[r.n];
+            if (!over) {
+                const double creep = vsm * atanh(0.5) * T;
+                printf("  seal %s, push 0.5 F_b: moved %.3g m in %g s (creep by hand %.3g m)\n",
+                       friction ? "on" : "off", moved, T, creep);
+                if (friction) CHECK(moved >= 0.0 && moved < 1.1 * creep, "held piston moved %g m", moved);
+                else CHECK(moved > 0.1, "without seal friction the piston should fall, moved %g m", moved);
+            } else if (friction) {
+                printf("  seal on, push 1.2 F_b: moved %.3g m in %g s\n", moved, T);
+                // 0.5 a t^2 with a between (1.2 F_b - F_b) / M and (1.2 F_b - F_c) / M.
+                const double lo = 0.5 * (0.2 * Fb / r.M) * T * T, hi = 0.5 * ((1.2 * Fb - Fc) / r.M) * T * T;
+                CHECK(moved > lo && moved < hi, "above breakaway: moved %g m, by hand %g..%g m", moved, lo, hi);
+            }
+            hyd_data_free(r.d);
+            hyd_model_free(r.m);
+        }
+    }
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_closed_volume);
     RUN_TEST(test_valve_cylinder_speed);
     RUN_TEST(test_relief_holds);
     RUN_TEST(test_spool_step);
     RUN_TEST(test_anti_cavitation);
+    RUN_TEST(test_seal_breakaway);
     TEST_MAIN_END();
 }
