@@ -66,9 +66,17 @@ static int hose_at(const hyd_model* m, int node) {
     return -1;
 }
 
-// The lane copy of a two-actuator circuit (hyd_fused_lanes), refreshed
-// whenever the records change (build, map).
+// The lane copy of a two-actuator circuit (hyd_fused_lanes) and the node
+// list of the events, refreshed whenever the records change (build, map).
 static void pack_lanes(hyd_fused* f) {
+    // The nodes' state indices in the order of hyd_fused_events' slots.
+    f->nev = 0;
+    for (int k = 0; k < f->nact; ++k) {
+        const hyd_fused_act* a = &f->act[k];
+        f->ev_s[f->nev++] = a->hA.s, f->ev_s[f->nev++] = a->hB.s;
+        f->ev_s[f->nev++] = a->cA.s, f->ev_s[f->nev++] = a->cB.s;
+    }
+    f->ev_s[f->nev++] = f->pl.s;
     f->lanes_ok = f->nact == 2 && f->m->air.use;
     if (!f->lanes_ok) return;
     hyd_fused_lanes* L = &f->ln;
@@ -151,6 +159,7 @@ int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int na
         a->GB = m->hose[hb].G;
         a->AA = c->AA, a->AB = c->AB, a->s = c->s, a->VA0 = c->VA0, a->VB0 = c->VB0;
         a->CL = c->CL, a->bv = c->bv, a->ks = c->ks, a->cs = c->cs, a->ws = c->ws;
+        a->inv_ws = 1.0 / c->ws;
         const int nodes[4] = {v->A, v->B, c->nA, c->nB};
         hyd_fused_node* recs[4] = {&a->hA, &a->hB, &a->cA, &a->cB};
         for (int j = 0; j < 4; ++j) {
@@ -321,46 +330,136 @@ static inline int low_octave(const hyd_fused_node* n, double p) {
     return p > 0.0 ? (int)(b >> 52) : INT_MIN; // at or below 0: lowest
 }
 
+// The interval (lo, hi) of pressures in which a node's octave and ramp
+// levels stay what node_events just stored, so that a later call with p
+// inside it would change nothing and count nothing (hyd_fused_events_update
+// then skips the node). Exact, with strict bounds on both sides: an
+// inclusive bound L becomes nextafter(L, -inf). Only the all-closed case
+// gets an interval (its bounds are pressures the laws compare with); a node
+// with an open relief or check gets an empty one (NaN) and is re-evaluated
+// at every call, as before.
+static void node_hold(const hyd_fused_node* n, double p, int o, double* lo, double* hi) {
+    if (!(n->p_lo < p && p < n->p_hi)) {
+        *lo = *hi = NAN;
+        return;
+    }
+    double l = n->p_lo, h = n->p_hi;
+    if (o == INT_MAX) { // p >= p_knee (or no air)
+        const double k = nextafter(n->p_knee, -HUGE_VAL);
+        if (k > l) l = k;
+    } else {
+        if (n->p_knee < h) h = n->p_knee;
+        if (o == INT_MIN) { // p <= 0
+            const double z = nextafter(0.0, HUGE_VAL);
+            if (z < h) h = z;
+        } else { // one binade: biased exponent o, [2^(o-1023), 2^(o-1022))
+            const uint64_t b0 = (uint64_t)o << 52, b1 = (uint64_t)(o + 1) << 52;
+            double L, U;
+            if (o == 0) L = 0.0; // subnormals: p > 0
+            else {
+                const uint64_t bl = b0 - 1; // the largest double below 2^(o-1023)
+                memcpy(&L, &bl, sizeof L);
+            }
+            memcpy(&U, &b1, sizeof U);
+            if (L > l) l = L;
+            if (U < h) h = U;
+        }
+    }
+    *lo = l, *hi = h;
+}
+
 // One node: its octave (slot *io of e->oct) and its ramps' levels (slots
-// from *il of e->lv). Returns 1 when either stiffened since the last call.
-static int node_events(hyd_fused_events* e, const hyd_fused_node* n, double p, int* io, int* il) {
+// from *il of e->lv), and the interval in which they hold. Returns 1 when
+// either stiffened since the last call.
+static int node_events(hyd_fused_events* e, const hyd_fused_node* n, double p, int io, int il) {
     int sw = 0;
     const int o = low_octave(n, p);
-    if (o > e->oct[*io] && o != INT_MAX) sw = 1;
-    e->oct[(*io)++] = o;
+    if (o > e->oct[io] && o != INT_MAX) sw = 1;
+    e->oct[io] = o;
+    node_hold(n, p, o, &e->hold_lo[io], &e->hold_hi[io]);
     if (n->p_lo < p && p < n->p_hi) { // every ramp closed: the common case
-        for (int i = 0; i < n->nramp; ++i) e->lv[(*il)++] = 0;
+        for (int i = 0; i < n->nramp; ++i) e->lv[il + i] = 0;
         return sw;
     }
     for (int i = 0; i < n->nramp; ++i) {
         const hyd_fused_ramp* r = &n->ramp[i];
         const double d = r->into ? r->p_tank - p : p - r->p_tank;
         const unsigned char lv = corner_level((d - r->pcr) * r->inv_w);
-        if (lv > e->lv[*il]) sw = 1;
-        e->lv[(*il)++] = lv;
+        if (lv > e->lv[il + i]) sw = 1;
+        e->lv[il + i] = lv;
     }
     return sw;
 }
 
+// A node inside its hold interval changes nothing (node_hold); the usual
+// case is two compares per node. NaN bounds (or p) take node_events.
+FUSED_INLINE int node_check(hyd_fused_events* e, const hyd_fused_node* n, double p, int* io, int* il,
+                            int fresh) {
+    const int i = (*io)++, l = *il;
+    *il += n->nramp;
+    if (!fresh && e->hold_lo[i] < p && p < e->hold_hi[i]) return 0;
+    return node_events(e, n, p, i, l);
+}
+
+// 1 when every node's pressure is strictly inside its hold interval (false
+// for NaN). With SSE2 two nodes per compare: this runs once per step.
+#if defined(__SSE2__)
+#include <emmintrin.h>
+static inline int nodes_held(const hyd_fused_events* e, const hyd_fused* f, const double* y) {
+    __m128d in = _mm_castsi128_pd(_mm_set1_epi32(-1));
+    int i = 0;
+    for (; i + 1 < f->nev; i += 2) {
+        const __m128d p = _mm_loadh_pd(_mm_load_sd(&y[f->ev_s[i]]), &y[f->ev_s[i + 1]]);
+        in = _mm_and_pd(in, _mm_and_pd(_mm_cmplt_pd(_mm_loadu_pd(&e->hold_lo[i]), p),
+                                       _mm_cmplt_pd(p, _mm_loadu_pd(&e->hold_hi[i]))));
+    }
+    int held = _mm_movemask_pd(in) == 3;
+    if (i < f->nev) {
+        const double p = y[f->ev_s[i]];
+        held &= e->hold_lo[i] < p && p < e->hold_hi[i];
+    }
+    return held;
+}
+#else
+static inline int nodes_held(const hyd_fused_events* e, const hyd_fused* f, const double* y) {
+    for (int i = 0; i < f->nev; ++i) {
+        const double p = y[f->ev_s[i]];
+        if (!(e->hold_lo[i] < p && p < e->hold_hi[i])) return 0;
+    }
+    return 1;
+}
+#endif
+
 unsigned long hyd_fused_events_update(hyd_fused_events* e, const hyd_fused* f, const double* y,
                                       const double* x, const double* cmd) {
     int sw = 0, io = 0, il = 0;
+    // The hold intervals come from f's thresholds: taken afresh for another
+    // circuit record or a new model revision (a rebuilt f).
+    const int fresh = !e->have || e->hold_f != f || e->hold_rev != f->m->revision;
+    e->hold_f = f;
+    e->hold_rev = f->m->revision;
+    // Every node inside its interval (nearly every step): no node changes.
+    // One pass over the packed state indices, left at the first node out.
+    int held = !fresh;
+    if (held) held = nodes_held(e, f, y);
     for (int k = 0; k < f->nact; ++k) {
         const hyd_fused_act* a = &f->act[k];
         if (!(fabs(cmd[k] - e->cmd[k]) <= HYD_FUSED_CMD_EVENT)) sw = 1;
         e->cmd[k] = cmd[k];
-        sw |= node_events(e, &a->hA, y[a->hA.s], &io, &il);
-        sw |= node_events(e, &a->hB, y[a->hB.s], &io, &il);
-        sw |= node_events(e, &a->cA, y[a->cA.s], &io, &il);
-        sw |= node_events(e, &a->cB, y[a->cB.s], &io, &il);
+        if (!held) {
+            sw |= node_check(e, &a->hA, y[a->hA.s], &io, &il, fresh);
+            sw |= node_check(e, &a->hB, y[a->hB.s], &io, &il, fresh);
+            sw |= node_check(e, &a->cA, y[a->cA.s], &io, &il, fresh);
+            sw |= node_check(e, &a->cB, y[a->cB.s], &io, &il, fresh);
+        }
         // End stops: penetration over the smoothing width ws (cylinder.c).
-        const double iw = 1.0 / a->ws;
+        const double iw = a->inv_ws;
         const unsigned char lo = corner_level(-x[k] * iw), hi = corner_level((x[k] - a->s) * iw);
         if (lo > e->stop[2 * k] || hi > e->stop[2 * k + 1]) sw = 1;
         e->stop[2 * k] = lo, e->stop[2 * k + 1] = hi;
     }
     const double pPL = y[f->pl.s];
-    sw |= node_events(e, &f->pl, pPL, &io, &il);
+    if (!held) sw |= node_check(e, &f->pl, pPL, &io, &il, fresh);
     // The pump's cut-off: a smoothstep over its band above pset, steep only
     // inside the band (level 1).
     const unsigned char lp = corner_level((pPL - f->p_in - f->pset) * f->inv_band);
