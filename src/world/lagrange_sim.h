@@ -109,6 +109,9 @@ void lsim_free(lsim* s);
 /// the block-diagonal pattern [spool] [hose A, chamber A] [hose B, chamber B]
 /// per actuator, 1x1 for other hydraulic states, [q1, q2, q1', q2'].
 hyd_problem lsim_problem(lsim* s, bool blocks);
+/// The valve commands at t [-]: u_cmd, or the scenario's at t (the last t's
+/// values kept in ks.cmd, as a scenario is a function of t).
+void lsim_commands(lsim* s, double t, double cmd[2]);
 
 /// Initial state at joint angles q0 [rad], at rest, with chamber pressures in
 /// static equilibrium with gravity (rod side or piston side at p_low [Pa abs])
