@@ -182,17 +182,10 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
 // for the run), so the last t's values are kept (lsim_ks.cmd): the events
 // at the start of a step, its first stage and the previous step's last
 // stage share t, and the tables are read once per step.
-void lsim_commands(lsim* s, double t, double cmd[2]) {
-    if (!s->scn) {
-        cmd[0] = s->u_cmd[0], cmd[1] = s->u_cmd[1];
-        return;
-    }
+void lsim_commands_read(lsim* s, double t) {
     lsim_ks* ks = &s->ks;
-    if (!(t == ks->cmd_t)) {
-        for (int i = 0; i < 2; ++i) ks->cmd[i] = scenario_command_hint(s->scn, i, t, &s->scn_seg_[i]);
-        ks->cmd_t = t;
-    }
-    cmd[0] = ks->cmd[0], cmd[1] = ks->cmd[1];
+    for (int i = 0; i < 2; ++i) ks->cmd[i] = scenario_command_hint(s->scn, i, t, &s->scn_seg_[i]);
+    ks->cmd_t = t;
 }
 
 static void commands(lsim* s, double t, double cmd[2]) { lsim_commands(s, t, cmd); }
