@@ -439,43 +439,62 @@ static inline int nodes_held(const hyd_fused_events* e, const hyd_fused* f, cons
 }
 #endif
 
-unsigned long hyd_fused_events_update(hyd_fused_events* e, const hyd_fused* f, const double* y,
-                                      const double* x, const double* cmd) {
-    int sw = 0, io = 0, il = 0;
-    // The hold intervals come from f's thresholds: taken afresh for another
-    // circuit record or a new model revision (a rebuilt f).
-    const int fresh = !e->have || e->hold_f != f || e->hold_rev != f->m->revision;
-    e->hold_f = f;
-    e->hold_rev = f->m->revision;
-    // Every node inside its interval (nearly every step): no node changes.
-    // One pass over the packed state indices, left at the first node out.
-    int held = !fresh;
-    if (held) held = nodes_held(e, f, y);
+// The command steps, end stops and the pump band: what every call looks
+// at. Returns 1 when one of them stiffened.
+FUSED_INLINE int other_events(hyd_fused_events* e, const hyd_fused* f, const double* y, const double* x,
+                              const double* cmd) {
+    int sw = 0;
     for (int k = 0; k < f->nact; ++k) {
         const hyd_fused_act* a = &f->act[k];
         if (!(fabs(cmd[k] - e->cmd[k]) <= HYD_FUSED_CMD_EVENT)) sw = 1;
         e->cmd[k] = cmd[k];
-        if (!held) {
-            sw |= node_check(e, &a->hA, y[a->hA.s], &io, &il, fresh);
-            sw |= node_check(e, &a->hB, y[a->hB.s], &io, &il, fresh);
-            sw |= node_check(e, &a->cA, y[a->cA.s], &io, &il, fresh);
-            sw |= node_check(e, &a->cB, y[a->cB.s], &io, &il, fresh);
-        }
         // End stops: penetration over the smoothing width ws (cylinder.c).
         const double iw = a->inv_ws;
         const unsigned char lo = corner_level(-x[k] * iw), hi = corner_level((x[k] - a->s) * iw);
         if (lo > e->stop[2 * k] || hi > e->stop[2 * k + 1]) sw = 1;
         e->stop[2 * k] = lo, e->stop[2 * k + 1] = hi;
     }
-    const double pPL = y[f->pl.s];
-    if (!held) sw |= node_check(e, &f->pl, pPL, &io, &il, fresh);
     // The pump's cut-off: a smoothstep over its band above pset, steep only
     // inside the band (level 1).
-    const unsigned char lp = corner_level((pPL - f->p_in - f->pset) * f->inv_band);
+    const unsigned char lp = corner_level((y[f->pl.s] - f->p_in - f->pset) * f->inv_band);
     if (lp == 1 && e->pump != 1) sw = 1;
     e->pump = lp;
+    return sw;
+}
+
+// A call with some node outside its hold interval (or none taken yet):
+// every node by node_check. Out of line, so that the common case keeps few
+// registers.
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static unsigned long events_nodes(hyd_fused_events* e, const hyd_fused* f, const double* y,
+                                  const double* x, const double* cmd, int fresh) {
+    int sw = 0, io = 0, il = 0;
+    for (int k = 0; k < f->nact; ++k) {
+        const hyd_fused_act* a = &f->act[k];
+        sw |= node_check(e, &a->hA, y[a->hA.s], &io, &il, fresh);
+        sw |= node_check(e, &a->hB, y[a->hB.s], &io, &il, fresh);
+        sw |= node_check(e, &a->cA, y[a->cA.s], &io, &il, fresh);
+        sw |= node_check(e, &a->cB, y[a->cB.s], &io, &il, fresh);
+    }
+    sw |= node_check(e, &f->pl, y[f->pl.s], &io, &il, fresh);
+    sw |= other_events(e, f, y, x, cmd);
     if (e->have && sw) ++e->count;
     e->have = 1;
+    return e->count;
+}
+
+unsigned long hyd_fused_events_update(hyd_fused_events* e, const hyd_fused* f, const double* y,
+                                      const double* x, const double* cmd) {
+    // The hold intervals come from f's thresholds: taken afresh for another
+    // circuit record or a new model revision (a rebuilt f).
+    const int fresh = !e->have || e->hold_f != f || e->hold_rev != f->m->revision;
+    e->hold_f = f;
+    e->hold_rev = f->m->revision;
+    // Every node inside its interval (nearly every step): no node changes.
+    if (fresh || !nodes_held(e, f, y)) return events_nodes(e, f, y, x, cmd, fresh);
+    if (other_events(e, f, y, x, cmd)) ++e->count; // (have is set: not fresh)
     return e->count;
 }
 
