@@ -77,6 +77,11 @@ static void pack_lanes(hyd_fused* f) {
         f->ev_s[f->nev++] = a->cA.s, f->ev_s[f->nev++] = a->cB.s;
     }
     f->ev_s[f->nev++] = f->pl.s;
+    f->stops_plain = f->nact == 2;
+    for (int k = 0; k < f->nact && k < 2; ++k) {
+        f->stroke2[k] = f->act[k].s;
+        f->stops_plain &= f->act[k].inv_ws > 0.0 && f->act[k].inv_ws < HUGE_VAL;
+    }
     f->lanes_ok = f->nact == 2 && f->m->air.use;
     if (!f->lanes_ok) return;
     hyd_fused_lanes* L = &f->ln;
@@ -444,6 +449,25 @@ static inline int nodes_held(const hyd_fused_events* e, const hyd_fused* f, cons
 FUSED_INLINE int other_events(hyd_fused_events* e, const hyd_fused* f, const double* y, const double* x,
                               const double* cmd) {
     int sw = 0;
+#if defined(__SSE2__)
+    // Two actuators, both strokes inside [0, s] and both stops free at the
+    // last call (the usual case): with 1/ws finite and > 0, -x/ws <= 0 and
+    // (x - s)/ws <= 0 exactly, so both levels stay 0; only the commands are
+    // compared, in one two-lane compare (false for NaN: a step).
+    if (f->nact == 2 && f->stops_plain) {
+        uint32_t st;
+        memcpy(&st, e->stop, sizeof st);
+        const __m128d xs = _mm_loadu_pd(x);
+        if (st == 0 && _mm_movemask_pd(_mm_and_pd(_mm_cmpge_pd(xs, _mm_setzero_pd()),
+                                                  _mm_cmple_pd(xs, _mm_loadu_pd(f->stroke2)))) == 3) {
+            const __m128d c = _mm_loadu_pd(cmd);
+            const __m128d d = _mm_andnot_pd(_mm_set1_pd(-0.0), _mm_sub_pd(c, _mm_loadu_pd(e->cmd)));
+            if (_mm_movemask_pd(_mm_cmple_pd(d, _mm_set1_pd(HYD_FUSED_CMD_EVENT))) != 3) sw = 1;
+            _mm_storeu_pd(e->cmd, c);
+            goto pump;
+        }
+    }
+#endif
     for (int k = 0; k < f->nact; ++k) {
         const hyd_fused_act* a = &f->act[k];
         if (!(fabs(cmd[k] - e->cmd[k]) <= HYD_FUSED_CMD_EVENT)) sw = 1;
@@ -454,8 +478,12 @@ FUSED_INLINE int other_events(hyd_fused_events* e, const hyd_fused* f, const dou
         if (lo > e->stop[2 * k] || hi > e->stop[2 * k + 1]) sw = 1;
         e->stop[2 * k] = lo, e->stop[2 * k + 1] = hi;
     }
+#if defined(__SSE2__)
+pump:
+#endif
     // The pump's cut-off: a smoothstep over its band above pset, steep only
     // inside the band (level 1).
+    {}
     const unsigned char lp = corner_level((y[f->pl.s] - f->p_in - f->pset) * f->inv_band);
     if (lp == 1 && e->pump != 1) sw = 1;
     e->pump = lp;

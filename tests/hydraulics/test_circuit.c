@@ -446,11 +446,13 @@ static double event_pressure(const hyd_fused_node* n) {
 }
 
 // hyd_fused_events_update skips the nodes whose pressure stays inside the
-// interval where their octave and ramp levels hold. Against the same
-// counter taken without that shortcut (the intervals invalidated before
-// every call): the same count after every call and the same stored levels,
-// over random walks that change one to three nodes at a time at the exact
-// switching pressures, and across a model edit that moves a relief's
+// interval where their octave and ramp levels hold, and checks strokes
+// inside [0, s] and the commands two lanes at a time. Against the same
+// counter taken without those shortcuts (the intervals invalidated before
+// every call, the stops and commands one by one): the same count after
+// every call and the same stored levels, over random walks that change one
+// to three nodes at a time at the exact switching pressures (and strokes
+// and commands at theirs), and across a model edit that moves a relief's
 // threshold (a rebuilt record at a new revision).
 static void test_fused_events_hold(void) {
     char err[256];
@@ -471,7 +473,7 @@ static void test_fused_events_hold(void) {
     srand(77);
     double y[NMAX];
     for (int i = 0; i < n; ++i) y[i] = 1e6;
-    const double x[2] = {0.5 * f.act[0].s, 0.5 * f.act[1].s}, cmd[2] = {0.0, 0.0};
+    double x[2] = {0.5 * f.act[0].s, 0.5 * f.act[1].s}, cmd[2] = {0.0, 0.0};
     int bad = 0, skipped = 0;
     for (int call = 0; call < 20000; ++call) {
         if (call == 10000) { // a live edit: the relief thresholds move
@@ -492,12 +494,30 @@ static void test_fused_events_hold(void) {
             const hyd_fused_node* nd = j == f.nev - 1 ? &f.pl : an[j % 4];
             y[f.ev_s[j]] = event_pressure(nd);
         }
-        er.hold_f = NULL; // the reference evaluates every node
+        // Strokes and commands: mostly still, sometimes at or beyond an end
+        // stop's edges (one ulp either side), a command step, or NaN.
+        for (int k = 0; k < 2; ++k) {
+            const double sk = f.act[k].s, wk = f.act[k].ws;
+            const double xs[9] = {0.5 * sk, 0.0, -0.0, nextafter(0.0, -1.0), sk, nextafter(sk, 2 * sk),
+                                  -0.5 * wk, sk + 2.0 * wk, NAN};
+            if (rand() % 8 == 0) x[k] = xs[rand() % 9];
+            if (rand() % 8 == 0) {
+                const int r = rand() % 4;
+                cmd[k] = r == 0 ? NAN : (r == 1 ? cmd[k] + 0.3 : urand(-1.0, 1.0) * 0.04 + (isnan(cmd[k]) ? 0.0 : cmd[k]));
+                if (fabs(cmd[k]) > 1.0) cmd[k] = 0.0;
+            }
+        }
+        // The reference evaluates every node and the stops and commands one
+        // by one (no two-lane check).
+        hyd_fused fr = f;
+        fr.stops_plain = 0;
+        er.hold_f = NULL;
         const unsigned long before = ec.count;
         const unsigned long cc = hyd_fused_events_update(&ec, &f, y, x, cmd);
-        const unsigned long cr = hyd_fused_events_update(&er, &f, y, x, cmd);
+        const unsigned long cr = hyd_fused_events_update(&er, &fr, y, x, cmd);
         skipped += cc == before;
-        bad += cc != cr || memcmp(ec.oct, er.oct, sizeof ec.oct) != 0 || memcmp(ec.lv, er.lv, sizeof ec.lv) != 0;
+        bad += cc != cr || memcmp(ec.oct, er.oct, sizeof ec.oct) != 0 || memcmp(ec.lv, er.lv, sizeof ec.lv) != 0 ||
+               memcmp(ec.stop, er.stop, sizeof ec.stop) != 0 || memcmp(ec.cmd, er.cmd, sizeof ec.cmd) != 0;
     }
     printf("  events: %lu counted in 20000 calls, %d calls without a switch\n", ec.count, skipped);
     CHECK(bad == 0, "%d calls where the held intervals changed the count or the levels", bad);
