@@ -66,9 +66,22 @@ static int hose_at(const hyd_model* m, int node) {
     return -1;
 }
 
-// The lane copy of a two-actuator circuit (hyd_fused_lanes), refreshed
-// whenever the records change (build, map).
+// The lane copy of a two-actuator circuit (hyd_fused_lanes) and the node
+// list of the events, refreshed whenever the records change (build, map).
 static void pack_lanes(hyd_fused* f) {
+    // The nodes' state indices in the order of hyd_fused_events' slots.
+    f->nev = 0;
+    for (int k = 0; k < f->nact; ++k) {
+        const hyd_fused_act* a = &f->act[k];
+        f->ev_s[f->nev++] = a->hA.s, f->ev_s[f->nev++] = a->hB.s;
+        f->ev_s[f->nev++] = a->cA.s, f->ev_s[f->nev++] = a->cB.s;
+    }
+    f->ev_s[f->nev++] = f->pl.s;
+    f->stops_plain = f->nact == 2;
+    for (int k = 0; k < f->nact && k < 2; ++k) {
+        f->stroke2[k] = f->act[k].s;
+        f->stops_plain &= f->act[k].inv_ws > 0.0 && f->act[k].inv_ws < HUGE_VAL;
+    }
     f->lanes_ok = f->nact == 2 && f->m->air.use;
     if (!f->lanes_ok) return;
     hyd_fused_lanes* L = &f->ln;
@@ -77,7 +90,7 @@ static void pack_lanes(hyd_fused* f) {
         L->Amax[k] = a->Amax, L->inv_tau[k] = a->inv_tau, L->ok[k] = a->ok, L->oinvP0[k] = a->oinvP0;
         L->okl[k] = a->okl, L->pT[k] = a->pT, L->GA[k] = a->GA, L->GB[k] = a->GB;
         L->AA[k] = a->AA, L->AB[k] = a->AB, L->s[k] = a->s, L->VA0[k] = a->VA0, L->VB0[k] = a->VB0;
-        L->VAmin[k] = HYD_VMIN_FRAC * a->VA0, L->VBmin[k] = HYD_VMIN_FRAC * a->VB0;
+        L->VAmin[k] = HYD_CYL_VMIN(a->VA0), L->VBmin[k] = HYD_CYL_VMIN(a->VB0);
         L->CL[k] = a->CL, L->bv[k] = a->bv;
         L->hV0[0][k] = a->hA.V0, L->hV0[1][k] = a->hB.V0;
         L->su[k] = a->su;
@@ -152,6 +165,7 @@ int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int na
         a->AA = c->AA, a->AB = c->AB, a->s = c->s, a->VA0 = c->VA0, a->VB0 = c->VB0;
         a->CL = c->CL, a->bv = c->bv, a->ks = c->ks, a->cs = c->cs, a->ws = c->ws;
         a->Fc = c->Fc, a->Fs = c->Fs, a->vst = c->vst, a->vsm = c->vsm;
+        a->inv_ws = 1.0 / c->ws;
         const int nodes[4] = {v->A, v->B, c->nA, c->nB};
         hyd_fused_node* recs[4] = {&a->hA, &a->hB, &a->cA, &a->cB};
         for (int j = 0; j < 4; ++j) {
@@ -227,6 +241,15 @@ FUSED_INLINE double node_c(const hyd_model* m, const hyd_fused_node* n, double p
     return hyd_node_c(m, n->bel, n->bec, p, V, NULL, NULL);
 }
 
+// Net inflows [m^3/s] of an actuator's nodes (the volume law's sum Q_in -
+// dV/dt): a hose from its valve port (in) less what it passes on (qh), a
+// chamber from its hose less the leakage A -> B, less dV/dt = A_A x' (A) or
+// -A_B x' (B); rq the node's reliefs and checks. One text for actuator() and
+// the two lanes.
+#define NET_HOSE(in, qh, rq) ((in) - (qh) + (rq))
+#define NET_CHAMBER_A(qh, leak, rq, AA, v) ((qh) - (leak) + (rq) - (AA) * (v))
+#define NET_CHAMBER_B(qh, leak, rq, AB, v) ((qh) + (leak) + (rq) + (AB) * (v))
+
 // Everything one actuator contributes, with or without partials. The
 // partials are "G": d(net inflow)/d(state), before scaling by Be/V.
 typedef struct act_out {
@@ -264,10 +287,10 @@ FUSED_INLINE void actuator(const hyd_fused_act* a, const double* y, double pPL, 
     hyd_cyl_volumes(a->VA0, a->VB0, a->AA, a->AB, a->s, x, &o->VA, &o->VB, &dVA, &dVB);
 
     double gA, gB, ghA, ghB;
-    o->nhA = inA - qhA + ramps_in(&a->hA, phA, &ghA);
-    o->nhB = inB - qhB + ramps_in(&a->hB, phB, &ghB);
-    o->nA = qhA - leak + ramps_in(&a->cA, pA, &gA) - a->AA * v;
-    o->nB = qhB + leak + ramps_in(&a->cB, pB, &gB) + a->AB * v;
+    o->nhA = NET_HOSE(inA, qhA, ramps_in(&a->hA, phA, &ghA));
+    o->nhB = NET_HOSE(inB, qhB, ramps_in(&a->hB, phB, &ghB));
+    o->nA = NET_CHAMBER_A(qhA, leak, ramps_in(&a->cA, pA, &gA), a->AA, v);
+    o->nB = NET_CHAMBER_B(qhB, leak, ramps_in(&a->cB, pB, &gB), a->AB, v);
 
     // Force with the end stops.
     double dFdx, dFdv;
@@ -325,53 +348,185 @@ static inline int low_octave(const hyd_fused_node* n, double p) {
     return p > 0.0 ? (int)(b >> 52) : INT_MIN; // at or below 0: lowest
 }
 
+// The interval (lo, hi) of pressures in which a node's octave and ramp
+// levels stay what node_events just stored, so that a later call with p
+// inside it would change nothing and count nothing (hyd_fused_events_update
+// then skips the node). Exact, with strict bounds on both sides: an
+// inclusive bound L becomes nextafter(L, -inf). Only the all-closed case
+// gets an interval (its bounds are pressures the laws compare with); a node
+// with an open relief or check gets an empty one (NaN) and is re-evaluated
+// at every call, as before.
+static void node_hold(const hyd_fused_node* n, double p, int o, double* lo, double* hi) {
+    if (!(n->p_lo < p && p < n->p_hi)) {
+        *lo = *hi = NAN;
+        return;
+    }
+    double l = n->p_lo, h = n->p_hi;
+    if (o == INT_MAX) { // p >= p_knee (or no air)
+        const double k = nextafter(n->p_knee, -HUGE_VAL);
+        if (k > l) l = k;
+    } else {
+        if (n->p_knee < h) h = n->p_knee;
+        if (o == INT_MIN) { // p <= 0
+            const double z = nextafter(0.0, HUGE_VAL);
+            if (z < h) h = z;
+        } else { // one binade: biased exponent o, [2^(o-1023), 2^(o-1022))
+            const uint64_t b0 = (uint64_t)o << 52, b1 = (uint64_t)(o + 1) << 52;
+            double L, U;
+            if (o == 0) L = 0.0; // subnormals: p > 0
+            else {
+                const uint64_t bl = b0 - 1; // the largest double below 2^(o-1023)
+                memcpy(&L, &bl, sizeof L);
+            }
+            memcpy(&U, &b1, sizeof U);
+            if (L > l) l = L;
+            if (U < h) h = U;
+        }
+    }
+    *lo = l, *hi = h;
+}
+
 // One node: its octave (slot *io of e->oct) and its ramps' levels (slots
-// from *il of e->lv). Returns 1 when either stiffened since the last call.
-static int node_events(hyd_fused_events* e, const hyd_fused_node* n, double p, int* io, int* il) {
+// from *il of e->lv), and the interval in which they hold. Returns 1 when
+// either stiffened since the last call.
+static int node_events(hyd_fused_events* e, const hyd_fused_node* n, double p, int io, int il) {
     int sw = 0;
     const int o = low_octave(n, p);
-    if (o > e->oct[*io] && o != INT_MAX) sw = 1;
-    e->oct[(*io)++] = o;
+    if (o > e->oct[io] && o != INT_MAX) sw = 1;
+    e->oct[io] = o;
+    node_hold(n, p, o, &e->hold_lo[io], &e->hold_hi[io]);
     if (n->p_lo < p && p < n->p_hi) { // every ramp closed: the common case
-        for (int i = 0; i < n->nramp; ++i) e->lv[(*il)++] = 0;
+        for (int i = 0; i < n->nramp; ++i) e->lv[il + i] = 0;
         return sw;
     }
     for (int i = 0; i < n->nramp; ++i) {
         const hyd_fused_ramp* r = &n->ramp[i];
         const double d = r->into ? r->p_tank - p : p - r->p_tank;
         const unsigned char lv = corner_level((d - r->pcr) * r->inv_w);
-        if (lv > e->lv[*il]) sw = 1;
-        e->lv[(*il)++] = lv;
+        if (lv > e->lv[il + i]) sw = 1;
+        e->lv[il + i] = lv;
     }
     return sw;
 }
 
-unsigned long hyd_fused_events_update(hyd_fused_events* e, const hyd_fused* f, const double* y,
-                                      const double* x, const double* cmd) {
-    int sw = 0, io = 0, il = 0;
+// A node inside its hold interval changes nothing (node_hold); the usual
+// case is two compares per node. NaN bounds (or p) take node_events.
+FUSED_INLINE int node_check(hyd_fused_events* e, const hyd_fused_node* n, double p, int* io, int* il,
+                            int fresh) {
+    const int i = (*io)++, l = *il;
+    *il += n->nramp;
+    if (!fresh && e->hold_lo[i] < p && p < e->hold_hi[i]) return 0;
+    return node_events(e, n, p, i, l);
+}
+
+// 1 when every node's pressure is strictly inside its hold interval (false
+// for NaN). With SSE2 two nodes per compare: this runs once per step.
+#if defined(__SSE2__)
+#include <emmintrin.h>
+static inline int nodes_held(const hyd_fused_events* e, const hyd_fused* f, const double* y) {
+    __m128d in = _mm_castsi128_pd(_mm_set1_epi32(-1));
+    int i = 0;
+    for (; i + 1 < f->nev; i += 2) {
+        const __m128d p = _mm_loadh_pd(_mm_load_sd(&y[f->ev_s[i]]), &y[f->ev_s[i + 1]]);
+        in = _mm_and_pd(in, _mm_and_pd(_mm_cmplt_pd(_mm_loadu_pd(&e->hold_lo[i]), p),
+                                       _mm_cmplt_pd(p, _mm_loadu_pd(&e->hold_hi[i]))));
+    }
+    int held = _mm_movemask_pd(in) == 3;
+    if (i < f->nev) {
+        const double p = y[f->ev_s[i]];
+        held &= e->hold_lo[i] < p && p < e->hold_hi[i];
+    }
+    return held;
+}
+#else
+static inline int nodes_held(const hyd_fused_events* e, const hyd_fused* f, const double* y) {
+    for (int i = 0; i < f->nev; ++i) {
+        const double p = y[f->ev_s[i]];
+        if (!(e->hold_lo[i] < p && p < e->hold_hi[i])) return 0;
+    }
+    return 1;
+}
+#endif
+
+// The command steps, end stops and the pump band: what every call looks
+// at. Returns 1 when one of them stiffened.
+FUSED_INLINE int other_events(hyd_fused_events* e, const hyd_fused* f, const double* y, const double* x,
+                              const double* cmd) {
+    int sw = 0;
+#if defined(__SSE2__)
+    // Two actuators, both strokes inside [0, s] and both stops free at the
+    // last call (the usual case): with 1/ws finite and > 0, -x/ws <= 0 and
+    // (x - s)/ws <= 0 exactly, so both levels stay 0; only the commands are
+    // compared, in one two-lane compare (false for NaN: a step).
+    if (f->nact == 2 && f->stops_plain) {
+        uint32_t st;
+        memcpy(&st, e->stop, sizeof st);
+        const __m128d xs = _mm_loadu_pd(x);
+        if (st == 0 && _mm_movemask_pd(_mm_and_pd(_mm_cmpge_pd(xs, _mm_setzero_pd()),
+                                                  _mm_cmple_pd(xs, _mm_loadu_pd(f->stroke2)))) == 3) {
+            const __m128d c = _mm_loadu_pd(cmd);
+            const __m128d d = _mm_andnot_pd(_mm_set1_pd(-0.0), _mm_sub_pd(c, _mm_loadu_pd(e->cmd)));
+            if (_mm_movemask_pd(_mm_cmple_pd(d, _mm_set1_pd(HYD_FUSED_CMD_EVENT))) != 3) sw = 1;
+            _mm_storeu_pd(e->cmd, c);
+            goto pump;
+        }
+    }
+#endif
     for (int k = 0; k < f->nact; ++k) {
         const hyd_fused_act* a = &f->act[k];
         if (!(fabs(cmd[k] - e->cmd[k]) <= HYD_FUSED_CMD_EVENT)) sw = 1;
         e->cmd[k] = cmd[k];
-        sw |= node_events(e, &a->hA, y[a->hA.s], &io, &il);
-        sw |= node_events(e, &a->hB, y[a->hB.s], &io, &il);
-        sw |= node_events(e, &a->cA, y[a->cA.s], &io, &il);
-        sw |= node_events(e, &a->cB, y[a->cB.s], &io, &il);
         // End stops: penetration over the smoothing width ws (cylinder.c).
-        const double iw = 1.0 / a->ws;
+        const double iw = a->inv_ws;
         const unsigned char lo = corner_level(-x[k] * iw), hi = corner_level((x[k] - a->s) * iw);
         if (lo > e->stop[2 * k] || hi > e->stop[2 * k + 1]) sw = 1;
         e->stop[2 * k] = lo, e->stop[2 * k + 1] = hi;
     }
-    const double pPL = y[f->pl.s];
-    sw |= node_events(e, &f->pl, pPL, &io, &il);
+#if defined(__SSE2__)
+pump:
+#endif
     // The pump's cut-off: a smoothstep over its band above pset, steep only
     // inside the band (level 1).
-    const unsigned char lp = corner_level((pPL - f->p_in - f->pset) * f->inv_band);
+    {}
+    const unsigned char lp = corner_level((y[f->pl.s] - f->p_in - f->pset) * f->inv_band);
     if (lp == 1 && e->pump != 1) sw = 1;
     e->pump = lp;
+    return sw;
+}
+
+// A call with some node outside its hold interval (or none taken yet):
+// every node by node_check. Out of line, so that the common case keeps few
+// registers.
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static unsigned long events_nodes(hyd_fused_events* e, const hyd_fused* f, const double* y,
+                                  const double* x, const double* cmd, int fresh) {
+    int sw = 0, io = 0, il = 0;
+    for (int k = 0; k < f->nact; ++k) {
+        const hyd_fused_act* a = &f->act[k];
+        sw |= node_check(e, &a->hA, y[a->hA.s], &io, &il, fresh);
+        sw |= node_check(e, &a->hB, y[a->hB.s], &io, &il, fresh);
+        sw |= node_check(e, &a->cA, y[a->cA.s], &io, &il, fresh);
+        sw |= node_check(e, &a->cB, y[a->cB.s], &io, &il, fresh);
+    }
+    sw |= node_check(e, &f->pl, y[f->pl.s], &io, &il, fresh);
+    sw |= other_events(e, f, y, x, cmd);
     if (e->have && sw) ++e->count;
     e->have = 1;
+    return e->count;
+}
+
+unsigned long hyd_fused_events_update(hyd_fused_events* e, const hyd_fused* f, const double* y,
+                                      const double* x, const double* cmd) {
+    // The hold intervals come from f's thresholds: taken afresh for another
+    // circuit record or a new model revision (a rebuilt f).
+    const int fresh = !e->have || e->hold_f != f || e->hold_rev != f->m->revision;
+    e->hold_f = f;
+    e->hold_rev = f->m->revision;
+    // Every node inside its interval (nearly every step): no node changes.
+    if (fresh || !nodes_held(e, f, y)) return events_nodes(e, f, y, x, cmd, fresh);
+    if (other_events(e, f, y, x, cmd)) ++e->count; // (have is set: not fresh)
     return e->count;
 }
 
@@ -481,16 +636,20 @@ void hyd_fused_jacobian(const hyd_fused* f, const double* y, const double* x, co
 
 // ------------------------------------------------------------------------
 // Two lanes: hyd_fused_eval for two actuators with actuator k in lane k of
-// SSE2 registers. Every lane runs exactly the scalar operations of
+// SSE2 registers. The laws are not written again here: every formula is the
+// component header's own macro (HYD_ORIFICE_*, HYD_SPOOL_RATE, HYD_HOSE_Q,
+// HYD_CYL_*, HYD_AIR_POLY, HYD_BE_*), expanded on __m128d, which GCC and
+// Clang treat as a vector type with + - * / lane by lane (a scalar operand
+// applies to both lanes). So every lane runs exactly the scalar operations of
 // actuator() / node_c() in the same order (IEEE add, mul, div and sqrt round
 // the same in a lane as in a scalar register, and -ffp-contract=off keeps
-// them unfused), so the result is bit for bit hyd_fused_eval's
+// them unfused), and the result is bit for bit hyd_fused_eval's
 // (test_fused in tests/hydraulics/test_circuit.c). Only the branches are replaced: both
 // orifice regimes are computed and blended, open reliefs and checks are
 // evaluated lane by lane, and the rare cases (an end stop, a pressure off the
 // Be table) send the whole evaluation to the scalar kernel.
 // ------------------------------------------------------------------------
-#if defined(__SSE2__)
+#if defined(__SSE2__) && defined(__GNUC__)
 #include <emmintrin.h>
 
 typedef __m128d v2;
@@ -508,16 +667,14 @@ static inline void st_at(double* y, const int* i, v2 v) {
 }
 static inline v2 blend(v2 m, v2 a, v2 b) { return _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b)); }
 
-// hyd_orifice_q's flow, both regimes, blended on |x| < 1.
+// hyd_orifice_q's flow (hyd_orifice.h), both regimes, blended on |x| < 1.
 static inline v2 orifice2(v2 k, v2 invP0, v2 kl, v2 A, v2 sA, v2 dp) {
     const v2 sign = _mm_set1_pd(-0.0);
-    const v2 x = _mm_mul_pd(_mm_mul_pd(dp, A), invP0);
+    const v2 x = HYD_ORIFICE_X(invP0, A, dp);
     const v2 lamm = _mm_cmplt_pd(_mm_andnot_pd(sign, x), _mm_set1_pd(1.0));
-    const v2 G = _mm_mul_pd(_mm_mul_pd(kl, A), sA);
-    const v2 lam = _mm_sub_pd(_mm_set1_pd(1.0), _mm_mul_pd(_mm_set1_pd(0.2), _mm_mul_pd(x, x)));
-    const v2 ql = _mm_mul_pd(_mm_mul_pd(G, dp), lam);
-    const v2 s = _mm_sqrt_pd(_mm_andnot_pd(sign, dp));
-    const v2 qt = _mm_mul_pd(_mm_mul_pd(k, A), _mm_or_pd(s, _mm_and_pd(sign, dp)));
+    const v2 ql = HYD_ORIFICE_LAMINAR(kl, A, sA, dp, x);
+    const v2 sdp = _mm_or_pd(_mm_sqrt_pd(_mm_andnot_pd(sign, dp)), _mm_and_pd(sign, dp)); // copysign
+    const v2 qt = HYD_ORIFICE_TURBULENT(k, A, sdp);
     return blend(lamm, ql, qt);
 }
 
@@ -532,27 +689,24 @@ static inline v2 node_c2(const hyd_model* m, const double* bel, const double* be
     for (int l = 0; l < 2; ++l) {
         uint64_t b;
         memcpy(&b, &y[idx[l]], sizeof b);
-        const int e = (int)(b >> 52) - 1023;
-        const int j = (int)(b >> (52 - 7)) & (HYD_AIR_SEG - 1);
+        int e, j;
+        hyd_air_index(b, &e, &j);
         c[l] = t->seg[j];
         oct[l] = t->oct[e];
     }
     // The mantissa in [1, 2), in both lanes at once.
     const __m128i bits = _mm_castpd_si128(P);
-    const v2 mant = _mm_castsi128_pd(_mm_or_si128(_mm_and_si128(bits, _mm_set1_epi64x(0x000FFFFFFFFFFFFFll)),
-                                                  _mm_set1_epi64x(0x3FF0000000000000ll)));
+    const v2 mant = _mm_castsi128_pd(_mm_or_si128(_mm_and_si128(bits, _mm_set1_epi64x((long long)HYD_AIR_MANT_MASK)),
+                                                  _mm_set1_epi64x((long long)HYD_AIR_ONE_BITS)));
 #define CO(i) _mm_set_pd(c[1][i], c[0][i])
-    const v2 x = _mm_sub_pd(mant, CO(HYD_AIR_DEG + 1));
-    const v2 x2 = _mm_mul_pd(x, x);
-    const v2 p01 = _mm_add_pd(CO(0), _mm_mul_pd(CO(1), x));
-    const v2 p23 = _mm_add_pd(CO(2), _mm_mul_pd(CO(3), x));
-    const v2 p45 = _mm_add_pd(CO(4), _mm_mul_pd(CO(5), x));
-    const v2 p = _mm_add_pd(p01, _mm_mul_pd(x2, _mm_add_pd(p23, _mm_mul_pd(x2, _mm_add_pd(p45, _mm_mul_pd(x2, CO(6)))))));
+    const v2 x = mant - CO(HYD_AIR_DEG + 1);
+    const v2 x2 = x * x;
+    const v2 p = HYD_AIR_POLY(CO, x, x2);
 #undef CO
-    const v2 rr = _mm_mul_pd(set2(oct[0], oct[1]), p);
-    const v2 N = _mm_mul_pd(_mm_mul_pd(ld(bel), _mm_add_pd(_mm_set1_pd(1.0), _mm_mul_pd(_mm_set1_pd(m->be_alpha), rr))), P);
-    const v2 D = _mm_add_pd(P, _mm_mul_pd(ld(bec), rr));
-    return _mm_div_pd(N, _mm_mul_pd(D, V));
+    const v2 rr = set2(oct[0], oct[1]) * p;
+    const v2 N = HYD_BE_N(ld(bel), m->be_alpha, rr, P);
+    const v2 D = HYD_BE_D(ld(bec), rr, P);
+    return HYD_BE_C(N, D, V);
 }
 
 // Flows of the open reliefs and checks, lane by lane with the scalar law;
@@ -585,7 +739,7 @@ static inline int closed2(const double* lo, const double* hi, v2 p) {
 // P >= HYD_BE_P_LO && P < 2^64 (false for NaN), as hyd_be_nd.
 static inline int fast2(v2 p) {
     return _mm_movemask_pd(_mm_and_pd(_mm_cmpge_pd(p, _mm_set1_pd(HYD_BE_P_LO)),
-                                      _mm_cmplt_pd(p, _mm_set1_pd(18446744073709551616.0))));
+                                      _mm_cmplt_pd(p, _mm_set1_pd(HYD_BE_P_HI))));
 }
 
 void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const double* v,
@@ -626,15 +780,15 @@ void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const
     const v2 one = _mm_set1_pd(1.0);
     const v2 c2 = _mm_min_pd(one, _mm_max_pd(_mm_set1_pd(-1.0), set2(cmd[0], cmd[1])));
     const v2 u = ld_at(y, L->su);
-    st_at(ydot, L->su, _mm_mul_pd(_mm_sub_pd(c2, u), ld(L->inv_tau)));
+    st_at(ydot, L->su, HYD_SPOOL_RATE(c2, u, ld(L->inv_tau)));
 
     // Valve edges: 1 feeds a work port from P, 2 drains the other to T.
     const v2 sign = _mm_set1_pd(-0.0);
     const v2 pos = _mm_cmpge_pd(u, _mm_setzero_pd());
-    const v2 A = _mm_mul_pd(ld(L->Amax), _mm_andnot_pd(sign, u));
+    const v2 A = HYD_VALVE_AREA(ld(L->Amax), _mm_andnot_pd(sign, u));
     const v2 sA = _mm_sqrt_pd(A);
-    const v2 dp1 = _mm_sub_pd(_mm_set1_pd(pPL), blend(pos, ph[0], ph[1]));
-    const v2 dp2 = _mm_sub_pd(blend(pos, ph[1], ph[0]), ld(L->pT));
+    const v2 dp1 = pPL - blend(pos, ph[0], ph[1]); // as hyd_valve_edges
+    const v2 dp2 = blend(pos, ph[1], ph[0]) - ld(L->pT);
     const v2 k = ld(L->ok), invP0 = ld(L->oinvP0), kl = ld(L->okl);
     const v2 q1 = orifice2(k, invP0, kl, A, sA, dp1);
     const v2 q2 = orifice2(k, invP0, kl, A, sA, dp2);
@@ -642,22 +796,23 @@ void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const
     const v2 inA = blend(pos, q1, nq2), inB = blend(pos, nq2, q1);
 
     // Hoses, leakage, volumes.
-    const v2 qhA = _mm_mul_pd(ld(L->GA), _mm_sub_pd(ph[0], pc[0]));
-    const v2 qhB = _mm_mul_pd(ld(L->GB), _mm_sub_pd(ph[1], pc[1]));
-    const v2 leak = _mm_mul_pd(ld(L->CL), _mm_sub_pd(pc[0], pc[1]));
+    const v2 qhA = HYD_HOSE_Q(ld(L->GA), ph[0], pc[0]);
+    const v2 qhB = HYD_HOSE_Q(ld(L->GB), ph[1], pc[1]);
+    const v2 leak = HYD_CYL_LEAK(ld(L->CL), pc[0], pc[1]);
     const v2 AA = ld(L->AA), AB = ld(L->AB);
-    const v2 VA = _mm_max_pd(_mm_add_pd(ld(L->VA0), _mm_mul_pd(AA, xs)), ld(L->VAmin));
-    const v2 VB = _mm_max_pd(_mm_add_pd(ld(L->VB0), _mm_mul_pd(AB, _mm_sub_pd(ld(L->s), xs))), ld(L->VBmin));
+    // max(a, b) is a > b ? a : b, the floor of hyd_cyl_volumes.
+    const v2 VA = _mm_max_pd(HYD_CYL_VA(ld(L->VA0), AA, xs), ld(L->VAmin));
+    const v2 VB = _mm_max_pd(HYD_CYL_VB(ld(L->VB0), AB, ld(L->s), xs), ld(L->VBmin));
     // Reliefs and checks: closed ones add +0.0, as ramps_in returns.
     const v2 z = _mm_setzero_pd();
     v2 rq[4] = {z, z, z, z};
     if (shut != 3) open_ramps2(f, y, cl, rq);
-    const v2 nhA = _mm_add_pd(_mm_sub_pd(inA, qhA), rq[0]);
-    const v2 nhB = _mm_add_pd(_mm_sub_pd(inB, qhB), rq[1]);
-    const v2 nA = _mm_sub_pd(_mm_add_pd(_mm_sub_pd(qhA, leak), rq[2]), _mm_mul_pd(AA, vs));
-    const v2 nB = _mm_add_pd(_mm_add_pd(_mm_add_pd(qhB, leak), rq[3]), _mm_mul_pd(AB, vs));
-    const v2 Fv = _mm_sub_pd(_mm_add_pd(_mm_sub_pd(_mm_sub_pd(_mm_mul_pd(pc[0], AA), _mm_mul_pd(pc[1], AB)),
-                                                   _mm_mul_pd(ld(L->bv), vs)), z), z);
+    const v2 nhA = NET_HOSE(inA, qhA, rq[0]);
+    const v2 nhB = NET_HOSE(inB, qhB, rq[1]);
+    const v2 nA = NET_CHAMBER_A(qhA, leak, rq[2], AA, vs);
+    const v2 nB = NET_CHAMBER_B(qhB, leak, rq[3], AB, vs);
+    // No end stop touched (checked above): both stop forces are +0.0.
+    const v2 Fv = HYD_CYL_FORCE(AA, AB, ld(L->bv), pc[0], pc[1], vs, z, z);
     _mm_storeu_pd(F, Fv);
     // Seal friction lane by lane, after the store as the scalar kernel
     // subtracts it after hyd_cyl_force (+0.0 when a cylinder has none).
@@ -667,10 +822,10 @@ void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const
         F[k2] -= hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, v[k2], &dseal);
     }
 
-    st_at(ydot, L->s_node[0], _mm_mul_pd(node_c2(m, L->bel[0], L->bec[0], ph[0], ld(L->hV0[0]), y, L->s_node[0]), nhA));
-    st_at(ydot, L->s_node[1], _mm_mul_pd(node_c2(m, L->bel[1], L->bec[1], ph[1], ld(L->hV0[1]), y, L->s_node[1]), nhB));
-    st_at(ydot, L->s_node[2], _mm_mul_pd(node_c2(m, L->bel[2], L->bec[2], pc[0], VA, y, L->s_node[2]), nA));
-    st_at(ydot, L->s_node[3], _mm_mul_pd(node_c2(m, L->bel[3], L->bec[3], pc[1], VB, y, L->s_node[3]), nB));
+    st_at(ydot, L->s_node[0], node_c2(m, L->bel[0], L->bec[0], ph[0], ld(L->hV0[0]), y, L->s_node[0]) * nhA);
+    st_at(ydot, L->s_node[1], node_c2(m, L->bel[1], L->bec[1], ph[1], ld(L->hV0[1]), y, L->s_node[1]) * nhB);
+    st_at(ydot, L->s_node[2], node_c2(m, L->bel[2], L->bec[2], pc[0], VA, y, L->s_node[2]) * nA);
+    st_at(ydot, L->s_node[3], node_c2(m, L->bel[3], L->bec[3], pc[1], VB, y, L->s_node[3]) * nB);
 
     double q1s[2];
     _mm_storeu_pd(q1s, q1);

@@ -65,6 +65,7 @@ typedef struct hyd_fused_act {
     double GA, GB;         ///< hose conductances [m^3/(s Pa)]
     double AA, AB, s, VA0, VB0, CL, bv, ks, cs, ws; ///< cylinder (hyd_cyl_c)
     double Fc, Fs, vst, vsm;                        ///< seal friction (hyd_cyl_seal)
+    double inv_ws;         ///< 1 / ws [1/m] (the end stops' event levels)
 } hyd_fused_act;
 
 /// Coupling partials of one actuator for the mechanics (hyd_fused_jacobian).
@@ -93,6 +94,10 @@ typedef struct hyd_fused {
     double qmax, pset, inv_band, p_in; ///< pump; p_in: its tank pressure [Pa abs]
     int lanes_ok;          ///< nact == 2 and the air tables are in use: hyd_fused_eval2 applies
     hyd_fused_lanes ln;
+    int nev;               ///< pressure nodes: 4 nact + 1
+    int ev_s[4 * HYD_FUSED_MAXACT + 1]; ///< their state indices in hyd_fused_events' slot order
+    int stops_plain;       ///< two actuators, 1/ws finite and > 0 (the events' two-lane stop check)
+    double stroke2[2];     ///< the two strokes s [m], side by side
 } hyd_fused;
 
 /// Pack model m for actuators k = 0..nact-1 (valve[k] drives cylinder[k];
@@ -149,6 +154,11 @@ typedef struct hyd_fused_events {
     unsigned char stop[2 * HYD_FUSED_MAXACT]; ///< end stops (low, high): 0 free, 1 in the width, 2 engaged
     unsigned char pump;    ///< the pump's cut-off: 0 below its band, 1 in it, 2 above
     int have;              ///< the fields above are set
+    /// Per node (as oct): its octave and ramp levels hold while hold_lo < p <
+    /// hold_hi [Pa abs], so the node needs no evaluation (NaN: always one).
+    double hold_lo[4 * HYD_FUSED_MAXACT + 1], hold_hi[4 * HYD_FUSED_MAXACT + 1];
+    const hyd_fused* hold_f; ///< the record and model revision the intervals were taken from
+    unsigned hold_rev;
 } hyd_fused_events;
 
 /// Count a switch that stiffens the circuit since the previous call: a

@@ -33,13 +33,22 @@ static inline double hyd_stop_force(double ks, double cs, double ws, double delt
     return ks * S + cs * W * ddelta;
 }
 
+/// The cylinder's laws as expressions of + - * only, one text for a double
+/// and the two lanes of circuit_kernel.c: the chamber volumes before their
+/// floor, the leakage, and the rod force with the stop forces flo, fhi.
+#define HYD_CYL_VA(VA0, AA, x) ((VA0) + (AA) * (x))
+#define HYD_CYL_VB(VB0, AB, s, x) ((VB0) + (AB) * ((s) - (x)))
+#define HYD_CYL_VMIN(V0) (HYD_VMIN_FRAC * (V0))
+#define HYD_CYL_LEAK(CL, pA, pB) ((CL) * ((pA) - (pB)))
+#define HYD_CYL_FORCE(AA, AB, bv, pA, pB, v, flo, fhi) ((pA) * (AA) - (pB) * (AB) - (bv) * (v) + (flo) - (fhi))
+
 /// Chamber volumes [m^3] at stroke x [m]: V_A = V_A0 + A_A x, V_B = V_B0 +
 /// A_B (s - x), each floored at HYD_VMIN_FRAC of its dead volume; *dVA, *dVB
 /// = dV/dx [m^2] (0 once the floor holds V).
 static inline void hyd_cyl_volumes(double VA0, double VB0, double AA, double AB, double s, double x,
                                    double* VA, double* VB, double* dVA, double* dVB) {
-    const double va = VA0 + AA * x, vb = VB0 + AB * (s - x);
-    const double vamin = HYD_VMIN_FRAC * VA0, vbmin = HYD_VMIN_FRAC * VB0;
+    const double va = HYD_CYL_VA(VA0, AA, x), vb = HYD_CYL_VB(VB0, AB, s, x);
+    const double vamin = HYD_CYL_VMIN(VA0), vbmin = HYD_CYL_VMIN(VB0);
     *VA = va > vamin ? va : vamin;
     *VB = vb > vbmin ? vb : vbmin;
     *dVA = va > vamin ? AA : 0.0;
@@ -47,7 +56,7 @@ static inline void hyd_cyl_volumes(double VA0, double VB0, double AA, double AB,
 }
 
 /// Internal leakage A -> B [m^3/s] with coefficient CL [m^3/(s Pa)].
-static inline double hyd_cyl_leak(double CL, double pA, double pB) { return CL * (pA - pB); }
+static inline double hyd_cyl_leak(double CL, double pA, double pB) { return HYD_CYL_LEAK(CL, pA, pB); }
 
 /// Rod force F [N] (+ extends): pA A_A - pB A_B - b_v x' plus the end stops
 /// (stiffness ks [N/m], damping cs [N s/m], width ws [m]) below 0 and beyond
@@ -62,7 +71,7 @@ static inline double hyd_cyl_force(double AA, double AB, double bv, double ks, d
     const double fhi = hyd_stop_force(ks, cs, ws, x - s, v, &fdh, &fvh);
     *dFdx = -fdl - fdh;
     *dFdv = -bv - fvl - fvh;
-    return pA * AA - pB * AB - bv * v + flo - fhi;
+    return HYD_CYL_FORCE(AA, AB, bv, pA, pB, v, flo, fhi);
 }
 
 /// Seal friction [N] (Coulomb + Stribeck, opposing x'), smooth through zero:

@@ -337,23 +337,50 @@ void hyd_air_tab_init(hyd_air_tab* t, const hyd_fluid_def* f);
 /// or no table): exact, with exp/log (fluid.c).
 double hyd_be_slow(const hyd_model* m, double bel, double P, double* dbe);
 
+/// Upper end of the table path [Pa abs] (2^64): above it, the exact law.
+#define HYD_BE_P_HI 18446744073709551616.0
+/// The bits of P = 2^e m that keep m in [1, 2): mask, then or the exponent of 1.
+#define HYD_AIR_MANT_MASK 0x000FFFFFFFFFFFFFull
+#define HYD_AIR_ONE_BITS 0x3FF0000000000000ull
+
+/// The table entries for P with bit pattern b: the octave e (index of
+/// oct[]) and the segment j of [1, 2) its mantissa falls in.
+static inline void hyd_air_index(uint64_t b, int* e, int* j) {
+    *e = (int)(b >> 52) - 1023;
+    *j = (int)(b >> (52 - 7)) & (HYD_AIR_SEG - 1);
+}
+
+/// The segment polynomial of m^(-1/n) at x = m - centre (x2 = x x), C(i) its
+/// coefficient i: Estrin's scheme, a shorter dependency chain than Horner,
+/// same rounding class. + - * only: one text for a double and the two lanes
+/// of circuit_kernel.c.
+#define HYD_AIR_POLY(C, x, x2)                                                                       \
+    (((C(0)) + (C(1)) * (x)) + (x2) * (((C(2)) + (C(3)) * (x)) + (x2) * (((C(4)) + (C(5)) * (x)) + (x2) * (C(6)))))
+
+/// The entrained-air law multiplied through by P (see hyd_be_nd), from the
+/// air ratio r: Be = N / D, and Be / V = N / (D V) with one division. One
+/// text for a double and the two lanes of circuit_kernel.c.
+#define HYD_BE_N(bel, alpha, r, P) ((bel) * (1.0 + (alpha) * (r)) * (P))
+#define HYD_BE_D(bec, r, P) ((P) + (bec) * (r))
+#define HYD_BE_C(N, D, V) ((N) / ((D) * (V)))
+
 /// r(P) = (p_a / P)^(1/n) from the table, for P in [1, 2^HYD_AIR_OCT).
 /// The exponent and the top mantissa bits of P index the tables directly, so
 /// there is no log, exp or division.
 static inline double hyd_air_ratio(const hyd_air_tab* t, double P) {
     uint64_t b;
     memcpy(&b, &P, sizeof b);
-    const int e = (int)(b >> 52) - 1023;
-    const int j = (int)(b >> (52 - 7)) & (HYD_AIR_SEG - 1);
-    const uint64_t mb = (b & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
+    int e, j;
+    hyd_air_index(b, &e, &j);
+    const uint64_t mb = (b & HYD_AIR_MANT_MASK) | HYD_AIR_ONE_BITS;
     double mant;
     memcpy(&mant, &mb, sizeof mant);
     const double* c = t->seg[j];
     const double x = mant - c[HYD_AIR_DEG + 1]; // exact: both in [1, 2]
-    // Estrin's scheme: a shorter dependency chain than Horner, same rounding class.
     const double x2 = x * x;
-    const double p01 = c[0] + c[1] * x, p23 = c[2] + c[3] * x, p45 = c[4] + c[5] * x;
-    const double p = p01 + x2 * (p23 + x2 * (p45 + x2 * c[6]));
+#define HYD_C_(i) c[i]
+    const double p = HYD_AIR_POLY(HYD_C_, x, x2);
+#undef HYD_C_
     return t->oct[e] * p;
 }
 
@@ -371,12 +398,12 @@ static inline int hyd_be_nd(const hyd_model* m, double bel, double bec, double P
         *N = bel, *D = 1.0, *r = 0.0;
         return m->be_alpha == 0.0;
     }
-    if (!(P >= HYD_BE_P_LO && P < 18446744073709551616.0)) // 2^64; false for NaN
+    if (!(P >= HYD_BE_P_LO && P < HYD_BE_P_HI)) // false for NaN
         return 0;
     const double rr = hyd_air_ratio(t, P);
     *r = rr;
-    *N = bel * (1.0 + m->be_alpha * rr) * P;
-    *D = P + bec * rr;
+    *N = HYD_BE_N(bel, m->be_alpha, rr, P);
+    *D = HYD_BE_D(bec, rr, P);
     return 1;
 }
 
@@ -389,7 +416,7 @@ static inline double hyd_node_c(const hyd_model* m, double bel, double bec, doub
                                 double* dbe) {
     double N, D, r;
     if (hyd_be_nd(m, bel, bec, P, &N, &D, &r)) {
-        const double c = N / (D * V);
+        const double c = HYD_BE_C(N, D, V);
         if (be) *be = c * V;
         if (dbe) {
             if (m->air.use) {

@@ -6,10 +6,16 @@
 
 #include "hyd_orifice.h"
 
+/// The spool lag on the clamped command c [-] (+ - * only: one text for a
+/// double and the two lanes of circuit_kernel.c).
+#define HYD_SPOOL_RATE(c, u, inv_tau) (((c) - (u)) * (inv_tau))
+/// A valve edge's opening area [m^2] at |u| of full opening Amax.
+#define HYD_VALVE_AREA(Amax, abs_u) ((Amax) * (abs_u))
+
 /// Spool rate u' [1/s] = (clamp(cmd, -1, 1) - u) / tau; a NaN command stays NaN.
 static inline double hyd_spool_rate(double cmd, double u, double inv_tau) {
     const double c = cmd > 1.0 ? 1.0 : (cmd < -1.0 ? -1.0 : cmd);
-    return (c - u) * inv_tau;
+    return HYD_SPOOL_RATE(c, u, inv_tau);
 }
 
 /// The two open metering edges of a valve at spool position u [-].
@@ -26,7 +32,7 @@ typedef struct hyd_valve_flow {
 static inline void hyd_valve_edges(const hyd_orif_k* ok, double Amax, double u, double pP,
                                    double pT, double pA, double pB, hyd_valve_flow* o) {
     const int pos = u >= 0.0;
-    const double A = Amax * fabs(u);
+    const double A = HYD_VALVE_AREA(Amax, fabs(u));
     o->pos = pos;
     o->q1 = hyd_orifice_q(ok, A, pP - (pos ? pA : pB), &o->g1, &o->g1A);
     o->q2 = hyd_orifice_q(ok, A, (pos ? pB : pA) - pT, &o->g2, &o->g2A);

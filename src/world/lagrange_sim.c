@@ -154,10 +154,17 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
     return p;
 }
 
-static void commands(lsim* s, double t, double cmd[2]) {
-    for (int i = 0; i < 2; ++i)
-        cmd[i] = s->scn ? scenario_command_hint(s->scn, i, t, &s->scn_seg_[i]) : s->u_cmd[i];
+// A scenario's commands are a function of t alone (the scenario is fixed
+// for the run), so the last t's values are kept (lsim_ks.cmd): the events
+// at the start of a step, its first stage and the previous step's last
+// stage share t, and the tables are read once per step.
+void lsim_commands_read(lsim* s, double t) {
+    lsim_ks* ks = &s->ks;
+    for (int i = 0; i < 2; ++i) ks->cmd[i] = scenario_command_hint(s->scn, i, t, &s->scn_seg_[i]);
+    ks->cmd_t = t;
 }
+
+static void commands(lsim* s, double t, double cmd[2]) { lsim_commands(s, t, cmd); }
 
 static void set_inputs(lsim* s, double t, const kin* k) {
     hyd_data* d = s->hd;

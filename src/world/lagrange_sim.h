@@ -109,6 +109,19 @@ void lsim_free(lsim* s);
 /// the block-diagonal pattern [spool] [hose A, chamber A] [hose B, chamber B]
 /// per actuator, 1x1 for other hydraulic states, [q1, q2, q1', q2'].
 hyd_problem lsim_problem(lsim* s, bool blocks);
+/// Read the scenario's commands at t into ks.cmd (lsim_commands).
+void lsim_commands_read(lsim* s, double t);
+/// The valve commands at t [-]: u_cmd, or the scenario's at t (the last t's
+/// values kept in ks.cmd, as a scenario is a function of t). Inline: three
+/// calls per step, two of them finding t cached.
+static inline void lsim_commands(lsim* s, double t, double cmd[2]) {
+    if (!s->scn) {
+        cmd[0] = s->u_cmd[0], cmd[1] = s->u_cmd[1];
+        return;
+    }
+    if (!(t == s->ks.cmd_t)) lsim_commands_read(s, t);
+    cmd[0] = s->ks.cmd[0], cmd[1] = s->ks.cmd[1];
+}
 
 /// Initial state at joint angles q0 [rad], at rest, with chamber pressures in
 /// static equilibrium with gravity (rod side or piston side at p_low [Pa abs])

@@ -83,20 +83,9 @@ static void geo_at(lsim* s, const double* y, double h, geo* g) {
     cylinder_kinematics(&s->mdl->mech, g->trig, rest, &g->k);
 }
 
-// Valve commands at t. Stage 2 of one step and stage 1 of the next share t,
-// so the scenario's tables are read once per step.
-static void commands_at(lsim* s, double t, double cmd[2]) {
-    if (!s->scn) {
-        cmd[0] = s->u_cmd[0], cmd[1] = s->u_cmd[1];
-        return;
-    }
-    lsim_ks* ks = &s->ks;
-    if (!(t == ks->cmd_t)) {
-        for (int i = 0; i < 2; ++i) ks->cmd[i] = scenario_command_hint(s->scn, i, t, &s->scn_seg_[i]);
-        ks->cmd_t = t;
-    }
-    cmd[0] = ks->cmd[0], cmd[1] = ks->cmd[1];
-}
+// Valve commands at t (lsim_commands: stage 2 of one step and stage 1 of
+// the next share t, so the scenario's tables are read once per step).
+static void commands_at(lsim* s, double t, double cmd[2]) { lsim_commands(s, t, cmd); }
 
 // f at a stage (t, y) with the mechanics carried from the midpoint.
 static void stage_f(lsim* s, const geo* g, double t, const double* y, double* f) {

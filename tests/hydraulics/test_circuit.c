@@ -425,6 +425,106 @@ static void test_fused(void) {
     hyd_model_free(m);
 }
 
+// A pressure for the event test: mostly at the edges the event levels
+// switch on (powers of two, the node's knee and its relief/check
+// thresholds, each exactly and one ulp either side), sometimes anywhere,
+// 0, negative or NaN.
+static double event_pressure(const hyd_fused_node* n) {
+    const int r = rand() % 16;
+    double p;
+    if (r < 4) p = ldexp(1.0, 10 + rand() % 16);
+    else if (r < 6) p = n->p_knee;
+    else if (r < 8) p = n->p_lo;
+    else if (r < 10) p = n->p_hi;
+    else if (r == 10) p = 0.0;
+    else if (r == 11) p = -urand(0.0, 1e5);
+    else if (r == 12) p = NAN;
+    else p = exp(urand(log(1e3), log(4e7)));
+    if (!isfinite(p)) return r == 12 ? p : 1e6;
+    const int side = rand() % 3;
+    return side == 0 ? p : nextafter(p, side == 1 ? -HUGE_VAL : HUGE_VAL);
+}
+
+// hyd_fused_events_update skips the nodes whose pressure stays inside the
+// interval where their octave and ramp levels hold, and checks strokes
+// inside [0, s] and the commands two lanes at a time. Against the same
+// counter taken without those shortcuts (the intervals invalidated before
+// every call, the stops and commands one by one): the same count after
+// every call and the same stored levels, over random walks that change one
+// to three nodes at a time at the exact switching pressures (and strokes
+// and commands at theirs), and across a model edit that moves a relief's
+// threshold (a rebuilt record at a new revision).
+static void test_fused_events_hold(void) {
+    char err[256];
+    hyd_model* m = hyd_model_default_crane(err, sizeof err);
+    if (!m) return;
+    const int n = hyd_model_nstate(m);
+    int valve[2], cyl[2];
+    for (int k = 0; k < 2; ++k) {
+        cyl[k] = hyd_model_cylinder(m, k ? "jib_cyl" : "lift_cyl");
+        valve[k] = hyd_model_valve(m, k ? "jib_valve" : "lift_valve");
+    }
+    hyd_fused f;
+    char why[128] = "";
+    CHECK(hyd_fused_build(m, valve, cyl, 2, &f, why, sizeof why) == 0, "refused: %s", why);
+    hyd_fused_events ec, er;
+    memset(&ec, 0, sizeof ec);
+    memset(&er, 0, sizeof er);
+    srand(77);
+    double y[NMAX];
+    for (int i = 0; i < n; ++i) y[i] = 1e6;
+    double x[2] = {0.5 * f.act[0].s, 0.5 * f.act[1].s}, cmd[2] = {0.0, 0.0};
+    int bad = 0, skipped = 0;
+    for (int call = 0; call < 20000; ++call) {
+        if (call == 10000) { // a live edit: the relief thresholds move
+            // Every node between the old and the new cracking pressure, held
+            // there by the old record's intervals.
+            for (int j = 0; j < f.nev; ++j) y[f.ev_s[j]] = 2.2e7;
+            hyd_fused_events_update(&ec, &f, y, x, cmd);
+            er.hold_f = NULL;
+            hyd_fused_events_update(&er, &f, y, x, cmd);
+            CHECK(hyd_model_set(m, "lift_relief_A.p_crack", 2.0e7, err, sizeof err) == 0, "%s", err);
+            CHECK(hyd_fused_build(m, valve, cyl, 2, &f, why, sizeof why) == 0, "refused: %s", why);
+        }
+        const int nch = 1 + rand() % 3;
+        for (int c = 0; c < nch; ++c) {
+            const int j = rand() % f.nev;
+            const hyd_fused_act* a = &f.act[j / 4 < 2 ? j / 4 : 0];
+            const hyd_fused_node* an[4] = {&a->hA, &a->hB, &a->cA, &a->cB};
+            const hyd_fused_node* nd = j == f.nev - 1 ? &f.pl : an[j % 4];
+            y[f.ev_s[j]] = event_pressure(nd);
+        }
+        // Strokes and commands: mostly still, sometimes at or beyond an end
+        // stop's edges (one ulp either side), a command step, or NaN.
+        for (int k = 0; k < 2; ++k) {
+            const double sk = f.act[k].s, wk = f.act[k].ws;
+            const double xs[9] = {0.5 * sk, 0.0, -0.0, nextafter(0.0, -1.0), sk, nextafter(sk, 2 * sk),
+                                  -0.5 * wk, sk + 2.0 * wk, NAN};
+            if (rand() % 8 == 0) x[k] = xs[rand() % 9];
+            if (rand() % 8 == 0) {
+                const int r = rand() % 4;
+                cmd[k] = r == 0 ? NAN : (r == 1 ? cmd[k] + 0.3 : urand(-1.0, 1.0) * 0.04 + (isnan(cmd[k]) ? 0.0 : cmd[k]));
+                if (fabs(cmd[k]) > 1.0) cmd[k] = 0.0;
+            }
+        }
+        // The reference evaluates every node and the stops and commands one
+        // by one (no two-lane check).
+        hyd_fused fr = f;
+        fr.stops_plain = 0;
+        er.hold_f = NULL;
+        const unsigned long before = ec.count;
+        const unsigned long cc = hyd_fused_events_update(&ec, &f, y, x, cmd);
+        const unsigned long cr = hyd_fused_events_update(&er, &fr, y, x, cmd);
+        skipped += cc == before;
+        bad += cc != cr || memcmp(ec.oct, er.oct, sizeof ec.oct) != 0 || memcmp(ec.lv, er.lv, sizeof ec.lv) != 0 ||
+               memcmp(ec.stop, er.stop, sizeof ec.stop) != 0 || memcmp(ec.cmd, er.cmd, sizeof ec.cmd) != 0;
+    }
+    printf("  events: %lu counted in 20000 calls, %d calls without a switch\n", ec.count, skipped);
+    CHECK(bad == 0, "%d calls where the held intervals changed the count or the levels", bad);
+    CHECK(ec.count > 1000 && skipped > 1000, "the walk does not exercise both cases (%lu, %d)", ec.count, skipped);
+    hyd_model_free(m);
+}
+
 // Circuits of another shape are refused with a reason, not mis-evaluated.
 static void test_fused_refuses(void) {
     char err[256];
@@ -670,6 +770,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_eval_mapped);
     RUN_TEST(test_fused);
     RUN_TEST(test_seal_partials);
+    RUN_TEST(test_fused_events_hold);
     RUN_TEST(test_fused_refuses);
     RUN_TEST(test_live_parameters);
     RUN_TEST(test_json_matches_default);
