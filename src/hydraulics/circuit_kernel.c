@@ -174,6 +174,10 @@ int hyd_fused_build(const hyd_model* m, const int* valve, const int* cyl, int na
             at[nodes[j]] = recs[j];
         }
     }
+    // Without seal friction the two-lane path skips its per-lane loop (it
+    // would subtract +0.0; about 20 instructions per evaluation).
+    f->seal = 0;
+    for (int k = 0; k < f->nact; ++k) f->seal |= f->act[k].Fc != 0.0 || f->act[k].Fs != 0.0;
     // Reliefs and checks: between a tank and one of the packed nodes.
     for (int pass = 0; pass < 2; ++pass) {
         const hyd_ramp_c* r = pass ? m->check : m->relief;
@@ -816,7 +820,7 @@ void hyd_fused_eval2(const hyd_fused* f, const double* y, const double* x, const
     _mm_storeu_pd(F, Fv);
     // Seal friction lane by lane, after the store as the scalar kernel
     // subtracts it after hyd_cyl_force (+0.0 when a cylinder has none).
-    for (int k2 = 0; k2 < 2; ++k2) {
+    for (int k2 = 0; k2 < 2 && f->seal; ++k2) {
         const hyd_fused_act* a = &f->act[k2];
         double dseal;
         F[k2] -= hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, v[k2], &dseal);

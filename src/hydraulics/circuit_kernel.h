@@ -98,6 +98,7 @@ typedef struct hyd_fused {
     int ev_s[4 * HYD_FUSED_MAXACT + 1]; ///< their state indices in hyd_fused_events' slot order
     int stops_plain;       ///< two actuators, 1/ws finite and > 0 (the events' two-lane stop check)
     double stroke2[2];     ///< the two strokes s [m], side by side
+    int seal;              ///< some cylinder has seal friction (else its terms are skipped)
 } hyd_fused;
 
 /// Pack model m for actuators k = 0..nact-1 (valve[k] drives cylinder[k];
