@@ -97,6 +97,9 @@ static void quiet_note(const char* line, void* user) {
     (void)user;
 }
 
+#ifdef CRANESIM_HAVE_NLOPT
+// Everything from here to run_nlopt is the search; a build without NLopt
+// has the command's parsing and checks only.
 static const char* short_path(const char* p) {
     // The last two parts of a long path ("lift_cyl.bore"), for the progress lines.
     const char* a = strrchr(p, '.');
@@ -215,7 +218,6 @@ static double evaluate(optimizer* o, const double* u, double* cval) {
     return f / (o->fscale > 0 ? o->fscale : 1.0);
 }
 
-#ifdef CRANESIM_HAVE_NLOPT
 typedef struct nl_user {
     optimizer* o;
     nlopt_opt opt;
@@ -500,9 +502,9 @@ int cmd_optimize(int argc, char** argv) {
     app_signals sig;
     app_signals_catch(&sig);
     const char* method = "?";
-    char err[512] = "";
     int code = EXIT_OK_;
 #ifdef CRANESIM_HAVE_NLOPT
+    char err[512] = "";
     if (run_nlopt(&o, xtol, &method, err, sizeof err)) {
         fprintf(stderr, "cranesim optimize: %s\n", err);
         code = EXIT_RUNTIME;
