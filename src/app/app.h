@@ -201,6 +201,18 @@ void app_compare_pressure(const sim_trace* a, const sim_trace* b, int ref, doubl
 int cmd_drive(int argc, char** argv);
 int cmd_study(int argc, char** argv);
 int cmd_sweep(int argc, char** argv);
+int cmd_optimize(int argc, char** argv);
+
+/// A --param range of sweep and optimize: a model path in the --set syntax,
+/// from lo to hi (lo <= hi, finite), in n values (1 when not a grid).
+typedef struct app_range {
+    char path[256];
+    double lo, hi;
+    long n;
+} app_range;
+/// Parse "PATH=LO:HI:N" (want_n) or "PATH=LO:HI" for command cmd. 0, or -1
+/// after one line on stderr.
+int app_parse_range(const char* cmd, const char* arg, bool want_n, app_range* p);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it
@@ -232,6 +244,10 @@ int app_plot_sweep(const char* png, const char* title, const char* xlab, const c
                    const double* y, long n, char* err, size_t errsz);
 int app_plot_heat(const char* png, const char* title, const char* xlab, const char* ylab, const double* z,
                   long nx, long ny, double x0, double x1, double y0, double y1, char* err, size_t errsz);
+/// The optimiser's convergence: objective f of n evaluations (NaN: failed),
+/// feasible or not, and the best feasible so far. 0, or -1 with a message.
+int app_plot_convergence(const char* png, const char* title, const char* ylab, const double* f, const bool* feasible,
+                         long n, char* err, size_t errsz);
 /// Overlay two runs (a: solid, b: dashed) to a PNG.
 int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb,
                      const char* title, const char* png, char* err, size_t errsz);

@@ -81,6 +81,7 @@ static const struct {
 } own_values[] = {
     {"run", {"--out", "--plot", "--metrics", NULL}},
     {"sweep", {"--param", "--lhs", "--seed", "--metrics", "--threads", "--out", "--plot", NULL}},
+    {"optimize", {"--param", "--minimize", "--constraint", "--maxeval", "--xtol", "--out", "--plot", NULL}},
     {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot", NULL}},
     {"study", {"--out-dir", "--repeat", NULL}},
     {"bench", {"--repeat", "--config", "--seed", NULL}},

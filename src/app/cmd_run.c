@@ -22,7 +22,8 @@ static void run_help(FILE* f) {
             " q: joint angles in the paper's convention, tip: end-arm tip from joint 1, F: forces)\n"
             "With --mechanics ode also: slew,hook_x,hook_y,hook_z,load_x,load_y,load_z,attached,\n"
             "  truck_tilt,contacts,max_depth (world frame, m, rad), and the slew actuator's\n"
-            "  x3,v3,p3A,p3B,u3,u3_cmd,F3 (zeros in the validation world)\n"
+            "  x3,v3,p3A,p3B,u3,u3_cmd,F3 (zeros in the validation world), and tip_wx,tip_wy,tip_wz\n"
+            "  (the end-arm tip in the world frame, where the rope hangs from)\n"
             "\n"
             "options:\n"
             "  --out FILE           CSV output (default run.csv); written to a temporary file in its\n"
@@ -30,8 +31,9 @@ static void run_help(FILE* f) {
             "                       interrupted one, with the rows so far): until then FILE is untouched\n"
             "  --plot FILE.png      also plot strokes, pressures, valve openings and tip path, and\n"
             "                       the energy per component as a bar chart to FILE_energy.png\n"
-            "  --metrics FILE.json  also write the run's metrics (peak pressures, relief time, end-stop\n"
-            "                       hits, ...; docs/sweep.md), replaced as --out is\n"
+            "  --metrics FILE.json  also write the run's metrics (peak pressures, relief time, per-relief\n"
+            "                       open time, end-stop hits, energy in and losses, hook sway, ...;\n"
+            "                       docs/sweep.md), replaced as --out is\n"
             "  --energy FILE.csv    per-component hydraulic power [W] at the output period: t, then\n"
             "                       per pump, valve edge (.meter_in, .meter_out), relief, check,\n"
             "                       orifice, hose, cylinder (.leak, .work), then tank, stored and\n"
@@ -390,6 +392,7 @@ int cmd_run(int argc, char** argv) {
     sim_run_energy(m, &sc, &c.sim, csv_row, &sink, NULL, c.quiet ? NULL : app_progress, NULL, en, &res);
     keep_flush(&sink.keep);
     metrics_finish(&sink.met, &res);
+    metrics_energy(&sink.met, en);
     if (!c.quiet) app_progress_done();
     if (res.note[0] && !app_signal_caught()) fprintf(stderr, "cranesim run: note: %s\n", res.note);
     const int werr = csv_close(&sink);

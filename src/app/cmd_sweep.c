@@ -4,6 +4,7 @@
 // srun), one results row per design in design-index order.
 #define _DEFAULT_SOURCE // strsep
 #include "app.h"
+#include "energy_acc.h"
 #include "json_util.h"
 #include "metrics.h"
 
@@ -44,7 +45,7 @@ static void sweep_help(FILE* f) {
             "  --lhs N              a Latin hypercube of N designs instead of the grid\n"
             "  --seed K             its random seed (default 1; same seed, same designs)\n"
             "  --metrics LIST       the metrics to tabulate, comma separated (default: every metric\n"
-            "                       the run has; p3A, p3B, slew and tilt: ode only):",
+            "                       the run has; p3A, p3B, slew, tilt and sway: ode only):",
             SW_MAXPAR);
     // Each name with its unit, wrapped under the option's text.
     int col = 999;
@@ -70,11 +71,7 @@ static void sweep_help(FILE* f) {
             "example: cranesim sweep --scenario ramp --param hydraulics.components.lift_cyl.bore=0.08:0.12:5\n");
 }
 
-typedef struct sweep_param {
-    char path[256];
-    double lo, hi;
-    long n;
-} sweep_param;
+typedef app_range sweep_param;
 
 typedef struct sweep {
     app_common c;
@@ -90,6 +87,7 @@ typedef struct sweep {
     int ncol;
     bool fail_fast;
     bool ode;
+    bool energy;        ///< a tabulated metric needs the energy accounting
     // Dispatch and results (under mu).
     pthread_mutex_t mu;
     pthread_cond_t cv;
@@ -220,12 +218,18 @@ static char* run_design(const sweep* s, long i, bool* failed) {
     cJSON_Delete(doc);
     if (m) {
         sim_result res;
+        sim_energy* en = s->energy ? sim_energy_create() : NULL;
         if (s->ode) pthread_mutex_lock(&g_ode_mu);
-        sim_run(m, &s->sc, &s->c.sim, design_row, &met, NULL, NULL, NULL, &res);
+        sim_run_energy(m, &s->sc, &s->c.sim, design_row, &met, NULL, NULL, NULL, en, &res);
         if (s->ode) pthread_mutex_unlock(&g_ode_mu);
         model_free(m);
-        if (res.status == SIM_REFUSED && app_signal_caught()) return NULL;
+        if (res.status == SIM_REFUSED && app_signal_caught()) {
+            sim_energy_free(en);
+            return NULL;
+        }
         metrics_finish(&met, &res);
+        if (en) metrics_energy(&met, en);
+        sim_energy_free(en);
         if (res.status != SIM_OK) {
             code = res.status == SIM_FAILED ? EXIT_RUNTIME : EXIT_USAGE;
             snprintf(err, sizeof err, "%s", res.message);
@@ -298,11 +302,11 @@ static void* worker(void* arg) {
 // Parsing
 // ---------------------------------------------------------------------------
 
-// "PATH=LO:HI:N" (grid) or "PATH=LO:HI" (--lhs). 0, or -1 after one line.
-static int parse_param(const char* arg, bool want_n, sweep_param* p) {
+// app.h: "PATH=LO:HI:N" (want_n) or "PATH=LO:HI"; shared with cmd_optimize.c.
+int app_parse_range(const char* cmd, const char* arg, bool want_n, app_range* p) {
     const char* eq = strrchr(arg, '=');
     if (!eq || eq == arg || (size_t)(eq - arg) >= sizeof p->path) {
-        fprintf(stderr, "cranesim sweep: --param '%s': expected PATH=LO:HI%s\n", arg, want_n ? ":N" : "");
+        fprintf(stderr, "cranesim %s: --param '%s': expected PATH=LO:HI%s\n", cmd, arg, want_n ? ":N" : "");
         return -1;
     }
     snprintf(p->path, sizeof p->path, "%.*s", (int)(eq - arg), arg);
@@ -313,16 +317,16 @@ static int parse_param(const char* arg, bool want_n, sweep_param* p) {
     for (char *q = buf, *tok; nf < 4 && (tok = strsep(&q, ":"));) f[nf++] = tok;
     if (nf != (want_n ? 3 : 2) || app_parse_double(f[0], &p->lo) || app_parse_double(f[1], &p->hi) ||
         !isfinite(p->lo) || !isfinite(p->hi)) {
-        if (nf == 3 && !want_n)
-            fprintf(stderr, "cranesim sweep: --param '%s': with --lhs give PATH=LO:HI (--lhs sets the count)\n",
-                    arg);
+        if (nf == 3 && !want_n && !strcmp(cmd, "sweep"))
+            fprintf(stderr, "cranesim %s: --param '%s': with --lhs give PATH=LO:HI (--lhs sets the count)\n",
+                    cmd, arg);
         else
-            fprintf(stderr, "cranesim sweep: --param '%s': expected PATH=LO:HI%s with finite numbers\n", arg,
+            fprintf(stderr, "cranesim %s: --param '%s': expected PATH=LO:HI%s with finite numbers\n", cmd, arg,
                     want_n ? ":N" : "");
         return -1;
     }
     if (p->lo > p->hi) {
-        fprintf(stderr, "cranesim sweep: --param '%s': LO %g is above HI %g\n", arg, p->lo, p->hi);
+        fprintf(stderr, "cranesim %s: --param '%s': LO %g is above HI %g\n", cmd, arg, p->lo, p->hi);
         return -1;
     }
     p->n = 1;
@@ -331,12 +335,12 @@ static int parse_param(const char* arg, bool want_n, sweep_param* p) {
         errno = 0;
         const long n = strtol(f[2], &end, 10);
         if (!*f[2] || *end || errno || n < 1 || n > SW_MAXDESIGN) {
-            fprintf(stderr, "cranesim sweep: --param '%s': N must be a whole number in [1, %d], got '%s'\n", arg,
+            fprintf(stderr, "cranesim %s: --param '%s': N must be a whole number in [1, %d], got '%s'\n", cmd, arg,
                     SW_MAXDESIGN, f[2]);
             return -1;
         }
         if (n == 1 && p->lo != p->hi) {
-            fprintf(stderr, "cranesim sweep: --param '%s': N = 1 needs LO = HI (one value)\n", arg);
+            fprintf(stderr, "cranesim %s: --param '%s': N = 1 needs LO = HI (one value)\n", cmd, arg);
             return -1;
         }
         p->n = n;
@@ -743,7 +747,7 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
     s.lhs = lhs;
     double nd = 1;
     for (int k = 0; k < nparam; ++k) {
-        if (parse_param(params[k], lhs == 0, &s.par[k])) return EXIT_USAGE;
+        if (app_parse_range("sweep", params[k], lhs == 0, &s.par[k])) return EXIT_USAGE;
         for (int j = 0; j < k; ++j)
             if (!strcmp(s.par[j].path, s.par[k].path)) {
                 fprintf(stderr, "cranesim sweep: --param %s given twice\n", s.par[k].path);
@@ -793,7 +797,12 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
     if (!rc && metrics) rc = parse_metrics(&s, metrics) ? EXIT_USAGE : 0;
     else if (!rc)
         for (int id = 0; id < MET_COUNT; ++id)
-            if (metrics_present((metric_id)id, s.ncol)) s.met[s.nmet++] = id;
+            // The energy metrics only when asked: the accounting costs a
+            // circuit evaluation per step, and the default table stays as it was.
+            if (metrics_present((metric_id)id, s.ncol) && id != MET_ENERGY_IN && id != MET_ENERGY_LOSS)
+                s.met[s.nmet++] = id;
+    for (int k = 0; k < s.nmet; ++k)
+        if (s.met[k] == MET_ENERGY_IN || s.met[k] == MET_ENERGY_LOSS) s.energy = true;
     if (!rc && plot && !(strlen(plot) > 4 && !strcmp(plot + strlen(plot) - 4, ".png")) && rank == 0)
         rc = app_make_dir("sweep", "--plot", plot) ? EXIT_USAGE : 0;
     if (!rc && lhs > 0 && make_lhs(&s, seed)) {

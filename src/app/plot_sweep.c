@@ -111,7 +111,65 @@ int app_plot_heat(const char* png, const char* title, const char* xlab, const ch
     heat_plot p = {title, xlab, ylab, z, nx, ny, x0, x1, y0, y1};
     return app_png_render(png, "1000x800", draw_heat, &p, err, errsz);
 }
+typedef struct conv_plot {
+    const char *title, *ylab;
+    const double *f;
+    const bool* feasible;
+    long n;
+} conv_plot;
+
+// The optimiser's convergence: every evaluation's objective (filled points
+// feasible, crosses infeasible, failed designs left out) and the best
+// feasible value so far as a line.
+static void draw_conv(void* user) {
+    const conv_plot* p = user;
+    plinit();
+    plschr(0, 0.9);
+    double* x = calloc((size_t)(p->n > 0 ? p->n : 1), sizeof *x);
+    double* y = calloc((size_t)(p->n > 0 ? p->n : 1), sizeof *y);
+    double* best = malloc((size_t)(p->n > 0 ? p->n : 1) * sizeof *best);
+    if (!x || !y || !best) {
+        free(x), free(y), free(best);
+        return;
+    }
+    long m = 0;
+    for (long i = 0; i < p->n; ++i)
+        if (isfinite(p->f[i])) x[m] = (double)(i + 1), y[m++] = p->f[i];
+    double ylo, yhi, xlo, xhi;
+    range(y, m, &ylo, &yhi);
+    range(x, m, &xlo, &xhi);
+    if (m == 0) xlo = 0, xhi = 1;
+    plcol0(15);
+    plenv(xlo, xhi, ylo, yhi, 0, 2);
+    pllab("evaluation", p->ylab, p->title);
+    for (long i = 0; i < p->n; ++i) {
+        if (!isfinite(p->f[i])) continue;
+        PLFLT px = (double)(i + 1), py = p->f[i];
+        plcol0(p->feasible[i] ? 1 : 9);
+        plpoin(1, &px, &py, p->feasible[i] ? 17 : 5);
+    }
+    long nb = 0;
+    double b = INFINITY;
+    for (long i = 0; i < p->n; ++i) {
+        if (isfinite(p->f[i]) && p->feasible[i]) b = fmin(b, p->f[i]);
+        if (isfinite(b)) x[nb] = (double)(i + 1), best[nb++] = b;
+    }
+    plcol0(3);
+    if (nb > 1) plline((PLINT)nb, x, best);
+    free(x), free(y), free(best);
+}
+
+int app_plot_convergence(const char* png, const char* title, const char* ylab, const double* f, const bool* feasible,
+                         long n, char* err, size_t errsz) {
+    conv_plot p = {title, ylab, f, feasible, n};
+    return app_png_render(png, "1000x700", draw_conv, &p, err, errsz);
+}
 #else
+int app_plot_convergence(const char* png, const char* title, const char* ylab, const double* f, const bool* feasible,
+                         long n, char* err, size_t errsz) {
+    (void)title, (void)ylab, (void)f, (void)feasible, (void)n;
+    return app_png_render(png, "", NULL, NULL, err, errsz);
+}
 int app_plot_sweep(const char* png, const char* title, const char* xlab, const char* ylab, const double* x,
                    const double* y, long n, char* err, size_t errsz) {
     (void)title, (void)xlab, (void)ylab, (void)x, (void)y, (void)n;

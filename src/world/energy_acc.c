@@ -14,6 +14,7 @@ struct sim_energy {
     int* group;
     int* comp; ///< component of the column, -1 for tank and stored
     double *P, *Pprev, *E; ///< (ncol) power now, at the last sample [W]; energy [J]
+    double* Topen; ///< (ncol) time its component was open [s] (reliefs; 0 for the others)
     long n;
     double t0, tprev;
     double es0, es1, em0, em1;
@@ -41,6 +42,7 @@ void sim_energy_free(sim_energy* e) {
     free(e->P);
     free(e->Pprev);
     free(e->E);
+    free(e->Topen);
     free(e);
 }
 
@@ -82,10 +84,11 @@ int sim_energy_bind(sim_energy* e, const hyd_model* m) {
     e->P = calloc(cap, sizeof *e->P);
     e->Pprev = calloc(cap, sizeof *e->Pprev);
     e->E = calloc(cap, sizeof *e->E);
+    e->Topen = calloc(cap, sizeof *e->Topen);
     e->p1 = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->p1);
     e->V1 = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->V1);
     e->phi = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->phi);
-    if (!e->d || !e->ydot || !e->name || !e->group || !e->comp || !e->P || !e->Pprev || !e->E || !e->p1 || !e->V1 ||
+    if (!e->d || !e->ydot || !e->name || !e->group || !e->comp || !e->P || !e->Pprev || !e->E || !e->Topen || !e->p1 || !e->V1 ||
         !e->phi) {
         unbind(e);
         return -1;
@@ -132,6 +135,7 @@ int sim_energy_ncol(const sim_energy* e) { return e->ncol; }
 const char* sim_energy_col_name(const sim_energy* e, int i) { return e->name[i]; }
 sim_energy_group sim_energy_col_group(const sim_energy* e, int i) { return (sim_energy_group)e->group[i]; }
 double sim_energy_col_energy(const sim_energy* e, int i) { return e->E[i]; }
+double sim_energy_col_open_time(const sim_energy* e, int i) { return e->Topen[i]; }
 
 // Every column's power taken from the fluid at the last evaluation [W].
 static void powers(sim_energy* e, const hyd_data* d) {
@@ -201,6 +205,10 @@ void sim_energy_sample_data(sim_energy* e, double t, const hyd_data* d, double e
     } else {
         const double h = t - e->tprev;
         for (int i = 0; i < e->ncol; ++i) e->E[i] += 0.5 * h * (e->P[i] + e->Pprev[i]);
+        // A relief's open time: the step counts when the relief passes flow
+        // at its end (the rows' relief_open convention, at step resolution).
+        for (int i = 0; i < e->ncol; ++i)
+            if (e->group[i] == SIM_EG_RELIEF && d->comp_open && d->comp_open[e->comp[i]]) e->Topen[i] += h;
     }
     memcpy(e->Pprev, e->P, (size_t)e->ncol * sizeof *e->P);
     const int nn = hyd_model_nnode(m);

@@ -70,6 +70,10 @@ const char* sim_energy_col_name(const sim_energy* e, int i);
 sim_energy_group sim_energy_col_group(const sim_energy* e, int i);
 /// Energy taken from the fluid by column i over the run [J].
 double sim_energy_col_energy(const sim_energy* e, int i);
+/// Time column i's component passed flow over the run [s], at the
+/// resolution of the samples (every integration step): a step counts when
+/// the component is open at its end. Relief columns only (0 for the others).
+double sim_energy_col_open_time(const sim_energy* e, int i);
 
 /// The balance over the run [J].
 typedef struct sim_energy_balance {

@@ -1,6 +1,8 @@
 // metrics.c: a run's metrics from its rows (metrics.h).
 #include "metrics.h"
 
+#include "energy_acc.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -25,6 +27,11 @@ static const metric_def k_metric[MET_COUNT] = {
     // so the metric is there only when the run has the slew channels.
     [MET_STOP_SLEW] = {"end_stop_hits_slew", "count", COL_X3},
     [MET_MAX_TILT] = {"max_truck_tilt", "rad", COL_TRUCK_TILT},
+    // Not from a channel (COL_T: every backend has them), from the energy balance.
+    [MET_ENERGY_IN] = {"energy_in", "J", COL_T},
+    [MET_ENERGY_LOSS] = {"energy_loss", "J", COL_T},
+    [MET_MAX_SWAY] = {"max_hook_sway", "rad", COL_TIP_WZ},
+    [MET_MAX_SWAY_AMP] = {"max_hook_sway_amplitude", "m", COL_TIP_WZ},
 };
 
 bool metrics_present(metric_id id, int ncol) { return id >= 0 && id < MET_COUNT && k_metric[id].col < ncol; }
@@ -48,7 +55,8 @@ void metrics_init(run_metrics* m, int ncol) {
     memset(m, 0, sizeof *m);
     m->ncol = ncol;
     for (int i = 0; i < MET_COUNT; ++i) {
-        m->present[i] = metrics_present((metric_id)i, ncol);
+        // The energy metrics wait for metrics_energy.
+        m->present[i] = metrics_present((metric_id)i, ncol) && i != MET_ENERGY_IN && i != MET_ENERGY_LOSS;
         m->value[i] = i <= MET_PEAK_P_PUMP ? -INFINITY : 0.0;
     }
 }
@@ -64,6 +72,16 @@ void metrics_row(run_metrics* m, const double* row) {
     for (int k = 0; k < 3; ++k)
         if (m->present[MET_STOP_LIFT + k] && (rising >> k & 1)) m->value[MET_STOP_LIFT + k] += 1;
     if (m->present[MET_MAX_TILT]) m->value[MET_MAX_TILT] = fmax(m->value[MET_MAX_TILT], fabs(row[COL_TRUCK_TILT]));
+    if (m->present[MET_MAX_SWAY]) {
+        // The rope from the tip to the hook: its horizontal offset [m] and
+        // its angle from hanging straight down [rad] (0 where the hook is
+        // the tip, as in the validation world).
+        const double dx = row[COL_HOOK_X] - row[COL_TIP_WX], dy = row[COL_HOOK_Y] - row[COL_TIP_WY];
+        const double drop = row[COL_TIP_WZ] - row[COL_HOOK_Z];
+        const double off = hypot(dx, dy);
+        m->value[MET_MAX_SWAY_AMP] = fmax(m->value[MET_MAX_SWAY_AMP], off);
+        m->value[MET_MAX_SWAY] = fmax(m->value[MET_MAX_SWAY], off > 0 ? atan2(off, drop) : 0.0);
+    }
     m->stop_prev = stops;
     m->t_prev = row[COL_T];
     ++m->rows;
@@ -80,6 +98,22 @@ void metrics_finish(run_metrics* m, const sim_result* r) {
     }
 }
 
+void metrics_energy(run_metrics* m, const sim_energy* e) {
+    sim_energy_balance b;
+    sim_energy_result(e, &b);
+    if (b.samples < 1) return;
+    m->value[MET_ENERGY_IN] = b.in;
+    m->value[MET_ENERGY_LOSS] = b.loss;
+    m->present[MET_ENERGY_IN] = m->present[MET_ENERGY_LOSS] = true;
+    m->per_step[MET_ENERGY_IN] = m->per_step[MET_ENERGY_LOSS] = true;
+    m->nrelief = 0;
+    for (int i = 0; i < sim_energy_ncol(e) && m->nrelief < METRICS_MAXRELIEF; ++i) {
+        if (sim_energy_col_group(e, i) != SIM_EG_RELIEF) continue;
+        snprintf(m->relief_name[m->nrelief], sizeof m->relief_name[0], "%s", sim_energy_col_name(e, i));
+        m->relief_time[m->nrelief++] = sim_energy_col_open_time(e, i);
+    }
+}
+
 void metrics_print(const run_metrics* m, FILE* f) {
     if (m->rows == 0) return;
     fprintf(f, "  metrics: relief open %.3f s; end-stop hits lift %.0f, jib %.0f", m->value[MET_RELIEF_TIME],
@@ -89,7 +123,21 @@ void metrics_print(const run_metrics* m, FILE* f) {
     if (m->present[MET_PEAK_P3A])
         fprintf(f, ", slew p3A %.2f, p3B %.2f MPa", m->value[MET_PEAK_P3A] * 1e-6, m->value[MET_PEAK_P3B] * 1e-6);
     if (m->present[MET_MAX_TILT]) fprintf(f, "; max truck tilt %.3f deg", m->value[MET_MAX_TILT] * 57.29577951308232);
+    if (m->present[MET_MAX_SWAY])
+        fprintf(f, "; max hook sway %.2f deg, %.3f m", m->value[MET_MAX_SWAY] * 57.29577951308232,
+                m->value[MET_MAX_SWAY_AMP]);
     fprintf(f, "\n");
+    // Which reliefs were open, and how long (only those that opened).
+    bool any = false;
+    for (int k = 0; k < m->nrelief; ++k) {
+        if (m->relief_time[k] <= 0) continue;
+        fprintf(f, "%s%s %.3f s", any ? ", " : "  metrics: open per relief: ", m->relief_name[k], m->relief_time[k]);
+        any = true;
+    }
+    if (any) fprintf(f, "\n");
+    if (m->present[MET_ENERGY_IN])
+        fprintf(f, "  metrics: energy in %.3f kJ, losses %.3f kJ\n", m->value[MET_ENERGY_IN] * 1e-3,
+                m->value[MET_ENERGY_LOSS] * 1e-3);
 }
 
 int metrics_write_json(const run_metrics* m, FILE* f) {
@@ -97,9 +145,14 @@ int metrics_write_json(const run_metrics* m, FILE* f) {
     bool first = true;
     for (int i = 0; i < MET_COUNT; ++i) {
         if (!m->present[i] || m->rows == 0) continue;
-        const bool peak = i <= MET_PEAK_P_PUMP;
+        const bool peak = i <= MET_PEAK_P_PUMP || i == MET_ENERGY_IN || i == MET_ENERGY_LOSS;
         fprintf(f, "%s\n    \"%s\": {\"value\": %.17g, \"unit\": \"%s\", \"over\": \"%s\"}", first ? "" : ",",
                 k_metric[i].name, m->value[i], k_metric[i].unit, peak && m->per_step[i] ? "steps" : "rows");
+        first = false;
+    }
+    for (int k = 0; k < m->nrelief && m->rows > 0; ++k) {
+        fprintf(f, "%s\n    \"relief_open_time.%s\": {\"value\": %.17g, \"unit\": \"s\", \"over\": \"steps\"}",
+                first ? "" : ",", m->relief_name[k], m->relief_time[k]);
         first = false;
     }
     fprintf(f, "\n  }\n}\n");

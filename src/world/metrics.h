@@ -24,11 +24,19 @@ typedef enum metric_id {
     MET_RELIEF_TIME,     ///< time with any relief valve passing flow [s], at row resolution
     MET_STOP_LIFT, MET_STOP_JIB, MET_STOP_SLEW, ///< end-stop hits (entries into a stop) [count]
     MET_MAX_TILT,        ///< largest truck tilt from vertical [rad] (ode)
-    // Energy in and losses come from the energy accounting: one id each
-    // here, their unit and name in metrics.c's table, their value set by
-    // that module into run_metrics.value[] with present[] raised.
+    // From the energy accounting (metrics_energy), over every integration
+    // step: absent until a run's balance is added.
+    MET_ENERGY_IN,       ///< energy delivered by the pumps and tanks [J]
+    MET_ENERGY_LOSS,     ///< energy lost in valves, reliefs, checks, orifices, hoses, leakage [J]
+    // The hook against the end-arm tip it hangs from (ode): the rope's angle
+    // from vertical and the hook's horizontal offset from the tip.
+    MET_MAX_SWAY,        ///< largest hook sway angle [rad]
+    MET_MAX_SWAY_AMP,    ///< largest hook sway amplitude (horizontal offset) [m]
     MET_COUNT
 } metric_id;
+
+/// Reliefs whose open time a run's metrics name (more are summed into none).
+#define METRICS_MAXRELIEF 16
 
 typedef struct run_metrics {
     int ncol;                   ///< the run's channel count
@@ -38,6 +46,9 @@ typedef struct run_metrics {
     long rows;
     double t_prev;              ///< the previous row's time [s]
     int stop_prev;              ///< the previous row's end_stop bits
+    int nrelief;                ///< reliefs named (metrics_energy)
+    char relief_name[METRICS_MAXRELIEF][64]; ///< component names
+    double relief_time[METRICS_MAXRELIEF];   ///< time each passed flow [s], over every step
 } run_metrics;
 
 /// Start the metrics of a run that writes ncol channels (sim_ncol).
@@ -52,7 +63,13 @@ void metrics_row(run_metrics* m, const double* row);
 /// when every step is a row, and equal).
 void metrics_finish(run_metrics* m, const sim_result* r);
 
-/// Which metrics a run of ncol channels has (before it runs: for a table's header).
+struct sim_energy;
+/// After a run with the energy accounting (sim_run_energy): energy in and
+/// losses from its balance, and each relief's open time (by component name).
+void metrics_energy(run_metrics* m, const struct sim_energy* e);
+
+/// Which metrics a run of ncol channels has (before it runs: for a table's
+/// header). Energy in and losses: every run that has the energy accounting.
 bool metrics_present(metric_id id, int ncol);
 /// The name used in --metrics lists, the JSON file and the sweep's CSV
 /// ("peak_p1A"), and the unit ("Pa", "s", "count", "rad").
@@ -66,6 +83,7 @@ void metric_names(char* buf, size_t n);
 /// The summary's block: a few lines, each starting with two spaces.
 void metrics_print(const run_metrics* m, FILE* f);
 /// The JSON document: {"metrics": {"NAME": {"value": V, "unit": U, "over": "steps"|"rows"}, ...}}
+/// and, after metrics_energy, "relief_open_time.COMPONENT" for each relief.
 /// (absent metrics left out; numbers with 17 significant digits). Returns 0, or -1 on a write error.
 int metrics_write_json(const run_metrics* m, FILE* f);
 

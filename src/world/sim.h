@@ -204,7 +204,11 @@ typedef struct sim_channel {
     X(P3B, "p3B", "Pa", SIM_CH_PRESSURE) \
     X(U3, "u3", "-", SIM_CH_OTHER) \
     X(U3_CMD, "u3_cmd", "-", SIM_CH_OTHER) \
-    X(F3, "F3", "N", SIM_CH_OTHER)
+    X(F3, "F3", "N", SIM_CH_OTHER) \
+    /* The end-arm tip in the world frame, where the rope hangs from (hook sway). */ \
+    X(TIP_WX, "tip_wx", "m", SIM_CH_OTHER) \
+    X(TIP_WY, "tip_wy", "m", SIM_CH_OTHER) \
+    X(TIP_WZ, "tip_wz", "m", SIM_CH_OTHER)
 
 #define SIM_COL_ENUM_(id, name, unit, kind) COL_##id,
 /// CSV column indices, in the order of the list.

@@ -14,7 +14,7 @@ static char out[1 << 16];
 
 // The value of metric name in a metrics JSON text, or NAN.
 static double json_metric(const char* text, const char* name) {
-    char key[96];
+    char key[160];
     snprintf(key, sizeof key, "\"%s\": {\"value\": ", name);
     const char* p = strstr(text, key);
     return p ? strtod(p + strlen(key), NULL) : NAN;
@@ -121,6 +121,141 @@ static void test_metrics_match_csv(void) {
     if (f) fclose(f);
     CHECK(json_metric(json, "peak_p1A") >= coarse && coarse > 1e7, "step peak %.17g below the rows' %.17g",
           json_metric(json, "peak_p1A"), coarse);
+}
+
+// Energy in and losses, and each relief's open time, against the energy
+// CSV (`run --energy`, the per-component powers [W] at the row period):
+// energy in is minus the pump and tank columns integrated by the
+// trapezoidal rule, the losses the valve, relief, check, orifice, hose and
+// leakage columns; a relief counts a row interval when its power is
+// positive at the row (it passes flow). The metrics come from every step,
+// the CSV from the 1 ms rows: equal to 1e-4 relative (energy) and to a few
+// rows (time). The overload scenario opens the lift port relief for over 1 s.
+static void test_energy_and_relief_metrics_match_energy_csv(void) {
+    const char* js = "metrics_energy.json";
+    const char* ecsv = "metrics_energy_p.csv";
+    char args[512];
+    snprintf(args, sizeof args, "run --scenario overload --duration 4 --out metrics_energy.csv --energy %s "
+             "--metrics %s", ecsv, js);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    CHECK(strstr(out, "metrics: energy in") && strstr(out, "open per relief: lift_relief_A"), "summary: %s", out);
+    static char json[8192];
+    CHECK(cli_read_file(js, json, sizeof json) > 0, "no %s", js);
+    FILE* f = fopen(ecsv, "r");
+    CHECK(f != NULL, "no %s", ecsv);
+    if (!f) return;
+    static char head[8192], line[8192];
+    if (!fgets(head, sizeof head, f)) head[0] = 0;
+    // Column roles from the header: 1 in (pump, tank), 2 loss, 0 neither.
+    enum { MAXC = 128 };
+    int role[MAXC] = {0}, nc = 0;
+    char names[MAXC][72];
+    for (char *p = head, *e; *p && nc < MAXC; p = e + 1) {
+        e = strpbrk(p, ",\n");
+        const size_t L = e ? (size_t)(e - p) : strlen(p);
+        snprintf(names[nc], sizeof names[nc], "%.*s", (int)L, p);
+        const char* n = names[nc];
+        const size_t nl = strlen(n);
+        if (!strcmp(n, "pump") || !strcmp(n, "tank")) role[nc] = 1;
+        else if (nc > 0 && strcmp(n, "stored") && strcmp(n, "expansion") &&
+                 !(nl > 5 && !strcmp(n + nl - 5, ".work")))
+            role[nc] = 2;
+        ++nc;
+        if (!e || *e == '\n') break;
+    }
+    double ein = 0, eloss = 0, tprev = 0, Tr[MAXC] = {0};
+    double prev[MAXC] = {0}, cur[MAXC];
+    long rows = 0;
+    while (fgets(line, sizeof line, f)) {
+        for (int k = 0; k < nc; ++k) cur[k] = csv_field(line, k);
+        if (rows > 0) {
+            const double h = cur[0] - tprev;
+            for (int k = 1; k < nc; ++k) {
+                const double e = 0.5 * h * (cur[k] + prev[k]);
+                if (role[k] == 1) ein -= e;
+                if (role[k] == 2) eloss += e;
+                if (cur[k] > 0) Tr[k] += h;
+            }
+        }
+        memcpy(prev, cur, sizeof cur);
+        tprev = cur[0];
+        ++rows;
+    }
+    fclose(f);
+    CHECK(rows > 1000, "energy CSV rows %ld", rows);
+    const double min = json_metric(json, "energy_in"), mloss = json_metric(json, "energy_loss");
+    CHECK(ein > 1e4 && fabs(min - ein) <= 1e-4 * ein, "energy_in %.9g J, CSV %.9g J", min, ein);
+    CHECK(eloss > 1e4 && fabs(mloss - eloss) <= 1e-4 * eloss, "energy_loss %.9g J, CSV %.9g J", mloss, eloss);
+    CHECK(strstr(json, "\"energy_in\": {\"value\"") && strstr(json, "\"unit\": \"J\""), "%s", json);
+    // Every relief of the circuit is named; each one's time as the CSV has it.
+    int nrel = 0;
+    for (int k = 1; k < nc; ++k) {
+        if (!strstr(names[k], "relief")) continue;
+        char key[96];
+        snprintf(key, sizeof key, "relief_open_time.%s", names[k]);
+        const double t = json_metric(json, key);
+        CHECK(isfinite(t) && fabs(t - Tr[k]) <= 3e-3, "%s: metrics %.6g s, energy CSV %.6g s", key, t, Tr[k]);
+        ++nrel;
+    }
+    CHECK(nrel == 5, "%d reliefs in the energy CSV", nrel);
+    CHECK(json_metric(json, "relief_open_time.lift_relief_A") > 1.0, "%s", json);
+    // The sweep tabulates the same energy on asking (one design, the same run).
+    CHECK(cli_run("sweep --scenario overload --duration 4 --param hydraulics.components.lift_cyl.bore=0.1:0.1:1 "
+                  "--metrics energy_in,energy_loss --out metrics_energy_sweep.csv -q",
+                  out, sizeof out) == 0,
+          "%s", out);
+    static char tab[4096];
+    CHECK(cli_read_file("metrics_energy_sweep.csv", tab, sizeof tab) > 0, "no sweep file");
+    CHECK(strstr(tab, "index,hydraulics.components.lift_cyl.bore,energy_in,energy_loss,exit,error\n") != NULL, "%s",
+          tab);
+    const char* r1 = strchr(tab, '\n');
+    CHECK(r1 && fabs(csv_field(r1 + 1, 2) - min) <= 1e-9 * min && fabs(csv_field(r1 + 1, 3) - mloss) <= 1e-9 * mloss,
+          "sweep row %s vs run %.17g %.17g", r1 ? r1 + 1 : "", min, mloss);
+}
+
+// Hook sway on the sandbox's swing scenario (a slew started and stopped
+// abruptly, the empty hook swinging on its rope): the largest horizontal
+// offset of the hook (hook_x/y) from the end-arm tip in the world
+// (tip_wx/y/z) and the rope's angle from vertical, atan2(offset, drop),
+// computed here from the CSV, equal the metrics (to the CSV's 9 digits).
+// The validation world hangs the hook at the tip: no sway at all.
+static void test_sway_metrics_match_csv(void) {
+    const char* csv = "metrics_swing.csv";
+    const char* js = "metrics_swing.json";
+    char args[512];
+    snprintf(args, sizeof args, "run --scenario sandbox_swing --duration 6 --out %s --metrics %s -q", csv, js);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    static char json[8192], line[8192];
+    CHECK(cli_read_file(js, json, sizeof json) > 0, "no %s", js);
+    FILE* f = fopen(csv, "r");
+    CHECK(f != NULL, "no %s", csv);
+    if (!f) return;
+    if (!fgets(line, sizeof line, f)) line[0] = 0;
+    const int hx = csv_col(line, "hook_x"), hy = csv_col(line, "hook_y"), hz = csv_col(line, "hook_z");
+    const int tx = csv_col(line, "tip_wx"), ty = csv_col(line, "tip_wy"), tz = csv_col(line, "tip_wz");
+    CHECK(hx > 0 && hy > 0 && hz > 0 && tx > 0 && ty > 0 && tz > 0, "columns: %s", line);
+    double amp = 0, ang = 0;
+    while (fgets(line, sizeof line, f)) {
+        const double dx = csv_field(line, hx) - csv_field(line, tx), dy = csv_field(line, hy) - csv_field(line, ty);
+        const double drop = csv_field(line, tz) - csv_field(line, hz);
+        const double off = sqrt(dx * dx + dy * dy);
+        amp = fmax(amp, off);
+        ang = fmax(ang, atan2(off, drop));
+    }
+    fclose(f);
+    // The slew steps swing the hook visibly (so hard here that the chain
+    // rope swings out to the horizontal: angle near 90 degrees).
+    CHECK(amp > 0.05 && ang > 0.01 && ang < 3.1415927, "no swing: %g m, %g rad", amp, ang);
+    CHECK_NEAR(json_metric(json, "max_hook_sway_amplitude"), amp, 1e-6);
+    CHECK_NEAR(json_metric(json, "max_hook_sway"), ang, 1e-6);
+    CHECK(strstr(json, "\"max_hook_sway\": {\"value\"") && strstr(json, "\"unit\": \"rad\"") &&
+              strstr(json, "\"unit\": \"m\""),
+          "%s", json);
+    snprintf(args, sizeof args, "run --scenario ramp --mechanics ode --duration 2 --out metrics_val.csv --metrics %s -q",
+             js);
+    CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
+    CHECK(cli_read_file(js, json, sizeof json) > 0, "no %s", js);
+    CHECK(json_metric(json, "max_hook_sway_amplitude") == 0 && json_metric(json, "max_hook_sway") == 0, "%s", json);
 }
 
 static const char* k_grid = "sweep --scenario ramp --duration 2 --param hydraulics.components.lift_cyl.bore=0.08:0.12:3 "
@@ -257,6 +392,8 @@ static void test_sweep_lhs_strata(void) {
 
 int main(int argc, char** argv) {
     RUN_TEST(test_metrics_match_csv);
+    RUN_TEST(test_energy_and_relief_metrics_match_energy_csv);
+    RUN_TEST(test_sway_metrics_match_csv);
     RUN_TEST(test_sweep_threads_same_file);
     RUN_TEST(test_sweep_failing_design_is_a_row);
     RUN_TEST(test_sweep_bad_input);
