@@ -77,15 +77,18 @@ const char* app_value(int argc, char** argv, int* i) {
 // app_opt_name up to --kernel).
 static const struct {
     const char* cmd;
-    const char* opts[10];
+    const char* opts[14];
 } own_values[] = {
     {"run", {"--out", "--plot", "--metrics", NULL}},
     {"sweep", {"--param", "--lhs", "--seed", "--metrics", "--threads", "--out", "--plot", NULL}},
-    {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot", NULL}},
+    {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot",
+                 "--set-a", "--set-b", "--out", NULL}},
+    {"replay", {"--out", "--metrics", "--plot", NULL}},
     {"study", {"--out-dir", "--repeat", NULL}},
     {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
-     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", NULL}},
+     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as",
+      "--session", "--replay", NULL}},
 };
 
 int app_check_values(const char* cmd, int argc, char** argv) {

@@ -22,6 +22,7 @@ static void usage(FILE* f) {
             "  study     solver study: every integrator against a CVODE reference, work-precision plot\n"
             "  sweep     one scenario on many designs (a grid or a Latin hypercube over model values),\n"
             "            in parallel (threads, MPI ranks): a results table and plots\n"
+            "  replay    run a recorded drive session again headless, on its design or a changed one\n"
             "  help      this text; cranesim help <command>: that command's help\n"
             "\n"
             "examples:\n"
@@ -38,7 +39,7 @@ static const struct {
     int (*fn)(int argc, char** argv);
 } commands[] = {
     {"run", cmd_run}, {"bench", cmd_bench}, {"compare", cmd_compare}, {"drive", cmd_drive}, {"study", cmd_study},
-    {"sweep", cmd_sweep},
+    {"sweep", cmd_sweep}, {"replay", cmd_replay},
 };
 
 static int (*find_command(const char* name))(int, char**) {
