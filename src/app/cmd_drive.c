@@ -429,6 +429,10 @@ int cmd_drive(int argc, char** argv) {
         fprintf(stderr, "cranesim drive: unknown option '%s' (see cranesim drive --help)\n", argv[i]);
         return EXIT_USAGE;
     }
+    if (replay && session_path) {
+        fprintf(stderr, "cranesim drive: --session: a replay records no session\n");
+        return EXIT_USAGE;
+    }
     // Every option is checked before anything runs, whichever mode follows:
     // an option accepted in one mode and ignored in another would hide a
     // mistake until the other mode is used.
@@ -467,6 +471,8 @@ int cmd_drive(int argc, char** argv) {
     o.charts = charts;
     o.readouts = readouts;
     o.record_path = record;
+    o.session_path = session_path;
+    o.replay_path = replay;
     o.save_as = save_as;
     o.world_name = c.sim.mechanics == SIM_ODE ? wname : NULL;
     int rc = drive_opts_check(&c, &o, err, sizeof err);
@@ -515,6 +521,12 @@ int cmd_drive(int argc, char** argv) {
     }
     if (!headless && display) snprintf(why, sizeof why, "this binary was built without the render module (CRANESIM_CORE_ONLY)");
 #endif
+    // The headless counterpart of the window's replay is its own command.
+    if (replay) {
+        fprintf(stderr, "cranesim drive: --replay %s: shows a session in the 3D window, and there is none (%s): "
+                        "cranesim replay %s runs it headless\n", replay, why, replay);
+        return EXIT_USAGE;
+    }
     // The headless run has no parameter panel, so nothing to save.
     if (save_as) fprintf(stderr, "cranesim drive: note: --save-as has no effect without the window (no parameter panel)\n");
     return drive_headless(&c, frame_rate, record, session_path, why, kind, wname);
