@@ -108,7 +108,49 @@ static void check_bad_sessions(void) {
     }
 }
 
+// compare on two designs: its CSV of both holds each design's own run rows
+// (as `run` writes them), and the bigger bore's peak is the lower one.
+static void check_compare_designs(void) {
+    const char* bore = "hydraulics.components.lift_cyl.bore=0.11";
+    char cmd[1024];
+    int rc = cli_run("run --quiet --scenario hold --out cd_a.csv", out, sizeof out);
+    CHECK(rc == 0, "run A: %s", out);
+    snprintf(cmd, sizeof cmd, "run --quiet --scenario hold --set %s --out cd_b.csv", bore);
+    rc = cli_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "run B: %s", out);
+    snprintf(cmd, sizeof cmd, "compare --quiet --scenario hold --set-b %s --out cd_both.csv", bore);
+    rc = cli_run(cmd, out, sizeof out);
+    CHECK(rc == 0, "compare: %d %s", rc, out);
+    const char* pk = strstr(out, "peak_p1A [MPa]");
+    double pa = NAN, pb = NAN, dd = NAN;
+    CHECK(pk && sscanf(pk + 14, "%lg %lg %lg", &pa, &pb, &dd) == 3, "no peak_p1A line: %s", out);
+    CHECK(pb < pa && fabs(dd - (pb - pa)) < 1e-5 * pa, "peak_p1A A %.6g, B %.6g, B - A %.6g MPa", pa, pb, dd);
+    static char both[1 << 23];
+    CHECK(cli_read_file("cd_a.csv", a, sizeof a) > 0 && cli_read_file("cd_b.csv", b, sizeof b) > 0 &&
+              cli_read_file("cd_both.csv", both, sizeof both) > 0,
+          "csv files");
+    for (int k = 0; k <= 10000; k += 2500) {
+        CHECK(csv_value(both, "p1A_A", k) == csv_value(a, "p1A", k), "row %d: p1A_A", k);
+        CHECK(csv_value(both, "p1A_B", k) == csv_value(b, "p1A", k), "row %d: p1A_B", k);
+        CHECK(csv_value(both, "x1_B", k) == csv_value(b, "x1", k), "row %d: x1_B", k);
+    }
+    // The same design twice differs by nothing.
+    rc = cli_run("compare --quiet --scenario hold --set-a mechanics.load_mass=800 --set-b mechanics.load_mass=800",
+                 out, sizeof out);
+    pk = strstr(out, "peak_p1A [MPa]");
+    CHECK(rc == 0 && pk && sscanf(pk + 14, "%lg %lg %lg", &pa, &pb, &dd) == 3 && dd == 0, "same design: %s", out);
+    // Bad input: one line, exit 2, nothing written.
+    unlink("cd_bad.csv");
+    rc = cli_run("compare --scenario hold --set-b hydraulics.components.lift_cyl.bor=0.11 --out cd_bad.csv", out,
+                 sizeof out);
+    CHECK(rc == 2 && cli_count_lines(out) == 1 && strstr(out, "design B") && access("cd_bad.csv", F_OK) != 0,
+          "a typo in --set-b: %d %s", rc, out);
+    rc = cli_run("compare --model a.json --model b.json --model c.json", out, sizeof out);
+    CHECK(rc == 2 && cli_count_lines(out) == 1 && strstr(out, "at most two"), "three models: %d %s", rc, out);
+}
+
 int main(void) {
+    check_compare_designs();
     check_bit_for_bit("sandbox", "--duration 1.5 --frame-rate 200");
     check_bit_for_bit("lagrange", "--mechanics lagrange --duration 1");
     // The burst at t = 2 s (a fault event the replay applies at the same ticks).
