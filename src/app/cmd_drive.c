@@ -523,7 +523,7 @@ int cmd_drive(int argc, char** argv) {
 #endif
     // The headless counterpart of the window's replay is its own command.
     if (replay) {
-        fprintf(stderr, "cranesim drive: --replay %s: shows a session in the 3D window, and there is none (%s): "
+        fprintf(stderr, "cranesim drive: --replay %s: needs the 3D window, which is not open (%s): "
                         "cranesim replay %s runs it headless\n", replay, why, replay);
         return EXIT_USAGE;
     }

@@ -1286,8 +1286,8 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     char where[96];
     if (c->sim.mechanics != SIM_ODE) snprintf(where, sizeof where, "the lagrange 2-DOF view");
     else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : "sandbox");
-    printf("cranesim drive: %s in %s%s; %s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
-           o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
+    printf("cranesim drive: %s in %s%s; %s%s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
+           o->replay_path ? "replaying " : "", o->replay_path ? o->replay_path : o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
                                                "R reset, C camera, F5 record, F12 screenshot, Esc quit)");
     // Ticks at 240 Hz: between rendered frames the loop still pumps events,
     // reads the sticks and commands the valves, so commands run faster than
