@@ -249,10 +249,16 @@ int cmd_replay(int argc, char** argv) {
         fprintf(stderr, "cranesim replay: cannot write %s: %s\n", out, strerror(we));
         code = EXIT_RUNTIME;
     }
-    printf("cranesim replay: %s (recorded by the %s drive; %s), %s%s\n", path, s.window ? "window" : "headless",
-           s.end, model_path || nset ? "changed design: " : "recorded design", model_path ? model_path : "");
-    for (int k = 0; k < nset; ++k) printf("%s--set %s", k || model_path ? ", " : "", sets[k]);
-    if (model_path || nset) printf("\n");
+    // The design replayed on: the recorded one, or what changed.
+    char design[1024] = "recorded design";
+    if (model_path || nset) {
+        size_t L = (size_t)snprintf(design, sizeof design, "changed design:%s%s", model_path ? " --model " : "",
+                                    model_path ? model_path : "");
+        for (int k = 0; k < nset && L < sizeof design; ++k)
+            L += (size_t)snprintf(design + L, sizeof design - L, " --set %s", sets[k]);
+    }
+    printf("cranesim replay: %s (recorded by the %s drive; %s), %s\n", path, s.window ? "window" : "headless", s.end,
+           design);
     printf("  %ld command updates, %ld rows; t = %.6g s\n", s.ntick, nrow, engine_time(l));
     if (nrow == s.nrow && same == nrow)
         printf("  rows identical to the recording: %ld of %ld (bit for bit)\n", same, s.nrow);
