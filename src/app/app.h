@@ -213,6 +213,7 @@ typedef struct app_range {
 /// Parse "PATH=LO:HI:N" (want_n) or "PATH=LO:HI" for command cmd. 0, or -1
 /// after one line on stderr.
 int app_parse_range(const char* cmd, const char* arg, bool want_n, app_range* p);
+int cmd_replay(int argc, char** argv);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it

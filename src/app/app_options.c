@@ -82,11 +82,14 @@ static const struct {
     {"run", {"--out", "--plot", "--metrics", "--energy", NULL}},
     {"sweep", {"--param", "--lhs", "--seed", "--metrics", "--threads", "--out", "--plot", NULL}},
     {"optimize", {"--param", "--minimize", "--constraint", "--maxeval", "--xtol", "--out", "--plot", NULL}},
-    {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot", NULL}},
+    {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot",
+                 "--set-a", "--set-b", "--out", NULL}},
+    {"replay", {"--out", "--metrics", "--plot", NULL}},
     {"study", {"--out-dir", "--repeat", NULL}},
     {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
-     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", "--readouts", NULL}},
+     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as",
+      "--readouts", "--session", "--replay", NULL}},
 };
 
 int app_check_values(const char* cmd, int argc, char** argv) {

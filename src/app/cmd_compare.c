@@ -1,7 +1,9 @@
 // cmd_compare.c: `cranesim compare`: one scenario run two ways, difference
 // metrics, overlay plots, and a pass/fail against given tolerances.
 #include "app.h"
+#include "metrics.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +17,8 @@ static void compare_help(FILE* f) {
     fprintf(f,
             "usage: cranesim compare [--scenario S] [--backends A,B] [--solvers A,B] [--variants A,B]\n"
             "                        [--dts H1,H2] [--tol-stroke MM] [--tol-pressure PCT] [--plot FILE.png]\n"
+            "       cranesim compare [--scenario S] --model A.json --model B.json | --set-a PATH=V ... --set-b PATH=V ...\n"
+            "                        [--mechanics M] [--plot FILE.png] [--out FILE.csv]\n"
             "\n"
             "Runs the scenario twice, differing in what the pair options say (the rest is\n"
             "shared), and prints RMS and maximum differences of strokes [mm], chamber\n"
@@ -22,6 +26,8 @@ static void compare_help(FILE* f) {
             "position [mm]. The reference is the side run by cvode, else the one with the\n"
             "shorter fixed step, else A.\n"
             "Default: --backends lagrange,ode (lagrange full vs the ode validation world).\n"
+            "Two designs: two --model files, or --set-a / --set-b changes (on the one --model), run on\n"
+            "the same backend and settings; adds their metrics side by side with B - A (docs/replay.md).\n"
             "\n"
             "options:\n"
             "  --backends A,B      lagrange | ode\n"
@@ -31,7 +37,11 @@ static void compare_help(FILE* f) {
             "  --tol-stroke MM     fail (exit 1) if the stroke RMS difference exceeds MM millimetres\n"
             "  --tol-pressure PCT  fail (exit 1) if the pressure RMS difference exceeds PCT %% of the\n"
             "                      reference's peak\n"
-            "  --plot FILE.png     overlay plot (solid: A, dashed: B)\n");
+            "  --plot FILE.png     overlay plot (solid: A, dashed: B)\n"
+            "  --model FILE        given twice: design A's and design B's model files\n"
+            "  --set-a PATH=VALUE  a change of design A's model (repeatable; --set changes both)\n"
+            "  --set-b PATH=VALUE  a change of design B's model (repeatable)\n"
+            "  --out FILE.csv      both runs' rows side by side: t, then each column as NAME_A, NAME_B\n");
     app_common_help(f, true);
 }
 
@@ -82,6 +92,55 @@ void app_compare_pressure(const sim_trace* a, const sim_trace* b, int ref, doubl
     *pct = peak > 0 ? 100.0 * worst / peak : 0.0;
 }
 
+// The designs' metrics side by side, B - A, in the units a reader compares.
+static void print_metrics(const sim_trace tr[2], const sim_result res[2], const sim_opts side[2], char label[2][96]) {
+    run_metrics met[2];
+    for (int s = 0; s < 2; ++s) {
+        metrics_init(&met[s], sim_ncol(&side[s]));
+        for (int i = 0; i < tr[s].nrow; ++i) metrics_row(&met[s], tr[s].v + (size_t)i * SIM_NCOL);
+        metrics_finish(&met[s], &res[s]);
+    }
+    printf("  %-27s %14s %14s %14s\n", "metric", "A", "B", "B - A");
+    for (int id = 0; id < MET_COUNT; ++id) {
+        if (!met[0].present[id] || !met[1].present[id]) continue;
+        const char* unit = metric_unit((metric_id)id);
+        double k = 1.0;
+        if (!strcmp(unit, "Pa")) k = 1e-6, unit = "MPa";
+        else if (!strcmp(unit, "rad")) k = 180 / M_PI, unit = "deg";
+        char name[64];
+        snprintf(name, sizeof name, "%s [%s]", metric_name((metric_id)id), unit);
+        printf("  %-27s %14.6g %14.6g %+14.6g\n", name, met[0].value[id] * k, met[1].value[id] * k,
+               (met[1].value[id] - met[0].value[id]) * k);
+    }
+    printf("  (A = %s, B = %s)\n", label[0], label[1]);
+}
+
+// Both runs' rows side by side by index: t (A's), then NAME_A, NAME_B for
+// every column both write. Returns 0, or -1 after one line on stderr.
+static int write_both(const char* path, const sim_trace tr[2], const sim_opts side[2]) {
+    const int na = sim_ncol(&side[0]), nb = sim_ncol(&side[1]);
+    const int ncol = na < nb ? na : nb, n = tr[0].nrow < tr[1].nrow ? tr[0].nrow : tr[1].nrow;
+    app_out o = {.f = NULL};
+    FILE* f = app_out_open(&o, path, "w");
+    int e = f ? 0 : errno;
+    if (f) {
+        fputs("t", f);
+        for (int c = 1; c < ncol; ++c) fprintf(f, ",%s_A,%s_B", sim_col_name[c], sim_col_name[c]);
+        fputc('\n', f);
+        for (int i = 0; i < n; ++i) {
+            const double* a = tr[0].v + (size_t)i * SIM_NCOL;
+            const double* b = tr[1].v + (size_t)i * SIM_NCOL;
+            fprintf(f, "%.9g", a[COL_T]);
+            for (int c = 1; c < ncol; ++c) fprintf(f, ",%.9g,%.9g", a[c], b[c]);
+            fputc('\n', f);
+        }
+        if (ferror(f)) e = errno ? errno : EIO;
+        e = app_out_close(&o, e, true);
+    }
+    if (e) fprintf(stderr, "cranesim compare: cannot write %s: %s\n", path, strerror(e));
+    return e ? -1 : 0;
+}
+
 int cmd_compare(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     sim_opts side[2];
@@ -91,10 +150,42 @@ int cmd_compare(int argc, char** argv) {
     const char* plot = NULL;
     char pa[64], pb[64];
     const char* pairs[4] = {NULL, NULL, NULL, NULL}; // backends, solvers, variants, dts
+    // Two designs: two model files, or per-side --set changes.
+    const char* models[2] = {NULL, NULL};
+    int nmodel = 0;
+    const char* side_set[2][APP_MAX_SET];
+    int nside_set[2] = {0, 0};
+    const char* out = NULL;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             compare_help(stdout);
             return 0;
+        }
+        if (!strcmp(argv[i], "--model")) {
+            const char* v = app_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            if (nmodel == 2) {
+                fprintf(stderr, "cranesim compare: --model: at most two (design A's and design B's), got a third '%s'\n", v);
+                return EXIT_USAGE;
+            }
+            models[nmodel++] = v;
+            continue;
+        }
+        if (!strcmp(argv[i], "--set-a") || !strcmp(argv[i], "--set-b")) {
+            const int sd = argv[i][6] == 'b';
+            const char* v = app_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            if (!strchr(v, '=') || nside_set[sd] + c.nset >= APP_MAX_SET) {
+                fprintf(stderr, "cranesim compare: --set-%c: expected PATH=VALUE (at most %d), got '%s'\n", 'a' + sd,
+                        APP_MAX_SET, v);
+                return EXIT_USAGE;
+            }
+            side_set[sd][nside_set[sd]++] = v;
+            continue;
+        }
+        if (!strcmp(argv[i], "--out")) {
+            if (!(out = app_value(argc, argv, &i))) return EXIT_USAGE;
+            continue;
         }
         int rc = app_parse_common(&c, argc, argv, &i);
         if (rc < 0) return EXIT_USAGE;
@@ -150,7 +241,26 @@ int cmd_compare(int argc, char** argv) {
             snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? "/" : "", v[s]);
         }
     }
-    if (!any_pair) { // the default comparison: lagrange full vs the ode validation world
+    const bool designs = nmodel == 2 || nside_set[0] || nside_set[1];
+    if (nmodel == 1) c.model_path = models[0];
+    if (designs) {
+        // Each side's label: its model file and its own changes.
+        for (int s = 0; s < 2; ++s) {
+            size_t L = strlen(label[s]);
+            if (nmodel == 2) {
+                const char* base = strrchr(models[s], '/');
+                L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? "/" : "", base ? base + 1 : models[s]);
+            }
+            for (int k = 0; k < nside_set[s] && L < sizeof label[s]; ++k) {
+                const char* eq = strchr(side_set[s][k], '=');
+                const char* dot = eq;
+                while (dot > side_set[s][k] && dot[-1] != '.') --dot; // the last path element
+                L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? " " : "", dot);
+            }
+            if (!label[s][0]) snprintf(label[s], sizeof label[s], "%s", s ? "B" : "A");
+        }
+    }
+    if (!any_pair && !designs) { // the default comparison: lagrange full vs the ode validation world
         side[0].mechanics = SIM_LAGRANGE;
         side[1].mechanics = SIM_ODE;
         snprintf(label[0], sizeof label[0], "lagrange");
@@ -158,6 +268,7 @@ int cmd_compare(int argc, char** argv) {
     }
     // Both runs and the plot file are checked before anything runs.
     if (plot && app_check_output("compare", "--plot", plot, ".png")) return EXIT_USAGE;
+    if (out && app_check_output("compare", "--out", out, ".csv")) return EXIT_USAGE;
     for (int s = 0; s < 2; ++s) {
         // A side's own choice (--backends, --solvers) counts as given.
         unsigned given = c.given;
@@ -178,13 +289,33 @@ int cmd_compare(int argc, char** argv) {
         return EXIT_USAGE;
     }
     model* m;
+    model* mb = NULL; // design B's model (designs only; else both run m)
     scenario sc;
-    int rc = app_load(&c, &m, &sc);
+    app_common ca = c;
+    if (designs) {
+        // Side A: its file, the shared --set, then its own.
+        if (nmodel == 2) ca.model_path = models[0];
+        for (int k = 0; k < nside_set[0]; ++k) ca.sets[ca.nset++] = side_set[0][k];
+    }
+    int rc = app_load(&ca, &m, &sc);
+    if (!rc && designs) {
+        const char* sets[APP_MAX_SET];
+        int n = 0;
+        for (int k = 0; k < c.nset; ++k) sets[n++] = c.sets[k];
+        for (int k = 0; k < nside_set[1] && n < APP_MAX_SET; ++k) sets[n++] = side_set[1][k];
+        char err[1024];
+        mb = model_load(nmodel == 2 ? models[1] : c.model_path, sets, n, err, sizeof err);
+        if (!mb) {
+            fprintf(stderr, "cranesim compare: design B: %s\n", err);
+            rc = EXIT_USAGE;
+        }
+    }
     // Both sides must run the scenario as written (no silent switch: the
     // comparison names its backends).
     for (int s = 0; s < 2 && !rc; ++s) rc = app_scenario_world("compare", &side[s], c.given, &sc, false, NULL);
     if (rc && m) {
         model_free(m);
+        model_free(mb);
         return rc;
     }
     if (rc) return rc;
@@ -196,7 +327,7 @@ int cmd_compare(int argc, char** argv) {
     sim_result res[2];
     for (int s = 0; s < 2; ++s) {
         if (!c.quiet && isatty(2)) fprintf(stderr, "run %s:\n", label[s]);
-        sim_run(m, &sc, &side[s], NULL, NULL, &tr[s], c.quiet ? NULL : app_progress, NULL, &res[s]);
+        sim_run(s && mb ? mb : m, &sc, &side[s], NULL, NULL, &tr[s], c.quiet ? NULL : app_progress, NULL, &res[s]);
         if (!c.quiet) app_progress_done();
         if (res[s].note[0]) fprintf(stderr, "cranesim compare: %s: note: %s\n", label[s], res[s].note);
         if (res[s].status) {
@@ -204,6 +335,7 @@ int cmd_compare(int argc, char** argv) {
             sim_trace_free(&tr[0]);
             sim_trace_free(&tr[1]);
             model_free(m);
+            model_free(mb);
             return app_exit_code(res[s].status, 0);
         }
     }
@@ -233,7 +365,10 @@ int cmd_compare(int argc, char** argv) {
     app_compare_pressure(&tr[0], &tr[1], ref, &prms, &ppeak, &press_pct);
     printf("  worst stroke RMS %.4g mm; worst pressure RMS %.4g MPa = %.3g %% of peak %.2f MPa (of the reference, %s = %s)\n",
            stroke_rms, prms * 1e-6, press_pct, ppeak * 1e-6, ref ? "B" : "A", label[ref]);
+    if (designs) print_metrics(tr, res, side, label);
     int code = 0;
+    if (out && write_both(out, tr, side)) code = EXIT_RUNTIME;
+    else if (out) printf("  rows of both -> %s\n", out);
     if (tol_stroke >= 0 && stroke_rms > tol_stroke) {
         printf("  FAIL: stroke RMS %.4g mm > tolerance %.4g mm\n", stroke_rms, tol_stroke);
         code = EXIT_RUNTIME;
@@ -255,5 +390,6 @@ int cmd_compare(int argc, char** argv) {
     sim_trace_free(&tr[0]);
     sim_trace_free(&tr[1]);
     model_free(m);
+    model_free(mb);
     return code;
 }

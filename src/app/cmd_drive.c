@@ -8,6 +8,7 @@
 // is checked before any of that, whichever mode follows.
 #include "app.h"
 #include "engine.h"
+#include "session.h"
 #include "world_desc.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
@@ -44,6 +45,9 @@ static void drive_help(FILE* f) {
             "  --frame-rate F      headless: command updates per second (default 75, the paper's rate);\n"
             "                      window: frame-rate cap (default 65)\n"
             "  --scripted          window: drive by the scenario's commands instead of the devices\n"
+            "  --session FILE      record the operator's input stream (commands per update, hook\n"
+            "                      events, model, settings, start) for cranesim replay (docs/replay.md)\n"
+            "  --replay SESSION    window: drive by a recorded session's commands instead of the devices\n"
             "  --mapping FILE      joystick axis mapping (JSON, see docs/render.md)\n"
             "  --charts LIST       strip-chart channels, CSV column names (up to 8), e.g.\n"
             "                      p1A,p1B,x1,u1,F1 (default: pressures, strokes, spools), or the\n"
@@ -122,11 +126,13 @@ static int world_info(const app_common* c, char* name, size_t n, char* err, size
 typedef struct drive_world {
     bool hook;        // a hook to attach loads (sandbox)
     bool noted;       // said once that a hook event had nothing to act on
+    session_writer* sess; // the session file, or NULL
 } drive_world;
 
 // Say what the scripted operator's hook did.
 static void report_hook(void* user, engine* l, int attach, int got) {
     drive_world* dw = user;
+    if (dw->sess) session_writer_hook(dw->sess, attach);
     if (!dw->hook) {
         if (!dw->noted) printf("  (the scenario's hook events are ignored: this world has no hook)\n");
         dw->noted = true;
@@ -148,8 +154,8 @@ static bool write_row(FILE* f, const double* row, int ncol) {
 }
 
 
-static int drive_headless(app_common* c, double frame_rate, const char* record, const char* why, int kind,
-                          const char* world_name) {
+static int drive_headless(app_common* c, double frame_rate, const char* record, const char* session_path,
+                          const char* why, int kind, const char* world_name) {
     model* m;
     scenario sc;
     const bool ode = c->sim.mechanics == SIM_ODE;
@@ -167,11 +173,14 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         return EXIT_USAGE;
     }
     char err[320];
+    // The session keeps the model as loaded: a replay adds the bursts itself.
+    cJSON* doc0 = session_path ? cJSON_Duplicate(m->json, 1) : NULL;
     if (sc.nfault) { // bursts need their orifices in the circuit (engine_fault_model)
         model* fm = engine_fault_model(m, &sc, err, sizeof err);
         model_free(m);
         if (!fm) {
             fprintf(stderr, "cranesim drive: %s\n", err);
+            cJSON_Delete(doc0);
             return EXIT_USAGE;
         }
         m = fm;
@@ -181,6 +190,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (!l) {
         fprintf(stderr, "cranesim drive: %s\n", err);
         model_free(m);
+        cJSON_Delete(doc0);
         return EXIT_USAGE;
     }
     // Replaces a previous record only when the drive ends (app_out). No
@@ -190,16 +200,34 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     FILE* f = record ? app_out_open(&rec, record, "w") : NULL;
     if (record && !f) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(errno));
+        cJSON_Delete(doc0);
         engine_destroy(l);
         model_free(m);
         return EXIT_USAGE;
     }
     const int ncol = engine_ncol(l);
+    // The session: what replay runs again (docs/replay.md). The scenario goes
+    // in only for its faults, which the replay applies at the same ticks.
+    session_writer sw = {.f = NULL};
+    if (session_path) {
+        char sbuf[512];
+        const char* sp = app_scenario_path(c->scenario_path, sbuf, sizeof sbuf);
+        const int so = session_writer_open(&sw, session_path, doc0, m->file, &c->sim, sc.nfault ? sp : NULL, sc.q0,
+                                           sc.slew0, m3, false, ncol, err, sizeof err);
+        cJSON_Delete(doc0);
+        if (so) {
+            fprintf(stderr, "cranesim drive: --session: %s\n", err);
+            app_out_close(&rec, 0, false);
+            engine_destroy(l);
+            model_free(m);
+            return EXIT_USAGE;
+        }
+    }
     // The sandbox has the truck, the slew and the hook; loads only if its
     // file has some. The validation world and the lagrange view have none.
     const bool sandbox = ode && kind == WORLD_SANDBOX;
     const bool loads = sandbox && engine_load_name(l, 0, NULL) != NULL;
-    drive_world dw = {.hook = sandbox};
+    drive_world dw = {.hook = sandbox, .sess = session_path ? &sw : NULL};
     int wr = 0; // errno of the first failed write to the record
     if (f) sim_csv_header(f, ncol);
     if (f && ferror(f)) wr = errno ? errno : EIO;
@@ -226,7 +254,9 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         engine_set_commands(l, u);
         // Advance to the frame's end on the simulated clock (the ode world
         // steps whole ODE steps, so aim at the target, not at +frame).
-        if (engine_advance(l, (i + 1) * frame - engine_time(l))) {
+        const double target = (i + 1) * frame;
+        if (engine_advance(l, target - engine_time(l))) {
+            session_writer_tick(&sw, tm, target, u, NULL, ncol);
             if (!c->quiet) app_progress_done();
             if (record) fprintf(stderr, "cranesim drive: %s; record kept in %s\n", engine_error(l), record);
             else fprintf(stderr, "cranesim drive: %s\n", engine_error(l));
@@ -234,6 +264,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
             break;
         }
         engine_row(l, row);
+        session_writer_tick(&sw, tm, target, u, row, ncol);
         // A record that cannot be written stops the run: driving on would
         // only lose more of it.
         if (f && !write_row(f, row, ncol)) {
@@ -262,6 +293,19 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         if (note[0]) fprintf(stderr, "cranesim drive: note: %s\n", note);
     }
     wr = app_out_close(&rec, wr, true);
+    if (session_path) {
+        char why_end[96];
+        if (code) snprintf(why_end, sizeof why_end, "stopped at t = %.6g s (exit %d)", engine_time(l), code);
+        else snprintf(why_end, sizeof why_end, "completed at t = %.6g s", engine_time(l));
+        const int se = session_writer_close(&sw, why_end);
+        if (se) {
+            fprintf(stderr, "cranesim drive: cannot write %s: %s\n", session_path, strerror(se));
+            if (!code) code = EXIT_RUNTIME;
+        } else {
+            printf("  session -> %s (%ld rows; cranesim replay %s runs it again)\n", session_path, sw.rows,
+                   session_path);
+        }
+    }
     if (wr) {
         fprintf(stderr, "cranesim drive: cannot write %s: %s\n", record, strerror(wr));
         code = EXIT_RUNTIME;
@@ -295,6 +339,8 @@ int cmd_drive(int argc, char** argv) {
     bool headless = false, scripted = false, rate_given = false;
     double frame_rate = 75.0, shot_at = 2.0;
     const char* record = NULL;
+    const char* session_path = NULL;
+    const char* replay = NULL;
     const char* shot = NULL;
     const char* mapping = NULL;
     const char* charts = NULL;
@@ -320,6 +366,14 @@ int cmd_drive(int argc, char** argv) {
         }
         if (!strcmp(argv[i], "--record") && i + 1 < argc) {
             record = argv[++i];
+            continue;
+        }
+        if (!strcmp(argv[i], "--session") && i + 1 < argc) {
+            session_path = argv[++i];
+            continue;
+        }
+        if (!strcmp(argv[i], "--replay") && i + 1 < argc) {
+            replay = argv[++i];
             continue;
         }
         if (!strcmp(argv[i], "--scripted")) {
@@ -375,10 +429,15 @@ int cmd_drive(int argc, char** argv) {
         fprintf(stderr, "cranesim drive: unknown option '%s' (see cranesim drive --help)\n", argv[i]);
         return EXIT_USAGE;
     }
+    if (replay && session_path) {
+        fprintf(stderr, "cranesim drive: --session: a replay records no session\n");
+        return EXIT_USAGE;
+    }
     // Every option is checked before anything runs, whichever mode follows:
     // an option accepted in one mode and ignored in another would hide a
     // mistake until the other mode is used.
     if ((record && app_check_output("drive", "--record", record, NULL)) ||
+        (session_path && app_check_output("drive", "--session", session_path, NULL)) ||
         (shot && app_check_output("drive", "--screenshot", shot, ".png")) ||
         (save_as && app_check_output("drive", "--save-as", save_as, ".json")))
         return EXIT_USAGE;
@@ -412,6 +471,8 @@ int cmd_drive(int argc, char** argv) {
     o.charts = charts;
     o.readouts = readouts;
     o.record_path = record;
+    o.session_path = session_path;
+    o.replay_path = replay;
     o.save_as = save_as;
     o.world_name = c.sim.mechanics == SIM_ODE ? wname : NULL;
     int rc = drive_opts_check(&c, &o, err, sizeof err);
@@ -460,7 +521,13 @@ int cmd_drive(int argc, char** argv) {
     }
     if (!headless && display) snprintf(why, sizeof why, "this binary was built without the render module (CRANESIM_CORE_ONLY)");
 #endif
+    // The headless counterpart of the window's replay is its own command.
+    if (replay) {
+        fprintf(stderr, "cranesim drive: --replay %s: needs the 3D window, which is not open (%s): "
+                        "cranesim replay %s runs it headless\n", replay, why, replay);
+        return EXIT_USAGE;
+    }
     // The headless run has no parameter panel, so nothing to save.
     if (save_as) fprintf(stderr, "cranesim drive: note: --save-as has no effect without the window (no parameter panel)\n");
-    return drive_headless(&c, frame_rate, record, why, kind, wname);
+    return drive_headless(&c, frame_rate, record, session_path, why, kind, wname);
 }

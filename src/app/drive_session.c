@@ -15,6 +15,7 @@
 #include "json_util.h"
 #include "panel.h"
 #include "render.h"
+#include "session.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -107,6 +108,11 @@ struct drive_session {
     int missed_window;   // missed ticks in the current second
     double missed_t0;
     drive_stats st;
+    session_writer sw;   // --session: the operator's input stream, until the first reset or rebuild
+    char sess_end[160];  // why it ended ("" while it runs)
+    int sess_err;        // errno of a failed session write (0: none)
+    session* rp;         // --replay: the session whose commands drive instead of the devices
+    long rp_next;        // its next tick
     char err[400];
     char status[512];
 };
@@ -330,7 +336,8 @@ static void refresh_mech_params(drive_session* s) {
 
 static engine* make_engine(drive_session* s, const double q0[2], double slew0) {
     char err[400];
-    engine* l = engine_create(s->m, &s->c.sim, q0, slew0, sim_load_mass(s->m, &s->sc, &s->c.sim), err, sizeof err);
+    const double m3 = s->rp ? s->rp->m3 : sim_load_mass(s->m, &s->sc, &s->c.sim);
+    engine* l = engine_create(s->m, &s->c.sim, q0, slew0, m3, err, sizeof err);
     if (!l) snprintf(s->err, sizeof s->err, "%s", err);
     return l;
 }
@@ -675,8 +682,23 @@ static void load_model(drive_session* s) {
     panel_set_message(s->pn, s->status);
 }
 
+// End the session file (docs/replay.md): it holds one world from its start,
+// so a reset, a rebuild or a panel change ends it; the window goes on.
+static void session_end(drive_session* s, const char* why) {
+    if (!s->sw.f) return;
+    snprintf(s->sess_end, sizeof s->sess_end, "%s at t = %.6g s", why, s->t_base + engine_time(s->l));
+    s->sess_err = session_writer_close(&s->sw, s->sess_end);
+}
+
+static void session_hook(void* user, engine* e, int attach, int got) {
+    (void)e, (void)got;
+    session_writer_hook(&((drive_session*)user)->sw, attach);
+}
+
 static void act_reset(void* user) {
     drive_session* s = user;
+    session_end(s, "reset");
+    s->rp_next = 0; // a replay starts again with the world
     rebuild_world(s, true);
     snprintf(s->status, sizeof s->status, "run reset");
 }
@@ -838,6 +860,24 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         *code = EXIT_USAGE;
         return NULL;
     }
+    if (o->replay_path) {
+        // The session's design (with --model, --set), settings and start;
+        // its commands replace the devices (drive_session_tick).
+        s->rp = calloc(1, sizeof *s->rp);
+        model* rm = NULL;
+        if (!s->rp || session_load(o->replay_path, s->rp, err, errsz) ||
+            !(rm = session_model(s->rp, s->c.model_path, s->c.sets, s->c.nset, err, errsz))) {
+            drive_session_destroy(s);
+            *code = EXIT_USAGE;
+            return NULL;
+        }
+        model_free(s->m);
+        s->m = rm;
+        s->c.sim = s->rp->sim;
+        memcpy(s->sc.q0, s->rp->q0, sizeof s->sc.q0);
+        s->sc.slew0 = s->rp->slew0;
+        s->sc.nfault = 0;
+    }
     s->l = make_engine(s, s->sc.q0, s->sc.slew0);
     s->sim_live = s->c.sim;
     s->mech_live = s->m->mech;
@@ -849,6 +889,22 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         return NULL;
     }
     s->ncol = engine_ncol(s->l);
+    if (s->rp && s->rp->ncol != s->ncol) {
+        snprintf(err, errsz, "session %s: ncol: the session has %d channels, this engine writes %d", s->rp->path,
+                 s->rp->ncol, s->ncol);
+        drive_session_destroy(s);
+        *code = EXIT_USAGE;
+        return NULL;
+    }
+    // The window's faults are not in the session (its scripted operator
+    // applies no bursts: the engine has no burst orifices).
+    if (o->session_path && !s->rp &&
+        session_writer_open(&s->sw, o->session_path, s->m->json, s->m->file, &s->c.sim, NULL, s->sc.q0, s->sc.slew0,
+                            sim_load_mass(s->m, &s->sc, &s->c.sim), true, s->ncol, err, errsz)) {
+        drive_session_destroy(s);
+        *code = EXIT_USAGE;
+        return NULL;
+    }
     s->chans = chan_list_create(s->l);
     s->chan_v = s->chans ? calloc((size_t)chan_list_count(s->chans), sizeof *s->chan_v) : NULL;
     if (!s->chans || !s->chan_v) {
@@ -942,6 +998,9 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
 void drive_session_destroy(drive_session* s) {
     if (!s) return;
     if (s->rec) fclose(s->rec); // drive_session_finish_record checks it; here only freed
+    if (s->sw.f) session_writer_close(&s->sw, "the window closed");
+    if (s->rp) session_free(s->rp);
+    free(s->rp);
     if (s->pn) {
         if (s->r) render_attach_panel(s->r, NULL);
         panel_destroy(s->pn);
@@ -1024,7 +1083,7 @@ int drive_session_tick(drive_session* s, double wall) {
     input_poll(s->in, dt_wall, &cmd);
     if (cmd.quit) quit = true;
     if (cmd.pause) s->paused = !s->paused;
-    if (cmd.reset) act_reset(s);
+    if (cmd.reset) act_reset(s); // ends the session file
     if (cmd.camera_next) render_set_camera_preset(s->r, (render_get_camera_preset(s->r) + 1) % RENDER_CAM_COUNT);
     if (cmd.camera_preset >= 0) render_set_camera_preset(s->r, (render_cam_preset)cmd.camera_preset);
     if (cmd.screenshot) {
@@ -1043,16 +1102,19 @@ int drive_session_tick(drive_session* s, double wall) {
                 s->changed[nchanged].i = i;
                 s->changed[nchanged++].v = s->param[i].value;
             }
+    if (nchanged) session_end(s, "a panel change");
     for (int k = 0; k < nchanged; ++k) {
         s->param[s->changed[k].i].value = s->changed[k].v;
         apply_param(s, s->changed[k].i);
     }
     if (s->load_pending) {
         s->load_pending = false;
+        session_end(s, "a model loaded");
         load_model(s);
     }
     if (s->rebuild) {
         s->rebuild = false;
+        session_end(s, "a rebuild");
         const double t_at = s->t_base + engine_time(s->l);
         const int seg = s->segment;
         rebuild_world(s, false);
@@ -1073,12 +1135,31 @@ int drive_session_tick(drive_session* s, double wall) {
         s->sim_offset += dt_wall;
         s->piece_paused += dt_wall;
         s->st.paused_time += dt_wall;
+    } else if (s->rp) {
+        // Replay: every recorded tick due by wall time, applied as the drive
+        // applied it (hooks, commands, the same advance), so the world moves
+        // bit for bit as recorded; at its end the window closes.
+        const double due = wall - s->sim_offset;
+        while (s->rp_next < s->rp->ntick && s->rp->tick[s->rp_next].target <= due) {
+            const session_tick* tk = &s->rp->tick[s->rp_next++];
+            for (int k = 0; k < tk->nhook; ++k) engine_hook(s->l, tk->hook[k]);
+            engine_set_commands(s->l, tk->u);
+            ++s->st.input_samples;
+            const double now = engine_time(s->l);
+            if (tk->target > now && engine_advance(s->l, tk->target - now)) {
+                snprintf(s->err, sizeof s->err, "%s", engine_error(s->l));
+                return -1;
+            }
+        }
+        if (s->rp_next >= s->rp->ntick) quit = true;
     } else {
         double u[3] = {cmd.lift, cmd.jib, cmd.slew};
         if (s->o.scripted) {
-            engine_play(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
+            engine_play(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, u, s->sw.f ? session_hook : NULL, s);
         } else if (cmd.hook_toggle) {
-            engine_hook(s->l, !engine_attached(s->l));
+            const int attach = !engine_attached(s->l);
+            session_writer_hook(&s->sw, attach);
+            engine_hook(s->l, attach);
         }
         engine_set_commands(s->l, u);
         ++s->st.input_samples;
@@ -1092,7 +1173,18 @@ int drive_session_tick(drive_session* s, double wall) {
             s->sim_offset += target - t - 0.1;
             target = t + 0.1;
         }
-        if (target > t && engine_advance(s->l, target - t)) {
+        const int adv = target > t ? engine_advance(s->l, target - t) : 0;
+        if (s->sw.f) {
+            // The tick, and the row the record keeps after it (one per
+            // simulated instant, as record_row; `segment` 0).
+            double r[SIM_NCOL + 1];
+            session_row(s, r);
+            const bool keep = !adv && (s->sw.rows == 0 || r[COL_T] > s->sw.t_last);
+            if (keep) s->sw.t_last = r[COL_T];
+            r[s->ncol] = 0;
+            session_writer_tick(&s->sw, s->t_base + t + 0.5 * dt_wall, target, u, keep ? r : NULL, s->ncol + 1);
+        }
+        if (adv) {
             snprintf(s->err, sizeof s->err, "%s", engine_error(s->l));
             return -1;
         }
@@ -1194,8 +1286,8 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     char where[96];
     if (c->sim.mechanics != SIM_ODE) snprintf(where, sizeof where, "the lagrange 2-DOF view");
     else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : "sandbox");
-    printf("cranesim drive: %s in %s%s; %s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
-           o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
+    printf("cranesim drive: %s in %s%s; %s%s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
+           o->replay_path ? "replaying " : "", o->replay_path ? o->replay_path : o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
                                                "R reset, C camera, F5 record, F12 screenshot, Esc quit)");
     // Ticks at 240 Hz: between rendered frames the loop still pumps events,
     // reads the sticks and commands the valves, so commands run faster than
@@ -1239,6 +1331,17 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
            st->sim_time, st->wall_time, extra, st->frames, rate_str(fps, sizeof fps, (double)st->frames, st->wall_time, "%.1f"),
            st->input_samples, rate_str(hz, sizeof hz, (double)st->input_samples, st->wall_time, "%.0f"), st->missed,
            st->triangles);
+    if (o->session_path) {
+        session_end(s, "the window closed");
+        if (s->sess_err) {
+            fprintf(stderr, "cranesim drive: cannot write %s: %s\n", o->session_path, strerror(s->sess_err));
+            code = EXIT_RUNTIME;
+        } else {
+            printf("  session -> %s (%ld rows, %s)\n", o->session_path, s->sw.rows, s->sess_end);
+        }
+    }
+    if (s->rp)
+        printf("  replayed %ld of %ld command updates of %s\n", s->rp_next, s->rp->ntick, s->rp->path);
     long rows = 0;
     if (drive_session_finish_record(s, &rows, err, sizeof err)) {
         fprintf(stderr, "cranesim drive: %s\n", err);

@@ -41,6 +41,8 @@ typedef struct drive_opts {
                               ///< ("p1A,p2A,x1,u1"); NULL: pressures, strokes, spools
     const char* readouts;     ///< HUD readouts: channel names as charts, comma-separated; NULL: none
     const char* world_name;   ///< the ode world's name for the banner ("validation"); NULL: "sandbox"
+    const char* session_path; ///< record the operator's input stream to this session file (docs/replay.md), or NULL
+    const char* replay_path;  ///< drive by this session's commands instead of the devices, or NULL
     const char* save_as;      ///< "save model" writes (and replaces) this file; NULL: a new
                               ///< cranesim_model_N.json each time (drive_save_name)
 } drive_opts;

@@ -24,6 +24,7 @@ static void usage(FILE* f) {
             "            in parallel (threads, MPI ranks): a results table and plots\n"
             "  optimize  the design (model values in bounds) that minimises a run metric under\n"
             "            constraints on others (NLopt, derivative-free): best model file, plot\n"
+            "  replay    run a recorded drive session again headless, on its design or a changed one\n"
             "  help      this text; cranesim help <command>: that command's help\n"
             "\n"
             "examples:\n"
@@ -40,7 +41,7 @@ static const struct {
     int (*fn)(int argc, char** argv);
 } commands[] = {
     {"run", cmd_run}, {"bench", cmd_bench}, {"compare", cmd_compare}, {"drive", cmd_drive}, {"study", cmd_study},
-    {"sweep", cmd_sweep}, {"optimize", cmd_optimize},
+    {"sweep", cmd_sweep}, {"optimize", cmd_optimize}, {"replay", cmd_replay},
 };
 
 static int (*find_command(const char* name))(int, char**) {

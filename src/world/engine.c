@@ -164,6 +164,10 @@ void engine_play(engine* e, const scenario* sc, double tm, int* ev, double u[3],
                  void* user) {
     play_ctx pc = {e, on_hook, user};
     scenario_play(sc, tm, ev, u, play_hook, &pc);
+    engine_apply_faults(e, sc, tm);
+}
+
+void engine_apply_faults(engine* e, const scenario* sc, double tm) {
     // Faults act on the engine's circuit at the same time as the commands
     // (bursts only if the engine was made from engine_fault_model's model).
     if (sc->nfault) {

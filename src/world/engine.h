@@ -144,6 +144,10 @@ typedef void (*engine_hook_fn)(void* user, engine* e, int attach, int got);
 void engine_play(engine* e, const scenario* sc, double tm, int* ev, double u[3], engine_hook_fn on_hook,
                  void* user);
 
+/// The scenario's fault events as engine_play applies them at time tm [s]
+/// (a replay applies them at the recorded ticks, without the scenario's commands).
+void engine_apply_faults(engine* e, const scenario* sc, double tm);
+
 /// Simulated time [s].
 double engine_time(const engine* e);
 /// The CSV row at the current time (sim.h columns; engine_ncol of them are set).
