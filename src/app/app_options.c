@@ -79,13 +79,14 @@ static const struct {
     const char* cmd;
     const char* opts[10];
 } own_values[] = {
-    {"run", {"--out", "--plot", "--metrics", NULL}},
+    {"run", {"--out", "--plot", "--metrics", "--rcl", NULL}},
+    {"loadchart", {"--margin", "--stability-factor", "--outreach", "--sectors", "--out", "--plot", NULL}},
     {"sweep", {"--param", "--lhs", "--seed", "--metrics", "--threads", "--out", "--plot", NULL}},
     {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot", NULL}},
     {"study", {"--out-dir", "--repeat", NULL}},
     {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
-     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", NULL}},
+     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", "--rcl", NULL}},
 };
 
 int app_check_values(const char* cmd, int argc, char** argv) {

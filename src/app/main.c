@@ -22,6 +22,8 @@ static void usage(FILE* f) {
             "  study     solver study: every integrator against a CVODE reference, work-precision plot\n"
             "  sweep     one scenario on many designs (a grid or a Latin hypercube over model values),\n"
             "            in parallel (threads, MPI ranks): a results table and plots\n"
+            "  loadchart rated capacity against outreach: hydraulic and (on the truck) stability limits,\n"
+            "            per slew sector, as CSV and PNG (docs/safety.md)\n"
             "  help      this text; cranesim help <command>: that command's help\n"
             "\n"
             "examples:\n"
@@ -38,7 +40,7 @@ static const struct {
     int (*fn)(int argc, char** argv);
 } commands[] = {
     {"run", cmd_run}, {"bench", cmd_bench}, {"compare", cmd_compare}, {"drive", cmd_drive}, {"study", cmd_study},
-    {"sweep", cmd_sweep},
+    {"sweep", cmd_sweep}, {"loadchart", cmd_loadchart},
 };
 
 static int (*find_command(const char* name))(int, char**) {
