@@ -241,6 +241,46 @@ static void test_limiter_filter(void) {
     model_free(m);
 }
 
+// On the truck: at 98.5 % near a sector boundary, slewing into the weaker
+// sector (where the same load would be over 100 %) is stopped, slewing
+// away from it is not.
+static void test_limiter_slew_towards_weaker_sector(void) {
+    model* m = load(NULL, 0);
+    if (!m) return;
+    world_desc wd;
+    char err[300];
+    CHECK(world_desc_load(CRANESIM_ASSETS "/worlds/sandbox.json", &wd, err, sizeof err) == 0, "%s", err);
+    rcl r;
+    CHECK(rcl_init(&r, m, &wd, err, sizeof err) == 0, "%s", err);
+    world_desc_free(&wd);
+    const double q1 = 135 * M_PI / 180, q2 = -110 * M_PI / 180; // 2.68 m: stability governs over the cab
+    double R, z, row[SIM_NCOL], out[3];
+    crane_tip(&m->mech, q1, q2, &R, &z);
+    // The boundary with the largest drop from the sector above to the one below.
+    int best = -1;
+    double ratio = 1;
+    for (int k = 1; k < r.chart.nsec; ++k) {
+        const double lo = loadchart_capacity(&r.chart, R, r.chart.sec_hi[k - 1] - 0.01, NULL);
+        const double hi = loadchart_capacity(&r.chart, R, r.chart.sec_lo[k] + 0.01, NULL);
+        if (lo / hi < ratio) ratio = lo / hi, best = k;
+    }
+    CHECK(best > 0 && ratio < 0.97, "no sector boundary at %.2f m with a drop of 3 %% (%g)", R, ratio);
+    if (best > 0) {
+        const double slew = r.chart.sec_lo[best] + 0.01, cap = loadchart_capacity(&r.chart, R, slew, NULL);
+        hold_row(m, q1, q2, 0.985 * cap + r.chart.hook_mass, row);
+        row[COL_SLEW] = slew;
+        static const double towards[3] = {0, 0, -1}, away[3] = {0, 0, 1};
+        rcl_filter(&r, row, towards, out);
+        CHECK(out[2] == 0, "slewing into the weaker sector let through: %g (util %.3f)", out[2], r.util);
+        rcl_filter(&r, row, away, out);
+        CHECK(out[2] == 1, "slewing away from the weaker sector cut: %g", out[2]);
+        printf("  at %.2f m, slew %.1f deg, util %.2f: towards the %.0f %% weaker sector %g, away %g\n", R,
+               slew * 180 / M_PI, r.util, 100 * (1 - ratio), 0.0, out[2]);
+    }
+    rcl_free(&r);
+    model_free(m);
+}
+
 // A scripted overload attempt: 1300 kg held with the end arm folded in
 // (33 % of the chart), then the jib driven outwards at full command for
 // 8 s (at full reach the chart rates 964 kg). With the limiter the jib is
@@ -295,6 +335,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_hydraulic_limit_matches_hand_calculation);
     RUN_TEST(test_stability_limit_matches_hand_calculation);
     RUN_TEST(test_limiter_filter);
+    RUN_TEST(test_limiter_slew_towards_weaker_sector);
     RUN_TEST(test_limiter_overload_attempt);
     RUN_TEST(test_chart_points_by_simulation);
     TEST_MAIN_END();
