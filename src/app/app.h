@@ -214,6 +214,7 @@ typedef struct app_range {
 /// after one line on stderr.
 int app_parse_range(const char* cmd, const char* arg, bool want_n, app_range* p);
 int cmd_replay(int argc, char** argv);
+int cmd_loadchart(int argc, char** argv);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it

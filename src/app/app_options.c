@@ -79,7 +79,8 @@ static const struct {
     const char* cmd;
     const char* opts[16];
 } own_values[] = {
-    {"run", {"--out", "--plot", "--metrics", "--energy", NULL}},
+    {"run", {"--out", "--plot", "--metrics", "--energy", "--rcl", NULL}},
+    {"loadchart", {"--margin", "--stability-factor", "--outreach", "--sectors", "--out", "--plot", NULL}},
     {"sweep", {"--param", "--lhs", "--seed", "--metrics", "--threads", "--out", "--plot", NULL}},
     {"optimize", {"--param", "--minimize", "--constraint", "--maxeval", "--xtol", "--out", "--plot", NULL}},
     {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot",
@@ -89,7 +90,7 @@ static const struct {
     {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
      {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as",
-      "--readouts", "--session", "--replay", NULL}},
+      "--readouts", "--session", "--replay", "--rcl", NULL}},
 };
 
 int app_check_values(const char* cmd, int argc, char** argv) {

@@ -7,6 +7,7 @@
 #include "app.h"
 #include "circuit_fast.h"
 #include "engine.h"
+#include "loadchart.h"
 #include "ode_world.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
@@ -54,6 +55,8 @@ static void bench_help(FILE* f) {
             "               sandbox, as fast as it runs, with drive's run checks: exit status,\n"
             "               non-finite values, ODE's solver messages, the failure if any, peak RSS\n"
             "               (--seed N, default 1)\n"
+            "  loadchart    not in the default set: the load chart of the model on the sandbox truck,\n"
+            "               50 outreach points, 8 slew sectors (--repeat runs, median wall time)\n"
             "  circuit-sizes  not in the default set: one circuit evaluation (fast kernel, reference)\n"
             "               on synthetic circuits of 1, 2, 4, 8, 16 actuators, ns per eval and per state\n"
             "  sweep        not in the default set: cranesim sweep of 64 designs of the scenario (lift\n"
@@ -71,6 +74,44 @@ static void bench_help(FILE* f) {
             "  --config NAME  only this configuration (repeatable)\n"
             "  --seed N       soak: the random input's seed (default 1)\n"
             "  --kernel K     lagrange kernel (see cranesim run --help; default split)\n");
+}
+
+// The load chart (docs/safety.md) of the model on the sandbox truck: 50
+// outreach points over its reach from 0.5 m, 8 slew sectors.
+static int bench_loadchart(const app_common* c, int repeat) {
+    char err[512];
+    model* m = model_load(c->model_path, c->sets, c->nset, err, sizeof err);
+    static world_desc wd;
+    char wb[512];
+    if (!m || world_desc_load(sim_world_path("sandbox", wb, sizeof wb), &wd, err, sizeof err)) {
+        printf("{\"config\":\"loadchart\",\"error\":\"%s\"}\n", err);
+        model_free(m);
+        return 1;
+    }
+    lc_truck t;
+    lc_truck_from_world(&wd, &t);
+    world_desc_free(&wd);
+    lc_opts o = lc_default_opts();
+    double rmin, rmax;
+    loadchart_reach(m, &rmin, &rmax);
+    o.lo = fmax(0.5, rmin), o.hi = floor(20 * rmax - 1) / 20, o.n = 50, o.sectors = 8;
+    double wall[64];
+    if (repeat > 64) repeat = 64;
+    static loadchart ch;
+    for (int r = 0; r < repeat; ++r) {
+        const double w0 = sim_wall_time();
+        if (loadchart_compute(m, &t, &o, &ch, err, sizeof err)) {
+            printf("{\"config\":\"loadchart\",\"error\":\"%s\"}\n", err);
+            model_free(m);
+            return 1;
+        }
+        wall[r] = sim_wall_time() - w0;
+        loadchart_free(&ch);
+    }
+    printf("{\"config\":\"loadchart\",\"points\":50,\"sectors\":8,\"repeat\":%d,\"wall_s\":%.4f,\"target_s\":10}\n",
+           repeat, app_median(wall, repeat));
+    model_free(m);
+    return 0;
 }
 
 typedef struct bench_cfg {
@@ -517,6 +558,10 @@ int cmd_bench(int argc, char** argv) {
             continue;
         }
         if (!strcmp(only[j], "circuit-sizes")) { if (bench_circuit_sizes(repeat)) return EXIT_RUNTIME; continue; }
+        if (!strcmp(only[j], "loadchart")) {
+            if (bench_loadchart(&c, repeat)) return EXIT_RUNTIME;
+            continue;
+        }
         bool found = false;
         for (size_t k = 0; k < sizeof configs / sizeof configs[0]; ++k) found |= !strcmp(only[j], configs[k].name);
         if (!found) {

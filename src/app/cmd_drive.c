@@ -19,6 +19,7 @@
 #include <math.h>
 #include <signal.h>
 #include <stdlib.h>
+#include "rcl.h"
 #include <string.h>
 #include <time.h>
 
@@ -48,6 +49,9 @@ static void drive_help(FILE* f) {
             "  --session FILE      record the operator's input stream (commands per update, hook\n"
             "                      events, model, settings, start) for cranesim replay (docs/replay.md)\n"
             "  --replay SESSION    window: drive by a recorded session's commands instead of the devices\n"
+            "  --rcl on|off        the rated capacity limiter (default on): warns at 90 %% of the load\n"
+            "                      chart, at 100 %% stops lift down, jib out and slewing towards a weaker\n"
+            "                      sector (docs/safety.md)\n"
             "  --mapping FILE      joystick axis mapping (JSON, see docs/render.md)\n"
             "  --charts LIST       strip-chart channels, CSV column names (up to 8), e.g.\n"
             "                      p1A,p1B,x1,u1,F1 (default: pressures, strokes, spools), or the\n"
@@ -239,6 +243,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     const long nframes = (long)ceil(duration * frame_rate - 1e-9);
     double w0 = sim_wall_time(), busy = 0, worst = 0;
     int missed = 0, code = 0, ev = 0, frames_done = 0;
+    double rcl_max = 0, rcl_t90 = 0; // the limiter's utilisation [-] and the time at or above 90 % [s]
     double row[SIM_NCOL];
     engine_row(l, row);
     // As in run: the first signal stops the loop, a second kills at once.
@@ -265,6 +270,10 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         }
         engine_row(l, row);
         session_writer_tick(&sw, tm, target, u, row, ncol);
+        if (ncol > COL_RCL_UTIL) {
+            if (row[COL_RCL_UTIL] >= RCL_WARN) rcl_t90 += frame;
+            rcl_max = fmax(rcl_max, row[COL_RCL_UTIL]);
+        }
         // A record that cannot be written stops the run: driving on would
         // only lose more of it.
         if (f && !write_row(f, row, ncol)) {
@@ -322,6 +331,9 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (sandbox) printf("; truck tilt %.2f deg", row[COL_TRUCK_TILT] * 180 / M_PI);
     if (!sandbox && m3 > 0) printf("; %.0f kg at the tip", m3);
     printf("\n");
+    if (ncol > COL_RCL_UTIL)
+        printf("  rated capacity limiter %s: utilisation max %.0f %%, %.2f s at or above 90 %%\n",
+               c->sim.rcl ? "on" : "off (measuring only)", 100 * rcl_max, rcl_t90);
     if (!wr && record)
         printf("  record -> %s (%d rows); for the 3D window run it on a machine with a display\n", record,
                frames_done);
@@ -336,6 +348,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
 int cmd_drive(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     c.sim.mechanics = SIM_ODE; // drive's default: the sandbox world
+    c.sim.rcl = true;          // the rated capacity limiter, unless --rcl off
     bool headless = false, scripted = false, rate_given = false;
     double frame_rate = 75.0, shot_at = 2.0;
     const char* record = NULL;
@@ -424,6 +437,15 @@ int cmd_drive(int argc, char** argv) {
                 fprintf(stderr, "cranesim drive: --frame-rate: expected 10..1000 frames/s, got '%s'\n", argv[i]);
                 return EXIT_USAGE;
             }
+            continue;
+        }
+        if (!strcmp(argv[i], "--rcl") && i + 1 < argc) {
+            const char* v = argv[++i];
+            if (strcmp(v, "on") && strcmp(v, "off")) {
+                fprintf(stderr, "cranesim drive: --rcl: expected on or off, got '%s'\n", v);
+                return EXIT_USAGE;
+            }
+            c.sim.rcl = !strcmp(v, "on");
             continue;
         }
         fprintf(stderr, "cranesim drive: unknown option '%s' (see cranesim drive --help)\n", argv[i]);

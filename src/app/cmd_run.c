@@ -8,6 +8,7 @@
 #include <math.h>
 #include <signal.h>
 #include <stdlib.h>
+#include "rcl.h"
 #include <string.h>
 
 static void run_help(FILE* f) {
@@ -39,6 +40,10 @@ static void run_help(FILE* f) {
             "                       orifice, hose, cylinder (.leak, .work), then tank, stored and\n"
             "                       expansion; power taken from the fluid is positive (a pump's is\n"
             "                       negative) and all columns but expansion sum to zero (docs/energy.md)\n"
+            "  --rcl on|off         the rated capacity limiter (default on): at 100 %% of the load\n"
+            "                       chart it stops lift down, jib out and slewing towards a weaker\n"
+            "                       sector (ode runs; a lagrange run only measures); rcl_util is the\n"
+            "                       last CSV column of ode runs (docs/safety.md)\n"
             "The summary prints the energy balance of the run in kJ (docs/energy.md).\n");
     app_common_help(f, true);
     fprintf(f,
@@ -118,6 +123,10 @@ static void keep_row(plot_keep* k, const double* row, int ncol) {
 // The summary's extremes, from every row.
 typedef struct row_stats {
     double pmax[4], xmin[2], xmax[2];
+    double rcl_max;   ///< largest rated capacity utilisation [-]
+    double rcl_t90;   ///< time at or above 90 % of it [s]
+    double t_prev;    ///< the previous row's time [s]
+    bool rcl_have;
 } row_stats;
 
 typedef struct csv_sink {
@@ -132,6 +141,7 @@ typedef struct csv_sink {
     row_stats st;
     run_metrics met;
     double t_last; ///< time of the last row written [s]
+    rcl* mon;      ///< the limiter's measurement where the rows have no rcl_util (lagrange), or NULL
 } csv_sink;
 
 // The CSV is opened at the first row (t = 0, before any step): a run refused
@@ -163,6 +173,19 @@ static int csv_row(void* user, const double* row) {
     for (int k = 0; k < 2; ++k) {
         s->st.xmin[k] = fmin(s->st.xmin[k], row[COL_X1 + k]);
         s->st.xmax[k] = fmax(s->st.xmax[k], row[COL_X1 + k]);
+    }
+    {
+        // The limiter's utilisation: the rows' column (ode), else measured
+        // from the row as the limiter measures it (lagrange).
+        double u = NAN;
+        if (s->ncol > COL_RCL_UTIL) u = row[COL_RCL_UTIL];
+        else if (s->mon) u = rcl_utilisation(s->mon, row);
+        if (isfinite(u)) {
+            if (s->st.rcl_have && u >= RCL_WARN) s->st.rcl_t90 += row[COL_T] - s->st.t_prev;
+            s->st.rcl_max = s->st.rcl_have ? fmax(s->st.rcl_max, u) : u;
+            s->st.rcl_have = true;
+        }
+        s->st.t_prev = row[COL_T];
     }
     keep_row(&s->keep, row, s->ncol);
     metrics_row(&s->met, row);
@@ -199,6 +222,11 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
            r->wall > 0 ? r->t_end / r->wall : 0.0, work);
     printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
            1e3 * xmax[1]);
+    if (st->rcl_have)
+        printf("  rated capacity limiter %s: utilisation max %.0f %%, %.3f s at or above 90 %%\n",
+               !o->rcl ? "off (measuring only)"
+                       : (o->mechanics == SIM_LAGRANGE ? "measuring only (lagrange scripted run)" : "on"),
+               100 * st->rcl_max, st->rcl_t90);
     // The peaks over every integration step when sim.c tracked them (between
     // coarse rows the true peak can be far higher than any row's); else
     // (CVODE) over the rows, and said so.
@@ -289,6 +317,7 @@ int cmd_run(int argc, char** argv) {
     const char* plot = NULL;
     const char* energy_csv = NULL;
     const char* metrics_out = NULL;
+    bool rcl_on = true;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             run_help(stdout);
@@ -312,6 +341,16 @@ int cmd_run(int argc, char** argv) {
         }
         if (!strcmp(argv[i], "--metrics")) {
             if (!(metrics_out = app_value(argc, argv, &i))) return EXIT_USAGE;
+            continue;
+        }
+        if (!strcmp(argv[i], "--rcl")) {
+            const char* v = app_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            if (strcmp(v, "on") && strcmp(v, "off")) {
+                fprintf(stderr, "cranesim run: --rcl: expected on or off, got '%s'\n", v);
+                return EXIT_USAGE;
+            }
+            rcl_on = !strcmp(v, "on");
             continue;
         }
         fprintf(stderr, "cranesim run: unknown option '%s' (see cranesim run --help)\n", argv[i]);
@@ -351,9 +390,15 @@ int cmd_run(int argc, char** argv) {
                     steps * 0.25e-6);
     }
     app_settle_unused(&c.sim);
+    c.sim.rcl = rcl_on;
 
     csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim),
                      .st = {.xmin = {INFINITY, INFINITY}, .xmax = {-INFINITY, -INFINITY}}};
+    static rcl mon;
+    if (sink.ncol <= COL_RCL_UTIL) {
+        char lerr[300];
+        if (rcl_init(&mon, m, NULL, lerr, sizeof lerr) == 0) sink.mon = &mon;
+    }
     metrics_init(&sink.met, sink.ncol);
     sim_trace tr = {0};
     if (plot) {
@@ -481,6 +526,7 @@ int cmd_run(int argc, char** argv) {
     }
     sim_energy_free(en);
     sim_trace_free(&tr);
+    if (sink.mon) rcl_free(sink.mon);
     model_free(m);
     return code;
 }

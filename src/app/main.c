@@ -25,6 +25,8 @@ static void usage(FILE* f) {
             "  optimize  the design (model values in bounds) that minimises a run metric under\n"
             "            constraints on others (NLopt, derivative-free): best model file, plot\n"
             "  replay    run a recorded drive session again headless, on its design or a changed one\n"
+            "  loadchart rated capacity against outreach: hydraulic and (on the truck) stability limits,\n"
+            "            per slew sector, as CSV and PNG (docs/safety.md)\n"
             "  help      this text; cranesim help <command>: that command's help\n"
             "\n"
             "examples:\n"
@@ -41,7 +43,7 @@ static const struct {
     int (*fn)(int argc, char** argv);
 } commands[] = {
     {"run", cmd_run}, {"bench", cmd_bench}, {"compare", cmd_compare}, {"drive", cmd_drive}, {"study", cmd_study},
-    {"sweep", cmd_sweep}, {"optimize", cmd_optimize}, {"replay", cmd_replay},
+    {"sweep", cmd_sweep}, {"optimize", cmd_optimize}, {"replay", cmd_replay}, {"loadchart", cmd_loadchart},
 };
 
 static int (*find_command(const char* name))(int, char**) {

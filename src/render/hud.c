@@ -360,6 +360,10 @@ int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDE
         if (nrel == 0 && s->cyl[i].relief_open) snprintf(w[n++], RENDER_WARN_LEN, "RELIEF OPEN: %s", nm);
         if (s->cyl[i].end_stop && n < max - 2) snprintf(w[n++], RENDER_WARN_LEN, "END STOP: %s", nm);
     }
+    if (s->rcl_have && s->rcl_util >= 0.9 && n < max - 1)
+        snprintf(w[n++], RENDER_WARN_LEN, s->rcl_util >= 1.0 && s->rcl_on ? "RATED CAPACITY %.0f %%: MOTIONS STOPPED"
+                                                                          : "RATED CAPACITY %.0f %%",
+                 100 * s->rcl_util);
     if (s->tipping && n < max - 1)
         snprintf(w[n++], RENDER_WARN_LEN, "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
     if (s->collision && n < max - 1) snprintf(w[n++], RENDER_WARN_LEN, "COLLISION");
@@ -388,6 +392,24 @@ static void draw_warnings(render* r, char w[][RENDER_WARN_LEN], int n) {
     }
 }
 
+// The rated capacity limiter's utilisation as a bar, bottom right: green
+// below 90 %, amber to 100 %, red beyond (the fill stops at 120 %).
+static void draw_rcl_bar(render* r, const world_snapshot* s) {
+    if (!s->rcl_have) return;
+    render_hud* h = &r->hud;
+    const float w = 220, hh = 14, x = (float)h->w - w - 14, y = (float)h->h - hh - 150;
+    const float green[4] = {0.2f, 0.8f, 0.3f, 1}, red[4] = {1.0f, 0.1f, 0.1f, 1};
+    const double u = s->rcl_util > 0 ? s->rcl_util : 0;
+    render_hud_rect(h, x - 6, y - 18, w + 12, hh + 24, k_panel);
+    char buf[64];
+    snprintf(buf, sizeof buf, "load moment %.0f %% of rated%s", 100 * u, s->rcl_on ? "" : " (RCL off)");
+    render_hud_text(h, x, y - 14, 1.0f, u >= 0.9 ? k_amber : k_white, buf);
+    render_hud_rect(h, x, y, w, hh, k_dim);
+    const float fill = (float)(u > 1.2 ? 1.0 : u / 1.2) * w;
+    render_hud_rect(h, x, y, fill, hh, u >= 1.0 ? red : (u >= 0.9 ? k_amber : green));
+    render_hud_rect(h, x + w / 1.2f - 1, y - 2, 2, hh + 4, k_white); // the 100 % mark
+}
+
 void render_hud_draw_overlay(render* r, const world_snapshot* s) {
     render_hud* h = &r->hud;
     // Warnings first as text, so the pressure bars keep clear of them.
@@ -397,6 +419,7 @@ void render_hud_draw_overlay(render* r, const world_snapshot* s) {
     warnings_box(r, w, nw, box);
     draw_pressure_bars(r, s, box);
     draw_readouts(r, s);
+    draw_rcl_bar(r, s);
     draw_warnings(r, w, nw);
     if (r->charts.n > 0) {
         float ch = 124.0f;

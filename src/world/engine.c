@@ -3,6 +3,8 @@
 #include "engine_impl.h"
 
 #include "model.h"
+#include "rcl.h"
+#include <stdlib.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -28,7 +30,34 @@ static const engine_ops* backend(const sim_opts* o) {
 
 engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
                       size_t errsz) {
-    return backend(o)->create(m, o, q0, slew0, m3, err, errsz);
+    engine* e = backend(o)->create(m, o, q0, slew0, m3, err, errsz);
+    if (!e) return NULL;
+    // The limiter filters every command a stepped driver sets (drive, the
+    // window's tick, the soak bench): one place for all of them.
+    e->rcl = engine_rcl_create(m, o, "sandbox");
+    return e;
+}
+
+struct rcl* engine_rcl_create(const model* m, const sim_opts* o, const char* default_world) {
+    char err[300], buf[512];
+    const char* wp = NULL;
+    if (o->mechanics == SIM_ODE) wp = sim_world_path(o->world ? o->world : default_world, buf, sizeof buf);
+    rcl* r = malloc(sizeof *r);
+    if (r && rcl_init_world(r, m, wp, err, sizeof err)) {
+        free(r);
+        r = NULL;
+    }
+    return r;
+}
+
+void engine_rcl_destroy(struct rcl* r) {
+    if (r) rcl_free(r), free(r);
+}
+
+// The limiter's utilisation into the row's rcl_util column, where the
+// backend publishes it.
+static void fill_rcl(engine* e, double* row) {
+    if (e->rcl && e->ops->nchannel > COL_RCL_UTIL) row[COL_RCL_UTIL] = rcl_utilisation(e->rcl, row);
 }
 
 // A burst's orifice while the hose holds: the smallest area an orifice
@@ -178,7 +207,9 @@ void engine_apply_faults(engine* e, const scenario* sc, double tm) {
 }
 
 void engine_destroy(engine* e) {
-    if (e) e->ops->destroy(e);
+    if (!e) return;
+    engine_rcl_destroy(e->rcl);
+    e->ops->destroy(e);
 }
 
 const char* engine_backend_name(const engine* e) { return e->ops->name; }
@@ -192,7 +223,23 @@ void engine_describe(const sim_opts* o, engine_desc* d) {
 void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n) {
     backend(o)->describe_work(o, r, buf, n);
 }
-void engine_set_commands(engine* e, const double u[3]) { e->ops->set_commands(e, u); }
+void engine_set_commands(engine* e, const double u[3]) {
+    if (!e->rcl || !e->o.rcl) {
+        if (e->rcl) { // still measured, for the HUD and the record
+            double row[SIM_NCOL];
+            e->ops->row(e, row);
+            rcl_utilisation(e->rcl, row);
+        }
+        e->ops->set_commands(e, u);
+        return;
+    }
+    double row[SIM_NCOL], v[3];
+    e->ops->row(e, row);
+    rcl_filter(e->rcl, row, u, v);
+    e->ops->set_commands(e, v);
+}
+
+const struct rcl* engine_rcl(const engine* e) { return e->rcl; }
 int engine_hook(engine* e, int attach) { return e->ops->hook ? e->ops->hook(e, attach) : -1; }
 
 const char* engine_load_name(const engine* e, int i, double* mass) {
@@ -228,8 +275,16 @@ const sim_channel* engine_channels_for(const sim_opts* o, int* n) {
     return sim_channels;
 }
 double engine_time(const engine* e) { return e->ops->time(e); }
-void engine_row(engine* e, double row[SIM_NCOL]) { e->ops->row(e, row); }
-void engine_snapshot(engine* e, world_snapshot* s) { e->ops->snapshot(e, s); }
+void engine_row(engine* e, double row[SIM_NCOL]) {
+    e->ops->row(e, row);
+    fill_rcl(e, row);
+}
+void engine_snapshot(engine* e, world_snapshot* s) {
+    e->ops->snapshot(e, s);
+    s->rcl_have = e->rcl != NULL;
+    s->rcl_on = e->rcl && e->o.rcl;
+    s->rcl_util = e->rcl ? e->rcl->util : 0.0;
+}
 const char* engine_error(const engine* e) { return e->err; }
 
 void engine_note(const engine* e, char* note, size_t n) {
@@ -248,6 +303,7 @@ static int advance(engine* e, double dt, engine_row_fn row_fn, void* user) {
     // passing as valid.
     double row[SIM_NCOL];
     e->ops->row(e, row);
+    fill_rcl(e, row);
     char what[200];
     const int rc = sim_check_row(&e->chk, row, e->ops->nchannel, what, sizeof what);
     if (rc) {

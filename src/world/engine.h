@@ -152,6 +152,15 @@ void engine_apply_faults(engine* e, const scenario* sc, double tm);
 double engine_time(const engine* e);
 /// The CSV row at the current time (sim.h columns; engine_ncol of them are set).
 void engine_row(engine* e, double row[SIM_NCOL]);
+struct rcl;
+/// The engine's rated capacity limiter (rcl.h), or NULL: it filters
+/// engine_set_commands when o->rcl, and fills the rows' rcl_util either way.
+const struct rcl* engine_rcl(const engine* e);
+/// A limiter for model m on the world of options o (default_world when
+/// o->world is NULL; no world for lagrange), or NULL when its chart cannot
+/// be made. engine_rcl_destroy frees it.
+struct rcl* engine_rcl_create(const model* m, const sim_opts* o, const char* default_world);
+void engine_rcl_destroy(struct rcl* r);
 /// Fill a snapshot for the renderer.
 void engine_snapshot(engine* e, world_snapshot* s);
 

@@ -61,6 +61,7 @@ struct engine {
     bool failed;    ///< a check or the step failed: the engine stays stopped
     engine_faults faults; ///< for engine_play's fault events (faults_ready once initialised)
     bool faults_ready;
+    struct rcl* rcl;      ///< the rated capacity limiter (engine.c), or NULL where its chart failed
 };
 
 extern const engine_ops engine_lagrange_ops, engine_ode_ops;

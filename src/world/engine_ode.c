@@ -5,6 +5,7 @@
 #include "energy_acc.h"
 
 #include "ode_world.h"
+#include "rcl.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -168,6 +169,10 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         return res->status = SIM_REFUSED;
     }
     if (en) sim_energy_sample(en, 0.0, ode_world_circuit_inputs(w, sim_energy_data(en)), ode_world_energy(w));
+    // The rated capacity limiter between the scenario and the world, as
+    // engine_set_commands has it for the stepped drivers.
+    struct rcl* lim = engine_rcl_create(m, o, "validation");
+    if (lim) row[COL_RCL_UTIL] = rcl_utilisation(lim, row);
     deliver(c, row);
     ++c->rows;
     for (long i = 0; i < nstep && !c->stop; ++i) {
@@ -178,6 +183,12 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         double u[3];
         scenario_play(sc, tm, &ev, u, play_hook, w);
         engine_faults_apply(&ef, ode_world_circuit(w), sc, tm);
+        if (lim && o->rcl) {
+            double now[SIM_NCOL], v[3];
+            sim_ode_row(w, now);
+            rcl_filter(lim, now, u, v);
+            memcpy(u, v, sizeof u);
+        }
         ode_world_set_commands(w, u);
         if (ode_world_step(w, dt)) {
             res->status = SIM_FAILED;
@@ -200,6 +211,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         if ((i + 1) % nout && i + 1 != nstep) continue;
         sim_ode_row(w, row);
         row[COL_T] = (double)(i + 1) * dt; // exact grid times, no accumulated round-off
+        if (lim) row[COL_RCL_UTIL] = rcl_utilisation(lim, row);
         {
             char what[200];
             const int rc = sim_check_row(&c->chk, row, SIM_NCOL, what, sizeof what);
@@ -223,6 +235,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     res->rows = c->rows;
     res->t_end = c->t_last_row;
     if (en) sim_energy_finish(en);
+    engine_rcl_destroy(lim);
     ode_world_destroy(w);
     res->peak_steps = true;
     const char* last;

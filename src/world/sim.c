@@ -17,7 +17,7 @@ const sim_channel sim_channels[SIM_NCOL] = {SIM_CHANNELS_BASE(CH_ENTRY_) SIM_CHA
 const char* const sim_col_name[SIM_NCOL] = {SIM_CHANNELS_BASE(CH_NAME_) SIM_CHANNELS_WORLD(CH_NAME_)};
 const char* const sim_col_unit[SIM_NCOL] = {SIM_CHANNELS_BASE(CH_UNIT_) SIM_CHANNELS_WORLD(CH_UNIT_)};
 // The README's fixed order of the first columns, and the world extras right after the base.
-_Static_assert(COL_U2_CMD == 16 && COL_END_STOP == 21 && COL_SLEW == SIM_NCOL_BASE && COL_F3 == SIM_NCOL_BASE + 17 && COL_TIP_WZ == SIM_NCOL - 1,
+_Static_assert(COL_U2_CMD == 16 && COL_END_STOP == 21 && COL_SLEW == SIM_NCOL_BASE && COL_F3 == SIM_NCOL_BASE + 17 && COL_TIP_WZ == SIM_NCOL - 2 && COL_RCL_UTIL == SIM_NCOL - 1,
                "the channel list lost its documented order");
 
 sim_opts sim_default_opts(void) {

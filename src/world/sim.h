@@ -56,6 +56,8 @@ typedef struct sim_opts {
     bool cvode;        ///< integrate with SUNDIALS CVODE (BDF) instead of `solver`
                        ///< (the outside reference; rtol/atol apply)
     sim_kernel kernel;   ///< how the circuit is evaluated (default SIM_KERNEL_SPLIT, the fastest)
+    bool rcl;            ///< the rated capacity limiter cuts commands (rcl.h); off (the library default):
+                         ///< it only measures rcl_util. run and drive turn it on unless --rcl off
 } sim_opts;
 
 // The settings its messages name: sim_param, sim_name_params, sim_param_name (param_names.h).
@@ -208,7 +210,9 @@ typedef struct sim_channel {
     /* The end-arm tip in the world frame, where the rope hangs from (hook sway). */ \
     X(TIP_WX, "tip_wx", "m", SIM_CH_OTHER) \
     X(TIP_WY, "tip_wy", "m", SIM_CH_OTHER) \
-    X(TIP_WZ, "tip_wz", "m", SIM_CH_OTHER)
+    X(TIP_WZ, "tip_wz", "m", SIM_CH_OTHER) \
+    /* Rated capacity limiter: load moment over the chart's rated moment (rcl.h). */ \
+    X(RCL_UTIL, "rcl_util", "-", SIM_CH_OTHER)
 
 #define SIM_COL_ENUM_(id, name, unit, kind) COL_##id,
 /// CSV column indices, in the order of the list.

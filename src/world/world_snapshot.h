@@ -110,6 +110,9 @@ typedef struct world_snapshot {
     /// The snapshot cylinder each open relief guards (index into cyl[]), or -1
     /// (a pump-line relief), and the chamber: 0 = A, 1 = B.
     int relief_cyl[WORLD_SNAP_MAX_RELIEFS], relief_port[WORLD_SNAP_MAX_RELIEFS];
+    uint8_t rcl_have;         ///< the rated capacity limiter measures (rcl_util is valid)
+    uint8_t rcl_on;           ///< ... and cuts the motions that increase the load moment
+    double rcl_util;          ///< its utilisation: load moment over the chart's rated moment [-]
 } world_snapshot;
 
 #ifdef __cplusplus

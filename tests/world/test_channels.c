@@ -15,7 +15,7 @@ static const char* const k_header_lagrange =
 static const char* const k_header_ode =
     "t,x1,x2,p1A,p1B,p2A,p2B,u1,u2,q1,q2,tip_x,tip_z,F1,F2,u1_cmd,u2_cmd,v1,v2,p_pump,relief_open,end_stop,"
     "slew,hook_x,hook_y,hook_z,load_x,load_y,load_z,attached,truck_tilt,contacts,max_depth,x3,v3,p3A,p3B,u3,"
-    "u3_cmd,F3,tip_wx,tip_wy,tip_wz\n";
+    "u3_cmd,F3,tip_wx,tip_wy,tip_wz,rcl_util\n";
 
 // The header sim_csv_header writes for ncol columns.
 static void header(int ncol, char* buf, size_t n) {

@@ -1,0 +1,63 @@
+// rcl.h: the rated capacity limiter. The load moment is measured as a
+// limiter on a real crane measures it: from the lift cylinder's chamber
+// pressures and the joint angles (the booms' own moment subtracted), not
+// from the load's mass; the utilisation is that moment over the load chart's
+// rated moment at the current outreach (and slew sector on the truck). At
+// 90 % it warns; from 95 % it slows and at 100 % it stops the motions that
+// increase the load moment (lift down, jib out, slewing towards a weaker
+// sector), leaving those that reduce it free. docs/safety.md.
+#ifndef RCL_H
+#define RCL_H
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "loadchart.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RCL_WARN 0.90  ///< utilisation of the warning [-]
+#define RCL_SLOW 0.90  ///< utilisation where the increasing motions start to slow [-]
+#define RCL_TAU 1.0    ///< time constant of the load moment's low-pass filter [s]
+
+typedef struct rcl {
+    const model* m;
+    loadchart chart;
+    double AA, AB;     ///< lift cylinder piston and annulus areas [m^2]
+    double util;       ///< last utilisation [-], from the filtered load moment
+    double m_filt;     ///< the filtered load estimate, moment over outreach over g [kg]
+    double t_last;     ///< the time it was last updated [s]
+    bool have;         ///< m_filt holds a value
+    bool warn;         ///< util >= RCL_WARN
+    bool stopped;      ///< the last filter cut a command
+} rcl;
+
+/// Build the limiter for model m on world wd (NULL or validation: the
+/// hydraulic limit only), with the default chart options over the crane's
+/// whole reach. Returns 0, or -1 with one line in err.
+int rcl_init(rcl* r, const model* m, const world_desc* wd, char* err, size_t errsz);
+/// As rcl_init, for the world file of an ode run (NULL: no world, lagrange).
+int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, size_t errsz);
+void rcl_free(rcl* r);
+
+/// Utilisation [-] from a CSV row (t, p1A, p1B, q1, q2, slew columns; slew
+/// 0 when absent). Also stored in r->util. The load the moment implies
+/// (moment / (g outreach)) is low-pass filtered (RCL_TAU) and multiplied
+/// back by the current outreach, as a limiter filters its pressure
+/// transducers but not its angle sensors: the
+/// chamber pressures ring by several MPa when a motion starts or stops, and
+/// a limiter acting on that would stop and free the crane by turns. Rows
+/// at the same time as the last one leave the filter as it is; an earlier
+/// time (a rewind) restarts it.
+double rcl_utilisation(rcl* r, const double* row);
+
+/// The command filter: the operator's commands u_in (lift, jib, slew in
+/// [-1, 1]; positive extends the lift and jib cylinders and increases the
+/// slew angle) into u_out, from the state in row. Returns the utilisation.
+double rcl_filter(rcl* r, const double* row, const double u_in[3], double u_out[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,342 @@
+// test_loadchart.c: the load chart against hand calculations (torque balance
+// from the geometry and relief settings; moments about the outrigger line
+// from the truck's mass, centre of mass and pad positions), against the
+// simulation (above a chart point a relief opens, below it the crane holds),
+// and the rated capacity limiter on scripted input.
+#include "check.h"
+#include "engine.h"
+#include "lagrange.h"
+#include "loadchart.h"
+#include "rcl.h"
+#include "sim.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static model* load(const char* const* sets, int nset) {
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", sets, nset, err, sizeof err);
+    CHECK(m != NULL, "model: %s", err);
+    return m;
+}
+
+// Hand calculation of the hydraulic limit at outreach R: every pose on a
+// 0.05 deg grid of the lifting arm, gravity torques written out from the
+// link masses and lengths, lever arms from the mount distances (r = a b sin
+// phi / x), pressures against the port relief less the margin.
+static double hand_hyd(const model* m, double R, double margin) {
+    const crane_mech* me = &m->mech;
+    const double g = me->gravity, L1 = me->link[0].length, L2 = me->link[1].length;
+    const double m1 = me->link[0].mass, m2 = me->link[1].mass, e1 = me->link[0].com, e2 = me->link[1].com;
+    double AA[2], AB[2], st, q1lo, q1hi, q2lo, q2hi;
+    for (int k = 0; k < 2; ++k) hyd_model_cylinder_geometry(m->hyd, m->cyl[k], &AA[k], &AB[k], &st);
+    q1lo = crane_joint_for_stroke(&me->act[0], 0), q1hi = crane_joint_for_stroke(&me->act[0], m->stroke[0]);
+    q2lo = crane_joint_for_stroke(&me->act[1], 0), q2hi = crane_joint_for_stroke(&me->act[1], m->stroke[1]);
+    const double pmax = (1 - margin) * 25e6, plow = 0.5e6; // the shipped port reliefs: 25 MPa
+    double best = INFINITY;
+    for (int i = 0; i <= 1800; ++i) {
+        const double q1 = q1lo + (q1hi - q1lo) * i / 1800.0;
+        const double s = (R - L1 * sin(q1)) / L2;
+        if (fabs(s) > 1) continue;
+        const double cand[2] = {asin(s), M_PI - asin(s)};
+        for (int c = 0; c < 2; ++c)
+            for (int w = -1; w <= 1; ++w) {
+                const double q2 = cand[c] + 2 * M_PI * w - q1;
+                if (q2 < q2lo || q2 > q2hi) continue;
+                const double q[2] = {q1, q2};
+                for (int k = 0; k < 2; ++k) {
+                    const crane_actuator* a = &me->act[k];
+                    const double phi = q[k] + a->phi_offset;
+                    const double x = sqrt(a->a * a->a + a->b * a->b - 2 * a->a * a->b * cos(phi));
+                    const double r = a->a * a->b * sin(phi) / x;
+                    // Torque = T0 + m3 T1 (joint 1 carries both booms, joint 2 the end arm).
+                    const double T0 = k == 0 ? (m1 * e1 + m2 * L1) * g * sin(q1) + m2 * e2 * g * sin(q1 + q2)
+                                             : m2 * e2 * g * sin(q1 + q2);
+                    const double T1 = k == 0 ? g * (L1 * sin(q1) + L2 * sin(q1 + q2)) : g * L2 * sin(q1 + q2);
+                    // Force F = T / r; chamber A: F <= pmax AA - plow AB; B: -F <= pmax AB - plow AA.
+                    double lim = INFINITY;
+                    if (T1 > 0) lim = ((pmax * AA[k] - plow * AB[k]) * r - T0) / T1;
+                    if (T1 < 0) lim = (-(pmax * AB[k] - plow * AA[k]) * r - T0) / T1;
+                    best = fmin(best, lim);
+                }
+            }
+    }
+    return best;
+}
+
+static void test_hydraulic_limit_matches_hand_calculation(void) {
+    model* m = load(NULL, 0);
+    if (!m) return;
+    lc_opts o = lc_default_opts();
+    o.lo = 1.5, o.hi = 4.2, o.n = 4; // 1.5, 2.4, 3.3, 4.2 m
+    loadchart c;
+    char err[300];
+    CHECK(loadchart_compute(m, NULL, &o, &c, err, sizeof err) == 0, "%s", err);
+    for (int i = 0; i < 4; i += (i == 0 ? 2 : 1)) { // 1.5, 3.3, 4.2 m
+        const double hand = hand_hyd(m, c.R[i], 0.10);
+        CHECK(isfinite(hand) && hand > 100, "hand calculation at %.2f m: %g kg", c.R[i], hand);
+        // The chart searches a 0.5 deg grid, the hand calculation 0.05 deg:
+        // the chart may miss the worst pose by a little, never by more.
+        CHECK_REL(c.hyd[i], hand, 0.01);
+        printf("  hydraulic limit at %.2f m: chart %.1f kg, hand %.1f kg\n", c.R[i], c.hyd[i], hand);
+    }
+    loadchart_free(&c);
+    model_free(m);
+}
+
+// Truck of assets/worlds/sandbox.json, written out: 6500 kg at the chassis
+// centre, column 0.9 m ahead of it, pads at x = 1.0 and -2.9 m, 4.0 m apart,
+// hook 40 kg plus 1.2 m of rope at 0.6 kg/m.
+static void test_stability_limit_matches_hand_calculation(void) {
+    model* m = load(NULL, 0);
+    if (!m) return;
+    world_desc wd;
+    char err[300];
+    CHECK(world_desc_load(CRANESIM_ASSETS "/worlds/sandbox.json", &wd, err, sizeof err) == 0, "%s", err);
+    lc_truck t;
+    lc_truck_from_world(&wd, &t);
+    world_desc_free(&wd);
+    CHECK(t.present && t.mass == 6500 && t.column_x == 0.9 && t.edge_x[0] == 1.0 && t.edge_x[1] == -2.9 &&
+              t.edge_y == 2.0,
+          "sandbox truck changed: the hand numbers below are for the shipped one");
+    // Pose: lifting arm at 20 deg elevation, end arm straight on (q2 = -30 deg
+    // from the lifting arm), slewed over the side (90 deg): the tip is
+    // beyond the left pads.
+    const double q1 = (90 + 20) * M_PI / 180, q2 = -30 * M_PI / 180;
+    const crane_mech* me = &m->mech;
+    const double L1 = me->link[0].length, L2 = me->link[1].length;
+    const double r1 = me->link[0].com * sin(q1), r2 = L1 * sin(q1) + me->link[1].com * sin(q1 + q2);
+    const double rt = L1 * sin(q1) + L2 * sin(q1 + q2);
+    // Distances inside the left edge y = 2.0 m: truck and column 2.0 m, the
+    // booms' centres 2.0 - r, the tip 2.0 - rt (< 0: outside).
+    const double hook = 40 + 0.6 * 1.2;
+    const double restoring = 6500 * 2.0 + me->column_mass * 2.0 + me->link[0].mass * (2.0 - r1) +
+                             me->link[1].mass * (2.0 - r2) + hook * (2.0 - rt);
+    const double hand = restoring / (1.25 * (rt - 2.0));
+    const double got = loadchart_stab_pose(m, &t, q1, q2, 0.5 * M_PI, 1.25);
+    printf("  stability limit over the side at %.2f m: %.1f kg, hand %.1f kg\n", rt, got, hand);
+    CHECK(rt > 2.0, "tip %.2f m not beyond the pads", rt);
+    CHECK_REL(got, hand, 1e-9);
+    // Over the cab (slew 0) the front pads are 0.1 m ahead of the column:
+    // the tip at rt is rt - 0.1 m beyond them.
+    const double front = (6500 * 1.0 + me->column_mass * 0.1 + me->link[0].mass * (0.1 - r1) +
+                          me->link[1].mass * (0.1 - r2) + hook * (0.1 - rt)) /
+                         (1.25 * (rt - 0.1));
+    CHECK_REL(loadchart_stab_pose(m, &t, q1, q2, 0.0, 1.25), front, 1e-9);
+    model_free(m);
+}
+
+// At two chart points (margin 0, so the chart's load is the relief's), the
+// crane held in the governing pose with valves closed: 10 % more load and a
+// port relief opens and the crane sinks; 10 % less and it holds. The
+// reliefs' override band is widened to 5 MPa so the 10 % overload (about
+// 1.7 MPa above the setting) starts inside it instead of being refused.
+static void sim_check(sim_mechanics mech) {
+    static const char* const sets[] = {"hydraulics.components.lift_relief_A.dp_override=5e6",
+                                       "hydraulics.components.lift_relief_B.dp_override=5e6",
+                                       "hydraulics.components.jib_relief_A.dp_override=5e6",
+                                       "hydraulics.components.jib_relief_B.dp_override=5e6"};
+    model* m = load(sets, 4);
+    if (!m) return;
+    lc_opts o = lc_default_opts();
+    o.margin = 0, o.lo = 2.0, o.hi = 4.0, o.n = 2;
+    loadchart c;
+    char err[300];
+    CHECK(loadchart_compute(m, NULL, &o, &c, err, sizeof err) == 0, "%s", err);
+    for (int i = 0; i < c.n; ++i)
+        for (int over = 0; over < 2; ++over) {
+            scenario sc;
+            memset(&sc, 0, sizeof sc);
+            snprintf(sc.name, sizeof sc.name, "chart point");
+            sc.duration = 2.0;
+            sc.load_mass = c.hyd[i] * (over ? 1.10 : 0.90);
+            sc.q0[0] = c.hyd_q[i][0], sc.q0[1] = c.hyd_q[i][1];
+            sim_opts so = sim_default_opts();
+            so.mechanics = mech;
+            so.dt_out = 0.01;
+            sim_trace tr = {0};
+            sim_result r;
+            CHECK(sim_run(m, &sc, &so, NULL, NULL, &tr, NULL, NULL, &r) == 0, "%s", r.message);
+            if (tr.nrow < 2) continue;
+            double relief = 0, dq = 0;
+            for (int j = 0; j < tr.nrow; ++j) {
+                const double* row = tr.v + (size_t)j * SIM_NCOL;
+                relief = fmax(relief, row[COL_RELIEF_OPEN]);
+                dq = fmax(dq, fmax(fabs(row[COL_Q1] - sc.q0[0]), fabs(row[COL_Q2] - sc.q0[1])));
+            }
+            printf("  %s, %.2f m, %.0f kg (%s 10 %%): relief_open %g, pose moved %.3f deg\n",
+                   mech == SIM_ODE ? "ode" : "lagrange", c.R[i], sc.load_mass, over ? "+" : "-", relief,
+                   dq * 180 / M_PI);
+            if (over) {
+                CHECK(relief > 0, "%.2f m +10 %%: no relief opened", c.R[i]);
+                CHECK(dq > 0.2 * M_PI / 180, "%.2f m +10 %%: crane did not sink (%.3f deg)", c.R[i], dq * 180 / M_PI);
+            } else {
+                CHECK(relief == 0, "%.2f m -10 %%: a relief opened", c.R[i]);
+                CHECK(dq < 0.2 * M_PI / 180, "%.2f m -10 %%: crane moved %.3f deg", c.R[i], dq * 180 / M_PI);
+            }
+            sim_trace_free(&tr);
+        }
+    loadchart_free(&c);
+    model_free(m);
+}
+
+static void test_chart_points_by_simulation(void) {
+    sim_check(SIM_LAGRANGE);
+    sim_check(SIM_ODE);
+}
+
+// A row of the state the limiter reads: pose, and lift pressures that hold
+// load mass ml [kg] there (the booms' own torque plus ml at the tip).
+static void hold_row(const model* m, double q1, double q2, double ml, double* row) {
+    static double t = 0; // each row 100 s after the last: the limiter's filter has settled on it
+    memset(row, 0, sizeof(double) * SIM_NCOL);
+    row[COL_T] = t += 100;
+    const double q[2] = {q1, q2};
+    double G[2], r, AA, AB, st;
+    lagrange_gravity(&m->mech, LAGRANGE_FULL, ml, q, G);
+    crane_pin_length(&m->mech.act[0], q1, &r);
+    hyd_model_cylinder_geometry(m->hyd, m->cyl[0], &AA, &AB, &st);
+    row[COL_Q1] = q1, row[COL_Q2] = q2;
+    row[COL_P1B] = 0.5e6;
+    row[COL_P1A] = (G[0] / r + row[COL_P1B] * AB) / AA;
+}
+
+static void test_limiter_filter(void) {
+    model* m = load(NULL, 0);
+    if (!m) return;
+    rcl r;
+    char err[300];
+    CHECK(rcl_init(&r, m, NULL, err, sizeof err) == 0, "%s", err);
+    const double q1 = 100 * M_PI / 180, q2 = -40 * M_PI / 180;
+    double R, z, row[SIM_NCOL], out[3];
+    crane_tip(&m->mech, q1, q2, &R, &z);
+    const double cap = loadchart_capacity(&r.chart, R, 0, NULL);
+    // The utilisation is the measured load over the rated load at this outreach.
+    hold_row(m, q1, q2, 0.5 * cap, row);
+    CHECK_NEAR(rcl_utilisation(&r, row), 0.5, 1e-6);
+    static const double down_out[3] = {-1, 1, 0}, up_in[3] = {1, -1, 0};
+    rcl_filter(&r, row, down_out, out);
+    CHECK(out[0] == -1 && out[1] == 1 && !r.warn, "at 50 %%: commands cut (%g, %g)", out[0], out[1]);
+    hold_row(m, q1, q2, 0.89 * cap, row);
+    rcl_filter(&r, row, down_out, out);
+    CHECK(!r.warn && out[0] == -1 && out[1] == 1, "at 89 %%: no warning %d, (%g, %g)", r.warn, out[0], out[1]);
+    hold_row(m, q1, q2, 0.95 * cap, row);
+    rcl_filter(&r, row, down_out, out);
+    CHECK(r.warn && fabs(out[0] + 0.5) < 1e-6 && fabs(out[1] - 0.5) < 1e-6, "at 95 %%: warning %d, (%g, %g) not halved",
+          r.warn, out[0], out[1]);
+    hold_row(m, q1, q2, 1.0 * cap, row);
+    rcl_filter(&r, row, down_out, out);
+    CHECK(out[0] == 0 && out[1] == 0, "at 100 %%: lift down %g and jib out %g not stopped", out[0], out[1]);
+    rcl_filter(&r, row, up_in, out);
+    CHECK(out[0] == 1 && out[1] == -1, "at 100 %%: lift up %g and jib in %g not let through", out[0], out[1]);
+    hold_row(m, q1, q2, 1.3 * cap, row);
+    rcl_filter(&r, row, up_in, out);
+    CHECK(out[0] == 1 && out[1] == -1, "at 130 %%: lift up %g and jib in %g not let through", out[0], out[1]);
+    rcl_free(&r);
+    model_free(m);
+}
+
+// On the truck: at 98.5 % near a sector boundary, slewing into the weaker
+// sector (where the same load would be over 100 %) is stopped, slewing
+// away from it is not.
+static void test_limiter_slew_towards_weaker_sector(void) {
+    model* m = load(NULL, 0);
+    if (!m) return;
+    world_desc wd;
+    char err[300];
+    CHECK(world_desc_load(CRANESIM_ASSETS "/worlds/sandbox.json", &wd, err, sizeof err) == 0, "%s", err);
+    rcl r;
+    CHECK(rcl_init(&r, m, &wd, err, sizeof err) == 0, "%s", err);
+    world_desc_free(&wd);
+    const double q1 = 135 * M_PI / 180, q2 = -110 * M_PI / 180; // 2.68 m: stability governs over the cab
+    double R, z, row[SIM_NCOL], out[3];
+    crane_tip(&m->mech, q1, q2, &R, &z);
+    // The boundary with the largest drop from the sector above to the one below.
+    int best = -1;
+    double ratio = 1;
+    for (int k = 1; k < r.chart.nsec; ++k) {
+        const double lo = loadchart_capacity(&r.chart, R, r.chart.sec_hi[k - 1] - 0.01, NULL);
+        const double hi = loadchart_capacity(&r.chart, R, r.chart.sec_lo[k] + 0.01, NULL);
+        if (lo / hi < ratio) ratio = lo / hi, best = k;
+    }
+    CHECK(best > 0 && ratio < 0.97, "no sector boundary at %.2f m with a drop of 3 %% (%g)", R, ratio);
+    if (best > 0) {
+        const double slew = r.chart.sec_lo[best] + 0.01, cap = loadchart_capacity(&r.chart, R, slew, NULL);
+        hold_row(m, q1, q2, 0.985 * cap + r.chart.hook_mass, row);
+        row[COL_SLEW] = slew;
+        static const double towards[3] = {0, 0, -1}, away[3] = {0, 0, 1};
+        rcl_filter(&r, row, towards, out);
+        CHECK(out[2] == 0, "slewing into the weaker sector let through: %g (util %.3f)", out[2], r.util);
+        rcl_filter(&r, row, away, out);
+        CHECK(out[2] == 1, "slewing away from the weaker sector cut: %g", out[2]);
+        printf("  at %.2f m, slew %.1f deg, util %.2f: towards the %.0f %% weaker sector %g, away %g\n", R,
+               slew * 180 / M_PI, r.util, 100 * (1 - ratio), 0.0, out[2]);
+    }
+    rcl_free(&r);
+    model_free(m);
+}
+
+// A scripted overload attempt: 1300 kg held with the end arm folded in
+// (33 % of the chart), then the jib driven outwards at full command for
+// 8 s (at full reach the chart rates 964 kg). With the limiter the jib is
+// stopped at about 3 m; without it, it runs to its end stop. The limiter
+// brings the crane to rest near 100 %, but the stop excites the loaded
+// booms' lightly damped oscillation on the trapped oil (the lift pressure
+// rings between about 4 and 22 MPa for seconds), which the limiter's 1 s
+// filter does not remove: rcl_util peaks near 1.19 (docs/safety.md). The
+// target of 1.02 is not met; this test holds what is: the jib stopped
+// well short of its travel and a lower peak than without the limiter.
+static double overload_attempt(const model* m, bool off, double* x2_end) {
+    sim_opts o = sim_default_opts();
+    o.mechanics = SIM_ODE;
+    o.world = CRANESIM_ASSETS "/worlds/validation.json";
+    o.rcl = !off;
+    const double q0[2] = {110 * M_PI / 180, -120 * M_PI / 180};
+    char err[300];
+    engine* e = engine_create(m, &o, q0, 0, 1300, err, sizeof err);
+    CHECK(e != NULL, "%s", err);
+    if (!e) return NAN;
+    double umax = 0, row[SIM_NCOL];
+    for (int i = 0; i < 8000; ++i) {
+        const double u[3] = {0, 1, 0}; // jib out, full command
+        engine_set_commands(e, u);
+        if (engine_advance(e, 1e-3)) {
+            CHECK(0, "%s", engine_error(e));
+            break;
+        }
+        engine_row(e, row);
+        umax = fmax(umax, row[COL_RCL_UTIL]);
+    }
+    *x2_end = row[COL_X2];
+    engine_destroy(e);
+    return umax;
+}
+
+static void test_limiter_overload_attempt(void) {
+    model* m = load(NULL, 0);
+    if (!m) return;
+    double x_on, x_off;
+    const double on = overload_attempt(m, false, &x_on), off = overload_attempt(m, true, &x_off);
+    printf("  overload attempt: max rcl_util %.3f with the limiter (jib stroke %.3f m), %.3f without (%.3f m)\n", on,
+           x_on, off, x_off);
+    CHECK(x_on < x_off - 0.15, "the jib was not stopped: stroke %.3f m with the limiter, %.3f m without", x_on, x_off);
+    CHECK(on < off, "with the limiter rcl_util reached %.3f, without %.3f", on, off);
+    CHECK(on < 1.25, "with the limiter rcl_util reached %.3f", on);
+    CHECK(off > 1.25, "without the limiter the attempt reached only %.3f: not an overload", off);
+    model_free(m);
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_hydraulic_limit_matches_hand_calculation);
+    RUN_TEST(test_stability_limit_matches_hand_calculation);
+    RUN_TEST(test_limiter_filter);
+    RUN_TEST(test_limiter_slew_towards_weaker_sector);
+    RUN_TEST(test_limiter_overload_attempt);
+    RUN_TEST(test_chart_points_by_simulation);
+    TEST_MAIN_END();
+}
