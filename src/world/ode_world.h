@@ -94,7 +94,26 @@ typedef struct ode_world_state {
     int attached;             ///< index of the load on the hook, or -1
     int end_stop;             ///< bit k: cylinder k at an end stop (hinge limit active or hydraulic stop)
     int relief_open;          ///< number of relief valves passing flow
+    // Sandbox: the truck's supports (the outrigger pads; the wheels when the
+    // outriggers are in), index 2 a + s: a = 0 front, 1 rear; s = 0 left
+    // (+y of the truck), 1 right. Zeros in the validation world.
+    double pad_F[4];          ///< vertical ground reaction on each support over the last step [N]
+    int pad_lifted;           ///< bit i: support i carries less than ODE_PAD_LIFT_FRAC of the weight
+                              ///< (0 before the first step)
+    /// Static stability margin of the current pose: the restoring over the
+    /// tipping moment of the weights of truck, crane, rope, hook and the
+    /// hooked load about the governing tipping line (the support polygon's
+    /// edge with the least ratio). Below 1 the truck tips over that line.
+    /// ODE_STAB_MARGIN_MAX when nothing is outboard of any line.
+    double stab_margin;
 } ode_world_state;
+
+/// A support counts as lifted off below this fraction of the total weight
+/// it and the others carry (1 %: about 0.9 kN on the shipped sandbox, where
+/// each pad carries about 23 kN at rest).
+#define ODE_PAD_LIFT_FRAC 0.01
+/// The stability margin reported when no weight is outboard of a tipping line.
+#define ODE_STAB_MARGIN_MAX 10.0
 
 /// Build a world. mech: crane mechanics (copied). hydraulics: the model's
 /// "hydraulics" JSON section (read, not kept); may be NULL when
