@@ -59,6 +59,7 @@ struct drive_session {
     input* in;
     panel* pn;
     world_snapshot* snap; // large: heap
+    int pad_lifted;       // the supports lifted at the last snapshot (render_pad_event)
     drive_param* param;  // the panel's entries (build_params)
     int nparam, capparam;
     int* pid;            // their panel ids
@@ -805,6 +806,8 @@ static void session_row(drive_session* s, double* row) {
 static void take_snapshot(drive_session* s) {
     engine_snapshot(s->l, s->snap);
     s->snap->t += s->t_base;
+    char note[192];
+    if (render_pad_event(s->snap, &s->pad_lifted, note, sizeof note)) fprintf(stderr, "cranesim drive: %s\n", note);
 }
 
 drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz,
@@ -1078,7 +1081,9 @@ int drive_session_tick(drive_session* s, double wall) {
         if (s->o.scripted) {
             engine_play(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, u, NULL, NULL);
         } else if (cmd.hook_toggle) {
-            engine_hook(s->l, !engine_attached(s->l));
+            const int want = !engine_attached(s->l); // what H asks; a failed attach is said on the console too
+            if (engine_hook_report(s->l, want, s->status, sizeof s->status) < 0 && want)
+                fprintf(stderr, "cranesim drive: %s\n", s->status);
         }
         engine_set_commands(s->l, u);
         ++s->st.input_samples;

@@ -1,6 +1,8 @@
 // metrics.c: a run's metrics from its rows (metrics.h).
 #include "metrics.h"
 
+#include "ode_world.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -25,6 +27,9 @@ static const metric_def k_metric[MET_COUNT] = {
     // so the metric is there only when the run has the slew channels.
     [MET_STOP_SLEW] = {"end_stop_hits_slew", "count", COL_X3},
     [MET_MAX_TILT] = {"max_truck_tilt", "rad", COL_TRUCK_TILT},
+    [MET_MIN_PAD_F] = {"min_pad_force", "N", COL_PAD_F1},
+    [MET_MIN_STAB_MARGIN] = {"min_stab_margin", "-", COL_STAB_MARGIN},
+    [MET_PAD_LIFTOFFS] = {"pad_liftoffs", "count", COL_PAD_F1},
 };
 
 bool metrics_present(metric_id id, int ncol) { return id >= 0 && id < MET_COUNT && k_metric[id].col < ncol; }
@@ -64,6 +69,24 @@ void metrics_row(run_metrics* m, const double* row) {
     for (int k = 0; k < 3; ++k)
         if (m->present[MET_STOP_LIFT + k] && (rising >> k & 1)) m->value[MET_STOP_LIFT + k] += 1;
     if (m->present[MET_MAX_TILT]) m->value[MET_MAX_TILT] = fmax(m->value[MET_MAX_TILT], fabs(row[COL_TRUCK_TILT]));
+    if (m->present[MET_MIN_PAD_F] && row[COL_T] >= ODE_SUPPORT_SETTLE_T - 1e-12) {
+        double fmin_ = INFINITY, sum = 0;
+        for (int i = 0; i < 4; ++i) {
+            fmin_ = fmin(fmin_, row[COL_PAD_F1 + i]);
+            sum += row[COL_PAD_F1 + i];
+        }
+        if (sum > 0) m->pads_seen = true;
+        int lifted = 0;
+        for (int i = 0; i < 4; ++i)
+            if (row[COL_PAD_F1 + i] < ODE_PAD_LIFT_FRAC * sum) lifted |= 1 << i;
+        const int rising_pads = lifted & ~(m->pad_rows > 0 ? m->pad_lift_prev : 0);
+        for (int i = 0; i < 4; ++i) m->value[MET_PAD_LIFTOFFS] += rising_pads >> i & 1;
+        const double margin = row[COL_STAB_MARGIN];
+        m->value[MET_MIN_PAD_F] = m->pad_rows ? fmin(m->value[MET_MIN_PAD_F], fmin_) : fmin_;
+        m->value[MET_MIN_STAB_MARGIN] = m->pad_rows ? fmin(m->value[MET_MIN_STAB_MARGIN], margin) : margin;
+        m->pad_lift_prev = lifted;
+        ++m->pad_rows;
+    }
     m->stop_prev = stops;
     m->t_prev = row[COL_T];
     ++m->rows;
@@ -89,6 +112,9 @@ void metrics_print(const run_metrics* m, FILE* f) {
     if (m->present[MET_PEAK_P3A])
         fprintf(f, ", slew p3A %.2f, p3B %.2f MPa", m->value[MET_PEAK_P3A] * 1e-6, m->value[MET_PEAK_P3B] * 1e-6);
     if (m->present[MET_MAX_TILT]) fprintf(f, "; max truck tilt %.3f deg", m->value[MET_MAX_TILT] * 57.29577951308232);
+    if (m->pads_seen)
+        fprintf(f, "; min pad force %.2f kN, min stability margin %.3f, pad lift-offs %.0f",
+                m->value[MET_MIN_PAD_F] * 1e-3, m->value[MET_MIN_STAB_MARGIN], m->value[MET_PAD_LIFTOFFS]);
     fprintf(f, "\n");
 }
 

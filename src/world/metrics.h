@@ -24,6 +24,11 @@ typedef enum metric_id {
     MET_RELIEF_TIME,     ///< time with any relief valve passing flow [s], at row resolution
     MET_STOP_LIFT, MET_STOP_JIB, MET_STOP_SLEW, ///< end-stop hits (entries into a stop) [count]
     MET_MAX_TILT,        ///< largest truck tilt from vertical [rad] (ode)
+    // The truck's supports (ode; zeros in the validation world), over the
+    // rows from ODE_SUPPORT_SETTLE_T on (the truck lands on its pads first).
+    MET_MIN_PAD_F,       ///< smallest vertical reaction on any support [N]
+    MET_MIN_STAB_MARGIN, ///< smallest stability margin [-]
+    MET_PAD_LIFTOFFS,    ///< supports lifting off: entries below ODE_PAD_LIFT_FRAC of the pads' sum [count]
     // Energy in and losses come from the energy accounting: one id each
     // here, their unit and name in metrics.c's table, their value set by
     // that module into run_metrics.value[] with present[] raised.
@@ -38,6 +43,9 @@ typedef struct run_metrics {
     long rows;
     double t_prev;              ///< the previous row's time [s]
     int stop_prev;              ///< the previous row's end_stop bits
+    long pad_rows;              ///< rows that counted for the support metrics
+    int pad_lift_prev;          ///< the previous such row's lifted supports (bits)
+    bool pads_seen;             ///< a row had support forces (a truck on the ground)
 } run_metrics;
 
 /// Start the metrics of a run that writes ncol channels (sim_ncol).

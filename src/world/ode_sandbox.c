@@ -281,6 +281,28 @@ void ow_hook_point(const ode_world* w, double p[3], double v[3]) {
     }
 }
 
+// Distance [m] from the hook's attach point hp to the top centre of load i.
+static double load_top_dist(const ode_world* w, int i, const double hp[3]) {
+    dVector3 top;
+    dBodyGetRelPointPos(w->load[i], 0, 0, 0.5 * w->desc.load[i].size[2], top);
+    return sqrt((top[0] - hp[0]) * (top[0] - hp[0]) + (top[1] - hp[1]) * (top[1] - hp[1]) +
+                (top[2] - hp[2]) * (top[2] - hp[2]));
+}
+
+int ode_world_nearest_load(const ode_world* w, double* dist, double* reach) {
+    if (reach) *reach = w->desc.hook.reach;
+    *dist = INFINITY;
+    if (w->dead || w->kind != WORLD_SANDBOX || w->nload == 0) return -1;
+    double hp[3];
+    ow_hook_point(w, hp, NULL);
+    int best = -1;
+    for (int i = 0; i < w->nload; ++i) {
+        const double d = load_top_dist(w, i, hp);
+        if (d < *dist) *dist = d, best = i;
+    }
+    return best;
+}
+
 int ow_attach(ode_world* w, int attach) {
     if (!attach) {
         if (w->attached >= 0) {
@@ -587,7 +609,7 @@ void ow_collide(ode_world* w) {
 }
 
 void ow_support_forces(ode_world* w) {
-    for (int i = 0; i < OW_NSUPPORT; ++i) w->support_F[i] = 0;
+    double F[OW_NSUPPORT] = {0};
     for (int f = 0; f < w->nsupport_fb; ++f) {
         // ODE reports f1 for the joint's first body and f2 for its second;
         // against the static world the truck is always the first (ODE moves
@@ -596,8 +618,10 @@ void ow_support_forces(ode_world* w) {
         const dBodyID b0 = dJointGetBody(j, 0), b1 = dJointGetBody(j, 1);
         const dJointFeedback* fb = &w->support_fb[f];
         const double fz = (!b0 || !b1 || b0 == w->truck) ? fb->f1[2] : fb->f2[2];
-        w->support_F[w->support_fb_of[f]] += fz;
+        F[w->support_fb_of[f]] += fz;
     }
+    const double a = 1.0 - exp(-w->opt.dt_ode / OW_SUPPORT_TAU);
+    for (int i = 0; i < OW_NSUPPORT; ++i) w->support_F[i] += a * (F[i] - w->support_F[i]);
 }
 
 // Weight [N] and position of body b, into the running moments about the
@@ -686,6 +710,19 @@ void ow_sandbox_snapshot(const ode_world* w, world_snapshot* s) {
     s->truck_tilt = ow_truck_tilt(w);
     s->tipping = s->truck_tilt > 5.0 * M_PI / 180.0;
     s->collision = (uint8_t)w->crane_contact;
+    s->npad = w->nsupport;
+    if (w->nsupport) {
+        double weight = 0;
+        s->stab_margin = ow_stab_margin(w, &weight);
+        s->pad_lifted = 0;
+        for (int i = 0; i < w->nsupport; ++i) {
+            dVector3 q;
+            dBodyGetRelPointPos(w->truck, w->support_pt[i][0], w->support_pt[i][1], w->support_pt[i][2], q);
+            s->pad_pos[i][0] = q[0], s->pad_pos[i][1] = q[1], s->pad_pos[i][2] = q[2];
+            s->pad_F[i] = w->support_F[i];
+            if (w->t >= ODE_SUPPORT_SETTLE_T - 1e-12 && w->support_F[i] < ODE_PAD_LIFT_FRAC * weight) s->pad_lifted |= 1 << i;
+        }
+    }
 
     // The slew rack drawn as a cylinder lying across the truck at the column
     // foot, its rod end moving with the rack travel.

@@ -97,9 +97,9 @@ typedef struct ode_world_state {
     // Sandbox: the truck's supports (the outrigger pads; the wheels when the
     // outriggers are in), index 2 a + s: a = 0 front, 1 rear; s = 0 left
     // (+y of the truck), 1 right. Zeros in the validation world.
-    double pad_F[4];          ///< vertical ground reaction on each support over the last step [N]
+    double pad_F[4];          ///< vertical ground reaction on each support [N], low-passed over about 5 ms
     int pad_lifted;           ///< bit i: support i carries less than ODE_PAD_LIFT_FRAC of the weight
-                              ///< (0 before the first step)
+                              ///< (never before ODE_SUPPORT_SETTLE_T)
     /// Static stability margin of the current pose: the restoring over the
     /// tipping moment of the weights of truck, crane, rope, hook and the
     /// hooked load about the governing tipping line (the support polygon's
@@ -112,6 +112,10 @@ typedef struct ode_world_state {
 /// it and the others carry (1 %: about 0.9 kN on the shipped sandbox, where
 /// each pad carries about 23 kN at rest).
 #define ODE_PAD_LIFT_FRAC 0.01
+/// The truck starts 0.5 mm above the ground, lands within 10 ms and stops
+/// rocking on its pads within 60 ms (the sandbox): no support counts as
+/// lifted off before this time [s] (metrics likewise).
+#define ODE_SUPPORT_SETTLE_T 0.1
 /// The stability margin reported when no weight is outboard of a tipping line.
 #define ODE_STAB_MARGIN_MAX 10.0
 
@@ -131,6 +135,10 @@ void ode_world_set_commands(ode_world* w, const double u_cmd[ODE_NACT]);
 /// hook's attach point (no-op if none or already attached); 0: release.
 /// Returns the load index attached, or -1.
 int ode_world_hook(ode_world* w, int attach);
+/// The load nearest the hook: its index (-1 when the world has none) and
+/// the distance [m] from the hook's attach point to its top centre, the
+/// distance ode_world_hook compares with hook.reach [m] (*reach, may be NULL).
+int ode_world_nearest_load(const ode_world* w, double* dist, double* reach);
 
 /// Advance by dt [s] (rounded to a whole number of ODE steps, at least one).
 /// Returns 0, or -1 when a body or hydraulic state became non-finite; then

@@ -30,6 +30,13 @@
 /// Contact joints on the supports whose forces ODE reports per step
 /// (dJointSetFeedback); a sphere on the heightfield makes one or two.
 #define OW_MAX_SUPPORT_FB 64
+/// Time constant [s] of the first-order filter on the support reactions.
+/// ODE's contact solver now and then hands one step's load to fewer pads
+/// (the pick-and-place: three pads at 0 N for one 1 ms step at 25.409 s, the
+/// next step catching the truck with 5 % more); unfiltered, every such step
+/// read as a lift-off. 5 ms lets one such step move a reading by 18 %, and a
+/// real lift-off reads below 1 % of the load within 25 ms.
+#define OW_SUPPORT_TAU 5e-3
 
 /// Collision categories (bits); which pairs collide is a table in ode_sandbox.c.
 enum {
@@ -158,7 +165,7 @@ struct ode_world {
     // Ground reactions on the truck's supports (ode_sandbox.c, ow_support_forces).
     int nsupport;                            ///< OW_NSUPPORT, or 0 (validation world)
     double support_pt[OW_NSUPPORT][3];       ///< contact point under each support, truck body coordinates [m]
-    double support_F[OW_NSUPPORT];           ///< vertical reaction on each over the last step [N]
+    double support_F[OW_NSUPPORT];           ///< vertical reaction on each, low-passed (OW_SUPPORT_TAU) [N]
     int nsupport_fb;                         ///< feedback slots used in this step
     dJointFeedback support_fb[OW_MAX_SUPPORT_FB];
     dJointID support_fb_joint[OW_MAX_SUPPORT_FB];

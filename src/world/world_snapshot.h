@@ -110,6 +110,14 @@ typedef struct world_snapshot {
     /// The snapshot cylinder each open relief guards (index into cyl[]), or -1
     /// (a pump-line relief), and the chamber: 0 = A, 1 = B.
     int relief_cyl[WORLD_SNAP_MAX_RELIEFS], relief_port[WORLD_SNAP_MAX_RELIEFS];
+    /// The truck's supports (outrigger pads, or wheels with the outriggers
+    /// in): 0 without a truck, else 4, front-left, front-right, rear-left,
+    /// rear-right.
+    int npad;
+    double pad_F[4];        ///< vertical ground reaction [N]
+    double pad_pos[4][3];   ///< contact point under each, world [m]
+    int pad_lifted;         ///< bit i: support i lifted off (below 1 % of the weight)
+    double stab_margin;     ///< restoring over tipping moment, governing tipping line [-]
 } world_snapshot;
 
 #ifdef __cplusplus
