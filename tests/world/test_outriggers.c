@@ -6,6 +6,7 @@
 // unloads the far pads, drops the margin below 1 and tips the truck.
 #include "check.h"
 
+#include "metrics.h"
 #include "model.h"
 #include "ode_world.h"
 
@@ -266,6 +267,35 @@ static void test_validation_zeros(void) {
     world_desc_free(&d);
 }
 
+// The metrics from rows by hand: rows before ODE_SUPPORT_SETTLE_T do not
+// count; the smallest pad force and margin; a lift-off is a pad entering
+// "below 1 % of the pads' sum", counted once while it stays there.
+static void test_metrics(void) {
+    run_metrics m;
+    metrics_init(&m, SIM_NCOL);
+    CHECK(m.present[MET_MIN_PAD_F] && m.present[MET_MIN_STAB_MARGIN] && m.present[MET_PAD_LIFTOFFS], "present");
+    CHECK(!metrics_present(MET_MIN_PAD_F, SIM_NCOL_BASE), "absent from lagrange rows");
+    static const double rows[][6] = {
+        // t, pad_F1..4 [N], stab_margin
+        {0.0, 0, 0, 0, 0, 10},          // landing: not counted
+        {0.2, 1e4, 2e4, 3e4, 4e4, 2.0}, // min 10 kN
+        {0.3, 5e4, 2e4, 3e4, 50, 1.5},  // pad 4 at 50 N < 1 % of 100 kN: lift-off 1
+        {0.4, 5e4, 2e4, 3e4, 60, 1.4},  // still lifted: no new event
+        {0.5, 5e4, 2e4, 3e4, 5e3, 1.8}, // down again
+        {0.6, 80, 2e4, 3e4, 40, 1.2},   // pads 1 and 4 lift: 3 in all
+    };
+    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; ++i) {
+        double r[SIM_NCOL] = {0};
+        r[COL_T] = rows[i][0];
+        for (int k = 0; k < 4; ++k) r[COL_PAD_F1 + k] = rows[i][1 + k];
+        r[COL_STAB_MARGIN] = rows[i][5];
+        metrics_row(&m, r);
+    }
+    CHECK_NEAR(m.value[MET_MIN_PAD_F], 40, 0);
+    CHECK_NEAR(m.value[MET_MIN_STAB_MARGIN], 1.2, 0);
+    CHECK_NEAR(m.value[MET_PAD_LIFTOFFS], 3, 0);
+}
+
 int main(int argc, char** argv) {
     char err[512];
     g_model = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
@@ -276,6 +306,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_weight_at_rest);
     RUN_TEST(test_side_tipping);
     RUN_TEST(test_validation_zeros);
+    RUN_TEST(test_metrics);
     model_free(g_model);
     TEST_MAIN_END();
 }
