@@ -285,7 +285,8 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     if (s->npad) {
         char line[160];
         int k = snprintf(line, sizeof line, "pads kN");
-        for (int i = 0; i < 4; ++i) k += snprintf(line + k, sizeof line - (size_t)k, "  %s %.1f", render_pad_name(i), s->pad_F[i] * 1e-3);
+        for (int i = 0; i < 4; ++i)
+            k += snprintf(line + k, sizeof line - (size_t)k, "  %s %.1f", render_pad_name(i), s->pad_F[i] * 1e-3);
         pad_margin_text(s, line + k, sizeof line - (size_t)k);
         w = fmaxf(w, render_hud_text_width(line, sc) + 12);
     }
@@ -410,7 +411,8 @@ int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDE
     if (s->npad && s->pad_lifted && n < max - 1) {
         int k = snprintf(w[n], RENDER_WARN_LEN, "PAD LIFTED OFF:");
         for (int i = 0; i < 4; ++i)
-            if (s->pad_lifted >> i & 1) k += snprintf(w[n] + k, (size_t)(RENDER_WARN_LEN - k), " %s", render_pad_name(i));
+            if (s->pad_lifted >> i & 1)
+                k += snprintf(w[n] + k, (size_t)(RENDER_WARN_LEN - k), " %s", render_pad_name(i));
         snprintf(w[n] + k, (size_t)(RENDER_WARN_LEN - k), " (margin %.2f)", s->stab_margin);
         ++n;
     }

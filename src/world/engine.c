@@ -196,9 +196,9 @@ int engine_hook_report(engine* e, int attach, char* msg, size_t n) {
         snprintf(msg, n, "H: this world has no hook (the sandbox has one)");
         return -1;
     }
-    const int before = engine_attached(e) ? 0 : -1;
-    // The load on the hook before a release, by the world's own order
-    // (ode_world_state.attached): asked for its name before it goes.
+    const bool had = engine_attached(e);
+    // The nearest load as the hook stands before it acts: what a failed
+    // attach names.
     double dist = INFINITY, reach = 0;
     const int near = e->ops->nearest_load ? e->ops->nearest_load(e, &dist, &reach) : -1;
     const int got = engine_hook(e, attach);
@@ -213,7 +213,7 @@ int engine_hook_report(engine* e, int attach, char* msg, size_t n) {
                      reach);
         else snprintf(msg, n, "H: no load in reach of the hook (this world has no loads)");
     } else {
-        snprintf(msg, n, before == 0 ? "released the load" : "nothing on the hook to release");
+        snprintf(msg, n, had ? "released the load" : "nothing on the hook to release");
     }
     return got;
 }

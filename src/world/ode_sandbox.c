@@ -624,6 +624,14 @@ void ow_support_forces(ode_world* w) {
     for (int i = 0; i < OW_NSUPPORT; ++i) w->support_F[i] += a * (F[i] - w->support_F[i]);
 }
 
+int ow_supports_lifted(const ode_world* w, double weight) {
+    int bits = 0;
+    if (w->t < ODE_SUPPORT_SETTLE_T - 1e-12) return 0;
+    for (int i = 0; i < w->nsupport; ++i)
+        if (w->support_F[i] < ODE_PAD_LIFT_FRAC * weight) bits |= 1 << i;
+    return bits;
+}
+
 // Weight [N] and position of body b, into the running moments about the
 // tipping line through a with horizontal inward normal n: the part inboard
 // restores, the part outboard tips [N m].
@@ -646,7 +654,8 @@ double ow_stab_margin(const ode_world* w, double* weight) {
     double P[OW_NSUPPORT][3], c[2] = {0, 0};
     for (int i = 0; i < OW_NSUPPORT; ++i) {
         dVector3 q;
-        dBodyGetRelPointPos(w->truck, w->support_pt[ring[i]][0], w->support_pt[ring[i]][1], w->support_pt[ring[i]][2], q);
+        const double* sp = w->support_pt[ring[i]];
+        dBodyGetRelPointPos(w->truck, sp[0], sp[1], sp[2], q);
         P[i][0] = q[0], P[i][1] = q[1], P[i][2] = q[2];
         c[0] += 0.25 * q[0], c[1] += 0.25 * q[1];
     }
@@ -714,14 +723,13 @@ void ow_sandbox_snapshot(const ode_world* w, world_snapshot* s) {
     if (w->nsupport) {
         double weight = 0;
         s->stab_margin = ow_stab_margin(w, &weight);
-        s->pad_lifted = 0;
         for (int i = 0; i < w->nsupport; ++i) {
             dVector3 q;
             dBodyGetRelPointPos(w->truck, w->support_pt[i][0], w->support_pt[i][1], w->support_pt[i][2], q);
             s->pad_pos[i][0] = q[0], s->pad_pos[i][1] = q[1], s->pad_pos[i][2] = q[2];
             s->pad_F[i] = w->support_F[i];
-            if (w->t >= ODE_SUPPORT_SETTLE_T - 1e-12 && w->support_F[i] < ODE_PAD_LIFT_FRAC * weight) s->pad_lifted |= 1 << i;
         }
+        s->pad_lifted = ow_supports_lifted(w, weight);
     }
 
     // The slew rack drawn as a cylinder lying across the truck at the column

@@ -918,10 +918,8 @@ static int get_state_ode(ode_world* w, void* arg) {
     if (w->nsupport) {
         double weight = 0;
         s->stab_margin = ow_stab_margin(w, &weight);
-        for (int i = 0; i < w->nsupport; ++i) {
-            s->pad_F[i] = w->support_F[i];
-            if (w->t >= ODE_SUPPORT_SETTLE_T - 1e-12 && w->support_F[i] < ODE_PAD_LIFT_FRAC * weight) s->pad_lifted |= 1 << i;
-        }
+        for (int i = 0; i < w->nsupport; ++i) s->pad_F[i] = w->support_F[i];
+        s->pad_lifted = ow_supports_lifted(w, weight);
     }
     return 0;
 }

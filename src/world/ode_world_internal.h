@@ -234,6 +234,9 @@ void ow_support_forces(ode_world* w);
 /// The static stability margin of the current pose (ode_world.h,
 /// ode_world_state.stab_margin) and the total weight the supports carry [N].
 double ow_stab_margin(const ode_world* w, double* weight);
+/// Bits of the supports lifted off now (ode_world_state.pad_lifted), weight
+/// the total the supports carry [N].
+int ow_supports_lifted(const ode_world* w, double weight);
 void ow_hook_point(const ode_world* w, double p[3], double v[3]);
 int ow_attach(ode_world* w, int attach);
 
