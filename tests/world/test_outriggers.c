@@ -184,9 +184,6 @@ static side_run run_side(double mass, const double q0[2]) {
             out.far_end += 0.01 * (s.pad_F[0] + s.pad_F[2]);
             out.sum_end += 0.01 * (s.pad_F[0] + s.pad_F[1] + s.pad_F[2] + s.pad_F[3]);
         }
-        if (getenv("OUTR_TRACE") && i % 10 == 0)
-            printf("    t %.2f pads %.0f %.0f %.0f %.0f margin %.3f tilt %.3f deg\n", i * 0.01, s.pad_F[0], s.pad_F[1],
-                   s.pad_F[2], s.pad_F[3], s.stab_margin, s.truck_tilt / DEG);
         if (i > 200) out.far_min = fmin(out.far_min, fmin(s.pad_F[0], s.pad_F[2]));
         if ((s.pad_lifted & 5) == 5) out.lifted_far = 1;
         out.tilt = fmax(out.tilt, s.truck_tilt);
