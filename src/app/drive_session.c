@@ -60,6 +60,7 @@ struct drive_session {
     input* in;
     panel* pn;
     world_snapshot* snap; // large: heap
+    int pad_lifted;       // the supports lifted at the last snapshot (render_pad_event)
     drive_param* param;  // the panel's entries (build_params)
     int nparam, capparam;
     int* pid;            // their panel ids
@@ -827,6 +828,8 @@ static void session_row(drive_session* s, double* row) {
 static void take_snapshot(drive_session* s) {
     engine_snapshot(s->l, s->snap);
     s->snap->t += s->t_base;
+    char note[192];
+    if (render_pad_event(s->snap, &s->pad_lifted, note, sizeof note)) fprintf(stderr, "cranesim drive: %s\n", note);
 }
 
 drive_session* drive_session_create(const app_common* c, const drive_opts* o, char* err, size_t errsz,
@@ -1157,9 +1160,10 @@ int drive_session_tick(drive_session* s, double wall) {
         if (s->o.scripted) {
             engine_play(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, u, s->sw.f ? session_hook : NULL, s);
         } else if (cmd.hook_toggle) {
-            const int attach = !engine_attached(s->l);
-            session_writer_hook(&s->sw, attach);
-            engine_hook(s->l, attach);
+            const int want = !engine_attached(s->l); // what H asks; a failed attach is said on the console too
+            session_writer_hook(&s->sw, want);
+            if (engine_hook_report(s->l, want, s->status, sizeof s->status) < 0 && want)
+                fprintf(stderr, "cranesim drive: %s\n", s->status);
         }
         engine_set_commands(s->l, u);
         ++s->st.input_samples;

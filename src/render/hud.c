@@ -266,16 +266,30 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
     }
 }
 
+// "   margin 1.17", or "   margin >= 10" at the world's cap (nothing outboard).
+static void pad_margin_text(const world_snapshot* s, char* buf, size_t n) {
+    if (s->stab_margin >= 10.0) snprintf(buf, n, "   margin >= 10");
+    else snprintf(buf, n, "   margin %.2f", s->stab_margin);
+}
+
 /// Readouts table, top left. Units in every row header.
 static float draw_readouts(render* r, const world_snapshot* s) {
     render_hud* h = &r->hud;
     const float sc = 1.5f, lh = 14.0f, col0 = 96.0f, colw = 84.0f;
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
-    const int nrows = 14 + r->nreadout;
+    const int nrows = 14 + r->nreadout + (s->npad ? 1 : 0);
     float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
     // The status line ("[keys: panel - Enter/Esc gives them back]") is the
     // widest text; the box grows to hold it rather than cut it at its edge.
     if (r->status[0]) w = fmaxf(w, render_hud_text_width(r->status, sc) + 12);
+    if (s->npad) {
+        char line[160];
+        int k = snprintf(line, sizeof line, "pads kN");
+        for (int i = 0; i < 4; ++i)
+            k += snprintf(line + k, sizeof line - (size_t)k, "  %s %.1f", render_pad_name(i), s->pad_F[i] * 1e-3);
+        pad_margin_text(s, line + k, sizeof line - (size_t)k);
+        w = fmaxf(w, render_hud_text_width(line, sc) + 12);
+    }
     render_hud_rect(h, x - 6, y - 6, w, lh * (float)nrows + 10, k_panel);
     h->readouts_rect[0] = x - 6, h->readouts_rect[1] = y - 6, h->readouts_rect[2] = w,
     h->readouts_rect[3] = lh * (float)nrows + 10;
@@ -323,6 +337,20 @@ static float draw_readouts(render* r, const world_snapshot* s) {
              s->truck_tilt * 180.0 / M_PI, s->p_supply * 1e-6);
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh;
+    if (s->npad) {
+        // The supports' ground reactions [kN], a lifted one in amber, and the
+        // stability margin (amber below 1.25, a usual stability factor; red
+        // text is kept for the warnings).
+        float px = x;
+        px += render_hud_text(h, px, y, sc, k_dim, "pads kN");
+        for (int i = 0; i < s->npad && i < 4; ++i) {
+            snprintf(buf, sizeof buf, "  %s %.1f", render_pad_name(i), s->pad_F[i] * 1e-3);
+            px += render_hud_text(h, px, y, sc, (s->pad_lifted >> i & 1) ? k_amber : k_white, buf);
+        }
+        pad_margin_text(s, buf, sizeof buf);
+        render_hud_text(h, px, y, sc, s->stab_margin < 1.25 ? k_amber : k_white, buf);
+        y += lh;
+    }
     // The app's channel readouts (render_set_readouts): name, value, unit
     // as its channel list gives them.
     for (int i = 0; i < r->nreadout; ++i) {
@@ -335,6 +363,23 @@ static float draw_readouts(render* r, const world_snapshot* s) {
         y += lh;
     }
     return y;
+}
+
+const char* render_pad_name(int i) {
+    static const char* const k_name[4] = {"FL", "FR", "RL", "RR"};
+    return i >= 0 && i < 4 ? k_name[i] : "?";
+}
+
+int render_pad_event(const world_snapshot* s, int* prev, char* buf, size_t n) {
+    const int now = s->npad ? s->pad_lifted : 0, rising = now & ~*prev;
+    *prev = now;
+    if (!rising) return 0;
+    int k = snprintf(buf, n, "t = %.2f s: outrigger pad lifted off:", s->t);
+    for (int i = 0; i < 4 && k > 0 && (size_t)k < n; ++i)
+        if (rising >> i & 1)
+            k += snprintf(buf + k, n - (size_t)k, " %s (%.2f kN)", render_pad_name(i), s->pad_F[i] * 1e-3);
+    if (k > 0 && (size_t)k < n) snprintf(buf + k, n - (size_t)k, "; stability margin %.2f", s->stab_margin);
+    return 1;
 }
 
 int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDER_WARN_LEN], int max) {
@@ -367,6 +412,16 @@ int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDE
     if (s->tipping && n < max - 1)
         snprintf(w[n++], RENDER_WARN_LEN, "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
     if (s->collision && n < max - 1) snprintf(w[n++], RENDER_WARN_LEN, "COLLISION");
+    if (s->npad && s->pad_lifted && n < max - 1) {
+        int k = snprintf(w[n], RENDER_WARN_LEN, "PAD LIFTED OFF:");
+        for (int i = 0; i < 4; ++i)
+            if (s->pad_lifted >> i & 1)
+                k += snprintf(w[n] + k, (size_t)(RENDER_WARN_LEN - k), " %s", render_pad_name(i));
+        snprintf(w[n] + k, (size_t)(RENDER_WARN_LEN - k), " (margin %.2f)", s->stab_margin);
+        ++n;
+    }
+    if (s->npad && s->stab_margin < 1 && !s->tipping && n < max - 1)
+        snprintf(w[n++], RENDER_WARN_LEN, "UNSTABLE: margin %.2f < 1", s->stab_margin);
     // Real time: the app's missed deadlines, or a measured factor below 1.
     bool slow = r->missed_deadlines > 0 || (s->rt_factor > 0 && s->rt_factor < 0.97);
     if (slow && n < max) snprintf(w[n++], RENDER_WARN_LEN, "CANNOT KEEP UP WITH REAL TIME (%.2fx)", s->rt_factor);

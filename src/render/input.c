@@ -19,6 +19,7 @@ struct input {
     Uint32 own_subsystems; ///< SDL subsystems we started, to quit them again
     bool key_pos[INPUT_AXIS_COUNT], key_neg[INPUT_AXIS_COUNT];
     double kb[INPUT_AXIS_COUNT]; ///< ramped keyboard contribution
+    bool shift[2];               ///< left, right Shift held: fine mode (INPUT_FINE_SCALE)
     // Edges collected between polls.
     bool hook, pause, reset, screenshot, quit, camera_next;
     int camera_preset;
@@ -329,6 +330,12 @@ static void press(input* in, int button) {
 /// Keys: arrows up/down = lift, W/S = jib, arrows left/right (or A/D) = slew.
 static void key_axis(input* in, SDL_Scancode sc, bool down) {
     switch (sc) {
+    case SDL_SCANCODE_LSHIFT:
+        in->shift[0] = down;
+        break;
+    case SDL_SCANCODE_RSHIFT:
+        in->shift[1] = down;
+        break;
     case SDL_SCANCODE_UP:
         in->key_pos[INPUT_LIFT] = down;
         break;
@@ -420,6 +427,7 @@ bool input_handle_event(input* in, const SDL_Event* ev) {
         if (ev->window.event != SDL_WINDOWEVENT_FOCUS_LOST) return false;
         memset(in->key_pos, 0, sizeof in->key_pos);
         memset(in->key_neg, 0, sizeof in->key_neg);
+        memset(in->shift, 0, sizeof in->shift);
         return true;
     case SDL_JOYDEVICEADDED:
         // Game controllers also send CONTROLLERDEVICEADDED; this one covers both.
@@ -468,8 +476,13 @@ static double device_axis(const input* in, int a) {
 void input_poll(input* in, double dt, input_command* out) {
     memset(out, 0, sizeof *out);
     double* dst[INPUT_AXIS_COUNT] = {&out->lift, &out->jib, &out->slew};
+    // Fine mode: on/off keys open a valve fully, which swings the load by
+    // about a metre; with Shift held they open it to INPUT_FINE_SCALE. The
+    // ramp keeps its rate, so a key reaches the smaller opening sooner.
+    out->fine = in->shift[0] || in->shift[1];
+    const double key_gain = out->fine ? INPUT_FINE_SCALE : 1.0;
     for (int a = 0; a < INPUT_AXIS_COUNT; ++a) {
-        double target = (in->key_pos[a] ? 1.0 : 0.0) - (in->key_neg[a] ? 1.0 : 0.0);
+        double target = key_gain * ((in->key_pos[a] ? 1.0 : 0.0) - (in->key_neg[a] ? 1.0 : 0.0));
         // Rate-limit the keyboard so a key opens the valve over keyboard_ramp.
         double rate = in->map.keyboard_ramp > 0 ? dt / in->map.keyboard_ramp : 2.0;
         double d = target - in->kb[a];

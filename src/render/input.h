@@ -48,7 +48,11 @@ typedef struct input_command {
     bool camera_next;    ///< cycle camera presets
     int camera_preset;   ///< -1 = no change, else a render_cam_preset (F1..F4)
     input_source source; ///< the device that is active
+    bool fine;           ///< Shift held: the keys command INPUT_FINE_SCALE of full opening
 } input_command;
+
+/// The keyboard's command in fine mode (Shift held), as a fraction of a key's full command.
+#define INPUT_FINE_SCALE 0.25
 
 typedef struct input_axis_map {
     int controller_axis; ///< SDL_GameControllerAxis, -1 = none

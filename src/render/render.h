@@ -200,6 +200,14 @@ const char* render_get_status(const render* r);
 /// stops, tipping, collision, "cannot keep up with real time". Returns the
 /// number of lines (at most max, capped at RENDER_WARN_MAX).
 int render_hud_warnings(const render* r, const world_snapshot* s, char out[][RENDER_WARN_LEN], int max);
+/// The truck's supports by their short names ("FL", "FR", "RL", "RR": front
+/// or rear, left or right), index as world_snapshot.pad_F.
+const char* render_pad_name(int i);
+/// A lift-off event for the console: the supports lifted in s and not in
+/// *prev (bits, updated), written as one line into buf. Returns 1 when
+/// there is one (once per event: a support that stays lifted says nothing
+/// more), else 0.
+int render_pad_event(const world_snapshot* s, int* prev, char* buf, size_t n);
 /// The app reports missed real-time deadlines here; any count > 0 in the last
 /// second shows the "cannot keep up with real time" warning.
 void render_set_missed_deadlines(render* r, int missed_last_second);

@@ -242,6 +242,33 @@ void engine_set_commands(engine* e, const double u[3]) {
 const struct rcl* engine_rcl(const engine* e) { return e->rcl; }
 int engine_hook(engine* e, int attach) { return e->ops->hook ? e->ops->hook(e, attach) : -1; }
 
+int engine_hook_report(engine* e, int attach, char* msg, size_t n) {
+    if (!e->ops->hook) {
+        snprintf(msg, n, "H: this world has no hook (the sandbox has one)");
+        return -1;
+    }
+    const bool had = engine_attached(e);
+    // The nearest load as the hook stands before it acts: what a failed
+    // attach names.
+    double dist = INFINITY, reach = 0;
+    const int near = e->ops->nearest_load ? e->ops->nearest_load(e, &dist, &reach) : -1;
+    const int got = engine_hook(e, attach);
+    double mass = 0;
+    if (attach && got >= 0) {
+        const char* nm = engine_load_name(e, got, &mass);
+        snprintf(msg, n, "hooked %s (%.0f kg)", nm ? nm : "a load", mass);
+    } else if (attach) {
+        const char* nm = near >= 0 ? engine_load_name(e, near, NULL) : NULL;
+        if (nm)
+            snprintf(msg, n, "H: no load in reach of the hook (nearest: %s, %.2f m away; reach %.2f m)", nm, dist,
+                     reach);
+        else snprintf(msg, n, "H: no load in reach of the hook (this world has no loads)");
+    } else {
+        snprintf(msg, n, had ? "released the load" : "nothing on the hook to release");
+    }
+    return got;
+}
+
 const char* engine_load_name(const engine* e, int i, double* mass) {
     return e->ops->hook ? e->ops->load_name(e, i, mass) : NULL;
 }

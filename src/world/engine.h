@@ -57,6 +57,12 @@ void engine_set_commands(engine* e, const double u[3]);
 /// Hook: 1 attach the nearest load in reach, 0 release. Returns the load
 /// index attached, or -1 (also where the world has no hook).
 int engine_hook(engine* e, int attach);
+/// engine_hook for an operator: attach (1) or release (0), and say what
+/// happened in msg, one line: "hooked load_500 (500 kg)", "released
+/// load_500", or why nothing was hooked: "H: no load in reach of the hook
+/// (nearest: load_500, 3.21 m away; reach 0.50 m)", "H: this world has no
+/// hook". Returns engine_hook's answer.
+int engine_hook_report(engine* e, int attach, char* msg, size_t n);
 /// Name and mass [kg] of load i of the world, or NULL.
 const char* engine_load_name(const engine* e, int i, double* mass);
 /// True while a load hangs on the hook.

@@ -23,6 +23,9 @@ typedef struct engine_ops {
     int (*hook)(engine* e, int attach);
     const char* (*load_name)(const engine* e, int i, double* mass);
     bool (*attached)(const engine* e);
+    /// NULL with hook: no distances known. The load nearest the hook, its
+    /// distance and the hook's reach [m] (ode_world_nearest_load).
+    int (*nearest_load)(const engine* e, double* dist, double* reach);
     hyd_model* (*circuit)(engine* e);
     /// The circuit's state now, in its own order (hyd_model_nstate of
     /// circuit()), into y; *in: the hydraulic data the engine last

@@ -60,6 +60,10 @@ static const char* ode_load_name(const engine* e, int i, double* mass) {
     return ode_world_load_name(W(e), i, mass);
 }
 
+static int ode_nearest_load(const engine* e, double* dist, double* reach) {
+    return ode_world_nearest_load(W(e), dist, reach);
+}
+
 static bool ode_attached(const engine* e) {
     ode_world_state st;
     ode_world_get_state(W(e), &st);
@@ -284,6 +288,7 @@ const engine_ops engine_ode_ops = {
     .hook = ode_hook,
     .load_name = ode_load_name,
     .attached = ode_attached,
+    .nearest_load = ode_nearest_load,
     .circuit = ode_circuit,
     .circuit_state = ode_circuit_state,
     .set_load = NULL, // the world's loads are bodies, picked up with the hook

@@ -2,6 +2,7 @@
 #include "metrics.h"
 
 #include "energy_acc.h"
+#include "ode_world.h"
 
 #include <math.h>
 #include <string.h>
@@ -32,6 +33,10 @@ static const metric_def k_metric[MET_COUNT] = {
     [MET_ENERGY_LOSS] = {"energy_loss", "J", COL_T},
     [MET_MAX_SWAY] = {"max_hook_sway", "rad", COL_TIP_WZ},
     [MET_MAX_SWAY_AMP] = {"max_hook_sway_amplitude", "m", COL_TIP_WZ},
+    }
+    [MET_MIN_PAD_F] = {"min_pad_force", "N", COL_PAD_F1},
+    [MET_MIN_STAB_MARGIN] = {"min_stab_margin", "-", COL_STAB_MARGIN},
+    [MET_PAD_LIFTOFFS] = {"pad_liftoffs", "count", COL_PAD_F1},
 };
 
 bool metrics_present(metric_id id, int ncol) { return id >= 0 && id < MET_COUNT && k_metric[id].col < ncol; }
@@ -81,6 +86,23 @@ void metrics_row(run_metrics* m, const double* row) {
         const double off = hypot(dx, dy);
         m->value[MET_MAX_SWAY_AMP] = fmax(m->value[MET_MAX_SWAY_AMP], off);
         m->value[MET_MAX_SWAY] = fmax(m->value[MET_MAX_SWAY], off > 0 ? atan2(off, drop) : 0.0);
+    if (m->present[MET_MIN_PAD_F] && row[COL_T] >= ODE_SUPPORT_SETTLE_T - 1e-12) {
+        double fmin_ = INFINITY, sum = 0;
+        for (int i = 0; i < 4; ++i) {
+            fmin_ = fmin(fmin_, row[COL_PAD_F1 + i]);
+            sum += row[COL_PAD_F1 + i];
+        }
+        if (sum > 0) m->pads_seen = true;
+        int lifted = 0;
+        for (int i = 0; i < 4; ++i)
+            if (row[COL_PAD_F1 + i] < ODE_PAD_LIFT_FRAC * sum) lifted |= 1 << i;
+        const int rising_pads = lifted & ~(m->pad_rows > 0 ? m->pad_lift_prev : 0);
+        for (int i = 0; i < 4; ++i) m->value[MET_PAD_LIFTOFFS] += rising_pads >> i & 1;
+        const double margin = row[COL_STAB_MARGIN];
+        m->value[MET_MIN_PAD_F] = m->pad_rows ? fmin(m->value[MET_MIN_PAD_F], fmin_) : fmin_;
+        m->value[MET_MIN_STAB_MARGIN] = m->pad_rows ? fmin(m->value[MET_MIN_STAB_MARGIN], margin) : margin;
+        m->pad_lift_prev = lifted;
+        ++m->pad_rows;
     }
     m->stop_prev = stops;
     m->t_prev = row[COL_T];
@@ -126,6 +148,9 @@ void metrics_print(const run_metrics* m, FILE* f) {
     if (m->present[MET_MAX_SWAY])
         fprintf(f, "; max hook sway %.2f deg, %.3f m", m->value[MET_MAX_SWAY] * 57.29577951308232,
                 m->value[MET_MAX_SWAY_AMP]);
+    if (m->pads_seen)
+        fprintf(f, "; min pad force %.2f kN, min stability margin %.3f, pad lift-offs %.0f",
+                m->value[MET_MIN_PAD_F] * 1e-3, m->value[MET_MIN_STAB_MARGIN], m->value[MET_PAD_LIFTOFFS]);
     fprintf(f, "\n");
     // Which reliefs were open, and how long (only those that opened).
     bool any = false;

@@ -32,6 +32,11 @@ typedef enum metric_id {
     // from vertical and the hook's horizontal offset from the tip.
     MET_MAX_SWAY,        ///< largest hook sway angle [rad]
     MET_MAX_SWAY_AMP,    ///< largest hook sway amplitude (horizontal offset) [m]
+    // The truck's supports (ode; zeros in the validation world), over the
+    // rows from ODE_SUPPORT_SETTLE_T on (the truck lands on its pads first).
+    MET_MIN_PAD_F,       ///< smallest vertical reaction on any support [N]
+    MET_MIN_STAB_MARGIN, ///< smallest stability margin [-]
+    MET_PAD_LIFTOFFS,    ///< supports lifting off: entries below ODE_PAD_LIFT_FRAC of the pads' sum [count]
     MET_COUNT
 } metric_id;
 
@@ -49,6 +54,9 @@ typedef struct run_metrics {
     int nrelief;                ///< reliefs named (metrics_energy)
     char relief_name[METRICS_MAXRELIEF][64]; ///< component names
     double relief_time[METRICS_MAXRELIEF];   ///< time each passed flow [s], over every step
+    long pad_rows;              ///< rows that counted for the support metrics
+    int pad_lift_prev;          ///< the previous such row's lifted supports (bits)
+    bool pads_seen;             ///< a row had support forces (a truck on the ground)
 } run_metrics;
 
 /// Start the metrics of a run that writes ncol channels (sim_ncol).

@@ -102,10 +102,21 @@ static int build_terrain(ode_world* w, char* err, size_t errsz) {
 
 // Attach collision geom g to the truck body at truck-frame position p
 // (the body's origin is at the centre of mass, truck_org from the frame's).
-static void truck_geom(ode_world* w, dGeomID g, const double p[3]) {
+static ow_geom* truck_geom(ode_world* w, dGeomID g, const double p[3]) {
     dGeomSetBody(g, w->truck);
     dGeomSetOffsetPosition(g, p[0] + w->truck_org[0], p[1] + w->truck_org[1], p[2] + w->truck_org[2]);
-    ow_add_geom(w, g, OW_CAT_TRUCK, w->desc.truck.friction);
+    return ow_add_geom(w, g, OW_CAT_TRUCK, w->desc.truck.friction);
+}
+
+// Make geom e (a sphere of radius r at truck-frame p) support i: its
+// contacts' forces are measured, at the point under its centre.
+static void mark_support(ode_world* w, ow_geom* e, int i, const double p[3], double r) {
+    if (!e) return;
+    e->support = i;
+    w->support_pt[i][0] = p[0] + w->truck_org[0];
+    w->support_pt[i][1] = p[1] + w->truck_org[1];
+    w->support_pt[i][2] = p[2] - r + w->truck_org[2];
+    w->nsupport = OW_NSUPPORT;
 }
 
 // Add a box to the truck at truck-frame position p: its drawing, and with
@@ -150,7 +161,9 @@ static void build_truck(ode_world* w, const double T[3], const double R[9]) {
     for (int a = 0; a < 2; ++a)
         for (int s = 0; s < 2; ++s) {
             const double wt[3] = {k->wheel_x[a], (s ? -0.5 : 0.5) * k->track, k->wheel_radius + lift};
-            truck_geom(w, dCreateSphere(w->dyn_space, k->wheel_radius), wt);
+            ow_geom* e = truck_geom(w, dCreateSphere(w->dyn_space, k->wheel_radius), wt);
+            // Without outriggers the wheels carry the truck: they are its supports.
+            if (!k->outriggers) mark_support(w, e, 2 * a + s, wt, k->wheel_radius);
             double wp[3] = {wt[0] + w->truck_org[0], wt[1] + w->truck_org[1], wt[2] + w->truck_org[2]};
             char nm[32];
             snprintf(nm, sizeof nm, "wheel_%d", 2 * a + s);
@@ -170,7 +183,7 @@ static void build_truck(ode_world* w, const double T[3], const double R[9]) {
             // (the support polygon is the same), with a quarter of the contact
             // rows in the truck's island, which dominates the step cost.
             const double rs = 0.5 * k->pad[0], sp[3] = {pp[0], pp[1], rs};
-            truck_geom(w, dCreateSphere(w->dyn_space, rs), sp);
+            mark_support(w, truck_geom(w, dCreateSphere(w->dyn_space, rs), sp), 2 * a + s, sp, rs);
             // Beam and leg, drawn only: the pad carries the contact.
             double half = 0.5 * k->outrigger_span - 0.5 * k->chassis[1];
             double bz = k->bed_height - k->chassis[2] + 0.1;
@@ -266,6 +279,28 @@ void ow_hook_point(const ode_world* w, double p[3], double v[3]) {
         dBodyGetRelPointVel(w->hook, 0, 0, z, a);
         v[0] = a[0], v[1] = a[1], v[2] = a[2];
     }
+}
+
+// Distance [m] from the hook's attach point hp to the top centre of load i.
+static double load_top_dist(const ode_world* w, int i, const double hp[3]) {
+    dVector3 top;
+    dBodyGetRelPointPos(w->load[i], 0, 0, 0.5 * w->desc.load[i].size[2], top);
+    return sqrt((top[0] - hp[0]) * (top[0] - hp[0]) + (top[1] - hp[1]) * (top[1] - hp[1]) +
+                (top[2] - hp[2]) * (top[2] - hp[2]));
+}
+
+int ode_world_nearest_load(const ode_world* w, double* dist, double* reach) {
+    if (reach) *reach = w->desc.hook.reach;
+    *dist = INFINITY;
+    if (w->dead || w->kind != WORLD_SANDBOX || w->nload == 0) return -1;
+    double hp[3];
+    ow_hook_point(w, hp, NULL);
+    int best = -1;
+    for (int i = 0; i < w->nload; ++i) {
+        const double d = load_top_dist(w, i, hp);
+        if (d < *dist) *dist = d, best = i;
+    }
+    return best;
 }
 
 int ow_attach(ode_world* w, int attach) {
@@ -545,6 +580,14 @@ static void near_cb(void* data, dGeomID g1, dGeomID g2) {
         c.surface.soft_cfm = w->desc.ode.contact_cfm;
         dJointID j = dJointCreateContact(w->world, w->contacts, &c);
         dJointAttach(j, b1, b2);
+        // A contact on a truck support reports its force (ow_support_forces).
+        const int sup = a->support >= 0 ? a->support : b->support;
+        if (sup >= 0 && w->nsupport_fb < OW_MAX_SUPPORT_FB) {
+            const int f = w->nsupport_fb++;
+            dJointSetFeedback(j, &w->support_fb[f]);
+            w->support_fb_joint[f] = j;
+            w->support_fb_of[f] = sup;
+        }
         double d = c.geom.depth;
         if (d > w->max_depth) w->max_depth = d;
         if (crane) {
@@ -560,8 +603,82 @@ void ow_collide(ode_world* w) {
     w->max_depth = 0;
     w->max_depth_crane = 0;
     w->crane_contact = 0;
+    w->nsupport_fb = 0;
     dSpaceCollide(w->dyn_space, w, near_cb);
     dSpaceCollide2((dGeomID)w->dyn_space, (dGeomID)w->static_space, w, near_cb);
+}
+
+void ow_support_forces(ode_world* w) {
+    double F[OW_NSUPPORT] = {0};
+    for (int f = 0; f < w->nsupport_fb; ++f) {
+        // ODE reports f1 for the joint's first body and f2 for its second;
+        // against the static world the truck is always the first (ODE moves
+        // a lone body to the first slot), else it is whichever it is.
+        const dJointID j = w->support_fb_joint[f];
+        const dBodyID b0 = dJointGetBody(j, 0), b1 = dJointGetBody(j, 1);
+        const dJointFeedback* fb = &w->support_fb[f];
+        const double fz = (!b0 || !b1 || b0 == w->truck) ? fb->f1[2] : fb->f2[2];
+        F[w->support_fb_of[f]] += fz;
+    }
+    const double a = 1.0 - exp(-w->opt.dt_ode / OW_SUPPORT_TAU);
+    for (int i = 0; i < OW_NSUPPORT; ++i) w->support_F[i] += a * (F[i] - w->support_F[i]);
+}
+
+int ow_supports_lifted(const ode_world* w, double weight) {
+    int bits = 0;
+    if (w->t < ODE_SUPPORT_SETTLE_T - 1e-12) return 0;
+    for (int i = 0; i < w->nsupport; ++i)
+        if (w->support_F[i] < ODE_PAD_LIFT_FRAC * weight) bits |= 1 << i;
+    return bits;
+}
+
+// Weight [N] and position of body b, into the running moments about the
+// tipping line through a with horizontal inward normal n: the part inboard
+// restores, the part outboard tips [N m].
+static void line_moment(dBodyID b, double g, const double a[3], const double n[2], double* restore, double* tip,
+                        double* weight) {
+    if (!b) return;
+    dMass m;
+    dBodyGetMass(b, &m);
+    const dReal* p = dBodyGetPosition(b);
+    const double s = n[0] * (p[0] - a[0]) + n[1] * (p[1] - a[1]), W = m.mass * g;
+    if (s > 0) *restore += W * s;
+    else *tip -= W * s;
+    *weight += W;
+}
+
+double ow_stab_margin(const ode_world* w, double* weight) {
+    // The support points in the world, walked round the polygon front-left,
+    // front-right, rear-right, rear-left (index 2 a + s).
+    static const int ring[OW_NSUPPORT] = {0, 1, 3, 2};
+    double P[OW_NSUPPORT][3], c[2] = {0, 0};
+    for (int i = 0; i < OW_NSUPPORT; ++i) {
+        dVector3 q;
+        const double* sp = w->support_pt[ring[i]];
+        dBodyGetRelPointPos(w->truck, sp[0], sp[1], sp[2], q);
+        P[i][0] = q[0], P[i][1] = q[1], P[i][2] = q[2];
+        c[0] += 0.25 * q[0], c[1] += 0.25 * q[1];
+    }
+    double margin = ODE_STAB_MARGIN_MAX, W = 0;
+    for (int e = 0; e < OW_NSUPPORT; ++e) {
+        const double* a = P[e];
+        const double* b = P[(e + 1) % OW_NSUPPORT];
+        double n[2] = {-(b[1] - a[1]), b[0] - a[0]};
+        const double len = hypot(n[0], n[1]);
+        if (len < 1e-9) continue;
+        n[0] /= len, n[1] /= len;
+        if (n[0] * (c[0] - a[0]) + n[1] * (c[1] - a[1]) < 0) n[0] = -n[0], n[1] = -n[1];
+        double R = 0, T = 0;
+        W = 0;
+        line_moment(w->truck, w->g, a, n, &R, &T, &W);
+        for (int f = 0; f < 3; ++f) line_moment(w->frame[f].body, w->g, a, n, &R, &T, &W);
+        for (int i = 0; i < w->nrope; ++i) line_moment(w->rope[i], w->g, a, n, &R, &T, &W);
+        line_moment(w->hook, w->g, a, n, &R, &T, &W);
+        if (w->attached >= 0) line_moment(w->load[w->attached], w->g, a, n, &R, &T, &W);
+        if (T > 0 && R < margin * T) margin = R / T;
+    }
+    if (weight) *weight = W;
+    return margin;
 }
 
 double ow_truck_tilt(const ode_world* w) {
@@ -602,6 +719,18 @@ void ow_sandbox_snapshot(const ode_world* w, world_snapshot* s) {
     s->truck_tilt = ow_truck_tilt(w);
     s->tipping = s->truck_tilt > 5.0 * M_PI / 180.0;
     s->collision = (uint8_t)w->crane_contact;
+    s->npad = w->nsupport;
+    if (w->nsupport) {
+        double weight = 0;
+        s->stab_margin = ow_stab_margin(w, &weight);
+        for (int i = 0; i < w->nsupport; ++i) {
+            dVector3 q;
+            dBodyGetRelPointPos(w->truck, w->support_pt[i][0], w->support_pt[i][1], w->support_pt[i][2], q);
+            s->pad_pos[i][0] = q[0], s->pad_pos[i][1] = q[1], s->pad_pos[i][2] = q[2];
+            s->pad_F[i] = w->support_F[i];
+        }
+        s->pad_lifted = ow_supports_lifted(w, weight);
+    }
 
     // The slew rack drawn as a cylinder lying across the truck at the column
     // foot, its rod end moving with the rack travel.

@@ -206,6 +206,7 @@ ow_geom* ow_add_geom(ode_world* w, dGeomID g, uint32_t cat, double friction) {
     e->g = g;
     e->cat = cat;
     e->friction = friction;
+    e->support = -1;
     dGeomSetData(g, e);
     return e;
 }
@@ -723,7 +724,10 @@ static int step_ode(ode_world* w, void* arg) {
         ow_apply_forces(w);
         if (w->kind == WORLD_SANDBOX) ow_collide(w);
         dWorldStep(w->world, h);
-        if (w->kind == WORLD_SANDBOX) dJointGroupEmpty(w->contacts);
+        if (w->kind == WORLD_SANDBOX) {
+            ow_support_forces(w);
+            dJointGroupEmpty(w->contacts);
+        }
         ++w->nstep;
         // Time as a step count times h, so long runs do not accumulate
         // round-off and repeated runs land on identical times.
@@ -911,6 +915,12 @@ static int get_state_ode(ode_world* w, void* arg) {
     s->max_depth = w->max_depth;
     s->max_depth_crane = w->max_depth_crane;
     s->attached = w->attached;
+    if (w->nsupport) {
+        double weight = 0;
+        s->stab_margin = ow_stab_margin(w, &weight);
+        for (int i = 0; i < w->nsupport; ++i) s->pad_F[i] = w->support_F[i];
+        s->pad_lifted = ow_supports_lifted(w, weight);
+    }
     return 0;
 }
 

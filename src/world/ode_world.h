@@ -94,7 +94,30 @@ typedef struct ode_world_state {
     int attached;             ///< index of the load on the hook, or -1
     int end_stop;             ///< bit k: cylinder k at an end stop (hinge limit active or hydraulic stop)
     int relief_open;          ///< number of relief valves passing flow
+    // Sandbox: the truck's supports (the outrigger pads; the wheels when the
+    // outriggers are in), index 2 a + s: a = 0 front, 1 rear; s = 0 left
+    // (+y of the truck), 1 right. Zeros in the validation world.
+    double pad_F[4];          ///< vertical ground reaction on each support [N], low-passed over about 5 ms
+    int pad_lifted;           ///< bit i: support i carries less than ODE_PAD_LIFT_FRAC of the weight
+                              ///< (never before ODE_SUPPORT_SETTLE_T)
+    /// Static stability margin of the current pose: the restoring over the
+    /// tipping moment of the weights of truck, crane, rope, hook and the
+    /// hooked load about the governing tipping line (the support polygon's
+    /// edge with the least ratio). Below 1 the truck tips over that line.
+    /// ODE_STAB_MARGIN_MAX when nothing is outboard of any line.
+    double stab_margin;
 } ode_world_state;
+
+/// A support counts as lifted off below this fraction of the total weight
+/// it and the others carry (1 %: about 0.9 kN on the shipped sandbox, where
+/// each pad carries about 23 kN at rest).
+#define ODE_PAD_LIFT_FRAC 0.01
+/// The truck starts 0.5 mm above the ground, lands within 10 ms and stops
+/// rocking on its pads within 60 ms (the sandbox): no support counts as
+/// lifted off before this time [s] (metrics likewise).
+#define ODE_SUPPORT_SETTLE_T 0.1
+/// The stability margin reported when no weight is outboard of a tipping line.
+#define ODE_STAB_MARGIN_MAX 10.0
 
 /// Build a world. mech: crane mechanics (copied). hydraulics: the model's
 /// "hydraulics" JSON section (read, not kept); may be NULL when
@@ -112,6 +135,10 @@ void ode_world_set_commands(ode_world* w, const double u_cmd[ODE_NACT]);
 /// hook's attach point (no-op if none or already attached); 0: release.
 /// Returns the load index attached, or -1.
 int ode_world_hook(ode_world* w, int attach);
+/// The load nearest the hook: its index (-1 when the world has none) and
+/// the distance [m] from the hook's attach point to its top centre, the
+/// distance ode_world_hook compares with hook.reach [m] (*reach, may be NULL).
+int ode_world_nearest_load(const ode_world* w, double* dist, double* reach);
 
 /// Advance by dt [s] (rounded to a whole number of ODE steps, at least one).
 /// Returns 0, or -1 when a body or hydraulic state became non-finite; then

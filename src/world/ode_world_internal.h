@@ -23,6 +23,20 @@
 /// to 45 kN; the chain then holds up to 4e5 N, twice the lift cylinder's
 /// push at its port relief (7.85e-3 m^2 x 26 MPa = 204 kN).
 #define OW_ROPE_DESIGN_TENSION 1e5
+/// Truck supports whose ground reaction is measured: the four outrigger pads
+/// (the four wheels when the outriggers are in), index 2 a + s with a = 0
+/// front, 1 rear and s = 0 left (+y), 1 right (-y).
+#define OW_NSUPPORT 4
+/// Contact joints on the supports whose forces ODE reports per step
+/// (dJointSetFeedback); a sphere on the heightfield makes one or two.
+#define OW_MAX_SUPPORT_FB 64
+/// Time constant [s] of the first-order filter on the support reactions.
+/// ODE's contact solver now and then hands one step's load to fewer pads
+/// (the pick-and-place: three pads at 0 N for one 1 ms step at 25.409 s, the
+/// next step catching the truck with 5 % more); unfiltered, every such step
+/// read as a lift-off. 5 ms lets one such step move a reading by 18 %, and a
+/// real lift-off reads below 1 % of the load within 25 ms.
+#define OW_SUPPORT_TAU 5e-3
 
 /// Collision categories (bits); which pairs collide is a table in ode_sandbox.c.
 enum {
@@ -35,6 +49,7 @@ typedef struct ow_geom {
     dGeomID g;
     uint32_t cat;     ///< OW_CAT_*
     double friction;  ///< Coulomb coefficient [-]; a pair uses the geometric mean
+    int support;      ///< truck support (OW_NSUPPORT) this geom carries, else -1
 } ow_geom;
 
 /// One entry of the snapshot: a primitive placed in a body's frame (or in the
@@ -147,6 +162,14 @@ struct ode_world {
     int ncontact;
     double max_depth, max_depth_crane;
     int crane_contact;
+    // Ground reactions on the truck's supports (ode_sandbox.c, ow_support_forces).
+    int nsupport;                            ///< OW_NSUPPORT, or 0 (validation world)
+    double support_pt[OW_NSUPPORT][3];       ///< contact point under each support, truck body coordinates [m]
+    double support_F[OW_NSUPPORT];           ///< vertical reaction on each, low-passed (OW_SUPPORT_TAU) [N]
+    int nsupport_fb;                         ///< feedback slots used in this step
+    dJointFeedback support_fb[OW_MAX_SUPPORT_FB];
+    dJointID support_fb_joint[OW_MAX_SUPPORT_FB];
+    int support_fb_of[OW_MAX_SUPPORT_FB];    ///< the support each slot's contact is on
 
     // Hydraulics (ode_coupling.c).
     hyd_model* hm;       ///< compiled circuit, NULL without hydraulics
@@ -205,6 +228,15 @@ int ow_build_sandbox(ode_world* w, char* err, size_t errsz);
 void ow_collide(ode_world* w);
 void ow_sandbox_snapshot(const ode_world* w, world_snapshot* s);
 double ow_truck_tilt(const ode_world* w);
+/// After dWorldStep, before the contact group is emptied: support_F from the
+/// contact joints' feedback.
+void ow_support_forces(ode_world* w);
+/// The static stability margin of the current pose (ode_world.h,
+/// ode_world_state.stab_margin) and the total weight the supports carry [N].
+double ow_stab_margin(const ode_world* w, double* weight);
+/// Bits of the supports lifted off now (ode_world_state.pad_lifted), weight
+/// the total the supports carry [N].
+int ow_supports_lifted(const ode_world* w, double weight);
 void ow_hook_point(const ode_world* w, double p[3], double v[3]);
 int ow_attach(ode_world* w, int attach);
 

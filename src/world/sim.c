@@ -17,7 +17,7 @@ const sim_channel sim_channels[SIM_NCOL] = {SIM_CHANNELS_BASE(CH_ENTRY_) SIM_CHA
 const char* const sim_col_name[SIM_NCOL] = {SIM_CHANNELS_BASE(CH_NAME_) SIM_CHANNELS_WORLD(CH_NAME_)};
 const char* const sim_col_unit[SIM_NCOL] = {SIM_CHANNELS_BASE(CH_UNIT_) SIM_CHANNELS_WORLD(CH_UNIT_)};
 // The README's fixed order of the first columns, and the world extras right after the base.
-_Static_assert(COL_U2_CMD == 16 && COL_END_STOP == 21 && COL_SLEW == SIM_NCOL_BASE && COL_F3 == SIM_NCOL_BASE + 17 && COL_TIP_WZ == SIM_NCOL - 2 && COL_RCL_UTIL == SIM_NCOL - 1,
+_Static_assert(COL_U2_CMD == 16 && COL_END_STOP == 21 && COL_SLEW == SIM_NCOL_BASE && COL_F3 == COL_SLEW + 17,
                "the channel list lost its documented order");
 
 sim_opts sim_default_opts(void) {
@@ -333,6 +333,8 @@ void sim_ode_row(ode_world* w, double* row) {
         st.max_depth, st.x[2], st.v[2], st.pA[2], st.pB[2], st.u[2], st.u_cmd[2], st.F[2],
         st.tip_world[0], st.tip_world[1], st.tip_world[2]};
     memcpy(row, v, sizeof v);
+    for (int i = 0; i < 4; ++i) row[COL_PAD_F1 + i] = st.pad_F[i];
+    row[COL_STAB_MARGIN] = st.stab_margin;
     // The attached load, else the first one: where the payload is.
     int li = st.attached >= 0 ? st.attached : (ode_world_nload(w) > 0 ? 0 : -1);
     if (li >= 0) {

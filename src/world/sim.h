@@ -212,7 +212,15 @@ typedef struct sim_channel {
     X(TIP_WY, "tip_wy", "m", SIM_CH_OTHER) \
     X(TIP_WZ, "tip_wz", "m", SIM_CH_OTHER) \
     /* Rated capacity limiter: load moment over the chart's rated moment (rcl.h). */ \
-    X(RCL_UTIL, "rcl_util", "-", SIM_CH_OTHER)
+    X(RCL_UTIL, "rcl_util", "-", SIM_CH_OTHER) \
+    /* The truck's supports (sandbox: outrigger pads, or wheels with the outriggers in; \
+       zeros in the validation world): vertical ground reaction front-left, front-right, \
+       rear-left, rear-right, and the static stability margin (ode_world_state). */ \
+    X(PAD_F1, "pad_F1", "N", SIM_CH_OTHER) \
+    X(PAD_F2, "pad_F2", "N", SIM_CH_OTHER) \
+    X(PAD_F3, "pad_F3", "N", SIM_CH_OTHER) \
+    X(PAD_F4, "pad_F4", "N", SIM_CH_OTHER) \
+    X(STAB_MARGIN, "stab_margin", "-", SIM_CH_OTHER)
 
 #define SIM_COL_ENUM_(id, name, unit, kind) COL_##id,
 /// CSV column indices, in the order of the list.

@@ -113,6 +113,14 @@ typedef struct world_snapshot {
     uint8_t rcl_have;         ///< the rated capacity limiter measures (rcl_util is valid)
     uint8_t rcl_on;           ///< ... and cuts the motions that increase the load moment
     double rcl_util;          ///< its utilisation: load moment over the chart's rated moment [-]
+    /// The truck's supports (outrigger pads, or wheels with the outriggers
+    /// in): 0 without a truck, else 4, front-left, front-right, rear-left,
+    /// rear-right.
+    int npad;
+    double pad_F[4];        ///< vertical ground reaction [N]
+    double pad_pos[4][3];   ///< contact point under each, world [m]
+    int pad_lifted;         ///< bit i: support i lifted off (below 1 % of the weight)
+    double stab_margin;     ///< restoring over tipping moment, governing tipping line [-]
 } world_snapshot;
 
 #ifdef __cplusplus

@@ -553,6 +553,67 @@ static void tap_key(drive_session* s, double* wall, SDL_Scancode sc) {
     run_for(s, wall, 1.0 / 240.0);
 }
 
+// H with no load in reach says so in the status line (the HUD), naming the
+// nearest load and its distance; the hook stays empty. The pads' forces and
+// the margin reach the snapshot, no pad is flagged at rest, and a flagged
+// pad gives the HUD's warning and one console line per event.
+// The status line the next frame shows (a frame is drawn only when the
+// last one has finished).
+static const char* status_now(drive_session* s, double* wall) {
+    render_wait(drive_session_render_ctx(s), 1.0);
+    run_for(s, wall, 2.0 / 240.0);
+    return render_get_status(drive_session_render_ctx(s));
+}
+
+static void test_hook_feedback_and_pads(void) {
+    drive_session* s = open_session();
+    if (!s) return;
+    double wall = 0;
+    CHECK(run_for(s, &wall, 0.5) == 0, "loop: %s", drive_session_error(s));
+    // The pick-and-place start has load_200 under the hook: H hooks it and
+    // says so, H again lets it go.
+    tap_key(s, &wall, SDL_SCANCODE_H);
+    const char* st = status_now(s, &wall);
+    CHECK(strstr(st, "hooked load_200 (200 kg)"), "status after H: '%s'", st);
+    tap_key(s, &wall, SDL_SCANCODE_H);
+    st = status_now(s, &wall);
+    CHECK(strstr(st, "released the load"), "status after H again: '%s'", st);
+    // Lift for 2 s: the hook rises out of reach; H then says so.
+    push_key(SDL_SCANCODE_UP, 1);
+    run_for(s, &wall, 2.0);
+    push_key(SDL_SCANCODE_UP, 0);
+    run_for(s, &wall, 1.0);
+    tap_key(s, &wall, SDL_SCANCODE_H);
+    st = status_now(s, &wall);
+    CHECK(strstr(st, "no load in reach of the hook (nearest: load_200,") && strstr(st, "m away; reach 0.50 m)"),
+          "status after H out of reach: '%s'", st);
+    const world_snapshot* snap = drive_session_snapshot(s);
+    CHECK(!snap->attached, "nothing hooked");
+    CHECK(snap->npad == 4, "four pads: %d", snap->npad);
+    const double sum = snap->pad_F[0] + snap->pad_F[1] + snap->pad_F[2] + snap->pad_F[3];
+    CHECK(sum > 6.5e4 && sum < 7.5e4, "pads carry the rig: %.0f N", sum);
+    CHECK(snap->pad_lifted == 0 && snap->stab_margin > 1, "at rest: lifted %d, margin %.2f", snap->pad_lifted,
+          snap->stab_margin);
+    char text[1024];
+    hud_warnings(s, text, sizeof text);
+    CHECK(!strstr(text, "PAD LIFTED"), "no pad warning at rest: '%s'", text);
+    // A copy with the rear-left pad flagged: the warning names it, and the
+    // console event comes once.
+    static world_snapshot lifted;
+    lifted = *snap;
+    lifted.pad_lifted = 1 << 2;
+    char w[RENDER_WARN_MAX][RENDER_WARN_LEN];
+    const int k = render_hud_warnings(drive_session_render_ctx(s), &lifted, w, RENDER_WARN_MAX);
+    int found = 0;
+    for (int i = 0; i < k; ++i) found |= strstr(w[i], "PAD LIFTED OFF: RL") != NULL;
+    CHECK(found, "the HUD warns of the lifted pad");
+    int prev = 0;
+    char note[192];
+    CHECK(render_pad_event(&lifted, &prev, note, sizeof note) == 1 && strstr(note, "RL"), "event: '%s'", note);
+    CHECK(render_pad_event(&lifted, &prev, note, sizeof note) == 0, "once per event");
+    drive_session_destroy(s);
+}
+
 // The real-time factor after a reset (R), a rebuild (a solver change) and a
 // pause is the simulation's own rate, 1.00 on a virtual clock that the loop
 // keeps up with: it divided the time since the reset by the wall time since
@@ -1139,6 +1200,7 @@ int main(int argc, char** argv) {
     setenv("EGL_PLATFORM", "surfaceless", 0);
     setenv("SDL_AUDIODRIVER", "dummy", 0);
     RUN_TEST(test_default_scene_frame);
+    RUN_TEST(test_hook_feedback_and_pads);
     RUN_TEST(test_joystick_and_keyboard_drive_the_lift);
     RUN_TEST(test_panel_change_takes_effect);
     RUN_TEST(test_panel_boom_edit);

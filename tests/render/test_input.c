@@ -171,6 +171,45 @@ static void test_keyboard(void) {
     input_destroy(in);
 }
 
+// Fine mode: with Shift held (either one) the keys command 25 % of full
+// opening, on every axis; released, full again. The ramp keeps its rate.
+static void test_fine_mode(void) {
+    input_mapping m = input_default_mapping();
+    m.keyboard_ramp = 0.5;
+    input* in = input_create(&m);
+    input_command cmd;
+    push_key(SDL_SCANCODE_LSHIFT, true);
+    push_key(SDL_SCANCODE_UP, true);
+    push_key(SDL_SCANCODE_S, true);
+    push_key(SDL_SCANCODE_RIGHT, true);
+    pump(in);
+    input_poll(in, 0.05, &cmd); // 0.05 s of a 0.5 s ramp: 0.1, below the fine target
+    CHECK_NEAR(cmd.lift, 0.1, 1e-12);
+    CHECK(cmd.fine, "Shift: fine mode");
+    input_poll(in, 1.0, &cmd);
+    CHECK_NEAR(cmd.lift, 0.25, 1e-12);
+    CHECK_NEAR(cmd.jib, -0.25, 1e-12);
+    CHECK_NEAR(cmd.slew, -0.25, 1e-12);
+    push_key(SDL_SCANCODE_LSHIFT, false);
+    pump(in);
+    input_poll(in, 1.0, &cmd);
+    CHECK(!cmd.fine, "Shift released");
+    CHECK_NEAR(cmd.lift, 1.0, 1e-12);
+    push_key(SDL_SCANCODE_RSHIFT, true);
+    pump(in);
+    input_poll(in, 1.0, &cmd);
+    CHECK_NEAR(cmd.lift, 0.25, 1e-12);
+    CHECK_NEAR(cmd.slew, -0.25, 1e-12);
+    push_key(SDL_SCANCODE_RSHIFT, false);
+    push_key(SDL_SCANCODE_UP, false);
+    push_key(SDL_SCANCODE_S, false);
+    push_key(SDL_SCANCODE_RIGHT, false);
+    pump(in);
+    input_poll(in, 1.0, &cmd);
+    CHECK_NEAR(cmd.lift, 0.0, 1e-12);
+    input_destroy(in);
+}
+
 static void test_mapping_file(void) {
     char path[512];
     snprintf(path, sizeof path, "%s/render_input_map.json", CRANESIM_BINARY_DIR);
@@ -290,6 +329,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_shape);
     RUN_TEST(test_virtual_controller_lift);
     RUN_TEST(test_keyboard);
+    RUN_TEST(test_fine_mode);
     RUN_TEST(test_mapping_file);
     RUN_TEST(test_plain_joystick);
     SDL_Quit();
