@@ -33,7 +33,6 @@ static const metric_def k_metric[MET_COUNT] = {
     [MET_ENERGY_LOSS] = {"energy_loss", "J", COL_T},
     [MET_MAX_SWAY] = {"max_hook_sway", "rad", COL_TIP_WZ},
     [MET_MAX_SWAY_AMP] = {"max_hook_sway_amplitude", "m", COL_TIP_WZ},
-    }
     [MET_MIN_PAD_F] = {"min_pad_force", "N", COL_PAD_F1},
     [MET_MIN_STAB_MARGIN] = {"min_stab_margin", "-", COL_STAB_MARGIN},
     [MET_PAD_LIFTOFFS] = {"pad_liftoffs", "count", COL_PAD_F1},
@@ -86,6 +85,7 @@ void metrics_row(run_metrics* m, const double* row) {
         const double off = hypot(dx, dy);
         m->value[MET_MAX_SWAY_AMP] = fmax(m->value[MET_MAX_SWAY_AMP], off);
         m->value[MET_MAX_SWAY] = fmax(m->value[MET_MAX_SWAY], off > 0 ? atan2(off, drop) : 0.0);
+    }
     if (m->present[MET_MIN_PAD_F] && row[COL_T] >= ODE_SUPPORT_SETTLE_T - 1e-12) {
         double fmin_ = INFINITY, sum = 0;
         for (int i = 0; i < 4; ++i) {
