@@ -9,6 +9,7 @@
 // rang in the P nodes behind the 50 kPa compensators.
 #include "check.h"
 #include "crane_fixture.h"
+#include "engine.h"
 #include "sim.h"
 
 #include <math.h>
@@ -75,7 +76,79 @@ static void test_solvers_agree(void) {
     model_free(m);
 }
 
+// Lowering through the counterbalance valve, in the full crane. 1000 kg
+// held (hose_burst_line's pose), valves closed; then the lift command ramps
+// slowly to -0.3 over 4 s, so the rod side (the valve's pilot) charges
+// slowly. The valve's opening balance (docs/hydraulics.md) says it cracks
+// when (p_l - p_v) + R (p_p - p_v) = p_setting: with the load pressure p_l
+// and the valve-port pressure p_v read at that moment, the pilot pressure
+// must be p_v + (p_setting - (p_l - p_v)) / R (25 MPa, R = 3: about 4 MPa),
+// within 5 %. And by hand from the holding state alone: raising the rod
+// side by p_p pushes the piston down, and the load side rises by
+// (A_B p_p - F_b) / A_A (area ratio 0.64; F_b = 4.5 kN, the seal's
+// breakaway, resists the creeping piston), so p_p = (p_setting - p_hold +
+// F_b / A_A) / (R + A_B / A_A) in gauge pressures, within 5 %. Before the
+// crack the lift only creeps by the load column's compression (about
+// 3.2 L x 1.7 MPa / Be over A_A: under 1 mm).
+static void test_lowering_pilot(void) {
+    scenario sc;
+    if (load_scenario("hose_burst_line", &sc)) return;
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031_ls.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    sim_opts o = sim_default_opts();
+    engine* e = engine_create(m, &o, sc.q0, sc.slew0, sim_load_mass(m, &sc, &o), err, sizeof err);
+    CHECK(e != NULL, "%s", err);
+    if (!e) {
+        model_free(m);
+        return;
+    }
+    const hyd_model* h = engine_circuit(e);
+    const int sl = hyd_model_node_state(h, hyd_model_find_node(h, "lift_cyl.A"));
+    const int sv = hyd_model_node_state(h, hyd_model_find_node(h, "lift_cbv_A"));
+    const int sp = hyd_model_node_state(h, hyd_model_find_node(h, "lift_hose_B"));
+    const int sx = hyd_model_find_state(h, "lift_cbv.spool");
+    CHECK(sl >= 0 && sv >= 0 && sp >= 0 && sx >= 0, "states %d %d %d %d", sl, sv, sp, sx);
+    const double pset = 25e6, R = 3.0, pt = 1e5;
+    const double AA = 0.25 * 3.14159265358979 * 0.1 * 0.1, AB = 0.25 * 3.14159265358979 * (0.1 * 0.1 - 0.06 * 0.06);
+    double y[256], row[SIM_NCOL];
+    CHECK(hyd_model_nstate(h) <= 256, "%d states", hyd_model_nstate(h));
+    // Settle for 1 s with the valves closed.
+    double u[3] = {0, 0, 0};
+    engine_set_commands(e, u);
+    CHECK(engine_advance_to(e, 1.0, NULL, NULL) == 0, "%s", engine_error(e));
+    engine_circuit_state(e, y, NULL);
+    const double p_hold = y[sl];
+    engine_row(e, row);
+    const double x0 = row[COL_X1];
+    int cracked = 0;
+    for (int k = 1; k <= 4000 && !cracked && sl >= 0 && sv >= 0 && sp >= 0 && sx >= 0; ++k) {
+        u[0] = -0.3 * k / 4000.0;
+        engine_set_commands(e, u);
+        if (engine_advance_to(e, 1.0 + 1e-3 * k, NULL, NULL)) break;
+        engine_circuit_state(e, y, NULL);
+        if (y[sx] < 0.01) continue;
+        cracked = 1;
+        const double pl = y[sl], pv = y[sv], pp = y[sp];
+        const double pred = pv + (pset - (pl - pv)) / R;
+        const double Fb = 4500.0; // lift_cyl coulomb + stribeck [N]
+        const double hand = pt + (pset - (p_hold - pt) + Fb / AA) / (R + AB / AA);
+        engine_row(e, row);
+        printf("  cracks at u = %.4f: pilot %.3f MPa; balance %.3f MPa (p_l %.3f, p_v %.3f); by hand from the "
+               "holding %.3f MPa: %.3f MPa; lift moved %.3f mm\n",
+               u[0], pp / 1e6, pred / 1e6, pl / 1e6, pv / 1e6, p_hold / 1e6, hand / 1e6, 1e3 * (row[COL_X1] - x0));
+        CHECK_REL(pp - pt, pred - pt, 0.05);
+        CHECK_REL(pp - pt, hand - pt, 0.05);
+        CHECK(fabs(row[COL_X1] - x0) < 1e-3, "the lift moved %g m before the valve cracked", row[COL_X1] - x0);
+    }
+    CHECK(cracked, "the counterbalance valve did not open while lowering");
+    engine_destroy(e);
+    model_free(m);
+}
+
 int main(int argc, char** argv) {
+    RUN_TEST(test_lowering_pilot);
     RUN_TEST(test_solvers_agree);
     TEST_MAIN_END();
 }
