@@ -63,6 +63,9 @@ static void bench_help(FILE* f) {
             "               bore 80..120 mm) on 1 and 2 threads: designs per minute and their ratio;\n"
             "               with MPI also on 1 and 2 ranks (mpiexec); then the peak RSS of sweeps of\n"
             "               100 and 10,000 designs of 0.05 s\n"
+            "  ls           not in the default set: Krus, h = 0.1 ms, on the scenario with the standard\n"
+            "               crane (hiab031.json) and the load-sensing crane (hiab031_ls.json), runs\n"
+            "               interleaved: ns per step of each, kernel, and LS over standard\n"
             "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
             "               operator, for --duration seconds of wall time (default 60): fps,\n"
             "               frame times, missed real-time deadlines, command rate\n"
@@ -140,6 +143,12 @@ static const bench_cfg configs[] = {
     {"sandbox-ode1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-3, "sandbox_pick_place"},
     {"sandbox-ode0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-4, "sandbox_pick_place"},
 };
+
+// ls: the cost of a Krus step on the load-sensing crane against the
+// standard crane, the same scenario and options, runs interleaved so that
+// the machine's load changes hit both alike. Returns 0, or -1 after
+// printing an error line.
+static int bench_ls(const app_common* c, const scenario* sc, int repeat);
 
 // ---- sweep: designs per minute on 1 and 2 threads, and memory ----
 
@@ -382,6 +391,50 @@ static sim_opts bench_opts(const sim_opts* common, const bench_cfg* b) {
     return o;
 }
 
+static int bench_ls(const app_common* c, const scenario* sc, int repeat) {
+    static const char* const files[2] = {"hiab031.json", "hiab031_ls.json"};
+    const bench_cfg b = {"ls", HYD_KRUS, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL};
+    sim_opts o = bench_opts(&c->sim, &b);
+    model* m[2] = {NULL, NULL};
+    int rc = 0;
+    for (int k = 0; k < 2 && !rc; ++k) {
+        char path[1024], err[512];
+        snprintf(path, sizeof path, "%s/models/%s", model_assets_dir(), files[k]);
+        m[k] = model_load(path, NULL, 0, err, sizeof err);
+        if (!m[k]) {
+            printf("{\"config\":\"ls\",\"error\":\"%s\"}\n", err);
+            rc = -1;
+        }
+    }
+    double walls[2][100], ns[2] = {0, 0};
+    long steps[2] = {0, 0};
+    const char* kern[2] = {"", ""};
+    for (int i = 0; i < repeat && !rc; ++i)
+        for (int k = 0; k < 2 && !rc; ++k) {
+            sim_result r;
+            sim_run(m[k], sc, &o, NULL, NULL, NULL, NULL, NULL, &r);
+            if (r.status) {
+                printf("{\"config\":\"ls\",\"model\":\"%s\",\"error\":\"%s\"}\n", files[k], r.message);
+                rc = -1;
+                break;
+            }
+            walls[k][i] = r.wall;
+            steps[k] = r.stats.steps;
+            kern[k] = r.split ? "split" : r.fused ? "fused" : r.fast ? "fast" : "general";
+        }
+    if (!rc) {
+        for (int k = 0; k < 2; ++k) ns[k] = 1e9 * app_median(walls[k], repeat) / (double)(steps[k] ? steps[k] : 1);
+        printf("{\"config\":\"ls\",\"scenario\":\"%s\",\"solver\":\"krus\",\"h_s\":%g,\"repeat\":%d,"
+               "\"steps\":%ld,\"kernel_standard\":\"%s\",\"ns_per_step_standard\":%.1f,"
+               "\"kernel_ls\":\"%s\",\"ns_per_step_ls\":%.1f,\"ls_over_standard\":%.3f}\n",
+               sc->name, o.h, repeat, steps[1], kern[0], ns[0], kern[1], ns[1], ns[1] / ns[0]);
+        fflush(stdout);
+    }
+    model_free(m[0]);
+    model_free(m[1]);
+    return rc;
+}
+
 // krus-length: the cost of a step against the length of the run. Spool
 // states used to decay into subnormal numbers some 20 s after their valve
 // closed and stay there, which made every later step dearer (issue 13: 280
@@ -539,7 +592,7 @@ int cmd_bench(int argc, char** argv) {
         fprintf(stderr, "cranesim bench: unknown option '%s' (see cranesim bench --help)\n", argv[i]);
         return EXIT_USAGE;
     }
-    bool want_drive = nonly == 0, want_length = nonly == 0, want_soak = false;
+    bool want_drive = nonly == 0, want_length = nonly == 0, want_soak = false, want_ls = false;
     for (int j = 0; j < nonly; ++j) {
         if (!strcmp(only[j], "drive")) {
             want_drive = true;
@@ -551,6 +604,10 @@ int cmd_bench(int argc, char** argv) {
         }
         if (!strcmp(only[j], "soak")) {
             want_soak = true;
+            continue;
+        }
+        if (!strcmp(only[j], "ls")) {
+            want_ls = true;
             continue;
         }
         if (!strcmp(only[j], "sweep")) {
@@ -637,6 +694,7 @@ int cmd_bench(int argc, char** argv) {
         fflush(stdout);
     }
     if (want_length && bench_length(&c, m, &sc, repeat)) code = EXIT_RUNTIME;
+    if (want_ls && bench_ls(&c, &sc, repeat)) code = EXIT_RUNTIME;
     model_free(m);
     if (want_soak) {
         const int scode = bench_soak(&c, c.sim.duration > 0 ? c.sim.duration : 600.0, seed);

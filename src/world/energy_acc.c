@@ -95,7 +95,10 @@ int sim_energy_bind(sim_energy* e, const hyd_model* m) {
     }
     for (int c = 0; c < nc; ++c) {
         switch (hyd_model_comp_type(m, c)) {
-        case HYD_PUMP: add_col(e, c, SIM_EG_SUPPLY, ""); break;
+        // Both pump kinds deliver the energy in; the LS pump used to fall
+        // into "other" as a negative loss, so the balance had no input.
+        case HYD_PUMP:
+        case HYD_LS_PUMP: add_col(e, c, SIM_EG_SUPPLY, ""); break;
         case HYD_VALVE:
             add_col(e, c, SIM_EG_VALVE_IN, ".meter_in");
             add_col(e, c, SIM_EG_VALVE_OUT, ".meter_out");

@@ -34,6 +34,32 @@ const char* model_default_path(void) {
 // integrators meet as an abort or a plausible wrong answer (a link mass of
 // 1e-300 kg aborted ODE); typical: a crane of the HIAB 031 class and its
 // relatives up to a few tonnes of lifting capacity.
+// The LS signal must reach each LS pump: its "ls" node is a tank (a fixed
+// signal), the output of a shuttle, or a work line itself (a node a valve,
+// hose or cylinder has a port on or owns). A volume fed by nothing of that
+// kind (only the pump, a bleed) would hold the pump at its margin above tank
+// pressure whatever the loads: a wiring mistake, not a design. Returns the
+// component index of the first such pump, or -1. (Checked for crane
+// models only: the component tests build LS pumps on held volumes.)
+static int ls_unreached(const hyd_model* m) {
+    const int nc = hyd_model_ncomp(m);
+    for (int c = 0; c < nc; ++c) {
+        if (hyd_model_comp_type(m, c) != HYD_LS_PUMP) continue;
+        const int ls = hyd_model_port_node(m, c, 2);
+        if (ls < 0 || hyd_model_node_role(m, ls) == HYD_NODE_TANK) continue;
+        const int own = hyd_model_node_owner(m, ls);
+        int reached = own >= 0 && hyd_model_comp_type(m, own) != HYD_LS_PUMP;
+        for (int k = 0; k < nc && !reached; ++k) {
+            const hyd_type t = hyd_model_comp_type(m, k);
+            if (t == HYD_SHUTTLE) reached = hyd_model_port_node(m, k, 2) == ls;
+            else if (t == HYD_VALVE || t == HYD_HOSE || t == HYD_CYLINDER)
+                for (int j = 0; j < 4 && !reached; ++j) reached = hyd_model_port_node(m, k, j) == ls;
+        }
+        if (!reached) return c;
+    }
+    return -1;
+}
+
 static const json_range R_GRAVITY = {0, 30, 9.7, 9.9, "m/s^2"};
 static const json_range R_COLUMN_HEIGHT = {0.1, 10, 0.5, 4, "m"};
 static const json_range R_COLUMN_MASS = {1, 1e5, 50, 5000, "kg"};
@@ -154,6 +180,16 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     if (c.failed) goto fail;
     m->hyd = hyd_model_from_json(hyd, file, "hydraulics", err, errsz);
     if (!m->hyd) goto fail;
+    {
+        const int bad = ls_unreached(m->hyd);
+        if (bad >= 0) {
+            char f[64];
+            snprintf(f, sizeof f, "hydraulics.components[%d].ls", bad);
+            json_fail(&c, f, "node '%s' is fed by no shuttle or work line: the LS network does not reach the pump",
+                      hyd_model_node_name(m->hyd, hyd_model_port_node(m->hyd, bad, 2)));
+            goto fail;
+        }
+    }
 
     for (int k = 0; k < 2; ++k) {
         char p[64];

@@ -131,6 +131,10 @@ static const bad_case ls_cases[] = {
      "hydraulics.components[10].pilot_ratio", "must be > 0, got 0"},
     {MODEL, "m_ls_mode.json", ML, "hydraulics.components.lift_comp.mode=2", NULL, NULL,
      "hydraulics.components[4].mode", NULL},
+    // The main shuttle wired into the pump line: the LS line keeps only its
+    // bleed and the sensing ports, so no load pressure reaches the pump.
+    {MODEL, "m_ls_unreached.json", ML, NULL, "\"out\": \"ls_line\"", "\"out\": \"pump_line\"",
+     "hydraulics.components[0].ls", "the LS network does not reach the pump"},
 };
 
 static void test_ls_components(void) {
