@@ -54,7 +54,7 @@ void render_prims_create(render_mesh prims[RENDER_PRIM_COUNT]);
 
 /// A loaded mesh file; ok == false means it failed and the primitive is used.
 typedef struct render_mesh_entry {
-    char key[192];
+    char key[272];
     bool ok;
     render_mesh mesh;
 } render_mesh_entry;

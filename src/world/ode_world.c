@@ -647,6 +647,7 @@ static int destroy_ode(ode_world* w, void* arg) {
     if (w->dyn_space) dSpaceDestroy(w->dyn_space);
     if (w->static_space) dSpaceDestroy(w->static_space);
     if (w->hfield) dGeomHeightfieldDataDestroy(w->hfield);
+    ow_mesh_destroy_data(w); // after the trimesh geoms that use them
     if (w->world) {
         dWorldSetStepThreadingImplementation(w->world, NULL, NULL);
         dWorldDestroy(w->world);
@@ -664,6 +665,7 @@ void ode_world_destroy(ode_world* w) {
     // torn down: then what is left of them is abandoned (a leak, once, at
     // the end of a failed run) rather than aborting.
     ow_trapped(w, "while destroying the world", destroy_ode, NULL);
+    ow_mesh_free(w);
     free(w->terrain);
     free(w);
     ode_release();
@@ -1024,6 +1026,11 @@ static int snapshot_ode(ode_world* w, void* arg) {
             b->mesh_scale = m->scale;
             b->mesh_up = m->up;
             memcpy(b->mesh_offset, m->has_offset ? m->offset : v->mesh_offset, sizeof b->mesh_offset);
+        } else if (v->mesh == OW_VIS_OWN_MESH) {
+            snprintf(b->mesh, sizeof b->mesh, "%s", v->mesh_file);
+            b->mesh_scale = v->mesh_scale;
+            b->mesh_up = v->mesh_up;
+            memcpy(b->mesh_offset, v->mesh_offset, sizeof b->mesh_offset);
         }
     }
     s->nbody = n;

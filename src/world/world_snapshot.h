@@ -51,7 +51,7 @@ typedef struct world_snap_body {
     double rot[9];              ///< body-to-world rotation, row-major 3x3
     double size[3];             ///< primitive dimensions, see world_shape [m]
     float rgba[4];              ///< colour, 0..1
-    char mesh[128];             ///< mesh file (relative to assets/meshes or absolute); "" = primitive
+    char mesh[256];             ///< mesh file (relative to assets/meshes or absolute); "" = primitive
     double mesh_scale;          ///< mesh units to metres (1 for metres, 0.001 for mm)
     int mesh_up;                ///< mesh up axis: 1 = y-up (glTF/OBJ default), 2 = z-up
     double mesh_offset[3];      ///< mesh origin in body frame [m]

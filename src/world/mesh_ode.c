@@ -1,0 +1,148 @@
+// mesh_ode.c: CAD meshes as ODE geoms: static triangle meshes for fixed
+// obstacles and terrain, convex hulls with the closed mesh's mass properties
+// for loose bodies (docs/ode_world.md, "Meshes").
+#include "ode_world_internal.h"
+#include "mesh_geom.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char* coll_path(const world_obj_mesh* om) { return om->collision[0] ? om->collision : om->file; }
+
+static ow_mesh* new_mesh(ode_world* w, char* err, size_t errsz) {
+    if (w->nmesh >= OW_MAX_MESHES) {
+        snprintf(err, errsz, "ode world: more than %d meshes", OW_MAX_MESHES);
+        return NULL;
+    }
+    ow_mesh* m = &w->mesh[w->nmesh++];
+    memset(m, 0, sizeof *m);
+    return m;
+}
+
+dGeomID ow_mesh_trimesh(ode_world* w, dSpaceID space, const world_obj_mesh* om, const double pos[3],
+                        const double R[9], char* err, size_t errsz) {
+    mesh_tri t;
+    char why[256];
+    if (mesh_load(coll_path(om), om->scale, om->up, &t, why, sizeof why)) {
+        snprintf(err, errsz, "%s: %s", coll_path(om), why);
+        return NULL;
+    }
+    ow_mesh* m = new_mesh(w, err, errsz);
+    if (!m) {
+        mesh_free(&t);
+        return NULL;
+    }
+    m->v = t.v;
+    m->nv = t.nv;
+    m->nt = t.nt;
+    m->idx = malloc((size_t)3 * t.nt * sizeof *m->idx);
+    if (!m->idx) {
+        free(t.idx);
+        snprintf(err, errsz, "ode world: out of memory (mesh %s)", coll_path(om));
+        return NULL;
+    }
+    for (int i = 0; i < 3 * t.nt; ++i) m->idx[i] = (dTriIndex)t.idx[i];
+    free(t.idx);
+    m->tmd = dGeomTriMeshDataCreate();
+    dGeomTriMeshDataBuildSingle(m->tmd, m->v, 3 * sizeof(float), m->nv, m->idx, 3 * m->nt, 3 * sizeof(dTriIndex));
+    // Face angles are what ODE's convex-vs-trimesh collider needs (without
+    // them it aborts on the first hull touching the mesh); concave edges
+    // keep box and sphere contacts off the mesh's inner edges.
+    dGeomTriMeshDataPreprocess2(m->tmd,
+                                (1U << dTRIDATAPREPROCESS_BUILD_CONCAVE_EDGES) |
+                                    (1U << dTRIDATAPREPROCESS_BUILD_FACE_ANGLES),
+                                NULL);
+    dGeomID g = dCreateTriMesh(space, m->tmd, NULL, NULL, NULL);
+    dGeomSetPosition(g, pos[0], pos[1], pos[2]);
+    dMatrix3 M;
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) M[4 * i + j] = R[3 * i + j];
+        M[4 * i + 3] = 0;
+    }
+    dGeomSetRotation(g, M);
+    return g;
+}
+
+dGeomID ow_mesh_hull(ode_world* w, dSpaceID space, const world_obj_mesh* om, double mass, dMass* dm, char* err,
+                     size_t errsz) {
+    mesh_tri t;
+    char why[256];
+    if (mesh_load(coll_path(om), om->scale, om->up, &t, why, sizeof why)) {
+        snprintf(err, errsz, "%s: %s", coll_path(om), why);
+        return NULL;
+    }
+    double V, c[3], I[9];
+    if (mesh_mass_props(&t, &V, c, I)) {
+        mesh_free(&t);
+        snprintf(err, errsz, "%s: the mesh encloses no volume", coll_path(om));
+        return NULL;
+    }
+    double* p = malloc((size_t)3 * (t.nv ? t.nv : 1) * sizeof *p);
+    if (!p) {
+        mesh_free(&t);
+        snprintf(err, errsz, "ode world: out of memory (mesh %s)", coll_path(om));
+        return NULL;
+    }
+    // Body frame: the object frame moved to the centre of mass (ODE bodies
+    // have their origin there).
+    for (int i = 0; i < t.nv; ++i)
+        for (int k = 0; k < 3; ++k) p[3 * i + k] = t.v[3 * i + k] - c[k];
+    const int nv = t.nv;
+    mesh_free(&t);
+    mesh_hull h;
+    int rc = mesh_hull_build(p, nv, &h);
+    free(p);
+    if (rc) {
+        snprintf(err, errsz, "%s: the mesh is flat: its convex hull has no volume", coll_path(om));
+        return NULL;
+    }
+    ow_mesh* m = new_mesh(w, err, errsz);
+    if (!m) {
+        mesh_hull_free(&h);
+        return NULL;
+    }
+    m->planes = malloc((size_t)4 * h.nf * sizeof *m->planes);
+    m->points = malloc((size_t)3 * h.nv * sizeof *m->points);
+    m->polys = malloc((size_t)4 * h.nf * sizeof *m->polys);
+    if (!m->planes || !m->points || !m->polys) {
+        mesh_hull_free(&h);
+        snprintf(err, errsz, "ode world: out of memory (mesh %s)", coll_path(om));
+        return NULL;
+    }
+    for (int i = 0; i < 4 * h.nf; ++i) m->planes[i] = h.plane[i];
+    for (int i = 0; i < 3 * h.nv; ++i) m->points[i] = h.v[i];
+    for (int f = 0; f < h.nf; ++f) {
+        m->polys[4 * f] = 3;
+        for (int k = 0; k < 3; ++k) m->polys[4 * f + 1 + k] = (unsigned)h.f[3 * f + k];
+    }
+    m->nv = h.nv;
+    m->nt = h.nf;
+    mesh_hull_free(&h);
+    // Inertia per unit density times the density mass / V.
+    const double rho = mass / V;
+    dMassSetParameters(dm, mass, 0, 0, 0, rho * I[0], rho * I[4], rho * I[8], rho * I[1], rho * I[2], rho * I[5]);
+    return dCreateConvex(space, m->planes, (unsigned)m->nt, m->points, (unsigned)m->nv, m->polys);
+}
+
+void ow_mesh_destroy_data(ode_world* w) {
+    for (int i = 0; i < w->nmesh; ++i)
+        if (w->mesh[i].tmd) {
+            dGeomTriMeshDataDestroy(w->mesh[i].tmd);
+            w->mesh[i].tmd = 0;
+        }
+}
+
+void ow_mesh_free(ode_world* w) {
+    for (int i = 0; i < w->nmesh; ++i) {
+        ow_mesh* m = &w->mesh[i];
+        free(m->v);
+        free(m->idx);
+        free(m->planes);
+        free(m->points);
+        free(m->polys);
+        memset(m, 0, sizeof *m);
+    }
+    w->nmesh = 0;
+}
