@@ -40,11 +40,15 @@ dGeomID ow_mesh_trimesh(ode_world* w, dSpaceID space, const world_obj_mesh* om, 
     m->idx = malloc((size_t)3 * t.nt * sizeof *m->idx);
     if (!m->idx) {
         free(t.idx);
+        w->nmesh--;
+        free(m->v);
         snprintf(err, errsz, "ode world: out of memory (mesh %s)", coll_path(om));
         return NULL;
     }
     for (int i = 0; i < 3 * t.nt; ++i) m->idx[i] = (dTriIndex)t.idx[i];
-    free(t.idx);
+    m->di = t.idx; // kept for the debug view
+    m->dv = malloc((size_t)3 * (t.nv ? t.nv : 1) * sizeof *m->dv);
+    if (m->dv) memcpy(m->dv, t.v, (size_t)3 * t.nv * sizeof *m->dv);
     m->tmd = dGeomTriMeshDataCreate();
     dGeomTriMeshDataBuildSingle(m->tmd, m->v, 3 * sizeof(float), m->nv, m->idx, 3 * m->nt, 3 * sizeof(dTriIndex));
     // Face angles are what ODE's convex-vs-trimesh collider needs (without
@@ -111,6 +115,11 @@ dGeomID ow_mesh_hull(ode_world* w, dSpaceID space, const world_obj_mesh* om, dou
         snprintf(err, errsz, "ode world: out of memory (mesh %s)", coll_path(om));
         return NULL;
     }
+    m->dv = malloc((size_t)3 * h.nv * sizeof *m->dv);
+    m->di = malloc((size_t)3 * h.nf * sizeof *m->di);
+    if (m->dv)
+        for (int i = 0; i < 3 * h.nv; ++i) m->dv[i] = (float)h.v[i];
+    if (m->di) memcpy(m->di, h.f, (size_t)3 * h.nf * sizeof *m->di);
     for (int i = 0; i < 4 * h.nf; ++i) m->planes[i] = h.plane[i];
     for (int i = 0; i < 3 * h.nv; ++i) m->points[i] = h.v[i];
     for (int f = 0; f < h.nf; ++f) {
@@ -142,7 +151,60 @@ void ow_mesh_free(ode_world* w) {
         free(m->planes);
         free(m->points);
         free(m->polys);
+        free(m->dv);
+        free(m->di);
         memset(m, 0, sizeof *m);
     }
     w->nmesh = 0;
+}
+
+void ow_collision_snapshot(const ode_world* w, world_snapshot* s) {
+    int n = 0;
+    for (int i = 0; i < w->ngeom && n < WORLD_SNAP_MAX_COLL; ++i) {
+        const ow_geom* e = &w->geom[i];
+        world_snap_coll* c = &s->coll[n];
+        memset(c, 0, sizeof *c);
+        const int cls = dGeomGetClass(e->g);
+        dVector3 v;
+        dReal r, l;
+        switch (cls) {
+        case dBoxClass:
+            c->shape = WORLD_SHAPE_BOX;
+            dGeomBoxGetLengths(e->g, v);
+            c->size[0] = v[0], c->size[1] = v[1], c->size[2] = v[2];
+            break;
+        case dSphereClass:
+            c->shape = WORLD_SHAPE_SPHERE;
+            c->size[0] = dGeomSphereGetRadius(e->g);
+            break;
+        case dCapsuleClass:
+            c->shape = WORLD_SHAPE_CAPSULE;
+            dGeomCapsuleGetParams(e->g, &r, &l);
+            c->size[0] = r, c->size[1] = l;
+            break;
+        case dCylinderClass:
+            c->shape = WORLD_SHAPE_CYLINDER;
+            dGeomCylinderGetParams(e->g, &r, &l);
+            c->size[0] = r, c->size[1] = l;
+            break;
+        case dTriMeshClass:
+        case dConvexClass: {
+            if (e->mesh < 0 || !w->mesh[e->mesh].dv || !w->mesh[e->mesh].di) continue;
+            const ow_mesh* m = &w->mesh[e->mesh];
+            c->shape = WORLD_SHAPE_TERRAIN;
+            c->v = m->dv, c->idx = m->di, c->nv = m->nv, c->nt = m->nt;
+            break;
+        }
+        default:
+            continue; // the heightfield is drawn as the terrain already
+        }
+        const dReal* p = dGeomGetPosition(e->g);
+        const dReal* R = dGeomGetRotation(e->g);
+        for (int k = 0; k < 3; ++k) {
+            c->pos[k] = p[k];
+            for (int j = 0; j < 3; ++j) c->rot[3 * k + j] = R[4 * k + j];
+        }
+        ++n;
+    }
+    s->ncoll = n;
 }

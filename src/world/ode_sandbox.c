@@ -357,7 +357,8 @@ static dBodyID mesh_body(ode_world* w, const char* name, world_role role, const 
     dBodySetPosition(b, pos[0] + rc[0], pos[1] + rc[1], pos[2] + rc[2]);
     set_rot(b, R);
     dGeomSetBody(g, b);
-    ow_add_geom(w, g, cat, friction);
+    ow_geom* e = ow_add_geom(w, g, cat, friction);
+    if (e) e->mesh = w->nmesh - 1;
     const double org[3] = {-om->com[0], -om->com[1], -om->com[2]};
     mesh_vis(w, name, role, rgba, om, b, org, NULL);
     allow_sleep(b);
@@ -411,7 +412,8 @@ static int build_obstacles(ode_world* w, char* err, size_t errsz) {
             } else {
                 dGeomID g = ow_mesh_trimesh(w, w->static_space, &o->mesh, o->position, R, err, errsz);
                 if (!g) return -1;
-                ow_add_geom(w, g, OW_CAT_OBST, o->friction);
+                ow_geom* e = ow_add_geom(w, g, OW_CAT_OBST, o->friction);
+                if (e) e->mesh = w->nmesh - 1;
                 mesh_vis(w, o->name, WORLD_ROLE_OBSTACLE, col, &o->mesh, 0, o->position, R);
             }
         } else if (o->mass > 0) {
@@ -447,7 +449,8 @@ static int build_terrain_mesh(ode_world* w, char* err, size_t errsz) {
     ow_rot_z(t->mesh_yaw, R);
     dGeomID g = ow_mesh_trimesh(w, w->static_space, &t->mesh, t->mesh_pos, R, err, errsz);
     if (!g) return -1;
-    ow_add_geom(w, g, OW_CAT_TERRAIN, t->friction);
+    ow_geom* e = ow_add_geom(w, g, OW_CAT_TERRAIN, t->friction);
+    if (e) e->mesh = w->nmesh - 1;
     mesh_vis(w, "terrain_mesh", WORLD_ROLE_OTHER, RGBA_TERRAIN, &t->mesh, 0, t->mesh_pos, R);
     return 0;
 }

@@ -206,6 +206,7 @@ ow_geom* ow_add_geom(ode_world* w, dGeomID g, uint32_t cat, double friction) {
     e->g = g;
     e->cat = cat;
     e->friction = friction;
+    e->mesh = -1;
     dGeomSetData(g, e);
     return e;
 }
@@ -1068,6 +1069,7 @@ static int snapshot_ode(ode_world* w, void* arg) {
     s->load_mass = w->kind == WORLD_VALIDATION ? w->m3 : 0;
     if (w->hm && w->ipump >= 0) s->p_supply = w->y[w->ipump];
     if (w->kind == WORLD_SANDBOX) ow_sandbox_snapshot(w, s);
+    ow_collision_snapshot(w, s);
     if (w->hm) {
         // Open reliefs by name, and on the cylinder whose chamber each
         // guards: snapshot cylinders are lift, jib, then the sandbox's slew.

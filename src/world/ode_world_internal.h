@@ -35,6 +35,7 @@ typedef struct ow_geom {
     dGeomID g;
     uint32_t cat;     ///< OW_CAT_*
     double friction;  ///< Coulomb coefficient [-]; a pair uses the geometric mean
+    int mesh;         ///< index into ode_world.mesh for trimesh and hull geoms, else -1
 } ow_geom;
 
 /// Mesh data ODE keeps pointers to while its geoms live (mesh_ode.c).
@@ -46,6 +47,8 @@ typedef struct ow_mesh {
     dReal* planes;       ///< hull planes (nx, ny, nz, d), body frame
     dReal* points;       ///< hull vertices, body frame [m]
     unsigned* polys;     ///< hull polygons (3, a, b, c)
+    float* dv;           ///< the shape's triangles for the debug view: vertices in the geom frame [m]
+    int* di;             ///< and indices (nv, nt of them)
 } ow_mesh;
 #define OW_MAX_MESHES (WORLD_DESC_MAX_LOADS + WORLD_DESC_MAX_OBSTACLES + 1)
 /// ow_vis.mesh: the entry draws its own mesh file (ow_vis.mesh_file).
@@ -241,6 +244,8 @@ dGeomID ow_mesh_hull(ode_world* w, dSpaceID space, const world_obj_mesh* om, dou
 /// Destroy the trimesh data (inside ODE's trap) and free the arrays.
 void ow_mesh_destroy_data(ode_world* w);
 void ow_mesh_free(ode_world* w);
+/// The collision shapes into the snapshot (debug view).
+void ow_collision_snapshot(const ode_world* w, world_snapshot* s);
 
 // ode_coupling.c
 int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz);

@@ -18,6 +18,7 @@ extern "C" {
 #define WORLD_SNAP_MAX_ROPE 32
 #define WORLD_SNAP_NAME 48
 #define WORLD_SNAP_MAX_RELIEFS 8
+#define WORLD_SNAP_MAX_COLL 256
 
 /// Primitive shape used when a body has no mesh or its mesh failed to load.
 typedef enum world_shape {
@@ -85,6 +86,19 @@ typedef struct world_snap_terrain {
     double dx, dy;       ///< spacing [m]
 } world_snap_terrain;
 
+/// A collision shape as the physics sees it (the debug view draws these over
+/// the scene). Mesh shapes point at triangles the world owns (valid while it
+/// lives, like the terrain heights).
+typedef struct world_snap_coll {
+    world_shape shape;     ///< BOX, SPHERE, CAPSULE, CYLINDER (size as in world_shape), or TERRAIN for a mesh
+    double pos[3];         ///< geom origin in world [m]
+    double rot[9];         ///< geom-to-world rotation, row-major
+    double size[3];        ///< see world_shape [m]
+    const float* v;        ///< mesh: 3 nv coordinates in the geom frame [m]
+    const int* idx;        ///< mesh: 3 nt indices
+    int nv, nt;
+} world_snap_coll;
+
 typedef struct world_snapshot {
     double t;              ///< simulated time [s]
     double rt_factor;      ///< measured simulated/wall time ratio, 0 if unknown
@@ -110,6 +124,8 @@ typedef struct world_snapshot {
     /// The snapshot cylinder each open relief guards (index into cyl[]), or -1
     /// (a pump-line relief), and the chamber: 0 = A, 1 = B.
     int relief_cyl[WORLD_SNAP_MAX_RELIEFS], relief_port[WORLD_SNAP_MAX_RELIEFS];
+    int ncoll;                                  ///< collision shapes (0: the world gives none)
+    world_snap_coll coll[WORLD_SNAP_MAX_COLL];
 } world_snapshot;
 
 #ifdef __cplusplus
