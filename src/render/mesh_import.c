@@ -36,7 +36,7 @@ int render_mesh_import(const char* path, mesh_tri* out, char* err, size_t errsz)
     }
     if (nt > MESH_MAX_TRIANGLES) {
         aiReleaseImport(sc);
-        snprintf(err, errsz, "more than %d triangles (%zu; docs/ode_world.md, \"Meshes\")", MESH_MAX_TRIANGLES, nt);
+        snprintf(err, errsz, "more than %d triangles (%zu; docs/ode_world.md, \"CAD meshes\")", MESH_MAX_TRIANGLES, nt);
         return -1;
     }
     out->v = malloc((nv ? nv : 1) * 3 * sizeof *out->v);

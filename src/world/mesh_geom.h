@@ -7,7 +7,7 @@
 // its identical vertices are welded (STL repeats them per facet) and its
 // degenerate triangles are dropped. On it: closedness, volume, centre of
 // mass and inertia (divergence theorem), and the convex hull for loose bodies.
-// See docs/ode_world.md, "Meshes".
+// See docs/ode_world.md, "CAD meshes".
 #ifndef MESH_GEOM_H
 #define MESH_GEOM_H
 

@@ -36,7 +36,12 @@ static int grow(void** p, int* cap, int need, size_t elem) {
     return 0;
 }
 
+// More vertices than 3 per allowed triangle cannot be a mesh within the
+// limit; stop there so a huge file is refused without reading it into memory.
+#define MESH_MAX_VERTICES (3 * MESH_MAX_TRIANGLES + 3)
+
 static int add_vertex(mesh_tri* m, int* cap, float x, float y, float z) {
+    if (m->nv >= MESH_MAX_VERTICES) return -2;
     if (grow((void**)&m->v, cap, 3 * (m->nv + 1), sizeof(float))) return -1;
     m->v[3 * m->nv] = x, m->v[3 * m->nv + 1] = y, m->v[3 * m->nv + 2] = z;
     return m->nv++;
@@ -72,7 +77,9 @@ static int read_obj(FILE* f, mesh_tri* m, char* err, size_t errsz) {
                 snprintf(err, errsz, "line %d: vertex coordinates must be finite", lineno);
                 return -1;
             }
-            if (add_vertex(m, &vcap, (float)x, (float)y, (float)z) < 0) goto oom;
+            const int r = add_vertex(m, &vcap, (float)x, (float)y, (float)z);
+            if (r == -2) goto too_big;
+            if (r < 0) goto oom;
         } else if (s[0] == 'f' && (s[1] == ' ' || s[1] == '\t')) {
             int ids[2], k = 0;
             char* p = s + 2;
@@ -102,6 +109,10 @@ static int read_obj(FILE* f, mesh_tri* m, char* err, size_t errsz) {
         }
     }
     return 0;
+too_big:
+    snprintf(err, errsz, "more than %d vertices (the limit is %d triangles; docs/ode_world.md, \"CAD meshes\")",
+             MESH_MAX_VERTICES, MESH_MAX_TRIANGLES);
+    return -1;
 oom:
     snprintf(err, errsz, "out of memory");
     return -1;
@@ -127,7 +138,7 @@ static int read_stl(FILE* f, mesh_tri* m, char* err, size_t errsz) {
         uint32_t n = (uint32_t)head[80] | (uint32_t)head[81] << 8 | (uint32_t)head[82] << 16 | (uint32_t)head[83] << 24;
         if ((uint64_t)size == 84 + 50ull * n) {
             if (n > MESH_MAX_TRIANGLES) {
-                snprintf(err, errsz, "more than %d triangles (%u; docs/ode_world.md, \"Meshes\")",
+                snprintf(err, errsz, "more than %d triangles (%u; docs/ode_world.md, \"CAD meshes\")",
                          MESH_MAX_TRIANGLES, n);
                 return -1;
             }
@@ -161,7 +172,11 @@ static int read_stl(FILE* f, mesh_tri* m, char* err, size_t errsz) {
             snprintf(err, errsz, "a vertex line needs three finite numbers");
             return -1;
         }
-        if ((id[k++] = add_vertex(m, &vcap, (float)x, (float)y, (float)z)) < 0) goto oom;
+        if ((id[k] = add_vertex(m, &vcap, (float)x, (float)y, (float)z)) == -2) {
+            snprintf(err, errsz, "more than %d triangles (docs/ode_world.md, \"CAD meshes\")", MESH_MAX_TRIANGLES);
+            return -1;
+        }
+        if (id[k++] < 0) goto oom;
         if (k == 3) {
             if (add_tri(m, &tcap, id[0], id[1], id[2])) goto oom;
             k = 0;
@@ -287,7 +302,7 @@ int mesh_load(const char* path, double scale, int up, mesh_tri* out, char* err, 
         }
     }
     if (rc == 0 && out->nt > MESH_MAX_TRIANGLES) {
-        snprintf(err, errsz, "more than %d triangles (docs/ode_world.md, \"Meshes\")", MESH_MAX_TRIANGLES);
+        snprintf(err, errsz, "more than %d triangles (docs/ode_world.md, \"CAD meshes\")", MESH_MAX_TRIANGLES);
         rc = -1;
     }
     if (rc == 0 && out->nt == 0) {

@@ -1,6 +1,6 @@
 // mesh_ode.c: CAD meshes as ODE geoms: static triangle meshes for fixed
 // obstacles and terrain, convex hulls with the closed mesh's mass properties
-// for loose bodies (docs/ode_world.md, "Meshes").
+// for loose bodies (docs/ode_world.md, "CAD meshes").
 #include "ode_world_internal.h"
 #include "mesh_geom.h"
 
