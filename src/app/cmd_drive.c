@@ -456,7 +456,8 @@ int cmd_drive(int argc, char** argv) {
 #else
     (void)scripted, (void)width, (void)height, (void)shot_at, (void)rate_given;
     // Without the render module these options have nothing to act on.
-    const char* needs = shot ? "--screenshot" : mapping ? "--mapping" : charts ? "--charts" : readouts ? "--readouts" : NULL;
+    const char* needs = shot ? "--screenshot" : mapping ? "--mapping" : charts ? "--charts" : readouts ? "--readouts"
+                        : collision_view ? "--collision-view" : NULL;
     if (needs) {
         fprintf(stderr, "cranesim drive: %s needs the render module (built without SDL2/GL)\n", needs);
         return EXIT_USAGE;
