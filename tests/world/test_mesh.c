@@ -312,6 +312,17 @@ static void test_box_vs_mesh_box(void) {
     snprintf(obst, sizeof obst,
              "[{\"name\": \"b\", \"kind\": \"box\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-4, -10]}]", path);
     slide_path(obst, pb, &yb);
+    // Turned by -35 deg (both the same way): the mesh turns with its yaw.
+    double qa[3], qb[3], za, zb;
+    slide_path("[{\"name\": \"b\", \"kind\": \"box\", \"size\": [4, 1, 1], \"position\": [-4, -10], "
+               "\"yaw_deg\": -35}]", qa, &za);
+    snprintf(obst, sizeof obst,
+             "[{\"name\": \"b\", \"kind\": \"box\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-4, -10], "
+             "\"yaw_deg\": -35}]", path);
+    slide_path(obst, qb, &zb);
+    CHECK(hypot(qa[0] - pa[0], qa[1] - pa[1]) > 0.05, "the turned block changes the path (%.3f %.3f vs %.3f %.3f)", qa[0], qa[1], pa[0], pa[1]);
+    CHECK_NEAR(qb[0], qa[0], 0.02);
+    CHECK_NEAR(qb[1], qa[1], 0.02);
     // The load stops against the block's face at y = -9.5 (its half width
     // 0.3 m): it must not pass it, and both paths agree.
     CHECK(ya > -9.5 + 0.25 && yb > -9.5 + 0.25, "stopped at the face: box %.3f, mesh %.3f", ya, yb);
