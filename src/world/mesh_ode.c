@@ -208,3 +208,29 @@ void ow_collision_snapshot(const ode_world* w, world_snapshot* s) {
     }
     s->ncoll = n;
 }
+
+int ow_mesh_merge_contacts(dContactGeom* c, int n, double radius) {
+    // Deepest first, so each cluster keeps its deepest point.
+    for (int i = 0; i < n; ++i) {
+        int b = i;
+        for (int j = i + 1; j < n; ++j)
+            if (c[j].depth > c[b].depth) b = j;
+        if (b != i) {
+            const dContactGeom t = c[i];
+            c[i] = c[b];
+            c[b] = t;
+        }
+    }
+    int keep = 0;
+    for (int i = 0; i < n; ++i) {
+        int dup = 0;
+        for (int k = 0; k < keep && !dup; ++k) {
+            const double dx = c[i].pos[0] - c[k].pos[0], dy = c[i].pos[1] - c[k].pos[1], dz = c[i].pos[2] - c[k].pos[2];
+            const double dot = c[i].normal[0] * c[k].normal[0] + c[i].normal[1] * c[k].normal[1] +
+                               c[i].normal[2] * c[k].normal[2];
+            dup = dx * dx + dy * dy + dz * dz < radius * radius && dot > 0.9;
+        }
+        if (!dup) c[keep++] = c[i];
+    }
+    return keep;
+}

@@ -617,6 +617,8 @@ static void near_cb(void* data, dGeomID g1, dGeomID g2) {
     if (max > (int)(sizeof w->cbuf / sizeof w->cbuf[0])) max = (int)(sizeof w->cbuf / sizeof w->cbuf[0]);
     int n = dCollide(g1, g2, max, w->cbuf, sizeof(dContactGeom));
     if (n <= 0) return;
+    if (n > 1 && (dGeomGetClass(g1) == dTriMeshClass || dGeomGetClass(g2) == dTriMeshClass))
+        n = ow_mesh_merge_contacts(w->cbuf, n, OW_MESH_MERGE_RADIUS);
     double mu = sqrt(a->friction * b->friction);
     int crane = a->cat == OW_CAT_CRANE || b->cat == OW_CAT_CRANE;
     for (int i = 0; i < n; ++i) {

@@ -51,6 +51,9 @@ typedef struct ow_mesh {
     int* di;             ///< and indices (nv, nt of them)
 } ow_mesh;
 #define OW_MAX_MESHES (WORLD_DESC_MAX_LOADS + WORLD_DESC_MAX_OBSTACLES + 1)
+/// Trimesh contacts closer than this are one (ow_mesh_merge_contacts) [m]:
+/// well under a load's or a boom's width, so a face keeps its corners.
+#define OW_MESH_MERGE_RADIUS 0.1
 /// ow_vis.mesh: the entry draws its own mesh file (ow_vis.mesh_file).
 #define OW_VIS_OWN_MESH (-2)
 
@@ -244,6 +247,10 @@ dGeomID ow_mesh_hull(ode_world* w, dSpaceID space, const world_obj_mesh* om, dou
 /// Destroy the trimesh data (inside ODE's trap) and free the arrays.
 void ow_mesh_destroy_data(ode_world* w);
 void ow_mesh_free(ode_world* w);
+/// Merge a trimesh pair's contacts closer than radius [m] with nearly the same
+/// normal into the deepest of them (ODE gives one per touched triangle, and
+/// each contact is three more rows in the island's LCP). Returns the count.
+int ow_mesh_merge_contacts(dContactGeom* c, int n, double radius);
 /// The collision shapes into the snapshot (debug view).
 void ow_collision_snapshot(const ode_world* w, world_snapshot* s);
 
