@@ -8,6 +8,7 @@
 #include "circuit_fast.h"
 #include "engine.h"
 #include "loadchart.h"
+#include "json_util.h"
 #include "ode_world.h"
 #ifdef CRANESIM_HAVE_RENDER
 #include "drive_session.h"
@@ -57,6 +58,9 @@ static void bench_help(FILE* f) {
             "               (--seed N, default 1)\n"
             "  loadchart    not in the default set: the load chart of the model on the sandbox truck,\n"
             "               50 outreach points, 8 slew sectors (--repeat runs, median wall time)\n"
+            "  mesh-50k     not in the default set: sandbox_wall (the boom pushed into the radial\n"
+            "               wall) at ODE 1 ms with the wall as a box and as a 50,000-triangle\n"
+            "               mesh of the same shape, in one run: both real-time factors and their ratio\n"
             "  circuit-sizes  not in the default set: one circuit evaluation (fast kernel, reference)\n"
             "               on synthetic circuits of 1, 2, 4, 8, 16 actuators, ns per eval and per state\n"
             "  sweep        not in the default set: cranesim sweep of 64 designs of the scenario (lift\n"
@@ -435,6 +439,108 @@ static int bench_ls(const app_common* c, const scenario* sc, int repeat) {
     return rc;
 }
 
+// ---- mesh-50k: a 50,000-triangle CAD obstacle against the same box ----
+
+// Write the sandbox's radial wall (2.5 x 0.3 x 4.5 m, origin at its foot)
+// as an OBJ with every face cut into cells of about cell metres: two
+// triangles a cell. Returns the triangles written, or -1.
+static long write_dense_wall(const char* path, double cell) {
+    FILE* f = fopen(path, "w");
+    if (!f) return -1;
+    const double lo[3] = {-1.25, -0.15, 0}, hi[3] = {1.25, 0.15, 4.5};
+    long nv = 0, nt = 0;
+    // Faces: fixed axis a at lo or hi, spanned by axes u, v.
+    for (int a = 0; a < 3; ++a)
+        for (int side = 0; side < 2; ++side) {
+            const int u = (a + 1) % 3, v = (a + 2) % 3;
+            const int nu = (int)ceil((hi[u] - lo[u]) / cell), nvv = (int)ceil((hi[v] - lo[v]) / cell);
+            const long base = nv;
+            for (int j = 0; j <= nvv; ++j)
+                for (int i = 0; i <= nu; ++i) {
+                    double p[3];
+                    p[a] = side ? hi[a] : lo[a];
+                    p[u] = lo[u] + (hi[u] - lo[u]) * i / nu;
+                    p[v] = lo[v] + (hi[v] - lo[v]) * j / nvv;
+                    fprintf(f, "v %.6f %.6f %.6f\n", p[0], p[1], p[2]);
+                    ++nv;
+                }
+            for (int j = 0; j < nvv; ++j)
+                for (int i = 0; i < nu; ++i) {
+                    const long q = base + (long)j * (nu + 1) + i + 1; // OBJ counts from 1
+                    const long r = q + nu + 1;
+                    // u x v is +a: wind outward on the hi side, reversed on the lo side.
+                    if (side) fprintf(f, "f %ld %ld %ld\nf %ld %ld %ld\n", q, q + 1, r + 1, q, r + 1, r);
+                    else fprintf(f, "f %ld %ld %ld\nf %ld %ld %ld\n", q, r + 1, q + 1, q, r, r + 1);
+                    nt += 2;
+                }
+        }
+    fclose(f);
+    return nt;
+}
+
+static int bench_mesh(const app_common* c, const model* m, int repeat) {
+    char dir[] = "/tmp/cranesim_bench_meshXXXXXX", obj[128], wpath[128], err[512], sbuf[512];
+    if (!mkdtemp(dir)) {
+        printf("{\"config\":\"mesh-50k\",\"error\":\"cannot make a temporary folder\"}\n");
+        return -1;
+    }
+    snprintf(obj, sizeof obj, "%s/wall_50k.obj", dir);
+    snprintf(wpath, sizeof wpath, "%s/sandbox_mesh_wall.json", dir);
+    const long ntri = write_dense_wall(obj, 0.0327);
+    char wbuf[512];
+    cJSON* root = ntri > 0 ? json_load_file(sim_world_path("sandbox", wbuf, sizeof wbuf), err, sizeof err) : NULL;
+    int rc = -1;
+    if (root) {
+        // wall_slew (the first obstacle) as the mesh: same place, same shape.
+        cJSON* wall = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(root, "obstacles"), 0);
+        cJSON_DeleteItemFromObjectCaseSensitive(wall, "size");
+        cJSON_AddItemToArray(cJSON_GetObjectItemCaseSensitive(wall, "position"), cJSON_CreateNumber(0));
+        cJSON_AddStringToObject(cJSON_AddObjectToObject(wall, "mesh"), "file", obj);
+        char* text = cJSON_Print(root);
+        FILE* f = text ? fopen(wpath, "w") : NULL;
+        if (f) {
+            fputs(text, f);
+            fclose(f);
+            rc = 0;
+        }
+        free(text);
+        cJSON_Delete(root);
+    }
+    scenario sc;
+    if (rc || scenario_load(app_scenario_path("sandbox_wall", sbuf, sizeof sbuf), &sc, err, sizeof err)) {
+        printf("{\"config\":\"mesh-50k\",\"error\":\"cannot set up the mesh world\"}\n");
+        rc = -1;
+    }
+    double rt[2] = {0, 0};
+    for (int k = 0; k < 2 && rc == 0; ++k) {
+        const bench_cfg b = {"mesh-50k", HYD_KRUS, 1e-4, false, 0, SIM_ODE, k ? wpath : "sandbox", 1e-3, NULL};
+        sim_opts o = bench_opts(&c->sim, &b);
+        double walls[100];
+        sim_result r;
+        for (int i = 0; i < repeat; ++i) {
+            sim_run(m, &sc, &o, NULL, NULL, NULL, NULL, NULL, &r);
+            walls[i] = r.wall;
+            if (r.status) break;
+        }
+        if (r.status) {
+            printf("{\"config\":\"mesh-50k\",\"error\":\"%s\"}\n", r.message);
+            rc = -1;
+            break;
+        }
+        const double wall = app_median(walls, repeat);
+        rt[k] = r.t_end / wall;
+        printf("{\"config\":\"mesh-50k\",\"scenario\":\"sandbox_wall\",\"obstacle\":\"%s\",\"triangles\":%ld,"
+               "\"dt_ode_s\":0.001,\"sim_time_s\":%.6g,\"wall_s_median\":%.6g,\"repeat\":%d,\"rt_factor\":%.1f}\n",
+               k ? "mesh" : "box", k ? ntri : 12L, r.t_end, wall, repeat, rt[k]);
+        fflush(stdout);
+    }
+    if (rc == 0) printf("{\"config\":\"mesh-50k\",\"rt_factor_mesh_over_box\":%.3f}\n", rt[1] / rt[0]);
+    remove(obj);
+    remove(wpath);
+    rmdir(dir);
+    return rc;
+}
+
 // krus-length: the cost of a step against the length of the run. Spool
 // states used to decay into subnormal numbers some 20 s after their valve
 // closed and stay there, which made every later step dearer (issue 13: 280
@@ -592,7 +698,7 @@ int cmd_bench(int argc, char** argv) {
         fprintf(stderr, "cranesim bench: unknown option '%s' (see cranesim bench --help)\n", argv[i]);
         return EXIT_USAGE;
     }
-    bool want_drive = nonly == 0, want_length = nonly == 0, want_soak = false, want_ls = false;
+    bool want_drive = nonly == 0, want_length = nonly == 0, want_soak = false, want_ls = false, want_mesh = false;
     for (int j = 0; j < nonly; ++j) {
         if (!strcmp(only[j], "drive")) {
             want_drive = true;
@@ -608,6 +714,10 @@ int cmd_bench(int argc, char** argv) {
         }
         if (!strcmp(only[j], "ls")) {
             want_ls = true;
+            continue;
+        }
+        if (!strcmp(only[j], "mesh-50k")) {
+            want_mesh = true;
             continue;
         }
         if (!strcmp(only[j], "sweep")) {
@@ -695,6 +805,7 @@ int cmd_bench(int argc, char** argv) {
     }
     if (want_length && bench_length(&c, m, &sc, repeat)) code = EXIT_RUNTIME;
     if (want_ls && bench_ls(&c, &sc, repeat)) code = EXIT_RUNTIME;
+    if (want_mesh && bench_mesh(&c, m, repeat)) code = EXIT_RUNTIME;
     model_free(m);
     if (want_soak) {
         const int scode = bench_soak(&c, c.sim.duration > 0 ? c.sim.duration : 600.0, seed);

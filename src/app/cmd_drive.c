@@ -62,6 +62,8 @@ static void drive_help(FILE* f) {
             "  --screenshot FILE   save a PNG of the view at --screenshot-at seconds and stop\n"
             "                      (offscreen when there is no display)\n"
             "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
+            "  --collision-view    window: start with the collision shapes drawn over the scene\n"
+            "                      (what the physics hits; G toggles it)\n"
             "  --save-as FILE      window: the panel's \"save model\" writes FILE (default: a new\n"
             "                      cranesim_model_N.json each time, never an existing file)\n"
             "  --size WxH          window size in pixels (default 1280x720)\n"
@@ -80,7 +82,7 @@ static void drive_help(FILE* f) {
             "(--solver cvode and --every do not apply to drive: it steps in real time and records one\n"
             "row per command update)\n"
             "keys: arrows = lift, W/S = jib, A/D = slew, H = hook, Tab = parameter panel, P = pause, R = reset,\n"
-            "      C / F1..F4 = camera, F5 = record CSV, F12 = screenshot, Esc = quit;\n"
+            "      C / F1..F4 = camera, G = collision shapes, F5 = record CSV, F12 = screenshot, Esc = quit;\n"
             "      hold Shift for fine mode (the keys command 25 %% of full opening)\n");
 }
 
@@ -360,6 +362,7 @@ int cmd_drive(int argc, char** argv) {
     const char* charts = NULL;
     const char* readouts = NULL;
     const char* save_as = NULL;
+    bool collision_view = false;
     int width = 1280, height = 720;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -408,6 +411,10 @@ int cmd_drive(int argc, char** argv) {
         }
         if (!strcmp(argv[i], "--save-as") && i + 1 < argc) {
             save_as = argv[++i];
+            continue;
+        }
+        if (!strcmp(argv[i], "--collision-view")) {
+            collision_view = true;
             continue;
         }
         if (!strcmp(argv[i], "--screenshot") && i + 1 < argc) {
@@ -497,6 +504,7 @@ int cmd_drive(int argc, char** argv) {
     o.session_path = session_path;
     o.replay_path = replay;
     o.save_as = save_as;
+    o.collision_view = collision_view;
     o.world_name = c.sim.mechanics == SIM_ODE ? wname : NULL;
     int rc = drive_opts_check(&c, &o, err, sizeof err);
     if (rc) {
@@ -532,7 +540,8 @@ int cmd_drive(int argc, char** argv) {
 #else
     (void)scripted, (void)width, (void)height, (void)shot_at, (void)rate_given;
     // Without the render module these options have nothing to act on.
-    const char* needs = shot ? "--screenshot" : mapping ? "--mapping" : charts ? "--charts" : readouts ? "--readouts" : NULL;
+    const char* needs = shot ? "--screenshot" : mapping ? "--mapping" : charts ? "--charts" : readouts ? "--readouts"
+                        : collision_view ? "--collision-view" : NULL;
     if (needs) {
         fprintf(stderr, "cranesim drive: %s needs the render module (built without SDL2/GL)\n", needs);
         return EXIT_USAGE;

@@ -931,6 +931,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     snprintf(asset_dir, sizeof asset_dir, "%s/meshes", model_assets_dir());
     rc.asset_dir = asset_dir;
     s->r = render_create(&rc, err, errsz);
+    if (s->r && o->collision_view) render_show_collision(s->r, true);
     if (!s->r) {
         // No screen to open a window on: the caller may run headless
         // instead. A window or GL context that fails on a real display is a

@@ -45,6 +45,7 @@ typedef struct drive_opts {
     const char* replay_path;  ///< drive by this session's commands instead of the devices, or NULL
     const char* save_as;      ///< "save model" writes (and replaces) this file; NULL: a new
                               ///< cranesim_model_N.json each time (drive_save_name)
+    bool collision_view;      ///< start with the collision shapes drawn over the scene (key G toggles)
 } drive_opts;
 
 drive_opts drive_default_opts(void);

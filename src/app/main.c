@@ -1,5 +1,9 @@
 // main.c: the cranesim command line.
 #include "app.h"
+#include "mesh_geom.h"
+#ifdef CRANESIM_HAVE_RENDER
+#include "render.h"
+#endif
 
 #include <string.h>
 
@@ -54,6 +58,11 @@ static int (*find_command(const char* name))(int, char**) {
 
 int main(int argc, char** argv) {
     app_name_params();
+#ifdef CRANESIM_HAVE_RENDER
+    // World meshes in glTF, Collada, FBX... come through assimp (the core
+    // reads OBJ and STL itself).
+    mesh_set_importer(render_mesh_import);
+#endif
     if (argc < 2) {
         usage(stderr);
         return EXIT_USAGE;

@@ -77,6 +77,9 @@ void render_destroy(render* r) {
     free(r);
 }
 
+void render_show_collision(render* r, bool on) { r->scene.show_collision = on; }
+bool render_collision_shown(const render* r) { return r->scene.show_collision; }
+
 bool render_handle_event(render* r, const SDL_Event* ev) {
     if (r->panel_gui && panel_gui_event(r->panel, ev)) return true;
     if (ev->type == SDL_WINDOWEVENT && ev->window.event == SDL_WINDOWEVENT_SIZE_CHANGED &&
@@ -84,6 +87,11 @@ bool render_handle_event(render* r, const SDL_Event* ev) {
         int w, h;
         SDL_GL_GetDrawableSize(r->win, &w, &h);
         render_targets_resize(r, w, h);
+        return true;
+    }
+    // G: the collision shapes over the scene (what the physics hits).
+    if (ev->type == SDL_KEYDOWN && !ev->key.repeat && ev->key.keysym.scancode == SDL_SCANCODE_G) {
+        r->scene.show_collision = !r->scene.show_collision;
         return true;
     }
     return render_camera_event(&r->cam, ev);

@@ -259,6 +259,17 @@ void render_demo_scene(world_snapshot* snap, const render_demo_params* p, float*
 /// Terrain grid used by render_demo_scene (65 x 65 samples).
 #define RENDER_DEMO_TERRAIN_N 65
 
+/// The debug view (key G): the snapshot's collision shapes drawn as
+/// wireframes over the scene.
+void render_show_collision(render* r, bool on);
+bool render_collision_shown(const render* r);
+
+/// The physics core's importer (world/mesh_geom.h, mesh_set_importer) for
+/// the formats it does not read itself: glTF/GLB, Collada, FBX, ... through
+/// assimp. Fills out (the file's own units and axes); 0, or -1 with why.
+struct mesh_tri;
+int render_mesh_import(const char* path, struct mesh_tri* out, char* err, size_t errsz);
+
 #ifdef __cplusplus
 }
 #endif

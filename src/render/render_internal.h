@@ -54,7 +54,7 @@ void render_prims_create(render_mesh prims[RENDER_PRIM_COUNT]);
 
 /// A loaded mesh file; ok == false means it failed and the primitive is used.
 typedef struct render_mesh_entry {
-    char key[192];
+    char key[272];
     bool ok;
     render_mesh mesh;
 } render_mesh_entry;
@@ -138,6 +138,9 @@ typedef struct render_scene {
     int nitems, capitems;
     long triangles;
     int draw_calls;
+    bool show_collision;  ///< debug view: collision shapes as wireframes over the scene (key G)
+    int ncmesh;           ///< uploaded collision meshes, by the world's triangle pointer
+    struct { const float* key; render_mesh mesh; } cmesh[64];
 } render_scene;
 
 bool render_scene_create(render_scene* sc);

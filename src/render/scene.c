@@ -200,6 +200,8 @@ void render_scene_free(render_scene* sc) {
         render_mesh_free(&sc->prim[i]);
     render_mesh_free(&sc->ground);
     render_mesh_free(&sc->terrain);
+    for (int i = 0; i < sc->ncmesh; ++i) render_mesh_free(&sc->cmesh[i].mesh);
+    sc->ncmesh = 0;
     if (sc->sky_vao) glDeleteVertexArrays(1, &sc->sky_vao);
     if (sc->obj.id) glDeleteProgram(sc->obj.id);
     if (sc->ground_prog.id) glDeleteProgram(sc->ground_prog.id);
@@ -516,6 +518,77 @@ static void use_lit(const render_lit_prog* p, const render_camera* cam, const re
     glUniform1i(p->u_shadow, 0);
 }
 
+// ---- debug view: collision shapes -------------------------------------------
+
+// The GL mesh of a world collision mesh (uploaded the first time it is seen;
+// the world's arrays do not change while it lives).
+static const render_mesh* coll_mesh(render_scene* sc, const world_snap_coll* c) {
+    for (int i = 0; i < sc->ncmesh; ++i)
+        if (sc->cmesh[i].key == c->v) return &sc->cmesh[i].mesh;
+    if (sc->ncmesh >= (int)(sizeof sc->cmesh / sizeof sc->cmesh[0])) return NULL;
+    render_vertex* v = calloc((size_t)(c->nv ? c->nv : 1), sizeof *v);
+    unsigned* idx = malloc((size_t)3 * (c->nt ? c->nt : 1) * sizeof *idx);
+    if (!v || !idx) {
+        free(v);
+        free(idx);
+        return NULL;
+    }
+    for (int i = 0; i < c->nv; ++i) {
+        memcpy(v[i].p, c->v + 3 * i, sizeof v[i].p);
+        v[i].n[2] = 1.0f;
+        v[i].c[0] = v[i].c[1] = v[i].c[2] = 1.0f;
+    }
+    for (int i = 0; i < 3 * c->nt; ++i) idx[i] = (unsigned)c->idx[i];
+    sc->cmesh[sc->ncmesh].key = c->v;
+    sc->cmesh[sc->ncmesh].mesh = render_mesh_upload(v, c->nv, idx, 3 * c->nt);
+    free(v);
+    free(idx);
+    return &sc->cmesh[sc->ncmesh++].mesh;
+}
+
+// Collision shapes as wireframes drawn over everything (depth test off), in
+// the same world transform the physics uses, so a visual mesh that does not
+// sit on its collision shape shows at once.
+static void draw_collision(render_scene* sc, const render_camera* cam, render_shadow* sh, const world_snapshot* s) {
+    static const float rgba[4] = {1.0f, 0.1f, 0.9f, 1.0f};
+    const int first = sc->nitems;
+    for (int i = 0; i < s->ncoll && i < WORLD_SNAP_MAX_COLL; ++i) {
+        const world_snap_coll* c = &s->coll[i];
+        world_snap_body b;
+        memset(&b, 0, sizeof b);
+        memcpy(b.pos, c->pos, sizeof b.pos);
+        memcpy(b.rot, c->rot, sizeof b.rot);
+        memcpy(b.size, c->size, sizeof b.size);
+        memcpy(b.rgba, rgba, sizeof b.rgba);
+        if (c->shape == WORLD_SHAPE_TERRAIN) {
+            const render_mesh* m = coll_mesh(sc, c);
+            render_draw_item* it = m ? push_item(sc, m, rgba) : NULL;
+            const float one[3] = {1, 1, 1};
+            if (it) rm_model(it->model, c->rot, one, c->pos);
+        } else {
+            b.shape = c->shape;
+            add_body_items(sc, NULL, &b);
+        }
+    }
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+    use_lit(&sc->obj, cam, sh);
+    float nm[9];
+    for (int i = first; i < sc->nitems; ++i) {
+        const render_draw_item* it = &sc->items[i];
+        rm_normal_matrix(nm, it->model);
+        glUniformMatrix4fv(sc->obj.u_model, 1, GL_FALSE, it->model);
+        glUniformMatrix3fv(sc->obj.u_normal, 1, GL_FALSE, nm);
+        glUniform4fv(sc->obj.u_color, 1, it->rgba);
+        render_mesh_draw(it->mesh);
+        ++sc->draw_calls;
+    }
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    glEnable(GL_DEPTH_TEST);
+    sc->nitems = first;
+}
+
 void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* sh,
                        const render_camera* cam, const world_snapshot* s, int w, int h) {
     sc->nitems = 0;
@@ -627,5 +700,6 @@ void render_scene_draw(render_scene* sc, render_mesh_cache* mc, render_shadow* s
     glDrawArrays(GL_TRIANGLES, 0, 3);
     ++sc->draw_calls;
     glDepthFunc(GL_LESS);
+    if (sc->show_collision) draw_collision(sc, cam, sh, s);
     glBindVertexArray(0);
 }

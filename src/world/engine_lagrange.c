@@ -482,6 +482,7 @@ static void lag_snapshot(engine* e, world_snapshot* s) {
     lsim_outputs(&l->ls, l->t, l->y, &o);
     const crane_mech* me = &l->ls.mdl->mech;
     memset(s, 0, offsetof(world_snapshot, body));
+    s->ncoll = 0; // after the bodies: not cleared above
     s->nbody = 0;
     s->ncyl = 0;
     s->nrope = 0;

@@ -319,7 +319,7 @@ int ow_attach(ode_world* w, int attach) {
     double bd = w->desc.hook.reach;
     for (int i = 0; i < w->nload; ++i) {
         dVector3 top;
-        dBodyGetRelPointPos(w->load[i], 0, 0, 0.5 * w->desc.load[i].size[2], top);
+        dBodyGetRelPointPos(w->load[i], 0, 0, w->load_top[i], top);
         double d = sqrt((top[0] - hp[0]) * (top[0] - hp[0]) + (top[1] - hp[1]) * (top[1] - hp[1]) +
                         (top[2] - hp[2]) * (top[2] - hp[2]));
         if (d <= bd) {
@@ -352,10 +352,66 @@ static void allow_sleep(dBodyID b) {
     dBodySetAutoDisableTime(b, 0);
 }
 
-static void build_loads(ode_world* w) {
+// The drawing of a meshed object: its bounding box as the fallback primitive
+// (centred on the bounds), the visual mesh placed so that its origin is the
+// object origin. org is the object origin in the body (or world) frame; the
+// collision geom uses the same transform, so what is drawn is what is hit.
+static void mesh_vis(ode_world* w, const char* name, world_role role, const float* rgba, const world_obj_mesh* om,
+                     dBodyID body, const double org[3], const double* R) {
+    double c[3], sz[3], p[3];
+    for (int k = 0; k < 3; ++k) c[k] = 0.5 * (om->lo[k] + om->hi[k]), sz[k] = om->hi[k] - om->lo[k];
+    if (body) {
+        for (int k = 0; k < 3; ++k) p[k] = org[k] + c[k]; // body frame = object axes
+    } else {
+        double rc[3];
+        ow_mat_vec(R, c, rc);
+        for (int k = 0; k < 3; ++k) p[k] = org[k] + rc[k];
+    }
+    ow_vis* v = ow_add_vis(w, name, role, WORLD_SHAPE_BOX, sz, rgba, OW_VIS_OWN_MESH, body, p, body ? NULL : R);
+    if (!v) return;
+    snprintf(v->mesh_file, sizeof v->mesh_file, "%s", om->file);
+    v->mesh_scale = om->scale;
+    v->mesh_up = om->up;
+    for (int k = 0; k < 3; ++k) v->mesh_offset[k] = -c[k]; // object origin in the primitive frame
+}
+
+// A loose meshed body (load or movable obstacle): convex hull of its
+// collision mesh, the closed mesh's mass properties, origin at the centre of
+// mass. Returns the body, or 0 with err.
+static dBodyID mesh_body(ode_world* w, const char* name, world_role role, const float* rgba, uint32_t cat,
+                         const world_obj_mesh* om, double mass, const double pos[3], double yaw, double friction,
+                         char* err, size_t errsz) {
+    dMass m;
+    dGeomID g = ow_mesh_hull(w, w->dyn_space, om, mass, &m, err, errsz);
+    if (!g) return 0;
+    double R[9], rc[3];
+    ow_rot_z(yaw, R);
+    ow_mat_vec(R, om->com, rc);
+    dBodyID b = dBodyCreate(w->world);
+    dBodySetMass(b, &m);
+    dBodySetPosition(b, pos[0] + rc[0], pos[1] + rc[1], pos[2] + rc[2]);
+    set_rot(b, R);
+    dGeomSetBody(g, b);
+    ow_geom* e = ow_add_geom(w, g, cat, friction);
+    if (e) e->mesh = w->nmesh - 1;
+    const double org[3] = {-om->com[0], -om->com[1], -om->com[2]};
+    mesh_vis(w, name, role, rgba, om, b, org, NULL);
+    allow_sleep(b);
+    return b;
+}
+
+static int build_loads(ode_world* w, char* err, size_t errsz) {
     w->nload = w->desc.nload;
     for (int i = 0; i < w->nload; ++i) {
         const world_load* L = &w->desc.load[i];
+        if (L->mesh.file[0]) {
+            dBodyID b = mesh_body(w, L->name, WORLD_ROLE_LOAD, RGBA_LOAD, OW_CAT_LOAD, &L->mesh, L->mass, L->position,
+                                  L->yaw, L->friction, err, errsz);
+            if (!b) return -1;
+            w->load[i] = b;
+            w->load_top[i] = L->mesh.hi[2] - L->mesh.com[2];
+            continue;
+        }
         dMass m;
         dMassSetBoxTotal(&m, L->mass, L->size[0], L->size[1], L->size[2]);
         dBodyID b = dBodyCreate(w->world);
@@ -370,17 +426,32 @@ static void build_loads(ode_world* w) {
         ow_add_vis(w, L->name, WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, L->size, RGBA_LOAD, WORLD_MESH_LOAD, b, NULL, NULL);
         allow_sleep(b);
         w->load[i] = b;
+        w->load_top[i] = 0.5 * L->size[2];
     }
+    return 0;
 }
 
-static void build_obstacles(ode_world* w) {
+static int build_obstacles(ode_world* w, char* err, size_t errsz) {
     for (int i = 0; i < w->desc.nobstacle; ++i) {
         const world_obstacle* o = &w->desc.obstacle[i];
         static const int mesh[3] = {WORLD_MESH_WALL, WORLD_MESH_BOX, WORLD_MESH_BUILDING};
         const float* col = o->kind == WORLD_OBST_WALL ? RGBA_WALL : o->kind == WORLD_OBST_BOX ? RGBA_BOX : RGBA_BUILDING;
         double R[9];
         ow_rot_z(o->yaw, R);
-        if (o->mass > 0) {
+        if (o->mesh.file[0]) {
+            if (o->mass > 0) {
+                dBodyID b = mesh_body(w, o->name, WORLD_ROLE_OBSTACLE, col, OW_CAT_OBST, &o->mesh, o->mass,
+                                      o->position, o->yaw, o->friction, err, errsz);
+                if (!b) return -1;
+                w->obst_body[i] = b;
+            } else {
+                dGeomID g = ow_mesh_trimesh(w, w->static_space, &o->mesh, o->position, R, err, errsz);
+                if (!g) return -1;
+                ow_geom* e = ow_add_geom(w, g, OW_CAT_OBST, o->friction);
+                if (e) e->mesh = w->nmesh - 1;
+                mesh_vis(w, o->name, WORLD_ROLE_OBSTACLE, col, &o->mesh, 0, o->position, R);
+            }
+        } else if (o->mass > 0) {
             dMass m;
             dMassSetBoxTotal(&m, o->mass, o->size[0], o->size[1], o->size[2]);
             dBodyID b = dBodyCreate(w->world);
@@ -401,13 +472,29 @@ static void build_obstacles(ode_world* w) {
             ow_add_vis(w, o->name, WORLD_ROLE_OBSTACLE, WORLD_SHAPE_BOX, o->size, col, mesh[o->kind], 0, o->position, R);
         }
     }
+    return 0;
+}
+
+// The terrain's own mesh (ramps, platforms) as a static trimesh on the
+// heightfield, colliding like the ground.
+static int build_terrain_mesh(ode_world* w, char* err, size_t errsz) {
+    const world_terrain* t = &w->desc.terrain;
+    if (!t->mesh.file[0]) return 0;
+    double R[9];
+    ow_rot_z(t->mesh_yaw, R);
+    dGeomID g = ow_mesh_trimesh(w, w->static_space, &t->mesh, t->mesh_pos, R, err, errsz);
+    if (!g) return -1;
+    ow_geom* e = ow_add_geom(w, g, OW_CAT_TERRAIN, t->friction);
+    if (e) e->mesh = w->nmesh - 1;
+    mesh_vis(w, "terrain_mesh", WORLD_ROLE_OTHER, RGBA_TERRAIN, &t->mesh, 0, t->mesh_pos, R);
+    return 0;
 }
 
 static double settle_rope(ode_world* w);
 
 int ow_build_sandbox(ode_world* w, char* err, size_t errsz) {
     const world_truck* k = &w->desc.truck;
-    if (build_terrain(w, err, errsz)) return -1;
+    if (build_terrain(w, err, errsz) || build_terrain_mesh(w, err, errsz)) return -1;
     double T[3] = {k->position[0], k->position[1], 0}, R[9];
     // Stand the truck on the ground under its centre, 0.5 mm up so it settles
     // onto its pads without an initial overlap.
@@ -457,8 +544,7 @@ int ow_build_sandbox(ode_world* w, char* err, size_t errsz) {
     }
     ow_slew_stops(w);
     build_rope(w);
-    build_loads(w);
-    build_obstacles(w);
+    if (build_loads(w, err, errsz) || build_obstacles(w, err, errsz)) return -1;
     const double overlap = settle_rope(w);
     if (overlap > 0) {
         snprintf(err, errsz,
@@ -566,6 +652,8 @@ static void near_cb(void* data, dGeomID g1, dGeomID g2) {
     if (max > (int)(sizeof w->cbuf / sizeof w->cbuf[0])) max = (int)(sizeof w->cbuf / sizeof w->cbuf[0]);
     int n = dCollide(g1, g2, max, w->cbuf, sizeof(dContactGeom));
     if (n <= 0) return;
+    if (n > 1 && (dGeomGetClass(g1) == dTriMeshClass || dGeomGetClass(g2) == dTriMeshClass))
+        n = ow_mesh_merge_contacts(w->cbuf, n, OW_MESH_MERGE_RADIUS);
     double mu = sqrt(a->friction * b->friction);
     int crane = a->cat == OW_CAT_CRANE || b->cat == OW_CAT_CRANE;
     for (int i = 0; i < n; ++i) {

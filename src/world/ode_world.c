@@ -207,6 +207,7 @@ ow_geom* ow_add_geom(ode_world* w, dGeomID g, uint32_t cat, double friction) {
     e->cat = cat;
     e->friction = friction;
     e->support = -1;
+    e->mesh = -1;
     dGeomSetData(g, e);
     return e;
 }
@@ -648,6 +649,7 @@ static int destroy_ode(ode_world* w, void* arg) {
     if (w->dyn_space) dSpaceDestroy(w->dyn_space);
     if (w->static_space) dSpaceDestroy(w->static_space);
     if (w->hfield) dGeomHeightfieldDataDestroy(w->hfield);
+    ow_mesh_destroy_data(w); // after the trimesh geoms that use them
     if (w->world) {
         dWorldSetStepThreadingImplementation(w->world, NULL, NULL);
         dWorldDestroy(w->world);
@@ -665,6 +667,7 @@ void ode_world_destroy(ode_world* w) {
     // torn down: then what is left of them is abandoned (a leak, once, at
     // the end of a failed run) rather than aborting.
     ow_trapped(w, "while destroying the world", destroy_ode, NULL);
+    ow_mesh_free(w);
     free(w->terrain);
     free(w);
     ode_release();
@@ -1034,6 +1037,11 @@ static int snapshot_ode(ode_world* w, void* arg) {
             b->mesh_scale = m->scale;
             b->mesh_up = m->up;
             memcpy(b->mesh_offset, m->has_offset ? m->offset : v->mesh_offset, sizeof b->mesh_offset);
+        } else if (v->mesh == OW_VIS_OWN_MESH) {
+            snprintf(b->mesh, sizeof b->mesh, "%s", v->mesh_file);
+            b->mesh_scale = v->mesh_scale;
+            b->mesh_up = v->mesh_up;
+            memcpy(b->mesh_offset, v->mesh_offset, sizeof b->mesh_offset);
         }
     }
     s->nbody = n;
@@ -1071,6 +1079,7 @@ static int snapshot_ode(ode_world* w, void* arg) {
     s->load_mass = w->kind == WORLD_VALIDATION ? w->m3 : 0;
     if (w->hm && w->ipump >= 0) s->p_supply = w->y[w->ipump];
     if (w->kind == WORLD_SANDBOX) ow_sandbox_snapshot(w, s);
+    ow_collision_snapshot(w, s);
     if (w->hm) {
         // Open reliefs by name, and on the cylinder whose chamber each
         // guards: snapshot cylinders are lift, jib, then the sandbox's slew.

@@ -50,7 +50,27 @@ typedef struct ow_geom {
     uint32_t cat;     ///< OW_CAT_*
     double friction;  ///< Coulomb coefficient [-]; a pair uses the geometric mean
     int support;      ///< truck support (OW_NSUPPORT) this geom carries, else -1
+    int mesh;         ///< index into ode_world.mesh for trimesh and hull geoms, else -1
 } ow_geom;
+
+/// Mesh data ODE keeps pointers to while its geoms live (mesh_ode.c).
+typedef struct ow_mesh {
+    dTriMeshDataID tmd;  ///< static trimesh data (0 for a hull)
+    float* v;            ///< trimesh vertices [m], object frame
+    dTriIndex* idx;      ///< trimesh indices
+    int nv, nt;          ///< trimesh or hull vertices, triangles (the debug view draws them)
+    dReal* planes;       ///< hull planes (nx, ny, nz, d), body frame
+    dReal* points;       ///< hull vertices, body frame [m]
+    unsigned* polys;     ///< hull polygons (3, a, b, c)
+    float* dv;           ///< the shape's triangles for the debug view: vertices in the geom frame [m]
+    int* di;             ///< and indices (nv, nt of them)
+} ow_mesh;
+#define OW_MAX_MESHES (WORLD_DESC_MAX_LOADS + WORLD_DESC_MAX_OBSTACLES + 1)
+/// Trimesh contacts closer than this are one (ow_mesh_merge_contacts) [m]:
+/// well under a load's or a boom's width, so a face keeps its corners.
+#define OW_MESH_MERGE_RADIUS 0.1
+/// ow_vis.mesh: the entry draws its own mesh file (ow_vis.mesh_file).
+#define OW_VIS_OWN_MESH (-2)
 
 /// One entry of the snapshot: a primitive placed in a body's frame (or in the
 /// world when body is 0, e.g. static obstacles).
@@ -65,6 +85,9 @@ typedef struct ow_vis {
     double pos[3];      ///< primitive centre in the body frame (or world) [m]
     double rot[9];      ///< primitive-to-body rotation, row-major
     double mesh_offset[3]; ///< mesh origin in the primitive frame [m] when the world file gives none
+    char mesh_file[256];   ///< mesh == OW_VIS_OWN_MESH: the object's own visual mesh (absolute path)
+    double mesh_scale;     ///< its scale [m/unit]
+    int mesh_up;           ///< its up axis (1 y, 2 z)
 } ow_vis;
 
 /// A crane frame (column, lifting arm, end arm) carried by an ODE body: the
@@ -146,6 +169,9 @@ struct ode_world {
     int nload;
     dBodyID load[WORLD_DESC_MAX_LOADS];
     dBodyID obst_body[WORLD_DESC_MAX_OBSTACLES]; ///< 0 for static obstacles
+    double load_top[WORLD_DESC_MAX_LOADS]; ///< load's top above its body origin (COM) [m], for the hook
+    int nmesh;
+    ow_mesh mesh[OW_MAX_MESHES];
     int held;            ///< crane frozen (kinematic)
 
     // Geoms and snapshot entries.
@@ -239,6 +265,26 @@ double ow_stab_margin(const ode_world* w, double* weight);
 int ow_supports_lifted(const ode_world* w, double weight);
 void ow_hook_point(const ode_world* w, double p[3], double v[3]);
 int ow_attach(ode_world* w, int attach);
+
+// mesh_ode.c
+/// A static ODE trimesh of om's collision mesh in space, its object frame at
+/// pos with rotation R. NULL with err on failure.
+dGeomID ow_mesh_trimesh(ode_world* w, dSpaceID space, const world_obj_mesh* om, const double pos[3],
+                        const double R[9], char* err, size_t errsz);
+/// A convex hull geom (not in a space yet: space given) of om's collision
+/// mesh in the body frame (origin at the centre of mass), and the body's
+/// mass of total mass [kg] with the closed mesh's inertia. NULL with err.
+dGeomID ow_mesh_hull(ode_world* w, dSpaceID space, const world_obj_mesh* om, double mass, dMass* m, char* err,
+                     size_t errsz);
+/// Destroy the trimesh data (inside ODE's trap) and free the arrays.
+void ow_mesh_destroy_data(ode_world* w);
+void ow_mesh_free(ode_world* w);
+/// Merge a trimesh pair's contacts closer than radius [m] with nearly the same
+/// normal into the deepest of them (ODE gives one per touched triangle, and
+/// each contact is three more rows in the island's LCP). Returns the count.
+int ow_mesh_merge_contacts(dContactGeom* c, int n, double radius);
+/// The collision shapes into the snapshot (debug view).
+void ow_collision_snapshot(const ode_world* w, world_snapshot* s);
 
 // ode_coupling.c
 int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz);

@@ -5,10 +5,13 @@
 #include "hydraulics.h"
 #include "json_util.h"
 #include "model.h"
+#include "mesh_geom.h"
 
 #include <dirent.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -164,6 +167,33 @@ static const json_range R_CONTACT_CFM = {1e-10, 1, 1e-8, 1e-3, ""};
 static const json_range R_MESH_SCALE = {1e-4, 1e4, 1e-3, 1e3, ""};
 static const json_range R_MESH_OFFSET = {-100, 100, -20, 20, "m"};
 
+static const json_range R_DENSITY = {1, 3e4, 50, 1e4, "kg/m^3"};
+
+// A meshed object's box size (its collision mesh's bounds) and, for a loose
+// body, its mass from "mass" or "density" (exactly one) and the volume.
+static double mesh_object_mass(json_ctx* c, const cJSON* o, const char* path, world_obj_mesh* om, double* size,
+                               const json_range* rmass, bool loose) {
+    for (int k = 0; k < 3; ++k) size[k] = om->hi[k] - om->lo[k];
+    if (!loose || c->failed) return 0;
+    const bool hm = cJSON_GetObjectItemCaseSensitive(o, "mass") != NULL;
+    const bool hd = cJSON_GetObjectItemCaseSensitive(o, "density") != NULL;
+    char fp[96];
+    if (hm && hd) {
+        json_path(fp, sizeof fp, path, "density");
+        json_fail(c, fp, "give \"mass\" or \"density\", not both");
+        return 0;
+    }
+    if (hm) return json_num_r(c, o, path, "mass", true, 0, rmass);
+    const double rho = json_num_r(c, o, path, "density", true, 0, &R_DENSITY);
+    if (c->failed) return 0;
+    const double m = rho * om->volume;
+    json_path(fp, sizeof fp, path, "density");
+    if (!(m >= rmass->lo && m <= rmass->hi))
+        json_fail(c, fp, "%g kg/m^3 times the mesh's volume %g m^3 gives %g kg, outside [%g, %g] kg", rho, om->volume,
+                  m, rmass->lo, rmass->hi);
+    return m;
+}
+
 // Position [x, y] or [x, y, z]; a missing or negative z means "rest on the
 // ground" and is resolved after the terrain is known (z = -1 marks it).
 static void read_position(json_ctx* c, const cJSON* o, const char* path, double* p) {
@@ -202,6 +232,84 @@ static void read_size(json_ctx* c, const cJSON* o, const char* path, const char*
     }
 }
 
+// ---- object meshes (CAD files) ----
+
+// Largest extent [m] an object mesh may have after scaling: a yard object
+// beyond 1 km is a unit mistake (a model in millimetres given scale 1).
+#define MESH_MAX_EXTENT 1000.0
+#define MESH_MIN_EXTENT 0.01
+
+// A mesh file named in the world file: absolute, or relative to the world
+// file's folder.
+static void resolve_path(char* out, size_t n, const char* dir, const char* file) {
+    if (file[0] == '/' || !dir[0]) snprintf(out, n, "%s", file);
+    else snprintf(out, n, "%s/%s", dir, file);
+}
+
+// Read {"file", "collision", "scale", "up"} (plus extra keys the caller
+// allows) at path.mesh, load the collision mesh and check it: bounds, and
+// for a loose body (loose = 1) a closed surface with a volume, its centre.
+// max_extent bounds the object's size [m].
+static void read_obj_mesh(json_ctx* c, const cJSON* m, const char* path, const char* dir, int loose,
+                          double max_extent, const char* const* keys, world_obj_mesh* om) {
+    char p[96], fp[112];
+    snprintf(p, sizeof p, "%s.mesh", path);
+    if (!cJSON_IsObject(m)) {
+        json_fail(c, p, "must be an object {\"file\": ..., \"scale\": ..., \"up\": ...}");
+        return;
+    }
+    json_only_keys(c, m, p, keys);
+    char file[256] = "", coll[256] = "", up[8];
+    json_str(c, m, p, "file", true, "", file, sizeof file);
+    json_str(c, m, p, "collision", false, "", coll, sizeof coll);
+    om->scale = json_num_r(c, m, p, "scale", false, 1.0, &R_MESH_SCALE);
+    json_str(c, m, p, "up", false, "z", up, sizeof up);
+    if (c->failed) return;
+    if (!strcmp(up, "y")) om->up = 1;
+    else if (!strcmp(up, "z")) om->up = 2;
+    else {
+        json_path(fp, sizeof fp, p, "up");
+        json_fail(c, fp, "must be \"y\" or \"z\", got \"%s\"", up);
+        return;
+    }
+    if (!file[0]) {
+        json_path(fp, sizeof fp, p, "file");
+        json_fail(c, fp, "must name a mesh file");
+        return;
+    }
+    resolve_path(om->file, sizeof om->file, dir, file);
+    if (coll[0]) resolve_path(om->collision, sizeof om->collision, dir, coll);
+    const char* cpath = coll[0] ? om->collision : om->file;
+    json_path(fp, sizeof fp, p, coll[0] ? "collision" : "file");
+    mesh_tri t;
+    char why[256];
+    if (mesh_load(cpath, om->scale, om->up, &t, why, sizeof why)) {
+        json_fail(c, fp, "%s: %s", cpath, why);
+        return;
+    }
+    if (t.dropped)
+        fprintf(stderr, "warning: %s: %s: %d degenerate (zero-area) triangles left out of the collision shape\n", fp,
+                cpath, t.dropped);
+    mesh_bounds(&t, om->lo, om->hi);
+    om->ntri = t.nt;
+    const double ext = fmax(om->hi[0] - om->lo[0], fmax(om->hi[1] - om->lo[1], om->hi[2] - om->lo[2]));
+    if (!(ext >= MESH_MIN_EXTENT && ext <= max_extent)) {
+        json_fail(c, fp, "%s: the mesh is %g m across at scale %g; it must be %g..%g m (a model in millimetres needs "
+                  "\"scale\": 0.001)", cpath, ext, om->scale, MESH_MIN_EXTENT, max_extent);
+    } else if (loose) {
+        const int open = mesh_open_edges(&t);
+        double I[9];
+        if (open)
+            json_fail(c, fp, "%s: the mesh is not closed (%d open or inconsistently wound edges), so it has no volume; "
+                      "a loose body needs a closed mesh (give one as \"collision\")", cpath, open);
+        else if (mesh_mass_props(&t, &om->volume, om->com, I))
+            json_fail(c, fp, "%s: the mesh encloses no volume", cpath);
+    }
+    mesh_free(&t);
+}
+
+static const char* const OBJ_MESH_KEYS[] = {"file", "collision", "scale", "up", NULL};
+
 static void load_ode(json_ctx* c, const cJSON* o, world_ode_params* p) {
     if (!o) return;
     static const char* const keys[] = {"erp", "cfm", "contact_erp", "contact_cfm", "surface_layer",
@@ -217,9 +325,9 @@ static void load_ode(json_ctx* c, const cJSON* o, world_ode_params* p) {
     p->max_contacts = json_int(c, o, "ode", "max_contacts", false, p->max_contacts, 1, 32);
 }
 
-static void load_terrain(json_ctx* c, const cJSON* o, world_terrain* t) {
+static void load_terrain(json_ctx* c, const cJSON* o, world_terrain* t, const char* dir) {
     if (!o) return;
-    static const char* const keys[] = {"size", "samples", "flat_radius", "friction", "hills", NULL};
+    static const char* const keys[] = {"size", "samples", "flat_radius", "friction", "hills", "mesh", NULL};
     json_only_keys(c, o, "terrain", keys);
     if (cJSON_GetObjectItemCaseSensitive(o, "size")) {
         json_vec(c, o, "terrain", "size", true, t->size, 2);
@@ -240,6 +348,14 @@ static void load_terrain(json_ctx* c, const cJSON* o, world_terrain* t) {
     }
     t->flat_radius = json_num_r(c, o, "terrain", "flat_radius", false, t->flat_radius, &R_FLAT_RADIUS);
     t->friction = json_num_r(c, o, "terrain", "friction", false, t->friction, &R_FRICTION);
+    const cJSON* tm = cJSON_GetObjectItemCaseSensitive(o, "mesh");
+    if (tm && !c->failed) {
+        static const char* const mkeys[] = {"file", "collision", "scale", "up", "position", "yaw_deg", NULL};
+        read_obj_mesh(c, tm, "terrain", dir, 0, 1e4, mkeys, &t->mesh);
+        if (!c->failed && cJSON_GetObjectItemCaseSensitive(tm, "position"))
+            json_vec_r(c, tm, "terrain.mesh", "position", true, t->mesh_pos, 3, &R_HILL_XY);
+        if (!c->failed) t->mesh_yaw = json_num(c, tm, "terrain.mesh", "yaw_deg", false, 0, -360, 360) * DEG;
+    }
     const cJSON* hills = json_arr(c, o, "terrain", "hills", false);
     if (!hills || c->failed) return;
     int n = cJSON_GetArraySize(hills);
@@ -331,7 +447,7 @@ static void load_hook(json_ctx* c, const cJSON* o, world_hook* h) {
     h->reach = json_num_r(c, o, "hook", "reach", false, h->reach, &R_HOOK_REACH);
 }
 
-static void load_loads(json_ctx* c, const cJSON* arr, world_desc* w) {
+static void load_loads(json_ctx* c, const cJSON* arr, world_desc* w, const char* dir) {
     if (!arr) return;
     int n = cJSON_GetArraySize(arr);
     if (n > WORLD_DESC_MAX_LOADS) {
@@ -346,14 +462,32 @@ static void load_loads(json_ctx* c, const cJSON* arr, world_desc* w) {
             json_fail(c, p, "must be an object");
             return;
         }
-        static const char* const keys[] = {"name", "mass", "size", "position", "yaw_deg", "friction", NULL};
+        static const char* const keys[] = {"name", "mass", "size", "position", "yaw_deg", "friction", "mesh",
+                                           "density", NULL};
         json_only_keys(c, o, p, keys);
         world_load* l = &w->load[i];
         char def[WORLD_DESC_NAME];
         snprintf(def, sizeof def, "load_%d", i);
         json_str(c, o, p, "name", false, def, l->name, sizeof l->name);
-        l->mass = json_num_r(c, o, p, "mass", true, 0, &R_LOAD_MASS);
-        read_size(c, o, p, "size", true, l->size, &R_LOAD_SIZE);
+        const cJSON* me = cJSON_GetObjectItemCaseSensitive(o, "mesh");
+        if (me && !c->failed) {
+            if (cJSON_GetObjectItemCaseSensitive(o, "size")) {
+                char fp[80];
+                json_path(fp, sizeof fp, p, "size");
+                json_fail(c, fp, "not used with a mesh (the mesh gives the shape)");
+            }
+            read_obj_mesh(c, me, p, dir, 1, 20.0, OBJ_MESH_KEYS, &l->mesh);
+            l->mass = mesh_object_mass(c, o, p, &l->mesh, l->size, &R_LOAD_MASS, true);
+        } else {
+            if (cJSON_GetObjectItemCaseSensitive(o, "density") && !c->failed) {
+                char fp[80];
+                json_path(fp, sizeof fp, p, "density");
+                json_fail(c, fp, "only a load with a mesh takes a density (a box load gives its mass)");
+            }
+            l->mass = json_num_r(c, o, p, "mass", true, 0, &R_LOAD_MASS);
+            read_size(c, o, p, "size", true, l->size, &R_LOAD_SIZE);
+            for (int k = 0; k < 3; ++k) l->mesh.lo[k] = -0.5 * l->size[k], l->mesh.hi[k] = 0.5 * l->size[k];
+        }
         read_position(c, o, p, l->position);
         l->yaw = json_num(c, o, p, "yaw_deg", false, 0, -360, 360) * DEG;
         l->friction = json_num_r(c, o, p, "friction", false, 0.6, &R_FRICTION);
@@ -361,7 +495,7 @@ static void load_loads(json_ctx* c, const cJSON* arr, world_desc* w) {
     }
 }
 
-static void load_obstacles(json_ctx* c, const cJSON* arr, world_desc* w) {
+static void load_obstacles(json_ctx* c, const cJSON* arr, world_desc* w, const char* dir) {
     if (!arr) return;
     int n = cJSON_GetArraySize(arr);
     if (n > WORLD_DESC_MAX_OBSTACLES) {
@@ -376,7 +510,8 @@ static void load_obstacles(json_ctx* c, const cJSON* arr, world_desc* w) {
             json_fail(c, p, "must be an object");
             return;
         }
-        static const char* const keys[] = {"name", "kind", "size", "position", "yaw_deg", "mass", "friction", NULL};
+        static const char* const keys[] = {"name", "kind", "size", "position", "yaw_deg", "mass", "friction",
+                                           "mesh", "density", NULL};
         json_only_keys(c, o, p, keys);
         world_obstacle* b = &w->obstacle[i];
         char def[WORLD_DESC_NAME], kind[16];
@@ -393,10 +528,32 @@ static void load_obstacles(json_ctx* c, const cJSON* arr, world_desc* w) {
                 json_fail(c, f, "must be \"wall\", \"box\" or \"building\", got \"%s\"", kind);
             }
         }
-        read_size(c, o, p, "size", true, b->size, &R_OBST_SIZE);
+        const cJSON* me = cJSON_GetObjectItemCaseSensitive(o, "mesh");
+        if (me && !c->failed) {
+            if (cJSON_GetObjectItemCaseSensitive(o, "size")) {
+                char fp[80];
+                json_path(fp, sizeof fp, p, "size");
+                json_fail(c, fp, "not used with a mesh (the mesh gives the shape)");
+            }
+            // Loose (given a mass or a density): the convex hull moves; else
+            // the mesh itself is fixed in place.
+            const bool loose = cJSON_GetObjectItemCaseSensitive(o, "density") ||
+                               (cJSON_GetObjectItemCaseSensitive(o, "mass") &&
+                                json_num_r(c, o, p, "mass", false, 0, &R_OBST_MASS) > 0);
+            read_obj_mesh(c, me, p, dir, loose, MESH_MAX_EXTENT, OBJ_MESH_KEYS, &b->mesh);
+            b->mass = mesh_object_mass(c, o, p, &b->mesh, b->size, &R_OBST_MASS, loose);
+        } else {
+            read_size(c, o, p, "size", true, b->size, &R_OBST_SIZE);
+            if (cJSON_GetObjectItemCaseSensitive(o, "density") && !c->failed) {
+                char fp[80];
+                json_path(fp, sizeof fp, p, "density");
+                json_fail(c, fp, "only an obstacle with a mesh takes a density (a box gives its mass)");
+            }
+            b->mass = json_num_r(c, o, p, "mass", false, 0, &R_OBST_MASS);
+            for (int k = 0; k < 3; ++k) b->mesh.lo[k] = -0.5 * b->size[k], b->mesh.hi[k] = 0.5 * b->size[k];
+        }
         read_position(c, o, p, b->position);
         b->yaw = json_num(c, o, p, "yaw_deg", false, 0, -360, 360) * DEG;
-        b->mass = json_num_r(c, o, p, "mass", false, 0, &R_OBST_MASS);
         b->friction = json_num_r(c, o, p, "friction", false, 0.6, &R_FRICTION);
         w->nobstacle = i + 1;
     }
@@ -524,8 +681,12 @@ static void check_overlaps(json_ctx* c, const world_desc* w) {
         const bool ld = i < w->nload;
         const double* p = ld ? w->load[i].position : w->obstacle[i - w->nload].position;
         const double* sz = ld ? w->load[i].size : w->obstacle[i - w->nload].size;
-        b[n] = (ovl_box){p[0], p[1], 0.5 * sz[0], 0.5 * sz[1], ld ? w->load[i].yaw : w->obstacle[i - w->nload].yaw,
-                         p[2] - 0.5 * sz[2], p[2] + 0.5 * sz[2]};
+        // The box's centre is the position; a mesh's bounds sit around its origin.
+        const world_obj_mesh* om = ld ? &w->load[i].mesh : &w->obstacle[i - w->nload].mesh;
+        const double yaw = ld ? w->load[i].yaw : w->obstacle[i - w->nload].yaw;
+        const double cx = 0.5 * (om->lo[0] + om->hi[0]), cy = 0.5 * (om->lo[1] + om->hi[1]);
+        b[n] = (ovl_box){p[0] + cos(yaw) * cx - sin(yaw) * cy, p[1] + sin(yaw) * cx + cos(yaw) * cy, 0.5 * sz[0],
+                         0.5 * sz[1], yaw, p[2] + om->lo[2], p[2] + om->hi[2]};
         snprintf(name[n], sizeof name[n], "%s \"%s\"", ld ? "load" : "obstacle",
                  ld ? w->load[i].name : w->obstacle[i - w->nload].name);
         if (ld) snprintf(path[n], sizeof path[0], "loads[%d].position", i);
@@ -541,13 +702,16 @@ static void check_overlaps(json_ctx* c, const world_desc* w) {
             }
 }
 
-// Resolve "rest on the ground" positions (z < 0) now that the terrain is known.
-static void settle_on_ground(const world_desc* w, double* pos, const double* size) {
+// Resolve "rest on the ground" positions (z < 0) now that the terrain is
+// known: the lowest point (a box's bottom, a mesh's lowest vertex) on the
+// ground under the position.
+static void settle_on_ground(const world_desc* w, double* pos, const world_obj_mesh* om) {
     if (pos[2] >= 0) return;
-    pos[2] = world_desc_terrain_height(w, pos[0], pos[1]) + 0.5 * size[2];
+    pos[2] = world_desc_terrain_height(w, pos[0], pos[1]) - om->lo[2];
 }
 
-int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, char* err, size_t errsz) {
+static int from_json_in(const cJSON* root, const char* file, const char* dir, world_desc* w, char* err,
+                        size_t errsz) {
     json_ctx c = {.file = file, .err = err, .errsz = errsz};
     char kind[32];
     world_desc_default(w, WORLD_VALIDATION);
@@ -588,13 +752,13 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     if (cJSON_GetObjectItemCaseSensitive(root, "gravity"))
         w->gravity = json_num_r(&c, root, "", "gravity", false, w->gravity, &R_GRAVITY);
     load_ode(&c, json_obj(&c, root, "", "ode", false), &w->ode);
-    load_terrain(&c, json_obj(&c, root, "", "terrain", false), &w->terrain);
+    load_terrain(&c, json_obj(&c, root, "", "terrain", false), &w->terrain, dir);
     load_truck(&c, json_obj(&c, root, "", "truck", false), &w->truck);
     load_slew(&c, json_obj(&c, root, "", "slew", false), &w->slew);
     load_rope(&c, json_obj(&c, root, "", "rope", false), &w->rope);
     load_hook(&c, json_obj(&c, root, "", "hook", false), &w->hook);
-    load_loads(&c, json_arr(&c, root, "", "loads", false), w);
-    load_obstacles(&c, json_arr(&c, root, "", "obstacles", false), w);
+    load_loads(&c, json_arr(&c, root, "", "loads", false), w, dir);
+    load_obstacles(&c, json_arr(&c, root, "", "obstacles", false), w, dir);
     load_meshes(&c, json_obj(&c, root, "", "meshes", false), w);
     load_circuit(&c, json_obj(&c, root, "", "circuit", false), w);
     if (!c.failed && w->kind == WORLD_SANDBOX) {
@@ -611,8 +775,8 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
         }
     }
     if (!c.failed) {
-        for (int i = 0; i < w->nload; ++i) settle_on_ground(w, w->load[i].position, w->load[i].size);
-        for (int i = 0; i < w->nobstacle; ++i) settle_on_ground(w, w->obstacle[i].position, w->obstacle[i].size);
+        for (int i = 0; i < w->nload; ++i) settle_on_ground(w, w->load[i].position, &w->load[i].mesh);
+        for (int i = 0; i < w->nobstacle; ++i) settle_on_ground(w, w->obstacle[i].position, &w->obstacle[i].mesh);
         if (w->kind == WORLD_SANDBOX) check_overlaps(&c, w);
         // Names must be unique: the snapshot and the CSV address bodies by name.
         for (int i = 0; i < w->nload + w->nobstacle && !c.failed; ++i) {
@@ -635,6 +799,10 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
         return -1;
     }
     return 0;
+}
+
+int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, char* err, size_t errsz) {
+    return from_json_in(root, file, "", w, err, errsz);
 }
 
 static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
@@ -680,7 +848,21 @@ int world_desc_load(const char* path, world_desc* w, char* err, size_t errsz) {
     cJSON* root = json_load_file(path, err, errsz);
     if (!root) return -1;
     const char* base = strrchr(path, '/');
-    int rc = world_desc_from_json(root, base ? base + 1 : path, w, err, errsz);
+    // Mesh files are relative to the world file's folder, made absolute so
+    // the renderer (which resolves bare names against assets/meshes) finds
+    // them wherever the program runs.
+    char dir[PATH_MAX] = "", cwd[PATH_MAX];
+    if (base) snprintf(dir, sizeof dir, "%.*s", (int)(base - path), path);
+    if (base == path) snprintf(dir, sizeof dir, "/");
+    if (dir[0] != '/' && getcwd(cwd, sizeof cwd)) {
+        const size_t lc = strlen(cwd), ld = strlen(dir);
+        if (lc + 1 + ld < sizeof dir) {
+            memmove(dir + lc + (ld ? 1 : 0), dir, ld + 1);
+            memcpy(dir, cwd, lc);
+            if (ld) dir[lc] = '/';
+        }
+    }
+    int rc = from_json_in(root, base ? base + 1 : path, dir, w, err, errsz);
     cJSON_Delete(root);
     return rc;
 }

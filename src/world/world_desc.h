@@ -45,6 +45,21 @@ enum {
 /// JSON key of a mesh slot ("truck", "wheel", ..., "building").
 extern const char* const world_mesh_key[WORLD_MESH_COUNT];
 
+/// A world object's own mesh (CAD file): its drawing and its collision
+/// shape share the object's transform. Paths are resolved against the world
+/// file's folder (or absolute). Bounds, volume and centre are of the collision
+/// mesh, in the object frame (mesh origin, world axes after scale and up) [m].
+typedef struct world_obj_mesh {
+    char file[256];       ///< visual mesh, resolved; "" = the object is a box
+    char collision[256];  ///< collision mesh, resolved ("" = file)
+    double scale;         ///< mesh units to metres [m/unit]
+    int up;               ///< 1 = y-up, 2 = z-up
+    double lo[3], hi[3];  ///< collision mesh bounds [m]
+    double volume;        ///< enclosed volume [m^3] (loose bodies; 0 otherwise)
+    double com[3];        ///< centre of mass [m] (loose bodies)
+    int ntri;             ///< collision triangles
+} world_obj_mesh;
+
 /// Gaussian hill on the terrain: h = height * exp(-r^2 / (2 radius^2)).
 typedef struct world_hill {
     double x, y;   ///< centre [m]
@@ -59,6 +74,9 @@ typedef struct world_terrain {
     double friction;       ///< Coulomb friction coefficient against terrain [-]
     int nhill;
     world_hill hill[WORLD_DESC_MAX_HILLS];
+    world_obj_mesh mesh;   ///< optional static mesh on the ground (ramps, platforms); file "" = none
+    double mesh_pos[3];    ///< mesh origin in the world [m]
+    double mesh_yaw;       ///< [rad]
 } world_terrain;
 
 /// The truck: one rigid body (chassis, cab, outrigger pads as its geoms)
@@ -114,6 +132,7 @@ typedef struct world_load {
     double position[3];   ///< centre [m]; z < 0 in the file means "rest on the ground"
     double yaw;           ///< [rad]
     double friction;      ///< [-]
+    world_obj_mesh mesh;  ///< mesh.file "" = a box of size; else position is the mesh origin
 } world_load;
 
 typedef enum world_obstacle_kind { WORLD_OBST_WALL = 0, WORLD_OBST_BOX, WORLD_OBST_BUILDING } world_obstacle_kind;
@@ -126,6 +145,7 @@ typedef struct world_obstacle {
     double yaw;           ///< [rad]
     double mass;          ///< 0: static (fixed); > 0: a loose box that can be pushed [kg]
     double friction;      ///< [-]
+    world_obj_mesh mesh;  ///< mesh.file "" = a box of size; else position is the mesh origin
 } world_obstacle;
 
 /// Numerical settings of the ODE world. See docs/ode_world.md for why.

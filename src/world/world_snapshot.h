@@ -18,6 +18,7 @@ extern "C" {
 #define WORLD_SNAP_MAX_ROPE 32
 #define WORLD_SNAP_NAME 48
 #define WORLD_SNAP_MAX_RELIEFS 8
+#define WORLD_SNAP_MAX_COLL 256
 
 /// Primitive shape used when a body has no mesh or its mesh failed to load.
 typedef enum world_shape {
@@ -51,7 +52,7 @@ typedef struct world_snap_body {
     double rot[9];              ///< body-to-world rotation, row-major 3x3
     double size[3];             ///< primitive dimensions, see world_shape [m]
     float rgba[4];              ///< colour, 0..1
-    char mesh[128];             ///< mesh file (relative to assets/meshes or absolute); "" = primitive
+    char mesh[256];             ///< mesh file (relative to assets/meshes or absolute); "" = primitive
     double mesh_scale;          ///< mesh units to metres (1 for metres, 0.001 for mm)
     int mesh_up;                ///< mesh up axis: 1 = y-up (glTF/OBJ default), 2 = z-up
     double mesh_offset[3];      ///< mesh origin in body frame [m]
@@ -84,6 +85,19 @@ typedef struct world_snap_terrain {
     int nx, ny;          ///< samples along x and y
     double dx, dy;       ///< spacing [m]
 } world_snap_terrain;
+
+/// A collision shape as the physics sees it (the debug view draws these over
+/// the scene). Mesh shapes point at triangles the world owns (valid while it
+/// lives, like the terrain heights).
+typedef struct world_snap_coll {
+    world_shape shape;     ///< BOX, SPHERE, CAPSULE, CYLINDER (size as in world_shape), or TERRAIN for a mesh
+    double pos[3];         ///< geom origin in world [m]
+    double rot[9];         ///< geom-to-world rotation, row-major
+    double size[3];        ///< see world_shape [m]
+    const float* v;        ///< mesh: 3 nv coordinates in the geom frame [m]
+    const int* idx;        ///< mesh: 3 nt indices
+    int nv, nt;
+} world_snap_coll;
 
 typedef struct world_snapshot {
     double t;              ///< simulated time [s]
@@ -121,6 +135,8 @@ typedef struct world_snapshot {
     double pad_pos[4][3];   ///< contact point under each, world [m]
     int pad_lifted;         ///< bit i: support i lifted off (below 1 % of the weight)
     double stab_margin;     ///< restoring over tipping moment, governing tipping line [-]
+    int ncoll;                                  ///< collision shapes (0: the world gives none)
+    world_snap_coll coll[WORLD_SNAP_MAX_COLL];
 } world_snapshot;
 
 #ifdef __cplusplus

@@ -269,7 +269,7 @@ static void test_oversize(void) {
 // lists the worlds; an index past the end of an array gives the length.
 static void test_messages(void) {
     int rc = cli_run("run --quiet --mechanics ode --world nosuch --scenario hold --out /dev/null", out_buf, sizeof out_buf);
-    CHECK(rc == 2 && strstr(out_buf, "--world nosuch: no such world (available: sandbox, validation") &&
+    CHECK(rc == 2 && strstr(out_buf, "--world nosuch: no such world (available: sandbox, site, validation") &&
               cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
     rc = cli_run("run --quiet --scenario hold --out /dev/null --set 'mechanics.links[5].mass=1'", out_buf, sizeof out_buf);

@@ -1,0 +1,74 @@
+// mesh_geom.h: triangle meshes for the physics core (no assimp here).
+//
+// The core reads OBJ and STL itself; other formats (glTF/GLB, Collada, FBX)
+// come through an importer the application installs (mesh_set_importer,
+// assimp in src/render), so the physics core builds and tests without it.
+// A mesh is converted to the world's z-up metres on load (scale, up axis),
+// its identical vertices are welded (STL repeats them per facet) and its
+// degenerate triangles are dropped. On it: closedness, volume, centre of
+// mass and inertia (divergence theorem), and the convex hull for loose bodies.
+// See docs/ode_world.md, "CAD meshes".
+#ifndef MESH_GEOM_H
+#define MESH_GEOM_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Most triangles a world mesh may have (a CAD obstacle of 50,000 triangles
+/// costs ODE well under a millisecond per contact query; a million would cost
+/// memory and load time for no gain in a crane yard).
+#define MESH_MAX_TRIANGLES 200000
+
+typedef struct mesh_tri {
+    int nv, nt;
+    float* v;       ///< 3 nv coordinates [m], z up
+    int* idx;       ///< 3 nt vertex indices
+    int dropped;    ///< degenerate triangles removed on load
+} mesh_tri;
+
+/// An importer for formats the core does not read: fill out->v/idx (mesh
+/// units, the file's own axes; malloc'd) and return 0, or -1 with why in err
+/// (no file name; the caller adds it).
+typedef int (*mesh_import_fn)(const char* path, mesh_tri* out, char* err, size_t errsz);
+void mesh_set_importer(mesh_import_fn fn);
+
+/// Load path (OBJ/STL here, others through the importer), scale [m/unit],
+/// up 1 = y-up (mesh y becomes z, mesh z becomes -y), 2 = z-up. Returns 0, or
+/// -1 with the problem in err (without the file name).
+int mesh_load(const char* path, double scale, int up, mesh_tri* out, char* err, size_t errsz);
+void mesh_free(mesh_tri* m);
+
+/// Axis-aligned bounds [m].
+void mesh_bounds(const mesh_tri* m, double lo[3], double hi[3]);
+
+/// Edges used by other than exactly two triangles in opposite directions
+/// (0 for a closed, consistently wound surface).
+int mesh_open_edges(const mesh_tri* m);
+
+/// Volume [m^3], centre of mass [m] and the inertia tensor about it per unit
+/// density [m^5] (row-major 3x3) of a closed mesh. Returns 0, or -1 if the
+/// volume is not positive after orienting (flat or open). Inside-out winding
+/// is accepted (the signs flip together).
+int mesh_mass_props(const mesh_tri* m, double* volume, double com[3], double I[9]);
+
+/// A convex hull: vertices, and triangles wound counter-clockwise seen from
+/// outside with their planes n.x = d (n unit, outward).
+typedef struct mesh_hull {
+    int nv, nf;
+    double* v;      ///< 3 nv [m]
+    int* f;         ///< 3 nf
+    double* plane;  ///< 4 nf: nx, ny, nz, d
+} mesh_hull;
+
+/// Hull of the mesh's vertices (incremental). Returns 0, or -1 if the points
+/// are flat (no volume) or memory ran out.
+int mesh_hull_build(const double* pts, int n, mesh_hull* h);
+void mesh_hull_free(mesh_hull* h);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,335 @@
+// mesh_io.c: reading OBJ and STL meshes into mesh_tri (the physics core's
+// own readers), the importer hook for other formats, welding and cleaning.
+#include "mesh_geom.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+static mesh_import_fn g_importer;
+
+void mesh_set_importer(mesh_import_fn fn) { g_importer = fn; }
+
+void mesh_free(mesh_tri* m) {
+    if (!m) return;
+    free(m->v);
+    free(m->idx);
+    memset(m, 0, sizeof *m);
+}
+
+// Growable arrays.
+static int grow(void** p, int* cap, int need, size_t elem) {
+    if (need <= *cap) return 0;
+    int c = *cap ? *cap : 64;
+    while (c < need) {
+        if (c > (1 << 28)) return -1;
+        c *= 2;
+    }
+    void* q = realloc(*p, (size_t)c * elem);
+    if (!q) return -1;
+    *p = q;
+    *cap = c;
+    return 0;
+}
+
+// More vertices than 3 per allowed triangle cannot be a mesh within the
+// limit; stop there so a huge file is refused without reading it into memory.
+#define MESH_MAX_VERTICES (3 * MESH_MAX_TRIANGLES + 3)
+
+static int add_vertex(mesh_tri* m, int* cap, float x, float y, float z) {
+    if (m->nv >= MESH_MAX_VERTICES) return -2;
+    if (grow((void**)&m->v, cap, 3 * (m->nv + 1), sizeof(float))) return -1;
+    m->v[3 * m->nv] = x, m->v[3 * m->nv + 1] = y, m->v[3 * m->nv + 2] = z;
+    return m->nv++;
+}
+
+static int add_tri(mesh_tri* m, int* cap, int a, int b, int c) {
+    // One over the limit is enough to refuse the file; stop reading there.
+    if (m->nt > MESH_MAX_TRIANGLES) return 0;
+    if (grow((void**)&m->idx, cap, 3 * (m->nt + 1), sizeof(int))) return -1;
+    m->idx[3 * m->nt] = a, m->idx[3 * m->nt + 1] = b, m->idx[3 * m->nt + 2] = c;
+    ++m->nt;
+    return 0;
+}
+
+// OBJ: "v x y z" and "f a b c ..." (a = v, v/vt, v//vn or v/vt/vn; negative
+// indices count back from the last vertex); polygons become fans. Everything
+// else (normals, texture coordinates, groups, materials) is not needed for
+// collision and is skipped.
+static int read_obj(FILE* f, mesh_tri* m, char* err, size_t errsz) {
+    char line[4096];
+    int vcap = 0, tcap = 0, lineno = 0;
+    while (fgets(line, sizeof line, f)) {
+        ++lineno;
+        char* s = line;
+        while (*s == ' ' || *s == '\t') ++s;
+        if (s[0] == 'v' && (s[1] == ' ' || s[1] == '\t')) {
+            double x, y, z;
+            if (sscanf(s + 2, "%lf %lf %lf", &x, &y, &z) != 3) {
+                snprintf(err, errsz, "line %d: a vertex needs three numbers", lineno);
+                return -1;
+            }
+            if (!isfinite(x) || !isfinite(y) || !isfinite(z) || fabs(x) > 1e30 || fabs(y) > 1e30 || fabs(z) > 1e30) {
+                snprintf(err, errsz, "line %d: vertex coordinates must be finite", lineno);
+                return -1;
+            }
+            const int r = add_vertex(m, &vcap, (float)x, (float)y, (float)z);
+            if (r == -2) goto too_big;
+            if (r < 0) goto oom;
+        } else if (s[0] == 'f' && (s[1] == ' ' || s[1] == '\t')) {
+            int ids[2], k = 0;
+            char* p = s + 2;
+            for (;;) {
+                while (*p == ' ' || *p == '\t') ++p;
+                if (!*p || *p == '\n' || *p == '\r' || *p == '#') break;
+                char* end;
+                long i = strtol(p, &end, 10);
+                if (end == p || i == 0) {
+                    snprintf(err, errsz, "line %d: bad face index", lineno);
+                    return -1;
+                }
+                long vi = i > 0 ? i - 1 : m->nv + i;
+                if (vi < 0 || vi >= m->nv) {
+                    snprintf(err, errsz, "line %d: face index %ld refers to no vertex (%d so far)", lineno, i, m->nv);
+                    return -1;
+                }
+                while (*end && *end != ' ' && *end != '\t' && *end != '\n' && *end != '\r') ++end;
+                p = end;
+                // Fan: (first, previous, this) for every index after the second.
+                if (k < 2) ids[k++] = (int)vi;
+                else {
+                    if (add_tri(m, &tcap, ids[0], ids[1], (int)vi)) goto oom;
+                    ids[1] = (int)vi;
+                }
+            }
+        }
+    }
+    return 0;
+too_big:
+    snprintf(err, errsz, "more than %d vertices (the limit is %d triangles; docs/ode_world.md, \"CAD meshes\")",
+             MESH_MAX_VERTICES, MESH_MAX_TRIANGLES);
+    return -1;
+oom:
+    snprintf(err, errsz, "out of memory");
+    return -1;
+}
+
+static float rd_f32(const unsigned char* p) {
+    uint32_t u = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+    float x;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+
+// STL, binary (80-byte header, count, 50 bytes a facet) or ASCII ("solid",
+// "vertex x y z" lines). Binary is recognised by its exact size, since some
+// exporters start binary headers with "solid" too.
+static int read_stl(FILE* f, mesh_tri* m, char* err, size_t errsz) {
+    if (fseek(f, 0, SEEK_END)) goto unreadable;
+    long size = ftell(f);
+    rewind(f);
+    unsigned char head[84];
+    int vcap = 0, tcap = 0;
+    if (size >= 84 && fread(head, 1, 84, f) == 84) {
+        uint32_t n = (uint32_t)head[80] | (uint32_t)head[81] << 8 | (uint32_t)head[82] << 16 | (uint32_t)head[83] << 24;
+        if ((uint64_t)size == 84 + 50ull * n) {
+            if (n > MESH_MAX_TRIANGLES) {
+                snprintf(err, errsz, "more than %d triangles (%u; docs/ode_world.md, \"CAD meshes\")",
+                         MESH_MAX_TRIANGLES, n);
+                return -1;
+            }
+            unsigned char rec[50];
+            for (uint32_t t = 0; t < n; ++t) {
+                if (fread(rec, 1, 50, f) != 50) goto unreadable;
+                int id[3];
+                for (int k = 0; k < 3; ++k) {
+                    float x = rd_f32(rec + 12 + 12 * k), y = rd_f32(rec + 16 + 12 * k), z = rd_f32(rec + 20 + 12 * k);
+                    if (!isfinite(x) || !isfinite(y) || !isfinite(z)) {
+                        snprintf(err, errsz, "facet %u: vertex coordinates must be finite", t);
+                        return -1;
+                    }
+                    if ((id[k] = add_vertex(m, &vcap, x, y, z)) < 0) goto oom;
+                }
+                if (add_tri(m, &tcap, id[0], id[1], id[2])) goto oom;
+            }
+            return 0;
+        }
+    }
+    rewind(f);
+    char line[1024];
+    int id[3], k = 0;
+    while (fgets(line, sizeof line, f)) {
+        char* s = line;
+        while (isspace((unsigned char)*s)) ++s;
+        if (strncasecmp(s, "vertex", 6)) continue;
+        double x, y, z;
+        if (sscanf(s + 6, "%lf %lf %lf", &x, &y, &z) != 3 || !isfinite(x) || !isfinite(y) || !isfinite(z) ||
+            fabs(x) > 1e30 || fabs(y) > 1e30 || fabs(z) > 1e30) {
+            snprintf(err, errsz, "a vertex line needs three finite numbers");
+            return -1;
+        }
+        if ((id[k] = add_vertex(m, &vcap, (float)x, (float)y, (float)z)) == -2) {
+            snprintf(err, errsz, "more than %d triangles (docs/ode_world.md, \"CAD meshes\")", MESH_MAX_TRIANGLES);
+            return -1;
+        }
+        if (id[k++] < 0) goto oom;
+        if (k == 3) {
+            if (add_tri(m, &tcap, id[0], id[1], id[2])) goto oom;
+            k = 0;
+        }
+    }
+    return 0;
+unreadable:
+    snprintf(err, errsz, "cannot read the file");
+    return -1;
+oom:
+    snprintf(err, errsz, "out of memory");
+    return -1;
+}
+
+// Weld vertices with identical coordinates (after conversion), so shared
+// edges are shared indices: closedness and hulls need it, and STL stores
+// every facet's corners separately. Open addressing on the bit patterns.
+static int weld(mesh_tri* m) {
+    size_t cap = 16;
+    while (cap < 2 * (size_t)m->nv) cap *= 2;
+    int* slot = malloc(cap * sizeof *slot);
+    int* remap = malloc((size_t)(m->nv ? m->nv : 1) * sizeof *remap);
+    if (!slot || !remap) {
+        free(slot);
+        free(remap);
+        return -1;
+    }
+    for (size_t i = 0; i < cap; ++i) slot[i] = -1;
+    int nu = 0;
+    for (int i = 0; i < m->nv; ++i) {
+        float* p = m->v + 3 * i;
+        for (int k = 0; k < 3; ++k)
+            if (p[k] == 0.0f) p[k] = 0.0f; // -0 and +0 are one point
+        uint32_t b[3];
+        memcpy(b, p, sizeof b);
+        uint64_t h = (b[0] * 0x9E3779B1u) ^ ((uint64_t)b[1] * 0x85EBCA77u) ^ ((uint64_t)b[2] * 0xC2B2AE3Du << 7);
+        size_t s = (size_t)(h ^ (h >> 29)) & (cap - 1);
+        for (;;) {
+            if (slot[s] < 0) {
+                memmove(m->v + 3 * nu, p, 3 * sizeof(float));
+                slot[s] = nu;
+                remap[i] = nu++;
+                break;
+            }
+            if (!memcmp(m->v + 3 * slot[s], p, 3 * sizeof(float))) {
+                remap[i] = slot[s];
+                break;
+            }
+            s = (s + 1) & (cap - 1);
+        }
+    }
+    for (int i = 0; i < 3 * m->nt; ++i) m->idx[i] = remap[m->idx[i]];
+    m->nv = nu;
+    free(slot);
+    free(remap);
+    return 0;
+}
+
+void mesh_bounds(const mesh_tri* m, double lo[3], double hi[3]) {
+    for (int k = 0; k < 3; ++k) lo[k] = m->nv ? INFINITY : 0, hi[k] = m->nv ? -INFINITY : 0;
+    for (int i = 0; i < m->nv; ++i)
+        for (int k = 0; k < 3; ++k) {
+            const double x = m->v[3 * i + k];
+            if (x < lo[k]) lo[k] = x;
+            if (x > hi[k]) hi[k] = x;
+        }
+}
+
+// Drop triangles of (near) zero area: repeated corners, or corners on a line.
+// ODE's trimesh colliders divide by a triangle's normal length, so such a
+// triangle would give a NaN contact normal. Area below 1e-12 of the mesh's
+// size squared counts as zero (float corners of a mesh 100 m across are
+// resolved to about 1e-5 m).
+static void drop_degenerate(mesh_tri* m) {
+    double lo[3], hi[3];
+    mesh_bounds(m, lo, hi);
+    const double d2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                      (hi[2] - lo[2]) * (hi[2] - lo[2]);
+    int n = 0;
+    for (int t = 0; t < m->nt; ++t) {
+        const int* ix = m->idx + 3 * t;
+        const float *a = m->v + 3 * ix[0], *b = m->v + 3 * ix[1], *c = m->v + 3 * ix[2];
+        const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+                     cz = e1[0] * e2[1] - e1[1] * e2[0];
+        const double area2 = sqrt(cx * cx + cy * cy + cz * cz);
+        if (ix[0] == ix[1] || ix[1] == ix[2] || ix[0] == ix[2] || !(area2 > 2e-12 * d2)) continue;
+        memmove(m->idx + 3 * n++, ix, 3 * sizeof(int));
+    }
+    m->dropped = m->nt - n;
+    m->nt = n;
+}
+
+static const char* ext_of(const char* path) {
+    const char* slash = strrchr(path, '/');
+    const char* dot = strrchr(path, '.');
+    return dot && (!slash || dot > slash) ? dot : "";
+}
+
+int mesh_load(const char* path, double scale, int up, mesh_tri* out, char* err, size_t errsz) {
+    memset(out, 0, sizeof *out);
+    const char* ext = ext_of(path);
+    const int obj = !strcasecmp(ext, ".obj"), stl = !strcasecmp(ext, ".stl");
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, errsz, "cannot open the mesh file");
+        return -1;
+    }
+    int rc;
+    if (obj || stl) {
+        rc = obj ? read_obj(f, out, err, errsz) : read_stl(f, out, err, errsz);
+        fclose(f);
+    } else {
+        fclose(f);
+        if (!g_importer) {
+            snprintf(err, errsz,
+                     "format \"%s\" needs the assimp importer, which this program does not have (OBJ and STL are read "
+                     "without it)",
+                     ext);
+            rc = -1;
+        } else {
+            rc = g_importer(path, out, err, errsz);
+        }
+    }
+    if (rc == 0 && out->nt > MESH_MAX_TRIANGLES) {
+        snprintf(err, errsz, "more than %d triangles (docs/ode_world.md, \"CAD meshes\")", MESH_MAX_TRIANGLES);
+        rc = -1;
+    }
+    if (rc == 0 && out->nt == 0) {
+        snprintf(err, errsz, "the mesh has no triangles");
+        rc = -1;
+    }
+    if (rc) {
+        mesh_free(out);
+        return -1;
+    }
+    // To the world's z-up metres (the renderer converts the same way).
+    for (int i = 0; i < out->nv; ++i) {
+        float* p = out->v + 3 * i;
+        const double x = p[0], y = p[1], z = p[2];
+        if (up == 1) p[0] = (float)(scale * x), p[1] = (float)(-scale * z), p[2] = (float)(scale * y);
+        else p[0] = (float)(scale * x), p[1] = (float)(scale * y), p[2] = (float)(scale * z);
+    }
+    if (weld(out)) {
+        mesh_free(out);
+        snprintf(err, errsz, "out of memory");
+        return -1;
+    }
+    drop_degenerate(out);
+    if (out->nt == 0) {
+        snprintf(err, errsz, "all %d triangles are degenerate (zero area)", out->dropped);
+        mesh_free(out);
+        return -1;
+    }
+    return 0;
+}

@@ -1,0 +1,495 @@
+// test_mesh.c: CAD meshes in the world: mass properties against the
+// analytic solids, the convex hull, a load at rest on a wedge at the height
+// its surface gives, a box obstacle against the same box as a mesh, the boom
+// stopped by a mesh wall, and the bad-mesh messages.
+#include "check.h"
+
+#include "json_util.h"
+#include "mesh_geom.h"
+#include "model.h"
+#include "ode_world.h"
+#include "ode_world_internal.h"
+#include "scenario.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#define PI 3.14159265358979323846
+#define DEG (PI / 180.0)
+
+static model* g_model;
+static char g_dir[512];
+
+// ---- writing meshes ----
+
+typedef struct obj_out {
+    FILE* f;
+    int nv;
+} obj_out;
+
+static int obj_open(obj_out* o, const char* name, char* path, size_t n) {
+    snprintf(path, n, "%s/%s", g_dir, name);
+    o->f = fopen(path, "w");
+    o->nv = 0;
+    return o->f ? 0 : -1;
+}
+static int obj_v(obj_out* o, double x, double y, double z) {
+    fprintf(o->f, "v %.9g %.9g %.9g\n", x, y, z);
+    return ++o->nv; // OBJ indices start at 1
+}
+static void obj_f(obj_out* o, int a, int b, int c) { fprintf(o->f, "f %d %d %d\n", a, b, c); }
+static void obj_quad(obj_out* o, int a, int b, int c, int d) { fprintf(o->f, "f %d %d %d %d\n", a, b, c, d); }
+
+// A box from lo to hi, outward winding (quads: the reader's fans).
+static void write_box(const char* name, const double lo[3], const double hi[3], char* path, size_t n) {
+    obj_out o;
+    if (obj_open(&o, name, path, n)) return;
+    int v[8];
+    for (int i = 0; i < 8; ++i) v[i] = obj_v(&o, i & 1 ? hi[0] : lo[0], i & 2 ? hi[1] : lo[1], i & 4 ? hi[2] : lo[2]);
+    obj_quad(&o, v[0], v[2], v[3], v[1]); // -z
+    obj_quad(&o, v[4], v[5], v[7], v[6]); // +z
+    obj_quad(&o, v[0], v[1], v[5], v[4]); // -y
+    obj_quad(&o, v[2], v[6], v[7], v[3]); // +y
+    obj_quad(&o, v[0], v[4], v[6], v[2]); // -x
+    obj_quad(&o, v[1], v[3], v[7], v[5]); // +x
+    fclose(o.f);
+}
+
+// A cylinder of radius r, height h along z, base centred at c, seg sides.
+static void write_cylinder(const char* name, double r, double h, const double c[3], int seg, char* path, size_t n) {
+    obj_out o;
+    if (obj_open(&o, name, path, n)) return;
+    const int b0 = obj_v(&o, c[0], c[1], c[2]), t0 = obj_v(&o, c[0], c[1], c[2] + h);
+    int first = 0;
+    for (int i = 0; i < seg; ++i) {
+        const double a = 2 * PI * i / seg;
+        const int k = obj_v(&o, c[0] + r * cos(a), c[1] + r * sin(a), c[2]);
+        obj_v(&o, c[0] + r * cos(a), c[1] + r * sin(a), c[2] + h);
+        if (!i) first = k;
+    }
+    for (int i = 0; i < seg; ++i) {
+        const int a = first + 2 * i, b = first + 2 * ((i + 1) % seg);
+        obj_f(&o, b0, b, a);
+        obj_f(&o, t0, a + 1, b + 1);
+        obj_quad(&o, a, b, b + 1, a + 1);
+    }
+    fclose(o.f);
+}
+
+// A wedge: footprint [-L/2, L/2] x [-W/2, W/2], height z0 at x = -L/2
+// rising to z1 at x = +L/2.
+static void write_wedge(const char* name, double L, double W, double z0, double z1, char* path, size_t n) {
+    obj_out o;
+    if (obj_open(&o, name, path, n)) return;
+    const double x0 = -0.5 * L, x1 = 0.5 * L, y0 = -0.5 * W, y1 = 0.5 * W;
+    const int a = obj_v(&o, x0, y0, 0), b = obj_v(&o, x1, y0, 0), c = obj_v(&o, x1, y1, 0), d = obj_v(&o, x0, y1, 0);
+    const int e = obj_v(&o, x0, y0, z0), f = obj_v(&o, x1, y0, z1), g = obj_v(&o, x1, y1, z1), h = obj_v(&o, x0, y1, z0);
+    obj_quad(&o, a, d, c, b); // bottom
+    obj_quad(&o, e, f, g, h); // top slope
+    obj_quad(&o, a, b, f, e); // -y
+    obj_quad(&o, d, h, g, c); // +y
+    obj_quad(&o, a, e, h, d); // -x
+    obj_quad(&o, b, c, g, f); // +x
+    fclose(o.f);
+}
+
+// ---- worlds ----
+
+// The shipped sandbox with its loads and obstacles replaced by the JSON
+// arrays given (text), built into d. 0, or -1 with err.
+static int sandbox_with(const char* loads, const char* obstacles, world_desc* d, char* err, size_t errsz) {
+    cJSON* root = json_load_file(CRANESIM_ASSETS "/worlds/sandbox.json", err, errsz);
+    if (!root) return -1;
+    cJSON_DeleteItemFromObjectCaseSensitive(root, "loads");
+    cJSON_DeleteItemFromObjectCaseSensitive(root, "obstacles");
+    if (loads) cJSON_AddItemToObject(root, "loads", cJSON_Parse(loads));
+    if (obstacles) cJSON_AddItemToObject(root, "obstacles", cJSON_Parse(obstacles));
+    int rc = world_desc_from_json(root, "test_world.json", d, err, errsz);
+    cJSON_Delete(root);
+    return rc;
+}
+
+static ode_world* make(const world_desc* d, double q1, double q2, double slew0) {
+    char err[512] = "";
+    ode_world_opts o = ode_world_default_opts();
+    o.q0[0] = q1 * DEG, o.q0[1] = q2 * DEG, o.slew0 = slew0 * DEG;
+    o.model_file = "hiab031.json";
+    ode_world* w = ode_world_create(&g_model->mech, cJSON_GetObjectItemCaseSensitive(g_model->json, "hydraulics"), d,
+                                    &o, err, sizeof err);
+    if (!w) fprintf(stderr, "create: %s\n", err);
+    return w;
+}
+
+// ---- mass properties ----
+
+static void test_mass_cube(void) {
+    char path[600], err[256];
+    const double lo[3] = {0, 1.5, 2.75}, hi[3] = {2, 2.5, 3.25}; // 2 x 1 x 0.5 m about (1, 2, 3)
+    write_box("cube.obj", lo, hi, path, sizeof path);
+    mesh_tri t;
+    CHECK(mesh_load(path, 1.0, 2, &t, err, sizeof err) == 0, "load: %s", err);
+    CHECK(t.nv == 8 && t.nt == 12, "welded %d vertices, %d triangles", t.nv, t.nt);
+    CHECK(mesh_open_edges(&t) == 0, "closed");
+    double V, c[3], I[9];
+    CHECK(mesh_mass_props(&t, &V, c, I) == 0, "props");
+    // Per unit density: V = abc, I_xx = V (b^2 + c^2) / 12, no products.
+    const double a = 2, b = 1, h = 0.5;
+    CHECK_REL(V, a * b * h, 1e-6);
+    CHECK_NEAR(c[0], 1, 1e-6);
+    CHECK_NEAR(c[1], 2, 1e-6);
+    CHECK_NEAR(c[2], 3, 1e-6);
+    CHECK_REL(I[0], V * (b * b + h * h) / 12, 1e-5);
+    CHECK_REL(I[4], V * (a * a + h * h) / 12, 1e-5);
+    CHECK_REL(I[8], V * (a * a + b * b) / 12, 1e-5);
+    CHECK(fabs(I[1]) < 1e-6 && fabs(I[2]) < 1e-6 && fabs(I[5]) < 1e-6, "products %g %g %g", I[1], I[2], I[5]);
+    // Inside-out winding gives the same solid.
+    for (int k = 0; k < t.nt; ++k) {
+        int s = t.idx[3 * k + 1];
+        t.idx[3 * k + 1] = t.idx[3 * k + 2];
+        t.idx[3 * k + 2] = s;
+    }
+    double V2, c2[3], I2[9];
+    CHECK(mesh_mass_props(&t, &V2, c2, I2) == 0 && fabs(V2 - V) < 1e-9 && fabs(I2[0] - I[0]) < 1e-9, "flipped");
+    mesh_free(&t);
+}
+
+static void test_mass_cylinder(void) {
+    char path[600], err[256];
+    const double r = 0.5, h = 1.2, base[3] = {-3, 4, 0.5};
+    write_cylinder("cyl.obj", r, h, base, 256, path, sizeof path);
+    // y-up conversion and a scale: the file is in the same units, so scale
+    // 2 doubles every length: V x 8, I x 32 per unit density.
+    mesh_tri t;
+    CHECK(mesh_load(path, 2.0, 2, &t, err, sizeof err) == 0, "load: %s", err);
+    CHECK(mesh_open_edges(&t) == 0, "closed");
+    double V, c[3], I[9];
+    CHECK(mesh_mass_props(&t, &V, c, I) == 0, "props");
+    const double R = 2 * r, H = 2 * h, Va = PI * R * R * H;
+    CHECK_REL(V, Va, 0.01);
+    CHECK_NEAR(c[0], 2 * base[0], 1e-4);
+    CHECK_NEAR(c[1], 2 * base[1], 1e-4);
+    CHECK_NEAR(c[2], 2 * (base[2] + 0.5 * h), 1e-4);
+    CHECK_REL(I[8], Va * R * R / 2, 0.01);
+    CHECK_REL(I[0], Va * (3 * R * R + H * H) / 12, 0.01);
+    CHECK_REL(I[4], Va * (3 * R * R + H * H) / 12, 0.01);
+    // Its hull: every rim vertex is on it, the centres of the caps are not.
+    double* p = malloc((size_t)3 * t.nv * sizeof *p);
+    for (int i = 0; i < 3 * t.nv; ++i) p[i] = t.v[i];
+    mesh_hull hl;
+    CHECK(mesh_hull_build(p, t.nv, &hl) == 0, "hull");
+    // (a cap centre lies on the hull's cap plane: it may be kept or not)
+    CHECK(hl.nv >= 2 * 256 && hl.nv <= 2 * 256 + 2, "hull vertices %d", hl.nv);
+    // Every vertex inside or on every plane.
+    double worst = 0;
+    for (int f = 0; f < hl.nf; ++f)
+        for (int i = 0; i < t.nv; ++i) {
+            const double s = hl.plane[4 * f] * p[3 * i] + hl.plane[4 * f + 1] * p[3 * i + 1] +
+                             hl.plane[4 * f + 2] * p[3 * i + 2] - hl.plane[4 * f + 3];
+            if (s > worst) worst = s;
+        }
+    CHECK(worst < 1e-6, "a point %g m outside the hull", worst);
+    mesh_hull_free(&hl);
+    free(p);
+    mesh_free(&t);
+    // y-up: the cylinder's axis (file z) becomes world -y.
+    CHECK(mesh_load(path, 1.0, 1, &t, err, sizeof err) == 0, "load y-up");
+    double lo[3], hi[3];
+    mesh_bounds(&t, lo, hi);
+    CHECK_NEAR(hi[1] - lo[1], h, 1e-5);
+    CHECK_NEAR(hi[2] - lo[2], 2 * r, 1e-3);
+    mesh_free(&t);
+}
+
+// The world's meshed load gets the closed mesh's mass properties in ODE.
+static void test_load_mass_in_world(void) {
+    char path[600], err[512], loads[1200];
+    const double lo[3] = {-0.5, -0.3, 0}, hi[3] = {0.5, 0.3, 0.4};
+    write_box("crate.obj", lo, hi, path, sizeof path);
+    snprintf(loads, sizeof loads,
+             "[{\"name\": \"crate\", \"mesh\": {\"file\": \"%s\"}, \"density\": 500, \"position\": [4, -3]}]", path);
+    world_desc d;
+    if (sandbox_with(loads, NULL, &d, err, sizeof err)) {
+        CHECK(0, "world: %s", err);
+        return;
+    }
+    CHECK_REL(d.load[0].mass, 500 * 0.24, 1e-6);
+    CHECK_NEAR(d.load[0].position[2], 0.0, 1e-9); // lowest point on the flat ground
+    ode_world* w = make(&d, 117.3, -65.8, -60);
+    if (!w) { CHECK(0, "world"); world_desc_free(&d); return; }
+    dMass m;
+    dBodyGetMass(w->load[0], &m);
+    CHECK_REL(m.mass, 120, 1e-6); // float vertices
+    CHECK_REL(m.I[0], 120 * (0.6 * 0.6 + 0.4 * 0.4) / 12, 1e-5);
+    CHECK_REL(m.I[5], 120 * (1.0 + 0.4 * 0.4) / 12, 1e-5);
+    CHECK_REL(m.I[10], 120 * (1.0 + 0.6 * 0.6) / 12, 1e-5);
+    // Body origin at the centre of mass: 0.2 m above the ground.
+    double p[3], v[3];
+    ode_world_load_state(w, 0, p, v);
+    CHECK_NEAR(p[2], 0.2, 1e-6);
+    ode_world_destroy(w);
+    world_desc_free(&d);
+}
+
+// ---- contact geometry ----
+
+// A 0.4 m box load dropped onto a static wedge comes to rest on the slope,
+// its centre h/2 / cos(theta) above the surface under it, far below the
+// wedge's bounding box top (1.2 m).
+static void test_rest_on_wedge(void) {
+    char path[600], err[512], obst[1200];
+    const double L = 3, z0 = 0.2, z1 = 1.2, hb = 0.4;
+    write_wedge("wedge.obj", L, 2, z0, z1, path, sizeof path);
+    snprintf(obst, sizeof obst,
+             "[{\"name\": \"wedge\", \"kind\": \"building\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-6, -9], "
+             "\"friction\": 1.2}]",
+             path);
+    world_desc d;
+    if (sandbox_with("[{\"name\": \"box\", \"mass\": 100, \"size\": [0.4, 0.4, 0.4], \"position\": [-6, -9, 1.6], "
+                     "\"friction\": 1.2}]",
+                     obst, &d, err, sizeof err)) {
+        CHECK(0, "world: %s", err);
+        return;
+    }
+    CHECK_NEAR(d.obstacle[0].position[2], 0, 1e-9);
+    ode_world* w = make(&d, 117.3, -65.8, -60);
+    if (!w) { CHECK(0, "world"); world_desc_free(&d); return; }
+    for (int i = 0; i < 300; ++i)
+        if (ode_world_step(w, 0.01)) {
+            CHECK(0, "step: %s", ode_world_error(w));
+            break;
+        }
+    double p[3], v[3];
+    ode_world_load_state(w, 0, p, v);
+    const double slope = (z1 - z0) / L, ct = 1 / sqrt(1 + slope * slope);
+    const double surf = z0 + slope * (p[0] - (-6) + 0.5 * L);
+    CHECK_NEAR(p[2], surf + 0.5 * hb / ct, 2e-3);
+    CHECK(p[2] < z1, "below the bounding box top");
+    CHECK(sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) < 0.01, "at rest (%.3g m/s)",
+          sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    ode_world_destroy(w);
+    world_desc_free(&d);
+}
+
+// A load pushed along the ground into a fixed block at 45 deg slides along
+// it; the block as a box and as a box-shaped mesh give the same path.
+static void slide_path(const char* obst, double out[3], double* min_x) {
+    char err[512];
+    world_desc d;
+    if (sandbox_with("[{\"name\": \"l\", \"mass\": 300, \"size\": [0.6, 0.6, 0.5], \"position\": [-6, -8], "
+                     "\"friction\": 0.3}]",
+                     obst, &d, err, sizeof err)) {
+        CHECK(0, "world: %s", err);
+        return;
+    }
+    ode_world* w = make(&d, 117.3, -65.8, -60);
+    if (!w) { CHECK(0, "world"); world_desc_free(&d); return; }
+    dBodySetLinearVel(w->load[0], 2.0, -2.0, 0);
+    *min_x = 1e9;
+    for (int i = 0; i < 200; ++i) {
+        if (ode_world_step(w, 0.01)) {
+            CHECK(0, "step: %s", ode_world_error(w));
+            break;
+        }
+        double p[3], v[3];
+        ode_world_load_state(w, 0, p, v);
+        if (p[1] < *min_x) *min_x = p[1];
+    }
+    double v[3];
+    ode_world_load_state(w, 0, out, v);
+    ode_world_destroy(w);
+    world_desc_free(&d);
+}
+
+static void test_box_vs_mesh_box(void) {
+    char path[600], obst[1200];
+    const double lo[3] = {-2, -0.5, 0}, hi[3] = {2, 0.5, 1};
+    write_box("block.obj", lo, hi, path, sizeof path);
+    double pa[3], pb[3], ya, yb;
+    slide_path("[{\"name\": \"b\", \"kind\": \"box\", \"size\": [4, 1, 1], \"position\": [-4, -10]}]", pa, &ya);
+    snprintf(obst, sizeof obst,
+             "[{\"name\": \"b\", \"kind\": \"box\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-4, -10]}]", path);
+    slide_path(obst, pb, &yb);
+    // Turned by -35 deg (both the same way): the mesh turns with its yaw.
+    double qa[3], qb[3], za, zb;
+    slide_path("[{\"name\": \"b\", \"kind\": \"box\", \"size\": [4, 1, 1], \"position\": [-4, -10], "
+               "\"yaw_deg\": -35}]", qa, &za);
+    snprintf(obst, sizeof obst,
+             "[{\"name\": \"b\", \"kind\": \"box\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-4, -10], "
+             "\"yaw_deg\": -35}]", path);
+    slide_path(obst, qb, &zb);
+    CHECK(hypot(qa[0] - pa[0], qa[1] - pa[1]) > 0.05, "the turned block changes the path (%.3f %.3f vs %.3f %.3f)", qa[0], qa[1], pa[0], pa[1]);
+    CHECK_NEAR(qb[0], qa[0], 0.02);
+    CHECK_NEAR(qb[1], qa[1], 0.02);
+    // The load stops against the block's face at y = -9.5 (its half width
+    // 0.3 m): it must not pass it, and both paths agree.
+    CHECK(ya > -9.5 + 0.25 && yb > -9.5 + 0.25, "stopped at the face: box %.3f, mesh %.3f", ya, yb);
+    CHECK(pa[0] > -6 + 0.2, "slid along the face (x %.3f)", pa[0]);
+    CHECK_NEAR(pb[0], pa[0], 0.02);
+    CHECK_NEAR(pb[1], pa[1], 0.02);
+    CHECK_NEAR(pb[2], pa[2], 0.005);
+}
+
+// The sandbox_wall scenario with its radial wall as a mesh: the end arm
+// stops at it (a crane contact: the COLLISION warning) and does not pass.
+static void test_boom_mesh_wall(void) {
+    char path[600], err[512];
+    const double lo[3] = {-1.25, -0.15, 0}, hi[3] = {1.25, 0.15, 4.5};
+    write_box("wall.obj", lo, hi, path, sizeof path);
+    cJSON* root = json_load_file(CRANESIM_ASSETS "/worlds/sandbox.json", err, sizeof err);
+    if (!root) { CHECK(0, "%s", err); return; }
+    cJSON* obs = cJSON_GetObjectItemCaseSensitive(root, "obstacles");
+    cJSON* wall = cJSON_GetArrayItem(obs, 0); // wall_slew
+    cJSON_DeleteItemFromObjectCaseSensitive(wall, "size");
+    cJSON* pos = cJSON_GetObjectItemCaseSensitive(wall, "position");
+    cJSON_AddItemToArray(pos, cJSON_CreateNumber(0)); // mesh origin on the ground
+    cJSON* m = cJSON_AddObjectToObject(wall, "mesh");
+    cJSON_AddStringToObject(m, "file", path);
+    world_desc d;
+    int rc = world_desc_from_json(root, "wall_world.json", &d, err, sizeof err);
+    cJSON_Delete(root);
+    if (rc) { CHECK(0, "world: %s", err); return; }
+    CHECK(d.obstacle[0].mesh.file[0] && d.obstacle[0].mass == 0, "a static mesh wall");
+    scenario sc;
+    if (scenario_load(CRANESIM_ASSETS "/scenarios/sandbox_wall.json", &sc, err, sizeof err)) {
+        CHECK(0, "%s", err);
+        world_desc_free(&d);
+        return;
+    }
+    ode_world* w = make(&d, sc.q0[0] / DEG, sc.q0[1] / DEG, sc.slew0 / DEG);
+    if (!w) { CHECK(0, "world"); world_desc_free(&d); return; }
+    double depth = 0, slew10 = 0;
+    int collision = 0;
+    static world_snapshot snap;
+    for (long i = 0; i < (long)(sc.duration / 0.01 + 0.5); ++i) {
+        double u[3];
+        for (int k = 0; k < 3; ++k) u[k] = scenario_command(&sc, k, i * 0.01);
+        ode_world_set_commands(w, u);
+        if (ode_world_step(w, 0.01)) {
+            CHECK(0, "step: %s", ode_world_error(w));
+            break;
+        }
+        ode_world_state s;
+        ode_world_get_state(w, &s);
+        if (s.max_depth_crane > depth) depth = s.max_depth_crane;
+        if (i == 1000) slew10 = s.slew;
+        ode_world_snapshot(w, &snap);
+        collision |= snap.collision;
+    }
+    ode_world_state s;
+    ode_world_get_state(w, &s);
+    CHECK(s.slew > 45 * DEG && s.slew < 60 * DEG, "slew stopped at %.2f deg", s.slew / DEG);
+    // At rest while pushing: the mean slew rate of the last 2 s (the
+    // trimesh contact jitters by about 1e-3 rad/s about it).
+    CHECK(fabs(s.slew - slew10) / 2 < 1e-3, "slew at rest (%.2g rad/s mean, %.2g now) while pushing",
+          (s.slew - slew10) / 2, s.slew_rate);
+    CHECK(collision, "COLLISION flagged");
+    CHECK(depth > 0 && depth < 5e-3, "penetration %.4f m", depth);
+    ode_world_destroy(w);
+    world_desc_free(&d);
+}
+
+// ---- bad meshes ----
+
+static void expect_bad(const char* loads, const char* obst, const char* want1, const char* want2) {
+    char err[1024] = "";
+    world_desc d;
+    int rc = sandbox_with(loads, obst, &d, err, sizeof err);
+    CHECK(rc == -1, "refused (%s)", want1);
+    if (rc == 0) world_desc_free(&d);
+    CHECK(strstr(err, want1) && (!want2 || strstr(err, want2)) && !strchr(err, '\n'), "message: %s", err);
+}
+
+static void test_bad_meshes(void) {
+    char path[600], p2[600], buf[1400];
+    // Missing file.
+    expect_bad(NULL, "[{\"name\": \"x\", \"mesh\": {\"file\": \"/nonexistent/site.obj\"}, \"position\": [-6, -9]}]",
+               "obstacles[0].mesh.file: /nonexistent/site.obj", "cannot open the mesh file");
+    // Empty mesh.
+    obj_out o;
+    obj_open(&o, "empty.obj", path, sizeof path);
+    fprintf(o.f, "# nothing\n");
+    fclose(o.f);
+    snprintf(buf, sizeof buf, "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-6, -9]}]", path);
+    expect_bad(NULL, buf, "empty.obj", "no triangles");
+    // Unreadable: a face that names no vertex.
+    obj_open(&o, "broken.obj", path, sizeof path);
+    fprintf(o.f, "v 0 0 0\nf 1 2 3\n");
+    fclose(o.f);
+    snprintf(buf, sizeof buf, "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-6, -9]}]", path);
+    expect_bad(NULL, buf, "broken.obj", "line 2: face index 2 refers to no vertex");
+    // Only degenerate triangles (all corners on a line).
+    obj_open(&o, "flat.obj", path, sizeof path);
+    fprintf(o.f, "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 3 2\n");
+    fclose(o.f);
+    snprintf(buf, sizeof buf, "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-6, -9]}]", path);
+    expect_bad(NULL, buf, "flat.obj", "all 2 triangles are degenerate");
+    // A load that is not closed: the wedge without its bottom.
+    obj_open(&o, "open.obj", path, sizeof path);
+    fprintf(o.f, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+    fclose(o.f);
+    snprintf(buf, sizeof buf, "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s\"}, \"mass\": 50, \"position\": [-6, -9]}]",
+             path);
+    expect_bad(buf, NULL, "loads[0].mesh.file", "is not closed (3 open");
+    // The same mesh as a fixed obstacle is fine (no volume needed).
+    {
+        char err[512];
+        world_desc d;
+        snprintf(buf, sizeof buf, "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-6, -9]}]", path);
+        CHECK(sandbox_with(NULL, buf, &d, err, sizeof err) == 0, "open mesh as a fixed obstacle: %s", err);
+        world_desc_free(&d);
+    }
+    // Absurd scale: a 4 m block read as millimetres given as metres x 1000.
+    const double lo[3] = {-2, -0.5, 0}, hi[3] = {2, 0.5, 1};
+    write_box("big.obj", lo, hi, p2, sizeof p2);
+    snprintf(buf, sizeof buf,
+             "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s\", \"scale\": 1000}, \"position\": [-6, -9]}]", p2);
+    expect_bad(NULL, buf, "4000 m across at scale 1000", "\"scale\": 0.001");
+    // Too many triangles.
+    obj_open(&o, "huge.obj", path, sizeof path);
+    fprintf(o.f, "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for (int i = 0; i <= MESH_MAX_TRIANGLES; ++i) fprintf(o.f, "f 1 2 3\n");
+    fclose(o.f);
+    snprintf(buf, sizeof buf, "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-6, -9]}]", path);
+    expect_bad(NULL, buf, "huge.obj", "more than 200000 triangles");
+    // A format the core does not read, without the importer.
+    snprintf(buf, sizeof buf, "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s/site.glb\"}, \"position\": [-6, -9]}]",
+             g_dir);
+    FILE* f = fopen(strchr(buf, '/') ? g_dir : "", "r");
+    if (f) fclose(f);
+    snprintf(path, sizeof path, "%s/site.glb", g_dir);
+    f = fopen(path, "w");
+    if (f) {
+        fputs("glTF", f);
+        fclose(f);
+    }
+    expect_bad(NULL, buf, "site.glb", "needs the assimp importer");
+    // Size and mesh together.
+    snprintf(buf, sizeof buf,
+             "[{\"name\": \"x\", \"size\": [1, 1, 1], \"mesh\": {\"file\": \"%s\"}, \"position\": [-6, -9]}]", p2);
+    expect_bad(NULL, buf, "obstacles[0].size", "not used with a mesh");
+}
+
+int main(int argc, char** argv) {
+    (void)argc;
+    (void)argv;
+    snprintf(g_dir, sizeof g_dir, "%s/mesh_test_files", CRANESIM_BINARY_DIR);
+    mkdir(g_dir, 0755);
+    char err[512];
+    g_model = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
+    if (!g_model) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    RUN_TEST(test_mass_cube);
+    RUN_TEST(test_mass_cylinder);
+    RUN_TEST(test_load_mass_in_world);
+    RUN_TEST(test_rest_on_wedge);
+    RUN_TEST(test_box_vs_mesh_box);
+    RUN_TEST(test_boom_mesh_wall);
+    RUN_TEST(test_bad_meshes);
+    model_free(g_model);
+    TEST_MAIN_END();
+}
