@@ -201,6 +201,7 @@ void app_compare_pressure(const sim_trace* a, const sim_trace* b, int ref, doubl
 int cmd_drive(int argc, char** argv);
 int cmd_study(int argc, char** argv);
 int cmd_sweep(int argc, char** argv);
+int cmd_serve(int argc, char** argv);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it

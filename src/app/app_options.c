@@ -86,6 +86,7 @@ static const struct {
     {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
      {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", NULL}},
+    {"serve", {"--listen", "--rate", "--max-clients", "--queue", "--timeout", NULL}},
 };
 
 int app_check_values(const char* cmd, int argc, char** argv) {

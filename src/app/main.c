@@ -22,6 +22,8 @@ static void usage(FILE* f) {
             "  study     solver study: every integrator against a CVODE reference, work-precision plot\n"
             "  sweep     one scenario on many designs (a grid or a Latin hypercube over model values),\n"
             "            in parallel (threads, MPI ranks): a results table and plots\n"
+            "  serve     the simulation computer: run the model in real time and stream its state over\n"
+            "            TCP to viewers and valve controllers (docs/protocol.md)\n"
             "  help      this text; cranesim help <command>: that command's help\n"
             "\n"
             "examples:\n"
@@ -38,7 +40,7 @@ static const struct {
     int (*fn)(int argc, char** argv);
 } commands[] = {
     {"run", cmd_run}, {"bench", cmd_bench}, {"compare", cmd_compare}, {"drive", cmd_drive}, {"study", cmd_study},
-    {"sweep", cmd_sweep},
+    {"sweep", cmd_sweep}, {"serve", cmd_serve},
 };
 
 static int (*find_command(const char* name))(int, char**) {
