@@ -202,6 +202,8 @@ int cmd_drive(int argc, char** argv);
 int cmd_study(int argc, char** argv);
 int cmd_sweep(int argc, char** argv);
 int cmd_serve(int argc, char** argv);
+/// bench --config serve (bench_serve.c): one JSON line; returns 0 or EXIT_RUNTIME.
+int bench_serve(const app_common* c, double duration);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it
