@@ -177,13 +177,17 @@ int bench_serve(const app_common* c, double duration) {
     int wst = 0;
     waitpid(pid, &wst, 0);
     long missed = -1, sframes = -1;
+    double worst = NAN, mean = NAN;
     if (logfd >= 0) {
         FILE* lf = fdopen(logfd, "r");
         rewind(lf);
         while (fgets(line, sizeof line, lf)) {
             const char* p = strstr(line, "] ");
             long a, b;
-            if (p && sscanf(p + 2, "%ld frames, %ld missed deadlines", &a, &b) == 2) sframes = a, missed = b;
+            double w, mn;
+            if (p && sscanf(p + 2, "%ld frames, %ld missed deadlines, worst frame %lf ms, mean frame %lf ms", &a, &b,
+                            &w, &mn) == 4)
+                sframes = a, missed = b, worst = w, mean = mn;
         }
         fclose(lf);
         unlink(logpath);
@@ -195,9 +199,10 @@ int bench_serve(const app_common* c, double duration) {
         printf("{\"config\":\"serve\",\"world\":\"sandbox\",\"rate_hz\":1000,\"clients\":3,\"wall_s\":%.3f,"
                "\"frames_per_s_controller\":%.1f,\"frames_per_s_watcher1\":%.1f,\"frames_per_s_watcher2\":%.1f,"
                "\"frames_lost\":[%ld,%ld,%ld],\"commands\":%ld,\"latency_ms_p50\":%.3f,\"latency_ms_p99\":%.3f,"
-               "\"latency_ms_max\":%.3f,\"server_frames\":%ld,\"missed_deadlines\":%ld,\"server_exit\":%d}\n",
+               "\"latency_ms_max\":%.3f,\"server_frames\":%ld,\"missed_deadlines\":%ld,\"server_frame_ms_mean\":%.3f,"
+               "\"server_frame_ms_worst\":%.3f,\"server_exit\":%d}\n",
                span, cs[0].frames / span, cs[1].frames / span, cs[2].frames / span, cs[0].lost, cs[1].lost,
-               cs[2].lost, nlat, p50 * 1e3, p99 * 1e3, mx * 1e3, sframes, missed,
+               cs[2].lost, nlat, p50 * 1e3, p99 * 1e3, mx * 1e3, sframes, missed, mean, worst,
                WIFEXITED(wst) ? WEXITSTATUS(wst) : -1);
         fflush(stdout);
     }

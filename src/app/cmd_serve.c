@@ -627,7 +627,7 @@ static int serve_loop(server* s, int lfd, double duration) {
     struct pollfd pf[SERVE_MAX_CLIENTS + 1];
     double next = sim_wall_time() + s->frame; // wall time of the next frame
     long missed = 0, frames = 0;
-    double worst = 0;
+    double worst = 0, busy = 0;
     while (!app_signal_caught()) {
         if (duration > 0 && s->k * s->frame >= duration - 1e-9) break;
         pf[0] = (struct pollfd){.fd = lfd, .events = POLLIN};
@@ -667,6 +667,7 @@ static int serve_loop(server* s, int lfd, double duration) {
         ++frames;
         const double done = sim_wall_time();
         worst = fmax(worst, done - now);
+        busy += done - now;
         next += s->frame;
         if (done > next) { // the frame's work ran past the next frame's start
             ++missed;
@@ -674,8 +675,8 @@ static int serve_loop(server* s, int lfd, double duration) {
         }
     }
     if (!s->quiet)
-        logf_(s, "%ld frames, %ld missed deadlines, worst frame %.3f ms; simulated %.3f s", frames, missed,
-              worst * 1e3, s->e ? engine_time(s->e) : 0.0);
+        logf_(s, "%ld frames, %ld missed deadlines, worst frame %.3f ms, mean frame %.3f ms; simulated %.3f s",
+              frames, missed, worst * 1e3, frames ? busy / frames * 1e3 : 0.0, s->e ? engine_time(s->e) : 0.0);
     return 0;
 }
 
