@@ -492,6 +492,13 @@ static bool read_client(server* s, int idx) {
         }
         c->read_frame += (size_t)n;
         c->rx_len += (size_t)n;
+        // The parser refuses a length above PROTO_MAX_CLIENT_FRAME from its
+        // header, so a full buffer means a parser fault: never wait on it.
+        if (c->rx_len == sizeof c->rx && proto_parse(c->rx, c->rx_len, PROTO_MAX_CLIENT_FRAME, &(size_t){0},
+                                                     &(proto_msg){0}, (char[8]){0}, 8) == 0) {
+            drop_client(s, idx, PROTO_E_MALFORMED, "malformed frame: longer than the receive buffer");
+            return false;
+        }
         size_t off = 0;
         for (;;) {
             proto_msg msg;

@@ -122,7 +122,7 @@ static inline int recv_all(int fd, uint8_t* b, size_t n, int ms) {
 
 // One frame parsed into *m (state frames into st). Returns its type, -1 closed, -2 timed out, -3 malformed.
 static inline int recv_frame(int fd, proto_msg* m, proto_state* st, int ms) {
-    static uint8_t b[PROTO_MAX_SERVER_FRAME + 8];
+    static _Thread_local uint8_t b[PROTO_MAX_SERVER_FRAME + 8]; // the hostile test reads on two threads
     int rc = recv_all(fd, b, 4, ms);
     if (rc) return rc;
     const uint32_t len = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
