@@ -85,7 +85,7 @@ static const struct {
     {"study", {"--out-dir", "--repeat", NULL}},
     {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
-     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", NULL}},
+     {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as", "--connect", NULL}},
     {"serve", {"--listen", "--rate", "--max-clients", "--queue", "--timeout", NULL}},
 };
 

@@ -1,6 +1,6 @@
 // run_with_server.c: run a client command against a real `cranesim serve`:
 // start the server on a free port, run the command with each "{PORT}" in
-// its arguments replaced by that port, then SIGINT the server. Passes when
+// its arguments (alone or inside one, 127.0.0.1:{PORT}) replaced by that port, then SIGINT the server. Passes when
 // the client exits 0 and the server ends cleanly (exit 0) on SIGINT.
 //   run_with_server [SERVE ARGS...] -- CLIENT ARGS...
 #define _DEFAULT_SOURCE // usleep, in serve_util.h
@@ -23,8 +23,18 @@ int main(int argc, char** argv) {
     char port[16];
     snprintf(port, sizeof port, "%d", sv.port);
     char* cargs[64];
+    static char sub[64][512];
     int n = 0;
-    for (int k = dd + 1; k < argc && n < 63; ++k) cargs[n++] = !strcmp(argv[k], "{PORT}") ? port : argv[k];
+    for (int k = dd + 1; k < argc && n < 63; ++k) { // "{PORT}" anywhere in an argument
+        const char* at = strstr(argv[k], "{PORT}");
+        if (at) {
+            snprintf(sub[n], sizeof sub[n], "%.*s%s%s", (int)(at - argv[k]), argv[k], port, at + 6);
+            cargs[n] = sub[n];
+        } else {
+            cargs[n] = argv[k];
+        }
+        ++n;
+    }
     cargs[n] = NULL;
     pid_t pid = fork();
     if (pid == 0) {
