@@ -21,7 +21,7 @@ static void put_bytes(wr* w, const void* p, size_t k) {
         w->fail = 1;
         return;
     }
-    memcpy(w->b + w->n, p, k);
+    if (k) memcpy(w->b + w->n, p, k); // p may be NULL when k is 0
     w->n += k;
 }
 static void put_u64(wr* w, uint64_t v) {

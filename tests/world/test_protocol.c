@@ -29,7 +29,7 @@ static size_t raw_cmd(uint8_t* b, uint64_t seq, uint8_t op, const void* pay, siz
     b[4] = PROTO_COMMAND;
     for (int i = 0; i < 8; ++i) b[5 + i] = (uint8_t)(seq >> (8 * i));
     b[13] = op;
-    memcpy(b + 14, pay, np);
+    if (np) memcpy(b + 14, pay, np);
     return 14 + np;
 }
 
