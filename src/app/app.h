@@ -215,6 +215,13 @@ typedef struct app_range {
 int app_parse_range(const char* cmd, const char* arg, bool want_n, app_range* p);
 int cmd_replay(int argc, char** argv);
 int cmd_loadchart(int argc, char** argv);
+int cmd_serve(int argc, char** argv);
+/// bench --config serve (bench_serve.c): one JSON line; returns 0 or EXIT_RUNTIME.
+int bench_serve(const app_common* c, double duration);
+/// drive --connect HOST:PORT, headless (drive_connect.c): the scripted
+/// operator sc drives a remote serve for duration seconds of wall time,
+/// reconnecting when the link drops. Returns 0, or EXIT_USAGE / EXIT_RUNTIME.
+int drive_connect(const char* addr, const scenario* sc, double duration);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it

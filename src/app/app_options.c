@@ -90,7 +90,8 @@ static const struct {
     {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
      {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as",
-      "--readouts", "--session", "--replay", "--rcl", NULL}},
+      "--readouts", "--session", "--replay", "--rcl", "--connect", NULL}},
+    {"serve", {"--listen", "--rate", "--max-clients", "--queue", "--timeout", NULL}},
 };
 
 int app_check_values(const char* cmd, int argc, char** argv) {

@@ -73,6 +73,10 @@ static void bench_help(FILE* f) {
             "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
             "               operator, for --duration seconds of wall time (default 60): fps,\n"
             "               frame times, missed real-time deadlines, command rate\n"
+            "  serve        not in the default set: cranesim serve streaming the sandbox at 1 kHz over\n"
+            "               loopback to 1 controlling and 2 watching clients for --duration seconds of\n"
+            "               wall time (default 60): frames/s each client received, frames lost, p50/p99\n"
+            "               latency from a command to the state echoing it, missed deadlines\n"
             "\n"
             "options:\n"
             "  --scenario S   default ramp\n"
@@ -700,6 +704,10 @@ int cmd_bench(int argc, char** argv) {
     }
     bool want_drive = nonly == 0, want_length = nonly == 0, want_soak = false, want_ls = false, want_mesh = false;
     for (int j = 0; j < nonly; ++j) {
+        if (!strcmp(only[j], "serve")) {
+            if (bench_serve(&c, c.sim.duration > 0 ? c.sim.duration : 60.0)) return EXIT_RUNTIME;
+            continue;
+        }
         if (!strcmp(only[j], "drive")) {
             want_drive = true;
             continue;

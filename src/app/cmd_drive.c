@@ -64,6 +64,9 @@ static void drive_help(FILE* f) {
             "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
             "  --collision-view    window: start with the collision shapes drawn over the scene\n"
             "                      (what the physics hits; G toggles it)\n"
+            "  --connect HOST:PORT drive a remote `cranesim serve` (docs/protocol.md) with the scripted\n"
+            "                      operator, headless, for --duration s of wall time (default 10): frames,\n"
+            "                      frames lost, command-to-echo latency; reconnects when the link drops\n"
             "  --save-as FILE      window: the panel's \"save model\" writes FILE (default: a new\n"
             "                      cranesim_model_N.json each time, never an existing file)\n"
             "  --size WxH          window size in pixels (default 1280x720)\n"
@@ -363,6 +366,7 @@ int cmd_drive(int argc, char** argv) {
     const char* readouts = NULL;
     const char* save_as = NULL;
     bool collision_view = false;
+    const char* connect_to = NULL;
     int width = 1280, height = 720;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -407,6 +411,10 @@ int cmd_drive(int argc, char** argv) {
         }
         if (!strcmp(argv[i], "--mapping") && i + 1 < argc) {
             mapping = argv[++i];
+            continue;
+        }
+        if (!strcmp(argv[i], "--connect") && i + 1 < argc) {
+            connect_to = argv[++i];
             continue;
         }
         if (!strcmp(argv[i], "--save-as") && i + 1 < argc) {
@@ -471,6 +479,17 @@ int cmd_drive(int argc, char** argv) {
         (shot && app_check_output("drive", "--screenshot", shot, ".png")) ||
         (save_as && app_check_output("drive", "--save-as", save_as, ".json")))
         return EXIT_USAGE;
+    if (connect_to) { // the visual computer's link to a cranesim serve (headless for now)
+        if (!c.scenario_path) c.scenario_path = app_default_drive_scenario(SIM_LAGRANGE);
+        model* m;
+        scenario sc;
+        int rc = app_load(&c, &m, &sc);
+        if (rc) return rc;
+        model_free(m);
+        printf("cranesim drive: --connect %s: headless link (scripted operator %s; the window does not draw a "
+               "remote crane yet)\n", connect_to, sc.name);
+        return drive_connect(connect_to, &sc, c.sim.duration > 0 ? c.sim.duration : 10.0);
+    }
     // drive's ode world is the sandbox unless --world says otherwise (run's
     // is the validation world): name it, so the checks see the same world.
     if (c.sim.mechanics == SIM_ODE && !c.sim.world) c.sim.world = "sandbox";

@@ -31,6 +31,8 @@ static void usage(FILE* f) {
             "  replay    run a recorded drive session again headless, on its design or a changed one\n"
             "  loadchart rated capacity against outreach: hydraulic and (on the truck) stability limits,\n"
             "            per slew sector, as CSV and PNG (docs/safety.md)\n"
+            "  serve     the simulation computer: run the model in real time and stream its state over\n"
+            "            TCP to viewers and valve controllers (docs/protocol.md)\n"
             "  help      this text; cranesim help <command>: that command's help\n"
             "\n"
             "examples:\n"
@@ -48,6 +50,7 @@ static const struct {
 } commands[] = {
     {"run", cmd_run}, {"bench", cmd_bench}, {"compare", cmd_compare}, {"drive", cmd_drive}, {"study", cmd_study},
     {"sweep", cmd_sweep}, {"optimize", cmd_optimize}, {"replay", cmd_replay}, {"loadchart", cmd_loadchart},
+    {"serve", cmd_serve},
 };
 
 static int (*find_command(const char* name))(int, char**) {

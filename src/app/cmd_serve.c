@@ -1,0 +1,823 @@
+// cmd_serve.c: `cranesim serve`: the simulation computer (docs/protocol.md).
+//
+// A stepped driver on an engine: per frame, apply the controlling client's
+// last commands, advance the engine one frame on the simulated clock, and
+// queue the state frame to every client. One thread, non-blocking sockets
+// and ppoll: the loop never waits on a client. Each client's send queue is
+// bounded, so a viewer that cannot keep up loses frames (its own only);
+// malformed input closes that connection, with the reason logged and sent.
+#define _GNU_SOURCE // ppoll
+#include "app.h"
+#include "engine.h"
+#include "protocol.h"
+
+#include <cJSON.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#define SERVE_MAX_CLIENTS 64
+#define SERVE_MAX_SETS 64
+#define SERVE_READ_PER_FRAME 65536 // bytes read from one client per frame: a flood cannot starve the others
+
+static void serve_help(FILE* f) {
+    fprintf(f,
+            "usage: cranesim serve [--model M] [--world W] [--mechanics ode|lagrange] [--listen ADDR:PORT]\n"
+            "                      [--rate HZ] [--max-clients N] [--lockstep] [--duration T]\n"
+            "\n"
+            "The simulation computer: runs the model headless in real time and streams its state over\n"
+            "TCP to clients (a viewer, `cranesim drive --connect`, a valve controller, examples/), which\n"
+            "send valve, hook, pause, reset and parameter commands back (docs/protocol.md). One client\n"
+            "controls; the others watch. SIGINT or SIGTERM stop it cleanly (exit 0).\n"
+            "\n"
+            "options:\n"
+            "  --listen ADDR:PORT  where to listen (default 127.0.0.1:7575, loopback only; another\n"
+            "                      address, e.g. 0.0.0.0:7575, only when asked; port 0: any free port)\n"
+            "  --rate HZ           state frames per second, 1..5000 (default 75, the paper's rate)\n"
+            "  --max-clients N     clients at once, 1..64 (default 8); one more is refused\n"
+            "  --queue N           frames queued per client before it loses frames, 2..4096 (default 64)\n"
+            "  --timeout S         a client that sends no hello, or reads nothing, for S seconds is\n"
+            "                      closed, 0.05..3600 (default 5)\n"
+            "  --lockstep          advance only on the controller's STEP commands (as fast as it asks:\n"
+            "                      reproduces a scripted run bit for bit)\n"
+            "  --duration T        stop after T simulated seconds (default: run until SIGINT)\n"
+            "  --scenario S        the start pose and load (default as drive); its commands are not played\n"
+            "  --mechanics M       ode (default: the sandbox world) or lagrange (analytic 2-DOF)\n"
+            "  --world W           ode: world file or name: sandbox (default), validation\n");
+    const unsigned all = APP_GIVEN(APP_OPT_COUNT) - 1u;
+    app_options_help(f, all & ~(APP_GIVEN(APP_OPT_SCENARIO) | APP_GIVEN(APP_OPT_MECHANICS) | APP_GIVEN(APP_OPT_WORLD) |
+                                APP_GIVEN(APP_OPT_DURATION) | APP_GIVEN(APP_OPT_EVERY)));
+    fprintf(f, "It prints \"listening on ADDR:PORT\" on stdout once ready, and logs clients on stderr.\n");
+}
+
+typedef struct client {
+    int fd, id;
+    char peer[80];
+    bool hello;            // handshake done
+    int role;              // proto_role
+    double t_open;         // wall time of the accept [s]
+    double t_partial;      // wall time a partial frame began waiting, 0: none
+    double stall_since;    // wall time its queue first overflowed, 0: keeping up
+    uint8_t rx[4096];      // > PROTO_MAX_CLIENT_FRAME + 4: a whole frame always fits
+    size_t rx_len;
+    uint8_t* out;
+    size_t out_cap, out_off, out_len;
+    size_t read_frame;     // bytes read during this frame
+    uint64_t frames, lost, cmds;
+} client;
+
+typedef struct serve_set {
+    char path[PROTO_MAX_PATH + 1];
+    double value;
+} serve_set;
+
+typedef struct server {
+    // the simulation
+    const model* m;
+    sim_opts* o;
+    const scenario* sc;
+    double m3;
+    engine* e;
+    world_snapshot* snap;
+    double frame;     // [s]
+    long k;           // frames since the (re)start: the engine advances to (k + 1) * frame
+    bool paused, lockstep, stopped;
+    double u[3];
+    uint64_t cmd_seq, seq;
+    serve_set sets[SERVE_MAX_SETS]; // parameters set by clients, applied again after a reset
+    int nset;
+    // the clients
+    client* c[SERVE_MAX_CLIENTS];
+    int nclient, max_clients, next_id, queue;
+    int controller; // client id, 0: none
+    double timeout;
+    proto_state* st;
+    uint8_t* frame_buf;
+    size_t frame_cap;
+    size_t queue_bytes; // a client's send queue: --queue state frames, plus room for the hello and notices
+    double w0;
+    bool quiet;
+} server;
+
+static void logf_(const server* s, const char* fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "cranesim serve: [%9.3f s] ", sim_wall_time() - s->w0);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+// ---- sending ----
+
+static void flush_client(client* c) {
+    while (c->out_off < c->out_len) {
+        ssize_t n = send(c->fd, c->out + c->out_off, c->out_len - c->out_off, MSG_NOSIGNAL);
+        if (n <= 0) break; // EAGAIN: the rest waits for POLLOUT; an error shows as a failed read
+        c->out_off += (size_t)n;
+    }
+    if (c->out_off == c->out_len) c->out_off = c->out_len = 0;
+    else if (c->out_off > c->out_cap / 2) {
+        memmove(c->out, c->out + c->out_off, c->out_len - c->out_off);
+        c->out_len -= c->out_off;
+        c->out_off = 0;
+    }
+}
+
+// Queue n bytes; false when they do not fit (the frame is lost for this client).
+static bool enqueue(client* c, const uint8_t* b, size_t n) {
+    if (c->out_off > 0 && c->out_len + n > c->out_cap) {
+        memmove(c->out, c->out + c->out_off, c->out_len - c->out_off);
+        c->out_len -= c->out_off;
+        c->out_off = 0;
+    }
+    if (c->out_len + n > c->out_cap) return false;
+    memcpy(c->out + c->out_len, b, n);
+    c->out_len += n;
+    return true;
+}
+
+static void send_text(client* c, uint8_t type, uint64_t seq, uint16_t code, const char* text) {
+    uint8_t b[PROTO_MAX_TEXT + 32];
+    size_t n = proto_put_text(b, sizeof b, type, seq, code, text);
+    if (n) enqueue(c, b, n);
+    flush_client(c);
+}
+
+static void drop_client(server* s, int idx, uint16_t code, const char* why) {
+    client* c = s->c[idx];
+    if (code) send_text(c, PROTO_ERROR, 0, code, why);
+    logf_(s, "client %d (%s) closed: %s (%llu frames sent, %llu lost, %llu commands)", c->id, c->peer, why,
+          (unsigned long long)c->frames, (unsigned long long)c->lost, (unsigned long long)c->cmds);
+    if (s->controller == c->id) {
+        s->controller = 0;
+        logf_(s, "no client controls the crane now (valves held at their last openings)");
+    }
+    shutdown(c->fd, SHUT_WR);
+    close(c->fd);
+    free(c->out);
+    free(c);
+    s->c[idx] = s->c[--s->nclient];
+}
+
+// ---- the simulation ----
+
+static int apply_set(server* s, const char* path, double value, char* err, size_t errsz) {
+    if (!strcmp(path, "mechanics.load_mass")) {
+        if (!engine_can_set_load(s->e)) {
+            snprintf(err, errsz, "set mechanics.load_mass: this engine's loads are bodies (use the hook)");
+            return -1;
+        }
+        if (!(value >= 0 && value <= 1e5)) {
+            snprintf(err, errsz, "set mechanics.load_mass: expected 0..1e5 kg, got %g", value);
+            return -1;
+        }
+        engine_set_load(s->e, value);
+        return 0;
+    }
+    const char* p = path;
+    if (!strncmp(p, "hydraulics.components.", 22)) p += 22;
+    else if (!strncmp(p, "hydraulics.", 11)) p += 11;
+    return hyd_model_set(engine_circuit(s->e), p, value, err, errsz);
+}
+
+static int build_engine(server* s, char* err, size_t errsz) {
+    s->e = engine_create(s->m, s->o, s->sc->q0, s->sc->slew0, s->m3, err, errsz);
+    if (!s->e) return -1;
+    s->k = 0;
+    s->stopped = false;
+    engine_set_commands(s->e, s->u);
+    for (int i = 0; i < s->nset; ++i) {
+        char e2[320];
+        if (apply_set(s, s->sets[i].path, s->sets[i].value, e2, sizeof e2)) logf_(s, "after reset: %s", e2);
+    }
+    return 0;
+}
+
+// Advance one frame. Returns false once the engine has stopped.
+static bool step_frame(server* s) {
+    if (s->stopped) return false;
+    if (engine_advance(s->e, (s->k + 1) * s->frame - engine_time(s->e))) {
+        s->stopped = true;
+        logf_(s, "the simulation stopped: %s (RESET starts it again)", engine_error(s->e));
+        return false;
+    }
+    ++s->k;
+    return true;
+}
+
+static void fill_state(server* s) {
+    proto_state* st = s->st;
+    double row[SIM_NCOL];
+    engine_row(s->e, row);
+    engine_snapshot(s->e, s->snap);
+    const world_snapshot* w = s->snap;
+    const int cols[9] = {COL_X1, COL_X2, COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_U1, COL_U2, COL_T};
+    for (int k = 0; k < 9; ++k) st->nine[k] = row[cols[k]];
+    st->seq = ++s->seq;
+    st->cmd_seq = s->cmd_seq;
+    st->flags = (s->paused ? PROTO_F_PAUSED : 0) | (w->attached ? PROTO_F_ATTACHED : 0) |
+                (s->stopped ? PROTO_F_STOPPED : 0) | (s->lockstep ? PROTO_F_LOCKSTEP : 0) |
+                (w->tipping ? PROTO_F_TIPPING : 0) | (w->main_relief_open ? PROTO_F_RELIEF : 0);
+    st->slew = w->slew;
+    memcpy(st->hook, w->hook, sizeof st->hook);
+    st->load_mass = w->load_mass;
+    const int ncol = engine_ncol(s->e);
+    st->attached = ncol > COL_ATTACHED ? (int32_t)row[COL_ATTACHED] : -1;
+    st->nrow = (uint16_t)(ncol < PROTO_MAX_ROW ? ncol : PROTO_MAX_ROW);
+    memcpy(st->row, row, st->nrow * sizeof row[0]);
+    st->nbody = (uint16_t)(w->nbody < PROTO_MAX_BODIES ? w->nbody : PROTO_MAX_BODIES);
+    for (int i = 0; i < st->nbody; ++i) {
+        memcpy(st->pose[i], w->body[i].pos, 3 * sizeof(double));
+        memcpy(st->pose[i] + 3, w->body[i].rot, 9 * sizeof(double));
+    }
+    st->ncyl = (uint8_t)(w->ncyl < PROTO_MAX_CYL ? w->ncyl : PROTO_MAX_CYL);
+    for (int i = 0; i < st->ncyl; ++i) {
+        const world_snap_cylinder* y = &w->cyl[i];
+        double* d = st->cyl[i];
+        memcpy(d, y->base, 3 * sizeof(double));
+        memcpy(d + 3, y->rod_end, 3 * sizeof(double));
+        d[6] = y->x, d[7] = y->pA, d[8] = y->pB, d[9] = y->u, d[10] = y->u_cmd, d[11] = y->force;
+    }
+    st->nrope = (uint8_t)(w->nrope < PROTO_MAX_ROPE ? w->nrope : PROTO_MAX_ROPE);
+    memcpy(st->rope, w->rope, st->nrope * sizeof w->rope[0]);
+}
+
+// The state now, to every client that finished its hello.
+static void broadcast(server* s) {
+    fill_state(s);
+    const size_t n = proto_put_state(s->frame_buf, s->frame_cap, s->st);
+    const double now = sim_wall_time();
+    for (int i = 0; i < s->nclient; ++i) {
+        client* c = s->c[i];
+        if (!c->hello) continue;
+        if (n && enqueue(c, s->frame_buf, n)) {
+            ++c->frames;
+        } else {
+            ++c->lost;
+            if (!c->stall_since) c->stall_since = now;
+        }
+        flush_client(c);
+        if (c->out_len == 0) c->stall_since = 0;
+    }
+}
+
+// ---- the hello's description ----
+
+static char* describe(server* s, const char* model_file) {
+    cJSON* j = cJSON_CreateObject();
+    cJSON_AddNumberToObject(j, "protocol", PROTO_VERSION);
+    cJSON_AddStringToObject(j, "model", s->m->name);
+    cJSON_AddStringToObject(j, "model_file", model_file);
+    cJSON_AddStringToObject(j, "backend", engine_backend_name(s->e));
+    engine_desc d;
+    engine_describe(s->o, &d);
+    cJSON_AddStringToObject(j, "world", d.world);
+    char wb[512];
+    cJSON_AddStringToObject(j, "world_file", s->o->mechanics == SIM_ODE ? sim_world_path(s->o->world, wb, sizeof wb) : "");
+    cJSON_AddStringToObject(j, "solver", hyd_method_name(s->o->solver));
+    cJSON_AddNumberToObject(j, "h", s->o->h);
+    cJSON_AddNumberToObject(j, "dt_ode", s->o->mechanics == SIM_ODE ? s->o->dt_ode : 0);
+    cJSON_AddNumberToObject(j, "frame", s->frame);
+    cJSON* ch = cJSON_AddArrayToObject(j, "channels");
+    int nch = 0;
+    const sim_channel* chs = engine_channels(s->e, &nch);
+    for (int i = 0; i < nch && i < PROTO_MAX_ROW; ++i) {
+        cJSON* o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", chs[i].name);
+        cJSON_AddStringToObject(o, "unit", chs[i].unit);
+        cJSON_AddItemToArray(ch, o);
+    }
+    cJSON* lo = cJSON_AddArrayToObject(j, "loads");
+    double mass;
+    const char* ln;
+    for (int i = 0; (ln = engine_load_name(s->e, i, &mass)) != NULL; ++i) {
+        cJSON* o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", ln);
+        cJSON_AddNumberToObject(o, "mass", mass);
+        cJSON_AddItemToArray(lo, o);
+    }
+    engine_snapshot(s->e, s->snap);
+    const world_snapshot* w = s->snap;
+    cJSON* bo = cJSON_AddArrayToObject(j, "bodies");
+    for (int i = 0; i < w->nbody && i < PROTO_MAX_BODIES; ++i) {
+        const world_snap_body* b = &w->body[i];
+        cJSON* o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", b->name);
+        cJSON_AddNumberToObject(o, "role", b->role);
+        cJSON_AddNumberToObject(o, "shape", b->shape);
+        cJSON_AddItemToObject(o, "size", cJSON_CreateDoubleArray(b->size, 3));
+        const double rgba[4] = {b->rgba[0], b->rgba[1], b->rgba[2], b->rgba[3]};
+        cJSON_AddItemToObject(o, "rgba", cJSON_CreateDoubleArray(rgba, 4));
+        cJSON_AddStringToObject(o, "mesh", b->mesh);
+        cJSON_AddNumberToObject(o, "mesh_scale", b->mesh_scale);
+        cJSON_AddNumberToObject(o, "mesh_up", b->mesh_up);
+        cJSON_AddItemToObject(o, "mesh_offset", cJSON_CreateDoubleArray(b->mesh_offset, 3));
+        cJSON_AddItemToArray(bo, o);
+    }
+    cJSON* cy = cJSON_AddArrayToObject(j, "cylinders");
+    for (int i = 0; i < w->ncyl && i < PROTO_MAX_CYL; ++i) {
+        const world_snap_cylinder* y = &w->cyl[i];
+        cJSON* o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", y->name);
+        cJSON_AddNumberToObject(o, "bore", y->bore);
+        cJSON_AddNumberToObject(o, "rod", y->rod);
+        cJSON_AddNumberToObject(o, "stroke_max", y->stroke_max);
+        cJSON_AddNumberToObject(o, "closed_length", y->closed_length);
+        cJSON_AddItemToArray(cy, o);
+    }
+    char* txt = cJSON_PrintUnformatted(j);
+    cJSON_Delete(j);
+    return txt;
+}
+
+// ---- a client's frames ----
+
+static void handle_command(server* s, client* c, const proto_command* cmd) {
+    ++c->cmds;
+    if (c->role != PROTO_CONTROL) {
+        char t[160];
+        snprintf(t, sizeof t, "command %llu (%s) refused: this client watches (another one controls)",
+                 (unsigned long long)cmd->seq, proto_op_name(cmd->op));
+        send_text(c, PROTO_NOTICE, cmd->seq, PROTO_E_READONLY, t);
+        return;
+    }
+    char err[400] = "";
+    int refused = 0;
+    switch (cmd->op) {
+    case PROTO_OP_VALVES:
+        memcpy(s->u, cmd->u, sizeof s->u);
+        engine_set_commands(s->e, s->u);
+        break;
+    case PROTO_OP_HOOK: {
+        int got = engine_hook(s->e, cmd->flag);
+        if (cmd->flag && got < 0) {
+            snprintf(err, sizeof err, "hook: no load in reach (or this world has no hook)");
+            refused = 1;
+        } else {
+            logf_(s, "client %d: hook %s", c->id, cmd->flag ? "attached" : "released");
+        }
+        break;
+    }
+    case PROTO_OP_PAUSE:
+        if (s->paused != (cmd->flag != 0)) logf_(s, "client %d: %s", c->id, cmd->flag ? "paused" : "running");
+        s->paused = cmd->flag != 0;
+        break;
+    case PROTO_OP_RESET:
+        engine_destroy(s->e);
+        s->e = NULL;
+        if (build_engine(s, err, sizeof err)) {
+            // The model built once already: only memory can fail here.
+            logf_(s, "reset failed: %s", err);
+            s->stopped = true;
+            refused = 1;
+            break;
+        }
+        logf_(s, "client %d: reset", c->id);
+        break;
+    case PROTO_OP_SET:
+        if (apply_set(s, cmd->path, cmd->value, err, sizeof err)) {
+            refused = 1;
+            break;
+        }
+        logf_(s, "client %d: set %s = %g", c->id, cmd->path, cmd->value);
+        {
+            int i = 0;
+            while (i < s->nset && strcmp(s->sets[i].path, cmd->path)) ++i;
+            if (i < SERVE_MAX_SETS) {
+                snprintf(s->sets[i].path, sizeof s->sets[i].path, "%s", cmd->path);
+                s->sets[i].value = cmd->value;
+                if (i == s->nset) ++s->nset;
+            }
+        }
+        break;
+    case PROTO_OP_STEP:
+        if (!s->lockstep) {
+            snprintf(err, sizeof err, "step: this server runs in real time (start it with --lockstep)");
+            refused = 1;
+            break;
+        }
+        s->cmd_seq = cmd->seq;
+        for (uint32_t k = 0; k < cmd->frames && !s->paused; ++k)
+            if (!step_frame(s)) break;
+        broadcast(s);
+        return;
+    }
+    if (refused) {
+        char t[PROTO_MAX_TEXT];
+        snprintf(t, sizeof t, "command %llu refused: %s", (unsigned long long)cmd->seq, err);
+        send_text(c, PROTO_NOTICE, cmd->seq, PROTO_E_REFUSED, t);
+        return;
+    }
+    s->cmd_seq = cmd->seq;
+}
+
+static char g_desc_file[600];
+static char* g_desc;
+
+// Returns false when the client was closed.
+static bool handle_frame(server* s, int idx, const proto_msg* msg) {
+    client* c = s->c[idx];
+    char why[200];
+    if (!c->hello) {
+        if (msg->type != PROTO_CLIENT_HELLO) {
+            drop_client(s, idx, PROTO_E_MALFORMED, "the first frame must be a client hello");
+            return false;
+        }
+        if (msg->u.chello.version != PROTO_VERSION) {
+            snprintf(why, sizeof why, "protocol version %u not supported (this server speaks %u)",
+                     msg->u.chello.version, PROTO_VERSION);
+            drop_client(s, idx, PROTO_E_VERSION, why);
+            return false;
+        }
+        c->role = PROTO_WATCH;
+        if (msg->u.chello.role == PROTO_CONTROL && !s->controller) {
+            c->role = PROTO_CONTROL;
+            s->controller = c->id;
+        }
+        proto_server_hello h = {.version = PROTO_VERSION, .role = (uint8_t)c->role, .lockstep = s->lockstep,
+                                .rate = 1.0 / s->frame, .json = g_desc, .json_len = (uint32_t)strlen(g_desc)};
+        const size_t n = proto_put_server_hello(s->frame_buf, s->frame_cap, &h);
+        if (!n || !enqueue(c, s->frame_buf, n)) {
+            drop_client(s, idx, PROTO_E_FULL, "the description does not fit the send queue");
+            return false;
+        }
+        c->hello = true;
+        logf_(s, "client %d (%s): hello, %s%s", c->id, c->peer, c->role == PROTO_CONTROL ? "controls" : "watches",
+              msg->u.chello.role == PROTO_CONTROL && c->role != PROTO_CONTROL ? " (control asked: held by another)"
+                                                                                 : "");
+        if (s->lockstep) { // a lockstep client sees the state before its first STEP
+            fill_state(s);
+            const size_t k = proto_put_state(s->frame_buf, s->frame_cap, s->st);
+            if (k && enqueue(c, s->frame_buf, k)) ++c->frames;
+        }
+        flush_client(c);
+        return true;
+    }
+    if (msg->type != PROTO_COMMAND) {
+        snprintf(why, sizeof why, "unexpected frame type %u after the hello (only commands)", msg->type);
+        drop_client(s, idx, PROTO_E_MALFORMED, why);
+        return false;
+    }
+    handle_command(s, c, &msg->u.cmd);
+    return true;
+}
+
+// Read what the client sent and act on each whole frame. Returns false when it was closed.
+static bool read_client(server* s, int idx) {
+    client* c = s->c[idx];
+    while (c->read_frame < SERVE_READ_PER_FRAME) {
+        ssize_t n = recv(c->fd, c->rx + c->rx_len, sizeof c->rx - c->rx_len, 0);
+        if (n == 0) {
+            drop_client(s, idx, 0, c->rx_len ? "disconnected in the middle of a frame" : "disconnected");
+            return false;
+        }
+        if (n < 0) {
+            if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) break;
+            char why[160];
+            snprintf(why, sizeof why, "connection failed: %s", strerror(errno));
+            drop_client(s, idx, 0, why);
+            return false;
+        }
+        c->read_frame += (size_t)n;
+        c->rx_len += (size_t)n;
+        // The parser refuses a length above PROTO_MAX_CLIENT_FRAME from its
+        // header, so a full buffer means a parser fault: never wait on it.
+        if (c->rx_len == sizeof c->rx && proto_parse(c->rx, c->rx_len, PROTO_MAX_CLIENT_FRAME, &(size_t){0},
+                                                     &(proto_msg){0}, (char[8]){0}, 8) == 0) {
+            drop_client(s, idx, PROTO_E_MALFORMED, "malformed frame: longer than the receive buffer");
+            return false;
+        }
+        size_t off = 0;
+        for (;;) {
+            proto_msg msg;
+            memset(&msg, 0, sizeof msg); // u.state NULL: a client may not send state frames
+            size_t used;
+            char err[256];
+            int rc = proto_parse(c->rx + off, c->rx_len - off, PROTO_MAX_CLIENT_FRAME, &used, &msg, err, sizeof err);
+            if (rc < 0) {
+                char why[300];
+                snprintf(why, sizeof why, "malformed frame: %s", err);
+                drop_client(s, idx, PROTO_E_MALFORMED, why);
+                return false;
+            }
+            if (rc == 0) break;
+            off += used;
+            if (!handle_frame(s, idx, &msg)) return false;
+        }
+        memmove(c->rx, c->rx + off, c->rx_len - off);
+        c->rx_len -= off;
+        c->t_partial = c->rx_len ? (c->t_partial ? c->t_partial : sim_wall_time()) : 0;
+    }
+    return true;
+}
+
+static void accept_clients(server* s, int lfd) {
+    for (;;) {
+        struct sockaddr_storage a;
+        socklen_t al = sizeof a;
+        int fd = accept(lfd, (struct sockaddr*)&a, &al);
+        if (fd < 0) return; // EAGAIN: none left (or a transient error: the next poll retries)
+        fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
+        fcntl(fd, F_SETFD, FD_CLOEXEC);
+        int one = 1;
+        setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one); // a frame goes out at once
+        // A small kernel buffer: frames a slow viewer cannot take are lost
+        // here, not queued for seconds behind it (256 KiB).
+        int sb = 256 * 1024;
+        setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &sb, sizeof sb);
+        char host[64] = "?", port[16] = "?";
+        getnameinfo((struct sockaddr*)&a, al, host, sizeof host, port, sizeof port, NI_NUMERICHOST | NI_NUMERICSERV);
+        client* c = calloc(1, sizeof *c);
+        const size_t cap = s->queue_bytes;
+        if (c) c->out = malloc(cap);
+        if (!c || !c->out) {
+            free(c);
+            close(fd);
+            logf_(s, "connection from %s:%s refused: out of memory", host, port);
+            continue;
+        }
+        c->fd = fd;
+        c->id = ++s->next_id;
+        c->out_cap = cap;
+        c->t_open = sim_wall_time();
+        snprintf(c->peer, sizeof c->peer, "%s:%s", host, port);
+        if (s->nclient >= s->max_clients) {
+            char why[120];
+            snprintf(why, sizeof why, "client limit reached (%d, --max-clients)", s->max_clients);
+            s->c[s->nclient++] = c;
+            drop_client(s, s->nclient - 1, PROTO_E_FULL, why);
+            continue;
+        }
+        s->c[s->nclient++] = c;
+        logf_(s, "client %d (%s) connected (%d of %d)", c->id, c->peer, s->nclient, s->max_clients);
+    }
+}
+
+// Close clients that sent no hello, left a frame half sent, or read nothing, for the timeout.
+static void check_timeouts(server* s) {
+    const double now = sim_wall_time();
+    for (int i = s->nclient - 1; i >= 0; --i) {
+        client* c = s->c[i];
+        char why[160];
+        if (!c->hello && now - c->t_open > s->timeout) {
+            snprintf(why, sizeof why, "no hello within %g s (--timeout)", s->timeout);
+            drop_client(s, i, PROTO_E_TIMEOUT, why);
+        } else if (c->t_partial && now - c->t_partial > s->timeout) {
+            snprintf(why, sizeof why, "a frame left incomplete for %g s (--timeout)", s->timeout);
+            drop_client(s, i, PROTO_E_TIMEOUT, why);
+        } else if (c->stall_since && now - c->stall_since > s->timeout) {
+            snprintf(why, sizeof why, "not reading: its queue was full for %g s (--timeout)", s->timeout);
+            drop_client(s, i, PROTO_E_SLOW, why);
+        }
+    }
+}
+
+static int open_listener(const char* addr, char* bound, size_t nb, char* err, size_t errsz) {
+    char host[256];
+    const char* colon = strrchr(addr, ':');
+    if (!colon || colon == addr || !colon[1] || (size_t)(colon - addr) >= sizeof host) {
+        snprintf(err, errsz, "--listen: expected ADDR:PORT (127.0.0.1:7575, [::1]:7575), got '%s'", addr);
+        return -1;
+    }
+    memcpy(host, addr, (size_t)(colon - addr));
+    host[colon - addr] = 0;
+    char* h = host;
+    if (h[0] == '[' && h[strlen(h) - 1] == ']') {
+        h[strlen(h) - 1] = 0;
+        ++h;
+    }
+    char* endp;
+    long port = strtol(colon + 1, &endp, 10);
+    if (*endp || port < 0 || port > 65535) {
+        snprintf(err, errsz, "--listen: port must be 0..65535, got '%s'", colon + 1);
+        return -1;
+    }
+    struct addrinfo hints = {.ai_family = AF_UNSPEC, .ai_socktype = SOCK_STREAM,
+                             .ai_flags = AI_PASSIVE | AI_NUMERICSERV}, *res;
+    int g = getaddrinfo(h, colon + 1, &hints, &res);
+    if (g) {
+        snprintf(err, errsz, "--listen %s: %s", addr, gai_strerror(g));
+        return -1;
+    }
+    int fd = socket(res->ai_family, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    int one = 1;
+    if (fd >= 0) setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    if (fd < 0 || bind(fd, res->ai_addr, res->ai_addrlen) || listen(fd, 16)) {
+        snprintf(err, errsz, "--listen %s: %s", addr, strerror(errno));
+        if (fd >= 0) close(fd);
+        freeaddrinfo(res);
+        return -1;
+    }
+    freeaddrinfo(res);
+    struct sockaddr_storage a;
+    socklen_t al = sizeof a;
+    getsockname(fd, (struct sockaddr*)&a, &al);
+    char hs[64], ps[16];
+    getnameinfo((struct sockaddr*)&a, al, hs, sizeof hs, ps, sizeof ps, NI_NUMERICHOST | NI_NUMERICSERV);
+    snprintf(bound, nb, strchr(hs, ':') ? "[%s]:%s" : "%s:%s", hs, ps);
+    return fd;
+}
+
+static int serve_loop(server* s, int lfd, double duration) {
+    struct pollfd pf[SERVE_MAX_CLIENTS + 1];
+    double next = sim_wall_time() + s->frame; // wall time of the next frame
+    long missed = 0, frames = 0;
+    double worst = 0, busy = 0;
+    while (!app_signal_caught()) {
+        if (duration > 0 && s->k * s->frame >= duration - 1e-9) break;
+        pf[0] = (struct pollfd){.fd = lfd, .events = POLLIN};
+        for (int i = 0; i < s->nclient; ++i)
+            pf[i + 1] = (struct pollfd){.fd = s->c[i]->fd,
+                                        .events = POLLIN | (s->c[i]->out_len > s->c[i]->out_off ? POLLOUT : 0)};
+        double wait = s->lockstep ? 0.1 : next - sim_wall_time();
+        if (wait < 0) wait = 0;
+        struct timespec ts = {(time_t)wait, (long)((wait - floor(wait)) * 1e9)};
+        const int np = s->nclient + 1;
+        int r = ppoll(pf, (nfds_t)np, &ts, NULL);
+        if (r < 0 && errno != EINTR) {
+            logf_(s, "poll failed: %s", strerror(errno));
+            return EXIT_RUNTIME;
+        }
+        if (r > 0) {
+            // Clients first (by fd: the array shifts as clients close), then new ones.
+            for (int p = np - 1; p >= 1; --p) {
+                if (!pf[p].revents) continue;
+                int idx = -1;
+                for (int i = 0; i < s->nclient; ++i)
+                    if (s->c[i]->fd == pf[p].fd) idx = i;
+                if (idx < 0) continue;
+                if (pf[p].revents & POLLOUT) flush_client(s->c[idx]);
+                if (pf[p].revents & (POLLIN | POLLHUP | POLLERR)) read_client(s, idx);
+            }
+            if (pf[0].revents & POLLIN) accept_clients(s, lfd);
+        }
+        check_timeouts(s);
+        if (s->lockstep) continue;
+        const double now = sim_wall_time();
+        if (now < next) continue;
+        // One frame: step (unless paused), then the state to everyone.
+        if (!s->paused) step_frame(s);
+        broadcast(s);
+        for (int i = 0; i < s->nclient; ++i) s->c[i]->read_frame = 0;
+        ++frames;
+        const double done = sim_wall_time();
+        worst = fmax(worst, done - now);
+        busy += done - now;
+        next += s->frame;
+        if (done > next) { // the frame's work ran past the next frame's start
+            ++missed;
+            if (done > next + 10 * s->frame) next = done + s->frame; // far behind: start again from now
+        }
+    }
+    if (!s->quiet)
+        logf_(s, "%ld frames, %ld missed deadlines, worst frame %.3f ms, mean frame %.3f ms; simulated %.3f s",
+              frames, missed, worst * 1e3, frames ? busy / frames * 1e3 : 0.0, s->e ? engine_time(s->e) : 0.0);
+    return 0;
+}
+
+int cmd_serve(int argc, char** argv) {
+    app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE;
+    const char* listen_at = "127.0.0.1:7575";
+    double rate = 75, timeout = 5;
+    int max_clients = 8, queue = 64;
+    bool lockstep = false;
+    for (int i = 0; i < argc; ++i) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            serve_help(stdout);
+            return 0;
+        }
+        if (!strcmp(argv[i], "--every")) {
+            fprintf(stderr, "cranesim serve: --every: serve sends one state frame per frame (use --rate)\n");
+            return EXIT_USAGE;
+        }
+        int rc = app_parse_common(&c, argc, argv, &i);
+        if (rc < 0) return EXIT_USAGE;
+        if (rc > 0) continue;
+        if (!strcmp(argv[i], "--lockstep")) {
+            lockstep = true;
+            continue;
+        }
+        const char* opt = argv[i];
+        if (!strcmp(opt, "--listen") || !strcmp(opt, "--rate") || !strcmp(opt, "--max-clients") ||
+            !strcmp(opt, "--timeout") || !strcmp(opt, "--queue")) {
+            const char* v = app_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            double d = 0;
+            if (strcmp(opt, "--listen") && app_parse_double(v, &d)) d = NAN;
+            if (!strcmp(opt, "--listen")) {
+                listen_at = v;
+            } else if (!strcmp(opt, "--rate")) {
+                if (!(d >= 1 && d <= 5000)) {
+                    fprintf(stderr, "cranesim serve: --rate: expected 1..5000 frames/s, got '%s'\n", v);
+                    return EXIT_USAGE;
+                }
+                rate = d;
+            } else if (!strcmp(opt, "--max-clients")) {
+                if (!(d >= 1 && d <= SERVE_MAX_CLIENTS) || d != floor(d)) {
+                    fprintf(stderr, "cranesim serve: --max-clients: expected a whole number 1..%d, got '%s'\n",
+                            SERVE_MAX_CLIENTS, v);
+                    return EXIT_USAGE;
+                }
+                max_clients = (int)d;
+            } else if (!strcmp(opt, "--queue")) {
+                if (!(d >= 2 && d <= 4096) || d != floor(d)) {
+                    fprintf(stderr, "cranesim serve: --queue: expected a whole number of frames 2..4096, got '%s'\n",
+                            v);
+                    return EXIT_USAGE;
+                }
+                queue = (int)d;
+            } else {
+                if (!(d >= 0.05 && d <= 3600)) {
+                    fprintf(stderr, "cranesim serve: --timeout: expected 0.05..3600 s, got '%s'\n", v);
+                    return EXIT_USAGE;
+                }
+                timeout = d;
+            }
+            continue;
+        }
+        fprintf(stderr, "cranesim serve: unknown option '%s' (see cranesim serve --help)\n", argv[i]);
+        return EXIT_USAGE;
+    }
+    if (c.sim.mechanics == SIM_ODE && !c.sim.world) c.sim.world = "sandbox";
+    if (c.sim.cvode) {
+        fprintf(stderr, "cranesim serve: --solver cvode: serve steps the hydraulics in real time with the in-house "
+                        "solvers: use krus, ros2, rk4, ros34pw2 or rodas3\n");
+        return EXIT_USAGE;
+    }
+    if (app_check_sim("serve", &c.sim, c.given)) return EXIT_USAGE;
+    app_note_unused("serve", c.given, &c.sim, 1);
+    app_settle_unused(&c.sim);
+    if (!c.scenario_path) {
+        c.scenario_path = app_default_drive_scenario(c.sim.mechanics);
+        if (c.sim.mechanics == SIM_ODE && strcmp(c.sim.world, "sandbox"))
+            c.scenario_path = app_default_drive_scenario(SIM_LAGRANGE);
+    }
+    model* m;
+    scenario sc;
+    int rc = app_load(&c, &m, &sc);
+    if (rc) return rc;
+    server s = {.m = m, .o = &c.sim, .sc = &sc, .frame = 1.0 / rate, .lockstep = lockstep, .max_clients = max_clients,
+                .queue = queue, .timeout = timeout, .quiet = c.quiet, .w0 = sim_wall_time()};
+    s.m3 = sim_load_mass(m, &sc, &c.sim);
+    s.snap = malloc(sizeof *s.snap);
+    s.st = malloc(sizeof *s.st);
+    s.frame_cap = PROTO_MAX_SERVER_FRAME + 8;
+    s.frame_buf = malloc(s.frame_cap);
+    char err[600];
+    if (!s.snap || !s.st || !s.frame_buf) {
+        fprintf(stderr, "cranesim serve: out of memory\n");
+        rc = EXIT_RUNTIME;
+        goto done;
+    }
+    if (build_engine(&s, err, sizeof err)) {
+        fprintf(stderr, "cranesim serve: %s\n", err);
+        rc = EXIT_USAGE;
+        goto done;
+    }
+    snprintf(g_desc_file, sizeof g_desc_file, "%s", m->file[0] ? m->file : model_default_path());
+    g_desc = describe(&s, g_desc_file);
+    // The state frame's size sets the queue's (a whole number of frames).
+    fill_state(&s);
+    s.seq = 0;
+    const size_t fl = proto_put_state(s.frame_buf, s.frame_cap, s.st);
+    s.queue_bytes = (size_t)queue * fl + strlen(g_desc) + 65536;
+    char bound[128];
+    int lfd = open_listener(listen_at, bound, sizeof bound, err, sizeof err);
+    if (lfd < 0) {
+        fprintf(stderr, "cranesim serve: %s\n", err);
+        rc = EXIT_USAGE;
+        goto done;
+    }
+    printf("cranesim serve: listening on %s (%s, %s, %g frames/s%s, state frame %zu bytes)\n", bound, m->name,
+           engine_backend_name(s.e), rate, lockstep ? ", lockstep" : "", fl);
+    fflush(stdout);
+    app_signals sig;
+    app_signals_catch(&sig);
+    rc = serve_loop(&s, lfd, c.sim.duration);
+    app_signals_restore(&sig);
+    if (app_signal_caught()) logf_(&s, "%s: stopping", app_signal_name(app_signal_caught()));
+    while (s.nclient) drop_client(&s, s.nclient - 1, PROTO_E_SHUTDOWN, "the server stops");
+    close(lfd);
+done:
+    free(g_desc);
+    g_desc = NULL;
+    if (s.e) engine_destroy(s.e);
+    free(s.snap);
+    free(s.st);
+    free(s.frame_buf);
+    model_free(m);
+    return rc;
+}

@@ -1,0 +1,175 @@
+// drive_connect.c: `cranesim drive --connect HOST:PORT` without the window:
+// the visual computer's link, headless. It joins a `cranesim serve` as the
+// controller (a watcher when another client controls), sends the scripted
+// operator's stick positions at the remote simulated time on every state
+// frame, and reports the link: frames received and lost (sequence gaps),
+// command-to-echo latency, and when the link drops, which it then tries to
+// reconnect once a second until the drive's time is up.
+#define _GNU_SOURCE
+#include "app.h"
+#include "protocol.h"
+
+#include <errno.h>
+#include <math.h>
+#include <netdb.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+static int dc_connect(const char* host, const char* port, char* err, size_t errsz) {
+    struct addrinfo hints = {.ai_socktype = SOCK_STREAM}, *res;
+    int g = getaddrinfo(host, port, &hints, &res);
+    if (g) {
+        snprintf(err, errsz, "%s:%s: %s", host, port, gai_strerror(g));
+        return -1;
+    }
+    int fd = socket(res->ai_family, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (fd < 0 || connect(fd, res->ai_addr, res->ai_addrlen)) {
+        snprintf(err, errsz, "%s:%s: %s", host, port, strerror(errno));
+        if (fd >= 0) close(fd);
+        freeaddrinfo(res);
+        return -1;
+    }
+    freeaddrinfo(res);
+    int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    uint8_t b[16];
+    const size_t n = proto_put_client_hello(b, sizeof b, PROTO_VERSION, PROTO_CONTROL);
+    if (send(fd, b, n, MSG_NOSIGNAL) != (ssize_t)n) {
+        snprintf(err, errsz, "%s:%s: %s", host, port, strerror(errno));
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+int drive_connect(const char* addr, const scenario* sc, double duration) {
+    char host[256], port[16];
+    const char* colon = strrchr(addr, ':');
+    if (!colon || colon == addr || !colon[1] || (size_t)(colon - addr) >= sizeof host || strlen(colon + 1) >= sizeof port) {
+        fprintf(stderr, "cranesim drive: --connect: expected HOST:PORT (127.0.0.1:7575), got '%s'\n", addr);
+        return EXIT_USAGE;
+    }
+    memcpy(host, addr, (size_t)(colon - addr));
+    host[colon - addr] = 0;
+    snprintf(port, sizeof port, "%s", colon + 1);
+    if (host[0] == '[' && host[strlen(host) - 1] == ']') {
+        memmove(host, host + 1, strlen(host));
+        host[strlen(host) - 1] = 0;
+    }
+    uint8_t* rx = malloc(PROTO_MAX_SERVER_FRAME + 8);
+    proto_state* st = malloc(sizeof *st);
+    if (!rx || !st) {
+        free(rx);
+        free(st);
+        fprintf(stderr, "cranesim drive: out of memory\n");
+        return EXIT_RUNTIME;
+    }
+    char err[512], said[600];
+    const double w0 = sim_wall_time();
+    long frames = 0, lost = 0, drops = 0, links = 0, nlat = 0;
+    double lat_sum = 0, lat_max = 0, sent_at = 0, last_t = 0;
+    uint64_t seq = 0, last_seq = 0;
+    int role = -1, code = 0;
+    bool ever = false;
+    app_signals sig;
+    app_signals_catch(&sig);
+    while (sim_wall_time() - w0 < duration && !app_signal_caught()) {
+        int fd = dc_connect(host, port, err, sizeof err);
+        if (fd < 0) {
+            if (!ever) { // nothing there at the start: say so, do not wait
+                fprintf(stderr, "cranesim drive: --connect %s\n", err);
+                code = EXIT_RUNTIME;
+                break;
+            }
+            sleep(1);
+            continue;
+        }
+        ++links;
+        size_t len = 0;
+        last_seq = 0;
+        bool up = true;
+        const char* why = "the server closed the link";
+        while (up && sim_wall_time() - w0 < duration && !app_signal_caught()) {
+            struct pollfd pf = {.fd = fd, .events = POLLIN};
+            if (poll(&pf, 1, 2000) <= 0) {
+                why = "no frame for 2 s";
+                up = false;
+                break;
+            }
+            ssize_t r = recv(fd, rx + len, PROTO_MAX_SERVER_FRAME + 8 - len, 0);
+            if (r <= 0) {
+                why = r == 0 ? "the server closed the link" : strerror(errno);
+                break;
+            }
+            len += (size_t)r;
+            size_t off = 0;
+            for (;;) {
+                proto_msg m;
+                memset(&m, 0, sizeof m);
+                m.u.state = st;
+                size_t used;
+                int rc = proto_parse(rx + off, len - off, PROTO_MAX_SERVER_FRAME, &used, &m, err, sizeof err);
+                if (rc < 0) {
+                    why = err;
+                    up = false;
+                    break;
+                }
+                if (rc == 0) break;
+                off += used;
+                if (m.type == PROTO_SERVER_HELLO) {
+                    role = m.u.shello.role;
+                    printf("cranesim drive: connected to %s (%s)%s\n", addr,
+                           role == PROTO_CONTROL ? "controlling" : "watching: another client controls",
+                           ever ? ", reconnected" : "");
+                    fflush(stdout);
+                    ever = true;
+                } else if (m.type == PROTO_ERROR) {
+                    snprintf(said, sizeof said, "the server says: %s", m.u.text.text);
+                    why = said;
+                    up = false;
+                    break;
+                } else if (m.type == PROTO_STATE) {
+                    ++frames;
+                    if (last_seq && st->seq > last_seq + 1) lost += (long)(st->seq - last_seq - 1);
+                    last_seq = st->seq;
+                    last_t = st->nine[8];
+                    if (seq && st->cmd_seq == seq && sent_at > 0) {
+                        const double l = sim_wall_time() - sent_at;
+                        lat_sum += l, lat_max = fmax(lat_max, l), ++nlat;
+                        sent_at = 0;
+                    }
+                    if (role == PROTO_CONTROL && sent_at == 0) {
+                        proto_command c = {.seq = ++seq, .op = PROTO_OP_VALVES};
+                        for (int k = 0; k < 3; ++k) c.u[k] = fmax(-1, fmin(1, scenario_command(sc, k, last_t)));
+                        uint8_t b[128];
+                        const size_t n = proto_put_command(b, sizeof b, &c);
+                        sent_at = sim_wall_time();
+                        send(fd, b, n, MSG_NOSIGNAL);
+                    }
+                }
+            }
+            memmove(rx, rx + off, len - off);
+            len -= off;
+        }
+        close(fd);
+        sent_at = 0;
+        if (!up || (sim_wall_time() - w0 < duration && !app_signal_caught())) {
+            ++drops;
+            printf("cranesim drive: link to %s lost: %s; reconnecting\n", addr, why);
+            fflush(stdout);
+        }
+    }
+    app_signals_restore(&sig);
+    if (ever)
+        printf("  link: %ld frames received, %ld lost, %ld drop%s, %ld connection%s; command-to-echo latency mean "
+               "%.2f ms, max %.2f ms (%ld commands); remote t = %.3f s\n",
+               frames, lost, drops, drops == 1 ? "" : "s", links, links == 1 ? "" : "s",
+               nlat ? 1e3 * lat_sum / nlat : 0.0, 1e3 * lat_max, nlat, last_t);
+    free(rx);
+    free(st);
+    return code;
+}

@@ -1,0 +1,328 @@
+// test_serve.c: `cranesim serve` as clients meet it (docs/protocol.md).
+//
+// 1. Bit for bit: a scripted client drives a lockstep server (VALVES, then
+//    STEP 1, per frame) with a scenario's stick positions, and the nine
+//    values of every state frame equal, bit for bit, the row of the same
+//    scenario run locally on an engine (same model, solver, step and frame:
+//    the operator's positions at the middle of each frame, as the headless
+//    drive plays them), on the lagrange crane and the ode sandbox.
+// 2. Malformed and hostile clients on a real-time server: each is closed
+//    (or refused) with its reason in the log, while a watcher keeps
+//    receiving frames and the controller keeps seeing its commands echoed.
+#define _DEFAULT_SOURCE // usleep, in serve_util.h
+#include "check.h"
+#include "engine.h"
+#include "model.h"
+#include "scenario.h"
+#include "serve_util.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+
+static proto_state g_st;
+
+// ---- 1. the served run equals the local run ----
+
+static void bit_for_bit(const char* mech, const char* scen, int nframes) {
+    const double rate = 75, frame = 1.0 / rate;
+    sim_opts o = sim_default_opts();
+    o.mechanics = strcmp(mech, "ode") ? SIM_LAGRANGE : SIM_ODE;
+    if (o.mechanics == SIM_ODE) o.world = "sandbox";
+    char err[512], path[1024];
+    model* m = model_load(NULL, NULL, 0, err, sizeof err);
+    snprintf(path, sizeof path, "%s/scenarios/%s.json", model_assets_dir(), scen);
+    scenario sc;
+    CHECK(m && scenario_load(path, &sc, err, sizeof err) == 0, "%s", err);
+    if (!m) return;
+    engine* l = engine_create(m, &o, sc.q0, sc.slew0, sim_load_mass(m, &sc, &o), err, sizeof err);
+    CHECK(l != NULL, "%s", err);
+    if (!l) return;
+
+    const char* args[] = {"--mechanics", mech, "--scenario", scen, "--lockstep", NULL};
+    served sv;
+    CHECK(serve_start(&sv, NULL, args) == 0, "server started");
+    int role = -1;
+    int fd = serve_join(sv.port, PROTO_CONTROL, &role);
+    CHECK(fd >= 0 && role == PROTO_CONTROL, "joined as controller (role %d)", role);
+    CHECK(fd >= 0 && next_state(fd, &g_st, 5000) == 0 && g_st.nine[8] == 0, "the state at t = 0 first");
+    long diff = 0, frames = 0;
+    double worst = 0;
+    for (int i = 0; i < nframes && fd >= 0; ++i) {
+        const double tm = engine_time(l) + 0.5 * frame;
+        double u[3];
+        for (int k = 0; k < 3; ++k) u[k] = scenario_command(&sc, k, tm);
+        engine_set_commands(l, u);
+        CHECK(engine_advance(l, (i + 1) * frame - engine_time(l)) == 0, "local step %d", i);
+        double row[SIM_NCOL];
+        engine_row(l, row);
+        const double nine[9] = {row[COL_X1], row[COL_X2], row[COL_P1A], row[COL_P1B], row[COL_P2A],
+                                row[COL_P2B], row[COL_U1], row[COL_U2], row[COL_T]};
+        proto_command c = {.seq = 2 * (uint64_t)i + 1, .op = PROTO_OP_VALVES};
+        for (int k = 0; k < 3; ++k) c.u[k] = fmax(-1, fmin(1, u[k]));
+        send_cmd(fd, &c);
+        c = (proto_command){.seq = 2 * (uint64_t)i + 2, .op = PROTO_OP_STEP, .frames = 1};
+        send_cmd(fd, &c);
+        if (next_state(fd, &g_st, 10000)) {
+            CHECK(0, "no state after step %d", i);
+            break;
+        }
+        ++frames;
+        CHECK(g_st.cmd_seq == c.seq, "frame %d echoes command %llu, got %llu", i, (unsigned long long)c.seq,
+              (unsigned long long)g_st.cmd_seq);
+        if (memcmp(nine, g_st.nine, sizeof nine)) ++diff;
+        for (int k = 0; k < 9; ++k) worst = fmax(worst, fabs(nine[k] - g_st.nine[k]));
+    }
+    printf("%s/%s: %ld frames served, %ld differ from the local run (largest difference %g)\n", mech, scen, frames,
+           diff, worst);
+    CHECK(frames == nframes && diff == 0, "%s: %ld of %ld frames differ, by up to %g", mech, diff, frames, worst);
+    CHECK(g_st.nine[8] == nframes * frame || fabs(g_st.nine[8] - nframes * frame) < 1e-3, "t = %g", g_st.nine[8]);
+    if (fd >= 0) close(fd);
+    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+    engine_destroy(l);
+    model_free(m);
+}
+
+// ---- 2. hostile clients ----
+
+// The healthy pair, read by a thread so that they never stall while the
+// main thread plays the bad client.
+static int g_w = -1, g_c = -1;
+static atomic_ullong g_wseq, g_cecho;
+static atomic_int g_wclosed, g_cclosed, g_stop;
+
+static void* reader(void* arg) {
+    (void)arg;
+    static proto_state sw, scs;
+    while (!atomic_load(&g_stop)) {
+        struct pollfd pf[2] = {{.fd = g_w, .events = POLLIN}, {.fd = g_c, .events = POLLIN}};
+        if (poll(pf, 2, 50) <= 0) continue;
+        proto_msg m;
+        if (pf[0].revents && !atomic_load(&g_wclosed)) {
+            int t = recv_frame(g_w, &m, &sw, 2000);
+            if (t == PROTO_STATE) atomic_store(&g_wseq, sw.seq);
+            else if (t < 0 || t == PROTO_ERROR) atomic_store(&g_wclosed, 1), g_w = -1;
+        }
+        if (pf[1].revents && !atomic_load(&g_cclosed)) {
+            int t = recv_frame(g_c, &m, &scs, 2000);
+            if (t == PROTO_STATE) atomic_store(&g_cecho, scs.cmd_seq);
+            else if (t < 0 || t == PROTO_ERROR) atomic_store(&g_cclosed, 1), g_c = -1;
+        }
+    }
+    return NULL;
+}
+
+static uint64_t g_seq = 100;
+
+// The watcher gets new frames and the controller's next command is echoed, within 3 s.
+static int others_served(void) {
+    const unsigned long long w0 = atomic_load(&g_wseq);
+    proto_command c = {.seq = ++g_seq, .op = PROTO_OP_VALVES, .u = {0.2, 0, 0}};
+    if (g_c < 0 || send_cmd(g_c, &c)) return 0;
+    for (int k = 0; k < 300; ++k) {
+        if (atomic_load(&g_wseq) > w0 + 2 && atomic_load(&g_cecho) == c.seq) return 1;
+        usleep(10000);
+    }
+    return 0;
+}
+
+static int raw(int port, const void* b, size_t n) {
+    int fd = tcp_connect(port);
+    if (fd >= 0 && n) send_all(fd, b, n);
+    return fd;
+}
+
+static void hostile(void) {
+    const char* log = "test_serve_hostile.log";
+    const char* args[] = {"--mechanics", "lagrange", "--rate", "200", "--timeout", "0.5", "--max-clients", "6",
+                          "--queue", "8", NULL};
+    served sv;
+    CHECK(serve_start(&sv, log, args) == 0, "server started");
+    int role;
+    g_w = serve_join(sv.port, PROTO_WATCH, &role);
+    CHECK(g_w >= 0 && role == PROTO_WATCH, "watcher");
+    g_c = serve_join(sv.port, PROTO_CONTROL, &role);
+    CHECK(g_c >= 0 && role == PROTO_CONTROL, "controller");
+    pthread_t th;
+    pthread_create(&th, NULL, reader, NULL);
+    CHECK(others_served(), "served before the cases");
+
+    uint8_t b[8192];
+    uint8_t hello[16];
+    const size_t nh = proto_put_client_hello(hello, sizeof hello, PROTO_VERSION, PROTO_WATCH);
+    int cases = 0;
+#define CASE(name, fd, wait_ms)                                                                   \
+    do {                                                                                          \
+        ++cases;                                                                                  \
+        const int fd_ = (fd);                                                                     \
+        CHECK(closed_within(fd_, (wait_ms)), "%s: the connection is closed", name);              \
+        close(fd_);                                                                               \
+        CHECK(others_served(), "%s: the others are still served", name);                          \
+        printf("case %d (%s): closed, the others served\n", cases, name);                        \
+    } while (0)
+
+    // 1. a truncated frame: a valves command whose length leaves out 2 bytes of it
+    {
+        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES};
+        size_t n = proto_put_command(b + 64, sizeof b - 64, &c);
+        memcpy(b, hello, nh);
+        b[64] = (uint8_t)(b[64] - 2);
+        memcpy(b + nh, b + 64, n - 2);
+        int fd = raw(sv.port, b, nh + n - 2);
+        CASE("truncated frame", fd, 3000);
+    }
+    // 2. a length of 2^31
+    {
+        memcpy(b, hello, nh);
+        const uint8_t big[5] = {0, 0, 0, 0x80, 4};
+        memcpy(b + nh, big, 5);
+        CASE("length 2^31", raw(sv.port, b, nh + 5), 3000);
+    }
+    // 3. protocol version 2
+    {
+        size_t n = proto_put_client_hello(b, sizeof b, 2, PROTO_WATCH);
+        int fd = raw(sv.port, b, n);
+        proto_msg m;
+        CHECK(recv_frame(fd, &m, &g_st, 3000) == PROTO_ERROR && m.u.text.code == PROTO_E_VERSION &&
+                  strstr(m.u.text.text, "version 2"),
+              "version 2 answered with an error frame");
+        CASE("bad version", fd, 3000);
+    }
+    // 4. an unknown op, 5. a NaN valve command (from a client that asked for control: it only watches)
+    for (int k = 0; k < 2; ++k) {
+        memcpy(b, hello, nh);
+        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .u = {0, 0, 0}};
+        size_t n = proto_put_command(b + nh, sizeof b - nh, &c);
+        if (k == 0) b[nh + 13] = 42;
+        else {
+            double nan = NAN;
+            memcpy(b + nh + 14, &nan, 8);
+        }
+        CASE(k == 0 ? "unknown command" : "NaN command", raw(sv.port, b, nh + n), 3000);
+    }
+    // 6. garbage (an HTTP request)
+    {
+        const char* http = "GET / HTTP/1.1\r\nHost: x\r\n\r\n";
+        CASE("garbage", raw(sv.port, http, strlen(http)), 3000);
+    }
+    // 7. a command before the hello
+    {
+        proto_command c = {.seq = 1, .op = PROTO_OP_RESET};
+        size_t n = proto_put_command(b, sizeof b, &c);
+        CASE("command before hello", raw(sv.port, b, n), 3000);
+    }
+    // 8. half open: connected, never a byte
+    CASE("half-open connection", raw(sv.port, NULL, 0), 5000);
+    // 9. half a frame after the hello, then silence
+    {
+        memcpy(b, hello, nh);
+        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES};
+        size_t n = proto_put_command(b + nh, sizeof b - nh, &c);
+        CASE("frame left half sent", raw(sv.port, b, nh + n / 2), 5000);
+    }
+    // 10. a client that never reads (a small receive buffer so it fills soon)
+    {
+        int fd = socket(AF_INET, SOCK_STREAM, 0);
+        int small = 4096;
+        setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+        struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)sv.port)};
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        CHECK(connect(fd, (struct sockaddr*)&a, sizeof a) == 0, "connect");
+        send_all(fd, hello, nh);
+        // Not reading: wait until the server has given up on it (its reset or EOF shows on a send).
+        int gone = 0;
+        for (int k = 0; k < 400 && !gone; ++k) {
+            usleep(50000);
+            FILE* f = fopen(log, "r");
+            char line[512];
+            while (f && fgets(line, sizeof line, f)) gone |= strstr(line, "not reading") != NULL;
+            if (f) fclose(f);
+        }
+        CHECK(gone, "the server closed the client that never reads");
+        CASE("client that never reads", fd, 3000);
+    }
+    // 11. a command flood from a second client that asked for control (it watches:
+    //     every command refused by a notice, which it does not read either)
+    {
+        int role2 = -1;
+        int fd = serve_join(sv.port, PROTO_CONTROL, &role2);
+        CHECK(fd >= 0 && role2 == PROTO_WATCH, "a second controller watches (role %d)", role2);
+        proto_command c = {.op = PROTO_OP_VALVES, .u = {1, 1, 1}};
+        size_t n = 0;
+        static uint8_t flood[1 << 20];
+        while (n + 64 < sizeof flood) {
+            c.seq++;
+            n += proto_put_command(flood + n, sizeof flood - n, &c);
+        }
+        int sent = 0;
+        for (int r = 0; r < 4; ++r) sent += send_all(fd, flood, n) == 0;
+        CHECK(others_served(), "served during a flood of %d MiB", sent);
+        close(fd);
+        ++cases;
+        printf("case %d (command flood, %llu commands x %d): the others served\n", cases,
+               (unsigned long long)c.seq, sent);
+    }
+    // 12. a state frame from a client
+    {
+        memcpy(b, hello, nh);
+        proto_state s0;
+        memset(&s0, 0, sizeof s0);
+        size_t n = proto_put_state(b + nh, sizeof b - nh, &s0);
+        CASE("state frame from a client", raw(sv.port, b, nh + n), 3000);
+    }
+    // 13. the client limit: 6 clients at most (2 healthy + 4 here); the 7th refused
+    {
+        int fds[4];
+        for (int k = 0; k < 4; ++k) fds[k] = serve_join(sv.port, PROTO_WATCH, NULL);
+        int fd = raw(sv.port, hello, nh);
+        proto_msg m;
+        CHECK(recv_frame(fd, &m, &g_st, 3000) == PROTO_ERROR && m.u.text.code == PROTO_E_FULL,
+              "the 7th client refused with the limit");
+        CASE("client limit", fd, 3000);
+        for (int k = 0; k < 4; ++k) close(fds[k]);
+    }
+    // A watcher's command is refused with a notice and the watcher stays.
+    {
+        int fd = serve_join(sv.port, PROTO_WATCH, NULL);
+        proto_command c = {.seq = 9, .op = PROTO_OP_RESET};
+        send_cmd(fd, &c);
+        proto_msg m;
+        int t;
+        while ((t = recv_frame(fd, &m, &g_st, 3000)) == PROTO_STATE) {
+        }
+        CHECK(t == PROTO_NOTICE && m.u.text.seq == 9 && m.u.text.code == PROTO_E_READONLY, "notice, got %d", t);
+        CHECK(next_state(fd, &g_st, 3000) == 0, "the watcher still gets frames");
+        close(fd);
+    }
+    // An unknown parameter: a notice to the controller, which stays in control.
+    {
+        proto_command c = {.seq = ++g_seq, .op = PROTO_OP_SET, .path = "lift_cyl.no_such", .value = 1};
+        send_cmd(g_c, &c);
+        CHECK(others_served(), "served after a refused set");
+    }
+    CHECK(cases >= 12, "%d cases", cases);
+    CHECK(!atomic_load(&g_wclosed) && !atomic_load(&g_cclosed), "the healthy pair stayed connected");
+    atomic_store(&g_stop, 1);
+    pthread_join(th, NULL);
+    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+    // Every case left its reason in the log.
+    const char* reasons[] = {"too short", "length 2147483648", "version 2 not supported", "unknown op 42",
+                             "opening 1 must be a number", "first frame must be a client hello", "no hello within",
+                             "left incomplete", "not reading", "client limit reached", "unexpected state frame",
+                             "the server stops"};
+    FILE* f = fopen(log, "r");
+    static char all[1 << 20];
+    size_t n = f ? fread(all, 1, sizeof all - 1, f) : 0;
+    all[n] = 0;
+    if (f) fclose(f);
+    for (size_t k = 0; k < sizeof reasons / sizeof reasons[0]; ++k)
+        CHECK(strstr(all, reasons[k]) != NULL, "the log names the reason '%s'", reasons[k]);
+}
+
+int main(void) {
+    signal(SIGPIPE, SIG_IGN);
+    bit_for_bit("lagrange", "drive_demo", 300);
+    bit_for_bit("ode", "sandbox_pick_place", 150);
+    hostile();
+    TEST_MAIN_END();
+}

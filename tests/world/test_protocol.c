@@ -1,0 +1,195 @@
+// test_protocol.c: the serve protocol's frames (docs/protocol.md): every
+// frame type encoded and parsed back bit for bit, the byte layout of the
+// header and the nine values checked by hand against the document, and the
+// parser's refusals (each malformed frame refused with a reason, none read
+// past its input).
+#include "check.h"
+#include "protocol.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+static proto_state s_in, s_out;
+
+static int parse(const uint8_t* b, size_t n, uint32_t max, proto_msg* m, char* err) {
+    size_t used = 0;
+    memset(m, 0, sizeof *m);
+    m->u.state = &s_out;
+    int rc = proto_parse(b, n, max, &used, m, err, 256);
+    if (rc == 1) CHECK(used == n, "used %zu of %zu", used, n);
+    return rc;
+}
+
+// A command frame written by hand: header, seq, op, then raw payload.
+static size_t raw_cmd(uint8_t* b, uint64_t seq, uint8_t op, const void* pay, size_t np) {
+    const uint32_t len = (uint32_t)(1 + 8 + 1 + np);
+    for (int i = 0; i < 4; ++i) b[i] = (uint8_t)(len >> (8 * i));
+    b[4] = PROTO_COMMAND;
+    for (int i = 0; i < 8; ++i) b[5 + i] = (uint8_t)(seq >> (8 * i));
+    b[13] = op;
+    if (np) memcpy(b + 14, pay, np);
+    return 14 + np;
+}
+
+int main(void) {
+    uint8_t buf[1 << 16];
+    char err[256];
+    proto_msg m;
+
+    // Client hello: 4 length + 1 type + 4 magic + 2 version + 1 role = 12 bytes.
+    size_t n = proto_put_client_hello(buf, sizeof buf, PROTO_VERSION, PROTO_CONTROL);
+    CHECK(n == 12, "hello is %zu bytes", n);
+    CHECK(buf[0] == 8 && buf[1] == 0 && buf[4] == 1 && buf[5] == 'C' && buf[6] == 'S' && buf[7] == 'I' &&
+              buf[8] == 'M' && buf[9] == 1 && buf[10] == 0 && buf[11] == 1,
+          "hello bytes");
+    CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == 1 && m.type == PROTO_CLIENT_HELLO &&
+              m.u.chello.version == 1 && m.u.chello.role == 1,
+          "hello parsed: %s", err);
+    // Every partial prefix asks for more.
+    for (size_t k = 0; k < n; ++k) CHECK(parse(buf, k, PROTO_MAX_CLIENT_FRAME, &m, err) == 0, "prefix %zu", k);
+
+    // Server hello with its JSON.
+    const char* js = "{\"model\":\"x\"}";
+    proto_server_hello h = {.version = 1, .role = 0, .lockstep = 1, .rate = 75, .json = js, .json_len = 13};
+    n = proto_put_server_hello(buf, sizeof buf, &h);
+    CHECK(parse(buf, n, PROTO_MAX_SERVER_FRAME, &m, err) == 1 && m.type == PROTO_SERVER_HELLO &&
+              m.u.shello.rate == 75 && m.u.shello.lockstep == 1 && m.u.shello.json_len == 13 &&
+              !memcmp(m.u.shello.json, js, 13),
+          "server hello: %s", err);
+
+    // State: bit for bit, including a NaN payload and -0.
+    memset(&s_in, 0, sizeof s_in);
+    for (int k = 0; k < 9; ++k) s_in.nine[k] = 0.1 * (k + 1) + 1e-17 * k;
+    s_in.nine[8] = -0.0;
+    s_in.seq = 0x0102030405060708ull;
+    s_in.cmd_seq = 42;
+    s_in.flags = PROTO_F_ATTACHED | PROTO_F_LOCKSTEP;
+    s_in.slew = 1.25;
+    s_in.attached = -1;
+    s_in.nrow = 30;
+    for (int k = 0; k < 30; ++k) s_in.row[k] = k * 3.3;
+    s_in.row[5] = NAN;
+    s_in.nbody = 17;
+    for (int i = 0; i < 17; ++i)
+        for (int k = 0; k < 12; ++k) s_in.pose[i][k] = i - k * 0.5;
+    s_in.ncyl = 3;
+    s_in.cyl[2][11] = 1e5;
+    s_in.nrope = 2;
+    s_in.rope[1][2] = -4;
+    n = proto_put_state(buf, sizeof buf, &s_in);
+    // 5 header + 9*8 + 8 + 8 + 4 + 8 + 24 + 8 + 4 + 2 + 30*8 + 2 + 17*96 + 1 + 3*96 + 1 + 2*24
+    CHECK(n == 5 + 72 + 8 + 8 + 4 + 8 + 24 + 8 + 4 + 2 + 240 + 2 + 17 * 96 + 1 + 3 * 96 + 1 + 48, "state %zu", n);
+    double x1;
+    memcpy(&x1, buf + 5, 8); // the first value after the header is x1 (a little-endian host)
+    CHECK(x1 == s_in.nine[0], "x1 first: %g", x1);
+    CHECK(parse(buf, n, PROTO_MAX_SERVER_FRAME, &m, err) == 1 && m.type == PROTO_STATE, "state: %s", err);
+    CHECK(!memcmp(s_out.nine, s_in.nine, sizeof s_in.nine) && s_out.seq == s_in.seq && s_out.cmd_seq == 42 &&
+              s_out.flags == s_in.flags && s_out.attached == -1 && s_out.nrow == 30 &&
+              !memcmp(s_out.row, s_in.row, 30 * 8) && s_out.nbody == 17 &&
+              !memcmp(s_out.pose, s_in.pose, 17 * 96) && s_out.ncyl == 3 && s_out.cyl[2][11] == 1e5 &&
+              s_out.nrope == 2 && s_out.rope[1][2] == -4 && signbit(s_out.nine[8]),
+          "state round trip");
+    // A state frame is refused where the caller has no buffer for it (a server).
+    m.u.state = NULL;
+    size_t used;
+    CHECK(proto_parse(buf, n, PROTO_MAX_SERVER_FRAME, &used, &m, err, sizeof err) == -1, "state refused");
+    // ...and by the client limit when it is longer.
+    CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "length"), "%s", err);
+
+    // Commands: every op round trips.
+    proto_command c = {.seq = 7, .op = PROTO_OP_VALVES, .u = {0.5, -1, 1}};
+    n = proto_put_command(buf, sizeof buf, &c);
+    CHECK(n == 5 + 8 + 1 + 24, "valves %zu", n);
+    CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == 1 && m.u.cmd.seq == 7 && m.u.cmd.u[1] == -1, "%s", err);
+    c = (proto_command){.seq = 8, .op = PROTO_OP_SET, .path = "lift_cyl.bore", .value = 0.11};
+    n = proto_put_command(buf, sizeof buf, &c);
+    CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == 1 && !strcmp(m.u.cmd.path, "lift_cyl.bore") &&
+              m.u.cmd.value == 0.11,
+          "set: %s", err);
+    c = (proto_command){.seq = 9, .op = PROTO_OP_STEP, .frames = 3};
+    n = proto_put_command(buf, sizeof buf, &c);
+    CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == 1 && m.u.cmd.frames == 3, "step: %s", err);
+    c = (proto_command){.seq = 10, .op = PROTO_OP_HOOK, .flag = 1};
+    n = proto_put_command(buf, sizeof buf, &c);
+    CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == 1 && m.u.cmd.flag == 1, "hook: %s", err);
+    n = proto_put_text(buf, sizeof buf, PROTO_NOTICE, 8, PROTO_E_REFUSED, "no such parameter");
+    CHECK(parse(buf, n, PROTO_MAX_SERVER_FRAME, &m, err) == 1 && m.type == PROTO_NOTICE && m.u.text.seq == 8 &&
+              !strcmp(m.u.text.text, "no such parameter"),
+          "notice: %s", err);
+
+    // Refusals, each with its reason.
+    uint8_t b[512];
+    // length 2^31, refused from the header alone (5 bytes here)
+    b[0] = 0, b[1] = 0, b[2] = 0, b[3] = 0x80, b[4] = 4;
+    CHECK(parse(b, 5, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "2147483648"), "2^31: %s", err);
+    // length 0
+    memset(b, 0, 8);
+    CHECK(parse(b, 8, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "length"), "0: %s", err);
+    // unknown type
+    b[0] = 1, b[1] = b[2] = b[3] = 0, b[4] = 99;
+    CHECK(parse(b, 5, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "unknown frame type 99"), "%s", err);
+    // unknown op
+    n = raw_cmd(b, 1, 77, NULL, 0);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "unknown op 77"), "%s", err);
+    // NaN, infinity and 1.5 in valves
+    double u[3] = {0, NAN, 0};
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, u, sizeof u);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "opening 2"), "NaN: %s", err);
+    u[1] = INFINITY;
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, u, sizeof u);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1, "inf");
+    u[1] = 0, u[2] = 1.5;
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, u, sizeof u);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "[-1, 1]"), "1.5: %s", err);
+    // a valves frame two bytes short, with a header that says so
+    u[2] = 0;
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, u, sizeof u - 2);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "too short"), "short: %s", err);
+    // one byte too many
+    n = raw_cmd(b, 2, PROTO_OP_RESET, "x", 1);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "after its fields"), "long: %s", err);
+    // a hook flag of 2, steps of 0
+    n = raw_cmd(b, 3, PROTO_OP_HOOK, "\2", 1);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1, "hook 2");
+    uint32_t zero = 0;
+    n = raw_cmd(b, 3, PROTO_OP_STEP, &zero, 4);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1, "step 0");
+    // a set path with a NUL, an empty one, a length past the frame, a NaN value
+    uint8_t sp[64];
+    sp[0] = 3, sp[1] = 0, memcpy(sp + 2, "a\0b", 3);
+    double v = 1;
+    memcpy(sp + 5, &v, 8);
+    n = raw_cmd(b, 4, PROTO_OP_SET, sp, 13);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "NUL"), "%s", err);
+    sp[0] = 0;
+    n = raw_cmd(b, 4, PROTO_OP_SET, sp, 10);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "path length"), "%s", err);
+    sp[0] = 200, memcpy(sp + 2, "abc", 3);
+    n = raw_cmd(b, 4, PROTO_OP_SET, sp, 13);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "too short"), "%s", err);
+    sp[0] = 3, v = NAN;
+    memcpy(sp + 5, &v, 8);
+    n = raw_cmd(b, 4, PROTO_OP_SET, sp, 13);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "finite"), "%s", err);
+    // a hello with the wrong magic, a role of 2
+    n = proto_put_client_hello(b, sizeof b, 1, 2);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "role"), "%s", err);
+    n = proto_put_client_hello(b, sizeof b, 1, 0);
+    b[5] = 'X';
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "magic"), "%s", err);
+
+    // Random bytes: the parser never claims more than it was given.
+    srand(1);
+    for (int it = 0; it < 20000; ++it) {
+        size_t k = (size_t)(rand() % 64);
+        for (size_t i = 0; i < k; ++i) b[i] = (uint8_t)rand();
+        if (k >= 4 && it % 2) b[0] = (uint8_t)(rand() % 40), b[1] = b[2] = b[3] = 0;
+        memset(&m, 0, sizeof m);
+        m.u.state = &s_out;
+        int rc = proto_parse(b, k, PROTO_MAX_CLIENT_FRAME, &used, &m, err, sizeof err);
+        CHECK(rc != 1 || (used <= k && used >= PROTO_HEADER), "used %zu of %zu", used, k);
+    }
+    TEST_MAIN_END();
+}
