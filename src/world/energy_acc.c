@@ -27,7 +27,7 @@ struct sim_energy {
 
 static const char* const group_names[SIM_EG_COUNT] = {
     "pump", "valve meter-in", "valve meter-out", "relief", "check", "orifice", "hose", "cylinder leakage",
-    "other", "work on mechanics", "tank", "stored", "expansion"};
+    "compensator", "counterbalance", "other", "work on mechanics", "tank", "stored", "expansion"};
 
 const char* sim_energy_group_name(sim_energy_group g) { return g < SIM_EG_COUNT ? group_names[g] : "?"; }
 
@@ -111,6 +111,8 @@ int sim_energy_bind(sim_energy* e, const hyd_model* m) {
             add_col(e, c, SIM_EG_LEAK, ".leak");
             add_col(e, c, SIM_EG_WORK, ".work");
             break;
+        case HYD_COMPENSATOR: add_col(e, c, SIM_EG_COMPENSATOR, ""); break;
+        case HYD_COUNTERBALANCE: add_col(e, c, SIM_EG_COUNTERBALANCE, ""); break;
         default: add_col(e, c, SIM_EG_OTHER, ""); break;
         }
     }

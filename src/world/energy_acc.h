@@ -25,6 +25,8 @@ typedef enum sim_energy_group {
     SIM_EG_ORIFICE,
     SIM_EG_HOSE,
     SIM_EG_LEAK,       ///< cylinder internal leakage
+    SIM_EG_COMPENSATOR, ///< pressure compensators (the drop they hold)
+    SIM_EG_COUNTERBALANCE, ///< counterbalance valves (check and pilot-assisted relief)
     SIM_EG_OTHER,      ///< any other component type (its whole P_c)
     SIM_EG_WORK,       ///< piston work on the mechanics
     SIM_EG_TANK,       ///< taken by the tanks (boundary flow work p_t Q_t)
