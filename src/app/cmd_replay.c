@@ -217,7 +217,12 @@ int cmd_replay(int argc, char** argv) {
         engine_row(l, row);
         if (s.window) row[ncol] = 0; // segment 0: a session ends at the first reset or rebuild
         // The row's text exactly as the record wrote it.
+        // A fresh stream per row: fclose leaves its buffer in line, which
+        // open_memstream would otherwise overwrite (a leak per row).
         if (mem) fclose(mem);
+        mem = NULL;
+        free(line);
+        line = NULL;
         mem = open_memstream(&line, &linecap);
         if (!mem) {
             code = EXIT_RUNTIME;
