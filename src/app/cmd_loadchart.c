@@ -72,12 +72,11 @@ static void draw_chart(void* user) {
     for (int i = 0; i < c->n; ++i) x[i] = c->R[i], y[i] = c->hyd[i];
     // The hydraulic limit alone, dashed; the rated capacity of each sector
     // solid, with a circle where the stability limit governs.
-    pllsty(2);
-    plcol0(1);
-    plline(c->n, x, y);
-    pllsty(1);
+    // Dark colours of the default map (blue, brown, magenta, ...): the light
+    // ones (yellow, aquamarine) do not read on white.
+    static const int sec_col[] = {9, 8, 13, 10, 12, 14, 11, 3};
     for (int s = 0; s < c->nsec; ++s) {
-        plcol0(2 + s % 12);
+        plcol0(sec_col[s % 8]);
         for (int i = 0; i < c->n; ++i) y[i] = loadchart_capacity(c, c->R[i], 0.5 * (c->sec_lo[s] + c->sec_hi[s]), NULL);
         plwidth(2);
         plline(c->n, x, y);
@@ -91,7 +90,12 @@ static void draw_chart(void* user) {
         sector_name(c, s, nm, sizeof nm);
         plmtex("t", -1.5 - 1.2 * s, 0.98, 1.0, nm);
     }
+    // The hydraulic limit last, dashed red over the sectors it governs.
+    for (int i = 0; i < c->n; ++i) y[i] = c->hyd[i];
+    pllsty(2);
     plcol0(1);
+    plline(c->n, x, y);
+    pllsty(1);
     plmtex("t", -1.5 - 1.2 * c->nsec, 0.98, 1.0, "dashed: hydraulic limit; o: stability governs");
 }
 
