@@ -280,6 +280,8 @@ static const struct {
                      "                         for krus/ros2 the mechanics once per step (docs/lagrange.md);\n"
                      "                       fused: the same, but f in full at every Krus/ROS2 stage;\n"
                      "                       general: the component loops and the solver's own sparse LU;\n"
+                     "                       lagrange without that shape: the fast kernel when it has a\n"
+                     "                         loop for every component (else the loops), general the loops;\n"
                      "                       with --mechanics ode, split and fused both mean the one-pass\n"
                      "                         circuit in the hydraulic sub-steps (the fast kernel for a\n"
                      "                         circuit without its shape), general the loops;\n"

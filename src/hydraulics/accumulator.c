@@ -11,16 +11,9 @@
 // eps = 1e-4 (value and slope continuous at V = 0, monotonic), which
 // stands for the poppet closing: at p_port = 0 the oil volume settles at
 // about -V0 sqrt(eps / n), under 1 % of V0.
-#include "hyd_internal.h"
+#include "hyd_accumulator.h"
 
 #include <math.h>
-
-#define ACC_EPS 1e-4
-
-typedef struct hyd_acc_c {
-    int node, adr, comp;
-    double p0, V0, n, G, Vinit;
-} hyd_acc_c;
 
 hyd_accumulator_def hyd_default_accumulator_def(void) {
     hyd_accumulator_def d = {0};
@@ -30,19 +23,6 @@ hyd_accumulator_def hyd_default_accumulator_def(void) {
     return d;
 }
 
-/// Gas pressure [Pa abs] at oil volume V [m^3]; *dp = dp_g / dV [Pa/m^3].
-static double acc_pgas(const hyd_acc_c* c, double V, double* dp) {
-    if (V >= 0.0) {
-        const double Vg = c->V0 - V;
-        const double p = c->p0 * pow(c->V0 / Vg, c->n);
-        *dp = c->n * p / Vg;
-        return p;
-    }
-    const double a = c->n * c->p0 / c->V0, k = 1.0 / (ACC_EPS * c->V0);
-    *dp = a * (1.0 - 2.0 * V * k);
-    return c->p0 + a * V * (1.0 - V * k);
-}
-
 static void accs_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, const double* y,
                       double* ydot, double* G, const int* map) {
     const int ld = m->nstate + 1;
@@ -50,7 +30,7 @@ static void accs_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, c
         const hyd_acc_c* c = (const hyd_acc_c*)rec + i;
         const int at = map ? map[c->adr] : c->adr;
         double dpg;
-        const double pg = acc_pgas(c, y[at], &dpg);
+        const double pg = hyd_acc_pgas(c, y[at], &dpg);
         const double q = c->G * (d->node_p[c->node] - pg); // into the accumulator
         if (ydot)
             ydot[at] = q;

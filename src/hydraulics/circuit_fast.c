@@ -12,11 +12,16 @@
 //      dBe/dp / V (net - dV/dt)
 #include "circuit_fast.h"
 
+#include "hyd_accumulator.h"
+#include "hyd_compensator.h"
+#include "hyd_counterbalance.h"
 #include "hyd_cylinder.h"
 #include "hyd_hose.h"
 #include "hyd_internal.h"
+#include "hyd_ls_pump.h"
 #include "hyd_orifice.h"
 #include "hyd_pump.h"
+#include "hyd_shuttle.h"
 #include "hyd_ramp.h"
 #include "hyd_valve.h"
 
@@ -50,7 +55,8 @@ struct hyd_fast {
 
 unsigned hyd_fast_types(void) {
     return 1u << HYD_PUMP | 1u << HYD_RELIEF | 1u << HYD_CHECK | 1u << HYD_ORIFICE |
-           1u << HYD_HOSE | 1u << HYD_VALVE | 1u << HYD_CYLINDER;
+           1u << HYD_HOSE | 1u << HYD_VALVE | 1u << HYD_CYLINDER | 1u << HYD_LS_PUMP |
+           1u << HYD_SHUTTLE | 1u << HYD_COMPENSATOR | 1u << HYD_COUNTERBALANCE | 1u << HYD_ACCUMULATOR;
 }
 
 // The copies of the model's records, sorted into fast and fallback (again
@@ -74,6 +80,12 @@ static void take_records(hyd_fast* k) {
     // records, which the reference hooks read, stay in circuit order).
     hyd_valve_c* va = k->rec[HYD_VALVE];
     for (int i = 0; i < k->nrec[HYD_VALVE]; ++i) va[i].adr = k->smap[va[i].adr];
+    hyd_ls_pump_c* lp = k->rec[HYD_LS_PUMP];
+    for (int i = 0; i < k->nrec[HYD_LS_PUMP]; ++i) lp[i].adr = k->smap[lp[i].adr];
+    hyd_cb_c* cb = k->rec[HYD_COUNTERBALANCE];
+    for (int i = 0; i < k->nrec[HYD_COUNTERBALANCE]; ++i) cb[i].adr = k->smap[cb[i].adr];
+    hyd_acc_c* ac = k->rec[HYD_ACCUMULATOR];
+    for (int i = 0; i < k->nrec[HYD_ACCUMULATOR]; ++i) ac[i].adr = k->smap[ac[i].adr];
     k->rev = m->revision;
 }
 
@@ -177,6 +189,19 @@ FAST_INLINE void flow(const hyd_fast* k, double* J, int ldj, int a, int b, doubl
 FAST_INLINE void jcol(const hyd_fast* k, double* J, int ldj, int a, int col, double g) {
     const int sa = k->ns[a];
     if (sa >= 0) J[(size_t)sa * ldj + col] += k->c[a] * g;
+}
+
+// J[row of node a][state of node b] += c_a g (nothing when either is a tank).
+FAST_INLINE void jent(const hyd_fast* k, double* J, int ldj, int a, int b, double g) {
+    const int sa = k->ns[a], sb = k->ns[b];
+    if (sa >= 0 && sb >= 0) J[(size_t)sa * ldj + sb] += k->c[a] * g;
+}
+
+// A component state's own row (unscaled: its rate is no pressure rate):
+// J[row][state of node b] += g (nothing for a tank).
+FAST_INLINE void jrow(const hyd_fast* k, double* row, int b, double g) {
+    const int sb = k->ns[b];
+    if (sb >= 0) row[sb] += g;
 }
 
 FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, double* J, int ldj) {
@@ -302,6 +327,97 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
             jcol(k, J, ldj, drain, c->adr, -du2);
             jcol(k, J, ldj, c->T, c->adr, du2);
             J[(size_t)c->adr * ldj + c->adr] = -c->inv_tau;
+        }
+    }
+    // Load-sensing components (their laws: hyd_ls_pump.h, hyd_shuttle.h,
+    // hyd_compensator.h, hyd_counterbalance.h, hyd_accumulator.h).
+    const hyd_ls_pump_c* lp = k->rec[HYD_LS_PUMP];
+    for (int i = 0; i < k->nrec[HYD_LS_PUMP]; ++i) {
+        const hyd_ls_pump_c* c = &lp[i];
+        double a1, a2;
+        const double target = hyd_ls_pump_target(c, p[c->in], p[c->out], p[c->ls], &a1, &a2);
+        const double eps = y[c->adr];
+        ydot[c->adr] = (target - eps) * c->inv_tau;
+        const double q = eps * c->qmax; // no pressure partial: delivery is eps q_max
+        k->net[c->in] -= q;
+        k->net[c->out] += q;
+        if (J) {
+            jcol(k, J, ldj, c->in, c->adr, -c->qmax);
+            jcol(k, J, ldj, c->out, c->adr, c->qmax);
+            double* row = J + (size_t)c->adr * ldj; // displacement row
+            jrow(k, row, c->out, (a1 + a2) * c->inv_tau);
+            jrow(k, row, c->ls, -a1 * c->inv_tau);
+            jrow(k, row, c->in, -a2 * c->inv_tau);
+            row[c->adr] -= c->inv_tau;
+        }
+    }
+    const hyd_shuttle_c* sh = k->rec[HYD_SHUTTLE];
+    for (int i = 0; i < k->nrec[HYD_SHUTTLE]; ++i) {
+        const hyd_shuttle_c* c = &sh[i];
+        double sa, sig, dsig;
+        const double q = hyd_shuttle_q(c, p[c->a], p[c->b], p[c->out], &sig, &dsig, &sa);
+        k->net[c->a] -= sig * q;
+        k->net[c->b] -= (1.0 - sig) * q;
+        k->net[c->out] += q;
+        if (J) {
+            const double qa = c->G * sa, qb = c->G * (1.0 - sa), qo = -c->G; // dq / dp
+            jent(k, J, ldj, c->a, c->a, -(dsig * q + sig * qa));
+            jent(k, J, ldj, c->a, c->b, -(-dsig * q + sig * qb));
+            jent(k, J, ldj, c->a, c->out, -sig * qo);
+            jent(k, J, ldj, c->b, c->a, -(-dsig * q + (1.0 - sig) * qa));
+            jent(k, J, ldj, c->b, c->b, -(dsig * q + (1.0 - sig) * qb));
+            jent(k, J, ldj, c->b, c->out, -(1.0 - sig) * qo);
+            jent(k, J, ldj, c->out, c->a, qa);
+            jent(k, J, ldj, c->out, c->b, qb);
+            jent(k, J, ldj, c->out, c->out, qo);
+        }
+    }
+    const hyd_comp_c* co = k->rec[HYD_COMPENSATOR];
+    for (int i = 0; i < k->nrec[HYD_COMPENSATOR]; ++i) {
+        const hyd_comp_c* c = &co[i];
+        double x, dq[4];
+        const double q = hyd_compensator_q(c, p[c->in], p[c->out], p[c->load], p[c->ref], &x, dq);
+        k->net[c->in] -= q;
+        k->net[c->out] += q;
+        if (J) {
+            const int node[4] = {c->in, c->out, c->load, c->ref};
+            for (int j = 0; j < 4; ++j) {
+                jent(k, J, ldj, c->in, node[j], -dq[j]);
+                jent(k, J, ldj, c->out, node[j], dq[j]);
+            }
+        }
+    }
+    const hyd_cb_c* cb = k->rec[HYD_COUNTERBALANCE];
+    for (int i = 0; i < k->nrec[HYD_COUNTERBALANCE]; ++i) {
+        const hyd_cb_c* c = &cb[i];
+        hyd_cb_flow e;
+        hyd_cb_law(c, y[c->adr], p[c->v], p[c->l], p[c->p], &e);
+        ydot[c->adr] = e.xdot;
+        flow(k, J, ldj, c->v, c->l, e.q, e.dqv, -e.dqv);
+        if (J) {
+            jcol(k, J, ldj, c->v, c->adr, -e.dqx);
+            jcol(k, J, ldj, c->l, c->adr, e.dqx);
+            double* row = J + (size_t)c->adr * ldj; // spool row
+            jrow(k, row, c->l, e.k);
+            jrow(k, row, c->v, -e.k * (1.0 + c->R));
+            jrow(k, row, c->p, e.k * c->R);
+            row[c->adr] -= c->inv_tau;
+        }
+    }
+    const hyd_acc_c* ac = k->rec[HYD_ACCUMULATOR];
+    for (int i = 0; i < k->nrec[HYD_ACCUMULATOR]; ++i) {
+        const hyd_acc_c* c = &ac[i];
+        double dpg;
+        const double pg = hyd_acc_pgas(c, y[c->adr], &dpg);
+        const double q = c->G * (p[c->node] - pg); // into the accumulator
+        ydot[c->adr] = q;
+        k->net[c->node] -= q;
+        if (J) {
+            jent(k, J, ldj, c->node, c->node, -c->G);
+            jcol(k, J, ldj, c->node, c->adr, c->G * dpg);
+            double* row = J + (size_t)c->adr * ldj; // oil volume row
+            jrow(k, row, c->node, c->G);
+            row[c->adr] -= c->G * dpg;
         }
     }
     for (int i = 0; i < k->nrec[HYD_CYLINDER]; ++i) {

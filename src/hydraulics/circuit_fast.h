@@ -4,7 +4,9 @@
 // inflow and every partial straight into the Jacobian, already scaled by its
 // row's Be/V: no per-port flow slots, no gather, no dense (n+1)^2 scratch.
 // The laws are the components' own (hyd_pump.h, hyd_ramp.h, hyd_orifice.h,
-// hyd_valve.h, hyd_hose.h, hyd_cylinder.h), so it agrees with the reference
+// hyd_valve.h, hyd_hose.h, hyd_cylinder.h, and for the load-sensing types
+// hyd_ls_pump.h, hyd_shuttle.h, hyd_compensator.h, hyd_counterbalance.h,
+// hyd_accumulator.h), so it agrees with the reference
 // loops (hyd_eval, hyd_jacobian) to rounding; only the summation order of a
 // node's inflows differs.
 //

@@ -19,13 +19,7 @@
 // of A and B); ref the highest LS pressure (the LS line); both are sensed
 // only. The setting range covers both uses (pre 0.5-1.5 MPa, post a few
 // 0.1 MPa).
-#include "hyd_orifice.h"
-
-typedef struct hyd_comp_c {
-    int in, out, load, ref, comp, post;
-    double A, set, inv_band;
-    hyd_orif_k ok;
-} hyd_comp_c;
+#include "hyd_compensator.h"
 
 hyd_compensator_def hyd_default_compensator_def(void) {
     hyd_compensator_def d = {0};
@@ -44,21 +38,13 @@ static void compensators_eval(const hyd_model* m, hyd_data* d, const void* rec, 
         const hyd_comp_c* c = (const hyd_comp_c*)rec + i;
         const double pin = d->node_p[c->in], pout = d->node_p[c->out];
         const double pl = d->node_p[c->load], pr = d->node_p[c->ref];
-        const double target = c->post ? pin - pr - c->set : c->set;
-        double ds;
-        const double x = 1.0 - hyd_smoothstep((pout - pl - target) * c->inv_band + 0.5, &ds);
-        const double dx = -ds * c->inv_band; // dx / d(dp_m - dp_t)
-        double g, gA;
-        const double q = hyd_orifice_q(&c->ok, c->A * x, pin - pout, &g, &gA);
+        double x, dq[4]; // d q / d p_in, p_out, p_load, p_ref
+        const double q = hyd_compensator_q(c, pin, pout, pl, pr, &x, dq);
         d->comp_q[2 * c->comp] = q;
         d->comp_open[c->comp] = x < 1.0;
         double* fl = d->flow_ + HYD_MAXSLOT * c->comp;
         fl[0] = -q, fl[1] = q, fl[2] = 0.0, fl[3] = 0.0;
         if (G) {
-            const double k = gA * c->A * dx; // dq / d(dp_m - dp_t)
-            double dq[4] = {g, -g + k, -k, 0.0}; // d q / d p_in, p_out, p_load, p_ref
-            if (c->post)
-                dq[0] -= k, dq[3] += k;
             const int node[4] = {c->in, c->out, c->load, c->ref};
             const int si = m->node_sidx[c->in], so = m->node_sidx[c->out];
             for (int j = 0; j < 4; ++j) {

@@ -14,14 +14,7 @@
 //   pressure (p_setting - p_l) / R (gauge) and holds (x_t = 0, no flow) below.
 // The net flow valve -> load is q = q_c - q_r. Hysteresis of a real valve
 // (spool friction) is not modelled.
-#include "hyd_orifice.h"
-#include "hyd_ramp.h"
-
-typedef struct hyd_cb_c {
-    int v, l, p, adr, comp;
-    double pset, R, inv_band, A, inv_tau, ccr, inv_cw, cq;
-    hyd_orif_k ok;
-} hyd_cb_c;
+#include "hyd_counterbalance.h"
 
 hyd_counterbalance_def hyd_default_counterbalance_def(void) {
     hyd_counterbalance_def d = {0};
@@ -44,30 +37,23 @@ static void cbs_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, co
         const int at = map ? map[c->adr] : c->adr;
         const double x = y[at];
         const double pv = d->node_p[c->v], pl = d->node_p[c->l], pp = d->node_p[c->p];
-        double ds;
-        const double z = (pl - pv) + c->R * (pp - pv) - c->pset;
-        const double xt = hyd_smoothstep(z * c->inv_band, &ds);
+        hyd_cb_flow e;
+        hyd_cb_law(c, x, pv, pl, pp, &e);
         if (ydot)
-            ydot[at] = (xt - x) * c->inv_tau;
-        double gc, tc;
-        const double qc = hyd_ramp_q(c->ccr, c->inv_cw, c->cq, pv - pl, &gc, &tc);
-        // A spool a rounding error below 0 is closed (the lag cannot leave [0, 1]).
-        const double xo = x > 0.0 ? x : 0.0;
-        double gr, gA;
-        const double qr = hyd_orifice_q(&c->ok, c->A * xo, pl - pv, &gr, &gA);
-        const double q = qc - qr; // valve -> load
+            ydot[at] = e.xdot;
+        const double q = e.q; // valve -> load
         d->comp_q[2 * c->comp] = q;
-        d->comp_open[c->comp] = qr != 0.0 || tc > 0.0;
+        d->comp_open[c->comp] = e.open;
         double* fl = d->flow_ + HYD_MAXSLOT * c->comp;
         fl[0] = -q, fl[1] = q, fl[2] = 0.0;
         if (G) {
             const int sv = m->node_sidx[c->v], sl = m->node_sidx[c->l], sp = m->node_sidx[c->p];
-            const double dqv = gc + gr, dql = -gc - gr; // dq / dp_v, dq / dp_l
-            const double dqx = x > 0.0 ? -gA * c->A : 0.0;
+            const double dqv = e.dqv, dql = -e.dqv; // dq / dp_v, dq / dp_l
+            const double dqx = e.dqx;
             G[sv * ld + sv] -= dqv, G[sv * ld + sl] -= dql, G[sv * ld + c->adr] -= dqx;
             G[sl * ld + sv] += dqv, G[sl * ld + sl] += dql, G[sl * ld + c->adr] += dqx;
             // Spool row (hyd_state_row_from_G).
-            const double k = ds * c->inv_band * c->inv_tau; // d x' / d z
+            const double k = e.k; // d x' / d z
             double* row = G + (size_t)c->adr * ld;
             row[sl] += k;
             row[sv] -= k * (1.0 + c->R);

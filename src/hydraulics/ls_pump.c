@@ -15,12 +15,7 @@
 // tau is the stroke time constant; eps_t in [0, 1] keeps eps in [0, 1]
 // without a limiter. The LS port draws no flow: the LS line's own bleed
 // orifice (a fixed orifice to tank) empties it.
-#include "hyd_internal.h"
-
-typedef struct hyd_ls_pump_c {
-    int in, out, ls, adr, comp;
-    double qmax, margin, inv_band, pcut, inv_cband, inv_tau;
-} hyd_ls_pump_c;
+#include "hyd_ls_pump.h"
 
 hyd_ls_pump_def hyd_default_ls_pump_def(void) {
     hyd_ls_pump_def d = {0};
@@ -53,10 +48,8 @@ static void ls_pumps_eval(const hyd_model* m, hyd_data* d, const void* rec, int 
         const int at = map ? map[c->adr] : c->adr;
         const double eps = y[at];
         const double pin = d->node_p[c->in], pout = d->node_p[c->out], pls = d->node_p[c->ls];
-        double ds1, ds2;
-        const double e_ls = 1.0 - hyd_smoothstep((pout - pls - c->margin) * c->inv_band + 0.5, &ds1);
-        const double e_co = 1.0 - hyd_smoothstep((pout - pin - c->pcut) * c->inv_cband, &ds2);
-        const double target = e_ls * e_co;
+        double a1, a2; // d e_ls e_co / d(p_out - p_ls), d(p_out - p_in)
+        const double target = hyd_ls_pump_target(c, pin, pout, pls, &a1, &a2);
         if (ydot)
             ydot[at] = (target - eps) * c->inv_tau;
         const double q = eps * c->qmax;
@@ -70,8 +63,6 @@ static void ls_pumps_eval(const hyd_model* m, hyd_data* d, const void* rec, int 
             G[si * ld + c->adr] -= c->qmax;
             G[so * ld + c->adr] += c->qmax;
             // Displacement row (hyd_state_row_from_G): d eps' / d p and d eps.
-            const double a1 = -ds1 * c->inv_band * e_co; // d e_ls e_co / d(p_out - p_ls)
-            const double a2 = -ds2 * c->inv_cband * e_ls; // d e_ls e_co / d(p_out - p_in)
             double* row = G + (size_t)c->adr * ld;
             row[so] += (a1 + a2) * c->inv_tau;
             row[sl] -= a1 * c->inv_tau;

@@ -11,33 +11,13 @@
 // port flows are C1 as well and their sum is q (mass is kept). The LS line
 // is a declared volume node; its bleed to tank is a fixed orifice
 // (orifice.c), which the LS pump needs to see a falling load.
-#include "hyd_internal.h"
-
-typedef struct hyd_shuttle_c {
-    int a, b, out, comp;
-    double G, w;
-} hyd_shuttle_c;
+#include "hyd_shuttle.h"
 
 hyd_shuttle_def hyd_default_shuttle_def(void) {
     hyd_shuttle_def d = {0};
     d.conductance = 2e-11;
     d.width = 1e5;
     return d;
-}
-
-/// C1 max of pa, pb with corner half-width w; *sa = d smax / d pa.
-static inline double shuttle_smax(double pa, double pb, double w, double* sa) {
-    const double dd = pa - pb;
-    if (dd <= -w) {
-        *sa = 0.0;
-        return pb;
-    }
-    if (dd >= w) {
-        *sa = 1.0;
-        return pa;
-    }
-    *sa = (dd + w) / (2.0 * w);
-    return pb + (dd + w) * (dd + w) / (4.0 * w);
 }
 
 static void shuttles_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, const double* y,
@@ -47,11 +27,8 @@ static void shuttles_eval(const hyd_model* m, hyd_data* d, const void* rec, int 
     for (int i = 0; i < n; ++i) {
         const hyd_shuttle_c* c = (const hyd_shuttle_c*)rec + i;
         const double pa = d->node_p[c->a], pb = d->node_p[c->b], po = d->node_p[c->out];
-        double sa, ds;
-        const double pm = shuttle_smax(pa, pb, c->w, &sa);
-        const double q = c->G * (pm - po);
-        const double sig = hyd_smoothstep((pa - pb + c->w) / (2.0 * c->w), &ds);
-        const double dsig = ds / (2.0 * c->w); // d sigma / d pa = - d sigma / d pb
+        double sa, sig, dsig; // dsig = d sigma / d pa = - d sigma / d pb
+        const double q = hyd_shuttle_q(c, pa, pb, po, &sig, &dsig, &sa);
         d->comp_q[2 * c->comp] = q;
         double* fl = d->flow_ + HYD_MAXSLOT * c->comp;
         fl[0] = -sig * q, fl[1] = -(1.0 - sig) * q, fl[2] = q;

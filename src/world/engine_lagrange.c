@@ -63,6 +63,7 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
     // general path, which reads the model on every call. Real time needs 1x,
     // not the fused kernel's speed.
     l->ls.use_fused = false;
+    l->ls.use_fast = false;
     const bool adaptive = hyd_method_is_adaptive(o->solver);
     l->prob = lsim_problem(&l->ls, !adaptive && !o->dense_jac);
     hyd_solver_opts so = hyd_default_solver_opts();
@@ -276,7 +277,9 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     ls.use_fused = ls.have_fused && !reference;
     ls.use_w = ls.w_layout && !reference; // the crane-specialised W too (lagrange_schur_w.c)
     ls.use_split = ls.w_layout && o->kernel == SIM_KERNEL_SPLIT;
+    ls.use_fast = ls.fk && !reference; // a circuit without the fused shape (lagrange_sim.h)
     res->fused = ls.use_fused;
+    res->fast = ls.use_fast;
     double y[LSIM_MAX_STATES];
     if (lsim_check_pose(&ls, sc->q0, res->message, sizeof res->message) ||
         check_fixed_step(m->hyd, o, o->h, o->duration > 0 ? o->duration : sc->duration, res)) {

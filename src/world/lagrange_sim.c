@@ -105,6 +105,13 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
     if (s->have_fused) events_setup(s);
     s->fz_rev = hyd_model_revision(hm);
     s->use_fused = s->have_fused;
+    if (!s->have_fused) {
+        // Not the standard shape: the fast kernel when it takes every
+        // component (else the general path, which takes any circuit).
+        s->fk = hyd_fast_create(hm, hyd_fast_types(), 0, NULL, 0);
+        if (s->fk && hyd_fast_map(s->fk, s->hpos)) hyd_fast_free(s->fk), s->fk = NULL;
+    }
+    s->use_fast = s->fk != NULL;
     s->w_layout = lsim_w_layout(s);
     s->use_w = s->w_layout;
     s->use_split = s->w_layout;
@@ -116,6 +123,8 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
 
 void lsim_free(lsim* s) {
     hyd_data_free(s->hd);
+    hyd_fast_free(s->fk);
+    s->fk = NULL;
     free(s->jh_);
     s->hd = NULL;
     s->jh_ = NULL;
@@ -195,7 +204,10 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt) {
     kin k;
     prepare(s, t, y, trig, &k);
     // The circuit reads and writes its states in place: state h is y[hpos[h]].
-    hyd_eval_mapped(s->mdl->hyd, s->hd, t, y, dydt, s->hpos);
+    if (s->use_fast && s->fk)
+        hyd_fast_eval(s->fk, s->hd, y, dydt);
+    else
+        hyd_eval_mapped(s->mdl->hyd, s->hd, t, y, dydt, s->hpos);
 
     const double tau[2] = {s->hd->cyl_F[s->mdl->cyl[0]] * k.r[0], s->hd->cyl_F[s->mdl->cyl[1]] * k.r[1]};
     lagrange_terms lt;
@@ -318,13 +330,17 @@ int lsim_jac(void* user, double t, const double* y, double* J) {
     double trig[4];
     kin k;
     prepare(s, t, y, trig, &k);
-    for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i]; // the circuit's own order
     hyd_data* d = s->hd;
-    hyd_jacobian(s->mdl->hyd, d, t, s->yh_, NULL, s->jh_, nh, 0, 0);
-
-    // Hydraulic block, permuted.
-    for (int i = 0; i < nh; ++i)
-        for (int j = 0; j < nh; ++j) J[i * n + j] = s->jh_[s->perm[i] * nh + s->perm[j]];
+    if (s->use_fast && s->fk) {
+        // Mapped (hyd_fast_map): the hydraulic block straight into J.
+        hyd_fast_jacobian(s->fk, d, y, NULL, J, n);
+    } else {
+        for (int i = 0; i < nh; ++i) s->yh_[s->perm[i]] = y[i]; // the circuit's own order
+        hyd_jacobian(s->mdl->hyd, d, t, s->yh_, NULL, s->jh_, nh, 0, 0);
+        // Hydraulic block, permuted.
+        for (int i = 0; i < nh; ++i)
+            for (int j = 0; j < nh; ++j) J[i * n + j] = s->jh_[s->perm[i] * nh + s->perm[j]];
+    }
 
     const int nhs = hyd_model_nstate(s->mdl->hyd);
     double F[2], dFdx[2], dFdv[2];
@@ -469,7 +485,12 @@ void lsim_initial_state(lsim* s, const double q0[2], double p_low, double* y) {
 
 void lsim_outputs(lsim* s, double t, const double* y, lsim_out* o) {
     double f[LSIM_MAX_STATES];
+    // The general path: it also fills the component outputs (comp_q,
+    // comp_open) that the rows and the energy balance read.
+    const bool fast = s->use_fast;
+    s->use_fast = false;
     lsim_rhs(s, t, y, f);
+    s->use_fast = fast;
     --s->nrhs; // an output evaluation is not solver work
     const crane_mech* me = &s->mdl->mech;
     const hyd_data* d = s->hd;

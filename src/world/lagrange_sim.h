@@ -8,6 +8,7 @@
 
 #include <stdbool.h>
 
+#include "circuit_fast.h"
 #include "hyd_fused.h"
 #include "hyd_solver.h"
 #include "lagrange.h"
@@ -85,6 +86,11 @@ typedef struct lsim {
     bool have_fused;       ///< the circuit has the standard shape
     bool use_fused;        ///< lsim_problem hands out the fused f and J (default: have_fused)
     char fused_why[96];    ///< why not, when !have_fused
+    // The fast kernel for any circuit (circuit_fast.h), in the system's state
+    // order, when the circuit has no fused shape and every component has a
+    // fast loop (no fallback: the fallback loops work in circuit order only).
+    hyd_fast* fk;
+    bool use_fast;         ///< lsim_rhs and lsim_jac evaluate the circuit with fk (default: fk != NULL)
     // Structured W (lagrange_schur_w.c) for the dense-pattern solvers.
     bool w_layout;         ///< the state layout lagrange_schur_w.c needs (standard circuit, 2 actuators)
     bool use_w;            ///< lsim_problem hands out wfactor/wsolve (default: w_layout)

@@ -1,0 +1,44 @@
+// hyd_counterbalance.h: the counterbalance valve's record and law
+// (counterbalance.c has the reasoning), written once for the reference loop
+// (counterbalance.c) and the fast kernel (circuit_fast.c).
+#ifndef HYD_COUNTERBALANCE_H
+#define HYD_COUNTERBALANCE_H
+
+#include "hyd_orifice.h"
+#include "hyd_ramp.h"
+
+typedef struct hyd_cb_c {
+    int v, l, p, adr, comp;
+    double pset, R, inv_band, A, inv_tau, ccr, inv_cw, cq;
+    hyd_orif_k ok;
+} hyd_cb_c;
+
+/// The valve at spool x [-] and valve, load, pilot pressures [Pa].
+typedef struct hyd_cb_flow {
+    double q;        ///< net flow valve -> load [m^3/s]
+    double xdot;     ///< spool rate [1/s]
+    double dqv;      ///< dq / dp_v [m^3/(s Pa)] (dq / dp_l = -dqv)
+    double dqx;      ///< dq / dx [m^3/s]
+    double k;        ///< d x' / d z [1/(s Pa)], z = (p_l - p_v) + R (p_p - p_v) - p_setting
+    int open;        ///< either path passes flow
+} hyd_cb_flow;
+
+static inline void hyd_cb_law(const hyd_cb_c* c, double x, double pv, double pl, double pp, hyd_cb_flow* o) {
+    double ds;
+    const double z = (pl - pv) + c->R * (pp - pv) - c->pset;
+    const double xt = hyd_smoothstep(z * c->inv_band, &ds);
+    o->xdot = (xt - x) * c->inv_tau;
+    double gc, tc;
+    const double qc = hyd_ramp_q(c->ccr, c->inv_cw, c->cq, pv - pl, &gc, &tc);
+    // A spool a rounding error below 0 is closed (the lag cannot leave [0, 1]).
+    const double xo = x > 0.0 ? x : 0.0;
+    double gr, gA;
+    const double qr = hyd_orifice_q(&c->ok, c->A * xo, pl - pv, &gr, &gA);
+    o->q = qc - qr;
+    o->open = qr != 0.0 || tc > 0.0;
+    o->dqv = gc + gr;
+    o->dqx = x > 0.0 ? -gA * c->A : 0.0;
+    o->k = ds * c->inv_band * c->inv_tau;
+}
+
+#endif
