@@ -45,7 +45,8 @@ static void sweep_help(FILE* f) {
             "  --lhs N              a Latin hypercube of N designs instead of the grid\n"
             "  --seed K             its random seed (default 1; same seed, same designs)\n"
             "  --metrics LIST       the metrics to tabulate, comma separated (default: every metric\n"
-            "                       the run has; p3A, p3B, slew, tilt and sway: ode only):",
+            "                       the run has but energy_in, energy_loss and collision_count; p3A,\n"
+            "                       p3B, slew, tilt, sway and collision_count: ode only):",
             SW_MAXPAR);
     // Each name with its unit, wrapped under the option's text.
     int col = 999;
@@ -241,7 +242,9 @@ static char* run_design(const sweep* s, long i, bool* failed) {
     // A failed design's metrics are left empty: those of a run cut short
     // by a blow-up are not the design's.
     for (int k = 0; k < s->nmet; ++k) {
-        if (code) sb_printf(&b, ",");
+        // A metric the run's world does not have (collisions in the
+        // validation world) is empty too, not 0.
+        if (code || (s->met[k] == MET_COLLISIONS && !met.present[MET_COLLISIONS])) sb_printf(&b, ",");
         else sb_printf(&b, ",%.17g", met.value[s->met[k]]);
     }
     sb_printf(&b, ",%d,", code);
@@ -799,7 +802,9 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
         for (int id = 0; id < MET_COUNT; ++id)
             // The energy metrics only when asked: the accounting costs a
             // circuit evaluation per step, and the default table stays as it was.
-            if (metrics_present((metric_id)id, s.ncol) && id != MET_ENERGY_IN && id != MET_ENERGY_LOSS)
+            // collision_count too, so the default columns stay those they were.
+            if (metrics_present((metric_id)id, s.ncol) && id != MET_ENERGY_IN && id != MET_ENERGY_LOSS &&
+                id != MET_COLLISIONS)
                 s.met[s.nmet++] = id;
     for (int k = 0; k < s.nmet; ++k)
         if (s.met[k] == MET_ENERGY_IN || s.met[k] == MET_ENERGY_LOSS) s.energy = true;

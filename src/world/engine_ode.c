@@ -12,6 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/// Collision pairs read from the world per ODE step (it records at most 16).
+#define OW_COLL_REPORT 16
+
 typedef struct eng_ode {
     engine base;
     ode_world* w;
@@ -205,6 +208,12 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         if (en)
             sim_energy_sample(en, (double)(i + 1) * dt, ode_world_circuit_inputs(w, sim_energy_data(en)),
                               ode_world_energy(w));
+        {
+            // Collisions at every ODE step (a touch shorter than a row counts).
+            const char* pairs[OW_COLL_REPORT][2];
+            const int np = ode_world_collisions(w, pairs, OW_COLL_REPORT);
+            if (np >= 0) sim_collisions_step(&res->coll, (double)(i + 1) * dt, (const char* const(*)[2])pairs, np);
+        }
         {
             // Peaks at every ODE step, not only at the rows.
             double pA[ODE_NACT], pB[ODE_NACT];

@@ -36,6 +36,9 @@ static const metric_def k_metric[MET_COUNT] = {
     [MET_MIN_PAD_F] = {"min_pad_force", "N", COL_PAD_F1},
     [MET_MIN_STAB_MARGIN] = {"min_stab_margin", "-", COL_STAB_MARGIN},
     [MET_PAD_LIFTOFFS] = {"pad_liftoffs", "count", COL_PAD_F1},
+    // Possible wherever the ode world's channels are; present only when the
+    // run's world reports collisions (the sandbox, not the validation world).
+    [MET_COLLISIONS] = {"collision_count", "count", COL_TRUCK_TILT},
 };
 
 bool metrics_present(metric_id id, int ncol) { return id >= 0 && id < MET_COUNT && k_metric[id].col < ncol; }
@@ -60,7 +63,8 @@ void metrics_init(run_metrics* m, int ncol) {
     m->ncol = ncol;
     for (int i = 0; i < MET_COUNT; ++i) {
         // The energy metrics wait for metrics_energy.
-        m->present[i] = metrics_present((metric_id)i, ncol) && i != MET_ENERGY_IN && i != MET_ENERGY_LOSS;
+        m->present[i] = metrics_present((metric_id)i, ncol) && i != MET_ENERGY_IN && i != MET_ENERGY_LOSS &&
+                        i != MET_COLLISIONS;
         m->value[i] = i <= MET_PEAK_P_PUMP ? -INFINITY : 0.0;
     }
 }
@@ -110,6 +114,11 @@ void metrics_row(run_metrics* m, const double* row) {
 }
 
 void metrics_finish(run_metrics* m, const sim_result* r) {
+    if (r->coll.have && metrics_present(MET_COLLISIONS, m->ncol)) {
+        m->coll = r->coll;
+        m->value[MET_COLLISIONS] = (double)r->coll.count;
+        m->present[MET_COLLISIONS] = m->per_step[MET_COLLISIONS] = true;
+    }
     if (!r->peak_steps) return;
     for (int k = 0; k < 4; ++k) {
         // A run stopped before its first step has no step peak (0).
@@ -151,6 +160,12 @@ void metrics_print(const run_metrics* m, FILE* f) {
     if (m->pads_seen)
         fprintf(f, "; min pad force %.2f kN, min stability margin %.3f, pad lift-offs %.0f",
                 m->value[MET_MIN_PAD_F] * 1e-3, m->value[MET_MIN_STAB_MARGIN], m->value[MET_PAD_LIFTOFFS]);
+    if (m->present[MET_COLLISIONS]) {
+        fprintf(f, "; collisions %.0f", m->value[MET_COLLISIONS]);
+        for (int k = 0; k < m->coll.npair; ++k)
+            fprintf(f, "%s%s at %.3f s", k ? ", " : " (", m->coll.pair[k], m->coll.first_t[k]);
+        if (m->coll.npair) fprintf(f, ")");
+    }
     fprintf(f, "\n");
     // Which reliefs were open, and how long (only those that opened).
     bool any = false;
@@ -170,9 +185,12 @@ int metrics_write_json(const run_metrics* m, FILE* f) {
     bool first = true;
     for (int i = 0; i < MET_COUNT; ++i) {
         if (!m->present[i] || m->rows == 0) continue;
-        const bool peak = i <= MET_PEAK_P_PUMP || i == MET_ENERGY_IN || i == MET_ENERGY_LOSS;
+        const bool peak = i <= MET_PEAK_P_PUMP || i == MET_ENERGY_IN || i == MET_ENERGY_LOSS || i == MET_COLLISIONS;
+        // The collision count is "collisions" in the file (the sweep's
+        // collision_count), next to its pairs.
         fprintf(f, "%s\n    \"%s\": {\"value\": %.17g, \"unit\": \"%s\", \"over\": \"%s\"}", first ? "" : ",",
-                k_metric[i].name, m->value[i], k_metric[i].unit, peak && m->per_step[i] ? "steps" : "rows");
+                i == MET_COLLISIONS ? "collisions" : k_metric[i].name, m->value[i], k_metric[i].unit,
+                peak && m->per_step[i] ? "steps" : "rows");
         first = false;
     }
     for (int k = 0; k < m->nrelief && m->rows > 0; ++k) {
@@ -180,6 +198,22 @@ int metrics_write_json(const run_metrics* m, FILE* f) {
                 first ? "" : ",", m->relief_name[k], m->relief_time[k]);
         first = false;
     }
-    fprintf(f, "\n  }\n}\n");
+    fprintf(f, "\n  }");
+    if (m->present[MET_COLLISIONS] && m->rows > 0) {
+        // Body names are the world file's (letters, digits, '_'), written
+        // escaped all the same.
+        fprintf(f, ",\n  \"collision_pairs\": [");
+        for (int k = 0; k < m->coll.npair; ++k) {
+            fprintf(f, "%s\n    {\"bodies\": \"", k ? "," : "");
+            for (const char* p = m->coll.pair[k]; *p; ++p) {
+                if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
+                else if ((unsigned char)*p < 0x20) fprintf(f, "\\u%04x", (unsigned char)*p);
+                else fputc(*p, f);
+            }
+            fprintf(f, "\", \"first_t\": %.17g}", m->coll.first_t[k]);
+        }
+        fprintf(f, "%s]", m->coll.npair ? "\n  " : "");
+    }
+    fprintf(f, "\n}\n");
     return ferror(f) ? -1 : 0;
 }

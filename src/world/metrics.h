@@ -37,6 +37,9 @@ typedef enum metric_id {
     MET_MIN_PAD_F,       ///< smallest vertical reaction on any support [N]
     MET_MIN_STAB_MARGIN, ///< smallest stability margin [-]
     MET_PAD_LIFTOFFS,    ///< supports lifting off: entries below ODE_PAD_LIFT_FRAC of the pads' sum [count]
+    // From the run's collisions (sim_result.coll, every ODE step; the ode
+    // sandbox): absent where the world has no contacts (validation).
+    MET_COLLISIONS,      ///< collision events, a pair starting to touch [count]
     MET_COUNT
 } metric_id;
 
@@ -57,6 +60,7 @@ typedef struct run_metrics {
     long pad_rows;              ///< rows that counted for the support metrics
     int pad_lift_prev;          ///< the previous such row's lifted supports (bits)
     bool pads_seen;             ///< a row had support forces (a truck on the ground)
+    sim_collisions coll;        ///< the pairs behind MET_COLLISIONS (metrics_finish)
 } run_metrics;
 
 /// Start the metrics of a run that writes ncol channels (sim_ncol).
@@ -68,7 +72,8 @@ void metrics_init(run_metrics* m, int ncol);
 void metrics_row(run_metrics* m, const double* row);
 /// After the run: the chamber peaks over every step from r when it tracked
 /// them (r->peak_steps) and they are higher than the rows' (they always are
-/// when every step is a row, and equal).
+/// when every step is a row, and equal). The collisions (count and pairs)
+/// from r->coll, where the world reports them.
 void metrics_finish(run_metrics* m, const sim_result* r);
 
 struct sim_energy;
@@ -91,7 +96,8 @@ void metric_names(char* buf, size_t n);
 /// The summary's block: a few lines, each starting with two spaces.
 void metrics_print(const run_metrics* m, FILE* f);
 /// The JSON document: {"metrics": {"NAME": {"value": V, "unit": U, "over": "steps"|"rows"}, ...}}
-/// and, after metrics_energy, "relief_open_time.COMPONENT" for each relief.
+/// and, after metrics_energy, "relief_open_time.COMPONENT" for each relief; with collisions,
+/// "collisions" (the collision_count metric) and "collision_pairs": [{"bodies": "A x B", "first_t": T}, ...].
 /// (absent metrics left out; numbers with 17 significant digits). Returns 0, or -1 on a write error.
 int metrics_write_json(const run_metrics* m, FILE* f);
 

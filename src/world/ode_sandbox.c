@@ -394,6 +394,7 @@ static dBodyID mesh_body(ode_world* w, const char* name, world_role role, const 
     dGeomSetBody(g, b);
     ow_geom* e = ow_add_geom(w, g, cat, friction);
     if (e) e->mesh = w->nmesh - 1;
+    ow_geom_name(e, name);
     const double org[3] = {-om->com[0], -om->com[1], -om->com[2]};
     mesh_vis(w, name, role, rgba, om, b, org, NULL);
     allow_sleep(b);
@@ -422,7 +423,7 @@ static int build_loads(ode_world* w, char* err, size_t errsz) {
         set_rot(b, R);
         dGeomID g = dCreateBox(w->dyn_space, L->size[0], L->size[1], L->size[2]);
         dGeomSetBody(g, b);
-        ow_add_geom(w, g, OW_CAT_LOAD, L->friction);
+        ow_geom_name(ow_add_geom(w, g, OW_CAT_LOAD, L->friction), L->name);
         ow_add_vis(w, L->name, WORLD_ROLE_LOAD, WORLD_SHAPE_BOX, L->size, RGBA_LOAD, WORLD_MESH_LOAD, b, NULL, NULL);
         allow_sleep(b);
         w->load[i] = b;
@@ -449,6 +450,7 @@ static int build_obstacles(ode_world* w, char* err, size_t errsz) {
                 if (!g) return -1;
                 ow_geom* e = ow_add_geom(w, g, OW_CAT_OBST, o->friction);
                 if (e) e->mesh = w->nmesh - 1;
+                ow_geom_name(e, o->name);
                 mesh_vis(w, o->name, WORLD_ROLE_OBSTACLE, col, &o->mesh, 0, o->position, R);
             }
         } else if (o->mass > 0) {
@@ -460,7 +462,7 @@ static int build_obstacles(ode_world* w, char* err, size_t errsz) {
             set_rot(b, R);
             dGeomID g = dCreateBox(w->dyn_space, o->size[0], o->size[1], o->size[2]);
             dGeomSetBody(g, b);
-            ow_add_geom(w, g, OW_CAT_OBST, o->friction);
+            ow_geom_name(ow_add_geom(w, g, OW_CAT_OBST, o->friction), o->name);
             ow_add_vis(w, o->name, WORLD_ROLE_OBSTACLE, WORLD_SHAPE_BOX, o->size, col, mesh[o->kind], b, NULL, NULL);
             allow_sleep(b);
             w->obst_body[i] = b;
@@ -468,7 +470,7 @@ static int build_obstacles(ode_world* w, char* err, size_t errsz) {
             dGeomID g = dCreateBox(w->static_space, o->size[0], o->size[1], o->size[2]);
             dGeomSetPosition(g, o->position[0], o->position[1], o->position[2]);
             geom_rot(g, R);
-            ow_add_geom(w, g, OW_CAT_OBST, o->friction);
+            ow_geom_name(ow_add_geom(w, g, OW_CAT_OBST, o->friction), o->name);
             ow_add_vis(w, o->name, WORLD_ROLE_OBSTACLE, WORLD_SHAPE_BOX, o->size, col, mesh[o->kind], 0, o->position, R);
         }
     }
@@ -636,6 +638,57 @@ static double settle_rope(ode_world* w) {
 
 // ---- contacts ----
 
+// A collision (ode_world_collisions): a crane part (column, boom) touching
+// the terrain, the truck, an obstacle or a load, or the hook touching the
+// truck or an obstacle. Not collisions: the hook on the ground or on a load
+// (that is how loads are picked and set down), loads on the ground or on
+// each other, the truck on its pads, the rope (it lies on what it lies on).
+static int is_collision(const ow_geom* a, const ow_geom* b) {
+    const uint32_t other_crane = a->cat == OW_CAT_CRANE ? b->cat : b->cat == OW_CAT_CRANE ? a->cat : 0;
+    if (other_crane & (OW_CAT_TERRAIN | OW_CAT_TRUCK | OW_CAT_OBST | OW_CAT_LOAD)) return 1;
+    const uint32_t other_hook = a->cat == OW_CAT_HOOK ? b->cat : b->cat == OW_CAT_HOOK ? a->cat : 0;
+    return (other_hook & (OW_CAT_TRUCK | OW_CAT_OBST)) != 0;
+}
+
+// Record the pair once per step, the crane's geom (or the hook) first.
+static void note_pair(ode_world* w, const ow_geom* a, const ow_geom* b) {
+    if (!(a->cat & (OW_CAT_CRANE | OW_CAT_HOOK)) || (b->cat == OW_CAT_CRANE && a->cat != OW_CAT_CRANE)) {
+        const ow_geom* t = a;
+        a = b;
+        b = t;
+    }
+    const int ia = (int)(a - w->geom), ib = (int)(b - w->geom);
+    for (int k = 0; k < w->ncoll_pair; ++k)
+        if (w->coll_pair[k][0] == ia && w->coll_pair[k][1] == ib) return;
+    if (w->ncoll_pair >= OW_MAX_COLL_PAIRS) return;
+    w->coll_pair[w->ncoll_pair][0] = ia;
+    w->coll_pair[w->ncoll_pair][1] = ib;
+    ++w->ncoll_pair;
+}
+
+static const char* geom_name(const ow_geom* e) {
+    if (e->name[0]) return e->name;
+    switch (e->cat) {
+    case OW_CAT_TERRAIN: return "terrain";
+    case OW_CAT_TRUCK: return "truck";
+    case OW_CAT_CRANE: return "crane";
+    case OW_CAT_ROPE: return "rope";
+    case OW_CAT_HOOK: return "hook";
+    case OW_CAT_LOAD: return "load";
+    default: return "obstacle";
+    }
+}
+
+int ode_world_collisions(const ode_world* w, const char* names[][2], int max) {
+    if (w->kind != WORLD_SANDBOX) return -1;
+    int n = 0;
+    for (int k = 0; k < w->ncoll_pair && n < max; ++k, ++n) {
+        names[n][0] = geom_name(&w->geom[w->coll_pair[k][0]]);
+        names[n][1] = geom_name(&w->geom[w->coll_pair[k][1]]);
+    }
+    return n;
+}
+
 static void near_cb(void* data, dGeomID g1, dGeomID g2) {
     ode_world* w = data;
     const ow_geom* a = dGeomGetData(g1);
@@ -684,6 +737,7 @@ static void near_cb(void* data, dGeomID g1, dGeomID g2) {
         }
     }
     w->ncontact += n;
+    if (is_collision(a, b)) note_pair(w, a, b);
 }
 
 void ow_collide(ode_world* w) {
@@ -691,6 +745,7 @@ void ow_collide(ode_world* w) {
     w->max_depth = 0;
     w->max_depth_crane = 0;
     w->crane_contact = 0;
+    w->ncoll_pair = 0;
     w->nsupport_fb = 0;
     dSpaceCollide(w->dyn_space, w, near_cb);
     dSpaceCollide2((dGeomID)w->dyn_space, (dGeomID)w->static_space, w, near_cb);

@@ -208,8 +208,13 @@ ow_geom* ow_add_geom(ode_world* w, dGeomID g, uint32_t cat, double friction) {
     e->friction = friction;
     e->support = -1;
     e->mesh = -1;
+    e->name[0] = 0;
     dGeomSetData(g, e);
     return e;
+}
+
+void ow_geom_name(ow_geom* e, const char* name) {
+    if (e) snprintf(e->name, sizeof e->name, "%s", name);
 }
 
 ow_vis* ow_add_vis(ode_world* w, const char* name, world_role role, world_shape shape, const double size[3],
@@ -300,7 +305,7 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
         f0->org[2] = 0.5 * hcol;
         dGeomID g = dCreateCylinder(w->dyn_space, rcol, hcol);
         dGeomSetBody(g, f0->body);
-        ow_add_geom(w, g, OW_CAT_CRANE, 0.5);
+        ow_geom_name(ow_add_geom(w, g, OW_CAT_CRANE, 0.5), "column");
     } else {
         memcpy(f0->wpos, col_pos, sizeof f0->wpos);
         memcpy(f0->wrot, col_rot, sizeof f0->wrot);
@@ -358,7 +363,7 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
             dGeomID g = dCreateBox(w->dyn_space, sz[0], sz[1], sz[2]);
             dGeomSetBody(g, f->body);
             dGeomSetOffsetPosition(g, gp[0], gp[1], gp[2]);
-            ow_add_geom(w, g, OW_CAT_CRANE, 0.5);
+            ow_geom_name(ow_add_geom(w, g, OW_CAT_CRANE, 0.5), name[i]);
         }
         ow_vis* bv = ow_add_vis(w, name[i], role[i], WORLD_SHAPE_BOX, sz, i ? RGBA_BOOM2 : RGBA_BOOM1, mesh[i], f->body,
                                 gp, NULL);

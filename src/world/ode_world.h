@@ -145,6 +145,13 @@ int ode_world_nearest_load(const ode_world* w, double* dist, double* reach);
 /// ode_world_error() names it and the time, and the world stays stopped.
 int ode_world_step(ode_world* w, double dt);
 const char* ode_world_error(const ode_world* w);
+/// The collision pairs touching in the last ODE step (a crane part against
+/// the terrain, the truck, an obstacle or a load; the hook against the truck
+/// or an obstacle): body names into names[i][0] (the crane's, or the hook)
+/// and names[i][1], at most max of them (the world records up to 16 a step).
+/// Returns their number, or -1 in a world without contacts (validation).
+/// The names live as long as the world.
+int ode_world_collisions(const ode_world* w, const char* names[][2], int max);
 
 /// Fill the renderer's picture completely (all bodies, cylinders, rope, terrain, flags).
 void ode_world_snapshot(const ode_world* w, world_snapshot* s);

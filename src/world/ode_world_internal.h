@@ -51,7 +51,11 @@ typedef struct ow_geom {
     double friction;  ///< Coulomb coefficient [-]; a pair uses the geometric mean
     int support;      ///< truck support (OW_NSUPPORT) this geom carries, else -1
     int mesh;         ///< index into ode_world.mesh for trimesh and hull geoms, else -1
+    char name[WORLD_SNAP_NAME]; ///< the body's name for collision reports ("boom1", a load's or an
+                                ///< obstacle's own); "" reads as its category ("terrain", "truck", "hook")
 } ow_geom;
+/// Colliding pairs one step records (ode_world_collisions); more are dropped.
+#define OW_MAX_COLL_PAIRS 16
 
 /// Mesh data ODE keeps pointers to while its geoms live (mesh_ode.c).
 typedef struct ow_mesh {
@@ -188,6 +192,8 @@ struct ode_world {
     int ncontact;
     double max_depth, max_depth_crane;
     int crane_contact;
+    int ncoll_pair;                          ///< collision pairs touching in the last step
+    int coll_pair[OW_MAX_COLL_PAIRS][2];     ///< their geoms (index into geom), the crane's first
     // Ground reactions on the truck's supports (ode_sandbox.c, ow_support_forces).
     int nsupport;                            ///< OW_NSUPPORT, or 0 (validation world)
     double support_pt[OW_NSUPPORT][3];       ///< contact point under each support, truck body coordinates [m]
@@ -285,6 +291,8 @@ void ow_mesh_free(ode_world* w);
 int ow_mesh_merge_contacts(dContactGeom* c, int n, double radius);
 /// The collision shapes into the snapshot (debug view).
 void ow_collision_snapshot(const ode_world* w, world_snapshot* s);
+/// Name geom e for collision reports (NULL e: nothing).
+void ow_geom_name(ow_geom* e, const char* name);
 
 // ode_coupling.c
 int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz);

@@ -423,6 +423,27 @@ static int deliver(void* user, const double* row) {
     return 0;
 }
 
+void sim_collisions_step(sim_collisions* c, double t, const char* const names[][2], int n) {
+    c->have = true;
+    for (int i = 0; i < n; ++i) {
+        char nm[sizeof c->pair[0]];
+        snprintf(nm, sizeof nm, "%s x %s", names[i][0], names[i][1]);
+        int k = 0;
+        while (k < c->npair && strcmp(c->pair[k], nm)) ++k;
+        if (k == c->npair) {
+            // A pair never seen: a new event.
+            if (c->npair == SIM_MAXCOLL) continue;
+            ++c->count;
+            memcpy(c->pair[k], nm, sizeof nm);
+            c->first_t[k] = c->last_t[k] = t;
+            ++c->npair;
+            continue;
+        }
+        if (t - c->last_t[k] >= SIM_COLL_GAP) ++c->count; // touching again after a gap
+        c->last_t[k] = t;
+    }
+}
+
 int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
             sim_trace* trace, sim_progress_fn progress, void* progress_user, sim_result* res) {
     return sim_run_energy(m, sc, o, row_fn, row_user, trace, progress, progress_user, NULL, res);

@@ -247,6 +247,28 @@ void sim_trace_free(sim_trace* tr);
 /// Called for every output row; return non-zero to stop the run.
 typedef int (*sim_row_fn)(void* user, const double* row);
 
+/// Distinct collision pairs a run tracks; the events of further pairs are
+/// not counted (32 is far more than a crane has parts times obstacles touching).
+#define SIM_MAXCOLL 32
+/// A contact between a pair that breaks for less than this and touches again
+/// is the same collision [s]: ODE's contacts come and go from step to step
+/// while a boom scrapes along a wall or rests on one.
+#define SIM_COLL_GAP 0.1
+/// Collisions of a run (the ode sandbox): events are a pair starting to
+/// touch, after SIM_COLL_GAP or more apart (sim_collisions_step).
+typedef struct sim_collisions {
+    bool have;           ///< the world reports collisions (else the run has no such metric)
+    long count;          ///< collision events [count]
+    int npair;           ///< distinct pairs named
+    char pair[SIM_MAXCOLL][2 * 48 + 4];  ///< "boom2 x wall_1", the crane's body first
+    double first_t[SIM_MAXCOLL];         ///< when each first touched [s]
+    double last_t[SIM_MAXCOLL];          ///< when each last touched [s]
+} sim_collisions;
+/// One step's touching pairs (names[i][0] x names[i][1]) at time t [s],
+/// n >= 0, into c (zeroed before the run's first step): counts each pair
+/// that starts to touch.
+void sim_collisions_step(sim_collisions* c, double t, const char* const names[][2], int n);
+
 typedef struct sim_result {
     int status;          ///< a sim_status: SIM_OK, SIM_FAILED, SIM_REFUSED (also: stopped by the callback)
     char message[512];   ///< failure description: state name, time
@@ -262,6 +284,7 @@ typedef struct sim_result {
     bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lagrange_split_step.c)
     bool fast;           ///< ode: the fast kernel for any circuit (circuit_fast.h), the circuit
                          ///< not having the fused kernel's shape
+    sim_collisions coll; ///< ode sandbox: the collisions at every ODE step (else coll.have is false)
 } sim_result;
 
 /// Run the scenario. Rows go to row_fn (may be NULL) and to trace (may be
