@@ -41,6 +41,14 @@ void mesh_set_importer(mesh_import_fn fn);
 int mesh_load(const char* path, double scale, int up, mesh_tri* out, char* err, size_t errsz);
 void mesh_free(mesh_tri* m);
 
+/// mesh_load keeps each finished mesh per process (key: path, modification
+/// time, size, scale, up; a few files, least recently used evicted), so a
+/// world file loaded by several steps parses its meshes once. Safe from
+/// several threads. Freed at exit; mesh_cache_clear frees it now.
+void mesh_cache_clear(void);
+/// Files parsed by mesh_load so far (cache misses), for tests.
+unsigned long long mesh_cache_parses(void);
+
 /// Axis-aligned bounds [m].
 void mesh_bounds(const mesh_tri* m, double lo[3], double hi[3]);
 

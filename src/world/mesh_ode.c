@@ -59,6 +59,12 @@ dGeomID ow_mesh_trimesh(ode_world* w, dSpaceID space, const world_obj_mesh* om, 
                                     (1U << dTRIDATAPREPROCESS_BUILD_FACE_ANGLES),
                                 NULL);
     dGeomID g = dCreateTriMesh(space, m->tmd, NULL, NULL, NULL);
+    // Temporal coherence: OPCODE keeps each pair's last query and refines it,
+    // instead of walking the whole tree again every step (the boom and the
+    // load move a few millimetres per 1 ms step).
+    dGeomTriMeshEnableTC(g, dBoxClass, 1);
+    dGeomTriMeshEnableTC(g, dSphereClass, 1);
+    dGeomTriMeshEnableTC(g, dCapsuleClass, 1);
     dGeomSetPosition(g, pos[0], pos[1], pos[2]);
     dMatrix3 M;
     for (int i = 0; i < 3; ++i) {

@@ -472,6 +472,53 @@ static void test_bad_meshes(void) {
     expect_bad(NULL, buf, "obstacles[0].size", "not used with a mesh");
 }
 
+// The per-process cache: a second load of an unchanged file parses nothing
+// and gives the same mesh; another scale is a different entry; a rewrite of
+// equal size (same tick possible) is parsed again and gives the new mesh;
+// a world file's validation and its ODE world parse its mesh once together.
+static void test_cache(void) {
+    char path[600], err[512];
+    const double lo[3] = {0, 0, 0}, hi1[3] = {1, 2, 3}, hi2[3] = {3, 2, 1};
+    write_box("cache_box.obj", lo, hi1, path, sizeof path);
+    mesh_tri a, b;
+    const unsigned long long p0 = mesh_cache_parses();
+    CHECK(mesh_load(path, 1.0, 2, &a, err, sizeof err) == 0, "load: %s", err);
+    CHECK(mesh_load(path, 1.0, 2, &b, err, sizeof err) == 0, "load again: %s", err);
+    CHECK(mesh_cache_parses() - p0 == 1, "%llu parses for two loads of one file", mesh_cache_parses() - p0);
+    CHECK(a.nv == b.nv && a.nt == b.nt && !memcmp(a.v, b.v, 3 * sizeof(float) * a.nv) &&
+              !memcmp(a.idx, b.idx, 3 * sizeof(int) * a.nt) && a.v != b.v,
+          "a cached load is an equal copy");
+    mesh_free(&b);
+    CHECK(mesh_load(path, 2.0, 2, &b, err, sizeof err) == 0, "load at scale 2: %s", err);
+    double blo[3], bhi[3];
+    mesh_bounds(&b, blo, bhi);
+    CHECK_NEAR(bhi[2], 6.0, 1e-6);
+    CHECK(mesh_cache_parses() - p0 == 2, "another scale is parsed (%llu)", mesh_cache_parses() - p0);
+    mesh_free(&b);
+    // Same digit count, so the same size; z now 1 m.
+    write_box("cache_box.obj", lo, hi2, path, sizeof path);
+    CHECK(mesh_load(path, 1.0, 2, &b, err, sizeof err) == 0, "load rewritten: %s", err);
+    mesh_bounds(&b, blo, bhi);
+    CHECK_NEAR(bhi[0], 3.0, 1e-6);
+    CHECK_NEAR(bhi[2], 1.0, 1e-6);
+    CHECK(mesh_cache_parses() - p0 == 3, "a rewritten file is parsed again (%llu)", mesh_cache_parses() - p0);
+    mesh_free(&a);
+    mesh_free(&b);
+    // A world with a fixed mesh obstacle: validation and the ODE world share one parse.
+    write_box("cache_wall.obj", (const double[3]){-0.5, -2, 0}, (const double[3]){0.5, 2, 3}, path, sizeof path);
+    char obs[900];
+    snprintf(obs, sizeof obs, "[{\"name\":\"w\",\"kind\":\"box\",\"position\":[-4,-10],\"mesh\":{\"file\":\"%s\"}}]",
+             path);
+    const unsigned long long p1 = mesh_cache_parses();
+    world_desc d;
+    CHECK(sandbox_with(NULL, obs, &d, err, sizeof err) == 0, "world: %s", err);
+    ode_world* w = make(&d, 117.3, -65.8, -60);
+    CHECK(w != NULL, "ode world");
+    CHECK(mesh_cache_parses() - p1 == 1, "%llu parses for one world", mesh_cache_parses() - p1);
+    if (w) ode_world_destroy(w);
+    world_desc_free(&d);
+}
+
 int main(int argc, char** argv) {
     (void)argc;
     (void)argv;
@@ -490,6 +537,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_box_vs_mesh_box);
     RUN_TEST(test_boom_mesh_wall);
     RUN_TEST(test_bad_meshes);
+    RUN_TEST(test_cache);
     model_free(g_model);
     TEST_MAIN_END();
 }
