@@ -15,24 +15,11 @@
 #include "crane_fixture.h"
 #include "engine.h"
 #include "sim.h"
+#include "row_store.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct rows {
-    int n, cap;
-    double* v; // n x SIM_NCOL
-} rows;
-
-static int keep_row(void* user, const double* row) {
-    rows* r = user;
-    if (r->n == r->cap) {
-        r->cap = r->cap ? 2 * r->cap : 1024;
-        r->v = realloc(r->v, (size_t)r->cap * SIM_NCOL * sizeof(double));
-    }
-    memcpy(r->v + (size_t)r->n++ * SIM_NCOL, row, SIM_NCOL * sizeof(double));
-    return 0;
-}
 
 static int g_progress;
 static void on_progress(void* user, double t, double t_end) {

@@ -13,6 +13,7 @@
 #include "crane_fixture.h"
 #include "engine.h"
 #include "sim.h"
+#include "row_store.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -67,20 +68,6 @@ static model* model_from_text(const char* text, const char* file) {
     return m;
 }
 
-typedef struct rows {
-    int n, cap;
-    double* v; // n x SIM_NCOL
-} rows;
-
-static int keep_row(void* user, const double* row) {
-    rows* r = user;
-    if (r->n == r->cap) {
-        r->cap = r->cap ? 2 * r->cap : 1024;
-        r->v = realloc(r->v, (size_t)r->cap * SIM_NCOL * sizeof(double));
-    }
-    memcpy(r->v + (size_t)r->n++ * SIM_NCOL, row, SIM_NCOL * sizeof(double));
-    return 0;
-}
 
 static void test_renamed_pump_line(void) {
     char* mtext = slurp(CRANESIM_ASSETS "/models/hiab031.json");
