@@ -154,6 +154,9 @@ static int set_if(hyd_model* hm, const char* path, double v) {
 // closes the bursts of a circuit a backend compiled itself from the model's
 // document (the ode world's, where they load open).
 int engine_faults_apply(const engine_faults* f, hyd_model* hm, const scenario* sc, double t) {
+    // Nothing to do without faults: the ode run calls this every ODE step,
+    // and the pump line below is a name lookup.
+    if (sc->nfault == 0) return 0;
     int changed = 0;
     double q = f->qmax0; // the lowest any stop allows by t
     for (int i = 0; i < sc->nfault; ++i) {
