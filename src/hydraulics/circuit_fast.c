@@ -204,6 +204,47 @@ FAST_INLINE void jrow(const hyd_fast* k, double* row, int b, double g) {
     if (sb >= 0) row[sb] += g;
 }
 
+#if defined(__SSE2__) && defined(__GNUC__)
+#include <emmintrin.h>
+#define FAST_LANES 1
+typedef __m128d fast_v2;
+
+// Be / V of two pressure nodes on the table path (hyd_node_c through
+// hyd_be_nd and hyd_air_ratio), node i in lane i. The law is the header's
+// macros (HYD_AIR_POLY, HYD_BE_N, HYD_BE_D, HYD_BE_C) expanded on __m128d:
+// each lane runs the scalar operations in the same order (IEEE + - * / round
+// the same in a lane; -ffp-contract=off keeps them unfused), so the values
+// are bit for bit hyd_node_c's. Only the table entries are gathered lane by
+// lane. The caller has checked both P are on the table path.
+FAST_INLINE fast_v2 node_c2(const hyd_model* m, double P0, double P1, double bel0, double bel1,
+                            double bec0, double bec1, double V0, double V1) {
+    const hyd_air_tab* t = &m->air;
+    const double P[2] = {P0, P1};
+    const double* c[2];
+    double oct[2], mant[2];
+    for (int l = 0; l < 2; ++l) {
+        uint64_t b;
+        memcpy(&b, &P[l], sizeof b);
+        int e, j;
+        hyd_air_index(b, &e, &j);
+        c[l] = t->seg[j];
+        oct[l] = t->oct[e];
+        const uint64_t mb = (b & HYD_AIR_MANT_MASK) | HYD_AIR_ONE_BITS;
+        memcpy(&mant[l], &mb, sizeof mant[l]);
+    }
+    const fast_v2 Pv = _mm_set_pd(P1, P0);
+#define CO(i) _mm_set_pd(c[1][i], c[0][i])
+    const fast_v2 x = _mm_set_pd(mant[1], mant[0]) - CO(HYD_AIR_DEG + 1);
+    const fast_v2 x2 = x * x;
+    const fast_v2 poly = HYD_AIR_POLY(CO, x, x2);
+#undef CO
+    const fast_v2 rr = _mm_set_pd(oct[1], oct[0]) * poly;
+    const fast_v2 N = HYD_BE_N(_mm_set_pd(bel1, bel0), m->be_alpha, rr, Pv);
+    const fast_v2 D = HYD_BE_D(_mm_set_pd(bec1, bec0), rr, Pv);
+    return HYD_BE_C(N, D, _mm_set_pd(V1, V0));
+}
+#endif
+
 FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, double* J, int ldj) {
     const hyd_model* m = k->m;
     if (k->rev != m->revision)
@@ -427,7 +468,32 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
     }
 
     // 6. Pressure rates.
-    for (int kk = 0; kk < m->nvol; ++kk) {
+    int kk0 = 0;
+#ifdef FAST_LANES
+    // The plain evaluation's Be / V two nodes at a time (the Jacobian took
+    // c in step 4). A pair with either pressure off the table path goes
+    // node by node below, in order, so the result does not depend on the
+    // pairing.
+    if (!J && m->air.use) {
+        for (; kk0 + 1 < m->nvol; kk0 += 2) {
+            const int n0 = m->vol_node[kk0], n1 = m->vol_node[kk0 + 1];
+            const double P0 = p[n0], P1 = p[n1];
+            if (!(P0 >= HYD_BE_P_LO && P0 < HYD_BE_P_HI && P1 >= HYD_BE_P_LO && P1 < HYD_BE_P_HI)) break;
+            const double V0 = d->node_V[n0], V1 = d->node_V[n1];
+            const fast_v2 c2 = node_c2(m, P0, P1, m->node_bel[n0], m->node_bel[n1], m->node_bec[n0],
+                                       m->node_bec[n1], V0, V1);
+            double c[2];
+            _mm_storeu_pd(c, c2);
+            d->node_be[n0] = c[0] * V0;
+            d->node_be[n1] = c[1] * V1;
+            d->node_q[n0] = k->net[n0];
+            d->node_q[n1] = k->net[n1];
+            ydot[k->ns[n0]] = c[0] * (k->net[n0] - d->node_dV[n0]);
+            ydot[k->ns[n1]] = c[1] * (k->net[n1] - d->node_dV[n1]);
+        }
+    }
+#endif
+    for (int kk = kk0; kk < m->nvol; ++kk) {
         const int node = m->vol_node[kk];
         const int s = k->ns[node];
         d->node_q[node] = k->net[node];
