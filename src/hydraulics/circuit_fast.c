@@ -51,6 +51,7 @@ struct hyd_fast {
     double* f;           ///< (nstate) rates when the Jacobian's caller wants none
     int* smap;           ///< (nstate) circuit state i lives at y[smap[i]] (hyd_fast_map)
     int* ns;             ///< (nnode) a node's state in the caller's order, -1 for a tank
+    int perm;            ///< smap is a permutation of 0..nstate-1 (the circuit's columns of J are 0..nstate-1)
 };
 
 unsigned hyd_fast_types(void) {
@@ -145,6 +146,7 @@ hyd_fast* hyd_fast_create(const hyd_model* m, unsigned types, int fallback, char
         return NULL;
     }
     for (int i = 0; i < m->nstate; ++i) k->smap[i] = i;
+    k->perm = 1;
     memcpy(k->ns, m->node_state, (size_t)m->nnode * sizeof *k->ns);
     take_records(k);
     return k;
@@ -154,6 +156,15 @@ int hyd_fast_map(hyd_fast* k, const int* map) {
     const hyd_model* m = k->m;
     if (k->nfb_comp) return -1; // the reference loops work in circuit order
     for (int i = 0; i < m->nstate; ++i) k->smap[i] = map ? map[i] : i;
+    // A permutation of 0..n-1 (the lagrange crane's: its circuit states come
+    // first) lets the Jacobian clear each row's n circuit columns in one
+    // memset instead of n scattered stores.
+    k->perm = 1;
+    for (int i = 0; i < m->nstate && k->perm; ++i) {
+        int seen = 0;
+        for (int j = 0; j < m->nstate; ++j) seen += k->smap[j] == i;
+        k->perm = seen == 1;
+    }
     for (int i = 0; i < m->nnode; ++i)
         k->ns[i] = m->node_state[i] >= 0 ? k->smap[m->node_state[i]] : -1;
     take_records(k);
@@ -258,11 +269,9 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
     memset(k->net, 0, (size_t)nnode * sizeof(double));
     const int n = m->nstate;
     if (J) {
-        int ident = 1;
-        for (int i = 0; i < n && ident; ++i) ident = k->smap[i] == i;
         for (int i = 0; i < n; ++i) {
             double* r = J + (size_t)k->smap[i] * ldj;
-            if (ident)
+            if (k->perm)
                 memset(r, 0, (size_t)n * sizeof *J);
             else
                 for (int j = 0; j < n; ++j) r[k->smap[j]] = 0.0;
