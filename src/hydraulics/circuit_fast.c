@@ -52,6 +52,12 @@ struct hyd_fast {
     int* smap;           ///< (nstate) circuit state i lives at y[smap[i]] (hyd_fast_map)
     int* ns;             ///< (nnode) a node's state in the caller's order, -1 for a tank
     int perm;            ///< smap is a permutation of 0..nstate-1 (the circuit's columns of J are 0..nstate-1)
+    /// (nvol) the pressure nodes in vol_node order with their state and modulus
+    /// constants side by side: the plain evaluation's node loops read one record.
+    struct fast_node {
+        int node, s;
+        double bel, bec; ///< liquid modulus, air weight [Pa] (hyd_model node_bel, node_bec)
+    } * pn;
 };
 
 unsigned hyd_fast_types(void) {
@@ -87,6 +93,13 @@ static void take_records(hyd_fast* k) {
     for (int i = 0; i < k->nrec[HYD_COUNTERBALANCE]; ++i) cb[i].adr = k->smap[cb[i].adr];
     hyd_acc_c* ac = k->rec[HYD_ACCUMULATOR];
     for (int i = 0; i < k->nrec[HYD_ACCUMULATOR]; ++i) ac[i].adr = k->smap[ac[i].adr];
+    for (int i = 0; i < m->nvol; ++i) {
+        const int node = m->vol_node[i];
+        k->pn[i].node = node;
+        k->pn[i].s = k->ns[node];
+        k->pn[i].bel = m->node_bel[node];
+        k->pn[i].bec = m->node_bec[node];
+    }
     k->rev = m->revision;
 }
 
@@ -104,6 +117,7 @@ void hyd_fast_free(hyd_fast* k) {
     free(k->f);
     free(k->smap);
     free(k->ns);
+    free(k->pn);
     free(k);
 }
 
@@ -137,7 +151,8 @@ hyd_fast* hyd_fast_create(const hyd_model* m, unsigned types, int fallback, char
         }
         ok = ok && HYD_ALLOC(k->fb_comp, m->ncomp) && HYD_ALLOC(k->c, m->nnode) &&
              HYD_ALLOC(k->dbe, m->nnode) && HYD_ALLOC(k->net, m->nnode) && HYD_ALLOC(k->f, m->nstate) &&
-             HYD_ALLOC(k->smap, m->nstate) && HYD_ALLOC(k->ns, m->nnode);
+             HYD_ALLOC(k->smap, m->nstate) && HYD_ALLOC(k->ns, m->nnode) &&
+             HYD_ALLOC(k->pn, m->nvol > 0 ? m->nvol : 1);
     }
     if (!ok) {
         hyd_fast_free(k);
@@ -263,7 +278,8 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
     const int nnode = m->nnode;
     double* p = d->node_p;
     for (int i = 0; i < m->ntank; ++i) p[m->tank_node[i]] = m->node_pfix[m->tank_node[i]];
-    for (int i = 0; i < m->nvol; ++i) p[m->vol_node[i]] = y[k->ns[m->vol_node[i]]];
+    const struct fast_node* pn = k->pn;
+    for (int i = 0; i < m->nvol; ++i) p[pn[i].node] = y[pn[i].s];
     memcpy(d->node_V, m->node_V0, (size_t)nnode * sizeof(double));
     memset(d->node_dV, 0, (size_t)nnode * sizeof(double));
     memset(k->net, 0, (size_t)nnode * sizeof(double));
@@ -485,20 +501,26 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
     // pairing.
     if (!J && m->air.use) {
         for (; kk0 + 1 < m->nvol; kk0 += 2) {
-            const int n0 = m->vol_node[kk0], n1 = m->vol_node[kk0 + 1];
-            const double P0 = p[n0], P1 = p[n1];
-            if (!(P0 >= HYD_BE_P_LO && P0 < HYD_BE_P_HI && P1 >= HYD_BE_P_LO && P1 < HYD_BE_P_HI)) break;
+            const struct fast_node* a = &pn[kk0];
+            const struct fast_node* b = a + 1;
+            const int n0 = a->node, n1 = b->node;
+            const double P0 = y[a->s], P1 = y[b->s];
+            // Both on the table path (as hyd_be_nd: false for NaN).
+            const fast_v2 Pv = _mm_set_pd(P1, P0);
+            if (_mm_movemask_pd(_mm_and_pd(_mm_cmpge_pd(Pv, _mm_set1_pd(HYD_BE_P_LO)),
+                                           _mm_cmplt_pd(Pv, _mm_set1_pd(HYD_BE_P_HI)))) != 3)
+                break;
             const double V0 = d->node_V[n0], V1 = d->node_V[n1];
-            const fast_v2 c2 = node_c2(m, P0, P1, m->node_bel[n0], m->node_bel[n1], m->node_bec[n0],
-                                       m->node_bec[n1], V0, V1);
+            const fast_v2 c2 = node_c2(m, P0, P1, a->bel, b->bel, a->bec, b->bec, V0, V1);
             double c[2];
             _mm_storeu_pd(c, c2);
+            const double q0 = k->net[n0], q1 = k->net[n1];
             d->node_be[n0] = c[0] * V0;
             d->node_be[n1] = c[1] * V1;
-            d->node_q[n0] = k->net[n0];
-            d->node_q[n1] = k->net[n1];
-            ydot[k->ns[n0]] = c[0] * (k->net[n0] - d->node_dV[n0]);
-            ydot[k->ns[n1]] = c[1] * (k->net[n1] - d->node_dV[n1]);
+            d->node_q[n0] = q0;
+            d->node_q[n1] = q1;
+            ydot[a->s] = c[0] * (q0 - d->node_dV[n0]);
+            ydot[b->s] = c[1] * (q1 - d->node_dV[n1]);
         }
     }
 #endif
