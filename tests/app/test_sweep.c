@@ -346,6 +346,12 @@ static void test_sweep_bad_input(void) {
         {"--lhs 4 --param hydraulics.components.lift_cyl.bore=0.08:0.12:3", "--lhs"},
         {"--param hydraulics.components.name=1:2:2", "name"},
         {"", "--param"},
+        // The parser sweep shares with optimize: a value missing, too many.
+        {"--param --threads 1", "--param needs a value"},
+        {"--param hydraulics.components.lift_cyl.bore=0.08:0.12:3 --plot", "--plot needs a value"},
+        {"--param a=0:1:2 --param b=0:1:2 --param c=0:1:2 --param d=0:1:2 --param e=0:1:2 --param f=0:1:2 "
+         "--param g=0:1:2 --param h=0:1:2 --param i=0:1:2",
+         "at most 8 --param"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         unlink("sweep_bad.csv");
