@@ -1,7 +1,8 @@
 // cmd_sweep.c: `cranesim sweep`: one scenario run on many designs (a full
 // grid or a Latin hypercube over model paths), the designs in parallel on
-// threads (and on MPI ranks when built with MPI and started by mpirun or
-// srun), one results row per design in design-index order.
+// threads (on the ode backend: worker processes; and on MPI ranks when built
+// with MPI and started by mpirun or srun), one results row per design in
+// design-index order.
 #define _DEFAULT_SOURCE // strsep
 #include "app.h"
 #include "energy_acc.h"
@@ -500,8 +501,8 @@ static void out_rest(sweep* s, sweep_out* o) {
 // Parent -> worker: long index; end of file: no more designs, exit.
 
 typedef struct sw_proc {
-    pid_t pid;    ///< 0: no worker in this slot
-    int req, res; ///< the parent's ends: requests out, rows in (non-blocking)
+    pid_t pid;    ///< 0: no worker in this slot (yet); -1: none could be started, left empty
+    int req, res; ///< the parent's ends: requests out, rows in (res non-blocking)
     long busy;    ///< the design it runs, -1 idle
     char* buf;    ///< the bytes of the row being received
     size_t n, cap;
