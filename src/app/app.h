@@ -213,6 +213,18 @@ typedef struct app_range {
 /// Parse "PATH=LO:HI:N" (want_n) or "PATH=LO:HI" for command cmd. 0, or -1
 /// after one line on stderr.
 int app_parse_range(const char* cmd, const char* arg, bool want_n, app_range* p);
+/// The options sweep and optimize share: --param (up to APP_MAX_PARAM), --out
+/// and --plot, their values as given (the defaults stay when absent).
+enum { APP_MAX_PARAM = 8 };
+typedef struct app_design_opts {
+    const char* param[APP_MAX_PARAM];
+    int nparam;
+    const char* out;
+    const char* plot;
+} app_design_opts;
+/// argv[*i] one of them: 1 (its value taken, *i moved past it); 0 not one of
+/// them; -1 after one line on stderr (no value, too many --param).
+int app_parse_design_opt(const char* cmd, int argc, char** argv, int* i, app_design_opts* d);
 int cmd_replay(int argc, char** argv);
 int cmd_loadchart(int argc, char** argv);
 int cmd_serve(int argc, char** argv);

@@ -65,6 +65,8 @@ static void bench_help(FILE* f) {
             "               on synthetic circuits of 1, 2, 4, 8, 16 actuators, ns per eval and per state\n"
             "  sweep        not in the default set: cranesim sweep of 64 designs of the scenario (lift\n"
             "               bore 80..120 mm) on 1 and 2 threads: designs per minute and their ratio;\n"
+            "               16 designs on the ode backend on 1 and 2 worker processes, interleaved\n"
+            "               (--repeat, medians), and their ratio;\n"
             "               with MPI also on 1 and 2 ranks (mpiexec); then the peak RSS of sweeps of\n"
             "               100 and 10,000 designs of 0.05 s\n"
             "  ls           not in the default set: Krus, h = 0.1 ms, on the scenario with the standard\n"
@@ -187,7 +189,7 @@ static int bench_child(char* const* args, double* wall, long* rss_kb, double* cp
 // designs per minute and their ratio; then the peak RSS of a sweep of 100
 // and of 10,000 designs of 0.05 s, which must not grow with the count (the
 // rows are written as they finish, each design's model freed).
-static int bench_sweep(const app_common* c) {
+static int bench_sweep(const app_common* c, int repeat) {
     const char* scen = c->scenario_path ? c->scenario_path : "ramp";
     char dur[32] = "";
     if (c->sim.duration > 0) snprintf(dur, sizeof dur, "%.17g", c->sim.duration);
@@ -212,6 +214,44 @@ static int bench_sweep(const app_common* c) {
         fflush(stdout);
     }
     printf("{\"config\":\"sweep\",\"designs_per_min_2_over_1\":%.3f}\n", dpm[1] / dpm[0]);
+    // The ode backend: 16 designs on 1 worker (in the process) and on 2
+    // worker processes, the two interleaved --repeat times (the machine's
+    // load hits both alike), median wall times.
+    {
+        if (repeat < 1) repeat = 1;
+        if (repeat > 16) repeat = 16;
+        double wall_w[2][16], cpu_w[2][16];
+        long rss_w[2] = {0, 0};
+        for (int r = 0; r < repeat; ++r)
+            for (int t = 1; t <= 2; ++t) {
+                char th[8];
+                snprintf(th, sizeof th, "%d", t);
+                char* args[] = {"cranesim", "sweep", "--scenario", (char*)scen, "--mechanics", "ode", "--param",
+                                "hydraulics.components.lift_cyl.bore=0.08:0.12:16", "--threads", th, "--out",
+                                "/dev/null", "--quiet", dur[0] ? "--duration" : NULL, dur, NULL};
+                long rss;
+                const int rc = bench_child(args, &wall_w[t - 1][r], &rss, &cpu_w[t - 1][r]);
+                if (rc) {
+                    printf("{\"config\":\"sweep-ode\",\"workers\":%d,\"error\":\"cranesim sweep exited %d\"}\n", t,
+                           rc);
+                    return EXIT_RUNTIME;
+                }
+                if (rss > rss_w[t - 1]) rss_w[t - 1] = rss;
+            }
+        double odpm[2];
+        for (int t = 0; t < 2; ++t) {
+            const double w = app_median(wall_w[t], repeat), cpu = app_median(cpu_w[t], repeat);
+            odpm[t] = 16 * 60.0 / w;
+            // ru_maxrss of a waited-for child covers its own reaped
+            // children too: with workers, the largest single process.
+            printf("{\"config\":\"sweep-ode\",\"scenario\":\"%s\",\"designs\":16,\"workers\":%d,\"repeat\":%d,"
+                   "\"wall_s\":%.3f,\"designs_per_min\":%.1f,\"cpu_s\":%.3f,\"cpu_per_wall\":%.2f,"
+                   "\"peak_rss_kb\":%ld}\n",
+                   scen, t + 1, repeat, w, odpm[t], cpu, cpu / w, rss_w[t]);
+        }
+        printf("{\"config\":\"sweep-ode\",\"designs_per_min_2_over_1\":%.3f}\n", odpm[1] / odpm[0]);
+        fflush(stdout);
+    }
 #ifdef CRANESIM_HAVE_MPI
     // The same 64 designs on 1 and 2 MPI ranks of one thread each (mpiexec
     // from PATH; as root Open MPI wants its consent).
@@ -729,7 +769,7 @@ int cmd_bench(int argc, char** argv) {
             continue;
         }
         if (!strcmp(only[j], "sweep")) {
-            if (bench_sweep(&c)) return EXIT_RUNTIME;
+            if (bench_sweep(&c, repeat)) return EXIT_RUNTIME;
             continue;
         }
         if (!strcmp(only[j], "circuit-sizes")) { if (bench_circuit_sizes(repeat)) return EXIT_RUNTIME; continue; }

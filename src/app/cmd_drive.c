@@ -340,6 +340,13 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (ncol > COL_RCL_UTIL)
         printf("  rated capacity limiter %s: utilisation max %.0f %%, %.2f s at or above 90 %%\n",
                c->sim.rcl ? "on" : "off (measuring only)", 100 * rcl_max, rcl_t90);
+    // As a scripted run's metrics line counts them (the sandbox only).
+    const sim_collisions* coll = engine_collisions(l);
+    if (coll) {
+        char t[SIM_COLL_TEXT];
+        sim_collisions_text(coll, t, sizeof t);
+        printf("  %s\n", t);
+    }
     if (!wr && record)
         printf("  record -> %s (%d rows); for the 3D window run it on a machine with a display\n", record,
                frames_done);

@@ -17,7 +17,7 @@
 #include <nlopt.h>
 #endif
 
-enum { OPT_MAXPAR = 8, OPT_MAXCON = 8, OPT_MAXEVAL = 100000 };
+enum { OPT_MAXPAR = APP_MAX_PARAM, OPT_MAXCON = 8, OPT_MAXEVAL = 100000 };
 
 static void optimize_help(FILE* f) {
     fprintf(f,
@@ -357,10 +357,8 @@ static int parse_constraint(const char* arg, int ncol, opt_con* c) {
 
 int cmd_optimize(int argc, char** argv) {
     optimizer o = {.c = {.sim = sim_default_opts()}, .obj_met = -1, .obj_par = -1, .maxeval = 60, .best = -1};
-    const char* out = "best_model.json";
-    const char* plot = NULL;
+    app_design_opts d = {.out = "best_model.json"};
     const char* minimize = NULL;
-    const char* params[OPT_MAXPAR];
     const char* cons[OPT_MAXCON];
     int ncons = 0;
     double xtol = 1e-4;
@@ -373,22 +371,18 @@ int cmd_optimize(int argc, char** argv) {
         int rc = app_parse_common(&o.c, argc, argv, &i);
         if (rc < 0) return EXIT_USAGE;
         if (rc > 0) continue;
-        const bool known = !strcmp(a, "--param") || !strcmp(a, "--minimize") || !strcmp(a, "--constraint") ||
-                           !strcmp(a, "--maxeval") || !strcmp(a, "--xtol") || !strcmp(a, "--out") ||
-                           !strcmp(a, "--plot");
+        rc = app_parse_design_opt("optimize", argc, argv, &i, &d);
+        if (rc < 0) return EXIT_USAGE;
+        if (rc > 0) continue;
+        const bool known = !strcmp(a, "--minimize") || !strcmp(a, "--constraint") || !strcmp(a, "--maxeval") ||
+                           !strcmp(a, "--xtol");
         if (!known) {
             fprintf(stderr, "cranesim optimize: unknown option '%s' (see cranesim optimize --help)\n", a);
             return EXIT_USAGE;
         }
         const char* v = app_value(argc, argv, &i);
         if (!v) return EXIT_USAGE;
-        if (!strcmp(a, "--param")) {
-            if (o.npar == OPT_MAXPAR) {
-                fprintf(stderr, "cranesim optimize: at most %d --param\n", OPT_MAXPAR);
-                return EXIT_USAGE;
-            }
-            params[o.npar++] = v;
-        } else if (!strcmp(a, "--constraint")) {
+        if (!strcmp(a, "--constraint")) {
             if (ncons == OPT_MAXCON) {
                 fprintf(stderr, "cranesim optimize: at most %d --constraint\n", OPT_MAXCON);
                 return EXIT_USAGE;
@@ -396,10 +390,6 @@ int cmd_optimize(int argc, char** argv) {
             cons[ncons++] = v;
         } else if (!strcmp(a, "--minimize")) {
             minimize = v;
-        } else if (!strcmp(a, "--out")) {
-            out = v;
-        } else if (!strcmp(a, "--plot")) {
-            plot = v;
         } else if (!strcmp(a, "--xtol")) {
             if (app_parse_double(v, &xtol) || !(xtol > 0 && xtol < 1)) {
                 fprintf(stderr, "cranesim optimize: --xtol must be in (0, 1) (a share of each range), got '%s'\n", v);
@@ -417,6 +407,10 @@ int cmd_optimize(int argc, char** argv) {
             o.maxeval = n;
         }
     }
+    o.npar = d.nparam;
+    const char* const* params = d.param;
+    const char* out = d.out;
+    const char* plot = d.plot;
     if (o.npar == 0) {
         fprintf(stderr, "cranesim optimize: give at least one --param PATH=LO:HI (see cranesim optimize --help)\n");
         return EXIT_USAGE;

@@ -192,6 +192,17 @@ static int apply_set(server* s, const char* path, double value, char* err, size_
     return hyd_model_set(engine_circuit(s->e), p, value, err, errsz);
 }
 
+// The collisions of the engine's run (since it was built: the start or
+// the last reset), as a scripted run's metrics line counts them; the
+// sandbox only.
+static void log_collisions(const server* s, const char* when) {
+    const sim_collisions* coll = s->e ? engine_collisions(s->e) : NULL;
+    if (!coll) return;
+    char t[SIM_COLL_TEXT];
+    sim_collisions_text(coll, t, sizeof t);
+    logf_(s, "%s: %s", when, t);
+}
+
 static int build_engine(server* s, char* err, size_t errsz) {
     s->e = engine_create(s->m, s->o, s->sc->q0, s->sc->slew0, s->m3, err, errsz);
     if (!s->e) return -1;
@@ -375,6 +386,7 @@ static void handle_command(server* s, client* c, const proto_command* cmd) {
         s->paused = cmd->flag != 0;
         break;
     case PROTO_OP_RESET:
+        log_collisions(s, "before the reset");
         engine_destroy(s->e);
         s->e = NULL;
         if (build_engine(s, err, sizeof err)) {
@@ -809,6 +821,7 @@ int cmd_serve(int argc, char** argv) {
     rc = serve_loop(&s, lfd, c.sim.duration);
     app_signals_restore(&sig);
     if (app_signal_caught()) logf_(&s, "%s: stopping", app_signal_name(app_signal_caught()));
+    log_collisions(&s, "at the stop");
     while (s.nclient) drop_client(&s, s.nclient - 1, PROTO_E_SHUTDOWN, "the server stops");
     close(lfd);
 done:

@@ -1,7 +1,8 @@
 // cmd_sweep.c: `cranesim sweep`: one scenario run on many designs (a full
 // grid or a Latin hypercube over model paths), the designs in parallel on
-// threads (and on MPI ranks when built with MPI and started by mpirun or
-// srun), one results row per design in design-index order.
+// threads (on the ode backend: worker processes; and on MPI ranks when built
+// with MPI and started by mpirun or srun), one results row per design in
+// design-index order.
 #define _DEFAULT_SOURCE // strsep
 #include "app.h"
 #include "energy_acc.h"
@@ -17,13 +18,20 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
 
 #ifdef CRANESIM_HAVE_MPI
 #include <mpi.h>
 #endif
 
-enum { SW_MAXPAR = 8, SW_MAXDESIGN = 10000000 };
+enum { SW_MAXPAR = APP_MAX_PARAM, SW_MAXDESIGN = 10000000 };
 
 static void sweep_help(FILE* f) {
     fprintf(f,
@@ -59,8 +67,9 @@ static void sweep_help(FILE* f) {
     }
     fprintf(f, "\n");
     fprintf(f,
-            "  --threads T          designs run at once (default: every core; 1 per rank under MPI;\n"
-            "                       ode designs run one at a time per process)\n"
+            "  --threads T          designs run at once (default: every core; 1 per rank under MPI):\n"
+            "                       threads, or on the ode backend T worker processes (ODE is\n"
+            "                       process-wide); a worker that dies fails its design (exit 1)\n"
             "  --fail-fast          stop at the first failing design (exit 1)\n"
             "  --out FILE           results CSV (default sweep.csv), replaced when the sweep ends\n"
             "  --plot DIR|FILE.png  plots: each metric against each parameter, and a heat map of\n"
@@ -191,6 +200,8 @@ static int design_row(void* user, const double* row) {
     return app_signal_caught() != 0;
 }
 
+static char* format_row(const sweep* s, long i, const run_metrics* met, int code, const char* err);
+
 // Run design i; its CSV row (malloc'd, with the newline), or NULL when a
 // signal cut it short (it is then not a finished design). *failed: exit != 0.
 static char* run_design(const sweep* s, long i, bool* failed) {
@@ -236,6 +247,15 @@ static char* run_design(const sweep* s, long i, bool* failed) {
             snprintf(err, sizeof err, "%s", res.message);
         }
     }
+    *failed = code != 0;
+    return format_row(s, i, &met, code, err);
+}
+
+// The CSV row of design i (malloc'd, with the newline): its values, the
+// metrics (empty when code != 0 or met is NULL), the exit code and err.
+static char* format_row(const sweep* s, long i, const run_metrics* met, int code, const char* err) {
+    double v[SW_MAXPAR];
+    for (int k = 0; k < s->npar; ++k) v[k] = design_value(s, i, k);
     sbuf b = {0};
     sb_printf(&b, "%ld", i);
     for (int k = 0; k < s->npar; ++k) sb_printf(&b, ",%.17g", v[k]);
@@ -244,8 +264,8 @@ static char* run_design(const sweep* s, long i, bool* failed) {
     for (int k = 0; k < s->nmet; ++k) {
         // A metric the run's world does not have (collisions in the
         // validation world) is empty too, not 0.
-        if (code || (s->met[k] == MET_COLLISIONS && !met.present[MET_COLLISIONS])) sb_printf(&b, ",");
-        else sb_printf(&b, ",%.17g", met.value[s->met[k]]);
+        if (code || !met || (s->met[k] == MET_COLLISIONS && !met->present[MET_COLLISIONS])) sb_printf(&b, ",");
+        else sb_printf(&b, ",%.17g", met->value[s->met[k]]);
     }
     sb_printf(&b, ",%d,", code);
     if (code) {
@@ -258,7 +278,6 @@ static char* run_design(const sweep* s, long i, bool* failed) {
         sb_printf(&b, "\"");
     }
     sb_printf(&b, "\n");
-    *failed = code != 0;
     return b.p;
 }
 
@@ -351,6 +370,29 @@ int app_parse_range(const char* cmd, const char* arg, bool want_n, app_range* p)
     return 0;
 }
 
+// app.h: --param, --out, --plot of sweep and optimize; one table, one loop.
+int app_parse_design_opt(const char* cmd, int argc, char** argv, int* i, app_design_opts* d) {
+    static const char* const names[] = {"--param", "--out", "--plot"};
+    const char* a = argv[*i];
+    int k = 0;
+    while (k < 3 && strcmp(a, names[k])) ++k;
+    if (k == 3) return 0;
+    const char* v = app_value(argc, argv, i);
+    if (!v) return -1;
+    if (k == 0) {
+        if (d->nparam == APP_MAX_PARAM) {
+            fprintf(stderr, "cranesim %s: at most %d --param\n", cmd, APP_MAX_PARAM);
+            return -1;
+        }
+        d->param[d->nparam++] = v;
+    } else if (k == 1) {
+        d->out = v;
+    } else {
+        d->plot = v;
+    }
+    return 1;
+}
+
 static int parse_metrics(sweep* s, const char* list) {
     char buf[1024];
     snprintf(buf, sizeof buf, "%s", list);
@@ -431,6 +473,310 @@ static void progress(const sweep* s, long done, long failed, double t0) {
     fflush(stderr);
 }
 
+// After a signal or --fail-fast: the finished rows beyond a gap, still in
+// index order; and the progress bar cleared.
+static void out_rest(sweep* s, sweep_out* o) {
+    for (long i = o->next_write; i < s->ndesign; ++i)
+        if (s->line[i]) {
+            out_line(s, o, i, s->line[i]);
+            s->line[i] = NULL;
+        }
+    if (!s->c.quiet && isatty(2)) fprintf(stderr, "\r%*s\r", 78, "");
+}
+
+// ---------------------------------------------------------------------------
+// ode designs on worker processes
+// ---------------------------------------------------------------------------
+
+// The ODE library is process-wide, so threads run ode designs one at a time.
+// To use every core without MPI, a sweep on the ode backend forks worker
+// processes instead (after the setup: each inherits the loaded model, the
+// scenario and the options, copy-on-write). The parent stays single-threaded
+// (fork is then safe, also to replace a worker that died) and keeps the
+// bookkeeping of the thread path: it hands one design index at a time to an
+// idle worker over a pipe and gets its finished row back, so the results
+// file, the progress bar and --fail-fast are those of a local run.
+//
+// Messages, worker -> parent: long index, uint32 length, the row's bytes.
+// Parent -> worker: long index; end of file: no more designs, exit.
+
+typedef struct sw_proc {
+    pid_t pid;    ///< 0: no worker in this slot (yet); -1: none could be started, left empty
+    int req, res; ///< the parent's ends: requests out, rows in (res non-blocking)
+    long busy;    ///< the design it runs, -1 idle
+    char* buf;    ///< the bytes of the row being received
+    size_t n, cap;
+} sw_proc;
+
+static int write_all(int fd, const void* p, size_t n) {
+    const char* c = p;
+    while (n > 0) {
+        const ssize_t k = write(fd, c, n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return -1;
+        c += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+static int read_all(int fd, void* p, size_t n) {
+    char* c = p;
+    while (n > 0) {
+        const ssize_t k = read(fd, c, n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return -1; // end of file: the parent is done (or gone)
+        c += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+// The worker's loop: a design index in, its row out, until end of file.
+static void __attribute__((noreturn)) proc_worker(const sweep* s, int req, int res) {
+    for (long i; read_all(req, &i, sizeof i) == 0;) {
+        if (i < 0 || i >= s->ndesign) break;
+        bool failed;
+        char* line = run_design(s, i, &failed);
+        if (!line) break;
+        const uint32_t L = (uint32_t)strlen(line);
+        const int e = write_all(res, &i, sizeof i) || write_all(res, &L, sizeof L) || write_all(res, line, L);
+        free(line);
+        if (e) break;
+    }
+    // _exit: the stdio buffers are the parent's (the results file's among them).
+    _exit(0);
+}
+
+// Start a worker in slot p. 0, or -1 (errno set).
+static int proc_start(sweep* s, sweep_out* o, sw_proc* all, int nproc, sw_proc* p) {
+    int rq[2], rs[2];
+    if (pipe(rq)) return -1;
+    if (pipe(rs)) {
+        close(rq[0]);
+        close(rq[1]);
+        return -1;
+    }
+    // Nothing buffered may be written twice (by the parent and the child).
+    fflush(stdout);
+    fflush(stderr);
+    if (o->f && fflush(o->f) && !o->err) o->err = errno ? errno : EIO;
+    const pid_t parent = getpid();
+    const pid_t pid = fork();
+    if (pid < 0) {
+        const int e = errno;
+        close(rq[0]), close(rq[1]), close(rs[0]), close(rs[1]);
+        errno = e;
+        return -1;
+    }
+    if (pid == 0) {
+        // Its own process group: Ctrl-C at the terminal reaches the parent
+        // only, which then stops the workers itself (the finished rows kept).
+        setpgid(0, 0);
+        // Gone with the parent (a SIGKILL gives it no chance to stop them).
+#ifdef __linux__
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+#endif
+        if (getppid() != parent) _exit(0);
+        signal(SIGINT, SIG_DFL);
+        signal(SIGTERM, SIG_DFL);
+        signal(SIGPIPE, SIG_DFL);
+        // The other workers' pipe ends: held open here, they would hide
+        // the end of file from those workers.
+        for (int k = 0; k < nproc; ++k)
+            if (all[k].pid > 0) close(all[k].req), close(all[k].res);
+        close(rq[1]);
+        close(rs[0]);
+        proc_worker(s, rq[0], rs[1]);
+    }
+    close(rq[0]);
+    close(rs[1]);
+    fcntl(rs[0], F_SETFL, fcntl(rs[0], F_GETFL) | O_NONBLOCK);
+    fcntl(rq[1], F_SETFD, FD_CLOEXEC);
+    fcntl(rs[0], F_SETFD, FD_CLOEXEC);
+    *p = (sw_proc){.pid = pid, .req = rq[1], .res = rs[0], .busy = -1};
+    return 0;
+}
+
+// Close slot p's pipes and reap its worker (after a SIGKILL when kill).
+// Returns its wait status.
+static int proc_end(sw_proc* p, bool kill_it) {
+    int st = 0;
+    if (p->pid <= 0) return 0;
+    close(p->req);
+    if (kill_it) kill(p->pid, SIGKILL);
+    while (waitpid(p->pid, &st, 0) < 0 && errno == EINTR) {
+    }
+    close(p->res);
+    free(p->buf);
+    *p = (sw_proc){.busy = -1};
+    return st;
+}
+
+// A finished row from a worker (or a failure row): into the table.
+static void proc_row(sweep* s, long i, char* line, long* done) {
+    if (i < 0 || i >= s->ndesign || s->line[i]) { // cannot happen: each design goes to one worker once
+        free(line);
+        return;
+    }
+    s->line[i] = line;
+    ++*done;
+    if (line_exit(s, line)) {
+        ++s->failed;
+        if (s->fail_fast) s->stop = true;
+    }
+}
+
+// Take what worker p has sent: a whole row makes it idle. Returns 1 when
+// it has closed its end (it died), else 0.
+static int proc_read(sweep* s, sw_proc* p, long* done) {
+    for (;;) {
+        if (p->cap - p->n < 4096) {
+            const size_t cap = p->cap ? 2 * p->cap : 8192;
+            char* b = realloc(p->buf, cap);
+            if (!b) abort(); // a row is a few hundred bytes
+            p->buf = b;
+            p->cap = cap;
+        }
+        const ssize_t k = read(p->res, p->buf + p->n, p->cap - p->n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k < 0) break; // EAGAIN: the rest later
+        if (k == 0) return 1;
+        p->n += (size_t)k;
+        const size_t hd = sizeof(long) + sizeof(uint32_t);
+        while (p->n >= hd) {
+            long i;
+            uint32_t L;
+            memcpy(&i, p->buf, sizeof i);
+            memcpy(&L, p->buf + sizeof i, sizeof L);
+            if (p->n < hd + L) break;
+            char* line = malloc((size_t)L + 1);
+            if (!line) abort();
+            memcpy(line, p->buf + hd, L);
+            line[L] = 0;
+            memmove(p->buf, p->buf + hd + L, p->n - hd - L);
+            p->n -= hd + L;
+            if (i == p->busy) {
+                proc_row(s, i, line, done);
+                p->busy = -1;
+            } else {
+                free(line);
+            }
+        }
+    }
+    return 0;
+}
+
+// What became of a worker, for its design's error field.
+static void proc_death(int st, char* msg, size_t n) {
+    if (WIFSIGNALED(st))
+        snprintf(msg, n, "the worker process running this design was killed by signal %d (%s)", WTERMSIG(st),
+                 strsignal(WTERMSIG(st)));
+    else if (WIFEXITED(st))
+        snprintf(msg, n, "the worker process running this design exited with status %d", WEXITSTATUS(st));
+    else
+        snprintf(msg, n, "the worker process running this design ended");
+}
+
+// Give design i to worker p, starting it if the slot is empty, once more
+// if it died idle. 0, or -1 with p's slot empty (errno set).
+static int proc_give(sweep* s, sweep_out* o, sw_proc* all, int nproc, sw_proc* p, long i) {
+    for (int attempt = 0; attempt < 2; ++attempt) {
+        if (p->pid <= 0 && proc_start(s, o, all, nproc, p)) return -1;
+        if (write_all(p->req, &i, sizeof i) == 0) {
+            p->busy = i;
+            return 0;
+        }
+        proc_end(p, false);
+    }
+    errno = EPIPE;
+    return -1;
+}
+
+static int sweep_procs(sweep* s, int nproc, sweep_out* o) {
+    sw_proc* w = calloc((size_t)nproc, sizeof *w);
+    struct pollfd* pf = calloc((size_t)nproc, sizeof *pf);
+    int* of = calloc((size_t)nproc, sizeof *of);
+    if (!w || !pf || !of) {
+        free(w), free(pf), free(of);
+        fprintf(stderr, "cranesim sweep: out of memory\n");
+        return EXIT_RUNTIME;
+    }
+    for (int k = 0; k < nproc; ++k) w[k].busy = -1;
+    // A worker gone (its pipe closed) must show up as a row, not kill us.
+    struct sigaction ign, old_pipe;
+    memset(&ign, 0, sizeof ign);
+    ign.sa_handler = SIG_IGN;
+    sigemptyset(&ign.sa_mask);
+    sigaction(SIGPIPE, &ign, &old_pipe);
+    int rc = 0, start_err = 0;
+    const double t0 = sim_wall_time();
+    long done = 0;
+    for (;;) {
+        const bool halt = s->stop || app_signal_caught();
+        // Hand out designs to idle workers. A slot whose worker cannot be
+        // started (fork refused) stays empty (pid -1); the others go on.
+        int npoll = 0;
+        bool running = false;
+        for (int k = 0; k < nproc; ++k) {
+            sw_proc* p = &w[k];
+            if (p->pid >= 0 && p->busy < 0 && !halt && s->next < s->ndesign) {
+                if (proc_give(s, o, w, nproc, p, s->next) == 0) {
+                    ++s->next;
+                } else {
+                    start_err = errno;
+                    p->pid = -1;
+                }
+            }
+            if (p->pid > 0) {
+                pf[npoll] = (struct pollfd){.fd = p->res, .events = POLLIN};
+                of[npoll++] = k;
+            }
+            running |= p->busy >= 0;
+        }
+        if (app_signal_caught()) break;
+        if (!running) {
+            if (!halt && s->next < s->ndesign) {
+                fprintf(stderr, "cranesim sweep: cannot start a worker process: %s\n", strerror(start_err));
+                rc = EXIT_RUNTIME;
+            }
+            break;
+        }
+        const int np = poll(pf, (nfds_t)npoll, 100); // 100 ms: the progress bar and the signal flag
+        if (np < 0 && errno != EINTR) {
+            fprintf(stderr, "cranesim sweep: poll: %s\n", strerror(errno));
+            rc = EXIT_RUNTIME;
+            break;
+        }
+        for (int j = 0; j < npoll && np > 0; ++j) {
+            if (!pf[j].revents) continue;
+            sw_proc* p = &w[of[j]];
+            if (!proc_read(s, p, &done)) continue;
+            const long i = p->busy;
+            const int st = proc_end(p, false);
+            if (i >= 0 && !app_signal_caught()) {
+                // A worker that crashed (or was killed) in a design: that
+                // design failed; the slot gets a new worker for the rest.
+                char msg[160];
+                proc_death(st, msg, sizeof msg);
+                proc_row(s, i, format_row(s, i, NULL, EXIT_RUNTIME, msg), &done);
+            }
+        }
+        out_flush(s, o);
+        if (!s->c.quiet) progress(s, done, s->failed, t0);
+    }
+    // Done, or stopped: idle workers exit at the end of file; after a
+    // signal (or an error) the running designs are abandoned, their
+    // workers killed. Every worker is reaped here.
+    const bool abandon = app_signal_caught() != 0 || rc != 0;
+    for (int k = 0; k < nproc; ++k) proc_end(&w[k], abandon);
+    sigaction(SIGPIPE, &old_pipe, NULL);
+    free(w), free(pf), free(of);
+    out_flush(s, o);
+    if (!s->c.quiet) progress(s, done, s->failed, t0);
+    return rc;
+}
+
 #ifdef CRANESIM_HAVE_MPI
 // Ranks > 0 send TAG_ROW (a design's index and row) and, when their designs
 // are done, TAG_DONE; rank 0 sends TAG_STOP (--fail-fast met a failure
@@ -458,6 +804,11 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
         for (int k = 0; k < s->npar; ++k) fprintf(o->f, ",%s", s->par[k].path);
         for (int k = 0; k < s->nmet; ++k) fprintf(o->f, ",%s", metric_name((metric_id)s->met[k]));
         fprintf(o->f, ",exit,error\n");
+    }
+    if (s->ode && nrank == 1 && threads > 1) {
+        const int rc = sweep_procs(s, threads, o);
+        out_rest(s, o);
+        return rc;
     }
     pthread_t* tid = calloc((size_t)threads, sizeof(pthread_t));
     if (!tid) return EXIT_RUNTIME;
@@ -596,13 +947,7 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
     for (int t = 0; t < started; ++t) pthread_join(tid[t], NULL);
     free(tid);
     if (rank > 0) return 0;
-    // After a signal or --fail-fast: the finished rows beyond a gap, still in index order.
-    for (long i = o->next_write; i < s->ndesign; ++i)
-        if (s->line[i]) {
-            out_line(s, o, i, s->line[i]);
-            s->line[i] = NULL;
-        }
-    if (!s->c.quiet && isatty(2)) fprintf(stderr, "\r%*s\r", 78, "");
+    out_rest(s, o);
     return 0;
 }
 
@@ -685,11 +1030,8 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
     sweep s;
     memset(&s, 0, sizeof s);
     s.c.sim = sim_default_opts();
-    const char* out = "sweep.csv";
-    const char* plot = NULL;
+    app_design_opts d = {.out = "sweep.csv"};
     const char* metrics = NULL;
-    const char* params[SW_MAXPAR];
-    int nparam = 0;
     long lhs = 0, threads = 0;
     uint64_t seed = 1;
     for (int i = 0; i < argc; ++i) {
@@ -705,26 +1047,18 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
             s.fail_fast = true;
             continue;
         }
-        const bool known = !strcmp(a, "--param") || !strcmp(a, "--lhs") || !strcmp(a, "--seed") ||
-                           !strcmp(a, "--metrics") || !strcmp(a, "--threads") || !strcmp(a, "--out") ||
-                           !strcmp(a, "--plot");
+        rc = app_parse_design_opt("sweep", argc, argv, &i, &d);
+        if (rc < 0) return EXIT_USAGE;
+        if (rc > 0) continue;
+        const bool known = !strcmp(a, "--lhs") || !strcmp(a, "--seed") || !strcmp(a, "--metrics") ||
+                           !strcmp(a, "--threads");
         if (!known) {
             fprintf(stderr, "cranesim sweep: unknown option '%s' (see cranesim sweep --help)\n", a);
             return EXIT_USAGE;
         }
         const char* v = app_value(argc, argv, &i);
         if (!v) return EXIT_USAGE;
-        if (!strcmp(a, "--param")) {
-            if (nparam == SW_MAXPAR) {
-                fprintf(stderr, "cranesim sweep: at most %d --param\n", SW_MAXPAR);
-                return EXIT_USAGE;
-            }
-            params[nparam++] = v;
-        } else if (!strcmp(a, "--out")) {
-            out = v;
-        } else if (!strcmp(a, "--plot")) {
-            plot = v;
-        } else if (!strcmp(a, "--metrics")) {
+        if (!strcmp(a, "--metrics")) {
             metrics = v;
         } else {
             char* end;
@@ -742,6 +1076,10 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
             else threads = (long)n;
         }
     }
+    const int nparam = d.nparam;
+    const char* const* params = d.param;
+    const char* out = d.out;
+    const char* plot = d.plot;
     if (nparam == 0) {
         fprintf(stderr, "cranesim sweep: give at least one --param PATH=LO:HI:N (see cranesim sweep --help)\n");
         return EXIT_USAGE;
@@ -881,8 +1219,11 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
                         const size_t n = strlen(shape);
                         snprintf(shape + n, sizeof shape - n, "%s%ld", k ? " x " : "grid ", s.par[k].n);
                     }
-                printf("cranesim sweep: %s, %ld designs (%s) on %ld thread%s%s in %.2f s -> %s\n", s.sc.name,
-                       s.ndesign, shape, threads, threads == 1 ? "" : "s", nrank > 1 ? " per rank" : "", wall, out);
+                // ode designs on more than one thread run on worker processes (sweep_procs).
+                const char* unit = s.ode && nrank == 1 && threads > 1 ? "worker process" : "thread";
+                printf("cranesim sweep: %s, %ld designs (%s) on %ld %s%s%s in %.2f s -> %s\n", s.sc.name, s.ndesign,
+                       shape, threads, unit, threads == 1 ? "" : strcmp(unit, "thread") ? "es" : "s",
+                       nrank > 1 ? " per rank" : "", wall, out);
                 if (nrank > 1) printf("  %d MPI ranks\n", nrank);
                 if (nfail)
                     printf("  %ld design%s failed (exit and error in %s rows)\n", nfail, nfail == 1 ? "" : "s",

@@ -316,6 +316,9 @@ void engine_snapshot(engine* e, world_snapshot* s) {
     s->rcl_util = e->rcl ? e->rcl->util : 0.0;
 }
 const char* engine_error(const engine* e) { return e->err; }
+const sim_collisions* engine_collisions(const engine* e) {
+    return e->ops->collisions ? e->ops->collisions(e) : NULL;
+}
 
 void engine_note(const engine* e, char* note, size_t n) {
     sim_checks_note(&e->chk, hyd_method_is_adaptive(e->o.solver), note, n);

@@ -139,6 +139,10 @@ model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t 
 /// or "".
 void engine_note(const engine* e, char* note, size_t n);
 const char* engine_error(const engine* e);
+/// The collisions since the engine was created (the ode sandbox: checked at
+/// every ODE step, as a scripted run counts them; sim.h), or NULL where the
+/// world reports none (the lagrange view, the ode validation world).
+const sim_collisions* engine_collisions(const engine* e);
 
 /// Hears a hook event the scripted operator applied: attach or release,
 /// and engine_hook's answer.

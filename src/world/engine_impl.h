@@ -40,6 +40,8 @@ typedef struct engine_ops {
     double (*time)(const engine* e);
     void (*row)(engine* e, double row[SIM_NCOL]);
     void (*snapshot)(engine* e, world_snapshot* s);
+    /// NULL (or a NULL result): the world reports no collisions.
+    const sim_collisions* (*collisions)(const engine* e);
 } engine_ops;
 
 /// Fault events of a scenario (scenario.h) applied to a running circuit:

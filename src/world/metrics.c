@@ -161,10 +161,9 @@ void metrics_print(const run_metrics* m, FILE* f) {
         fprintf(f, "; min pad force %.2f kN, min stability margin %.3f, pad lift-offs %.0f",
                 m->value[MET_MIN_PAD_F] * 1e-3, m->value[MET_MIN_STAB_MARGIN], m->value[MET_PAD_LIFTOFFS]);
     if (m->present[MET_COLLISIONS]) {
-        fprintf(f, "; collisions %.0f", m->value[MET_COLLISIONS]);
-        for (int k = 0; k < m->coll.npair; ++k)
-            fprintf(f, "%s%s at %.3f s", k ? ", " : " (", m->coll.pair[k], m->coll.first_t[k]);
-        if (m->coll.npair) fprintf(f, ")");
+        char t[SIM_COLL_TEXT];
+        sim_collisions_text(&m->coll, t, sizeof t);
+        fprintf(f, "; %s", t);
     }
     fprintf(f, "\n");
     // Which reliefs were open, and how long (only those that opened).

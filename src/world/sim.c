@@ -444,6 +444,14 @@ void sim_collisions_step(sim_collisions* c, double t, const char* const names[][
     }
 }
 
+void sim_collisions_text(const sim_collisions* c, char* buf, size_t n) {
+    if (n == 0) return;
+    size_t L = (size_t)snprintf(buf, n, "collisions %ld", c->count);
+    for (int k = 0; k < c->npair && L < n; ++k)
+        L += (size_t)snprintf(buf + L, n - L, "%s%s at %.3f s", k ? ", " : " (", c->pair[k], c->first_t[k]);
+    if (c->npair && L < n) snprintf(buf + L, n - L, ")");
+}
+
 int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
             sim_trace* trace, sim_progress_fn progress, void* progress_user, sim_result* res) {
     return sim_run_energy(m, sc, o, row_fn, row_user, trace, progress, progress_user, NULL, res);

@@ -268,6 +268,11 @@ typedef struct sim_collisions {
 /// n >= 0, into c (zeroed before the run's first step): counts each pair
 /// that starts to touch.
 void sim_collisions_step(sim_collisions* c, double t, const char* const names[][2], int n);
+/// "collisions N (A x B at T s, ...)" into buf (n bytes, SIM_COLL_TEXT
+/// holds every pair): each distinct pair with the time it first touched, no
+/// newline (the run's metrics line, drive's and serve's summary).
+#define SIM_COLL_TEXT (32 + SIM_MAXCOLL * (2 * 48 + 4 + 24))
+void sim_collisions_text(const sim_collisions* c, char* buf, size_t n);
 
 typedef struct sim_result {
     int status;          ///< a sim_status: SIM_OK, SIM_FAILED, SIM_REFUSED (also: stopped by the callback)

@@ -117,6 +117,13 @@ static void test_optimize_bad_input(void) {
         {"--param " BORE "=0.05:0.15 --minimize " BORE " --maxeval 0", "--maxeval"},
         {"--param " BORE "=0.05:0.15", "--minimize"},
         {"--minimize peak_p1A", "--param"},
+        // The parser optimize shares with sweep: a value missing, too many, a bad range.
+        {"--param --minimize peak_p1A", "--param needs a value"},
+        {"--param " BORE "=0.05:0.15 --minimize " BORE " --out", "--out needs a value"},
+        {"--param a=0:1 --param b=0:1 --param c=0:1 --param d=0:1 --param e=0:1 --param f=0:1 --param g=0:1 "
+         "--param h=0:1 --param i=0:1 --minimize a",
+         "at most 8 --param"},
+        {"--param " BORE "=0.05 --minimize " BORE, "expected PATH=LO:HI"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         unlink("opt_bad.json");

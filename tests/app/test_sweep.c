@@ -346,6 +346,12 @@ static void test_sweep_bad_input(void) {
         {"--lhs 4 --param hydraulics.components.lift_cyl.bore=0.08:0.12:3", "--lhs"},
         {"--param hydraulics.components.name=1:2:2", "name"},
         {"", "--param"},
+        // The parser sweep shares with optimize: a value missing, too many.
+        {"--param --threads 1", "--param needs a value"},
+        {"--param hydraulics.components.lift_cyl.bore=0.08:0.12:3 --plot", "--plot needs a value"},
+        {"--param a=0:1:2 --param b=0:1:2 --param c=0:1:2 --param d=0:1:2 --param e=0:1:2 --param f=0:1:2 "
+         "--param g=0:1:2 --param h=0:1:2 --param i=0:1:2",
+         "at most 8 --param"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         unlink("sweep_bad.csv");
@@ -390,10 +396,56 @@ static void test_sweep_lhs_strata(void) {
     }
 }
 
+// drive's headless summary counts collisions as a scripted run does (at
+// every ODE step, by pair): sandbox_wall driven headless against `cranesim
+// run` of the same scenario, the same count and pairs, each first touch
+// within a frame (drive sets the valves once a frame, 75 a second; run at
+// every ODE step). The lagrange view has no contacts: no such line.
+static void test_drive_summary_collisions_match_run(void) {
+    static char json[16384], drv[1 << 15];
+    CHECK(cli_run("run --scenario sandbox_wall --duration 4 --out drive_coll_run.csv --metrics drive_coll.json -q",
+                  out, sizeof out) == 0,
+          "%s", out);
+    CHECK(cli_read_file("drive_coll.json", json, sizeof json) > 0, "no drive_coll.json");
+    const double n_run = json_metric(json, "collisions");
+    CHECK(n_run >= 1, "run: no collisions on sandbox_wall: %s", json);
+    CHECK(cli_run("drive --headless --scenario sandbox_wall --duration 4", drv, sizeof drv) == 0, "%s", drv);
+    const char* line = strstr(drv, "\n  collisions ");
+    CHECK(line, "drive's summary has no collisions line:\n%s", drv);
+    if (!line) return;
+    line += strlen("\n  collisions ");
+    const char* eol = strchr(line, '\n');
+    CHECK(strtod(line, NULL) == n_run, "drive counts %g collisions, run %g", strtod(line, NULL), n_run);
+    int npair = 0;
+    for (const char* p = strstr(json, "\"bodies\": \""); p; p = strstr(p, "\"bodies\": \"")) {
+        p += strlen("\"bodies\": \"");
+        const char* q = strchr(p, '"');
+        if (!q) break;
+        char key[160];
+        snprintf(key, sizeof key, "%.*s at ", (int)(q - p), p);
+        const char* f = strstr(p, "\"first_t\": ");
+        const double t_run = f ? strtod(f + strlen("\"first_t\": "), NULL) : NAN;
+        const char* d = strstr(line, key);
+        CHECK(d && (!eol || d < eol), "drive's line lacks the pair '%.*s': %.*s", (int)(q - p), p,
+              eol ? (int)(eol - line) : 200, line);
+        if (d) {
+            const double t_drive = strtod(d + strlen(key), NULL);
+            CHECK(fabs(t_drive - t_run) <= 1.0 / 75 + 1e-3, "'%.*s' first touched at %g s in drive, %g s in run",
+                  (int)(q - p), p, t_drive, t_run);
+        }
+        ++npair;
+        p = q;
+    }
+    CHECK(npair >= 1, "run's JSON has no collision_pairs: %s", json);
+    CHECK(cli_run("drive --headless --mechanics lagrange --duration 0.5", drv, sizeof drv) == 0, "%s", drv);
+    CHECK(!strstr(drv, "collisions"), "the lagrange view reports collisions:\n%s", drv);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_metrics_match_csv);
     RUN_TEST(test_energy_and_relief_metrics_match_energy_csv);
     RUN_TEST(test_sway_metrics_match_csv);
+    RUN_TEST(test_drive_summary_collisions_match_run);
     RUN_TEST(test_sweep_threads_same_file);
     RUN_TEST(test_sweep_failing_design_is_a_row);
     RUN_TEST(test_sweep_bad_input);
