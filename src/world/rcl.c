@@ -91,6 +91,7 @@ double rcl_utilisation(rcl* r, const double* row) {
     // not the moment, so the outreach (known at once from the angles) acts
     // without lag and only the pressure's ringing is smoothed.
     const double m_raw = load_moment(r, row, &R) / (g * fmax(R, RCL_R_MIN));
+    r->R = R;
     const double t = row[COL_T];
     // Two first-order stages of RCL_TAU / 2: the same 1 s lag to a step as
     // one stage of RCL_TAU, but the booms' ringing on the oil (2.5 Hz on
@@ -153,8 +154,7 @@ double rcl_filter(rcl* r, const double* row, const double u_in[3], double u_out[
     if (u_out[0] < 0) u_out[0] *= a; // lowering the lifting arm
     if (u_out[1] > 0) u_out[1] *= a; // unfolding the end arm outwards
     if (u_out[2] != 0 && r->chart.stab) {
-        double R;
-        load_moment(r, row, &R);
+        const double R = r->R; // this row's, from rcl_utilisation above
         const double s = row[COL_SLEW];
         const double here = loadchart_capacity(&r->chart, R, s, NULL);
         const double there = loadchart_capacity(&r->chart, R, s + (u_out[2] > 0 ? 1 : -1) * RCL_SLEW_LOOK, NULL);

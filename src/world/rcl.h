@@ -31,6 +31,7 @@ typedef struct rcl {
     double AA, AB;     ///< lift cylinder piston and annulus areas [m^2]
     double util;       ///< last utilisation [-], from the filtered load moment
     double util_ahead; ///< the utilisation the same load would have ahead, where the motion is going [-]
+    double R;          ///< the outreach at the last utilisation [m]
     double allow;      ///< fraction of the increasing motions let through at the last filter [-]
     double t_allow;    ///< the time of that filter [s]
     double m_filt;     ///< the filtered load estimate, moment over outreach over g [kg]
