@@ -3,9 +3,11 @@
 // pressures and the joint angles (the booms' own moment subtracted), not
 // from the load's mass; the utilisation is that moment over the load chart's
 // rated moment at the current outreach (and slew sector on the truck). At
-// 90 % it warns; from 95 % it slows and at 100 % it stops the motions that
-// increase the load moment (lift down, jib out, slewing towards a weaker
-// sector), leaving those that reduce it free. docs/safety.md.
+// 90 % it warns; from 90 % of the utilisation ahead (the same load at the
+// weakest chart point the tip reaches within RCL_LOOK_T) it slows, with a
+// ramp, and at 100 % it stops the motions that increase the load moment
+// (lift down, jib out, slewing towards a weaker sector), leaving those that
+// reduce it free. docs/safety.md.
 #ifndef RCL_H
 #define RCL_H
 #include <stdbool.h>
@@ -19,14 +21,22 @@ extern "C" {
 
 #define RCL_WARN 0.90  ///< utilisation of the warning [-]
 #define RCL_SLOW 0.90  ///< utilisation where the increasing motions start to slow [-]
-#define RCL_TAU 1.0    ///< time constant of the load moment's low-pass filter [s]
+#define RCL_TAU 1.0    ///< the load moment's low-pass filter: two stages of RCL_TAU / 2 each [s]
+#define RCL_LOOK_T 0.5 ///< how far ahead in time the limiter looks along the outreach [s]
+#define RCL_RAMP 0.25  ///< the shortest time the limiter takes to stop a full-speed motion [s]
 
 typedef struct rcl {
     const model* m;
     loadchart chart;
     double AA, AB;     ///< lift cylinder piston and annulus areas [m^2]
     double util;       ///< last utilisation [-], from the filtered load moment
+    double util_ahead; ///< the utilisation the same load would have ahead, where the motion is going [-]
+    double R;          ///< the outreach at the last utilisation [m]
+    double allow;      ///< fraction of the increasing motions let through at the last filter [-]
+    double t_allow;    ///< the time of that filter [s]
     double m_filt;     ///< the filtered load estimate, moment over outreach over g [kg]
+    double m_stage;    ///< the first of the filter's two stages [kg]
+    double rd_env;     ///< envelope of the outreach speed (peak, decaying by RCL_TAU) [m/s]
     double t_last;     ///< the time it was last updated [s]
     bool have;         ///< m_filt holds a value
     bool warn;         ///< util >= RCL_WARN

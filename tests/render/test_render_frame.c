@@ -413,6 +413,89 @@ static void test_warnings_shown(void) {
     render_destroy(r);
 }
 
+// The rated capacity bar, bottom right (docs/safety.md): the fill grows
+// with rcl_util, full at 120 %, a white mark at 100 %; green below 90 %,
+// amber from 90 % to 100 %, red beyond.
+typedef struct bar_scan {
+    int green, amber, red; ///< fill length in the bar's middle row, per colour [px]
+    int x0;                ///< where the fill starts [px], -1 if none
+    int mark;              ///< the 100 % mark's column [px], -1 if none
+} bar_scan;
+
+static bool near_rgb(const unsigned char* c, int r, int g, int b) {
+    return abs(c[0] - r) <= 3 && abs(c[1] - g) <= 3 && abs(c[2] - b) <= 3;
+}
+
+// The row of the bottom-right quarter with the most fill pixels, and on it
+// the fill's length per colour and the white mark right of where it starts.
+static bar_scan scan_rcl_bar(void) {
+    bar_scan best = {0, 0, 0, -1, -1};
+    for (int y = H / 2; y < H; ++y) {
+        bar_scan b = {0, 0, 0, -1, -1};
+        for (int x = W / 2; x < W; ++x) {
+            const unsigned char* c = at(x, y);
+            // The HUD's colours (hud.c): green 0.2 0.8 0.3, amber 1 0.7 0.15, red 1 0.1 0.1.
+            const bool g = near_rgb(c, 51, 204, 77), a = near_rgb(c, 255, 178, 38), r = near_rgb(c, 255, 26, 26);
+            if ((g || a || r) && b.x0 < 0) b.x0 = x;
+            b.green += g, b.amber += a, b.red += r;
+        }
+        if (b.green + b.amber + b.red > best.green + best.amber + best.red) best = b;
+    }
+    return best;
+}
+
+// The white 100 % mark: the first white column right of x0 in rows y.
+static int find_mark(int x0) {
+    for (int x = x0 > 0 ? x0 : W / 2; x < W; ++x) {
+        int n = 0;
+        for (int y = H / 2; y < H; ++y) n += near_rgb(at(x, y), 255, 255, 255);
+        if (n >= 14 && n <= 24) return x; // the mark is the bar's height plus 4 px; text is scattered
+    }
+    return -1;
+}
+
+static void test_rcl_bar(void) {
+    render* r = make(true);
+    if (!r) return;
+    render_demo_params p = render_demo_default_params();
+    render_demo_scene(&snap, &p, terrain);
+    snap.rcl_have = false;
+    render_frame(r, &snap);
+    render_read_pixels(r, px, W, H);
+    const bar_scan none = scan_rcl_bar();
+    static const double util[3] = {0.5, 0.95, 1.1};
+    bar_scan b[3];
+    int mark[3];
+    for (int k = 0; k < 3; ++k) {
+        render_demo_scene(&snap, &p, terrain);
+        snap.rcl_have = true, snap.rcl_on = true, snap.rcl_util = util[k];
+        render_frame(r, &snap);
+        render_read_pixels(r, px, W, H);
+        b[k] = scan_rcl_bar();
+        mark[k] = find_mark(b[k].x0);
+        printf("  rcl_util %.2f: green %d, amber %d, red %d px from x %d, 100 %% mark at x %d\n", util[k], b[k].green,
+               b[k].amber, b[k].red, b[k].x0, mark[k]);
+    }
+    CHECK(none.green + none.amber + none.red < 20, "no limiter: %d bar-coloured pixels in a row",
+          none.green + none.amber + none.red);
+    CHECK(b[0].green > 20 && b[0].amber == 0 && b[0].red == 0, "50 %%: green %d, amber %d, red %d", b[0].green,
+          b[0].amber, b[0].red);
+    CHECK(b[1].amber > 20 && b[1].green == 0 && b[1].red == 0, "95 %%: green %d, amber %d, red %d", b[1].green,
+          b[1].amber, b[1].red);
+    CHECK(b[2].red > 20 && b[2].green == 0 && b[2].amber == 0, "110 %%: green %d, amber %d, red %d", b[2].green,
+          b[2].amber, b[2].red);
+    // Length: the fill from its start to the 100 % mark is 100 %.
+    CHECK(mark[0] > b[0].x0 && mark[0] == mark[1], "100 %% mark at %d and %d px", mark[0], mark[1]);
+    if (mark[0] > b[0].x0) {
+        const double full = mark[0] + 1 - b[0].x0; // the mark is 2 px wide, centred on 100 %
+        CHECK_NEAR(b[0].green, 0.5 * full, 2.0);
+        CHECK_NEAR(b[1].amber, 0.95 * full, 2.0);
+        // Beyond the mark the fill runs on (the mark covers 2 px of it).
+        CHECK_NEAR(b[2].red, 1.1 * full - 2, 3.0);
+    }
+    render_destroy(r);
+}
+
 static void test_panel_draws_offscreen(void) {
     render* r = make(true);
     if (!r) return;
@@ -529,6 +612,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_missing_mesh_falls_back);
     RUN_TEST(test_cad_mesh_formats);
     RUN_TEST(test_warnings_shown);
+    RUN_TEST(test_rcl_bar);
     RUN_TEST(test_panel_draws_offscreen);
     RUN_TEST(test_mesh_drawn_where_body_point_says);
     RUN_TEST(test_png_write_failure);
