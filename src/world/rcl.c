@@ -74,6 +74,21 @@ static double outreach_rate(const rcl* r, const double* row) {
     return (me->link[0].length * cos(q[0]) + c12) * qd[0] + c12 * qd[1];
 }
 
+// Outreach gained per metre of stroke of cylinder k [m/m] at the row's
+// pose: dR/dq_k / (dx_k/dq_k), R = L1 sin q1 + L2 sin(q1 + q2). A positive
+// command extends the cylinder, so a command of this sign moves the tip out.
+// Below 1 mm per metre the motion leaves the moment as it is: let through.
+static double outreach_per_stroke(const rcl* r, const double* row, int k) {
+    const crane_mech* me = &r->m->mech;
+    const double q1 = row[COL_Q1], q2 = row[COL_Q2];
+    const double c12 = me->link[1].length * cos(q1 + q2);
+    const double dRdq = k == 0 ? me->link[0].length * cos(q1) + c12 : c12;
+    double dxdq;
+    crane_pin_length(&me->act[k], k == 0 ? q1 : q2, &dxdq);
+    const double g = fabs(dxdq) > 1e-6 ? dRdq / dxdq : 0.0;
+    return fabs(g) < 1e-3 ? 0.0 : g;
+}
+
 // Smallest capacity [kg] over the outreaches [a, b] at slew s [rad]: the
 // chart is linear between its points, so its value at both ends and at the
 // points inside.
@@ -151,8 +166,12 @@ double rcl_filter(rcl* r, const double* row, const double u_in[3], double u_out[
         a = fmin(a, r->allow + da); // and back up as gently
     }
     r->allow = a, r->t_allow = t;
-    if (u_out[0] < 0) u_out[0] *= a; // lowering the lifting arm
-    if (u_out[1] > 0) u_out[1] *= a; // unfolding the end arm outwards
+    // A boom motion raises the load moment when it carries the tip
+    // outwards. Which command that is depends on the pose: lowering the
+    // lifting arm does while the tip is above the arm's pin, but with the
+    // end arm hanging below the pin, lifting swings the tip out as well.
+    for (int k = 0; k < 2; ++k)
+        if (u_out[k] * outreach_per_stroke(r, row, k) > 0) u_out[k] *= a;
     if (u_out[2] != 0 && r->chart.stab) {
         const double R = r->R; // this row's, from rcl_utilisation above
         const double s = row[COL_SLEW];

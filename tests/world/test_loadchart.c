@@ -250,37 +250,65 @@ static void hold_row(const model* m, double q1, double q2, double ml, double* ro
     row[COL_P1A] = (G[0] / r + row[COL_P1B] * AB) / AA;
 }
 
+// The sign of the command on cylinder k (a positive command extends it)
+// that carries the tip outwards at pose (q1, q2), by finite differences of
+// the tip's position and the cylinder's pin length.
+static double tip_out_command(const model* m, double q1, double q2, int k) {
+    const double h = 1e-6;
+    double R0, R1, z, d;
+    crane_tip(&m->mech, q1, q2, &R0, &z);
+    crane_tip(&m->mech, q1 + (k == 0 ? h : 0), q2 + (k == 1 ? h : 0), &R1, &z);
+    const double q = k == 0 ? q1 : q2;
+    const double dx = crane_pin_length(&m->mech.act[k], q + h, &d) - crane_pin_length(&m->mech.act[k], q, &d);
+    return (R1 - R0) * dx > 0 ? 1.0 : -1.0;
+}
+
+static void limiter_filter_at(const model* m, rcl* r, double q1, double q2, const char* what) {
+    double R, z, row[SIM_NCOL], out[3];
+    crane_tip(&m->mech, q1, q2, &R, &z);
+    const double cap = loadchart_capacity(&r->chart, R, 0, NULL);
+    // The commands that carry the tip out (raise the load moment) and in.
+    const double s1 = tip_out_command(m, q1, q2, 0), s2 = tip_out_command(m, q1, q2, 1);
+    const double outw[3] = {s1, s2, 0}, inw[3] = {-s1, -s2, 0};
+    printf("  %s: R %.3f m, tip %+.3f m from the pin, outwards = lift %+g, jib %+g\n", what, R, z, s1, s2);
+    // The utilisation is the measured load over the rated load at this outreach.
+    hold_row(m, q1, q2, 0.5 * cap, row);
+    CHECK_NEAR(rcl_utilisation(r, row), 0.5, 1e-6);
+    rcl_filter(r, row, outw, out);
+    CHECK(out[0] == outw[0] && out[1] == outw[1] && !r->warn, "%s at 50 %%: commands cut (%g, %g)", what, out[0], out[1]);
+    hold_row(m, q1, q2, 0.89 * cap, row);
+    rcl_filter(r, row, outw, out);
+    CHECK(!r->warn && out[0] == outw[0] && out[1] == outw[1], "%s at 89 %%: no warning %d, (%g, %g)", what, r->warn,
+          out[0], out[1]);
+    hold_row(m, q1, q2, 0.95 * cap, row);
+    rcl_filter(r, row, outw, out);
+    CHECK(r->warn && fabs(out[0] - 0.5 * outw[0]) < 1e-6 && fabs(out[1] - 0.5 * outw[1]) < 1e-6,
+          "%s at 95 %%: warning %d, (%g, %g) not halved", what, r->warn, out[0], out[1]);
+    hold_row(m, q1, q2, 1.0 * cap, row);
+    rcl_filter(r, row, outw, out);
+    CHECK(out[0] == 0 && out[1] == 0, "%s at 100 %%: outward lift %g and jib %g not stopped", what, out[0], out[1]);
+    rcl_filter(r, row, inw, out);
+    CHECK(out[0] == inw[0] && out[1] == inw[1], "%s at 100 %%: inward lift %g and jib %g not let through", what,
+          out[0], out[1]);
+    hold_row(m, q1, q2, 1.3 * cap, row);
+    rcl_filter(r, row, inw, out);
+    CHECK(out[0] == inw[0] && out[1] == inw[1], "%s at 130 %%: inward lift %g and jib %g not let through", what,
+          out[0], out[1]);
+}
+
+// Two poses: the end arm above the lifting arm's pin, where lowering the
+// arm carries the tip out, and hanging below it, where lifting does (the
+// lifting arm turns the whole tip about its pin).
 static void test_limiter_filter(void) {
     model* m = load(NULL, 0);
     if (!m) return;
     rcl r;
     char err[300];
     CHECK(rcl_init(&r, m, NULL, err, sizeof err) == 0, "%s", err);
-    const double q1 = 100 * M_PI / 180, q2 = -40 * M_PI / 180;
-    double R, z, row[SIM_NCOL], out[3];
-    crane_tip(&m->mech, q1, q2, &R, &z);
-    const double cap = loadchart_capacity(&r.chart, R, 0, NULL);
-    // The utilisation is the measured load over the rated load at this outreach.
-    hold_row(m, q1, q2, 0.5 * cap, row);
-    CHECK_NEAR(rcl_utilisation(&r, row), 0.5, 1e-6);
-    static const double down_out[3] = {-1, 1, 0}, up_in[3] = {1, -1, 0};
-    rcl_filter(&r, row, down_out, out);
-    CHECK(out[0] == -1 && out[1] == 1 && !r.warn, "at 50 %%: commands cut (%g, %g)", out[0], out[1]);
-    hold_row(m, q1, q2, 0.89 * cap, row);
-    rcl_filter(&r, row, down_out, out);
-    CHECK(!r.warn && out[0] == -1 && out[1] == 1, "at 89 %%: no warning %d, (%g, %g)", r.warn, out[0], out[1]);
-    hold_row(m, q1, q2, 0.95 * cap, row);
-    rcl_filter(&r, row, down_out, out);
-    CHECK(r.warn && fabs(out[0] + 0.5) < 1e-6 && fabs(out[1] - 0.5) < 1e-6, "at 95 %%: warning %d, (%g, %g) not halved",
-          r.warn, out[0], out[1]);
-    hold_row(m, q1, q2, 1.0 * cap, row);
-    rcl_filter(&r, row, down_out, out);
-    CHECK(out[0] == 0 && out[1] == 0, "at 100 %%: lift down %g and jib out %g not stopped", out[0], out[1]);
-    rcl_filter(&r, row, up_in, out);
-    CHECK(out[0] == 1 && out[1] == -1, "at 100 %%: lift up %g and jib in %g not let through", out[0], out[1]);
-    hold_row(m, q1, q2, 1.3 * cap, row);
-    rcl_filter(&r, row, up_in, out);
-    CHECK(out[0] == 1 && out[1] == -1, "at 130 %%: lift up %g and jib in %g not let through", out[0], out[1]);
+    limiter_filter_at(m, &r, 130 * M_PI / 180, -60 * M_PI / 180, "tip above the pin");
+    CHECK(tip_out_command(m, 130 * M_PI / 180, -60 * M_PI / 180, 0) < 0, "tip above the pin: lowering should carry it out");
+    limiter_filter_at(m, &r, 100 * M_PI / 180, -40 * M_PI / 180, "tip below the pin");
+    CHECK(tip_out_command(m, 100 * M_PI / 180, -40 * M_PI / 180, 0) > 0, "tip below the pin: lifting should carry it out");
     rcl_free(&r);
     model_free(m);
 }
@@ -633,24 +661,31 @@ static void test_limiter_lets_reducing_motions_through(void) {
     engine* e = engine_create(m, &o, q0, 0, 1100, err, sizeof err);
     CHECK(e != NULL, "%s", err);
     if (!e) return;
-    double row[SIM_NCOL], x2_stop = 0, x1_stop = 0;
+    double row[SIM_NCOL], R_stop = 0, z, in1 = 0, in2 = 0;
     for (int i = 0; i < 11000; ++i) {
-        const bool back = i >= 8000; // 8 s jib out, then 3 s jib in and lift up
-        const double u[3] = {back ? 1 : 0, back ? -1 : 1, 0};
+        // 8 s jib out, then 3 s of the two commands that bring the tip in
+        // at the pose where the limiter stopped it.
+        const bool back = i >= 8000;
+        const double u[3] = {back ? in1 : 0, back ? in2 : 1, 0};
         engine_set_commands(e, u);
         if (engine_advance(e, 1e-3)) break;
         engine_row(e, row);
-        if (i == 7999) x2_stop = row[COL_X2], x1_stop = row[COL_X1];
+        if (i == 7999) {
+            crane_tip(&m->mech, row[COL_Q1], row[COL_Q2], &R_stop, &z);
+            in1 = -tip_out_command(m, row[COL_Q1], row[COL_Q2], 0);
+            in2 = -tip_out_command(m, row[COL_Q1], row[COL_Q2], 1);
+        }
         if (i == 8010) {
             // 10 ms after the operator reversed: both commands passed whole.
-            CHECK(row[COL_U1_CMD] == 1 && row[COL_U2_CMD] == -1, "reducing commands cut: lift %g, jib %g",
-                  row[COL_U1_CMD], row[COL_U2_CMD]);
+            CHECK(row[COL_U1_CMD] == in1 && row[COL_U2_CMD] == in2, "reducing commands cut: lift %g of %g, jib %g of %g",
+                  row[COL_U1_CMD], in1, row[COL_U2_CMD], in2);
         }
     }
-    printf("  after the stop: jib stroke %.3f -> %.3f m, lift %.3f -> %.3f m\n", x2_stop, row[COL_X2], x1_stop,
-           row[COL_X1]);
-    CHECK(row[COL_X2] < x2_stop - 0.1, "jib did not come in: %.3f -> %.3f m", x2_stop, row[COL_X2]);
-    CHECK(row[COL_X1] > x1_stop + 0.05, "lift did not go up: %.3f -> %.3f m", x1_stop, row[COL_X1]);
+    double R_end;
+    crane_tip(&m->mech, row[COL_Q1], row[COL_Q2], &R_end, &z);
+    printf("  after the stop: lift %+g, jib %+g; outreach %.3f -> %.3f m\n", in1, in2, R_stop, R_end);
+    CHECK(in2 < 0, "the jib should come in with a negative command here");
+    CHECK(R_end < R_stop - 0.3, "the tip did not come in: %.3f -> %.3f m", R_stop, R_end);
     engine_destroy(e);
     model_free(m);
 }
