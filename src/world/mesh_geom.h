@@ -27,6 +27,7 @@ typedef struct mesh_tri {
     float* v;       ///< 3 nv coordinates [m], z up
     int* idx;       ///< 3 nt vertex indices
     int dropped;    ///< degenerate triangles removed on load
+    int merged;     ///< triangles removed by mesh_merge_coplanar
 } mesh_tri;
 
 /// An importer for formats the core does not read: fill out->v/idx (mesh
@@ -59,6 +60,9 @@ unsigned long long mesh_cache_parses(void);
 #define MESH_FLAT_TOL_RAD 1e-4
 #define MESH_FLAT_TOL_M 1e-5
 int mesh_merge_coplanar(mesh_tri* m, double tol_rad, double tol_m);
+/// mesh_load, then mesh_merge_coplanar at the MESH_FLAT_ tolerances, the
+/// merged mesh cached beside the loaded one (a static trimesh's shape).
+int mesh_load_flat(const char* path, double scale, int up, mesh_tri* out, char* err, size_t errsz);
 
 /// Axis-aligned bounds [m].
 void mesh_bounds(const mesh_tri* m, double lo[3], double hi[3]);

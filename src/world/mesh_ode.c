@@ -25,23 +25,20 @@ dGeomID ow_mesh_trimesh(ode_world* w, dSpaceID space, const world_obj_mesh* om, 
                         const double R[9], char* err, size_t errsz) {
     mesh_tri t;
     char why[256];
-    if (mesh_load(coll_path(om), om->scale, om->up, &t, why, sizeof why)) {
+    // A fixed mesh only collides: its flat faces merged leave the surface as
+    // it is and spare ODE a test per cell of a finely cut face (a 51,104-
+    // triangle wall cost 1.6 times the box, docs/ode_world.md).
+    if (mesh_load_flat(coll_path(om), om->scale, om->up, &t, why, sizeof why)) {
         snprintf(err, errsz, "%s: %s", coll_path(om), why);
         return NULL;
     }
-    // A fixed mesh only collides: its flat faces merged leave the surface as
-    // it is and spare ODE a test per cell of a finely cut face (a 51,104-
-    // triangle wall cost 1.6 times the box, docs/ode_world.md). Out of memory
-    // leaves the mesh as loaded.
-    const int nt0 = t.nt;
-    const int merged = mesh_merge_coplanar(&t, MESH_FLAT_TOL_RAD, MESH_FLAT_TOL_M);
     ow_mesh* m = new_mesh(w, err, errsz);
     if (!m) {
         mesh_free(&t);
         return NULL;
     }
-    m->nt_file = nt0;
-    m->nt_merged = merged > 0 ? merged : 0;
+    m->nt_file = t.nt + t.merged;
+    m->nt_merged = t.merged;
     m->v = t.v;
     m->nv = t.nv;
     m->nt = t.nt;

@@ -318,6 +318,7 @@ int mesh_merge_coplanar(mesh_tri* m, double tol_rad, double tol_m) {
     m->nv = nvn;
     removed = nt - ntn;
     m->nt = ntn;
+    m->merged += removed;
 done:
     free(keep);
     if (s.fan)

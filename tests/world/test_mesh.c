@@ -480,6 +480,21 @@ static void test_merge_flat_box(void) {
         CHECK_NEAR(blo[k], lo[k], 1e-6);
         CHECK_NEAR(bhi[k], hi[k], 1e-6);
     }
+    // mesh_load_flat gives the merged mesh (cached the second time), and
+    // mesh_load of the same file still the file's own triangles.
+    mesh_tri a, b, c0;
+    const unsigned long long p0 = mesh_cache_parses();
+    CHECK(mesh_load_flat(path, 1, 2, &a, err, sizeof err) == 0, "load flat: %s", err);
+    CHECK(mesh_load_flat(path, 1, 2, &b, err, sizeof err) == 0, "load flat again: %s", err);
+    CHECK(mesh_load(path, 1, 2, &c0, err, sizeof err) == 0, "load: %s", err);
+    CHECK(mesh_cache_parses() == p0, "no parse (%llu)", mesh_cache_parses() - p0);
+    CHECK(a.nt == 12 && b.nt == 12 && a.merged == nt - 12 && b.merged == nt - 12 && a.nv == t.nv &&
+              !memcmp(a.v, t.v, 3 * sizeof(float) * t.nv) && !memcmp(b.idx, t.idx, 3 * sizeof(int) * t.nt),
+          "flat loads: %d and %d triangles, as merged here", a.nt, b.nt);
+    CHECK(c0.nt == nt && c0.merged == 0, "mesh_load unmerged (%d triangles)", c0.nt);
+    mesh_free(&a);
+    mesh_free(&b);
+    mesh_free(&c0);
     mesh_free(&t);
 }
 
