@@ -27,6 +27,7 @@ typedef struct mesh_tri {
     float* v;       ///< 3 nv coordinates [m], z up
     int* idx;       ///< 3 nt vertex indices
     int dropped;    ///< degenerate triangles removed on load
+    int merged;     ///< triangles removed by mesh_merge_coplanar
 } mesh_tri;
 
 /// An importer for formats the core does not read: fill out->v/idx (mesh
@@ -48,6 +49,20 @@ void mesh_free(mesh_tri* m);
 void mesh_cache_clear(void);
 /// Files parsed by mesh_load so far (cache misses), for tests.
 unsigned long long mesh_cache_parses(void);
+
+/// Coplanar triangles of a static collision mesh merged without changing the
+/// surface: vertices inside a flat face, or on a straight crease or border,
+/// are collapsed onto a neighbour when every triangle keeps its original
+/// plane within tol_rad [rad] and the removed vertex lies within tol_m [m]
+/// of the new triangles (mesh_simplify.c). Corners, curved parts and
+/// non-manifold places stay. Returns the triangles removed, or -1 when memory
+/// ran out (m unchanged then).
+#define MESH_FLAT_TOL_RAD 1e-4
+#define MESH_FLAT_TOL_M 1e-5
+int mesh_merge_coplanar(mesh_tri* m, double tol_rad, double tol_m);
+/// mesh_load, then mesh_merge_coplanar at the MESH_FLAT_ tolerances, the
+/// merged mesh cached beside the loaded one (a static trimesh's shape).
+int mesh_load_flat(const char* path, double scale, int up, mesh_tri* out, char* err, size_t errsz);
 
 /// Axis-aligned bounds [m].
 void mesh_bounds(const mesh_tri* m, double lo[3], double hi[3]);

@@ -68,6 +68,8 @@ typedef struct ow_mesh {
     unsigned* polys;     ///< hull polygons (3, a, b, c)
     float* dv;           ///< the shape's triangles for the debug view: vertices in the geom frame [m]
     int* di;             ///< and indices (nv, nt of them)
+    int nt_file;         ///< static trimesh: triangles as loaded, before flat faces were merged
+    int nt_merged;       ///< and how many of them mesh_merge_coplanar removed
 } ow_mesh;
 #define OW_MAX_MESHES (WORLD_DESC_MAX_LOADS + WORLD_DESC_MAX_OBSTACLES + 1)
 /// Trimesh contacts closer than this are one (ow_mesh_merge_contacts) [m]:

@@ -58,6 +58,42 @@ static void write_box(const char* name, const double lo[3], const double hi[3], 
     fclose(o.f);
 }
 
+// A box from lo to hi with every face cut into a grid of cells of about
+// cell metres (two triangles a cell, as the bench's 50,000-triangle wall and
+// as CAD exports of flat faces often are), faces wound outward. bump > 0
+// lifts the middle grid vertex of the +z face by bump metres (a shape the
+// merge must keep). Returns the triangles written.
+static int write_dense_box(const char* name, const double lo[3], const double hi[3], double cell, double bump,
+                           char* path, size_t n) {
+    obj_out o;
+    if (obj_open(&o, name, path, n)) return 0;
+    int nt = 0;
+    for (int a = 0; a < 3; ++a)
+        for (int side = 0; side < 2; ++side) {
+            const int u = (a + 1) % 3, v = (a + 2) % 3;
+            const int nu = (int)ceil((hi[u] - lo[u]) / cell), nw = (int)ceil((hi[v] - lo[v]) / cell);
+            const int base = o.nv + 1;
+            for (int j = 0; j <= nw; ++j)
+                for (int i = 0; i <= nu; ++i) {
+                    double p[3];
+                    p[a] = side ? hi[a] : lo[a];
+                    p[u] = lo[u] + (hi[u] - lo[u]) * i / nu;
+                    p[v] = lo[v] + (hi[v] - lo[v]) * j / nw;
+                    if (a == 2 && side && i == nu / 2 && j == nw / 2) p[a] += bump;
+                    obj_v(&o, p[0], p[1], p[2]);
+                }
+            for (int j = 0; j < nw; ++j)
+                for (int i = 0; i < nu; ++i) {
+                    const int q = base + j * (nu + 1) + i, r = q + nu + 1;
+                    if (side) obj_f(&o, q, q + 1, r + 1), obj_f(&o, q, r + 1, r);
+                    else obj_f(&o, q, r + 1, q + 1), obj_f(&o, q, r, r + 1);
+                    nt += 2;
+                }
+        }
+    fclose(o.f);
+    return nt;
+}
+
 // A cylinder of radius r, height h along z, base centred at c, seg sides.
 static void write_cylinder(const char* name, double r, double h, const double c[3], int seg, char* path, size_t n) {
     obj_out o;
@@ -330,14 +366,22 @@ static void test_box_vs_mesh_box(void) {
     CHECK_NEAR(pb[0], pa[0], 0.02);
     CHECK_NEAR(pb[1], pa[1], 0.02);
     CHECK_NEAR(pb[2], pa[2], 0.005);
+    // The block with its faces cut into 5 cm cells slides the load the same.
+    double pc[3], yc;
+    write_dense_box("block_dense.obj", lo, hi, 0.05, 0, path, sizeof path);
+    snprintf(obst, sizeof obst,
+             "[{\"name\": \"b\", \"kind\": \"box\", \"mesh\": {\"file\": \"%s\"}, \"position\": [-4, -10]}]", path);
+    slide_path(obst, pc, &yc);
+    CHECK(yc > -9.5 + 0.25, "stopped at the dense block's face: %.3f", yc);
+    CHECK_NEAR(pc[0], pa[0], 0.02);
+    CHECK_NEAR(pc[1], pa[1], 0.02);
+    CHECK_NEAR(pc[2], pa[2], 0.005);
 }
 
 // The sandbox_wall scenario with its radial wall as a mesh: the end arm
 // stops at it (a crane contact: the COLLISION warning) and does not pass.
-static void test_boom_mesh_wall(void) {
-    char path[600], err[512];
-    const double lo[3] = {-1.25, -0.15, 0}, hi[3] = {1.25, 0.15, 4.5};
-    write_box("wall.obj", lo, hi, path, sizeof path);
+static void boom_mesh_wall(const char* path, int nt_file) {
+    char err[512];
     cJSON* root = json_load_file(CRANESIM_ASSETS "/worlds/sandbox.json", err, sizeof err);
     if (!root) { CHECK(0, "%s", err); return; }
     cJSON* obs = cJSON_GetObjectItemCaseSensitive(root, "obstacles");
@@ -360,6 +404,13 @@ static void test_boom_mesh_wall(void) {
     }
     ode_world* w = make(&d, sc.q0[0] / DEG, sc.q0[1] / DEG, sc.slew0 / DEG);
     if (!w) { CHECK(0, "world"); world_desc_free(&d); return; }
+    // The ODE trimesh is the wall's 12 triangles however finely the file
+    // cuts its faces.
+    int mk = -1;
+    for (int k = 0; k < w->nmesh; ++k)
+        if (w->mesh[k].tmd) mk = k;
+    CHECK(mk >= 0 && w->mesh[mk].nt == 12 && w->mesh[mk].nt_file == nt_file, "trimesh of %d triangles from %d",
+          mk >= 0 ? w->mesh[mk].nt : -1, mk >= 0 ? w->mesh[mk].nt_file : -1);
     double depth = 0, slew10 = 0;
     int collision = 0;
     static world_snapshot snap;
@@ -389,6 +440,110 @@ static void test_boom_mesh_wall(void) {
     CHECK(depth > 0 && depth < 5e-3, "penetration %.4f m", depth);
     ode_world_destroy(w);
     world_desc_free(&d);
+}
+
+// ---- flat faces merged (mesh_merge_coplanar) ----
+
+static double mesh_area(const mesh_tri* m) {
+    double A = 0;
+    for (int f = 0; f < m->nt; ++f) {
+        const float* a = m->v + 3 * m->idx[3 * f];
+        const float* b = m->v + 3 * m->idx[3 * f + 1];
+        const float* c = m->v + 3 * m->idx[3 * f + 2];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double x = u[1] * w[2] - u[2] * w[1], y = u[2] * w[0] - u[0] * w[2], z = u[0] * w[1] - u[1] * w[0];
+        A += 0.5 * sqrt(x * x + y * y + z * z);
+    }
+    return A;
+}
+
+// A box cut into 0.05 m cells is a box: 12 triangles on its 8 corners, the
+// same closed surface (area, volume and bounds of the analytic box).
+static void test_merge_flat_box(void) {
+    char path[600], err[256];
+    const double lo[3] = {-1.25, -0.15, 0}, hi[3] = {1.25, 0.15, 4.5};
+    const int nt = write_dense_box("dense_box.obj", lo, hi, 0.05, 0, path, sizeof path);
+    mesh_tri t;
+    if (mesh_load(path, 1, 2, &t, err, sizeof err)) { CHECK(0, "load: %s", err); return; }
+    CHECK(t.nt == nt && nt > 10000, "%d triangles loaded of %d", t.nt, nt);
+    const int removed = mesh_merge_coplanar(&t, MESH_FLAT_TOL_RAD, MESH_FLAT_TOL_M);
+    CHECK(removed == nt - 12 && t.nt == 12 && t.nv == 8, "%d triangles, %d vertices left (removed %d)", t.nt, t.nv,
+          removed);
+    CHECK(mesh_open_edges(&t) == 0, "still closed");
+    const double L[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    CHECK_NEAR(mesh_area(&t), 2 * (L[0] * L[1] + L[1] * L[2] + L[0] * L[2]), 1e-4);
+    double V, c[3], I[9], blo[3], bhi[3];
+    CHECK(mesh_mass_props(&t, &V, c, I) == 0, "volume");
+    CHECK_NEAR(V, L[0] * L[1] * L[2], 1e-5);
+    mesh_bounds(&t, blo, bhi);
+    for (int k = 0; k < 3; ++k) {
+        CHECK_NEAR(blo[k], lo[k], 1e-6);
+        CHECK_NEAR(bhi[k], hi[k], 1e-6);
+    }
+    // mesh_load_flat gives the merged mesh (cached the second time), and
+    // mesh_load of the same file still the file's own triangles.
+    mesh_tri a, b, c0;
+    const unsigned long long p0 = mesh_cache_parses();
+    CHECK(mesh_load_flat(path, 1, 2, &a, err, sizeof err) == 0, "load flat: %s", err);
+    CHECK(mesh_load_flat(path, 1, 2, &b, err, sizeof err) == 0, "load flat again: %s", err);
+    CHECK(mesh_load(path, 1, 2, &c0, err, sizeof err) == 0, "load: %s", err);
+    CHECK(mesh_cache_parses() == p0, "no parse (%llu)", mesh_cache_parses() - p0);
+    CHECK(a.nt == 12 && b.nt == 12 && a.merged == nt - 12 && b.merged == nt - 12 && a.nv == t.nv &&
+              !memcmp(a.v, t.v, 3 * sizeof(float) * t.nv) && !memcmp(b.idx, t.idx, 3 * sizeof(int) * t.nt),
+          "flat loads: %d and %d triangles, as merged here", a.nt, b.nt);
+    CHECK(c0.nt == nt && c0.merged == 0, "mesh_load unmerged (%d triangles)", c0.nt);
+    mesh_free(&a);
+    mesh_free(&b);
+    mesh_free(&c0);
+    mesh_free(&t);
+}
+
+// What is not flat stays: a 2 mm bump on a finely cut face keeps its vertex
+// and the volume its cone adds, and a cylinder keeps every side facet (only
+// the caps' centre vertices go, two triangles each).
+static void test_merge_keeps_shape(void) {
+    char path[600], err[256];
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0.5}, bump = 2e-3;
+    write_dense_box("bump_box.obj", lo, hi, 0.05, bump, path, sizeof path);
+    mesh_tri t;
+    if (mesh_load(path, 1, 2, &t, err, sizeof err)) { CHECK(0, "load: %s", err); return; }
+    double V0, V1, c[3], I[9];
+    CHECK(mesh_mass_props(&t, &V0, c, I) == 0, "volume");
+    const double A0 = mesh_area(&t);
+    CHECK(V0 - 0.5 > 1e-7, "the bump adds volume (%.3g m^3)", V0 - 0.5);
+    CHECK(mesh_merge_coplanar(&t, MESH_FLAT_TOL_RAD, MESH_FLAT_TOL_M) > 0, "merged");
+    int found = 0;
+    for (int i = 0; i < t.nv; ++i)
+        found |= fabs(t.v[3 * i] - 0.5) < 1e-6 && fabs(t.v[3 * i + 1] - 0.5) < 1e-6 &&
+                 fabs(t.v[3 * i + 2] - (0.5 + bump)) < 1e-6;
+    CHECK(found, "the bump's vertex is kept");
+    CHECK(mesh_mass_props(&t, &V1, c, I) == 0, "volume after");
+    CHECK_NEAR(V1, V0, 1e-9);
+    CHECK_NEAR(mesh_area(&t), A0, 1e-6);
+    CHECK(mesh_open_edges(&t) == 0, "still closed");
+    CHECK(t.nt < 40, "the flat parts merged (%d triangles)", t.nt);
+    mesh_free(&t);
+
+    const int seg = 48;
+    write_cylinder("merge_cyl.obj", 0.5, 1.0, (const double[3]){0, 0, 0}, seg, path, sizeof path);
+    if (mesh_load(path, 1, 2, &t, err, sizeof err)) { CHECK(0, "load: %s", err); return; }
+    CHECK(t.nt == 4 * seg && t.nv == 2 * seg + 2, "cylinder as written (%d, %d)", t.nt, t.nv);
+    CHECK(mesh_mass_props(&t, &V0, c, I) == 0, "volume");
+    CHECK(mesh_merge_coplanar(&t, MESH_FLAT_TOL_RAD, MESH_FLAT_TOL_M) == 4, "the caps' centres go");
+    CHECK(t.nt == 4 * seg - 4 && t.nv == 2 * seg, "%d triangles, %d vertices", t.nt, t.nv);
+    CHECK(mesh_mass_props(&t, &V1, c, I) == 0, "volume after");
+    CHECK_NEAR(V1, V0, 1e-9);
+    mesh_free(&t);
+}
+
+static void test_boom_mesh_wall(void) {
+    char path[600];
+    const double lo[3] = {-1.25, -0.15, 0}, hi[3] = {1.25, 0.15, 4.5};
+    write_box("wall.obj", lo, hi, path, sizeof path);
+    boom_mesh_wall(path, 12);
+    // The same wall cut into 5 cm cells (10,000 triangles and more).
+    const int nt = write_dense_box("wall_dense.obj", lo, hi, 0.05, 0, path, sizeof path);
+    boom_mesh_wall(path, nt);
 }
 
 // ---- bad meshes ----
@@ -538,6 +693,8 @@ int main(int argc, char** argv) {
     RUN_TEST(test_boom_mesh_wall);
     RUN_TEST(test_bad_meshes);
     RUN_TEST(test_cache);
+    RUN_TEST(test_merge_flat_box);
+    RUN_TEST(test_merge_keeps_shape);
     model_free(g_model);
     TEST_MAIN_END();
 }
