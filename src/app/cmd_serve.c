@@ -229,10 +229,24 @@ static void fill_state(server* s) {
     st->cmd_seq = s->cmd_seq;
     st->flags = (s->paused ? PROTO_F_PAUSED : 0) | (w->attached ? PROTO_F_ATTACHED : 0) |
                 (s->stopped ? PROTO_F_STOPPED : 0) | (s->lockstep ? PROTO_F_LOCKSTEP : 0) |
-                (w->tipping ? PROTO_F_TIPPING : 0) | (w->main_relief_open ? PROTO_F_RELIEF : 0);
+                (w->tipping ? PROTO_F_TIPPING : 0) | (w->main_relief_open ? PROTO_F_RELIEF : 0) |
+                (w->collision ? PROTO_F_COLLISION : 0) | (w->rcl_have ? PROTO_F_RCL_HAVE : 0) |
+                (w->rcl_on ? PROTO_F_RCL_ON : 0) | (uint32_t)(w->npad ? (w->pad_lifted & 15) : 0) * PROTO_F_PAD_LIFTED0;
     st->slew = w->slew;
     memcpy(st->hook, w->hook, sizeof st->hook);
     st->load_mass = w->load_mass;
+    memcpy(st->tip, w->tip, sizeof st->tip);
+    st->roll = st->pitch = 0;
+    for (int i = 0; i < w->nbody; ++i)
+        if (w->body[i].role == WORLD_ROLE_TRUCK) {
+            proto_roll_pitch(w->body[i].rot, &st->roll, &st->pitch);
+            break;
+        }
+    st->p_supply = w->p_supply;
+    st->rcl_util = w->rcl_util;
+    st->stab_margin = w->stab_margin;
+    st->npad = (uint8_t)(w->npad > 0 && w->npad <= PROTO_MAX_PADS ? w->npad : 0);
+    memcpy(st->pad_F, w->pad_F, st->npad * sizeof w->pad_F[0]);
     const int ncol = engine_ncol(s->e);
     st->attached = ncol > COL_ATTACHED ? (int32_t)row[COL_ATTACHED] : -1;
     st->nrow = (uint16_t)(ncol < PROTO_MAX_ROW ? ncol : PROTO_MAX_ROW);
@@ -248,7 +262,18 @@ static void fill_state(server* s) {
         double* d = st->cyl[i];
         memcpy(d, y->base, 3 * sizeof(double));
         memcpy(d + 3, y->rod_end, 3 * sizeof(double));
-        d[6] = y->x, d[7] = y->pA, d[8] = y->pB, d[9] = y->u, d[10] = y->u_cmd, d[11] = y->force;
+        d[6] = y->x, d[7] = y->pA, d[8] = y->pB, d[9] = y->u, d[10] = y->u_cmd, d[11] = y->force, d[12] = y->v;
+        st->cyl_bits[i] = (uint8_t)((y->relief_open ? PROTO_CYL_RELIEF : 0) | (y->end_stop ? PROTO_CYL_END_STOP : 0));
+    }
+    st->nrelief = 0;
+    for (int i = 0; i < w->nrelief && i < WORLD_SNAP_MAX_RELIEFS && st->nrelief < PROTO_MAX_RELIEFS; ++i) {
+        proto_relief* q = &st->relief[st->nrelief];
+        const int cyl = w->relief_cyl[i];
+        if (!w->relief[i][0]) continue;
+        q->cyl = (int8_t)(cyl >= 0 && cyl < st->ncyl ? cyl : -1);
+        q->port = (uint8_t)(w->relief_port[i] ? 1 : 0);
+        snprintf(q->name, sizeof q->name, "%s", w->relief[i]);
+        ++st->nrelief;
     }
     st->nrope = (uint8_t)(w->nrope < PROTO_MAX_ROPE ? w->nrope : PROTO_MAX_ROPE);
     memcpy(st->rope, w->rope, st->nrope * sizeof w->rope[0]);
