@@ -1,8 +1,9 @@
 /* client.c: a small cranesim serve client in plain C (libc and POSIX sockets
  * only, no cranesim headers: the wire format is docs/protocol.md). It asks
  * for control, lifts the boom for half of its frames and lowers it for the
- * other half, and prints the paper's nine values of every tenth state frame
- * and the command-to-echo delay.
+ * other half, and prints for every tenth state frame the paper's nine values,
+ * the crane tip in the world, the truck's roll and pitch and the supply
+ * pressure, and at the end the command-to-echo delay (protocol version 2).
  *
  *   cc -O2 -o client examples/client.c -lm
  *   cranesim serve &            # listens on 127.0.0.1:7575
@@ -19,6 +20,10 @@
 #include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 static void put32(uint8_t* p, uint32_t v) { for (int i = 0; i < 4; ++i) p[i] = (uint8_t)(v >> (8 * i)); }
 static void put64(uint8_t* p, uint64_t v) { for (int i = 0; i < 8; ++i) p[i] = (uint8_t)(v >> (8 * i)); }
@@ -73,9 +78,9 @@ int main(int argc, char** argv) {
     freeaddrinfo(res);
     int one = 1;
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    /* CLIENT_HELLO: magic "CSIM", version 1, role 1 (control). */
+    /* CLIENT_HELLO: magic "CSIM", version 2, role 1 (control). */
     uint8_t hello[12];
-    put32(hello, 8); hello[4] = 1; memcpy(hello + 5, "CSIM", 4); hello[9] = 1; hello[10] = 0; hello[11] = 1;
+    put32(hello, 8); hello[4] = 1; memcpy(hello + 5, "CSIM", 4); hello[9] = 2; hello[10] = 0; hello[11] = 1;
     send(fd, hello, sizeof hello, 0);
     static uint8_t b[1 << 20];
     uint32_t len;
@@ -91,7 +96,8 @@ int main(int argc, char** argv) {
     double sent_at = 0, worst = 0;
     long got = 0, lost = 0;
     uint64_t last_frame = 0;
-    printf("      t [s]    x1 [mm]    x2 [mm]  p1A [MPa]  p1B [MPa]  p2A [MPa]  p2B [MPa]      u1      u2\n");
+    printf("      t [s]    x1 [mm]    x2 [mm]  p1A [MPa]  p1B [MPa]  p2A [MPa]  p2B [MPa]      u1      u2"
+           "         tip x, y, z [m]  roll, pitch [deg] p_s [MPa]\n");
     while (got < frames) {
         type = read_frame(fd, b, sizeof b, &len);
         if (type < 0) {
@@ -107,6 +113,10 @@ int main(int argc, char** argv) {
         double v[9]; /* the nine values: x1 x2 p1A p1B p2A p2B u1 u2 t */
         for (int k = 0; k < 9; ++k) v[k] = getf(b + 1 + 8 * k);
         const uint64_t fseq = get64(b + 73), echo = get64(b + 81);
+        /* After flags, slew, hook, load mass and attached: the tip (world, m),
+         * the truck's roll and pitch (rad), the supply pressure (Pa). */
+        double x[6];
+        for (int k = 0; k < 6; ++k) x[k] = getf(b + 137 + 8 * k);
         if (last_frame && fseq > last_frame + 1) lost += (long)(fseq - last_frame - 1);
         last_frame = fseq;
         if (echo == sent_seq && echo != last_echo) {
@@ -114,8 +124,9 @@ int main(int argc, char** argv) {
             last_echo = echo;
         }
         if (got % 10 == 0)
-            printf("%11.3f %10.1f %10.1f %10.3f %10.3f %10.3f %10.3f %7.3f %7.3f\n", v[8], v[0] * 1e3, v[1] * 1e3,
-                   v[2] * 1e-6, v[3] * 1e-6, v[4] * 1e-6, v[5] * 1e-6, v[6], v[7]);
+            printf("%11.3f %10.1f %10.1f %10.3f %10.3f %10.3f %10.3f %7.3f %7.3f %7.2f %7.2f %7.2f %8.2f %8.2f %9.3f\n",
+                   v[8], v[0] * 1e3, v[1] * 1e3, v[2] * 1e-6, v[3] * 1e-6, v[4] * 1e-6, v[5] * 1e-6, v[6], v[7], x[0],
+                   x[1], x[2], x[3] * 180 / M_PI, x[4] * 180 / M_PI, x[5] * 1e-6);
         ++got;
         /* A new command every frame: lift up, then down. */
         const double lift = got < frames / 2 ? 0.6 : -0.6;

@@ -5,7 +5,9 @@
 // on every frame it receives; the time from sending command n to the first
 // state frame echoing n is its latency. One JSON line: frames per second
 // each client received, frames lost, p50/p99/max latency, and the server's
-// own count of missed frame deadlines (from its log).
+// own count of missed frame deadlines and how late its frames started (from
+// its log), then the machine's floor without any simulation (bs_baseline)
+// and the load average before and after: whether a p99 is the machine's or ours.
 #define _GNU_SOURCE
 #include "app.h"
 #include "protocol.h"
@@ -21,6 +23,7 @@
 #include <string.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 typedef struct bconn {
@@ -94,6 +97,72 @@ static int cmp_d(const void* a, const void* b) {
     return (x > y) - (x < y);
 }
 
+// The machine's own floor, with no simulation: a child process echoes 8
+// bytes over TCP loopback (TCP_NODELAY), and this process sends them once per
+// millisecond on an absolute timer, as the server paces its frames. p[0],
+// p[1]: round trip p50, p99 [s]; p[2]: how late the timer woke, p99 [s].
+static void bs_baseline(double seconds, double p[3]) {
+    p[0] = p[1] = p[2] = NAN;
+    int lfd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET};
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t al = sizeof a;
+    if (lfd < 0 || bind(lfd, (struct sockaddr*)&a, sizeof a) || listen(lfd, 1) ||
+        getsockname(lfd, (struct sockaddr*)&a, &al)) {
+        if (lfd >= 0) close(lfd);
+        return;
+    }
+    pid_t pid = fork();
+    if (pid == 0) {
+        int fd = accept(lfd, NULL, NULL);
+        int one = 1;
+        setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+        uint8_t b[8];
+        while (recv(fd, b, 8, MSG_WAITALL) == 8 && send(fd, b, 8, MSG_NOSIGNAL) == 8) {
+        }
+        _exit(0);
+    }
+    close(lfd);
+    int fd = pid > 0 ? socket(AF_INET, SOCK_STREAM, 0) : -1;
+    if (fd < 0 || connect(fd, (struct sockaddr*)&a, sizeof a)) {
+        if (fd >= 0) close(fd);
+        if (pid > 0) waitpid(pid, NULL, 0);
+        return;
+    }
+    int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    const long n = (long)(seconds * 1000);
+    double* rtt = malloc((size_t)n * sizeof *rtt);
+    double* late = malloc((size_t)n * sizeof *late);
+    long k = 0;
+    struct timespec next;
+    clock_gettime(CLOCK_MONOTONIC, &next);
+    while (rtt && late && k < n) {
+        next.tv_nsec += 1000000;
+        if (next.tv_nsec >= 1000000000) next.tv_nsec -= 1000000000, ++next.tv_sec;
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL);
+        const double t0 = sim_wall_time();
+        late[k] = t0 - ((double)next.tv_sec + 1e-9 * (double)next.tv_nsec);
+        uint8_t b[8] = {0};
+        if (send(fd, b, 8, MSG_NOSIGNAL) != 8 || recv(fd, b, 8, MSG_WAITALL) != 8) break;
+        rtt[k++] = sim_wall_time() - t0;
+        // Far behind (a long stall): start the timer again from now.
+        struct timespec now;
+        clock_gettime(CLOCK_MONOTONIC, &now);
+        if ((double)now.tv_sec + 1e-9 * (double)now.tv_nsec > (double)next.tv_sec + 1e-9 * (double)next.tv_nsec + 0.01)
+            next = now;
+    }
+    close(fd);
+    waitpid(pid, NULL, 0);
+    if (k > 0) {
+        qsort(rtt, (size_t)k, sizeof *rtt, cmp_d);
+        qsort(late, (size_t)k, sizeof *late, cmp_d);
+        p[0] = rtt[k / 2], p[1] = rtt[(long)(0.99 * (k - 1))], p[2] = late[(long)(0.99 * (k - 1))];
+    }
+    free(rtt);
+    free(late);
+}
+
 int bench_serve(const app_common* c, double duration) {
     (void)c;
     int out[2];
@@ -121,6 +190,8 @@ int bench_serve(const app_common* c, double duration) {
         const char* at = strstr(line, "listening on 127.0.0.1:");
         if (at) port = atoi(at + strlen("listening on 127.0.0.1:"));
     }
+    double load0[3] = {NAN, NAN, NAN};
+    getloadavg(load0, 3);
     bconn cs[3];
     memset(cs, 0, sizeof cs);
     proto_state* st = malloc(sizeof *st);
@@ -177,7 +248,7 @@ int bench_serve(const app_common* c, double duration) {
     int wst = 0;
     waitpid(pid, &wst, 0);
     long missed = -1, sframes = -1;
-    double worst = NAN, mean = NAN;
+    double worst = NAN, mean = NAN, late50 = NAN, late99 = NAN;
     if (logfd >= 0) {
         FILE* lf = fdopen(logfd, "r");
         rewind(lf);
@@ -188,10 +259,16 @@ int bench_serve(const app_common* c, double duration) {
             if (p && sscanf(p + 2, "%ld frames, %ld missed deadlines, worst frame %lf ms, mean frame %lf ms", &a, &b,
                             &w, &mn) == 4)
                 sframes = a, missed = b, worst = w, mean = mn;
+            const char* q = p ? strstr(p, "after its deadline p50 ") : NULL;
+            if (q) sscanf(q, "after its deadline p50 %lf ms, p99 %lf ms", &late50, &late99);
         }
         fclose(lf);
         unlink(logpath);
     }
+    // The machine's floor right after, for 10 s (or the run's length if shorter).
+    double base[3] = {NAN, NAN, NAN}, load1[3] = {NAN, NAN, NAN};
+    if (!code) bs_baseline(fmin(10.0, duration), base);
+    getloadavg(load1, 3);
     if (!code) {
         qsort(lat, (size_t)nlat, sizeof *lat, cmp_d);
         const double p50 = nlat ? lat[nlat / 2] : NAN, p99 = nlat ? lat[(long)(0.99 * (nlat - 1))] : NAN,
@@ -200,10 +277,12 @@ int bench_serve(const app_common* c, double duration) {
                "\"frames_per_s_controller\":%.1f,\"frames_per_s_watcher1\":%.1f,\"frames_per_s_watcher2\":%.1f,"
                "\"frames_lost\":[%ld,%ld,%ld],\"commands\":%ld,\"latency_ms_p50\":%.3f,\"latency_ms_p99\":%.3f,"
                "\"latency_ms_max\":%.3f,\"server_frames\":%ld,\"missed_deadlines\":%ld,\"server_frame_ms_mean\":%.3f,"
-               "\"server_frame_ms_worst\":%.3f,\"server_exit\":%d}\n",
+               "\"server_frame_ms_worst\":%.3f,\"server_start_late_ms_p50\":%.2f,\"server_start_late_ms_p99\":%.2f,"
+               "\"baseline_rtt_ms_p50\":%.3f,\"baseline_rtt_ms_p99\":%.3f,\"baseline_timer_late_ms_p99\":%.3f,"
+               "\"loadavg_1min_start\":%.2f,\"loadavg_1min_end\":%.2f,\"server_exit\":%d}\n",
                span, cs[0].frames / span, cs[1].frames / span, cs[2].frames / span, cs[0].lost, cs[1].lost,
-               cs[2].lost, nlat, p50 * 1e3, p99 * 1e3, mx * 1e3, sframes, missed, mean, worst,
-               WIFEXITED(wst) ? WEXITSTATUS(wst) : -1);
+               cs[2].lost, nlat, p50 * 1e3, p99 * 1e3, mx * 1e3, sframes, missed, mean, worst, late50, late99,
+               base[0] * 1e3, base[1] * 1e3, base[2] * 1e3, load0[0], load1[0], WIFEXITED(wst) ? WEXITSTATUS(wst) : -1);
         fflush(stdout);
     }
     for (int k = 0; k < 3; ++k) {

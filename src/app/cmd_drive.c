@@ -64,9 +64,11 @@ static void drive_help(FILE* f) {
             "  --screenshot-at T   simulated time of the screenshot [s] (default 2)\n"
             "  --collision-view    window: start with the collision shapes drawn over the scene\n"
             "                      (what the physics hits; G toggles it)\n"
-            "  --connect HOST:PORT drive a remote `cranesim serve` (docs/protocol.md) with the scripted\n"
-            "                      operator, headless, for --duration s of wall time (default 10): frames,\n"
-            "                      frames lost, command-to-echo latency; reconnects when the link drops\n"
+            "  --connect HOST:PORT drive a remote `cranesim serve` (docs/protocol.md): the window draws\n"
+            "                      its crane with this drive's scene, HUD and charts (link, frames lost and\n"
+            "                      latency top right) and sends the sticks; --screenshot works as locally;\n"
+            "                      headless: the scripted operator for --duration s of wall time (default\n"
+            "                      10); both reconnect when the link drops\n"
             "  --save-as FILE      window: the panel's \"save model\" writes FILE (default: a new\n"
             "                      cranesim_model_N.json each time, never an existing file)\n"
             "  --size WxH          window size in pixels (default 1280x720)\n"
@@ -486,15 +488,64 @@ int cmd_drive(int argc, char** argv) {
         (shot && app_check_output("drive", "--screenshot", shot, ".png")) ||
         (save_as && app_check_output("drive", "--save-as", save_as, ".json")))
         return EXIT_USAGE;
-    if (connect_to) { // the visual computer's link to a cranesim serve (headless for now)
+    if (connect_to) { // the visual computer's link to a cranesim serve (docs/protocol.md)
+        if (replay || session_path || save_as) {
+            fprintf(stderr, "cranesim drive: --connect: %s applies to a local drive only\n",
+                    replay ? "--replay" : session_path ? "--session" : "--save-as");
+            return EXIT_USAGE;
+        }
+        char cwhy[700];
+        const bool cdisplay = !headless && have_display(cwhy, sizeof cwhy);
+#ifdef CRANESIM_HAVE_RENDER
+        if (!headless && (cdisplay || shot)) {
+            // The window (or an offscreen view for a screenshot) draws the
+            // remote crane with the local drive's scene, HUD and charts.
+            drive_opts o = drive_default_opts();
+            o.width = width;
+            o.height = height;
+            if (rate_given) o.fps_cap = frame_rate;
+            o.mapping_file = mapping;
+            o.charts = charts;
+            o.readouts = readouts;
+            o.record_path = record;
+            o.offscreen = !cdisplay;
+            o.scripted = scripted || o.offscreen;
+            char err[600];
+            if (c.sim.mechanics == SIM_ODE && !c.sim.world) c.sim.world = "sandbox";
+            int rc = drive_opts_check(&c, &o, err, sizeof err);
+            if (rc) {
+                fprintf(stderr, "cranesim drive: %s\n", err);
+                return rc;
+            }
+            char nowin[512];
+            rc = drive_connect_window(&c, &o, connect_to, c.sim.duration, shot, shot_at, nowin, sizeof nowin);
+            if (rc != DRIVE_NO_WINDOW) return rc;
+            if (shot) {
+                o.offscreen = true;
+                o.scripted = true;
+                rc = drive_connect_window(&c, &o, connect_to, c.sim.duration, shot, shot_at, nowin, sizeof nowin);
+                if (rc == DRIVE_NO_WINDOW) {
+                    fprintf(stderr, "cranesim drive: %s\n", nowin);
+                    return EXIT_RUNTIME;
+                }
+                return rc;
+            }
+            printf("cranesim drive: %s: the link runs headless\n", strncmp(nowin, "render: ", 8) ? nowin : nowin + 8);
+        }
+#else
+        (void)cdisplay;
+        if (shot) {
+            fprintf(stderr, "cranesim drive: --screenshot needs the render module (built without SDL2/GL)\n");
+            return EXIT_USAGE;
+        }
+#endif
         if (!c.scenario_path) c.scenario_path = app_default_drive_scenario(SIM_LAGRANGE);
         model* m;
         scenario sc;
         int rc = app_load(&c, &m, &sc);
         if (rc) return rc;
         model_free(m);
-        printf("cranesim drive: --connect %s: headless link (scripted operator %s; the window does not draw a "
-               "remote crane yet)\n", connect_to, sc.name);
+        printf("cranesim drive: --connect %s: headless link (scripted operator %s)\n", connect_to, sc.name);
         return drive_connect(connect_to, &sc, c.sim.duration > 0 ? c.sim.duration : 10.0);
     }
     // drive's ode world is the sandbox unless --world says otherwise (run's

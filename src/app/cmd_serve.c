@@ -23,6 +23,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
@@ -240,10 +241,24 @@ static void fill_state(server* s) {
     st->cmd_seq = s->cmd_seq;
     st->flags = (s->paused ? PROTO_F_PAUSED : 0) | (w->attached ? PROTO_F_ATTACHED : 0) |
                 (s->stopped ? PROTO_F_STOPPED : 0) | (s->lockstep ? PROTO_F_LOCKSTEP : 0) |
-                (w->tipping ? PROTO_F_TIPPING : 0) | (w->main_relief_open ? PROTO_F_RELIEF : 0);
+                (w->tipping ? PROTO_F_TIPPING : 0) | (w->main_relief_open ? PROTO_F_RELIEF : 0) |
+                (w->collision ? PROTO_F_COLLISION : 0) | (w->rcl_have ? PROTO_F_RCL_HAVE : 0) |
+                (w->rcl_on ? PROTO_F_RCL_ON : 0) | (uint32_t)(w->npad ? (w->pad_lifted & 15) : 0) * PROTO_F_PAD_LIFTED0;
     st->slew = w->slew;
     memcpy(st->hook, w->hook, sizeof st->hook);
     st->load_mass = w->load_mass;
+    memcpy(st->tip, w->tip, sizeof st->tip);
+    st->roll = st->pitch = 0;
+    for (int i = 0; i < w->nbody; ++i)
+        if (w->body[i].role == WORLD_ROLE_TRUCK) {
+            proto_roll_pitch(w->body[i].rot, &st->roll, &st->pitch);
+            break;
+        }
+    st->p_supply = w->p_supply;
+    st->rcl_util = w->rcl_util;
+    st->stab_margin = w->stab_margin;
+    st->npad = (uint8_t)(w->npad > 0 && w->npad <= PROTO_MAX_PADS ? w->npad : 0);
+    memcpy(st->pad_F, w->pad_F, st->npad * sizeof w->pad_F[0]);
     const int ncol = engine_ncol(s->e);
     st->attached = ncol > COL_ATTACHED ? (int32_t)row[COL_ATTACHED] : -1;
     st->nrow = (uint16_t)(ncol < PROTO_MAX_ROW ? ncol : PROTO_MAX_ROW);
@@ -259,7 +274,18 @@ static void fill_state(server* s) {
         double* d = st->cyl[i];
         memcpy(d, y->base, 3 * sizeof(double));
         memcpy(d + 3, y->rod_end, 3 * sizeof(double));
-        d[6] = y->x, d[7] = y->pA, d[8] = y->pB, d[9] = y->u, d[10] = y->u_cmd, d[11] = y->force;
+        d[6] = y->x, d[7] = y->pA, d[8] = y->pB, d[9] = y->u, d[10] = y->u_cmd, d[11] = y->force, d[12] = y->v;
+        st->cyl_bits[i] = (uint8_t)((y->relief_open ? PROTO_CYL_RELIEF : 0) | (y->end_stop ? PROTO_CYL_END_STOP : 0));
+    }
+    st->nrelief = 0;
+    for (int i = 0; i < w->nrelief && i < WORLD_SNAP_MAX_RELIEFS && st->nrelief < PROTO_MAX_RELIEFS; ++i) {
+        proto_relief* q = &st->relief[st->nrelief];
+        const int cyl = w->relief_cyl[i];
+        if (!w->relief[i][0]) continue;
+        q->cyl = (int8_t)(cyl >= 0 && cyl < st->ncyl ? cyl : -1);
+        q->port = (uint8_t)(w->relief_port[i] ? 1 : 0);
+        snprintf(q->name, sizeof q->name, "%s", w->relief[i]);
+        ++st->nrelief;
     }
     st->nrope = (uint8_t)(w->nrope < PROTO_MAX_ROPE ? w->nrope : PROTO_MAX_ROPE);
     memcpy(st->rope, w->rope, st->nrope * sizeof w->rope[0]);
@@ -647,6 +673,12 @@ static int serve_loop(server* s, int lfd, double duration) {
     double next = sim_wall_time() + s->frame; // wall time of the next frame
     long missed = 0, frames = 0;
     double worst = 0, busy = 0;
+    // How late each frame starts after its deadline, in 0.05 ms bins to
+    // 100 ms (the last bin: later): the wake-ups the machine grants, apart
+    // from the frame's own work.
+    enum { LATE_BINS = 2001 };
+    static long late[LATE_BINS];
+    memset(late, 0, sizeof late);
     while (!app_signal_caught()) {
         if (duration > 0 && s->k * s->frame >= duration - 1e-9) break;
         pf[0] = (struct pollfd){.fd = lfd, .events = POLLIN};
@@ -679,6 +711,8 @@ static int serve_loop(server* s, int lfd, double duration) {
         if (s->lockstep) continue;
         const double now = sim_wall_time();
         if (now < next) continue;
+        const long lb = (long)((now - next) / 5e-5);
+        ++late[lb < LATE_BINS - 1 ? lb : LATE_BINS - 1];
         // One frame: step (unless paused), then the state to everyone.
         if (!s->paused) step_frame(s);
         broadcast(s);
@@ -693,9 +727,21 @@ static int serve_loop(server* s, int lfd, double duration) {
             if (done > next + 10 * s->frame) next = done + s->frame; // far behind: start again from now
         }
     }
+    double late_q[2] = {0, 0};
+    for (int q = 0; q < 2 && frames; ++q) {
+        const long want = (long)ceil((q ? 0.99 : 0.5) * (double)frames);
+        long acc = 0;
+        for (int b = 0; b < LATE_BINS; ++b)
+            if ((acc += late[b]) >= want) {
+                late_q[q] = (b + 1) * 0.05; // the bin's upper edge [ms]
+                break;
+            }
+    }
     if (!s->quiet)
-        logf_(s, "%ld frames, %ld missed deadlines, worst frame %.3f ms, mean frame %.3f ms; simulated %.3f s",
-              frames, missed, worst * 1e3, frames ? busy / frames * 1e3 : 0.0, s->e ? engine_time(s->e) : 0.0);
+        logf_(s, "%ld frames, %ld missed deadlines, worst frame %.3f ms, mean frame %.3f ms; simulated %.3f s; "
+                 "frame start after its deadline p50 %.2f ms, p99 %.2f ms",
+              frames, missed, worst * 1e3, frames ? busy / frames * 1e3 : 0.0, s->e ? engine_time(s->e) : 0.0,
+              late_q[0], late_q[1]);
     return 0;
 }
 
@@ -816,6 +862,9 @@ int cmd_serve(int argc, char** argv) {
     printf("cranesim serve: listening on %s (%s, %s, %g frames/s%s, state frame %zu bytes)\n", bound, m->name,
            engine_backend_name(s.e), rate, lockstep ? ", lockstep" : "", fl);
     fflush(stdout);
+    // The frames are paced by ppoll timeouts: the default 50 us timer slack
+    // would let every wake-up come up to 50 us late on top of scheduling.
+    prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
     app_signals sig;
     app_signals_catch(&sig);
     rc = serve_loop(&s, lfd, c.sim.duration);

@@ -14,6 +14,7 @@
 #include "input.h"
 #include "json_util.h"
 #include "panel.h"
+#include "protocol.h"
 #include "render.h"
 #include "session.h"
 
@@ -116,6 +117,12 @@ struct drive_session {
     long rp_next;        // its next tick
     char err[400];
     char status[512];
+    // Remote mode (drive --connect): the snapshot and row come from the server.
+    bool remote;
+    bool remote_fed;              // a state has arrived
+    double remote_row[SIM_NCOL];  // its row (the server's channels, checked equal to the engine's)
+    int remote_nrow;
+    drive_remote_input rin;       // the operator's input of the last tick
 };
 
 drive_opts drive_default_opts(void) {
@@ -821,11 +828,16 @@ int drive_session_finish_record(drive_session* s, long* rows, char* err, size_t 
 
 // The world's row, on the session's clock.
 static void session_row(drive_session* s, double* row) {
+    if (s->remote) {
+        memcpy(row, s->remote_row, sizeof s->remote_row);
+        return;
+    }
     engine_row(s->l, row);
     row[COL_T] += s->t_base;
 }
 
 static void take_snapshot(drive_session* s) {
+    if (s->remote) return; // drive_session_feed fills it
     engine_snapshot(s->l, s->snap);
     s->snap->t += s->t_base;
     char note[192];
@@ -1026,12 +1038,104 @@ void drive_session_destroy(drive_session* s) {
 static void render_snapshot(drive_session* s) {
     // Over less than 0.1 s of wall time the ratio means nothing (a frame at
     // t = 0 would read thousands); 0 is "unknown" (world_snapshot.h).
-    s->snap->rt_factor = drive_session_rt_factor(s);
+    if (!s->remote) s->snap->rt_factor = drive_session_rt_factor(s);
     render_frame(s->r, s->snap);
     render_present(s->r);
     s->st.triangles = render_get_stats(s->r).triangles;
     ++s->st.frames;
 }
+
+void drive_session_set_remote(drive_session* s) {
+    s->remote = true;
+    render_attach_panel(s->r, NULL);
+    // The local engine's collision shapes would stand still while the
+    // remote crane moves: the remote view has none.
+    s->snap->ncoll = 0;
+    s->rin = (drive_remote_input){.hook = -1, .pause = -1, .reset = -1};
+}
+
+void drive_session_feed(drive_session* s, const proto_state* st, double rt_factor) {
+    world_snapshot* w = s->snap;
+    // The static parts (names, shapes, meshes, terrain) stay the local
+    // engine's, built from the same files; the caller checked the bodies match.
+    const int nb = st->nbody < w->nbody ? st->nbody : w->nbody;
+    for (int i = 0; i < nb; ++i) {
+        memcpy(w->body[i].pos, st->pose[i], 3 * sizeof(double));
+        memcpy(w->body[i].rot, st->pose[i] + 3, 9 * sizeof(double));
+    }
+    w->ncyl = st->ncyl < WORLD_SNAP_MAX_CYLINDERS ? st->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    for (int i = 0; i < w->ncyl; ++i) {
+        world_snap_cylinder* y = &w->cyl[i];
+        const double* d = st->cyl[i];
+        memcpy(y->base, d, 3 * sizeof(double));
+        memcpy(y->rod_end, d + 3, 3 * sizeof(double));
+        y->x = d[6], y->pA = d[7], y->pB = d[8], y->u = d[9], y->u_cmd = d[10], y->force = d[11], y->v = d[12];
+        y->relief_open = (st->cyl_bits[i] & PROTO_CYL_RELIEF) != 0;
+        y->end_stop = (st->cyl_bits[i] & PROTO_CYL_END_STOP) != 0;
+    }
+    w->nrope = st->nrope < WORLD_SNAP_MAX_ROPE ? st->nrope : WORLD_SNAP_MAX_ROPE;
+    memcpy(w->rope, st->rope, (size_t)w->nrope * sizeof w->rope[0]);
+    w->t = st->nine[8];
+    w->rt_factor = rt_factor;
+    memcpy(w->tip, st->tip, sizeof w->tip);
+    memcpy(w->hook, st->hook, sizeof w->hook);
+    w->load_mass = st->load_mass;
+    w->slew = st->slew;
+    w->truck_tilt = acos(cos(st->roll) * cos(st->pitch)); // the world's acos(R22), within rounding
+    w->p_supply = st->p_supply;
+    w->attached = (st->flags & PROTO_F_ATTACHED) != 0;
+    w->tipping = (st->flags & PROTO_F_TIPPING) != 0;
+    w->collision = (st->flags & PROTO_F_COLLISION) != 0;
+    w->main_relief_open = (st->flags & PROTO_F_RELIEF) != 0;
+    w->nrelief = st->nrelief < WORLD_SNAP_MAX_RELIEFS ? st->nrelief : WORLD_SNAP_MAX_RELIEFS;
+    for (int i = 0; i < w->nrelief; ++i) {
+        snprintf(w->relief[i], sizeof w->relief[i], "%s", st->relief[i].name);
+        w->relief_cyl[i] = st->relief[i].cyl;
+        w->relief_port[i] = st->relief[i].port;
+    }
+    w->rcl_have = (st->flags & PROTO_F_RCL_HAVE) != 0;
+    w->rcl_on = (st->flags & PROTO_F_RCL_ON) != 0;
+    w->rcl_util = st->rcl_util;
+    w->npad = st->npad;
+    memcpy(w->pad_F, st->pad_F, sizeof w->pad_F);
+    w->pad_lifted = (int)(st->flags / PROTO_F_PAD_LIFTED0) & 15;
+    w->stab_margin = st->stab_margin;
+    w->ncoll = 0;
+    memset(s->remote_row, 0, sizeof s->remote_row);
+    s->remote_nrow = st->nrow < SIM_NCOL ? st->nrow : SIM_NCOL;
+    memcpy(s->remote_row, st->row, (size_t)s->remote_nrow * sizeof(double));
+    s->remote_fed = true;
+    s->st.sim_time = w->t;
+    char note[192];
+    if (render_pad_event(w, &s->pad_lifted, note, sizeof note)) fprintf(stderr, "cranesim drive: %s\n", note);
+    // The charts take every state frame (a local drive samples every drawn
+    // frame): the remote's own time axis, no frame left out.
+    if (s->nchart) {
+        for (int i = 0; i < s->nchart; ++i)
+            if (s->chart_col[i] >= 0 && s->chart_col[i] < s->remote_nrow)
+                render_chart_push(s->r, s->chart_id[i], w->t, s->remote_row[s->chart_col[i]]);
+    } else {
+        render_charts_sample(s->r, w);
+    }
+    if (s->nreadout)
+        for (int i = 0; i < s->nreadout; ++i) {
+            const int k = s->readout_col[i];
+            s->chan_v[k >= 0 ? k : 0] = k >= 0 && k < s->remote_nrow ? s->remote_row[k] : NAN;
+        }
+}
+
+void drive_session_remote_input(drive_session* s, drive_remote_input* in) {
+    *in = s->rin;
+    s->rin.hook = s->rin.pause = s->rin.reset = -1; // requests are taken once
+}
+
+void drive_session_set_link(drive_session* s, const char* text, const char* down) { render_set_link(s->r, text, down); }
+
+double drive_session_time(const drive_session* s) {
+    return s->remote ? s->snap->t : s->t_base + engine_time(s->l);
+}
+
+const char* drive_session_status_line(const drive_session* s) { return render_get_status(s->r); }
 
 double drive_session_rt_factor(const drive_session* s) {
     // The current piece only, and only the time it ran: a pause holds the
@@ -1086,8 +1190,13 @@ int drive_session_tick(drive_session* s, double wall) {
     input_command cmd;
     input_poll(s->in, dt_wall, &cmd);
     if (cmd.quit) quit = true;
-    if (cmd.pause) s->paused = !s->paused;
-    if (cmd.reset) act_reset(s); // ends the session file
+    if (s->remote) { // the server pauses and resets: asked once, by drive_connect
+        if (cmd.pause) s->rin.pause = 1;
+        if (cmd.reset) s->rin.reset = 1;
+    } else {
+        if (cmd.pause) s->paused = !s->paused;
+        if (cmd.reset) act_reset(s); // ends the session file
+    }
     if (cmd.camera_next) render_set_camera_preset(s->r, (render_get_camera_preset(s->r) + 1) % RENDER_CAM_COUNT);
     if (cmd.camera_preset >= 0) render_set_camera_preset(s->r, (render_cam_preset)cmd.camera_preset);
     if (cmd.screenshot) {
@@ -1134,7 +1243,13 @@ int drive_session_tick(drive_session* s, double wall) {
     }
 
     double t = engine_time(s->l);
-    if (s->paused) {
+    if (s->remote) {
+        // The sticks (or the script, which drive_connect plays at the remote
+        // time) go to the server; nothing steps here.
+        s->rin.u[0] = cmd.lift, s->rin.u[1] = cmd.jib, s->rin.u[2] = cmd.slew;
+        if (cmd.hook_toggle) s->rin.hook = !s->snap->attached;
+        ++s->st.input_samples;
+    } else if (s->paused) {
         // Hold simulated time: the clock offset grows with the paused time.
         s->sim_offset += dt_wall;
         s->piece_paused += dt_wall;
@@ -1194,7 +1309,7 @@ int drive_session_tick(drive_session* s, double wall) {
             return -1;
         }
     }
-    s->st.sim_time = s->sim_done + engine_time(s->l);
+    if (!s->remote) s->st.sim_time = s->sim_done + engine_time(s->l);
     if (wall - s->missed_t0 >= 1.0) {
         render_set_missed_deadlines(s->r, s->missed_window);
         s->missed_window = 0;
@@ -1208,7 +1323,7 @@ int drive_session_tick(drive_session* s, double wall) {
     // One CSV row per tick at most, shared by the recording and the charts.
     double row[SIM_NCOL];
     if (s->rec || (frame && (s->nchart || s->nreadout))) session_row(s, row);
-    if (frame && (s->nchart || s->nreadout)) {
+    if (frame && (s->nchart || s->nreadout) && !s->remote) {
         memcpy(s->chan_v, row, sizeof *row * (size_t)chan_list_nrow(s->chans));
         if (s->chart_circuit) chan_list_values(s->chans, s->l, s->chan_v, true);
     }
@@ -1221,7 +1336,7 @@ int drive_session_tick(drive_session* s, double wall) {
         // say so where the operator looks.
         const char* keys = panel_gui_wants_keyboard(s->pn) ? "  [keys: panel - Enter/Esc gives them back]" : "";
         snprintf(status, sizeof status, "%s%s%s%s%s%s", s->paused ? "PAUSED  " : "", s->rec ? "REC  " : "", s->status,
-                 src, panel_gui_visible(s->pn) ? "" : "  [Tab: parameters]", keys);
+                 src, panel_gui_visible(s->pn) || s->remote ? "" : "  [Tab: parameters]", keys);
         render_set_status(s->r, status);
         take_snapshot(s);
         if (s->nreadout) {
@@ -1234,7 +1349,9 @@ int drive_session_tick(drive_session* s, double wall) {
             }
             render_set_readouts(s->r, rd, s->nreadout);
         }
-        if (s->nchart) {
+        if (s->remote) {
+            // drive_session_feed sampled the charts with every state
+        } else if (s->nchart) {
             for (int i = 0; i < s->nchart; ++i)
                 if (s->chart_col[i] >= 0) render_chart_push(s->r, s->chart_id[i], row[COL_T], s->chan_v[s->chart_col[i]]);
         } else

@@ -122,6 +122,32 @@ const struct chan_list* drive_session_channels(const drive_session* s);
 /// The row (CSV columns) at the current simulated time.
 void drive_session_row(drive_session* s, double* row);
 
+struct proto_state;
+/// Remote mode (drive --connect): the session draws a crane simulated
+/// elsewhere. Its engine, built from the server's model and world files,
+/// gives the scene (bodies, meshes, terrain) and the channel names and is
+/// never stepped; drive_session_feed gives each state. The parameter panel
+/// is detached (its values would be the idle local engine's).
+void drive_session_set_remote(drive_session* s);
+/// One state frame (protocol.h): poses, cylinders, rope and HUD values into
+/// the snapshot the next frame draws, and one sample for the charts.
+/// rt_factor: the remote simulated time over wall time, 0 unknown.
+void drive_session_feed(drive_session* s, const struct proto_state* st, double rt_factor);
+/// The operator's input of the last tick, remote mode: stick positions
+/// u[3] in [-1, 1] and the requests (each -1: none): hook (0 release, 1
+/// attach), pause (toggle: 1), reset (1).
+typedef struct drive_remote_input {
+    double u[3];
+    int hook, pause, reset;
+} drive_remote_input;
+void drive_session_remote_input(drive_session* s, drive_remote_input* in);
+/// The link's HUD line and, when the link is down, its warning (NULL: up).
+void drive_session_set_link(drive_session* s, const char* text, const char* down);
+/// Simulated time the session shows [s] (remote mode: the last state's).
+double drive_session_time(const drive_session* s);
+/// The status line the next frame shows (as composed by the tick).
+const char* drive_session_status_line(const drive_session* s);
+
 /// Take a new file name for "save model" in the working directory:
 /// cranesim_model_N.json with the smallest N >= 1 no file has, created empty
 /// so no other writer gets it. Returns 0, or -1 with errno.
@@ -132,6 +158,12 @@ int drive_save_name(char* path, size_t n);
 /// no_window) when the window cannot open.
 int drive_window_main(const app_common* c, const drive_opts* o, double duration, const char* screenshot,
                       double screenshot_at, char* no_window, size_t no_window_sz);
+
+/// drive --connect HOST:PORT in the window (drive_connect_window.c): the
+/// remote crane drawn by a remote-mode session. Returns an exit code, or
+/// DRIVE_NO_WINDOW (the reason in no_window) when no window opens.
+int drive_connect_window(const app_common* c, const drive_opts* o, const char* addr, double duration,
+                         const char* screenshot, double screenshot_at, char* no_window, size_t no_window_sz);
 
 /// Benchmark: the real-time loop offscreen at w x h with the scripted
 /// operator for `seconds` of wall time; prints one JSON line (fps median and

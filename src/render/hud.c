@@ -385,6 +385,8 @@ int render_pad_event(const world_snapshot* s, int* prev, char* buf, size_t n) {
 int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDER_WARN_LEN], int max) {
     int n = 0;
     if (max > RENDER_WARN_MAX) max = RENDER_WARN_MAX;
+    // A dropped link first: everything below is the last state received.
+    if (r->link_down[0] && n < max) snprintf(w[n++], RENDER_WARN_LEN, "%s", r->link_down);
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
     // Each open relief by its circuit name, with the cylinder chamber it
     // guards: "MAIN RELIEF OPEN" for every relief sent an operator slewing
@@ -476,6 +478,11 @@ void render_hud_draw_overlay(render* r, const world_snapshot* s) {
     draw_readouts(r, s);
     draw_rcl_bar(r, s);
     draw_warnings(r, w, nw);
+    if (r->link[0]) { // the remote link, top right, clear of the warnings at the centre
+        const float tw = render_hud_text_width(r->link, 1.0f);
+        render_hud_rect(h, (float)h->w - tw - 16, 4, tw + 12, 16, k_panel);
+        render_hud_text(h, (float)h->w - tw - 10, 7, 1.0f, r->link_down[0] ? k_amber : k_white, r->link);
+    }
     if (r->charts.n > 0) {
         float ch = 124.0f;
         render_charts_draw(h, &r->charts, 10, (float)h->h - ch - 10, (float)h->w - 20, ch);

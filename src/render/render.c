@@ -271,6 +271,11 @@ void render_set_status(render* r, const char* text) {
 
 const char* render_get_status(const render* r) { return r->status; }
 
+void render_set_link(render* r, const char* text, const char* down) {
+    snprintf(r->link, sizeof r->link, "%s", text ? text : "");
+    snprintf(r->link_down, sizeof r->link_down, "%s", down ? down : "");
+}
+
 const char* render_get_readout(const render* r, int k, double* value, const char** unit) {
     if (k < 0 || k >= r->nreadout) return NULL;
     if (value) *value = r->readout[k].value;

@@ -190,6 +190,10 @@ typedef struct render_readout {
 void render_set_readouts(render* r, const render_readout* v, int n);
 /// Readout k as last set: its name (NULL when k is out of range), value and unit.
 const char* render_get_readout(const render* r, int k, double* value, const char** unit);
+/// The remote link's line (drive --connect: who controls, frames, loss,
+/// latency), drawn small at the top right; NULL or "" for none. down, when
+/// not NULL or "", is the first warning line (the link dropped).
+void render_set_link(render* r, const char* text, const char* down);
 /// The status line as last set.
 const char* render_get_status(const render* r);
 /// Longest warning line and most lines render_hud_warnings gives.

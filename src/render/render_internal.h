@@ -232,6 +232,8 @@ struct render {
     panel* panel;
     bool panel_gui;
     char status[128];
+    char link[160];    ///< the remote link line (drive --connect), "" none
+    char link_down[RENDER_WARN_LEN]; ///< the link is down: this warning, "" while it is up
     struct {
         char name[64], unit[16];
         double value;

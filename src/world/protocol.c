@@ -109,8 +109,14 @@ size_t proto_put_command(uint8_t* buf, size_t cap, const proto_command* c) {
 
 size_t proto_put_state(uint8_t* buf, size_t cap, const proto_state* s) {
     if (s->nrow > PROTO_MAX_ROW || s->nbody > PROTO_MAX_BODIES || s->ncyl > PROTO_MAX_CYL ||
-        s->nrope > PROTO_MAX_ROPE)
+        s->nrope > PROTO_MAX_ROPE || s->npad > PROTO_MAX_PADS || s->nrelief > PROTO_MAX_RELIEFS)
         return 0;
+    for (int i = 0; i < s->nrelief; ++i) {
+        const size_t k = strnlen(s->relief[i].name, PROTO_RELIEF_NAME + 1);
+        if (k == 0 || k > PROTO_RELIEF_NAME || s->relief[i].cyl < -1 || s->relief[i].cyl >= s->ncyl ||
+            s->relief[i].port > 1)
+            return 0;
+    }
     wr w;
     begin(&w, buf, cap, PROTO_STATE);
     put_f64s(&w, s->nine, 9);
@@ -121,14 +127,34 @@ size_t proto_put_state(uint8_t* buf, size_t cap, const proto_state* s) {
     put_f64s(&w, s->hook, 3);
     put_f64(&w, s->load_mass);
     put_u32(&w, (uint32_t)s->attached);
+    put_f64s(&w, s->tip, 3);
+    put_f64(&w, s->roll);
+    put_f64(&w, s->pitch);
+    put_f64(&w, s->p_supply);
+    put_f64(&w, s->rcl_util);
+    put_f64(&w, s->stab_margin);
+    put_u8(&w, s->npad);
+    put_f64s(&w, s->pad_F, s->npad);
     put_u16(&w, s->nrow);
     put_f64s(&w, s->row, s->nrow);
     put_u16(&w, s->nbody);
     for (int i = 0; i < s->nbody; ++i) put_f64s(&w, s->pose[i], 12);
     put_u8(&w, s->ncyl);
-    for (int i = 0; i < s->ncyl; ++i) put_f64s(&w, s->cyl[i], 12);
+    for (int i = 0; i < s->ncyl; ++i) {
+        put_f64s(&w, s->cyl[i], PROTO_CYL_VALUES);
+        put_u8(&w, s->cyl_bits[i]);
+    }
     put_u8(&w, s->nrope);
     for (int i = 0; i < s->nrope; ++i) put_f64s(&w, s->rope[i], 3);
+    put_u8(&w, s->nrelief);
+    for (int i = 0; i < s->nrelief; ++i) {
+        const proto_relief* q = &s->relief[i];
+        const size_t k = strlen(q->name);
+        put_u8(&w, (uint8_t)(q->cyl + 1)); // 0: no cylinder
+        put_u8(&w, q->port);
+        put_u8(&w, (uint8_t)k);
+        put_bytes(&w, q->name, k);
+    }
     return end(&w);
 }
 
@@ -141,6 +167,14 @@ size_t proto_put_text(uint8_t* buf, size_t cap, uint8_t type, uint64_t seq, uint
     put_u16(&w, (uint16_t)n);
     put_bytes(&w, text, n);
     return end(&w);
+}
+
+void proto_roll_pitch(const double rot[9], double* roll, double* pitch) {
+    double s = -rot[6]; // sin(pitch) = -R[2][0]
+    if (s > 1) s = 1;
+    if (s < -1) s = -1;
+    *pitch = asin(s);
+    *roll = atan2(rot[7], rot[8]);
 }
 
 // ---- reading ----
@@ -274,6 +308,19 @@ static int parse_state(rd* r, proto_state* s, char* err, size_t errsz) {
     get_f64s(r, s->hook, 3);
     s->load_mass = get_f64(r);
     s->attached = (int32_t)get_u32(r);
+    get_f64s(r, s->tip, 3);
+    s->roll = get_f64(r);
+    s->pitch = get_f64(r);
+    s->p_supply = get_f64(r);
+    s->rcl_util = get_f64(r);
+    s->stab_margin = get_f64(r);
+    s->npad = get_u8(r);
+    if (r->fail) return 0;
+    if (s->npad > PROTO_MAX_PADS) {
+        snprintf(err, errsz, "state: %u supports, at most %d", s->npad, PROTO_MAX_PADS);
+        return -1;
+    }
+    get_f64s(r, s->pad_F, s->npad);
     s->nrow = get_u16(r);
     if (r->fail) return 0;
     if (s->nrow > PROTO_MAX_ROW) {
@@ -294,7 +341,14 @@ static int parse_state(rd* r, proto_state* s, char* err, size_t errsz) {
         snprintf(err, errsz, "state: %u cylinders, at most %d", s->ncyl, PROTO_MAX_CYL);
         return -1;
     }
-    for (int i = 0; i < s->ncyl; ++i) get_f64s(r, s->cyl[i], 12);
+    for (int i = 0; i < s->ncyl; ++i) {
+        get_f64s(r, s->cyl[i], PROTO_CYL_VALUES);
+        s->cyl_bits[i] = get_u8(r);
+        if (!r->fail && s->cyl_bits[i] > (PROTO_CYL_RELIEF | PROTO_CYL_END_STOP)) {
+            snprintf(err, errsz, "state: cylinder %d: status bits 0x%02x, only 0x03 defined", i, s->cyl_bits[i]);
+            return -1;
+        }
+    }
     s->nrope = get_u8(r);
     if (r->fail) return 0;
     if (s->nrope > PROTO_MAX_ROPE) {
@@ -302,6 +356,33 @@ static int parse_state(rd* r, proto_state* s, char* err, size_t errsz) {
         return -1;
     }
     for (int i = 0; i < s->nrope; ++i) get_f64s(r, s->rope[i], 3);
+    s->nrelief = get_u8(r);
+    if (r->fail) return 0;
+    if (s->nrelief > PROTO_MAX_RELIEFS) {
+        snprintf(err, errsz, "state: %u open reliefs, at most %d", s->nrelief, PROTO_MAX_RELIEFS);
+        return -1;
+    }
+    for (int i = 0; i < s->nrelief; ++i) {
+        proto_relief* q = &s->relief[i];
+        const int cyl = (int)get_u8(r) - 1;
+        q->port = get_u8(r);
+        const uint8_t k = get_u8(r);
+        if (r->fail) return 0;
+        if (cyl >= s->ncyl || q->port > 1 || k == 0 || k > PROTO_RELIEF_NAME) {
+            snprintf(err, errsz, "state: relief %d: cylinder %d of %u, port %u or name of %u bytes (1..%d) out of range",
+                     i, cyl, s->ncyl, q->port, k, PROTO_RELIEF_NAME);
+            return -1;
+        }
+        const uint8_t* p = get_bytes(r, k);
+        if (!p) return 0;
+        if (memchr(p, 0, k)) {
+            snprintf(err, errsz, "state: relief %d: name contains a NUL byte", i);
+            return -1;
+        }
+        q->cyl = (int8_t)cyl;
+        memcpy(q->name, p, k);
+        q->name[k] = 0;
+    }
     return r->fail ? 0 : 1;
 }
 

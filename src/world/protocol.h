@@ -16,7 +16,9 @@ extern "C" {
 
 /// "CSIM" as a little-endian u32: the first field of both hellos.
 #define PROTO_MAGIC 0x4D495343u
-#define PROTO_VERSION 1u
+/// 2: the state frame carries the tip, the truck's roll and pitch, the supply
+/// pressure and what the HUD shows (limiter, supports, open reliefs).
+#define PROTO_VERSION 2u
 /// Frame header: u32 length of what follows (type byte + payload), then the type.
 #define PROTO_HEADER 5
 /// The longest frame a client may send (a SET with its path is the longest) [bytes after the length].
@@ -28,6 +30,10 @@ extern "C" {
 #define PROTO_MAX_CYL 4
 #define PROTO_MAX_ROPE 32
 #define PROTO_MAX_PATH 256
+#define PROTO_MAX_PADS 4
+#define PROTO_MAX_RELIEFS 8
+#define PROTO_RELIEF_NAME 47 ///< longest relief name [bytes]
+#define PROTO_CYL_VALUES 13  ///< f64 per cylinder record
 #define PROTO_MAX_TEXT 512
 
 enum proto_type {
@@ -59,7 +65,20 @@ enum {
     PROTO_F_LOCKSTEP = 1u << 3, ///< the server advances only on STEP commands
     PROTO_F_TIPPING = 1u << 4,
     PROTO_F_RELIEF = 1u << 5,
+    PROTO_F_COLLISION = 1u << 6, ///< a crane part touches an obstacle
+    PROTO_F_RCL_HAVE = 1u << 7,  ///< the rated capacity limiter measures (rcl_util valid)
+    PROTO_F_RCL_ON = 1u << 8,    ///< ... and stops the motions that increase the load moment
+    PROTO_F_PAD_LIFTED0 = 1u << 9, ///< bits 9..12: support FL, FR, RL, RR lifted off
 };
+/// Cylinder status bits (proto_state.cyl_bits).
+enum { PROTO_CYL_RELIEF = 1u << 0, PROTO_CYL_END_STOP = 1u << 1 };
+
+/// An open relief valve: its circuit name and the chamber it guards.
+typedef struct proto_relief {
+    int8_t cyl;   ///< index into the frame's cylinders, -1: none (a pump-line relief)
+    uint8_t port; ///< 0 chamber A, 1 chamber B
+    char name[PROTO_RELIEF_NAME + 1];
+} proto_relief;
 
 typedef struct proto_client_hello {
     uint32_t version;
@@ -95,15 +114,32 @@ typedef struct proto_state {
     double hook[3];   ///< [m], world frame
     double load_mass; ///< on the hook or at the tip [kg]
     int32_t attached; ///< load index on the hook, -1 none
+    double tip[3];    ///< end-arm tip, world frame [m]
+    double roll, pitch; ///< truck attitude [rad]: roll about its x axis (+ left side up), pitch about
+                        ///< its y axis (+ nose down); body rotation Rz(yaw) Ry(pitch) Rx(roll); 0 without a truck
+    double p_supply;  ///< supply (pump line) pressure, absolute [Pa]
+    double rcl_util;  ///< rated capacity limiter: load moment over rated [-] (flag PROTO_F_RCL_HAVE)
+    double stab_margin; ///< restoring over tipping moment [-] (with supports)
+    uint8_t npad;     ///< truck supports, 0 or 4: FL, FR, RL, RR
+    double pad_F[PROTO_MAX_PADS]; ///< their vertical ground reactions [N]
     uint16_t nrow;    ///< the row's columns (names in the hello's "channels")
     double row[PROTO_MAX_ROW];
     uint16_t nbody;   ///< body poses, in the hello's "bodies" order: pos[3] [m], rot[9] row-major
     double pose[PROTO_MAX_BODIES][12];
-    uint8_t ncyl;     ///< cylinders: base[3], rod_end[3] [m], x [m], pA, pB [Pa], u, u_cmd [-], force [N]
-    double cyl[PROTO_MAX_CYL][12];
+    uint8_t ncyl;     ///< cylinders: base[3], rod_end[3] [m], x [m], pA, pB [Pa], u, u_cmd [-], force [N], v [m/s]
+    double cyl[PROTO_MAX_CYL][PROTO_CYL_VALUES];
+    uint8_t cyl_bits[PROTO_MAX_CYL]; ///< PROTO_CYL_RELIEF, PROTO_CYL_END_STOP
     uint8_t nrope;    ///< rope polyline, tip to hook [m]
     double rope[PROTO_MAX_ROPE][3];
+    uint8_t nrelief;  ///< relief valves passing flow
+    proto_relief relief[PROTO_MAX_RELIEFS];
 } proto_state;
+
+/// The truck's roll and pitch [rad] from its body-to-world rotation
+/// (row-major), for R = Rz(yaw) Ry(pitch) Rx(roll): pitch = -asin(R[2][0]),
+/// roll = atan2(R[2][1], R[2][2]). The tilt from upright is then
+/// acos(cos(roll) cos(pitch)).
+void proto_roll_pitch(const double rot[9], double* roll, double* pitch);
 
 typedef struct proto_text {
     uint64_t seq;   ///< NOTICE: the command refused; ERROR: 0

@@ -46,8 +46,9 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
     int fd = serve_join(sv.port, PROTO_CONTROL, &role);
     CHECK(fd >= 0 && role == PROTO_CONTROL, "joined as controller (role %d)", role);
     CHECK(fd >= 0 && next_state(fd, &g_st, 5000) == 0 && g_st.nine[8] == 0, "the state at t = 0 first");
-    long diff = 0, frames = 0;
-    double worst = 0;
+    long diff = 0, frames = 0, diff2 = 0, tilted = 0;
+    double worst = 0, tilt_err = 0;
+    world_snapshot* snap = malloc(sizeof *snap);
     for (int i = 0; i < nframes && fd >= 0; ++i) {
         const double tm = engine_time(l) + 0.5 * frame;
         double u[3];
@@ -72,13 +73,32 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
               (unsigned long long)g_st.cmd_seq);
         if (memcmp(nine, g_st.nine, sizeof nine)) ++diff;
         for (int k = 0; k < 9; ++k) worst = fmax(worst, fabs(nine[k] - g_st.nine[k]));
+        // Version 2: the tip in the world, the truck's roll and pitch and the
+        // supply pressure equal the local run's; the tilt from roll and
+        // pitch is the world's own tilt from upright (acos of the truck's
+        // z-axis z component, another formula), within rounding.
+        engine_snapshot(l, snap);
+        double roll = 0, pitch = 0;
+        for (int b = 0; b < snap->nbody; ++b)
+            if (snap->body[b].role == WORLD_ROLE_TRUCK) proto_roll_pitch(snap->body[b].rot, &roll, &pitch);
+        if (memcmp(snap->tip, g_st.tip, sizeof g_st.tip) || roll != g_st.roll || pitch != g_st.pitch ||
+            snap->p_supply != g_st.p_supply || g_st.p_supply != row[COL_P_PUMP])
+            ++diff2;
+        tilt_err = fmax(tilt_err, fabs(acos(cos(g_st.roll) * cos(g_st.pitch)) - snap->truck_tilt));
+        if (fabs(g_st.roll) + fabs(g_st.pitch) > 0) ++tilted;
     }
+    printf("%s/%s: tip, roll/pitch, p_supply differ in %ld frames; tilt from roll/pitch within %.3g rad of the "
+           "world's; %ld frames with the truck tilted\n", mech, scen, diff2, tilt_err, tilted);
+    CHECK(diff2 == 0, "%s: tip, roll, pitch or p_supply differ from the local run in %ld frames", mech, diff2);
+    CHECK(tilt_err < 1e-9, "%s: tilt from roll and pitch off by %g rad", mech, tilt_err);
+    CHECK(o.mechanics != SIM_ODE || tilted > 0, "the sandbox truck tilts a little on its supports");
     printf("%s/%s: %ld frames served, %ld differ from the local run (largest difference %g)\n", mech, scen, frames,
            diff, worst);
     CHECK(frames == nframes && diff == 0, "%s: %ld of %ld frames differ, by up to %g", mech, diff, frames, worst);
     CHECK(g_st.nine[8] == nframes * frame || fabs(g_st.nine[8] - nframes * frame) < 1e-3, "t = %g", g_st.nine[8]);
     if (fd >= 0) close(fd);
     CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+    free(snap);
     engine_destroy(l);
     model_free(m);
 }
@@ -178,15 +198,18 @@ static void hostile(void) {
         memcpy(b + nh, big, 5);
         CASE("length 2^31", raw(sv.port, b, nh + 5), 3000);
     }
-    // 3. protocol version 2
-    {
-        size_t n = proto_put_client_hello(b, sizeof b, 2, PROTO_WATCH);
+    // 3. a client of protocol version 1 (the state frame before the tip, roll,
+    // pitch and supply pressure) and one of a version yet to come
+    for (int v = 1; v <= 3; v += 2) {
+        size_t n = proto_put_client_hello(b, sizeof b, (uint32_t)v, PROTO_WATCH);
         int fd = raw(sv.port, b, n);
         proto_msg m;
+        char want[96];
+        snprintf(want, sizeof want, "protocol version %d not supported (this server speaks 2)", v);
         CHECK(recv_frame(fd, &m, &g_st, 3000) == PROTO_ERROR && m.u.text.code == PROTO_E_VERSION &&
-                  strstr(m.u.text.text, "version 2"),
-              "version 2 answered with an error frame");
-        CASE("bad version", fd, 3000);
+                  strstr(m.u.text.text, want),
+              "version %d answered with '%s'", v, want);
+        CASE(v == 1 ? "old version" : "future version", fd, 3000);
     }
     // 4. an unknown op, 5. a NaN valve command (from a client that asked for control: it only watches)
     for (int k = 0; k < 2; ++k) {
@@ -306,7 +329,7 @@ static void hostile(void) {
     pthread_join(th, NULL);
     CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
     // Every case left its reason in the log.
-    const char* reasons[] = {"too short", "length 2147483648", "version 2 not supported", "unknown op 42",
+    const char* reasons[] = {"too short", "length 2147483648", "version 1 not supported", "version 3 not supported", "unknown op 42",
                              "opening 1 must be a number", "first frame must be a client hello", "no hello within",
                              "left incomplete", "not reading", "client limit reached", "unexpected state frame",
                              "the server stops"};

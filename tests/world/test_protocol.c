@@ -42,10 +42,10 @@ int main(void) {
     size_t n = proto_put_client_hello(buf, sizeof buf, PROTO_VERSION, PROTO_CONTROL);
     CHECK(n == 12, "hello is %zu bytes", n);
     CHECK(buf[0] == 8 && buf[1] == 0 && buf[4] == 1 && buf[5] == 'C' && buf[6] == 'S' && buf[7] == 'I' &&
-              buf[8] == 'M' && buf[9] == 1 && buf[10] == 0 && buf[11] == 1,
+              buf[8] == 'M' && buf[9] == 2 && buf[10] == 0 && buf[11] == 1,
           "hello bytes");
     CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == 1 && m.type == PROTO_CLIENT_HELLO &&
-              m.u.chello.version == 1 && m.u.chello.role == 1,
+              m.u.chello.version == 2 && m.u.chello.role == 1,
           "hello parsed: %s", err);
     // Every partial prefix asks for more.
     for (size_t k = 0; k < n; ++k) CHECK(parse(buf, k, PROTO_MAX_CLIENT_FRAME, &m, err) == 0, "prefix %zu", k);
@@ -76,14 +76,33 @@ int main(void) {
         for (int k = 0; k < 12; ++k) s_in.pose[i][k] = i - k * 0.5;
     s_in.ncyl = 3;
     s_in.cyl[2][11] = 1e5;
+    s_in.cyl[1][12] = -0.25;
+    s_in.cyl_bits[1] = PROTO_CYL_END_STOP;
     s_in.nrope = 2;
     s_in.rope[1][2] = -4;
+    s_in.tip[0] = 3.5, s_in.tip[1] = -1.25, s_in.tip[2] = 4.75;
+    s_in.roll = 0.03, s_in.pitch = -0.02;
+    s_in.p_supply = 17.5e6;
+    s_in.rcl_util = 0.93;
+    s_in.stab_margin = 1.7;
+    s_in.npad = 4;
+    for (int i = 0; i < 4; ++i) s_in.pad_F[i] = 1e4 * (i + 1);
+    s_in.nrelief = 2;
+    s_in.relief[0] = (proto_relief){.cyl = 1, .port = 1, .name = "jib_relief_B"};
+    s_in.relief[1] = (proto_relief){.cyl = -1, .port = 0, .name = "main_relief"};
     n = proto_put_state(buf, sizeof buf, &s_in);
-    // 5 header + 9*8 + 8 + 8 + 4 + 8 + 24 + 8 + 4 + 2 + 30*8 + 2 + 17*96 + 1 + 3*96 + 1 + 2*24
-    CHECK(n == 5 + 72 + 8 + 8 + 4 + 8 + 24 + 8 + 4 + 2 + 240 + 2 + 17 * 96 + 1 + 3 * 96 + 1 + 48, "state %zu", n);
-    double x1;
+    // 5 header + 9*8 + 8 + 8 + 4 + 8 + 24 + 8 + 4, then (version 2) tip 24 + roll, pitch 16 + p_supply 8 +
+    // rcl 8 + margin 8 + 1 + 4*8 pads, then 2 + 30*8 + 2 + 17*96 + 1 + 3*(13*8 + 1) + 1 + 2*24, then
+    // 1 + (3 + 12) + (3 + 11) reliefs.
+    const size_t head = 5 + 72 + 8 + 8 + 4 + 8 + 24 + 8 + 4;
+    CHECK(n == head + 24 + 16 + 8 + 8 + 8 + 1 + 32 + 2 + 240 + 2 + 17 * 96 + 1 + 3 * 105 + 1 + 48 + 1 + 15 + 14,
+          "state %zu", n);
+    double x1, tip_x, p_s;
     memcpy(&x1, buf + 5, 8); // the first value after the header is x1 (a little-endian host)
     CHECK(x1 == s_in.nine[0], "x1 first: %g", x1);
+    memcpy(&tip_x, buf + head, 8); // the tip right after `attached`, as docs/protocol.md lays it out
+    memcpy(&p_s, buf + head + 40, 8);
+    CHECK(tip_x == 3.5 && p_s == 17.5e6, "tip x %g and p_supply %g where the document puts them", tip_x, p_s);
     CHECK(parse(buf, n, PROTO_MAX_SERVER_FRAME, &m, err) == 1 && m.type == PROTO_STATE, "state: %s", err);
     CHECK(!memcmp(s_out.nine, s_in.nine, sizeof s_in.nine) && s_out.seq == s_in.seq && s_out.cmd_seq == 42 &&
               s_out.flags == s_in.flags && s_out.attached == -1 && s_out.nrow == 30 &&
@@ -91,6 +110,44 @@ int main(void) {
               !memcmp(s_out.pose, s_in.pose, 17 * 96) && s_out.ncyl == 3 && s_out.cyl[2][11] == 1e5 &&
               s_out.nrope == 2 && s_out.rope[1][2] == -4 && signbit(s_out.nine[8]),
           "state round trip");
+    CHECK(!memcmp(s_out.tip, s_in.tip, sizeof s_in.tip) && s_out.roll == 0.03 && s_out.pitch == -0.02 &&
+              s_out.p_supply == 17.5e6 && s_out.rcl_util == 0.93 && s_out.stab_margin == 1.7 && s_out.npad == 4 &&
+              !memcmp(s_out.pad_F, s_in.pad_F, sizeof s_in.pad_F) && s_out.cyl[1][12] == -0.25 &&
+              s_out.cyl_bits[1] == PROTO_CYL_END_STOP && s_out.cyl_bits[0] == 0 && s_out.nrelief == 2 &&
+              s_out.relief[0].cyl == 1 && s_out.relief[0].port == 1 && !strcmp(s_out.relief[0].name, "jib_relief_B") &&
+              s_out.relief[1].cyl == -1 && !strcmp(s_out.relief[1].name, "main_relief"),
+          "state round trip (version 2 fields)");
+    // Version 2 refusals: a relief naming a cylinder the frame does not have,
+    // five supports, unknown cylinder status bits.
+    {
+        uint8_t bad[1 << 16];
+        memcpy(bad, buf, n);
+        bad[n - 14] = 9; // relief 1's cylinder byte: cylinder 8 of 3
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "relief 1"), "relief: %s", err);
+        memcpy(bad, buf, n);
+        bad[head + 64] = 5;
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "supports"), "pads: %s", err);
+        memcpy(bad, buf, n);
+        const size_t cyl0 = head + 64 + 1 + 32 + 2 + 240 + 2 + 17 * 96 + 1;
+        bad[cyl0 + 104] = 4;
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "status bits"), "bits: %s", err);
+    }
+    // Roll and pitch from a rotation built from known angles, R = Rz Ry Rx,
+    // and the tilt from upright acos(R[2][2]) = acos(cos roll cos pitch).
+    {
+        const double yaw = 0.7, pitch = -0.13, roll = 0.21;
+        const double cy = cos(yaw), sy = sin(yaw), cp = cos(pitch), sp = sin(pitch), cr = cos(roll), sr = sin(roll);
+        const double R[9] = {cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,
+                             sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,
+                             -sp,     cp * sr,                cp * cr};
+        double r2, p2;
+        proto_roll_pitch(R, &r2, &p2);
+        CHECK(fabs(r2 - roll) < 1e-15 && fabs(p2 - pitch) < 1e-15, "roll %.17g pitch %.17g", r2, p2);
+        CHECK(fabs(acos(cos(r2) * cos(p2)) - acos(R[8])) < 1e-14, "tilt from roll and pitch");
+        const double up[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        proto_roll_pitch(up, &r2, &p2);
+        CHECK(r2 == 0 && p2 == 0, "upright: roll %g pitch %g", r2, p2);
+    }
     // A state frame is refused where the caller has no buffer for it (a server).
     m.u.state = NULL;
     size_t used;

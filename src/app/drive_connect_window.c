@@ -1,0 +1,497 @@
+// drive_connect_window.c: `cranesim drive --connect HOST:PORT` in the 3D
+// window: the visual computer of the paper's split. The scene, HUD, bars and
+// charts are the local drive's (drive_session in remote mode): its engine is
+// built from the model and world files the server's hello names and is
+// never stepped; every state frame replaces the snapshot's poses and values.
+// The sticks and keys (or the scripted operator, at the remote time) go back
+// as commands; the HUD shows who controls, frames received and lost, and the
+// command-to-echo latency. When the link drops it says so on screen and on
+// stderr, keeps the last picture, and reconnects with a doubling back-off
+// (0.25 s to 4 s) until the server is back.
+#define _GNU_SOURCE
+#include "app.h"
+#include "drive_session.h"
+#include "protocol.h"
+#include "render.h"
+
+#include <cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <netdb.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+typedef struct rlink {
+    const char* addr;
+    char host[256], port[16];
+    int fd;                  // -1: down
+    uint8_t* rx;
+    size_t len;
+    proto_state* st;
+    int role;                // granted, -1 before the hello
+    bool lockstep, ever;
+    double rate;             // frames per simulated second [Hz]
+    uint64_t seq, last_seq;  // our last command; the last frame's number
+    double sent_at;          // wall time of our last command, 0: none in flight [s]
+    long frames, lost, drops, links, nlat;
+    double lat_sum, lat_max, lat_avg; // [s]; lat_avg smoothed for the HUD
+    double last_frame_wall, retry_at, backoff;
+    double rt_w0, rt_t0;     // wall and remote time at the start of the rate window [s]
+    double rt;               // remote simulated over wall time, 0 unknown
+    char why[600];
+    int nbody_local;
+    int ev;                  // the scripted operator's next hook event
+    const scenario* sc;
+    bool scripted;
+    char* hjson;             // the first hello's description (a copy)
+} rlink;
+
+static int lk_connect(rlink* k, char* err, size_t errsz) {
+    struct addrinfo hints = {.ai_socktype = SOCK_STREAM}, *res;
+    int g = getaddrinfo(k->host, k->port, &hints, &res);
+    if (g) {
+        snprintf(err, errsz, "%s: %s", k->addr, gai_strerror(g));
+        return -1;
+    }
+    int fd = socket(res->ai_family, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    // A connect to a host that does not answer must not freeze the window:
+    // Linux takes SO_SNDTIMEO as the connect timeout (0.5 s).
+    struct timeval tv = {0, 500000};
+    if (fd >= 0) setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
+    if (fd < 0 || connect(fd, res->ai_addr, res->ai_addrlen)) {
+        snprintf(err, errsz, "%s: %s", k->addr, strerror(errno));
+        if (fd >= 0) close(fd);
+        freeaddrinfo(res);
+        return -1;
+    }
+    freeaddrinfo(res);
+    int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one); // a command goes out at once
+    uint8_t b[16];
+    const size_t n = proto_put_client_hello(b, sizeof b, PROTO_VERSION, PROTO_CONTROL);
+    if (send(fd, b, n, MSG_NOSIGNAL) != (ssize_t)n) {
+        snprintf(err, errsz, "%s: %s", k->addr, strerror(errno));
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+// Read one whole frame within ms milliseconds (the hello, before the window opens).
+static int lk_read_frame(rlink* k, proto_msg* m, int ms, char* err, size_t errsz) {
+    const double t_end = sim_wall_time() + ms * 1e-3;
+    for (;;) {
+        size_t used;
+        memset(m, 0, sizeof *m);
+        m->u.state = k->st;
+        int rc = proto_parse(k->rx, k->len, PROTO_MAX_SERVER_FRAME, &used, m, err, errsz);
+        if (rc < 0) return -1;
+        if (rc == 1) {
+            // The hello's JSON points into rx, which moves on: keep a copy.
+            if (m->type == PROTO_SERVER_HELLO) {
+                free(k->hjson);
+                k->hjson = malloc(m->u.shello.json_len + 1);
+                if (!k->hjson) {
+                    snprintf(err, errsz, "out of memory");
+                    return -1;
+                }
+                memcpy(k->hjson, m->u.shello.json, m->u.shello.json_len);
+                k->hjson[m->u.shello.json_len] = 0;
+                m->u.shello.json = k->hjson;
+            }
+            k->len -= used;
+            memmove(k->rx, k->rx + used, k->len);
+            return 1;
+        }
+        const double left = t_end - sim_wall_time();
+        struct pollfd pf = {.fd = k->fd, .events = POLLIN};
+        if (left <= 0 || poll(&pf, 1, (int)(left * 1e3) + 1) <= 0) {
+            snprintf(err, errsz, "no answer from the server within %d ms", ms);
+            return -1;
+        }
+        ssize_t r = recv(k->fd, k->rx + k->len, PROTO_MAX_SERVER_FRAME + 8 - k->len, 0);
+        if (r <= 0) {
+            snprintf(err, errsz, "%s", r == 0 ? "the server closed the link" : strerror(errno));
+            return -1;
+        }
+        k->len += (size_t)r;
+    }
+}
+
+static void lk_send(rlink* k, const proto_command* c) {
+    uint8_t b[PROTO_MAX_CLIENT_FRAME + 8];
+    const size_t n = proto_put_command(b, sizeof b, c);
+    if (n && k->fd >= 0) send(k->fd, b, n, MSG_NOSIGNAL); // a failure shows as a closed link at the next read
+}
+
+static void lk_down(rlink* k, drive_session* s, const char* why) {
+    if (k->fd < 0) return;
+    close(k->fd);
+    k->fd = -1;
+    k->len = 0;
+    k->sent_at = 0;
+    k->role = -1;
+    ++k->drops;
+    snprintf(k->why, sizeof k->why, "%s", why);
+    fprintf(stderr, "cranesim drive: link to %s lost: %s; reconnecting\n", k->addr, why);
+    k->backoff = 0.25;
+    k->retry_at = sim_wall_time() + k->backoff;
+    char down[RENDER_WARN_LEN];
+    snprintf(down, sizeof down, "LINK LOST: %.90s", why);
+    drive_session_set_link(s, "link down: showing the last state received; reconnecting", down);
+}
+
+static int scripted_hook(void* user, int attach) {
+    rlink* k = user;
+    proto_command c = {.seq = ++k->seq, .op = PROTO_OP_HOOK, .flag = (uint8_t)attach};
+    lk_send(k, &c);
+    return -1;
+}
+
+// A state frame arrived: draw it, count it, and answer it with the operator's commands.
+static void lk_state(rlink* k, drive_session* s) {
+    const proto_state* st = k->st;
+    const double now = sim_wall_time();
+    ++k->frames;
+    if (k->last_seq && st->seq > k->last_seq + 1) k->lost += (long)(st->seq - k->last_seq - 1);
+    k->last_seq = st->seq;
+    k->last_frame_wall = now;
+    if (k->sent_at > 0 && st->cmd_seq >= k->seq) {
+        const double l = now - k->sent_at;
+        k->lat_sum += l, k->lat_max = fmax(k->lat_max, l), ++k->nlat;
+        k->lat_avg = k->lat_avg > 0 ? 0.9 * k->lat_avg + 0.1 * l : l;
+        k->sent_at = 0;
+    }
+    // The remote real-time factor over at least 0.5 s of wall time; none in
+    // lockstep (the server runs as fast as it is stepped).
+    if (k->rt_w0 == 0 || st->nine[8] < k->rt_t0) k->rt_w0 = now, k->rt_t0 = st->nine[8];
+    else if (now - k->rt_w0 >= 0.5) {
+        k->rt = k->lockstep ? 0 : (st->nine[8] - k->rt_t0) / (now - k->rt_w0);
+        k->rt_w0 = now, k->rt_t0 = st->nine[8];
+    }
+    drive_session_feed(s, st, k->rt);
+    if (k->role != PROTO_CONTROL) return;
+    // The operator's positions: the devices of the last tick, or the script
+    // at the middle of the coming frame (as the headless drive and the
+    // server's lockstep test play it).
+    drive_remote_input in;
+    drive_session_remote_input(s, &in);
+    if (in.reset == 1) {
+        lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_RESET});
+        k->ev = 0;
+    }
+    if (in.pause == 1)
+        lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_PAUSE, .flag = !(st->flags & PROTO_F_PAUSED)});
+    if (in.hook >= 0) lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_HOOK, .flag = (uint8_t)in.hook});
+    proto_command c = {.op = PROTO_OP_VALVES};
+    if (k->scripted) {
+        double u[3];
+        scenario_play(k->sc, st->nine[8] + 0.5 / k->rate, &k->ev, u, scripted_hook, k);
+        for (int j = 0; j < 3; ++j) c.u[j] = u[j];
+    } else {
+        memcpy(c.u, in.u, sizeof c.u);
+    }
+    for (int j = 0; j < 3; ++j) c.u[j] = fmax(-1, fmin(1, isfinite(c.u[j]) ? c.u[j] : 0));
+    // One command in flight in real time (its echo times the link); in
+    // lockstep every frame is answered with the openings and one step.
+    if (k->lockstep || k->sent_at == 0) {
+        c.seq = ++k->seq;
+        if (k->sent_at == 0) k->sent_at = now;
+        lk_send(k, &c);
+    }
+    if (k->lockstep) lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_STEP, .frames = 1});
+}
+
+// The server's hello on a (re)connection: the role, the rate, and the same world.
+static int lk_hello(rlink* k, const proto_msg* m, char* err, size_t errsz) {
+    k->role = m->u.shello.role;
+    k->lockstep = m->u.shello.lockstep;
+    k->rate = m->u.shello.rate;
+    cJSON* j = cJSON_ParseWithLength(m->u.shello.json, m->u.shello.json_len);
+    const int nb = cJSON_GetArraySize(cJSON_GetObjectItem(j, "bodies"));
+    cJSON_Delete(j);
+    if (k->nbody_local >= 0 && nb != k->nbody_local) {
+        snprintf(err, errsz, "the server now runs another world (%d bodies, this view has %d): restart drive --connect",
+                 nb, k->nbody_local);
+        return -1;
+    }
+    printf("cranesim drive: connected to %s (%s%s)%s\n", k->addr,
+           k->role == PROTO_CONTROL ? "controlling" : "watching: another client controls",
+           k->lockstep ? ", lockstep" : "", k->ever ? ", reconnected" : "");
+    fflush(stdout);
+    k->ever = true;
+    ++k->links;
+    k->last_seq = 0;
+    k->last_frame_wall = sim_wall_time();
+    k->rt_w0 = 0;
+    return 0;
+}
+
+// Everything the socket has now (up to wait_s for the first byte); the
+// bytes already buffered (frames that came with the hello) first.
+static void lk_pump(rlink* k, drive_session* s, double wait_s) {
+    if (k->fd < 0) return;
+    bool polled = false;
+    for (;;) {
+        if (polled) {
+            ssize_t r = recv(k->fd, k->rx + k->len, PROTO_MAX_SERVER_FRAME + 8 - k->len, MSG_DONTWAIT);
+            if (r == 0 || (r < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) {
+                lk_down(k, s, r == 0 ? "the server closed the link" : strerror(errno));
+                return;
+            }
+            if (r < 0) break;
+            k->len += (size_t)r;
+        }
+        size_t off = 0;
+        char err[512];
+        for (;;) {
+            proto_msg m;
+            memset(&m, 0, sizeof m);
+            m.u.state = k->st;
+            size_t used;
+            int rc = proto_parse(k->rx + off, k->len - off, PROTO_MAX_SERVER_FRAME, &used, &m, err, sizeof err);
+            if (rc < 0) {
+                lk_down(k, s, err);
+                return;
+            }
+            if (rc == 0) break;
+            off += used;
+            if (m.type == PROTO_SERVER_HELLO) {
+                if (lk_hello(k, &m, err, sizeof err)) {
+                    lk_down(k, s, err);
+                    return;
+                }
+            } else if (m.type == PROTO_ERROR) {
+                char why[600];
+                snprintf(why, sizeof why, "the server says: %s", m.u.text.text);
+                lk_down(k, s, why);
+                return;
+            } else if (m.type == PROTO_NOTICE) {
+                fprintf(stderr, "cranesim drive: the server says: %s\n", m.u.text.text);
+            } else if (m.type == PROTO_STATE) {
+                lk_state(k, s);
+            }
+        }
+        memmove(k->rx, k->rx + off, k->len - off);
+        k->len -= off;
+        if (!polled) {
+            struct pollfd pf = {.fd = k->fd, .events = POLLIN};
+            const int pr = poll(&pf, 1, wait_s > 0 ? (int)ceil(wait_s * 1e3) : 0);
+            if (pr <= 0) {
+                if (sim_wall_time() - k->last_frame_wall > 2.0) lk_down(k, s, "no frame for 2 s");
+                return;
+            }
+            polled = true;
+        }
+    }
+}
+
+static void lk_hud(rlink* k, drive_session* s) {
+    if (k->fd < 0) return;
+    char t[160];
+    const double pct = k->frames + k->lost ? 100.0 * (double)k->lost / (double)(k->frames + k->lost) : 0;
+    snprintf(t, sizeof t, "link %s %s: %ld frames, %ld lost (%.1f %%), latency %.1f ms (max %.1f)", k->addr,
+             k->role == PROTO_CONTROL ? "controlling" : "watching", k->frames, k->lost, pct, 1e3 * k->lat_avg,
+             1e3 * k->lat_max);
+    drive_session_set_link(s, t, NULL);
+}
+
+static bool file_exists(const char* p) { return p && p[0] && access(p, R_OK) == 0; }
+
+int drive_connect_window(const app_common* c0, const drive_opts* o, const char* addr, double duration,
+                         const char* shot, double shot_at, char* no_window, size_t no_window_sz) {
+    rlink k = {.addr = addr, .fd = -1, .role = -1, .nbody_local = -1, .backoff = 0.25, .scripted = o->scripted};
+    const char* colon = strrchr(addr, ':');
+    if (!colon || colon == addr || !colon[1] || (size_t)(colon - addr) >= sizeof k.host ||
+        strlen(colon + 1) >= sizeof k.port) {
+        fprintf(stderr, "cranesim drive: --connect: expected HOST:PORT (127.0.0.1:7575), got '%s'\n", addr);
+        return EXIT_USAGE;
+    }
+    memcpy(k.host, addr, (size_t)(colon - addr));
+    k.host[colon - addr] = 0;
+    snprintf(k.port, sizeof k.port, "%s", colon + 1);
+    if (k.host[0] == '[' && k.host[strlen(k.host) - 1] == ']') {
+        memmove(k.host, k.host + 1, strlen(k.host));
+        k.host[strlen(k.host) - 1] = 0;
+    }
+    k.rx = malloc(PROTO_MAX_SERVER_FRAME + 8);
+    k.st = malloc(sizeof *k.st);
+    char err[700];
+    int code = EXIT_RUNTIME;
+    drive_session* s = NULL;
+    cJSON* desc = NULL;
+    if (!k.rx || !k.st) {
+        fprintf(stderr, "cranesim drive: out of memory\n");
+        goto done;
+    }
+    // The hello first: the scene is built from the files it names.
+    k.fd = lk_connect(&k, err, sizeof err);
+    proto_msg m;
+    if (k.fd < 0 || lk_read_frame(&k, &m, 5000, err, sizeof err) < 0) {
+        fprintf(stderr, "cranesim drive: --connect %s: %s\n", addr, err);
+        goto done;
+    }
+    if (m.type == PROTO_ERROR) {
+        fprintf(stderr, "cranesim drive: --connect %s: the server says: %s\n", addr, m.u.text.text);
+        goto done;
+    }
+    if (m.type != PROTO_SERVER_HELLO) {
+        fprintf(stderr, "cranesim drive: --connect %s: the server's first frame is not its hello\n", addr);
+        goto done;
+    }
+    desc = cJSON_ParseWithLength(m.u.shello.json, m.u.shello.json_len);
+    const char* model_file = cJSON_GetStringValue(cJSON_GetObjectItem(desc, "model_file"));
+    const char* world_file = cJSON_GetStringValue(cJSON_GetObjectItem(desc, "world_file"));
+    const char* backend = cJSON_GetStringValue(cJSON_GetObjectItem(desc, "backend"));
+    if (!desc || !backend) {
+        fprintf(stderr, "cranesim drive: --connect %s: server hello: no JSON description with a \"backend\"\n", addr);
+        goto done;
+    }
+    app_common c = *c0;
+    char model_buf[1024], world_buf[1024]; // the session keeps the paths: not into the JSON
+    snprintf(model_buf, sizeof model_buf, "%s", model_file ? model_file : "");
+    snprintf(world_buf, sizeof world_buf, "%s", world_file ? world_file : "");
+    model_file = model_buf, world_file = world_buf;
+    c.sim.mechanics = strcmp(backend, "ode") ? SIM_LAGRANGE : SIM_ODE;
+    // The server's files where this computer has them (the same install);
+    // else this drive's --model and --world, which must describe the same crane.
+    const char* dflt = model_default_path();
+    const char* base = strrchr(dflt, '/') ? strrchr(dflt, '/') + 1 : dflt;
+    if (file_exists(model_file)) c.model_path = model_file;
+    else if (!strcmp(model_file, base) || !strcmp(model_file, dflt)) c.model_path = NULL; // the shipped model, by name
+    else if (model_file && model_file[0])
+        printf("cranesim drive: the server's model %s is not here: drawing %s\n", model_file,
+               c.model_path ? c.model_path : "the default model");
+    if (c.sim.mechanics == SIM_ODE) {
+        if (file_exists(world_file)) c.sim.world = world_file;
+        else {
+            if (!c.sim.world) c.sim.world = "sandbox";
+            printf("cranesim drive: the server's world %s is not here: drawing %s\n", world_file ? world_file : "?",
+                   c.sim.world);
+        }
+    }
+    if (!c.scenario_path) c.scenario_path = app_default_drive_scenario(c.sim.mechanics);
+    int ccode;
+    s = drive_session_create(&c, o, err, sizeof err, &ccode);
+    if (!s) {
+        if (ccode == DRIVE_NO_WINDOW) snprintf(no_window, no_window_sz, "%s", err);
+        else fprintf(stderr, "cranesim drive: %s\n", err);
+        code = ccode;
+        goto done;
+    }
+    // The same world: the hello's bodies by name, in order.
+    const world_snapshot* w = drive_session_snapshot(s);
+    cJSON* bodies = cJSON_GetObjectItem(desc, "bodies");
+    const int nb = cJSON_GetArraySize(bodies);
+    if (nb != w->nbody) {
+        fprintf(stderr, "cranesim drive: --connect %s: the server's world has %d bodies, this one (%s) %d: give "
+                        "--model and --world as the server runs them\n", addr, nb,
+                c.sim.mechanics == SIM_ODE ? c.sim.world : "lagrange", w->nbody);
+        code = EXIT_USAGE;
+        goto done;
+    }
+    for (int i = 0; i < nb; ++i) {
+        const char* bn = cJSON_GetStringValue(cJSON_GetObjectItem(cJSON_GetArrayItem(bodies, i), "name"));
+        if (!bn || strcmp(bn, w->body[i].name)) {
+            fprintf(stderr, "cranesim drive: --connect %s: body %d is '%s' on the server, '%s' here: give --model "
+                            "and --world as the server runs them\n", addr, i, bn ? bn : "?", w->body[i].name);
+            code = EXIT_USAGE;
+            goto done;
+        }
+    }
+    k.nbody_local = nb;
+    scenario* sc = malloc(sizeof *sc);
+    model* dm = NULL;
+    if (!sc || app_load_msg(&c, &dm, sc, err, sizeof err)) {
+        fprintf(stderr, "cranesim drive: %s\n", sc ? err : "out of memory");
+        free(sc);
+        code = EXIT_USAGE;
+        goto done;
+    }
+    model_free(dm);
+    k.sc = sc;
+    drive_session_set_remote(s);
+    if (lk_hello(&k, &m, err, sizeof err)) { // cannot fail: nbody checked above
+        fprintf(stderr, "cranesim drive: %s\n", err);
+        goto done_sc;
+    }
+    cJSON_Delete(desc);
+    desc = NULL;
+    printf("cranesim drive: %s from %s%s; %s\n", o->offscreen ? "offscreen view" : "window", addr,
+           k.lockstep ? " (lockstep: every frame answered with a step)" : "",
+           o->scripted ? "scripted operator" : "joystick or keyboard (the server pauses, resets, hooks)");
+    const double tick = 1.0 / 240.0;
+    const double w0 = sim_wall_time();
+    code = 0;
+    bool shot_done = false;
+    app_signals sig;
+    app_signals_catch(&sig);
+    for (;;) {
+        const double wall = sim_wall_time() - w0;
+        int rc = drive_session_tick(s, wall);
+        if (rc < 0) {
+            fprintf(stderr, "cranesim drive: %s\n", drive_session_error(s));
+            code = EXIT_RUNTIME;
+            break;
+        }
+        if (shot && !shot_done && k.frames > 0 && drive_session_time(s) >= shot_at) {
+            drive_session_render(s);
+            if (drive_session_screenshot(s, shot, err, sizeof err)) {
+                fprintf(stderr, "cranesim drive: %s\n", err);
+                code = EXIT_RUNTIME;
+            } else {
+                printf("  screenshot -> %s (remote t = %.3f s)\n", shot, drive_session_time(s));
+            }
+            shot_done = true;
+            if (duration <= 0) break;
+        }
+        if (rc > 0 || (duration > 0 && wall >= duration) || app_signal_caught()) break;
+        // Reconnect when the back-off is over (doubling to 4 s).
+        if (k.fd < 0 && sim_wall_time() >= k.retry_at) {
+            k.fd = lk_connect(&k, err, sizeof err);
+            if (k.fd < 0) {
+                k.backoff = fmin(2 * k.backoff, 4.0);
+                k.retry_at = sim_wall_time() + k.backoff;
+                char line[200];
+                snprintf(line, sizeof line, "link down: %.80s; next try in %.2g s", err, k.backoff);
+                char down[RENDER_WARN_LEN];
+                snprintf(down, sizeof down, "LINK LOST: %.90s", k.why);
+                drive_session_set_link(s, line, down);
+            } else {
+                k.len = 0;
+                k.last_frame_wall = sim_wall_time();
+            }
+        }
+        // Wait for the next tick on the socket, not in a sleep: a frame that
+        // arrives is drawn and answered at once (the command-to-echo latency
+        // is the link's, not the tick's).
+        const double left = w0 + wall + tick - sim_wall_time();
+        if (k.fd >= 0) lk_pump(&k, s, left);
+        else if (left > 0) drive_session_idle(s, left);
+        lk_hud(&k, s);
+    }
+    app_signals_restore(&sig);
+    {
+        const drive_stats* st = drive_session_stats(s);
+        printf("  drew %ld frames in %.2f s wall; link: %ld frames received, %ld lost, %ld drop%s, %ld connection%s; "
+               "command-to-echo latency mean %.2f ms, max %.2f ms (%ld commands); remote t = %.3f s\n",
+               st->frames, sim_wall_time() - w0, k.frames, k.lost, k.drops, k.drops == 1 ? "" : "s", k.links,
+               k.links == 1 ? "" : "s", k.nlat ? 1e3 * k.lat_sum / k.nlat : 0.0, 1e3 * k.lat_max, k.nlat,
+               drive_session_time(s));
+    }
+done_sc:
+    free(sc);
+done:
+    cJSON_Delete(desc);
+    if (k.fd >= 0) close(k.fd);
+    if (s) drive_session_destroy(s);
+    free(k.rx);
+    free(k.st);
+    free(k.hjson);
+    return code;
+}

@@ -1,0 +1,157 @@
+// test_drive_connect.c: `cranesim drive --connect` draws the remote crane as
+// a local drive draws the same state.
+//
+// A lockstep `cranesim serve` (the sandbox) is driven by `cranesim drive
+// --connect --screenshot` (offscreen): it answers every state frame with the
+// scripted operator's openings and one step, so the remote state at the
+// screenshot is reproducible. Here the same scenario runs on a local engine
+// frame by frame (the openings at the middle of each frame, hook events as
+// the player gives them), its snapshot sampled into the charts once per frame
+// as the remote view samples every state frame, and a local drive session
+// renders that state at the same size. The two pictures must match: at most
+// 2 % of the pixels differ by more than 40 of 255 in a channel. Not bit for
+// bit, and why: the HUD's frame rate is each renderer's own wall-clock
+// measure, and the remote view draws its link line (frames, latency) top
+// right. The same comparison against the local state 1.5 s later must fail
+// it by far: the tolerance tells states apart.
+#define _DEFAULT_SOURCE
+#include "check.h"
+#include "drive_session.h"
+#include "render.h"
+#include "serve_util.h"
+
+#include <math.h>
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+
+#define W 960
+#define H 540
+// The top line holds the two differences by design: the HUD's frame rate
+// (each renderer's own wall-clock measure) and the remote view's link line.
+#define TOP 24
+
+// Pixels whose largest channel difference exceeds 40 (of 255), as a fraction;
+// the mask of them to mask_png (white: differs) when not NULL, to look at.
+// Rows from y0 down (y0 = 0: the whole picture).
+static double differing(const unsigned char* a, const unsigned char* b, int y0, const char* mask_png) {
+    long n = 0;
+    unsigned char* mask = mask_png ? calloc((size_t)W * H, 1) : NULL;
+    for (long i = (long)y0 * W; i < (long)W * H; ++i) {
+        int d = 0;
+        for (int c = 0; c < 3; ++c) {
+            const int x = abs((int)a[4 * i + c] - (int)b[4 * i + c]);
+            if (x > d) d = x;
+        }
+        if (d > 40) ++n;
+        if (mask) mask[i] = d > 40 ? 255 : 0;
+    }
+    if (mask) stbi_write_png(mask_png, W, H, 1, mask, W);
+    free(mask);
+    return (double)n / ((double)W * (H - y0));
+}
+
+static unsigned char* load_png(const char* path) {
+    int w = 0, h = 0, n = 0;
+    unsigned char* p = stbi_load(path, &w, &h, &n, 4);
+    CHECK(p && w == W && h == H, "%s: %dx%d", path, w, h);
+    if (p && (w != W || h != H)) {
+        stbi_image_free(p);
+        return NULL;
+    }
+    return p;
+}
+
+static void hook_cb(void* user, engine* e, int attach, int got) { (void)user, (void)e, (void)attach, (void)got; }
+
+int main(void) {
+    const char* scen = "sandbox_pick_place";
+    const char* args[] = {"--mechanics", "ode", "--scenario", scen, "--lockstep", NULL};
+    served sv = {0};
+    CHECK(serve_start(&sv, "test_drive_connect_serve.log", args) == 0, "server started");
+    // The remote view, as a user runs it.
+    char addr[64], cmd[1024];
+    snprintf(addr, sizeof addr, "127.0.0.1:%d", sv.port);
+    remove("connect_remote.png");
+    snprintf(cmd, sizeof cmd,
+             "%s/cranesim drive --connect %s --scenario %s --screenshot connect_remote.png --screenshot-at 4 "
+             "--size %dx%d 2>&1",
+             CRANESIM_BINARY_DIR, addr, scen, W, H);
+    FILE* p = popen(cmd, "r");
+    char line[1024];
+    double t_remote = -1;
+    while (p && fgets(line, sizeof line, p)) {
+        fputs(line, stdout);
+        const char* at = strstr(line, "screenshot -> connect_remote.png (remote t = ");
+        if (at) t_remote = atof(at + strlen("screenshot -> connect_remote.png (remote t = "));
+    }
+    const int prc = p ? pclose(p) : -1;
+    CHECK(prc == 0 && t_remote >= 4, "drive --connect exit %d, screenshot at remote t = %g s", prc, t_remote);
+    CHECK(serve_stop(&sv) == 0, "server exits 0");
+
+    // The same run locally, rendered by a drive session at t_remote and 1.5 s later.
+    app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE;
+    c.sim.world = "sandbox";
+    char sp[512];
+    snprintf(sp, sizeof sp, "%s/scenarios/%s.json", CRANESIM_ASSETS, scen);
+    c.scenario_path = sp;
+    drive_opts o = drive_default_opts();
+    o.offscreen = true;
+    o.scripted = true;
+    o.width = W;
+    o.height = H;
+    char err[512];
+    drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
+    CHECK(s != NULL, "session: %s", err);
+    scenario sc;
+    CHECK(scenario_load(sp, &sc, err, sizeof err) == 0, "%s", err);
+    if (!s || t_remote < 0) {
+        TEST_MAIN_END();
+    }
+    engine* l = drive_session_engine(s);
+    render* r = drive_session_render_ctx(s);
+    world_snapshot* snap = malloc(sizeof *snap);
+    const double frame = 1.0 / 75; // the server's default rate
+    int ev = 0;
+    engine_snapshot(l, snap);
+    render_charts_sample(r, snap);
+    // What the remote view's status line says for a scripted operator.
+    render_set_status(r, "  [scripted]");
+    const long k_shot = lround(t_remote / frame);
+    double d_same = 1, d_all = 1, d_later = 0;
+    for (long k = 0; k < k_shot + 113; ++k) {
+        const double tm = engine_time(l) + 0.5 * frame;
+        double u[3];
+        engine_play(l, &sc, tm, &ev, u, hook_cb, NULL);
+        for (int j = 0; j < 3; ++j) u[j] = fmax(-1, fmin(1, u[j]));
+        engine_set_commands(l, u);
+        CHECK(engine_advance(l, (k + 1) * frame - engine_time(l)) == 0, "local step %ld", k);
+        engine_snapshot(l, snap);
+        render_charts_sample(r, snap);
+        if (k + 1 == k_shot || k + 1 == k_shot + 113) {
+            CHECK(fabs(engine_time(l) - t_remote) < 1e-3 || k + 1 != k_shot, "local t %g, remote %g",
+                  engine_time(l), t_remote);
+            drive_session_render(s);
+            const char* png = k + 1 == k_shot ? "connect_local.png" : "connect_later.png";
+            CHECK(drive_session_screenshot(s, png, err, sizeof err) == 0, "%s", err);
+        }
+    }
+    unsigned char* a = load_png("connect_remote.png");
+    unsigned char* b = load_png("connect_local.png");
+    unsigned char* later = load_png("connect_later.png");
+    if (a && b && later) {
+        d_all = differing(a, b, 0, "connect_diff.png");
+        d_same = differing(a, b, TOP, NULL);
+        d_later = differing(a, later, TOP, NULL);
+    }
+    printf("pixels differing by > 40/255: remote vs local at t = %.3f s: %.3f %% of the picture, %.4f %% below "
+           "the top line; vs local 1.5 s later: %.3f %% below it\n",
+           t_remote, 100 * d_all, 100 * d_same, 100 * d_later);
+    CHECK(d_all < 0.02, "the remote view differs from the local one in %.2f %% of the pixels", 100 * d_all);
+    CHECK(d_same < 1e-3, "below the top line the remote view differs in %.4f %% of the pixels", 100 * d_same);
+    CHECK(d_later > 0.02, "a later state must differ (%.2f %%)", 100 * d_later);
+    stbi_image_free(a), stbi_image_free(b), stbi_image_free(later);
+    free(snap);
+    drive_session_destroy(s);
+    TEST_MAIN_END();
+}
