@@ -161,8 +161,13 @@ static void drop_client(server* s, int idx, uint16_t code, const char* why) {
     logf_(s, "client %d (%s) closed: %s (%llu frames sent, %llu lost, %llu commands)", c->id, c->peer, why,
           (unsigned long long)c->frames, (unsigned long long)c->lost, (unsigned long long)c->cmds);
     if (s->controller == c->id) {
+        // Dead-man: a controller that left (or whose link timed out) can no
+        // longer stop what it started, so its last openings must not stay
+        // applied. All three spools go to neutral (0) at once.
         s->controller = 0;
-        logf_(s, "no client controls the crane now (valves held at their last openings)");
+        memset(s->u, 0, sizeof s->u);
+        if (s->e) engine_set_commands(s->e, s->u);
+        logf_(s, "no client controls the crane now (valves to neutral)");
     }
     shutdown(c->fd, SHUT_WR);
     close(c->fd);
