@@ -155,6 +155,11 @@ double app_output_period(const sim_opts* o);
 void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind);
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
                        bool* switched);
+/// app_scenario_world with the advice after the refusal given by the caller
+/// (NULL: "run it with --mechanics ode --world sandbox"), for a command whose
+/// own options put the run where it is (compare's --backends).
+int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
+                              bool* switched, const char* remedy);
 
 /// Resolve a scenario argument: an existing file, or assets/scenarios/<name>.json.
 const char* app_scenario_path(const char* arg, char* buf, size_t n);

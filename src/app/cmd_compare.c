@@ -312,7 +312,22 @@ int cmd_compare(int argc, char** argv) {
     }
     // Both sides must run the scenario as written (no silent switch: the
     // comparison names its backends).
-    for (int s = 0; s < 2 && !rc; ++s) rc = app_scenario_world("compare", &side[s], c.given, &sc, false, NULL);
+    // The advice must name what put a side on the wrong crane: the default
+    // pair or the user's --backends (--mechanics alone is overridden by them).
+    for (int s = 0; s < 2 && !rc; ++s) {
+        char remedy[400];
+        const char* ab = s ? "B" : "A";
+        if (side[s].mechanics == SIM_LAGRANGE && (pairs[0] || (!any_pair && !designs)))
+            snprintf(remedy, sizeof remedy,
+                     "side %s runs there because of %s; to compare in the sandbox, keep both sides there: "
+                     "--mechanics ode --world sandbox with another pair (--dts H1,H2, or --set-a/--set-b)",
+                     ab, pairs[0] ? "--backends" : "the default --backends lagrange,ode");
+        else if (side[s].mechanics == SIM_ODE)
+            snprintf(remedy, sizeof remedy, "give --world sandbox (side %s runs the ode backend)", ab);
+        else
+            snprintf(remedy, sizeof remedy, "run it with --mechanics ode --world sandbox");
+        rc = app_scenario_world_remedy("compare", &side[s], c.given, &sc, false, NULL, remedy);
+    }
     if (rc && m) {
         model_free(m);
         model_free(mb);

@@ -211,14 +211,23 @@ static void test_scenario_world(void) {
         "run --quiet --scenario sandbox_wall --mechanics lagrange --out world.csv",
         "run --quiet --scenario sandbox_pick_place --mechanics ode --world validation --out world.csv",
         "compare --quiet --scenario sandbox_wall --duration 0.1",
+        // Side A is on the lagrange crane because of the default pair, not
+        // --mechanics: the advice must name --backends (it repeated the
+        // options the user had given).
+        "compare --quiet --scenario sandbox_swing --mechanics ode --world sandbox --duration 0.1",
     };
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < 4; ++i) {
         cli_write_file("world.csv", "old\n");
         rc = cli_run(refused[i], out, sizeof out);
-        CHECK(rc == 2 && strstr(out, "run it with --mechanics ode --world sandbox"), "%s: exit %d: %s", refused[i],
-              rc, out);
+        const char* want = i < 2 ? "run it with --mechanics ode --world sandbox" : "the default --backends lagrange,ode";
+        CHECK(rc == 2 && strstr(out, want) && cli_count_lines(out) == 1, "%s: exit %d: %s", refused[i], rc, out);
+        CHECK(i < 2 || !strstr(out, "run it with"), "%s: circular advice: %s", refused[i], out);
         CHECK(cli_read_file("world.csv", buf, sizeof buf) == 4, "%s: the old file changed", refused[i]);
     }
+    // An explicit pair names --backends too.
+    rc = cli_run("compare --quiet --scenario sandbox_swing --backends lagrange,ode --world sandbox --duration 0.1", out,
+                 sizeof out);
+    CHECK(rc == 2 && strstr(out, "because of --backends"), "explicit --backends: exit %d: %s", rc, out);
 }
 
 // The Quick start's headless drive (scripts/run.sh) wrote drive.csv into the
