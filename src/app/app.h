@@ -72,6 +72,11 @@ void app_options_help(FILE* f, unsigned which);
 /// in it unless it is an existing device or pipe (/dev/stdout). Returns 0, or
 /// -1 after one line "cranesim CMD: OPT FILE: problem" on stderr.
 int app_check_output(const char* cmd, const char* opt, const char* path, const char* ext);
+/// Refuse two of a command's outputs naming one file (the second write would
+/// replace the first): paths[k] (NULL: not given) for option opts[k]. Same
+/// file: the same inode when both exist, else the same real folder and
+/// name. Devices and pipes may be shared. Returns 0, or -1 after one line.
+int app_check_distinct(const char* cmd, const char* const* opts, const char* const* paths, int n);
 /// Flush and close f. Returns 0, or the errno of the first failure: first
 /// (a write the caller already saw fail, 0 if none), else the flush's or the
 /// close's, else EIO for an error flagged on the stream with no errno left

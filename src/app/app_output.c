@@ -142,6 +142,45 @@ int app_check_output(const char* cmd, const char* opt, const char* path, const c
     return 0;
 }
 
+// The file path names, as "realpath(dirname)/basename" (the folder must
+// exist: app_check_output has checked it); false if it cannot be resolved.
+static bool resolved_name(const char* path, char* out, size_t n) {
+    char dir[PATH_MAX], real[PATH_MAX];
+    const char* slash = strrchr(path, '/');
+    const char* base = slash ? slash + 1 : path;
+    if (!slash) snprintf(dir, sizeof dir, ".");
+    else if (slash == path) snprintf(dir, sizeof dir, "/");
+    else snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    if (!realpath(dir, real)) return false;
+    return (size_t)snprintf(out, n, "%s/%s", real, base) < n;
+}
+
+int app_check_distinct(const char* cmd, const char* const* opts, const char* const* paths, int n) {
+    for (int i = 0; i < n; ++i) {
+        for (int j = i + 1; j < n; ++j) {
+            if (!paths[i] || !paths[j]) continue;
+            struct stat si, sj;
+            const bool ei = stat(paths[i], &si) == 0, ej = stat(paths[j], &sj) == 0;
+            bool same;
+            if (ei && ej) {
+                // Devices and pipes (/dev/null twice) take any number of writers.
+                same = si.st_dev == sj.st_dev && si.st_ino == sj.st_ino && S_ISREG(si.st_mode);
+            } else if (ei != ej) {
+                same = false; // one name exists, the other does not: two files
+            } else {
+                char a[2 * PATH_MAX], b[2 * PATH_MAX];
+                same = resolved_name(paths[i], a, sizeof a) && resolved_name(paths[j], b, sizeof b) && !strcmp(a, b);
+            }
+            if (same) {
+                fprintf(stderr, "cranesim %s: %s %s and %s %s name the same file: each output needs its own\n", cmd,
+                        opts[i], paths[i], opts[j], paths[j]);
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
 int app_make_dir(const char* cmd, const char* opt, const char* dir) {
     char buf[1024];
     if (!*dir) {

@@ -269,6 +269,8 @@ int cmd_compare(int argc, char** argv) {
     // Both runs and the plot file are checked before anything runs.
     if (plot && app_check_output("compare", "--plot", plot, ".png")) return EXIT_USAGE;
     if (out && app_check_output("compare", "--out", out, ".csv")) return EXIT_USAGE;
+    if (app_check_distinct("compare", (const char* const[]){"--out", "--plot"}, (const char* const[]){out, plot}, 2))
+        return EXIT_USAGE;
     for (int s = 0; s < 2; ++s) {
         // A side's own choice (--backends, --solvers) counts as given.
         unsigned given = c.given;

@@ -477,7 +477,9 @@ int cmd_drive(int argc, char** argv) {
     if ((record && app_check_output("drive", "--record", record, NULL)) ||
         (session_path && app_check_output("drive", "--session", session_path, NULL)) ||
         (shot && app_check_output("drive", "--screenshot", shot, ".png")) ||
-        (save_as && app_check_output("drive", "--save-as", save_as, ".json")))
+        (save_as && app_check_output("drive", "--save-as", save_as, ".json")) ||
+        app_check_distinct("drive", (const char* const[]){"--record", "--session", "--screenshot", "--save-as", "--replay"},
+                           (const char* const[]){record, session_path, shot, save_as, replay}, 5))
         return EXIT_USAGE;
     if (connect_to) { // the visual computer's link to a cranesim serve (headless for now)
         if (!c.scenario_path) c.scenario_path = app_default_drive_scenario(SIM_LAGRANGE);

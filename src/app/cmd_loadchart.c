@@ -163,6 +163,8 @@ int cmd_loadchart(int argc, char** argv) {
     }
     if (app_check_output("loadchart", "--out", out, ".csv")) return EXIT_USAGE;
     if (png && app_check_output("loadchart", "--plot", png, ".png")) return EXIT_USAGE;
+    if (app_check_distinct("loadchart", (const char* const[]){"--out", "--plot"}, (const char* const[]){out, png}, 2))
+        return EXIT_USAGE;
     model* m = model_load(c.model_path, c.sets, c.nset, err, sizeof err);
     if (!m) {
         fprintf(stderr, "cranesim loadchart: %s\n", err);

@@ -367,7 +367,9 @@ int cmd_run(int argc, char** argv) {
     // Everything that can be checked is checked before a file is touched.
     if (app_check_output("run", "--out", out, NULL) || (plot && app_check_output("run", "--plot", plot, ".png")) ||
         (energy_csv && app_check_output("run", "--energy", energy_csv, NULL)) ||
-        (metrics_out && app_check_output("run", "--metrics", metrics_out, ".json")))
+        (metrics_out && app_check_output("run", "--metrics", metrics_out, ".json")) ||
+        app_check_distinct("run", (const char* const[]){"--out", "--plot", "--energy", "--metrics"},
+                           (const char* const[]){out, plot, energy_csv, metrics_out}, 4))
         return EXIT_USAGE;
     int rc = app_check_sim("run", &c.sim, c.given);
     if (rc) return rc;

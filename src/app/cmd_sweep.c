@@ -768,7 +768,9 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
     if (plot) {
         const size_t L = strlen(plot);
         if (L > 4 && !strcmp(plot + L - 4, ".png")) {
-            if (app_check_output("sweep", "--plot", plot, ".png")) return EXIT_USAGE;
+            if (app_check_output("sweep", "--plot", plot, ".png") ||
+                app_check_distinct("sweep", (const char* const[]){"--out", "--plot"}, (const char* const[]){out, plot}, 2))
+                return EXIT_USAGE;
         }
     }
     int rc = app_check_sim("sweep", &s.c.sim, s.c.given);

@@ -312,6 +312,43 @@ static void test_interrupted_drive(void) {
     CHECK(tmp[0] == 0, "temporary %s left behind", tmp);
 }
 
+// Two outputs of one command naming one file: the second write replaced the
+// first (`run --out x.png --plot x.png` left a PNG where the CSV was). Now
+// refused before anything runs, the existing file untouched; by name, by
+// another spelling of the name, by a hard link; devices may be shared.
+static void test_same_output_file(void) {
+    static char out[8192], buf[256];
+    remove("same.png");
+    remove("same.csv");
+    remove("same_link.png");
+    int rc = cli_run("run --quiet --duration 0.05 --out same.png --plot ./same.png", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--out same.png and --plot ./same.png name the same file") && cli_count_lines(out) == 1,
+          "new file twice: exit %d: %s", rc, out);
+    CHECK(cli_read_file("same.png", buf, sizeof buf) < 0, "a refused run created same.png");
+    cli_write_file("same.png", "old\n");
+    rc = cli_run("run --quiet --duration 0.05 --out same.png --energy same.png", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--out same.png and --energy same.png name the same file"), "--energy: exit %d: %s",
+          rc, out);
+    mkdir("samedir", 0755);
+    rc = cli_run("run --quiet --duration 0.05 --energy samedir/../same.png --plot same.png --out /dev/null", out,
+                 sizeof out);
+    CHECK(rc == 2 && strstr(out, "--plot same.png and --energy samedir/../same.png name the same file"),
+          "--energy via ..: exit %d: %s", rc, out);
+    CHECK(cli_read_file("same.png", buf, sizeof buf) == 4, "the old file changed");
+    cli_write_file("same.csv", "old\n");
+    CHECK(link("same.csv", "same_link.png") == 0, "hard link");
+    rc = cli_run("compare --quiet --scenario hold --duration 0.05 --solvers krus,ros2 --out same.csv --plot same_link.png",
+                 out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "cranesim compare: --out same.csv and --plot same_link.png name the same file"),
+          "compare, hard link: exit %d: %s", rc, out);
+    CHECK(cli_read_file("same.csv", buf, sizeof buf) == 4, "the old file changed");
+    rc = cli_run("run --quiet --duration 0.05 --out /dev/null --energy /dev/null", out, sizeof out);
+    CHECK(rc == 0, "/dev/null twice: exit %d: %s", rc, out);
+    remove("same.png");
+    remove("same.csv");
+    remove("same_link.png");
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_run_memory);
     RUN_TEST(test_duration_caps);
@@ -323,5 +360,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_soak_runs);
     RUN_TEST(test_replace_keeps_link_and_mode);
     RUN_TEST(test_interrupted_drive);
+    RUN_TEST(test_same_output_file);
     TEST_MAIN_END();
 }
