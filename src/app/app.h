@@ -121,8 +121,8 @@ int app_out_close(app_out* o, int first, bool keep);
 /// write(2) or flushed). Returns 0 or -1.
 int app_out_commit_signal(const app_out* o);
 
-/// Create directory dir and its parents (mkdir -p) and check it is a writable
-/// directory. Returns 0, or -1 after one line on stderr naming opt and dir.
+/// Create directory dir (its last component only: the parent must exist) and
+/// check it is a writable directory. Returns 0, or -1 after one line on stderr naming opt and dir.
 int app_make_dir(const char* cmd, const char* opt, const char* dir);
 /// Reject, before anything runs, a run sim_run cannot honour as asked:
 /// --solver cvode with ode or without CVODE in the build, an output period

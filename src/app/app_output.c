@@ -192,22 +192,30 @@ int app_make_dir(const char* cmd, const char* opt, const char* dir) {
         return -1;
     }
     snprintf(buf, sizeof buf, "%s", dir);
-    // mkdir -p: each prefix ending before a '/', then the whole path.
-    for (char* p = buf + 1;; ++p) {
-        if (*p && *p != '/') continue;
-        const char keep = *p;
-        *p = 0;
-        struct stat st;
+    // Only the last component is made: a missing parent is more likely a
+    // typo in the path than a tree to create (as for an output file's folder).
+    size_t L = strlen(buf);
+    while (L > 1 && buf[L - 1] == '/') buf[--L] = 0;
+    struct stat st;
+    if (stat(buf, &st) != 0) {
+        char parent[1024];
+        const char* slash = strrchr(buf, '/');
+        if (!slash) snprintf(parent, sizeof parent, ".");
+        else if (slash == buf) snprintf(parent, sizeof parent, "/");
+        else snprintf(parent, sizeof parent, "%.*s", (int)(slash - buf), buf);
+        struct stat sp;
+        if (stat(parent, &sp) || !S_ISDIR(sp.st_mode)) {
+            fprintf(stderr, "cranesim %s: %s %s: no directory %s\n", cmd, opt, dir, parent);
+            return -1;
+        }
         if (mkdir(buf, 0755) && errno != EEXIST) {
-            fprintf(stderr, "cranesim %s: %s %s: cannot create %s: %s\n", cmd, opt, dir, buf, strerror(errno));
+            fprintf(stderr, "cranesim %s: %s %s: cannot create it: %s\n", cmd, opt, dir, strerror(errno));
             return -1;
         }
-        if (stat(buf, &st) || !S_ISDIR(st.st_mode)) {
-            fprintf(stderr, "cranesim %s: %s %s: %s exists and is not a directory\n", cmd, opt, dir, buf);
-            return -1;
-        }
-        *p = keep;
-        if (!keep) break;
+    }
+    if (stat(buf, &st) || !S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "cranesim %s: %s %s: exists and is not a directory\n", cmd, opt, dir);
+        return -1;
     }
     if (access(dir, W_OK | X_OK)) {
         fprintf(stderr, "cranesim %s: %s %s: cannot write into it: %s\n", cmd, opt, dir, strerror(errno));

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #define DATA CRANESIM_TESTDATA
 
@@ -421,17 +422,27 @@ static void test_study_usage(void) {
     CHECK(rc == 2 && strstr(out, "--out-dir cli_study_file") && !strstr(out, "reference:") && !strstr(out, "reference run failed"),
           "--out-dir naming a file: exit %d: %s", rc, out);
     remove("cli_study_file");
-    // A nested folder is made with its parents.
-    remove("cli_study/sub/deeper/study.md");
-    rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study/sub/deeper", out, sizeof out);
+    // Only the last folder is made: a missing parent is refused before any
+    // run, like an output file's missing folder, and nothing is created.
+    remove("cli_study2/made/study.md");
+    remove("cli_study2/made/study.jsonl");
+    remove("cli_study2/made/work_precision.png");
+    rmdir("cli_study2/made");
+    rmdir("cli_study2");
+    rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study2/made", out, sizeof out);
     if (rc == 2 && strstr(out, "needs the CVODE reference")) {
         // Only a build without SUNDIALS gets here (the study cannot run at
         // all); the checks above still ran. Said, not counted as a pass.
-        printf("  SKIPPED: nested --out-dir (no CVODE in this build)\n");
+        printf("  SKIPPED: --out-dir (no CVODE in this build)\n");
         return;
     }
-    CHECK(rc == 0 && exists("cli_study/sub/deeper/study.md") && exists("cli_study/sub/deeper/study.jsonl"),
-          "nested --out-dir: exit %d: %.300s", rc, out);
+    CHECK(rc == 2 && strstr(out, "--out-dir cli_study2/made: no directory cli_study2") && cli_count_lines(out) == 1 &&
+              stat("cli_study2", &(struct stat){0}) != 0,
+          "--out-dir with a missing parent: exit %d: %.300s", rc, out);
+    mkdir("cli_study2", 0755);
+    rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study2/made/", out, sizeof out);
+    CHECK(rc == 0 && exists("cli_study2/made/study.md") && exists("cli_study2/made/study.jsonl"),
+          "--out-dir in an existing folder: exit %d: %.300s", rc, out);
 }
 
 // A fixed step lands on every output time, so --every must be a whole number
