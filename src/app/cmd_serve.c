@@ -678,7 +678,10 @@ static int serve_loop(server* s, int lfd, double duration) {
         for (int i = 0; i < s->nclient; ++i) s->c[i]->read_frame = 0;
         ++frames;
         const double done = sim_wall_time();
-        worst = fmax(worst, done - now);
+        // Worst frame from its scheduled start (next), so a late wake-up
+        // counts as it does for a missed deadline: missed > 0 exactly when
+        // worst > the frame period. busy stays the work alone.
+        worst = fmax(worst, done - next);
         busy += done - now;
         next += s->frame;
         if (done > next) { // the frame's work ran past the next frame's start

@@ -11,6 +11,9 @@
 //    receiving frames and the controller keeps seeing its commands echoed.
 // 3. Dead-man: a controller opens the jib valve and leaves; the next client
 //    finds the spools back at neutral and the strokes at rest.
+// 4. The closing statistics: a server stopped (SIGSTOP) for 300 ms misses
+//    deadlines, and its worst frame, timed from the frame's scheduled start,
+//    says so (it timed the work alone: a few ms against missed deadlines).
 #define _DEFAULT_SOURCE // usleep, in serve_util.h
 #include "check.h"
 #include "engine.h"
@@ -382,11 +385,47 @@ static void dead_man(void) {
     CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
 }
 
+// ---- 4. worst frame and missed deadlines agree ----
+
+static void late_wakeup(void) {
+    const char* log = CRANESIM_BINARY_DIR "/tests/app/serve_late.log";
+    const char* args[] = {"--mechanics", "lagrange", "--scenario", "hold", "--duration", "3", NULL};
+    served sv;
+    CHECK(serve_start(&sv, log, args) == 0, "server started");
+    usleep(500000);
+    kill(sv.pid, SIGSTOP);
+    usleep(300000);
+    kill(sv.pid, SIGCONT);
+    usleep(300000);
+    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+    static char all[1 << 16];
+    FILE* f = fopen(log, "r");
+    size_t n = f ? fread(all, 1, sizeof all - 1, f) : 0;
+    all[n] = 0;
+    if (f) fclose(f);
+    const char* st = strstr(all, " missed deadlines, worst frame ");
+    long missed = -1;
+    double worst = NAN;
+    if (st) {
+        const char* b = st;
+        while (b > all && b[-1] >= '0' && b[-1] <= '9') --b;
+        missed = strtol(b, NULL, 10);
+        worst = strtod(st + strlen(" missed deadlines, worst frame "), NULL);
+    }
+    const double period_ms = 1e3 / 75;
+    printf("late wake-up: %ld missed deadlines, worst frame %.3f ms (period %.3f ms)\n", missed, worst, period_ms);
+    CHECK(missed >= 1, "a 300 ms stop missed no deadline? %s", st ? st : all);
+    CHECK(worst >= 250, "worst frame %.3f ms after a 300 ms stop", worst);
+    CHECK((missed > 0) == (worst > period_ms), "%ld missed deadlines but worst frame %.3f ms (period %.3f ms)", missed,
+          worst, period_ms);
+}
+
 int main(void) {
     signal(SIGPIPE, SIG_IGN);
     bit_for_bit("lagrange", "drive_demo", 300);
     bit_for_bit("ode", "sandbox_pick_place", 150);
     hostile();
     dead_man();
+    late_wakeup();
     TEST_MAIN_END();
 }
