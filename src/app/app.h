@@ -61,6 +61,11 @@ const char* app_value(int argc, char** argv, int* i);
 /// "cranesim CMD: option X needs a value" (so `drive --record` at the end is
 /// not called an unknown option).
 int app_check_values(const char* cmd, int argc, char** argv);
+/// The command line of cmd with each "--opt=value" of a value-taking option
+/// split into "--opt" "value" (as getopt_long takes both). Returns a new
+/// NULL-terminated array (free it; the strings are argv's) with its length in
+/// *argc, or NULL when out of memory.
+char** app_split_equals(const char* cmd, int* argc, char** argv);
 /// Help text for the common options.
 void app_common_help(FILE* f, bool with_solver);
 /// Help text for the common options in `which` (APP_GIVEN bits), in the usual order.
@@ -192,6 +197,12 @@ int app_set_solver(sim_opts* o, const char* opt, const char* v);
 void app_sort(double* v, int n);
 /// The median of v[0..n-1] (v is sorted in place; n >= 1).
 double app_median(double* v, int n);
+/// v in the shortest "%.15g" / "%.16g" / "%.17g" form that reads back equal
+/// (CSV cells, --set assignments); returns buf.
+const char* app_fmt_double(char* buf, size_t n, double v);
+/// A simulated-to-wall time ratio for "Nx real time": whole numbers from 1,
+/// two significant digits below (0.42); returns buf.
+const char* app_fmt_speed(char* buf, size_t n, double ratio);
 /// The scenario drive uses when none is given: the sandbox pick-and-place for
 /// the ode world, the scripted lagrange demo otherwise.
 const char* app_default_drive_scenario(sim_mechanics mech);

@@ -244,20 +244,33 @@ int cmd_compare(int argc, char** argv) {
     const bool designs = nmodel == 2 || nside_set[0] || nside_set[1];
     if (nmodel == 1) c.model_path = models[0];
     if (designs) {
-        // Each side's label: its model file and its own changes.
-        for (int s = 0; s < 2; ++s) {
-            size_t L = strlen(label[s]);
-            if (nmodel == 2) {
-                const char* base = strrchr(models[s], '/');
-                L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? "/" : "", base ? base + 1 : models[s]);
+        // Each side's label: its model file and its own changes, short
+        // (file base names, the last path element) unless the short labels
+        // are equal; a side with no file and no change of its own is named
+        // by the model file both share ("A = A" said nothing).
+        char pair_label[2][96];
+        memcpy(pair_label, label, sizeof pair_label);
+        for (int full = 0; full < 2; ++full) {
+            for (int s = 0; s < 2; ++s) {
+                memcpy(label[s], pair_label[s], sizeof label[s]);
+                size_t L = strlen(label[s]);
+                if (nmodel == 2) {
+                    const char* base = full ? NULL : strrchr(models[s], '/');
+                    L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? "/" : "",
+                                          base ? base + 1 : models[s]);
+                }
+                for (int k = 0; k < nside_set[s] && L < sizeof label[s]; ++k) {
+                    const char* dot = full ? side_set[s][k] : strchr(side_set[s][k], '=');
+                    while (!full && dot > side_set[s][k] && dot[-1] != '.') --dot; // the last path element
+                    L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? " " : "", dot);
+                }
+                if (!label[s][0]) {
+                    const char* file = c.model_path ? c.model_path : model_default_path();
+                    const char* base = full ? NULL : strrchr(file, '/');
+                    snprintf(label[s], sizeof label[s], "%s", base ? base + 1 : file);
+                }
             }
-            for (int k = 0; k < nside_set[s] && L < sizeof label[s]; ++k) {
-                const char* eq = strchr(side_set[s][k], '=');
-                const char* dot = eq;
-                while (dot > side_set[s][k] && dot[-1] != '.') --dot; // the last path element
-                L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? " " : "", dot);
-            }
-            if (!label[s][0]) snprintf(label[s], sizeof label[s], "%s", s ? "B" : "A");
+            if (strcmp(label[0], label[1])) break;
         }
     }
     if (!any_pair && !designs) { // the default comparison: lagrange full vs the ode validation world

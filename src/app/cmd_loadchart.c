@@ -181,10 +181,19 @@ int cmd_loadchart(int argc, char** argv) {
     lc_truck t;
     lc_truck_from_world(&wd, &t);
     world_desc_free(&wd);
+    double rmin, rmax;
+    loadchart_reach(m, &rmin, &rmax);
     if (!range_given) {
-        double rmin, rmax;
-        loadchart_reach(m, &rmin, &rmax);
         lo.lo = fmax(0.5, rmin), lo.hi = floor(20 * rmax - 1) / 20; // 5 cm steps, inside the reach
+    } else if (lo.lo < fmax(0.0, rmin) - 1e-9 || lo.hi > rmax + 1e-9) {
+        // The range a user may give: outreaches are >= 0 (a tip behind the
+        // slew axis, where the folded crane can reach, is no outreach), so
+        // the bound said is the one LO must meet, not the bare reach.
+        fprintf(stderr, "cranesim loadchart: --outreach: %g:%g m is outside the crane's reach: LO:HI must lie in "
+                        "[%.3f, %.3f] m\n",
+                lo.lo, lo.hi, fmax(0.0, rmin), rmax);
+        model_free(m);
+        return EXIT_USAGE;
     }
     static loadchart ch;
     const double w0 = sim_wall_time();

@@ -222,8 +222,9 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     else printf(" (h = %g ms%s)\n", o->h * 1e3, kern);
     char work[200];
     engine_describe_work(o, r, work, sizeof work);
-    printf("  simulated %.3f s in %.3f s wall: %.0fx real time; %s\n", r->t_end, r->wall,
-           r->wall > 0 ? r->t_end / r->wall : 0.0, work);
+    char speed[32];
+    printf("  simulated %.3f s in %.3f s wall: %sx real time; %s\n", r->t_end, r->wall,
+           app_fmt_speed(speed, sizeof speed, r->wall > 0 ? r->t_end / r->wall : 0.0), work);
     printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
            1e3 * xmax[1]);
     if (st->rcl_have)

@@ -5,6 +5,7 @@
 #include "cli_util.h"
 
 #include <dirent.h>
+#include <math.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -349,6 +350,57 @@ static void test_same_output_file(void) {
     remove("same_link.png");
 }
 
+// Small things a new user met: "--opt=value" was an unknown option; sweep
+// wrote 0.080000000000000002 for 0.08; a run slower than real time said
+// "0x real time"; compare labelled a side with no changes "A = A"; drive
+// --replay of a missing file talked about the window; loadchart refused
+// --outreach 0:6 naming a reach from -0.104 m that LO may not use.
+static void test_small_things(void) {
+    static char out[16384], buf[4096];
+    remove("eq.csv");
+    int rc = cli_run("run --quiet --scenario=hold --duration=0.05 --out=eq.csv --set=hydraulics.components.lift_cyl.bore=0.11",
+                     out, sizeof out);
+    CHECK(rc == 0 && cli_read_file("eq.csv", buf, sizeof buf) > 0, "--opt=value: exit %d: %s", rc, out);
+    rc = cli_run("run --quiet=1 --out /dev/null", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "unknown option '--quiet=1'"), "a flag with =: exit %d: %s", rc, out);
+    remove("eq.csv");
+
+    rc = cli_run("sweep --quiet --scenario hold --duration 0.05 --param hydraulics.components.lift_cyl.bore=0.08:0.1:3 "
+                 "--metrics peak_p1A --out eq_sweep.csv",
+                 out, sizeof out);
+    CHECK(rc == 0 && cli_read_file("eq_sweep.csv", buf, sizeof buf) > 0, "sweep: exit %d: %s", rc, out);
+    // Shortest form, and it reads back to the design's value: 0.08 + 0.01 k.
+    CHECK(strstr(buf, "\n0,0.08,") && strstr(buf, "\n1,0.09,") && strstr(buf, "\n2,0.1,"), "sweep CSV: %s", buf);
+    for (const char* p = strchr(buf, '\n'); p && p[1]; p = strchr(p + 1, '\n')) {
+        const char* c = strchr(p + 1, ',');
+        const char* e = c ? strchr(c + 1, ',') : NULL;
+        CHECK(c && e && e - c - 1 <= 17, "a long number: %.60s", p + 1);
+    }
+    remove("eq_sweep.csv");
+
+    // 20000 steps of 0.1 us for 2 ms: far slower than real time.
+    rc = cli_run("run --scenario hold --duration 0.002 --dt 1e-7 --out /dev/null", out, sizeof out);
+    const char* w = strstr(out, "s wall: ");
+    const char* sim = strstr(out, "simulated ");
+    double ratio = w ? strtod(w + strlen("s wall: "), NULL) : NAN;
+    double t_end = sim ? strtod(sim + strlen("simulated "), NULL) : NAN;
+    double wall = sim ? strtod(strstr(sim, " in ") + 4, NULL) : NAN;
+    CHECK(rc == 0 && ratio > 0 && fabs(ratio - t_end / wall) <= 0.1 * t_end / wall + 0.01,
+          "slower than real time: %.3g printed for %g s / %g s: %s", ratio, t_end, wall, out);
+
+    rc = cli_run("compare --quiet --scenario hold --duration 0.05 --set-b hydraulics.components.lift_cyl.bore=0.11", out,
+                 sizeof out);
+    CHECK(rc == 0 && strstr(out, "(A = hiab031.json, B = bore=0.11)") && !strstr(out, "A = A"), "labels: %s", out);
+
+    rc = cli_run("drive --replay nosuch.session", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--replay nosuch.session: cannot read: No such file") && cli_count_lines(out) == 1,
+          "missing replay: exit %d: %s", rc, out);
+
+    rc = cli_run("loadchart --outreach 0:6:10 --out /dev/null", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "must lie in [0.000, ") && !strstr(out, "[-"), "loadchart --outreach: exit %d: %s", rc,
+          out);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_run_memory);
     RUN_TEST(test_duration_caps);
@@ -361,5 +413,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_replace_keeps_link_and_mode);
     RUN_TEST(test_interrupted_drive);
     RUN_TEST(test_same_output_file);
+    RUN_TEST(test_small_things);
     TEST_MAIN_END();
 }
