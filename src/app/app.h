@@ -61,6 +61,11 @@ const char* app_value(int argc, char** argv, int* i);
 /// "cranesim CMD: option X needs a value" (so `drive --record` at the end is
 /// not called an unknown option).
 int app_check_values(const char* cmd, int argc, char** argv);
+/// The command line of cmd with each "--opt=value" of a value-taking option
+/// split into "--opt" "value" (as getopt_long takes both). Returns a new
+/// NULL-terminated array (free it; the strings are argv's) with its length in
+/// *argc, or NULL when out of memory.
+char** app_split_equals(const char* cmd, int* argc, char** argv);
 /// Help text for the common options.
 void app_common_help(FILE* f, bool with_solver);
 /// Help text for the common options in `which` (APP_GIVEN bits), in the usual order.
@@ -72,6 +77,11 @@ void app_options_help(FILE* f, unsigned which);
 /// in it unless it is an existing device or pipe (/dev/stdout). Returns 0, or
 /// -1 after one line "cranesim CMD: OPT FILE: problem" on stderr.
 int app_check_output(const char* cmd, const char* opt, const char* path, const char* ext);
+/// Refuse two of a command's outputs naming one file (the second write would
+/// replace the first): paths[k] (NULL: not given) for option opts[k]. Same
+/// file: the same inode when both exist, else the same real folder and
+/// name. Devices and pipes may be shared. Returns 0, or -1 after one line.
+int app_check_distinct(const char* cmd, const char* const* opts, const char* const* paths, int n);
 /// Flush and close f. Returns 0, or the errno of the first failure: first
 /// (a write the caller already saw fail, 0 if none), else the flush's or the
 /// close's, else EIO for an error flagged on the stream with no errno left
@@ -116,8 +126,8 @@ int app_out_close(app_out* o, int first, bool keep);
 /// write(2) or flushed). Returns 0 or -1.
 int app_out_commit_signal(const app_out* o);
 
-/// Create directory dir and its parents (mkdir -p) and check it is a writable
-/// directory. Returns 0, or -1 after one line on stderr naming opt and dir.
+/// Create directory dir (its last component only: the parent must exist) and
+/// check it is a writable directory. Returns 0, or -1 after one line on stderr naming opt and dir.
 int app_make_dir(const char* cmd, const char* opt, const char* dir);
 /// Reject, before anything runs, a run sim_run cannot honour as asked:
 /// --solver cvode with ode or without CVODE in the build, an output period
@@ -155,6 +165,11 @@ double app_output_period(const sim_opts* o);
 void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind);
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
                        bool* switched);
+/// app_scenario_world with the advice after the refusal given by the caller
+/// (NULL: "run it with --mechanics ode --world sandbox"), for a command whose
+/// own options put the run where it is (compare's --backends).
+int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
+                              bool* switched, const char* remedy);
 
 /// Resolve a scenario argument: an existing file, or assets/scenarios/<name>.json.
 const char* app_scenario_path(const char* arg, char* buf, size_t n);
@@ -182,6 +197,12 @@ int app_set_solver(sim_opts* o, const char* opt, const char* v);
 void app_sort(double* v, int n);
 /// The median of v[0..n-1] (v is sorted in place; n >= 1).
 double app_median(double* v, int n);
+/// v in the shortest "%.15g" / "%.16g" / "%.17g" form that reads back equal
+/// (CSV cells, --set assignments); returns buf.
+const char* app_fmt_double(char* buf, size_t n, double v);
+/// A simulated-to-wall time ratio for "Nx real time": whole numbers from 1,
+/// two significant digits below (0.42); returns buf.
+const char* app_fmt_speed(char* buf, size_t n, double ratio);
 /// The scenario drive uses when none is given: the sandbox pick-and-place for
 /// the ode world, the scripted lagrange demo otherwise.
 const char* app_default_drive_scenario(sim_mechanics mech);

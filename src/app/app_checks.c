@@ -200,6 +200,11 @@ void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind)
 
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
                        bool* switched) {
+    return app_scenario_world_remedy(cmd, o, given, sc, may_switch, switched, NULL);
+}
+
+int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
+                              bool* switched, const char* remedy) {
     if (switched) *switched = false;
     const char* why = sandbox_use(sc);
     if (!why) return 0;
@@ -226,8 +231,9 @@ int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scena
         return 0;
     }
     fprintf(stderr,
-            "cranesim %s: scenario %s %s, which the %s has not: run it with --mechanics ode --world sandbox\n", cmd,
-            name, why, o->mechanics == SIM_ODE ? "validation world" : "lagrange 2-DOF crane");
+            "cranesim %s: scenario %s %s, which the %s has not: %s\n", cmd, name, why,
+            o->mechanics == SIM_ODE ? "validation world" : "lagrange 2-DOF crane",
+            remedy ? remedy : "run it with --mechanics ode --world sandbox");
     return EXIT_USAGE;
 }
 

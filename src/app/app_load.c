@@ -60,5 +60,17 @@ int app_load_msg(const app_common* c, model** m, scenario* sc, char* err, size_t
         *m = NULL;
         return EXIT_USAGE;
     }
+    // The start pose against this model's joint ranges, here where the file
+    // name is known (the engines check again, for callers without a file).
+    for (int k = 0; k < 2; ++k) {
+        const crane_actuator* a = &(*m)->mech.act[k];
+        char why[400];
+        if (crane_check_pose(a, (*m)->stroke[k], sc->q0[a->joint], why, sizeof why)) {
+            snprintf(err, errsz, "%s: %s", sp, why);
+            model_free(*m);
+            *m = NULL;
+            return EXIT_USAGE;
+        }
+    }
     return 0;
 }

@@ -114,6 +114,43 @@ int app_check_values(const char* cmd, int argc, char** argv) {
     return 0;
 }
 
+// Whether a is an option of cmd that takes a value (common or its own).
+static bool takes_value(const char* const* own, const char* a, size_t len) {
+    for (int k = 0; k <= APP_OPT_KERNEL; ++k)
+        if (strlen(app_opt_name[k]) == len && !strncmp(a, app_opt_name[k], len)) return true;
+    for (int k = 0; own && own[k]; ++k)
+        if (strlen(own[k]) == len && !strncmp(a, own[k], len)) return true;
+    return false;
+}
+
+char** app_split_equals(const char* cmd, int* argc, char** argv) {
+    const char* const* own = NULL;
+    for (size_t k = 0; k < sizeof own_values / sizeof own_values[0]; ++k)
+        if (!strcmp(cmd, own_values[k].cmd)) own = own_values[k].opts;
+    // At most one extra word per argument, plus the terminating NULL.
+    char** out = malloc(sizeof *out * (2 * (size_t)*argc + 1));
+    if (!out) return NULL;
+    int n = 0;
+    bool value_next = false; // argv[i] is the value of the option before it
+    for (int i = 0; i < *argc; ++i) {
+        char* a = argv[i];
+        char* eq = strncmp(a, "--", 2) ? NULL : strchr(a, '=');
+        // Only a value option is split: "--quiet=1" stays unknown, and the
+        // value of a value option is never split.
+        if (!value_next && eq && takes_value(own, a, (size_t)(eq - a))) {
+            *eq = 0; // argv's strings are ours to change (C11 5.1.2.2.1)
+            out[n++] = a;
+            out[n++] = eq + 1;
+            continue;
+        }
+        value_next = !value_next && takes_value(own, a, strlen(a));
+        out[n++] = a;
+    }
+    out[n] = NULL;
+    *argc = n;
+    return out;
+}
+
 static int positive(const char* opt, const char* s, double* v) {
     if (app_parse_double(s, v) || !(*v > 0)) {
         fprintf(stderr, "cranesim: %s: expected a positive number, got '%s'\n", opt, s);
@@ -304,4 +341,24 @@ void app_common_help(FILE* f, bool with_solver) {
                             APP_GIVEN(APP_OPT_JAC_EVERY) | APP_GIVEN(APP_OPT_DENSE_JAC) |
                             APP_GIVEN(APP_OPT_KERNEL) | APP_GIVEN(APP_OPT_DURATION) | APP_GIVEN(APP_OPT_EVERY);
     app_options_help(f, with_solver ? all : all & ~solver);
+}
+
+const char* app_fmt_double(char* buf, size_t n, double v) {
+    // The shortest of 15, 16, 17 significant digits that reads back to the
+    // same double: 0.08 prints as 0.08, not 0.080000000000000002, and every
+    // value still round-trips (17 digits always do, IEEE 754 binary64).
+    for (int p = 15; p <= 17; ++p) {
+        snprintf(buf, n, "%.*g", p, v);
+        if (p == 17 || strtod(buf, NULL) == v) break;
+    }
+    return buf;
+}
+
+const char* app_fmt_speed(char* buf, size_t n, double ratio) {
+    // Whole numbers from 1x up (as before); below, two significant digits:
+    // a run at 0.42x real time printed "0x".
+    if (!(ratio >= 0) || !isfinite(ratio)) snprintf(buf, n, "-");
+    else if (ratio >= 1) snprintf(buf, n, "%.0f", ratio);
+    else snprintf(buf, n, "%.2g", ratio);
+    return buf;
 }

@@ -142,6 +142,45 @@ int app_check_output(const char* cmd, const char* opt, const char* path, const c
     return 0;
 }
 
+// The file path names, as "realpath(dirname)/basename" (the folder must
+// exist: app_check_output has checked it); false if it cannot be resolved.
+static bool resolved_name(const char* path, char* out, size_t n) {
+    char dir[PATH_MAX], real[PATH_MAX];
+    const char* slash = strrchr(path, '/');
+    const char* base = slash ? slash + 1 : path;
+    if (!slash) snprintf(dir, sizeof dir, ".");
+    else if (slash == path) snprintf(dir, sizeof dir, "/");
+    else snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    if (!realpath(dir, real)) return false;
+    return (size_t)snprintf(out, n, "%s/%s", real, base) < n;
+}
+
+int app_check_distinct(const char* cmd, const char* const* opts, const char* const* paths, int n) {
+    for (int i = 0; i < n; ++i) {
+        for (int j = i + 1; j < n; ++j) {
+            if (!paths[i] || !paths[j]) continue;
+            struct stat si, sj;
+            const bool ei = stat(paths[i], &si) == 0, ej = stat(paths[j], &sj) == 0;
+            bool same;
+            if (ei && ej) {
+                // Devices and pipes (/dev/null twice) take any number of writers.
+                same = si.st_dev == sj.st_dev && si.st_ino == sj.st_ino && S_ISREG(si.st_mode);
+            } else if (ei != ej) {
+                same = false; // one name exists, the other does not: two files
+            } else {
+                char a[2 * PATH_MAX], b[2 * PATH_MAX];
+                same = resolved_name(paths[i], a, sizeof a) && resolved_name(paths[j], b, sizeof b) && !strcmp(a, b);
+            }
+            if (same) {
+                fprintf(stderr, "cranesim %s: %s %s and %s %s name the same file: each output needs its own\n", cmd,
+                        opts[i], paths[i], opts[j], paths[j]);
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
 int app_make_dir(const char* cmd, const char* opt, const char* dir) {
     char buf[1024];
     if (!*dir) {
@@ -153,22 +192,30 @@ int app_make_dir(const char* cmd, const char* opt, const char* dir) {
         return -1;
     }
     snprintf(buf, sizeof buf, "%s", dir);
-    // mkdir -p: each prefix ending before a '/', then the whole path.
-    for (char* p = buf + 1;; ++p) {
-        if (*p && *p != '/') continue;
-        const char keep = *p;
-        *p = 0;
-        struct stat st;
+    // Only the last component is made: a missing parent is more likely a
+    // typo in the path than a tree to create (as for an output file's folder).
+    size_t L = strlen(buf);
+    while (L > 1 && buf[L - 1] == '/') buf[--L] = 0;
+    struct stat st;
+    if (stat(buf, &st) != 0) {
+        char parent[1024];
+        const char* slash = strrchr(buf, '/');
+        if (!slash) snprintf(parent, sizeof parent, ".");
+        else if (slash == buf) snprintf(parent, sizeof parent, "/");
+        else snprintf(parent, sizeof parent, "%.*s", (int)(slash - buf), buf);
+        struct stat sp;
+        if (stat(parent, &sp) || !S_ISDIR(sp.st_mode)) {
+            fprintf(stderr, "cranesim %s: %s %s: no directory %s\n", cmd, opt, dir, parent);
+            return -1;
+        }
         if (mkdir(buf, 0755) && errno != EEXIST) {
-            fprintf(stderr, "cranesim %s: %s %s: cannot create %s: %s\n", cmd, opt, dir, buf, strerror(errno));
+            fprintf(stderr, "cranesim %s: %s %s: cannot create it: %s\n", cmd, opt, dir, strerror(errno));
             return -1;
         }
-        if (stat(buf, &st) || !S_ISDIR(st.st_mode)) {
-            fprintf(stderr, "cranesim %s: %s %s: %s exists and is not a directory\n", cmd, opt, dir, buf);
-            return -1;
-        }
-        *p = keep;
-        if (!keep) break;
+    }
+    if (stat(buf, &st) || !S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "cranesim %s: %s %s: exists and is not a directory\n", cmd, opt, dir);
+        return -1;
     }
     if (access(dir, W_OK | X_OK)) {
         fprintf(stderr, "cranesim %s: %s %s: cannot write into it: %s\n", cmd, opt, dir, strerror(errno));

@@ -244,20 +244,33 @@ int cmd_compare(int argc, char** argv) {
     const bool designs = nmodel == 2 || nside_set[0] || nside_set[1];
     if (nmodel == 1) c.model_path = models[0];
     if (designs) {
-        // Each side's label: its model file and its own changes.
-        for (int s = 0; s < 2; ++s) {
-            size_t L = strlen(label[s]);
-            if (nmodel == 2) {
-                const char* base = strrchr(models[s], '/');
-                L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? "/" : "", base ? base + 1 : models[s]);
+        // Each side's label: its model file and its own changes, short
+        // (file base names, the last path element) unless the short labels
+        // are equal; a side with no file and no change of its own is named
+        // by the model file both share ("A = A" said nothing).
+        char pair_label[2][96];
+        memcpy(pair_label, label, sizeof pair_label);
+        for (int full = 0; full < 2; ++full) {
+            for (int s = 0; s < 2; ++s) {
+                memcpy(label[s], pair_label[s], sizeof label[s]);
+                size_t L = strlen(label[s]);
+                if (nmodel == 2) {
+                    const char* base = full ? NULL : strrchr(models[s], '/');
+                    L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? "/" : "",
+                                          base ? base + 1 : models[s]);
+                }
+                for (int k = 0; k < nside_set[s] && L < sizeof label[s]; ++k) {
+                    const char* dot = full ? side_set[s][k] : strchr(side_set[s][k], '=');
+                    while (!full && dot > side_set[s][k] && dot[-1] != '.') --dot; // the last path element
+                    L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? " " : "", dot);
+                }
+                if (!label[s][0]) {
+                    const char* file = c.model_path ? c.model_path : model_default_path();
+                    const char* base = full ? NULL : strrchr(file, '/');
+                    snprintf(label[s], sizeof label[s], "%s", base ? base + 1 : file);
+                }
             }
-            for (int k = 0; k < nside_set[s] && L < sizeof label[s]; ++k) {
-                const char* eq = strchr(side_set[s][k], '=');
-                const char* dot = eq;
-                while (dot > side_set[s][k] && dot[-1] != '.') --dot; // the last path element
-                L += (size_t)snprintf(label[s] + L, sizeof label[s] - L, "%s%s", L ? " " : "", dot);
-            }
-            if (!label[s][0]) snprintf(label[s], sizeof label[s], "%s", s ? "B" : "A");
+            if (strcmp(label[0], label[1])) break;
         }
     }
     if (!any_pair && !designs) { // the default comparison: lagrange full vs the ode validation world
@@ -269,6 +282,8 @@ int cmd_compare(int argc, char** argv) {
     // Both runs and the plot file are checked before anything runs.
     if (plot && app_check_output("compare", "--plot", plot, ".png")) return EXIT_USAGE;
     if (out && app_check_output("compare", "--out", out, ".csv")) return EXIT_USAGE;
+    if (app_check_distinct("compare", (const char* const[]){"--out", "--plot"}, (const char* const[]){out, plot}, 2))
+        return EXIT_USAGE;
     for (int s = 0; s < 2; ++s) {
         // A side's own choice (--backends, --solvers) counts as given.
         unsigned given = c.given;
@@ -312,7 +327,22 @@ int cmd_compare(int argc, char** argv) {
     }
     // Both sides must run the scenario as written (no silent switch: the
     // comparison names its backends).
-    for (int s = 0; s < 2 && !rc; ++s) rc = app_scenario_world("compare", &side[s], c.given, &sc, false, NULL);
+    // The advice must name what put a side on the wrong crane: the default
+    // pair or the user's --backends (--mechanics alone is overridden by them).
+    for (int s = 0; s < 2 && !rc; ++s) {
+        char remedy[400];
+        const char* ab = s ? "B" : "A";
+        if (side[s].mechanics == SIM_LAGRANGE && (pairs[0] || (!any_pair && !designs)))
+            snprintf(remedy, sizeof remedy,
+                     "side %s runs there because of %s; to compare in the sandbox, keep both sides there: "
+                     "--mechanics ode --world sandbox with another pair (--dts H1,H2, or --set-a/--set-b)",
+                     ab, pairs[0] ? "--backends" : "the default --backends lagrange,ode");
+        else if (side[s].mechanics == SIM_ODE)
+            snprintf(remedy, sizeof remedy, "give --world sandbox (side %s runs the ode backend)", ab);
+        else
+            snprintf(remedy, sizeof remedy, "run it with --mechanics ode --world sandbox");
+        rc = app_scenario_world_remedy("compare", &side[s], c.given, &sc, false, NULL, remedy);
+    }
     if (rc && m) {
         model_free(m);
         model_free(mb);

@@ -328,8 +328,10 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         code = EXIT_RUNTIME;
     }
     double wall = sim_wall_time() - w0;
-    printf("  simulated %.2f s in %.2f s wall; physics busy %.1f %% of the time: capacity %.0fx real time\n",
-           engine_time(l), wall, wall > 0 ? 100 * busy / wall : 0.0, busy > 0 ? engine_time(l) / busy : 0.0);
+    char speed[32];
+    printf("  simulated %.2f s in %.2f s wall; physics busy %.1f %% of the time: capacity %sx real time\n",
+           engine_time(l), wall, wall > 0 ? 100 * busy / wall : 0.0,
+           app_fmt_speed(speed, sizeof speed, busy > 0 ? engine_time(l) / busy : 0.0));
     printf("  frames: %d of %.1f ms, worst frame %.2f ms, missed deadlines %d\n", frames_done, frame * 1e3,
            worst * 1e3, missed);
     printf("  final: lift stroke %.0f mm, jib stroke %.0f mm, tip at reach %.2f m, height %.2f m", row[COL_X1] * 1e3,
@@ -486,8 +488,20 @@ int cmd_drive(int argc, char** argv) {
     if ((record && app_check_output("drive", "--record", record, NULL)) ||
         (session_path && app_check_output("drive", "--session", session_path, NULL)) ||
         (shot && app_check_output("drive", "--screenshot", shot, ".png")) ||
-        (save_as && app_check_output("drive", "--save-as", save_as, ".json")))
+        (save_as && app_check_output("drive", "--save-as", save_as, ".json")) ||
+        app_check_distinct("drive", (const char* const[]){"--record", "--session", "--screenshot", "--save-as", "--replay"},
+                           (const char* const[]){record, session_path, shot, save_as, replay}, 5))
         return EXIT_USAGE;
+    // A session that is not there is the first thing wrong, before any word
+    // on the window it would play in.
+    if (replay) {
+        FILE* rf = fopen(replay, "rb");
+        if (!rf) {
+            fprintf(stderr, "cranesim drive: --replay %s: cannot read: %s\n", replay, strerror(errno));
+            return EXIT_USAGE;
+        }
+        fclose(rf);
+    }
     if (connect_to) { // the visual computer's link to a cranesim serve (docs/protocol.md)
         if (replay || session_path || save_as) {
             fprintf(stderr, "cranesim drive: --connect: %s applies to a local drive only\n",

@@ -163,6 +163,8 @@ int cmd_loadchart(int argc, char** argv) {
     }
     if (app_check_output("loadchart", "--out", out, ".csv")) return EXIT_USAGE;
     if (png && app_check_output("loadchart", "--plot", png, ".png")) return EXIT_USAGE;
+    if (app_check_distinct("loadchart", (const char* const[]){"--out", "--plot"}, (const char* const[]){out, png}, 2))
+        return EXIT_USAGE;
     model* m = model_load(c.model_path, c.sets, c.nset, err, sizeof err);
     if (!m) {
         fprintf(stderr, "cranesim loadchart: %s\n", err);
@@ -179,10 +181,19 @@ int cmd_loadchart(int argc, char** argv) {
     lc_truck t;
     lc_truck_from_world(&wd, &t);
     world_desc_free(&wd);
+    double rmin, rmax;
+    loadchart_reach(m, &rmin, &rmax);
     if (!range_given) {
-        double rmin, rmax;
-        loadchart_reach(m, &rmin, &rmax);
         lo.lo = fmax(0.5, rmin), lo.hi = floor(20 * rmax - 1) / 20; // 5 cm steps, inside the reach
+    } else if (lo.lo < fmax(0.0, rmin) - 1e-9 || lo.hi > rmax + 1e-9) {
+        // The range a user may give: outreaches are >= 0 (a tip behind the
+        // slew axis, where the folded crane can reach, is no outreach), so
+        // the bound said is the one LO must meet, not the bare reach.
+        fprintf(stderr, "cranesim loadchart: --outreach: %g:%g m is outside the crane's reach: LO:HI must lie in "
+                        "[%.3f, %.3f] m\n",
+                lo.lo, lo.hi, fmax(0.0, rmin), rmax);
+        model_free(m);
+        return EXIT_USAGE;
     }
     static loadchart ch;
     const double w0 = sim_wall_time();

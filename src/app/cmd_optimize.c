@@ -427,7 +427,8 @@ int cmd_optimize(int argc, char** argv) {
                 return EXIT_USAGE;
             }
     }
-    if (app_check_output("optimize", "--out", out, ".json") || (plot && app_check_output("optimize", "--plot", plot, ".png")))
+    if (app_check_output("optimize", "--out", out, ".json") || (plot && app_check_output("optimize", "--plot", plot, ".png")) ||
+        app_check_distinct("optimize", (const char* const[]){"--out", "--plot"}, (const char* const[]){out, plot}, 2))
         return EXIT_USAGE;
     int rc = app_check_sim("optimize", &o.c.sim, o.c.given);
     if (rc) return rc;

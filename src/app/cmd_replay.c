@@ -120,7 +120,9 @@ int cmd_replay(int argc, char** argv) {
     }
     if ((out && app_check_output("replay", "--out", out, NULL)) ||
         (metrics_out && app_check_output("replay", "--metrics", metrics_out, ".json")) ||
-        (plot && app_check_output("replay", "--plot", plot, ".png")))
+        (plot && app_check_output("replay", "--plot", plot, ".png")) ||
+        app_check_distinct("replay", (const char* const[]){"SESSION", "--out", "--metrics", "--plot"},
+                           (const char* const[]){path, out, metrics_out, plot}, 4))
         return EXIT_USAGE;
     char err[1200];
     session s;

@@ -222,8 +222,9 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     else printf(" (h = %g ms%s)\n", o->h * 1e3, kern);
     char work[200];
     engine_describe_work(o, r, work, sizeof work);
-    printf("  simulated %.3f s in %.3f s wall: %.0fx real time; %s\n", r->t_end, r->wall,
-           r->wall > 0 ? r->t_end / r->wall : 0.0, work);
+    char speed[32];
+    printf("  simulated %.3f s in %.3f s wall: %sx real time; %s\n", r->t_end, r->wall,
+           app_fmt_speed(speed, sizeof speed, r->wall > 0 ? r->t_end / r->wall : 0.0), work);
     printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
            1e3 * xmax[1]);
     if (st->rcl_have)
@@ -367,7 +368,9 @@ int cmd_run(int argc, char** argv) {
     // Everything that can be checked is checked before a file is touched.
     if (app_check_output("run", "--out", out, NULL) || (plot && app_check_output("run", "--plot", plot, ".png")) ||
         (energy_csv && app_check_output("run", "--energy", energy_csv, NULL)) ||
-        (metrics_out && app_check_output("run", "--metrics", metrics_out, ".json")))
+        (metrics_out && app_check_output("run", "--metrics", metrics_out, ".json")) ||
+        app_check_distinct("run", (const char* const[]){"--out", "--plot", "--energy", "--metrics"},
+                           (const char* const[]){out, plot, energy_csv, metrics_out}, 4))
         return EXIT_USAGE;
     int rc = app_check_sim("run", &c.sim, c.given);
     if (rc) return rc;

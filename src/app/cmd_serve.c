@@ -162,8 +162,13 @@ static void drop_client(server* s, int idx, uint16_t code, const char* why) {
     logf_(s, "client %d (%s) closed: %s (%llu frames sent, %llu lost, %llu commands)", c->id, c->peer, why,
           (unsigned long long)c->frames, (unsigned long long)c->lost, (unsigned long long)c->cmds);
     if (s->controller == c->id) {
+        // Dead-man: a controller that left (or whose link timed out) can no
+        // longer stop what it started, so its last openings must not stay
+        // applied. All three spools go to neutral (0) at once.
         s->controller = 0;
-        logf_(s, "no client controls the crane now (valves held at their last openings)");
+        memset(s->u, 0, sizeof s->u);
+        if (s->e) engine_set_commands(s->e, s->u);
+        logf_(s, "no client controls the crane now (valves to neutral)");
     }
     shutdown(c->fd, SHUT_WR);
     close(c->fd);
@@ -719,7 +724,10 @@ static int serve_loop(server* s, int lfd, double duration) {
         for (int i = 0; i < s->nclient; ++i) s->c[i]->read_frame = 0;
         ++frames;
         const double done = sim_wall_time();
-        worst = fmax(worst, done - now);
+        // Worst frame from its scheduled start (next), so a late wake-up
+        // counts as it does for a missed deadline: missed > 0 exactly when
+        // worst > the frame period. busy stays the work alone.
+        worst = fmax(worst, done - next);
         busy += done - now;
         next += s->frame;
         if (done > next) { // the frame's work ran past the next frame's start

@@ -332,9 +332,11 @@ int cmd_study(int argc, char** argv) {
                 fprintf(outs[o], "| %s | failed: %s | | | | | | | | | |\n", s->name, s->why);
                 continue;
             }
-            fprintf(outs[o], "| %s | %.3g | %.3g | %.3g | %.3g | %ld | %ld | %ld | %ld | %.4f | %.0f |\n", s->name,
+            char speed[32];
+            fprintf(outs[o], "| %s | %.3g | %.3g | %.3g | %.3g | %ld | %ld | %ld | %ld | %.4f | %s |\n", s->name,
                     s->p_max * 1e-6, 100 * s->p_max / ppeak, s->p_rms * 1e-6, s->x_max * 1e3, s->st.steps,
-                    s->st.fevals, s->st.jevals, s->st.lus, s->wall, rr.t_end / s->wall); // simulated time: --duration or the scenario's
+                    s->st.fevals, s->st.jevals, s->st.lus, s->wall,
+                    app_fmt_speed(speed, sizeof speed, rr.t_end / s->wall)); // simulated time: --duration or the scenario's
         }
     }
     for (int i = 0; i < n; ++i) {

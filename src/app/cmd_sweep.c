@@ -218,7 +218,8 @@ static char* run_design(const sweep* s, long i, bool* failed) {
     }
     for (int k = 0; k < s->npar && !code; ++k) {
         char asg[320];
-        snprintf(asg, sizeof asg, "%s=%.17g", s->par[k].path, v[k]);
+        char num[32];
+        snprintf(asg, sizeof asg, "%s=%s", s->par[k].path, app_fmt_double(num, sizeof num, v[k]));
         if (json_set_path(doc, asg, err, sizeof err)) code = EXIT_USAGE;
     }
     model* m = NULL;
@@ -258,14 +259,15 @@ static char* format_row(const sweep* s, long i, const run_metrics* met, int code
     for (int k = 0; k < s->npar; ++k) v[k] = design_value(s, i, k);
     sbuf b = {0};
     sb_printf(&b, "%ld", i);
-    for (int k = 0; k < s->npar; ++k) sb_printf(&b, ",%.17g", v[k]);
+    char num[32];
+    for (int k = 0; k < s->npar; ++k) sb_printf(&b, ",%s", app_fmt_double(num, sizeof num, v[k]));
     // A failed design's metrics are left empty: those of a run cut short
     // by a blow-up are not the design's.
     for (int k = 0; k < s->nmet; ++k) {
         // A metric the run's world does not have (collisions in the
         // validation world) is empty too, not 0.
         if (code || !met || (s->met[k] == MET_COLLISIONS && !met->present[MET_COLLISIONS])) sb_printf(&b, ",");
-        else sb_printf(&b, ",%.17g", met->value[s->met[k]]);
+        else sb_printf(&b, ",%s", app_fmt_double(num, sizeof num, met->value[s->met[k]]));
     }
     sb_printf(&b, ",%d,", code);
     if (code) {
@@ -1106,7 +1108,9 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
     if (plot) {
         const size_t L = strlen(plot);
         if (L > 4 && !strcmp(plot + L - 4, ".png")) {
-            if (app_check_output("sweep", "--plot", plot, ".png")) return EXIT_USAGE;
+            if (app_check_output("sweep", "--plot", plot, ".png") ||
+                app_check_distinct("sweep", (const char* const[]){"--out", "--plot"}, (const char* const[]){out, plot}, 2))
+                return EXIT_USAGE;
         }
     }
     int rc = app_check_sim("sweep", &s.c.sim, s.c.given);
@@ -1127,8 +1131,8 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
     // a sweep of refused designs. (Its values are checked per design.)
     for (int k = 0; k < nparam && !rc; ++k) {
         cJSON* doc = cJSON_Duplicate(s.base->json, 1);
-        char asg[320], err[1024];
-        snprintf(asg, sizeof asg, "%s=%.17g", s.par[k].path, s.par[k].lo);
+        char asg[320], err[1024], num[32];
+        snprintf(asg, sizeof asg, "%s=%s", s.par[k].path, app_fmt_double(num, sizeof num, s.par[k].lo));
         if (!doc || json_set_path(doc, asg, err, sizeof err)) {
             fprintf(stderr, "cranesim sweep: --param %s: %s\n", s.par[k].path, doc ? err : "out of memory");
             rc = EXIT_USAGE;
@@ -1163,7 +1167,8 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
         app_common cn = s.c;
         char asg[SW_MAXPAR][320];
         for (int k = 0; k < nparam && cn.nset < APP_MAX_SET; ++k) {
-            snprintf(asg[k], sizeof asg[k], "%s=%.17g", s.par[k].path, s.par[k].lo);
+            char num[32];
+            snprintf(asg[k], sizeof asg[k], "%s=%s", s.par[k].path, app_fmt_double(num, sizeof num, s.par[k].lo));
             cn.sets[cn.nset++] = asg[k];
         }
         if (rank == 0) app_note_load("sweep", &cn, &s.c.sim, &s.sc);

@@ -5,6 +5,7 @@
 #include "render.h"
 #endif
 
+#include <stdlib.h>
 #include <string.h>
 
 #ifndef CRANESIM_VERSION
@@ -95,6 +96,14 @@ int main(int argc, char** argv) {
         fprintf(stderr, "cranesim: unknown command '%s' (try cranesim help)\n", cmd);
         return EXIT_USAGE;
     }
-    if (app_check_values(cmd, argc - 2, argv + 2)) return EXIT_USAGE;
-    return fn(argc - 2, argv + 2);
+    int n = argc - 2;
+    char** args = app_split_equals(cmd, &n, argv + 2);
+    if (!args) {
+        fprintf(stderr, "cranesim: out of memory\n");
+        return EXIT_RUNTIME;
+    }
+    int rc = app_check_values(cmd, n, args);
+    if (!rc) rc = fn(n, args);
+    free(args);
+    return rc;
 }

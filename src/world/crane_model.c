@@ -2,6 +2,7 @@
 #include "crane_model.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -98,6 +99,26 @@ double crane_joint_for_stroke(const crane_actuator* a, double x) {
     q = atan2(sin(q), cos(q));
     if (a->joint == 0 && q < 0) q += 2.0 * M_PI; // q1 lives in (0, 2 pi)
     return q;
+}
+
+int crane_check_pose(const crane_actuator* a, double stroke, double q, char* err, size_t errsz) {
+    const double deg = 180.0 / M_PI;
+    double lo = crane_joint_for_stroke(a, 0.0), hi = crane_joint_for_stroke(a, stroke);
+    if (lo > hi) {
+        double t = lo;
+        lo = hi;
+        hi = t;
+    }
+    // The stroke alone cannot tell a pose from its mirror image about the
+    // cylinder's mounts (phi and -phi give the same pin length), so the pose
+    // must also be the one the stroke maps back to on the mounts' branch.
+    const double x = crane_stroke(a, q);
+    const double back = crane_joint_for_stroke(a, x);
+    const bool on_branch = isfinite(back) && fabs(remainder(q - back, 2.0 * M_PI)) < 1e-6;
+    if (x >= -1e-9 && x <= stroke + 1e-9 && on_branch) return 0;
+    snprintf(err, errsz, "initial.q%d_deg: %.2f deg is outside joint %d's range %.1f..%.1f deg (cylinder %s over its stroke 0..%.3f m)",
+             a->joint + 1, q * deg, a->joint + 1, lo * deg, hi * deg, a->cylinder, stroke);
+    return -1;
 }
 
 void crane_tip(const crane_mech* m, double q1, double q2, double* x, double* z) {

@@ -12,6 +12,8 @@
 #ifndef CRANE_MODEL_H
 #define CRANE_MODEL_H
 
+#include <stddef.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -82,6 +84,11 @@ double crane_stroke(const crane_actuator* a, double q);
 /// Joint angle [rad] that gives stroke x [m] (inverse of crane_stroke over the
 /// branch phi in (0, pi)). Returns NAN if unreachable.
 double crane_joint_for_stroke(const crane_actuator* a, double x);
+
+/// Whether joint angle q [rad] is a pose actuator a reaches over its stroke
+/// [0, stroke] m on the mounts' branch. Returns 0, or -1 with a one-line
+/// message giving the joint's range in degrees.
+int crane_check_pose(const crane_actuator* a, double stroke, double q, char* err, size_t errsz);
 
 /// Tip position relative to joint 1 (x reach, z height) [m].
 void crane_tip(const crane_mech* m, double q1, double q2, double* x, double* z);

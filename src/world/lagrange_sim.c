@@ -449,12 +449,7 @@ int lsim_check_pose(const lsim* s, const double q0[2], char* err, size_t errsz) 
     const model* m = s->mdl;
     for (int k = 0; k < 2; ++k) {
         const crane_actuator* a = &m->mech.act[k];
-        const double x = crane_stroke(a, q0[a->joint]);
-        if (!(x >= -1e-9 && x <= m->stroke[k] + 1e-9)) {
-            snprintf(err, errsz, "initial q%d = %.2f deg puts cylinder %s at stroke %.4f m, outside [0, %.3f] m",
-                     a->joint + 1, q0[a->joint] * (180.0 / 3.14159265358979323846), a->cylinder, x, m->stroke[k]);
-            return -1;
-        }
+        if (crane_check_pose(a, m->stroke[k], q0[a->joint], err, errsz)) return -1;
     }
     return 0;
 }

@@ -420,12 +420,7 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
         if (c->stroke > 0) {
             // Reject an initial pose the cylinder cannot reach: the hinge
             // limit would otherwise snap the boom on the first step.
-            double xs = crane_stroke(a, q0[k]);
-            if (!(xs >= -1e-9 && xs <= c->stroke + 1e-9)) {
-                snprintf(err, errsz, "initial q%d = %.2f deg puts cylinder %s at stroke %.4f m, outside [0, %.3f] m",
-                         k + 1, q0[k] * 180.0 / M_PI, a->cylinder, xs, c->stroke);
-                return -1;
-            }
+            if (crane_check_pose(a, c->stroke, q0[k], err, errsz)) return -1;
             double lo, hi;
             if (w->opt.stop_limits && joint_limits(a, c->stroke, q0[k], &lo, &hi) == 0 && lo > -M_PI && hi < M_PI) {
                 dJointID j = k ? w->j2 : w->j1;

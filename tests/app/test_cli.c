@@ -4,10 +4,13 @@
 #include "cli_util.h"
 #include "fixture_edit.h"
 
+#include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #define DATA CRANESIM_TESTDATA
 
@@ -421,17 +424,27 @@ static void test_study_usage(void) {
     CHECK(rc == 2 && strstr(out, "--out-dir cli_study_file") && !strstr(out, "reference:") && !strstr(out, "reference run failed"),
           "--out-dir naming a file: exit %d: %s", rc, out);
     remove("cli_study_file");
-    // A nested folder is made with its parents.
-    remove("cli_study/sub/deeper/study.md");
-    rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study/sub/deeper", out, sizeof out);
+    // Only the last folder is made: a missing parent is refused before any
+    // run, like an output file's missing folder, and nothing is created.
+    remove("cli_study2/made/study.md");
+    remove("cli_study2/made/study.jsonl");
+    remove("cli_study2/made/work_precision.png");
+    rmdir("cli_study2/made");
+    rmdir("cli_study2");
+    rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study2/made", out, sizeof out);
     if (rc == 2 && strstr(out, "needs the CVODE reference")) {
         // Only a build without SUNDIALS gets here (the study cannot run at
         // all); the checks above still ran. Said, not counted as a pass.
-        printf("  SKIPPED: nested --out-dir (no CVODE in this build)\n");
+        printf("  SKIPPED: --out-dir (no CVODE in this build)\n");
         return;
     }
-    CHECK(rc == 0 && exists("cli_study/sub/deeper/study.md") && exists("cli_study/sub/deeper/study.jsonl"),
-          "nested --out-dir: exit %d: %.300s", rc, out);
+    CHECK(rc == 2 && strstr(out, "--out-dir cli_study2/made: no directory cli_study2") && cli_count_lines(out) == 1 &&
+              stat("cli_study2", &(struct stat){0}) != 0,
+          "--out-dir with a missing parent: exit %d: %.300s", rc, out);
+    mkdir("cli_study2", 0755);
+    rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study2/made/", out, sizeof out);
+    CHECK(rc == 0 && exists("cli_study2/made/study.md") && exists("cli_study2/made/study.jsonl"),
+          "--out-dir in an existing folder: exit %d: %.300s", rc, out);
 }
 
 // A fixed step lands on every output time, so --every must be a whole number
@@ -521,6 +534,63 @@ static void test_rk4_jacobian_note(void) {
     CHECK(rc == 0 && strstr(out, "note: --jac-every has no effect with rk4") && cli_count_lines(out) == 1, "%s", out);
 }
 
+// A shipped scenario's description must say what the run does: hose_burst
+// said the boom sinks "until it rests on the lift cylinder's end stop", yet
+// in its 8 s the stroke only falls to 261 mm. The sink rate, the final
+// stroke and the end stop it states are read from the description and
+// checked against the run (the rate against the CSV's stroke, the stop
+// against its end_stop bits).
+static void test_hose_burst_description(void) {
+    static char out[8192], scen[4096], csv[4 << 20];
+    CHECK(cli_read_file(CRANESIM_ASSETS "/scenarios/hose_burst.json", scen, sizeof scen) > 0, "no hose_burst.json");
+    const char* d = strstr(scen, "\"description\"");
+    double rate = NAN, x_from = NAN, x_to = NAN, t_end = NAN;
+    const char* a = d ? strstr(d, "about ") : NULL;
+    if (a) sscanf(a, "about %lf mm/s, %lf to %lf mm by %lf s", &rate, &x_from, &x_to, &t_end);
+    CHECK(isfinite(rate) && isfinite(x_to) && isfinite(t_end),
+          "the description states no sink rate and final stroke: %.300s", d ? d : scen);
+    const bool says_no_stop = d && strstr(d, "short of its end stop");
+    int rc = cli_run("run --quiet --scenario hose_burst --out hose_burst.csv", out, sizeof out);
+    CHECK(rc == 0, "exit %d: %s", rc, out);
+    CHECK(cli_read_file("hose_burst.csv", csv, sizeof csv) > 0, "no CSV");
+    // Columns by the header's names.
+    int it = -1, ix = -1, ie = -1, col = 0;
+    for (const char* p = csv; *p && *p != '\n'; ++col) {
+        const char* e = p + strcspn(p, ",\n");
+        if (e - p == 1 && !strncmp(p, "t", 1)) it = col;
+        if (e - p == 2 && !strncmp(p, "x1", 2)) ix = col;
+        if (e - p == 8 && !strncmp(p, "end_stop", 8)) ie = col;
+        p = *e == ',' ? e + 1 : e;
+    }
+    CHECK(it >= 0 && ix >= 0 && ie >= 0, "columns t %d, x1 %d, end_stop %d", it, ix, ie);
+    if (it < 0 || ix < 0 || ie < 0) return;
+    double x3 = NAN, x_last = NAN, t_last = NAN;
+    long stop_rows = 0;
+    for (const char* line = strchr(csv, '\n'); line && line[1]; line = strchr(line + 1, '\n')) {
+        double v[64];
+        int n = 0;
+        for (const char* p = line + 1; n < 64;) {
+            char* e;
+            v[n++] = strtod(p, &e);
+            if (*e != ',') break;
+            p = e + 1;
+        }
+        if (n <= ix || n <= ie || n <= it) continue;
+        if (fabs(v[it] - 3.0) < 1e-9) x3 = v[ix];
+        x_last = v[ix], t_last = v[it];
+        stop_rows += v[ie] != 0;
+    }
+    const double measured = (x3 - x_last) / (t_last - 3.0) * 1e3; // [mm/s], well after the burst at 2 s
+    printf("hose_burst: stated %g mm/s, to %g mm by %g s; run %.2f mm/s, %.1f mm at %g s, %ld end-stop rows\n", rate,
+           x_to, t_end, measured, x_last * 1e3, t_last, stop_rows);
+    CHECK(fabs(measured - rate) < 0.05 * rate, "sink rate: stated %g, run %.2f mm/s", rate, measured);
+    CHECK(fabs(t_last - t_end) < 1e-9 && fabs(x_last * 1e3 - x_to) < 1.0, "final stroke: stated %g mm at %g s, run %.1f",
+          x_to, t_end, x_last * 1e3);
+    CHECK(says_no_stop == (stop_rows == 0), "the description says %s the end stop; the run has %ld rows on it",
+          says_no_stop ? "short of" : "nothing about being short of", stop_rows);
+    remove("hose_burst.csv");
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_help_and_usage);
     RUN_TEST(test_bad_models);
@@ -542,5 +612,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_every_multiple_of_step);
     RUN_TEST(test_notes_on_unused_options);
     RUN_TEST(test_run_summary);
+    RUN_TEST(test_hose_burst_description);
     TEST_MAIN_END();
 }

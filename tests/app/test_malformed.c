@@ -194,6 +194,12 @@ static const bad_case corpus[] = {
     {SCENARIO, "s_duration_neg.json", S, "duration=-1", NULL, NULL, "duration", "must be > 0"},
     {SCENARIO, "s_duration_huge.json", S, "duration=1e9", NULL, NULL, "duration", "[0.001, 86400] s"},
     {SCENARIO, "s_q1.json", S, "initial.q1_deg=400", NULL, NULL, "initial.q1_deg", "<= 360"},
+    // Poses whose strokes are in range but on the mirror branch of the
+    // mounts (boom folded backwards, jib bent the wrong way): they ran.
+    {SCENARIO, "s_q1_mirror.json", S, "initial.q1_deg=300", NULL, NULL, "initial.q1_deg",
+     "300.00 deg is outside joint 1's range"},
+    {SCENARIO, "s_q2_mirror.json", S, "initial.q2_deg=100", NULL, NULL, "initial.q2_deg",
+     "100.00 deg is outside joint 2's range -135"},
     {SCENARIO, "s_is_model.json", M, NULL, "\"name\"", "\"name\"", "this is a model file (use --model)", NULL},
     {SCENARIO, "s_is_world.json", W, NULL, "\"name\"", "\"name\"", "this is a world file (use --world)", NULL},
     {SCENARIO, "s_hook_inf.json", SP, NULL, "[24.0, \"release\"]", "[1e400, \"release\"]", "hook[1]",
@@ -383,6 +389,27 @@ static void test_shipped_quiet(void) {
     }
 }
 
+// The ode backend refuses a mirror-branch start pose the same way (its
+// hinge limits were set from the stroke only, around the backwards boom).
+static void test_start_pose_ode(void) {
+    const bad_case cases[] = {
+        {SCENARIO, "s_sb_q1_mirror.json", SB, "initial.q1_deg=300", NULL, NULL, "initial.q1_deg", "outside joint 1"},
+        {SCENARIO, "s_sb_q2_mirror.json", SB, "initial.q2_deg=100", NULL, NULL, "initial.q2_deg", "outside joint 2"},
+    };
+    for (int i = 0; i < 2; ++i) {
+        const char* file = make_case(&cases[i]);
+        CHECK(file != NULL, "cannot make %s", cases[i].name);
+        if (!file) continue;
+        char cmd[2048];
+        snprintf(cmd, sizeof cmd, "run --quiet --mechanics ode --world sandbox --scenario %s --duration 0.01 --out /dev/null",
+                 file);
+        int rc = cli_run(cmd, out_buf, sizeof out_buf);
+        CHECK(rc == 2 && strstr(out_buf, cases[i].name) && strstr(out_buf, cases[i].field) &&
+                  strstr(out_buf, cases[i].msg) && strstr(out_buf, " deg") && cli_count_lines(out_buf) == 1,
+              "%s: exit %d: %s", cases[i].name, rc, out_buf);
+    }
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_hard_ranges);
     RUN_TEST(test_ls_components);
@@ -394,5 +421,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_sandbox_start_names_the_hook);
     RUN_TEST(test_one_range_per_value);
     RUN_TEST(test_shipped_quiet);
+    RUN_TEST(test_start_pose_ode);
     TEST_MAIN_END();
 }

@@ -5,6 +5,7 @@
 #include "cli_util.h"
 
 #include <dirent.h>
+#include <math.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -211,14 +212,23 @@ static void test_scenario_world(void) {
         "run --quiet --scenario sandbox_wall --mechanics lagrange --out world.csv",
         "run --quiet --scenario sandbox_pick_place --mechanics ode --world validation --out world.csv",
         "compare --quiet --scenario sandbox_wall --duration 0.1",
+        // Side A is on the lagrange crane because of the default pair, not
+        // --mechanics: the advice must name --backends (it repeated the
+        // options the user had given).
+        "compare --quiet --scenario sandbox_swing --mechanics ode --world sandbox --duration 0.1",
     };
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < 4; ++i) {
         cli_write_file("world.csv", "old\n");
         rc = cli_run(refused[i], out, sizeof out);
-        CHECK(rc == 2 && strstr(out, "run it with --mechanics ode --world sandbox"), "%s: exit %d: %s", refused[i],
-              rc, out);
+        const char* want = i < 2 ? "run it with --mechanics ode --world sandbox" : "the default --backends lagrange,ode";
+        CHECK(rc == 2 && strstr(out, want) && cli_count_lines(out) == 1, "%s: exit %d: %s", refused[i], rc, out);
+        CHECK(i < 2 || !strstr(out, "run it with"), "%s: circular advice: %s", refused[i], out);
         CHECK(cli_read_file("world.csv", buf, sizeof buf) == 4, "%s: the old file changed", refused[i]);
     }
+    // An explicit pair names --backends too.
+    rc = cli_run("compare --quiet --scenario sandbox_swing --backends lagrange,ode --world sandbox --duration 0.1", out,
+                 sizeof out);
+    CHECK(rc == 2 && strstr(out, "because of --backends"), "explicit --backends: exit %d: %s", rc, out);
 }
 
 // The Quick start's headless drive (scripts/run.sh) wrote drive.csv into the
@@ -303,6 +313,94 @@ static void test_interrupted_drive(void) {
     CHECK(tmp[0] == 0, "temporary %s left behind", tmp);
 }
 
+// Two outputs of one command naming one file: the second write replaced the
+// first (`run --out x.png --plot x.png` left a PNG where the CSV was). Now
+// refused before anything runs, the existing file untouched; by name, by
+// another spelling of the name, by a hard link; devices may be shared.
+static void test_same_output_file(void) {
+    static char out[8192], buf[256];
+    remove("same.png");
+    remove("same.csv");
+    remove("same_link.png");
+    int rc = cli_run("run --quiet --duration 0.05 --out same.png --plot ./same.png", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--out same.png and --plot ./same.png name the same file") && cli_count_lines(out) == 1,
+          "new file twice: exit %d: %s", rc, out);
+    CHECK(cli_read_file("same.png", buf, sizeof buf) < 0, "a refused run created same.png");
+    cli_write_file("same.png", "old\n");
+    rc = cli_run("run --quiet --duration 0.05 --out same.png --energy same.png", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--out same.png and --energy same.png name the same file"), "--energy: exit %d: %s",
+          rc, out);
+    mkdir("samedir", 0755);
+    rc = cli_run("run --quiet --duration 0.05 --energy samedir/../same.png --plot same.png --out /dev/null", out,
+                 sizeof out);
+    CHECK(rc == 2 && strstr(out, "--plot same.png and --energy samedir/../same.png name the same file"),
+          "--energy via ..: exit %d: %s", rc, out);
+    CHECK(cli_read_file("same.png", buf, sizeof buf) == 4, "the old file changed");
+    cli_write_file("same.csv", "old\n");
+    CHECK(link("same.csv", "same_link.png") == 0, "hard link");
+    rc = cli_run("compare --quiet --scenario hold --duration 0.05 --solvers krus,ros2 --out same.csv --plot same_link.png",
+                 out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "cranesim compare: --out same.csv and --plot same_link.png name the same file"),
+          "compare, hard link: exit %d: %s", rc, out);
+    CHECK(cli_read_file("same.csv", buf, sizeof buf) == 4, "the old file changed");
+    rc = cli_run("run --quiet --duration 0.05 --out /dev/null --energy /dev/null", out, sizeof out);
+    CHECK(rc == 0, "/dev/null twice: exit %d: %s", rc, out);
+    remove("same.png");
+    remove("same.csv");
+    remove("same_link.png");
+}
+
+// Small things a new user met: "--opt=value" was an unknown option; sweep
+// wrote 0.080000000000000002 for 0.08; a run slower than real time said
+// "0x real time"; compare labelled a side with no changes "A = A"; drive
+// --replay of a missing file talked about the window; loadchart refused
+// --outreach 0:6 naming a reach from -0.104 m that LO may not use.
+static void test_small_things(void) {
+    static char out[16384], buf[4096];
+    remove("eq.csv");
+    int rc = cli_run("run --quiet --scenario=hold --duration=0.05 --out=eq.csv --set=hydraulics.components.lift_cyl.bore=0.11",
+                     out, sizeof out);
+    CHECK(rc == 0 && cli_read_file("eq.csv", buf, sizeof buf) > 0, "--opt=value: exit %d: %s", rc, out);
+    rc = cli_run("run --quiet=1 --out /dev/null", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "unknown option '--quiet=1'"), "a flag with =: exit %d: %s", rc, out);
+    remove("eq.csv");
+
+    rc = cli_run("sweep --quiet --scenario hold --duration 0.05 --param hydraulics.components.lift_cyl.bore=0.08:0.1:3 "
+                 "--metrics peak_p1A --out eq_sweep.csv",
+                 out, sizeof out);
+    CHECK(rc == 0 && cli_read_file("eq_sweep.csv", buf, sizeof buf) > 0, "sweep: exit %d: %s", rc, out);
+    // Shortest form, and it reads back to the design's value: 0.08 + 0.01 k.
+    CHECK(strstr(buf, "\n0,0.08,") && strstr(buf, "\n1,0.09,") && strstr(buf, "\n2,0.1,"), "sweep CSV: %s", buf);
+    for (const char* p = strchr(buf, '\n'); p && p[1]; p = strchr(p + 1, '\n')) {
+        const char* c = strchr(p + 1, ',');
+        const char* e = c ? strchr(c + 1, ',') : NULL;
+        CHECK(c && e && e - c - 1 <= 17, "a long number: %.60s", p + 1);
+    }
+    remove("eq_sweep.csv");
+
+    // 20000 steps of 0.1 us for 2 ms: far slower than real time.
+    rc = cli_run("run --scenario hold --duration 0.002 --dt 1e-7 --out /dev/null", out, sizeof out);
+    const char* w = strstr(out, "s wall: ");
+    const char* sim = strstr(out, "simulated ");
+    double ratio = w ? strtod(w + strlen("s wall: "), NULL) : NAN;
+    double t_end = sim ? strtod(sim + strlen("simulated "), NULL) : NAN;
+    double wall = sim ? strtod(strstr(sim, " in ") + 4, NULL) : NAN;
+    CHECK(rc == 0 && ratio > 0 && fabs(ratio - t_end / wall) <= 0.1 * t_end / wall + 0.01,
+          "slower than real time: %.3g printed for %g s / %g s: %s", ratio, t_end, wall, out);
+
+    rc = cli_run("compare --quiet --scenario hold --duration 0.05 --set-b hydraulics.components.lift_cyl.bore=0.11", out,
+                 sizeof out);
+    CHECK(rc == 0 && strstr(out, "(A = hiab031.json, B = bore=0.11)") && !strstr(out, "A = A"), "labels: %s", out);
+
+    rc = cli_run("drive --replay nosuch.session", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--replay nosuch.session: cannot read: No such file") && cli_count_lines(out) == 1,
+          "missing replay: exit %d: %s", rc, out);
+
+    rc = cli_run("loadchart --outreach 0:6:10 --out /dev/null", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "must lie in [0.000, ") && !strstr(out, "[-"), "loadchart --outreach: exit %d: %s", rc,
+          out);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_run_memory);
     RUN_TEST(test_duration_caps);
@@ -314,5 +412,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_soak_runs);
     RUN_TEST(test_replace_keeps_link_and_mode);
     RUN_TEST(test_interrupted_drive);
+    RUN_TEST(test_same_output_file);
+    RUN_TEST(test_small_things);
     TEST_MAIN_END();
 }

@@ -9,6 +9,11 @@
 // 2. Malformed and hostile clients on a real-time server: each is closed
 //    (or refused) with its reason in the log, while a watcher keeps
 //    receiving frames and the controller keeps seeing its commands echoed.
+// 3. Dead-man: a controller opens the jib valve and leaves; the next client
+//    finds the spools back at neutral and the strokes at rest.
+// 4. The closing statistics: a server stopped (SIGSTOP) for 300 ms misses
+//    deadlines, and its worst frame, timed from the frame's scheduled start,
+//    says so (it timed the work alone: a few ms against missed deadlines).
 #define _DEFAULT_SOURCE // usleep, in serve_util.h
 #include "check.h"
 #include "engine.h"
@@ -342,10 +347,108 @@ static void hostile(void) {
         CHECK(strstr(all, reasons[k]) != NULL, "the log names the reason '%s'", reasons[k]);
 }
 
+// ---- 3. dead-man on disconnect ----
+
+static void dead_man(void) {
+    const char* args[] = {"--mechanics", "lagrange", "--scenario", "drive_demo", "--lockstep", NULL};
+    served sv;
+    CHECK(serve_start(&sv, NULL, args) == 0, "server started");
+    int role = -1;
+    int fd = serve_join(sv.port, PROTO_CONTROL, &role);
+    CHECK(fd >= 0 && role == PROTO_CONTROL, "the first client controls (role %d)", role);
+    if (fd < 0) {
+        serve_stop(&sv);
+        return;
+    }
+    CHECK(next_state(fd, &g_st, 5000) == 0, "the state at t = 0");
+    // Jib valve at -0.7 for 0.2 s (15 frames at 75 Hz): the jib stroke moves
+    // (from 156 mm; held open it reaches its end stop after about 1 s).
+    proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .u = {0, -0.7, 0}};
+    send_cmd(fd, &c);
+    const double x2_start = g_st.nine[1];
+    c = (proto_command){.seq = 2, .op = PROTO_OP_STEP, .frames = 15};
+    send_cmd(fd, &c);
+    CHECK(next_state(fd, &g_st, 10000) == 0, "state after 15 frames");
+    const double x2_open = g_st.nine[1], u2_open = g_st.nine[7];
+    const double v_open = fabs(x2_open - x2_start) / (15 / 75.0); // [m/s]
+    CHECK(u2_open < -0.3 && v_open > 1e-3, "the jib spool opened (u2 %g) and the stroke moved (%g m/s)", u2_open,
+          v_open);
+    close(fd);
+    // The server may see the close after the next hello: ask again until granted.
+    int fd2 = -1;
+    for (int k = 0; k < 100; ++k) {
+        fd2 = serve_join(sv.port, PROTO_CONTROL, &role);
+        if (fd2 >= 0 && role == PROTO_CONTROL) break;
+        if (fd2 >= 0) close(fd2);
+        fd2 = -1;
+        usleep(20000);
+    }
+    CHECK(fd2 >= 0, "the next client got control");
+    if (fd2 >= 0) {
+        CHECK(next_state(fd2, &g_st, 5000) == 0, "state after the hello");
+        // No VALVES command from the new client: 0.2 s for the spools to
+        // close (their lag is a few tens of ms), then 0.2 s in which the
+        // stroke must stay put. With the valve left open it would move on
+        // at v_open (still short of the end stop by then).
+        c = (proto_command){.seq = 1, .op = PROTO_OP_STEP, .frames = 15};
+        send_cmd(fd2, &c);
+        CHECK(next_state(fd2, &g_st, 10000) == 0, "state after 15 more frames");
+        const double x2_a = g_st.nine[1];
+        c = (proto_command){.seq = 2, .op = PROTO_OP_STEP, .frames = 15};
+        send_cmd(fd2, &c);
+        CHECK(next_state(fd2, &g_st, 10000) == 0, "state after 15 more frames");
+        const double v_after = fabs(g_st.nine[1] - x2_a) / (15 / 75.0);
+        printf("dead-man: u2 %.3f -> %.3g, jib stroke speed %.3g -> %.3g m/s\n", u2_open, g_st.nine[7], v_open,
+               v_after);
+        CHECK(fabs(g_st.nine[6]) < 0.01 && fabs(g_st.nine[7]) < 0.01, "spools at neutral (u1 %g, u2 %g)",
+              g_st.nine[6], g_st.nine[7]);
+        CHECK(v_after < 0.1 * v_open, "the jib stroke stopped: %g m/s (was %g m/s)", v_after, v_open);
+        close(fd2);
+    }
+    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+}
+
+// ---- 4. worst frame and missed deadlines agree ----
+
+static void late_wakeup(void) {
+    const char* log = CRANESIM_BINARY_DIR "/tests/app/serve_late.log";
+    const char* args[] = {"--mechanics", "lagrange", "--scenario", "hold", "--duration", "3", NULL};
+    served sv;
+    CHECK(serve_start(&sv, log, args) == 0, "server started");
+    usleep(500000);
+    kill(sv.pid, SIGSTOP);
+    usleep(300000);
+    kill(sv.pid, SIGCONT);
+    usleep(300000);
+    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+    static char all[1 << 16];
+    FILE* f = fopen(log, "r");
+    size_t n = f ? fread(all, 1, sizeof all - 1, f) : 0;
+    all[n] = 0;
+    if (f) fclose(f);
+    const char* st = strstr(all, " missed deadlines, worst frame ");
+    long missed = -1;
+    double worst = NAN;
+    if (st) {
+        const char* b = st;
+        while (b > all && b[-1] >= '0' && b[-1] <= '9') --b;
+        missed = strtol(b, NULL, 10);
+        worst = strtod(st + strlen(" missed deadlines, worst frame "), NULL);
+    }
+    const double period_ms = 1e3 / 75;
+    printf("late wake-up: %ld missed deadlines, worst frame %.3f ms (period %.3f ms)\n", missed, worst, period_ms);
+    CHECK(missed >= 1, "a 300 ms stop missed no deadline? %s", st ? st : all);
+    CHECK(worst >= 250, "worst frame %.3f ms after a 300 ms stop", worst);
+    CHECK((missed > 0) == (worst > period_ms), "%ld missed deadlines but worst frame %.3f ms (period %.3f ms)", missed,
+          worst, period_ms);
+}
+
 int main(void) {
     signal(SIGPIPE, SIG_IGN);
     bit_for_bit("lagrange", "drive_demo", 300);
     bit_for_bit("ode", "sandbox_pick_place", 150);
     hostile();
+    dead_man();
+    late_wakeup();
     TEST_MAIN_END();
 }
