@@ -245,6 +245,7 @@ static void sp_symbolic(hyd_solver* s) {
         if (m[i]) s->sp_ppos[np++] = i;
     }
     s->sp_np = np;
+    s->sp_wclean = 0; // positions that left the fill may hold old factors
 }
 
 void hydSparseInit(hyd_solver* s) { sp_symbolic(s); }
@@ -256,13 +257,12 @@ static int sp_factor(hyd_solver* s, double gh) {
     const int n = s->n, nn = n * n;
     const double* restrict jb = s->jb;
     double* restrict w = s->w;
-    // W's entries, then two cheap checks instead of one branchy pass over
-    // n^2 entries: (1) any non-zero outside the known pattern (integer OR of
-    // the magnitude bits, masked to the off-pattern positions: vectorises),
-    // (2) max |J| and non-finiteness over the pattern's positions only (off
-    // the pattern every entry is then an exact zero). The magnitude bits of
-    // doubles order like unsigned integers, Inf and NaN above every finite.
-    for (int i = 0; i < nn; ++i) w[i] = -gh * jb[i];
+    // Two cheap checks instead of one branchy pass over n^2 entries: (1)
+    // any non-zero outside the known pattern (integer OR of the magnitude
+    // bits, masked to the off-pattern positions: vectorises), (2) max |J| and
+    // non-finiteness over the pattern's positions only (off the pattern every
+    // entry is then an exact zero). The magnitude bits of doubles order like
+    // unsigned integers, Inf and NaN above every finite.
     const uint64_t* restrict zm = s->sp_zmask;
     uint64_t off = 0;
     for (int i = 0; i < nn; ++i) {
@@ -276,16 +276,33 @@ static int sp_factor(hyd_solver* s, double gh) {
         unsigned char* jm = s->sp_jmask;
         for (int i = 0; i < nn; ++i)
             if (jb[i] != 0.0 || jb[i] != jb[i]) jm[i] = 1;
-        sp_symbolic(s);
+        sp_symbolic(s); // clears sp_wclean: the fill may have moved
     }
+    // W's entries. Off the pattern they are zero (J is), and stay so while
+    // only the pattern's positions are written: then those alone are formed
+    // (on the LS crane 165 of 625), in the pass that finds max |J|.
     const int* restrict pp = s->sp_ppos;
     const int np = s->sp_np;
     uint64_t bmax = 0;
-    for (int p = 0; p < np; ++p) {
-        uint64_t b;
-        memcpy(&b, &jb[pp[p]], sizeof b);
-        b &= ~(UINT64_C(1) << 63);
-        bmax = b > bmax ? b : bmax;
+    if (s->sp_wclean) {
+        for (int p = 0; p < np; ++p) {
+            const int i = pp[p];
+            const double v = jb[i];
+            w[i] = -gh * v;
+            uint64_t b;
+            memcpy(&b, &v, sizeof b);
+            b &= ~(UINT64_C(1) << 63);
+            bmax = b > bmax ? b : bmax;
+        }
+    } else {
+        for (int i = 0; i < nn; ++i) w[i] = -gh * jb[i];
+        for (int p = 0; p < np; ++p) {
+            uint64_t b;
+            memcpy(&b, &jb[pp[p]], sizeof b);
+            b &= ~(UINT64_C(1) << 63);
+            bmax = b > bmax ? b : bmax;
+        }
+        s->sp_wclean = 1;
     }
     if (bmax >= UINT64_C(0x7ff0000000000000)) return -1; // Inf or NaN in J
     double jmax;
@@ -405,6 +422,7 @@ int hydFactorW(hyd_solver* s, double gh) {
             return w_factored(s, gh);
         }
         s->sp_fallbacks++; // a weak diagonal pivot: the dense LU below
+        s->sp_wclean = 0;  // which writes every entry of W
     }
     for (int b = 0; b < s->nblock; ++b) {
         const int m = s->boff[b + 1] - s->boff[b];
