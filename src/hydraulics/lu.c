@@ -245,7 +245,6 @@ static void sp_symbolic(hyd_solver* s) {
         if (m[i]) s->sp_ppos[np++] = i;
     }
     s->sp_np = np;
-    s->sp_wclean = 0; // positions that left the fill may hold old factors
 }
 
 void hydSparseInit(hyd_solver* s) { sp_symbolic(s); }
@@ -276,33 +275,23 @@ static int sp_factor(hyd_solver* s, double gh) {
         unsigned char* jm = s->sp_jmask;
         for (int i = 0; i < nn; ++i)
             if (jb[i] != 0.0 || jb[i] != jb[i]) jm[i] = 1;
-        sp_symbolic(s); // clears sp_wclean: the fill may have moved
+        sp_symbolic(s);
     }
-    // W's entries. Off the pattern they are zero (J is), and stay so while
-    // only the pattern's positions are written: then those alone are formed
-    // (on the LS crane 165 of 625), in the pass that finds max |J|.
+    // W's entries on the pattern only (on the LS crane 165 of 625), in the
+    // pass that finds max |J|: the elimination and the solves read no other
+    // entry (the pattern holds the fill), so whatever the dense fallback left
+    // off the pattern is never read. Fill positions get -gh * 0 = 0.
     const int* restrict pp = s->sp_ppos;
     const int np = s->sp_np;
     uint64_t bmax = 0;
-    if (s->sp_wclean) {
-        for (int p = 0; p < np; ++p) {
-            const int i = pp[p];
-            const double v = jb[i];
-            w[i] = -gh * v;
-            uint64_t b;
-            memcpy(&b, &v, sizeof b);
-            b &= ~(UINT64_C(1) << 63);
-            bmax = b > bmax ? b : bmax;
-        }
-    } else {
-        for (int i = 0; i < nn; ++i) w[i] = -gh * jb[i];
-        for (int p = 0; p < np; ++p) {
-            uint64_t b;
-            memcpy(&b, &jb[pp[p]], sizeof b);
-            b &= ~(UINT64_C(1) << 63);
-            bmax = b > bmax ? b : bmax;
-        }
-        s->sp_wclean = 1;
+    for (int p = 0; p < np; ++p) {
+        const int i = pp[p];
+        const double v = jb[i];
+        w[i] = -gh * v;
+        uint64_t b;
+        memcpy(&b, &v, sizeof b);
+        b &= ~(UINT64_C(1) << 63);
+        bmax = b > bmax ? b : bmax;
     }
     if (bmax >= UINT64_C(0x7ff0000000000000)) return -1; // Inf or NaN in J
     double jmax;
@@ -422,7 +411,6 @@ int hydFactorW(hyd_solver* s, double gh) {
             return w_factored(s, gh);
         }
         s->sp_fallbacks++; // a weak diagonal pivot: the dense LU below
-        s->sp_wclean = 0;  // which writes every entry of W
     }
     for (int b = 0; b < s->nblock; ++b) {
         const int m = s->boff[b + 1] - s->boff[b];

@@ -88,7 +88,6 @@ struct hyd_solver {
     uint64_t* sp_zmask;    ///< (n x n) magnitude-bit mask of the positions off the pattern
     int* sp_ppos;          ///< (n x n) positions on the pattern, sp_np of them
     int sp_np;
-    int sp_wclean;         ///< W is zero off the pattern (only its positions were written since)
     long sp_fallbacks;     ///< factorisations that needed the dense pivoting path
     int w_custom;          ///< W is factored by the problem's wfactor (solve with wsolve)
 

@@ -148,6 +148,14 @@ static void test_sparse_w(void) {
         e = spj_solve(s, &q, gh, &sparse);
         CHECK(e < 1e-10, "n = %d fallback: error %.3g", n, e);
         CHECK(!sparse && s->sp_fallbacks == fb + 1, "n = %d: weak pivot falls back", n);
+        // Back to a strong diagonal on the same pattern: the sparse path
+        // again, on a W that the dense LU had filled in every entry (those
+        // off the pattern must not survive into the sparse factors).
+        for (int i = 0; i < n; ++i) q.J[i * n + i] = -1e4 - 1e3 * fabs(urand(&seed)); // above the 500s
+        e = spj_solve(s, &q, 0.01, &sparse);
+        CHECK(e < 1e-12 && sparse, "n = %d after the fallback: error %.3g, sparse %d", n, e, sparse);
+        e = spj_solve(s, &q, 0.02, &sparse); // and once more, from a sparse W
+        CHECK(e < 1e-12 && sparse, "n = %d sparse again: error %.3g, sparse %d", n, e, sparse);
         // Non-finite J: W is singular, as with the dense LU.
         q.J[2] = NAN;
         double y[16] = {0}, f0[16] = {0};
