@@ -153,8 +153,8 @@ hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solv
     // Sparse path of a dense W (lu.c). Lists hold at most n(n-1)/2 entries.
     if (dense && n >= 3) {
         const size_t nn = (size_t)n * (size_t)n, tri = (size_t)n * (size_t)(n - 1) / 2;
-        s->sp_mask = calloc(nn, 1);
-        s->sp_lptr = calloc(3 * ((size_t)n + 1) + 5 * tri, sizeof(int));
+        s->sp_mask = calloc(2 * nn, 1); // the factors' pattern, then J's (sp_jmask)
+        s->sp_lptr = calloc(3 * ((size_t)n + 1) + 5 * tri + 2 * (size_t)n, sizeof(int));
         s->sp_scale = calloc((size_t)n, sizeof(double));
         s->sp_zmask = calloc(nn, sizeof(uint64_t));
         s->sp_ppos = calloc(nn, sizeof(int));
@@ -162,8 +162,9 @@ hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solv
             hyd_solver_destroy(s);
             return NULL;
         }
+        s->sp_jmask = s->sp_mask + nn;
         for (int i = 0; i < n; ++i) {
-            s->sp_mask[(size_t)i * (size_t)n + (size_t)i] = 1;
+            s->sp_jmask[(size_t)i * (size_t)n + (size_t)i] = 1;
             s->sp_scale[i] = 1.0;
         }
         int* ip = s->sp_lptr + (n + 1);
@@ -174,6 +175,8 @@ hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solv
         s->sp_upos = ip, ip += tri;
         s->sp_fpos = ip, ip += tri;
         s->sp_fcol = ip, ip += tri;
+        s->sp_perm = ip, ip += n;
+        s->sp_pos = ip, ip += n;
         s->sp_on = 1;
         hydSparseInit(s);
     }

@@ -60,21 +60,27 @@ struct hyd_solver {
     double w_gh;   ///< gamma * h that w was factored with [s]
 
     // Sparse path for a dense W (nblock == 1; lu.c). J's non-zeros seen so
-    // far (their union, plus the diagonal and the fill of an LU in natural
-    // order) are kept in sp_mask; W is factored without row exchanges over
-    // that pattern only, accepting a diagonal pivot when it is at least
-    // HYD_SP_THRESH times the largest entry below it in its column (threshold
-    // partial pivoting). Otherwise that W falls back to the dense LU with
-    // partial pivoting.
+    // far (their union, plus the diagonal) are kept in sp_jmask. From that
+    // pattern a pivot order is chosen (Markowitz on the diagonal: least fill),
+    // and W is factored in that order without row exchanges over the
+    // pattern and its fill (sp_mask) only, accepting a diagonal pivot when it
+    // is at least HYD_SP_THRESH times the largest entry below it in its
+    // column (threshold partial pivoting). Otherwise that W falls back to the
+    // dense LU with partial pivoting. The factors stay in W's dense storage,
+    // in the states' own order; only the lists below follow the pivot order.
     int sp_on;             ///< the sparse path is available (dense W, n >= 3)
     int w_sparse;          ///< w holds a sparse, unpivoted factorisation
-    unsigned char* sp_mask;///< (n x n) pattern of W's factors
+    unsigned char* sp_mask;///< (n x n) pattern of W's factors (J's, the diagonal and the fill)
+    unsigned char* sp_jmask;///< (n x n) union of J's non-zeros and the diagonal
+    int* sp_perm;          ///< (n) pivot order: the state eliminated k-th
+    int* sp_pos;           ///< (n) its inverse: the step at which state i is eliminated
+    // Lists per elimination step k (pivot sp_perm[k]); indices are states.
     int* sp_lptr;          ///< (n + 1) column k of L: rows sp_lrow[sp_lptr[k] ..]
     int* sp_lrow;
-    int* sp_uptr;          ///< (n + 1) row k of U right of the diagonal: sp_ucol[...]
+    int* sp_uptr;          ///< (n + 1) row sp_perm[k] of U, the states eliminated after it: sp_ucol[...]
     int* sp_ucol;
-    int* sp_upos;          ///< position k*n + j of each sp_ucol entry
-    int* sp_fptr;          ///< (n + 1) row i of L left of the diagonal: sp_fpos/sp_fcol
+    int* sp_upos;          ///< position sp_perm[k]*n + j of each sp_ucol entry
+    int* sp_fptr;          ///< (n + 1) row sp_perm[k] of L, the states eliminated before it: sp_fpos/sp_fcol
     int* sp_fpos;
     int* sp_fcol;
     double* sp_scale;      ///< (n) 1 / (atol + rtol |y_i|) at the Jacobian point: the

@@ -415,6 +415,10 @@ static void test_study_usage(void) {
           out);
     rc = cli_run("study --quick --repeat 1 --duration 0.05 --solver krus", out, sizeof out);
     CHECK(rc == 2 && strstr(out, "--solver") && cli_count_lines(out) == 1, "--solver: exit %d: %s", rc, out);
+    // An --only that names no configuration: one line, before the reference run.
+    rc = cli_run("study --quick --repeat 1 --duration 0.05 --only no_such_solver", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--only") && strstr(out, "no_such_solver") && cli_count_lines(out) == 1,
+          "--only matching nothing: exit %d: %s", rc, out);
     rc = cli_run("study --quick --repeat 1 --duration 0.05 --out-dir ''", out, sizeof out);
     CHECK(rc == 2 && strstr(out, "--out-dir") && cli_count_lines(out) == 1, "empty --out-dir: exit %d: %s", rc, out);
     // A file where the folder should be: refused before the reference run.
@@ -445,6 +449,15 @@ static void test_study_usage(void) {
     rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study2/made/", out, sizeof out);
     CHECK(rc == 0 && exists("cli_study2/made/study.md") && exists("cli_study2/made/study.jsonl"),
           "--out-dir in an existing folder: exit %d: %.300s", rc, out);
+    // --only keeps the configurations it names, and the matched-accuracy
+    // comparison is printed for each adaptive method (in 0.05 s the runs at
+    // rtol 1e-3 are within 1 % of peak; whether CVODE matches them varies).
+    rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --only rtol=0.001 --out-dir cli_study2/only", out,
+                 sizeof out);
+    CHECK(rc == 0 && strstr(out, "| rodas3 rtol=0.001 |") && strstr(out, "| cvode rtol=0.001 |") &&
+              !strstr(out, "krus h=") && !strstr(out, "rtol=0.01 ") && strstr(out, "\n* rodas3") && strstr(out, "\n* ros34pw2") &&
+              strstr(out, "matched accuracy"),
+          "--only rtol=0.001: exit %d: %.3000s", rc, out);
 }
 
 // A fixed step lands on every output time, so --every must be a whole number

@@ -135,16 +135,27 @@ static void test_sparse_w(void) {
         q.J[n - 1] = -30.0;
         e = spj_solve(s, &q, 0.02, &sparse);
         CHECK(e < 1e-12, "n = %d grown pattern: error %.3g", n, e);
-        // Zero the diagonal of W's first row (J_00 = 1/gh) and make the first
-        // column large: the threshold test must hand over to the pivoting LU.
+        // Zero W's whole diagonal (J_ii = 1/gh), whatever order the states
+        // are eliminated in the first pivot is zero, and give each row a
+        // large entry in the next column (W stays far from singular): the
+        // threshold test must hand over to the pivoting LU.
         const double gh = 0.05;
-        q.J[0] = 1.0 / gh;
-        q.J[1 * n + 0] = 500.0;
-        q.J[1] = 7.0;
+        for (int i = 0; i < n; ++i) {
+            q.J[i * n + i] = 1.0 / gh;
+            q.J[i * n + (i + 1) % n] = 500.0;
+        }
         long fb = s->sp_fallbacks;
         e = spj_solve(s, &q, gh, &sparse);
         CHECK(e < 1e-10, "n = %d fallback: error %.3g", n, e);
         CHECK(!sparse && s->sp_fallbacks == fb + 1, "n = %d: weak pivot falls back", n);
+        // Back to a strong diagonal on the same pattern: the sparse path
+        // again, on a W that the dense LU had filled in every entry (those
+        // off the pattern must not survive into the sparse factors).
+        for (int i = 0; i < n; ++i) q.J[i * n + i] = -1e4 - 1e3 * fabs(urand(&seed)); // above the 500s
+        e = spj_solve(s, &q, 0.01, &sparse);
+        CHECK(e < 1e-12 && sparse, "n = %d after the fallback: error %.3g, sparse %d", n, e, sparse);
+        e = spj_solve(s, &q, 0.02, &sparse); // and once more, from a sparse W
+        CHECK(e < 1e-12 && sparse, "n = %d sparse again: error %.3g, sparse %d", n, e, sparse);
         // Non-finite J: W is singular, as with the dense LU.
         q.J[2] = NAN;
         double y[16] = {0}, f0[16] = {0};
@@ -154,10 +165,44 @@ static void test_sparse_w(void) {
     }
 }
 
+// An arrow matrix (state 0 coupled both ways to every other state, the
+// others only to it: a pressure node feeding many branches). Eliminated in
+// natural order, state 0 first, its row and column fill the whole matrix:
+// n (n - 1) off-diagonal factor entries. Eliminated last, nothing fills:
+// 2 (n - 1), the fill-free order any minimum-fill rule finds (the hub among
+// the last two). The solve
+// must be as exact either way.
+static void test_sparse_order(void) {
+    for (int n = 4; n <= 16; n += 4) {
+        spj q = {.n = n};
+        for (int i = 0; i < n; ++i) q.J[i * n + i] = -100.0 - i;
+        for (int i = 1; i < n; ++i) {
+            q.J[i] = 10.0 + i;          // row 0
+            q.J[i * n] = -5.0 - 0.5 * i; // column 0
+        }
+        hyd_problem p = {0};
+        p.n = n, p.f = spj_f, p.jac = spj_jac, p.user = &q, p.autonomous = 1;
+        hyd_solver* s = hyd_solver_create(&p, HYD_RODAS3, NULL);
+        CHECK(s && s->sp_on, "n = %d: sparse path available", n);
+        if (!s) continue;
+        int sparse = 0;
+        const double e = spj_solve(s, &q, 0.01, &sparse);
+        CHECK(e < 1e-12 && sparse, "n = %d arrow: error %.3g, sparse %d", n, e, sparse);
+        const int nlu = s->sp_lptr[n] + s->sp_uptr[n];
+        CHECK(nlu == 2 * (n - 1), "n = %d arrow: %d off-diagonal factor entries, want %d (natural order: %d)", n,
+              nlu, 2 * (n - 1), n * (n - 1));
+        // With two states left, hub and one leaf, either may go first.
+        CHECK(s->sp_pos[0] >= n - 2, "n = %d arrow: the hub state eliminated at step %d, want one of the last two",
+              n, s->sp_pos[0]);
+        hyd_solver_destroy(s);
+    }
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_random_system);
     RUN_TEST(test_pivoting_needed);
     RUN_TEST(test_singular);
     RUN_TEST(test_sparse_w);
+    RUN_TEST(test_sparse_order);
     TEST_MAIN_END();
 }
