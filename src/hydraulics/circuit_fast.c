@@ -399,7 +399,7 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
             jcol(k, J, ldj, c->l, c->adr, e.dqx);
             double* row = J + (size_t)c->adr * ldj; // spool row
             jrow(k, row, c->l, e.k);
-            jrow(k, row, c->v, -e.k * (1.0 + c->R));
+            jrow(k, row, c->v, e.kv);
             jrow(k, row, c->p, e.k * c->R);
             row[c->adr] -= c->inv_tau;
         }

@@ -240,6 +240,7 @@ typedef struct hyd_counterbalance_def {
     double check_crack; ///< check valve cracking pressure [Pa]; default 0.05e6
     double check_open;  ///< check valve pressure from crack to rated flow [Pa]; default 0.2e6
     double check_q;     ///< check valve rated flow [m^3/s]; default 1.6667e-3 (100 L/min)
+    double vented;      ///< 1: spring chamber vented to atmosphere (z referenced to p_atm, not p_valve); default 0
 } hyd_counterbalance_def;
 
 /// Gas-charged accumulator: gas p V_g^n = p0 V0^n, oil volume V = V0 - V_g
@@ -413,7 +414,8 @@ int hyd_model_node_owner(const hyd_model* m, int i);
 /// A, 1 chamber B), or -1.
 int hyd_model_comp_node(const hyd_model* m, int comp, int k);
 /// The node at port k of component comp (in the order of its JSON ports:
-/// pump/relief/check/orifice inlet, outlet; hose to; valve P, T, A, B), or -1.
+/// pump/relief/check/orifice inlet, outlet; hose to; valve P, T, A, B; shuttle
+/// a, b, out and, in spool mode, its valve's T as port 3), or -1.
 int hyd_model_port_node(const hyd_model* m, int comp, int k);
 /// The hose whose far end ("to") is node i (a cylinder chamber), as a
 /// component index, or -1. Its own pressure state is

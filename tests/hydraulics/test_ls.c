@@ -568,6 +568,8 @@ static void test_flow_sharing(void) {
 
 // -------------------------------------------------------- counterbalance
 
+static double cb_vented = 0.0; // the valves cb_circuit builds: 1 spring chamber vented
+
 static hyd_model* cb_circuit(void) {
     hyd_builder* b = hyd_builder_create();
     add_tank(b, "t", PT);
@@ -577,6 +579,7 @@ static hyd_model* cb_circuit(void) {
     add_orifice(b, "o", "v", "t", 1e-6);
     hyd_counterbalance_def c = hyd_default_counterbalance_def();
     c.name = "cbv", c.valve = "v", c.load = "l", c.pilot = "p", c.p_setting = 25e6, c.pilot_ratio = 3;
+    c.vented = cb_vented;
     hyd_add(b, HYD_COUNTERBALANCE, &c);
     return compile(b);
 }
@@ -645,6 +648,41 @@ static void test_counterbalance(void) {
     y[ip] = PT, y[ix] = 0;
     c1_check(m, y, iv, PT + 15e6 + 0.05e6, "counterbalance, check crack");
     c1_check(m, y, iv, PT + 15e6 + 0.25e6, "counterbalance, check full open");
+    hyd_model_free(m);
+}
+
+// The spring chamber vented to atmosphere: the opening balance is referenced
+// to p_atm instead of the valve port, so with the valve port at 2 MPa gauge
+// the valve cracks at p_atm + (p_set - (p_l - p_atm)) / R (the valve port's
+// pressure no longer pushes it shut), against p_v + (p_set - (p_l - p_v)) / R
+// when not vented.
+static void test_counterbalance_vented(void) {
+    const double patm = 101325.0, pl = PT + 15e6, pv = PT + 2e6, R = 3.0;
+    const double hand[2] = {pv + (25e6 - (pl - pv)) / R, patm + (25e6 - (pl - patm)) / R};
+    for (int v = 0; v < 2; ++v) {
+        cb_vented = v;
+        double lo = PT, hi = PT + 10e6;
+        for (int i = 0; i < 40; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            if (cb_flow(pv, pl, mid) < -1e-9) hi = mid; else lo = mid;
+        }
+        printf("  counterbalance %s: opens at pilot %.4f MPa abs, hand %.4f MPa\n", v ? "vented" : "not vented",
+               hi / 1e6, hand[v] / 1e6);
+        CHECK(fabs(hi - hand[v]) <= 0.01 * (hand[v] - PT), "vented %d: opening pilot %.6g, hand %.6g", v, hi, hand[v]);
+    }
+    cb_vented = 1;
+    hyd_model* m = cb_circuit();
+    cb_vented = 0;
+    if (!m) return;
+    const int iv = st(m, "v.p"), il = st(m, "l.p"), ip = st(m, "p.p"), ix = st(m, "cbv.spool");
+    const double pps[] = {PT + 1e6, hand[1] + 1e5, PT + 5e6};
+    const double xs[] = {0.01, 0.02, 0.6};
+    for (int k = 0; k < 3; ++k) {
+        double y[MAXN];
+        hyd_model_initial_state(m, y);
+        y[iv] = pv, y[il] = pl, y[ip] = pps[k], y[ix] = xs[k];
+        jac_check(m, y, 1e-5, "counterbalance, vented");
+    }
     hyd_model_free(m);
 }
 
@@ -750,6 +788,8 @@ static void test_json(void) {
     json_error(c, "hydraulics.components[3].pilot_ratio: must be");
     snprintf(c, sizeof c, cbv, "-3");
     json_error(c, "hydraulics.components[3].pilot_ratio: must be");
+    snprintf(c, sizeof c, cbv, "3, \"vented\": 0.5");
+    json_error(c, "hydraulics.components[3].vented: must be 0 (spring chamber at the valve port) or 1");
     json_error("{\"name\": \"k\", \"type\": \"compensator\", \"inlet\": \"pl\", \"outlet\": \"c\", \"load\": \"t\", \"ref\": \"ls\", \"area\": 1e-4, \"mode\": 0.5}",
                "hydraulics.components[3].mode: must be 0 (pre-compensated) or 1");
     json_error("{\"name\": \"a\", \"type\": \"accumulator\", \"port\": \"pl\", \"p0\": 5e6, \"V0\": 1e-2, \"n\": 0.5}",
@@ -783,6 +823,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_compensator_jacobian);
     RUN_TEST(test_flow_sharing);
     RUN_TEST(test_counterbalance);
+    RUN_TEST(test_counterbalance_vented);
     RUN_TEST(test_accumulator);
     RUN_TEST(test_json);
     TEST_MAIN_END();
