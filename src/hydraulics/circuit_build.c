@@ -382,6 +382,10 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
         int node[HYD_MAXPORT] = {0};
         char msg[200];
         for (int k = 0; k < np; ++k) {
+            if (pi[k].ref) {
+                node[k] = -1; // a component, resolved below once every record is bound
+                continue;
+            }
             if (!el->port[k]) {
                 free(conn);
                 return fail(m, NULL, e, 2, i, pi[k].name, "missing node name");
@@ -393,14 +397,15 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
                 return fail(m, NULL, e, 2, i, pi[k].name, msg);
             }
             for (int j = 0; j < k; ++j)
-                if (node[j] == node[k]) {
+                if (!pi[j].ref && node[j] == node[k]) {
                     snprintf(msg, sizeof msg, "same node '%s' as %s", el->port[k], pi[j].name);
                     free(conn);
                     return fail(m, NULL, e, 2, i, pi[k].name, msg);
                 }
         }
         for (int k = 0; k < np; ++k)
-            ++conn[node[k]];
+            if (node[k] >= 0)
+                ++conn[node[k]];
         int own[HYD_MAXSLOT], st[HYD_MAXSLOT + 4];
         for (int k = 0; k < d->nnode; ++k)
             own[k] = m->comp_node0[i] + k;
@@ -433,6 +438,30 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
             return fail(m, NULL, e, 1, i, "name", msg);
         }
     free(conn);
+    // Component references (a shuttle's valve): by name, after every record
+    // is bound, so the one named may come later in the list.
+    for (int i = 0; i < b->ncomp; ++i) {
+        const hyd_elem* el = &b->comp[i];
+        const hyd_component* d = hyd_component_of(el->type);
+        for (int k = 0; k < d->nport; ++k) {
+            if (!d->ports[k].ref || !el->port[k])
+                continue;
+            int r = -1;
+            for (int j = 0; j < b->ncomp && r < 0; ++j)
+                if (b->comp[j].name && !strcmp(b->comp[j].name, el->port[k]))
+                    r = j;
+            char msg[200];
+            if (r < 0 || r == i) {
+                snprintf(msg, sizeof msg, r < 0 ? "unknown component '%s'" : "'%s' is the component itself",
+                         el->port[k]);
+                return fail(m, NULL, e, 2, i, d->ports[k].name, msg);
+            }
+            const int node = d->bind_ref(m, comp_rec(m, i), r, msg, sizeof msg);
+            if (node < 0)
+                return fail(m, NULL, e, 2, i, d->ports[k].name, msg);
+            m->comp_slot[HYD_MAXSLOT * i + d->nnode + k] = node;
+        }
+    }
     if (build_incidence(m))
         return fail(m, NULL, e, -1, 0, "", "out of memory");
     hyd_model_derive(m, e);

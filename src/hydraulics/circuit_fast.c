@@ -91,6 +91,8 @@ static void take_records(hyd_fast* k) {
     for (int i = 0; i < k->nrec[HYD_LS_PUMP]; ++i) lp[i].adr = k->smap[lp[i].adr];
     hyd_cb_c* cb = k->rec[HYD_COUNTERBALANCE];
     for (int i = 0; i < k->nrec[HYD_COUNTERBALANCE]; ++i) cb[i].adr = k->smap[cb[i].adr];
+    hyd_comp_c* co = k->rec[HYD_COMPENSATOR];
+    for (int i = 0; i < k->nrec[HYD_COMPENSATOR]; ++i) co[i].adr = k->smap[co[i].adr];
     hyd_acc_c* ac = k->rec[HYD_ACCUMULATOR];
     for (int i = 0; i < k->nrec[HYD_ACCUMULATOR]; ++i) ac[i].adr = k->smap[ac[i].adr];
     for (int i = 0; i < m->nvol; ++i) {
@@ -100,6 +102,9 @@ static void take_records(hyd_fast* k) {
         k->pn[i].bel = m->node_bel[node];
         k->pn[i].bec = m->node_bec[node];
     }
+    hyd_shuttle_c* sh = k->rec[HYD_SHUTTLE];
+    for (int i = 0; i < k->nrec[HYD_SHUTTLE]; ++i)
+        if (sh[i].su >= 0) sh[i].su = k->smap[sh[i].su]; // spool mode: the valve's spool
     k->rev = m->revision;
 }
 
@@ -420,37 +425,32 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
     const hyd_shuttle_c* sh = k->rec[HYD_SHUTTLE];
     for (int i = 0; i < k->nrec[HYD_SHUTTLE]; ++i) {
         const hyd_shuttle_c* c = &sh[i];
-        double sa, sig, dsig;
-        const double q = hyd_shuttle_q(c, p[c->a], p[c->b], p[c->out], &sig, &dsig, &sa);
-        k->net[c->a] -= sig * q;
-        k->net[c->b] -= (1.0 - sig) * q;
-        k->net[c->out] += q;
-        if (J) {
-            const double qa = c->G * sa, qb = c->G * (1.0 - sa), qo = -c->G; // dq / dp
-            jent(k, J, ldj, c->a, c->a, -(dsig * q + sig * qa));
-            jent(k, J, ldj, c->a, c->b, -(-dsig * q + sig * qb));
-            jent(k, J, ldj, c->a, c->out, -sig * qo);
-            jent(k, J, ldj, c->b, c->a, -(-dsig * q + (1.0 - sig) * qa));
-            jent(k, J, ldj, c->b, c->b, -(dsig * q + (1.0 - sig) * qb));
-            jent(k, J, ldj, c->b, c->out, -(1.0 - sig) * qo);
-            jent(k, J, ldj, c->out, c->a, qa);
-            jent(k, J, ldj, c->out, c->b, qb);
-            jent(k, J, ldj, c->out, c->out, qo);
-        }
+        const int spool = c->su >= 0;
+        hyd_shuttle_flow e;
+        hyd_shuttle_law(c, spool ? y[c->su] : 0.0, p[c->a], p[c->b], p[c->out], spool ? p[c->t] : 0.0, &e);
+        const int ns = spool ? 4 : 3;
+        const int node[4] = {c->a, c->b, c->out, c->t};
+        for (int r = 0; r < ns; ++r) k->net[node[r]] += e.f[r];
+        if (J)
+            for (int r = 0; r < ns; ++r) {
+                for (int j = 0; j < ns; ++j) jent(k, J, ldj, node[r], node[j], e.g[r][j]);
+                if (spool) jcol(k, J, ldj, node[r], c->su, e.du[r]);
+            }
     }
     const hyd_comp_c* co = k->rec[HYD_COMPENSATOR];
     for (int i = 0; i < k->nrec[HYD_COMPENSATOR]; ++i) {
         const hyd_comp_c* c = &co[i];
-        double x, dq[4];
-        const double q = hyd_compensator_q(c, p[c->in], p[c->out], p[c->load], p[c->ref], &x, dq);
-        k->net[c->in] -= q;
-        k->net[c->out] += q;
+        hyd_comp_flow e;
+        hyd_compensator_law(c, y[c->adr], p[c->in], p[c->out], p[c->load], p[c->ref], &e);
+        ydot[c->adr] = e.xdot;
+        flow(k, J, ldj, c->in, c->out, e.q, e.dq[0], e.dq[1]);
         if (J) {
+            jcol(k, J, ldj, c->in, c->adr, -e.dqx);
+            jcol(k, J, ldj, c->out, c->adr, e.dqx);
             const int node[4] = {c->in, c->out, c->load, c->ref};
-            for (int j = 0; j < 4; ++j) {
-                jent(k, J, ldj, c->in, node[j], -dq[j]);
-                jent(k, J, ldj, c->out, node[j], dq[j]);
-            }
+            double* row = J + (size_t)c->adr * ldj; // spool row
+            for (int j = 0; j < 4; ++j) jrow(k, row, node[j], e.dxd[j]);
+            row[c->adr] -= c->inv_tau;
         }
     }
     const hyd_cb_c* cb = k->rec[HYD_COUNTERBALANCE];
@@ -465,7 +465,7 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
             jcol(k, J, ldj, c->l, c->adr, e.dqx);
             double* row = J + (size_t)c->adr * ldj; // spool row
             jrow(k, row, c->l, e.k);
-            jrow(k, row, c->v, -e.k * (1.0 + c->R));
+            jrow(k, row, c->v, e.kv);
             jrow(k, row, c->p, e.k * c->R);
             row[c->adr] -= c->inv_tau;
         }

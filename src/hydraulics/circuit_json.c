@@ -66,7 +66,8 @@ static int read_params(const jctx* c, const cJSON* o, const char* path, void* de
             if (!strcmp(key, ports[k].name)) {
                 found = 1;
                 if (!cJSON_IsString(it) || !it->valuestring[0]) {
-                    jerr(c, fpath, "must be a node name (non-empty string), got %s", jtype(it));
+                    jerr(c, fpath, "must be a %s name (non-empty string), got %s",
+                         ports[k].ref ? "component" : "node", jtype(it));
                     return -1;
                 }
                 port_out[k] = it->valuestring;
@@ -101,7 +102,7 @@ static int read_params(const jctx* c, const cJSON* o, const char* path, void* de
             return -1;
         }
     for (int k = 0; k < nports; ++k)
-        if (!port_out[k]) {
+        if (!port_out[k] && !ports[k].ref) { // a component reference is optional
             char fpath[200];
             snprintf(fpath, sizeof fpath, "%s.%s", path, ports[k].name);
             jerr(c, fpath, "missing required port (a node name)");
@@ -466,7 +467,8 @@ static cJSON* elem_to_json(const hyd_elem* e) {
     const hyd_param_info* p = hyd_params_of(e->type, &np);
     const hyd_port_info* ports = hyd_ports_of(e->type, &nports);
     for (int k = 0; k < nports; ++k)
-        cJSON_AddStringToObject(o, ports[k].name, e->port[k]);
+        if (e->port[k]) // an optional component reference may be unset
+            cJSON_AddStringToObject(o, ports[k].name, e->port[k]);
     for (int k = 0; k < np; ++k)
         cJSON_AddNumberToObject(o, p[k].name, *(const double*)((const char*)&e->def + p[k].off));
     return o;

@@ -188,6 +188,13 @@ void hyd_model_jacobian_pattern(const hyd_model* m, unsigned char* P) {
             for (int k = 0; k < ns; ++k)
                 P[(size_t)sa * n + s0 + k] = 1;
         }
+        // A state of another component its flows follow (a shuttle's valve spool).
+        const int rs = d->ref_state && d->rec_size
+                           ? d->ref_state((const char*)m->rec[d->type] + (size_t)m->comp_sub[c] * d->rec_size)
+                           : -1;
+        for (int a = 0; a < HYD_MAXSLOT && rs >= 0; ++a)
+            if (slot[a] >= 0 && m->node_state[slot[a]] >= 0)
+                P[(size_t)m->node_state[slot[a]] * n + rs] = 1;
         for (int k = 0; k < ns; ++k)
             P[(size_t)(s0 + k) * n + s0 + k] = 1; // a lag on its own state
         if (d->states_sense_ports)

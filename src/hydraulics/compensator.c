@@ -27,33 +27,45 @@ hyd_compensator_def hyd_default_compensator_def(void) {
     d.setting = 1e6;
     d.band = 5e4;
     d.mode = 1.0;
+    d.tau = 0.005;
     return d;
 }
 
 static void compensators_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, const double* y,
                               double* ydot, double* G, const int* map) {
-    (void)y, (void)ydot, (void)map;
     const int ld = m->nstate + 1;
     for (int i = 0; i < n; ++i) {
         const hyd_comp_c* c = (const hyd_comp_c*)rec + i;
-        const double pin = d->node_p[c->in], pout = d->node_p[c->out];
-        const double pl = d->node_p[c->load], pr = d->node_p[c->ref];
-        double x, dq[4]; // d q / d p_in, p_out, p_load, p_ref
-        const double q = hyd_compensator_q(c, pin, pout, pl, pr, &x, dq);
+        const int at = map ? map[c->adr] : c->adr;
+        hyd_comp_flow e;
+        hyd_compensator_law(c, y[at], d->node_p[c->in], d->node_p[c->out], d->node_p[c->load],
+                            d->node_p[c->ref], &e);
+        if (ydot)
+            ydot[at] = e.xdot;
+        const double q = e.q;
         d->comp_q[2 * c->comp] = q;
-        d->comp_open[c->comp] = x < 1.0;
+        d->comp_open[c->comp] = y[at] < 1.0;
         double* fl = d->flow_ + HYD_MAXSLOT * c->comp;
         fl[0] = -q, fl[1] = q, fl[2] = 0.0, fl[3] = 0.0;
         if (G) {
             const int node[4] = {c->in, c->out, c->load, c->ref};
             const int si = m->node_sidx[c->in], so = m->node_sidx[c->out];
-            for (int j = 0; j < 4; ++j) {
-                const int sj = m->node_sidx[node[j]];
-                G[si * ld + sj] -= dq[j];
-                G[so * ld + sj] += dq[j];
-            }
+            hyd_jac_flow(m, G, c->in, c->out, e.dq[0], e.dq[1]);
+            G[si * ld + c->adr] -= e.dqx;
+            G[so * ld + c->adr] += e.dqx;
+            // Spool row (hyd_state_row_from_G).
+            double* row = G + (size_t)c->adr * ld;
+            for (int j = 0; j < 4; ++j) row[m->node_sidx[node[j]]] += e.dxd[j];
+            row[c->adr] -= c->inv_tau;
         }
     }
+}
+
+static void compensators_jacobian(const hyd_model* m, hyd_data* d, const void* rec, int n, double* Jb, int ldj) {
+    if (!Jb)
+        return;
+    for (int i = 0; i < n; ++i)
+        hyd_state_row_from_G(m, d, ((const hyd_comp_c*)rec)[i].adr, Jb, ldj);
 }
 
 // mode selects a law: only 0 and 1 mean something.
@@ -77,12 +89,19 @@ static void compensator_derive(hyd_model* m, const void* def, void* rec, int nod
     c->set = d->setting;
     c->inv_band = 1.0 / d->band;
     c->post = d->mode != 0.0;
+    c->inv_tau = 1.0 / d->tau;
 }
 
 static void compensator_bind(void* rec, int comp, const int* port, const int* own, const int* state) {
-    (void)own, (void)state;
+    (void)own;
     hyd_comp_c* c = rec;
     c->comp = comp, c->in = port[0], c->out = port[1], c->load = port[2], c->ref = port[3];
+    c->adr = state[0];
+}
+
+static void compensator_initial(const void* def, const void* rec, double* y0) {
+    (void)def;
+    y0[((const hyd_comp_c*)rec)->adr] = 1.0; // open: its spring holds it open at rest
 }
 
 static const hyd_param_info compensator_params[] = {
@@ -91,7 +110,11 @@ static const hyd_param_info compensator_params[] = {
     HYD_PARAM(hyd_compensator_def, setting, "Pa", HYD_R_NONNEG, 0, 0, 5e6, 1e5, 1.5e6),
     HYD_PARAM(hyd_compensator_def, band, "Pa", HYD_R_POS, 0, 1e3, 2e6, 1e4, 3e5),
     HYD_PARAM(hyd_compensator_def, mode, "-", HYD_R_FRAC, 0, 0, 1, 0, 1),
+    // The spool's lag (its damping orifice): below 0.1 ms it is the static
+    // law's stiffness again; a compensator slower than 50 ms lags the valve.
+    HYD_PARAM(hyd_compensator_def, tau, "s", HYD_R_POS, 0, 1e-4, 1, 1e-3, 0.05),
 };
+static const char* const compensator_states[] = {"spool"};
 static const hyd_port_info compensator_ports[] = {
     HYD_PORT(hyd_compensator_def, inlet), HYD_PORT(hyd_compensator_def, outlet),
     HYD_PORT(hyd_compensator_def, load), HYD_PORT(hyd_compensator_def, ref)};
@@ -103,7 +126,9 @@ const hyd_component hyd_compensator_component = {
     .type = HYD_COMPENSATOR, .name = "compensator", .def_size = sizeof(hyd_compensator_def),
     .params = compensator_params, .nparam = HYD_COUNT(compensator_params),
     .ports = compensator_ports, .nport = HYD_COUNT(compensator_ports),
-    .rec_size = sizeof(hyd_comp_c),
+    .states = compensator_states, .nstate = HYD_COUNT(compensator_states),
+    .rec_size = sizeof(hyd_comp_c), .states_sense_ports = 1,
     .defaults = compensator_defaults, .validate = compensator_validate, .bind = compensator_bind,
-    .derive = compensator_derive, .eval = compensators_eval,
+    .derive = compensator_derive, .initial = compensator_initial, .eval = compensators_eval,
+    .jacobian = compensators_jacobian,
 };

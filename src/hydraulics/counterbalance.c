@@ -56,7 +56,7 @@ static void cbs_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, co
             const double k = e.k; // d x' / d z
             double* row = G + (size_t)c->adr * ld;
             row[sl] += k;
-            row[sv] -= k * (1.0 + c->R);
+            row[sv] += e.kv;
             row[sp] += k * c->R;
             row[c->adr] -= c->inv_tau;
         }
@@ -83,6 +83,7 @@ static void cb_derive(hyd_model* m, const void* def, void* rec, int node0) {
     c->ccr = d->check_crack;
     c->inv_cw = 1.0 / d->check_open;
     c->cq = d->check_q;
+    c->pvent = d->vented != 0.0 ? m->fluid.p_atm : -1.0;
 }
 
 static void cb_bind(void* rec, int comp, const int* port, const int* own, const int* state) {
@@ -107,7 +108,20 @@ static const hyd_param_info cb_params[] = {
     HYD_PARAM(hyd_counterbalance_def, check_crack, "Pa", HYD_R_NONNEG, 0, 0, 1e7, 0, 1e6),
     HYD_PARAM(hyd_counterbalance_def, check_open, "Pa", HYD_R_POS, 0, 1e2, 1e7, 5e3, 1e6),
     HYD_PARAM(hyd_counterbalance_def, check_q, "m^3/s", HYD_R_POS, 0, 1e-7, 0.1, 1e-5, 5e-3),
+    HYD_PARAM(hyd_counterbalance_def, vented, "-", HYD_R_FRAC, 0, 0, 1, 0, 1),
 };
+
+// vented selects where the spring chamber is referenced: only 0 and 1 mean something.
+static int cb_validate(const void* def, char* field, size_t fsz, char* msg, size_t msz) {
+    const hyd_counterbalance_def* d = def;
+    if (d->vented != 0.0 && d->vented != 1.0) {
+        snprintf(field, fsz, "vented");
+        snprintf(msg, msz, "must be 0 (spring chamber at the valve port) or 1 (vented to atmosphere), got %g",
+                 d->vented);
+        return -1;
+    }
+    return 0;
+}
 static const hyd_port_info cb_ports[] = {HYD_PORT(hyd_counterbalance_def, valve),
                                          HYD_PORT(hyd_counterbalance_def, load),
                                          HYD_PORT(hyd_counterbalance_def, pilot)};
@@ -122,6 +136,6 @@ const hyd_component hyd_counterbalance_component = {
     .ports = cb_ports, .nport = HYD_COUNT(cb_ports),
     .states = cb_states, .nstate = HYD_COUNT(cb_states),
     .rec_size = sizeof(hyd_cb_c), .states_sense_ports = 1,
-    .defaults = cb_defaults, .bind = cb_bind, .derive = cb_derive, .initial = cb_initial,
+    .defaults = cb_defaults, .validate = cb_validate, .bind = cb_bind, .derive = cb_derive, .initial = cb_initial,
     .eval = cbs_eval, .jacobian = cbs_jacobian,
 };

@@ -7,27 +7,36 @@
 #include "hyd_orifice.h"
 
 typedef struct hyd_comp_c {
-    int in, out, load, ref, comp, post;
-    double A, set, inv_band;
+    int in, out, load, ref, comp, post, adr;
+    double A, set, inv_band, inv_tau;
     hyd_orif_k ok;
 } hyd_comp_c;
 
-/// Flow q [m^3/s] inlet -> outlet at inlet, outlet, load and ref pressures
-/// [Pa]; *x the opening [-]; dq[0..3] = dq / dp of inlet, outlet, load, ref
-/// [m^3/(s Pa)].
-static inline double hyd_compensator_q(const hyd_comp_c* c, double pin, double pout, double pl,
-                                       double pr, double* x, double dq[4]) {
+/// The compensator at spool opening x [-] and inlet, outlet, load and ref
+/// pressures [Pa].
+typedef struct hyd_comp_flow {
+    double q;       ///< flow inlet -> outlet [m^3/s]
+    double dq[2];   ///< dq / dp of inlet, outlet [m^3/(s Pa)] (the sensed ports only steer x)
+    double dqx;     ///< dq / dx [m^3/s]
+    double xt;      ///< the opening the spool's force balance asks [-]
+    double xdot;    ///< spool rate [1/s]
+    double dxd[4];  ///< d x' / d p of inlet, outlet, load, ref [1/(s Pa)]
+} hyd_comp_flow;
+
+static inline void hyd_compensator_law(const hyd_comp_c* c, double x, double pin, double pout, double pl,
+                                       double pr, hyd_comp_flow* o) {
     const double target = c->post ? pin - pr - c->set : c->set;
     double ds;
-    *x = 1.0 - hyd_smoothstep((pout - pl - target) * c->inv_band + 0.5, &ds);
-    const double dx = -ds * c->inv_band; // dx / d(dp_m - dp_t)
+    o->xt = 1.0 - hyd_smoothstep((pout - pl - target) * c->inv_band + 0.5, &ds);
+    o->xdot = (o->xt - x) * c->inv_tau;
+    const double k = -ds * c->inv_band * c->inv_tau; // d x' / d(dp_m - dp_t)
+    o->dxd[0] = c->post ? -k : 0.0, o->dxd[1] = k, o->dxd[2] = -k, o->dxd[3] = c->post ? k : 0.0;
+    // A spool a rounding error below 0 is closed (the lag cannot leave [0, 1]).
+    const double xo = x > 0.0 ? x : 0.0;
     double g, gA;
-    const double q = hyd_orifice_q(&c->ok, c->A * *x, pin - pout, &g, &gA);
-    const double k = gA * c->A * dx; // dq / d(dp_m - dp_t)
-    dq[0] = g, dq[1] = -g + k, dq[2] = -k, dq[3] = 0.0;
-    if (c->post)
-        dq[0] -= k, dq[3] += k;
-    return q;
+    o->q = hyd_orifice_q(&c->ok, c->A * xo, pin - pout, &g, &gA);
+    o->dq[0] = g, o->dq[1] = -g;
+    o->dqx = x > 0.0 ? gA * c->A : 0.0;
 }
 
 #endif

@@ -10,6 +10,7 @@
 typedef struct hyd_cb_c {
     int v, l, p, adr, comp;
     double pset, R, inv_band, A, inv_tau, ccr, inv_cw, cq;
+    double pvent; ///< vented spring chamber: its pressure [Pa abs]; < 0: referenced to the valve port
     hyd_orif_k ok;
 } hyd_cb_c;
 
@@ -19,13 +20,16 @@ typedef struct hyd_cb_flow {
     double xdot;     ///< spool rate [1/s]
     double dqv;      ///< dq / dp_v [m^3/(s Pa)] (dq / dp_l = -dqv)
     double dqx;      ///< dq / dx [m^3/s]
-    double k;        ///< d x' / d z [1/(s Pa)], z = (p_l - p_v) + R (p_p - p_v) - p_setting
+    double k;        ///< d x' / d z [1/(s Pa)], z = (p_l - p_r) + R (p_p - p_r) - p_setting
+    double kv;       ///< d x' / d p_v [1/(s Pa)]: -(1 + R) k with the chamber at the valve port, 0 vented
     int open;        ///< either path passes flow
 } hyd_cb_flow;
 
 static inline void hyd_cb_law(const hyd_cb_c* c, double x, double pv, double pl, double pp, hyd_cb_flow* o) {
     double ds;
-    const double z = (pl - pv) + c->R * (pp - pv) - c->pset;
+    // The spring chamber's pressure p_r: the valve port, or the drain it is vented to.
+    const double pr = c->pvent < 0.0 ? pv : c->pvent;
+    const double z = (pl - pr) + c->R * (pp - pr) - c->pset;
     const double xt = hyd_smoothstep(z * c->inv_band, &ds);
     o->xdot = (xt - x) * c->inv_tau;
     double gc, tc;
@@ -39,6 +43,7 @@ static inline void hyd_cb_law(const hyd_cb_c* c, double x, double pv, double pl,
     o->dqv = gc + gr;
     o->dqx = x > 0.0 ? -gA * c->A : 0.0;
     o->k = ds * c->inv_band * c->inv_tau;
+    o->kv = c->pvent < 0.0 ? -(1.0 + c->R) * o->k : 0.0;
 }
 
 #endif

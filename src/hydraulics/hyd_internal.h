@@ -51,10 +51,13 @@ typedef struct hyd_elem {
 enum { HYD_R_POS = 0, HYD_R_NONNEG, HYD_R_ANY, HYD_R_UNIT, HYD_R_FRAC, HYD_R_ZERO_DEF };
 
 /// A port of a component type: its name and the offset of its const char*
-/// field inside the type's def struct.
+/// field inside the type's def struct. ref = 1: not a node but the optional
+/// name of another component (a shuttle's "valve", whose spool it follows);
+/// the type's bind_ref hook resolves it and names the node of its flow slot.
 typedef struct hyd_port_info {
     const char* name;
     size_t off;
+    int ref;
 } hyd_port_info;
 
 typedef struct hyd_param_info {
@@ -70,7 +73,10 @@ typedef struct hyd_param_info {
 /// Table entries: HYD_PARAM(def type, field, unit, rule, required, hard lo, hi,
 /// typical lo, hi); HYD_PORT(def type, field); HYD_COUNT(array).
 #define HYD_PARAM(T, f, unit, rule, req, lo, hi, tlo, thi) {#f, unit, offsetof(T, f), rule, req, lo, hi, tlo, thi}
-#define HYD_PORT(T, f) {#f, offsetof(T, f)}
+#define HYD_PORT(T, f) {#f, offsetof(T, f), 0}
+/// An optional component reference (hyd_port_info.ref); at most one per type,
+/// and the last of its ports.
+#define HYD_PORT_REF(T, f) {#f, offsetof(T, f), 1}
 #define HYD_COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
 /// A def struct must fit the element's storage (hyd_elem.def.raw).
 #define HYD_DEF_FITS(T) _Static_assert(sizeof(T) <= HYD_DEF_MAX, #T " is larger than HYD_DEF_MAX")
@@ -128,6 +134,15 @@ typedef struct hyd_component {
     /// component index, port[k] the node of port k, own[k] the k-th owned
     /// node, state[k] the k-th state (owned-node pressures, then states[]).
     void (*bind)(void* rec, int comp, const int* port, const int* own, const int* state);
+    /// The component named by its reference port (index ref, after every
+    /// record is bound): check it, write what the record needs of it, and
+    /// return the node of the reference port's flow slot (>= 0), or -1 with
+    /// a message. NULL for types without a reference port.
+    int (*bind_ref)(const hyd_model* m, void* rec, int ref, char* msg, size_t msz);
+    /// A state of another component that its flows depend on (a shuttle's
+    /// valve spool), or -1: hyd_model_jacobian_pattern gives the rows of its
+    /// flow slots that column. NULL: none.
+    int (*ref_state)(const void* rec);
     /// Derived values: the record's constants from def and the fluid, and the
     /// fixed volume, liquid modulus, initial and fixed pressure of each owned
     /// node (node0: the first owned node; they are consecutive). rec is NULL

@@ -8,7 +8,10 @@
 
 typedef struct hyd_shuttle_c {
     int a, b, out, comp;
+    int t;   ///< spool mode: the drain (the valve's T node); -1 in max-select mode
+    int su;  ///< spool mode: the valve's spool state; -1 in max-select mode
     double G, w;
+    double inv_uw; ///< 1 / spool_width [-]
 } hyd_shuttle_c;
 
 /// C1 max of pa, pb with corner half-width w; *sa = d smax / d pa.
@@ -36,6 +39,55 @@ static inline double hyd_shuttle_q(const hyd_shuttle_c* c, double pa, double pb,
     *sig = hyd_smoothstep((pa - pb + c->w) / (2.0 * c->w), &ds);
     *dsig = ds / (2.0 * c->w);
     return c->G * (pm - po);
+}
+
+/// Either mode as flows into the four slots a, b, out, t and their partials
+/// (the t slot is 0 in max-select mode, whose flows do not depend on u).
+typedef struct hyd_shuttle_flow {
+    double f[4];    ///< flow into the node at a, b, out, t [m^3/s]
+    double g[4][4]; ///< d f[i] / d p_j, j = a, b, out, t [m^3/(s Pa)]
+    double du[4];   ///< d f[i] / d u [m^3/s] (spool mode)
+} hyd_shuttle_flow;
+
+/// The law at spool position u [-] (read in spool mode only) and the
+/// pressures [Pa] at a, b, out and t (pt unused in max-select mode).
+/// Spool mode: the gallery connects out to a, b and t through the shares
+///   wa = s(u / uw), wb = s(-u / uw), wt = 1 - wa - wb   (s: smoothstep)
+/// of the conductance G: q_k = G w_k (p_k - p_out) from port k into out.
+static inline void hyd_shuttle_law(const hyd_shuttle_c* c, double u, double pa, double pb, double po,
+                                   double pt, hyd_shuttle_flow* o) {
+    memset(o, 0, sizeof *o);
+    if (c->su < 0) {
+        double sa, sig, dsig;
+        const double q = hyd_shuttle_q(c, pa, pb, po, &sig, &dsig, &sa);
+        const double qa = c->G * sa, qb = c->G * (1.0 - sa), qo = -c->G; // dq / dp
+        o->f[0] = -sig * q, o->f[1] = -(1.0 - sig) * q, o->f[2] = q;
+        o->g[0][0] = -(dsig * q + sig * qa);
+        o->g[0][1] = -(-dsig * q + sig * qb);
+        o->g[0][2] = -sig * qo;
+        o->g[1][0] = -(-dsig * q + (1.0 - sig) * qa);
+        o->g[1][1] = -(dsig * q + (1.0 - sig) * qb);
+        o->g[1][2] = -(1.0 - sig) * qo;
+        o->g[2][0] = qa, o->g[2][1] = qb, o->g[2][2] = qo;
+        return;
+    }
+    double dsa, dsb;
+    const double wa = hyd_smoothstep(u * c->inv_uw, &dsa);
+    const double wb = hyd_smoothstep(-u * c->inv_uw, &dsb);
+    const double w[3] = {wa, wb, 1.0 - wa - wb};
+    const double dw[3] = {dsa * c->inv_uw, -dsb * c->inv_uw, (dsb - dsa) * c->inv_uw}; // d w / d u
+    const double pk[3] = {pa, pb, pt};
+    static const int slot[3] = {0, 1, 3};
+    for (int k = 0; k < 3; ++k) {
+        const double gk = c->G * w[k];
+        const double q = gk * (pk[k] - po); // port k -> out
+        const double qu = c->G * dw[k] * (pk[k] - po);
+        const int s = slot[k];
+        o->f[s] -= q, o->f[2] += q;
+        o->g[s][s] -= gk, o->g[s][2] += gk;
+        o->g[2][s] += gk, o->g[2][2] -= gk;
+        o->du[s] -= qu, o->du[2] += qu;
+    }
 }
 
 #endif

@@ -186,19 +186,25 @@ typedef struct hyd_ls_pump_def {
     double eps0;        ///< initial displacement [-]; default 0
 } hyd_ls_pump_def;
 
-/// LS shuttle (signal network): flow G (smax(p_a, p_b) - p_out) into node out,
-/// drawn from a and b; smax is max with a C1 corner of half-width "width".
+/// LS shuttle (signal network). Max-select mode (valve NULL): flow
+/// G (smax(p_a, p_b) - p_out) into node out, drawn from a and b; smax is max
+/// with a C1 corner of half-width "width". Spool mode (valve names a 4/3
+/// valve whose A and B are a and b): the section's LS port, which senses the
+/// work port the spool feeds (a for u > 0, b for u < 0) and drains to the
+/// valve's T in neutral, switching smoothly over spool_width of travel.
 typedef struct hyd_shuttle_def {
     const char* name;
     const char* a;       ///< first sensed node (a work port or an upstream shuttle)
     const char* b;       ///< second sensed node
     const char* out;     ///< LS line node (declare it as a volume)
+    const char* valve;   ///< optional: the valve whose spool it follows (spool mode); NULL: max-select
     double conductance;  ///< laminar conductance of the signal path [m^3/(s Pa)]; default 2e-11
     double width;        ///< half-width of the max-select corner [Pa]; default 1e5
+    double spool_width;  ///< spool mode: spool travel over which the LS edge opens [-]; default 0.2
 } hyd_shuttle_def;
 
 /// Section pressure compensator: an orifice inlet -> outlet of area x area,
-/// x in [0, 1] set so that the meter-in drop p_outlet - p_load of the valve
+/// x in [0, 1] (a spool state lagging its set point by tau) set so that the meter-in drop p_outlet - p_load of the valve
 /// it feeds is setting (mode 0, pre-compensated) or p_inlet - p_ref - setting
 /// (mode 1, post-compensated / flow sharing; ref = the highest LS pressure).
 typedef struct hyd_compensator_def {
@@ -212,6 +218,7 @@ typedef struct hyd_compensator_def {
     double setting;     ///< spring setting [Pa]; default 1e6 (pre), see mode
     double band;        ///< drop error from open to closed [Pa]; default 5e4
     double mode;        ///< 0: pre-compensated, 1: post-compensated (flow sharing); default 1
+    double tau;         ///< spool time constant [s] (state "<name>.spool", starts open); default 0.005
 } hyd_compensator_def;
 
 /// Counterbalance (over-centre) valve between a valve-side node and a load
@@ -233,6 +240,7 @@ typedef struct hyd_counterbalance_def {
     double check_crack; ///< check valve cracking pressure [Pa]; default 0.05e6
     double check_open;  ///< check valve pressure from crack to rated flow [Pa]; default 0.2e6
     double check_q;     ///< check valve rated flow [m^3/s]; default 1.6667e-3 (100 L/min)
+    double vented;      ///< 1: spring chamber vented to atmosphere (z referenced to p_atm, not p_valve); default 0
 } hyd_counterbalance_def;
 
 /// Gas-charged accumulator: gas p V_g^n = p0 V0^n, oil volume V = V0 - V_g
@@ -406,7 +414,8 @@ int hyd_model_node_owner(const hyd_model* m, int i);
 /// A, 1 chamber B), or -1.
 int hyd_model_comp_node(const hyd_model* m, int comp, int k);
 /// The node at port k of component comp (in the order of its JSON ports:
-/// pump/relief/check/orifice inlet, outlet; hose to; valve P, T, A, B), or -1.
+/// pump/relief/check/orifice inlet, outlet; hose to; valve P, T, A, B; shuttle
+/// a, b, out and, in spool mode, its valve's T as port 3), or -1.
 int hyd_model_port_node(const hyd_model* m, int comp, int k);
 /// The hose whose far end ("to") is node i (a cylinder chamber), as a
 /// component index, or -1. Its own pressure state is

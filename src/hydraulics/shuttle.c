@@ -17,34 +17,32 @@ hyd_shuttle_def hyd_default_shuttle_def(void) {
     hyd_shuttle_def d = {0};
     d.conductance = 2e-11;
     d.width = 1e5;
+    d.spool_width = 0.2;
     return d;
 }
 
 static void shuttles_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, const double* y,
                           double* ydot, double* G, const int* map) {
-    (void)y, (void)ydot, (void)map;
+    (void)ydot;
     const int ld = m->nstate + 1;
     for (int i = 0; i < n; ++i) {
         const hyd_shuttle_c* c = (const hyd_shuttle_c*)rec + i;
-        const double pa = d->node_p[c->a], pb = d->node_p[c->b], po = d->node_p[c->out];
-        double sa, sig, dsig; // dsig = d sigma / d pa = - d sigma / d pb
-        const double q = hyd_shuttle_q(c, pa, pb, po, &sig, &dsig, &sa);
-        d->comp_q[2 * c->comp] = q;
+        const int spool = c->su >= 0;
+        const double u = spool ? y[map ? map[c->su] : c->su] : 0.0;
+        const double pt = spool ? d->node_p[c->t] : 0.0;
+        hyd_shuttle_flow e;
+        hyd_shuttle_law(c, u, d->node_p[c->a], d->node_p[c->b], d->node_p[c->out], pt, &e);
+        d->comp_q[2 * c->comp] = e.f[2];
         double* fl = d->flow_ + HYD_MAXSLOT * c->comp;
-        fl[0] = -sig * q, fl[1] = -(1.0 - sig) * q, fl[2] = q;
+        fl[0] = e.f[0], fl[1] = e.f[1], fl[2] = e.f[2], fl[3] = e.f[3];
         if (G) {
-            const int s_a = m->node_sidx[c->a], s_b = m->node_sidx[c->b], s_o = m->node_sidx[c->out];
-            const double qa = c->G * sa, qb = c->G * (1.0 - sa), qo = -c->G; // dq / dp
-            // Inflows: -sigma q at a, -(1 - sigma) q at b, q at out.
-            G[s_a * ld + s_a] -= dsig * q + sig * qa;
-            G[s_a * ld + s_b] -= -dsig * q + sig * qb;
-            G[s_a * ld + s_o] -= sig * qo;
-            G[s_b * ld + s_a] -= -dsig * q + (1.0 - sig) * qa;
-            G[s_b * ld + s_b] -= dsig * q + (1.0 - sig) * qb;
-            G[s_b * ld + s_o] -= (1.0 - sig) * qo;
-            G[s_o * ld + s_a] += qa;
-            G[s_o * ld + s_b] += qb;
-            G[s_o * ld + s_o] += qo;
+            const int ns = spool ? 4 : 3;
+            const int node[4] = {c->a, c->b, c->out, spool ? c->t : c->out};
+            for (int r = 0; r < ns; ++r) {
+                double* row = G + (size_t)m->node_sidx[node[r]] * ld;
+                for (int j = 0; j < ns; ++j) row[m->node_sidx[node[j]]] += e.g[r][j];
+                if (spool) row[c->su] += e.du[r];
+            }
         }
     }
 }
@@ -55,21 +53,53 @@ static void shuttle_derive(hyd_model* m, const void* def, void* rec, int node0) 
     hyd_shuttle_c* c = rec;
     c->G = d->conductance;
     c->w = d->width;
+    c->inv_uw = 1.0 / d->spool_width;
 }
 
 static void shuttle_bind(void* rec, int comp, const int* port, const int* own, const int* state) {
     (void)own, (void)state;
     hyd_shuttle_c* c = rec;
     c->comp = comp, c->a = port[0], c->b = port[1], c->out = port[2];
+    c->t = -1, c->su = -1; // max-select unless a valve is named (shuttle_bind_ref)
 }
+
+// Spool mode: the valve named by "valve" must be a 4/3 valve whose work
+// ports are a (sensed for u > 0) and b (u < 0); the drain is its T port.
+static int shuttle_bind_ref(const hyd_model* m, void* rec, int ref, char* msg, size_t msz) {
+    hyd_shuttle_c* c = rec;
+    const char* name = m->comp[ref].name;
+    if (m->comp[ref].type != HYD_VALVE) {
+        snprintf(msg, msz, "'%s' is a %s, not a valve (a shuttle in spool mode follows a 4/3 valve's spool)",
+                 name, hyd_type_name(m->comp[ref].type));
+        return -1;
+    }
+    const hyd_valve_c* v = &m->valve[m->comp_sub[ref]];
+    if (v->A != c->a || v->B != c->b) {
+        snprintf(msg, msz,
+                 "valve '%s' has work ports A '%s', B '%s': in spool mode the shuttle's a and b must be "
+                 "them (a sensed for a positive spool, b for a negative)",
+                 name, m->node_name[v->A], m->node_name[v->B]);
+        return -1;
+    }
+    c->t = v->T;
+    c->su = v->adr;
+    return v->T;
+}
+
+static int shuttle_ref_state(const void* rec) { return ((const hyd_shuttle_c*)rec)->su; }
 
 static const hyd_param_info shuttle_params[] = {
     HYD_PARAM(hyd_shuttle_def, conductance, "m^3/(s Pa)", HYD_R_POS, 0, 1e-15, 1e-8, 1e-12, 1e-10),
     HYD_PARAM(hyd_shuttle_def, width, "Pa", HYD_R_POS, 0, 1e2, 2e6, 1e4, 5e5),
+    // Spool travel over which the LS edge opens (a fraction of full stroke):
+    // below 1e-3 the switch is a step to the stiff solvers; above 0.5 the
+    // signal lags most of the metering range.
+    HYD_PARAM(hyd_shuttle_def, spool_width, "-", HYD_R_POS, 0, 1e-3, 0.5, 0.02, 0.3),
 };
 static const hyd_port_info shuttle_ports[] = {HYD_PORT(hyd_shuttle_def, a), HYD_PORT(hyd_shuttle_def, b),
-                                              HYD_PORT(hyd_shuttle_def, out)};
-static const hyd_node_role shuttle_roles[] = {HYD_NODE_LINE, HYD_NODE_LINE, HYD_NODE_LS};
+                                              HYD_PORT(hyd_shuttle_def, out),
+                                              HYD_PORT_REF(hyd_shuttle_def, valve)};
+static const hyd_node_role shuttle_roles[] = {HYD_NODE_LINE, HYD_NODE_LINE, HYD_NODE_LS, HYD_NODE_LINE};
 
 static void shuttle_defaults(void* def) { *(hyd_shuttle_def*)def = hyd_default_shuttle_def(); }
 
@@ -79,5 +109,6 @@ const hyd_component hyd_shuttle_component = {
     .params = shuttle_params, .nparam = HYD_COUNT(shuttle_params),
     .ports = shuttle_ports, .nport = HYD_COUNT(shuttle_ports),
     .rec_size = sizeof(hyd_shuttle_c), .port_roles = shuttle_roles,
-    .defaults = shuttle_defaults, .bind = shuttle_bind, .derive = shuttle_derive, .eval = shuttles_eval,
+    .defaults = shuttle_defaults, .bind = shuttle_bind, .bind_ref = shuttle_bind_ref,
+    .ref_state = shuttle_ref_state, .derive = shuttle_derive, .eval = shuttles_eval,
 };

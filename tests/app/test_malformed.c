@@ -128,11 +128,11 @@ static const bad_case ls_cases[] = {
     {MODEL, "m_ls_margin.json", ML, "hydraulics.components.pump.margin=-2e6", NULL, NULL,
      "hydraulics.components[0].margin", "must be > 0, got -2e6"},
     {MODEL, "m_ls_pilot.json", ML, "hydraulics.components.lift_cbv.pilot_ratio=0", NULL, NULL,
-     "hydraulics.components[10].pilot_ratio", "must be > 0, got 0"},
+     "hydraulics.components[8].pilot_ratio", "must be > 0, got 0"},
     {MODEL, "m_ls_mode.json", ML, "hydraulics.components.lift_comp.mode=2", NULL, NULL,
-     "hydraulics.components[4].mode", NULL},
-    // The main shuttle wired into the pump line: the LS line keeps only its
-    // bleed and the sensing ports, so no load pressure reaches the pump.
+     "hydraulics.components[3].mode", NULL},
+    // The main shuttle wired into the pump line: the LS line keeps only the
+    // pump's sensing port, so no load pressure reaches the pump.
     {MODEL, "m_ls_unreached.json", ML, NULL, "\"out\": \"ls_line\"", "\"out\": \"pump_line\"",
      "hydraulics.components[0].ls", "the LS network does not reach the pump"},
 };

@@ -375,6 +375,68 @@ static void test_shuttle(void) {
     hyd_model_free(m);
 }
 
+// A section's LS port in spool mode: the shuttle follows the valve's spool
+// (a sensed for u > 0, b for u < 0, the valve's T in neutral).
+static hyd_model* spool_shuttle_circuit(const char* valve_name) {
+    hyd_builder* b = hyd_builder_create();
+    add_tank(b, "t", PT);
+    add_volume(b, "P", 1e-4);
+    add_volume(b, "A", 1e-4);
+    add_volume(b, "B", 1e-4);
+    add_volume(b, "ls", 5e-6);
+    add_valve(b, "v", "P", "t", "A", "B", 0.0);
+    hyd_shuttle_def s = hyd_default_shuttle_def();
+    s.name = "sh", s.a = "A", s.b = "B", s.out = "ls", s.valve = valve_name;
+    hyd_add(b, HYD_SHUTTLE, &s);
+    return compile(b);
+}
+
+static void test_shuttle_spool(void) {
+    hyd_model* m = spool_shuttle_circuit("v");
+    if (!m) return;
+    const int iA = st(m, "A.p"), iB = st(m, "B.p"), io = st(m, "ls.p"), iu = st(m, "v.spool");
+    const double G = 2e-11, uw = 0.2;
+    // Every regime of the spool: negative and open, the LS edge opening on
+    // either side (near neutral), positive and open; and the LS line above
+    // the port. (Not at u = 0 itself, where the valve's own edges switch
+    // sides: its central difference there is not its derivative.)
+    const double u[] = {-0.7, -0.15, -0.03, 0.002, 0.04, 0.12, 0.6};
+    for (int k = 0; k < 7; ++k) {
+        double y[MAXN];
+        hyd_model_initial_state(m, y);
+        y[st(m, "P.p")] = 12e6, y[iA] = 8e6, y[iB] = 3e6, y[io] = k == 6 ? 9e6 : 5e6, y[iu] = u[k];
+        jac_check(m, y, 1e-5, "shuttle, spool mode");
+    }
+    // Hand values: open to A it senses A, to B it senses B, in neutral the
+    // tank; half way up the edge, smoothstep(1/2) = 1/2 of the conductance.
+    hyd_data* d = hyd_data_create(m);
+    double y[MAXN], f[MAXN];
+    hyd_model_initial_state(m, y);
+    y[iA] = 8e6, y[iB] = 3e6, y[io] = 5e6;
+    const int c = hyd_model_find(m, "sh");
+    const double want[4][2] = {{0.5, G * (8e6 - 5e6)}, {-0.5, G * (3e6 - 5e6)}, {0.0, G * (PT - 5e6)},
+                               {0.5 * uw, 0.5 * G * (8e6 - 5e6) + 0.5 * G * (PT - 5e6)}};
+    for (int k = 0; k < 4; ++k) {
+        y[iu] = want[k][0];
+        hyd_eval(m, d, 0, y, f);
+        CHECK_REL(d->comp_q[2 * c], want[k][1], 1e-12);
+        // Mass kept: the LS node gets the signal flow; in neutral (the
+        // valve closed, so the work ports see the shuttle only) all of it
+        // comes from the tank and none from A or B.
+        const int na = hyd_model_find_node(m, "A"), nb = hyd_model_find_node(m, "B"), nl = hyd_model_find_node(m, "ls");
+        CHECK_NEAR(d->node_q[nl], d->comp_q[2 * c], 1e-18);
+        if (k == 2) CHECK(d->node_q[na] == 0.0 && d->node_q[nb] == 0.0, "neutral: A %g, B %g", d->node_q[na], d->node_q[nb]);
+    }
+    hyd_data_free(d);
+    // C1 where the shares switch: neutral and the ends of the LS edge.
+    hyd_model_initial_state(m, y);
+    y[iA] = 8e6, y[iB] = 3e6, y[io] = 5e6;
+    c1_check(m, y, iu, 0.0, "shuttle spool mode, neutral");
+    c1_check(m, y, iu, uw, "shuttle spool mode, A edge open");
+    c1_check(m, y, iu, -uw, "shuttle spool mode, B edge open");
+    hyd_model_free(m);
+}
+
 // ----------------------------------------------------------- compensator
 
 static hyd_model* comp_jac_circuit(double mode) {
@@ -506,6 +568,8 @@ static void test_flow_sharing(void) {
 
 // -------------------------------------------------------- counterbalance
 
+static double cb_vented = 0.0; // the valves cb_circuit builds: 1 spring chamber vented
+
 static hyd_model* cb_circuit(void) {
     hyd_builder* b = hyd_builder_create();
     add_tank(b, "t", PT);
@@ -515,6 +579,7 @@ static hyd_model* cb_circuit(void) {
     add_orifice(b, "o", "v", "t", 1e-6);
     hyd_counterbalance_def c = hyd_default_counterbalance_def();
     c.name = "cbv", c.valve = "v", c.load = "l", c.pilot = "p", c.p_setting = 25e6, c.pilot_ratio = 3;
+    c.vented = cb_vented;
     hyd_add(b, HYD_COUNTERBALANCE, &c);
     return compile(b);
 }
@@ -583,6 +648,41 @@ static void test_counterbalance(void) {
     y[ip] = PT, y[ix] = 0;
     c1_check(m, y, iv, PT + 15e6 + 0.05e6, "counterbalance, check crack");
     c1_check(m, y, iv, PT + 15e6 + 0.25e6, "counterbalance, check full open");
+    hyd_model_free(m);
+}
+
+// The spring chamber vented to atmosphere: the opening balance is referenced
+// to p_atm instead of the valve port, so with the valve port at 2 MPa gauge
+// the valve cracks at p_atm + (p_set - (p_l - p_atm)) / R (the valve port's
+// pressure no longer pushes it shut), against p_v + (p_set - (p_l - p_v)) / R
+// when not vented.
+static void test_counterbalance_vented(void) {
+    const double patm = 101325.0, pl = PT + 15e6, pv = PT + 2e6, R = 3.0;
+    const double hand[2] = {pv + (25e6 - (pl - pv)) / R, patm + (25e6 - (pl - patm)) / R};
+    for (int v = 0; v < 2; ++v) {
+        cb_vented = v;
+        double lo = PT, hi = PT + 10e6;
+        for (int i = 0; i < 40; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            if (cb_flow(pv, pl, mid) < -1e-9) hi = mid; else lo = mid;
+        }
+        printf("  counterbalance %s: opens at pilot %.4f MPa abs, hand %.4f MPa\n", v ? "vented" : "not vented",
+               hi / 1e6, hand[v] / 1e6);
+        CHECK(fabs(hi - hand[v]) <= 0.01 * (hand[v] - PT), "vented %d: opening pilot %.6g, hand %.6g", v, hi, hand[v]);
+    }
+    cb_vented = 1;
+    hyd_model* m = cb_circuit();
+    cb_vented = 0;
+    if (!m) return;
+    const int iv = st(m, "v.p"), il = st(m, "l.p"), ip = st(m, "p.p"), ix = st(m, "cbv.spool");
+    const double pps[] = {PT + 1e6, hand[1] + 1e5, PT + 5e6};
+    const double xs[] = {0.01, 0.02, 0.6};
+    for (int k = 0; k < 3; ++k) {
+        double y[MAXN];
+        hyd_model_initial_state(m, y);
+        y[iv] = pv, y[il] = pl, y[ip] = pps[k], y[ix] = xs[k];
+        jac_check(m, y, 1e-5, "counterbalance, vented");
+    }
     hyd_model_free(m);
 }
 
@@ -688,12 +788,30 @@ static void test_json(void) {
     json_error(c, "hydraulics.components[3].pilot_ratio: must be");
     snprintf(c, sizeof c, cbv, "-3");
     json_error(c, "hydraulics.components[3].pilot_ratio: must be");
+    snprintf(c, sizeof c, cbv, "3, \"vented\": 0.5");
+    json_error(c, "hydraulics.components[3].vented: must be 0 (spring chamber at the valve port) or 1");
     json_error("{\"name\": \"k\", \"type\": \"compensator\", \"inlet\": \"pl\", \"outlet\": \"c\", \"load\": \"t\", \"ref\": \"ls\", \"area\": 1e-4, \"mode\": 0.5}",
                "hydraulics.components[3].mode: must be 0 (pre-compensated) or 1");
     json_error("{\"name\": \"a\", \"type\": \"accumulator\", \"port\": \"pl\", \"p0\": 5e6, \"V0\": 1e-2, \"n\": 0.5}",
                "hydraulics.components[3].n: must be");
     json_error("{\"name\": \"s\", \"type\": \"shuttle\", \"a\": \"pl\", \"b\": \"c\", \"out\": \"ls\", \"width\": 0}",
                "hydraulics.components[3].width: must be");
+    // Spool mode: the valve must exist, be a valve, and have a and b as its work ports.
+    const char* spool = "{\"name\": \"s\", \"type\": \"shuttle\", \"a\": \"pl\", \"b\": \"c\", \"out\": \"ls\", \"valve\": %s}";
+    snprintf(c, sizeof c, spool, "\"nope\"");
+    json_error(c, "hydraulics.components[3].valve: unknown component 'nope'");
+    snprintf(c, sizeof c, spool, "\"o\"");
+    json_error(c, "hydraulics.components[3].valve: 'o' is a orifice, not a valve");
+    snprintf(c, sizeof c, spool, "3");
+    json_error(c, "hydraulics.components[3].valve: must be a component name");
+    snprintf(c, sizeof c, spool, "\"v\"}, {\"name\": \"v\", \"type\": \"valve\", \"P\": \"pl\", \"T\": \"t\", \"A\": \"c\", \"B\": \"pl2\"");
+    json_error(c, "unknown node"); // (no pl2: the valve itself is refused first)
+    snprintf(c, sizeof c, spool, "\"v\", \"spool_width\": 0.9}, {\"name\": \"v\", \"type\": \"valve\", \"P\": \"ls\", \"T\": \"t\", \"A\": \"pl\", \"B\": \"c\"");
+    json_error(c, "hydraulics.components[3].spool_width: must be in [0.001, 0.5]");
+    snprintf(c, sizeof c, spool, "\"v\"}, {\"name\": \"v\", \"type\": \"valve\", \"P\": \"ls\", \"T\": \"t\", \"A\": \"c\", \"B\": \"pl\"");
+    json_error(c, "hydraulics.components[3].valve: valve 'v' has work ports A 'c', B 'pl'");
+    snprintf(c, sizeof c, spool, "\"v\"}, {\"name\": \"v\", \"type\": \"valve\", \"P\": \"ls\", \"T\": \"t\", \"A\": \"pl\", \"B\": \"c\"");
+    json_error(c, NULL);
 }
 
 int main(int argc, char** argv) {
@@ -701,9 +819,11 @@ int main(int argc, char** argv) {
     RUN_TEST(test_ls_pump_cutoff);
     RUN_TEST(test_ls_pump_jacobian);
     RUN_TEST(test_shuttle);
+    RUN_TEST(test_shuttle_spool);
     RUN_TEST(test_compensator_jacobian);
     RUN_TEST(test_flow_sharing);
     RUN_TEST(test_counterbalance);
+    RUN_TEST(test_counterbalance_vented);
     RUN_TEST(test_accumulator);
     RUN_TEST(test_json);
     TEST_MAIN_END();

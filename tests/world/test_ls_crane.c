@@ -147,7 +147,130 @@ static void test_lowering_pilot(void) {
     model_free(m);
 }
 
+
+// Flow sharing on the full crane: ls_flow_sharing drives lift and jib at
+// full command together (1-3 s), more than the pump's 35 L/min. The
+// post-compensated sections must share the pump's flow in the ratio of the
+// commands (1:1) within 3 %. The flows come from the rows' cylinder
+// velocities times the piston areas (both extend), not from the circuit's
+// own flow outputs. The window starts at 1.5 s: until about 1.45 s the
+// overrunning jib still refills its piston side through the anti-cavitation
+// check (a flow no section meters). Before the LS ports followed the spool,
+// the jib's shuttle sensed its rod side and the flows were 13.9 : 19.8 L/min.
+static void test_flow_sharing_crane(void) {
+    scenario sc;
+    if (load_scenario("ls_flow_sharing", &sc)) return;
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031_ls.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    sim_trace tr = {0};
+    if (run(m, &sc, HYD_KRUS, 1e-4, 0, &tr)) {
+        model_free(m);
+        return;
+    }
+    const double pi = 3.14159265358979;
+    const double A1 = 0.25 * pi * 0.1 * 0.1, A2 = 0.25 * pi * 0.08 * 0.08; // piston areas [m^2]
+    double q1 = 0, q2 = 0, c1 = 0, c2 = 0;
+    int n = 0;
+    for (int i = 0; i < tr.nrow; ++i) {
+        const double* r = tr.v + (size_t)i * SIM_NCOL;
+        if (r[COL_T] < 1.5 - 1e-9 || r[COL_T] > 3.0 + 1e-9) continue;
+        q1 += r[COL_V1] * A1, q2 += r[COL_V2] * A2;
+        c1 += r[COL_U1_CMD], c2 += r[COL_U2_CMD];
+        ++n;
+    }
+    CHECK(n > 1000, "%d rows in the window", n);
+    if (n > 0) {
+        q1 /= n, q2 /= n, c1 /= n, c2 /= n;
+        printf("  saturated, commands %.3f : %.3f: lift %.2f L/min, jib %.2f L/min (sum %.2f of the pump's 35), "
+               "ratio %.4f\n", c1, c2, 6e4 * q1, 6e4 * q2, 6e4 * (q1 + q2), (q1 / q2) / (c1 / c2));
+        CHECK(fabs((q1 / q2) / (c1 / c2) - 1.0) <= 0.03, "flow ratio %.4f, commands %.4f", q1 / q2, c1 / c2);
+        // Saturated indeed: the two take (nearly) all of the pump's flow
+        // (the rest compresses the lines and leaks).
+        CHECK(6e4 * (q1 + q2) > 0.95 * 35.0 && 6e4 * (q1 + q2) < 35.0, "sum %.2f L/min", 6e4 * (q1 + q2));
+    }
+    sim_trace_free(&tr);
+    model_free(m);
+}
+
+// In neutral each section's LS port is drained to tank through its spool,
+// so with the valves closed the whole LS network settles at tank pressure
+// (0.1 MPa abs; the LS line w/4 above, the main shuttle's corner) and the pump at its standby, whatever the loads hold. A
+// max-select shuttle of A and B would hand the holding pressure of a work
+// line to the pump instead (the jib's rod side, 2.5 MPa: the pump then stood
+// at 19.5 MPa on ramp before any command).
+static void test_ls_neutral(void) {
+    scenario sc;
+    if (load_scenario("ls_flow_sharing", &sc)) return;
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031_ls.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    sim_opts o = sim_default_opts();
+    engine* e = engine_create(m, &o, sc.q0, sc.slew0, sim_load_mass(m, &sc, &o), err, sizeof err);
+    CHECK(e != NULL, "%s", err);
+    if (!e) {
+        model_free(m);
+        return;
+    }
+    const hyd_model* h = engine_circuit(e);
+    const char* ls[3] = {"lift_ls", "jib_ls", "ls_line"};
+    const char* port[2] = {"jib_hose_B", "lift_hose_B"};
+    double u[3] = {0, 0, 0}, y[256];
+    CHECK(hyd_model_nstate(h) <= 256, "%d states", hyd_model_nstate(h));
+    engine_set_commands(e, u);
+    CHECK(engine_advance_to(e, 0.8, NULL, NULL) == 0, "%s", engine_error(e));
+    engine_circuit_state(e, y, NULL);
+    for (int k = 0; k < 2; ++k) {
+        const int s = hyd_model_node_state(h, hyd_model_find_node(h, port[k]));
+        CHECK(s >= 0 && y[s] > 0.4e6, "%s holds %g Pa", port[k], s >= 0 ? y[s] : 0.0);
+    }
+    for (int k = 0; k < 3; ++k) {
+        const int s = hyd_model_node_state(h, hyd_model_find_node(h, ls[k]));
+        CHECK(s >= 0, "no node %s", ls[k]);
+        if (s < 0) continue;
+        printf("  neutral: %s at %.4f MPa abs\n", ls[k], y[s] / 1e6);
+        // The main shuttle's smooth max of two equal inputs is w/4 above
+        // them (corner half-width w = 0.1 MPa, docs/hydraulics.md).
+        CHECK_NEAR(y[s], 1e5 + (k == 2 ? 0.25 * 1e5 : 0.0), 1e3);
+    }
+    engine_destroy(e);
+    model_free(m);
+}
+
+// Long fixed steps on the LS crane. The draft blew up in the first
+// millisecond at Krus 1 ms and ROS2 0.2 and 1 ms (section LS nodes below
+// absolute zero): its max-select shuttles charged the 5 mL LS nodes from
+// 0.1 MPa to the work lines' holding pressures through 2e-11 m^3/(s Pa) at
+// t = 0. With the LS ports following the spool the initial state is
+// consistent (in neutral the LS network sits at tank pressure), and these
+// steps integrate the whole ramp as they do on the standard crane.
+static void test_long_steps(void) {
+    scenario sc;
+    if (load_scenario("ramp", &sc)) return;
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031_ls.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    const struct { hyd_method s; double h; } runs[] = {{HYD_KRUS, 1e-3}, {HYD_ROS2, 2e-4}, {HYD_ROS2, 1e-3}};
+    for (size_t j = 0; j < sizeof runs / sizeof runs[0]; ++j) {
+        sim_opts o = sim_default_opts();
+        o.solver = runs[j].s, o.h = runs[j].h, o.dt_out = runs[j].h > 1e-3 ? runs[j].h : 1e-3;
+        sim_trace tr = {0};
+        sim_result r;
+        const int rc = sim_run(m, &sc, &o, NULL, NULL, &tr, NULL, NULL, &r);
+        CHECK(rc == 0, "%s h = %g: %s", runs[j].s == HYD_KRUS ? "krus" : "ros2", runs[j].h, r.message);
+        CHECK(tr.nrow > 0 && tr.v[(size_t)(tr.nrow - 1) * SIM_NCOL + COL_T] > 19.99, "stopped early");
+        sim_trace_free(&tr);
+    }
+    model_free(m);
+}
+
 int main(int argc, char** argv) {
+    RUN_TEST(test_ls_neutral);
+    RUN_TEST(test_long_steps);
+    RUN_TEST(test_flow_sharing_crane);
     RUN_TEST(test_lowering_pilot);
     RUN_TEST(test_solvers_agree);
     TEST_MAIN_END();
