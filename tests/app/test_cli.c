@@ -434,6 +434,10 @@ static void test_study_usage(void) {
     remove("cli_study2/made/study.jsonl");
     remove("cli_study2/made/work_precision.png");
     rmdir("cli_study2/made");
+    remove("cli_study2/only/study.md");
+    remove("cli_study2/only/study.jsonl");
+    remove("cli_study2/only/work_precision.png");
+    rmdir("cli_study2/only");
     rmdir("cli_study2");
     rc = cli_run("study --quiet --quick --repeat 1 --duration 0.05 --out-dir cli_study2/made", out, sizeof out);
     if (rc == 2 && strstr(out, "needs the CVODE reference")) {
