@@ -651,6 +651,72 @@ static void test_counterbalance(void) {
     hyd_model_free(m);
 }
 
+// The pilot damping of the LS crane's counterbalance valves
+// (docs/hydraulics.md): the pilot port on a 50 mL volume fed from the line
+// through a 1e-8 m^2 orifice, so the pilot pressure is its own state,
+// p_pilot' = Be(p_pilot)/V Q_orifice(p_line - p_pilot). By hand, default
+// fluid (rho 870, nu 3.2e-5, Re_tr 100, cd 0.65): P0 = rho pi (Re nu)^2 /
+// (8 cd^2), laminar below dp = P0/A (0.83 MPa), G = 1.25 cd sqrt(2/rho) A^1.5
+// / sqrt(P0); Be of the entrained-air law at the pilot pressure; so the lag
+// is tau_p = V/(Be G), about 0.1 s. Then the Jacobian of valve, orifice and
+// pilot volume against central differences in each regime (laminar and
+// turbulent damping flow, both ways, valve shut, cracking and open) and C1
+// at the orifice's laminar/turbulent switch.
+static void test_counterbalance_pilot_damping(void) {
+    const double V = 5e-5, A = 1e-8;
+    hyd_builder* b = hyd_builder_create();
+    add_tank(b, "t", PT);
+    add_volume(b, "v", 1e-4);
+    add_volume(b, "l", 1e-3);
+    add_volume(b, "line", 1e-4);
+    add_volume(b, "pil", V);
+    add_orifice(b, "o", "v", "t", 1e-6);
+    add_orifice(b, "damp", "line", "pil", A);
+    hyd_counterbalance_def c = hyd_default_counterbalance_def();
+    c.name = "cbv", c.valve = "v", c.load = "l", c.pilot = "pil", c.p_setting = 25e6, c.pilot_ratio = 4;
+    c.area = 2e-5;
+    hyd_add(b, HYD_COUNTERBALANCE, &c);
+    hyd_model* m = compile(b);
+    if (!m) return;
+    const int iv = st(m, "v.p"), il = st(m, "l.p"), iln = st(m, "line.p"), ip = st(m, "pil.p"), ix = st(m, "cbv.spool");
+    const double rho = 870.0, nu = 32e-6, re = 100.0, cd = 0.65, pi = 3.14159265358979;
+    const double P0 = rho * pi * (re * nu) * (re * nu) / (8.0 * cd * cd);
+    const double G = 1.25 * cd * sqrt(2.0 / rho) * A * sqrt(A) / sqrt(P0);
+    // Entrained-air modulus at P (docs/hydraulics.md), alpha 0.005, n 1.4.
+    const double P = PT + 3e6, r = pow(101325.0 / P, 1.0 / 1.4);
+    const double Be = 1.2e9 * (1.0 + 0.005 * r) / (1.0 + 0.005 * 1.2e9 * r / (1.4 * P));
+    const double dp = 0.1e6, x = dp * A / P0;
+    hyd_data* d = hyd_data_create(m);
+    double y[MAXN], f[MAXN];
+    hyd_model_initial_state(m, y);
+    y[iv] = PT, y[il] = PT + 15e6, y[ix] = 0.0, y[ip] = P, y[iln] = P + dp;
+    hyd_eval(m, d, 0, y, f);
+    const double tau = V / (Be * G);
+    printf("  pilot damping: transition %.3f MPa, G %.4g m^3/(s Pa), Be %.4g Pa: tau_p %.4f s\n", P0 / A / 1e6, G, Be,
+           tau);
+    CHECK_REL(f[ip], Be / V * G * dp * (1.0 - 0.2 * x * x), 1e-6);
+    CHECK(tau > 0.08 && tau < 0.13, "tau_p %g s, docs say about 0.1 s", tau);
+    hyd_data_free(d);
+    // Regimes: {line - pilot, pilot, spool}; the valve cracks at a pilot of
+    // (25 - 15) / 4 = 2.5 MPa gauge and is fully open 0.25 MPa above (band
+    // 1 MPa over R), so: shut, cracking, open, open, shut, off the
+    // crack point itself (a central difference across it does not converge,
+    // test_counterbalance).
+    const double cases[][3] = {
+        {0.1e6, PT + 1e6, 0.01},  {2e6, PT + 2.6e6, 0.02},  {-2e6, PT + 3.3e6, 0.3},
+        {0.3e6, PT + 5e6, 0.6},   {-0.05e6, PT + 2e6, 0.05},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        hyd_model_initial_state(m, y);
+        y[iv] = PT, y[il] = PT + 15e6, y[ip] = cases[k][1], y[iln] = cases[k][1] + cases[k][0], y[ix] = cases[k][2];
+        jac_check(m, y, 1e-5, "counterbalance with pilot damping");
+    }
+    hyd_model_initial_state(m, y);
+    y[iv] = PT, y[il] = PT + 15e6, y[ip] = PT + 3e6, y[ix] = 0.2;
+    c1_check(m, y, iln, PT + 3e6 + P0 / A, "pilot damping orifice, laminar/turbulent");
+    hyd_model_free(m);
+}
+
 // The spring chamber vented to atmosphere: the opening balance is referenced
 // to p_atm instead of the valve port, so with the valve port at 2 MPa gauge
 // the valve cracks at p_atm + (p_set - (p_l - p_atm)) / R (the valve port's
@@ -824,6 +890,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_flow_sharing);
     RUN_TEST(test_counterbalance);
     RUN_TEST(test_counterbalance_vented);
+    RUN_TEST(test_counterbalance_pilot_damping);
     RUN_TEST(test_accumulator);
     RUN_TEST(test_json);
     TEST_MAIN_END();
