@@ -200,6 +200,19 @@ double app_median(double* v, int n);
 /// v in the shortest "%.15g" / "%.16g" / "%.17g" form that reads back equal
 /// (CSV cells, --set assignments); returns buf.
 const char* app_fmt_double(char* buf, size_t n, double v);
+/// The run metrics' units as a user reads and types them (app_units.c):
+/// metrics are SI (metric_unit: Pa, rad, J, m, s, N); the run summary shows
+/// MPa, deg, kJ, m, s, kN. met is a metric_id. The display unit, the factor
+/// display = SI * scale, and "NAME [UNIT]" for a plot axis.
+const char* app_metric_disp_unit(int met);
+double app_metric_disp_scale(int met);
+const char* app_metric_label(int met, char* buf, size_t n);
+/// "24MPa", "24e6Pa", "24 MPa", "5deg", "1.5kJ", "30mm" for metric met, into SI.
+/// A metric with a unit needs one (a bare number is refused); a count or a
+/// ratio takes a bare number only. 0, or -1 with one line in err.
+int app_metric_parse_value(int met, const char* text, double* si, char* err, size_t errsz);
+/// The SI value of one `unit` of metric met (a report unit); 0, or -1 with err.
+int app_metric_unit_scale(int met, const char* unit, double* si, char* err, size_t errsz);
 /// A simulated-to-wall time ratio for "Nx real time": whole numbers from 1,
 /// two significant digits below (0.42); returns buf.
 const char* app_fmt_speed(char* buf, size_t n, double ratio);

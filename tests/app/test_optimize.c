@@ -59,10 +59,14 @@ static void test_optimize_finds_hand_bore(void) {
     unlink("opt_best.json");
     unlink("opt_conv.png");
     const int rc = cli_run("optimize --scenario hold --duration 0.5 --param " BORE "=0.05:0.15 --minimize " BORE
-                           " --constraint 'peak_p1A<=18e6' --out opt_best.json --plot opt_conv.png",
+                           " --constraint 'peak_p1A<=18MPa' --out opt_best.json --plot opt_conv.png",
                            out, sizeof out);
     CHECK(rc == 0, "rc %d: %s", rc, out);
     CHECK(strstr(out, "COBYLA") && strstr(out, "optimize: eval 1:"), "%s", out);
+    // The progress lines give the constrained pressure in the summary's unit.
+    const char* pl = strstr(out, "peak_p1A ");
+    const double shown = pl ? strtod(pl + strlen("peak_p1A "), NULL) : NAN;
+    CHECK(pl && shown > 5 && shown < 100 && !strncmp(strchr(pl + 9, ' '), " MPa", 4), "progress: %.80s", pl ? pl : out);
     const double b = best_bore(out);
     CHECK(fabs(b - b_hand) <= 2e-3 * b_hand, "optimum %.6g m, by hand %.6g m", b, b_hand);
     // The model file is the model with that bore: a run of it is feasible.
@@ -88,7 +92,7 @@ static void test_optimize_finds_hand_bore(void) {
 // largest bore.
 static void test_optimize_failing_designs_infeasible(void) {
     int rc = cli_run("optimize --scenario hold --duration 0.3 --param " BORE "=-0.06:0.15 --minimize " BORE
-                     " --constraint 'peak_p1A<=18e6' --out opt_fail.json",
+                     " --constraint 'peak_p1A<=18e6Pa' --out opt_fail.json",
                      out, sizeof out);
     CHECK(rc == 0, "rc %d: %s", rc, out);
     CHECK(strstr(out, "failed (exit 2)") && strstr(out, "must be"), "no refused design seen: %s", out);
@@ -114,6 +118,12 @@ static void test_optimize_bad_input(void) {
         {"--param " BORE "=0.05:0.15 --minimize peak_p3A", "peak_p3A"},
         {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<20e6'", "METRIC<=V"},
         {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<=abc'", "finite number"},
+        // A pressure needs its unit: 24 meant as MPa would be 24 Pa.
+        {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<=24'", "needs a unit"},
+        {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<=24'", "MPa, kPa, bar, Pa"},
+        {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<=24psi'", "'psi' is not one of"},
+        {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'end_stop_hits_lift<=1s'", "plain number"},
+        {"--param " BORE "=0.05:0.15 --minimize 'peak_p1A[deg]'", "'deg' is not one of"},
         {"--param " BORE "=0.05:0.15 --minimize " BORE " --maxeval 0", "--maxeval"},
         {"--param " BORE "=0.05:0.15", "--minimize"},
         {"--minimize peak_p1A", "--param"},
