@@ -241,6 +241,12 @@ int cmd_compare(int argc, char** argv) {
         fprintf(stderr, "cranesim compare: unknown option '%s' (see cranesim compare --help)\n", argv[i]);
         return EXIT_USAGE;
     }
+    // --dts sets both sides' steps: a --dt beside it would be overridden
+    // on both, so one of them was not meant.
+    if (pairs[3] && (c.given & APP_GIVEN(APP_OPT_DT))) {
+        fprintf(stderr, "cranesim compare: --dt and --dts both given: --dts H1,H2 sets each side's step; drop --dt\n");
+        return EXIT_USAGE;
+    }
     side[0] = side[1] = c.sim;
     label[0][0] = label[1][0] = 0;
     for (int k = 0; k < 4; ++k) {
@@ -295,6 +301,19 @@ int cmd_compare(int argc, char** argv) {
             }
             if (strcmp(label[0], label[1])) break;
         }
+    }
+    if (any_pair && designs) {
+        // Two designs and a setting pair: the differences are the sum of the
+        // design's effect and the setting's, which the table cannot separate.
+        static const char* const popt[] = {"--backends", "--solvers", "--variants", "--dts"};
+        char which[80] = "";
+        size_t L = 0;
+        for (int k = 0; k < 4; ++k)
+            if (pairs[k]) L += (size_t)snprintf(which + L, sizeof which - L, "%s%s", L ? ", " : "", popt[k]);
+        fprintf(stderr,
+                "cranesim compare: note: A and B differ in design (%s) and in %s: the differences mix both; "
+                "compare one change at a time to tell them apart\n",
+                nmodel == 2 ? "--model A --model B" : "--set-a/--set-b", which);
     }
     if (!any_pair && !designs) { // the default comparison: lagrange full vs the ode validation world
         side[0].mechanics = SIM_LAGRANGE;
