@@ -129,8 +129,8 @@ static int run_design(const optimizer* o, const double* v, run_metrics* met, cha
         return EXIT_RUNTIME;
     }
     for (int k = 0; k < o->npar; ++k) {
-        char asg[320];
-        snprintf(asg, sizeof asg, "%s=%.17g", o->par[k].path, v[k]);
+        char asg[320], num[40];
+        snprintf(asg, sizeof asg, "%s=%s", o->par[k].path, app_fmt_double(num, sizeof num, v[k]));
         if (json_set_path(doc, asg, err, errsz)) {
             cJSON_Delete(doc);
             return EXIT_USAGE;
@@ -307,6 +307,29 @@ static int run_nlopt(optimizer* o, double xtol, const char** method, char* err, 
 }
 #endif
 
+// Every number of the document as its shortest round-trip text: cJSON
+// prints a value that 15 digits do not carry with 17 (0.081531047980044041
+// for 0.08153104798004404), so the design values read as typed, and back
+// equal. 0, or -1 out of memory.
+static int shortest_numbers(cJSON* node) {
+    for (cJSON* c = node->child; c; c = c->next) {
+        if (cJSON_IsNumber(c) && isfinite(c->valuedouble)) {
+            char num[40];
+            // The node becomes raw text in place (its key and siblings kept);
+            // the text is allocated by cJSON, which frees it with the node.
+            cJSON* raw = cJSON_CreateRaw(app_fmt_double(num, sizeof num, c->valuedouble));
+            if (!raw) return -1;
+            c->type = cJSON_Raw | (c->type & cJSON_StringIsConst);
+            c->valuestring = raw->valuestring;
+            raw->valuestring = NULL;
+            cJSON_Delete(raw);
+        } else if (shortest_numbers(c)) {
+            return -1;
+        }
+    }
+    return 0;
+}
+
 // Write the model with the best design's values to path (temporary file
 // renamed over it). 0, or an errno.
 static int write_model(const optimizer* o, const double* v, const char* path) {
@@ -314,14 +337,14 @@ static int write_model(const optimizer* o, const double* v, const char* path) {
     if (!doc) return ENOMEM;
     char err[512];
     for (int k = 0; k < o->npar; ++k) {
-        char asg[320];
-        snprintf(asg, sizeof asg, "%s=%.17g", o->par[k].path, v[k]);
+        char asg[320], num[40];
+        snprintf(asg, sizeof asg, "%s=%s", o->par[k].path, app_fmt_double(num, sizeof num, v[k]));
         if (json_set_path(doc, asg, err, sizeof err)) {
             cJSON_Delete(doc);
             return EINVAL;
         }
     }
-    char* text = cJSON_Print(doc);
+    char* text = shortest_numbers(doc) ? NULL : cJSON_Print(doc);
     cJSON_Delete(doc);
     if (!text) return ENOMEM;
     app_out out;
@@ -451,8 +474,8 @@ int cmd_optimize(int argc, char** argv) {
     // Every path must name a number in the model: a typo is bad input.
     for (int k = 0; k < o.npar && !rc; ++k) {
         cJSON* doc = cJSON_Duplicate(o.base->json, 1);
-        char asg[320], err[1024];
-        snprintf(asg, sizeof asg, "%s=%.17g", o.par[k].path, o.par[k].lo);
+        char asg[320], num[40], err[1024];
+        snprintf(asg, sizeof asg, "%s=%s", o.par[k].path, app_fmt_double(num, sizeof num, o.par[k].lo));
         if (!doc || json_set_path(doc, asg, err, sizeof err)) {
             fprintf(stderr, "cranesim optimize: --param %s: %s\n", o.par[k].path, doc ? err : "out of memory");
             rc = EXIT_USAGE;

@@ -34,6 +34,29 @@ static double csv_field(const char* line, int k) {
     return p ? strtod(p, NULL) : NAN;
 }
 
+// Every "bore": value of a model file written by optimize is the shortest
+// of 15, 16, 17 significant digits that reads back to the same double (the
+// written design reads as a user would type it); the count checked.
+static int check_shortest_bores(const char* js) {
+    int n = 0;
+    for (const char* p = strstr(js, "\"bore\":"); p; p = strstr(p + 1, "\"bore\":")) {
+        const char* t = p + strlen("\"bore\":");
+        while (*t == ' ' || *t == '\t') ++t;
+        char tok[64];
+        const size_t L = strcspn(t, ",\n}");
+        snprintf(tok, sizeof tok, "%.*s", (int)L, t);
+        const double v = strtod(tok, NULL);
+        char best[64];
+        for (int d = 15; d <= 17; ++d) {
+            snprintf(best, sizeof best, "%.*g", d, v);
+            if (strtod(best, NULL) == v) break;
+        }
+        CHECK(!strcmp(tok, best), "bore written as '%s', shortest round trip '%s'", tok, best);
+        ++n;
+    }
+    return n;
+}
+
 // The hand solution. On `hold` the crane starts static (the chamber
 // pressures that hold the load still) and stays so: the lift cylinder's
 // force F = p1A A_A - p1B A_B is set by the load and the pose, not by the
@@ -71,6 +94,9 @@ static void test_optimize_finds_hand_bore(void) {
     CHECK(fabs(b - b_hand) <= 2e-3 * b_hand, "optimum %.6g m, by hand %.6g m", b, b_hand);
     // The model file is the model with that bore: a run of it is feasible.
     CHECK(access("opt_best.json", F_OK) == 0, "no model file");
+    static char model_js[1 << 16];
+    CHECK(cli_read_file("opt_best.json", model_js, sizeof model_js) > 0 && check_shortest_bores(model_js) >= 2,
+          "no bores in the written model");
     CHECK(cli_run("run --model opt_best.json --scenario hold --duration 0.5 --out opt_check.csv "
                   "--metrics opt_check.json -q",
                   out, sizeof out) == 0,
