@@ -94,6 +94,29 @@ static const struct {
     {"serve", {"--listen", "--rate", "--max-clients", "--queue", "--timeout", NULL}},
 };
 
+// The value options a command documents as repeatable (each use adds one);
+// "*": every command. Any other value option given twice is refused: the
+// last value used to win silently (--dt 1e-5 --dt 1e-4 ran at 1e-4).
+static const struct {
+    const char* cmd;
+    const char* opts[4];
+} repeatable[] = {
+    {"*", {"--set", NULL}},
+    {"sweep", {"--param", NULL}},
+    {"optimize", {"--param", "--constraint", NULL}},
+    {"compare", {"--model", "--set-a", "--set-b", NULL}}, // --model: design A's and B's
+    {"bench", {"--config", NULL}},
+};
+
+static bool is_repeatable(const char* cmd, const char* a) {
+    for (size_t k = 0; k < sizeof repeatable / sizeof repeatable[0]; ++k) {
+        if (strcmp(repeatable[k].cmd, "*") && strcmp(repeatable[k].cmd, cmd)) continue;
+        for (int j = 0; repeatable[k].opts[j]; ++j)
+            if (!strcmp(repeatable[k].opts[j], a)) return true;
+    }
+    return false;
+}
+
 int app_check_values(const char* cmd, int argc, char** argv) {
     const char* const* own = NULL;
     for (size_t k = 0; k < sizeof own_values / sizeof own_values[0]; ++k)
@@ -109,6 +132,13 @@ int app_check_values(const char* cmd, int argc, char** argv) {
             fprintf(stderr, "cranesim %s: option %s needs a value (see cranesim %s --help)\n", cmd, a, cmd);
             return EXIT_USAGE;
         }
+        if (!is_repeatable(cmd, a))
+            for (int j = 0; j < i; ++j)
+                if (!strcmp(argv[j], a)) {
+                    fprintf(stderr, "cranesim %s: option %s given twice (%s, then %s): give it once\n", cmd, a,
+                            argv[j + 1], argv[i + 1]);
+                    return EXIT_USAGE;
+                }
         ++i;
     }
     return 0;

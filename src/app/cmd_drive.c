@@ -379,6 +379,7 @@ int cmd_drive(int argc, char** argv) {
     bool collision_view = false;
     const char* connect_to = NULL;
     int width = 1280, height = 720;
+    bool size_given = false, shot_at_given = false; // for the headless note
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             drive_help(stdout);
@@ -441,6 +442,7 @@ int cmd_drive(int argc, char** argv) {
             continue;
         }
         if (!strcmp(argv[i], "--screenshot-at") && i + 1 < argc) {
+            shot_at_given = true;
             // Capped like --duration: a simulated time, compared and counted
             // against the run's.
             if (app_parse_double(argv[++i], &shot_at) || shot_at < 0 || shot_at > SIM_MAX_DURATION) {
@@ -451,6 +453,7 @@ int cmd_drive(int argc, char** argv) {
             continue;
         }
         if (!strcmp(argv[i], "--size") && i + 1 < argc) {
+            size_given = true;
             if (sscanf(argv[++i], "%dx%d", &width, &height) != 2 || width < 64 || height < 64 || width > 8192 ||
                 height > 8192) {
                 fprintf(stderr, "cranesim drive: --size: expected WxH like 1280x720, got '%s'\n", argv[i]);
@@ -652,5 +655,25 @@ int cmd_drive(int argc, char** argv) {
     }
     // The headless run has no parameter panel, so nothing to save.
     if (save_as) fprintf(stderr, "cranesim drive: note: --save-as has no effect without the window (no parameter panel)\n");
+    // The window's own options do nothing here: one note naming them (a
+    // note, not an error, as for --save-as: the same command line works
+    // with and without a display).
+    {
+        const struct {
+            bool given;
+            const char* name;
+        } win[] = {{charts != NULL, "--charts"}, {readouts != NULL, "--readouts"}, {size_given, "--size"},
+                   {mapping != NULL, "--mapping"}, {scripted, "--scripted"}, {collision_view, "--collision-view"},
+                   {shot != NULL, "--screenshot"}, {shot_at_given, "--screenshot-at"}};
+        char list[200] = "";
+        size_t L = 0;
+        int n = 0;
+        for (size_t k = 0; k < sizeof win / sizeof win[0]; ++k)
+            if (win[k].given && L < sizeof list)
+                L += (size_t)snprintf(list + L, sizeof list - L, "%s%s", n++ ? ", " : "", win[k].name);
+        if (n)
+            fprintf(stderr, "cranesim drive: note: %s %s no effect headless (%s): %s only for the window\n", list,
+                    n > 1 ? "have" : "has", why, n > 1 ? "they are" : "it is");
+    }
     return drive_headless(&c, frame_rate, record, session_path, why, kind, wname);
 }

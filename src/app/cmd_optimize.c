@@ -35,9 +35,12 @@ static void optimize_help(FILE* f) {
             "\n"
             "options:\n"
             "  --param PATH=LO:HI     a model path (the --set syntax, a number) and its bounds (up to %d)\n"
-            "  --minimize M           the objective: a metric name, or a --param PATH\n"
-            "  --constraint 'M<=V'    a bound on a metric, in its unit (also M>=V; up to %d; quoted:\n"
-            "                         < and > are shell redirections)\n"
+            "  --minimize M           the objective: a metric name, or a --param PATH; 'M[UNIT]'\n"
+            "                         reports a metric in UNIT (default the run summary's unit)\n"
+            "  --constraint 'M<=V'    a bound on a metric, V with its unit: 'peak_p1A<=24MPa' (or\n"
+            "                         24e6Pa, 240bar), deg/rad, kJ/J, m/mm, s/ms, kN/N; a count takes\n"
+            "                         a plain number (also M>=V; up to %d; quoted: < and > are shell\n"
+            "                         redirections)\n"
             "  --maxeval N            most evaluations (default 60)\n"
             "  --xtol X               stop when a step changes every parameter by less than X of its\n"
             "                         range (default 1e-4)\n"
@@ -48,8 +51,8 @@ static void optimize_help(FILE* f) {
     int col = 999;
     for (int id = 0; id < MET_COUNT; ++id) {
         char tok[96];
-        snprintf(tok, sizeof tok, " %s [%s]%s", metric_name((metric_id)id), metric_unit((metric_id)id),
-                 id + 1 < MET_COUNT ? "," : "");
+        char lab[80];
+        snprintf(tok, sizeof tok, " %s%s", app_metric_label(id, lab, sizeof lab), id + 1 < MET_COUNT ? "," : "");
         if (col + (int)strlen(tok) > 92) col = fprintf(f, "\n  ");
         col += fprintf(f, "%s", tok);
     }
@@ -59,12 +62,12 @@ static void optimize_help(FILE* f) {
             "\nexit codes: 0 done, 1 no feasible design found, NLopt failed or a failed write, 2 bad input\n"
             "(nothing is written), 130 or 143 interrupted (nothing written)\n"
             "example: cranesim optimize --scenario hold --param hydraulics.components.lift_cyl.bore=0.06:0.14 \\\n"
-            "           --minimize hydraulics.components.lift_cyl.bore --constraint peak_p1A<=20e6\n");
+            "           --minimize hydraulics.components.lift_cyl.bore --constraint 'peak_p1A<=20MPa'\n");
 }
 
 typedef struct opt_con {
     int met;      ///< metric_id
-    double bound; ///< V [metric unit]
+    double bound; ///< V [SI: metric_unit]
     bool ge;      ///< M >= V (else M <= V)
 } opt_con;
 
@@ -76,6 +79,8 @@ typedef struct optimizer {
     int npar;
     int obj_met;  ///< metric_id of the objective, or -1: the design value obj_par
     int obj_par;
+    const char* obj_unit; ///< the unit the objective metric is reported in
+    double obj_scale;     ///< reported = SI * obj_scale
     opt_con con[OPT_MAXCON];
     int ncon;
     int ncol;
@@ -124,8 +129,8 @@ static int run_design(const optimizer* o, const double* v, run_metrics* met, cha
         return EXIT_RUNTIME;
     }
     for (int k = 0; k < o->npar; ++k) {
-        char asg[320];
-        snprintf(asg, sizeof asg, "%s=%.17g", o->par[k].path, v[k]);
+        char asg[320], num[40];
+        snprintf(asg, sizeof asg, "%s=%s", o->par[k].path, app_fmt_double(num, sizeof num, v[k]));
         if (json_set_path(doc, asg, err, errsz)) {
             cJSON_Delete(doc);
             return EXIT_USAGE;
@@ -195,10 +200,15 @@ static double evaluate(optimizer* o, const double* u, double* cval) {
         } else {
             // The objective when it is a metric (a design value is on the line already).
             printf(" ->");
-            if (o->obj_met >= 0) printf(" %s %.6g%s", metric_name((metric_id)o->obj_met), f, o->ncon ? "," : "");
-            for (int j = 0; j < o->ncon; ++j)
-                printf(" %s %.6g%s", metric_name((metric_id)o->con[j].met), met.value[o->con[j].met],
-                       j + 1 < o->ncon ? "," : "");
+            // In the summary's units (the objective in its report unit).
+            if (o->obj_met >= 0)
+                printf(" %s %.6g %s%s", metric_name((metric_id)o->obj_met), f * o->obj_scale, o->obj_unit,
+                       o->ncon ? "," : "");
+            for (int j = 0; j < o->ncon; ++j) {
+                const int cm = o->con[j].met;
+                printf(" %s %.6g %s%s", metric_name((metric_id)cm), met.value[cm] * app_metric_disp_scale(cm),
+                       app_metric_disp_unit(cm), j + 1 < o->ncon ? "," : "");
+            }
             printf("%s\n", feas ? "" : " (infeasible)");
         }
         fflush(stdout);
@@ -297,6 +307,29 @@ static int run_nlopt(optimizer* o, double xtol, const char** method, char* err, 
 }
 #endif
 
+// Every number of the document as its shortest round-trip text: cJSON
+// prints a value that 15 digits do not carry with 17 (0.081531047980044041
+// for 0.08153104798004404), so the design values read as typed, and back
+// equal. 0, or -1 out of memory.
+static int shortest_numbers(cJSON* node) {
+    for (cJSON* c = node->child; c; c = c->next) {
+        if (cJSON_IsNumber(c) && isfinite(c->valuedouble)) {
+            char num[40];
+            // The node becomes raw text in place (its key and siblings kept);
+            // the text is allocated by cJSON, which frees it with the node.
+            cJSON* raw = cJSON_CreateRaw(app_fmt_double(num, sizeof num, c->valuedouble));
+            if (!raw) return -1;
+            c->type = cJSON_Raw | (c->type & cJSON_StringIsConst);
+            c->valuestring = raw->valuestring;
+            raw->valuestring = NULL;
+            cJSON_Delete(raw);
+        } else if (shortest_numbers(c)) {
+            return -1;
+        }
+    }
+    return 0;
+}
+
 // Write the model with the best design's values to path (temporary file
 // renamed over it). 0, or an errno.
 static int write_model(const optimizer* o, const double* v, const char* path) {
@@ -304,14 +337,14 @@ static int write_model(const optimizer* o, const double* v, const char* path) {
     if (!doc) return ENOMEM;
     char err[512];
     for (int k = 0; k < o->npar; ++k) {
-        char asg[320];
-        snprintf(asg, sizeof asg, "%s=%.17g", o->par[k].path, v[k]);
+        char asg[320], num[40];
+        snprintf(asg, sizeof asg, "%s=%s", o->par[k].path, app_fmt_double(num, sizeof num, v[k]));
         if (json_set_path(doc, asg, err, sizeof err)) {
             cJSON_Delete(doc);
             return EINVAL;
         }
     }
-    char* text = cJSON_Print(doc);
+    char* text = shortest_numbers(doc) ? NULL : cJSON_Print(doc);
     cJSON_Delete(doc);
     if (!text) return ENOMEM;
     app_out out;
@@ -345,9 +378,9 @@ static int parse_constraint(const char* arg, int ncol, opt_con* c) {
         fprintf(stderr, "cranesim optimize: --constraint: this run has no %s (the ode world's channels)\n", name);
         return -1;
     }
-    if (app_parse_double(op + 2, &c->bound) || !isfinite(c->bound)) {
-        fprintf(stderr, "cranesim optimize: --constraint '%s': V must be a finite number [%s], got '%s'\n", arg,
-                metric_unit((metric_id)id), op + 2);
+    char err[256];
+    if (app_metric_parse_value(id, op + 2, &c->bound, err, sizeof err)) {
+        fprintf(stderr, "cranesim optimize: --constraint '%s': %s\n", arg, err);
         return -1;
     }
     c->met = id;
@@ -441,15 +474,42 @@ int cmd_optimize(int argc, char** argv) {
     // Every path must name a number in the model: a typo is bad input.
     for (int k = 0; k < o.npar && !rc; ++k) {
         cJSON* doc = cJSON_Duplicate(o.base->json, 1);
-        char asg[320], err[1024];
-        snprintf(asg, sizeof asg, "%s=%.17g", o.par[k].path, o.par[k].lo);
+        char asg[320], num[40], err[1024];
+        snprintf(asg, sizeof asg, "%s=%s", o.par[k].path, app_fmt_double(num, sizeof num, o.par[k].lo));
         if (!doc || json_set_path(doc, asg, err, sizeof err)) {
             fprintf(stderr, "cranesim optimize: --param %s: %s\n", o.par[k].path, doc ? err : "out of memory");
             rc = EXIT_USAGE;
         }
         cJSON_Delete(doc);
     }
+    char objmet[96] = "";
+    const char* objunit_arg = NULL;
     if (!rc) {
+        // "METRIC[UNIT]": the metric, reported in UNIT.
+        const char* br = strchr(minimize, '[');
+        const size_t L = strlen(minimize);
+        if (br && br > minimize && L > 0 && minimize[L - 1] == ']' && (size_t)(br - minimize) < sizeof objmet) {
+            // (A prefix that is no metric leaves it to the path lookup: a
+            // model path may end in an index.)
+            snprintf(objmet, sizeof objmet, "%.*s", (int)(br - minimize), minimize);
+            o.obj_met = metric_find(objmet);
+            static char unit[32];
+            snprintf(unit, sizeof unit, "%.*s", (int)(L - 1 - (size_t)(br - minimize) - 1), br + 1);
+            if (o.obj_met >= 0) objunit_arg = unit;
+        }
+    }
+    if (!rc && objunit_arg) {
+        double si;
+        char err[256];
+        if (app_metric_unit_scale(o.obj_met, objunit_arg, &si, err, sizeof err)) {
+            fprintf(stderr, "cranesim optimize: --minimize '%s': %s\n", minimize, err);
+            rc = EXIT_USAGE;
+        } else {
+            o.obj_unit = objunit_arg;
+            o.obj_scale = 1.0 / si;
+        }
+    }
+    if (!rc && !objunit_arg) {
         o.obj_met = metric_find(minimize);
         for (int k = 0; k < o.npar && o.obj_met < 0; ++k)
             if (!strcmp(minimize, o.par[k].path)) o.obj_par = k;
@@ -459,7 +519,13 @@ int cmd_optimize(int argc, char** argv) {
             fprintf(stderr, "cranesim optimize: --minimize: '%s' is neither a metric (%s) nor a --param path\n",
                     minimize, names);
             rc = EXIT_USAGE;
-        } else if (o.obj_met >= 0 && !metrics_present((metric_id)o.obj_met, o.ncol)) {
+        } else if (o.obj_met >= 0) {
+            o.obj_unit = app_metric_disp_unit(o.obj_met);
+            o.obj_scale = app_metric_disp_scale(o.obj_met);
+        }
+    }
+    if (!rc && o.obj_met >= 0) {
+        if (!metrics_present((metric_id)o.obj_met, o.ncol)) {
             fprintf(stderr, "cranesim optimize: --minimize: this run has no %s (the ode world's channels)\n", minimize);
             rc = EXIT_USAGE;
         }
@@ -510,7 +576,8 @@ int cmd_optimize(int argc, char** argv) {
     app_signals_restore(&sig);
     hyd_set_note_handler(old_note, note_user);
     const char* objname = o.obj_met >= 0 ? metric_name((metric_id)o.obj_met) : o.par[o.obj_par].path;
-    const char* objunit = o.obj_met >= 0 ? metric_unit((metric_id)o.obj_met) : "";
+    const char* objunit = o.obj_met >= 0 ? o.obj_unit : "";
+    const double objscale = o.obj_met >= 0 ? o.obj_scale : 1.0;
     if (app_signal_caught()) {
         fprintf(stderr, "cranesim optimize: interrupted (%s) after %ld evaluations; nothing written\n",
                 app_signal_name(app_signal_caught()), o.neval);
@@ -526,7 +593,7 @@ int cmd_optimize(int argc, char** argv) {
         printf("cranesim optimize: %s, %s, %ld evaluations; best feasible design (evaluation %ld):\n",
                o.sc.name[0] ? o.sc.name : o.c.scenario_path, method, o.neval, o.best + 1);
         for (int k = 0; k < o.npar; ++k) printf("  %s = %.9g\n", o.par[k].path, v[k]);
-        if (o.obj_met >= 0) printf("  %s = %.9g %s\n", objname, o.f[o.best], objunit);
+        if (o.obj_met >= 0) printf("  %s = %.9g %s\n", objname, o.f[o.best] * objscale, objunit);
         const int e = write_model(&o, v, out);
         if (e) {
             fprintf(stderr, "cranesim optimize: cannot write %s: %s\n", out, strerror(e));
@@ -539,6 +606,8 @@ int cmd_optimize(int argc, char** argv) {
         char perr[512], title[256], ylab[160];
         snprintf(title, sizeof title, "%s: %s", o.sc.name, method);
         snprintf(ylab, sizeof ylab, "%s%s%s%s", objname, objunit[0] ? " [" : "", objunit, objunit[0] ? "]" : "");
+        // The objective in its report unit (o.f is not read after the plot).
+        for (long k = 0; k < o.neval; ++k) o.f[k] *= objscale;
         if (app_plot_convergence(plot, title, ylab, o.f, o.feas, o.neval, perr, sizeof perr)) {
             fprintf(stderr, "cranesim optimize: plot: %s\n", perr);
             if (code == EXIT_OK_) code = EXIT_RUNTIME;

@@ -56,7 +56,7 @@ static void sweep_help(FILE* f) {
             "                       the run has but energy_in, energy_loss and collision_count; p3A,\n"
             "                       p3B, slew, tilt, sway and collision_count: ode only):",
             SW_MAXPAR);
-    // Each name with its unit, wrapped under the option's text.
+    // Each name with its unit (the CSV's, SI), wrapped under the option's text.
     int col = 999;
     for (int id = 0; id < MET_COUNT; ++id) {
         char tok[96];
@@ -73,7 +73,9 @@ static void sweep_help(FILE* f) {
             "  --fail-fast          stop at the first failing design (exit 1)\n"
             "  --out FILE           results CSV (default sweep.csv), replaced when the sweep ends\n"
             "  --plot DIR|FILE.png  plots: each metric against each parameter, and a heat map of\n"
-            "                       each metric for a two-parameter grid (a .png name: the first)\n");
+            "                       each metric for a two-parameter grid (a .png name: the first);\n"
+            "                       the metrics in the run summary's units (MPa, deg, kJ, kN), the\n"
+            "                       CSV's in the SI units listed above\n");
     app_common_help(f, true);
     fprintf(f,
             "\nexit codes: 0 done (also with failing designs), 1 --fail-fast stopped or a failed write,\n"
@@ -975,14 +977,17 @@ static int sweep_plots(const sweep* s, const sweep_out* o, const char* plot) {
     char err[512], png[1400], title[400];
     for (int mk = 0; mk < s->nmet && !rc && !(one && nplot); ++mk) {
         const char* mn = metric_name((metric_id)s->met[mk]);
+        // The axis and the colours in the run summary's units (MPa, deg, kJ),
+        // as a user reads the runs; the CSV stays SI.
         char ylab[96];
-        snprintf(ylab, sizeof ylab, "%s [%s]", mn, metric_unit((metric_id)s->met[mk]));
+        app_metric_label(s->met[mk], ylab, sizeof ylab);
+        const double ysc = app_metric_disp_scale(s->met[mk]);
         if (s->npar == 2 && s->lhs == 0) {
             // Heat map over the grid (row-major: the second parameter fastest).
             const long nx = s->par[0].n, ny = s->par[1].n;
             double* z = malloc((size_t)nx * (size_t)ny * sizeof(double));
             if (!z) break;
-            for (long i = 0; i < s->ndesign; ++i) z[i] = o->plotv[(size_t)i * w + 2 + (size_t)mk];
+            for (long i = 0; i < s->ndesign; ++i) z[i] = o->plotv[(size_t)i * w + 2 + (size_t)mk] * ysc;
             if (one) snprintf(png, sizeof png, "%s", plot);
             else snprintf(png, sizeof png, "%.*s/%s_heat.png", dirlen, plot, mn);
             snprintf(title, sizeof title, "%s: %s", s->sc.name, ylab);
@@ -1003,7 +1008,7 @@ static int sweep_plots(const sweep* s, const sweep_out* o, const char* plot) {
                 const double* v = o->plotv + (size_t)i * w;
                 if (isfinite(v[pk]) && isfinite(v[s->npar + mk])) {
                     x[n] = v[pk];
-                    y[n] = v[s->npar + mk];
+                    y[n] = v[s->npar + mk] * ysc;
                     ++n;
                 }
             }

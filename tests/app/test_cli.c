@@ -251,6 +251,19 @@ static void test_sandbox_start_poses(void) {
           "want one line naming the pose: %s", out);
 }
 
+// compare's pressure figure is of the higher peak, with no side taken as
+// the reference; a cvode side whose --rtol is too loose (1e-2 blows up on
+// ramp: pump_line.p below zero at 1.6 s) is told which --rtol runs it.
+static void test_compare_no_reference_and_loose_rtol(void) {
+    static char out[8192];
+    int rc = cli_run("compare --quiet --scenario ramp --solvers krus,cvode --rtol 1e-2", out, sizeof out);
+    CHECK(rc == 1 && strstr(out, "pump_line.p") && strstr(out, "--rtol 0.001 runs it") && cli_count_lines(out) == 1,
+          "exit %d: %s", rc, out);
+    rc = cli_run("compare --quiet --scenario hold --duration 0.5 --solvers krus,cvode", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "% of the higher peak") && strstr(out, "no side is taken as the reference"),
+          "exit %d: %s", rc, out);
+}
+
 static void test_bad_world_and_compare_tolerance(void) {
     static char out[8192];
     int rc = cli_run("run --quiet --mechanics ode --world " DATA "/missing_world.json --scenario ramp --out /dev/null", out,
@@ -620,6 +633,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_sandbox_start_poses);
     RUN_TEST(test_rk4_jacobian_note);
     RUN_TEST(test_bad_world_and_compare_tolerance);
+    RUN_TEST(test_compare_no_reference_and_loose_rtol);
     RUN_TEST(test_help_topics);
     RUN_TEST(test_missing_values);
     RUN_TEST(test_strict_numbers);

@@ -1,7 +1,7 @@
 // test_compare.c: `compare`'s pressure figure as functions, on hand-made
-// traces. The "% of peak" is of the reference's peak: the side run by
-// CVODE, else the one with the shorter fixed step, else A. It used to be
-// side A's peak whatever A was.
+// traces. The "% of peak" is of the higher of the two runs' peaks: no side
+// is taken as right (CVODE at rtol 1e-3 was taken as the reference though
+// it is 4 % off the converged peak on ramp, Krus 0.1 ms 0.0007 %).
 #include "app.h"
 #include "check.h"
 
@@ -24,42 +24,30 @@ static sim_trace make_trace(int n, double peak, double offset) {
     return tr;
 }
 
-static void test_percent_of_reference_peak(void) {
+static void test_percent_of_higher_peak(void) {
     // A peaks at 10 MPa, B at 10 MPa + 2 MPa: B - A = 2 MPa on every row of
-    // p1A, so the RMS difference is 2 MPa: 20 % of A's peak, 16.67 % of B's
-    // (12 MPa).
+    // p1A, so the RMS difference is 2 MPa: 2/12 = 16.67 % of the higher
+    // peak (B's), whichever side is named first and whatever either side
+    // ran (the settings no longer choose a side: both are default here, and
+    // the first-named A's peak gave 20 %).
     sim_trace a = make_trace(101, 10e6, 0.0), b = make_trace(101, 10e6, 2e6);
     double rms, peak, pct;
-    app_compare_pressure(&a, &b, 1, &rms, &peak, &pct);
+    int side = -1;
+    app_compare_pressure(&a, &b, &rms, &peak, &pct, &side);
     CHECK_NEAR(rms, 2e6, 1e-6);
     CHECK_NEAR(peak, 12e6, 1e-6);
     CHECK_NEAR(pct, 100.0 * 2.0 / 12.0, 1e-9);
-    app_compare_pressure(&a, &b, 0, &rms, &peak, &pct);
-    CHECK_NEAR(peak, 10e6, 1e-6);
-    CHECK_NEAR(pct, 20.0, 1e-9);
+    CHECK(side == 1, "the higher peak is B's, got side %d", side);
+    app_compare_pressure(&b, &a, &rms, &peak, &pct, &side);
+    CHECK_NEAR(rms, 2e6, 1e-6);
+    CHECK_NEAR(peak, 12e6, 1e-6);
+    CHECK_NEAR(pct, 100.0 * 2.0 / 12.0, 1e-9);
+    CHECK(side == 0, "swapped: the higher peak is A's, got side %d", side);
     sim_trace_free(&a);
     sim_trace_free(&b);
 }
 
-static void test_reference_side(void) {
-    sim_opts a = sim_default_opts(), b = sim_default_opts();
-    CHECK(app_compare_reference(&a, &b) == 0, "same settings: A");
-    b.cvode = true;
-    CHECK(app_compare_reference(&a, &b) == 1, "B is cvode");
-    a.cvode = true, b.cvode = false;
-    CHECK(app_compare_reference(&a, &b) == 0, "A is cvode");
-    a = sim_default_opts(), b = sim_default_opts();
-    a.h = 1e-3, b.h = 1e-4;
-    CHECK(app_compare_reference(&a, &b) == 1, "B has the shorter step");
-    a.h = 1e-4, b.h = 1e-3;
-    CHECK(app_compare_reference(&a, &b) == 0, "A has the shorter step");
-    // An adaptive side has no step to compare: the first named.
-    a.solver = HYD_RODAS3, b.h = 1e-5;
-    CHECK(app_compare_reference(&a, &b) == 0, "adaptive A vs fixed B: A");
-}
-
 int main(int argc, char** argv) {
-    RUN_TEST(test_percent_of_reference_peak);
-    RUN_TEST(test_reference_side);
+    RUN_TEST(test_percent_of_higher_peak);
     TEST_MAIN_END();
 }

@@ -34,6 +34,29 @@ static double csv_field(const char* line, int k) {
     return p ? strtod(p, NULL) : NAN;
 }
 
+// Every "bore": value of a model file written by optimize is the shortest
+// of 15, 16, 17 significant digits that reads back to the same double (the
+// written design reads as a user would type it); the count checked.
+static int check_shortest_bores(const char* js) {
+    int n = 0;
+    for (const char* p = strstr(js, "\"bore\":"); p; p = strstr(p + 1, "\"bore\":")) {
+        const char* t = p + strlen("\"bore\":");
+        while (*t == ' ' || *t == '\t') ++t;
+        char tok[64];
+        const size_t L = strcspn(t, ",\n}");
+        snprintf(tok, sizeof tok, "%.*s", (int)L, t);
+        const double v = strtod(tok, NULL);
+        char best[64];
+        for (int d = 15; d <= 17; ++d) {
+            snprintf(best, sizeof best, "%.*g", d, v);
+            if (strtod(best, NULL) == v) break;
+        }
+        CHECK(!strcmp(tok, best), "bore written as '%s', shortest round trip '%s'", tok, best);
+        ++n;
+    }
+    return n;
+}
+
 // The hand solution. On `hold` the crane starts static (the chamber
 // pressures that hold the load still) and stays so: the lift cylinder's
 // force F = p1A A_A - p1B A_B is set by the load and the pose, not by the
@@ -59,14 +82,21 @@ static void test_optimize_finds_hand_bore(void) {
     unlink("opt_best.json");
     unlink("opt_conv.png");
     const int rc = cli_run("optimize --scenario hold --duration 0.5 --param " BORE "=0.05:0.15 --minimize " BORE
-                           " --constraint 'peak_p1A<=18e6' --out opt_best.json --plot opt_conv.png",
+                           " --constraint 'peak_p1A<=18MPa' --out opt_best.json --plot opt_conv.png",
                            out, sizeof out);
     CHECK(rc == 0, "rc %d: %s", rc, out);
     CHECK(strstr(out, "COBYLA") && strstr(out, "optimize: eval 1:"), "%s", out);
+    // The progress lines give the constrained pressure in the summary's unit.
+    const char* pl = strstr(out, "peak_p1A ");
+    const double shown = pl ? strtod(pl + strlen("peak_p1A "), NULL) : NAN;
+    CHECK(pl && shown > 5 && shown < 100 && !strncmp(strchr(pl + 9, ' '), " MPa", 4), "progress: %.80s", pl ? pl : out);
     const double b = best_bore(out);
     CHECK(fabs(b - b_hand) <= 2e-3 * b_hand, "optimum %.6g m, by hand %.6g m", b, b_hand);
     // The model file is the model with that bore: a run of it is feasible.
     CHECK(access("opt_best.json", F_OK) == 0, "no model file");
+    static char model_js[1 << 16];
+    CHECK(cli_read_file("opt_best.json", model_js, sizeof model_js) > 0 && check_shortest_bores(model_js) >= 2,
+          "no bores in the written model");
     CHECK(cli_run("run --model opt_best.json --scenario hold --duration 0.5 --out opt_check.csv "
                   "--metrics opt_check.json -q",
                   out, sizeof out) == 0,
@@ -88,7 +118,7 @@ static void test_optimize_finds_hand_bore(void) {
 // largest bore.
 static void test_optimize_failing_designs_infeasible(void) {
     int rc = cli_run("optimize --scenario hold --duration 0.3 --param " BORE "=-0.06:0.15 --minimize " BORE
-                     " --constraint 'peak_p1A<=18e6' --out opt_fail.json",
+                     " --constraint 'peak_p1A<=18e6Pa' --out opt_fail.json",
                      out, sizeof out);
     CHECK(rc == 0, "rc %d: %s", rc, out);
     CHECK(strstr(out, "failed (exit 2)") && strstr(out, "must be"), "no refused design seen: %s", out);
@@ -114,6 +144,12 @@ static void test_optimize_bad_input(void) {
         {"--param " BORE "=0.05:0.15 --minimize peak_p3A", "peak_p3A"},
         {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<20e6'", "METRIC<=V"},
         {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<=abc'", "finite number"},
+        // A pressure needs its unit: 24 meant as MPa would be 24 Pa.
+        {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<=24'", "needs a unit"},
+        {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<=24'", "MPa, kPa, bar, Pa"},
+        {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'peak_p1A<=24psi'", "'psi' is not one of"},
+        {"--param " BORE "=0.05:0.15 --minimize " BORE " --constraint 'end_stop_hits_lift<=1s'", "plain number"},
+        {"--param " BORE "=0.05:0.15 --minimize 'peak_p1A[deg]'", "'deg' is not one of"},
         {"--param " BORE "=0.05:0.15 --minimize " BORE " --maxeval 0", "--maxeval"},
         {"--param " BORE "=0.05:0.15", "--minimize"},
         {"--minimize peak_p1A", "--param"},

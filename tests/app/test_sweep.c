@@ -306,9 +306,9 @@ static void test_sweep_threads_same_file(void) {
 static void test_sweep_failing_design_is_a_row(void) {
     static char a[1 << 15];
     const char* base = "sweep --scenario ramp --duration 1 --param hydraulics.components.lift_cyl.bore=-0.1:0.1:3 "
-                       "--metrics peak_p1A --threads 2";
+                       "--metrics peak_p1A";
     char args[1024];
-    snprintf(args, sizeof args, "%s --out sweep_fail.csv", base);
+    snprintf(args, sizeof args, "%s --threads 2 --out sweep_fail.csv", base);
     CHECK(cli_run(args, out, sizeof out) == 0, "%s", out);
     CHECK(cli_read_file("sweep_fail.csv", a, sizeof a) > 0, "no file");
     CHECK(cli_count_lines(a) == 4, "%s", a);
