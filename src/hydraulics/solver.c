@@ -265,7 +265,7 @@ static int eval_jacobian(hyd_solver* s, double t, const double* y, const double*
     const hyd_problem* p = s->p;
     const int n = s->n;
     if (p->jac) {
-        memset(s->jfull, 0, (size_t)n * (size_t)n * sizeof *s->jfull);
+        if (!p->jac_full) memset(s->jfull, 0, (size_t)n * (size_t)n * sizeof *s->jfull);
         if (p->jac(p->user, t, y, s->jfull) != 0) return HYD_ERR_RHS;
         if (s->jfull != s->jb) {
             for (int b = 0; b < s->nblock; ++b) {
