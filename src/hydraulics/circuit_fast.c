@@ -426,16 +426,22 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
     for (int i = 0; i < k->nrec[HYD_SHUTTLE]; ++i) {
         const hyd_shuttle_c* c = &sh[i];
         const int spool = c->su >= 0;
-        hyd_shuttle_flow e;
-        hyd_shuttle_law(c, spool ? y[c->su] : 0.0, p[c->a], p[c->b], p[c->out], spool ? p[c->t] : 0.0, &e);
+        const double u = spool ? y[c->su] : 0.0, pt = spool ? p[c->t] : 0.0;
         const int ns = spool ? 4 : 3;
         const int node[4] = {c->a, c->b, c->out, c->t};
+        if (!J) { // the flows alone
+            double f[4];
+            hyd_shuttle_flows(c, u, p[c->a], p[c->b], p[c->out], pt, f);
+            for (int r = 0; r < ns; ++r) k->net[node[r]] += f[r];
+            continue;
+        }
+        hyd_shuttle_flow e;
+        hyd_shuttle_law(c, u, p[c->a], p[c->b], p[c->out], pt, &e);
         for (int r = 0; r < ns; ++r) k->net[node[r]] += e.f[r];
-        if (J)
-            for (int r = 0; r < ns; ++r) {
-                for (int j = 0; j < ns; ++j) jent(k, J, ldj, node[r], node[j], e.g[r][j]);
-                if (spool) jcol(k, J, ldj, node[r], c->su, e.du[r]);
-            }
+        for (int r = 0; r < ns; ++r) {
+            for (int j = 0; j < ns; ++j) jent(k, J, ldj, node[r], node[j], e.g[r][j]);
+            if (spool) jcol(k, J, ldj, node[r], c->su, e.du[r]);
+        }
     }
     const hyd_comp_c* co = k->rec[HYD_COMPENSATOR];
     for (int i = 0; i < k->nrec[HYD_COMPENSATOR]; ++i) {

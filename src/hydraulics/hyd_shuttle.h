@@ -49,6 +49,38 @@ typedef struct hyd_shuttle_flow {
     double du[4];   ///< d f[i] / d u [m^3/s] (spool mode)
 } hyd_shuttle_flow;
 
+/// The spool-mode gallery shares wa, wb, wt of G at spool position u [-]
+/// (see hyd_shuttle_law) and, when dw is non-NULL, d w / d u [1/-].
+static inline void hyd_shuttle_shares(const hyd_shuttle_c* c, double u, double w[3], double* dw) {
+    double dsa, dsb;
+    const double wa = hyd_smoothstep(u * c->inv_uw, &dsa);
+    const double wb = hyd_smoothstep(-u * c->inv_uw, &dsb);
+    w[0] = wa, w[1] = wb, w[2] = 1.0 - wa - wb;
+    if (dw) dw[0] = dsa * c->inv_uw, dw[1] = -dsb * c->inv_uw, dw[2] = (dsb - dsa) * c->inv_uw;
+}
+
+/// The flows alone (f of hyd_shuttle_law, the same operations in the same
+/// order, so bit for bit): the plain evaluation, which needs no partials,
+/// skips clearing and filling the 20 partial slots.
+static inline void hyd_shuttle_flows(const hyd_shuttle_c* c, double u, double pa, double pb, double po,
+                                     double pt, double f[4]) {
+    if (c->su < 0) {
+        double sa, sig, dsig;
+        const double q = hyd_shuttle_q(c, pa, pb, po, &sig, &dsig, &sa);
+        f[0] = -sig * q, f[1] = -(1.0 - sig) * q, f[2] = q, f[3] = 0.0;
+        return;
+    }
+    double w[3];
+    hyd_shuttle_shares(c, u, w, NULL);
+    const double pk[3] = {pa, pb, pt};
+    f[0] = f[1] = f[2] = f[3] = 0.0;
+    static const int slot[3] = {0, 1, 3};
+    for (int k = 0; k < 3; ++k) {
+        const double q = c->G * w[k] * (pk[k] - po); // port k -> out
+        f[slot[k]] -= q, f[2] += q;
+    }
+}
+
 /// The law at spool position u [-] (read in spool mode only) and the
 /// pressures [Pa] at a, b, out and t (pt unused in max-select mode).
 /// Spool mode: the gallery connects out to a, b and t through the shares
@@ -71,11 +103,8 @@ static inline void hyd_shuttle_law(const hyd_shuttle_c* c, double u, double pa, 
         o->g[2][0] = qa, o->g[2][1] = qb, o->g[2][2] = qo;
         return;
     }
-    double dsa, dsb;
-    const double wa = hyd_smoothstep(u * c->inv_uw, &dsa);
-    const double wb = hyd_smoothstep(-u * c->inv_uw, &dsb);
-    const double w[3] = {wa, wb, 1.0 - wa - wb};
-    const double dw[3] = {dsa * c->inv_uw, -dsb * c->inv_uw, (dsb - dsa) * c->inv_uw}; // d w / d u
+    double w[3], dw[3]; // shares and d w / d u
+    hyd_shuttle_shares(c, u, w, dw);
     const double pk[3] = {pa, pb, pt};
     static const int slot[3] = {0, 1, 3};
     for (int k = 0; k < 3; ++k) {

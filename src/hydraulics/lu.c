@@ -442,6 +442,7 @@ int hydFactorW(hyd_solver* s, double gh) {
                 return HYD_ERR_SINGULAR;
         }
     }
+    for (int t = 0; t < s->nb1; ++t) s->b1w[t] = s->w[s->moff[s->border[t]]];
     return w_factored(s, gh);
 }
 
@@ -456,10 +457,9 @@ void hydSolveW(const hyd_solver* s, double* x) {
     }
     const int* restrict bo = s->border;
     const int e1 = s->nb1, e2 = s->nb1 + s->nb2;
-    for (int t = 0; t < e1; ++t) {
-        const int b = bo[t];
-        x[s->boff[b]] *= s->w[s->moff[b]];
-    }
+    const int* restrict x1 = s->b1x;
+    const double* restrict w1 = s->b1w;
+    for (int t = 0; t < e1; ++t) x[x1[t]] *= w1[t];
     for (int t = e1; t < e2; ++t) {
         const int b = bo[t], o = s->boff[b];
         const double* w = s->w + s->moff[b];

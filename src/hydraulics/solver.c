@@ -96,7 +96,9 @@ hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solv
     s->piv = calloc((size_t)n, sizeof *s->piv);
     s->wswap = calloc((size_t)nblock, sizeof *s->wswap);
     s->border = calloc((size_t)nblock, sizeof *s->border);
-    if (!s->boff || !s->moff || !s->bblk || !s->piv || !s->wswap || !s->border) {
+    s->b1x = calloc((size_t)nblock, sizeof *s->b1x);
+    s->b1w = calloc((size_t)nblock, sizeof *s->b1w);
+    if (!s->boff || !s->moff || !s->bblk || !s->piv || !s->wswap || !s->border || !s->b1x || !s->b1w) {
         hyd_solver_destroy(s);
         return NULL;
     }
@@ -115,7 +117,10 @@ hyd_solver* hyd_solver_create(const hyd_problem* p, hyd_method m, const hyd_solv
             const int bs = s->boff[b + 1] - s->boff[b];
             if ((cls < 3 && bs == cls) || (cls == 3 && bs > 2)) s->border[nb++] = b;
         }
-        if (cls == 1) s->nb1 = nb;
+        if (cls == 1) {
+            s->nb1 = nb;
+            for (int t = 0; t < nb; ++t) s->b1x[t] = s->boff[s->border[t]];
+        }
         if (cls == 2) s->nb2 = nb - s->nb1;
     }
 
@@ -194,6 +199,8 @@ void hyd_solver_destroy(hyd_solver* s) {
     free(s->piv);
     free(s->wswap);
     free(s->border);
+    free(s->b1x);
+    free(s->b1w);
     free(s->sp_mask);
     free(s->sp_lptr);
     free(s->sp_scale);
@@ -265,7 +272,7 @@ static int eval_jacobian(hyd_solver* s, double t, const double* y, const double*
     const hyd_problem* p = s->p;
     const int n = s->n;
     if (p->jac) {
-        memset(s->jfull, 0, (size_t)n * (size_t)n * sizeof *s->jfull);
+        if (!p->jac_full) memset(s->jfull, 0, (size_t)n * (size_t)n * sizeof *s->jfull);
         if (p->jac(p->user, t, y, s->jfull) != 0) return HYD_ERR_RHS;
         if (s->jfull != s->jb) {
             for (int b = 0; b < s->nblock; ++b) {

@@ -49,6 +49,11 @@ struct hyd_solver {
     // the nb2 of size 2, then the rest (block indices).
     int nb1, nb2;
     int* border;   ///< (nblock)
+    // The nb1 blocks of size 1 flat: their state index and 1/W, copied out of
+    // boff/w at each factorisation, so their solve is one load pair and a
+    // multiply per state instead of three dependent index loads.
+    int* b1x;      ///< (nblock) state index of the t-th size-1 block
+    double* b1w;   ///< (nblock) its 1 / W [-]
     double* ft;    ///< (n) df/dt at the Jacobian point (RODAS3)
     int j_valid;   ///< jb holds a usable Jacobian
     int j_force;   ///< re-evaluate J at the next step (after a rejection or reset)

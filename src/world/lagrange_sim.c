@@ -148,6 +148,12 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
     const bool fz = s->use_fused && s->have_fused;
     p.f = fz ? lsim_rhs_fused : lsim_rhs;
     p.jac = fz ? lsim_jac_fused : lsim_jac;
+    // lsim_jac writes all of J: the circuit's rows (hyd_fast_jacobian clears
+    // its rows' circuit columns, the coupling columns are stored), the
+    // mechanics' rows (mech_jac, and the hydraulic columns stored below it).
+    // lsim_jac_fused clears J itself. Checked by test_lagrange's
+    // NaN-prefilled J.
+    p.jac_full = 1;
     p.dfdt = lsim_dfdt;
     p.user = s;
     if (s->have_fused) p.events = lsim_events;

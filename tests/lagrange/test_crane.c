@@ -397,6 +397,52 @@ static void test_fused_matches_general(void) {
     model_free(m);
 }
 
+// lsim_problem sets jac_full: the solver no longer clears J before asking for
+// it, so each Jacobian callback must write every entry of J itself. Prefilled
+// with NaN and with zeros, J must come out bit for bit the same, on the
+// standard and the load-sensing crane, through every path (fused, the fast
+// kernel mapped into J, the general loops), with a joint frozen or not.
+static void test_jac_writes_all(void) {
+    static const char* const file[2] = {CRANESIM_ASSETS "/models/hiab031.json",
+                                        CRANESIM_ASSETS "/models/hiab031_ls.json"};
+    srand(99);
+    for (int f = 0; f < 2; ++f) {
+        char err[512];
+        model* m = model_load(file[f], NULL, 0, err, sizeof err);
+        CHECK(m != NULL, "%s: %s", file[f], err);
+        if (!m) continue;
+        lsim s;
+        CHECK(lsim_init(&s, m, LAGRANGE_FULL, 500, err, sizeof err) == 0, "%s", err);
+        const int n = s.n;
+        const hyd_problem p = lsim_problem(&s, true);
+        CHECK(p.jac_full, "%s: jac_full not set", file[f]);
+        static double J0[LSIM_MAX_STATES * LSIM_MAX_STATES], Jn[LSIM_MAX_STATES * LSIM_MAX_STATES];
+        double y[LSIM_MAX_STATES];
+        int paths = 0, bad = 0;
+        for (int path = 0; path < 3; ++path) {
+            if (path == 0 && !s.have_fused) continue;
+            if (path == 1 && !s.fk) continue;
+            const bool fast = s.use_fast;
+            s.use_fast = path == 1;
+            ++paths;
+            for (int trial = 0; trial < 50; ++trial) {
+                random_crane_state(&s, y);
+                s.frozen_q[0] = trial % 5 == 1, s.frozen_q[1] = trial % 7 == 3;
+                for (int i = 0; i < n * n; ++i) J0[i] = 0.0, Jn[i] = NAN;
+                if (path == 0) lsim_jac_fused(&s, 0.0, y, J0), lsim_jac_fused(&s, 0.0, y, Jn);
+                else lsim_jac(&s, 0.0, y, J0), lsim_jac(&s, 0.0, y, Jn);
+                for (int i = 0; i < n * n; ++i) bad += memcmp(&J0[i], &Jn[i], sizeof J0[i]) != 0;
+            }
+            s.frozen_q[0] = s.frozen_q[1] = 0;
+            s.use_fast = fast;
+        }
+        CHECK(paths >= 2, "%s: only %d Jacobian paths", file[f], paths);
+        CHECK(bad == 0, "%s: %d entries of J depend on what J held before", file[f], bad);
+        lsim_free(&s);
+        model_free(m);
+    }
+}
+
 // Componentwise backward error of x as a solution of W x = b (Oettli-Prager):
 //   max_i |W x - b|_i / (sum_j |W_ij| |x_j| + |b_i|).
 static double backward_error(const double* W, int n, const double* x, const double* b) {
@@ -519,6 +565,7 @@ static void test_sincos(void) {
 int main(int argc, char** argv) {
     RUN_TEST(test_fused_matches_general);
     RUN_TEST(test_sincos);
+    RUN_TEST(test_jac_writes_all);
     RUN_TEST(test_structured_w);
     RUN_TEST(test_jacobian_matches_finite_differences);
     RUN_TEST(test_static_hold_matches_torque_balance);
