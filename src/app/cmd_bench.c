@@ -72,9 +72,10 @@ static void bench_help(FILE* f) {
             "  ls           not in the default set: Krus, h = 0.1 ms, on the scenario with the standard\n"
             "               crane (hiab031.json) and the load-sensing crane (hiab031_ls.json), runs\n"
             "               interleaved: ns per step of each, kernel, and LS over standard\n"
-            "  drive        the interactive loop offscreen at 1280x720 on the sandbox, scripted\n"
-            "               operator, for --duration seconds of wall time (default 60): fps,\n"
-            "               frame times, missed real-time deadlines, command rate\n"
+            "  drive        the interactive loop offscreen at 1280x720 on the sandbox (or the\n"
+            "               sandbox-type world --world names, e.g. site), scripted operator, for\n"
+            "               --duration seconds of wall time (default 60): fps, frame times,\n"
+            "               missed real-time deadlines, command rate, the world and its bodies\n"
             "  serve        not in the default set: cranesim serve streaming the sandbox at 1 kHz over\n"
             "               loopback to 1 controlling and 2 watching clients for --duration seconds of\n"
             "               wall time (default 60): frames/s each client received, frames lost, p50/p99\n"
@@ -693,6 +694,35 @@ static int bench_circuit_sizes(int repeat) {
     return 0;
 }
 
+// The drive configuration runs the pick-and-place operator, which needs a
+// hook and loads: a world of the sandbox type (sandbox, site). 0, or
+// EXIT_USAGE with one line naming the world and the problem.
+static int bench_check_drive_world(const char* world) {
+    char buf[512], err[512];
+    const char* path = sim_world_path(world, buf, sizeof buf);
+    world_desc* wd = malloc(sizeof *wd); // large (fixed arrays of loads, obstacles)
+    if (!wd) {
+        fprintf(stderr, "cranesim bench: out of memory\n");
+        return EXIT_RUNTIME;
+    }
+    int rc = 0;
+    if (world_desc_load(path, wd, err, sizeof err)) {
+        fprintf(stderr, "cranesim bench: %s\n", err); // the loader's line names the world
+        rc = EXIT_USAGE;
+    } else {
+        if (wd->kind != WORLD_SANDBOX) {
+            fprintf(stderr,
+                    "cranesim bench: --world %s: a %s world; the drive configuration needs a sandbox-type world "
+                    "(hook and loads: sandbox, site)\n",
+                    world, world_kind_name(wd->kind));
+            rc = EXIT_USAGE;
+        }
+        world_desc_free(wd);
+    }
+    free(wd);
+    return rc;
+}
+
 int cmd_bench(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     int repeat = 3;
@@ -787,10 +817,20 @@ int cmd_bench(int argc, char** argv) {
     // Each configuration fixes these itself: say so rather than ignore them.
     static const int fixed[] = {APP_OPT_SOLVER, APP_OPT_DT,    APP_OPT_RTOL,   APP_OPT_ATOL,
                                 APP_OPT_MECHANICS, APP_OPT_WORLD, APP_OPT_DT_ODE, APP_OPT_DENSE_JAC};
+    // --world is drive's own option (the world it draws); the other
+    // configurations fix theirs.
+    bool want_other = nonly == 0;
+    for (int j = 0; j < nonly; ++j) want_other |= strcmp(only[j], "drive") != 0;
+    if ((c.given & APP_GIVEN(APP_OPT_WORLD)) && want_drive) {
+        const int wrc = bench_check_drive_world(c.sim.world);
+        if (wrc) return wrc;
+    }
     for (size_t k = 0; k < sizeof fixed / sizeof fixed[0]; ++k)
-        if (c.given & APP_GIVEN(fixed[k]))
+        if ((c.given & APP_GIVEN(fixed[k])) && !(fixed[k] == APP_OPT_WORLD && want_drive))
             fprintf(stderr, "cranesim bench: note: %s has no effect: each configuration sets its own (see --help)\n",
                     app_opt_name[fixed[k]]);
+    if ((c.given & APP_GIVEN(APP_OPT_WORLD)) && want_drive && want_other)
+        fprintf(stderr, "cranesim bench: note: %s applies to the drive configuration only\n", app_opt_name[APP_OPT_WORLD]);
     // The options that do apply (--every, --load) must suit every configuration.
     for (size_t k = 0; k < sizeof configs / sizeof configs[0]; ++k) {
         bool want = nonly == 0;

@@ -1505,6 +1505,11 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
         drive_session_idle(s, wall + tick - next);
     }
     const drive_stats* st = drive_session_stats(s);
+    // The world the engine was built on (c->sim.world, the sandbox when
+    // none is named), and the bodies of its last snapshot, so a reader can
+    // tell the worlds apart by what ran, not only by name.
+    const char* world = c->sim.mechanics != SIM_ODE ? "lagrange" : c->sim.world ? c->sim.world : "sandbox";
+    take_snapshot(s);
     int n = st->nframe_ms < 4096 ? st->nframe_ms : 4096;
     double* ms = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1));
     // Skip the first frames (shader compilation, mesh upload).
@@ -1515,12 +1520,12 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
     printf("{\"config\":\"drive\",\"width\":%d,\"height\":%d,\"world\":\"%s\",\"wall_s\":%.3f,"
            "\"sim_time_s\":%.3f,\"rt_factor\":%.3f,\"frames\":%ld,\"fps_mean\":%.1f,\"fps_median\":%.1f,"
            "\"fps_p5\":%.1f,\"frame_ms_p50\":%.2f,\"frame_ms_p95\":%.2f,\"missed_deadlines\":%ld,"
-           "\"command_rate_hz\":%.1f,\"triangles\":%ld%s}\n",
-           w, h, c->sim.mechanics == SIM_ODE ? "sandbox" : "lagrange", st->wall_time, st->sim_time,
+           "\"command_rate_hz\":%.1f,\"triangles\":%ld,\"bodies\":%d%s}\n",
+           w, h, world, st->wall_time, st->sim_time,
            st->wall_time > 0 ? st->sim_time / st->wall_time : 0, st->frames,
            st->wall_time > 0 ? st->frames / st->wall_time : 0, p50 > 0 ? 1e3 / p50 : 0, p95 > 0 ? 1e3 / p95 : 0,
            p50, p95, st->missed, st->wall_time > 0 ? st->input_samples / st->wall_time : 0, st->triangles,
-           code ? ",\"error\":\"numerical failure\"" : "");
+           s->snap->nbody, code ? ",\"error\":\"numerical failure\"" : "");
     fflush(stdout);
     free(ms);
     drive_session_destroy(s);

@@ -244,6 +244,39 @@ static void test_validation_world_report(void) {
     for (int i = 0; i < 5; ++i) CHECK(strstr(out, present[i]), "sandbox report lacks '%s': %s", present[i], out);
 }
 
+// bench --config drive runs the world --world names and says so: the name,
+// and the bodies of its last snapshot, counted by hand from the world files.
+// Both worlds have 26 bodies of their own (terrain, truck, 4 wheels, 4
+// outriggers of pad, beam and leg, column, 2 booms, 4 rope links, hook);
+// the sandbox adds 3 loads and 12 obstacles (41), the site its terrain mesh
+// (the dock), 2 loads and 3 obstacles (32).
+static void test_bench_drive_world(void) {
+    static const struct {
+        const char* opt;
+        const char* world;
+        int bodies;
+    } k[] = {{"", "sandbox", 41}, {"--world site", "site", 32}};
+    long tris[2] = {0, 0};
+    for (int i = 0; i < 2; ++i) {
+        char a[256], want[64];
+        snprintf(a, sizeof a, "bench --config drive --duration 1 %s", k[i].opt);
+        int rc = cli_run_env(NO_DISPLAY, a, out, sizeof out);
+        snprintf(want, sizeof want, "\"world\":\"%s\"", k[i].world);
+        const char* b = strstr(out, "\"bodies\":");
+        const char* t = strstr(out, "\"triangles\":");
+        CHECK(rc == 0 && strstr(out, want) && b && atoi(b + 9) == k[i].bodies && t,
+              "%s: want world %s with %d bodies: exit %d: %s", a, k[i].world, k[i].bodies, rc, out);
+        CHECK(!strstr(out, "has no effect"), "%s: a note that --world does nothing: %s", a, out);
+        if (t) tris[i] = atol(t + 12);
+    }
+    CHECK(tris[0] > 0 && tris[1] > 0 && tris[0] != tris[1], "the same triangles in both worlds: %ld", tris[0]);
+    // Only sandbox-type worlds: the pick-and-place needs a hook and loads.
+    int rc = cli_run_env(NO_DISPLAY, "bench --config drive --duration 1 --world validation", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--world validation") && cli_count_lines(out) == 1, "exit %d: %s", rc, out);
+    rc = cli_run_env(NO_DISPLAY, "bench --config drive --duration 1 --world nosuch", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "nosuch") && cli_count_lines(out) == 1, "exit %d: %s", rc, out);
+}
+
 // --help: the keys come last, after the shared options.
 static void test_help_keys_last(void) {
     int rc = drive("", "--help");
@@ -326,6 +359,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_no_rates_over_an_instant);
     RUN_TEST(test_validation_world_report);
     RUN_TEST(test_help_keys_last);
+    RUN_TEST(test_bench_drive_world);
     RUN_TEST(test_drive_record_is_the_run);
     RUN_TEST(test_drive_plays_faults);
     TEST_MAIN_END();
