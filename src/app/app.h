@@ -250,7 +250,8 @@ int cmd_replay(int argc, char** argv);
 int cmd_loadchart(int argc, char** argv);
 int cmd_serve(int argc, char** argv);
 /// bench --config serve (bench_serve.c): one JSON line; returns 0 or EXIT_RUNTIME.
-int bench_serve(const app_common* c, double duration);
+/// realtime: the server runs with --realtime (config serve) or without (serve-plain).
+int bench_serve(const app_common* c, double duration, bool realtime);
 /// drive --connect HOST:PORT, headless (drive_connect.c): the scripted
 /// operator sc drives a remote serve for duration seconds of wall time,
 /// reconnecting when the link drops. Returns 0, or EXIT_USAGE / EXIT_RUNTIME.

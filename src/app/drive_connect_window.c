@@ -360,10 +360,18 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     c.sim.mechanics = strcmp(backend, "ode") ? SIM_LAGRANGE : SIM_ODE;
     // The server's files where this computer has them (the same install);
     // else this drive's --model and --world, which must describe the same crane.
+    // Version 2 servers before "model_asset" sent the model's bare base name:
+    // that one is still taken as the shipped default when it is its name.
     const char* dflt = model_default_path();
     const char* base = strrchr(dflt, '/') ? strrchr(dflt, '/') + 1 : dflt;
+    const char* asset = cJSON_GetStringValue(cJSON_GetObjectItem(desc, "model_asset"));
+    char asset_buf[1024];
+    snprintf(asset_buf, sizeof asset_buf, "%s/%s", model_assets_dir(), asset ? asset : "");
     if (file_exists(model_file)) c.model_path = model_file;
-    else if (!strcmp(model_file, base) || !strcmp(model_file, dflt)) c.model_path = NULL; // the shipped model, by name
+    else if (asset && asset[0] && file_exists(asset_buf)) { // the same file in this install's assets
+        snprintf(model_buf, sizeof model_buf, "%s", asset_buf);
+        c.model_path = model_buf;
+    } else if (!strcmp(model_file, base) || !strcmp(model_file, dflt)) c.model_path = NULL; // the shipped model, by name
     else if (model_file && model_file[0])
         printf("cranesim drive: the server's model %s is not here: drawing %s\n", model_file,
                c.model_path ? c.model_path : "the default model");
