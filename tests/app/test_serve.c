@@ -18,6 +18,9 @@
 //    stop of 200 ms is logged as a missed deadline whose frame started
 //    about 200 ms late (the cause: the wake-up, not the step); --realtime
 //    with --lockstep and a --spin out of range are refused with exit 2.
+// 6. The hello names the model so another directory can resolve it: the
+//    default and the LS crane as absolute paths of readable files, and as
+//    paths in the assets folder (models/hiab031.json, models/hiab031_ls.json).
 #define _DEFAULT_SOURCE // usleep, in serve_util.h
 #include "check.h"
 #include "engine.h"
@@ -497,6 +500,38 @@ static void realtime_log(void) {
     }
 }
 
+// ---- 6. the model named so a viewer can resolve it ----
+
+static void hello_model(const char* model, const char* want_asset) {
+    const char* args[] = {"--mechanics", "lagrange", "--lockstep", model ? "--model" : NULL, model, NULL};
+    served sv;
+    CHECK(serve_start(&sv, NULL, args) == 0, "server started");
+    int fd = tcp_connect(sv.port);
+    uint8_t b[32];
+    size_t n = proto_put_client_hello(b, sizeof b, PROTO_VERSION, PROTO_WATCH);
+    proto_msg m;
+    char file[1024] = "", asset[256] = "";
+    if (fd >= 0 && !send_all(fd, b, n) && recv_frame(fd, &m, &g_st, 5000) == PROTO_SERVER_HELLO) {
+        // The description's two fields, read as plain text: "model_file":"...".
+        char js[1 << 16];
+        const size_t L = m.u.shello.json_len < sizeof js - 1 ? m.u.shello.json_len : sizeof js - 1;
+        memcpy(js, m.u.shello.json, L);
+        js[L] = 0;
+        const char* f = strstr(js, "\"model_file\":\"");
+        const char* a = strstr(js, "\"model_asset\":\"");
+        if (f) sscanf(f + 14, "%1023[^\"]", file);
+        if (a) sscanf(a + 15, "%255[^\"]", asset);
+    }
+    if (fd >= 0) close(fd);
+    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+    printf("hello: model_file %s, model_asset %s\n", file, asset);
+    CHECK(file[0] == '/' && access(file, R_OK) == 0, "model_file '%s': not an absolute path of a readable file", file);
+    const size_t lf = strlen(file), la = strlen(want_asset);
+    CHECK(lf > la && !strcmp(file + lf - la, want_asset) && file[lf - la - 1] == '/', "model_file '%s' is not %s",
+          file, want_asset);
+    CHECK(!strcmp(asset, want_asset), "model_asset '%s', want '%s'", asset, want_asset);
+}
+
 int main(void) {
     signal(SIGPIPE, SIG_IGN);
     bit_for_bit("lagrange", "drive_demo", 300);
@@ -505,5 +540,7 @@ int main(void) {
     dead_man();
     late_wakeup();
     realtime_log();
+    hello_model(NULL, "models/hiab031.json");
+    hello_model(CRANESIM_ASSETS "/models/hiab031_ls.json", "models/hiab031_ls.json");
     TEST_MAIN_END();
 }
