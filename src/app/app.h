@@ -255,7 +255,9 @@ int bench_serve(const app_common* c, double duration, bool realtime);
 /// drive --connect HOST:PORT, headless (drive_connect.c): the scripted
 /// operator sc drives a remote serve for duration seconds of wall time,
 /// reconnecting when the link drops. Returns 0, or EXIT_USAGE / EXIT_RUNTIME.
-int drive_connect(const char* addr, const scenario* sc, double duration);
+/// sets: the drive's --set values, sent to the server as SET commands on
+/// each link; its answer (accepted or refused with its reason) on stdout.
+int drive_connect(const char* addr, const scenario* sc, double duration, const char* const* sets, int nset);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it

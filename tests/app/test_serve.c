@@ -21,6 +21,11 @@
 // 6. The hello names the model so another directory can resolve it: the
 //    default and the LS crane as absolute paths of readable files, and as
 //    paths in the assets folder (models/hiab031.json, models/hiab031_ls.json).
+// 7. `drive --connect --set` sends the set to the server as SET: the main
+//    relief set to 100 bar (from 220) is accepted, and the server's state
+//    frames show it: with the valves closed the supply, held at the pump's
+//    200 bar compensator setting before, now sits at the relief's 100 bar
+//    (plus its rise for the pump's flow), as the relief then passes all of it.
 #define _DEFAULT_SOURCE // usleep, in serve_util.h
 #include "check.h"
 #include "engine.h"
@@ -532,6 +537,41 @@ static void hello_model(const char* model, const char* want_asset) {
     CHECK(!strcmp(asset, want_asset), "model_asset '%s', want '%s'", asset, want_asset);
 }
 
+// ---- 7. a set through the link changes the server's model ----
+
+// The supply pressure of the last of ~1 s of state frames, as a watcher [Pa abs].
+static double supply_now(int port) {
+    int fd = serve_join(port, PROTO_WATCH, NULL);
+    double p = NAN;
+    for (int k = 0; fd >= 0 && k < 75; ++k)
+        if (!next_state(fd, &g_st, 2000)) p = g_st.p_supply;
+    if (fd >= 0) close(fd);
+    return p;
+}
+
+static void remote_set(void) {
+    const char* args[] = {"--mechanics", "lagrange", "--scenario", "hold", NULL};
+    served sv;
+    CHECK(serve_start(&sv, NULL, args) == 0, "server started");
+    const double before = supply_now(sv.port);
+    char cmd[512], out[4096] = "";
+    snprintf(cmd, sizeof cmd,
+             "%s/cranesim drive --connect 127.0.0.1:%d --headless --duration 0.5 --set "
+             "hydraulics.components.main_relief.p_crack=1e7 2>&1",
+             CRANESIM_BINARY_DIR, sv.port);
+    FILE* p = popen(cmd, "r");
+    size_t n = p ? fread(out, 1, sizeof out - 1, p) : 0;
+    out[n] = 0;
+    if (p) pclose(p);
+    const double after = supply_now(sv.port);
+    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+    printf("remote set: supply %.4g Pa before, %.4g Pa after main_relief.p_crack = 1e7 Pa\n", before, after);
+    CHECK(strstr(out, "the server accepted --set hydraulics.components.main_relief.p_crack=1e7"),
+          "no acceptance in: %s", out);
+    CHECK(before > 1.8e7, "supply before the set %.4g Pa: the pump's 200 bar setting expected", before);
+    CHECK(after > 0.95e7 && after < 1.3e7, "supply after the set %.4g Pa: the relief's 100 bar expected", after);
+}
+
 int main(void) {
     signal(SIGPIPE, SIG_IGN);
     bit_for_bit("lagrange", "drive_demo", 300);
@@ -542,5 +582,6 @@ int main(void) {
     realtime_log();
     hello_model(NULL, "models/hiab031.json");
     hello_model(CRANESIM_ASSETS "/models/hiab031_ls.json", "models/hiab031_ls.json");
+    remote_set();
     TEST_MAIN_END();
 }
