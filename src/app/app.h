@@ -258,6 +258,9 @@ int bench_serve(const app_common* c, double duration, bool realtime);
 /// sets: the drive's --set values, sent to the server as SET commands on
 /// each link; its answer (accepted or refused with its reason) on stdout.
 int drive_connect(const char* addr, const scenario* sc, double duration, const char* const* sets, int nset);
+/// A drive --set (hydraulics.components.lift_cyl.bore=0.1) as the protocol's
+/// SET path (lift_cyl.bore) and value: 0, or -1 when it is not PATH=NUMBER.
+int drive_set_path(const char* set, char* path, size_t np, double* v);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it

@@ -49,7 +49,7 @@ static int dc_connect(const char* host, const char* port, char* err, size_t errs
 // A --set of the drive as the protocol's SET path: a circuit parameter
 // without "hydraulics.components." (the fluid without "hydraulics."); any
 // other path as given, for the server to accept or refuse.
-static int dc_set_path(const char* set, char* path, size_t np, double* v) {
+int drive_set_path(const char* set, char* path, size_t np, double* v) {
     const char* eq = strrchr(set, '=');
     if (!eq) return -1;
     char* end;
@@ -151,7 +151,7 @@ int drive_connect(const char* addr, const scenario* sc, double duration, const c
                     for (int k = 0; k < nset && k < 64 && role == PROTO_CONTROL; ++k) {
                         proto_command c = {.seq = ++seq, .op = PROTO_OP_SET};
                         set_seq[k] = 0;
-                        if (dc_set_path(sets[k], c.path, sizeof c.path, &c.value)) {
+                        if (drive_set_path(sets[k], c.path, sizeof c.path, &c.value)) {
                             printf("cranesim drive: --set %s: not sent (expected PATH=VALUE)\n", sets[k]);
                             --seq;
                             continue;
