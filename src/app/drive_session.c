@@ -1115,6 +1115,19 @@ static void render_snapshot(drive_session* s) {
 
 void drive_session_set_remote(drive_session* s) {
     s->remote = true; // the panel stays: its circuit edits go to the server (remote_param)
+    // The state frames carry the row's channels, not the circuit's: say so
+    // once for a chart of one (its readout says it on the HUD).
+    // (The HUD's readout box holds about 30 characters: it says "not sent".)
+    for (int i = 0; i < s->nchart; ++i)
+        if (s->chart_col[i] >= chan_list_nrow(s->chans)) {
+            const sim_channel* ch = chan_list_channel(s->chans, s->chart_col[i]);
+            printf("cranesim drive: chart %s: not sent by the server (the state frames carry the row's channels, "
+                   "not the circuit's): it stays empty\n", ch ? ch->name : "?");
+        }
+    for (int i = 0; i < s->nreadout; ++i)
+        if (s->readout_col[i] >= chan_list_nrow(s->chans))
+            printf("cranesim drive: readout %s: not sent by the server (the state frames carry the row's channels, "
+                   "not the circuit's): it reads \"not sent\"\n", s->readout_name[i]);
     // The local engine's collision shapes would stand still while the
     // remote crane moves: the remote view has none.
     s->snap->ncoll = 0;
@@ -1410,9 +1423,13 @@ int drive_session_tick(drive_session* s, double wall) {
             render_readout rd[8];
             for (int i = 0; i < s->nreadout; ++i) {
                 const int k = s->readout_col[i];
-                // A channel a loaded model lacks reads NaN.
-                rd[i] = (render_readout){s->readout_name[i], s->readout_unit[i],
-                                         k >= 0 ? s->chan_v[k] / s->readout_scale[i] : NAN};
+                // No value: a channel a loaded model lacks, or (remote) a
+                // circuit channel, which the state frames do not carry.
+                const bool unsent = s->remote && (!s->remote_fed || k < 0 || k >= s->remote_nrow);
+                rd[i] = (render_readout){s->readout_name[i],
+                                         !unsent ? (k < 0 ? "not in this model" : s->readout_unit[i])
+                                         : s->remote_fed ? "not sent" : "waiting",
+                                         k >= 0 && !unsent ? s->chan_v[k] / s->readout_scale[i] : NAN};
             }
             render_set_readouts(s->r, rd, s->nreadout);
         }

@@ -21,7 +21,9 @@
 // unchanged run). A remote session's panel edit of a circuit parameter is
 // queued for the server under its protocol path in SI units (10 MPa shown:
 // main_relief.p_crack = 1e7 Pa) and leaves the idle local circuit alone; an
-// edit of a mechanical value is not sent and is put back.
+// edit of a mechanical value is not sent and is put back. A chart and a
+// readout of a circuit channel (not in the state frames) say "not sent by
+// the server"; a chart of a row channel does not.
 #define _DEFAULT_SOURCE
 #include "check.h"
 #include "drive_session.h"
@@ -100,14 +102,20 @@ int main(void) {
     // same server, later in its run: the picture is not compared).
     snprintf(cmd, sizeof cmd,
              "%s/cranesim drive --connect %s --scenario %s --screenshot connect_set.png --screenshot-at 4.5 "
-             "--size 320x180 --set hydraulics.components.main_relief.p_crack=2.2e7 2>&1",
+             "--size 320x180 --set hydraulics.components.main_relief.p_crack=2.2e7 --charts lift_cyl.A.p,x1 "
+             "--readouts lift_cyl.A.p 2>&1",
              CRANESIM_BINARY_DIR, addr, scen);
     FILE* p2 = popen(cmd, "r");
     bool set_ok = false;
+    int unsent = 0; // the circuit channel's chart and readout said not sent, and nothing else
     while (p2 && fgets(line, sizeof line, p2))
         if (strstr(line, "accepted by the server: main_relief.p_crack = 2.2e+07")) set_ok = true;
+        else if (strstr(line, "chart lift_cyl.A.p: not sent by the server")) ++unsent;
+        else if (strstr(line, "readout lift_cyl.A.p: not sent by the server")) ++unsent;
+        else if (strstr(line, "not sent by the server")) unsent = -100; // x1 is sent
     if (p2) pclose(p2);
     CHECK(set_ok, "drive --connect --set: no 'accepted by the server: main_relief.p_crack = 2.2e+07' line");
+    CHECK(unsent == 2, "chart and readout lift_cyl.A.p should say 'not sent by the server', x1 not (%d)", unsent);
     CHECK(serve_stop(&sv) == 0, "server exits 0");
 
     // The same run locally, rendered by a drive session at t_remote and 1.5 s later.
