@@ -263,11 +263,17 @@ int cmd_replay(int argc, char** argv);
 int cmd_loadchart(int argc, char** argv);
 int cmd_serve(int argc, char** argv);
 /// bench --config serve (bench_serve.c): one JSON line; returns 0 or EXIT_RUNTIME.
-int bench_serve(const app_common* c, double duration);
+/// realtime: the server runs with --realtime (config serve) or without (serve-plain).
+int bench_serve(const app_common* c, double duration, bool realtime);
 /// drive --connect HOST:PORT, headless (drive_connect.c): the scripted
 /// operator sc drives a remote serve for duration seconds of wall time,
 /// reconnecting when the link drops. Returns 0, or EXIT_USAGE / EXIT_RUNTIME.
-int drive_connect(const char* addr, const scenario* sc, double duration);
+/// sets: the drive's --set values, sent to the server as SET commands on
+/// each link; its answer (accepted or refused with its reason) on stdout.
+int drive_connect(const char* addr, const scenario* sc, double duration, const char* const* sets, int nset);
+/// A drive --set (hydraulics.components.lift_cyl.bore=0.1) as the protocol's
+/// SET path (lift_cyl.bore) and value: 0, or -1 when it is not PATH=NUMBER.
+int drive_set_path(const char* set, char* path, size_t np, double* v);
 
 /// Render a PLplot page into memory and write it to the PNG file png, checking
 /// every write (PLplot itself does not report a failed write). Before draw it

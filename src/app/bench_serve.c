@@ -163,7 +163,7 @@ static void bs_baseline(double seconds, double p[3]) {
     free(late);
 }
 
-int bench_serve(const app_common* c, double duration) {
+int bench_serve(const app_common* c, double duration, bool realtime) {
     (void)c;
     int out[2];
     if (pipe(out)) return EXIT_RUNTIME;
@@ -174,7 +174,8 @@ int bench_serve(const app_common* c, double duration) {
     posix_spawn_file_actions_adddup2(&fa, out[1], 1);
     if (logfd >= 0) posix_spawn_file_actions_adddup2(&fa, logfd, 2);
     posix_spawn_file_actions_addclose(&fa, out[0]);
-    char* args[] = {"cranesim", "serve", "--listen", "127.0.0.1:0", "--rate", "1000", "--queue", "256", NULL};
+    char* args[] = {"cranesim", "serve", "--listen", "127.0.0.1:0", "--rate", "1000", "--queue", "256",
+                    "--log-misses", realtime ? "--realtime" : NULL, NULL};
     pid_t pid;
     extern char** environ;
     if (posix_spawn(&pid, "/proc/self/exe", &fa, NULL, args, environ)) {
@@ -249,6 +250,8 @@ int bench_serve(const app_common* c, double duration) {
     waitpid(pid, &wst, 0);
     long missed = -1, sframes = -1;
     double worst = NAN, mean = NAN, late50 = NAN, late99 = NAN;
+    long cause[5] = {0, 0, 0, 0, 0}; // woke late, page faults, preempted, long step, other
+    char rt[16] = "off";
     if (logfd >= 0) {
         FILE* lf = fdopen(logfd, "r");
         rewind(lf);
@@ -259,6 +262,26 @@ int bench_serve(const app_common* c, double duration) {
             if (p && sscanf(p + 2, "%ld frames, %ld missed deadlines, worst frame %lf ms, mean frame %lf ms", &a, &b,
                             &w, &mn) == 4)
                 sframes = a, missed = b, worst = w, mean = mn;
+            // Each missed deadline's line: sort it by its cause. Started
+            // late by more than half a frame: the wake-up (the scheduler);
+            // else a page fault in it, else a step longer than a frame, else
+            // the send; with an involuntary switch in it: preempted.
+            double sl, stp, snd;
+            long fmin_, fmaj, ivc, vc, fr;
+            double at;
+            if (p && sscanf(p + 2,
+                            "missed deadline: frame %ld at %lf s: started %lf ms late, step %lf ms, send %lf ms; "
+                            "during the frame %ld minor + %ld major page faults, %ld involuntary + %ld voluntary",
+                            &fr, &at, &sl, &stp, &snd, &fmin_, &fmaj, &ivc, &vc) == 9) {
+                if (sl > 0.5) ++cause[0];
+                else if (fmin_ + fmaj > 0) ++cause[1];
+                else if (ivc > 0) ++cause[2];
+                else if (stp > 1.0) ++cause[3];
+                else ++cause[4];
+            }
+            if (p && !strncmp(p + 2, "real time: ", 11))
+                snprintf(rt, sizeof rt, "%s", !strncmp(p + 13, "SCHED_FIFO priority", 19) ? "SCHED_FIFO"
+                                              : strstr(p, "nice -10 instead") ? "nice -10" : "none");
             const char* q = p ? strstr(p, "after its deadline p50 ") : NULL;
             if (q) sscanf(q, "after its deadline p50 %lf ms, p99 %lf ms", &late50, &late99);
         }
@@ -273,16 +296,19 @@ int bench_serve(const app_common* c, double duration) {
         qsort(lat, (size_t)nlat, sizeof *lat, cmp_d);
         const double p50 = nlat ? lat[nlat / 2] : NAN, p99 = nlat ? lat[(long)(0.99 * (nlat - 1))] : NAN,
                      mx = nlat ? lat[nlat - 1] : NAN;
-        printf("{\"config\":\"serve\",\"world\":\"sandbox\",\"rate_hz\":1000,\"clients\":3,\"wall_s\":%.3f,"
+        printf("{\"config\":\"%s\",\"world\":\"sandbox\",\"rate_hz\":1000,\"clients\":3,\"wall_s\":%.3f,"
                "\"frames_per_s_controller\":%.1f,\"frames_per_s_watcher1\":%.1f,\"frames_per_s_watcher2\":%.1f,"
                "\"frames_lost\":[%ld,%ld,%ld],\"commands\":%ld,\"latency_ms_p50\":%.3f,\"latency_ms_p99\":%.3f,"
                "\"latency_ms_max\":%.3f,\"server_frames\":%ld,\"missed_deadlines\":%ld,\"server_frame_ms_mean\":%.3f,"
                "\"server_frame_ms_worst\":%.3f,\"server_start_late_ms_p50\":%.2f,\"server_start_late_ms_p99\":%.2f,"
                "\"baseline_rtt_ms_p50\":%.3f,\"baseline_rtt_ms_p99\":%.3f,\"baseline_timer_late_ms_p99\":%.3f,"
+               "\"missed_woke_late\":%ld,\"missed_page_faults\":%ld,\"missed_preempted\":%ld,"
+               "\"missed_long_step\":%ld,\"missed_other\":%ld,\"server_realtime\":\"%s\","
                "\"loadavg_1min_start\":%.2f,\"loadavg_1min_end\":%.2f,\"server_exit\":%d}\n",
-               span, cs[0].frames / span, cs[1].frames / span, cs[2].frames / span, cs[0].lost, cs[1].lost,
+               realtime ? "serve" : "serve-plain", span, cs[0].frames / span, cs[1].frames / span, cs[2].frames / span, cs[0].lost, cs[1].lost,
                cs[2].lost, nlat, p50 * 1e3, p99 * 1e3, mx * 1e3, sframes, missed, mean, worst, late50, late99,
-               base[0] * 1e3, base[1] * 1e3, base[2] * 1e3, load0[0], load1[0], WIFEXITED(wst) ? WEXITSTATUS(wst) : -1);
+               base[0] * 1e3, base[1] * 1e3, base[2] * 1e3, cause[0], cause[1], cause[2], cause[3], cause[4], rt,
+               load0[0], load1[0], WIFEXITED(wst) ? WEXITSTATUS(wst) : -1);
         fflush(stdout);
     }
     for (int k = 0; k < 3; ++k) {

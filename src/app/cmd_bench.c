@@ -79,7 +79,9 @@ static void bench_help(FILE* f) {
             "  serve        not in the default set: cranesim serve streaming the sandbox at 1 kHz over\n"
             "               loopback to 1 controlling and 2 watching clients for --duration seconds of\n"
             "               wall time (default 60): frames/s each client received, frames lost, p50/p99\n"
-            "               latency from a command to the state echoing it, missed deadlines\n"
+            "               latency from a command to the state echoing it, missed deadlines and their\n"
+            "               causes; the server runs with --realtime (its JSON says what was granted)\n"
+            "  serve-plain  not in the default set: serve without --realtime (normal priority)\n"
             "\n"
             "options:\n"
             "  --scenario S   default ramp\n"
@@ -775,7 +777,11 @@ int cmd_bench(int argc, char** argv) {
     bool want_drive = nonly == 0, want_length = nonly == 0, want_soak = false, want_ls = false, want_mesh = false;
     for (int j = 0; j < nonly; ++j) {
         if (!strcmp(only[j], "serve")) {
-            if (bench_serve(&c, c.sim.duration > 0 ? c.sim.duration : 60.0)) return EXIT_RUNTIME;
+            if (bench_serve(&c, c.sim.duration > 0 ? c.sim.duration : 60.0, true)) return EXIT_RUNTIME;
+            continue;
+        }
+        if (!strcmp(only[j], "serve-plain")) {
+            if (bench_serve(&c, c.sim.duration > 0 ? c.sim.duration : 60.0, false)) return EXIT_RUNTIME;
             continue;
         }
         if (!strcmp(only[j], "drive")) {

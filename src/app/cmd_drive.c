@@ -563,7 +563,7 @@ int cmd_drive(int argc, char** argv) {
         if (rc) return rc;
         model_free(m);
         printf("cranesim drive: --connect %s: headless link (scripted operator %s)\n", connect_to, sc.name);
-        return drive_connect(connect_to, &sc, c.sim.duration > 0 ? c.sim.duration : 10.0);
+        return drive_connect(connect_to, &sc, c.sim.duration > 0 ? c.sim.duration : 10.0, c.sets, c.nset);
     }
     // drive's ode world is the sandbox unless --world says otherwise (run's
     // is the validation world): name it, so the checks see the same world.

@@ -14,6 +14,7 @@
 #include <cJSON.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <math.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -23,7 +24,11 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <malloc.h>
+#include <sched.h>
+#include <sys/mman.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
@@ -52,6 +57,12 @@ static void serve_help(FILE* f) {
             "                      closed, 0.05..3600 (default 5)\n"
             "  --lockstep          advance only on the controller's STEP commands (as fast as it asks:\n"
             "                      reproduces a scripted run bit for bit)\n"
+            "  --realtime          real-time priority: SCHED_FIFO (or else nice -10) where permitted, memory\n"
+            "                      locked and pre-faulted; a note says what was not granted (not with --lockstep)\n"
+            "  --spin US           spin the last US microseconds before each frame instead of sleeping,\n"
+            "                      0..2000 (default 100): the timer's wake-up is late by the scheduler's latency\n"
+            "  --log-misses        log each missed frame deadline: how late it started, its step and send\n"
+            "                      times, and the page faults and context switches during it\n"
             "  --duration T        stop after T simulated seconds (default: run until SIGINT)\n"
             "  --scenario S        the start pose and load (default as drive); its commands are not played\n"
             "  --mechanics M       ode (default: the sandbox world) or lagrange (analytic 2-DOF)\n"
@@ -109,6 +120,9 @@ typedef struct server {
     size_t queue_bytes; // a client's send queue: --queue state frames, plus room for the hello and notices
     double w0;
     bool quiet;
+    // real-time pacing
+    double spin;      // the last part of each wait spent spinning instead of sleeping [s]
+    bool log_misses;  // a line per missed deadline with its times and the thread's faults and switches
 } server;
 
 static void logf_(const server* s, const char* fmt, ...) {
@@ -317,11 +331,12 @@ static void broadcast(server* s) {
 
 // ---- the hello's description ----
 
-static char* describe(server* s, const char* model_file) {
+static char* describe(server* s, const char* model_file, const char* model_asset) {
     cJSON* j = cJSON_CreateObject();
     cJSON_AddNumberToObject(j, "protocol", PROTO_VERSION);
     cJSON_AddStringToObject(j, "model", s->m->name);
     cJSON_AddStringToObject(j, "model_file", model_file);
+    cJSON_AddStringToObject(j, "model_asset", model_asset);
     cJSON_AddStringToObject(j, "backend", engine_backend_name(s->e));
     engine_desc d;
     engine_describe(s->o, &d);
@@ -466,7 +481,7 @@ static void handle_command(server* s, client* c, const proto_command* cmd) {
     s->cmd_seq = cmd->seq;
 }
 
-static char g_desc_file[600];
+static char g_desc_file[PATH_MAX];
 static char* g_desc;
 
 // Returns false when the client was closed.
@@ -673,6 +688,39 @@ static int open_listener(const char* addr, char* bound, size_t nb, char* err, si
     return fd;
 }
 
+// --realtime: what the process may have of a real-time task, each step
+// logged with what was granted. Memory first: a page fault inside a frame
+// costs a few us (minor) to ms (major), so the heap is kept (no trimming, no
+// mmap for big blocks: a freed block is not unmapped and faulted in again),
+// the pages locked, and the stack touched now. Then the scheduler: SCHED_FIFO
+// at a low real-time priority (10 of 1..99) wakes the server ahead of every
+// normal task, so the other processes on the cores no longer delay its
+// frames; the kernel's real-time throttling still leaves them 5 % of a core.
+static void go_realtime(server* s) {
+    mallopt(M_TRIM_THRESHOLD, -1);
+    mallopt(M_MMAP_MAX, 0);
+    char mem[160];
+    if (mlockall(MCL_CURRENT | MCL_FUTURE))
+        snprintf(mem, sizeof mem, "memory not locked (mlockall: %s)", strerror(errno));
+    else
+        snprintf(mem, sizeof mem, "memory locked");
+    volatile char stack[256 * 1024]; // 256 KiB of stack faulted in now, not in a frame
+    for (size_t i = 0; i < sizeof stack; i += 4096) stack[i] = 0;
+    struct sched_param sp = {.sched_priority = 10};
+    if (!sched_setscheduler(0, SCHED_FIFO, &sp)) {
+        logf_(s, "real time: SCHED_FIFO priority 10, %s", mem);
+        return;
+    }
+    const int fifo_errno = errno;
+    if (!setpriority(PRIO_PROCESS, 0, -10)) {
+        logf_(s, "real time: SCHED_FIFO not permitted (%s): nice -10 instead, %s", strerror(fifo_errno), mem);
+        return;
+    }
+    logf_(s, "real time: not permitted (SCHED_FIFO: %s; nice -10: %s): normal priority, %s (root, or "
+             "CAP_SYS_NICE and CAP_IPC_LOCK, or rtprio and memlock limits, grant them)",
+          strerror(fifo_errno), strerror(errno), mem);
+}
+
 static int serve_loop(server* s, int lfd, double duration) {
     struct pollfd pf[SERVE_MAX_CLIENTS + 1];
     double next = sim_wall_time() + s->frame; // wall time of the next frame
@@ -690,7 +738,10 @@ static int serve_loop(server* s, int lfd, double duration) {
         for (int i = 0; i < s->nclient; ++i)
             pf[i + 1] = (struct pollfd){.fd = s->c[i]->fd,
                                         .events = POLLIN | (s->c[i]->out_len > s->c[i]->out_off ? POLLOUT : 0)};
-        double wait = s->lockstep ? 0.1 : next - sim_wall_time();
+        // Sleep until `spin` before the deadline: a wake-up from the timer
+        // comes late by the scheduler's latency (tens of us idle, ms under
+        // load), so the last stretch is a poll with no timeout, repeated.
+        double wait = s->lockstep ? 0.1 : next - s->spin - sim_wall_time();
         if (wait < 0) wait = 0;
         struct timespec ts = {(time_t)wait, (long)((wait - floor(wait)) * 1e9)};
         const int np = s->nclient + 1;
@@ -714,12 +765,18 @@ static int serve_loop(server* s, int lfd, double duration) {
         }
         check_timeouts(s);
         if (s->lockstep) continue;
-        const double now = sim_wall_time();
-        if (now < next) continue;
+        double now = sim_wall_time();
+        if (now < next - s->spin) continue;
+        // Within `spin` of the deadline: spin to it (clients are polled
+        // again on the next pass, a frame later at most).
+        while (now < next) now = sim_wall_time();
         const long lb = (long)((now - next) / 5e-5);
         ++late[lb < LATE_BINS - 1 ? lb : LATE_BINS - 1];
+        struct rusage ru0, ru1;
+        if (s->log_misses) getrusage(RUSAGE_THREAD, &ru0);
         // One frame: step (unless paused), then the state to everyone.
         if (!s->paused) step_frame(s);
+        const double stepped = sim_wall_time();
         broadcast(s);
         for (int i = 0; i < s->nclient; ++i) s->c[i]->read_frame = 0;
         ++frames;
@@ -729,9 +786,19 @@ static int serve_loop(server* s, int lfd, double duration) {
         // worst > the frame period. busy stays the work alone.
         worst = fmax(worst, done - next);
         busy += done - now;
+        const double due = next;
         next += s->frame;
         if (done > next) { // the frame's work ran past the next frame's start
             ++missed;
+            if (s->log_misses) {
+                getrusage(RUSAGE_THREAD, &ru1);
+                logf_(s, "missed deadline: frame %ld at %.3f s: started %.3f ms late, step %.3f ms, send %.3f ms; "
+                         "during the frame %ld minor + %ld major page faults, %ld involuntary + %ld voluntary "
+                         "context switches",
+                      frames, due - s->w0, (now - due) * 1e3, (stepped - now) * 1e3, (done - stepped) * 1e3,
+                      ru1.ru_minflt - ru0.ru_minflt, ru1.ru_majflt - ru0.ru_majflt, ru1.ru_nivcsw - ru0.ru_nivcsw,
+                      ru1.ru_nvcsw - ru0.ru_nvcsw);
+            }
             if (done > next + 10 * s->frame) next = done + s->frame; // far behind: start again from now
         }
     }
@@ -759,7 +826,8 @@ int cmd_serve(int argc, char** argv) {
     const char* listen_at = "127.0.0.1:7575";
     double rate = 75, timeout = 5;
     int max_clients = 8, queue = 64;
-    bool lockstep = false;
+    bool lockstep = false, realtime = false, log_misses = false;
+    double spin_us = 100;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             serve_help(stdout);
@@ -774,6 +842,25 @@ int cmd_serve(int argc, char** argv) {
         if (rc > 0) continue;
         if (!strcmp(argv[i], "--lockstep")) {
             lockstep = true;
+            continue;
+        }
+        if (!strcmp(argv[i], "--realtime")) {
+            realtime = true;
+            continue;
+        }
+        if (!strcmp(argv[i], "--log-misses")) {
+            log_misses = true;
+            continue;
+        }
+        if (!strcmp(argv[i], "--spin")) {
+            const char* v = app_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            double d = NAN;
+            if (app_parse_double(v, &d) || !(d >= 0 && d <= 2000)) {
+                fprintf(stderr, "cranesim serve: --spin: expected 0..2000 us, got '%s'\n", v);
+                return EXIT_USAGE;
+            }
+            spin_us = d;
             continue;
         }
         const char* opt = argv[i];
@@ -817,6 +904,10 @@ int cmd_serve(int argc, char** argv) {
         fprintf(stderr, "cranesim serve: unknown option '%s' (see cranesim serve --help)\n", argv[i]);
         return EXIT_USAGE;
     }
+    if (realtime && lockstep) {
+        fprintf(stderr, "cranesim serve: --realtime: a --lockstep server has no frame deadlines (drop one of them)\n");
+        return EXIT_USAGE;
+    }
     if (c.sim.mechanics == SIM_ODE && !c.sim.world) c.sim.world = "sandbox";
     if (c.sim.cvode) {
         fprintf(stderr, "cranesim serve: --solver cvode: serve steps the hydraulics in real time with the in-house "
@@ -836,7 +927,8 @@ int cmd_serve(int argc, char** argv) {
     int rc = app_load(&c, &m, &sc);
     if (rc) return rc;
     server s = {.m = m, .o = &c.sim, .sc = &sc, .frame = 1.0 / rate, .lockstep = lockstep, .max_clients = max_clients,
-                .queue = queue, .timeout = timeout, .quiet = c.quiet, .w0 = sim_wall_time()};
+                .queue = queue, .timeout = timeout, .quiet = c.quiet, .w0 = sim_wall_time(),
+                .spin = lockstep ? 0 : spin_us * 1e-6, .log_misses = log_misses};
     s.m3 = sim_load_mass(m, &sc, &c.sim);
     s.snap = malloc(sizeof *s.snap);
     s.st = malloc(sizeof *s.st);
@@ -853,8 +945,18 @@ int cmd_serve(int argc, char** argv) {
         rc = EXIT_USAGE;
         goto done;
     }
-    snprintf(g_desc_file, sizeof g_desc_file, "%s", m->file[0] ? m->file : model_default_path());
-    g_desc = describe(&s, g_desc_file);
+    // The model as a path the viewer can resolve: absolute (the model keeps
+    // only its file's base name, which names no file from another working
+    // directory), and relative to the assets folder when it is in it.
+    const char* mpath = c.model_path ? c.model_path : model_default_path();
+    if (!realpath(mpath, g_desc_file)) snprintf(g_desc_file, sizeof g_desc_file, "%s", mpath);
+    char assets[PATH_MAX];
+    const char* asset = "";
+    if (realpath(model_assets_dir(), assets)) {
+        const size_t L = strlen(assets);
+        if (!strncmp(g_desc_file, assets, L) && g_desc_file[L] == '/') asset = g_desc_file + L + 1;
+    }
+    g_desc = describe(&s, g_desc_file, asset);
     // The state frame's size sets the queue's (a whole number of frames).
     fill_state(&s);
     s.seq = 0;
@@ -873,6 +975,7 @@ int cmd_serve(int argc, char** argv) {
     // The frames are paced by ppoll timeouts: the default 50 us timer slack
     // would let every wake-up come up to 50 us late on top of scheduling.
     prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
+    if (realtime) go_realtime(&s);
     app_signals sig;
     app_signals_catch(&sig);
     rc = serve_loop(&s, lfd, c.sim.duration);

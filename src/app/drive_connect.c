@@ -46,7 +46,26 @@ static int dc_connect(const char* host, const char* port, char* err, size_t errs
     return fd;
 }
 
-int drive_connect(const char* addr, const scenario* sc, double duration) {
+// A --set of the drive as the protocol's SET path: a circuit parameter
+// without "hydraulics.components." (the fluid without "hydraulics."); any
+// other path as given, for the server to accept or refuse.
+int drive_set_path(const char* set, char* path, size_t np, double* v) {
+    const char* eq = strrchr(set, '=');
+    if (!eq) return -1;
+    char* end;
+    *v = strtod(eq + 1, &end);
+    if (end == eq + 1 || *end) return -1;
+    const char* p = set;
+    if (!strncmp(p, "hydraulics.components.", 22)) p += 22;
+    else if (!strncmp(p, "hydraulics.fluid.", 17)) p += 11;
+    const size_t n = (size_t)(eq - p);
+    if (n == 0 || n >= np || n > PROTO_MAX_PATH) return -1;
+    memcpy(path, p, n);
+    path[n] = 0;
+    return 0;
+}
+
+int drive_connect(const char* addr, const scenario* sc, double duration, const char* const* sets, int nset) {
     char host[256], port[16];
     const char* colon = strrchr(addr, ':');
     if (!colon || colon == addr || !colon[1] || (size_t)(colon - addr) >= sizeof host || strlen(colon + 1) >= sizeof port) {
@@ -72,7 +91,7 @@ int drive_connect(const char* addr, const scenario* sc, double duration) {
     const double w0 = sim_wall_time();
     long frames = 0, lost = 0, drops = 0, links = 0, nlat = 0;
     double lat_sum = 0, lat_max = 0, sent_at = 0, last_t = 0;
-    uint64_t seq = 0, last_seq = 0;
+    uint64_t seq = 0, last_seq = 0, set_seq[64] = {0}; // set_seq: a SET sent, not answered yet
     int role = -1, code = 0;
     bool ever = false;
     app_signals sig;
@@ -127,6 +146,27 @@ int drive_connect(const char* addr, const scenario* sc, double duration) {
                            ever ? ", reconnected" : "");
                     fflush(stdout);
                     ever = true;
+                    // The drive's --set values go to the server once per
+                    // link (a reset server keeps them; a new one has not had them).
+                    for (int k = 0; k < nset && k < 64 && role == PROTO_CONTROL; ++k) {
+                        proto_command c = {.seq = ++seq, .op = PROTO_OP_SET};
+                        set_seq[k] = 0;
+                        if (drive_set_path(sets[k], c.path, sizeof c.path, &c.value)) {
+                            printf("cranesim drive: --set %s: not sent (expected PATH=VALUE)\n", sets[k]);
+                            --seq;
+                            continue;
+                        }
+                        uint8_t b[PROTO_MAX_CLIENT_FRAME + 8];
+                        const size_t n = proto_put_command(b, sizeof b, &c);
+                        if (n && send(fd, b, n, MSG_NOSIGNAL) == (ssize_t)n) set_seq[k] = seq;
+                    }
+                } else if (m.type == PROTO_NOTICE) {
+                    for (int k = 0; k < nset && k < 64; ++k)
+                        if (set_seq[k] && m.u.text.seq == set_seq[k]) {
+                            printf("cranesim drive: the server refused --set %s: %s\n", sets[k], m.u.text.text);
+                            set_seq[k] = 0;
+                        }
+                    fflush(stdout);
                 } else if (m.type == PROTO_ERROR) {
                     snprintf(said, sizeof said, "the server says: %s", m.u.text.text);
                     why = said;
@@ -134,6 +174,13 @@ int drive_connect(const char* addr, const scenario* sc, double duration) {
                     break;
                 } else if (m.type == PROTO_STATE) {
                     ++frames;
+                    // A SET is applied (not refused) when the echo passes it.
+                    for (int k = 0; k < nset && k < 64; ++k)
+                        if (set_seq[k] && st->cmd_seq >= set_seq[k]) {
+                            printf("cranesim drive: the server accepted --set %s\n", sets[k]);
+                            fflush(stdout);
+                            set_seq[k] = 0;
+                        }
                     if (last_seq && st->seq > last_seq + 1) lost += (long)(st->seq - last_seq - 1);
                     last_seq = st->seq;
                     last_t = st->nine[8];

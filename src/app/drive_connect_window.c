@@ -49,6 +49,8 @@ typedef struct rlink {
     const scenario* sc;
     bool scripted;
     char* hjson;             // the first hello's description (a copy)
+    struct { uint64_t seq; char path[128]; double v; } pend[16]; // SETs sent, no answer yet
+    int npend;
 } rlink;
 
 static int lk_connect(rlink* k, char* err, size_t errsz) {
@@ -141,6 +143,10 @@ static void lk_down(rlink* k, drive_session* s, const char* why) {
     fprintf(stderr, "cranesim drive: link to %s lost: %s; reconnecting\n", k->addr, why);
     k->backoff = 0.25;
     k->retry_at = sim_wall_time() + k->backoff;
+    if (k->npend) { // sent on the lost link: the server may or may not have applied them
+        drive_session_set_answer(s, "link lost before the server answered a parameter change");
+        k->npend = 0;
+    }
     char down[RENDER_WARN_LEN];
     snprintf(down, sizeof down, "LINK LOST: %.90s", why);
     drive_session_set_link(s, "link down: showing the last state received; reconnecting", down);
@@ -175,6 +181,32 @@ static void lk_state(rlink* k, drive_session* s) {
         k->rt_w0 = now, k->rt_t0 = st->nine[8];
     }
     drive_session_feed(s, st, k->rt);
+    // A SET not refused by the time the echo passes it was applied.
+    for (int i = 0; i < k->npend; ++i)
+        if (st->cmd_seq >= k->pend[i].seq) {
+            char t[300];
+            snprintf(t, sizeof t, "accepted by the server: %s = %.6g", k->pend[i].path, k->pend[i].v);
+            printf("cranesim drive: %s\n", t);
+            fflush(stdout);
+            drive_session_set_answer(s, t);
+            k->pend[i--] = k->pend[--k->npend];
+        }
+    {
+        char path[128];
+        double v;
+        while (k->npend < 16 && drive_session_take_set(s, path, sizeof path, &v)) {
+            if (k->role != PROTO_CONTROL) {
+                drive_session_set_answer(s, "not sent: this view watches (another client controls)");
+                continue;
+            }
+            proto_command c = {.seq = ++k->seq, .op = PROTO_OP_SET, .value = v};
+            snprintf(c.path, sizeof c.path, "%s", path);
+            lk_send(k, &c);
+            k->pend[k->npend].seq = c.seq;
+            snprintf(k->pend[k->npend].path, sizeof k->pend[0].path, "%s", path);
+            k->pend[k->npend++].v = v;
+        }
+    }
     if (k->role != PROTO_CONTROL) return;
     // The operator's positions: the devices of the last tick, or the script
     // at the middle of the coming frame (as the headless drive and the
@@ -273,6 +305,16 @@ static void lk_pump(rlink* k, drive_session* s, double wait_s) {
                 return;
             } else if (m.type == PROTO_NOTICE) {
                 fprintf(stderr, "cranesim drive: the server says: %s\n", m.u.text.text);
+                for (int i = 0; i < k->npend; ++i)
+                    if (k->pend[i].seq == m.u.text.seq) {
+                        char t[700];
+                        snprintf(t, sizeof t, "refused by the server: %s = %.6g: %s", k->pend[i].path, k->pend[i].v,
+                                 m.u.text.text);
+                        printf("cranesim drive: %s\n", t);
+                        fflush(stdout);
+                        drive_session_set_answer(s, t);
+                        k->pend[i--] = k->pend[--k->npend];
+                    }
             } else if (m.type == PROTO_STATE) {
                 lk_state(k, s);
             }
@@ -360,10 +402,18 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     c.sim.mechanics = strcmp(backend, "ode") ? SIM_LAGRANGE : SIM_ODE;
     // The server's files where this computer has them (the same install);
     // else this drive's --model and --world, which must describe the same crane.
+    // Version 2 servers before "model_asset" sent the model's bare base name:
+    // that one is still taken as the shipped default when it is its name.
     const char* dflt = model_default_path();
     const char* base = strrchr(dflt, '/') ? strrchr(dflt, '/') + 1 : dflt;
+    const char* asset = cJSON_GetStringValue(cJSON_GetObjectItem(desc, "model_asset"));
+    char asset_buf[1024];
+    snprintf(asset_buf, sizeof asset_buf, "%s/%s", model_assets_dir(), asset ? asset : "");
     if (file_exists(model_file)) c.model_path = model_file;
-    else if (!strcmp(model_file, base) || !strcmp(model_file, dflt)) c.model_path = NULL; // the shipped model, by name
+    else if (asset && asset[0] && file_exists(asset_buf)) { // the same file in this install's assets
+        snprintf(model_buf, sizeof model_buf, "%s", asset_buf);
+        c.model_path = model_buf;
+    } else if (!strcmp(model_file, base) || !strcmp(model_file, dflt)) c.model_path = NULL; // the shipped model, by name
     else if (model_file && model_file[0])
         printf("cranesim drive: the server's model %s is not here: drawing %s\n", model_file,
                c.model_path ? c.model_path : "the default model");
@@ -416,6 +466,14 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     model_free(dm);
     k.sc = sc;
     drive_session_set_remote(s);
+    // The drive's --set values go to the server with the first frames, as a
+    // panel edit does (the local model has them already, for the panel).
+    for (int i = 0; i < c0->nset; ++i) {
+        char path[128];
+        double v;
+        if (drive_set_path(c0->sets[i], path, sizeof path, &v) || drive_session_queue_set(s, path, v))
+            printf("cranesim drive: --set %s: not sent to the server\n", c0->sets[i]);
+    }
     if (lk_hello(&k, &m, err, sizeof err)) { // cannot fail: nbody checked above
         fprintf(stderr, "cranesim drive: %s\n", err);
         goto done_sc;

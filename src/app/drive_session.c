@@ -123,6 +123,8 @@ struct drive_session {
     double remote_row[SIM_NCOL];  // its row (the server's channels, checked equal to the engine's)
     int remote_nrow;
     drive_remote_input rin;       // the operator's input of the last tick
+    struct { char path[128]; double v; } rset[16]; // panel edits for the server (SET), oldest first
+    int nrset;
 };
 
 drive_opts drive_default_opts(void) {
@@ -350,9 +352,63 @@ static engine* make_engine(drive_session* s, const double q0[2], double slew0) {
     return l;
 }
 
+static void say(drive_session* s, const char* text) {
+    snprintf(s->status, sizeof s->status, "%s", text);
+    if (s->pn) panel_set_message(s->pn, s->status);
+}
+
+int drive_session_queue_set(drive_session* s, const char* path, double v) {
+    if (s->nrset == 16 || strlen(path) >= sizeof s->rset[0].path) return -1;
+    snprintf(s->rset[s->nrset].path, sizeof s->rset[0].path, "%s", path);
+    s->rset[s->nrset++].v = v;
+    return 0;
+}
+
+int drive_session_take_set(drive_session* s, char* path, size_t np, double* v) {
+    if (!s->nrset) return 0;
+    snprintf(path, np, "%s", s->rset[0].path);
+    *v = s->rset[0].v;
+    memmove(s->rset, s->rset + 1, (size_t)--s->nrset * sizeof s->rset[0]);
+    return 1;
+}
+
+void drive_session_set_answer(drive_session* s, const char* text) { say(s, text); }
+
+// Remote mode: a panel edit goes to the server as SET (the protocol takes
+// circuit parameters by their model path and, where the backend carries it
+// as a parameter, the load); the server's answer comes back through
+// drive_session_set_answer. Anything else would only edit the idle local
+// engine: it is put back and the panel says why.
+static void remote_param(drive_session* s, drive_param* p) {
+    const double si = p->value * p->scale;
+    char t[300];
+    if ((p->kind == PK_HYD && !p->world_only) || p->kind == PK_LOAD) {
+        const char* path = p->kind == PK_LOAD ? "mechanics.load_mass" : p->hyd_path;
+        // The panel shows the asked value until the server answers.
+        if (drive_session_queue_set(s, path, si))
+            snprintf(t, sizeof t, "not sent: %s (16 changes already waiting for the link)", path);
+        else
+            snprintf(t, sizeof t, "sent to the server: %s = %.6g", path, si);
+        say(s, t);
+        return;
+    }
+    if (p->kind == PK_MECH) p->value = *model_param_ptr(&s->m->mech, p->mech) / p->scale;
+    if (p->kind == PK_STEP) p->value = s->c.sim.h / p->scale;
+    if (p->kind == PK_SOLVER)
+        for (int k = 0; k < NSOLVER; ++k)
+            if (k_solver[k] == s->c.sim.solver) p->value = k;
+    snprintf(t, sizeof t, "not sent: %s/%s is set where the server starts (the link takes circuit parameters%s)",
+             p->group, p->label, engine_can_set_load(s->l) ? " and the load" : "");
+    say(s, t);
+}
+
 // Apply one accepted panel change to the running simulation.
 static void apply_param(drive_session* s, int i) {
     drive_param* p = &s->param[i];
+    if (s->remote) {
+        remote_param(s, p);
+        return;
+    }
     const double si = p->value * p->scale;
     char e[256];
     switch (p->kind) {
@@ -599,6 +655,10 @@ static int setup_charts(drive_session* s, const char* list, char* err, size_t er
 
 static void act_load(void* user) {
     drive_session* s = user;
+    if (s->remote) {
+        say(s, "load model: not over the link (start the server with --model)");
+        return;
+    }
     s->load_pending = true; // at the next tick: not from inside the panel's own drawing
 }
 
@@ -705,6 +765,10 @@ static void session_hook(void* user, engine* e, int attach, int got) {
 
 static void act_reset(void* user) {
     drive_session* s = user;
+    if (s->remote) { // the server resets, asked once by the link
+        s->rin.reset = 1;
+        return;
+    }
     session_end(s, "reset");
     s->rp_next = 0; // a replay starts again with the world
     rebuild_world(s, true);
@@ -749,6 +813,10 @@ static void act_save(void* user) {
 
 static void act_pause(void* user) {
     drive_session* s = user;
+    if (s->remote) {
+        s->rin.pause = 1;
+        return;
+    }
     s->paused = !s->paused;
 }
 
@@ -1046,8 +1114,20 @@ static void render_snapshot(drive_session* s) {
 }
 
 void drive_session_set_remote(drive_session* s) {
-    s->remote = true;
-    render_attach_panel(s->r, NULL);
+    s->remote = true; // the panel stays: its circuit edits go to the server (remote_param)
+    // The state frames carry the row's channels, not the circuit's: say so
+    // once for a chart of one (its readout says it on the HUD).
+    // (The HUD's readout box holds about 30 characters: it says "not sent".)
+    for (int i = 0; i < s->nchart; ++i)
+        if (s->chart_col[i] >= chan_list_nrow(s->chans)) {
+            const sim_channel* ch = chan_list_channel(s->chans, s->chart_col[i]);
+            printf("cranesim drive: chart %s: not sent by the server (the state frames carry the row's channels, "
+                   "not the circuit's): it stays empty\n", ch ? ch->name : "?");
+        }
+    for (int i = 0; i < s->nreadout; ++i)
+        if (s->readout_col[i] >= chan_list_nrow(s->chans))
+            printf("cranesim drive: readout %s: not sent by the server (the state frames carry the row's channels, "
+                   "not the circuit's): it reads \"not sent\"\n", s->readout_name[i]);
     // The local engine's collision shapes would stand still while the
     // remote crane moves: the remote view has none.
     s->snap->ncoll = 0;
@@ -1343,9 +1423,13 @@ int drive_session_tick(drive_session* s, double wall) {
             render_readout rd[8];
             for (int i = 0; i < s->nreadout; ++i) {
                 const int k = s->readout_col[i];
-                // A channel a loaded model lacks reads NaN.
-                rd[i] = (render_readout){s->readout_name[i], s->readout_unit[i],
-                                         k >= 0 ? s->chan_v[k] / s->readout_scale[i] : NAN};
+                // No value: a channel a loaded model lacks, or (remote) a
+                // circuit channel, which the state frames do not carry.
+                const bool unsent = s->remote && (!s->remote_fed || k < 0 || k >= s->remote_nrow);
+                rd[i] = (render_readout){s->readout_name[i],
+                                         !unsent ? (k < 0 ? "not in this model" : s->readout_unit[i])
+                                         : s->remote_fed ? "not sent" : "waiting",
+                                         k >= 0 && !unsent ? s->chan_v[k] / s->readout_scale[i] : NAN};
             }
             render_set_readouts(s->r, rd, s->nreadout);
         }

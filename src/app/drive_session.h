@@ -127,8 +127,18 @@ struct proto_state;
 /// elsewhere. Its engine, built from the server's model and world files,
 /// gives the scene (bodies, meshes, terrain) and the channel names and is
 /// never stepped; drive_session_feed gives each state. The parameter panel
-/// is detached (its values would be the idle local engine's).
+/// stays: its circuit edits are queued for the server (drive_session_take_set),
+/// the rest are put back (they would only edit the idle local engine).
 void drive_session_set_remote(drive_session* s);
+/// Remote mode: a parameter change for the server (a panel edit, or the
+/// drive's --set), queued until the link sends it as SET: path as the
+/// protocol's (lift_cyl.bore, mechanics.load_mass), value SI. -1: queue full.
+int drive_session_queue_set(drive_session* s, const char* path, double v);
+/// The oldest queued change into path and *v: 1, or 0 when none.
+int drive_session_take_set(drive_session* s, char* path, size_t np, double* v);
+/// The server's answer to a change (accepted, refused and why): the status
+/// line and the panel's message.
+void drive_session_set_answer(drive_session* s, const char* text);
 /// One state frame (protocol.h): poses, cylinders, rope and HUD values into
 /// the snapshot the next frame draws, and one sample for the charts.
 /// rt_factor: the remote simulated time over wall time, 0 unknown.

@@ -354,7 +354,9 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     // The app's channel readouts (render_set_readouts): name, value, unit
     // as its channel list gives them.
     for (int i = 0; i < r->nreadout; ++i) {
-        snprintf(buf, sizeof buf, "%s %.4g %s", r->readout[i].name, r->readout[i].value, r->readout[i].unit);
+        // No value (NaN): the unit field says why ("not sent": a remote view's circuit channel).
+        if (isnan(r->readout[i].value)) snprintf(buf, sizeof buf, "%s: %s", r->readout[i].name, r->readout[i].unit);
+        else snprintf(buf, sizeof buf, "%s %.4g %s", r->readout[i].name, r->readout[i].value, r->readout[i].unit);
         render_hud_text(h, x, y, sc, k_white, buf);
         y += lh;
     }

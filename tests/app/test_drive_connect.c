@@ -14,9 +14,20 @@
 // measure, and the remote view draws its link line (frames, latency) top
 // right. The same comparison against the local state 1.5 s later must fail
 // it by far: the tolerance tells states apart.
+//
+// Parameter changes in the remote view: the drive's --set goes to the server
+// as SET through the window's link, and its answer is printed ("accepted by
+// the server": the main relief's own 22 MPa, so the picture stays that of the
+// unchanged run). A remote session's panel edit of a circuit parameter is
+// queued for the server under its protocol path in SI units (10 MPa shown:
+// main_relief.p_crack = 1e7 Pa) and leaves the idle local circuit alone; an
+// edit of a mechanical value is not sent and is put back. A chart and a
+// readout of a circuit channel (not in the state frames) say "not sent by
+// the server"; a chart of a row channel does not.
 #define _DEFAULT_SOURCE
 #include "check.h"
 #include "drive_session.h"
+#include "panel.h"
 #include "render.h"
 #include "serve_util.h"
 
@@ -78,6 +89,7 @@ int main(void) {
              CRANESIM_BINARY_DIR, addr, scen, W, H);
     FILE* p = popen(cmd, "r");
     char line[1024];
+
     double t_remote = -1;
     while (p && fgets(line, sizeof line, p)) {
         fputs(line, stdout);
@@ -86,6 +98,24 @@ int main(void) {
     }
     const int prc = p ? pclose(p) : -1;
     CHECK(prc == 0 && t_remote >= 4, "drive --connect exit %d, screenshot at remote t = %g s", prc, t_remote);
+    // The drive's --set through the window's link (a second view of the
+    // same server, later in its run: the picture is not compared).
+    snprintf(cmd, sizeof cmd,
+             "%s/cranesim drive --connect %s --scenario %s --screenshot connect_set.png --screenshot-at 4.5 "
+             "--size 320x180 --set hydraulics.components.main_relief.p_crack=2.2e7 --charts lift_cyl.A.p,x1 "
+             "--readouts lift_cyl.A.p 2>&1",
+             CRANESIM_BINARY_DIR, addr, scen);
+    FILE* p2 = popen(cmd, "r");
+    bool set_ok = false;
+    int unsent = 0; // the circuit channel's chart and readout said not sent, and nothing else
+    while (p2 && fgets(line, sizeof line, p2))
+        if (strstr(line, "accepted by the server: main_relief.p_crack = 2.2e+07")) set_ok = true;
+        else if (strstr(line, "chart lift_cyl.A.p: not sent by the server")) ++unsent;
+        else if (strstr(line, "readout lift_cyl.A.p: not sent by the server")) ++unsent;
+        else if (strstr(line, "not sent by the server")) unsent = -100; // x1 is sent
+    if (p2) pclose(p2);
+    CHECK(set_ok, "drive --connect --set: no 'accepted by the server: main_relief.p_crack = 2.2e+07' line");
+    CHECK(unsent == 2, "chart and readout lift_cyl.A.p should say 'not sent by the server', x1 not (%d)", unsent);
     CHECK(serve_stop(&sv) == 0, "server exits 0");
 
     // The same run locally, rendered by a drive session at t_remote and 1.5 s later.
@@ -152,6 +182,30 @@ int main(void) {
     CHECK(d_later > 0.02, "a later state must differ (%.2f %%)", 100 * d_later);
     stbi_image_free(a), stbi_image_free(b), stbi_image_free(later);
     free(snap);
+    // The panel in remote mode.
+    drive_session_set_remote(s);
+    char msg[256], path[128] = "";
+    double v = 0, local = 0;
+    panel* pn = drive_session_panel(s);
+    CHECK(panel_set(pn, "main_relief (relief)/p_crack", 10.0, msg, sizeof msg) == PANEL_OK, "%s", msg);
+    drive_session_tick(s, 100.0);
+    CHECK(drive_session_take_set(s, path, sizeof path, &v) == 1 && !strcmp(path, "main_relief.p_crack") &&
+              fabs(v - 1e7) < 1e-3,
+          "queued for the server: '%s' = %g", path, v);
+    CHECK(hyd_model_get(engine_circuit(drive_session_engine(s)), "main_relief.p_crack", &local) == 0 &&
+              fabs(local - 22e6) < 1,
+          "the idle local circuit changed: %g Pa", local);
+    const double mass0 = drive_session_model(s)->mech.link[1].mass;
+    CHECK(panel_set(pn, "end_arm (link)/mass", 2.0 * mass0, msg, sizeof msg) == PANEL_OK, "%s", msg);
+    drive_session_tick(s, 100.1);
+    // The status line is composed when a tick draws (not while the renderer is busy).
+    for (int k = 0; k < 40 && !strstr(drive_session_status_line(s), "not sent"); ++k) {
+        drive_session_tick(s, 100.2 + 0.05 * k);
+        usleep(20000);
+    }
+    CHECK(drive_session_take_set(s, path, sizeof path, &v) == 0, "a link mass was queued for the server: %s", path);
+    CHECK(strstr(drive_session_status_line(s), "not sent"), "status: %s", drive_session_status_line(s));
+    CHECK(drive_session_model(s)->mech.link[1].mass == mass0, "the local model's end arm mass changed");
     drive_session_destroy(s);
     TEST_MAIN_END();
 }
