@@ -60,7 +60,7 @@ static void serve_help(FILE* f) {
             "  --realtime          real-time priority: SCHED_FIFO (or else nice -10) where permitted, memory\n"
             "                      locked and pre-faulted; a note says what was not granted (not with --lockstep)\n"
             "  --spin US           spin the last US microseconds before each frame instead of sleeping,\n"
-            "                      0..2000 (default 100): the timer's wake-up is late by the scheduler's latency\n"
+            "                      0..2000 (default 500): the timer's wake-up is late by the scheduler's latency\n"
             "  --log-misses        log each missed frame deadline: how late it started, its step and send\n"
             "                      times, and the page faults and context switches during it\n"
             "  --duration T        stop after T simulated seconds (default: run until SIGINT)\n"
@@ -827,7 +827,7 @@ int cmd_serve(int argc, char** argv) {
     double rate = 75, timeout = 5;
     int max_clients = 8, queue = 64;
     bool lockstep = false, realtime = false, log_misses = false;
-    double spin_us = 100;
+    double spin_us = 500;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             serve_help(stdout);
