@@ -505,6 +505,17 @@ int cmd_drive(int argc, char** argv) {
         }
         fclose(rf);
     }
+#ifdef CRANESIM_HAVE_RENDER
+    // The window's options, the same for a local drive and a remote one.
+    drive_opts win = drive_default_opts();
+    win.width = width;
+    win.height = height;
+    if (rate_given) win.fps_cap = frame_rate;
+    win.mapping_file = mapping;
+    win.charts = charts;
+    win.readouts = readouts;
+    win.record_path = record;
+#endif
     if (connect_to) { // the visual computer's link to a cranesim serve (docs/protocol.md)
         if (replay || session_path || save_as) {
             fprintf(stderr, "cranesim drive: --connect: %s applies to a local drive only\n",
@@ -517,14 +528,7 @@ int cmd_drive(int argc, char** argv) {
         if (!headless && (cdisplay || shot)) {
             // The window (or an offscreen view for a screenshot) draws the
             // remote crane with the local drive's scene, HUD and charts.
-            drive_opts o = drive_default_opts();
-            o.width = width;
-            o.height = height;
-            if (rate_given) o.fps_cap = frame_rate;
-            o.mapping_file = mapping;
-            o.charts = charts;
-            o.readouts = readouts;
-            o.record_path = record;
+            drive_opts o = win; // the local drive's window options, for the remote crane
             o.offscreen = !cdisplay;
             o.scripted = scripted || o.offscreen;
             char err[600];
@@ -587,14 +591,7 @@ int cmd_drive(int argc, char** argv) {
     const bool display = have_display(why, sizeof why);
     if (headless) snprintf(why, sizeof why, "--headless");
 #ifdef CRANESIM_HAVE_RENDER
-    drive_opts o = drive_default_opts();
-    o.width = width;
-    o.height = height;
-    if (rate_given) o.fps_cap = frame_rate;
-    o.mapping_file = mapping;
-    o.charts = charts;
-    o.readouts = readouts;
-    o.record_path = record;
+    drive_opts o = win;
     o.session_path = session_path;
     o.replay_path = replay;
     o.save_as = save_as;
