@@ -76,6 +76,21 @@ static void test_solvers_agree(void) {
     model_free(m);
 }
 
+// The LS crane on the default engine at scenario name's start; NULL (with
+// the check failed and nothing left allocated) if either does not load.
+static engine* ls_engine(const char* name, scenario* sc, model** m) {
+    if (load_scenario(name, sc)) return NULL;
+    char err[512];
+    *m = model_load(CRANESIM_ASSETS "/models/hiab031_ls.json", NULL, 0, err, sizeof err);
+    CHECK(*m != NULL, "%s", err);
+    if (!*m) return NULL;
+    sim_opts o = sim_default_opts();
+    engine* e = engine_create(*m, &o, sc->q0, sc->slew0, sim_load_mass(*m, sc, &o), err, sizeof err);
+    CHECK(e != NULL, "%s", err);
+    if (!e) model_free(*m);
+    return e;
+}
+
 // Lowering through the counterbalance valve, in the full crane. 1000 kg
 // held (hose_burst_line's pose), valves closed; then the lift command ramps
 // slowly to -0.3 over 4 s, so the rod side (the valve's pilot) charges
@@ -95,18 +110,9 @@ static void test_solvers_agree(void) {
 // 3.2 L x 1.7 MPa / Be over A_A: under 1 mm).
 static void test_lowering_pilot(void) {
     scenario sc;
-    if (load_scenario("hose_burst_line", &sc)) return;
-    char err[512];
-    model* m = model_load(CRANESIM_ASSETS "/models/hiab031_ls.json", NULL, 0, err, sizeof err);
-    CHECK(m != NULL, "%s", err);
-    if (!m) return;
-    sim_opts o = sim_default_opts();
-    engine* e = engine_create(m, &o, sc.q0, sc.slew0, sim_load_mass(m, &sc, &o), err, sizeof err);
-    CHECK(e != NULL, "%s", err);
-    if (!e) {
-        model_free(m);
-        return;
-    }
+    model* m;
+    engine* e = ls_engine("hose_burst_line", &sc, &m);
+    if (!e) return;
     const hyd_model* h = engine_circuit(e);
     const int sl = hyd_model_node_state(h, hyd_model_find_node(h, "lift_cyl.A"));
     const int sv = hyd_model_node_state(h, hyd_model_find_node(h, "lift_cbv_A"));
@@ -266,18 +272,9 @@ static void test_flow_sharing_crane(void) {
 // at 19.5 MPa on ramp before any command).
 static void test_ls_neutral(void) {
     scenario sc;
-    if (load_scenario("ls_flow_sharing", &sc)) return;
-    char err[512];
-    model* m = model_load(CRANESIM_ASSETS "/models/hiab031_ls.json", NULL, 0, err, sizeof err);
-    CHECK(m != NULL, "%s", err);
-    if (!m) return;
-    sim_opts o = sim_default_opts();
-    engine* e = engine_create(m, &o, sc.q0, sc.slew0, sim_load_mass(m, &sc, &o), err, sizeof err);
-    CHECK(e != NULL, "%s", err);
-    if (!e) {
-        model_free(m);
-        return;
-    }
+    model* m;
+    engine* e = ls_engine("ls_flow_sharing", &sc, &m);
+    if (!e) return;
     const hyd_model* h = engine_circuit(e);
     const char* ls[3] = {"lift_ls", "jib_ls", "ls_line"};
     const char* port[2] = {"jib_hose_B", "lift_hose_B"};
