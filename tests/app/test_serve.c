@@ -420,24 +420,30 @@ static void dead_man(void) {
     CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
 }
 
+// A server run with args (log in log), stopped (SIGSTOP) for stop_us half a
+// second in, then let run 0.3 s more and ended; its log in all.
+static void serve_stalled(const char* log, const char** args, useconds_t stop_us, char* all, size_t nall) {
+    served sv;
+    CHECK(serve_start(&sv, log, args) == 0, "server started");
+    usleep(500000);
+    kill(sv.pid, SIGSTOP);
+    usleep(stop_us);
+    kill(sv.pid, SIGCONT);
+    usleep(300000);
+    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+    FILE* f = fopen(log, "r");
+    size_t n = f ? fread(all, 1, nall - 1, f) : 0;
+    all[n] = 0;
+    if (f) fclose(f);
+}
+
 // ---- 4. worst frame and missed deadlines agree ----
 
 static void late_wakeup(void) {
     const char* log = CRANESIM_BINARY_DIR "/tests/app/serve_late.log";
     const char* args[] = {"--mechanics", "lagrange", "--scenario", "hold", "--duration", "3", NULL};
-    served sv;
-    CHECK(serve_start(&sv, log, args) == 0, "server started");
-    usleep(500000);
-    kill(sv.pid, SIGSTOP);
-    usleep(300000);
-    kill(sv.pid, SIGCONT);
-    usleep(300000);
-    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
     static char all[1 << 16];
-    FILE* f = fopen(log, "r");
-    size_t n = f ? fread(all, 1, sizeof all - 1, f) : 0;
-    all[n] = 0;
-    if (f) fclose(f);
+    serve_stalled(log, args, 300000, all, sizeof all);
     const char* st = strstr(all, " missed deadlines, worst frame ");
     long missed = -1;
     double worst = NAN;
@@ -461,19 +467,8 @@ static void realtime_log(void) {
     const char* log = CRANESIM_BINARY_DIR "/tests/app/serve_rt.log";
     const char* args[] = {"--mechanics", "lagrange", "--scenario", "hold", "--duration", "3", "--realtime",
                           "--log-misses", NULL};
-    served sv;
-    CHECK(serve_start(&sv, log, args) == 0, "server started");
-    usleep(500000);
-    kill(sv.pid, SIGSTOP);
-    usleep(200000);
-    kill(sv.pid, SIGCONT);
-    usleep(300000);
-    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
     static char all[1 << 16];
-    FILE* f = fopen(log, "r");
-    size_t n = f ? fread(all, 1, sizeof all - 1, f) : 0;
-    all[n] = 0;
-    if (f) fclose(f);
+    serve_stalled(log, args, 200000, all, sizeof all);
     // Granted or not, one line says which (root in CI: SCHED_FIFO).
     CHECK(strstr(all, "] real time: SCHED_FIFO priority 10") || strstr(all, "] real time: SCHED_FIFO not permitted") ||
               strstr(all, "] real time: not permitted"),
