@@ -51,6 +51,8 @@ typedef struct rlink {
     char* hjson;             // the first hello's description (a copy)
     struct { uint64_t seq; char path[128]; double v; } pend[16]; // SETs sent, no answer yet
     int npend;
+    const char* const* sets; // the drive's --set values, sent on every link
+    int nset;
 } rlink;
 
 static int lk_connect(rlink* k, char* err, size_t errsz) {
@@ -239,8 +241,21 @@ static void lk_state(rlink* k, drive_session* s) {
     if (k->lockstep) lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_STEP, .frames = 1});
 }
 
+// The drive's --set values go to the server with the first frames of every
+// link, as a panel edit does (the local model has them already, for the
+// panel): the server at the other end of a new link may be a restarted one
+// that never had them, and one that had them takes the same values again.
+static void lk_queue_sets(const rlink* k, drive_session* s) {
+    for (int i = 0; i < k->nset; ++i) {
+        char path[128];
+        double v;
+        if (drive_set_path(k->sets[i], path, sizeof path, &v) || drive_session_queue_set(s, path, v))
+            printf("cranesim drive: --set %s: not sent to the server\n", k->sets[i]);
+    }
+}
+
 // The server's hello on a (re)connection: the role, the rate, and the same world.
-static int lk_hello(rlink* k, const proto_msg* m, char* err, size_t errsz) {
+static int lk_hello(rlink* k, drive_session* s, const proto_msg* m, char* err, size_t errsz) {
     k->role = m->u.shello.role;
     k->lockstep = m->u.shello.lockstep;
     k->rate = m->u.shello.rate;
@@ -261,6 +276,7 @@ static int lk_hello(rlink* k, const proto_msg* m, char* err, size_t errsz) {
     k->last_seq = 0;
     k->last_frame_wall = sim_wall_time();
     k->rt_w0 = 0;
+    lk_queue_sets(k, s);
     return 0;
 }
 
@@ -294,7 +310,7 @@ static void lk_pump(rlink* k, drive_session* s, double wait_s) {
             if (rc == 0) break;
             off += used;
             if (m.type == PROTO_SERVER_HELLO) {
-                if (lk_hello(k, &m, err, sizeof err)) {
+                if (lk_hello(k, s, &m, err, sizeof err)) {
                     lk_down(k, s, err);
                     return;
                 }
@@ -466,15 +482,9 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     model_free(dm);
     k.sc = sc;
     drive_session_set_remote(s);
-    // The drive's --set values go to the server with the first frames, as a
-    // panel edit does (the local model has them already, for the panel).
-    for (int i = 0; i < c0->nset; ++i) {
-        char path[128];
-        double v;
-        if (drive_set_path(c0->sets[i], path, sizeof path, &v) || drive_session_queue_set(s, path, v))
-            printf("cranesim drive: --set %s: not sent to the server\n", c0->sets[i]);
-    }
-    if (lk_hello(&k, &m, err, sizeof err)) { // cannot fail: nbody checked above
+    k.sets = (const char* const*)c0->sets;
+    k.nset = c0->nset;
+    if (lk_hello(&k, s, &m, err, sizeof err)) { // cannot fail: nbody checked above
         fprintf(stderr, "cranesim drive: %s\n", err);
         goto done_sc;
     }

@@ -30,9 +30,10 @@ typedef struct served {
     FILE* out; // the server's stdout
 } served;
 
-// Start `cranesim serve --listen 127.0.0.1:0 ARGS...` (args NULL-terminated)
-// with its stderr to errlog (or inherited when NULL). Returns 0 with the port.
-static inline int serve_start(served* sv, const char* errlog, const char* const* args) {
+// Start `cranesim serve --listen 127.0.0.1:PORT ARGS...` (args NULL-terminated;
+// port 0: the kernel picks one) with its stderr to errlog (or inherited when
+// NULL). Returns 0 with the port.
+static inline int serve_start_on(served* sv, int port, const char* errlog, const char* const* args) {
     int p[2];
     if (pipe(p)) return -1;
     pid_t pid = fork();
@@ -45,7 +46,9 @@ static inline int serve_start(served* sv, const char* errlog, const char* const*
             FILE* e = fopen(errlog, "w");
             if (e) dup2(fileno(e), 2);
         }
-        const char* argv[64] = {CRANESIM_BINARY_DIR "/cranesim", "serve", "--listen", "127.0.0.1:0"};
+        char listen[32];
+        snprintf(listen, sizeof listen, "127.0.0.1:%d", port);
+        const char* argv[64] = {CRANESIM_BINARY_DIR "/cranesim", "serve", "--listen", listen};
         int n = 4;
         for (int k = 0; args && args[k] && n < 62; ++k) argv[n++] = args[k];
         argv[n] = NULL;
@@ -64,6 +67,10 @@ static inline int serve_start(served* sv, const char* errlog, const char* const*
         }
     }
     return -1;
+}
+
+static inline int serve_start(served* sv, const char* errlog, const char* const* args) {
+    return serve_start_on(sv, 0, errlog, args);
 }
 
 // SIGINT, then the exit status (-1: it did not end by itself within 20 s).

@@ -72,6 +72,46 @@ static unsigned char* load_png(const char* path) {
     return p;
 }
 
+// A restarted server never had the drive's --set: after the link comes back
+// the drive sends it again, in the window's link (an offscreen view, with a
+// screenshot early on so it draws) and in the headless one. A real-time
+// server is stopped once it has accepted the value, a new one starts on the
+// same port, and the drive must say "reconnected" and have the value
+// accepted a second time.
+static void reconnect_resends_set(bool window) {
+    const char* args[] = {"--mechanics", "ode", "--scenario", "sandbox_pick_place", NULL};
+    const char* accept = window ? "accepted by the server: main_relief.p_crack = 2.2e+07"
+                                : "the server accepted --set hydraulics.components.main_relief.p_crack=2.2e7";
+    served a = {0}, b = {0};
+    CHECK(serve_start(&a, "test_drive_connect_reconnect_a.log", args) == 0, "first server started");
+    char cmd[1024], line[1024];
+    snprintf(cmd, sizeof cmd,
+             "%s/cranesim drive --connect 127.0.0.1:%d --scenario sandbox_pick_place --duration 8 %s "
+             "--set hydraulics.components.main_relief.p_crack=2.2e7 2>&1",
+             CRANESIM_BINARY_DIR, a.port,
+             window ? "--size 320x180 --screenshot connect_reconnect.png --screenshot-at 0.2" : "--headless");
+    FILE* p = popen(cmd, "r");
+    int accepted = 0, reconnected = 0, restarted = 0;
+    while (p && fgets(line, sizeof line, p)) {
+        fputs(line, stdout);
+        if (strstr(line, accept)) ++accepted;
+        if (strstr(line, "reconnected")) ++reconnected;
+        if (accepted == 1 && !restarted) {
+            restarted = 1;
+            CHECK(serve_stop(&a) == 0, "first server exits 0");
+            CHECK(serve_start_on(&b, a.port, "test_drive_connect_reconnect_b.log", args) == 0,
+                  "second server started on port %d", a.port);
+        }
+    }
+    CHECK(p && pclose(p) == 0, "%s drive --connect across a server restart exits 0", window ? "window" : "headless");
+    CHECK(restarted && reconnected == 1, "%s: the drive reconnected to the restarted server (%d)",
+          window ? "window" : "headless", reconnected);
+    CHECK(accepted == 2, "%s: --set accepted %d times: once per server expected", window ? "window" : "headless",
+          accepted);
+    if (restarted) CHECK(serve_stop(&b) == 0, "second server exits 0");
+    else serve_stop(&a);
+}
+
 static void hook_cb(void* user, engine* e, int attach, int got) { (void)user, (void)e, (void)attach, (void)got; }
 
 int main(void) {
@@ -117,6 +157,8 @@ int main(void) {
     CHECK(set_ok, "drive --connect --set: no 'accepted by the server: main_relief.p_crack = 2.2e+07' line");
     CHECK(unsent == 2, "chart and readout lift_cyl.A.p should say 'not sent by the server', x1 not (%d)", unsent);
     CHECK(serve_stop(&sv) == 0, "server exits 0");
+    reconnect_resends_set(true);
+    reconnect_resends_set(false);
 
     // The same run locally, rendered by a drive session at t_remote and 1.5 s later.
     app_common c = {.sim = sim_default_opts()};
