@@ -134,7 +134,9 @@ void engine_faults_init(engine_faults* f, const hyd_model* hm) {
     f->pump = -1;
     f->qmax0 = 0.0;
     for (int c = 0; c < hyd_model_ncomp(hm) && f->pump < 0; ++c)
-        if (hyd_model_comp_type(hm, c) == HYD_PUMP) f->pump = c;
+        // Both pumps deliver at most q_max (the LS pump eps q_max), so a
+        // stop takes q_max away from either.
+        if (hyd_model_comp_type(hm, c) == HYD_PUMP || hyd_model_comp_type(hm, c) == HYD_LS_PUMP) f->pump = c;
     if (f->pump >= 0) {
         char path[160];
         snprintf(path, sizeof path, "%s.q_max", hyd_model_comp_name(hm, f->pump));
