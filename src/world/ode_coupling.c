@@ -226,12 +226,47 @@ static void block_pattern(ode_world* w) {
     }
 }
 
+// The world fragment's "patch" ("component.field": "node") applied to a copy
+// of the model's hydraulics section: each named component must exist there
+// and the field must already name a node (a string), so a patch can rewire
+// a port and nothing else. Returns the copy, or NULL with the error.
+static cJSON* patched_hydraulics(const cJSON* hydraulics, const cJSON* patch, const char* wf, const char* mfile,
+                                 char* err, size_t errsz) {
+    cJSON* h = cJSON_Duplicate(hydraulics, 1);
+    if (!h) {
+        snprintf(err, errsz, "ode world: out of memory");
+        return NULL;
+    }
+    const cJSON* it;
+    cJSON_ArrayForEach(it, patch) {
+        char comp[128];
+        const char* dot = strchr(it->string, '.');
+        snprintf(comp, sizeof comp, "%.*s", (int)(dot - it->string), it->string);
+        cJSON* c = NULL;
+        cJSON* e;
+        cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(h, "components")) {
+            const cJSON* n = cJSON_GetObjectItemCaseSensitive(e, "name");
+            if (cJSON_IsString(n) && !strcmp(n->valuestring, comp)) c = e;
+        }
+        const cJSON* f = c ? cJSON_GetObjectItemCaseSensitive(c, dot + 1) : NULL;
+        if (!c || !cJSON_IsString(f)) {
+            snprintf(err, errsz, "%s: circuit_ls.patch.%s: %s %s in %s", wf, it->string,
+                     c ? "no port field" : "no component", c ? dot + 1 : comp, mfile);
+            cJSON_Delete(h);
+            return NULL;
+        }
+        cJSON_ReplaceItemInObjectCaseSensitive(c, dot + 1, cJSON_CreateString(it->valuestring));
+    }
+    return h;
+}
+
 // The run's one compiled circuit. A world that adds components (the
 // sandbox's slew) compiles the model's circuit with them appended, so an
 // error in the world's part names the world file and its own index; else
 // the model's compiled circuit is used as it is (opts.circuit), and the
 // panel's edits reach the world and the model at once.
-int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz) {
+int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, const char* part, char* err,
+                  size_t errsz) {
     const char* mfile = w->opt.model_file;
     const int sandbox = w->kind == WORLD_SANDBOX;
     if (!sandbox) extra = NULL;
@@ -242,9 +277,20 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, cha
         snprintf(err, errsz, "%s: hydraulics: missing (required by the ode world)", mfile);
         return -1;
     } else {
-        w->hm = extra ? hyd_model_from_json_extra(hydraulics, mfile, "hydraulics", extra,
-                                                  w->desc.file[0] ? w->desc.file : "world", "circuit", err, errsz)
+        const char* wf = w->desc.file[0] ? w->desc.file : "world";
+        const cJSON* patch = extra ? cJSON_GetObjectItemCaseSensitive(extra, "patch") : NULL;
+        cJSON* ph = NULL; // the patched model section, and the fragment without its patch
+        cJSON* fx = NULL;
+        if (patch) {
+            if (!(ph = patched_hydraulics(hydraulics, patch, wf, mfile, err, errsz))) return -1;
+            fx = cJSON_Duplicate(extra, 1);
+            if (fx) cJSON_DeleteItemFromObjectCaseSensitive(fx, "patch");
+            hydraulics = ph, extra = fx;
+        }
+        w->hm = extra ? hyd_model_from_json_extra(hydraulics, mfile, "hydraulics", extra, wf, part, err, errsz)
                       : hyd_model_from_json(hydraulics, mfile, "hydraulics", err, errsz);
+        cJSON_Delete(ph);
+        cJSON_Delete(fx);
         w->own_hm = 1;
         if (!w->hm) return -1;
     }

@@ -573,7 +573,10 @@ static int build_world(ode_world* w, void* arg) {
 
     // The hydraulic circuit first: cylinder strokes are needed for the limits.
     if (w->opt.hydraulics) {
-        if (ow_hyd_create(w, a->hydraulics, a->desc ? a->desc->circuit : NULL, a->err, a->errsz)) return -1;
+        // An LS model takes the world's LS slew section where it has one.
+        const cJSON* frag = world_desc_circuit_for(a->desc, a->hydraulics);
+        const char* part = a->desc && frag && frag == a->desc->circuit_ls ? "circuit_ls" : "circuit";
+        if (ow_hyd_create(w, a->hydraulics, frag, part, a->err, a->errsz)) return -1;
     } else {
         // Without a circuit, strokes come from nowhere; hinge limits are off.
         for (int k = 0; k < 2; ++k) w->act[k].stroke = 0;
@@ -623,7 +626,7 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
     } else {
         world_desc_default(&w->desc, WORLD_VALIDATION);
     }
-    w->desc.circuit = NULL; // never owned here
+    w->desc.circuit = w->desc.circuit_ls = NULL; // never owned here
     w->kind = w->desc.kind;
     w->g = w->desc.gravity >= 0 ? w->desc.gravity : w->mech.gravity;
     w->m3 = opt.load_mass >= 0 ? opt.load_mass : w->mech.load_mass;

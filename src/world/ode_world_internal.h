@@ -297,7 +297,8 @@ void ow_collision_snapshot(const ode_world* w, world_snapshot* s);
 void ow_geom_name(ow_geom* e, const char* name);
 
 // ode_coupling.c
-int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, char* err, size_t errsz);
+int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, const char* part, char* err,
+                  size_t errsz);
 void ow_hyd_destroy(ode_world* w);
 void ow_hyd_init_state(ode_world* w);
 int ow_hyd_step(ode_world* w, double dt);

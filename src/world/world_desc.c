@@ -109,7 +109,19 @@ void world_desc_default(world_desc* w, world_kind kind) {
 void world_desc_free(world_desc* w) {
     if (!w) return;
     cJSON_Delete(w->circuit);
-    w->circuit = NULL;
+    cJSON_Delete(w->circuit_ls);
+    w->circuit = w->circuit_ls = NULL;
+}
+
+const cJSON* world_desc_circuit_for(const world_desc* w, const cJSON* hydraulics) {
+    if (!w) return NULL;
+    const cJSON* comps = cJSON_GetObjectItemCaseSensitive(hydraulics, "components");
+    const cJSON* it;
+    cJSON_ArrayForEach(it, comps) {
+        const cJSON* t = cJSON_GetObjectItemCaseSensitive(it, "type");
+        if (cJSON_IsString(t) && !strcmp(t->valuestring, "ls_pump")) return w->circuit_ls ? w->circuit_ls : w->circuit;
+    }
+    return w->circuit;
 }
 
 double world_desc_terrain_height(const world_desc* w, double x, double y) {
@@ -594,15 +606,29 @@ static void load_meshes(json_ctx* c, const cJSON* o, world_desc* w) {
 }
 
 // The circuit fragment must look like a hydraulics section's lists; its
-// contents are checked when the merged circuit is compiled.
-static void load_circuit(json_ctx* c, const cJSON* o, world_desc* w) {
+// contents are checked when the merged circuit is compiled. circuit_ls may
+// also patch the model's components: "component.field": "node name" (the
+// component and its field are checked against the model when it is merged).
+static void load_circuit(json_ctx* c, const cJSON* o, const char* key, cJSON** out) {
     if (!o) return;
-    json_only_keys(c, o, "circuit", (const char* const[]){"nodes", "components", NULL});
-    json_arr(c, o, "circuit", "nodes", false);
-    json_arr(c, o, "circuit", "components", false);
+    const bool ls = !strcmp(key, "circuit_ls");
+    json_only_keys(c, o, key, ls ? (const char* const[]){"nodes", "components", "patch", NULL}
+                                 : (const char* const[]){"nodes", "components", NULL});
+    json_arr(c, o, key, "nodes", false);
+    json_arr(c, o, key, "components", false);
+    const cJSON* patch = ls ? json_obj(c, o, key, "patch", false) : NULL;
+    const cJSON* it;
+    cJSON_ArrayForEach(it, patch) {
+        char path[160];
+        snprintf(path, sizeof path, "%s.patch.%s", key, it->string);
+        const char* dot = strchr(it->string, '.');
+        if (!dot || dot == it->string || !dot[1]) json_fail(c, path, "expected \"component.field\" as the key");
+        else if (!cJSON_IsString(it) || !it->valuestring[0]) json_fail(c, path, "expected a node name (a string)");
+        if (c->failed) return;
+    }
     if (c->failed) return;
-    w->circuit = cJSON_Duplicate(o, 1);
-    if (!w->circuit) json_fail(c, "circuit", "out of memory");
+    *out = cJSON_Duplicate(o, 1);
+    if (!*out) json_fail(c, key, "out of memory");
 }
 
 // A body must stand on the terrain (centred on the origin): ODE aborted on a
@@ -720,7 +746,7 @@ static int from_json_in(const cJSON* root, const char* file, const char* dir, wo
         return -1;
     }
     static const char* const keys[] = {"name", "description", "type", "gravity", "ode", "terrain", "truck",
-                                       "slew", "circuit", "rope", "hook", "loads", "obstacles",
+                                       "slew", "circuit", "circuit_ls", "rope", "hook", "loads", "obstacles",
                                        "meshes", NULL};
     if (json_wrong_kind(&c, root, "world")) return -1;
     json_only_keys(&c, root, "", keys);
@@ -760,7 +786,8 @@ static int from_json_in(const cJSON* root, const char* file, const char* dir, wo
     load_loads(&c, json_arr(&c, root, "", "loads", false), w, dir);
     load_obstacles(&c, json_arr(&c, root, "", "obstacles", false), w, dir);
     load_meshes(&c, json_obj(&c, root, "", "meshes", false), w);
-    load_circuit(&c, json_obj(&c, root, "", "circuit", false), w);
+    load_circuit(&c, json_obj(&c, root, "", "circuit", false), "circuit", &w->circuit);
+    load_circuit(&c, json_obj(&c, root, "", "circuit_ls", false), "circuit_ls", &w->circuit_ls);
     if (!c.failed && w->kind == WORLD_SANDBOX) {
         check_on_terrain(&c, "truck.position", w->truck.position, false, &w->terrain);
         for (int i = 0; i < w->nload && !c.failed; ++i) {

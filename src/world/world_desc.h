@@ -178,7 +178,16 @@ typedef struct world_desc {
     /// Extra hydraulic nodes/components {"nodes": [...], "components": [...]}
     /// appended to the model's circuit (owned; NULL if none).
     cJSON* circuit;
+    /// The same for a model with a load-sensing pump (owned; NULL if none):
+    /// the slew as a compensated LS section, plus "patch", an object of
+    /// "component.field": "node" that rewires the model's own components
+    /// (its LS shuttle's output) so the slew's signal joins the LS network.
+    cJSON* circuit_ls;
 } world_desc;
+
+/// The fragment for a model's hydraulics section: circuit_ls when the
+/// circuit has a load-sensing pump and the world has one, else circuit.
+const cJSON* world_desc_circuit_for(const world_desc* w, const cJSON* hydraulics);
 
 /// Defaults for a world of the given kind (the built-in validation world, or
 /// the built-in sandbox without loads, obstacles or circuit extras).

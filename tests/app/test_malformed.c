@@ -18,7 +18,7 @@
 
 #define ASSETS CRANESIM_ASSETS
 
-enum kind { MODEL, SCENARIO, WORLD };
+enum kind { MODEL, SCENARIO, WORLD, WORLD_LS };
 
 typedef struct bad_case {
     enum kind kind;
@@ -60,6 +60,11 @@ static void command_for(const bad_case* k, const char* file, const char* out, ch
         snprintf(cmd, n, "run --quiet --model %s --scenario hold --duration 0.01 --out %s", file, out);
     else if (k->kind == SCENARIO)
         snprintf(cmd, n, "run --quiet --scenario %s --duration 0.01 --out %s", file, out);
+    else if (k->kind == WORLD_LS) // the LS slew section is only merged into an LS model's circuit
+        snprintf(cmd, n,
+                 "run --quiet --model %s/models/hiab031_ls.json --mechanics ode --world %s --scenario sandbox_swing "
+                 "--duration 0.01 --out %s",
+                 ASSETS, file, out);
     else if (strstr(k->base, "sandbox"))
         snprintf(cmd, n, "run --quiet --mechanics ode --world %s --scenario sandbox_swing --duration 0.01 --out %s",
                  file, out);
@@ -103,6 +108,15 @@ static const bad_case range_cases[] = {
     {WORLD, "w_load_size.json", W, "loads[0].size=[1e308, 1, 1]", NULL, NULL, "loads[0].size[0]", "must be in [0.01, 20] m"},
     {WORLD, "w_truck_far.json", W, "truck.position=[1e30, 0]", NULL, NULL, "truck.position", "must lie on the terrain"},
     {WORLD, "w_column_radius.json", W, "slew.column_radius=5", NULL, NULL, "slew.column_radius", "[0.02, 2] m"},
+    {WORLD, "w_patch_key.json", W, NULL, "\"ls_shuttle.out\": \"ls_line_booms\"", "\"ls_shuttle\": \"ls_line_booms\"",
+     "circuit_ls.patch.ls_shuttle", "expected \"component.field\""},
+    {WORLD, "w_patch_value.json", W, NULL, "\"ls_shuttle.out\": \"ls_line_booms\"", "\"ls_shuttle.out\": 3",
+     "circuit_ls.patch.ls_shuttle.out", "expected a node name"},
+    {WORLD_LS, "w_patch_comp.json", W, NULL, "\"ls_shuttle.out\": \"ls_line_booms\"",
+     "\"no_shuttle.out\": \"ls_line_booms\"", "circuit_ls.patch.no_shuttle.out", "no component no_shuttle"},
+    {WORLD_LS, "w_patch_field.json", W, NULL, "\"ls_shuttle.out\": \"ls_line_booms\"",
+     "\"ls_shuttle.margin\": \"ls_line_booms\"", "circuit_ls.patch.ls_shuttle.margin", "no port field margin"},
+    {WORLD_LS, "w_ls_node.json", W, NULL, "\"b\": \"slew_ls\"", "\"b\": \"slew_lx\"", "circuit_ls", "slew_lx"},
     {MODEL, "m_link_mass.json", M, "mechanics.links[1].mass=1e-300", NULL, NULL, "mechanics.links[1].mass",
      "must be in [1, 1e5] kg, got 1e-300"},
     {MODEL, "m_p_crack.json", M, "hydraulics.components.main_relief.p_crack=22", NULL, NULL,

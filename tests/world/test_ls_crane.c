@@ -331,8 +331,63 @@ static void test_long_steps(void) {
     model_free(m);
 }
 
+// The slew in the sandbox on the LS crane is a load-sensing section of its
+// own (the world's circuit_ls: compensator, spool-mode shuttle, a
+// max-select shuttle into the pump's LS line). While the slew alone moves
+// (sandbox_swing, 1-2 s at 0.8) the pump must sit one margin (2 MPa) above
+// the slew's loaded chamber, within the compensator's setting plus the LS
+// line's drop (0.5 MPa), and the slew must turn as far as the standard
+// crane's, whose pump stands at 20 MPa (within 15 %). With the slew fed from
+// the pump line outside the LS network the pump stayed at standby (2.1-2.8
+// MPa) and the slew turned 6.6 deg against 33.5.
+static void test_sandbox_slew_ls(void) {
+    scenario sc;
+    if (load_scenario("sandbox_swing", &sc)) return;
+    const char* models[2] = {"hiab031_ls.json", "hiab031.json"};
+    double turned[2] = {0, 0};
+    for (int k = 0; k < 2; ++k) {
+        char path[512], err[512];
+        snprintf(path, sizeof path, "%s/models/%s", CRANESIM_ASSETS, models[k]);
+        model* m = model_load(path, NULL, 0, err, sizeof err);
+        CHECK(m != NULL, "%s", err);
+        if (!m) continue;
+        sim_opts o = sim_default_opts();
+        o.mechanics = SIM_ODE;
+        o.world = CRANESIM_ASSETS "/worlds/sandbox.json";
+        sim_trace tr = {0};
+        sim_result r;
+        const int rc = sim_run(m, &sc, &o, NULL, NULL, &tr, NULL, NULL, &r);
+        CHECK(rc == 0, "%s: %s", models[k], r.message);
+        if (rc == 0) {
+            double s0 = NAN, s1 = NAN, dmin = 1e30, dmax = -1e30;
+            for (int i = 0; i < tr.nrow; ++i) {
+                const double* row = tr.v + (size_t)i * SIM_NCOL;
+                const double t = row[COL_T];
+                if (fabs(t - 1.0) < 5e-4) s0 = row[COL_SLEW];
+                if (fabs(t - 2.0) < 5e-4) s1 = row[COL_SLEW];
+                if (t >= 1.5 && t <= 1.95) {
+                    const double d = row[COL_P_PUMP] - fmax(row[COL_P3A], row[COL_P3B]);
+                    dmin = fmin(dmin, d), dmax = fmax(dmax, d);
+                }
+            }
+            turned[k] = fabs(s1 - s0) * 57.29577951308232; // deg/rad
+            printf("  %s: slew turns %.1f deg in 1-2 s; p_pump - max(p3A, p3B) %.2f..%.2f MPa over 1.5-1.95 s\n",
+                   models[k], turned[k], dmin / 1e6, dmax / 1e6);
+            if (k == 0)
+                CHECK(dmin > 2e6 - 0.5e6 && dmax < 2e6 + 0.5e6,
+                      "LS crane: the pump does not follow the slew's load: margin %.2f..%.2f MPa (2 MPa expected)",
+                      dmin / 1e6, dmax / 1e6);
+            sim_trace_free(&tr);
+        }
+        model_free(m);
+    }
+    CHECK(turned[1] > 10 && fabs(turned[0] - turned[1]) < 0.15 * turned[1],
+          "the LS crane slews %.1f deg, the standard crane %.1f deg", turned[0], turned[1]);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_ls_neutral);
+    RUN_TEST(test_sandbox_slew_ls);
     RUN_TEST(test_long_steps);
     RUN_TEST(test_flow_sharing_crane);
     RUN_TEST(test_lowering_pilot);
