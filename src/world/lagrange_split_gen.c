@@ -38,11 +38,6 @@ static int refresh_j(lsim* s, double t, const double* y) {
     lsim_jac(s, t, y, kg->J);
     ks->gh = 0.0;
     ks->have_j = false;
-    // Rows in order, so the state reported is the first one broken.
-    for (int b = 0, o = 0; b < s->nblock; o += s->block[b++])
-        for (int i = o; i < o + s->block[b]; ++i)
-            for (int j = o; j < o + s->block[b]; ++j)
-                if (!isfinite(J[i * n + j])) return i;
     for (int k = 0; k < kg->n1; ++k) kg->j1[k] = J[kg->i1[k] * (n + 1)];
     for (int k = 0; k < kg->n2; ++k) {
         const int i = kg->i2[k];
@@ -52,6 +47,20 @@ static int refresh_j(lsim* s, double t, const double* y) {
     }
     for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j) kg->jm[i * 4 + j] = J[(iq + i) * n + iq + j];
+    // x * 0 is 0 for finite x, NaN otherwise: one sum answers for every
+    // block entry; only a broken J takes the row scan.
+    double bad = 0.0;
+    for (int k = 0; k < kg->n1; ++k) bad += kg->j1[k] * 0.0;
+    for (int k = 0; k < kg->n2; ++k)
+        for (int e = 0; e < 4; ++e) bad += kg->j2[k][e] * 0.0;
+    for (int e = 0; e < 16; ++e) bad += kg->jm[e] * 0.0;
+    if (bad != 0.0) {
+        // Rows in order, so the state reported is the first one broken.
+        for (int b = 0, o = 0; b < s->nblock; o += s->block[b++])
+            for (int i = o; i < o + s->block[b]; ++i)
+                for (int j = o; j < o + s->block[b]; ++j)
+                    if (!isfinite(J[i * n + j])) return i;
+    }
     ks->have_j = true;
     return -1;
 }
