@@ -492,7 +492,7 @@ static int bench_ls(const app_common* c, const scenario* sc, int repeat) {
             }
             walls[k][i] = r.wall;
             steps[k] = r.stats.steps;
-            kern[k] = r.split ? "split" : r.fused ? "fused" : r.fast ? "fast" : "general";
+            kern[k] = r.split ? (r.fast ? "split-fast" : "split") : r.fused ? "fused" : r.fast ? "fast" : "general";
         }
     if (!rc) {
         for (int k = 0; k < 2; ++k) ns[k] = 1e9 * app_median(walls[k], repeat) / (double)(steps[k] ? steps[k] : 1);
@@ -913,7 +913,8 @@ int cmd_bench(int argc, char** argv) {
                hyd_method_name(o.solver),
                hyd_method_is_adaptive(o.solver) ? 0.0 : o.h, hyd_method_is_adaptive(o.solver) ? o.rtol : 0.0,
                hyd_method_is_adaptive(o.solver) ? "dense" : (o.dense_jac ? "dense" : "blocks"),
-               r.split ? "split" : r.fused ? "fused" : r.fast ? "fast" : "general", r.t_end, wall,
+               r.split ? (r.fast ? "split-fast" : "split") : r.fused ? "fused" : r.fast ? "fast" : "general", r.t_end,
+               wall,
                repeat, r.t_end / wall, r.stats.steps, r.stats.rejected, r.stats.fevals, r.stats.jevals,
                r.stats.lus, 1e9 * wall / (double)(r.stats.steps ? r.stats.steps : 1));
         fflush(stdout);

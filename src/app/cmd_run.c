@@ -215,7 +215,10 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     printf("cranesim run: %s, %s", scen, d.label);
     printf(", solver %s", o->cvode ? "cvode" : hyd_method_name(o->solver));
     // Which circuit kernel ran (cranesim run --help, --kernel).
-    const char* kern = r->split ? ", split step" : r->fused ? ", fused kernel" : r->fast ? ", fast kernel" : ", general kernel";
+    // The split step runs on the one-pass circuit (standard crane) or on the
+    // fast kernel (any other circuit, lagrange_split_gen.c).
+    const char* kern = r->split ? (r->fast ? ", split step on the fast kernel" : ", split step")
+                       : r->fused ? ", fused kernel" : r->fast ? ", fast kernel" : ", general kernel";
     if (adaptive) printf(" (rtol %g, atol %g%s)\n", o->rtol, o->atol, kern);
     else if (d.h_reduced) // sub-stepped at min(--dt, the outer step)
         printf(" (h = %g ms: --dt %g ms reduced to the ODE step%s)\n", d.dt_outer * 1e3, o->h * 1e3, kern);

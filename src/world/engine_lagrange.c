@@ -276,7 +276,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     const bool reference = o->kernel == SIM_KERNEL_GENERAL;
     ls.use_fused = ls.have_fused && !reference;
     ls.use_w = ls.w_layout && !reference; // the crane-specialised W too (lagrange_schur_w.c)
-    ls.use_split = ls.w_layout && o->kernel == SIM_KERNEL_SPLIT;
+    ls.use_split = (ls.w_layout || ls.gen_layout) && o->kernel == SIM_KERNEL_SPLIT;
     ls.use_fast = ls.fk && !reference; // a circuit without the fused shape (lagrange_sim.h)
     res->fused = ls.use_fused;
     res->fast = ls.use_fast;

@@ -24,6 +24,23 @@ static double phi_of_stroke(const crane_actuator* a, double x) {
     return c >= -1.0 && c <= 1.0 ? acos(c) : NAN;
 }
 
+// The block pattern lagrange_split_gen.c takes: 1x1 and 2x2 blocks of
+// hydraulic states, then the 4x4 mechanics block at iq (lsim_init's
+// order always has it; checked, not assumed).
+static bool gen_blocks(lsim* s) {
+    lsim_kg* kg = &s->kg;
+    kg->n1 = kg->n2 = 0;
+    int o = 0;
+    for (int b = 0; b < s->nblock; ++b) {
+        const int m = s->block[b];
+        if (m == 1) kg->i1[kg->n1++] = o;
+        else if (m == 2) kg->i2[kg->n2++] = o;
+        else if (!(m == 4 && o == s->iq && b == s->nblock - 1)) return false;
+        o += m;
+    }
+    return o == s->n && s->block[s->nblock - 1] == 4;
+}
+
 // Joint ranges in which lsim_events can skip the strokes (ev_phi).
 static void events_setup(lsim* s) {
     for (int k = 0; k < 2; ++k) {
@@ -114,7 +131,13 @@ int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err,
     s->use_fast = s->fk != NULL;
     s->w_layout = lsim_w_layout(s);
     s->use_w = s->w_layout;
-    s->use_split = s->w_layout;
+    s->gen_layout = s->fk && gen_blocks(s);
+    if (s->gen_layout && !(s->kg.J = malloc((size_t)s->n * (size_t)s->n * sizeof(double)))) {
+        snprintf(err, errsz, "out of memory");
+        lsim_free(s);
+        return -1;
+    }
+    s->use_split = s->w_layout || s->gen_layout;
     s->ks.cmd_t = NAN;
     lagrange_consts_init(&m->mech, v, m3, &s->lk);
     for (int i = 0; i < s->nh; ++i) s->is_pressure[i] = hyd_model_state_kind(hm, s->perm[i]) == HYD_STATE_PRESSURE;
@@ -126,6 +149,8 @@ void lsim_free(lsim* s) {
     hyd_fast_free(s->fk);
     s->fk = NULL;
     free(s->jh_);
+    free(s->kg.J);
+    s->kg.J = NULL;
     s->hd = NULL;
     s->jh_ = NULL;
 }
@@ -162,6 +187,8 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
         p.nblock = s->nblock;
         p.block_size = s->block;
         if (fz && s->use_split && s->w_layout) p.wstep = lsim_wstep;
+        // Any other circuit on the fast kernel: the same step, per block.
+        else if (!fz && s->use_fast && s->fk && s->use_split && s->gen_layout) p.wstep = lsim_wstep_gen;
     } else if (s->use_w && s->w_layout) {
         p.wfactor = lsim_wfactor;
         p.wsolve = lsim_wsolve;

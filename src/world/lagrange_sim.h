@@ -55,6 +55,24 @@ typedef struct lsim_ks {
     double cmd[2];         ///< valve commands at cmd_t [-]
 } lsim_ks;
 
+/// State of the split step for any circuit on the fast kernel
+/// (lagrange_split_gen.c): the diagonal blocks of the last J in the block
+/// pattern of lsim (1x1 and 2x2 blocks of hydraulic states, then the 4x4
+/// mechanics block) and W^-1 of each for ks.gh. The anchor of the midpoint
+/// sines, the commands and gh are kept in lsim_ks, as for the standard step.
+typedef struct lsim_kg {
+    int n1, n2;                        ///< number of 1x1 and 2x2 blocks
+    int i1[LSIM_MAX_STATES];           ///< state of each 1x1 block
+    int i2[LSIM_MAX_STATES / 2];       ///< first state of each 2x2 block
+    double j1[LSIM_MAX_STATES];        ///< d f_i / d y_i of the 1x1 blocks [1/s]
+    double j2[LSIM_MAX_STATES / 2][4]; ///< the 2x2 blocks, row-major [1/s]
+    double jm[16];                     ///< [q1, q2, q1', q2'] block, row-major
+    double w1[LSIM_MAX_STATES];        ///< 1 / W of the 1x1 blocks
+    double w2[LSIM_MAX_STATES / 2][4]; ///< W^-1 of the 2x2 blocks
+    double wm[16];                     ///< W^-1 of the mechanics block
+    double* J;                         ///< n x n scratch for lsim_jac (owned)
+} lsim_kg;
+
 typedef struct lsim {
     const model* mdl;
     lagrange_variant variant;
@@ -96,8 +114,11 @@ typedef struct lsim {
     bool use_w;            ///< lsim_problem hands out wfactor/wsolve (default: w_layout)
     lsim_w w;
     // Split Krus/ROS2 step (lagrange_split_step.c) for the block-pattern fixed-step runs.
-    bool use_split;        ///< lsim_problem(s, true) hands out lsim_wstep (default: w_layout)
+    bool use_split;        ///< lsim_problem(s, true) hands out lsim_wstep (w_layout) or lsim_wstep_gen (gen_layout, use_fast); default true
     lsim_ks ks;
+    // Split step for any circuit on the fast kernel (lagrange_split_gen.c).
+    bool gen_layout;       ///< fk and the blocks lsim_kg takes: lsim_problem(s, true) can hand out lsim_wstep_gen
+    lsim_kg kg;
     hyd_fused_events ev;   ///< event counter of lsim_events
     unsigned fz_rev;       ///< hyd_model_revision that fz was packed at
     /// Cylinder k is clear of both end stops and their smoothing widths
@@ -154,6 +175,12 @@ void lsim_wsolve(void* user, double* x);
 /// Requires w_layout.
 int lsim_wstep(void* user, double t, const double* y, double h, double gamma, int new_jac,
                double* ynew);
+/// The same step for any circuit on the fast kernel (lagrange_split_gen.c):
+/// f at each stage is lsim_rhs's fast-kernel f with the mechanics carried
+/// from the midpoint, J is lsim_jac's, W^-1 per diagonal block. Requires
+/// gen_layout.
+int lsim_wstep_gen(void* user, double t, const double* y, double h, double gamma, int new_jac,
+                   double* ynew);
 int lsim_rhs(void* user, double t, const double* y, double* dydt);
 /// hyd_problem.events (requires have_fused): counts the switches between
 /// successive calls (hyd_fused_events_update): a valve command step, a

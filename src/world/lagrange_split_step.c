@@ -33,7 +33,7 @@
 // solver's own block solve (hydSolveW) would do the same algebra in about
 // 280 instructions a solve against 120 here.
 #include "lagrange_sim.h"
-#include "lsim_kin.h"
+#include "lsim_split.h"
 
 #include <float.h>
 #include <math.h>
@@ -41,47 +41,9 @@
 
 enum { IPL = 10, IQ = 11, NS = 15 };
 
-// Mechanics at the step's predicted midpoint.
-typedef struct geo {
-    double qm[2];
-    double trig[4]; ///< sin q1, cos q1, sin q2, cos q2 at qm
-    kin k;          ///< x, r, dr at qm (k.v unused)
-} geo;
+typedef lsim_geo geo;
 
-// sin and cos of the midpoint angles. From one step's midpoint to the next
-// the angles move by |e| = h |q'| + O(h^2), about 1e-5 rad at h = 0.1 ms,
-// so the addition identities with short series for sin e and cos e
-// (remainders e^7/5040 and e^6/720, below 1.5e-21 for |e| < 1e-3) replace
-// the two sincos calls. Each rotation rounds to about an ulp; the anchor is
-// a fresh sincos at every new Jacobian (every jac_every steps), so the
-// drift stays within a few ulp.
-static void midpoint_trig(lsim_ks* ks, const double* qm, double* trig) {
-    const double e0 = qm[0] - ks->qa[0], e1 = qm[1] - ks->qa[1];
-    if (ks->have_anchor && fabs(e0) < 1e-3 && fabs(e1) < 1e-3) {
-        const double e[2] = {e0, e1};
-        for (int j = 0; j < 2; ++j) {
-            const double e2 = e[j] * e[j];
-            const double se = e[j] * (1.0 - e2 * (1.0 / 6.0 - e2 * (1.0 / 120.0)));
-            const double ce = 1.0 - e2 * (0.5 - e2 * (1.0 / 24.0));
-            const double sj = ks->sa[j] * ce + ks->ca[j] * se, cj = ks->ca[j] * ce - ks->sa[j] * se;
-            trig[2 * j] = ks->sa[j] = sj;
-            trig[2 * j + 1] = ks->ca[j] = cj;
-        }
-    } else {
-        lagrange_sincos(qm[0], &trig[0], &trig[1]);
-        lagrange_sincos(qm[1], &trig[2], &trig[3]);
-        ks->sa[0] = trig[0], ks->ca[0] = trig[1], ks->sa[1] = trig[2], ks->ca[1] = trig[3];
-        ks->have_anchor = true;
-    }
-    ks->qa[0] = qm[0], ks->qa[1] = qm[1];
-}
-
-static void geo_at(lsim* s, const double* y, double h, geo* g) {
-    for (int j = 0; j < 2; ++j) g->qm[j] = y[IQ + j] + 0.5 * h * y[IQ + 2 + j];
-    midpoint_trig(&s->ks, g->qm, g->trig);
-    static const double rest[2] = {0.0, 0.0};
-    cylinder_kinematics(&s->mdl->mech, g->trig, rest, &g->k);
-}
+static void geo_at(lsim* s, const double* y, double h, geo* g) { lsim_geo_at(s, y, IQ, h, g); }
 
 // Valve commands at t (lsim_commands: stage 2 of one step and stage 1 of
 // the next share t, so the scenario's tables are read once per step).
@@ -89,25 +51,11 @@ static void commands_at(lsim* s, double t, double cmd[2]) { lsim_commands(s, t, 
 
 // f at a stage (t, y) with the mechanics carried from the midpoint.
 static void stage_f(lsim* s, const geo* g, double t, const double* y, double* f) {
-    const double d[2] = {y[IQ] - g->qm[0], y[IQ + 1] - g->qm[1]};
-    const double* qd = y + IQ + 2;
-    double x[2], v[2], r[2], cmd[2], F[2];
-    for (int i = 0; i < 2; ++i) {
-        r[i] = g->k.r[i] + g->k.dr[i] * d[i];
-        x[i] = g->k.x[i] + d[i] * (g->k.r[i] + 0.5 * g->k.dr[i] * d[i]);
-        v[i] = r[i] * qd[i];
-    }
+    double x[2], v[2], r[2], trig[4], cmd[2], F[2];
+    lsim_geo_carry(g, y, IQ, x, v, r, trig);
     commands_at(s, t, cmd);
     hyd_fused_eval2(&s->fz, y, x, v, cmd, f, F);
-
-    const double* tm = g->trig;
-    const double e0 = 1.0 - 0.5 * d[0] * d[0], e1 = 1.0 - 0.5 * d[1] * d[1];
-    const double trig[4] = {tm[0] * e0 + tm[1] * d[0], tm[1] * e0 - tm[0] * d[0],
-                            tm[2] * e1 + tm[3] * d[1], tm[3] * e1 - tm[2] * d[1]};
-    const double tau[2] = {F[0] * r[0], F[1] * r[1]};
-    double qdd[2];
-    lagrange_accel_fast(&s->lk, trig, qd, tau, qdd);
-    lsim_mech_out(s, qd, qdd, f + IQ);
+    lsim_split_mech(s, trig, y + IQ + 2, F, r, f + IQ);
 }
 
 // The diagonal blocks of J at (t, y), from the fused analytic Jacobian.
@@ -141,65 +89,14 @@ static int refresh_j(lsim* s, double t, const double* y) {
     return -1;
 }
 
-// 1 / (1 - gh j), or 0 when W is singular to working precision (the test
-// of the solver's own 1x1 blocks, lu.c).
-static double inv1(double gh, double j) {
-    const double w = 1.0 - gh * j;
-    return fabs(w) > DBL_EPSILON * fmax(1.0, fabs(gh * j)) ? 1.0 / w : 0.0;
-}
-
-// W^-1 of the 4x4 block I - gh m by Gauss-Jordan with partial pivoting. Not
-// hyd_lu_factor + four hyd_lu_solve: those general, careful loops cost about
-// 1,800 instructions per Jacobian against about 450 here, 5 % of a Krus step
-// at one Jacobian per 10 steps (callgrind, 2026-11-23).
-static int inv4(double gh, const double* m, double* out) {
-    double a[4][8];
-    double amax = 0.0;
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) {
-            a[i][j] = (i == j) - gh * m[i * 4 + j];
-            a[i][4 + j] = i == j;
-            if (fabs(a[i][j]) > amax) amax = fabs(a[i][j]);
-        }
-    for (int c = 0; c < 4; ++c) {
-        int p = c;
-        for (int i = c + 1; i < 4; ++i)
-            if (fabs(a[i][c]) > fabs(a[p][c])) p = i;
-        if (!(fabs(a[p][c]) > 64.0 * DBL_EPSILON * amax)) return -1;
-        if (p != c)
-            for (int j = 0; j < 8; ++j) {
-                const double tmp = a[c][j];
-                a[c][j] = a[p][j], a[p][j] = tmp;
-            }
-        const double inv = 1.0 / a[c][c];
-        for (int j = 0; j < 8; ++j) a[c][j] *= inv;
-        for (int i = 0; i < 4; ++i) {
-            if (i == c) continue;
-            const double l = a[i][c];
-            for (int j = 0; j < 8; ++j) a[i][j] -= l * a[c][j];
-        }
-    }
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) out[i * 4 + j] = a[i][4 + j];
-    return 0;
-}
-
 static int form_w(lsim_ks* ks, double gh) {
     for (int k = 0; k < 2; ++k) {
-        if ((ks->wu[k] = inv1(gh, ks->ju[k])) == 0.0) return HYD_ERR_SINGULAR;
-        for (int c = 0; c < 2; ++c) {
-            const double* m = ks->jh[k][c];
-            const double a = 1.0 - gh * m[0], b = -gh * m[1], cc = -gh * m[2], d = 1.0 - gh * m[3];
-            const double det = a * d - b * cc;
-            // The singularity test of lu.c's 2x2 blocks.
-            if (!(fabs(det) > 4.0 * DBL_EPSILON * fmax(fabs(a * d), fabs(b * cc)))) return HYD_ERR_SINGULAR;
-            const double id = 1.0 / det;
-            double* w = ks->wh[k][c];
-            w[0] = d * id, w[1] = -b * id, w[2] = -cc * id, w[3] = a * id;
-        }
+        if ((ks->wu[k] = lsim_inv1(gh, ks->ju[k])) == 0.0) return HYD_ERR_SINGULAR;
+        for (int c = 0; c < 2; ++c)
+            if (lsim_inv2(gh, ks->jh[k][c], ks->wh[k][c])) return HYD_ERR_SINGULAR;
     }
-    if ((ks->wpl = inv1(gh, ks->jpl)) == 0.0) return HYD_ERR_SINGULAR;
-    if (inv4(gh, ks->jm, ks->wm)) return HYD_ERR_SINGULAR;
+    if ((ks->wpl = lsim_inv1(gh, ks->jpl)) == 0.0) return HYD_ERR_SINGULAR;
+    if (lsim_inv4(gh, ks->jm, ks->wm, 64.0)) return HYD_ERR_SINGULAR;
     ks->gh = gh;
     return HYD_OK;
 }

@@ -286,7 +286,7 @@ typedef struct sim_result {
     hyd_solver_stats stats;
     long rows;
     bool fused;          ///< the run used the fused circuit kernel (lagrange or ode)
-    bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lagrange_split_step.c)
+    bool split;          ///< lagrange: ... and the split Krus/ROS2 step (lagrange_split_step.c; with fast: lagrange_split_gen.c)
     bool fast;           ///< ode: the fast kernel for any circuit (circuit_fast.h), the circuit
                          ///< not having the fused kernel's shape
     sim_collisions coll; ///< ode sandbox: the collisions at every ODE step (else coll.have is false)
