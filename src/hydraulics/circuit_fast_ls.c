@@ -50,6 +50,7 @@
 #include "hyd_ramp.h"
 #include "hyd_valve.h"
 
+#include <float.h>
 #include <string.h>
 
 // The records of type t and how many there are.
@@ -63,6 +64,65 @@ static void set_mask(double* d, int on) {
 #if defined(__SSE2__) && defined(__GNUC__)
 #define LSK_LANES 1
 #endif
+
+// Doubles in order as integers (for the bisection below): a monotone map of
+// the finite doubles onto int64.
+static int64_t dkey(double x) {
+    int64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b >= 0 ? b : INT64_MIN - b;
+}
+static double dval(int64_t k) {
+    const int64_t b = k >= 0 ? k : INT64_MIN - k;
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+// The ramp's rounded t (hyd_ramp_q's HYD_RAMP_T) at pressure p of its
+// volume end (the other a tank).
+static double ramp_t(const hyd_fast_ls_ramp* r, double p) {
+    const double pi = r->in >= 0 ? p : r->pin, po = r->out >= 0 ? p : r->pout;
+    return HYD_RAMP_T(pi - po, r->pcr, r->inv_w);
+}
+
+// The closed set {p : t(p) <= 0} of a ramp from a volume to a tank (a
+// relief: t rises with p) or from a tank into a volume (a check: t falls
+// with p). Each rounded operation of t is monotone in p (with inv_w > 0),
+// so the set is p <= b (relief) or p >= b (check) with b found by bisection
+// on the doubles themselves: exactly the p the loops skip. *b = +-HUGE_VAL
+// when every finite p is inside, -+HUGE_VAL when none is. Returns 0 when
+// inv_w is not positive and finite (then no bound is taken).
+static int ramp_bound(const hyd_fast_ls_ramp* r, int relief, double* b) {
+    if (!(r->inv_w > 0.0 && r->inv_w < HUGE_VAL)) return 0;
+    // inside(p): t(p) <= 0; relief: true below b; check: true above b.
+    int64_t lo = dkey(-DBL_MAX), hi = dkey(DBL_MAX);
+#define INSIDE(k) (ramp_t(r, dval(k)) <= 0.0)
+    // The midpoint without overflow (hi - lo may exceed INT64_MAX).
+#define MID(a, b) ((int64_t)((uint64_t)(a) + ((uint64_t)(b) - (uint64_t)(a)) / 2))
+    if (relief) {
+        if (INSIDE(hi)) return *b = HUGE_VAL, 1;
+        if (!INSIDE(lo)) return *b = -HUGE_VAL, 1;
+        while ((uint64_t)hi - (uint64_t)lo > 1) { // INSIDE(lo), !INSIDE(hi)
+            const int64_t mid = MID(lo, hi);
+            if (INSIDE(mid)) lo = mid;
+            else hi = mid;
+        }
+        *b = dval(lo);
+    } else {
+        if (INSIDE(lo)) return *b = -HUGE_VAL, 1;
+        if (!INSIDE(hi)) return *b = HUGE_VAL, 1;
+        while ((uint64_t)hi - (uint64_t)lo > 1) { // !INSIDE(lo), INSIDE(hi)
+            const int64_t mid = MID(lo, hi);
+            if (INSIDE(mid)) hi = mid;
+            else lo = mid;
+        }
+        *b = dval(hi);
+    }
+#undef INSIDE
+#undef MID
+    return 1;
+}
 
 void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fast_ls* L) {
     memset(L, 0, sizeof *L);
@@ -169,6 +229,18 @@ void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fa
             q->pin = m->node_pfix[r[i].in], q->pout = m->node_pfix[r[i].out];
             q->pcr = r[i].pcr, q->inv_w = r[i].inv_w, q->qr = r[i].qr;
         }
+    }
+    for (int i = 0; i < LSK_NSLOT; ++i) L->lo[i] = -HUGE_VAL, L->hi[i] = HUGE_VAL;
+    L->ramp_any = 0;
+    for (int i = 0; i < L->nramp; ++i) {
+        const hyd_fast_ls_ramp* q = &L->ramp[i];
+        double b;
+        if ((q->in >= 0) == (q->out >= 0) || !ramp_bound(q, q->in >= 0, &b)) {
+            L->ramp_any |= q->in >= 0 || q->out >= 0; // between two tanks: no node sees it
+            continue;
+        }
+        if (q->in >= 0) L->hi[q->in] = fmin(L->hi[q->in], b); // relief: closed while p <= b
+        else L->lo[q->out] = fmax(L->lo[q->out], b);          // check: closed while p >= b
     }
     L->pump = *pu;
     L->pump.adr = smap[pu->adr];
@@ -295,9 +367,14 @@ int hyd_fast_ls_eval(const hyd_fast_ls* L, const hyd_model* m, hyd_data* d, cons
     ok &= _mm_movemask_pd(_mm_and_pd(_mm_cmple_pd(_mm_sub_pd(z, xs), z), _mm_cmple_pd(xs - ld(L->stroke), z)));
     if (ok != 3) return 0;
 
-    // Reliefs and checks first (the loops' first flows into any node).
+    // Reliefs and checks first (the loops' first flows into any node): all
+    // closed while every slot is inside its bounds (NaN was refused above).
+    int shut = 3;
+    for (int j = 0; j < LSK_NSEC; ++j)
+        shut &= _mm_movemask_pd(_mm_and_pd(_mm_cmple_pd(ld(&L->lo[2 * j]), P[j]), _mm_cmple_pd(P[j], ld(&L->hi[2 * j]))));
+    shut &= _mm_movemask_pd(_mm_and_pd(_mm_cmple_pd(ld(&L->lo[LSK_PL]), Psh), _mm_cmple_pd(Psh, ld(&L->hi[LSK_PL]))));
     double st[LSK_NSLOT];
-    const int open = ramps(L, y, st);
+    const int open = shut == 3 && !L->ramp_any ? 0 : ramps(L, y, st);
     v2 S[LSK_NSEC];
     for (int j = 0; j < LSK_NSEC; ++j) S[j] = open ? ld(&st[2 * j]) : z;
     const double spl = open ? st[LSK_PL] : 0.0, sll = open ? st[LSK_LL] : 0.0;
@@ -406,6 +483,8 @@ int hyd_fast_ls_eval(const hyd_fast_ls* L, const hyd_model* m, hyd_data* d, cons
     st_at(d->node_V, &L->node[2 * LSK_CB], VB);
     st_at(d->node_dV, &L->node[2 * LSK_CA], dVA);
     st_at(d->node_dV, &L->node[2 * LSK_CB], dVB);
+    // Unrolled: the chamber cases and the slot offsets become constants.
+#pragma GCC unroll 8
     for (int j = 0; j < LSK_NSEC; ++j) {
         v2 V = ld(&L->V0[2 * j]), net = n[j]; // x - (+0.0) is x: the fixed nodes' dV/dt is left out
         if (j == LSK_CA) V = VA, net = n[j] - dVA;

@@ -35,6 +35,12 @@ typedef struct hyd_fast_ls {
     double bel[LSK_NSLOT], bec[LSK_NSLOT], V0[LSK_NSLOT];
     int nramp;
     hyd_fast_ls_ramp ramp[LSK_MAXRAMP];
+    /// Every relief and check is closed (t <= 0, the loops skip it) exactly
+    /// when lo <= p <= hi in every slot [Pa abs] (hyd_fast_ls_pack finds the
+    /// bounds on the ramps' own rounded t). ramp_any: a ramp between two
+    /// volumes, which no bound describes (the ramps are then tried each time).
+    double lo[LSK_NSLOT], hi[LSK_NSLOT];
+    int ramp_any;
     hyd_ls_pump_c pump;        ///< adr in the caller's order
     double pump_pin;           ///< its inlet tank's pressure [Pa abs]
     hyd_shuttle_c lssh;        ///< the LS shuttle (max-select) of the two sections' LS nodes
