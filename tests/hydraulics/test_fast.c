@@ -496,31 +496,40 @@ static void test_ls_lanes(void) {
     }
     CHECK(bad == 0, "LS lanes: %d outputs differ from the loops", bad);
 
-    // Ulp by ulp across each relief's and check's opening: a chamber of
-    // either section and the pump line at the pressures around p_tank +
-    // p_crack (reliefs) and p_tank - p_crack (checks), each on the lane
-    // path (the other pressures mid-range, strokes free).
+    // Ulp by ulp across each relief's and check's opening (p_tank + p_crack,
+    // p_tank - p_crack), on the lane path: a section's chambers, hose B and
+    // counterbalance valve side all at the swept pressure and every spool,
+    // compensator, counterbalance valve and the pump's displacement at 0, so
+    // that the chambers' reliefs or checks are their nodes' only flows (and
+    // the pump line's main relief its only one): an opening taken one ulp
+    // late or early shows in the rates. Every other pressure mid-range.
     hyd_fast* ka = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
     hyd_fast* kb = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
     if (!ka || !kb) return;
     hyd_fast_lanes(kb, 0);
-    static const char* const sweep[] = {"lift_cyl.A", "lift_cyl.B", "jib_cyl.A", "jib_cyl.B", "pump_line"};
-    static const double edge[] = {1e5 + 25e6, 1e5 - 5e4, 1e5 + 25e6, 1e5 - 5e4, 1e5 + 23e6};
-    int swept = 0;
+    static const char* const sec[2][4] = {{"lift_cyl.A", "lift_cyl.B", "lift_hose_B", "lift_cbv_A"},
+                                          {"jib_cyl.A", "jib_cyl.B", "jib_hose_B", "jib_cbv_A"}};
+    static const char* const pl[4] = {"pump_line", NULL, NULL, NULL};
+    const struct { const char* const* nodes; double edge; } sweep[5] = {
+        {sec[0], 1e5 + 25e6}, {sec[0], 1e5 - 5e4}, {sec[1], 1e5 + 25e6}, {sec[1], 1e5 - 5e4}, {pl, 1e5 + 23e6}};
+    int swept = 0, moved = 0;
     bad = 0;
     for (int e = 0; e < 5; ++e) {
-        int at = -1;
-        for (int nd = 0; nd < hyd_model_nnode(m); ++nd)
-            if (!strcmp(hyd_model_node_name(m, nd), sweep[e])) at = hyd_model_node_state(m, nd);
-        CHECK(at >= 0, "no pressure node %s", sweep[e]);
-        if (at < 0) continue;
+        int at[4] = {-1, -1, -1, -1};
+        for (int j = 0; j < 4 && sweep[e].nodes[j]; ++j) {
+            for (int nd = 0; nd < hyd_model_nnode(m); ++nd)
+                if (!strcmp(hyd_model_node_name(m, nd), sweep[e].nodes[j])) at[j] = hyd_model_node_state(m, nd);
+            CHECK(at[j] >= 0, "no pressure node %s", sweep[e].nodes[j]);
+        }
+        double f_lo = 0.0, f_hi = 0.0;
         for (int k = -40; k <= 40; ++k) {
             random_state(m, da, y);
             for (int i = 0; i < n; ++i)
-                if (hyd_model_state_kind(m, i) == HYD_STATE_PRESSURE) y[i] = urand(1e6, 15e6);
-            double p = edge[e];
+                y[i] = hyd_model_state_kind(m, i) == HYD_STATE_PRESSURE ? urand(1e6, 15e6) : 0.0;
+            double p = sweep[e].edge;
             for (int s = 0; s < (k < 0 ? -k : k); ++s) p = nextafter(p, k < 0 ? 0.0 : HUGE_VAL);
-            y[at] = p;
+            for (int j = 0; j < 4; ++j)
+                if (at[j] >= 0) y[at[j]] = p;
             for (int c = 0; c < hyd_model_ncylinder(m); ++c) {
                 double AA, AB, s;
                 hyd_model_cylinder_geometry(m, c, &AA, &AB, &s);
@@ -532,9 +541,13 @@ static void test_ls_lanes(void) {
             hyd_fast_eval(ka, da, y, fa);
             hyd_fast_eval(kb, db, y, fb);
             swept += hyd_fast_lanes_count(ka) != c0;
-            bad += same_outputs(m, da, db, fa, fb, n, sweep[e], k);
+            bad += same_outputs(m, da, db, fa, fb, n, sweep[e].nodes[0], k);
+            if (k == -40) f_lo = db->node_q[hyd_model_state_node(m, at[0])];
+            if (k == 40) f_hi = db->node_q[hyd_model_state_node(m, at[0])];
         }
+        moved += f_lo != f_hi; // the valve did open (or close) inside the sweep
     }
+    CHECK(moved == 5, "only %d of 5 sweeps crossed an opening", moved);
     CHECK(swept == 5 * 81, "the sweep took the lane path %d of %d times", swept, 5 * 81);
     CHECK(bad == 0, "LS lanes at the reliefs' and checks' openings: %d outputs differ", bad);
 
