@@ -51,6 +51,7 @@
 #include "hyd_valve.h"
 
 #include <float.h>
+#include <math.h>
 #include <string.h>
 
 // The records of type t and how many there are.
@@ -202,7 +203,9 @@ void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fa
         L->VAmin[l] = HYD_CYL_VMIN(y->VA0), L->VBmin[l] = HYD_CYL_VMIN(y->VB0);
         L->CL[l] = y->CL, L->bv[l] = y->bv;
         L->Fc[l] = y->Fc, L->Fs[l] = y->Fs, L->vst[l] = y->vst, L->vsm[l] = y->vsm;
-        L->seal |= y->Fc != 0.0 || y->Fs != 0.0;
+        L->seal_l[l] = y->Fc != 0.0 || y->Fs != 0.0;
+        set_mask(&L->seal_m[l], L->seal_l[l]);
+        L->seal |= L->seal_l[l];
     }
     if (sh[0].a != L->node[2 * LSK_LS] || sh[0].b != L->node[2 * LSK_LS + 1]) return;
     // Every slot a distinct volume node (nvol == LSK_NSLOT: then every volume
@@ -460,17 +463,34 @@ int hyd_fast_ls_eval(const hyd_fast_ls* L, const hyd_model* m, hyd_data* d, cons
     const double npl = ((spl + qpump) - qcs[0]) - qcs[1];
     const double nll = sll + fls[2];
 
-    // Cylinders: force with no stop touched (both stop forces +0.0), then the
-    // seal friction lane by lane (subtracted after, as the loops do).
-    double F[2];
-    _mm_storeu_pd(F, HYD_CYL_FORCE(AA, AB, ld(L->bv), P[LSK_CA], P[LSK_CB], vs, z, z));
+    // Cylinders: force with no stop touched (both stop forces +0.0), less the
+    // seal friction (hyd_cyl_seal's algebra in the lanes, exp and tanh lane
+    // by lane; a cylinder without it subtracts +0.0 with dseal +0.0, as
+    // hyd_cyl_seal returns).
+    const v2 bv = ld(L->bv);
+    v2 Fv = HYD_CYL_FORCE(AA, AB, bv, P[LSK_CA], P[LSK_CB], vs, z, z);
+    v2 dseal = z;
+    if (L->seal) {
+        const v2 r = HYD_CYL_SEAL_R(vs, ld(L->vst)), arg = HYD_CYL_SEAL_ARG(vs, ld(L->vsm));
+        double mr2[2], a[2], ex[2] = {0.0, 0.0}, th[2] = {0.0, 0.0};
+        _mm_storeu_pd(mr2, _mm_xor_pd(r, sign) * r); // -r * r
+        _mm_storeu_pd(a, arg);
+        for (int l = 0; l < 2; ++l)
+            if (L->seal_l[l]) ex[l] = exp(mr2[l]), th[l] = tanh(a[l]);
+        const v2 e = ld(L->Fs) * ld(ex), thv = ld(th);
+        const v2 mag = HYD_CYL_SEAL_MAG(ld(L->Fc), e);
+        const v2 sm = ld(L->seal_m);
+        Fv = Fv - _mm_and_pd(sm, HYD_CYL_SEAL_F(mag, thv));
+        dseal = _mm_and_pd(sm, HYD_CYL_SEAL_DFDV(mag, thv, ld(L->vsm), r, ld(L->vst), e));
+    }
+    double F[2], dFv[2];
+    _mm_storeu_pd(F, Fv);
+    _mm_storeu_pd(dFv, _mm_xor_pd(bv, sign) - dseal); // -b_v - fv_lo - fv_hi - dseal
     for (int l = 0; l < 2; ++l) {
         const int ic = L->ci[l];
-        double dseal = 0.0;
-        if (L->seal) F[l] -= hyd_cyl_seal(L->Fc[l], L->Fs[l], L->vst[l], L->vsm[l], d->cyl_v[ic], &dseal);
         d->cyl_F[ic] = F[l];
-        d->dFdx[ic] = -0.0;             // -fd_lo - fd_hi of two untouched stops
-        d->dFdv[ic] = -L->bv[l] - dseal; // -b_v - fv_lo - fv_hi - dseal
+        d->dFdx[ic] = -0.0; // -fd_lo - fd_hi of two untouched stops
+        d->dFdv[ic] = dFv[l];
         d->cyl_stop[ic] = 0;
     }
 

@@ -60,6 +60,8 @@ typedef struct hyd_fast_ls {
     double AA[2], AB[2], stroke[2], VA0[2], VB0[2], VAmin[2], VBmin[2], CL[2], bv[2];
     double Fc[2], Fs[2], vst[2], vsm[2];
     int seal;                  ///< some cylinder has seal friction
+    int seal_l[2];             ///< cylinder l has (F_c or F_s non-zero)
+    double seal_m[2];          ///< all bits set where seal_l
 } hyd_fast_ls;
 
 /// Recognise the layout on model m with the caller's state order smap and

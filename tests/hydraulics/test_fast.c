@@ -388,8 +388,9 @@ static hyd_model* ls_model(void) {
 
 // Every output hyd_fast_eval promises, bit for bit (memcmp: -0 and +0
 // differ, NaNs must have the same bits): rates at the caller's places (Y of
-// N entries, circuit state i at map[i]), cylinder forces and stops, and per
-// node p, V, dV/dt, and for the pressure nodes the net inflow and Be.
+// N entries, circuit state i at map[i]), cylinder forces and stops (and the
+// force partials both paths also write), and per node p, V, dV/dt, and for
+// the pressure nodes the net inflow and Be.
 static int same_outputs(const hyd_model* m, const hyd_data* a, const hyd_data* b, const double* fa,
                         const double* fb, int N, const char* what, int trial) {
     int bad = 0;
@@ -405,6 +406,9 @@ static int same_outputs(const hyd_model* m, const hyd_data* a, const hyd_data* b
     for (int c = 0; c < hyd_model_ncylinder(m); ++c) {
         SAME(a->cyl_F[c], b->cyl_F[c], "cyl_F", c);
         SAME(a->cyl_stop[c], b->cyl_stop[c], "cyl_stop", c);
+        // Not promised by hyd_fast_eval, but written by both paths: the same.
+        SAME(a->dFdx[c], b->dFdx[c], "dFdx", c);
+        SAME(a->dFdv[c], b->dFdv[c], "dFdv", c);
     }
     for (int nd = 0; nd < hyd_model_nnode(m); ++nd) {
         SAME(a->node_p[nd], b->node_p[nd], "node_p", nd);
