@@ -114,6 +114,7 @@ static void take_records(hyd_fast* k) {
         if (sh[i].su >= 0) sh[i].su = k->smap[sh[i].su]; // spool mode: the valve's spool
     if (k->nfb_comp) k->ls.ok = 0;
     else hyd_fast_ls_pack(m, k->smap, k->ns, &k->ls);
+    if (k->lanes == 2) hyd_fast_ls_avx(&k->ls, 0);
     k->rev = m->revision;
 }
 
@@ -594,7 +595,10 @@ void hyd_fast_eval(hyd_fast* k, hyd_data* d, const double* y, double* ydot) {
 }
 
 int hyd_fast_lanes(hyd_fast* k, int on) {
-    if (on >= 0) k->lanes = on != 0;
+    if (on >= 0) {
+        k->lanes = on == 2 ? 2 : on != 0;
+        if (k->ls.ok) hyd_fast_ls_avx(&k->ls, on != 2);
+    }
     return k->ls.ok;
 }
 

@@ -49,8 +49,10 @@ int hyd_fast_nfallback(const hyd_fast* k);
 /// assets/models/hiab031_ls.json) has a one-pass evaluation with its two
 /// sections in two SSE2 lanes, bit for bit the loops' (circuit_fast_ls.c);
 /// hyd_fast_eval takes it whenever no end stop is touched and every pressure
-/// is on the Be table. on = 0 switches it off, 1 on (the default), < 0
-/// leaves it. Returns 1 when the circuit has that layout.
+/// is on the Be table (in AVX form where the CPU has it, else SSE2; the
+/// same values). on = 0 switches it off, 1 on (the default), 2 on in its
+/// SSE2 form even with AVX (for tests), < 0 leaves it. Returns 1 when the
+/// circuit has that layout.
 int hyd_fast_lanes(hyd_fast* k, int on);
 /// Evaluations the one-pass layout path has taken so far.
 unsigned long hyd_fast_lanes_count(const hyd_fast* k);

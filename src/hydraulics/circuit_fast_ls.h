@@ -60,6 +60,7 @@ typedef struct hyd_fast_ls {
     double AA[2], AB[2], stroke[2], VA0[2], VB0[2], VAmin[2], VBmin[2], CL[2], bv[2];
     double Fc[2], Fs[2], vst[2], vsm[2];
     int seal;                  ///< some cylinder has seal friction
+    int avx;                   ///< take the AVX form of the kernel (hyd_fast_ls_avx)
     int seal_l[2];             ///< cylinder l has (F_c or F_s non-zero)
     double seal_m[2];          ///< all bits set where seal_l
 } hyd_fast_ls;
@@ -68,6 +69,10 @@ typedef struct hyd_fast_ls {
 /// node states ns (hyd_fast's), and pack it into L; L->ok = 0 when m is of any
 /// other shape (or the air tables are off, or SSE2 is missing).
 void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fast_ls* L);
+
+/// Take the AVX form of the one-pass kernel (on, and the CPU has AVX) or the
+/// SSE2 form; the same values bit for bit. hyd_fast_ls_pack chooses AVX.
+void hyd_fast_ls_avx(hyd_fast_ls* L, int on);
 
 /// hyd_fast_eval on the layout in one pass. Returns 0 without writing
 /// anything when the state is not the common case (an end stop touched, a

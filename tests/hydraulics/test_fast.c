@@ -445,16 +445,19 @@ static void test_ls_lanes(void) {
     if (!map || !y || !Y || !fa || !fb || !da || !db) return;
     for (int i = 0; i < n; ++i) map[i] = N - 1 - 2 * i;
     int bad = 0;
-    for (int mapped = 0; mapped < 2; ++mapped) {
+    // Pass 0: circuit order; 1: mapped; 2: circuit order, the kernel's
+    // SSE2 form (passes 0 and 1 take its AVX form where the CPU has AVX).
+    for (int pass = 0; pass < 3; ++pass) {
+        const int mapped = pass == 1;
         hyd_fast* ka = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
         hyd_fast* kb = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
         CHECK(ka && kb, "LS crane: fast kernel refused: %s", why);
         if (!ka || !kb) return;
         if (mapped) CHECK(hyd_fast_map(ka, map) == 0 && hyd_fast_map(kb, map) == 0, "map refused");
-        CHECK(hyd_fast_lanes(ka, -1) == 1, "the LS crane layout is not recognised");
+        CHECK(hyd_fast_lanes(ka, pass == 2 ? 2 : -1) == 1, "the LS crane layout is not recognised");
         hyd_fast_lanes(kb, 0);
         const int M = mapped ? N : n;
-        const char* what = mapped ? "LS lanes, mapped" : "LS lanes";
+        const char* what = pass == 2 ? "LS lanes, SSE2 form" : mapped ? "LS lanes, mapped" : "LS lanes";
         // Regimes seen on the lane path: [0] a chamber's relief or check
         // open, [1] a spool negative (the valve reversed), [2] a pressure
         // below 2 kPa (Be near its floor).
