@@ -57,17 +57,20 @@
 // The records of type t and how many there are.
 #define RECS(m, t, T) ((const T*)(m)->rec[t])
 
-static void set_mask(double* d, int on) {
-    const uint64_t b = on ? ~0ull : 0ull;
-    memcpy(d, &b, sizeof b);
-}
-
 #if defined(__SSE2__) && defined(__GNUC__)
 #define LSK_LANES 1
 #if defined(__x86_64__)
 #define LSK_AVX 1 // an AVX form of the kernel, taken when the CPU has AVX
 #endif
 #endif
+
+// The pack's helpers (the lanes only: without SSE2 the layout is never taken).
+#ifdef LSK_LANES
+static void set_mask(double* d, int on) {
+    const uint64_t b = on ? ~0ull : 0ull;
+    memcpy(d, &b, sizeof b);
+}
+
 
 // Doubles in order as integers (for the bisection below): a monotone map of
 // the finite doubles onto int64.
@@ -127,6 +130,8 @@ static int ramp_bound(const hyd_fast_ls_ramp* r, int relief, double* b) {
 #undef MID
     return 1;
 }
+
+#endif
 
 void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fast_ls* L) {
     memset(L, 0, sizeof *L);
