@@ -11,6 +11,7 @@
 //   6. per pressure node ydot = c (net - dV/dt), and the diagonal term
 //      dBe/dp / V (net - dV/dt)
 #include "circuit_fast.h"
+#include "circuit_fast_ls.h"
 
 #include "hyd_accumulator.h"
 #include "hyd_compensator.h"
@@ -58,6 +59,12 @@ struct hyd_fast {
         int node, s;
         double bel, bec; ///< liquid modulus, air weight [Pa] (hyd_model node_bel, node_bec)
     } * pn;
+    /// The load-sensing crane layout in one pass (circuit_fast_ls.c), when
+    /// recognised and not switched off (hyd_fast_lanes); nls counts the
+    /// evaluations it took.
+    hyd_fast_ls ls;
+    int lanes;
+    unsigned long nls;
 };
 
 unsigned hyd_fast_types(void) {
@@ -105,6 +112,9 @@ static void take_records(hyd_fast* k) {
     hyd_shuttle_c* sh = k->rec[HYD_SHUTTLE];
     for (int i = 0; i < k->nrec[HYD_SHUTTLE]; ++i)
         if (sh[i].su >= 0) sh[i].su = k->smap[sh[i].su]; // spool mode: the valve's spool
+    if (k->nfb_comp) k->ls.ok = 0;
+    else hyd_fast_ls_pack(m, k->smap, k->ns, &k->ls);
+    if (k->lanes == 2) hyd_fast_ls_avx(&k->ls, 0);
     k->rev = m->revision;
 }
 
@@ -167,6 +177,7 @@ hyd_fast* hyd_fast_create(const hyd_model* m, unsigned types, int fallback, char
     }
     for (int i = 0; i < m->nstate; ++i) k->smap[i] = i;
     k->perm = 1;
+    k->lanes = 1;
     memcpy(k->ns, m->node_state, (size_t)m->nnode * sizeof *k->ns);
     take_records(k);
     return k;
@@ -408,8 +419,8 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
         double a1, a2;
         const double target = hyd_ls_pump_target(c, p[c->in], p[c->out], p[c->ls], &a1, &a2);
         const double eps = y[c->adr];
-        ydot[c->adr] = (target - eps) * c->inv_tau;
-        const double q = eps * c->qmax; // no pressure partial: delivery is eps q_max
+        ydot[c->adr] = HYD_LS_PUMP_RATE(target, eps, c->inv_tau);
+        const double q = HYD_LS_PUMP_Q(eps, c->qmax); // no pressure partial: delivery is eps q_max
         k->net[c->in] -= q;
         k->net[c->out] += q;
         if (J) {
@@ -564,9 +575,34 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
     }
 }
 
-void hyd_fast_eval(hyd_fast* k, hyd_data* d, const double* y, double* ydot) {
+// The plain evaluation by the loops, out of line: inlined into
+// hyd_fast_eval its prologue (the loops' registers and stack) ran before the
+// one-pass path could return, about 30 instructions per evaluation.
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static void eval_loops(hyd_fast* k, hyd_data* d, const double* y, double* ydot) {
     run(k, d, y, ydot, NULL, 0);
 }
+
+void hyd_fast_eval(hyd_fast* k, hyd_data* d, const double* y, double* ydot) {
+    if (k->rev != k->m->revision) take_records(k);
+    if (k->ls.ok && k->lanes && hyd_fast_ls_eval(&k->ls, k->m, d, y, ydot)) {
+        ++k->nls;
+        return;
+    }
+    eval_loops(k, d, y, ydot);
+}
+
+int hyd_fast_lanes(hyd_fast* k, int on) {
+    if (on >= 0) {
+        k->lanes = on == 2 ? 2 : on != 0;
+        if (k->ls.ok) hyd_fast_ls_avx(&k->ls, on != 2);
+    }
+    return k->ls.ok;
+}
+
+unsigned long hyd_fast_lanes_count(const hyd_fast* k) { return k->nls; }
 
 void hyd_fast_jacobian(hyd_fast* k, hyd_data* d, const double* y, double* ydot, double* J, int ldj) {
     const hyd_model* m = k->m;

@@ -44,6 +44,19 @@ int hyd_fast_map(hyd_fast* k, const int* map);
 /// Components evaluated by their reference loop.
 int hyd_fast_nfallback(const hyd_fast* k);
 
+/// The load-sensing crane layout (an LS pump, LS shuttle and two
+/// compensated sections with counterbalance valves, as
+/// assets/models/hiab031_ls.json) has a one-pass evaluation with its two
+/// sections in two SSE2 lanes, bit for bit the loops' (circuit_fast_ls.c);
+/// hyd_fast_eval takes it whenever no end stop is touched and every pressure
+/// is on the Be table (in AVX form where the CPU has it, else SSE2; the
+/// same values). on = 0 switches it off, 1 on (the default), 2 on in its
+/// SSE2 form even with AVX (for tests), < 0 leaves it. Returns 1 when the
+/// circuit has that layout.
+int hyd_fast_lanes(hyd_fast* k, int on);
+/// Evaluations the one-pass layout path has taken so far.
+unsigned long hyd_fast_lanes_count(const hyd_fast* k);
+
 /// ydot = f(y) as hyd_eval, with the inputs in d. Fills d->cyl_F, cyl_stop,
 /// node_p, node_V, node_dV, node_q and node_be (not comp_q or comp_open).
 void hyd_fast_eval(hyd_fast* k, hyd_data* d, const double* y, double* ydot);

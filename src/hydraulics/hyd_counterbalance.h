@@ -14,6 +14,17 @@ typedef struct hyd_cb_c {
     hyd_orif_k ok;
 } hyd_cb_c;
 
+/// The opening signal z [Pa] = (p_l - p_r) + R (p_p - p_r) - p_setting and
+/// the net flow valve -> load (check path qc less relief path qr), + - *
+/// only: one text for a double and the two lanes of circuit_fast_ls.c (the
+/// spool lag is hyd_compensator.h's HYD_LAG_RATE, the paths hyd_ramp.h's and
+/// hyd_orifice.h's laws).
+#define HYD_CB_Z(pl, pr, R, pp, pset) (((pl) - (pr)) + (R) * ((pp) - (pr)) - (pset))
+#define HYD_CB_Q(qc, qr) ((qc) - (qr))
+#ifndef HYD_LAG_RATE
+#define HYD_LAG_RATE(xt, x, inv_tau) (((xt) - (x)) * (inv_tau))
+#endif
+
 /// The valve at spool x [-] and valve, load, pilot pressures [Pa].
 typedef struct hyd_cb_flow {
     double q;        ///< net flow valve -> load [m^3/s]
@@ -29,16 +40,16 @@ static inline void hyd_cb_law(const hyd_cb_c* c, double x, double pv, double pl,
     double ds;
     // The spring chamber's pressure p_r: the valve port, or the drain it is vented to.
     const double pr = c->pvent < 0.0 ? pv : c->pvent;
-    const double z = (pl - pr) + c->R * (pp - pr) - c->pset;
+    const double z = HYD_CB_Z(pl, pr, c->R, pp, c->pset);
     const double xt = hyd_smoothstep(z * c->inv_band, &ds);
-    o->xdot = (xt - x) * c->inv_tau;
+    o->xdot = HYD_LAG_RATE(xt, x, c->inv_tau);
     double gc, tc;
     const double qc = hyd_ramp_q(c->ccr, c->inv_cw, c->cq, pv - pl, &gc, &tc);
     // A spool a rounding error below 0 is closed (the lag cannot leave [0, 1]).
     const double xo = x > 0.0 ? x : 0.0;
     double gr, gA;
     const double qr = hyd_orifice_q(&c->ok, c->A * xo, pl - pv, &gr, &gA);
-    o->q = qc - qr;
+    o->q = HYD_CB_Q(qc, qr);
     o->open = qr != 0.0 || tc > 0.0;
     o->dqv = gc + gr;
     o->dqx = x > 0.0 ? -gA * c->A : 0.0;

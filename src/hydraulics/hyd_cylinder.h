@@ -74,6 +74,17 @@ static inline double hyd_cyl_force(double AA, double AB, double bv, double ks, d
     return HYD_CYL_FORCE(AA, AB, bv, pA, pB, v, flo, fhi);
 }
 
+/// The seal friction's algebra as expressions of + - * / only (one text for
+/// a double and the two lanes of circuit_fast_ls.c; exp and tanh stay the
+/// libm functions, called lane by lane): the Stribeck ratio r = v / v_st and
+/// the regularisation argument v / v_sm, the magnitude F_c + F_s exp(-r^2)
+/// from e = F_s exp(-r^2), the force, and its rate partial.
+#define HYD_CYL_SEAL_R(v, vst) ((v) / (vst))
+#define HYD_CYL_SEAL_ARG(v, vsm) ((v) / (vsm))
+#define HYD_CYL_SEAL_MAG(Fc, e) ((Fc) + (e))
+#define HYD_CYL_SEAL_F(mag, th) ((mag) * (th))
+#define HYD_CYL_SEAL_DFDV(mag, th, vsm, r, vst, e) ((mag) * (1.0 - (th) * (th)) / (vsm) - 2.0 * (r) / (vst) * (e) * (th))
+
 /// Seal friction [N] (Coulomb + Stribeck, opposing x'), smooth through zero:
 ///   F_seal = (F_c + F_s exp(-(v/v_st)^2)) tanh(v/v_sm)
 /// F_c Coulomb [N], F_s breakaway excess [N] (static force F_c + F_s),
@@ -85,11 +96,11 @@ static inline double hyd_cyl_seal(double Fc, double Fs, double vst, double vsm, 
         *dFdv = 0.0;
         return 0.0;
     }
-    const double r = v / vst, e = Fs * exp(-r * r), th = tanh(v / vsm);
-    const double mag = Fc + e;
+    const double r = HYD_CYL_SEAL_R(v, vst), e = Fs * exp(-r * r), th = tanh(HYD_CYL_SEAL_ARG(v, vsm));
+    const double mag = HYD_CYL_SEAL_MAG(Fc, e);
     // d/dv: mag (1 - th^2)/v_sm + th dmag/dv, dmag/dv = -2 r e / v_st.
-    *dFdv = mag * (1.0 - th * th) / vsm - 2.0 * r / vst * e * th;
-    return mag * th;
+    *dFdv = HYD_CYL_SEAL_DFDV(mag, th, vsm, r, vst, e);
+    return HYD_CYL_SEAL_F(mag, th);
 }
 
 #endif

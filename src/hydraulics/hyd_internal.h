@@ -486,6 +486,11 @@ static inline void hyd_state_row_from_G(const hyd_model* m, const hyd_data* d, i
     memcpy(Jb + (size_t)s * ldj, d->scratch_ + (size_t)s * (n + 1), (size_t)n * sizeof(double));
 }
 
+/// The smoothstep's cubic t^2 (3 - 2t) (+ - * only: one text for a double and
+/// the two lanes of circuit_fast_ls.c). On t clamped to [0, 1] it is
+/// hyd_smoothstep bit for bit: 0 (also for t = -0) and 1 at the clamps.
+#define HYD_SMOOTHSTEP_POLY(t) ((t) * (t) * (3.0 - 2.0 * (t)))
+
 /// C1 smoothstep s(t) = 3t^2 - 2t^3 on [0,1], 0 below, 1 above; *ds = ds/dt.
 static inline double hyd_smoothstep(double t, double* ds) {
     if (t <= 0.0) {
@@ -497,7 +502,7 @@ static inline double hyd_smoothstep(double t, double* ds) {
         return 1.0;
     }
     *ds = 6.0 * t * (1.0 - t);
-    return t * t * (3.0 - 2.0 * t);
+    return HYD_SMOOTHSTEP_POLY(t);
 }
 
 

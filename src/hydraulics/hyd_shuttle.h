@@ -14,6 +14,13 @@ typedef struct hyd_shuttle_c {
     double inv_uw; ///< 1 / spool_width [-]
 } hyd_shuttle_c;
 
+/// Spool mode as expressions of + - * only, one text for a double and the
+/// two lanes of circuit_fast_ls.c: the share of the tank port left by the
+/// work ports' shares wa, wb, and the flow from port k at pk into out at po
+/// through share w of G.
+#define HYD_SHUTTLE_WT(wa, wb) (1.0 - (wa) - (wb))
+#define HYD_SHUTTLE_QK(G, w, pk, po) ((G) * (w) * ((pk) - (po)))
+
 /// C1 max of pa, pb with corner half-width w; *sa = d smax / d pa.
 static inline double hyd_shuttle_smax(double pa, double pb, double w, double* sa) {
     const double dd = pa - pb;
@@ -55,7 +62,7 @@ static inline void hyd_shuttle_shares(const hyd_shuttle_c* c, double u, double w
     double dsa, dsb;
     const double wa = hyd_smoothstep(u * c->inv_uw, &dsa);
     const double wb = hyd_smoothstep(-u * c->inv_uw, &dsb);
-    w[0] = wa, w[1] = wb, w[2] = 1.0 - wa - wb;
+    w[0] = wa, w[1] = wb, w[2] = HYD_SHUTTLE_WT(wa, wb);
     if (dw) dw[0] = dsa * c->inv_uw, dw[1] = -dsb * c->inv_uw, dw[2] = (dsb - dsa) * c->inv_uw;
 }
 
@@ -76,7 +83,7 @@ static inline void hyd_shuttle_flows(const hyd_shuttle_c* c, double u, double pa
     f[0] = f[1] = f[2] = f[3] = 0.0;
     static const int slot[3] = {0, 1, 3};
     for (int k = 0; k < 3; ++k) {
-        const double q = c->G * w[k] * (pk[k] - po); // port k -> out
+        const double q = HYD_SHUTTLE_QK(c->G, w[k], pk[k], po); // port k -> out
         f[slot[k]] -= q, f[2] += q;
     }
 }
@@ -109,7 +116,7 @@ static inline void hyd_shuttle_law(const hyd_shuttle_c* c, double u, double pa, 
     static const int slot[3] = {0, 1, 3};
     for (int k = 0; k < 3; ++k) {
         const double gk = c->G * w[k];
-        const double q = gk * (pk[k] - po); // port k -> out
+        const double q = HYD_SHUTTLE_QK(c->G, w[k], pk[k], po); // port k -> out (gk (pk - po))
         const double qu = c->G * dw[k] * (pk[k] - po);
         const int s = slot[k];
         o->f[s] -= q, o->f[2] += q;

@@ -51,8 +51,8 @@ static void ls_pumps_eval(const hyd_model* m, hyd_data* d, const void* rec, int 
         double a1, a2; // d e_ls e_co / d(p_out - p_ls), d(p_out - p_in)
         const double target = hyd_ls_pump_target(c, pin, pout, pls, &a1, &a2);
         if (ydot)
-            ydot[at] = (target - eps) * c->inv_tau;
-        const double q = eps * c->qmax;
+            ydot[at] = HYD_LS_PUMP_RATE(target, eps, c->inv_tau);
+        const double q = HYD_LS_PUMP_Q(eps, c->qmax);
         d->comp_q[2 * c->comp] = q;
         d->comp_open[c->comp] = target < 1.0;
         double* fl = d->flow_ + HYD_MAXSLOT * c->comp;

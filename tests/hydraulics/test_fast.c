@@ -372,6 +372,234 @@ static void test_off_table(void) {
     hyd_model_free(m);
 }
 
+// The shipped LS crane's model (quiet: its load notes are not under test).
+static hyd_model* ls_model(void) {
+    static const char* const path = HYD_ASSETS "/models/hiab031_ls.json";
+    char err[512];
+    cJSON* mj = read_json(path);
+    cJSON* h = mj ? cJSON_GetObjectItemCaseSensitive(mj, "hydraulics") : NULL;
+    hyd_set_note_handler(quiet, NULL);
+    hyd_model* m = h ? hyd_model_from_json(h, path, "hydraulics", err, sizeof err) : NULL;
+    hyd_set_note_handler(NULL, NULL);
+    cJSON_Delete(mj);
+    CHECK(m != NULL, "%s: %s", path, err);
+    return m;
+}
+
+// Every output hyd_fast_eval promises, bit for bit (memcmp: -0 and +0
+// differ, NaNs must have the same bits): rates at the caller's places (Y of
+// N entries, circuit state i at map[i]), cylinder forces and stops (and the
+// force partials both paths also write), and per node p, V, dV/dt, and for
+// the pressure nodes the net inflow and Be.
+static int same_outputs(const hyd_model* m, const hyd_data* a, const hyd_data* b, const double* fa,
+                        const double* fb, int N, const char* what, int trial) {
+    int bad = 0;
+#define SAME(x, y, name, i)                                                                               \
+    do {                                                                                                  \
+        if (memcmp(&(x), &(y), sizeof(x))) {                                                              \
+            if (bad++ < 3)                                                                                \
+                fprintf(stderr, "%s trial %d: %s[%d] lanes %.17g loops %.17g\n", what, trial, name, i,    \
+                        (double)(x), (double)(y));                                                        \
+        }                                                                                                 \
+    } while (0)
+    for (int i = 0; i < N; ++i) SAME(fa[i], fb[i], "ydot", i);
+    for (int c = 0; c < hyd_model_ncylinder(m); ++c) {
+        SAME(a->cyl_F[c], b->cyl_F[c], "cyl_F", c);
+        SAME(a->cyl_stop[c], b->cyl_stop[c], "cyl_stop", c);
+        // Not promised by hyd_fast_eval, but written by both paths: the same.
+        SAME(a->dFdx[c], b->dFdx[c], "dFdx", c);
+        SAME(a->dFdv[c], b->dFdv[c], "dFdv", c);
+    }
+    for (int nd = 0; nd < hyd_model_nnode(m); ++nd) {
+        SAME(a->node_p[nd], b->node_p[nd], "node_p", nd);
+        SAME(a->node_V[nd], b->node_V[nd], "node_V", nd);
+        SAME(a->node_dV[nd], b->node_dV[nd], "node_dV", nd);
+        if (hyd_model_node_state(m, nd) < 0) continue;
+        SAME(a->node_q[nd], b->node_q[nd], "node_q", nd);
+        SAME(a->node_be[nd], b->node_be[nd], "node_be", nd);
+    }
+#undef SAME
+    return bad;
+}
+
+// The LS crane's one-pass evaluation (circuit_fast_ls.c) against the fast
+// kernel's own loops (the same kernel with it switched off), bit for bit,
+// on random states in every regime: spools closed, cracking and open both
+// ways, reliefs and checks closed, on their corner and open, the anti-
+// cavitation checks at near vacuum, counterbalance valves shut and relieving,
+// strokes free and in the stops (those go to the loops); in the circuit's
+// order and in a scattered caller order (hyd_fast_map); pressures swept ulp
+// by ulp across every relief's and check's opening (the pack's closed bounds
+// are exact); after a parameter change (the records are packed again).
+// The reference loops (hyd_eval) are compared at TOL in test_ls_crane.
+static void test_ls_lanes(void) {
+    hyd_model* m = ls_model();
+    if (!m) return;
+    char why[256] = "", err[256];
+    const int n = hyd_model_nstate(m), N = 2 * n + 3;
+    int* map = malloc((size_t)n * sizeof *map);
+    double *y = calloc((size_t)n, sizeof *y), *Y = calloc((size_t)N, sizeof *Y);
+    double *fa = calloc((size_t)N, sizeof *fa), *fb = calloc((size_t)N, sizeof *fb);
+    hyd_data* da = hyd_data_create(m);
+    hyd_data* db = hyd_data_create(m);
+    if (!map || !y || !Y || !fa || !fb || !da || !db) return;
+    for (int i = 0; i < n; ++i) map[i] = N - 1 - 2 * i;
+    int bad = 0;
+    // Pass 0: circuit order; 1: mapped; 2: circuit order, the kernel's
+    // SSE2 form (passes 0 and 1 take its AVX form where the CPU has AVX).
+    for (int pass = 0; pass < 3; ++pass) {
+        const int mapped = pass == 1;
+        hyd_fast* ka = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+        hyd_fast* kb = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+        CHECK(ka && kb, "LS crane: fast kernel refused: %s", why);
+        if (!ka || !kb) return;
+        if (mapped) CHECK(hyd_fast_map(ka, map) == 0 && hyd_fast_map(kb, map) == 0, "map refused");
+        CHECK(hyd_fast_lanes(ka, pass == 2 ? 2 : -1) == 1, "the LS crane layout is not recognised");
+        hyd_fast_lanes(kb, 0);
+        const int M = mapped ? N : n;
+        const char* what = pass == 2 ? "LS lanes, SSE2 form" : mapped ? "LS lanes, mapped" : "LS lanes";
+        // Regimes seen on the lane path: [0] a chamber's relief or check
+        // open, [1] a spool negative (the valve reversed), [2] a pressure
+        // below 2 kPa (Be near its floor).
+        int seen[3] = {0, 0, 0};
+        unsigned long before = hyd_fast_lanes_count(ka);
+        int taken = 0;
+        for (int trial = 0; trial < 4 * TRIALS; ++trial) {
+            random_state(m, da, y);
+            // Mostly free strokes, so most trials take the lane path.
+            for (int c = 0; c < hyd_model_ncylinder(m); ++c) {
+                double AA, AB, s;
+                hyd_model_cylinder_geometry(m, c, &AA, &AB, &s);
+                if (rand() % 4) da->cyl_x[c] = urand(0.0, s);
+            }
+            memcpy(db->cyl_x, da->cyl_x, (size_t)hyd_model_ncylinder(m) * sizeof(double));
+            memcpy(db->cyl_v, da->cyl_v, (size_t)hyd_model_ncylinder(m) * sizeof(double));
+            memcpy(db->valve_cmd, da->valve_cmd, (size_t)hyd_model_nvalve(m) * sizeof(double));
+            for (int i = 0; i < M; ++i) Y[i] = 0.0;
+            for (int i = 0; i < n; ++i) Y[mapped ? map[i] : i] = y[i];
+            for (int i = 0; i < M; ++i) fa[i] = fb[i] = 7.0;
+            const unsigned long c0 = hyd_fast_lanes_count(ka);
+            hyd_fast_eval(ka, da, Y, fa);
+            hyd_fast_eval(kb, db, Y, fb);
+            const int lane = hyd_fast_lanes_count(ka) != c0;
+            taken += lane;
+            bad += same_outputs(m, da, db, fa, fb, M, what, trial);
+            if (!lane) continue;
+            for (int i = 0; i < n; ++i) {
+                const int node = hyd_model_state_node(m, i);
+                const char* nm = node >= 0 ? hyd_model_node_name(m, node) : "";
+                if (node >= 0 && (y[i] > 25.1e6 || y[i] < 0.5e5) && strstr(nm, "_cyl.")) seen[0] = 1;
+                if (node >= 0 && y[i] < 2e3) seen[2] = 1;
+                if (hyd_model_state_kind(m, i) == HYD_STATE_SPOOL && y[i] < -1e-3) seen[1] = 1;
+            }
+        }
+        CHECK(hyd_fast_lanes_count(ka) - before == (unsigned long)taken, "lane count off");
+        CHECK(taken > TRIALS, "%s: only %d of %d trials took the lane path", what, taken, 4 * TRIALS);
+        CHECK(seen[0] && seen[1] && seen[2], "%s: a regime was not visited (%d %d %d)", what, seen[0], seen[1],
+              seen[2]);
+        CHECK(hyd_fast_lanes_count(kb) == 0, "the switched-off kernel took the lane path");
+        hyd_fast_free(kb);
+        hyd_fast_free(ka);
+    }
+    CHECK(bad == 0, "LS lanes: %d outputs differ from the loops", bad);
+
+    // Ulp by ulp across each relief's and check's opening (p_tank + p_crack,
+    // p_tank - p_crack), on the lane path: a section's chambers, hose B and
+    // counterbalance valve side all at the swept pressure and every spool,
+    // compensator, counterbalance valve and the pump's displacement at 0, so
+    // that the chambers' reliefs or checks are their nodes' only flows (and
+    // the pump line's main relief its only one): an opening taken one ulp
+    // late or early shows in the rates. Every other pressure mid-range.
+    hyd_fast* ka = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+    hyd_fast* kb = hyd_fast_create(m, hyd_fast_types(), 0, why, sizeof why);
+    if (!ka || !kb) return;
+    hyd_fast_lanes(kb, 0);
+    static const char* const sec[2][4] = {{"lift_cyl.A", "lift_cyl.B", "lift_hose_B", "lift_cbv_A"},
+                                          {"jib_cyl.A", "jib_cyl.B", "jib_hose_B", "jib_cbv_A"}};
+    static const char* const pl[4] = {"pump_line", NULL, NULL, NULL};
+    const struct { const char* const* nodes; double edge; } sweep[5] = {
+        {sec[0], 1e5 + 25e6}, {sec[0], 1e5 - 5e4}, {sec[1], 1e5 + 25e6}, {sec[1], 1e5 - 5e4}, {pl, 1e5 + 23e6}};
+    int swept = 0, moved = 0;
+    bad = 0;
+    for (int e = 0; e < 5; ++e) {
+        int at[4] = {-1, -1, -1, -1};
+        for (int j = 0; j < 4 && sweep[e].nodes[j]; ++j) {
+            for (int nd = 0; nd < hyd_model_nnode(m); ++nd)
+                if (!strcmp(hyd_model_node_name(m, nd), sweep[e].nodes[j])) at[j] = hyd_model_node_state(m, nd);
+            CHECK(at[j] >= 0, "no pressure node %s", sweep[e].nodes[j]);
+        }
+        double f_lo = 0.0, f_hi = 0.0;
+        for (int k = -40; k <= 40; ++k) {
+            random_state(m, da, y);
+            for (int i = 0; i < n; ++i)
+                y[i] = hyd_model_state_kind(m, i) == HYD_STATE_PRESSURE ? urand(1e6, 15e6) : 0.0;
+            double p = sweep[e].edge;
+            for (int s = 0; s < (k < 0 ? -k : k); ++s) p = nextafter(p, k < 0 ? 0.0 : HUGE_VAL);
+            for (int j = 0; j < 4; ++j)
+                if (at[j] >= 0) y[at[j]] = p;
+            for (int c = 0; c < hyd_model_ncylinder(m); ++c) {
+                double AA, AB, s;
+                hyd_model_cylinder_geometry(m, c, &AA, &AB, &s);
+                da->cyl_x[c] = db->cyl_x[c] = 0.5 * s;
+                db->cyl_v[c] = da->cyl_v[c];
+            }
+            memcpy(db->valve_cmd, da->valve_cmd, (size_t)hyd_model_nvalve(m) * sizeof(double));
+            const unsigned long c0 = hyd_fast_lanes_count(ka);
+            hyd_fast_eval(ka, da, y, fa);
+            hyd_fast_eval(kb, db, y, fb);
+            swept += hyd_fast_lanes_count(ka) != c0;
+            bad += same_outputs(m, da, db, fa, fb, n, sweep[e].nodes[0], k);
+            if (k == -40) f_lo = db->node_q[hyd_model_state_node(m, at[0])];
+            if (k == 40) f_hi = db->node_q[hyd_model_state_node(m, at[0])];
+        }
+        moved += f_lo != f_hi; // the valve did open (or close) inside the sweep
+    }
+    CHECK(moved == 5, "only %d of 5 sweeps crossed an opening", moved);
+    CHECK(swept == 5 * 81, "the sweep took the lane path %d of %d times", swept, 5 * 81);
+    CHECK(bad == 0, "LS lanes at the reliefs' and checks' openings: %d outputs differ", bad);
+
+    // After a parameter change the lane path packs the new records.
+    CHECK(hyd_model_set(m, "lift_relief_A.p_crack", 12e6, err, sizeof err) == 0, "%s", err);
+    CHECK(hyd_model_set(m, "jib_cbv.pilot_ratio", 3.0, err, sizeof err) == 0, "%s", err);
+    CHECK(hyd_model_set(m, "lift_comp.setting", 3e5, err, sizeof err) == 0, "%s", err);
+    bad = 0;
+    int taken = 0;
+    for (int trial = 0; trial < TRIALS; ++trial) {
+        random_state(m, da, y);
+        for (int c = 0; c < hyd_model_ncylinder(m); ++c) {
+            double AA, AB, s;
+            hyd_model_cylinder_geometry(m, c, &AA, &AB, &s);
+            da->cyl_x[c] = db->cyl_x[c] = urand(0.0, s);
+            db->cyl_v[c] = da->cyl_v[c];
+        }
+        memcpy(db->valve_cmd, da->valve_cmd, (size_t)hyd_model_nvalve(m) * sizeof(double));
+        const unsigned long c0 = hyd_fast_lanes_count(ka);
+        hyd_fast_eval(ka, da, y, fa);
+        hyd_fast_eval(kb, db, y, fb);
+        taken += hyd_fast_lanes_count(ka) != c0;
+        bad += same_outputs(m, da, db, fa, fb, n, "after hyd_model_set", trial);
+    }
+    CHECK(taken > TRIALS / 2, "after hyd_model_set: %d of %d trials took the lane path", taken, TRIALS);
+    CHECK(bad == 0, "LS lanes after hyd_model_set: %d outputs differ", bad);
+    if (ka) compare("LS crane after hyd_model_set", m, ka);
+    hyd_fast_free(kb);
+    hyd_fast_free(ka);
+
+    // Any other layout keeps the loops: the standard crane, and the LS crane
+    // with an accumulator (a type the layout has no place for).
+    char e2[256];
+    hyd_model* sm = hyd_model_default_crane(e2, sizeof e2);
+    hyd_fast* ks = sm ? hyd_fast_create(sm, hyd_fast_types(), 0, why, sizeof why) : NULL;
+    CHECK(ks && hyd_fast_lanes(ks, -1) == 0, "the standard crane taken for the LS layout");
+    hyd_fast_free(ks);
+    hyd_model_free(sm);
+
+    hyd_data_free(db);
+    hyd_data_free(da);
+    free(fb), free(fa), free(Y), free(y), free(map);
+    hyd_model_free(m);
+}
+
 static void test_synthetic(void) {
     const int sizes[] = {1, 2, 4, 8};
     for (int s = 0; s < 4; ++s) {
@@ -542,5 +770,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_live_change);
     RUN_TEST(test_mapped);
     RUN_TEST(test_off_table);
+    RUN_TEST(test_ls_lanes);
     TEST_MAIN_END();
 }
