@@ -60,6 +60,85 @@ static int ls_unreached(const hyd_model* m) {
     return -1;
 }
 
+// Whether the signal at node n reaches node target through the LS network:
+// n is target, or a shuttle has n as its port a or b and its out reaches
+// target (a chain of shuttles, either mode). seen: nnode bytes, cleared by
+// the caller.
+static int ls_reaches(const hyd_model* m, int n, int target, unsigned char* seen) {
+    if (n == target) return 1;
+    if (n < 0 || seen[n]) return 0;
+    seen[n] = 1;
+    const int nc = hyd_model_ncomp(m);
+    for (int k = 0; k < nc; ++k) {
+        if (hyd_model_comp_type(m, k) != HYD_SHUTTLE) continue;
+        if (hyd_model_port_node(m, k, 0) != n && hyd_model_port_node(m, k, 1) != n) continue;
+        if (ls_reaches(m, hyd_model_port_node(m, k, 2), target, seen)) return 1;
+    }
+    return 0;
+}
+
+// The LS pump a section's signal must reach: the one whose outlet feeds the
+// compensator's inlet (comp >= 0), else the first LS pump; -1 when none.
+static int ls_pump_for(const hyd_model* m, int comp) {
+    const int nc = hyd_model_ncomp(m);
+    int first = -1;
+    for (int c = 0; c < nc; ++c) {
+        if (hyd_model_comp_type(m, c) != HYD_LS_PUMP) continue;
+        if (first < 0) first = c;
+        if (comp >= 0 && hyd_model_port_node(m, c, 1) == hyd_model_port_node(m, comp, 0)) return c;
+    }
+    return first;
+}
+
+// Every section's LS signal must reach the pump, not only the pump's own ls
+// node be fed (ls_unreached): a section shuttle (spool mode: the section's
+// LS port) whose out, or a compensator whose load, leads through no chain of
+// shuttles to the pump's ls node is a section the pump never senses, and it
+// stalls at the standby pressure under load. A post compensator's ref must
+// be that ls node itself: it holds p_pump - p_ref - setting across the
+// metering edge, so a ref on the tank or an orphaned node gives a drop of
+// about the whole pump pressure (no flow control at all). A pre compensator
+// (mode 0) does not use ref. Fails c with one line and returns 1, or 0.
+static int ls_section_fault(json_ctx* c, const hyd_model* m) {
+    const int nc = hyd_model_ncomp(m), nn = hyd_model_nnode(m);
+    unsigned char* seen = calloc((size_t)(nn > 0 ? nn : 1), 1);
+    if (!seen) return 0;
+    int bad = 0;
+    for (int k = 0; k < nc && !bad; ++k) {
+        const hyd_type t = hyd_model_comp_type(m, k);
+        const int spool_shuttle = t == HYD_SHUTTLE && hyd_model_port_node(m, k, 3) >= 0;
+        if (!spool_shuttle && t != HYD_COMPENSATOR) continue;
+        const int pump = ls_pump_for(m, t == HYD_COMPENSATOR ? k : -1);
+        if (pump < 0) break;
+        const int ls = hyd_model_port_node(m, pump, 2);
+        const char* lsname = hyd_model_node_name(m, ls);
+        char f[80];
+        const int sig = hyd_model_port_node(m, k, 2); // shuttle out, compensator load
+        memset(seen, 0, (size_t)nn);
+        if (!ls_reaches(m, sig, ls, seen)) {
+            snprintf(f, sizeof f, "hydraulics.components[%d].%s", k, spool_shuttle ? "out" : "load");
+            json_fail(c, f, "node '%s' leads through no shuttle to the ls node '%s' of pump '%s': the pump never senses this section's load",
+                      hyd_model_node_name(m, sig), lsname, hyd_model_comp_name(m, pump));
+            bad = 1;
+            break;
+        }
+        if (t != HYD_COMPENSATOR) continue;
+        char path[160];
+        double mode = 1.0;
+        snprintf(path, sizeof path, "%s.mode", hyd_model_comp_name(m, k));
+        hyd_model_get(m, path, &mode);
+        const int ref = hyd_model_port_node(m, k, 3);
+        if (mode != 0.0 && ref != ls) {
+            snprintf(f, sizeof f, "hydraulics.components[%d].ref", k);
+            json_fail(c, f, "must be the ls node '%s' of pump '%s' (a post compensator holds p_pump - p_ref - setting), got '%s'",
+                      lsname, hyd_model_comp_name(m, pump), hyd_model_node_name(m, ref));
+            bad = 1;
+        }
+    }
+    free(seen);
+    return bad;
+}
+
 static const json_range R_GRAVITY = {0, 30, 9.7, 9.9, "m/s^2"};
 static const json_range R_COLUMN_HEIGHT = {0.1, 10, 0.5, 4, "m"};
 static const json_range R_COLUMN_MASS = {1, 1e5, 50, 5000, "kg"};
@@ -189,6 +268,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
                       hyd_model_node_name(m->hyd, hyd_model_port_node(m->hyd, bad, 2)));
             goto fail;
         }
+        if (ls_section_fault(&c, m->hyd)) goto fail;
     }
 
     for (int k = 0; k < 2; ++k) {

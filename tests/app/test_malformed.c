@@ -31,6 +31,15 @@ typedef struct bad_case {
     const char* msg;   ///< must appear in the message too (NULL: no check)
 } bad_case;
 
+// Cases that need a second text replacement after the first (a node declared,
+// then wired in), by file name.
+static const struct {
+    const char *name, *from, *to;
+} second_edit[] = {
+    {"m_ls_orphan_out.json", "\"out\": \"lift_ls\",", "\"out\": \"lift_ls_orphan\","},
+    {"m_ls_orphan_load.json", "\"load\": \"lift_ls\",", "\"load\": \"lift_ls_orphan\","},
+};
+
 static char out_buf[16384];
 
 
@@ -50,7 +59,12 @@ static const char* make_case(const bad_case* k) {
     char base[1024];
     snprintf(base, sizeof base, "%s/%s", ASSETS, k->base);
     snprintf(path, sizeof path, "%s/%s", dir(), k->name);
-    return fixture_edit(base, path, k->set, k->from, k->to) ? NULL : path;
+    if (fixture_edit(base, path, k->set, k->from, k->to)) return NULL;
+    for (size_t i = 0; i < sizeof second_edit / sizeof second_edit[0]; ++i)
+        if (!strcmp(k->name, second_edit[i].name) &&
+            fixture_edit(path, path, NULL, second_edit[i].from, second_edit[i].to))
+            return NULL;
+    return path;
 }
 
 static const char SENTINEL[] = "t,x1\n0,0.5\nthis file must survive a refused run\n";
@@ -121,6 +135,12 @@ static void test_hard_ranges(void) { run_cases(range_cases, (int)(sizeof range_c
 
 #define ML "models/hiab031_ls.json"
 
+// A node "lift_ls_orphan" declared next to "lift_ls" (a second replacement
+// wires a section's signal into it).
+#define LS_ORPHAN_FROM "\"name\": \"lift_ls\","
+#define LS_ORPHAN_TO                                                                                                   \
+    "\"name\": \"lift_ls_orphan\", \"type\": \"volume\", \"volume\": 5e-06, \"p0\": 100000.0}, {\"name\": \"lift_ls\","
+
 // Malformed load-sensing components in the LS crane model.
 static const bad_case ls_cases[] = {
     {MODEL, "m_ls_no_port.json", ML, NULL, "\"ls\": \"ls_line\",", "", "hydraulics.components[0].ls",
@@ -135,6 +155,14 @@ static const bad_case ls_cases[] = {
     // pump's sensing port, so no load pressure reaches the pump.
     {MODEL, "m_ls_unreached.json", ML, NULL, "\"out\": \"ls_line\"", "\"out\": \"pump_line\"",
      "hydraulics.components[0].ls", "the LS network does not reach the pump"},
+    // A section whose LS signal ends in a node of its own: the pump's ls node
+    // is still fed (by the main shuttle), but never by this section.
+    {MODEL, "m_ls_orphan_out.json", ML, NULL, LS_ORPHAN_FROM, LS_ORPHAN_TO, "hydraulics.components[5].out",
+     "node 'lift_ls_orphan' leads through no shuttle to the ls node 'ls_line'"},
+    {MODEL, "m_ls_orphan_load.json", ML, NULL, LS_ORPHAN_FROM, LS_ORPHAN_TO, "hydraulics.components[3].load",
+     "node 'lift_ls_orphan' leads through no shuttle"},
+    {MODEL, "m_ls_comp_ref_tank.json", ML, NULL, "\"ref\": \"ls_line\",", "\"ref\": \"tank\",",
+     "hydraulics.components[3].ref", "must be the ls node 'ls_line' of pump 'pump'"},
 };
 
 static void test_ls_components(void) {
