@@ -264,8 +264,8 @@ static void print_energy(const sim_energy_balance* b) {
         printf(", counterbalance valves %.3f", b->group[SIM_EG_COUNTERBALANCE] * 1e-3);
     if (b->group[SIM_EG_OTHER] != 0.0) printf(", other %.3f", b->group[SIM_EG_OTHER] * 1e-3);
     printf(")\n  energy: released by displaced fluid %.3f kJ; work on mechanics %.3f kJ; stored in the fluid %+.3f "
-           "kJ; residual %.3f %%\n",
-           b->expansion * 1e-3, b->work * 1e-3, b->stored * 1e-3, b->residual_pct);
+           "kJ; residual %.3f %% of %.3f kJ turned over\n",
+           b->expansion * 1e-3, b->work * 1e-3, b->stored * 1e-3, b->residual_pct, b->turnover * 1e-3);
     if (isfinite(b->mech))
         printf("  energy: mechanics (kinetic + potential) %+.3f kJ, so %.3f kJ of the work went to friction, end "
                "stops and joints\n",

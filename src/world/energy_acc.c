@@ -243,7 +243,20 @@ void sim_energy_result(const sim_energy* e, sim_energy_balance* b) {
     b->stored = es1 - e->es0;
     b->expansion = b->group[SIM_EG_EXPANSION];
     b->residual = b->in - b->loss - b->expansion - b->work - b->stored;
-    b->residual_pct = b->in != 0.0 ? 100.0 * b->residual / b->in : 0.0;
+    // Normalised by the energy turned over, not by "in": with the pump near
+    // standby (hold, a burst line) the fluid's energy comes from the loads
+    // sinking (work < 0) and its stored energy, and "in" can be near 0 or
+    // negative, so 1 J over 5 J in read 17 %. Each term of the balance is a
+    // source (in > 0, or loss, X, work, stored < 0) or a sink; the turnover
+    // is the larger of the two sums (they differ by the residual).
+    const double terms[5] = {b->in, -b->loss, -b->expansion, -b->work, -b->stored};
+    double src = 0.0, snk = 0.0;
+    for (int k = 0; k < 5; ++k) {
+        if (terms[k] > 0.0) src += terms[k];
+        else snk -= terms[k];
+    }
+    b->turnover = fmax(src, snk);
+    b->residual_pct = b->turnover > 0.0 ? 100.0 * b->residual / b->turnover : 0.0;
     b->mech = e->em1 - e->em0;
     b->t0 = e->t0;
     b->t1 = e->tprev;

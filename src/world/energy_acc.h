@@ -89,7 +89,9 @@ typedef struct sim_energy_balance {
     double stored;     ///< change of the fluid's compression energy, from the end states (state function)
     double stored_rate;///< the same from the integrated rate (for comparison)
     double residual;   ///< in - loss - expansion - work - stored
-    double residual_pct; ///< 100 residual / in
+    double turnover;   ///< energy turned over: the larger of the sources' and the sinks' sums of the terms
+                       ///< in, -loss, -expansion, -work, -stored (each counted on the side its sign gives)
+    double residual_pct; ///< 100 residual / turnover
     double mech;       ///< change of the mechanics' energy (kinetic + potential); NAN when unknown
     double t0, t1;     ///< the samples' first and last time [s]
     long samples;

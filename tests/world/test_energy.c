@@ -13,7 +13,8 @@
 
 // The run's balance on scenario scen with model file model_file in
 // assets/models (NULL: the default crane).
-static void run_balance_of(const char* model_file, const char* scen, sim_mechanics mech, sim_energy_balance* b) {
+static void run_balance_with(const char* model_file, const char* scen, sim_mechanics mech, hyd_method solver,
+                             sim_energy_balance* b) {
     scenario sc;
     memset(b, 0, sizeof *b);
     model* m = NULL;
@@ -32,6 +33,7 @@ static void run_balance_of(const char* model_file, const char* scen, sim_mechani
     if (!m) return;
     sim_opts o = sim_default_opts();
     o.mechanics = mech;
+    o.solver = solver;
     o.world = CRANESIM_ASSETS "/worlds/validation.json";
     sim_energy* en = sim_energy_create();
     CHECK(en != NULL, "out of memory");
@@ -40,6 +42,10 @@ static void run_balance_of(const char* model_file, const char* scen, sim_mechani
     sim_energy_result(en, b);
     sim_energy_free(en);
     model_free(m);
+}
+
+static void run_balance_of(const char* model_file, const char* scen, sim_mechanics mech, sim_energy_balance* b) {
+    run_balance_with(model_file, scen, mech, sim_default_opts().solver, b);
 }
 
 static void run_balance(const char* scen, sim_mechanics mech, sim_energy_balance* b) {
@@ -124,7 +130,45 @@ static void test_overload_balance(void) {
     }
 }
 
+// Runs whose pump delivers almost nothing: the fluid's energy comes from the
+// loads sinking (work < 0), and "in" is a few J or negative. The residual is
+// a share of the energy turned over (docs/energy.md); over "in" it read
+// -6.4 % on hose_burst (2 J of 13 kJ turned over) and 17 % on the LS
+// crane's hold. The turnover is checked against its definition (the larger
+// of the sources' and the sinks' sums) from the terms themselves.
+static void test_low_input_balance(void) {
+    static const struct {
+        const char *model, *scen;
+        hyd_method solver;
+    } cases[] = {
+        {NULL, "hose_burst", HYD_KRUS},
+        {"hiab031_ls.json", "hose_burst", HYD_KRUS},
+        // Krus 0.1 ms leaves 0.86 J of the LS standby's start transient in
+        // the residual (2.7 % of 32 J; docs/energy.md): ROS34PW2 resolves it.
+        {"hiab031_ls.json", "hold", HYD_ROS34PW2},
+        {"hiab031_ls.json", "hose_burst_line", HYD_ROS34PW2},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        sim_energy_balance b;
+        run_balance_with(cases[i].model, cases[i].scen, SIM_LAGRANGE, cases[i].solver, &b);
+        char name[96];
+        snprintf(name, sizeof name, "%s %s", cases[i].model ? cases[i].model : "hiab031.json", cases[i].scen);
+        print_balance(name, &b);
+        CHECK(fabs(b.in) < 0.2 * fabs(b.work), "%s: in %g J, work %g J: not a low-input run", name, b.in, b.work);
+        const double src = fmax(b.in, 0) + fmax(-b.loss, 0) + fmax(-b.expansion, 0) + fmax(-b.work, 0) +
+                           fmax(-b.stored, 0);
+        const double snk = fmax(-b.in, 0) + fmax(b.loss, 0) + fmax(b.expansion, 0) + fmax(b.work, 0) +
+                           fmax(b.stored, 0);
+        CHECK(fabs(b.turnover - fmax(src, snk)) <= 1e-9 * b.turnover, "%s: turnover %g J, sources %g J, sinks %g J",
+              name, b.turnover, src, snk);
+        CHECK(fabs(src - snk - b.residual) <= 1e-9 * b.turnover, "%s: sources - sinks %g J, residual %g J", name,
+              src - snk, b.residual);
+        CHECK(fabs(b.residual_pct) < 1.0, "%s: residual %.3f %% of the energy turned over", name, b.residual_pct);
+    }
+}
+
 int main(void) {
+    test_low_input_balance();
     test_ramp_balance();
     test_ls_ramp_balance();
     test_ls_uses_less();
