@@ -268,10 +268,13 @@ static void print_energy(const sim_energy* en, const sim_energy_balance* b) {
            b->group[SIM_EG_VALVE_OUT] * 1e-3, b->group[SIM_EG_RELIEF] * 1e-3, b->group[SIM_EG_CHECK] * 1e-3,
            b->group[SIM_EG_ORIFICE] * 1e-3, b->group[SIM_EG_HOSE] * 1e-3, b->group[SIM_EG_LEAK] * 1e-3);
     // The load-sensing components' groups, only where the circuit has them.
-    if (b->group[SIM_EG_COMPENSATOR] != 0.0) printf(", compensators %.3f", b->group[SIM_EG_COMPENSATOR] * 1e-3);
-    if (b->group[SIM_EG_COUNTERBALANCE] != 0.0)
+    // (whenever it has them, also at exactly 0: a counterbalance valve that
+    // stayed shut on hold is a result, not a missing group).
+    if (group_columns(en, SIM_EG_COMPENSATOR))
+        printf(", compensators %.3f", b->group[SIM_EG_COMPENSATOR] * 1e-3);
+    if (group_columns(en, SIM_EG_COUNTERBALANCE))
         printf(", counterbalance valves %.3f", b->group[SIM_EG_COUNTERBALANCE] * 1e-3);
-    if (b->group[SIM_EG_OTHER] != 0.0) printf(", other %.3f", b->group[SIM_EG_OTHER] * 1e-3);
+    if (group_columns(en, SIM_EG_OTHER)) printf(", other %.3f", b->group[SIM_EG_OTHER] * 1e-3);
     printf(")\n  energy: released by displaced fluid %.3f kJ; work on mechanics %.3f kJ; stored in the fluid %+.3f kJ",
            b->expansion * 1e-3, b->work * 1e-3, (b->stored - b->gas) * 1e-3);
     if (has_gas) printf(", in accumulator gas %+.3f kJ", b->gas * 1e-3);
