@@ -5,6 +5,7 @@
 #include "hydraulics.h"
 #include "json_util.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -139,6 +140,57 @@ static int ls_section_fault(json_ctx* c, const hyd_model* m) {
     return bad;
 }
 
+static double comp_param(const hyd_model* m, int comp, const char* field) {
+    char path[160];
+    double v = NAN;
+    snprintf(path, sizeof path, "%s.%s", hyd_model_comp_name(m, comp), field);
+    hyd_model_get(m, path, &v);
+    return v;
+}
+
+// Parameter sets that are each in range but do not fit together, as notes
+// (the run goes on): a relief on a LS pump's outlet that cracks below the
+// pump's cut-off plus its band opens before the pump destrokes and burns the
+// whole delivery at the relief (the cut-off is there to make that
+// unnecessary); a post compensator whose setting is not below the pump's
+// margin leaves its metering edge margin - setting <= 0, so the section
+// gives no flow however far the spool opens.
+static void ls_param_notes(json_ctx* c, const hyd_model* m) {
+    const int nc = hyd_model_ncomp(m);
+    for (int p = 0; p < nc; ++p) {
+        if (hyd_model_comp_type(m, p) != HYD_LS_PUMP) continue;
+        const int out = hyd_model_port_node(m, p, 1);
+        const double cut = comp_param(m, p, "p_cutoff"), band = comp_param(m, p, "cutoff_band");
+        const double margin = comp_param(m, p, "margin");
+        for (int k = 0; k < nc; ++k) {
+            char f[80], a[24], b[24], d[24];
+            const hyd_type t = hyd_model_comp_type(m, k);
+            if (t == HYD_RELIEF && hyd_model_port_node(m, k, 0) == out) {
+                const double crack = comp_param(m, k, "p_crack");
+                if (!(crack < cut + band)) continue;
+                snprintf(f, sizeof f, "hydraulics.components[%d].p_crack", k);
+                hyd_fmt_num(a, sizeof a, crack);
+                hyd_fmt_num(b, sizeof b, cut);
+                hyd_fmt_num(d, sizeof d, band);
+                json_note(c, f,
+                          "%s Pa is below the cut-off of LS pump '%s' plus its band (%s + %s Pa): the relief opens "
+                          "before the pump destrokes and burns its delivery",
+                          a, hyd_model_comp_name(m, p), b, d);
+            } else if (t == HYD_COMPENSATOR && hyd_model_port_node(m, k, 0) == out && comp_param(m, k, "mode") != 0.0) {
+                const double set = comp_param(m, k, "setting");
+                if (!(set >= margin)) continue;
+                snprintf(f, sizeof f, "hydraulics.components[%d].setting", k);
+                hyd_fmt_num(a, sizeof a, set);
+                hyd_fmt_num(b, sizeof b, margin);
+                json_note(c, f,
+                          "%s Pa is not below the margin of LS pump '%s' (%s Pa): the metering edge gets margin - "
+                          "setting <= 0 and the section no flow",
+                          a, hyd_model_comp_name(m, p), b);
+            }
+        }
+    }
+}
+
 static const json_range R_GRAVITY = {0, 30, 9.7, 9.9, "m/s^2"};
 static const json_range R_COLUMN_HEIGHT = {0.1, 10, 0.5, 4, "m"};
 static const json_range R_COLUMN_MASS = {1, 1e5, 50, 5000, "kg"};
@@ -269,6 +321,8 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
             goto fail;
         }
         if (ls_section_fault(&c, m->hyd)) goto fail;
+        ls_param_notes(&c, m->hyd);
+        json_flush_notes(&c);
     }
 
     for (int k = 0; k < 2; ++k) {

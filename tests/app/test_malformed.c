@@ -388,6 +388,25 @@ static void test_typical_notes(void) {
                               "[0.03, 0.3] m") &&
               cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
+    // Values in range that do not fit together (the LS crane): a main relief
+    // below the pump's cut-off plus band, a post compensator's setting not
+    // below the pump's margin. One line each, the run goes on.
+    rc = cli_run("run --quiet --model " ASSETS "/" ML " --scenario hold --duration 0.01 --out /dev/null "
+                 "--set hydraulics.components.main_relief.p_crack=21.2e6",
+                 out_buf, sizeof out_buf);
+    CHECK(rc == 0 &&
+              strstr(out_buf, "note: hiab031_ls.json: hydraulics.components[1].p_crack: 2.12e7 Pa is below the cut-off "
+                              "of LS pump 'pump' plus its band (2.1e7 + 5e5 Pa)") &&
+              cli_count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    rc = cli_run("run --quiet --model " ASSETS "/" ML " --scenario hold --duration 0.01 --out /dev/null "
+                 "--set hydraulics.components.jib_comp.setting=2e6",
+                 out_buf, sizeof out_buf);
+    CHECK(rc == 0 &&
+              strstr(out_buf, "note: hiab031_ls.json: hydraulics.components[15].setting: 2e6 Pa is not below the margin "
+                              "of LS pump 'pump' (2e6 Pa)") &&
+              cli_count_lines(out_buf) == 2, // and the typical range [1e5, 1.5e6] Pa
+          "exit %d: %s", rc, out_buf);
     rc = cli_run("run --quiet --scenario ramp --duration 0.01 --out /dev/null --load 4000", out_buf, sizeof out_buf);
     CHECK(rc == 0 && strstr(out_buf, "note:") && strstr(out_buf, "--load 4000 kg") && cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
