@@ -366,7 +366,9 @@ static cJSON* load_with_sets(const char* path, const char* const* sets, int n, c
     for (int i = 0; i < n; ++i) {
         char e[400];
         if (json_set_path(root, sets[i], e, sizeof e)) {
-            snprintf(err, errsz, "%s: %s", path, e);
+            // The file's base name, as every other message of the loader.
+            const char* base = strrchr(path, '/');
+            snprintf(err, errsz, "%s: %s", base ? base + 1 : path, e);
             cJSON_Delete(root);
             return NULL;
         }
