@@ -11,6 +11,7 @@
 // p Q_t with the circuit. These terms sum to zero exactly at every
 // evaluation (the identity of docs/energy.md), so a new component type needs
 // no code here.
+#include "hyd_accumulator.h"
 #include "hyd_internal.h"
 
 #include <math.h>
@@ -150,4 +151,38 @@ double hyd_expansion_power(const hyd_model* m, const hyd_data* d) {
         if (dV != 0.0) P -= dV * phi_n(m, n, d->node_p[n], 24);
     }
     return P;
+}
+
+// The accumulator's record of component c, or NULL for any other type.
+static const hyd_acc_c* acc_rec(const hyd_model* m, int c) {
+    if (c < 0 || c >= m->ncomp || m->comp[c].type != HYD_ACCUMULATOR) return NULL;
+    return (const hyd_acc_c*)m->rec[HYD_ACCUMULATOR] + m->comp_sub[c];
+}
+
+// p_g q: accumulator.c writes q (into the accumulator) and p_g as its two
+// flows.
+double hyd_comp_gas_power(const hyd_model* m, const hyd_data* d, int c) {
+    return acc_rec(m, c) ? d->comp_q[2 * c] * d->comp_q[2 * c + 1] : 0.0;
+}
+
+// The gas's compression energy, integral of p_g dV over the oil volume from
+// 0 (the precharge): with p_g V_g^n = p0 V0^n, V = V0 - V_g, it is
+// p0 V0 (r^((n-1)/n) - 1)/(n - 1), r = p_g/p0 (n = 1: p0 V0 ln r). Below
+// the precharge (V < 0, the poppet law p_g = p0 + a V (1 - k V) of
+// hyd_accumulator.h) V is the root of that quadratic near 0 and the
+// integral is p0 V + a V^2/2 - a k V^3/3 (< 0: the oil was drawn out
+// against the poppet).
+double hyd_comp_gas_energy(const hyd_model* m, const hyd_data* d, int c) {
+    const hyd_acc_c* a = acc_rec(m, c);
+    if (!a) return 0.0;
+    const double pg = d->comp_q[2 * c + 1];
+    if (pg >= a->p0) {
+        const double r = pg / a->p0;
+        if (fabs(a->n - 1.0) < 1e-9) return a->p0 * a->V0 * log(r);
+        return a->p0 * a->V0 * (pow(r, (a->n - 1.0) / a->n) - 1.0) / (a->n - 1.0);
+    }
+    const double s = a->n * a->p0 / a->V0, k = 1.0 / (HYD_ACC_EPS * a->V0), dp = pg - a->p0;
+    // V = (1 - sqrt(1 - 4 k dp / s)) / (2 k), in the form without cancellation.
+    const double V = 2.0 * dp / s / (1.0 + sqrt(1.0 - 4.0 * k * dp / s));
+    return a->p0 * V + 0.5 * s * V * V - s * k * V * V * V / 3.0;
 }

@@ -643,6 +643,15 @@ double hyd_node_phi(const hyd_model* m, int node, double p);
 double hyd_node_phi_increment(const hyd_model* m, int node, double p0, double p1);
 /// One node's term V phi(p) of hyd_stored_energy [J] (0 for a tank).
 double hyd_node_stored_energy(const hyd_model* m, int node, double p, double V);
+/// An accumulator's gas (0 for any other component): the power the oil does
+/// compressing it, p_g q [W] (q into the accumulator; hyd_comp_power minus
+/// it is the loss in its inlet, (p_port - p_g) q), and its compression
+/// energy relative to the precharge (oil volume 0) [J], a state function of
+/// the gas pressure: the polytropic work integral of p_g dV from 0 to the
+/// oil volume, p0 V0 ((p_g/p0)^((n-1)/n) - 1)/(n - 1) (n = 1: p0 V0
+/// ln(p_g/p0)). From the outputs of the last hyd_eval in d.
+double hyd_comp_gas_power(const hyd_model* m, const hyd_data* d, int comp);
+double hyd_comp_gas_energy(const hyd_model* m, const hyd_data* d, int comp);
 
 #ifdef __cplusplus
 }

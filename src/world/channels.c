@@ -40,8 +40,11 @@ chan_list* chan_list_create(engine* e) {
     const sim_channel* row = engine_channels(e, &c->nrow);
     const hyd_model* m = c->hm;
     const int nnode = hyd_model_nnode(m), ncomp = hyd_model_ncomp(m), ns = hyd_model_nstate(m);
-    // At most: a pressure per node, a spool per valve, two flows per component.
-    const int cap = c->nrow + nnode + 3 * ncomp;
+    // At most: a pressure per node, a spool per valve, two flows per
+    // component, and every other state a component owns.
+    int nother = 0;
+    for (int i = 0; i < ns; ++i) nother += hyd_model_state_kind(m, i) == HYD_STATE_OTHER;
+    const int cap = c->nrow + nnode + 3 * ncomp + nother;
     c->ch = calloc((size_t)cap, sizeof *c->ch);
     c->name = calloc((size_t)(cap - c->nrow) + 1, sizeof *c->name);
     c->src = calloc((size_t)(cap - c->nrow) + 1, sizeof *c->src);
@@ -63,6 +66,17 @@ chan_list* chan_list_create(engine* e) {
     for (int v = 0; v < hyd_model_nvalve(m); ++v) {
         snprintf(nm, sizeof nm, "%s.spool", hyd_model_comp_name(m, hyd_model_valve_comp(m, v)));
         add(c, cap, nm, "-", SIM_CH_OTHER, SRC_STATE, hyd_model_valve_state(m, v));
+    }
+    // The states of the load-sensing components and accumulators under their
+    // state names (docs/hydraulics.md): a LS pump's displacement
+    // "<name>.disp", a compensator's or counterbalance valve's spool
+    // "<name>.spool" (fractions of full, [-]), an accumulator's oil volume
+    // "<name>.oil" [m^3].
+    for (int i = 0; i < ns; ++i) {
+        if (hyd_model_state_kind(m, i) != HYD_STATE_OTHER) continue;
+        const char* sn = hyd_model_state_name(m, i);
+        const char* dot = strrchr(sn, '.');
+        add(c, cap, sn, dot && !strcmp(dot, ".oil") ? "m^3" : "-", SIM_CH_OTHER, SRC_STATE, i);
     }
     for (int k = 0; k < ncomp; ++k) {
         const char* cn = hyd_model_comp_name(m, k);

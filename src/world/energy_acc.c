@@ -18,6 +18,7 @@ struct sim_energy {
     long n;
     double t0, tprev;
     double es0, es1, em0, em1;
+    double gas0, gas1; ///< accumulators' gas energy at the first and the last sample [J]
     int finished;
     double *p1, *V1; ///< (nnode) node pressures and volumes at the last sample
     double* phi;     ///< (nnode) phi(p1) of nodes whose volume has moved (NAN: not followed yet)
@@ -113,6 +114,13 @@ int sim_energy_bind(sim_energy* e, const hyd_model* m) {
             break;
         case HYD_COMPENSATOR: add_col(e, c, SIM_EG_COMPENSATOR, ""); break;
         case HYD_COUNTERBALANCE: add_col(e, c, SIM_EG_COUNTERBALANCE, ""); break;
+        // The gas compression is stored energy (it comes back when the
+        // accumulator discharges), not a loss; the column <name> keeps the
+        // loss in its inlet only.
+        case HYD_ACCUMULATOR:
+            add_col(e, c, SIM_EG_OTHER, "");
+            add_col(e, c, SIM_EG_STORED, ".gas");
+            break;
         default: add_col(e, c, SIM_EG_OTHER, ""); break;
         }
     }
@@ -157,7 +165,7 @@ static void powers(sim_energy* e, const hyd_data* d) {
         }
         case SIM_EG_WORK: e->P[i] = hyd_comp_piston_power(m, d, c); break;
         case SIM_EG_TANK: e->P[i] = -hyd_boundary_power(m, d); break;
-        case SIM_EG_STORED: e->P[i] = hyd_stored_power(m, d); break;
+        case SIM_EG_STORED: e->P[i] = c >= 0 ? hyd_comp_gas_power(m, d, c) : hyd_stored_power(m, d); break;
         case SIM_EG_EXPANSION: {
             // hyd_expansion_power, with phi followed along the run (one
             // Simpson panel per step) instead of integrated afresh.
@@ -176,7 +184,7 @@ static void powers(sim_energy* e, const hyd_data* d) {
             e->P[i] = P;
             break;
         }
-        default: e->P[i] = hyd_comp_power(m, d, c); break;
+        default: e->P[i] = hyd_comp_power(m, d, c) - hyd_comp_gas_power(m, d, c); break;
         }
     }
 }
@@ -203,7 +211,12 @@ void sim_energy_sample_data(sim_energy* e, double t, const hyd_data* d, double e
     const hyd_model* m = e->m;
     if (!m) return;
     powers(e, d);
+    double gas = 0.0;
+    for (int i = 0; i < e->ncol; ++i)
+        if (e->group[i] == SIM_EG_STORED && e->comp[i] >= 0) gas += hyd_comp_gas_energy(m, d, e->comp[i]);
+    e->gas1 = gas;
     if (e->n == 0) {
+        e->gas0 = gas;
         e->t0 = t;
         e->es0 = hyd_stored_energy(m, d->node_p, d->node_V);
         e->em0 = e_mech;
@@ -240,10 +253,24 @@ void sim_energy_result(const sim_energy* e, sim_energy_balance* b) {
     b->work = b->group[SIM_EG_WORK];
     b->stored_rate = b->group[SIM_EG_STORED];
     const double es1 = e->finished ? e->es1 : e->m && e->n ? hyd_stored_energy(e->m, e->p1, e->V1) : e->es0;
-    b->stored = es1 - e->es0;
+    b->gas = e->gas1 - e->gas0;
+    b->stored = es1 - e->es0 + b->gas;
     b->expansion = b->group[SIM_EG_EXPANSION];
     b->residual = b->in - b->loss - b->expansion - b->work - b->stored;
-    b->residual_pct = b->in != 0.0 ? 100.0 * b->residual / b->in : 0.0;
+    // Normalised by the energy turned over, not by "in": with the pump near
+    // standby (hold, a burst line) the fluid's energy comes from the loads
+    // sinking (work < 0) and its stored energy, and "in" can be near 0 or
+    // negative, so 1 J over 5 J in read 17 %. Each term of the balance is a
+    // source (in > 0, or loss, X, work, stored < 0) or a sink; the turnover
+    // is the larger of the two sums (they differ by the residual).
+    const double terms[5] = {b->in, -b->loss, -b->expansion, -b->work, -b->stored};
+    double src = 0.0, snk = 0.0;
+    for (int k = 0; k < 5; ++k) {
+        if (terms[k] > 0.0) src += terms[k];
+        else snk -= terms[k];
+    }
+    b->turnover = fmax(src, snk);
+    b->residual_pct = b->turnover > 0.0 ? 100.0 * b->residual / b->turnover : 0.0;
     b->mech = e->em1 - e->em0;
     b->t0 = e->t0;
     b->t1 = e->tprev;

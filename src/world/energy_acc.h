@@ -30,7 +30,7 @@ typedef enum sim_energy_group {
     SIM_EG_OTHER,      ///< any other component type (its whole P_c)
     SIM_EG_WORK,       ///< piston work on the mechanics
     SIM_EG_TANK,       ///< taken by the tanks (boundary flow work p_t Q_t)
-    SIM_EG_STORED,     ///< rate of compression energy in the fluid, p V/Be dp/dt
+    SIM_EG_STORED,     ///< rate of compression energy in the fluid, p V/Be dp/dt, and in accumulators' gas, p_g q
     SIM_EG_EXPANSION,  ///< compression energy leaving with displaced fluid (hyd_expansion_power)
     SIM_EG_COUNT
 } sim_energy_group;
@@ -65,7 +65,7 @@ void sim_energy_sample_data(sim_energy* e, double t, const hyd_data* d, double e
 void sim_energy_csv(sim_energy* e, FILE* f, double dt);
 
 /// Columns: per component (a valve two, meter-in and meter-out; a cylinder
-/// two, leak and work), then "tank", "stored" and "expansion". All but the
+/// two, leak and work; an accumulator two, its inlet's loss and gas), then "tank", "stored" and "expansion". All but the
 /// last sum to zero at every sample (the identity of hydraulics.h).
 int sim_energy_ncol(const sim_energy* e);
 const char* sim_energy_col_name(const sim_energy* e, int i);
@@ -86,10 +86,14 @@ typedef struct sim_energy_balance {
     double loss;       ///< sum of the loss groups (valves .. other)
     double expansion;  ///< compression energy released by fluid the chambers displaced
     double work;       ///< piston work on the mechanics
-    double stored;     ///< change of the fluid's compression energy, from the end states (state function)
+    double stored;     ///< change of the compression energy of the fluid and the accumulators' gas, from the
+                       ///< end states (state functions)
+    double gas;        ///< of it, the accumulators' gas
     double stored_rate;///< the same from the integrated rate (for comparison)
     double residual;   ///< in - loss - expansion - work - stored
-    double residual_pct; ///< 100 residual / in
+    double turnover;   ///< energy turned over: the larger of the sources' and the sinks' sums of the terms
+                       ///< in, -loss, -expansion, -work, -stored (each counted on the side its sign gives)
+    double residual_pct; ///< 100 residual / turnover
     double mech;       ///< change of the mechanics' energy (kinetic + potential); NAN when unknown
     double t0, t1;     ///< the samples' first and last time [s]
     long samples;

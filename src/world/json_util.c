@@ -563,6 +563,25 @@ static void set_path_missing(const char* assignment, const cJSON* node, const ch
     }
 }
 
+// Whether key is a numeric field of the circuit element obj (an object with
+// a "type" the circuit knows, or the fluid: prev is the segment above obj):
+// a --set may then add it although the file leaves it at its default (the
+// loader range-checks it as any value in the file).
+static bool schema_field(const cJSON* obj, const char* prev, const char* key) {
+    if (!cJSON_IsObject(obj)) return false;
+    if (prev && !strcmp(prev, "fluid")) {
+        for (int k = 0; k < hyd_fluid_param_count(); ++k)
+            if (!strcmp(hyd_fluid_param_name(k), key)) return true;
+        return false;
+    }
+    const cJSON* ty = cJSON_GetObjectItemCaseSensitive(obj, "type");
+    const int t = cJSON_IsString(ty) ? hyd_type_parse(ty->valuestring) : -1;
+    if (t < 0) return false;
+    for (int k = 0; k < hyd_param_count((hyd_type)t); ++k)
+        if (!strcmp(hyd_param_name((hyd_type)t, k), key)) return true;
+    return false;
+}
+
 int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) {
     // Messages quote the whole argument: it is what the user typed.
     const char* eq = strchr(assignment, '=');
@@ -592,6 +611,20 @@ int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) 
     char at[256] = ""; // the path walked so far, for messages
     for (int i = 0; i < nseg; ++i) {
         cJSON* next = child_by_segment(parent, &segs[i]);
+        if (!next && i == nseg - 1 && !segs[i].index && schema_field(parent, i ? segs[i - 1].key : NULL, segs[i].key)) {
+            // A field of the element's type absent from the file: added as a
+            // number (its type in the schema), then range-checked on load.
+            const char* vend = NULL;
+            cJSON* nv = value_numbers_ok(value) ? cJSON_ParseWithOpts(value, &vend, 1) : NULL;
+            if (!cJSON_IsNumber(nv)) {
+                snprintf(err, errsz, "%s '%s': %s must be a number, got '%s'", sim_param_name(SIM_PARAM_SET), assignment,
+                         path, value);
+                cJSON_Delete(nv);
+                return -1;
+            }
+            cJSON_AddItemToObject(parent, segs[i].key, nv);
+            return 0;
+        }
         if (!next) {
             set_path_missing(assignment, parent, at, &segs[i], err, errsz);
             return -1;

@@ -5,6 +5,7 @@
 #include "hydraulics.h"
 #include "json_util.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,6 +59,136 @@ static int ls_unreached(const hyd_model* m) {
         if (!reached) return c;
     }
     return -1;
+}
+
+// Whether the signal at node n reaches node target through the LS network:
+// n is target, or a shuttle has n as its port a or b and its out reaches
+// target (a chain of shuttles, either mode). seen: nnode bytes, cleared by
+// the caller.
+static int ls_reaches(const hyd_model* m, int n, int target, unsigned char* seen) {
+    if (n == target) return 1;
+    if (n < 0 || seen[n]) return 0;
+    seen[n] = 1;
+    const int nc = hyd_model_ncomp(m);
+    for (int k = 0; k < nc; ++k) {
+        if (hyd_model_comp_type(m, k) != HYD_SHUTTLE) continue;
+        if (hyd_model_port_node(m, k, 0) != n && hyd_model_port_node(m, k, 1) != n) continue;
+        if (ls_reaches(m, hyd_model_port_node(m, k, 2), target, seen)) return 1;
+    }
+    return 0;
+}
+
+// The LS pump a section's signal must reach: the one whose outlet feeds the
+// compensator's inlet (comp >= 0), else the first LS pump; -1 when none.
+static int ls_pump_for(const hyd_model* m, int comp) {
+    const int nc = hyd_model_ncomp(m);
+    int first = -1;
+    for (int c = 0; c < nc; ++c) {
+        if (hyd_model_comp_type(m, c) != HYD_LS_PUMP) continue;
+        if (first < 0) first = c;
+        if (comp >= 0 && hyd_model_port_node(m, c, 1) == hyd_model_port_node(m, comp, 0)) return c;
+    }
+    return first;
+}
+
+// Every section's LS signal must reach the pump, not only the pump's own ls
+// node be fed (ls_unreached): a section shuttle (spool mode: the section's
+// LS port) whose out, or a compensator whose load, leads through no chain of
+// shuttles to the pump's ls node is a section the pump never senses, and it
+// stalls at the standby pressure under load. A post compensator's ref must
+// be that ls node itself: it holds p_pump - p_ref - setting across the
+// metering edge, so a ref on the tank or an orphaned node gives a drop of
+// about the whole pump pressure (no flow control at all). A pre compensator
+// (mode 0) does not use ref. Fails c with one line and returns 1, or 0.
+static int ls_section_fault(json_ctx* c, const hyd_model* m) {
+    const int nc = hyd_model_ncomp(m), nn = hyd_model_nnode(m);
+    unsigned char* seen = calloc((size_t)(nn > 0 ? nn : 1), 1);
+    if (!seen) return 0;
+    int bad = 0;
+    for (int k = 0; k < nc && !bad; ++k) {
+        const hyd_type t = hyd_model_comp_type(m, k);
+        const int spool_shuttle = t == HYD_SHUTTLE && hyd_model_port_node(m, k, 3) >= 0;
+        if (!spool_shuttle && t != HYD_COMPENSATOR) continue;
+        const int pump = ls_pump_for(m, t == HYD_COMPENSATOR ? k : -1);
+        if (pump < 0) break;
+        const int ls = hyd_model_port_node(m, pump, 2);
+        const char* lsname = hyd_model_node_name(m, ls);
+        char f[80];
+        const int sig = hyd_model_port_node(m, k, 2); // shuttle out, compensator load
+        memset(seen, 0, (size_t)nn);
+        if (!ls_reaches(m, sig, ls, seen)) {
+            snprintf(f, sizeof f, "hydraulics.components[%d].%s", k, spool_shuttle ? "out" : "load");
+            json_fail(c, f, "node '%s' leads through no shuttle to the ls node '%s' of pump '%s': the pump never senses this section's load",
+                      hyd_model_node_name(m, sig), lsname, hyd_model_comp_name(m, pump));
+            bad = 1;
+            break;
+        }
+        if (t != HYD_COMPENSATOR) continue;
+        char path[160];
+        double mode = 1.0;
+        snprintf(path, sizeof path, "%s.mode", hyd_model_comp_name(m, k));
+        hyd_model_get(m, path, &mode);
+        const int ref = hyd_model_port_node(m, k, 3);
+        if (mode != 0.0 && ref != ls) {
+            snprintf(f, sizeof f, "hydraulics.components[%d].ref", k);
+            json_fail(c, f, "must be the ls node '%s' of pump '%s' (a post compensator holds p_pump - p_ref - setting), got '%s'",
+                      lsname, hyd_model_comp_name(m, pump), hyd_model_node_name(m, ref));
+            bad = 1;
+        }
+    }
+    free(seen);
+    return bad;
+}
+
+static double comp_param(const hyd_model* m, int comp, const char* field) {
+    char path[160];
+    double v = NAN;
+    snprintf(path, sizeof path, "%s.%s", hyd_model_comp_name(m, comp), field);
+    hyd_model_get(m, path, &v);
+    return v;
+}
+
+// Parameter sets that are each in range but do not fit together, as notes
+// (the run goes on): a relief on a LS pump's outlet that cracks below the
+// pump's cut-off plus its band opens before the pump destrokes and burns the
+// whole delivery at the relief (the cut-off is there to make that
+// unnecessary); a post compensator whose setting is not below the pump's
+// margin leaves its metering edge margin - setting <= 0, so the section
+// gives no flow however far the spool opens.
+static void ls_param_notes(json_ctx* c, const hyd_model* m) {
+    const int nc = hyd_model_ncomp(m);
+    for (int p = 0; p < nc; ++p) {
+        if (hyd_model_comp_type(m, p) != HYD_LS_PUMP) continue;
+        const int out = hyd_model_port_node(m, p, 1);
+        const double cut = comp_param(m, p, "p_cutoff"), band = comp_param(m, p, "cutoff_band");
+        const double margin = comp_param(m, p, "margin");
+        for (int k = 0; k < nc; ++k) {
+            char f[80], a[24], b[24], d[24];
+            const hyd_type t = hyd_model_comp_type(m, k);
+            if (t == HYD_RELIEF && hyd_model_port_node(m, k, 0) == out) {
+                const double crack = comp_param(m, k, "p_crack");
+                if (!(crack < cut + band)) continue;
+                snprintf(f, sizeof f, "hydraulics.components[%d].p_crack", k);
+                hyd_fmt_num(a, sizeof a, crack);
+                hyd_fmt_num(b, sizeof b, cut);
+                hyd_fmt_num(d, sizeof d, band);
+                json_note(c, f,
+                          "%s Pa is below the cut-off of LS pump '%s' plus its band (%s + %s Pa): the relief opens "
+                          "before the pump destrokes and burns its delivery",
+                          a, hyd_model_comp_name(m, p), b, d);
+            } else if (t == HYD_COMPENSATOR && hyd_model_port_node(m, k, 0) == out && comp_param(m, k, "mode") != 0.0) {
+                const double set = comp_param(m, k, "setting");
+                if (!(set >= margin)) continue;
+                snprintf(f, sizeof f, "hydraulics.components[%d].setting", k);
+                hyd_fmt_num(a, sizeof a, set);
+                hyd_fmt_num(b, sizeof b, margin);
+                json_note(c, f,
+                          "%s Pa is not below the margin of LS pump '%s' (%s Pa): the metering edge gets margin - "
+                          "setting <= 0 and the section no flow",
+                          a, hyd_model_comp_name(m, p), b);
+            }
+        }
+    }
 }
 
 static const json_range R_GRAVITY = {0, 30, 9.7, 9.9, "m/s^2"};
@@ -189,6 +320,9 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
                       hyd_model_node_name(m->hyd, hyd_model_port_node(m->hyd, bad, 2)));
             goto fail;
         }
+        if (ls_section_fault(&c, m->hyd)) goto fail;
+        ls_param_notes(&c, m->hyd);
+        json_flush_notes(&c);
     }
 
     for (int k = 0; k < 2; ++k) {
@@ -232,7 +366,9 @@ static cJSON* load_with_sets(const char* path, const char* const* sets, int n, c
     for (int i = 0; i < n; ++i) {
         char e[400];
         if (json_set_path(root, sets[i], e, sizeof e)) {
-            snprintf(err, errsz, "%s: %s", path, e);
+            // The file's base name, as every other message of the loader.
+            const char* base = strrchr(path, '/');
+            snprintf(err, errsz, "%s: %s", base ? base + 1 : path, e);
             cJSON_Delete(root);
             return NULL;
         }

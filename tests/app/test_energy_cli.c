@@ -56,8 +56,30 @@ static void test_energy_bad_path(void) {
     CHECK(rc == 2 && strstr(out, "--energy") && cli_count_lines(out) == 1, "rc %d: %s", rc, out);
 }
 
+// The summary names a group whenever the circuit has such components, also
+// when its energy is exactly 0 (the LS crane's counterbalance valves stay
+// shut on hold, and the group used to vanish), and never otherwise.
+static void test_summary_groups(void) {
+    static char out[16384];
+    int rc = cli_run("run --model " CRANESIM_ASSETS "/models/hiab031_ls.json --scenario hold --duration 0.5 --out /dev/null",
+                     out, sizeof out);
+    const char* line = strstr(out, "energy: in ");
+    CHECK(rc == 0 && line, "rc %d: %s", rc, out);
+    if (!line) return;
+    CHECK(strstr(line, "counterbalance valves 0.000") != NULL, "no counterbalance group: %.400s", line);
+    CHECK(strstr(line, "compensators ") != NULL, "no compensator group: %.400s", line);
+    rc = cli_run("run --scenario hold --duration 0.5 --out /dev/null", out, sizeof out);
+    line = strstr(out, "energy: in ");
+    CHECK(rc == 0 && line, "rc %d: %s", rc, out);
+    if (!line) return;
+    const char* eol = strchr(line, '\n');
+    const char* cb = strstr(line, "counterbalance");
+    CHECK(!cb || (eol && cb > eol), "the standard crane has no counterbalance valves: %.400s", line);
+}
+
 int main(void) {
     test_energy_csv_rows_sum_to_zero();
+    test_summary_groups();
     test_energy_bad_path();
     printf("%d checks, %d failed\n", check_count_, check_failures_);
     return check_failures_ != 0;

@@ -31,6 +31,15 @@ typedef struct bad_case {
     const char* msg;   ///< must appear in the message too (NULL: no check)
 } bad_case;
 
+// Cases that need a second text replacement after the first (a node declared,
+// then wired in), by file name.
+static const struct {
+    const char *name, *from, *to;
+} second_edit[] = {
+    {"m_ls_orphan_out.json", "\"out\": \"lift_ls\",", "\"out\": \"lift_ls_orphan\","},
+    {"m_ls_orphan_load.json", "\"load\": \"lift_ls\",", "\"load\": \"lift_ls_orphan\","},
+};
+
 static char out_buf[16384];
 
 
@@ -50,7 +59,12 @@ static const char* make_case(const bad_case* k) {
     char base[1024];
     snprintf(base, sizeof base, "%s/%s", ASSETS, k->base);
     snprintf(path, sizeof path, "%s/%s", dir(), k->name);
-    return fixture_edit(base, path, k->set, k->from, k->to) ? NULL : path;
+    if (fixture_edit(base, path, k->set, k->from, k->to)) return NULL;
+    for (size_t i = 0; i < sizeof second_edit / sizeof second_edit[0]; ++i)
+        if (!strcmp(k->name, second_edit[i].name) &&
+            fixture_edit(path, path, NULL, second_edit[i].from, second_edit[i].to))
+            return NULL;
+    return path;
 }
 
 static const char SENTINEL[] = "t,x1\n0,0.5\nthis file must survive a refused run\n";
@@ -135,6 +149,12 @@ static void test_hard_ranges(void) { run_cases(range_cases, (int)(sizeof range_c
 
 #define ML "models/hiab031_ls.json"
 
+// A node "lift_ls_orphan" declared next to "lift_ls" (a second replacement
+// wires a section's signal into it).
+#define LS_ORPHAN_FROM "\"name\": \"lift_ls\","
+#define LS_ORPHAN_TO                                                                                                   \
+    "\"name\": \"lift_ls_orphan\", \"type\": \"volume\", \"volume\": 5e-06, \"p0\": 100000.0}, {\"name\": \"lift_ls\","
+
 // Malformed load-sensing components in the LS crane model.
 static const bad_case ls_cases[] = {
     {MODEL, "m_ls_no_port.json", ML, NULL, "\"ls\": \"ls_line\",", "", "hydraulics.components[0].ls",
@@ -149,6 +169,14 @@ static const bad_case ls_cases[] = {
     // pump's sensing port, so no load pressure reaches the pump.
     {MODEL, "m_ls_unreached.json", ML, NULL, "\"out\": \"ls_line\"", "\"out\": \"pump_line\"",
      "hydraulics.components[0].ls", "the LS network does not reach the pump"},
+    // A section whose LS signal ends in a node of its own: the pump's ls node
+    // is still fed (by the main shuttle), but never by this section.
+    {MODEL, "m_ls_orphan_out.json", ML, NULL, LS_ORPHAN_FROM, LS_ORPHAN_TO, "hydraulics.components[5].out",
+     "node 'lift_ls_orphan' leads through no shuttle to the ls node 'ls_line'"},
+    {MODEL, "m_ls_orphan_load.json", ML, NULL, LS_ORPHAN_FROM, LS_ORPHAN_TO, "hydraulics.components[3].load",
+     "node 'lift_ls_orphan' leads through no shuttle"},
+    {MODEL, "m_ls_comp_ref_tank.json", ML, NULL, "\"ref\": \"ls_line\",", "\"ref\": \"tank\",",
+     "hydraulics.components[3].ref", "must be the ls node 'ls_line' of pump 'pump'"},
 };
 
 static void test_ls_components(void) {
@@ -373,6 +401,25 @@ static void test_typical_notes(void) {
               strstr(out_buf, "note: w_note_bore.json: circuit.components[3].bore: 0.025 is outside the typical range "
                               "[0.03, 0.3] m") &&
               cli_count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    // Values in range that do not fit together (the LS crane): a main relief
+    // below the pump's cut-off plus band, a post compensator's setting not
+    // below the pump's margin. One line each, the run goes on.
+    rc = cli_run("run --quiet --model " ASSETS "/" ML " --scenario hold --duration 0.01 --out /dev/null "
+                 "--set hydraulics.components.main_relief.p_crack=21.2e6",
+                 out_buf, sizeof out_buf);
+    CHECK(rc == 0 &&
+              strstr(out_buf, "note: hiab031_ls.json: hydraulics.components[1].p_crack: 2.12e7 Pa is below the cut-off "
+                              "of LS pump 'pump' plus its band (2.1e7 + 5e5 Pa)") &&
+              cli_count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    rc = cli_run("run --quiet --model " ASSETS "/" ML " --scenario hold --duration 0.01 --out /dev/null "
+                 "--set hydraulics.components.jib_comp.setting=2e6",
+                 out_buf, sizeof out_buf);
+    CHECK(rc == 0 &&
+              strstr(out_buf, "note: hiab031_ls.json: hydraulics.components[15].setting: 2e6 Pa is not below the margin "
+                              "of LS pump 'pump' (2e6 Pa)") &&
+              cli_count_lines(out_buf) == 2, // and the typical range [1e5, 1.5e6] Pa
           "exit %d: %s", rc, out_buf);
     rc = cli_run("run --quiet --scenario ramp --duration 0.01 --out /dev/null --load 4000", out_buf, sizeof out_buf);
     CHECK(rc == 0 && strstr(out_buf, "note:") && strstr(out_buf, "--load 4000 kg") && cli_count_lines(out_buf) == 1,

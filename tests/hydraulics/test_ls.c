@@ -811,6 +811,50 @@ static void test_accumulator(void) {
     hyd_model_free(m);
 }
 
+// The gas's compression energy (energy.c) against the polytropic work from
+// the precharge by hand, from the oil volume V: integral of p0 (V0/(V0 - v))^n
+// dv = p0 V0 ((V0/(V0 - V))^(n-1) - 1)/(n - 1), isothermal p0 V0 ln(V0/(V0 - V));
+// its slope in V is the gas pressure (dE/dV = p_g), also below the precharge
+// (the poppet law), and the gas power is p_g q.
+static void test_accumulator_gas_energy(void) {
+    const double ns[] = {1.0, 1.4}, p0 = 5e6, V0 = 1e-2;
+    for (int k = 0; k < 2; ++k) {
+        hyd_model* m = acc_circuit(1, 0, ns[k]);
+        if (!m) return;
+        hyd_data* d = hyd_data_create(m);
+        const int c = hyd_model_find(m, "acc"), iv = st(m, "acc.oil"), is = st(m, "s.p");
+        double y[MAXN], f[MAXN];
+        hyd_model_initial_state(m, y);
+        y[is] = 12e6;
+        const double Vs[] = {1e-3, 3e-3, 6e-3};
+        for (int j = 0; j < 3; ++j) {
+            y[iv] = Vs[j];
+            hyd_eval(m, d, 0.0, y, f);
+            const double r = V0 / (V0 - Vs[j]);
+            const double hand = ns[k] == 1.0 ? p0 * V0 * log(r) : p0 * V0 * (pow(r, ns[k] - 1.0) - 1.0) / (ns[k] - 1.0);
+            CHECK_REL(hyd_comp_gas_energy(m, d, c), hand, 1e-9);
+            CHECK_REL(hyd_comp_gas_power(m, d, c), d->comp_q[2 * c] * p0 * pow(r, ns[k]), 1e-9);
+        }
+        // dE/dV = p_g by central differences, charged and on the poppet law.
+        const double Vd[] = {4e-3, -2e-6};
+        for (int j = 0; j < 2; ++j) {
+            const double h = Vd[j] > 0 ? 1e-7 : 1e-10;
+            double E[2];
+            for (int s = 0; s < 2; ++s) {
+                y[iv] = Vd[j] + (s ? h : -h);
+                hyd_eval(m, d, 0.0, y, f);
+                E[s] = hyd_comp_gas_energy(m, d, c);
+            }
+            y[iv] = Vd[j];
+            hyd_eval(m, d, 0.0, y, f);
+            CHECK_REL((E[1] - E[0]) / (2.0 * h), d->comp_q[2 * c + 1], 1e-5);
+        }
+        CHECK(hyd_comp_gas_energy(m, d, hyd_model_find(m, "o")) == 0.0, "an orifice has no gas");
+        hyd_data_free(d);
+        hyd_model_free(m);
+    }
+}
+
 // ------------------------------------------------------------------ JSON
 
 static void json_error(const char* comp, const char* want) {
@@ -892,6 +936,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_counterbalance_vented);
     RUN_TEST(test_counterbalance_pilot_damping);
     RUN_TEST(test_accumulator);
+    RUN_TEST(test_accumulator_gas_energy);
     RUN_TEST(test_json);
     TEST_MAIN_END();
 }

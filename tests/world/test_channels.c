@@ -2,6 +2,7 @@
 // that each engine publishes, and the CSV header, sim_col_name and
 // sim_col_unit are made from it: the header each backend writes is the one
 // the README documents (these are the headers main wrote before the list).
+#include "channels.h"
 #include "check.h"
 #include "crane_fixture.h"
 #include "engine.h"
@@ -79,9 +80,57 @@ static void test_engines_publish(void) {
     model_free(m);
 }
 
+// The LS crane's own states are channels under their state names, with the
+// engine's state values: the pump's displacement, the compensators' and
+// counterbalance valves' spools (docs/hydraulics.md); an accumulator's oil
+// volume in m^3.
+static void test_ls_state_channels(void) {
+    char err[512];
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031_ls.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    scenario sc;
+    if (!m || load_scenario("ramp", &sc)) {
+        model_free(m);
+        return;
+    }
+    sim_opts o = sim_default_opts();
+    engine* e = engine_create(m, &o, sc.q0, sc.slew0, sim_load_mass(m, &sc, &o), err, sizeof err);
+    CHECK(e != NULL, "%s", err);
+    if (!e) {
+        model_free(m);
+        return;
+    }
+    // Lift out for 0.3 s: the pump strokes out, the lift compensator throttles.
+    const double u[3] = {0.6, 0, 0};
+    engine_set_commands(e, u);
+    CHECK(engine_advance(e, 0.3) == 0, "advance");
+    const hyd_model* hm = engine_circuit(e);
+    chan_list* cl = chan_list_create(e);
+    CHECK(cl != NULL, "no channel list");
+    const int n = chan_list_count(cl);
+    double v[512], y[256];
+    CHECK(n <= 512 && hyd_model_nstate(hm) <= 256, "%d channels", n);
+    chan_list_values(cl, e, v, false);
+    engine_circuit_state(e, y, NULL);
+    static const char* const names[] = {"pump.disp", "lift_comp.spool", "jib_comp.spool", "lift_cbv.spool",
+                                        "jib_cbv.spool"};
+    for (int i = 0; i < 5; ++i) {
+        const int k = chan_list_find(cl, names[i]), st = hyd_model_find_state(hm, names[i]);
+        CHECK(k >= 0 && st >= 0, "no channel %s (state %d)", names[i], st);
+        if (k < 0 || st < 0) continue;
+        CHECK(v[k] == y[st], "%s: channel %g, state %g", names[i], v[k], y[st]);
+        if (i == 0) CHECK(v[k] > 0.05, "pump.disp %g: the pump delivers while lifting", v[k]);
+        CHECK(!strcmp(chan_list_channel(cl, k)->unit, "-"), "%s: unit %s", names[i], chan_list_channel(cl, k)->unit);
+    }
+    chan_list_free(cl);
+    engine_destroy(e);
+    model_free(m);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_headers_unchanged);
     RUN_TEST(test_one_list);
     RUN_TEST(test_engines_publish);
+    RUN_TEST(test_ls_state_channels);
     TEST_MAIN_END();
 }
