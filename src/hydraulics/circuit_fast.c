@@ -420,9 +420,8 @@ FAST_INLINE void run(hyd_fast* k, hyd_data* d, const double* y, double* ydot, do
         const double target = hyd_ls_pump_target(c, p[c->in], p[c->out], p[c->ls], &a1, &a2);
         const double eps = y[c->adr];
         ydot[c->adr] = HYD_LS_PUMP_RATE(target, eps, c->inv_tau);
-        const double q = HYD_LS_PUMP_Q(eps, c->qmax); // no pressure partial: delivery is eps q_max
-        k->net[c->in] -= q;
-        k->net[c->out] += q;
+        const double q = HYD_LS_PUMP_Q(eps, c->qmax, c->cleak, p[c->out], p[c->in]);
+        flow(k, J, ldj, c->in, c->out, q, c->cleak, -c->cleak); // the leak's pressure partials
         if (J) {
             jcol(k, J, ldj, c->in, c->adr, -c->qmax);
             jcol(k, J, ldj, c->out, c->adr, c->qmax);

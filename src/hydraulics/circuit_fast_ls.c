@@ -400,7 +400,7 @@ static inline __attribute__((always_inline)) int ls_eval(const hyd_fast_ls* L, c
     const double target = hyd_ls_pump_target(&L->pump, L->pump_pin, ppl, pll, &a1, &a2);
     const double eps = y[L->pump.adr];
     ydot[L->pump.adr] = HYD_LS_PUMP_RATE(target, eps, L->pump.inv_tau);
-    const double qpump = HYD_LS_PUMP_Q(eps, L->pump.qmax);
+    const double qpump = HYD_LS_PUMP_Q(eps, L->pump.qmax, L->pump.cleak, ppl, L->pump_pin);
     double fls[4];
     hyd_shuttle_flows(&L->lssh, 0.0, y[L->s[2 * LSK_LS]], y[L->s[2 * LSK_LS + 1]], pll, 0.0, fls);
 

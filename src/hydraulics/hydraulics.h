@@ -184,6 +184,7 @@ typedef struct hyd_ls_pump_def {
     double cutoff_band; ///< pressure rise from cut-off start to zero flow [Pa]; default 0.5e6
     double tau;         ///< displacement time constant (stroke time) [s]; default 0.08
     double eps0;        ///< initial displacement [-]; default 0
+    double leakage;     ///< internal leakage outlet -> inlet per pressure difference [m^3/(s Pa)]; default 0
 } hyd_ls_pump_def;
 
 /// LS shuttle (signal network). Max-select mode (valve NULL): flow

@@ -13,7 +13,20 @@
 // cut-off, whatever the LS signal asks (a product: either spool alone can
 // destroke the pump; where both are inside their bands it is C1 as well).
 // tau is the stroke time constant; eps_t in [0, 1] keeps eps in [0, 1]
-// without a limiter. The LS port draws no flow: the LS line's own bleed
+// without a limiter.
+//
+// Internal leakage (the pump's volumetric loss, laminar: gaps of the
+// pistons and the valve plate) takes q_leak = c_leak (p_out - p_in) back to
+// the inlet, so q = eps q_max - q_leak. It is what brings a dead-headed
+// pump line down to standby: once every section is closed, the controller
+// has destroked the pump (eps -> 0) and without a leak the line keeps the
+// pressure the last stroke left (up to the relief setting); with it the line
+// falls, with the time constant V_line / (Be c_leak), until the controller
+// strokes again to hold p_out = p_ls + margin. A real pump leaks some 1-5 %
+// of its rated flow at its rated pressure: c_leak = 0.02 q_max / p_cutoff is
+// about 5.6e-13 m^3/(s Pa) for 35 L/min and 21 MPa (default 0, the ideal
+// pump). The energy accounts count the net delivery: the leak is a loss
+// inside the pump, before its outlet. The LS port draws no flow: the LS line's own bleed
 // orifice (a fixed orifice to tank) empties it.
 #include "hyd_ls_pump.h"
 
@@ -38,6 +51,7 @@ static void ls_pump_derive(hyd_model* m, const void* def, void* rec, int node0) 
     c->pcut = d->p_cutoff;
     c->inv_cband = 1.0 / d->cutoff_band;
     c->inv_tau = 1.0 / d->tau;
+    c->cleak = d->leakage;
 }
 
 static void ls_pumps_eval(const hyd_model* m, hyd_data* d, const void* rec, int n, const double* y,
@@ -52,16 +66,21 @@ static void ls_pumps_eval(const hyd_model* m, hyd_data* d, const void* rec, int 
         const double target = hyd_ls_pump_target(c, pin, pout, pls, &a1, &a2);
         if (ydot)
             ydot[at] = HYD_LS_PUMP_RATE(target, eps, c->inv_tau);
-        const double q = HYD_LS_PUMP_Q(eps, c->qmax);
+        const double q = HYD_LS_PUMP_Q(eps, c->qmax, c->cleak, pout, pin);
         d->comp_q[2 * c->comp] = q;
         d->comp_open[c->comp] = target < 1.0;
         double* fl = d->flow_ + HYD_MAXSLOT * c->comp;
         fl[0] = -q, fl[1] = q, fl[2] = 0.0;
         if (G) {
             const int si = m->node_sidx[c->in], so = m->node_sidx[c->out], sl = m->node_sidx[c->ls];
-            // Flow column: dq/deps = q_max.
+            // Flow column: dq/deps = q_max; the leak's dq/dp_out = -c_leak,
+            // dq/dp_in = c_leak.
             G[si * ld + c->adr] -= c->qmax;
             G[so * ld + c->adr] += c->qmax;
+            G[si * ld + si] -= c->cleak;
+            G[si * ld + so] += c->cleak;
+            G[so * ld + si] += c->cleak;
+            G[so * ld + so] -= c->cleak;
             // Displacement row (hyd_state_row_from_G): d eps' / d p and d eps.
             double* row = G + (size_t)c->adr * ld;
             row[so] += (a1 + a2) * c->inv_tau;
@@ -111,6 +130,7 @@ static const hyd_param_info ls_pump_params[] = {
     HYD_PARAM(hyd_ls_pump_def, cutoff_band, "Pa", HYD_R_POS, 0, 1e3, 1e7, 1e5, 3e6),
     HYD_PARAM(hyd_ls_pump_def, tau, "s", HYD_R_POS, 0, 1e-3, 10, 0.05, 0.15),
     HYD_PARAM(hyd_ls_pump_def, eps0, "-", HYD_R_FRAC, 0, 0, 1, 0, 1),
+    HYD_PARAM(hyd_ls_pump_def, leakage, "m^3/(s Pa)", HYD_R_NONNEG, 0, 0, 1e-10, 0, 5e-12),
 };
 static const hyd_port_info ls_pump_ports[] = {HYD_PORT(hyd_ls_pump_def, inlet),
                                               HYD_PORT(hyd_ls_pump_def, outlet),

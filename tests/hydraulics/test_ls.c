@@ -272,7 +272,52 @@ static void test_ls_pump_cutoff(void) {
     }
 }
 
-static void test_ls_pump_jacobian(void) {
+// Standby with the pump's internal leakage: every section closed (no load
+// orifice), the LS line held at a load pressure. The leak c (p_out - p_in)
+// is the only flow out of the pump line, so at steady state the pump
+// strokes to eps = c (p_out - p_in) / q_max exactly (the line's net inflow
+// is zero) and the controller holds p_out - p_ls at the margin, within its
+// band: by hand, with c = 5.6e-13 m^3/(s Pa) at 12 MPa, eps = 6.7e-3.
+// Without the leak a pump line left at 20 MPa stays there: the controller
+// can only take flow away, eps settles at 0 and p_out - p_ls stays 10 MPa.
+static void test_ls_pump_standby(void) {
+    const double pload = 10e6, margin = 2e6, c = 5.6e-13, qmax = 1e-3;
+    for (int leak = 1; leak >= 0; --leak) {
+        hyd_builder* b = hyd_builder_create();
+        add_tank(b, "t", PT);
+        add_volume(b, "sig", 1e-4);
+        add_volume(b, "pl", 1e-3);
+        hyd_ls_pump_def p = hyd_default_ls_pump_def();
+        p.name = "pump", p.inlet = "t", p.outlet = "pl", p.ls = "sig", p.q_max = qmax, p.eps0 = 0.0;
+        p.leakage = leak ? c : 0.0;
+        hyd_add(b, HYD_LS_PUMP, &p);
+        hyd_model* m = compile(b);
+        if (!m) return;
+        hyd_data* d = hyd_data_create(m);
+        double y[MAXN];
+        hyd_model_initial_state(m, y);
+        y[st(m, "pl.p")] = PT + 20e6; // what a dead-headed stroke left
+        y[st(m, "sig.p")] = pload;
+        int fix[MAXN] = {0};
+        fix[st(m, "sig.p")] = 1;
+        const double res = steady_fix(m, d, y, fix);
+        const double dp = y[st(m, "pl.p")] - pload, eps = y[st(m, "pump.disp")];
+        const double eps_hand = leak ? c * (y[st(m, "pl.p")] - PT) / qmax : 0.0;
+        printf("  ls_pump %s leakage, sections closed: p_pump - p_LS = %.1f kPa, eps = %.4g (by hand %.4g)\n",
+               leak ? "with" : "without", dp / 1e3, eps, eps_hand);
+        if (leak) {
+            CHECK(res < 1e-6, "not steady: %g", res);
+            CHECK(fabs(dp - margin) <= 0.02 * margin, "standby: p_pump - p_LS = %.6g, margin %.6g", dp, margin);
+            CHECK_REL(eps, eps_hand, 1e-6);
+        } else {
+            CHECK(dp > 9e6, "without a leak the line cannot fall to standby, yet p_pump - p_LS = %.6g", dp);
+        }
+        hyd_data_free(d);
+        hyd_model_free(m);
+    }
+}
+
+static void ls_pump_jacobian(double leak) {
     // Sensed LS line as a volume, so its column exists.
     hyd_builder* b = hyd_builder_create();
     add_tank(b, "t", PT);
@@ -280,6 +325,7 @@ static void test_ls_pump_jacobian(void) {
     add_volume(b, "ls", 1e-4);
     hyd_ls_pump_def p = hyd_default_ls_pump_def();
     p.name = "pump", p.inlet = "t", p.outlet = "pl", p.ls = "ls", p.q_max = 1e-3;
+    p.leakage = leak; // its pressure partials too
     hyd_add(b, HYD_LS_PUMP, &p);
     add_orifice(b, "load", "pl", "t", 1e-5);
     add_orifice(b, "bleed", "ls", "t", 1e-7);
@@ -322,6 +368,12 @@ static void test_ls_pump_jacobian(void) {
     CHECK(k == NULL && strstr(why, "'pump' (ls_pump)"), "fast kernel without ls_pump: %s", why);
     hyd_fast_free(k);
     hyd_model_free(m);
+}
+
+// The ideal pump and one with the crane's internal leakage (5.6e-13 m^3/(s Pa)).
+static void test_ls_pump_jacobian(void) {
+    ls_pump_jacobian(0.0);
+    ls_pump_jacobian(5.6e-13);
 }
 
 // --------------------------------------------------------------- shuttle
@@ -927,6 +979,7 @@ static void test_json(void) {
 int main(int argc, char** argv) {
     RUN_TEST(test_ls_pump_margin);
     RUN_TEST(test_ls_pump_cutoff);
+    RUN_TEST(test_ls_pump_standby);
     RUN_TEST(test_ls_pump_jacobian);
     RUN_TEST(test_shuttle);
     RUN_TEST(test_shuttle_spool);
