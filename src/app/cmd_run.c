@@ -278,10 +278,20 @@ static void print_energy(const sim_energy* en, const sim_energy_balance* b) {
     if (group_columns(en, SIM_EG_COUNTERBALANCE))
         printf(", counterbalance valves %.3f", b->group[SIM_EG_COUNTERBALANCE] * 1e-3);
     if (group_columns(en, SIM_EG_OTHER)) printf(", other %.3f", b->group[SIM_EG_OTHER] * 1e-3);
-    printf(")\n  energy: released by displaced fluid %.3f kJ; work on mechanics %.3f kJ; stored in the fluid %+.3f kJ",
-           b->expansion * 1e-3, b->work * 1e-3, (b->stored - b->gas) * 1e-3);
-    if (has_gas) printf(", in accumulator gas %+.3f kJ", b->gas * 1e-3);
-    printf("; residual %.3f %% of %.3f kJ turned over\n", b->residual_pct, b->turnover * 1e-3);
+    printf(")\n  energy: released by displaced fluid %.3f kJ; work on mechanics %.3f kJ", b->expansion * 1e-3,
+           b->work * 1e-3);
+    // The fluid's compression energy is a function of each node's pressure
+    // on (0, inf): a node that ended below absolute zero (a fixed step that
+    // rang at a stiff event, which the run noted) has none, so the balance
+    // cannot be closed, and the summary says so instead of printing NaN.
+    if (!isfinite(b->stored)) {
+        printf("; stored in the fluid: undefined (a node ended below absolute zero, see the note above); no "
+               "residual\n");
+    } else {
+        printf("; stored in the fluid %+.3f kJ", (b->stored - b->gas) * 1e-3);
+        if (has_gas) printf(", in accumulator gas %+.3f kJ", b->gas * 1e-3);
+        printf("; residual %.3f %% of %.3f kJ turned over\n", b->residual_pct, b->turnover * 1e-3);
+    }
     if (isfinite(b->mech))
         printf("  energy: mechanics (kinetic + potential) %+.3f kJ, so %.3f kJ of the work went to friction, end "
                "stops and joints\n",

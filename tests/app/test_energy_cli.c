@@ -77,10 +77,27 @@ static void test_summary_groups(void) {
     CHECK(!cb || (eol && cb > eol), "the standard crane has no counterbalance valves: %.400s", line);
 }
 
+// A fixed step that rings below absolute zero at a stiff event and leaves a
+// node there at the end (the LS crane with an ideal, leak-free pump at Krus
+// 0.5 ms: its lift hose ends at -54 kPa): the fluid's compression energy is
+// undefined there, and the summary must say so instead of printing NaN as
+// the stored energy and the residual.
+static void test_summary_below_zero(void) {
+    static char out[16384];
+    int rc = cli_run("run --model " CRANESIM_ASSETS "/models/hiab031_ls.json --scenario ramp --solver krus --dt 5e-4 "
+                     "--set hydraulics.components.pump.leakage=0 --out /dev/null",
+                     out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "dipped below absolute zero"), "the run should note the dip: rc %d: %s", rc, out);
+    CHECK(strstr(out, "stored in the fluid: undefined (a node ended below absolute zero") != NULL,
+          "no 'undefined' stored energy: %s", out);
+    CHECK(!strstr(out, "nan") && !strstr(out, "NaN"), "NaN in the summary: %s", out);
+}
+
 int main(void) {
     test_energy_csv_rows_sum_to_zero();
     test_summary_groups();
     test_energy_bad_path();
+    test_summary_below_zero();
     printf("%d checks, %d failed\n", check_count_, check_failures_);
     return check_failures_ != 0;
 }
