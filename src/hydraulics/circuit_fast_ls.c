@@ -263,19 +263,7 @@ void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fa
 }
 
 #ifdef LSK_LANES
-#include <emmintrin.h>
-
-typedef __m128d v2;
-
-static inline v2 ld(const double* p) { return _mm_loadu_pd(p); }
-static inline v2 set2(double l0, double l1) { return _mm_set_pd(l1, l0); }
-// Lanes from two scattered places (i[0], i[1]) and back.
-static inline v2 ld_at(const double* y, const int* i) { return _mm_set_pd(y[i[1]], y[i[0]]); }
-static inline void st_at(double* y, const int* i, v2 v) {
-    _mm_storel_pd(&y[i[0]], v);
-    _mm_storeh_pd(&y[i[1]], v);
-}
-static inline v2 blend(v2 m, v2 a, v2 b) { return _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b)); }
+#include "hyd_lanes.h"
 
 // hyd_smoothstep's value: its cubic on t clamped to [0, 1]. maxpd(0, t)
 // returns t unless 0 > t (so t for a NaN and for -0, whose cubic is +0), and
@@ -287,17 +275,6 @@ static inline v2 smooth2(v2 t) {
 // x > 0 ? x : 0 (a spool a rounding error below 0 is closed): maxpd(x, 0)
 // returns 0 unless x > 0, also for a NaN.
 static inline v2 open2(v2 x) { return _mm_max_pd(x, _mm_setzero_pd()); }
-
-// hyd_orifice_q's flow (hyd_orifice.h), both regimes, blended on |x| < 1.
-static inline v2 orifice2(v2 k, v2 invP0, v2 kl, v2 A, v2 sA, v2 dp) {
-    const v2 sign = _mm_set1_pd(-0.0);
-    const v2 x = HYD_ORIFICE_X(invP0, A, dp);
-    const v2 lamm = _mm_cmplt_pd(_mm_andnot_pd(sign, x), _mm_set1_pd(1.0));
-    const v2 ql = HYD_ORIFICE_LAMINAR(kl, A, sA, dp, x);
-    const v2 sdp = _mm_or_pd(_mm_sqrt_pd(_mm_andnot_pd(sign, dp)), _mm_and_pd(sign, dp)); // copysign
-    const v2 qt = HYD_ORIFICE_TURBULENT(k, A, sdp);
-    return blend(lamm, ql, qt);
-}
 
 // hyd_ramp_q's flow: +0.0 while t <= 0, qr t^2 below 1, qr (2t - 1) beyond.
 static inline v2 ramp2(v2 pcr, v2 inv_w, v2 qr, v2 dp) {
@@ -328,17 +305,7 @@ static inline v2 node_c2(const hyd_model* m, const double* bel, const double* be
         c[l] = t->seg[j];
         oct[l] = t->oct[e];
     }
-    const v2 mant = _mm_castsi128_pd(_mm_or_si128(_mm_and_si128(bits, _mm_set1_epi64x((long long)HYD_AIR_MANT_MASK)),
-                                                  _mm_set1_epi64x((long long)HYD_AIR_ONE_BITS)));
-#define CO(i) _mm_set_pd(c[1][i], c[0][i])
-    const v2 x = mant - CO(HYD_AIR_DEG + 1);
-    const v2 x2 = x * x;
-    const v2 p = HYD_AIR_POLY(CO, x, x2);
-#undef CO
-    const v2 rr = set2(oct[0], oct[1]) * p;
-    const v2 N = HYD_BE_N(ld(bel), m->be_alpha, rr, P);
-    const v2 D = HYD_BE_D(ld(bec), rr, P);
-    return HYD_BE_C(N, D, V);
+    return hyd_node_c2_tab(m, bel, bec, P, V, c, oct);
 }
 
 // The open reliefs' and checks' flows into their nodes' starting sums st
