@@ -17,6 +17,16 @@ static inline int load_scenario(const char* name, scenario* sc) {
     return rc;
 }
 
+/// assets/models/<file> (e.g. "hiab031_ls.json"); NULL, the failure
+/// CHECKed, when it does not load.
+static inline model* load_model(const char* file) {
+    char path[512], err[512];
+    snprintf(path, sizeof path, "%s/models/%s", CRANESIM_ASSETS, file);
+    model* m = model_load(path, NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s: %s", file, err);
+    return m;
+}
+
 /// The default model (assets/models/hiab031.json) and scenario `name`;
 /// NULL (the failure CHECKed) when either does not load.
 static inline model* load_crane(const char* name, scenario* sc) {

@@ -21,10 +21,7 @@ static void run_balance_with(const char* model_file, const char* scen, sim_mecha
     memset(b, 0, sizeof *b);
     model* m = NULL;
     if (model_file) {
-        char path[512], err[512];
-        snprintf(path, sizeof path, "%s/models/%s", CRANESIM_ASSETS, model_file);
-        m = model_load(path, NULL, 0, err, sizeof err);
-        CHECK(m != NULL, "%s", err);
+        m = load_model(model_file);
         if (m && load_scenario(scen, &sc)) {
             model_free(m);
             m = NULL;

@@ -77,10 +77,7 @@ static void test_pump_stop(void) {
     for (int k = 0; k < 2; ++k) {
         scenario sc;
         if (load_scenario("ramp", &sc)) return;
-        char path[512], err[512];
-        snprintf(path, sizeof path, "%s/models/%s", CRANESIM_ASSETS, models[k]);
-        model* m = model_load(path, NULL, 0, err, sizeof err);
-        CHECK(m != NULL, "%s", err);
+        model* m = load_model(models[k]);
         if (!m) continue;
         sc.duration = 5.0;
         for (int mech = 0; mech < 2; ++mech) {
@@ -130,10 +127,7 @@ static void test_counterbalance_holds(void) {
     if (load_scenario("hose_burst_line", &sc)) return;
     const char* models[2] = {"hiab031_ls.json", "hiab031.json"};
     for (int k = 0; k < 2; ++k) {
-        char path[512], err[512];
-        snprintf(path, sizeof path, "%s/models/%s", CRANESIM_ASSETS, models[k]);
-        model* m = model_load(path, NULL, 0, err, sizeof err);
-        CHECK(m != NULL, "%s", err);
+        model* m = load_model(models[k]);
         if (!m) continue;
         sim_trace tr = {0};
         if (!run(m, &sc, SIM_LAGRANGE, &tr)) {

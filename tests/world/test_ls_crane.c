@@ -362,10 +362,7 @@ static void test_sandbox_slew_ls(void) {
     const char* models[2] = {"hiab031_ls.json", "hiab031.json"};
     double turned[2] = {0, 0};
     for (int k = 0; k < 2; ++k) {
-        char path[512], err[512];
-        snprintf(path, sizeof path, "%s/models/%s", CRANESIM_ASSETS, models[k]);
-        model* m = model_load(path, NULL, 0, err, sizeof err);
-        CHECK(m != NULL, "%s", err);
+        model* m = load_model(models[k]);
         if (!m) continue;
         sim_opts o = sim_default_opts();
         o.mechanics = SIM_ODE;
