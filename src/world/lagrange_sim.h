@@ -61,9 +61,14 @@ typedef struct lsim_ks {
 /// mechanics block) and W^-1 of each for ks.gh. The anchor of the midpoint
 /// sines, the commands and gh are kept in lsim_ks, as for the standard step.
 typedef struct lsim_kg {
-    int n1, n2;                        ///< number of 1x1 and 2x2 blocks
+    int n1, n2, n3;                    ///< number of 1x1, 2x2 and 3x3 blocks
     int i1[LSIM_MAX_STATES];           ///< state of each 1x1 block
     int i2[LSIM_MAX_STATES / 2];       ///< first state of each 2x2 block
+    int i3[LSIM_MAX_STATES / 3];       ///< first state of each 3x3 block
+    double j3[LSIM_MAX_STATES / 3][9]; ///< the 3x3 blocks, row-major [1/s]
+    double w3[LSIM_MAX_STATES / 3][9]; ///< W^-1 of the 3x3 blocks
+    int nv, iv;                        ///< size (0: none, 5..8) and first state of the one larger block
+    double jv[64], wv[64];             ///< that block of J and its W^-1, row-major nv x nv
     double j1[LSIM_MAX_STATES];        ///< d f_i / d y_i of the 1x1 blocks [1/s]
     double j2[LSIM_MAX_STATES / 2][4]; ///< the 2x2 blocks, row-major [1/s]
     double jm[16];                     ///< [q1, q2, q1', q2'] block, row-major

@@ -106,42 +106,59 @@ static inline int lsim_inv2(double gh, const double* m, double* w) {
     return 0;
 }
 
-// W^-1 of the 4x4 block I - gh m by Gauss-Jordan with partial pivoting; -1
+// W^-1 of the N x N block I - gh m by Gauss-Jordan with partial pivoting; -1
 // when a pivot is at or below tol * eps * max|W_ij| (lu.c's test is tol = 1;
 // a NaN fails it too). Not
 // hyd_lu_factor + four hyd_lu_solve: those general, careful loops cost about
 // 1,800 instructions per Jacobian against about 450 here, 5 % of a Krus step
 // at one Jacobian per 10 steps (callgrind, 2026-11-23).
-static inline int lsim_inv4(double gh, const double* m, double* out, double tol) {
-    double a[4][8];
-    double amax = 0.0;
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) {
-            a[i][j] = (i == j) - gh * m[i * 4 + j];
-            a[i][4 + j] = i == j;
-            if (fabs(a[i][j]) > amax) amax = fabs(a[i][j]);
-        }
-    for (int c = 0; c < 4; ++c) {
-        int p = c;
-        for (int i = c + 1; i < 4; ++i)
-            if (fabs(a[i][c]) > fabs(a[p][c])) p = i;
-        if (!(fabs(a[p][c]) > tol * DBL_EPSILON * amax)) return -1;
-        if (p != c)
-            for (int j = 0; j < 8; ++j) {
-                const double tmp = a[c][j];
-                a[c][j] = a[p][j], a[p][j] = tmp;
-            }
-        const double inv = 1.0 / a[c][c];
-        for (int j = 0; j < 8; ++j) a[c][j] *= inv;
-        for (int i = 0; i < 4; ++i) {
-            if (i == c) continue;
-            const double l = a[i][c];
-            for (int j = 0; j < 8; ++j) a[i][j] -= l * a[c][j];
-        }
+// One text for every size: LSIM_INV_BODY(N, NMAX) is the body with N the
+// size (a constant for the fixed sizes, so each compiles to the unrolled
+// code of a fixed-size inverse; nb for the one variable-size block) and NMAX
+// its storage.
+#define LSIM_INV_BODY(N, NMAX)                                                                         \
+    {                                                                                                  \
+        double a[NMAX][2 * NMAX];                                                                      \
+        double amax = 0.0;                                                                             \
+        for (int i = 0; i < N; ++i)                                                                    \
+            for (int j = 0; j < N; ++j) {                                                              \
+                a[i][j] = (i == j) - gh * m[i * N + j];                                                \
+                a[i][N + j] = i == j;                                                                  \
+                if (fabs(a[i][j]) > amax) amax = fabs(a[i][j]);                                        \
+            }                                                                                          \
+        for (int c = 0; c < N; ++c) {                                                                  \
+            int p = c;                                                                                 \
+            for (int i = c + 1; i < N; ++i)                                                            \
+                if (fabs(a[i][c]) > fabs(a[p][c])) p = i;                                              \
+            if (!(fabs(a[p][c]) > tol * DBL_EPSILON * amax)) return -1;                                \
+            if (p != c)                                                                                \
+                for (int j = 0; j < 2 * N; ++j) {                                                      \
+                    const double tmp = a[c][j];                                                        \
+                    a[c][j] = a[p][j], a[p][j] = tmp;                                                  \
+                }                                                                                      \
+            const double inv = 1.0 / a[c][c];                                                          \
+            for (int j = 0; j < 2 * N; ++j) a[c][j] *= inv;                                            \
+            for (int i = 0; i < N; ++i) {                                                              \
+                if (i == c) continue;                                                                  \
+                const double l = a[i][c];                                                              \
+                for (int j = 0; j < 2 * N; ++j) a[i][j] -= l * a[c][j];                                \
+            }                                                                                          \
+        }                                                                                              \
+        for (int i = 0; i < N; ++i)                                                                    \
+            for (int j = 0; j < N; ++j) out[i * N + j] = a[i][N + j];                                  \
+        return 0;                                                                                      \
     }
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) out[i * 4 + j] = a[i][4 + j];
-    return 0;
-}
+// The 3x3 blocks behind a counterbalance valve (lagrange_split_gen.c).
+static inline int lsim_inv3(double gh, const double* m, double* out, double tol) LSIM_INV_BODY(3, 3)
+// The mechanics block.
+static inline int lsim_inv4(double gh, const double* m, double* out, double tol) LSIM_INV_BODY(4, 4)
+// The LS crane's supply block (pump line, displacement, two P nodes, two
+// compensator spools), unrolled.
+static inline int lsim_inv6(double gh, const double* m, double* out, double tol) LSIM_INV_BODY(6, 6)
+#define LSIM_MAX_VBLOCK 8
+// A block of nb <= LSIM_MAX_VBLOCK states (the supply block, lagrange_sim.c).
+static inline int lsim_invv(int nb, double gh, const double* m, double* out, double tol)
+    LSIM_INV_BODY(nb, LSIM_MAX_VBLOCK)
+#undef LSIM_INV_BODY
 
 #endif
