@@ -1060,6 +1060,12 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
             const sim_channel* ch = chan_list_channel(s->chans, s->readout_col[i]);
             snprintf(s->readout_name[i], sizeof s->readout_name[i], "%s", ch->name);
             s->readout_scale[i] = display_unit(ch->unit, s->readout_unit[i], sizeof s->readout_unit[i]);
+            // A channel's fraction (spool, displacement) in %, as its strip
+            // chart shows it (a panel's unitless parameter stays as it is).
+            if (!strcmp(ch->unit, "-")) {
+                snprintf(s->readout_unit[i], sizeof s->readout_unit[i], "%%");
+                s->readout_scale[i] = 0.01;
+            }
             if (s->readout_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
         }
     }
