@@ -178,31 +178,9 @@ static inline void solve_stage(const lsim_kg* restrict kg, int iq, int stage, do
 int lsim_wstep_gen(void* user, double t, const double* y, double h, double gamma, int new_jac,
                    double* ynew) {
     lsim* s = user;
-    lsim_ks* ks = &s->ks;
-    const int n = s->n;
-    if (new_jac || !ks->have_j) {
-        ks->cmd_t = NAN; // after a reset the commands may have been changed
-        ks->have_anchor = false;
-        const int bad = refresh_j(s, t, y);
-        if (bad >= 0) {
-            // As lsim_wstep: the state whose row broke down turns
-            // non-finite, and the solver reports it at t + h.
-            for (int i = 0; i < n; ++i) ynew[i] = y[i];
-            ynew[bad] = NAN;
-            return 0;
-        }
-    }
-    int nlu = 0;
-    const double gh = gamma * h;
-    // As the generic driver: a relative change below 1e-8 keeps W.
-    if (ks->gh == 0.0 || fabs(gh - ks->gh) > 1e-8 * fabs(gh)) {
-        const int rc = form_w(s, gh);
-        if (rc != HYD_OK) {
-            ks->gh = 0.0;
-            return rc;
-        }
-        nlu = 1;
-    }
+    int nlu;
+    const int rc = lsim_step_prepare(s, t, y, gamma * h, new_jac, s->n, ynew, refresh_j, form_w, &nlu);
+    if (rc) return rc > 0 ? 0 : rc;
     lsim_geo g;
     lsim_geo_at(s, y, s->iq, h, &g);
     double f[LSIM_MAX_STATES], hf0[LSIM_MAX_STATES], k1[LSIM_MAX_STATES], ys[LSIM_MAX_STATES];

@@ -89,6 +89,10 @@ static int refresh_j(lsim* s, double t, const double* y) {
     return -1;
 }
 
+static int form_w(lsim_ks* ks, double gh);
+// form_w as lsim_step_prepare calls it.
+static int form_w_of(lsim* s, double gh) { return form_w(&s->ks, gh); }
+
 static int form_w(lsim_ks* ks, double gh) {
     for (int k = 0; k < 2; ++k) {
         if ((ks->wu[k] = lsim_inv1(gh, ks->ju[k])) == 0.0) return HYD_ERR_SINGULAR;
@@ -142,29 +146,9 @@ int lsim_wstep(void* user, double t, const double* y, double h, double gamma, in
                double* ynew) {
     lsim* s = user;
     lsim_ks* ks = &s->ks;
-    if (new_jac || !ks->have_j) {
-        ks->cmd_t = NAN; // after a reset the commands may have been changed
-        ks->have_anchor = false;
-        const int bad = refresh_j(s, t, y);
-        if (bad >= 0) {
-            // As the generic step would: the state whose row broke down
-            // turns non-finite, and the solver reports it at t + h.
-            for (int i = 0; i < NS; ++i) ynew[i] = y[i];
-            ynew[bad] = NAN;
-            return 0;
-        }
-    }
-    int nlu = 0;
-    const double gh = gamma * h;
-    // As the generic driver: a relative change below 1e-8 keeps W.
-    if (ks->gh == 0.0 || fabs(gh - ks->gh) > 1e-8 * fabs(gh)) {
-        const int rc = form_w(ks, gh);
-        if (rc != HYD_OK) {
-            ks->gh = 0.0;
-            return rc;
-        }
-        nlu = 1;
-    }
+    int nlu;
+    const int rc = lsim_step_prepare(s, t, y, gamma * h, new_jac, NS, ynew, refresh_j, form_w_of, &nlu);
+    if (rc) return rc > 0 ? 0 : rc;
     geo g;
     geo_at(s, y, h, &g);
     double f[NS], hf0[NS], k1[NS], ys[NS];

@@ -161,4 +161,41 @@ static inline int lsim_invv(int nb, double gh, const double* m, double* out, dou
     LSIM_INV_BODY(nb, LSIM_MAX_VBLOCK)
 #undef LSIM_INV_BODY
 
+// What both split steps do before their stages: a new J when the solver
+// asks or none is held (refresh: -1, or the first state whose block row is
+// not finite: that state turns non-finite in ynew and the step is done, as
+// the generic step would have it), then W^-1 when gamma h has changed by
+// more than 1e-8 relatively (the generic driver's rule; form: HYD_OK or
+// an error). Returns 1 when ynew is already the step's result, a negative
+// HYD_ERR_* code, else 0 with *nlu the factorisations done (0 or 1).
+// Always inlined, so the two callbacks are direct calls.
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline int lsim_step_prepare(lsim* s, double t, const double* y, double gh, int new_jac, int n,
+                                    double* ynew, int (*refresh)(lsim*, double, const double*),
+                                    int (*form)(lsim*, double), int* nlu) {
+    lsim_ks* ks = &s->ks;
+    *nlu = 0;
+    if (new_jac || !ks->have_j) {
+        ks->cmd_t = NAN; // after a reset the commands may have been changed
+        ks->have_anchor = false;
+        const int bad = refresh(s, t, y);
+        if (bad >= 0) {
+            for (int i = 0; i < n; ++i) ynew[i] = y[i];
+            ynew[bad] = NAN;
+            return 1;
+        }
+    }
+    if (ks->gh == 0.0 || fabs(gh - ks->gh) > 1e-8 * fabs(gh)) {
+        const int rc = form(s, gh);
+        if (rc != HYD_OK) {
+            ks->gh = 0.0;
+            return rc;
+        }
+        *nlu = 1;
+    }
+    return 0;
+}
+
 #endif
