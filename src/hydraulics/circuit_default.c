@@ -1,6 +1,7 @@
 // circuit_default.c: the default two-actuator crane circuit (docs/model.md,
-// the same circuit as tests/hydraulics/data/crane_circuit.json), built
-// through the public builder API.
+// the same circuit as tests/hydraulics/data/crane_circuit.json, both without
+// the seal friction of assets/models/hiab031.json), built through the public
+// builder API.
 #include "hydraulics.h"
 
 #include <stdio.h>

@@ -321,7 +321,9 @@ void hyd_model_free(hyd_model* m);
 
 /// The default two-actuator crane circuit of docs/model.md (components named
 /// as in tests/hydraulics/data/crane_circuit.json: "lift_valve", "lift_cyl",
-/// "jib_valve", "jib_cyl", ...). 11 states.
+/// "jib_valve", "jib_cyl", ...), without the seals' Coulomb and Stribeck
+/// friction that assets/models/hiab031.json carries (the component default,
+/// off; tests of the seal law set it themselves). 11 states.
 hyd_model* hyd_model_default_crane(char* err, size_t errsz);
 /// A synthetic circuit with nact in [1, 64] actuators for tests and benches:
 /// tank, pump line, a pump (35 L/min per actuator) and main relief, then per

@@ -188,8 +188,10 @@ static void test_renamed_components_get_a_full_panel(void) {
 }
 
 // Lift bore 100 -> 120 mm in the panel: the lift force the engine computes
-// is pA A_A - pB A_B - b v with the new areas (cylinder law, away from the
-// stops), A_A = pi D^2 / 4, A_B = pi (D^2 - d^2) / 4.
+// is pA A_A - pB A_B - b v - F_seal(v) with the new areas (cylinder law,
+// away from the stops), A_A = pi D^2 / 4, A_B = pi (D^2 - d^2) / 4, the
+// seal friction F_seal = (F_c + F_s exp(-(v/v_st)^2)) tanh(v/v_sm) as
+// docs/hydraulics.md writes it (the bore does not change it).
 static void test_bore_edit_changes_the_force(void) {
     drive_session* s = open_ok(SIM_LAGRANGE, NULL, NULL);
     if (!s) return;
@@ -204,11 +206,18 @@ static void test_bore_edit_changes_the_force(void) {
     hyd_model_get(hm, "lift_cyl.bore", &D);
     hyd_model_get(hm, "lift_cyl.rod", &d);
     hyd_model_get(hm, "lift_cyl.friction", &bv);
+    double Fc = 0, Fs = 0, vst = 1, vsm = 1;
+    hyd_model_get(hm, "lift_cyl.coulomb", &Fc);
+    hyd_model_get(hm, "lift_cyl.stribeck", &Fs);
+    hyd_model_get(hm, "lift_cyl.v_stribeck", &vst);
+    hyd_model_get(hm, "lift_cyl.v_smooth", &vsm);
     CHECK(D == 0.12, "engine bore %g m", D);
     double row[SIM_NCOL];
     drive_session_row(s, row);
-    const double F = row[COL_P1A] * M_PI * D * D / 4 - row[COL_P1B] * M_PI * (D * D - d * d) / 4 - bv * row[COL_V1];
-    const double F_old = row[COL_P1A] * M_PI * 0.01 / 4 - row[COL_P1B] * M_PI * (0.01 - d * d) / 4 - bv * row[COL_V1];
+    const double v = row[COL_V1];
+    const double seal = (Fc + Fs * exp(-(v / vst) * (v / vst))) * tanh(v / vsm);
+    const double F = row[COL_P1A] * M_PI * D * D / 4 - row[COL_P1B] * M_PI * (D * D - d * d) / 4 - bv * v - seal;
+    const double F_old = row[COL_P1A] * M_PI * 0.01 / 4 - row[COL_P1B] * M_PI * (0.01 - d * d) / 4 - bv * v - seal;
     CHECK(fabs(row[COL_F1] - F) <= 1e-9 * fabs(F), "F1 %.9g N, hand %.9g N (old bore %.6g N)", row[COL_F1], F, F_old);
     CHECK(fabs(F - F_old) > 0.2 * fabs(F), "the new bore makes no difference: %g vs %g N", F, F_old);
     drive_session_destroy(s);

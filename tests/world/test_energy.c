@@ -69,9 +69,14 @@ static void test_ramp_balance(void) {
         const char* name = k ? "ode ramp" : "lagrange ramp";
         print_balance(name, &b);
         // The ramp really moves the crane with the pump delivering (else
-        // the balance would be trivially closed).
+        // the balance would be trivially closed). The work term must count:
+        // above 1 % of the energy in, 50 times the 0.02 % residual allowed
+        // below, so that a balance without it would fail. (With the seal
+        // friction the cylinders' work on ramp is 2.6 % of the energy in:
+        // of the 5.1 kJ the booms give up, 3.8 kJ go to friction, 0.55 kJ
+        // without the seals' Coulomb and Stribeck terms.)
         CHECK(b.pump > 10e3, "%s: the pump delivered only %g J", name, b.pump);
-        CHECK(fabs(b.work) > 0.05 * b.in && fabs(b.mech) > 0.05 * b.in, "%s: work %g J, mechanics %g J of %g J in", name, b.work, b.mech, b.in);
+        CHECK(fabs(b.work) > 0.01 * b.in && fabs(b.mech) > 0.05 * b.in, "%s: work %g J, mechanics %g J of %g J in", name, b.work, b.mech, b.in);
         CHECK(fabs(b.residual_pct) < 1.0, "%s: residual %.3f %% of the energy in", name, b.residual_pct);
         // Tighter than asked (measured: below 0.001 %): the smallest term,
         // the check valves' 0.05 %, must be in it too.

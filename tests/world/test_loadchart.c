@@ -360,9 +360,15 @@ static void test_limiter_slew_towards_weaker_sector(void) {
 // (it stays below the chart past 2.88 m, then meets it smoothly near 3.1 m).
 // The limiter must hold rcl_util at or below 1.02 all the way, on the
 // pressures' ringing too (the booms ring on the oil at about 2.5 Hz, the
-// lift pressure swinging by up to +-10 MPa). Without the limiter the jib
-// runs to its end stop (1.36 at 1300 kg): the attempt is an overload.
-static double overload_attempt(const model* m, sim_mechanics mech, bool off, double load, double* x2_end) {
+// lift pressure swinging by up to +-10 MPa), plus what the lift cylinder's
+// seal friction does to a load read from its pressures: while the cylinder
+// stands, the seal carries up to its breakaway force F_c + F_s either way,
+// so the load the limiter reads is uncertain by (F_c + F_s) (dx/dq1) / (g R)
+// (*band, at the pose of the highest reading, as a fraction of the load:
+// 0.05 at 1300 kg). Without the limiter the jib runs to its end stop (1.33
+// at 1300 kg): the attempt is an overload.
+static double overload_attempt(const model* m, sim_mechanics mech, bool off, double load, double* x2_end,
+                               double* band) {
     sim_opts o = sim_default_opts();
     o.mechanics = mech;
     o.world = mech == SIM_ODE ? CRANESIM_ASSETS "/worlds/validation.json" : NULL;
@@ -374,7 +380,7 @@ static double overload_attempt(const model* m, sim_mechanics mech, bool off, dou
     if (!e) return NAN;
     const rcl* r = engine_rcl(e);
     CHECK(r != NULL, "no limiter");
-    double umax = 0, row[SIM_NCOL];
+    double umax = 0, row[SIM_NCOL], q_at_max[2] = {q0[0], q0[1]};
     for (int i = 0; i < 8000 && r; ++i) {
         const double u[3] = {0, 1, 0}; // jib out, full command
         engine_set_commands(e, u);
@@ -385,9 +391,15 @@ static double overload_attempt(const model* m, sim_mechanics mech, bool off, dou
         engine_row(e, row);
         // The stepped lagrange engine has no rcl_util column: the limiter's
         // own value, the one the ode rows record.
-        umax = fmax(umax, r->util);
+        if (r->util > umax) umax = r->util, q_at_max[0] = row[COL_Q1], q_at_max[1] = row[COL_Q2];
     }
     *x2_end = row[COL_X2];
+    double Fc = 0, Fs = 0, dxdq, R, z;
+    hyd_model_get(m->hyd, "lift_cyl.coulomb", &Fc);
+    hyd_model_get(m->hyd, "lift_cyl.stribeck", &Fs);
+    crane_pin_length(&m->mech.act[0], q_at_max[0], &dxdq);
+    crane_tip(&m->mech, q_at_max[0], q_at_max[1], &R, &z);
+    *band = (Fc + Fs) * fabs(dxdq) / (m->mech.gravity * R * load);
     engine_destroy(e);
     return umax;
 }
@@ -399,12 +411,14 @@ static void test_limiter_overload_attempt(void) {
     for (int b = 0; b < 2; ++b) {
         const sim_mechanics mech = b ? SIM_LAGRANGE : SIM_ODE;
         for (int k = 0; k < 2; ++k) {
-            double x_on, x_off;
-            const double on = overload_attempt(m, mech, false, loads[k], &x_on);
-            const double off = overload_attempt(m, mech, true, loads[k], &x_off);
-            printf("  %s, %.0f kg: max rcl_util %.3f with the limiter (jib stroke %.3f m), %.3f without (%.3f m)\n",
-                   b ? "lagrange" : "ode", loads[k], on, x_on, off, x_off);
-            CHECK(on <= 1.02, "%s %.0f kg: with the limiter rcl_util reached %.3f", b ? "lagrange" : "ode", loads[k], on);
+            double x_on, x_off, band, band_off;
+            const double on = overload_attempt(m, mech, false, loads[k], &x_on, &band);
+            const double off = overload_attempt(m, mech, true, loads[k], &x_off, &band_off);
+            printf("  %s, %.0f kg: max rcl_util %.3f with the limiter (jib stroke %.3f m; seal band %.3f), %.3f "
+                   "without (%.3f m)\n",
+                   b ? "lagrange" : "ode", loads[k], on, x_on, band, off, x_off);
+            CHECK(on <= 1.02 + band, "%s %.0f kg: with the limiter rcl_util reached %.3f (allowed 1.02 + %.3f)",
+                  b ? "lagrange" : "ode", loads[k], on, band);
             CHECK(off > 1.05, "%s %.0f kg: without the limiter only %.3f: not an overload", b ? "lagrange" : "ode",
                   loads[k], off);
             CHECK(x_on < x_off - 0.15, "the jib was not stopped: stroke %.3f m with the limiter, %.3f m without", x_on,
