@@ -111,6 +111,8 @@ static const sim_collisions* ode_collisions(const engine* e) {
     return ode_world_kind(l->w) == WORLD_SANDBOX ? &l->coll : NULL;
 }
 
+static void ode_part_energy(const engine* e, double E[2]) { ode_world_part_energy(W(e), &E[0], &E[1]); }
+
 static double ode_time(const engine* e) { return ode_world_time(W(e)); }
 static void ode_row(engine* e, double row[SIM_NCOL]) { sim_ode_row(W(e), row); }
 static void ode_snapshot(engine* e, world_snapshot* s) { ode_world_snapshot(W(e), s); }
@@ -327,6 +329,7 @@ const engine_ops engine_ode_ops = {
     .circuit_state = ode_circuit_state,
     .set_load = NULL, // the world's loads are bodies, picked up with the hook
     .set_link = ode_set_link,
+    .part_energy = ode_part_energy,
     .resize_links = false, // a body's geometry is fixed when it is built
     .step = ode_step,
     .time = ode_time,

@@ -847,6 +847,18 @@ double ode_world_energy(const ode_world* w) {
     return e;
 }
 
+void ode_world_part_energy(const ode_world* w, double* crane, double* hook) {
+    *crane = *hook = NAN;
+    if (w->dead) return;
+    double c = 0, h = 0;
+    for (int f = 0; f < 3; ++f)
+        if (w->frame[f].body) c += body_energy(w->frame[f].body, w->g);
+    for (int i = 0; i < w->nrope; ++i) h += body_energy(w->rope[i], w->g);
+    if (w->hook) h += body_energy(w->hook, w->g);
+    *crane = c;
+    *hook = h;
+}
+
 // ---- state ----
 
 static void tip_point(const ode_world* w, double p[3], double v[3]) {
