@@ -631,6 +631,7 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
     w->g = w->desc.gravity >= 0 ? w->desc.gravity : w->mech.gravity;
     w->m3 = opt.load_mass >= 0 ? opt.load_mass : w->mech.load_mass;
     w->attached = -1;
+    w->released = -1;
     w->ipump = -1;
     for (int k = 0; k < ODE_NACT; ++k) w->act[k].cyl = w->act[k].valve = -1;
 
