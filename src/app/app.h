@@ -154,10 +154,12 @@ double app_output_period(const sim_opts* o);
 /// A scenario that slews the crane or works the hook (slew commands, an
 /// initial slew, hook events) is written for a world with a slewing column
 /// and a hook: the sandbox. Run elsewhere its slew and hook would be dropped.
+/// A --world of that kind (sandbox, site) given without --mechanics makes o
+/// ode (a world is the ode backend's; one note on stderr, *switched set).
 /// With may_switch, no --world and no --mechanics other than ode given, o
-/// becomes ode on the sandbox (one note on stderr, and *switched is set):
-/// the scenario runs in its world. Otherwise a run o cannot honour is refused: one line
-/// saying how to run it, EXIT_USAGE. Returns 0 when o runs it as written.
+/// becomes ode on the sandbox (the same): the scenario runs in its world.
+/// Otherwise a run o cannot honour is refused: one line saying how to run
+/// it, EXIT_USAGE. Returns 0 when o runs it as written.
 /// drive's counterpart: the scenario is a scripted operator there, so a
 /// slew it commands in a world without one (lagrange, the validation world)
 /// is not refused but said, once, on stderr. world_kind: the ode world's
@@ -167,9 +169,10 @@ int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scena
                        bool* switched);
 /// app_scenario_world with the advice after the refusal given by the caller
 /// (NULL: "run it with --mechanics ode --world sandbox"), for a command whose
-/// own options put the run where it is (compare's --backends).
+/// own options put the run where it is (compare's --backends); quiet: no
+/// note of a switch (compare says it once for both sides).
 int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
-                              bool* switched, const char* remedy);
+                              bool* switched, const char* remedy, bool quiet);
 
 /// Resolve a scenario argument: an existing file, or assets/scenarios/<name>.json.
 const char* app_scenario_path(const char* arg, char* buf, size_t n);
