@@ -295,9 +295,17 @@ double app_tick_step(double lo, double hi, int max_ticks);
 int app_tick_decimals(double step);
 void app_tick_label(double v, double step, char* buf, size_t n);
 
-/// Plot a run's main time histories to a PNG (PLplot). Returns 0, or -1 with
-/// a message (also when cranesim was built without PLplot).
-int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz);
+/// Plot a run's main time histories to a PNG (PLplot); slew: the run's world
+/// has a slew drive, whose channels are drawn too. Returns 0, or -1 with a
+/// message (also when cranesim was built without PLplot).
+int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* png, char* err, size_t errsz);
+/// The run plot's time panels (0 strokes, 1 chamber pressures, 2 valve spools
+/// and commands): their columns and legend names (pure; no PLplot), the lift
+/// and jib, and with slew the slew's. Returns how many.
+#define APP_PLOT_MAXSERIES 6
+int app_plot_run_channels(int panel, bool slew, int cols[APP_PLOT_MAXSERIES], const char* names[APP_PLOT_MAXSERIES]);
+/// The run with options o has a slew drive (an ode world with a slewing column).
+bool app_world_has_slew(const sim_opts* o);
 /// A bar chart of n energies kj [kJ] named names (one bar each, in order) to a PNG.
 int app_plot_energy(const char* const* names, const double* kj, int n, const char* title, const char* png, char* err,
                     size_t errsz);

@@ -30,6 +30,11 @@ static int world_kind_of(const sim_opts* o, char* err, size_t errsz) {
     return kind;
 }
 
+bool app_world_has_slew(const sim_opts* o) {
+    char err[512];
+    return o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX;
+}
+
 // |a / b - round(a / b)| within 1e-9 relative: a is a whole multiple of b.
 static bool whole_multiple(double a, double b) {
     const double r = a / b;

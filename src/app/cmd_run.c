@@ -545,7 +545,7 @@ int cmd_run(int argc, char** argv) {
         engine_describe(&c.sim, &d);
         snprintf(title, sizeof title, "%s: %s, %s", sc.name, d.title,
                  c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
-        if (app_plot_run(&tr, title, plot, err, sizeof err)) {
+        if (app_plot_run(&tr, title, app_world_has_slew(&c.sim), plot, err, sizeof err)) {
             fprintf(stderr, "cranesim run: plot: %s\n", err);
             if (code == EXIT_OK_) code = EXIT_RUNTIME;
         } else if (!c.quiet) {
