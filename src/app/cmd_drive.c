@@ -199,7 +199,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         model_free(m);
         return EXIT_USAGE;
     }
-    char err[320];
+    char err[512];
     // The session keeps the model as loaded: a replay adds the bursts itself.
     cJSON* doc0 = session_path ? cJSON_Duplicate(m->json, 1) : NULL;
     if (sc.nfault) { // bursts need their orifices in the circuit (engine_fault_model)
