@@ -154,10 +154,12 @@ double app_output_period(const sim_opts* o);
 /// A scenario that slews the crane or works the hook (slew commands, an
 /// initial slew, hook events) is written for a world with a slewing column
 /// and a hook: the sandbox. Run elsewhere its slew and hook would be dropped.
+/// A --world of that kind (sandbox, site) given without --mechanics makes o
+/// ode (a world is the ode backend's; one note on stderr, *switched set).
 /// With may_switch, no --world and no --mechanics other than ode given, o
-/// becomes ode on the sandbox (one note on stderr, and *switched is set):
-/// the scenario runs in its world. Otherwise a run o cannot honour is refused: one line
-/// saying how to run it, EXIT_USAGE. Returns 0 when o runs it as written.
+/// becomes ode on the sandbox (the same): the scenario runs in its world.
+/// Otherwise a run o cannot honour is refused: one line saying how to run
+/// it, EXIT_USAGE. Returns 0 when o runs it as written.
 /// drive's counterpart: the scenario is a scripted operator there, so a
 /// slew it commands in a world without one (lagrange, the validation world)
 /// is not refused but said, once, on stderr. world_kind: the ode world's
@@ -167,9 +169,10 @@ int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scena
                        bool* switched);
 /// app_scenario_world with the advice after the refusal given by the caller
 /// (NULL: "run it with --mechanics ode --world sandbox"), for a command whose
-/// own options put the run where it is (compare's --backends).
+/// own options put the run where it is (compare's --backends); quiet: no
+/// note of a switch (compare says it once for both sides).
 int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
-                              bool* switched, const char* remedy);
+                              bool* switched, const char* remedy, bool quiet);
 
 /// Resolve a scenario argument: an existing file, or assets/scenarios/<name>.json.
 const char* app_scenario_path(const char* arg, char* buf, size_t n);
@@ -292,9 +295,17 @@ double app_tick_step(double lo, double hi, int max_ticks);
 int app_tick_decimals(double step);
 void app_tick_label(double v, double step, char* buf, size_t n);
 
-/// Plot a run's main time histories to a PNG (PLplot). Returns 0, or -1 with
-/// a message (also when cranesim was built without PLplot).
-int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz);
+/// Plot a run's main time histories to a PNG (PLplot); slew: the run's world
+/// has a slew drive, whose channels are drawn too. Returns 0, or -1 with a
+/// message (also when cranesim was built without PLplot).
+int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* png, char* err, size_t errsz);
+/// The run plot's time panels (0 strokes, 1 chamber pressures, 2 valve spools
+/// and commands): their columns and legend names (pure; no PLplot), the lift
+/// and jib, and with slew the slew's. Returns how many.
+#define APP_PLOT_MAXSERIES 6
+int app_plot_run_channels(int panel, bool slew, int cols[APP_PLOT_MAXSERIES], const char* names[APP_PLOT_MAXSERIES]);
+/// The run with options o has a slew drive (an ode world with a slewing column).
+bool app_world_has_slew(const sim_opts* o);
 /// A bar chart of n energies kj [kJ] named names (one bar each, in order) to a PNG.
 int app_plot_energy(const char* const* names, const double* kj, int n, const char* title, const char* png, char* err,
                     size_t errsz);

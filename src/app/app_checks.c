@@ -30,6 +30,11 @@ static int world_kind_of(const sim_opts* o, char* err, size_t errsz) {
     return kind;
 }
 
+bool app_world_has_slew(const sim_opts* o) {
+    char err[512];
+    return o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX;
+}
+
 // |a / b - round(a / b)| within 1e-9 relative: a is a whole multiple of b.
 static bool whole_multiple(double a, double b) {
     const double r = a / b;
@@ -200,39 +205,51 @@ void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind)
 
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
                        bool* switched) {
-    return app_scenario_world_remedy(cmd, o, given, sc, may_switch, switched, NULL);
+    return app_scenario_world_remedy(cmd, o, given, sc, may_switch, switched, NULL, false);
 }
 
 int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
-                              bool* switched, const char* remedy) {
+                              bool* switched, const char* remedy, bool quiet) {
     if (switched) *switched = false;
     const char* why = sandbox_use(sc);
     if (!why) return 0;
+    const char* name = sc->name[0] ? sc->name : "the scenario";
+    const bool world_given = given & APP_GIVEN(APP_OPT_WORLD), mech_given = given & APP_GIVEN(APP_OPT_MECHANICS);
     char err[512];
-    if (o->mechanics == SIM_ODE) {
+    // A world is the ode backend's: --world without --mechanics asks for an
+    // ode run as much as --mechanics ode does.
+    if (o->mechanics == SIM_ODE || (world_given && !mech_given)) {
         const int kind = world_kind_of(o, err, sizeof err);
-        if (kind == WORLD_SANDBOX) return 0;
         // A world file that does not load is the first thing wrong: say that,
         // not that the scenario needs another world.
-        if (kind < 0) {
+        if (kind < 0 && (o->mechanics == SIM_ODE || world_given)) {
             fprintf(stderr, "cranesim %s: %s\n", cmd, err);
             return EXIT_USAGE;
         }
+        if (kind == WORLD_SANDBOX) {
+            if (o->mechanics != SIM_ODE) {
+                o->mechanics = SIM_ODE;
+                if (switched) *switched = true;
+                if (!quiet)
+                    fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs with --mechanics ode in --world %s\n",
+                            cmd, name, why, o->world);
+            }
+            return 0;
+        }
     }
-    const char* name = sc->name[0] ? sc->name : "the scenario";
     // No world chosen (--world), and no backend or the ode one: its world.
-    if (may_switch && !(given & APP_GIVEN(APP_OPT_WORLD)) &&
-        (!(given & APP_GIVEN(APP_OPT_MECHANICS)) || o->mechanics == SIM_ODE)) {
+    if (may_switch && !world_given && (!mech_given || o->mechanics == SIM_ODE)) {
         o->mechanics = SIM_ODE;
         o->world = "sandbox";
         if (switched) *switched = true;
-        fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs in its world, --mechanics ode --world sandbox\n",
-                cmd, name, why);
+        if (!quiet)
+            fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs in its world, --mechanics ode --world sandbox\n",
+                    cmd, name, why);
         return 0;
     }
     fprintf(stderr,
             "cranesim %s: scenario %s %s, which the %s has not: %s\n", cmd, name, why,
-            o->mechanics == SIM_ODE ? "validation world" : "lagrange 2-DOF crane",
+            o->mechanics == SIM_ODE || (world_given && !mech_given) ? "validation world" : "lagrange 2-DOF crane",
             remedy ? remedy : "run it with --mechanics ode --world sandbox");
     return EXIT_USAGE;
 }

@@ -367,10 +367,12 @@ int cmd_compare(int argc, char** argv) {
             rc = EXIT_USAGE;
         }
     }
-    // Both sides must run the scenario as written (no silent switch: the
-    // comparison names its backends).
+    // Both sides must run the scenario as written: a backend the pair (or
+    // the default pair) chose is never switched; a side's options that leave
+    // the backend or the world open go to the sandbox as run's do, said once.
     // The advice must name what put a side on the wrong crane: the default
     // pair or the user's --backends (--mechanics alone is overridden by them).
+    bool switched[2] = {false, false};
     for (int s = 0; s < 2 && !rc; ++s) {
         char remedy[400];
         const char* ab = s ? "B" : "A";
@@ -383,7 +385,11 @@ int cmd_compare(int argc, char** argv) {
             snprintf(remedy, sizeof remedy, "give --world sandbox (side %s runs the ode backend)", ab);
         else
             snprintf(remedy, sizeof remedy, "run it with --mechanics ode --world sandbox");
-        rc = app_scenario_world_remedy("compare", &side[s], c.given, &sc, false, NULL, remedy);
+        const unsigned given =
+            c.given | (pairs[0] || (!any_pair && !designs) ? APP_GIVEN(APP_OPT_MECHANICS) : 0u);
+        rc = app_scenario_world_remedy("compare", &side[s], given, &sc, true, &switched[s], remedy,
+                                       s == 1 && switched[0]);
+        if (!rc && switched[s]) rc = app_check_sim("compare", &side[s], given);
     }
     if (rc && m) {
         model_free(m);

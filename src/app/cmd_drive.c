@@ -140,10 +140,13 @@ static int world_info(const app_common* c, char* name, size_t n, char* err, size
 typedef struct drive_world {
     bool hook;        // a hook to attach loads (sandbox)
     bool noted;       // said once that a hook event had nothing to act on
+    bool noted_empty; // said once that a release found nothing on the hook
+    int held;         // the load on the hook, -1: none (only the scenario works the hook here)
     session_writer* sess; // the session file, or NULL
 } drive_world;
 
-// Say what the scripted operator's hook did.
+// Say what the scripted operator's hook did, and only that: a load picked
+// up or let go by name; a release with nothing on the hook once.
 static void report_hook(void* user, engine* l, int attach, int got) {
     drive_world* dw = user;
     if (dw->sess) session_writer_hook(dw->sess, attach);
@@ -153,11 +156,21 @@ static void report_hook(void* user, engine* l, int attach, int got) {
         return;
     }
     double mass = 0;
-    const char* name = got >= 0 ? engine_load_name(l, got, &mass) : NULL;
     const double t = engine_time(l);
-    if (attach && name) printf("  t = %5.2f s: hook picked up %s (%.0f kg)\n", t, name, mass);
-    else if (attach) printf("  t = %5.2f s: hook found no load in reach\n", t);
-    else printf("  t = %5.2f s: hook released the load\n", t);
+    if (attach) {
+        const char* name = got >= 0 ? engine_load_name(l, got, &mass) : NULL;
+        if (got >= 0 && got == dw->held) return; // already on the hook: nothing happened
+        if (name) printf("  t = %5.2f s: hook picked up %s (%.0f kg)\n", t, name, mass);
+        else printf("  t = %5.2f s: hook found no load in reach\n", t);
+        dw->held = got;
+    } else if (dw->held >= 0) {
+        const char* name = engine_load_name(l, dw->held, &mass);
+        printf("  t = %5.2f s: hook released %s (%.0f kg)\n", t, name ? name : "its load", mass);
+        dw->held = -1;
+    } else if (!dw->noted_empty) {
+        printf("  t = %5.2f s: the scenario releases the hook with nothing on it (said once)\n", t);
+        dw->noted_empty = true;
+    }
 }
 
 // One CSV row; false (errno kept) when the stream has failed.
@@ -186,7 +199,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         model_free(m);
         return EXIT_USAGE;
     }
-    char err[320];
+    char err[512];
     // The session keeps the model as loaded: a replay adds the bursts itself.
     cJSON* doc0 = session_path ? cJSON_Duplicate(m->json, 1) : NULL;
     if (sc.nfault) { // bursts need their orifices in the circuit (engine_fault_model)
@@ -241,7 +254,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     // file has some. The validation world and the lagrange view have none.
     const bool sandbox = ode && kind == WORLD_SANDBOX;
     const bool loads = sandbox && engine_load_name(l, 0, NULL) != NULL;
-    drive_world dw = {.hook = sandbox, .sess = session_path ? &sw : NULL};
+    drive_world dw = {.hook = sandbox, .held = -1, .sess = session_path ? &sw : NULL};
     int wr = 0; // errno of the first failed write to the record
     if (f) sim_csv_header(f, ncol);
     if (f && ferror(f)) wr = errno ? errno : EIO;

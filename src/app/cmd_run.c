@@ -33,8 +33,9 @@ static void run_help(FILE* f) {
             "  --out FILE           CSV output (default run.csv); written to a temporary file in its\n"
             "                       folder and renamed over FILE when the run ends (also a failed or\n"
             "                       interrupted one, with the rows so far): until then FILE is untouched\n"
-            "  --plot FILE.png      also plot strokes, pressures, valve openings and tip path, and\n"
-            "                       the energy per component as a bar chart to FILE_energy.png\n"
+            "  --plot FILE.png      also plot strokes, pressures, valve openings (lift, jib, and the\n"
+            "                       slew where the world has one) and tip path, and the energy per\n"
+            "                       component as a bar chart to FILE_energy.png\n"
             "  --metrics FILE.json  also write the run's metrics (peak pressures, relief time, per-relief\n"
             "                       open time, end-stop hits, energy in and losses, hook sway,\n"
             "                       collisions with the bodies involved (ode sandbox), ...;\n"
@@ -545,7 +546,7 @@ int cmd_run(int argc, char** argv) {
         engine_describe(&c.sim, &d);
         snprintf(title, sizeof title, "%s: %s, %s", sc.name, d.title,
                  c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
-        if (app_plot_run(&tr, title, plot, err, sizeof err)) {
+        if (app_plot_run(&tr, title, app_world_has_slew(&c.sim), plot, err, sizeof err)) {
             fprintf(stderr, "cranesim run: plot: %s\n", err);
             if (code == EXIT_OK_) code = EXIT_RUNTIME;
         } else if (!c.quiet) {

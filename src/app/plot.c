@@ -40,6 +40,23 @@ static int write_file(const char* path, const void* data, size_t n, char* err, s
 // step from app_tick_step and print each label with as many decimals as the
 // step needs (app_tick_label), so neighbouring labels always differ.
 
+int app_plot_run_channels(int panel, bool slew, int cols[APP_PLOT_MAXSERIES], const char* names[APP_PLOT_MAXSERIES]) {
+    // Lift and jib, then the slew where the world drives one (the sandbox:
+    // its rack's stroke, chambers and valve are a function like the others).
+    static const int c[3][APP_PLOT_MAXSERIES] = {{COL_X1, COL_X2, COL_X3},
+                                                 {COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_P3A, COL_P3B},
+                                                 {COL_U1, COL_U2, COL_U1_CMD, COL_U2_CMD, COL_U3, COL_U3_CMD}};
+    static const char* const nm[3][APP_PLOT_MAXSERIES] = {
+        {"x1 lift", "x2 jib", "x3 slew"},
+        {"p1A", "p1B", "p2A", "p2B", "p3A", "p3B"},
+        {"u1 spool", "u2 spool", "u1 cmd", "u2 cmd", "u3 spool", "u3 cmd"}};
+    static const int n[3][2] = {{2, 3}, {4, 6}, {4, 6}};
+    if (panel < 0 || panel > 2) return 0;
+    const int k = n[panel][slew ? 1 : 0];
+    for (int i = 0; i < k; ++i) cols[i] = c[panel][i], names[i] = nm[panel][i];
+    return k;
+}
+
 double app_tick_step(double lo, double hi, int max_ticks) {
     const double span = fabs(hi - lo);
     if (!(span > 0) || !isfinite(span) || max_ticks < 1) return 1.0;
@@ -224,6 +241,7 @@ static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, c
 typedef struct traces_plot {
     const sim_trace *a, *b;
     const char *la, *lb, *title;
+    bool slew; ///< the world has a slew drive: its channels too
     PLFLT *xb, *yb;
 } traces_plot;
 
@@ -233,18 +251,16 @@ static void draw_traces(void* user) {
     PLFLT *xb = p->xb, *yb = p->yb;
     plstar(2, 2);
     plschr(0, 0.9);
-    const int xs[] = {COL_X1, COL_X2};
-    const char* const xn[] = {"x1 lift", "x2 jib"};
-    const int ps[] = {COL_P1A, COL_P1B, COL_P2A, COL_P2B};
-    const char* const pn[] = {"p1A", "p1B", "p2A", "p2B"};
-    const int us[] = {COL_U1, COL_U2, COL_U1_CMD, COL_U2_CMD};
-    const char* const un[] = {"u1 spool", "u2 spool", "u1 cmd", "u2 cmd"};
+    int xs[APP_PLOT_MAXSERIES], ps[APP_PLOT_MAXSERIES], us[APP_PLOT_MAXSERIES];
+    const char *xn[APP_PLOT_MAXSERIES], *pn[APP_PLOT_MAXSERIES], *un[APP_PLOT_MAXSERIES];
+    const int nx = app_plot_run_channels(0, p->slew, xs, xn), np = app_plot_run_channels(1, p->slew, ps, pn),
+              nu = app_plot_run_channels(2, p->slew, us, un);
     const int tz[] = {COL_TIP_Z};
     char t1[300];
     snprintf(t1, sizeof t1, "Cylinder strokes - %s", p->title);
-    panel(a, b, COL_T, 1, xs, 2, 1e3, "t [s]", "stroke [mm]", t1, xn, xb, yb);
-    panel(a, b, COL_T, 1, ps, 4, 1e-6, "t [s]", "pressure [MPa abs]", "Chamber pressures", pn, xb, yb);
-    panel(a, b, COL_T, 1, us, 4, 100, "t [s]", "opening [%]", "Valve spools and commands", un, xb, yb);
+    panel(a, b, COL_T, 1, xs, nx, 1e3, "t [s]", "stroke [mm]", t1, xn, xb, yb);
+    panel(a, b, COL_T, 1, ps, np, 1e-6, "t [s]", "pressure [MPa abs]", "Chamber pressures", pn, xb, yb);
+    panel(a, b, COL_T, 1, us, nu, 100, "t [s]", "opening [%]", "Valve spools and commands", un, xb, yb);
     char t4[200];
     if (b) snprintf(t4, sizeof t4, "Tip path (solid: %s, dashed: %s)", p->la, p->lb);
     else snprintf(t4, sizeof t4, "Tip path relative to joint 1");
@@ -252,7 +268,7 @@ static void draw_traces(void* user) {
 }
 
 static int plot_traces(const sim_trace* a, const char* la, const sim_trace* b, const char* lb, const char* title,
-                       const char* png, char* err, size_t errsz) {
+                       bool slew, const char* png, char* err, size_t errsz) {
     int n = a->nrow > (b ? b->nrow : 0) ? a->nrow : b->nrow;
     PLFLT* xb = malloc(sizeof(PLFLT) * (size_t)n);
     PLFLT* yb = malloc(sizeof(PLFLT) * (size_t)n);
@@ -262,20 +278,20 @@ static int plot_traces(const sim_trace* a, const char* la, const sim_trace* b, c
         snprintf(err, errsz, "out of memory");
         return -1;
     }
-    traces_plot p = {a, b, la, lb, title, xb, yb};
+    traces_plot p = {a, b, la, lb, title, slew, xb, yb};
     const int rc = app_png_render(png, "1400x1000", draw_traces, &p, err, errsz);
     free(xb);
     free(yb);
     return rc;
 }
 
-int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz) {
-    return plot_traces(tr, "", NULL, "", title, png, err, errsz);
+int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* png, char* err, size_t errsz) {
+    return plot_traces(tr, "", NULL, "", title, slew, png, err, errsz);
 }
 
 int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb, const char* title,
                      const char* png, char* err, size_t errsz) {
-    return plot_traces(a, la, b, lb, title, png, err, errsz);
+    return plot_traces(a, la, b, lb, title, false, png, err, errsz);
 }
 
 typedef struct bars_plot {
@@ -324,8 +340,8 @@ int app_png_render(const char* png, const char* geometry, void (*draw)(void* use
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
     return -1;
 }
-int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz) {
-    (void)tr, (void)title, (void)png;
+int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* png, char* err, size_t errsz) {
+    (void)tr, (void)title, (void)slew, (void)png;
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
     return -1;
 }

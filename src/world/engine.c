@@ -278,6 +278,12 @@ const char* engine_load_name(const engine* e, int i, double* mass) {
     return e->ops->hook ? e->ops->load_name(e, i, mass) : NULL;
 }
 
+bool engine_part_energy(const engine* e, double E[2]) {
+    if (!e->ops->part_energy) return false;
+    e->ops->part_energy(e, E);
+    return true;
+}
+
 bool engine_attached(const engine* e) { return e->ops->hook ? e->ops->attached(e) : false; }
 hyd_model* engine_circuit(engine* e) { return e->ops->circuit(e); }
 

@@ -63,6 +63,11 @@ int engine_hook(engine* e, int attach);
 /// (nearest: load_500, 3.21 m away; reach 0.50 m)", "H: this world has no
 /// hook". Returns engine_hook's answer.
 int engine_hook_report(engine* e, int attach, char* msg, size_t n);
+/// The mechanical energy [J] (kinetic + potential from z = 0) of the
+/// crane's column and booms into E[0] and of its rope and hook into E[1],
+/// where the backend has bodies for them (the ode world); false, E
+/// untouched, where it has not (the lagrange crane).
+bool engine_part_energy(const engine* e, double E[2]);
 /// Name and mass [kg] of load i of the world, or NULL.
 const char* engine_load_name(const engine* e, int i, double* mass);
 /// True while a load hangs on the hook.

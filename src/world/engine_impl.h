@@ -40,6 +40,8 @@ typedef struct engine_ops {
     double (*time)(const engine* e);
     void (*row)(engine* e, double row[SIM_NCOL]);
     void (*snapshot)(engine* e, world_snapshot* s);
+    /// NULL: no bodies to weigh (engine_part_energy).
+    void (*part_energy)(const engine* e, double E[2]);
     /// NULL (or a NULL result): the world reports no collisions.
     const sim_collisions* (*collisions)(const engine* e);
 } engine_ops;

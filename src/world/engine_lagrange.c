@@ -53,7 +53,8 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
     lsim_initial_state(&l->ls, q0, 0.5e6, l->y);
     double row0[SIM_NCOL];
     lag_row(&l->base, row0);
-    if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, m3, err, errsz)) {
+    const sim_start_load ld = {&m->mech, {q0[0], q0[1]}, m3, false};
+    if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, &ld, err, errsz)) {
         lsim_free(&l->ls);
         free(l);
         return NULL;
@@ -292,7 +293,8 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
         lsim_outputs(&ls, 0.0, y, &lo);
         const double row0[SIM_NCOL_BASE] = {[COL_P1A] = lo.pA[0], [COL_P1B] = lo.pB[0], [COL_P2A] = lo.pA[1],
                                             [COL_P2B] = lo.pB[1]};
-        if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, m3, res->message, sizeof res->message)) {
+        const sim_start_load ld = {&m->mech, {sc->q0[0], sc->q0[1]}, m3, false};
+        if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, &ld, res->message, sizeof res->message)) {
             lsim_free(&ls);
             return res->status = SIM_REFUSED;
         }

@@ -24,6 +24,21 @@ typedef struct eng_ode {
 
 static ode_world* W(const engine* e) { return ((const eng_ode*)e)->w; }
 
+// What the crane holds at the start (sim_check_start): in the sandbox the
+// world's hook and rope hang at the tip (the tip mass its start state is
+// set for), in the validation world the tip load m3 [kg].
+static sim_start_load start_load(const model* m, const ode_world* w, const double q0[2], double m3) {
+    sim_start_load ld = {&m->mech, {q0[0], q0[1]}, m3, false};
+    if (ode_world_kind(w) == WORLD_SANDBOX) {
+        int n;
+        double len, lm, li, hm, hc, hi;
+        ode_world_rope_info(w, &n, &len, &lm, &li, &hm, &hc, &hi);
+        ld.m_tip = n * lm + hm;
+        ld.world_tip = true;
+    }
+    return ld;
+}
+
 static engine* ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           char* err, size_t errsz) {
     eng_ode* l = calloc(1, sizeof *l);
@@ -42,9 +57,9 @@ static engine* ode_create(const model* m, const sim_opts* o, const double q0[2],
     const double dt = ode_world_dt(l->w), h = o->h < dt ? o->h : dt;
     double row0[SIM_NCOL];
     sim_ode_row(l->w, row0);
+    const sim_start_load ld = start_load(m, l->w, q0, m3);
     if (sim_check_fixed_step(ode_world_circuit(l->w), o, h, 0.0, err, errsz) ||
-        sim_check_start(ode_world_circuit(l->w), row0, SIM_NCOL,
-                        ode_world_kind(l->w) == WORLD_SANDBOX ? -1.0 : m3, err, errsz)) {
+        sim_check_start(ode_world_circuit(l->w), row0, SIM_NCOL, &ld, err, errsz)) {
         ode_world_destroy(l->w);
         free(l);
         return NULL;
@@ -110,6 +125,8 @@ static const sim_collisions* ode_collisions(const engine* e) {
     const eng_ode* l = (const eng_ode*)e;
     return ode_world_kind(l->w) == WORLD_SANDBOX ? &l->coll : NULL;
 }
+
+static void ode_part_energy(const engine* e, double E[2]) { ode_world_part_energy(W(e), &E[0], &E[1]); }
 
 static double ode_time(const engine* e) { return ode_world_time(W(e)); }
 static void ode_row(engine* e, double row[SIM_NCOL]) { sim_ode_row(W(e), row); }
@@ -187,9 +204,9 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             return res->status = SIM_REFUSED;
         }
         // In the sandbox the tip carries the world's hook and rope, not a
-        // tip load (-1: sim_check_start words it so).
-        const double m3 = ode_world_kind(w) == WORLD_SANDBOX ? -1.0 : sim_load_mass(m, sc, o);
-        if (sim_check_start(ode_world_circuit(w), row, SIM_NCOL, m3, res->message, sizeof res->message)) {
+        // tip load (start_load).
+        const sim_start_load ld = start_load(m, w, sc->q0, sim_load_mass(m, sc, o));
+        if (sim_check_start(ode_world_circuit(w), row, SIM_NCOL, &ld, res->message, sizeof res->message)) {
             ode_world_destroy(w);
             return res->status = SIM_REFUSED;
         }
@@ -327,6 +344,7 @@ const engine_ops engine_ode_ops = {
     .circuit_state = ode_circuit_state,
     .set_load = NULL, // the world's loads are bodies, picked up with the hook
     .set_link = ode_set_link,
+    .part_energy = ode_part_energy,
     .resize_links = false, // a body's geometry is fixed when it is built
     .step = ode_step,
     .time = ode_time,

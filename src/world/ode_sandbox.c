@@ -303,9 +303,38 @@ int ode_world_nearest_load(const ode_world* w, double* dist, double* reach) {
     return best;
 }
 
+// Deepest overlap [m] of the hook with load i now (0: they do not touch).
+static double hook_load_overlap(const ode_world* w, int i) {
+    dContactGeom c[8];
+    double depth = 0;
+    for (int a = 0; a < w->ngeom; ++a) {
+        if (w->geom[a].cat != OW_CAT_HOOK) continue;
+        for (int b = 0; b < w->ngeom; ++b) {
+            if (w->geom[b].cat != OW_CAT_LOAD || dGeomGetBody(w->geom[b].g) != w->load[i]) continue;
+            const int n = dCollide(w->geom[a].g, w->geom[b].g, 8, c, sizeof c[0]);
+            for (int k = 0; k < n; ++k) depth = fmax(depth, c[k].depth);
+        }
+    }
+    return depth;
+}
+
 int ow_attach(ode_world* w, int attach) {
     if (!attach) {
         if (w->attached >= 0) {
+            // The hook and its load are joined, so they do not collide
+            // (near_cb): when the rope is slack, as on a load set down, the
+            // hook leans over about the joint at its bottom and into the load
+            // (5 cm in the pick-and-place). Let go, their contacts would push
+            // that overlap apart at erp depth / H (10 m/s at 1 ms): that threw
+            // the hook 1.1 m up, over the tip, and shook the booms. So until
+            // the overlap is gone the contacts only keep it from growing
+            // (near_cb measures their depth from release_allow): the hook
+            // comes out as the rope lifts it, with no energy handed to it.
+            const double d = hook_load_overlap(w, w->attached);
+            if (d > w->desc.ode.surface_layer) {
+                w->released = w->attached;
+                w->release_allow = d;
+            }
             dJointAttach(w->hook_joint, 0, 0);
             dJointDisable(w->hook_joint);
             w->attached = -1;
@@ -335,6 +364,7 @@ int ow_attach(ode_world* w, int attach) {
     dJointAttach(w->hook_joint, w->hook, w->load[best]);
     dJointSetBallAnchor(w->hook_joint, hp[0], hp[1], hp[2]);
     w->attached = best;
+    w->released = -1; // joined again: no contacts between them at all
     return best;
 }
 
@@ -709,6 +739,9 @@ static void near_cb(void* data, dGeomID g1, dGeomID g2) {
         n = ow_mesh_merge_contacts(w->cbuf, n, OW_MESH_MERGE_RADIUS);
     double mu = sqrt(a->friction * b->friction);
     int crane = a->cat == OW_CAT_CRANE || b->cat == OW_CAT_CRANE;
+    // The hook and the load it has just let go, still overlapping (ow_attach).
+    const int clearing = w->released >= 0 && (a->cat | b->cat) == (OW_CAT_HOOK | OW_CAT_LOAD) &&
+                         (b1 == w->load[w->released] || b2 == w->load[w->released]);
     for (int i = 0; i < n; ++i) {
         dContact c;
         memset(&c, 0, sizeof c);
@@ -719,6 +752,12 @@ static void near_cb(void* data, dGeomID g1, dGeomID g2) {
         c.surface.mu = mu;
         c.surface.soft_erp = w->desc.ode.contact_erp;
         c.surface.soft_cfm = w->desc.ode.contact_cfm;
+        if (clearing) {
+            // ODE corrects the depth beyond the surface layer; measured from
+            // the overlap allowed, a contact holds that and pushes nothing.
+            if (c.geom.depth > w->release_depth) w->release_depth = c.geom.depth;
+            c.geom.depth -= w->release_allow;
+        }
         dJointID j = dJointCreateContact(w->world, w->contacts, &c);
         dJointAttach(j, b1, b2);
         // A contact on a truck support reports its force (ow_support_forces).
@@ -729,7 +768,7 @@ static void near_cb(void* data, dGeomID g1, dGeomID g2) {
             w->support_fb_joint[f] = j;
             w->support_fb_of[f] = sup;
         }
-        double d = c.geom.depth;
+        double d = w->cbuf[i].depth;
         if (d > w->max_depth) w->max_depth = d;
         if (crane) {
             if (d > w->max_depth_crane) w->max_depth_crane = d;
@@ -747,8 +786,16 @@ void ow_collide(ode_world* w) {
     w->crane_contact = 0;
     w->ncoll_pair = 0;
     w->nsupport_fb = 0;
+    w->release_depth = -1;
     dSpaceCollide(w->dyn_space, w, near_cb);
     dSpaceCollide2((dGeomID)w->dyn_space, (dGeomID)w->static_space, w, near_cb);
+    if (w->released >= 0) {
+        // The allowance follows the overlap down as the hook comes out and
+        // ends with it (a contact within the surface layer is corrected by
+        // nothing, so ending there pushes nothing either).
+        if (w->release_depth <= w->desc.ode.surface_layer) w->released = -1;
+        else if (w->release_depth < w->release_allow) w->release_allow = w->release_depth;
+    }
 }
 
 void ow_support_forces(ode_world* w) {

@@ -631,6 +631,7 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
     w->g = w->desc.gravity >= 0 ? w->desc.gravity : w->mech.gravity;
     w->m3 = opt.load_mass >= 0 ? opt.load_mass : w->mech.load_mass;
     w->attached = -1;
+    w->released = -1;
     w->ipump = -1;
     for (int k = 0; k < ODE_NACT; ++k) w->act[k].cyl = w->act[k].valve = -1;
 
@@ -845,6 +846,18 @@ double ode_world_energy(const ode_world* w) {
     if (w->hook) e += body_energy(w->hook, w->g);
     for (int i = 0; i < w->nload; ++i) e += body_energy(w->load[i], w->g);
     return e;
+}
+
+void ode_world_part_energy(const ode_world* w, double* crane, double* hook) {
+    *crane = *hook = NAN;
+    if (w->dead) return;
+    double c = 0, h = 0;
+    for (int f = 0; f < 3; ++f)
+        if (w->frame[f].body) c += body_energy(w->frame[f].body, w->g);
+    for (int i = 0; i < w->nrope; ++i) h += body_energy(w->rope[i], w->g);
+    if (w->hook) h += body_energy(w->hook, w->g);
+    *crane = c;
+    *hook = h;
 }
 
 // ---- state ----

@@ -215,6 +215,10 @@ void ode_world_lock_booms(ode_world* w, int lock);
 /// Mechanical energy of all dynamic bodies [J]: kinetic (translation and
 /// rotation) plus gravitational potential relative to z = 0.
 double ode_world_energy(const ode_world* w);
+/// The same for parts of the crane [J]: its column and booms into *crane,
+/// its rope links and hook into *hook (0 where the world has none; NAN for
+/// both once ODE has failed in the world).
+void ode_world_part_energy(const ode_world* w, double* crane, double* hook);
 /// Set the joint rates q1', q2' [rad/s] (rigidly moving the distal bodies), for tests.
 void ode_world_set_joint_rates(ode_world* w, const double qd[2]);
 /// Rope model for analytic checks: number of rope links, link length [m],

@@ -172,6 +172,11 @@ struct ode_world {
     dBodyID hook;
     dJointID hook_joint; ///< pre-created ball joint for attaching a load
     int attached;        ///< load index or -1
+    /// The load the hook let go while the two still overlap, or -1: their
+    /// contacts may stop the overlap growing but not push it apart (ow_attach).
+    int released;
+    double release_allow;  ///< overlap [m] those contacts leave alone: its depth at the release, only ever smaller
+    double release_depth;  ///< their deepest contact in this step's collision [m], -1: none
     int nload;
     dBodyID load[WORLD_DESC_MAX_LOADS];
     dBodyID obst_body[WORLD_DESC_MAX_OBSTACLES]; ///< 0 for static obstacles

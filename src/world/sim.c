@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "engine_impl.h"
+#include "lagrange.h"
 #include "ode_world.h"
 
 #define CH_ENTRY_(id, name, unit, kind) {name, unit, kind},
@@ -205,7 +206,8 @@ void sim_check_message(char* out, size_t n, const char* what, const char* how, b
     else snprintf(out, n, "numerical blow-up: %s (%s): %s", what, how, sim_blowup_hint(adaptive, t, bad));
 }
 
-int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz) {
+int sim_check_start(const hyd_model* hm, const double* row, int ncol, const sim_start_load* ld, char* err,
+                    size_t errsz) {
     if (!hm) return 0;
     double pmax = -1;
     const char* which = NULL;
@@ -225,19 +227,43 @@ int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3,
     for (int j = 0; j < 6; ++j) {
         const int c = pcol[j];
         if (c >= ncol || !(row[c] > pmax)) continue;
-        if (m3 < 0) // the sandbox: the world's hook and rope hang at the tip
-            snprintf(err, errsz,
-                     "the start pose needs %s = %.4g MPa to hold the crane still with the world's hook and rope at "
-                     "the tip, above the circuit's highest relief setting (%s: %.4g MPa, p_crack + dp_override): "
-                     "the crane cannot hold them here (a lighter hook or rope in the world file, or another start "
-                     "pose)",
-                     sim_col_name[c], row[c] * 1e-6, which, pmax * 1e-6);
-        else
-            snprintf(err, errsz,
-                     "the start pose needs %s = %.4g MPa to hold the crane still with %g kg at the tip, above the "
-                     "circuit's highest relief setting (%s: %.4g MPa, p_crack + dp_override): the crane cannot hold "
-                     "this load here (a smaller %s or another start pose)",
-                     sim_col_name[c], row[c] * 1e-6, m3, which, pmax * 1e-6, sim_param_name(SIM_PARAM_LOAD));
+        char tip[96];
+        if (ld->world_tip) snprintf(tip, sizeof tip, "the world's hook and rope at the tip (%.4g kg)", ld->m_tip);
+        else snprintf(tip, sizeof tip, "%.4g kg at the tip", ld->m_tip);
+        const int n = snprintf(err, errsz,
+                               "the start pose needs %s = %.4g MPa to hold still, above the highest relief setting "
+                               "(%s: %.4g MPa, p_crack + dp_override)",
+                               sim_col_name[c], row[c] * 1e-6, which, pmax * 1e-6);
+        if (n < 0 || (size_t)n >= errsz) return SIM_REFUSED;
+        char* e = err + n;
+        const size_t en = errsz - (size_t)n;
+        // What the holding torque of the boom joint at fault is for: the
+        // gravity torque G(q) with the tip mass against G without it (the
+        // statics the start state is set from). The slew holds no weight.
+        const int k = j / 2;
+        double share = NAN; // the tip mass's share of joint k's torque
+        if (ld->mech && k < 2) {
+            double G[2], G0[2];
+            lagrange_gravity(ld->mech, LAGRANGE_FULL, ld->m_tip, ld->q, G);
+            lagrange_gravity(ld->mech, LAGRANGE_FULL, 0.0, ld->q, G0);
+            if (fabs(G[k]) > 0) share = fmin(fmax((G[k] - G0[k]) / G[k], 0.0), 1.0);
+        }
+        static const char* const joint[2] = {"lift", "jib"};
+        if (isnan(share)) {
+            snprintf(e, en, ": the crane cannot hold itself and %s here (another start pose)", tip);
+        } else if (share >= 0.5) {
+            char fix[96];
+            if (ld->world_tip) snprintf(fix, sizeof fix, "a lighter hook or rope in the world file");
+            else snprintf(fix, sizeof fix, "a smaller %s", sim_param_name(SIM_PARAM_LOAD));
+            snprintf(e, en, ": the crane cannot hold %s here: %.0f %% of the %s's torque, the booms' own weight %.0f %% "
+                     "(%s, or another start pose)", tip, 100 * share, joint[k], 100 * (1 - share), fix);
+        } else {
+            snprintf(e, en,
+                     ": the crane cannot hold its own booms here: their weight (mechanics.links[0].mass %.0f kg and "
+                     "links[1].mass %.0f kg) is %.0f %% of the %s's torque, %s %.0f %% (lighter booms or another "
+                     "start pose)",
+                     ld->mech->link[0].mass, ld->mech->link[1].mass, 100 * (1 - share), joint[k], tip, 100 * share);
+        }
         return SIM_REFUSED;
     }
     return 0;

@@ -133,10 +133,18 @@ void sim_check_message(char* out, size_t n, const char* what, const char* how, b
 /// static start (decision 5) gives each chamber the pressure that holds the
 /// crane still; with a load too heavy for the pose that is more than any
 /// relief lets the circuit reach (100 t at the tip: 459 MPa), a state the
-/// reliefs cannot cap because it is set, not integrated. m3: the tip load
-/// [kg], for the message; < 0 in the sandbox, where the world's hook and
-/// rope hang at the tip. Returns SIM_OK, or SIM_REFUSED with one line in err.
-int sim_check_start(const hyd_model* hm, const double* row, int ncol, double m3, char* err, size_t errsz);
+/// reliefs cannot cap because it is set, not integrated. ld: what the crane
+/// holds, for the message, which says what takes the holding torque of the
+/// joint at fault (the booms' own weight, the mass at the tip) and so what
+/// to change. Returns SIM_OK, or SIM_REFUSED with one line in err.
+typedef struct sim_start_load {
+    const crane_mech* mech; ///< the booms (NULL: their share is not said)
+    double q[2];            ///< the start pose [rad], the paper's convention
+    double m_tip;           ///< the mass at the tip [kg]: the tip load, or the world's hook and rope
+    bool world_tip;         ///< m_tip is the world's hook and rope (the sandbox), not a tip load
+} sim_start_load;
+int sim_check_start(const hyd_model* hm, const double* row, int ncol, const sim_start_load* ld, char* err,
+                    size_t errsz);
 
 /// True when this build has the CVODE reference solver.
 bool sim_have_cvode(void);

@@ -351,6 +351,46 @@ static void test_drive_plays_faults(void) {
     remove("drv_fault_drive.csv");
 }
 
+static int write_text(const char* path, const char* text) {
+    FILE* f = fopen(path, "w");
+    if (!f) return -1;
+    fputs(text, f);
+    return fclose(f);
+}
+
+// The headless drive says what the scenario's hook did and only that (issue
+// 25, item 29: a drive whose hook never reached a load printed "hook released
+// the load" at each of its 16 release events): a release of a load that was
+// on the hook names it; a release with nothing on the hook is said once; an
+// attach while the load is already on the hook says nothing.
+static void test_hook_report(void) {
+    // Slewed to -90 deg the hook hangs 2 m from the nearest load (reach 0.5 m).
+    CHECK(write_text("drv_hook_empty.json",
+                     "{\"name\": \"hook_empty\", \"duration\": 0.8, "
+                     "\"initial\": {\"q1_deg\": 125, \"q2_deg\": -60, \"slew_deg\": -90}, \"commands\": {}, "
+                     "\"hook\": [[0.1, \"attach\"], [0.2, \"release\"], [0.3, \"release\"], [0.4, \"attach\"], "
+                     "[0.5, \"release\"], [0.6, \"release\"]]}\n") == 0,
+          "scenario file");
+    int rc = drive(NO_DISPLAY, "--headless --scenario drv_hook_empty.json");
+    CHECK(rc == 0 && !strstr(out, "released") && occurrences(out, "releases the hook with nothing on it") == 1 &&
+              occurrences(out, "hook found no load in reach") == 2,
+          "exit %d: %s", rc, out);
+    // The pick-and-place's start: load_200 under the hook.
+    CHECK(write_text("drv_hook_load.json",
+                     "{\"name\": \"hook_load\", \"duration\": 0.8, "
+                     "\"initial\": {\"q1_deg\": 117.3, \"q2_deg\": -65.8, \"slew_deg\": -60}, \"commands\": {}, "
+                     "\"hook\": [[0.1, \"attach\"], [0.2, \"attach\"], [0.4, \"release\"], [0.5, \"release\"]]}\n") ==
+              0,
+          "scenario file");
+    rc = drive(NO_DISPLAY, "--headless --scenario drv_hook_load.json");
+    CHECK(rc == 0 && occurrences(out, "hook picked up load_200 (200 kg)") == 1 &&
+              occurrences(out, "hook released load_200 (200 kg)") == 1 && occurrences(out, "released") == 1 &&
+              occurrences(out, "releases the hook with nothing on it") == 1,
+          "exit %d: %s", rc, out);
+    remove("drv_hook_empty.json");
+    remove("drv_hook_load.json");
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_dead_display_runs_headless);
     RUN_TEST(test_dead_wayland_runs_headless);
@@ -362,5 +402,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_bench_drive_world);
     RUN_TEST(test_drive_record_is_the_run);
     RUN_TEST(test_drive_plays_faults);
+    RUN_TEST(test_hook_report);
     TEST_MAIN_END();
 }

@@ -7,6 +7,7 @@
 #include <dirent.h>
 #include <math.h>
 #include <signal.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
@@ -260,6 +261,42 @@ static void test_scenario_world(void) {
     rc = cli_run("compare --quiet --scenario sandbox_swing --backends lagrange,ode --world sandbox --duration 0.1", out,
                  sizeof out);
     CHECK(rc == 2 && strstr(out, "because of --backends"), "explicit --backends: exit %d: %s", rc, out);
+    // Options consistent with the sandbox are accepted (issue 25, item 13:
+    // `run --scenario sandbox_pick_place --world sandbox` was refused as if
+    // it asked for the lagrange crane, while the same without --world ran). A
+    // world without --mechanics is an ode run there, said once; the rows are
+    // the sandbox's (a hook, a slew).
+    const char* const accepted[] = {
+        "run --scenario sandbox_pick_place --world sandbox --duration 0.1 --out world.csv",
+        "run --scenario sandbox_pick_place --world site --duration 0.1 --out world.csv",
+        "run --scenario sandbox_pick_place --mechanics ode --duration 0.1 --out world.csv",
+        "run --scenario sandbox_pick_place --mechanics ode --world sandbox --duration 0.1 --out world.csv",
+        "compare --scenario sandbox_pick_place --world sandbox --dts 1e-4,5e-5 --duration 0.1 --out world.csv",
+        "compare --scenario sandbox_pick_place --mechanics ode --dts 1e-4,5e-5 --duration 0.1 --out world.csv",
+        "compare --scenario sandbox_swing --world sandbox --set-b hydraulics.components.lift_cyl.bore=0.11 "
+        "--duration 0.1 --out world.csv",
+        "sweep --scenario sandbox_pick_place --world sandbox --param hydraulics.components.lift_cyl.bore=0.1:0.11:2 "
+        "--duration 0.1 --out world.csv",
+    };
+    for (int i = 0; i < (int)(sizeof accepted / sizeof accepted[0]); ++i) {
+        remove("world.csv");
+        rc = cli_run(accepted[i], out, sizeof out);
+        const bool noted = strstr(accepted[i], "--mechanics ode --world") == NULL;
+        const char* note = strstr(out, "note: scenario sandbox_");
+        CHECK(rc == 0 && !strstr(out, "has not") && (noted ? note && !strstr(note + 1, "note: scenario") : !note),
+              "%s: exit %d: %s", accepted[i], rc, out);
+        // run's and compare's rows have the hook (hook_z, hook_z_A), sweep's
+        // designs the hook's sway.
+        CHECK(cli_read_file("world.csv", buf, sizeof buf) > 0 && (strstr(buf, ",hook_z") || strstr(buf, ",max_hook_sway,")),
+              "%s: no sandbox columns: %.200s", accepted[i], buf);
+    }
+    // Options that contradict it are still refused, saying which.
+    rc = cli_run("run --quiet --scenario sandbox_pick_place --mechanics lagrange --world sandbox --out world.csv", out,
+                 sizeof out);
+    CHECK(rc == 2 && strstr(out, "lagrange 2-DOF crane has not") && cli_count_lines(out) == 1, "exit %d: %s", rc, out);
+    rc = cli_run("run --quiet --scenario sandbox_pick_place --world validation --out world.csv", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "validation world has not") && cli_count_lines(out) == 1, "exit %d: %s", rc, out);
+    remove("world.csv");
 }
 
 // The Quick start's headless drive (scripts/run.sh) wrote drive.csv into the

@@ -1,0 +1,67 @@
+// test_plot_channels.c: the run plot draws every function the run has (issue
+// 25, item 15: `run --plot` of a sandbox run had no slew channel, though on
+// sandbox_wall the slew relief is open 9.1 s). Pure functions, no PLplot: the
+// channels of each time panel, and which runs have a slew drive (an ode world
+// with a slewing column: the sandbox and the site, not the validation world
+// and not the lagrange crane).
+#include "app.h"
+#include "check.h"
+
+#include <stdbool.h>
+#include <string.h>
+
+static bool has(const int* cols, int n, int col) {
+    for (int i = 0; i < n; ++i)
+        if (cols[i] == col) return true;
+    return false;
+}
+
+static void test_panels(void) {
+    static const int lift_jib[3][4] = {{COL_X1, COL_X2, -1, -1},
+                                       {COL_P1A, COL_P1B, COL_P2A, COL_P2B},
+                                       {COL_U1, COL_U2, COL_U1_CMD, COL_U2_CMD}};
+    static const int slew[3][2] = {{COL_X3, -1}, {COL_P3A, COL_P3B}, {COL_U3, COL_U3_CMD}};
+    for (int p = 0; p < 3; ++p)
+        for (int s = 0; s < 2; ++s) {
+            int cols[APP_PLOT_MAXSERIES];
+            const char* names[APP_PLOT_MAXSERIES];
+            const int n = app_plot_run_channels(p, s, cols, names);
+            CHECK(n > 0 && n <= APP_PLOT_MAXSERIES, "panel %d: %d series", p, n);
+            for (int k = 0; k < 4; ++k)
+                if (lift_jib[p][k] >= 0)
+                    CHECK(has(cols, n, lift_jib[p][k]), "panel %d (slew %d): no %s", p, s,
+                          sim_channels[lift_jib[p][k]].name);
+            for (int k = 0; k < 2; ++k)
+                if (slew[p][k] >= 0)
+                    CHECK(has(cols, n, slew[p][k]) == (s == 1), "panel %d (slew %d): %s %s", p, s,
+                          sim_channels[slew[p][k]].name, s ? "missing" : "drawn for a crane without a slew");
+            // Each series named, no name twice (the legend tells them apart).
+            for (int i = 0; i < n; ++i) {
+                CHECK(names[i] && names[i][0], "panel %d: series %d unnamed", p, i);
+                for (int j = 0; j < i; ++j) CHECK(strcmp(names[i], names[j]), "panel %d: '%s' twice", p, names[i]);
+            }
+        }
+}
+
+static void test_which_runs_slew(void) {
+    static const struct {
+        sim_mechanics mech;
+        const char* world;
+        bool slew;
+    } k[] = {{SIM_ODE, "sandbox", true},     {SIM_ODE, "site", true},
+             {SIM_ODE, "validation", false}, {SIM_LAGRANGE, "sandbox", false},
+             {SIM_LAGRANGE, NULL, false},    {SIM_ODE, CRANESIM_ASSETS "/worlds/sandbox.json", true}};
+    for (int i = 0; i < (int)(sizeof k / sizeof k[0]); ++i) {
+        sim_opts o = sim_default_opts();
+        o.mechanics = k[i].mech;
+        o.world = k[i].world;
+        CHECK(app_world_has_slew(&o) == k[i].slew, "%s, world %s: slew %d", k[i].mech == SIM_ODE ? "ode" : "lagrange",
+              k[i].world ? k[i].world : "(none)", (int)!k[i].slew);
+    }
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_panels);
+    RUN_TEST(test_which_runs_slew);
+    TEST_MAIN_END();
+}
