@@ -134,6 +134,7 @@ drive_opts drive_default_opts(void) {
     o.height = 720;
     o.fps_cap = 65.0;
     o.hud = true;
+    o.replay_rcl = -1;
     return o;
 }
 
@@ -956,7 +957,8 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         }
         model_free(s->m);
         s->m = rm;
-        s->c.sim = s->rp->sim;
+        s->c.sim = s->rp->sim; // the limiter's setting too (drive --rcl overrides it)
+        if (o->replay_rcl >= 0) s->c.sim.rcl = o->replay_rcl != 0;
         memcpy(s->sc.q0, s->rp->q0, sizeof s->sc.q0);
         s->sc.slew0 = s->rp->slew0;
         s->sc.nfault = 0;
@@ -1498,9 +1500,13 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     char where[96];
     if (c->sim.mechanics != SIM_ODE) snprintf(where, sizeof where, "the lagrange 2-DOF view");
     else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : "sandbox");
-    printf("cranesim drive: %s in %s%s; %s%s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
+    printf("cranesim drive: %s in %s%s; %s%s%s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
            o->replay_path ? "replaying " : "", o->replay_path ? o->replay_path : o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
-                                               "R reset, C camera, F5 record, F12 screenshot, Esc quit)");
+                                               "R reset, C camera, F5 record, F12 screenshot, Esc quit)",
+           !s->rp ? ""
+           : o->replay_rcl >= 0 ? (s->c.sim.rcl ? ", rated capacity limiter on (--rcl)" : ", rated capacity limiter off (--rcl)")
+           : s->rp->rcl_recorded ? (s->c.sim.rcl ? ", rated capacity limiter on as recorded" : ", rated capacity limiter off as recorded")
+                                 : ", rated capacity limiter on (the session does not record its setting)");
     // Ticks at 240 Hz: between rendered frames the loop still pumps events,
     // reads the sticks and commands the valves, so commands run faster than
     // frames (>= 75 Hz, the paper's rate, even while a frame takes 12 ms).

@@ -46,6 +46,7 @@ typedef struct drive_opts {
     const char* save_as;      ///< "save model" writes (and replaces) this file; NULL: a new
                               ///< cranesim_model_N.json each time (drive_save_name)
     bool collision_view;      ///< start with the collision shapes drawn over the scene (key G toggles)
+    int replay_rcl;           ///< with replay_path: the limiter 1 on, 0 off (--rcl), -1 as the session recorded it
 } drive_opts;
 
 drive_opts drive_default_opts(void);
