@@ -263,6 +263,8 @@ static void fill_state(server* s) {
                 (w->tipping ? PROTO_F_TIPPING : 0) | (w->main_relief_open ? PROTO_F_RELIEF : 0) |
                 (w->collision ? PROTO_F_COLLISION : 0) | (w->rcl_have ? PROTO_F_RCL_HAVE : 0) |
                 (w->rcl_on ? PROTO_F_RCL_ON : 0) | (uint32_t)(w->npad ? (w->pad_lifted & 15) : 0) * PROTO_F_PAD_LIFTED0;
+    for (int k = 0; k < 3 && k < w->ncyl; ++k)
+        if (w->cyl[k].rcl_cut) st->flags |= PROTO_F_RCL_CUT0 << k;
     st->slew = w->slew;
     memcpy(st->hook, w->hook, sizeof st->hook);
     st->load_mass = w->load_mass;

@@ -1142,7 +1142,7 @@ void drive_session_set_remote(drive_session* s) {
     s->rin = (drive_remote_input){.hook = -1, .pause = -1, .reset = -1};
 }
 
-void drive_session_feed(drive_session* s, const proto_state* st, double rt_factor) {
+void drive_session_feed(drive_session* s, const proto_state* st, double rt_factor, const double* demand) {
     world_snapshot* w = s->snap;
     // The static parts (names, shapes, meshes, terrain) stay the local
     // engine's, built from the same files; the caller checked the bodies match.
@@ -1160,6 +1160,10 @@ void drive_session_feed(drive_session* s, const proto_state* st, double rt_facto
         y->x = d[6], y->pA = d[7], y->pB = d[8], y->u = d[9], y->u_cmd = d[10], y->force = d[11], y->v = d[12];
         y->relief_open = (st->cyl_bits[i] & PROTO_CYL_RELIEF) != 0;
         y->end_stop = (st->cyl_bits[i] & PROTO_CYL_END_STOP) != 0;
+        // Where the server's limiter cut a command: the operator's demand is
+        // this drive's own when it controls, else not known here (NaN).
+        y->rcl_cut = i < 3 && (st->flags & (PROTO_F_RCL_CUT0 << i)) != 0;
+        y->u_op = !y->rcl_cut ? y->u_cmd : demand ? demand[i] : NAN;
     }
     w->nrope = st->nrope < WORLD_SNAP_MAX_ROPE ? st->nrope : WORLD_SNAP_MAX_ROPE;
     memcpy(w->rope, st->rope, (size_t)w->nrope * sizeof w->rope[0]);
@@ -1419,7 +1423,14 @@ int drive_session_tick(drive_session* s, double wall) {
     if (frame) {
         char status[640];
         // Who drives: the scenario, a named device, or the keyboard alone.
-        const char* src = s->o.scripted ? "  [scripted]" : input_device_name(s->in) ? "" : "  [keyboard]";
+        // A replay is driven by the session's recorded commands, not by the
+        // scenario: it says which session.
+        char rp_src[160] = "";
+        if (s->rp) {
+            const char* base = strrchr(s->rp->path, '/');
+            snprintf(rp_src, sizeof rp_src, "  [replay of %.120s]", base ? base + 1 : s->rp->path);
+        }
+        const char* src = s->rp ? rp_src : s->o.scripted ? "  [scripted]" : input_device_name(s->in) ? "" : "  [keyboard]";
         // While a value is typed the keys go to the panel, not the crane:
         // say so where the operator looks.
         const char* keys = panel_gui_wants_keyboard(s->pn) ? "  [keys: panel - Enter/Esc gives them back]" : "";

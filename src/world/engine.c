@@ -229,6 +229,10 @@ void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, siz
     backend(o)->describe_work(o, r, buf, n);
 }
 void engine_set_commands(engine* e, const double u[3]) {
+    // The operator's demand and what was let through, for the HUD (it shows
+    // both where the limiter cut).
+    memcpy(e->u_op, u, sizeof e->u_op);
+    memcpy(e->u_lim, u, sizeof e->u_lim);
     if (!e->rcl || !e->o.rcl) {
         if (e->rcl) { // still measured, for the HUD and the record
             double row[SIM_NCOL];
@@ -241,6 +245,7 @@ void engine_set_commands(engine* e, const double u[3]) {
     double row[SIM_NCOL], v[3];
     e->ops->row(e, row);
     rcl_filter(e->rcl, row, u, v);
+    memcpy(e->u_lim, v, sizeof e->u_lim);
     e->ops->set_commands(e, v);
 }
 
@@ -316,6 +321,12 @@ void engine_snapshot(engine* e, world_snapshot* s) {
     s->rcl_have = e->rcl != NULL;
     s->rcl_on = e->rcl && e->o.rcl;
     s->rcl_util = e->rcl ? e->rcl->util : 0.0;
+    // Cylinder k (lift, jib, slew) carries command k.
+    for (int k = 0; k < s->ncyl && k < WORLD_SNAP_MAX_CYLINDERS; ++k) {
+        world_snap_cylinder* c = &s->cyl[k];
+        c->rcl_cut = k < 3 && s->rcl_on && e->u_lim[k] != e->u_op[k];
+        c->u_op = c->rcl_cut ? e->u_op[k] : c->u_cmd;
+    }
 }
 const char* engine_error(const engine* e) { return e->err; }
 const sim_collisions* engine_collisions(const engine* e) {
