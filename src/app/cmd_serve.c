@@ -561,6 +561,20 @@ static bool read_client(server* s, int idx) {
         }
         size_t off = 0;
         for (;;) {
+            // Before the hello only a hello is heard: any other frame is
+            // refused for that, whatever its fields (a command frame checked
+            // first was "command frame too short" for a client that simply
+            // had not said hello).
+            if (!c->hello && c->rx_len - off >= PROTO_HEADER && c->rx[off + 4] != PROTO_CLIENT_HELLO) {
+                static const char* const k_type[] = {"", "client hello", "server hello", "state", "command", "error",
+                                                     "notice"};
+                const uint8_t ty = c->rx[off + 4];
+                char why[160];
+                snprintf(why, sizeof why, "no hello: the first frame must be a client hello, got %s%s frame (type %u)",
+                         ty >= 1 && ty <= 6 ? "a " : "an unknown", ty >= 1 && ty <= 6 ? k_type[ty] : "", ty);
+                drop_client(s, idx, PROTO_E_MALFORMED, why);
+                return false;
+            }
             proto_msg msg;
             memset(&msg, 0, sizeof msg); // u.state NULL: a client may not send state frames
             size_t used;
