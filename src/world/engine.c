@@ -30,12 +30,24 @@ static const engine_ops* backend(const sim_opts* o) {
 
 engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
                       size_t errsz) {
+    return engine_create_rcl(m, o, q0, slew0, m3, NULL, err, errsz);
+}
+
+engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
+                          struct rcl* r, char* err, size_t errsz) {
     engine* e = backend(o)->create(m, o, q0, slew0, m3, err, errsz);
     if (!e) return NULL;
     // The limiter filters every command a stepped driver sets (drive, the
-    // window's tick, the soak bench): one place for all of them.
-    e->rcl = engine_rcl_create(m, o, "sandbox");
+    // window's tick, the soak bench, serve): one place for all of them.
+    if (r) rcl_reset(r);
+    e->rcl = r ? r : engine_rcl_create(m, o, "sandbox");
     return e;
+}
+
+struct rcl* engine_rcl_detach(engine* e) {
+    struct rcl* r = e->rcl;
+    e->rcl = NULL;
+    return r;
 }
 
 struct rcl* engine_rcl_create(const model* m, const sim_opts* o, const char* default_world) {

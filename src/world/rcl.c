@@ -46,6 +46,12 @@ int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, si
 
 void rcl_free(rcl* r) { loadchart_free(&r->chart); }
 
+void rcl_reset(rcl* r) {
+    const rcl keep = *r;
+    memset(r, 0, sizeof *r);
+    r->m = keep.m, r->chart = keep.chart, r->AA = keep.AA, r->AB = keep.AB, r->stroke = keep.stroke;
+}
+
 // Load moment about joint 1 [N m] measured from the lift pressures: the
 // cylinder's torque F r less the booms' own gravity torque at these angles,
 // less the hook's (it hangs at the tip whatever it carries). *R: outreach [m].

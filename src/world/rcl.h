@@ -60,6 +60,9 @@ int rcl_init(rcl* r, const model* m, const world_desc* wd, char* err, size_t err
 /// As rcl_init, for the world file of an ode run (NULL: no world, lagrange).
 int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, size_t errsz);
 void rcl_free(rcl* r);
+/// Start again: the state rcl_init leaves (no measurement, nothing cut),
+/// keeping the chart.
+void rcl_reset(rcl* r);
 
 /// Utilisation [-] from a CSV row (t, p1A, p1B, q1, q2, slew columns; slew
 /// 0 when absent). Also stored in r->util. The load the moment implies
