@@ -85,13 +85,13 @@ static const struct {
     {"optimize", {"--param", "--minimize", "--constraint", "--maxeval", "--xtol", "--out", "--plot", NULL}},
     {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot",
                  "--set-a", "--set-b", "--out", NULL}},
-    {"replay", {"--out", "--metrics", "--plot", NULL}},
+    {"replay", {"--out", "--metrics", "--plot", "--rcl", NULL}},
     {"study", {"--out-dir", "--repeat", NULL}},
     {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
      {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as",
       "--readouts", "--session", "--replay", "--rcl", "--connect", NULL}},
-    {"serve", {"--listen", "--rate", "--max-clients", "--queue", "--timeout", NULL}},
+    {"serve", {"--listen", "--rate", "--max-clients", "--queue", "--timeout", "--rcl", NULL}},
 };
 
 // The value options a command documents as repeatable (each use adds one);

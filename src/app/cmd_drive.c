@@ -50,8 +50,9 @@ static void drive_help(FILE* f) {
             "                      events, model, settings, start) for cranesim replay (docs/replay.md)\n"
             "  --replay SESSION    window: drive by a recorded session's commands instead of the devices\n"
             "  --rcl on|off        the rated capacity limiter (default on): warns at 90 %% of the load\n"
-            "                      chart, at 100 %% stops lift down, jib out and slewing towards a weaker\n"
-            "                      sector (docs/safety.md)\n"
+            "                      chart, at 100 %% stops the motions that carry the load outwards and\n"
+            "                      slewing towards a weaker sector (docs/safety.md); with --replay the\n"
+            "                      default is the session's setting; with --connect the server's limiter acts\n"
             "  --mapping FILE      joystick axis mapping (JSON, see docs/render.md)\n"
             "  --charts LIST       strip-chart channels, CSV column names (up to 8), e.g.\n"
             "                      p1A,p1B,x1,u1,F1 (default: pressures, strokes, spools), or the\n"
@@ -381,7 +382,7 @@ int cmd_drive(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     c.sim.mechanics = SIM_ODE; // drive's default: the sandbox world
     c.sim.rcl = true;          // the rated capacity limiter, unless --rcl off
-    bool headless = false, scripted = false, rate_given = false;
+    bool headless = false, scripted = false, rate_given = false, rcl_given = false;
     double frame_rate = 75.0, shot_at = 2.0;
     const char* record = NULL;
     const char* session_path = NULL;
@@ -491,6 +492,7 @@ int cmd_drive(int argc, char** argv) {
                 return EXIT_USAGE;
             }
             c.sim.rcl = !strcmp(v, "on");
+            rcl_given = true;
             continue;
         }
         fprintf(stderr, "cranesim drive: unknown option '%s' (see cranesim drive --help)\n", argv[i]);
@@ -535,6 +537,13 @@ int cmd_drive(int argc, char** argv) {
         if (replay || session_path || save_as) {
             fprintf(stderr, "cranesim drive: --connect: %s applies to a local drive only\n",
                     replay ? "--replay" : session_path ? "--session" : "--save-as");
+            return EXIT_USAGE;
+        }
+        // The limiter that acts is the server's (its --rcl): a local one
+        // would filter nothing the server steps.
+        if (rcl_given) {
+            fprintf(stderr, "cranesim drive: --connect: --rcl: the rated capacity limiter is the server's (cranesim "
+                            "serve --rcl on|off); the HUD shows its state\n");
             return EXIT_USAGE;
         }
         char cwhy[700];
@@ -609,6 +618,7 @@ int cmd_drive(int argc, char** argv) {
     drive_opts o = win;
     o.session_path = session_path;
     o.replay_path = replay;
+    o.replay_rcl = replay && rcl_given ? c.sim.rcl : -1;
     o.save_as = save_as;
     o.collision_view = collision_view;
     o.world_name = c.sim.mechanics == SIM_ODE ? wname : NULL;

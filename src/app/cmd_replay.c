@@ -14,12 +14,13 @@
 static void replay_help(FILE* f) {
     fprintf(f,
             "usage: cranesim replay SESSION [--model M] [--set PATH=V ...] [--out FILE.csv] [--metrics FILE.json]\n"
-            "                       [--plot FILE.png] [--quiet]\n"
+            "                       [--plot FILE.png] [--rcl on|off] [--quiet]\n"
             "\n"
             "Runs a session recorded by `cranesim drive --session FILE` (window or headless) again,\n"
             "headless: the same commands at the same command updates, the same hook events, the same\n"
-            "world, solver and start. On the recorded design the rows are those of the drive, bit for\n"
-            "bit; with --model or --set the same operator input drives another design. Prints the\n"
+            "world, solver, rated capacity limiter and start. On the recorded design the rows are those\n"
+            "of the drive, bit for bit; with --model or --set the same operator input (the operator's\n"
+            "own demands, through the same limiter) drives another design. Prints the\n"
             "recorded and the replayed run's metrics side by side with their differences, and how many\n"
             "rows are identical to the recording.\n"
             "\n"
@@ -29,6 +30,8 @@ static void replay_help(FILE* f) {
             "  --out FILE.csv      the replay's rows, in the record's format (drive --record)\n"
             "  --metrics FILE.json the replay's metrics (as cranesim run --metrics)\n"
             "  --plot FILE.png     overlay plot: recorded (solid) and replayed (dashed)\n"
+            "  --rcl on|off        the rated capacity limiter: default as recorded (a session written before\n"
+            "                      the setting was recorded: on, drive's default; docs/replay.md)\n"
             "  --quiet             no progress bar\n");
 }
 
@@ -84,6 +87,7 @@ int cmd_replay(int argc, char** argv) {
     const char* sets[APP_MAX_SET];
     int nset = 0;
     bool quiet = false;
+    int rcl = -1; // --rcl: 1 on, 0 off, -1 as recorded
     for (int i = 0; i < argc; ++i) {
         const char* a = argv[i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -92,6 +96,16 @@ int cmd_replay(int argc, char** argv) {
         }
         if (!strcmp(a, "--quiet")) {
             quiet = true;
+            continue;
+        }
+        if (!strcmp(a, "--rcl")) {
+            const char* v = app_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            if (strcmp(v, "on") && strcmp(v, "off")) {
+                fprintf(stderr, "cranesim replay: --rcl: expected on or off, got '%s'\n", v);
+                return EXIT_USAGE;
+            }
+            rcl = !strcmp(v, "on");
             continue;
         }
         const char** dst = !strcmp(a, "--model") ? &model_path : !strcmp(a, "--out") ? &out
@@ -130,6 +144,9 @@ int cmd_replay(int argc, char** argv) {
         fprintf(stderr, "cranesim replay: %s\n", err);
         return EXIT_USAGE;
     }
+    // The limiter as the drive had it (the session's setting), unless --rcl.
+    const bool rcl_recorded = s.rcl_recorded, rcl_as_recorded = s.sim.rcl;
+    if (rcl >= 0) s.sim.rcl = rcl != 0;
     model* m = session_model(&s, model_path, sets, nset, err, sizeof err);
     if (!m) {
         fprintf(stderr, "cranesim replay: %s\n", err);
@@ -267,6 +284,17 @@ int cmd_replay(int argc, char** argv) {
     printf("cranesim replay: %s (recorded by the %s drive; %s), %s\n", path, s.window ? "window" : "headless", s.end,
            design);
     printf("  %ld command updates, %ld rows; t = %.6g s\n", s.ntick, nrow, engine_time(l));
+    if (rcl >= 0 && rcl_recorded)
+        printf("  rated capacity limiter %s (--rcl; recorded %s)\n", s.sim.rcl ? "on" : "off",
+               rcl_as_recorded ? "on" : "off");
+    else if (rcl >= 0)
+        printf("  rated capacity limiter %s (--rcl; the session does not record its setting)\n",
+               s.sim.rcl ? "on" : "off");
+    else if (rcl_recorded)
+        printf("  rated capacity limiter %s, as recorded\n", s.sim.rcl ? "on" : "off (measuring only)");
+    else
+        printf("  rated capacity limiter on: the session does not record its setting (written before it was), "
+               "so drive's default; if it was recorded with --rcl off, replay with --rcl off\n");
     if (nrow == s.nrow && same == nrow)
         printf("  rows identical to the recording: %ld of %ld (bit for bit)\n", same, s.nrow);
     else

@@ -36,6 +36,12 @@
 #define SERVE_MAX_CLIENTS 64
 #define SERVE_MAX_SETS 64
 #define SERVE_READ_PER_FRAME 65536 // bytes read from one client per frame: a flood cannot starve the others
+// The shortest wall time between two engine rebuilds (RESET) [s]. A rebuild
+// of the sandbox takes about 7 ms with the limiter's chart kept (95 ms when
+// it was computed again), during which no client gets a frame: one per
+// second at most, so a stream of RESETs cannot take the frames of every
+// client (before: 100 RESETs stopped them for 9.4 s).
+#define SERVE_RESET_INTERVAL 1.0
 
 static void serve_help(FILE* f) {
     fprintf(f,
@@ -63,6 +69,9 @@ static void serve_help(FILE* f) {
             "                      0..2000 (default 500): the timer's wake-up is late by the scheduler's latency\n"
             "  --log-misses        log each missed frame deadline: how late it started, its step and send\n"
             "                      times, and the page faults and context switches during it\n"
+            "  --rcl on|off        the rated capacity limiter (default on, as a local drive): it stops the\n"
+            "                      motions that carry the load outwards at 100 %% of the load chart, on the\n"
+            "                      controller's commands at every frame (docs/safety.md)\n"
             "  --duration T        stop after T simulated seconds (default: run until SIGINT)\n"
             "  --scenario S        the start pose and load (default as drive); its commands are not played\n"
             "  --mechanics M       ode (default: the sandbox world) or lagrange (analytic 2-DOF)\n"
@@ -109,6 +118,12 @@ typedef struct server {
     uint64_t cmd_seq, seq;
     serve_set sets[SERVE_MAX_SETS]; // parameters set by clients, applied again after a reset
     int nset;
+    // RESET: marked when it arrives, done once before the engine is next
+    // used (commands that need it, the frame): a run of RESETs is one rebuild
+    bool reset_pending;
+    int reset_client;     // the client that asked (the log's)
+    long reset_merged;    // RESETs merged into the pending one
+    double t_reset;       // wall time of the last rebuild [s] (0: none yet)
     // the clients
     client* c[SERVE_MAX_CLIENTS];
     int nclient, max_clients, next_id, queue;
@@ -223,9 +238,15 @@ static void log_collisions(const server* s, const char* when) {
     logf_(s, "%s: %s", when, t);
 }
 
-static int build_engine(server* s, char* err, size_t errsz) {
-    s->e = engine_create(s->m, s->o, s->sc->q0, s->sc->slew0, s->m3, err, errsz);
-    if (!s->e) return -1;
+// The engine at the start pose; lim: the previous engine's limiter (its
+// chart depends only on the model and the world, neither of which a SET
+// changes: a SET acts on the engine's circuit), or NULL.
+static int build_engine(server* s, struct rcl* lim, char* err, size_t errsz) {
+    s->e = engine_create_rcl(s->m, s->o, s->sc->q0, s->sc->slew0, s->m3, lim, err, errsz);
+    if (!s->e) {
+        engine_rcl_destroy(lim);
+        return -1;
+    }
     s->k = 0;
     s->stopped = false;
     engine_set_commands(s->e, s->u);
@@ -236,9 +257,40 @@ static int build_engine(server* s, char* err, size_t errsz) {
     return 0;
 }
 
+// A pending RESET: the engine rebuilt at the start pose (the clock at 0),
+// once for every RESET that came since the last frame or command that used
+// the engine. Returns false when the rebuild failed.
+static bool do_reset(server* s) {
+    if (!s->reset_pending) return true;
+    s->reset_pending = false;
+    log_collisions(s, "before the reset");
+    struct rcl* lim = engine_rcl_detach(s->e);
+    engine_destroy(s->e);
+    s->e = NULL;
+    char err[400];
+    const double t0 = sim_wall_time();
+    const int rc = build_engine(s, lim, err, sizeof err);
+    s->t_reset = sim_wall_time();
+    if (rc) {
+        // The model built once already: only memory can fail here.
+        logf_(s, "reset failed: %s", err);
+        s->stopped = true;
+        return false;
+    }
+    char merged[64] = "";
+    if (s->reset_merged) snprintf(merged, sizeof merged, ", %ld more merged into it", s->reset_merged);
+    logf_(s, "client %d: reset (rebuilt in %.1f ms%s)", s->reset_client, (s->t_reset - t0) * 1e3, merged);
+    s->reset_merged = 0;
+    return true;
+}
+
 // Advance one frame. Returns false once the engine has stopped.
 static bool step_frame(server* s) {
-    if (s->stopped) return false;
+    if (!do_reset(s) || s->stopped) return false;
+    // The controller's commands again at every frame, not only when they
+    // change: the limiter (engine_set_commands) cuts them from the state
+    // reached, as a local drive's ticks have it.
+    engine_set_commands(s->e, s->u);
     if (engine_advance(s->e, (s->k + 1) * s->frame - engine_time(s->e))) {
         s->stopped = true;
         logf_(s, "the simulation stopped: %s (RESET starts it again)", engine_error(s->e));
@@ -249,6 +301,7 @@ static bool step_frame(server* s) {
 }
 
 static void fill_state(server* s) {
+    do_reset(s);
     proto_state* st = s->st;
     double row[SIM_NCOL];
     engine_row(s->e, row);
@@ -263,6 +316,8 @@ static void fill_state(server* s) {
                 (w->tipping ? PROTO_F_TIPPING : 0) | (w->main_relief_open ? PROTO_F_RELIEF : 0) |
                 (w->collision ? PROTO_F_COLLISION : 0) | (w->rcl_have ? PROTO_F_RCL_HAVE : 0) |
                 (w->rcl_on ? PROTO_F_RCL_ON : 0) | (uint32_t)(w->npad ? (w->pad_lifted & 15) : 0) * PROTO_F_PAD_LIFTED0;
+    for (int k = 0; k < 3 && k < w->ncyl; ++k)
+        if (w->cyl[k].rcl_cut) st->flags |= PROTO_F_RCL_CUT0 << k;
     st->slew = w->slew;
     memcpy(st->hook, w->hook, sizeof st->hook);
     st->load_mass = w->load_mass;
@@ -412,6 +467,9 @@ static void handle_command(server* s, client* c, const proto_command* cmd) {
     }
     char err[400] = "";
     int refused = 0;
+    // Every command but VALVES, PAUSE and RESET acts on the engine: a
+    // pending reset first, so the commands take effect in their order.
+    if (cmd->op == PROTO_OP_HOOK || cmd->op == PROTO_OP_SET || cmd->op == PROTO_OP_STEP) do_reset(s);
     switch (cmd->op) {
     case PROTO_OP_VALVES:
         memcpy(s->u, cmd->u, sizeof s->u);
@@ -431,19 +489,24 @@ static void handle_command(server* s, client* c, const proto_command* cmd) {
         if (s->paused != (cmd->flag != 0)) logf_(s, "client %d: %s", c->id, cmd->flag ? "paused" : "running");
         s->paused = cmd->flag != 0;
         break;
-    case PROTO_OP_RESET:
-        log_collisions(s, "before the reset");
-        engine_destroy(s->e);
-        s->e = NULL;
-        if (build_engine(s, err, sizeof err)) {
-            // The model built once already: only memory can fail here.
-            logf_(s, "reset failed: %s", err);
-            s->stopped = true;
+    case PROTO_OP_RESET: {
+        // Merged into one that has not been done yet; else at most one
+        // rebuild per SERVE_RESET_INTERVAL.
+        const double since = sim_wall_time() - s->t_reset;
+        if (s->reset_pending) {
+            ++s->reset_merged;
+        } else if (s->t_reset > 0 && since < SERVE_RESET_INTERVAL) {
+            snprintf(err, sizeof err,
+                     "reset: the last one was %.2f s ago; at most one per %g s (a rebuild stops the frames of every "
+                     "client)",
+                     since, SERVE_RESET_INTERVAL);
             refused = 1;
-            break;
+        } else {
+            s->reset_pending = true;
+            s->reset_client = c->id;
         }
-        logf_(s, "client %d: reset", c->id);
         break;
+    }
     case PROTO_OP_SET:
         if (apply_set(s, cmd->path, cmd->value, err, sizeof err)) {
             refused = 1;
@@ -559,6 +622,20 @@ static bool read_client(server* s, int idx) {
         }
         size_t off = 0;
         for (;;) {
+            // Before the hello only a hello is heard: any other frame is
+            // refused for that, whatever its fields (a command frame checked
+            // first was "command frame too short" for a client that simply
+            // had not said hello).
+            if (!c->hello && c->rx_len - off >= PROTO_HEADER && c->rx[off + 4] != PROTO_CLIENT_HELLO) {
+                static const char* const k_type[] = {"", "client hello", "server hello", "state", "command", "error",
+                                                     "notice"};
+                const uint8_t ty = c->rx[off + 4];
+                char why[160];
+                snprintf(why, sizeof why, "no hello: the first frame must be a client hello, got %s%s frame (type %u)",
+                         ty >= 1 && ty <= 6 ? "a " : "an unknown", ty >= 1 && ty <= 6 ? k_type[ty] : "", ty);
+                drop_client(s, idx, PROTO_E_MALFORMED, why);
+                return false;
+            }
             proto_msg msg;
             memset(&msg, 0, sizeof msg); // u.state NULL: a client may not send state frames
             size_t used;
@@ -764,6 +841,13 @@ static int serve_loop(server* s, int lfd, double duration) {
             if (pf[0].revents & POLLIN) accept_clients(s, lfd);
         }
         check_timeouts(s);
+        if (s->reset_pending) {
+            // Between frames: the clock starts again at 0, so the frames
+            // start again from now (no catch-up burst, no deadline counted
+            // as missed for the rebuild's time).
+            do_reset(s);
+            next = sim_wall_time() + s->frame;
+        }
         if (s->lockstep) continue;
         double now = sim_wall_time();
         if (now < next - s->spin) continue;
@@ -823,6 +907,7 @@ static int serve_loop(server* s, int lfd, double duration) {
 int cmd_serve(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     c.sim.mechanics = SIM_ODE;
+    c.sim.rcl = true; // the rated capacity limiter, as a local drive's, unless --rcl off
     const char* listen_at = "127.0.0.1:7575";
     double rate = 75, timeout = 5;
     int max_clients = 8, queue = 64;
@@ -850,6 +935,16 @@ int cmd_serve(int argc, char** argv) {
         }
         if (!strcmp(argv[i], "--log-misses")) {
             log_misses = true;
+            continue;
+        }
+        if (!strcmp(argv[i], "--rcl")) {
+            const char* v = app_value(argc, argv, &i);
+            if (!v) return EXIT_USAGE;
+            if (strcmp(v, "on") && strcmp(v, "off")) {
+                fprintf(stderr, "cranesim serve: --rcl: expected on or off, got '%s'\n", v);
+                return EXIT_USAGE;
+            }
+            c.sim.rcl = !strcmp(v, "on");
             continue;
         }
         if (!strcmp(argv[i], "--spin")) {
@@ -940,7 +1035,7 @@ int cmd_serve(int argc, char** argv) {
         rc = EXIT_RUNTIME;
         goto done;
     }
-    if (build_engine(&s, err, sizeof err)) {
+    if (build_engine(&s, NULL, err, sizeof err)) {
         fprintf(stderr, "cranesim serve: %s\n", err);
         rc = EXIT_USAGE;
         goto done;
@@ -969,8 +1064,10 @@ int cmd_serve(int argc, char** argv) {
         rc = EXIT_USAGE;
         goto done;
     }
-    printf("cranesim serve: listening on %s (%s, %s, %g frames/s%s, state frame %zu bytes)\n", bound, m->name,
-           engine_backend_name(s.e), rate, lockstep ? ", lockstep" : "", fl);
+    printf("cranesim serve: listening on %s (%s, %s, %g frames/s%s, state frame %zu bytes, rated capacity limiter "
+           "%s)\n",
+           bound, m->name, engine_backend_name(s.e), rate, lockstep ? ", lockstep" : "", fl,
+           !engine_rcl(s.e) ? "unavailable" : c.sim.rcl ? "on" : "off (measuring only)");
     fflush(stdout);
     // The frames are paced by ppoll timeouts: the default 50 us timer slack
     // would let every wake-up come up to 50 us late on top of scheduling.

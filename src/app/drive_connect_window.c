@@ -48,6 +48,8 @@ typedef struct rlink {
     int ev;                  // the scripted operator's next hook event
     const scenario* sc;
     bool scripted;
+    double u_sent[3];        // the valve commands last sent (the operator's demand, for the HUD)
+    bool have_sent;
     char* hjson;             // the first hello's description (a copy)
     struct { uint64_t seq; char path[128]; double v; } pend[16]; // SETs sent, no answer yet
     int npend;
@@ -182,7 +184,7 @@ static void lk_state(rlink* k, drive_session* s) {
         k->rt = k->lockstep ? 0 : (st->nine[8] - k->rt_t0) / (now - k->rt_w0);
         k->rt_w0 = now, k->rt_t0 = st->nine[8];
     }
-    drive_session_feed(s, st, k->rt);
+    drive_session_feed(s, st, k->rt, k->role == PROTO_CONTROL && k->have_sent ? k->u_sent : NULL);
     // A SET not refused by the time the echo passes it was applied.
     for (int i = 0; i < k->npend; ++i)
         if (st->cmd_seq >= k->pend[i].seq) {
@@ -237,6 +239,8 @@ static void lk_state(rlink* k, drive_session* s) {
         c.seq = ++k->seq;
         if (k->sent_at == 0) k->sent_at = now;
         lk_send(k, &c);
+        memcpy(k->u_sent, c.u, sizeof k->u_sent); // the demand the server's limiter acts on
+        k->have_sent = true;
     }
     if (k->lockstep) lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_STEP, .frames = 1});
 }
@@ -257,6 +261,7 @@ static void lk_queue_sets(const rlink* k, drive_session* s) {
 // The server's hello on a (re)connection: the role, the rate, and the same world.
 static int lk_hello(rlink* k, drive_session* s, const proto_msg* m, char* err, size_t errsz) {
     k->role = m->u.shello.role;
+    k->have_sent = false; // a new link: nothing sent on it yet
     k->lockstep = m->u.shello.lockstep;
     k->rate = m->u.shello.rate;
     cJSON* j = cJSON_ParseWithLength(m->u.shello.json, m->u.shello.json_len);

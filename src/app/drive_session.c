@@ -134,6 +134,7 @@ drive_opts drive_default_opts(void) {
     o.height = 720;
     o.fps_cap = 65.0;
     o.hud = true;
+    o.replay_rcl = -1;
     return o;
 }
 
@@ -956,7 +957,8 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         }
         model_free(s->m);
         s->m = rm;
-        s->c.sim = s->rp->sim;
+        s->c.sim = s->rp->sim; // the limiter's setting too (drive --rcl overrides it)
+        if (o->replay_rcl >= 0) s->c.sim.rcl = o->replay_rcl != 0;
         memcpy(s->sc.q0, s->rp->q0, sizeof s->sc.q0);
         s->sc.slew0 = s->rp->slew0;
         s->sc.nfault = 0;
@@ -1140,7 +1142,7 @@ void drive_session_set_remote(drive_session* s) {
     s->rin = (drive_remote_input){.hook = -1, .pause = -1, .reset = -1};
 }
 
-void drive_session_feed(drive_session* s, const proto_state* st, double rt_factor) {
+void drive_session_feed(drive_session* s, const proto_state* st, double rt_factor, const double* demand) {
     world_snapshot* w = s->snap;
     // The static parts (names, shapes, meshes, terrain) stay the local
     // engine's, built from the same files; the caller checked the bodies match.
@@ -1158,6 +1160,10 @@ void drive_session_feed(drive_session* s, const proto_state* st, double rt_facto
         y->x = d[6], y->pA = d[7], y->pB = d[8], y->u = d[9], y->u_cmd = d[10], y->force = d[11], y->v = d[12];
         y->relief_open = (st->cyl_bits[i] & PROTO_CYL_RELIEF) != 0;
         y->end_stop = (st->cyl_bits[i] & PROTO_CYL_END_STOP) != 0;
+        // Where the server's limiter cut a command: the operator's demand is
+        // this drive's own when it controls, else not known here (NaN).
+        y->rcl_cut = i < 3 && (st->flags & (PROTO_F_RCL_CUT0 << i)) != 0;
+        y->u_op = !y->rcl_cut ? y->u_cmd : demand ? demand[i] : NAN;
     }
     w->nrope = st->nrope < WORLD_SNAP_MAX_ROPE ? st->nrope : WORLD_SNAP_MAX_ROPE;
     memcpy(w->rope, st->rope, (size_t)w->nrope * sizeof w->rope[0]);
@@ -1417,7 +1423,14 @@ int drive_session_tick(drive_session* s, double wall) {
     if (frame) {
         char status[640];
         // Who drives: the scenario, a named device, or the keyboard alone.
-        const char* src = s->o.scripted ? "  [scripted]" : input_device_name(s->in) ? "" : "  [keyboard]";
+        // A replay is driven by the session's recorded commands, not by the
+        // scenario: it says which session.
+        char rp_src[160] = "";
+        if (s->rp) {
+            const char* base = strrchr(s->rp->path, '/');
+            snprintf(rp_src, sizeof rp_src, "  [replay of %.120s]", base ? base + 1 : s->rp->path);
+        }
+        const char* src = s->rp ? rp_src : s->o.scripted ? "  [scripted]" : input_device_name(s->in) ? "" : "  [keyboard]";
         // While a value is typed the keys go to the panel, not the crane:
         // say so where the operator looks.
         const char* keys = panel_gui_wants_keyboard(s->pn) ? "  [keys: panel - Enter/Esc gives them back]" : "";
@@ -1498,9 +1511,13 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     char where[96];
     if (c->sim.mechanics != SIM_ODE) snprintf(where, sizeof where, "the lagrange 2-DOF view");
     else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : "sandbox");
-    printf("cranesim drive: %s in %s%s; %s%s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
+    printf("cranesim drive: %s in %s%s; %s%s%s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
            o->replay_path ? "replaying " : "", o->replay_path ? o->replay_path : o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
-                                               "R reset, C camera, F5 record, F12 screenshot, Esc quit)");
+                                               "R reset, C camera, F5 record, F12 screenshot, Esc quit)",
+           !s->rp ? ""
+           : o->replay_rcl >= 0 ? (s->c.sim.rcl ? ", rated capacity limiter on (--rcl)" : ", rated capacity limiter off (--rcl)")
+           : s->rp->rcl_recorded ? (s->c.sim.rcl ? ", rated capacity limiter on as recorded" : ", rated capacity limiter off as recorded")
+                                 : ", rated capacity limiter on (the session does not record its setting)");
     // Ticks at 240 Hz: between rendered frames the loop still pumps events,
     // reads the sticks and commands the valves, so commands run faster than
     // frames (>= 75 Hz, the paper's rate, even while a frame takes 12 ms).

@@ -46,6 +46,7 @@ typedef struct drive_opts {
     const char* save_as;      ///< "save model" writes (and replaces) this file; NULL: a new
                               ///< cranesim_model_N.json each time (drive_save_name)
     bool collision_view;      ///< start with the collision shapes drawn over the scene (key G toggles)
+    int replay_rcl;           ///< with replay_path: the limiter 1 on, 0 off (--rcl), -1 as the session recorded it
 } drive_opts;
 
 drive_opts drive_default_opts(void);
@@ -142,7 +143,10 @@ void drive_session_set_answer(drive_session* s, const char* text);
 /// One state frame (protocol.h): poses, cylinders, rope and HUD values into
 /// the snapshot the next frame draws, and one sample for the charts.
 /// rt_factor: the remote simulated time over wall time, 0 unknown.
-void drive_session_feed(drive_session* s, const struct proto_state* st, double rt_factor);
+/// demand: the valve commands this drive last sent as the server's
+/// controller (the operator's demand the HUD shows beside a command the
+/// server's limiter cut), or NULL (watching: not known here).
+void drive_session_feed(drive_session* s, const struct proto_state* st, double rt_factor, const double* demand);
 /// The operator's input of the last tick, remote mode: stick positions
 /// u[3] in [-1, 1] and the requests (each -1: none): hook (0 release, 1
 /// attach), pause (toggle: 1), reset (1).

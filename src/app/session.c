@@ -59,6 +59,9 @@ int session_writer_open(session_writer* w, const char* path, const cJSON* model_
     cJSON_AddBoolToObject(s, "dense_jac", o->dense_jac);
     cJSON_AddNumberToObject(s, "kernel", o->kernel);
     cJSON_AddStringToObject(s, "world", o->world ? o->world : "");
+    // The limiter acts on the commands: without its setting a replay cannot
+    // give the drive's rows (docs/replay.md).
+    cJSON_AddBoolToObject(s, "rcl", o->rcl);
     cJSON* st = cJSON_AddObjectToObject(h, "initial");
     cJSON_AddItemToObject(st, "q0", cJSON_CreateDoubleArray(q0, 2));
     cJSON_AddNumberToObject(st, "slew0", slew0);
@@ -225,6 +228,13 @@ int session_load(const char* path, session* s, char* err, size_t errsz) {
         s->sim.jac_every = (int)num(so, "jac_every", &ok);
         s->sim.dense_jac = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(so, "dense_jac"));
         s->sim.kernel = (sim_kernel)(int)num(so, "kernel", &ok);
+        // A session written before the limiter's setting was recorded has
+        // none: it replays with the limiter on, drive's default then as now
+        // (session.h; docs/replay.md).
+        const cJSON* rcl = cJSON_GetObjectItemCaseSensitive(so, "rcl");
+        s->rcl_recorded = cJSON_IsBool(rcl);
+        s->sim.rcl = s->rcl_recorded ? cJSON_IsTrue(rcl) : true;
+        if (rcl && !s->rcl_recorded) ok = false;
         const cJSON* w = cJSON_GetObjectItemCaseSensitive(so, "world");
         if (cJSON_IsString(w)) snprintf(s->world, sizeof s->world, "%s", w->valuestring);
         s->sim.world = s->world[0] ? s->world : NULL;

@@ -38,7 +38,10 @@ typedef struct session {
     cJSON* header;       ///< the parsed header (owned)
     const cJSON* model;  ///< its model document (in header)
     const cJSON* scenario; ///< its scenario document, or NULL (faults not replayed)
-    sim_opts sim;
+    sim_opts sim;        ///< the recorded settings; sim.rcl the limiter's
+    bool rcl_recorded;   ///< the header has the limiter's setting ("sim": {"rcl": ...}); a session
+                         ///< written before it was recorded has not, and sim.rcl is then true
+                         ///< (drive's default)
     char world[256];     ///< ode world name or file ("" none)
     double q0[2], slew0, m3;
     bool window;         ///< recorded by the window: the record has a `segment` column

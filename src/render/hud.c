@@ -320,7 +320,9 @@ static float draw_readouts(render* r, const world_snapshot* s) {
                               : row == 0 || row == 1 ? "%.1f"
                                                      : "%.2f";
             snprintf(buf, sizeof buf, fmt, v[row]);
-            const float* colr = (row == 2 || row == 3) && c->relief_open ? k_amber : k_white;
+            // u_cmd in amber where the limiter cut the operator's demand (the
+            // warning line gives the demand beside it).
+            const float* colr = ((row == 2 || row == 3) && c->relief_open) || (row == 5 && c->rcl_cut) ? k_amber : k_white;
             render_hud_text(h, x + col0 + colw * (float)i, y, sc, colr, buf);
         }
         y += lh;
@@ -380,8 +382,23 @@ int render_pad_event(const world_snapshot* s, int* prev, char* buf, size_t n) {
     for (int i = 0; i < 4 && k > 0 && (size_t)k < n; ++i)
         if (rising >> i & 1)
             k += snprintf(buf + k, n - (size_t)k, " %s (%.2f kN)", render_pad_name(i), s->pad_F[i] * 1e-3);
-    if (k > 0 && (size_t)k < n) snprintf(buf + k, n - (size_t)k, "; stability margin %.2f", s->stab_margin);
+    if (k > 0 && (size_t)k < n) render_pad_margin_text(s, buf + k, n - (size_t)k);
     return 1;
+}
+
+void render_pad_margin_text(const world_snapshot* s, char* buf, size_t n) {
+    // A pad lifts off (below 1 % of the weight) long before the truck tips:
+    // one corner unloads and the truck stands on three pads, rocking about
+    // their diagonal, while the margin about the tipping lines (the pad
+    // rectangle's edges) can still be 2. Said so, the two figures do not
+    // read as a contradiction ("PAD LIFTED OFF (margin 2.04)").
+    const int lifted = s->pad_lifted & 15;
+    const bool one = lifted && !(lifted & (lifted - 1));
+    char m[16];
+    if (s->stab_margin >= 10.0) snprintf(m, sizeof m, ">= 10"); // the world's cap: nothing outboard
+    else snprintf(m, sizeof m, "%.2f", s->stab_margin);
+    if (one && s->stab_margin >= 1.0) snprintf(buf, n, " - on three pads, not tipping (tipping margin %s)", m);
+    else snprintf(buf, n, " - tipping margin %s", m);
 }
 
 int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDER_WARN_LEN], int max) {
@@ -409,10 +426,41 @@ int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDE
         if (nrel == 0 && s->cyl[i].relief_open) snprintf(w[n++], RENDER_WARN_LEN, "RELIEF OPEN: %s", nm);
         if (s->cyl[i].end_stop && n < max - 2) snprintf(w[n++], RENDER_WARN_LEN, "END STOP: %s", nm);
     }
-    if (s->rcl_have && s->rcl_util >= 0.9 && n < max - 1)
-        snprintf(w[n++], RENDER_WARN_LEN, s->rcl_util >= 1.0 && s->rcl_on ? "RATED CAPACITY %.0f %%: MOTIONS STOPPED"
-                                                                          : "RATED CAPACITY %.0f %%",
-                 100 * s->rcl_util);
+    if (s->rcl_have && n < max - 1) {
+        // Where the limiter cut the operator's demand, a second line gives
+        // the demand beside what it let through ("jib: demand +100 %, let
+        // through +0 %"), so the operator sees which stick is held and by
+        // how much. A remote watcher does not know the controller's demand.
+        bool cut = false, stopped = false;
+        for (int i = 0; i < ncyl; ++i)
+            if (s->cyl[i].rcl_cut) cut = true, stopped |= fabs(s->cyl[i].u_cmd) < 0.005;
+        if (s->rcl_util >= 0.9 || cut) {
+            // Below 90 % where the tip is, a cut comes from the limiter's
+            // look-ahead (a weaker chart point within reach) or a weaker
+            // slew sector: "LIMIT AHEAD", or 67 % and STOPPED read as a
+            // contradiction.
+            snprintf(w[n++], RENDER_WARN_LEN, "RATED CAPACITY %.0f %%%s%s", 100 * s->rcl_util,
+                     cut && s->rcl_util < 0.9 ? ", LIMIT AHEAD" : "",
+                     !cut ? "" : stopped ? ": MOTIONS STOPPED" : ": MOTIONS SLOWED");
+            if (cut && n < max - 1) {
+                int k = 0;
+                const char* sep = "";
+                for (int i = 0; i < ncyl && k >= 0 && k < RENDER_WARN_LEN; ++i) {
+                    const world_snap_cylinder* c = &s->cyl[i];
+                    if (!c->rcl_cut) continue;
+                    const char* nm = c->name[0] ? c->name : "cylinder";
+                    if (isnan(c->u_op))
+                        k += snprintf(w[n] + k, (size_t)(RENDER_WARN_LEN - k), "%s%s: cut to %+.0f %%", sep, nm,
+                                      100 * c->u_cmd);
+                    else
+                        k += snprintf(w[n] + k, (size_t)(RENDER_WARN_LEN - k), "%s%s: demand %+.0f %%, let through %+.0f %%",
+                                      sep, nm, 100 * c->u_op, 100 * c->u_cmd);
+                    sep = "; ";
+                }
+                ++n;
+            }
+        }
+    }
     if (s->tipping && n < max - 1)
         snprintf(w[n++], RENDER_WARN_LEN, "TIPPING! tilt %.1f deg", s->truck_tilt * 180.0 / M_PI);
     if (s->collision && n < max - 1) snprintf(w[n++], RENDER_WARN_LEN, "COLLISION");
@@ -421,7 +469,7 @@ int render_hud_warnings(const render* r, const world_snapshot* s, char w[][RENDE
         for (int i = 0; i < 4; ++i)
             if (s->pad_lifted >> i & 1)
                 k += snprintf(w[n] + k, (size_t)(RENDER_WARN_LEN - k), " %s", render_pad_name(i));
-        snprintf(w[n] + k, (size_t)(RENDER_WARN_LEN - k), " (margin %.2f)", s->stab_margin);
+        render_pad_margin_text(s, w[n] + k, (size_t)(RENDER_WARN_LEN - k));
         ++n;
     }
     if (s->npad && s->stab_margin < 1 && !s->tipping && n < max - 1)

@@ -212,6 +212,10 @@ const char* render_pad_name(int i);
 /// there is one (once per event: a support that stays lifted says nothing
 /// more), else 0.
 int render_pad_event(const world_snapshot* s, int* prev, char* buf, size_t n);
+/// What the lifted supports mean for stability, appended to their names:
+/// " - on three pads, not tipping (tipping margin 2.04)" for one support at
+/// a margin of 1 or more, else " - tipping margin 0.95".
+void render_pad_margin_text(const world_snapshot* s, char* buf, size_t n);
 /// The app reports missed real-time deadlines here; any count > 0 in the last
 /// second shows the "cannot keep up with real time" warning.
 void render_set_missed_deadlines(render* r, int missed_last_second);

@@ -30,12 +30,24 @@ static const engine_ops* backend(const sim_opts* o) {
 
 engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
                       size_t errsz) {
+    return engine_create_rcl(m, o, q0, slew0, m3, NULL, err, errsz);
+}
+
+engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
+                          struct rcl* r, char* err, size_t errsz) {
     engine* e = backend(o)->create(m, o, q0, slew0, m3, err, errsz);
     if (!e) return NULL;
     // The limiter filters every command a stepped driver sets (drive, the
-    // window's tick, the soak bench): one place for all of them.
-    e->rcl = engine_rcl_create(m, o, "sandbox");
+    // window's tick, the soak bench, serve): one place for all of them.
+    if (r) rcl_reset(r);
+    e->rcl = r ? r : engine_rcl_create(m, o, "sandbox");
     return e;
+}
+
+struct rcl* engine_rcl_detach(engine* e) {
+    struct rcl* r = e->rcl;
+    e->rcl = NULL;
+    return r;
 }
 
 struct rcl* engine_rcl_create(const model* m, const sim_opts* o, const char* default_world) {
@@ -229,6 +241,10 @@ void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, siz
     backend(o)->describe_work(o, r, buf, n);
 }
 void engine_set_commands(engine* e, const double u[3]) {
+    // The operator's demand and what was let through, for the HUD (it shows
+    // both where the limiter cut).
+    memcpy(e->u_op, u, sizeof e->u_op);
+    memcpy(e->u_lim, u, sizeof e->u_lim);
     if (!e->rcl || !e->o.rcl) {
         if (e->rcl) { // still measured, for the HUD and the record
             double row[SIM_NCOL];
@@ -241,6 +257,7 @@ void engine_set_commands(engine* e, const double u[3]) {
     double row[SIM_NCOL], v[3];
     e->ops->row(e, row);
     rcl_filter(e->rcl, row, u, v);
+    memcpy(e->u_lim, v, sizeof e->u_lim);
     e->ops->set_commands(e, v);
 }
 
@@ -322,6 +339,12 @@ void engine_snapshot(engine* e, world_snapshot* s) {
     s->rcl_have = e->rcl != NULL;
     s->rcl_on = e->rcl && e->o.rcl;
     s->rcl_util = e->rcl ? e->rcl->util : 0.0;
+    // Cylinder k (lift, jib, slew) carries command k.
+    for (int k = 0; k < s->ncyl && k < WORLD_SNAP_MAX_CYLINDERS; ++k) {
+        world_snap_cylinder* c = &s->cyl[k];
+        c->rcl_cut = k < 3 && s->rcl_on && e->u_lim[k] != e->u_op[k];
+        c->u_op = c->rcl_cut ? e->u_op[k] : c->u_cmd;
+    }
 }
 const char* engine_error(const engine* e) { return e->err; }
 const sim_collisions* engine_collisions(const engine* e) {

@@ -176,6 +176,17 @@ const struct rcl* engine_rcl(const engine* e);
 /// be made. engine_rcl_destroy frees it.
 struct rcl* engine_rcl_create(const model* m, const sim_opts* o, const char* default_world);
 void engine_rcl_destroy(struct rcl* r);
+/// Take the engine's limiter (NULL if it has none); the engine then has none.
+/// Its chart is most of what building an engine costs (the sandbox: about
+/// 80 %), and it depends only on the model and the world.
+struct rcl* engine_rcl_detach(engine* e);
+/// As engine_create, with limiter r (from engine_rcl_detach of an engine of
+/// the same model, options and world) instead of a new one: its filter
+/// starts again (rcl_reset), so the engine steps exactly as a new one. The
+/// engine owns r from then; on failure (NULL) r is still the caller's. r NULL:
+/// as engine_create.
+engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
+                          struct rcl* r, char* err, size_t errsz);
 /// Fill a snapshot for the renderer.
 void engine_snapshot(engine* e, world_snapshot* s);
 

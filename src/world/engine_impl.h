@@ -69,6 +69,8 @@ struct engine {
     engine_faults faults; ///< for engine_play's fault events (faults_ready once initialised)
     bool faults_ready;
     struct rcl* rcl;      ///< the rated capacity limiter (engine.c), or NULL where its chart failed
+    double u_op[3];       ///< the operator's last commands lift, jib, slew, as given to engine_set_commands [-]
+    double u_lim[3];      ///< what the limiter let through of them [-] (u_op when it cut nothing)
 };
 
 extern const engine_ops engine_lagrange_ops, engine_ode_ops;

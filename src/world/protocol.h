@@ -69,6 +69,8 @@ enum {
     PROTO_F_RCL_HAVE = 1u << 7,  ///< the rated capacity limiter measures (rcl_util valid)
     PROTO_F_RCL_ON = 1u << 8,    ///< ... and stops the motions that increase the load moment
     PROTO_F_PAD_LIFTED0 = 1u << 9, ///< bits 9..12: support FL, FR, RL, RR lifted off
+    PROTO_F_RCL_CUT0 = 1u << 13, ///< bits 13..15: the limiter cut the lift, jib, slew command (a client
+                                 ///< that ignores them reads the frame as before)
 };
 /// Cylinder status bits (proto_state.cyl_bits).
 enum { PROTO_CYL_RELIEF = 1u << 0, PROTO_CYL_END_STOP = 1u << 1 };

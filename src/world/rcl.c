@@ -19,6 +19,7 @@ int rcl_init(rcl* r, const model* m, const world_desc* wd, char* err, size_t err
     r->m = m;
     double st;
     hyd_model_cylinder_geometry(m->hyd, m->cyl[0], &r->AA, &r->AB, &st);
+    r->stroke = st;
     lc_truck t;
     lc_truck_from_world(wd, &t);
     lc_opts o = lc_default_opts();
@@ -44,6 +45,12 @@ int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, si
 }
 
 void rcl_free(rcl* r) { loadchart_free(&r->chart); }
+
+void rcl_reset(rcl* r) {
+    const rcl keep = *r;
+    memset(r, 0, sizeof *r);
+    r->m = keep.m, r->chart = keep.chart, r->AA = keep.AA, r->AB = keep.AB, r->stroke = keep.stroke;
+}
 
 // Load moment about joint 1 [N m] measured from the lift pressures: the
 // cylinder's torque F r less the booms' own gravity torque at these angles,
@@ -108,20 +115,33 @@ double rcl_utilisation(rcl* r, const double* row) {
     const double m_raw = load_moment(r, row, &R) / (g * fmax(R, RCL_R_MIN));
     r->R = R;
     const double t = row[COL_T];
+    // On or near an end stop the lift pressure is load plus the stop's
+    // force (with the valve still open, the pump's pressure: 20.6 MPa read
+    // as 131 % of a 200 kg load on the sandbox), so it is not taken there.
+    r->x_lift = crane_stroke(&r->m->mech.act[0], row[COL_Q1]);
+    const bool trust = r->x_lift > RCL_STOP_BAND && r->x_lift < r->stroke - RCL_STOP_BAND;
+    r->held = !trust;
     // Two first-order stages of RCL_TAU / 2: the same 1 s lag to a step as
     // one stage of RCL_TAU, but the booms' ringing on the oil (2.5 Hz on
     // the shipped crane, the lift pressure swinging by +-10 MPa) is cut to
     // 1.6 % instead of 6 %.
     const double rd = outreach_rate(r, row);
     if (!r->have || t < r->t_last || !isfinite(r->m_filt) || !isfinite(r->m_stage)) {
-        r->m_filt = r->m_stage = m_raw, r->have = true;
+        r->have = true, r->have_load = false;
+        r->m_filt = r->m_stage = 0.0;
         r->rd_env = fabs(rd);
     } else if (t > r->t_last) {
         const double k = 1.0 - exp(-(t - r->t_last) / (0.5 * RCL_TAU));
-        r->m_stage += k * (m_raw - r->m_stage);
+        // Off the stop the first stage takes the measurement; on it, its
+        // input is cut and the second stage still settles on the first: the
+        // estimate becomes the last load measured clear of the stop.
+        if (trust && r->have_load) r->m_stage += k * (m_raw - r->m_stage);
         r->m_filt += k * (r->m_stage - r->m_filt);
         r->rd_env = fmax(fabs(rd), r->rd_env * exp(-(t - r->t_last) / RCL_TAU));
     }
+    // The first trusted row starts the filter at its value (at the start of a
+    // run, or when a run that began on a stop leaves it).
+    if (trust && !r->have_load) r->m_filt = r->m_stage = m_raw, r->have_load = true;
     r->t_last = t;
     const double load = fmax(0.0, r->m_filt);
     const double cap = loadchart_capacity(&r->chart, R, row[COL_SLEW], NULL);

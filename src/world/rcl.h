@@ -24,6 +24,11 @@ extern "C" {
 #define RCL_TAU 1.0    ///< the load moment's low-pass filter: two stages of RCL_TAU / 2 each [s]
 #define RCL_LOOK_T 0.5 ///< how far ahead in time the limiter looks along the outreach [s]
 #define RCL_RAMP 0.25  ///< the shortest time the limiter takes to stop a full-speed motion [s]
+/// Stroke band at either end of the lift cylinder's stroke inside which its
+/// pressures are not load [m]: a cylinder on its end stop carries the stop's
+/// force too (with the valve open, up to the pump's pressure), which a
+/// pressure-based limiter cannot tell from load.
+#define RCL_STOP_BAND 0.01
 
 typedef struct rcl {
     const model* m;
@@ -38,7 +43,12 @@ typedef struct rcl {
     double m_stage;    ///< the first of the filter's two stages [kg]
     double rd_env;     ///< envelope of the outreach speed (peak, decaying by RCL_TAU) [m/s]
     double t_last;     ///< the time it was last updated [s]
-    bool have;         ///< m_filt holds a value
+    double stroke;     ///< the lift cylinder's stroke [m]
+    double x_lift;     ///< the lift cylinder's stroke at the last utilisation, from q1 [m]
+    bool have;         ///< t_last and rd_env hold values
+    bool have_load;    ///< m_filt holds a measured value (a row with trusted pressures came)
+    bool held;         ///< the last row's lift cylinder was within RCL_STOP_BAND of an end stop:
+                       ///< its pressures were not used, the load estimate held
     bool warn;         ///< util >= RCL_WARN
     bool stopped;      ///< the last filter cut a command
 } rcl;
@@ -50,6 +60,9 @@ int rcl_init(rcl* r, const model* m, const world_desc* wd, char* err, size_t err
 /// As rcl_init, for the world file of an ode run (NULL: no world, lagrange).
 int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, size_t errsz);
 void rcl_free(rcl* r);
+/// Start again: the state rcl_init leaves (no measurement, nothing cut),
+/// keeping the chart.
+void rcl_reset(rcl* r);
 
 /// Utilisation [-] from a CSV row (t, p1A, p1B, q1, q2, slew columns; slew
 /// 0 when absent). Also stored in r->util. The load the moment implies
@@ -60,6 +73,13 @@ void rcl_free(rcl* r);
 /// a limiter acting on that would stop and free the crane by turns. Rows
 /// at the same time as the last one leave the filter as it is; an earlier
 /// time (a rewind) restarts it.
+///
+/// Within RCL_STOP_BAND of either end of the lift cylinder's stroke (from
+/// q1, as a limiter knows it from its angle sensor) the pressures are not
+/// taken: the filter's input is cut and its second stage settles on the
+/// first, so the estimate holds the last load measured clear of the stop
+/// (0 until one was). The jib cylinder's stop needs nothing: its force acts
+/// between the two booms and cancels in the moment about joint 1.
 double rcl_utilisation(rcl* r, const double* row);
 
 /// The command filter: the operator's commands u_in (lift, jib, slew in

@@ -74,6 +74,9 @@ typedef struct world_snap_cylinder {
     double force;          ///< cylinder force, + extends [N]
     double u;              ///< spool opening of its valve, -1..1
     double u_cmd;          ///< commanded opening, -1..1
+    double u_op;           ///< the operator's demand before the rated capacity limiter, -1..1 (u_cmd
+                           ///< unless rcl_cut; a remote view knows it only for its own demand)
+    uint8_t rcl_cut;       ///< the rated capacity limiter cut the operator's demand (u_cmd < u_op)
     uint8_t relief_open;   ///< a relief on one of its chambers is passing flow
     uint8_t end_stop;      ///< at an end stop
 } world_snap_cylinder;

@@ -614,6 +614,58 @@ static void test_hook_feedback_and_pads(void) {
     drive_session_destroy(s);
 }
 
+// The limiter's HUD line (issue 25, item 19): where it cuts a command, the
+// operator's own demand beside what went through. 1300 kg at the tip in the
+// validation world, the jib out at full command (tests/app/data): the
+// limiter stops the jib within 0.5 s, before the chart's cliff. And the pad
+// line says what a lifted pad means for stability, instead of "PAD LIFTED
+// OFF (margin 2.04)", which read as a contradiction.
+static void test_limiter_hud_shows_demand(void) {
+    app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE;
+    c.sim.world = "validation";
+    c.sim.rcl = true; // as `drive` has it
+    c.scenario_path = CRANESIM_TESTDATA "/rcl_overload.json";
+    drive_opts o = drive_default_opts();
+    o.offscreen = true;
+    o.scripted = true;
+    char err[512];
+    drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
+    CHECK(s != NULL, "session: %s", err);
+    if (!s) return;
+    double wall = 0;
+    CHECK(run_for(s, &wall, 1.6) == 0, "loop: %s", drive_session_error(s));
+    char text[1024];
+    hud_warnings(s, text, sizeof text);
+    const world_snapshot* snap = drive_session_snapshot(s);
+    printf("  limiter cutting the jib: '%s'\n", text);
+    CHECK(snap->ncyl >= 2 && snap->cyl[1].rcl_cut && snap->cyl[1].u_op == 1.0 && snap->cyl[1].u_cmd < 0.5,
+          "jib: cut %d, demand %g, let through %g", snap->cyl[1].rcl_cut, snap->cyl[1].u_op, snap->cyl[1].u_cmd);
+    char want[128];
+    snprintf(want, sizeof want, "%s: demand +100 %%, let through %+.0f %%", snap->cyl[1].name, 100 * snap->cyl[1].u_cmd);
+    CHECK(strstr(text, "RATED CAPACITY") && strstr(text, want), "the warning lacks '%s': '%s'", want, text);
+    CHECK(!snap->cyl[0].rcl_cut, "the lift was not commanded, yet flagged as cut");
+    // The pad line on copies of a snapshot: one pad at a margin of 2.04, two at 0.95.
+    static world_snapshot p;
+    p = *snap;
+    p.npad = 4;
+    p.pad_lifted = 1 << 2;
+    p.stab_margin = 2.04;
+    char w[RENDER_WARN_MAX][RENDER_WARN_LEN];
+    int k = render_hud_warnings(drive_session_render_ctx(s), &p, w, RENDER_WARN_MAX);
+    int found = 0;
+    for (int i = 0; i < k; ++i)
+        found |= strstr(w[i], "PAD LIFTED OFF: RL - on three pads, not tipping (tipping margin 2.04)") != NULL;
+    CHECK(found, "one pad lifted at a margin of 2.04: no or another pad line");
+    p.pad_lifted = (1 << 2) | (1 << 3);
+    p.stab_margin = 0.95;
+    k = render_hud_warnings(drive_session_render_ctx(s), &p, w, RENDER_WARN_MAX);
+    found = 0;
+    for (int i = 0; i < k; ++i) found |= strstr(w[i], "PAD LIFTED OFF: RL RR - tipping margin 0.95") != NULL;
+    CHECK(found, "two pads lifted at 0.95: no or another pad line");
+    drive_session_destroy(s);
+}
+
 // The real-time factor after a reset (R), a rebuild (a solver change) and a
 // pause is the simulation's own rate, 1.00 on a virtual clock that the loop
 // keeps up with: it divided the time since the reset by the wall time since
@@ -1221,6 +1273,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_default_view_shows_hook_and_load);
     RUN_TEST(test_presets_keep_out_of_the_truck);
     RUN_TEST(test_slew_valve_in_the_panel);
+    RUN_TEST(test_limiter_hud_shows_demand);
     SDL_Quit();
     TEST_MAIN_END();
 }

@@ -81,6 +81,60 @@ static void check_bigger_bore(void) {
     CHECK(fabs(peak - hand) < 0.02 * hand, "peak_p1A %.6g Pa, hand %.6g Pa", peak, hand);
 }
 
+// The largest cut of the jib command over the rows of a record: the
+// operator's 1.0 less the u2_cmd the engine was given [-] (0: never cut).
+static double jib_cut(const char* csv, int nrow) {
+    double cut = 0;
+    for (int k = 0; k < nrow; ++k) {
+        const double t = csv_value(csv, "t", k), u = csv_value(csv, "u2_cmd", k);
+        if (t > 0.25 && isfinite(u)) cut = fmax(cut, 1.0 - u);
+    }
+    return cut;
+}
+
+// A drive in which the rated capacity limiter acted (1300 kg at the tip, the
+// jib out at full command in the validation world: the limiter stops it
+// within 0.5 s) replays bit for bit, the limiter included; on a changed
+// design the replay runs the same limiter (it cuts the same operator input
+// there too); a session without the limiter's setting (written before it was
+// recorded) replays with the limiter on and says so; --rcl off replays
+// without it.
+static void check_limiter_replay(void) {
+    const char* args = "--world validation --scenario " CRANESIM_TESTDATA "/rcl_overload.json --duration 2 "
+                       "--frame-rate 100";
+    check_bit_for_bit("limiter acting", args);
+    long na = cli_read_file("rp_rec.csv", a, sizeof a);
+    const double cut = na > 0 ? jib_cut(a, 200) : 0;
+    printf("  limiter acting: the jib command was cut by up to %.2f in the recorded drive\n", cut);
+    CHECK(cut > 0.5, "the limiter did not act in the recorded drive (cut %.2f): the test shows nothing", cut);
+    CHECK(strstr(out, "rated capacity limiter on, as recorded") != NULL, "replay does not name the limiter: %s", out);
+    // A changed design: the same limiter cuts the same demand.
+    int rc = cli_run("replay rp.session --quiet --set hydraulics.components.lift_cyl.bore=0.105 --out rp_rep2.csv", out,
+                     sizeof out);
+    CHECK(rc == 0, "changed design: exit %d: %s", rc, out);
+    long nb = cli_read_file("rp_rep2.csv", b, sizeof b);
+    const double cut2 = nb > 0 ? jib_cut(b, 200) : 0;
+    printf("  changed design: cut by up to %.2f\n", cut2);
+    CHECK(cut2 > 0.5, "the replay on a changed design ran without the limiter (cut %.2f)", cut2);
+    // --rcl off: the operator's full command reaches the engine.
+    rc = cli_run("replay rp.session --quiet --rcl off --out rp_rep3.csv", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "rated capacity limiter off (--rcl; recorded on)"), "--rcl off: exit %d: %s", rc, out);
+    nb = cli_read_file("rp_rep3.csv", b, sizeof b);
+    CHECK(nb > 0 && jib_cut(b, 200) == 0, "--rcl off: the jib command was still cut by %.2f", jib_cut(b, 200));
+    // An older session: no "rcl" in its settings. It replays with the
+    // limiter on (drive's default), here bit for bit, and says so.
+    na = cli_read_file("rp.session", a, sizeof a);
+    char* key = na > 0 ? strstr(a, ",\"rcl\":true") : NULL;
+    CHECK(key != NULL, "the session does not record the limiter's setting");
+    if (key) {
+        memmove(key, key + 11, strlen(key + 11) + 1);
+        CHECK(cli_write_file("rp_old.session", a) == 0, "write");
+        rc = cli_run("replay rp_old.session --quiet", out, sizeof out);
+        CHECK(rc == 0 && strstr(out, "(bit for bit)") && strstr(out, "does not record its setting"),
+              "old session: exit %d: %s", rc, out);
+    }
+}
+
 // Bad input: one line, exit 2, no output file.
 static void check_refused(const char* what, const char* session_text, const char* want) {
     CHECK(cli_write_file("rp_bad.session", session_text) == 0, "write");
@@ -155,6 +209,7 @@ int main(void) {
     check_bit_for_bit("lagrange", "--mechanics lagrange --duration 1");
     // The burst at t = 2 s (a fault event the replay applies at the same ticks).
     check_bit_for_bit("lagrange hose burst", "--mechanics lagrange --scenario hose_burst --duration 2.5 --frame-rate 100");
+    check_limiter_replay();
     check_bigger_bore();
     check_bad_sessions();
     TEST_MAIN_END();

@@ -5,6 +5,7 @@
 #include "app.h"
 #include "check.h"
 #include "drive_session.h"
+#include "render.h"
 
 #include <SDL2/SDL.h>
 #include <stdlib.h>
@@ -116,6 +117,11 @@ static void replay_in_the_window(void) {
         rc = drive_session_tick(s, wall);
     }
     CHECK(rc == 1, "the replay did not end the window (rc %d): %s", rc, drive_session_error(s));
+    // The status line names the session that drives (it said "[scripted]"
+    // in `drive --replay`, "[keyboard]" here).
+    const char* st = render_get_status(drive_session_render_ctx(s));
+    CHECK(strstr(st, "[replay of rw.session]") && !strstr(st, "[scripted]") && !strstr(st, "[keyboard]"),
+          "status while replaying: '%s'", st);
     long rows = 0;
     char err[400];
     CHECK(drive_session_finish_record(s, &rows, err, sizeof err) == 0, "record: %s", err);
