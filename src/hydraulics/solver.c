@@ -429,7 +429,8 @@ static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_ne
     // Fixed-step methods never leave f(t_{n+1}, y_{n+1}) behind, so skip the
     // cache check (and its copy of y) unless an adaptive run just filled it.
     int rc;
-    if (s->p->wstep && (s->method == HYD_KRUS || s->method == HYD_ROS2)) {
+    const int ws = s->p->wstep && (s->method == HYD_KRUS || s->method == HYD_ROS2);
+    if (ws) {
         // The problem's own step kernel (hyd_problem.wstep).
         const int need_j = jacobian_due(s, *t, y);
         rc = s->p->wstep(s->p->user, *t, y, h, hydKrusGamma(s->method), need_j, s->ynew);
@@ -456,6 +457,7 @@ static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_ne
     s->st.steps++;
     s->j_steps++;
     s->last_h = h;
+    s->last_wstep = ws;
     if (s->p->settle) s->p->settle(s->p->user, *t, y);
     return HYD_OK;
 }
