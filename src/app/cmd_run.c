@@ -281,6 +281,9 @@ static void print_energy(const sim_energy* en, const sim_energy_balance* b) {
     if (group_columns(en, SIM_EG_OTHER)) printf(", other %.3f", b->group[SIM_EG_OTHER] * 1e-3);
     printf(")\n  energy: released by displaced fluid %.3f kJ; work on mechanics %.3f kJ", b->expansion * 1e-3,
            b->work * 1e-3);
+    // The ode world's strokes re-anchored to the bodies at each ODE step
+    // (docs/energy.md); 0 on the lagrange crane, and then not printed.
+    if (b->coupling != 0.0) printf("; put in by the ODE coupling %+.3f kJ", b->coupling * 1e-3);
     // The fluid's compression energy is a function of each node's pressure
     // on (0, inf): a node that ended below absolute zero (a fixed step that
     // rang at a stiff event, which the run noted) has none, so the balance

@@ -200,7 +200,14 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         ode_world_destroy(w);
         return res->status = SIM_REFUSED;
     }
-    if (en) sim_energy_sample(en, 0.0, ode_world_circuit_inputs(w, sim_energy_data(en)), ode_world_energy(w));
+    // The balance at every hydraulic step (ode_coupling.c), the mechanics'
+    // energy after every ODE step.
+    if (en && ode_world_follow_energy(w, en)) {
+        snprintf(res->message, sizeof res->message, "out of memory for the energy balance");
+        ode_world_destroy(w);
+        return res->status = SIM_REFUSED;
+    }
+    if (en) sim_energy_mech(en, ode_world_energy(w));
     // The rated capacity limiter between the scenario and the world, as
     // engine_set_commands has it for the stepped drivers.
     struct rcl* lim = engine_rcl_create(m, o, "validation");
@@ -227,12 +234,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             snprintf(res->message, sizeof res->message, "numerical blow-up: %s", ode_world_error(w));
             break;
         }
-        // The balance at every ODE step, from the circuit's state at its end
-        // with the inputs its hydraulic sub-steps integrated (rates held
-        // over the step).
-        if (en)
-            sim_energy_sample(en, (double)(i + 1) * dt, ode_world_circuit_inputs(w, sim_energy_data(en)),
-                              ode_world_energy(w));
+        if (en) sim_energy_mech(en, ode_world_energy(w));
         {
             // Collisions at every ODE step (a touch shorter than a row counts).
             const char* pairs[OW_COLL_REPORT][2];
