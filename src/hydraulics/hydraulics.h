@@ -628,6 +628,12 @@ double hyd_boundary_power(const hyd_model* m, const hyd_data* d);
 /// Rate of compression energy stored in the fluid [W]: sum over pressure
 /// nodes of p V/Be dp/dt = p (Q_in - dV/dt).
 double hyd_stored_power(const hyd_model* m, const hyd_data* d);
+/// All of the above in one pass over the slots and nodes (an energy balance
+/// that follows every step): comp_P and piston_P (ncomp each) as
+/// hyd_comp_power and hyd_comp_piston_power of every component, *boundary
+/// as hyd_boundary_power, *stored as hyd_stored_power.
+void hyd_power_terms(const hyd_model* m, const hyd_data* d, double* comp_P, double* piston_P, double* boundary,
+                     double* stored);
 /// Compression energy stored in the fluid [J], a state function of the node
 /// pressures p and volumes V (nnode each, as hyd_data node_p, node_V):
 /// sum V phi(p), phi(p) = integral from p_atm to p of s / Be(s) ds.

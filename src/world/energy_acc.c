@@ -27,6 +27,9 @@ struct sim_energy {
     double *Pn, *pn, *Vn, *phin; ///< (ncol, nnode x 3) as P, p1, V1, phi
     unsigned char* openn;        ///< (ncol) its component passes flow (reliefs)
     double gasn;
+    double *compP, *pistP;       ///< (ncomp) scratch: hyd_power_terms
+    int nvn, *vn;                ///< the nodes with a pressure state (expansion)
+    unsigned char* acc;          ///< (ncol) the column's component is an accumulator
     FILE* csv;
     double csv_dt, csv_next;
     // Following the solver's steps (sim_energy_follow): the system's state
@@ -57,6 +60,7 @@ void sim_energy_free(sim_energy* e) {
     free(e->openn);
     free(e->E);
     free(e->Topen);
+    free(e->acc);
     free(e->yprev);
     free(e->dq);
     free(e->work);
@@ -86,6 +90,11 @@ static void unbind(sim_energy* e) {
     free(e->pn);
     free(e->Vn);
     free(e->phin);
+    free(e->compP);
+    free(e->pistP);
+    free(e->vn);
+    e->compP = e->pistP = NULL;
+    e->vn = NULL;
     e->d = NULL, e->p1 = e->V1 = e->phi = e->pn = e->Vn = e->phin = NULL;
     e->m = NULL;
 }
@@ -104,14 +113,18 @@ int sim_energy_bind(sim_energy* e, const hyd_model* m) {
     e->openn = calloc(cap, sizeof *e->openn);
     e->E = calloc(cap, sizeof *e->E);
     e->Topen = calloc(cap, sizeof *e->Topen);
+    e->acc = calloc(cap, sizeof *e->acc);
     e->p1 = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->p1);
     e->V1 = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->V1);
     e->phi = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->phi);
     e->pn = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->pn);
     e->Vn = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->Vn);
     e->phin = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->phin);
-    if (!e->d || !e->name || !e->group || !e->comp || !e->P || !e->Pn || !e->openn || !e->E || !e->Topen ||
-        !e->p1 || !e->V1 || !e->phi || !e->pn || !e->Vn || !e->phin) {
+    e->compP = calloc((size_t)(nc > 0 ? nc : 1), sizeof *e->compP);
+    e->pistP = calloc((size_t)(nc > 0 ? nc : 1), sizeof *e->pistP);
+    e->vn = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->vn);
+    if (!e->d || !e->acc || !e->name || !e->group || !e->comp || !e->P || !e->Pn || !e->openn || !e->E || !e->Topen ||
+        !e->p1 || !e->V1 || !e->phi || !e->pn || !e->Vn || !e->phin || !e->compP || !e->pistP || !e->vn) {
         unbind(e);
         return -1;
     }
@@ -148,7 +161,11 @@ int sim_energy_bind(sim_energy* e, const hyd_model* m) {
     add_col(e, -1, SIM_EG_TANK, "tank");
     add_col(e, -1, SIM_EG_STORED, "stored");
     add_col(e, -1, SIM_EG_EXPANSION, "expansion");
-    for (int n = 0; n < nn; ++n) e->phi[n] = NAN;
+    for (int i = 0; i < e->ncol; ++i) e->acc[i] = e->comp[i] >= 0 && hyd_model_comp_type(m, e->comp[i]) == HYD_ACCUMULATOR;
+    for (int n = 0; n < nn; ++n) {
+        e->phi[n] = NAN;
+        if (hyd_model_node_state(m, n) >= 0) e->vn[e->nvn++] = n;
+    }
     if (e->csv) {
         fprintf(e->csv, "t");
         for (int i = 0; i < e->ncol; ++i) fprintf(e->csv, ",%s", e->name[i]);
@@ -176,6 +193,8 @@ double sim_energy_col_open_time(const sim_energy* e, int i) { return e->Topen[i]
 // sample's, into phiout (NULL: a stage point of a step, not kept).
 static void powers(sim_energy* e, const hyd_data* d, double* P, double* phiout) {
     const hyd_model* m = e->m;
+    double boundary, stored;
+    hyd_power_terms(m, d, e->compP, e->pistP, &boundary, &stored);
     for (int i = 0; i < e->ncol; ++i) {
         const int c = e->comp[i];
         switch (e->group[i]) {
@@ -186,16 +205,16 @@ static void powers(sim_energy* e, const hyd_data* d, double* P, double* phiout) 
             P[i] = ed[e->group[i] == SIM_EG_VALVE_OUT];
             break;
         }
-        case SIM_EG_WORK: P[i] = hyd_comp_piston_power(m, d, c); break;
-        case SIM_EG_TANK: P[i] = -hyd_boundary_power(m, d); break;
-        case SIM_EG_STORED: P[i] = c >= 0 ? hyd_comp_gas_power(m, d, c) : hyd_stored_power(m, d); break;
+        case SIM_EG_WORK: P[i] = e->pistP[c]; break;
+        case SIM_EG_TANK: P[i] = -boundary; break;
+        case SIM_EG_STORED: P[i] = c >= 0 ? hyd_comp_gas_power(m, d, c) : stored; break;
         case SIM_EG_EXPANSION: {
             // hyd_expansion_power, with phi followed along the run (one
             // Simpson panel per step) instead of integrated afresh.
             double X = 0.0;
-            for (int n = 0; n < hyd_model_nnode(m); ++n) {
+            for (int j = 0; j < e->nvn; ++j) {
+                const int n = e->vn[j];
                 const double dV = d->node_dV[n];
-                if (hyd_model_node_state(m, n) < 0) continue;
                 double ph = e->phi[n];
                 if (isnan(ph)) {
                     if (dV == 0.0) {
@@ -212,7 +231,8 @@ static void powers(sim_energy* e, const hyd_data* d, double* P, double* phiout) 
             P[i] = X;
             break;
         }
-        default: P[i] = hyd_comp_power(m, d, c) - hyd_comp_gas_power(m, d, c); break;
+        // The gas's share of an accumulator's power is stored (its .gas column).
+        default: P[i] = e->compP[c] - (e->acc[i] ? hyd_comp_gas_power(m, d, c) : 0.0); break;
         }
     }
 }

@@ -188,12 +188,16 @@ static void track_peaks(run_ctx* c, const double* y) {
 }
 
 // sim_energy_eval_fn: the circuit at (t, y) of the crane's system, through
-// the general path (lsim_outputs), which fills every output of ls->hd the
-// balance reads.
+// the general path (as lsim_outputs), which fills every output of ls->hd
+// the balance reads.
 static const hyd_data* energy_eval(void* user, double t, const double* y) {
     lsim* ls = user;
-    lsim_out lo;
-    lsim_outputs(ls, t, y, &lo);
+    double f[LSIM_MAX_STATES];
+    const bool fast = ls->use_fast;
+    ls->use_fast = false;
+    lsim_rhs(ls, t, y, f);
+    ls->use_fast = fast;
+    --ls->nrhs; // an output evaluation is not solver work
     return ls->hd;
 }
 
