@@ -221,6 +221,10 @@ void hyd_solver_reset(hyd_solver* s);
 /// reuse as its next first stage, and keep the step-size history and J.
 void hyd_solver_inputs_changed(hyd_solver* s);
 
+/// Set (or with NULL clear) opts.on_step after create: a caller that decides
+/// later to follow the steps (an energy balance attached to a running engine).
+void hyd_solver_set_on_step(hyd_solver* s, void (*on_step)(void* user, double t, const double* y), void* user);
+
 const hyd_solver_stats* hyd_solver_get_stats(const hyd_solver* s);
 void hyd_solver_clear_stats(hyd_solver* s);
 /// Last accepted step size [s].

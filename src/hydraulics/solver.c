@@ -224,6 +224,11 @@ void hyd_solver_inputs_changed(hyd_solver* s) {
     if (s) s->fc_valid = 0;
 }
 
+void hyd_solver_set_on_step(hyd_solver* s, void (*on_step)(void* user, double t, const double* y), void* user) {
+    s->o.on_step = on_step;
+    s->o.on_step_user = user;
+}
+
 const hyd_solver_stats* hyd_solver_get_stats(const hyd_solver* s) { return &s->st; }
 void hyd_solver_clear_stats(hyd_solver* s) { memset(&s->st, 0, sizeof s->st); }
 double hyd_solver_last_h(const hyd_solver* s) { return s->last_h; }

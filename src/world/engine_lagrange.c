@@ -26,6 +26,7 @@ typedef struct eng_lagrange {
     hyd_solver* solver;
     double t;
     double y[LSIM_MAX_STATES];
+    struct sim_energy* energy; ///< engine_follow_energy's balance, or NULL
 } eng_lagrange;
 
 static void lag_row(engine* e, double row[SIM_NCOL]);
@@ -129,6 +130,10 @@ static void lag_set_commands(engine* e, const double u[3]) {
 
 static int lag_step(engine* e, double dt) {
     eng_lagrange* l = (eng_lagrange*)e;
+    // Commands, a load, a link or a fault may have changed since the last
+    // step at the same state: the balance's next step starts from their
+    // powers.
+    if (l->energy) sim_energy_follow_inputs(l->energy, l->t, l->y);
     int rc = hyd_solver_advance(l->solver, &l->t, l->y, l->t + dt);
     if (rc == HYD_OK) return 0;
     double tb = l->t;
@@ -479,6 +484,22 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     return res->status;
 }
 
+// engine_follow_energy: the solver calls the balance after every step.
+static void lag_energy_step(void* user, double t, const double* y) {
+    eng_lagrange* l = user;
+    sim_energy_follow_step(l->energy, l->solver, t, y, mech_energy(&l->ls, y));
+}
+
+static int lag_follow_energy(engine* e, struct sim_energy* en) {
+    eng_lagrange* l = (eng_lagrange*)e;
+    if (sim_energy_follow(en, l->ls.n, energy_eval, &l->ls) ||
+        sim_energy_follow_sample(en, l->t, l->y, mech_energy(&l->ls, l->y)))
+        return -1;
+    l->energy = en;
+    hyd_solver_set_on_step(l->solver, lag_energy_step, l);
+    return 0;
+}
+
 // ---- The renderer's picture ----
 
 // Planar crane placed in the world: boom plane = x-z, joint 1 at the column
@@ -620,4 +641,5 @@ const engine_ops engine_lagrange_ops = {
     .time = lag_time,
     .row = lag_row,
     .snapshot = lag_snapshot,
+    .follow_energy = lag_follow_energy,
 };

@@ -19,6 +19,7 @@ typedef struct eng_ode {
     engine base;
     ode_world* w;
     sim_collisions coll; ///< the sandbox's collisions since create, every ODE step
+    struct sim_energy* energy; ///< engine_follow_energy's balance, or NULL
 } eng_ode;
 
 
@@ -101,9 +102,19 @@ static int ode_step(engine* e, double dt) {
                 sim_collisions_step(&((eng_ode*)e)->coll, ode_world_time(w), (const char* const(*)[2])pairs, np);
         }
     }
+    // The bodies' energy at the end (the world integrates the circuit's
+    // terms at its hydraulic sub-steps).
+    if (rc == 0 && ((eng_ode*)e)->energy) sim_energy_mech(((eng_ode*)e)->energy, ode_world_energy(w));
     if (rc == 0) return 0;
     snprintf(e->err, sizeof e->err, "%s", ode_world_error(w));
     return 1;
+}
+
+static int ode_follow_energy(engine* e, struct sim_energy* en) {
+    if (ode_world_follow_energy(W(e), en)) return -1;
+    sim_energy_mech(en, ode_world_energy(W(e)));
+    ((eng_ode*)e)->energy = en;
+    return 0;
 }
 
 static const sim_collisions* ode_collisions(const engine* e) {
@@ -335,4 +346,5 @@ const engine_ops engine_ode_ops = {
     .row = ode_row,
     .snapshot = ode_snapshot,
     .collisions = ode_collisions,
+    .follow_energy = ode_follow_energy,
 };
