@@ -16,6 +16,18 @@
 
 #include <math.h>
 
+int hyd_comp_flows(const hyd_model* m, const hyd_data* d, int c, int* node, double* q) {
+    if (c < 0 || c >= m->ncomp) return 0;
+    int n = 0;
+    for (int k = 0; k < HYD_MAXSLOT; ++k) {
+        const int nd = m->comp_slot[HYD_MAXSLOT * c + k];
+        if (nd < 0) continue;
+        node[n] = nd;
+        q[n++] = d->flow_[HYD_MAXSLOT * c + k];
+    }
+    return n;
+}
+
 // Power the component c takes from the fluid through its flow slots [W].
 double hyd_comp_power(const hyd_model* m, const hyd_data* d, int c) {
     double P = 0.0;

@@ -612,6 +612,12 @@ double hyd_open_ramp(double d, double w, double* dr);
 // exactly (each term from the same flows), for any circuit.
 // ---------------------------------------------------------------------------
 
+/// The flows of component comp from the last evaluation: for each of its
+/// flow slots (its owned nodes, then its ports) the node (node[k]) and the
+/// flow into it (q[k], m^3/s; 4 slots at most). Every term below is made
+/// from these; they also let a caller account for every flow into a set of
+/// nodes (tests/world/test_flow_accounting.c). Returns the number of slots.
+int hyd_comp_flows(const hyd_model* m, const hyd_data* d, int comp, int* node, double* q);
 /// Hydraulic power component comp takes from the fluid at its ports and owned
 /// nodes [W]: - sum over its flow slots of p_node * (flow into that node).
 double hyd_comp_power(const hyd_model* m, const hyd_data* d, int comp);
