@@ -306,6 +306,23 @@ int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* 
 int app_plot_run_channels(int panel, bool slew, int cols[APP_PLOT_MAXSERIES], const char* names[APP_PLOT_MAXSERIES]);
 /// The run with options o has a slew drive (an ode world with a slewing column).
 bool app_world_has_slew(const sim_opts* o);
+// The energy balance's summary lines (app_energy.c, docs/energy.md).
+struct sim_energy;
+struct sim_energy_balance;
+struct engine;
+/// The balance b of en, as run prints it: "  energy: in ... kJ ..." (who:
+/// "energy WHO:" instead, e.g. "A"; NULL: "energy:").
+void app_print_energy(const struct sim_energy* en, const struct sim_energy_balance* b, const char* who);
+/// b[1] - b[0] (b: two)' balances, term by term, in kJ ("energy WHO: ...").
+void app_print_energy_diff(const struct sim_energy* const en[2], const struct sim_energy_balance* b,
+                           const char* who);
+/// A new balance kept by engine e from now on (engine_follow_energy); NULL
+/// (with a note on stderr) when it cannot be made.
+struct sim_energy* app_energy_follow(const char* cmd, struct engine* e);
+/// Finish en, print it (after the line title, when not NULL) and free it.
+/// NULL: nothing.
+void app_energy_report(struct sim_energy* en, const char* title);
+
 /// A bar chart of n energies kj [kJ] named names (one bar each, in order) to a PNG.
 int app_plot_energy(const char* const* names, const double* kj, int n, const char* title, const char* png, char* err,
                     size_t errsz);

@@ -1,6 +1,7 @@
 // cmd_compare.c: `cranesim compare`: one scenario run two ways, difference
 // metrics, overlay plots, and a pass/fail against given tolerances.
 #include "app.h"
+#include "energy_acc.h"
 #include "metrics.h"
 
 #include <errno.h>
@@ -25,7 +26,8 @@ static void compare_help(FILE* f) {
             "pressures [MPa and %% of the higher of the two peaks], joint angles [deg] and tip\n"
             "position [mm]. Neither side is taken as right: the figures are differences\n"
             "between the two runs (cvode at its default --rtol 1e-3 is further from the\n"
-            "converged peak pressure than krus at 0.1 ms; README.md).\n"
+            "converged peak pressure than krus at 0.1 ms; README.md). Then each side's energy\n"
+            "balance [kJ] as run prints it, and B - A term by term (docs/energy.md).\n"
             "Default: --backends lagrange,ode (lagrange full vs the ode validation world).\n"
             "Two designs: two --model files, or --set-a / --set-b changes (on the one --model), run on\n"
             "the same backend and settings; adds their metrics side by side with B - A (docs/replay.md).\n"
@@ -95,12 +97,14 @@ void app_compare_pressure(const sim_trace* a, const sim_trace* b, double* rms_pa
 }
 
 // The designs' metrics side by side, B - A, in the units a reader compares.
-static void print_metrics(const sim_trace tr[2], const sim_result res[2], const sim_opts side[2], char label[2][96]) {
+static void print_metrics(const sim_trace tr[2], const sim_result res[2], const sim_opts side[2], char label[2][96],
+                          sim_energy* const en[2]) {
     run_metrics met[2];
     for (int s = 0; s < 2; ++s) {
         metrics_init(&met[s], sim_ncol(&side[s]));
         for (int i = 0; i < tr[s].nrow; ++i) metrics_row(&met[s], tr[s].v + (size_t)i * SIM_NCOL);
         metrics_finish(&met[s], &res[s]);
+        if (en[s]) metrics_energy(&met[s], en[s]);
     }
     printf("  %-27s %14s %14s %14s\n", "metric", "A", "B", "B - A");
     for (int id = 0; id < MET_COUNT; ++id) {
@@ -403,15 +407,21 @@ int cmd_compare(int argc, char** argv) {
     app_settle_unused(&side[1]);
     sim_trace tr[2] = {{0}, {0}};
     sim_result res[2];
+    // Each side's energy balance, as run keeps it (docs/energy.md); NULL
+    // when out of memory (the comparison runs without it).
+    sim_energy* en[2] = {sim_energy_create(), sim_energy_create()};
     for (int s = 0; s < 2; ++s) {
         if (!c.quiet && isatty(2)) fprintf(stderr, "run %s:\n", label[s]);
-        sim_run(s && mb ? mb : m, &sc, &side[s], NULL, NULL, &tr[s], c.quiet ? NULL : app_progress, NULL, &res[s]);
+        sim_run_energy(s && mb ? mb : m, &sc, &side[s], NULL, NULL, &tr[s], c.quiet ? NULL : app_progress, NULL, en[s],
+                       &res[s]);
         if (!c.quiet) app_progress_done();
         if (res[s].note[0]) fprintf(stderr, "cranesim compare: %s: note: %s\n", label[s], res[s].note);
         if (res[s].status) {
             char works[200] = "";
             if (res[s].status == SIM_FAILED) loose_tolerance(s && mb ? mb : m, &sc, &side[s], works, sizeof works);
             fprintf(stderr, "cranesim compare: %s: %s%s\n", label[s], res[s].message, works);
+            sim_energy_free(en[0]);
+            sim_energy_free(en[1]);
             sim_trace_free(&tr[0]);
             sim_trace_free(&tr[1]);
             model_free(m);
@@ -445,7 +455,18 @@ int cmd_compare(int argc, char** argv) {
     printf("  worst stroke RMS %.4g mm; worst pressure RMS %.4g MPa = %.3g %% of the higher peak %.2f MPa (%s = %s; "
            "no side is taken as the reference)\n",
            stroke_rms, prms * 1e-6, press_pct, ppeak * 1e-6, pside ? "B" : "A", label[pside]);
-    if (designs) print_metrics(tr, res, side, label);
+    if (designs) print_metrics(tr, res, side, label, en);
+    if (en[0] && en[1]) {
+        // Each side's balance as run prints it, then B - A term by term.
+        sim_energy_balance eb[2];
+        sim_energy_result(en[0], &eb[0]);
+        sim_energy_result(en[1], &eb[1]);
+        if (eb[0].samples > 1 && eb[1].samples > 1) {
+            app_print_energy(en[0], &eb[0], "A");
+            app_print_energy(en[1], &eb[1], "B");
+            app_print_energy_diff((const sim_energy* const[2]){en[0], en[1]}, eb, "B - A");
+        }
+    }
     int code = 0;
     if (out && write_both(out, tr, side)) code = EXIT_RUNTIME;
     else if (out) printf("  rows of both -> %s\n", out);
@@ -467,6 +488,8 @@ int cmd_compare(int argc, char** argv) {
             printf("  plot -> %s\n", plot);
         }
     }
+    sim_energy_free(en[0]);
+    sim_energy_free(en[1]);
     sim_trace_free(&tr[0]);
     sim_trace_free(&tr[1]);
     model_free(m);

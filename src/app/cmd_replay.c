@@ -203,6 +203,7 @@ int cmd_replay(int argc, char** argv) {
         return EXIT_USAGE;
     }
     if (f) session_csv_header(&s, f);
+    struct sim_energy* en = app_energy_follow("replay", l); // the replay's energy balance, as run's
     sim_trace tr[2] = {{0}, {0}}; // recorded, replayed
     // The table compares both runs' rows as written (%.9g text), so rows that
     // are identical give a difference of exactly 0; --metrics writes the
@@ -310,6 +311,7 @@ int cmd_replay(int argc, char** argv) {
         printf("  %-27s %14.6g %14.6g %+14.6g\n", name, met[0].value[id] * k, met[1].value[id] * k,
                (met[1].value[id] - met[0].value[id]) * k);
     }
+    app_energy_report(en, "energy of the replay (a session records no balance of the drive):");
     if (out && !we) printf("  %ld rows -> %s\n", nrow, out);
     if (metrics_out) {
         app_out mo = {.f = NULL};

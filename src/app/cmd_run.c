@@ -255,51 +255,6 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     printf("  %ld rows -> %s\n", r->rows, out);
 }
 
-// The energy balance (docs/energy.md): what came in, where it went, and
-// how much of it the accounting misses.
-// Number of columns of group g (the circuit's components of that kind; the
-// fluid's own "stored" column counts in SIM_EG_STORED).
-static int group_columns(const sim_energy* en, sim_energy_group g) {
-    int n = 0;
-    for (int i = 0; i < sim_energy_ncol(en); ++i) n += sim_energy_col_group(en, i) == g;
-    return n;
-}
-
-static void print_energy(const sim_energy* en, const sim_energy_balance* b) {
-    const int has_gas = group_columns(en, SIM_EG_STORED) > 1;
-    printf("  energy: in %.3f kJ (pump %.3f, tanks %.3f); losses %.3f kJ (valves %.3f meter-in + %.3f meter-out, "
-           "relief %.3f, check %.3f, orifice %.3f, hose %.3f, cylinder leakage %.3f",
-           b->in * 1e-3, b->pump * 1e-3, b->tank * 1e-3, b->loss * 1e-3, b->group[SIM_EG_VALVE_IN] * 1e-3,
-           b->group[SIM_EG_VALVE_OUT] * 1e-3, b->group[SIM_EG_RELIEF] * 1e-3, b->group[SIM_EG_CHECK] * 1e-3,
-           b->group[SIM_EG_ORIFICE] * 1e-3, b->group[SIM_EG_HOSE] * 1e-3, b->group[SIM_EG_LEAK] * 1e-3);
-    // The load-sensing components' groups, only where the circuit has them.
-    // (whenever it has them, also at exactly 0: a counterbalance valve that
-    // stayed shut on hold is a result, not a missing group).
-    if (group_columns(en, SIM_EG_COMPENSATOR))
-        printf(", compensators %.3f", b->group[SIM_EG_COMPENSATOR] * 1e-3);
-    if (group_columns(en, SIM_EG_COUNTERBALANCE))
-        printf(", counterbalance valves %.3f", b->group[SIM_EG_COUNTERBALANCE] * 1e-3);
-    if (group_columns(en, SIM_EG_OTHER)) printf(", other %.3f", b->group[SIM_EG_OTHER] * 1e-3);
-    printf(")\n  energy: released by displaced fluid %.3f kJ; work on mechanics %.3f kJ", b->expansion * 1e-3,
-           b->work * 1e-3);
-    // The fluid's compression energy is a function of each node's pressure
-    // on (0, inf): a node that ended below absolute zero (a fixed step that
-    // rang at a stiff event, which the run noted) has none, so the balance
-    // cannot be closed, and the summary says so instead of printing NaN.
-    if (!isfinite(b->stored)) {
-        printf("; stored in the fluid: undefined (a node ended below absolute zero, see the note above); no "
-               "residual\n");
-    } else {
-        printf("; stored in the fluid %+.3f kJ", (b->stored - b->gas) * 1e-3);
-        if (has_gas) printf(", in accumulator gas %+.3f kJ", b->gas * 1e-3);
-        printf("; residual %.3f %% of %.3f kJ turned over\n", b->residual_pct, b->turnover * 1e-3);
-    }
-    if (isfinite(b->mech))
-        printf("  energy: mechanics (kinetic + potential) %+.3f kJ, so %.3f kJ of the work went to friction, end "
-               "stops and joints\n",
-               b->mech * 1e-3, (b->work - b->mech) * 1e-3);
-}
-
 // FILE.png -> FILE_energy.png (the bar chart next to the run's plot);
 // false for a plot that is not a .png file name (a device or a pipe such
 // as /dev/stdout, which app_check_output lets through): no chart then.
@@ -523,7 +478,7 @@ int cmd_run(int argc, char** argv) {
     sim_energy_result(en, &eb);
     if (code == EXIT_OK_ && !c.quiet) {
         print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, &sink.met, out);
-        if (eb.samples > 1) print_energy(en, &eb);
+        if (eb.samples > 1) app_print_energy(en, &eb, NULL);
         if (energy_csv) printf("  energy -> %s\n", energy_csv);
     }
     // The metrics of the rows written (also of a failed or interrupted run's).

@@ -16,6 +16,18 @@
 
 #include <math.h>
 
+int hyd_comp_flows(const hyd_model* m, const hyd_data* d, int c, int* node, double* q) {
+    if (c < 0 || c >= m->ncomp) return 0;
+    int n = 0;
+    for (int k = 0; k < HYD_MAXSLOT; ++k) {
+        const int nd = m->comp_slot[HYD_MAXSLOT * c + k];
+        if (nd < 0) continue;
+        node[n] = nd;
+        q[n++] = d->flow_[HYD_MAXSLOT * c + k];
+    }
+    return n;
+}
+
 // Power the component c takes from the fluid through its flow slots [W].
 double hyd_comp_power(const hyd_model* m, const hyd_data* d, int c) {
     double P = 0.0;
@@ -75,6 +87,27 @@ double hyd_stored_power(const hyd_model* m, const hyd_data* d) {
         P += d->node_p[n] * (d->node_q[n] - d->node_dV[n]);
     }
     return P;
+}
+
+void hyd_power_terms(const hyd_model* m, const hyd_data* d, double* comp_P, double* piston_P, double* boundary,
+                     double* stored) {
+    double B = 0.0;
+    for (int c = 0; c < m->ncomp; ++c) {
+        double P = 0.0;
+        for (int k = 0; k < HYD_MAXSLOT; ++k) {
+            const int node = m->comp_slot[HYD_MAXSLOT * c + k];
+            if (node < 0) continue;
+            const double pq = d->node_p[node] * d->flow_[HYD_MAXSLOT * c + k];
+            P -= pq;
+            if (m->node_state[node] < 0) B -= pq; // a tank's side of the same flow
+        }
+        comp_P[c] = P;
+        piston_P[c] = 0.0;
+    }
+    for (int n = 0; n < m->nnode; ++n)
+        if (m->node_owner[n] >= 0 && m->node_state[n] >= 0) piston_P[m->node_owner[n]] += d->node_p[n] * d->node_dV[n];
+    *boundary = B;
+    *stored = hyd_stored_power(m, d);
 }
 
 // s / Be(s) * s: the integrand of phi in ln s (ds = s du).

@@ -78,6 +78,10 @@ typedef struct hyd_problem {
     /// crane: lagrange_split_step.c). NULL: the generic stage arithmetic (krus.c).
     int (*wstep)(void* user, double t, const double* y, double h, double gamma, int new_jac,
                  double* ynew);
+    /// Optional, with wstep: the stage point y + k1 of the last step wstep
+    /// took (n values), for hyd_solver_step_quadrature. NULL: not kept (the
+    /// quadrature then refuses a wstep step).
+    const double* (*wstage)(void* user);
     /// Optional domain of the states: returns 0 when y is admissible, else
     /// 1 + the index of a state outside it. The adaptive methods reject a
     /// trial step that leaves the domain and retry with a smaller h, as they
@@ -217,12 +221,33 @@ void hyd_solver_reset(hyd_solver* s);
 /// reuse as its next first stage, and keep the step-size history and J.
 void hyd_solver_inputs_changed(hyd_solver* s);
 
+/// Set (or with NULL clear) opts.on_step after create: a caller that decides
+/// later to follow the steps (an energy balance attached to a running engine).
+void hyd_solver_set_on_step(hyd_solver* s, void (*on_step)(void* user, double t, const double* y), void* user);
+
 const hyd_solver_stats* hyd_solver_get_stats(const hyd_solver* s);
 void hyd_solver_clear_stats(hyd_solver* s);
 /// Last accepted step size [s].
 double hyd_solver_last_h(const hyd_solver* s);
 /// After HYD_ERR_NONFINITE: index of the first non-finite state, and its time [s].
 int hyd_solver_bad_state(const hyd_solver* s, double* t_bad);
+
+/// Quadrature callback: nq values P(t, y) into P. Return 0 on success.
+typedef int (*hyd_quad_fn)(void* user, double t, const double* y, double* P);
+
+/// The quadrature of nq extra states q' = P(t, y) over the last accepted step
+/// by the method that took it, as if q had been integrated together with y
+/// (quadrature.c): the stage points and stage vectors of that step, and for
+/// the linearly implicit methods one directional derivative of P. Call it
+/// before the next step (from on_step, or after hyd_solver_step). (t0, y0) is
+/// where the step started, y1 where it ended (the solver's y now), P0 =
+/// P(t0, y0) and P1 = P(t1, y1); work holds nq doubles. dq receives the
+/// increments of q. Evaluations of fn per step: none for Krus (it is the
+/// trapezoid), 1 for ROS2, 4 for the four-stage methods, 3 for RK4. 0 (dq
+/// set; all zero before any step), or HYD_ERR_RHS (fn failed, or a wstep
+/// step whose problem keeps no wstage).
+int hyd_solver_step_quadrature(hyd_solver* s, double t0, const double* y0, const double* y1, const double* P0,
+                               const double* P1, int nq, hyd_quad_fn fn, void* user, double* work, double* dq);
 
 /// Small dense LU with partial pivoting, in place on row-major a (n x n).
 /// Returns 0, or -1 if singular. Exposed for tests and for callers that build

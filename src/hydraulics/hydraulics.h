@@ -614,6 +614,12 @@ double hyd_open_ramp(double d, double w, double* dr);
 // exactly (each term from the same flows), for any circuit.
 // ---------------------------------------------------------------------------
 
+/// The flows of component comp from the last evaluation: for each of its
+/// flow slots (its owned nodes, then its ports) the node (node[k]) and the
+/// flow into it (q[k], m^3/s; 4 slots at most). Every term below is made
+/// from these; they also let a caller account for every flow into a set of
+/// nodes (tests/world/test_flow_accounting.c). Returns the number of slots.
+int hyd_comp_flows(const hyd_model* m, const hyd_data* d, int comp, int* node, double* q);
 /// Hydraulic power component comp takes from the fluid at its ports and owned
 /// nodes [W]: - sum over its flow slots of p_node * (flow into that node).
 double hyd_comp_power(const hyd_model* m, const hyd_data* d, int comp);
@@ -630,6 +636,12 @@ double hyd_boundary_power(const hyd_model* m, const hyd_data* d);
 /// Rate of compression energy stored in the fluid [W]: sum over pressure
 /// nodes of p V/Be dp/dt = p (Q_in - dV/dt).
 double hyd_stored_power(const hyd_model* m, const hyd_data* d);
+/// All of the above in one pass over the slots and nodes (an energy balance
+/// that follows every step): comp_P and piston_P (ncomp each) as
+/// hyd_comp_power and hyd_comp_piston_power of every component, *boundary
+/// as hyd_boundary_power, *stored as hyd_stored_power.
+void hyd_power_terms(const hyd_model* m, const hyd_data* d, double* comp_P, double* piston_P, double* boundary,
+                     double* stored);
 /// Compression energy stored in the fluid [J], a state function of the node
 /// pressures p and volumes V (nnode each, as hyd_data node_p, node_V):
 /// sum V phi(p), phi(p) = integral from p_atm to p of s / Be(s) ds.

@@ -224,6 +224,11 @@ void hyd_solver_inputs_changed(hyd_solver* s) {
     if (s) s->fc_valid = 0;
 }
 
+void hyd_solver_set_on_step(hyd_solver* s, void (*on_step)(void* user, double t, const double* y), void* user) {
+    s->o.on_step = on_step;
+    s->o.on_step_user = user;
+}
+
 const hyd_solver_stats* hyd_solver_get_stats(const hyd_solver* s) { return &s->st; }
 void hyd_solver_clear_stats(hyd_solver* s) { memset(&s->st, 0, sizeof s->st); }
 double hyd_solver_last_h(const hyd_solver* s) { return s->last_h; }
@@ -429,7 +434,8 @@ static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_ne
     // Fixed-step methods never leave f(t_{n+1}, y_{n+1}) behind, so skip the
     // cache check (and its copy of y) unless an adaptive run just filled it.
     int rc;
-    if (s->p->wstep && (s->method == HYD_KRUS || s->method == HYD_ROS2)) {
+    const int ws = s->p->wstep && (s->method == HYD_KRUS || s->method == HYD_ROS2);
+    if (ws) {
         // The problem's own step kernel (hyd_problem.wstep).
         const int need_j = jacobian_due(s, *t, y);
         rc = s->p->wstep(s->p->user, *t, y, h, hydKrusGamma(s->method), need_j, s->ynew);
@@ -456,6 +462,7 @@ static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_ne
     s->st.steps++;
     s->j_steps++;
     s->last_h = h;
+    s->last_wstep = ws;
     if (s->p->settle) s->p->settle(s->p->user, *t, y);
     return HYD_OK;
 }

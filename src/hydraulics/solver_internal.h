@@ -124,6 +124,7 @@ struct hyd_solver {
     int have_acc;    ///< h_acc/err_acc are meaningful
     int last_rejected;
     double last_h;   ///< last accepted step [s]
+    int last_wstep;  ///< the last step was the problem's wstep (hyd_solver_step_quadrature)
 
     hyd_solver_stats st;
     int bad_i;

@@ -8,22 +8,37 @@
 struct sim_energy {
     const hyd_model* m;
     hyd_data* d;
-    double* ydot; ///< (nstate) scratch for hyd_eval
     int ncol;
     char (*name)[72];
     int* group;
     int* comp; ///< component of the column, -1 for tank and stored
-    double *P, *Pprev, *E; ///< (ncol) power now, at the last sample [W]; energy [J]
+    double *P, *E; ///< (ncol) power at the last sample [W]; energy [J]
     double* Topen; ///< (ncol) time its component was open [s] (reliefs; 0 for the others)
     long n;
     double t0, tprev;
     double es0, es1, em0, em1;
     double gas0, gas1; ///< accumulators' gas energy at the first and the last sample [J]
+    double coupling;   ///< compression energy the volumes' jumps between steps put in (sim_energy_follow_inputs) [J]
     int finished;
     double *p1, *V1; ///< (nnode) node pressures and volumes at the last sample
     double* phi;     ///< (nnode) phi(p1) of nodes whose volume has moved (NAN: not followed yet)
+    // The next sample, taken (capture) before it is added (commit): a step's
+    // quadrature evaluates its stage points against the last sample.
+    double *Pn, *pn, *Vn, *phin; ///< (ncol, nnode x 3) as P, p1, V1, phi
+    unsigned char* openn;        ///< (ncol) its component passes flow (reliefs)
+    double gasn;
+    double *compP, *pistP;       ///< (ncomp) scratch: hyd_power_terms
+    int nvn, *vn;                ///< the nodes with a pressure state (expansion)
+    unsigned char* acc;          ///< (ncol) the column's component is an accumulator
     FILE* csv;
     double csv_dt, csv_next;
+    // Following the solver's steps (sim_energy_follow): the system's state
+    // at the last sample, and scratch for the step's quadrature.
+    int ny;              ///< size of the solver's state (0: not following)
+    sim_energy_eval_fn eval;
+    void* eval_user;
+    double* yprev;       ///< (ny) the state at the last sample
+    double *dq, *work;   ///< (ncol) the step's energies [J]; quadrature scratch
 };
 
 static const char* const group_names[SIM_EG_COUNT] = {
@@ -41,9 +56,14 @@ void sim_energy_free(sim_energy* e) {
     free(e->group);
     free(e->comp);
     free(e->P);
-    free(e->Pprev);
+    free(e->Pn);
+    free(e->openn);
     free(e->E);
     free(e->Topen);
+    free(e->acc);
+    free(e->yprev);
+    free(e->dq);
+    free(e->work);
     free(e);
 }
 
@@ -64,33 +84,47 @@ sim_energy* sim_energy_create(void) {
 
 static void unbind(sim_energy* e) {
     hyd_data_free(e->d);
-    free(e->ydot);
     free(e->p1);
     free(e->V1);
     free(e->phi);
-    e->d = NULL, e->ydot = e->p1 = e->V1 = e->phi = NULL;
+    free(e->pn);
+    free(e->Vn);
+    free(e->phin);
+    free(e->compP);
+    free(e->pistP);
+    free(e->vn);
+    e->compP = e->pistP = NULL;
+    e->vn = NULL;
+    e->d = NULL, e->p1 = e->V1 = e->phi = e->pn = e->Vn = e->phin = NULL;
     e->m = NULL;
 }
 
 int sim_energy_bind(sim_energy* e, const hyd_model* m) {
     if (e->m || e->ncol) return -1; // one run per accumulator
     e->m = m;
-    const int nc = hyd_model_ncomp(m), nn = hyd_model_nnode(m), ns = hyd_model_nstate(m);
+    const int nc = hyd_model_ncomp(m), nn = hyd_model_nnode(m);
     const size_t cap = (size_t)(2 * nc + 3);
     e->d = hyd_data_create(m);
-    e->ydot = calloc((size_t)(ns > 0 ? ns : 1), sizeof *e->ydot);
     e->name = calloc(cap, sizeof *e->name);
     e->group = calloc(cap, sizeof *e->group);
     e->comp = calloc(cap, sizeof *e->comp);
     e->P = calloc(cap, sizeof *e->P);
-    e->Pprev = calloc(cap, sizeof *e->Pprev);
+    e->Pn = calloc(cap, sizeof *e->Pn);
+    e->openn = calloc(cap, sizeof *e->openn);
     e->E = calloc(cap, sizeof *e->E);
     e->Topen = calloc(cap, sizeof *e->Topen);
+    e->acc = calloc(cap, sizeof *e->acc);
     e->p1 = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->p1);
     e->V1 = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->V1);
     e->phi = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->phi);
-    if (!e->d || !e->ydot || !e->name || !e->group || !e->comp || !e->P || !e->Pprev || !e->E || !e->Topen || !e->p1 || !e->V1 ||
-        !e->phi) {
+    e->pn = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->pn);
+    e->Vn = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->Vn);
+    e->phin = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->phin);
+    e->compP = calloc((size_t)(nc > 0 ? nc : 1), sizeof *e->compP);
+    e->pistP = calloc((size_t)(nc > 0 ? nc : 1), sizeof *e->pistP);
+    e->vn = calloc((size_t)(nn > 0 ? nn : 1), sizeof *e->vn);
+    if (!e->d || !e->acc || !e->name || !e->group || !e->comp || !e->P || !e->Pn || !e->openn || !e->E || !e->Topen ||
+        !e->p1 || !e->V1 || !e->phi || !e->pn || !e->Vn || !e->phin || !e->compP || !e->pistP || !e->vn) {
         unbind(e);
         return -1;
     }
@@ -127,7 +161,11 @@ int sim_energy_bind(sim_energy* e, const hyd_model* m) {
     add_col(e, -1, SIM_EG_TANK, "tank");
     add_col(e, -1, SIM_EG_STORED, "stored");
     add_col(e, -1, SIM_EG_EXPANSION, "expansion");
-    for (int n = 0; n < nn; ++n) e->phi[n] = NAN;
+    for (int i = 0; i < e->ncol; ++i) e->acc[i] = e->comp[i] >= 0 && hyd_model_comp_type(m, e->comp[i]) == HYD_ACCUMULATOR;
+    for (int n = 0; n < nn; ++n) {
+        e->phi[n] = NAN;
+        if (hyd_model_node_state(m, n) >= 0) e->vn[e->nvn++] = n;
+    }
     if (e->csv) {
         fprintf(e->csv, "t");
         for (int i = 0; i < e->ncol; ++i) fprintf(e->csv, ",%s", e->name[i]);
@@ -150,9 +188,13 @@ sim_energy_group sim_energy_col_group(const sim_energy* e, int i) { return (sim_
 double sim_energy_col_energy(const sim_energy* e, int i) { return e->E[i]; }
 double sim_energy_col_open_time(const sim_energy* e, int i) { return e->Topen[i]; }
 
-// Every column's power taken from the fluid at the last evaluation [W].
-static void powers(sim_energy* e, const hyd_data* d) {
+// Every column's power taken from the fluid at the evaluation d into P
+// [W]; phi of the moving nodes at d's pressures, followed from the last
+// sample's, into phiout (NULL: a stage point of a step, not kept).
+static void powers(sim_energy* e, const hyd_data* d, double* P, double* phiout) {
     const hyd_model* m = e->m;
+    double boundary, stored;
+    hyd_power_terms(m, d, e->compP, e->pistP, &boundary, &stored);
     for (int i = 0; i < e->ncol; ++i) {
         const int c = e->comp[i];
         switch (e->group[i]) {
@@ -160,31 +202,37 @@ static void powers(sim_energy* e, const hyd_data* d) {
         case SIM_EG_VALVE_OUT: {
             double ed[2];
             hyd_valve_edge_power(m, d, c, ed);
-            e->P[i] = ed[e->group[i] == SIM_EG_VALVE_OUT];
+            P[i] = ed[e->group[i] == SIM_EG_VALVE_OUT];
             break;
         }
-        case SIM_EG_WORK: e->P[i] = hyd_comp_piston_power(m, d, c); break;
-        case SIM_EG_TANK: e->P[i] = -hyd_boundary_power(m, d); break;
-        case SIM_EG_STORED: e->P[i] = c >= 0 ? hyd_comp_gas_power(m, d, c) : hyd_stored_power(m, d); break;
+        case SIM_EG_WORK: P[i] = e->pistP[c]; break;
+        case SIM_EG_TANK: P[i] = -boundary; break;
+        case SIM_EG_STORED: P[i] = c >= 0 ? hyd_comp_gas_power(m, d, c) : stored; break;
         case SIM_EG_EXPANSION: {
             // hyd_expansion_power, with phi followed along the run (one
             // Simpson panel per step) instead of integrated afresh.
-            double P = 0.0;
-            for (int n = 0; n < hyd_model_nnode(m); ++n) {
+            double X = 0.0;
+            for (int j = 0; j < e->nvn; ++j) {
+                const int n = e->vn[j];
                 const double dV = d->node_dV[n];
-                if (hyd_model_node_state(m, n) < 0) continue;
-                if (isnan(e->phi[n])) {
-                    if (dV == 0.0) continue;
-                    e->phi[n] = hyd_node_phi(m, n, d->node_p[n]);
+                double ph = e->phi[n];
+                if (isnan(ph)) {
+                    if (dV == 0.0) {
+                        if (phiout) phiout[n] = NAN;
+                        continue;
+                    }
+                    ph = hyd_node_phi(m, n, d->node_p[n]);
                 } else if (e->n > 0) {
-                    e->phi[n] += hyd_node_phi_increment(m, n, e->p1[n], d->node_p[n]);
+                    ph += hyd_node_phi_increment(m, n, e->p1[n], d->node_p[n]);
                 }
-                P -= dV * e->phi[n];
+                if (phiout) phiout[n] = ph;
+                X -= dV * ph;
             }
-            e->P[i] = P;
+            P[i] = X;
             break;
         }
-        default: e->P[i] = hyd_comp_power(m, d, c) - hyd_comp_gas_power(m, d, c); break;
+        // The gas's share of an accumulator's power is stored (its .gas column).
+        default: P[i] = e->compP[c] - (e->acc[i] ? hyd_comp_gas_power(m, d, c) : 0.0); break;
         }
     }
 }
@@ -201,38 +249,48 @@ void sim_energy_csv(sim_energy* e, FILE* f, double dt) {
     e->csv_next = 0.0;
 }
 
-void sim_energy_sample(sim_energy* e, double t, const double* y, double e_mech) {
-    if (!e->m) return;
-    hyd_eval(e->m, e->d, t, y, e->ydot);
-    sim_energy_sample_data(e, t, e->d, e_mech);
+// Take the next sample from the evaluation d (every output filled).
+static void capture(sim_energy* e, const hyd_data* d) {
+    const hyd_model* m = e->m;
+    const int nn = hyd_model_nnode(m);
+    // phi of nodes that are not followed stays NaN (powers writes only the
+    // nodes of a volume state).
+    memcpy(e->phin, e->phi, (size_t)nn * sizeof *e->phin);
+    powers(e, d, e->Pn, e->phin);
+    memcpy(e->pn, d->node_p, (size_t)nn * sizeof *e->pn);
+    memcpy(e->Vn, d->node_V, (size_t)nn * sizeof *e->Vn);
+    double gas = 0.0;
+    for (int i = 0; i < e->ncol; ++i) {
+        if (e->group[i] == SIM_EG_STORED && e->comp[i] >= 0) gas += hyd_comp_gas_energy(m, d, e->comp[i]);
+        e->openn[i] = e->group[i] == SIM_EG_RELIEF && d->comp_open && d->comp_open[e->comp[i]];
+    }
+    e->gasn = gas;
 }
 
-void sim_energy_sample_data(sim_energy* e, double t, const hyd_data* d, double e_mech) {
+// Add the captured sample at t: dE (NULL: the trapezoid from the last
+// sample) the energies since the last sample [J].
+static void commit(sim_energy* e, double t, double e_mech, const double* dE) {
     const hyd_model* m = e->m;
-    if (!m) return;
-    powers(e, d);
-    double gas = 0.0;
-    for (int i = 0; i < e->ncol; ++i)
-        if (e->group[i] == SIM_EG_STORED && e->comp[i] >= 0) gas += hyd_comp_gas_energy(m, d, e->comp[i]);
-    e->gas1 = gas;
+    e->gas1 = e->gasn;
     if (e->n == 0) {
-        e->gas0 = gas;
+        e->gas0 = e->gasn;
         e->t0 = t;
-        e->es0 = hyd_stored_energy(m, d->node_p, d->node_V);
+        e->es0 = hyd_stored_energy(m, e->pn, e->Vn);
         e->em0 = e_mech;
     } else {
         const double h = t - e->tprev;
-        for (int i = 0; i < e->ncol; ++i) e->E[i] += 0.5 * h * (e->P[i] + e->Pprev[i]);
+        for (int i = 0; i < e->ncol; ++i) e->E[i] += dE ? dE[i] : 0.5 * h * (e->P[i] + e->Pn[i]);
         // A relief's open time: the step counts when the relief passes flow
         // at its end (the rows' relief_open convention, at step resolution).
         for (int i = 0; i < e->ncol; ++i)
-            if (e->group[i] == SIM_EG_RELIEF && d->comp_open && d->comp_open[e->comp[i]]) e->Topen[i] += h;
+            if (e->openn[i]) e->Topen[i] += h;
     }
-    memcpy(e->Pprev, e->P, (size_t)e->ncol * sizeof *e->P);
     const int nn = hyd_model_nnode(m);
-    memcpy(e->p1, d->node_p, (size_t)nn * sizeof *e->p1);
-    memcpy(e->V1, d->node_V, (size_t)nn * sizeof *e->V1);
-    e->em1 = e_mech;
+    memcpy(e->P, e->Pn, (size_t)e->ncol * sizeof *e->P);
+    memcpy(e->p1, e->pn, (size_t)nn * sizeof *e->p1);
+    memcpy(e->V1, e->Vn, (size_t)nn * sizeof *e->V1);
+    memcpy(e->phi, e->phin, (size_t)nn * sizeof *e->phi);
+    if (!isnan(e_mech) || e->n == 0) e->em1 = e_mech;
     e->tprev = t;
     ++e->n;
     if (e->csv && t >= e->csv_next - 1e-9 * e->csv_dt) {
@@ -241,6 +299,86 @@ void sim_energy_sample_data(sim_energy* e, double t, const hyd_data* d, double e
         // little early still writes the row of its grid time).
         e->csv_next = (floor(t / e->csv_dt + 1e-6) + 1.0) * e->csv_dt;
     }
+}
+
+int sim_energy_follow(sim_energy* e, int n, sim_energy_eval_fn eval, void* user) {
+    if (!e->m || n <= 0 || !eval) return -1;
+    free(e->yprev);
+    free(e->dq);
+    free(e->work);
+    e->yprev = calloc((size_t)n, sizeof *e->yprev);
+    e->dq = calloc((size_t)e->ncol, sizeof *e->dq);
+    e->work = calloc((size_t)e->ncol, sizeof *e->work);
+    if (!e->yprev || !e->dq || !e->work) return -1;
+    e->ny = n;
+    e->eval = eval;
+    e->eval_user = user;
+    return 0;
+}
+
+int sim_energy_quad(void* user, double t, const double* y, double* P) {
+    sim_energy* e = user;
+    const hyd_data* d = e->eval(e->eval_user, t, y);
+    if (!d) return -1;
+    powers(e, d, P, NULL);
+    return 0;
+}
+
+int sim_energy_follow_sample(sim_energy* e, double t, const double* y, double e_mech) {
+    return sim_energy_follow_integrated(e, t, y, e_mech, NULL);
+}
+
+int sim_energy_follow_integrated(sim_energy* e, double t, const double* y, double e_mech, const double* dE) {
+    if (!e->m || !e->ny) return -1;
+    const hyd_data* d = e->eval(e->eval_user, t, y);
+    if (!d) return -1;
+    capture(e, d);
+    commit(e, t, e_mech, dE);
+    memcpy(e->yprev, y, (size_t)e->ny * sizeof *y);
+    return 0;
+}
+
+int sim_energy_follow_inputs(sim_energy* e, double t, const double* y) {
+    if (!e->m || !e->ny) return -1;
+    if (e->n == 0) return sim_energy_follow_sample(e, t, y, NAN);
+    const hyd_data* d = e->eval(e->eval_user, t, y);
+    if (!d) return -1;
+    // The pressures are the last sample's (the state did not move); a volume
+    // that changed holds V phi(p) more compression energy at them, which no
+    // flow brought. phi as followed (the moving chambers), else afresh.
+    const hyd_model* m = e->m;
+    for (int n = 0; n < hyd_model_nnode(m); ++n) {
+        const double dV = d->node_V[n] - e->V1[n];
+        if (dV == 0.0 || hyd_model_node_state(m, n) < 0) continue;
+        const double ph = isnan(e->phi[n]) ? hyd_node_phi(m, n, d->node_p[n]) : e->phi[n];
+        e->coupling += dV * ph;
+    }
+    capture(e, d);
+    for (int i = 0; i < e->ncol; ++i) e->dq[i] = 0.0;
+    commit(e, t, NAN, e->dq);
+    return 0;
+}
+
+void sim_energy_mech(sim_energy* e, double e_mech) {
+    if (e->n <= 1) e->em0 = e_mech; // at the first sample: the start too
+    e->em1 = e_mech;
+}
+
+int sim_energy_follow_step(sim_energy* e, hyd_solver* s, double t, const double* y, double e_mech) {
+    if (!e->m || !e->ny) return -1;
+    if (e->n == 0) return sim_energy_follow_sample(e, t, y, e_mech);
+    // The end first (its powers are the quadrature's P1), then the step's
+    // stage points, evaluated against the last sample (phi, P0 = its
+    // powers), which the end then replaces.
+    const hyd_data* d = e->eval(e->eval_user, t, y);
+    if (!d) return -1;
+    capture(e, d);
+    const int rc = hyd_solver_step_quadrature(s, e->tprev, e->yprev, y, e->P, e->Pn, e->ncol, sim_energy_quad, e,
+                                              e->work, e->dq);
+    if (rc) return -1;
+    commit(e, t, e_mech, e->dq);
+    memcpy(e->yprev, y, (size_t)e->ny * sizeof *y);
+    return 0;
 }
 
 void sim_energy_result(const sim_energy* e, sim_energy_balance* b) {
@@ -256,16 +394,17 @@ void sim_energy_result(const sim_energy* e, sim_energy_balance* b) {
     b->gas = e->gas1 - e->gas0;
     b->stored = es1 - e->es0 + b->gas;
     b->expansion = b->group[SIM_EG_EXPANSION];
-    b->residual = b->in - b->loss - b->expansion - b->work - b->stored;
+    b->coupling = e->coupling;
+    b->residual = b->in + b->coupling - b->loss - b->expansion - b->work - b->stored;
     // Normalised by the energy turned over, not by "in": with the pump near
     // standby (hold, a burst line) the fluid's energy comes from the loads
     // sinking (work < 0) and its stored energy, and "in" can be near 0 or
     // negative, so 1 J over 5 J in read 17 %. Each term of the balance is a
     // source (in > 0, or loss, X, work, stored < 0) or a sink; the turnover
     // is the larger of the two sums (they differ by the residual).
-    const double terms[5] = {b->in, -b->loss, -b->expansion, -b->work, -b->stored};
+    const double terms[6] = {b->in, b->coupling, -b->loss, -b->expansion, -b->work, -b->stored};
     double src = 0.0, snk = 0.0;
-    for (int k = 0; k < 5; ++k) {
+    for (int k = 0; k < 6; ++k) {
         if (terms[k] > 0.0) src += terms[k];
         else snk -= terms[k];
     }

@@ -1,6 +1,7 @@
 // engine.c: the backend-independent half of engine.h: dispatch to the
 // backend's engine_ops, and the run checks every engine applies after a step.
 #include "engine_impl.h"
+#include "energy_acc.h"
 
 #include "model.h"
 #include "rcl.h"
@@ -303,6 +304,11 @@ bool engine_part_energy(const engine* e, double E[2]) {
 
 bool engine_attached(const engine* e) { return e->ops->hook ? e->ops->attached(e) : false; }
 hyd_model* engine_circuit(engine* e) { return e->ops->circuit(e); }
+
+int engine_follow_energy(engine* e, struct sim_energy* en) {
+    if (!en || !e->ops->follow_energy || sim_energy_bind(en, engine_circuit(e))) return -1;
+    return e->ops->follow_energy(e, en);
+}
 
 void engine_set_load(engine* e, double m3) {
     if (e->ops->set_load) e->ops->set_load(e, m3);

@@ -75,6 +75,14 @@ bool engine_attached(const engine* e);
 /// The circuit the running engine uses (the model's for lagrange, the
 /// world's own copy for ode): hyd_model_set on it takes effect at the next step.
 hyd_model* engine_circuit(engine* e);
+struct sim_energy;
+/// Keep the energy balance en (a new sim_energy_create, energy_acc.h) of
+/// this engine from now on: bound to its circuit, integrated at every step
+/// of its solver by the step's own method, as the scripted runs do
+/// (docs/energy.md). The caller reads it (sim_energy_result) and frees it
+/// after engine_destroy, or calls sim_energy_finish first. 0, or -1 (out of
+/// memory, already bound). Costs an evaluation of the circuit per step.
+int engine_follow_energy(engine* e, struct sim_energy* en);
 /// Set the tip load [kg] where the engine carries it as a parameter
 /// (lagrange; takes effect at the next step).
 void engine_set_load(engine* e, double m3);

@@ -44,6 +44,9 @@ typedef struct engine_ops {
     void (*part_energy)(const engine* e, double E[2]);
     /// NULL (or a NULL result): the world reports no collisions.
     const sim_collisions* (*collisions)(const engine* e);
+    /// Integrate the energy balance en (bound by engine_follow_energy to
+    /// circuit()) at every step from now on; 0, or -1.
+    int (*follow_energy)(engine* e, struct sim_energy* en);
 } engine_ops;
 
 /// Fault events of a scenario (scenario.h) applied to a running circuit:

@@ -26,6 +26,7 @@ typedef struct eng_lagrange {
     hyd_solver* solver;
     double t;
     double y[LSIM_MAX_STATES];
+    struct sim_energy* energy; ///< engine_follow_energy's balance, or NULL
 } eng_lagrange;
 
 static void lag_row(engine* e, double row[SIM_NCOL]);
@@ -130,6 +131,10 @@ static void lag_set_commands(engine* e, const double u[3]) {
 
 static int lag_step(engine* e, double dt) {
     eng_lagrange* l = (eng_lagrange*)e;
+    // Commands, a load, a link or a fault may have changed since the last
+    // step at the same state: the balance's next step starts from their
+    // powers.
+    if (l->energy) sim_energy_follow_inputs(l->energy, l->t, l->y);
     int rc = hyd_solver_advance(l->solver, &l->t, l->y, l->t + dt);
     if (rc == HYD_OK) return 0;
     double tb = l->t;
@@ -170,7 +175,8 @@ typedef struct run_ctx {
     int npress;    ///< pressure states (emit checks only these)
     int press[LSIM_MAX_STATES];
     struct sim_energy* energy; ///< NULL, or the balance accumulated at the steps
-    double energy_next;        ///< the next step at or after this time [s] is sampled
+    hyd_solver* solver;        ///< the run's solver (NULL with CVODE)
+    double *q, *q_row;         ///< CVODE: the balance's columns integrated with the state, and at the last row [J]
 } run_ctx;
 
 static int check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, double t_end, sim_result* res) {
@@ -187,28 +193,46 @@ static void track_peaks(run_ctx* c, const double* y) {
     for (int k = 0; k < 4; ++k) c->peak[k] = fmax(c->peak[k], y[c->pidx[k]]);
 }
 
-// One sample of the energy balance at (t, y): lsim_outputs evaluates the
-// circuit at (t, y) through the general path, which fills every output of
-// ls->hd the balance reads; then the crane's energy.
-static void energy_sample(run_ctx* c, double t, const double* y) {
-    lsim* ls = c->ls;
-    // The next sample is the first step at least 1 ms on (the ode world's
-    // default step): the balance closes to 1e-4 of the energy in on ramp
-    // and overload either way, and sampling every 0.1 ms step made the run
-    // 2.5 times as slow (docs/energy.md).
-    enum { ENERGY_PER_S = 1000 };
-    c->energy_next = t + (1.0 - 1e-6) / ENERGY_PER_S;
-    lsim_out lo;
-    lsim_outputs(ls, t, y, &lo);
-    const double q[2] = {y[ls->iq], y[ls->iq + 1]}, qd[2] = {y[ls->iq + 2], y[ls->iq + 3]};
-    sim_energy_sample_data(c->energy, t, ls->hd, lagrange_energy(&ls->mdl->mech, ls->m3, q, qd));
+// sim_energy_eval_fn: the circuit at (t, y) of the crane's system, through
+// the general path (as lsim_outputs), which fills every output of ls->hd
+// the balance reads.
+static const hyd_data* energy_eval(void* user, double t, const double* y) {
+    lsim* ls = user;
+    double f[LSIM_MAX_STATES];
+    const bool fast = ls->use_fast;
+    ls->use_fast = false;
+    lsim_rhs(ls, t, y, f);
+    ls->use_fast = fast;
+    --ls->nrhs; // an output evaluation is not solver work
+    return ls->hd;
 }
 
-// hyd_solver_opts.on_step: peaks between the rows too, and the energy balance.
+// The crane's mechanical energy (kinetic + potential) at y [J].
+static double mech_energy(const lsim* ls, const double* y) {
+    const double q[2] = {y[ls->iq], y[ls->iq + 1]}, qd[2] = {y[ls->iq + 2], y[ls->iq + 3]};
+    return lagrange_energy(&ls->mdl->mech, ls->m3, q, qd);
+}
+
+// CVODE's rows: its steps are its own, and it integrates the balance's
+// columns with the state (hyd_cvode_opts.q); each row adds what they grew
+// since the last one.
+static void energy_row(run_ctx* c, double t, const double* y) {
+    const int nc = sim_energy_ncol(c->energy);
+    for (int i = 0; i < nc; ++i) {
+        const double q = c->q[i];
+        c->q[i] -= c->q_row[i]; // the growth, passed in place
+        c->q_row[i] = q;
+    }
+    sim_energy_follow_integrated(c->energy, t, y, mech_energy(c->ls, y), c->q);
+    memcpy(c->q, c->q_row, (size_t)nc * sizeof *c->q);
+}
+
+// hyd_solver_opts.on_step: peaks between the rows too, and the energy
+// balance, every step by the step's own method (energy_acc.h).
 static void on_step(void* user, double t, const double* y) {
     run_ctx* c = user;
     if (c->sink->summary) track_peaks(c, y);
-    if (c->energy && t >= c->energy_next) energy_sample(c, t, y);
+    if (c->energy) sim_energy_follow_step(c->energy, c->solver, t, y, mech_energy(c->ls, y));
 }
 
 static const char* state_name(const lsim* ls, int i, char* buf, size_t n);
@@ -222,9 +246,9 @@ static int check_failed(run_ctx* c, double t) {
 static int emit(void* user, double t, const double* y) {
     run_ctx* c = user;
     track_peaks(c, y);
-    // CVODE's steps are its own: the balance is sampled at the rows.
-    if (c->energy && c->o->cvode && !(c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out))
-        energy_sample(c, t, y);
+    // CVODE's steps are its own: its quadrature is added at the rows (after
+    // the start, which the run samples itself).
+    if (c->energy && c->o->cvode && c->rows > 0 && t > c->t_last_row + 1e-9 * c->o->dt_out) energy_row(c, t, y);
     // Segments share their end points: write each output time once.
     if (c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out) return 0;
     char nb[96];
@@ -332,7 +356,9 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     }
     // The run's context, filled below; its address goes to the solver now.
     run_ctx c;
-    if (k->energy && sim_energy_bind(k->energy, m->hyd)) {
+    double* eq = NULL; // CVODE: the balance's quadrature, and its value at the last row
+    if (k->energy && (sim_energy_bind(k->energy, m->hyd) || sim_energy_follow(k->energy, ls.n, energy_eval, &ls) ||
+                      (o->cvode && !(eq = calloc(2 * (size_t)sim_energy_ncol(k->energy), sizeof *eq))))) {
         snprintf(res->message, sizeof res->message, "out of memory for the energy balance");
         lsim_free(&ls);
         return res->status = SIM_REFUSED;
@@ -358,7 +384,8 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     // (the breakpoints are rounded to this grid, so it must not pass t_end).
     if (oo.dt_out > t_end && t_end > 0) oo.dt_out = t_end;
     o = &oo;
-    c = (run_ctx){.ls = &ls, .o = o, .sink = k, .t_end = t_end, .energy = k->energy,
+    c = (run_ctx){.ls = &ls, .o = o, .sink = k, .t_end = t_end, .energy = k->energy, .solver = s, .q = eq,
+                  .q_row = eq ? eq + sim_energy_ncol(k->energy) : NULL,
                   .all_states = so.out_states == NULL,
                   .pidx = {ls.ip[0][0], ls.ip[0][1], ls.ip[1][0], ls.ip[1][1]}};
     memcpy(c.press, press, sizeof press);
@@ -374,7 +401,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     hyd_solver_stats cv = {0};
     double w0 = sim_wall_time();
     int rc = HYD_OK;
-    if (c.energy && !o->cvode) energy_sample(&c, 0.0, y);
+    if (c.energy) sim_energy_follow_sample(c.energy, 0.0, y, mech_energy(&ls, y));
     emit(&c, 0.0, y);
     for (int i = 0; i <= nbp && rc == HYD_OK && !c.stop && t < t_end; ++i) {
         double tb = i < nbp ? ceil(bp[i] / o->dt_out - 1e-9) * o->dt_out : t_end;
@@ -384,12 +411,21 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
         // their value at its midpoint, the breakpoints bound them.
         engine_faults_apply(&ef, m->hyd, sc, 0.5 * (t + tb));
         if (s) hyd_solver_reset(s);
+        // A fault's new opening changes the powers at the same state: the
+        // balance's next step starts from them.
+        if (c.energy && t > 0.0) sim_energy_follow_inputs(c.energy, t, y);
 #ifdef CRANESIM_HAVE_CVODE
         if (o->cvode) {
             hyd_cvode_opts co = hyd_cvode_default_opts();
             co.rtol = o->rtol;
             co.atol = o->atol;
             co.h_max = 0.5;
+            if (c.energy) {
+                co.nq = sim_energy_ncol(c.energy);
+                co.qfn = sim_energy_quad;
+                co.quser = c.energy;
+                co.q = c.q;
+            }
             hyd_solver_stats cs = {0};
             rc = hyd_cvode_integrate(&prob, &co, t, y, tb, o->dt_out, emit, &c, &cs);
             cv.steps += cs.steps;
@@ -402,7 +438,6 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
             rc = hyd_solver_integrate(s, t, y, tb, o->dt_out, emit, &c);
         if (rc == HYD_OK && !c.stop) t = tb;
     }
-    if (c.energy && !o->cvode) energy_sample(&c, t, y); // the end state (a repeat adds nothing)
     res->wall = sim_wall_time() - w0;
     res->stats = o->cvode ? cv : *hyd_solver_get_stats(s);
     res->rows = c.rows;
@@ -445,9 +480,26 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     res->peak_steps = !o->cvode && k->summary;
     if (!res->status) sim_checks_note(&c.chk, adaptive, res->note, sizeof res->note);
     if (k->energy) sim_energy_finish(k->energy);
+    free(eq);
     hyd_solver_destroy(s);
     lsim_free(&ls);
     return res->status;
+}
+
+// engine_follow_energy: the solver calls the balance after every step.
+static void lag_energy_step(void* user, double t, const double* y) {
+    eng_lagrange* l = user;
+    sim_energy_follow_step(l->energy, l->solver, t, y, mech_energy(&l->ls, y));
+}
+
+static int lag_follow_energy(engine* e, struct sim_energy* en) {
+    eng_lagrange* l = (eng_lagrange*)e;
+    if (sim_energy_follow(en, l->ls.n, energy_eval, &l->ls) ||
+        sim_energy_follow_sample(en, l->t, l->y, mech_energy(&l->ls, l->y)))
+        return -1;
+    l->energy = en;
+    hyd_solver_set_on_step(l->solver, lag_energy_step, l);
+    return 0;
 }
 
 // ---- The renderer's picture ----
@@ -591,4 +643,5 @@ const engine_ops engine_lagrange_ops = {
     .time = lag_time,
     .row = lag_row,
     .snapshot = lag_snapshot,
+    .follow_energy = lag_follow_energy,
 };

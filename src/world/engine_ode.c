@@ -19,6 +19,7 @@ typedef struct eng_ode {
     engine base;
     ode_world* w;
     sim_collisions coll; ///< the sandbox's collisions since create, every ODE step
+    struct sim_energy* energy; ///< engine_follow_energy's balance, or NULL
 } eng_ode;
 
 
@@ -116,9 +117,19 @@ static int ode_step(engine* e, double dt) {
                 sim_collisions_step(&((eng_ode*)e)->coll, ode_world_time(w), (const char* const(*)[2])pairs, np);
         }
     }
+    // The bodies' energy at the end (the world integrates the circuit's
+    // terms at its hydraulic sub-steps).
+    if (rc == 0 && ((eng_ode*)e)->energy) sim_energy_mech(((eng_ode*)e)->energy, ode_world_energy(w));
     if (rc == 0) return 0;
     snprintf(e->err, sizeof e->err, "%s", ode_world_error(w));
     return 1;
+}
+
+static int ode_follow_energy(engine* e, struct sim_energy* en) {
+    if (ode_world_follow_energy(W(e), en)) return -1;
+    sim_energy_mech(en, ode_world_energy(W(e)));
+    ((eng_ode*)e)->energy = en;
+    return 0;
 }
 
 static const sim_collisions* ode_collisions(const engine* e) {
@@ -217,7 +228,14 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         ode_world_destroy(w);
         return res->status = SIM_REFUSED;
     }
-    if (en) sim_energy_sample(en, 0.0, ode_world_circuit_inputs(w, sim_energy_data(en)), ode_world_energy(w));
+    // The balance at every hydraulic step (ode_coupling.c), the mechanics'
+    // energy after every ODE step.
+    if (en && ode_world_follow_energy(w, en)) {
+        snprintf(res->message, sizeof res->message, "out of memory for the energy balance");
+        ode_world_destroy(w);
+        return res->status = SIM_REFUSED;
+    }
+    if (en) sim_energy_mech(en, ode_world_energy(w));
     // The rated capacity limiter between the scenario and the world, as
     // engine_set_commands has it for the stepped drivers.
     struct rcl* lim = engine_rcl_create(m, o, "validation");
@@ -244,12 +262,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             snprintf(res->message, sizeof res->message, "numerical blow-up: %s", ode_world_error(w));
             break;
         }
-        // The balance at every ODE step, from the circuit's state at its end
-        // with the inputs its hydraulic sub-steps integrated (rates held
-        // over the step).
-        if (en)
-            sim_energy_sample(en, (double)(i + 1) * dt, ode_world_circuit_inputs(w, sim_energy_data(en)),
-                              ode_world_energy(w));
+        if (en) sim_energy_mech(en, ode_world_energy(w));
         {
             // Collisions at every ODE step (a touch shorter than a row counts).
             const char* pairs[OW_COLL_REPORT][2];
@@ -351,4 +364,5 @@ const engine_ops engine_ode_ops = {
     .row = ode_row,
     .snapshot = ode_snapshot,
     .collisions = ode_collisions,
+    .follow_energy = ode_follow_energy,
 };

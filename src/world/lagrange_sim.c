@@ -246,6 +246,7 @@ hyd_problem lsim_problem(lsim* s, bool blocks) {
     if (blocks) {
         p.nblock = s->nblock;
         p.block_size = s->block;
+        p.wstage = lsim_wstage;
         if (fz && s->use_split && s->w_layout) p.wstep = lsim_wstep;
         // Any other circuit on the fast kernel: the same step, per block.
         else if (!fz && s->use_fast && s->fk && s->use_split && s->gen_layout) p.wstep = lsim_wstep_gen;
@@ -341,6 +342,8 @@ unsigned long lsim_events(void* user, double t, const double* y) {
     }
     return hyd_fused_events_update(&s->ev, &s->fz, y, x, cmd);
 }
+
+const double* lsim_wstage(void* user) { return ((const lsim*)user)->ystage; }
 
 // The spool lag tau u' = cmd - u with cmd = 0 decays geometrically (Krus at
 // 0.1 ms: by 0.9934 per step) and would reach the subnormal numbers about

@@ -124,6 +124,10 @@ typedef struct lsim {
     // Split step for any circuit on the fast kernel (lagrange_split_gen.c).
     bool gen_layout;       ///< fk and the blocks lsim_kg takes: lsim_problem(s, true) can hand out lsim_wstep_gen
     lsim_kg kg;
+    /// The stage point y + k1 of the last split step (lsim_wstep,
+    /// lsim_wstep_gen; hyd_problem.wstage): the energy balance integrates
+    /// its powers with the step's own stages (energy_acc.h).
+    double ystage[LSIM_MAX_STATES];
     hyd_fused_events ev;   ///< event counter of lsim_events
     unsigned fz_rev;       ///< hyd_model_revision that fz was packed at
     /// Cylinder k is clear of both end stops and their smoothing widths
@@ -196,6 +200,8 @@ unsigned long lsim_events(void* user, double t, const double* y);
 /// hyd_problem.settle: a spool within HYD_SPOOL_SETTLE of 0 while its
 /// command is as close to 0 is set to exactly 0.
 int lsim_settle(void* user, double t, double* y);
+/// hyd_problem.wstage: lsim.ystage, the last split step's stage point.
+const double* lsim_wstage(void* user);
 /// df/dt: time enters only through the valve commands of the scenario, so
 /// only the spool rows are non-zero: (du_cmd/dt) / tau_s.
 int lsim_dfdt(void* user, double t, const double* y, double* dfdt);

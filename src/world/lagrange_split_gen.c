@@ -183,7 +183,8 @@ int lsim_wstep_gen(void* user, double t, const double* y, double h, double gamma
     if (rc) return rc > 0 ? 0 : rc;
     lsim_geo g;
     lsim_geo_at(s, y, s->iq, h, &g);
-    double f[LSIM_MAX_STATES], hf0[LSIM_MAX_STATES], k1[LSIM_MAX_STATES], ys[LSIM_MAX_STATES];
+    double f[LSIM_MAX_STATES], hf0[LSIM_MAX_STATES], k1[LSIM_MAX_STATES];
+    double* ys = s->ystage; // kept for hyd_problem.wstage
     stage_f(s, &g, t, y, f);
     solve_stage(&s->kg, s->iq, 1, h, f, y, hf0, k1, ys);
     stage_f(s, &g, t + h, ys, f);

@@ -151,7 +151,8 @@ int lsim_wstep(void* user, double t, const double* y, double h, double gamma, in
     if (rc) return rc > 0 ? 0 : rc;
     geo g;
     geo_at(s, y, h, &g);
-    double f[NS], hf0[NS], k1[NS], ys[NS];
+    double f[NS], hf0[NS], k1[NS];
+    double* ys = s->ystage; // kept for hyd_problem.wstage
     stage_f(s, &g, t, y, f);
     solve_stage(ks, 1, h, f, y, hf0, k1, ys);
     stage_f(s, &g, t + h, ys, f);

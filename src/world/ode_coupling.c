@@ -10,6 +10,7 @@
 // modes stay inside the implicit hydraulic integrator; the mechanics sees a
 // force lagged by at most one ODE step.
 #include "ode_world_internal.h"
+#include "energy_acc.h"
 
 
 #include <math.h>
@@ -278,6 +279,42 @@ static cJSON* patched_hydraulics(const cJSON* hydraulics, const cJSON* patch, co
 // error in the world's part names the world file and its own index; else
 // the model's compiled circuit is used as it is (opts.circuit), and the
 // panel's edits reach the world and the model at once.
+// hyd_solver_opts.on_step of the adaptive methods: the energy balance of
+// each step they take.
+static void on_step(void* user, double t, const double* y) {
+    ode_world* w = user;
+    if (w->energy) sim_energy_follow_step(w->energy, w->hs, t, y, NAN);
+}
+
+// sim_energy_eval_fn: the circuit at (t, y) with the inputs the hydraulic
+// steps integrate there (set_inputs; before the first ODE step, the
+// actuators as read at creation), into the balance's own data.
+static const hyd_data* energy_eval(void* user, double t, const double* y) {
+    ode_world* w = user;
+    hyd_data* d = sim_energy_data(w->energy);
+    const double tau = t - w->step_t0;
+    for (int k = 0; k < ODE_NACT; ++k) {
+        const ow_act* c = &w->act[k];
+        if (c->cyl < 0) continue;
+        d->cyl_x[c->cyl] = w->hyd_started ? w->x0[k] + w->v0[k] * tau : c->x;
+        d->cyl_v[c->cyl] = w->hyd_started ? w->v0[k] : c->v;
+        if (c->valve >= 0) d->valve_cmd[c->valve] = w->u_cmd[k];
+    }
+    double ydot[OW_MAX_HYD];
+    hyd_eval(w->hm, d, t, y, ydot);
+    return d;
+}
+
+int ode_world_follow_energy(ode_world* w, struct sim_energy* e) {
+    if (!w->hm || !e) return -1;
+    w->energy = e;
+    if (sim_energy_follow(e, w->nh, energy_eval, w) || sim_energy_follow_sample(e, w->th, w->y, NAN)) {
+        w->energy = NULL;
+        return -1;
+    }
+    return 0;
+}
+
 int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, const char* part, char* err,
                   size_t errsz) {
     const char* mfile = w->opt.model_file;
@@ -357,6 +394,8 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, con
     hyd_solver_opts so = hyd_default_solver_opts();
     so.h = adaptive ? 0.0 : w->opt.dt_hyd;
     so.h_max = w->opt.dt_ode;
+    so.on_step = on_step;
+    so.on_step_user = w;
     if (w->opt.rtol > 0) so.rtol = w->opt.rtol;
     if (w->opt.atol > 0) so.atol = w->opt.atol;
     so.jac_every = adaptive ? 1 : (w->opt.jac_every > 0 ? w->opt.jac_every : 1);
@@ -445,6 +484,11 @@ int ow_hyd_step(ode_world* w, double H) {
         w->v0[k] = w->act[k].v;
     }
     w->step_t0 = w->th;
+    w->hyd_started = 1;
+    // The strokes, rates and commands this step integrates start here: the
+    // balance's next step starts from their powers, and the chambers'
+    // volumes re-anchored to the bodies' strokes are its coupling term.
+    if (w->energy) sim_energy_follow_inputs(w->energy, w->th, w->y);
     // A live parameter edit (hyd_model_set) since the last step: the packed
     // constants are stale. (The solver reads f and jac through &w->hp.)
     if (w->hp.events && hyd_model_revision(w->hm) != w->fz_rev) fused_setup(w);
@@ -460,6 +504,8 @@ int ow_hyd_step(ode_world* w, double H) {
     for (int i = 0; i < nloop; ++i) {
         int rc = adaptive ? hyd_solver_advance(w->hs, &w->th, w->y, w->step_t0 + H)
                           : hyd_solver_step(w->hs, &w->th, w->y, h);
+        // (hyd_solver_step calls no on_step: the fixed sub-step's balance here.)
+        if (rc == HYD_OK && !adaptive && w->energy) sim_energy_follow_step(w->energy, w->hs, w->th, w->y, NAN);
         if (rc != HYD_OK) {
             double tb = w->th;
             int bad = rc == HYD_ERR_NONFINITE || rc == HYD_ERR_DOMAIN ? hyd_solver_bad_state(w->hs, &tb) : -1;
@@ -496,22 +542,4 @@ int ow_hyd_step(ode_world* w, double H) {
         }
     }
     return 0;
-}
-
-// The circuit's inputs at the end of the last hydraulic step, as the
-// hydraulics saw them (strokes extrapolated over the step at its rate, the
-// rate held; before the first step, the actuators as read at creation),
-// written into d; returns the circuit state (NULL without a circuit). For
-// the energy balance: the same inputs the hydraulic steps integrated.
-const double* ode_world_circuit_inputs(const ode_world* w, hyd_data* d) {
-    if (!w->hm) return NULL;
-    const double tau = w->th - w->step_t0;
-    for (int k = 0; k < ODE_NACT; ++k) {
-        const ow_act* c = &w->act[k];
-        if (c->cyl < 0) continue;
-        d->cyl_x[c->cyl] = w->nstep > 0 ? w->x0[k] + w->v0[k] * tau : c->x;
-        d->cyl_v[c->cyl] = w->nstep > 0 ? w->v0[k] : c->v;
-        if (c->valve >= 0) d->valve_cmd[c->valve] = w->u_cmd[k];
-    }
-    return w->y;
 }

@@ -234,10 +234,13 @@ void ode_world_rope_info(const ode_world* w, int* nlink, double* link_len, doubl
 void ode_world_swing_hook(ode_world* w, const double omega[3]);
 /// Per-step hydraulic sub-steps taken since create (for benchmarks).
 long ode_world_hyd_steps(const ode_world* w);
-/// The circuit's inputs (strokes, rates, commands) at the end of the last
-/// hydraulic step, as the hydraulics integrated them, written into d (data
-/// of ode_world_circuit); returns its state vector, or NULL without a circuit.
-const double* ode_world_circuit_inputs(const ode_world* w, hyd_data* d);
+struct sim_energy;
+/// Integrate the energy balance e (energy_acc.h, bound to ode_world_circuit)
+/// at every hydraulic step by the step's own method, starting with a
+/// sample at the present state; the caller passes the mechanics' energy
+/// after each ODE step (sim_energy_mech). e must outlive the world's steps.
+/// 0, or -1 (no circuit, out of memory).
+int ode_world_follow_energy(ode_world* w, struct sim_energy* e);
 /// The hydraulic solver's work counters (steps, rejections, f evaluations,
 /// Jacobians, factorisations) since the world was created; zeros without
 /// hydraulics.

@@ -227,6 +227,10 @@ struct ode_world {
     double x0[ODE_NACT], v0[ODE_NACT]; ///< strokes and rates at the step start
     int ipump;           ///< state index of the pump-line pressure, or -1
     long hyd_steps;
+    // The energy balance (ode_world_follow_energy), integrated at every
+    // hydraulic step; NULL: none.
+    struct sim_energy* energy;
+    int hyd_started;     ///< ow_hyd_step has set x0, v0 and step_t0 at least once
     // The straight-line circuit kernel (hyd_fused.h) for the solver's f and
     // J, when the circuit has the standard shape and opts.general_circuit is
     // 0. Lane j drives actuator fz_act[j]. Rebuilt when the circuit's

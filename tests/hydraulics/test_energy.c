@@ -88,6 +88,23 @@ static void test_identity_default_crane(void) {
     }
     CHECK(scale > 100.0, "the state moves no power (%g W)", scale);
     CHECK(fabs(sum) < 1e-9 * scale, "terms sum to %g W of %g W", sum, scale);
+    // The one-pass form (hyd_power_terms, for a balance that follows every
+    // step) gives the same terms.
+    const int nc = hyd_model_ncomp(m);
+    double* cp = calloc((size_t)nc, sizeof *cp);
+    double* pp = calloc((size_t)nc, sizeof *pp);
+    double B = NAN, S = NAN;
+    if (cp && pp) {
+        hyd_power_terms(m, d, cp, pp, &B, &S);
+        for (int c = 0; c < nc; ++c) {
+            CHECK_NEAR(cp[c], hyd_comp_power(m, d, c), 1e-12 * scale);
+            CHECK_NEAR(pp[c], hyd_comp_piston_power(m, d, c), 1e-12 * scale);
+        }
+        CHECK_NEAR(B, hyd_boundary_power(m, d), 1e-12 * scale);
+        CHECK_NEAR(S, hyd_stored_power(m, d), 1e-12 * scale);
+    }
+    free(cp);
+    free(pp);
     free(y);
     free(f);
     hyd_data_free(d);

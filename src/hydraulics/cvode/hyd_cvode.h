@@ -17,6 +17,17 @@ typedef struct hyd_cvode_opts {
     double h_max;   ///< largest step [s]; <= 0: no limit
     long max_steps; ///< step cap for the whole run
     int max_order;  ///< BDF order cap, 1..5 (0: CVODE's default, 5)
+    /// Optional quadrature: nq integrals q' = qfn(quser, t, y) taken by the
+    /// same BDF steps (CVODES' quadratures: after each step's nonlinear
+    /// solve, left out of the error test, so y and the steps are those of a
+    /// run without them). For an energy balance's powers, which samples at
+    /// the outputs integrate badly: the steps inside an output period are
+    /// CVODE's own. q: nq values, q(t0) on entry, updated before each call
+    /// of out and at return. 0 / NULL: none.
+    int nq;
+    hyd_quad_fn qfn;
+    void* quser;
+    double* q;
 } hyd_cvode_opts;
 
 hyd_cvode_opts hyd_cvode_default_opts(void);
