@@ -160,6 +160,9 @@ bool panel_gui_visible(const panel* p);
 /// Whether the window has the keyboard (a value is being typed): keys then
 /// go to it, not to the crane. Enter or Escape gives the keyboard back.
 bool panel_gui_wants_keyboard(const panel* p);
+/// The panel's window has the focus (it was clicked, or a value is typed):
+/// Esc then leaves the panel instead of reaching the crane's keys.
+bool panel_gui_has_focus(const panel* p);
 /// Screen rectangle (x, y, w, h [px]) of parameter id's widget as last drawn;
 /// false if it was not drawn (hidden window, collapsed group).
 bool panel_gui_item_rect(const panel* p, int id, float rect[4]);

@@ -168,6 +168,8 @@ extern "C" bool panel_gui_visible(const panel* p) { return p && p->visible; }
 
 extern "C" bool panel_gui_wants_keyboard(const panel* p) { return p && p->visible && p->wants_keyboard; }
 
+extern "C" bool panel_gui_has_focus(const panel* p) { return p && p->visible && p->focused; }
+
 extern "C" bool panel_gui_item_rect(const panel* p, int id, float rect[4]) {
     if (!p || id < 0 || id >= p->nparam || !p->visible || !p->param[id].drawn) return false;
     std::memcpy(rect, p->param[id].rect, 4 * sizeof(float));
@@ -236,11 +238,13 @@ extern "C" void panel_gui_draw(panel* p) {
             ImGui::PopTextWrapPos();
         }
         // Who has the keyboard: while a value is typed the crane's keys go
-        // here; Enter or Escape gives them back (below).
+        // here; Enter or Escape gives them back (below). Esc in the panel
+        // never quits the drive (drive_session.c).
         ImGui::PushTextWrapPos(0.0f);
         if (p->wants_keyboard)
             ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.2f, 1.0f),
-                               "The panel has the keyboard: Enter or Esc gives it back to the crane.");
+                               "The panel has the keyboard: Enter applies the value, Esc drops it; both give "
+                               "the keyboard back to the crane.");
         if (any_release) ImGui::TextDisabled("* applied on release; rebuilds the world (loads back at their start)");
         ImGui::PopTextWrapPos();
         // Groups in the order they were first registered.
@@ -268,6 +272,9 @@ extern "C" void panel_gui_draw(panel* p) {
         const bool focused = ImGui::IsWindowFocused(ImGuiFocusedFlags_RootAndChildWindows);
         ImGui::End();
         if ((enter || esc) && focused) ImGui::SetWindowFocus(nullptr);
+        p->focused = focused && !enter && !esc;
+    } else {
+        p->focused = false;
     }
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());

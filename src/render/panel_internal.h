@@ -50,6 +50,7 @@ struct panel {
     char last_error[256];
     bool visible;
     bool wants_keyboard;  ///< ImGui had the keyboard at the last frame
+    bool focused;         ///< the panel's window had the focus at the end of the last frame
     bool have_mouse;      ///< mouse_x/y hold the last mouse event's position
     /// Keys pressed since the last frame (SDL scancodes), and key-ups held
     /// back for after it: ImGui 1.86 reads key states once per frame, so a
