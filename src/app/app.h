@@ -200,6 +200,11 @@ double app_median(double* v, int n);
 /// v in the shortest "%.15g" / "%.16g" / "%.17g" form that reads back equal
 /// (CSV cells, --set assignments); returns buf.
 const char* app_fmt_double(char* buf, size_t n, double v);
+/// The double of v's 15-significant-digit decimal when that is within 4 ulps
+/// of v, else v: a computed grid point lo + (hi - lo) j / (n - 1) becomes the
+/// decimal it stands for (0.11, as `--set ...=0.11` gives it, not
+/// 0.11000000000000001).
+double app_snap_decimal(double v);
 /// The run metrics' units as a user reads and types them (app_units.c):
 /// metrics are SI (metric_unit: Pa, rad, J, m, s, N); the run summary shows
 /// MPa, deg, kJ, m, s, kN. met is a metric_id. The display unit, the factor
