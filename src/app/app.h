@@ -297,6 +297,28 @@ double app_tick_step(double lo, double hi, int max_ticks);
 int app_tick_decimals(double step);
 void app_tick_label(double v, double step, char* buf, size_t n);
 
+/// A point's text label for app_place_labels: the point (x, y) and the
+/// text's width and height in one unit (mm on the page); the placement comes
+/// back as the text's reference point (lx, ly: the text's vertical centre, its
+/// left edge when just = 0, its right edge when just = 1) and whether a
+/// leader line must join it to its point (placed farther out).
+typedef struct app_label {
+    double x, y, w, h;
+    double lx, ly, just;
+    bool leader;
+} app_label;
+/// Place labels nfixed..n-1 so that no two of l[0..n) overlap (the first
+/// nfixed are placed already: a legend, say), none covers a point's marker (of
+/// radius r, at (px, py)[0..np), the labelled points among them) and each
+/// stays inside area {x0, y0, x1, y1}: beside its point (right, left, above,
+/// below, the diagonals), farther out with a leader line when nothing nearer
+/// is free. Returns how many labels could not be placed free of overlaps
+/// (placed where they overlap least).
+int app_place_labels(app_label* l, int nfixed, int n, const double area[4], const double* px, const double* py,
+                     int np, double r);
+/// The area two placed labels share (0: none), in the unit of their sizes.
+double app_label_overlap(const app_label* a, const app_label* b);
+
 /// Plot a run's main time histories to a PNG (PLplot). Returns 0, or -1 with
 /// a message (also when cranesim was built without PLplot).
 int app_plot_run(const sim_trace* tr, const char* title, const char* png, char* err, size_t errsz);
