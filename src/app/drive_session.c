@@ -44,6 +44,10 @@ typedef struct drive_param {
     int mech;          ///< PK_MECH, PK_LOAD: entry of the mechanics table (model_param_info)
     bool on_release;   ///< applied when the edit ends: it rebuilds the world
     bool world_only;   ///< PK_HYD of the world's circuit, not the model's (not saved)
+    /// PK_HYD whose 0 means "the fluid's value" (a volume's bulk_modulus) and
+    /// is 0: the panel shows the fluid's value it runs with, noted "fluid's",
+    /// until it is set (it showed "0 MPa", and a drag from 0 went nowhere).
+    char inherit[96];  ///< the fluid's path it follows ("fluid.bulk_modulus"), or ""
 } drive_param;
 
 // The solver choice of the panel: the in-house integrators drive can step.
@@ -223,6 +227,15 @@ static void add_element(drive_session* s, const hyd_model* live, const char* nam
         drive_param* p = add_param(s, PK_HYD, group, hyd_param_name(t, k), hyd_param_unit(t, k), lo, hi, tlo, thi, v);
         if (!p) return;
         snprintf(p->hyd_path, sizeof p->hyd_path, "%s", hp);
+        // 0 below a hard range that starts above 0 is the "0 = the fluid's
+        // value" of the component table (nothing else passes the loader).
+        char fp[96];
+        double fv;
+        snprintf(fp, sizeof fp, "fluid.%s", hyd_param_name(t, k));
+        if (v == 0 && lo > 0 && hyd_model_get(live, fp, &fv) == 0) {
+            snprintf(p->inherit, sizeof p->inherit, "%s", fp);
+            p->value = fv / p->scale;
+        }
         double mv;
         if (hyd_model_get(s->m->hyd, hp, &mv) == 0)
             snprintf(p->json, sizeof p->json, "hydraulics.%s.%s", is_node ? "nodes" : "components", hp);
@@ -324,7 +337,8 @@ static void build_params(drive_session* s) {
 static void sync_json(drive_session* s, const drive_param* p) {
     if (!p->json[0] || p->kind == PK_SOLVER || p->kind == PK_STEP) return;
     char a[240], e[200];
-    snprintf(a, sizeof a, "%s=%.10g", p->json, p->value * p->scale);
+    // An entry that follows the fluid is 0 in the file (the fluid's value is shown).
+    snprintf(a, sizeof a, "%s=%.10g", p->json, p->inherit[0] ? 0.0 : p->value * p->scale);
     json_set_path(s->m->json, a, e, sizeof e);
 }
 
@@ -429,6 +443,31 @@ static void saved(drive_session* s) {
     s->unsaved_names[0] = '\0';
 }
 
+// After a circuit entry was set to si: an entry that followed the fluid has
+// its own value now (or follows it again when set to 0); a fluid value moves
+// the entries that follow it.
+static void follow_fluid(drive_session* s, drive_param* p, double si) {
+    char fp[96];
+    snprintf(fp, sizeof fp, "fluid.%s", p->label);
+    for (int i = 0; i < s->nparam; ++i) {
+        drive_param* q = &s->param[i];
+        if (q->kind != PK_HYD) continue;
+        if (q == p && si != 0 && q->inherit[0]) {
+            q->inherit[0] = '\0';
+            panel_set_note(s->pn, s->pid[i], "");
+        } else if (q == p && si == 0) {
+            double fv;
+            if (hyd_model_get(engine_circuit(s->l), fp, &fv) == 0 && strcmp(fp, p->hyd_path)) {
+                snprintf(q->inherit, sizeof q->inherit, "%s", fp);
+                q->value = fv / q->scale;
+                panel_set_note(s->pn, s->pid[i], "fluid's");
+            }
+        } else if (q != p && q->inherit[0] && !strcmp(q->inherit, p->hyd_path)) {
+            q->value = si / q->scale;
+        }
+    }
+}
+
 // Apply one accepted panel change to the running simulation; -1 when the
 // circuit rejected it (the panel shows the old value again).
 static int apply_param(drive_session* s, int i) {
@@ -448,8 +487,11 @@ static int apply_param(drive_session* s, int i) {
             snprintf(s->status, sizeof s->status, "rejected: %s", e);
             double old;
             if (!hyd_model_get(engine_circuit(s->l), p->hyd_path, &old)) p->value = old / p->scale;
+            if (p->inherit[0] && old == 0 && !hyd_model_get(engine_circuit(s->l), p->inherit, &old))
+                p->value = old / p->scale; // still the fluid's
             return -1;
         }
+        follow_fluid(s, p, si);
         break;
     case PK_MECH: {
         crane_mech* me = &s->m->mech;
@@ -717,6 +759,7 @@ static int setup_panel(drive_session* s) {
                         ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
                         : panel_add_param(s->pn, &d);
         if (p->kind != PK_SOLVER) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
+        if (p->inherit[0]) panel_set_note(s->pn, s->pid[i], "fluid's");
     }
     panel_add_text(s->pn, "model file", s->load_path, sizeof s->load_path);
     panel_add_action(s->pn, "reset run", act_reset, s);

@@ -2,13 +2,18 @@
 // of `cranesim drive` (SDL events into drive_session_tick, offscreen GL, the
 // panel's ImGui window): Esc in the panel leaves the panel and never quits;
 // quitting with panel changes not saved asks once and says which; Esc with
-// nothing unsaved quits at once, as before.
+// nothing unsaved quits at once, as before. And the panel as drawn: its
+// buttons inside its window, the load-moment bar uncovered, a value whose 0
+// means "the fluid's" shown as the fluid's value.
 #include "check.h"
 #include "drive_session.h"
 #include "panel.h"
 #include "render.h"
 
 #include <SDL2/SDL.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -209,6 +214,102 @@ static void test_saved_changes_quit_at_once(void) {
     CHECK(chdir(cwd) == 0 && rmdir(dir) == 0, "clean up %s", dir);
 }
 
+static bool inside(const float in[4], const float out[4]) {
+    return in[0] >= out[0] && in[1] >= out[1] && in[0] + in[2] <= out[0] + out[2] && in[1] + in[3] <= out[1] + out[3];
+}
+
+static bool apart(const float a[4], const float b[4]) {
+    return a[0] + a[2] <= b[0] || b[0] + b[2] <= a[0] || a[1] + a[3] <= b[1] || b[1] + b[3] <= a[1];
+}
+
+// At 1280 x 720 the panel's four buttons sat in one row and "load model" was
+// cut off at the window's edge; the window reached down over the load-moment
+// bar. Each button now lies inside the window, and the window clear of the bar.
+static void test_panel_layout(void) {
+    drive_session* s = open_session();
+    if (!s) return;
+    double wall = 0;
+    tap(s, &wall, SDL_SCANCODE_TAB);
+    ticks(s, &wall, 3);
+    render_wait(drive_session_render_ctx(s), 1.0);
+    ticks(s, &wall, 2);
+    panel* pn = drive_session_panel(s);
+    float win[4], bar[4], b[4];
+    CHECK(panel_gui_window_rect(pn, win), "the panel's window not drawn");
+    CHECK(panel_action_count(pn) == 4, "%d actions", panel_action_count(pn));
+    for (int a = 0; a < panel_action_count(pn); ++a) {
+        CHECK(panel_gui_action_rect(pn, a, b), "button %s not drawn", panel_action_label(pn, a));
+        CHECK(inside(b, win), "button '%s' at x %.0f..%.0f, y %.0f..%.0f outside the window x %.0f..%.0f, y %.0f..%.0f",
+              panel_action_label(pn, a), b[0], b[0] + b[2], b[1], b[1] + b[3], win[0], win[0] + win[2], win[1],
+              win[1] + win[3]);
+    }
+    CHECK(render_hud_rcl_rect(drive_session_render_ctx(s), bar), "no load-moment bar drawn");
+    CHECK(apart(win, bar), "the panel (y %.0f..%.0f) covers the load-moment bar (y %.0f..%.0f)", win[1],
+          win[1] + win[3], bar[1], bar[1] + bar[3]);
+    drive_session_destroy(s);
+}
+
+// The pump line volume's bulk_modulus is 0 in the model: "the fluid's". The
+// panel showed "0 MPa" (and a drag from 0 went nowhere); it shows the fluid's
+// 1200 MPa, noted "fluid's", and the model keeps its 0. Set, it is the
+// volume's own (no note, saved); set to 0 it follows the fluid again; while
+// it follows, a change of the fluid's moves it.
+static void test_fluid_default_shown(void) {
+    char dir[] = "/tmp/cranesim_fluid_XXXXXX", cwd[1024];
+    CHECK(mkdtemp(dir) != NULL && getcwd(cwd, sizeof cwd) != NULL && chdir(dir) == 0, "temp dir");
+    drive_session* s = open_session();
+    if (!s) return;
+    double wall = 0;
+    panel* pn = drive_session_panel(s);
+    const int id = panel_find(pn, "pump_line (volume)/bulk_modulus");
+    const int fid = panel_find(pn, "fluid/bulk_modulus");
+    CHECK(id >= 0 && fid >= 0, "entries %d %d", id, fid);
+    if (id < 0 || fid < 0) return;
+    CHECK(panel_get(pn, id) == 1200 && panel_get(pn, fid) == 1200 && !strcmp(panel_note(pn, id), "fluid's"),
+          "pump_line bulk_modulus %g %s (%s), fluid's %g", panel_get(pn, id), panel_unit(pn, id), panel_note(pn, id),
+          panel_get(pn, fid));
+    char msg[256];
+    // The fluid's value moves a volume that follows it.
+    CHECK(panel_set(pn, "fluid/bulk_modulus", 1500, msg, sizeof msg) == PANEL_OK, "%s", msg);
+    ticks(s, &wall, 2);
+    CHECK(panel_get(pn, id) == 1500 && !strcmp(panel_note(pn, id), "fluid's"), "after the fluid's 1500: %g (%s)",
+          panel_get(pn, id), panel_note(pn, id));
+    // Saved while it follows: the file keeps 0 (the fluid's), with the fluid's new value.
+    char err[512];
+    CHECK(panel_run_action(pn, "save model"), "save action");
+    ticks(s, &wall, 2);
+    model* m = model_load("cranesim_model_1.json", NULL, 0, err, sizeof err);
+    double v = -1, fv = -1;
+    CHECK(m && hyd_model_get(m->hyd, "pump_line.bulk_modulus", &v) == 0 && v == 0 &&
+              hyd_model_get(m->hyd, "fluid.bulk_modulus", &fv) == 0 && fv == 1.5e9,
+          "saved while following: pump_line %g Pa, fluid %g Pa (%s)", v, fv, m ? "" : err);
+    model_free(m);
+    CHECK(panel_set(pn, "pump_line (volume)/bulk_modulus", 900, msg, sizeof msg) == PANEL_OK, "%s", msg);
+    ticks(s, &wall, 2);
+    v = -1;
+    CHECK(hyd_model_get(engine_circuit(drive_session_engine(s)), "pump_line.bulk_modulus", &v) == 0 && v == 9e8,
+          "engine pump_line bulk_modulus %g Pa", v);
+    CHECK(!strcmp(panel_note(pn, id), ""), "set to 900 MPa it still says '%s'", panel_note(pn, id));
+    CHECK(panel_run_action(pn, "save model"), "save action");
+    ticks(s, &wall, 2);
+    m = model_load("cranesim_model_2.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "saved model: %s", err);
+    v = -1;
+    CHECK(m && hyd_model_get(m->hyd, "pump_line.bulk_modulus", &v) == 0 && v == 9e8, "saved bulk_modulus %g Pa", v);
+    model_free(m);
+    // Back to 0: the fluid's again.
+    CHECK(panel_set(pn, "pump_line (volume)/bulk_modulus", 0, msg, sizeof msg) == PANEL_OK, "%s", msg);
+    ticks(s, &wall, 2);
+    CHECK(panel_get(pn, id) == 1500 && !strcmp(panel_note(pn, id), "fluid's"), "set to 0: %g (%s)", panel_get(pn, id),
+          panel_note(pn, id));
+    CHECK(hyd_model_get(engine_circuit(drive_session_engine(s)), "pump_line.bulk_modulus", &v) == 0 && v == 0,
+          "engine pump_line bulk_modulus %g Pa after 0", v);
+    drive_session_destroy(s);
+    remove("cranesim_model_1.json");
+    remove("cranesim_model_2.json");
+    CHECK(chdir(cwd) == 0 && rmdir(dir) == 0, "clean up %s", dir);
+}
+
 int main(int argc, char** argv) {
     setenv("SDL_VIDEODRIVER", "offscreen", 0);
     setenv("EGL_PLATFORM", "surfaceless", 0);
@@ -216,6 +317,8 @@ int main(int argc, char** argv) {
     RUN_TEST(test_esc_after_an_edit_leaves_the_panel);
     RUN_TEST(test_esc_while_typing_cancels_the_value);
     RUN_TEST(test_saved_changes_quit_at_once);
+    RUN_TEST(test_panel_layout);
+    RUN_TEST(test_fluid_default_shown);
     SDL_Quit();
     TEST_MAIN_END();
 }
