@@ -8,7 +8,7 @@ set -eu
 FUZZ_PKGS="clang libclang-rt-14-dev"
 PKGS="cmake make gcc g++ pkg-config libode-dev libcjson-dev libplplot-dev plplot-driver-cairo libsundials-dev \
 libsdl2-dev libassimp-dev libgl-dev libegl-dev libgles-dev libosmesa6-dev libgl1-mesa-dri \
-libegl-mesa0 libimgui-dev libstb-dev xvfb xauth libopenmpi-dev openmpi-bin libnlopt-dev"
+libegl-mesa0 libimgui-dev libstb-dev xvfb xauth libopenmpi-dev openmpi-bin libnlopt-dev python3"
 [ "${1:-}" = "fuzz" ] && PKGS="$PKGS $FUZZ_PKGS"
 missing=""
 for p in $PKGS; do

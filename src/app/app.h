@@ -203,6 +203,11 @@ double app_median(double* v, int n);
 /// v in the shortest "%.15g" / "%.16g" / "%.17g" form that reads back equal
 /// (CSV cells, --set assignments); returns buf.
 const char* app_fmt_double(char* buf, size_t n, double v);
+/// The double of v's 15-significant-digit decimal when that is within 4 ulps
+/// of v, else v: a computed grid point lo + (hi - lo) j / (n - 1) becomes the
+/// decimal it stands for (0.11, as `--set ...=0.11` gives it, not
+/// 0.11000000000000001).
+double app_snap_decimal(double v);
 /// The run metrics' units as a user reads and types them (app_units.c):
 /// metrics are SI (metric_unit: Pa, rad, J, m, s, N); the run summary shows
 /// MPa, deg, kJ, m, s, kN. met is a metric_id. The display unit, the factor
@@ -294,6 +299,28 @@ int app_png_render(const char* png, const char* geometry, void (*draw)(void* use
 double app_tick_step(double lo, double hi, int max_ticks);
 int app_tick_decimals(double step);
 void app_tick_label(double v, double step, char* buf, size_t n);
+
+/// A point's text label for app_place_labels: the point (x, y) and the
+/// text's width and height in one unit (mm on the page); the placement comes
+/// back as the text's reference point (lx, ly: the text's vertical centre, its
+/// left edge when just = 0, its right edge when just = 1) and whether a
+/// leader line must join it to its point (placed farther out).
+typedef struct app_label {
+    double x, y, w, h;
+    double lx, ly, just;
+    bool leader;
+} app_label;
+/// Place labels nfixed..n-1 so that no two of l[0..n) overlap (the first
+/// nfixed are placed already: a legend, say), none covers a point's marker (of
+/// radius r, at (px, py)[0..np), the labelled points among them) and each
+/// stays inside area {x0, y0, x1, y1}: beside its point (right, left, above,
+/// below, the diagonals), farther out with a leader line when nothing nearer
+/// is free. Returns how many labels could not be placed free of overlaps
+/// (placed where they overlap least).
+int app_place_labels(app_label* l, int nfixed, int n, const double area[4], const double* px, const double* py,
+                     int np, double r);
+/// The area two placed labels share (0: none), in the unit of their sizes.
+double app_label_overlap(const app_label* a, const app_label* b);
 
 /// Plot a run's main time histories to a PNG (PLplot); slew: the run's world
 /// has a slew drive, whose channels are drawn too. Returns 0, or -1 with a

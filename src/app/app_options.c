@@ -386,6 +386,15 @@ const char* app_fmt_double(char* buf, size_t n, double v) {
     return buf;
 }
 
+double app_snap_decimal(double v) {
+    if (!isfinite(v) || v == 0) return v;
+    char b[32];
+    snprintf(b, sizeof b, "%.15g", v);
+    const double d = strtod(b, NULL);
+    const double ulp = nextafter(fabs(v), INFINITY) - fabs(v);
+    return fabs(d - v) <= 4 * ulp ? d : v;
+}
+
 const char* app_fmt_speed(char* buf, size_t n, double ratio) {
     // Whole numbers from 1x up (as before); below, two significant digits:
     // a run at 0.42x real time printed "0x".

@@ -14,6 +14,7 @@
 #include <string.h>
 #include <strings.h>
 #include <dirent.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -26,6 +27,52 @@ int app_fclose_checked(FILE* f, int first) {
     if (fclose(f) != 0 && !e) e = errno ? errno : EIO;
     if (flagged && !e) e = EIO;
     return e;
+}
+
+// The temporary files of an output are named ".NAME.cranesim-HOST-PID.XXXXXX"
+// in NAME's folder: the host and process that write it. A run killed with
+// SIGKILL (or a crash) cannot remove its own; the next run that writes NAME
+// removes those of this host whose process is gone, and says so. A file
+// whose process still runs (another cranesim writing NAME) is never touched,
+// nor one of another host (a shared folder: its pids mean nothing here), nor
+// a name of another form (the ".NAME.XXXXXX" of older versions: whose it is
+// cannot be told).
+static void temp_prefix(char* out, size_t n, const char* base) {
+    char host[65] = "";
+    if (gethostname(host, sizeof host - 1)) snprintf(host, sizeof host, "localhost");
+    host[sizeof host - 1] = 0;
+    for (char* c = host; *c; ++c)
+        if (*c == '/' || *c == '-') *c = '_'; // the pid follows the last '-'
+    snprintf(out, n, ".%s.cranesim-%.32s-", base, host);
+}
+
+static void remove_stale_temps(const char* dir, const char* base) {
+    char pre[400];
+    temp_prefix(pre, sizeof pre, base);
+    const size_t lp = strlen(pre);
+    DIR* d = opendir(dir[0] ? dir : ".");
+    if (!d) return;
+    for (struct dirent* e; (e = readdir(d));) {
+        const char* nm = e->d_name;
+        if (strncmp(nm, pre, lp)) continue;
+        // PID, then "." and mkstemp's six characters, nothing else.
+        const char* p = nm + lp;
+        char* end;
+        errno = 0;
+        const long pid = strtol(p, &end, 10);
+        if (end == p || !isdigit((unsigned char)*p) || errno || pid <= 0 || *end != '.' || strlen(end + 1) != 6)
+            continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue; // alive (or not ours to ask): keep it
+        char full[PATH_MAX + 300];
+        snprintf(full, sizeof full, "%s%s", dir, nm);
+        struct stat st;
+        if (lstat(full, &st) || !S_ISREG(st.st_mode) || st.st_uid != getuid()) continue;
+        if (unlink(full) == 0)
+            fprintf(stderr, "note: removed %s, the temporary file of an output of cranesim process %ld, which "
+                            "ended without finishing it (killed)\n",
+                    full, pid);
+    }
+    closedir(d);
 }
 
 FILE* app_out_open(app_out* o, const char* path, const char* mode) {
@@ -48,7 +95,16 @@ FILE* app_out_open(app_out* o, const char* path, const char* mode) {
     memcpy(o->path, target, strlen(target) + 1); // fits: checked above
     const char* slash = strrchr(o->path, '/');
     const int dl = slash ? (int)(slash - o->path + 1) : 0;
-    snprintf(o->tmp, sizeof o->tmp, "%.*s.%s.XXXXXX", dl, o->path, o->path + dl);
+    char dir[PATH_MAX], pre[400];
+    snprintf(dir, sizeof dir, "%.*s", dl, o->path);
+    remove_stale_temps(dir, o->path + dl);
+    temp_prefix(pre, sizeof pre, o->path + dl);
+    if ((size_t)snprintf(o->tmp, sizeof o->tmp, "%s%s%ld.XXXXXX", dir, pre, (long)getpid()) >= sizeof o->tmp ||
+        strlen(pre) + 30 >= NAME_MAX) {
+        // A name too long to add the host and pid: the short form, which a
+        // later run cannot tell from another's and leaves alone after a kill.
+        snprintf(o->tmp, sizeof o->tmp, "%.*s.%s.XXXXXX", dl, o->path, o->path + dl);
+    }
     const int fd = mkstemp(o->tmp);
     if (fd < 0) {
         // A folder we may not create files in, holding a file we may write:

@@ -90,7 +90,8 @@ static void drive_help(FILE* f) {
             "(--solver cvode and --every do not apply to drive: it steps in real time and records one\n"
             "row per command update)\n"
             "keys: arrows = lift, W/S = jib, A/D = slew, H = hook, Tab = parameter panel, P = pause, R = reset,\n"
-            "      C / F1..F4 = camera, G = collision shapes, F5 = record CSV, F12 = screenshot, Esc = quit;\n"
+            "      C / F1..F4 = camera, G = collision shapes, F5 = record CSV, F12 = screenshot, Esc = quit\n"
+            "      (in the parameter panel Esc only leaves the panel; with panel changes not saved, Esc twice);\n"
             "      hold Shift for fine mode (the keys command 25 %% of full opening)\n");
 }
 

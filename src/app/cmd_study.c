@@ -92,6 +92,19 @@ typedef struct wp_plot {
     double xlo, xhi, ylo, yhi;
 } wp_plot;
 
+// A point's label: the step or the tolerance alone ("0.1 ms", "1e-5"); the
+// legend says which the family varies.
+static void wp_label(const char* name, char* out, size_t n) {
+    if (!strncmp(name, "h=", 2)) {
+        snprintf(out, n, "%.*s ms", (int)(strlen(name) - 4), name + 2); // "h=0.1ms"
+        return;
+    }
+    const char* v = strncmp(name, "rtol=", 5) ? name : name + 5;
+    snprintf(out, n, "%s", v);
+    char* e = strstr(out, "e-0"); // 1e-05 -> 1e-5
+    if (e) memmove(e + 2, e + 3, strlen(e + 3) + 1);
+}
+
 // x: max pressure error in % of ppeak [Pa]; y: wall time.
 static void draw_wp(void* user) {
     const wp_plot* p = user;
@@ -104,27 +117,29 @@ static void draw_wp(void* user) {
     pllab("max chamber-pressure error [% of peak] (log)", "wall time [s] (log)", p->title);
     plschr(0, 0.7);
     static const int col[] = {1, 3, 9, 8, 12, 13};
-    // One colour per method family, a line through its points and a legend;
-    // each point carries only its step or tolerance, offset per family so
-    // neighbouring families (ROS34PW2 and RODAS3 lie on top of each other)
-    // keep their labels apart. Offsets in decades of the log axes.
+    // One colour per method family, a line through its points and a legend
+    // (bottom left: no method is both fast and accurate there); each point
+    // carries its step or tolerance, placed clear of the others
+    // (app_place_labels: ros34pw2 and rodas3 lie on top of each other).
     const char* fam[] = {"krus", "ros2", "rk4", "ros34pw2", "rodas3", "cvode"};
-    static const double dx[] = {0.06, 0.06, 0.06, -0.06, 0.06, 0.06};
-    static const double dy[] = {-0.07, 0.07, 0.0, -0.03, 0.07, 0.07};
-    static const double just[] = {0.0, 0.0, 0.0, 1.0, 0.0, 0.0};
+    const char* legend[] = {"krus (h)", "ros2 (h)", "rk4 (h)", "ros34pw2 (rtol)", "rodas3 (rtol)", "cvode (rtol)"};
+    enum { MAXP = 96 };
+    PLFLT ax[MAXP], ay[MAXP];
+    char lab[MAXP][24];
+    int lfam[MAXP], np = 0;
     int shown[6], nshown = 0;
     for (int f = 0; f < 6; ++f) {
-        PLFLT xs[16], ys[16];
-        const char* lab[16];
+        PLFLT xs[MAXP], ys[MAXP];
         int k = 0;
         const size_t lf = strlen(fam[f]);
-        for (int i = 0; i < n && k < 16; ++i) {
+        for (int i = 0; i < n && np < MAXP; ++i) {
             if (c[i].failed || !(c[i].p_max > 0) || !(c[i].wall > 0) || strncmp(c[i].name, fam[f], lf) ||
                 c[i].name[lf] != ' ')
                 continue;
-            xs[k] = log10(100 * c[i].p_max / ppeak);
-            ys[k] = log10(c[i].wall);
-            lab[k] = c[i].name + lf + 1; // "h=0.1ms", "rtol=0.001"
+            xs[k] = ax[np] = log10(100 * c[i].p_max / ppeak);
+            ys[k] = ay[np] = log10(c[i].wall);
+            wp_label(c[i].name + lf + 1, lab[np], sizeof lab[np]);
+            lfam[np++] = f;
             ++k;
         }
         if (!k) continue;
@@ -132,9 +147,6 @@ static void draw_wp(void* user) {
         plcol0(col[f]);
         plline(k, xs, ys);
         plpoin(k, xs, ys, 17);
-        // CVODE's loose tolerances bunch up: alternate above and below.
-        for (int j = 0; j < k; ++j)
-            plptex(xs[j] + dx[f], ys[j] + (f == 5 && j % 2 ? -dy[f] - 0.05 : dy[f]), 1, 0, just[f], lab[j]);
     }
     PLINT opt[6], tcol[6], lcol[6], lsty[6], scol[6], snum[6];
     PLFLT lwid[6], sscale[6];
@@ -145,13 +157,53 @@ static void draw_wp(void* user) {
         opt[i] = PL_LEGEND_LINE | PL_LEGEND_SYMBOL;
         tcol[i] = 15, lcol[i] = scol[i] = col[f], lsty[i] = 1, lwid[i] = 1.0;
         sscale[i] = 1.0, snum[i] = 1, sym[i] = "•";
-        text[i] = fam[f];
+        text[i] = legend[f];
     }
-    PLFLT lw, lh;
+    PLFLT lw = 0, lh = 0;
     plschr(0, 0.8);
-    pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE,
-             0.02, 0.02, 0.08, 0, 15, 1, 0, 0, nshown, opt, 1.0, 1.0, 2.0, 0.0, tcol, text, NULL, NULL, NULL, NULL,
-             lcol, lsty, lwid, scol, sscale, snum, sym);
+    pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+             PL_POSITION_BOTTOM | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.02, 0.02, 0.08, 0, 15, 1, 0, 0, nshown,
+             opt, 1.0, 1.0, 2.0, 0.0, tcol, text, NULL, NULL, NULL, NULL, lcol, lsty, lwid, scol, sscale, snum, sym);
+    // The labels, placed in mm on the page: world -> mm through the
+    // viewport (normalised) and the page size.
+    plschr(0, 0.7);
+    PLFLT wx0, wx1, wy0, wy1, vx0, vx1, vy0, vy1, sx0, sx1, sy0, sy1, def, ht;
+    plgvpw(&wx0, &wx1, &wy0, &wy1);
+    plgvpd(&vx0, &vx1, &vy0, &vy1);
+    plgspa(&sx0, &sx1, &sy0, &sy1);
+    plgchr(&def, &ht);
+    const double mx = (vx1 - vx0) * (sx1 - sx0) / (wx1 - wx0), my = (vy1 - vy0) * (sy1 - sy0) / (wy1 - wy0);
+    const double ox = sx0 + vx0 * (sx1 - sx0), oy = sy0 + vy0 * (sy1 - sy0);
+    static app_label l[MAXP + 1];
+    double px[MAXP], py[MAXP];
+    // Label 0: the legend's box (lw, lh: fractions of the viewport), fixed.
+    const double vw = (vx1 - vx0) * (sx1 - sx0), vh = (vy1 - vy0) * (sy1 - sy0);
+    l[0] = (app_label){.w = lw * vw + 2.0, .h = lh * vh + 2.0};
+    l[0].lx = ox + 0.02 * vw - 1.0, l[0].ly = oy + 0.02 * vh + 0.5 * l[0].h - 1.0, l[0].just = 0;
+    for (int i = 0; i < np; ++i) {
+        px[i] = ox + (ax[i] - wx0) * mx, py[i] = oy + (ay[i] - wy0) * my;
+        // A character is about 0.62 character heights wide in the cairo sans font.
+        l[i + 1] = (app_label){.x = px[i], .y = py[i], .w = (0.62 * (double)strlen(lab[i]) + 0.4) * ht,
+                               .h = 1.3 * ht};
+    }
+    const double area[4] = {ox, oy, ox + vw, oy + vh};
+    app_place_labels(l, 1, np + 1, area, px, py, np, 0.6 * ht);
+    for (int i = 0; i < np; ++i) {
+        const app_label* q = &l[i + 1];
+        plcol0(col[lfam[i]]);
+        const double lx = wx0 + (q->lx - ox) / mx, ly = wy0 + (q->ly - oy) / my;
+        if (q->leader) {
+            // A dotted line from the point to the nearest point of the label's box.
+            const double b0 = q->lx - q->just * q->w, b1 = q->ly - 0.5 * q->h;
+            const double nx = fmin(fmax(px[i], b0), b0 + q->w), ny = fmin(fmax(py[i], b1), b1 + q->h);
+            PLFLT xs[2] = {ax[i], wx0 + (nx - ox) / mx}, ys[2] = {ay[i], wy0 + (ny - oy) / my};
+            pllsty(3);
+            plline(2, xs, ys);
+            pllsty(1);
+        }
+        // plptex's reference point is the text's vertical centre.
+        plptex(lx, ly, 1, 0, q->just, lab[i]);
+    }
 }
 
 // The work-precision plot; 1 when no configuration has a point to plot

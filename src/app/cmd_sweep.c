@@ -131,7 +131,9 @@ static double design_value(const sweep* s, long i, int k) {
     const long j = (i / stride) % p->n;
     if (p->n == 1) return p->lo;
     if (j == p->n - 1) return p->hi;
-    return p->lo + (p->hi - p->lo) * ((double)j / (double)(p->n - 1));
+    // The grid point as the decimal it stands for: the design then is the
+    // run of `--set PATH=0.11`, bit for bit, and the file says 0.11.
+    return app_snap_decimal(p->lo + (p->hi - p->lo) * ((double)j / (double)(p->n - 1)));
 }
 
 // A 64-bit generator the same on every machine (splitmix64), so a seed

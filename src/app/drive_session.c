@@ -44,6 +44,10 @@ typedef struct drive_param {
     int mech;          ///< PK_MECH, PK_LOAD: entry of the mechanics table (model_param_info)
     bool on_release;   ///< applied when the edit ends: it rebuilds the world
     bool world_only;   ///< PK_HYD of the world's circuit, not the model's (not saved)
+    /// PK_HYD whose 0 means "the fluid's value" (a volume's bulk_modulus) and
+    /// is 0: the panel shows the fluid's value it runs with, noted "fluid's",
+    /// until it is set (it showed "0 MPa", and a drag from 0 went nowhere).
+    char inherit[96];  ///< the fluid's path it follows ("fluid.bulk_modulus"), or ""
 } drive_param;
 
 // The solver choice of the panel: the in-house integrators drive can step.
@@ -125,6 +129,11 @@ struct drive_session {
     drive_remote_input rin;       // the operator's input of the last tick
     struct { char path[128]; double v; } rset[16]; // panel edits for the server (SET), oldest first
     int nrset;
+    // Panel changes of the model not saved ("save model") since the start or
+    // the last load: how many entries, and their names for the messages.
+    int unsaved;
+    char unsaved_names[240];
+    double esc_armed; // wall time Esc asked to confirm a quit with unsaved changes [s] (< 0: not asked)
 };
 
 drive_opts drive_default_opts(void) {
@@ -219,6 +228,15 @@ static void add_element(drive_session* s, const hyd_model* live, const char* nam
         drive_param* p = add_param(s, PK_HYD, group, hyd_param_name(t, k), hyd_param_unit(t, k), lo, hi, tlo, thi, v);
         if (!p) return;
         snprintf(p->hyd_path, sizeof p->hyd_path, "%s", hp);
+        // 0 below a hard range that starts above 0 is the "0 = the fluid's
+        // value" of the component table (nothing else passes the loader).
+        char fp[96];
+        double fv;
+        snprintf(fp, sizeof fp, "fluid.%s", hyd_param_name(t, k));
+        if (v == 0 && lo > 0 && hyd_model_get(live, fp, &fv) == 0) {
+            snprintf(p->inherit, sizeof p->inherit, "%s", fp);
+            p->value = fv / p->scale;
+        }
         double mv;
         if (hyd_model_get(s->m->hyd, hp, &mv) == 0)
             snprintf(p->json, sizeof p->json, "hydraulics.%s.%s", is_node ? "nodes" : "components", hp);
@@ -320,7 +338,8 @@ static void build_params(drive_session* s) {
 static void sync_json(drive_session* s, const drive_param* p) {
     if (!p->json[0] || p->kind == PK_SOLVER || p->kind == PK_STEP) return;
     char a[240], e[200];
-    snprintf(a, sizeof a, "%s=%.10g", p->json, p->value * p->scale);
+    // An entry that follows the fluid is 0 in the file (the fluid's value is shown).
+    snprintf(a, sizeof a, "%s=%.10g", p->json, p->inherit[0] ? 0.0 : p->value * p->scale);
     json_set_path(s->m->json, a, e, sizeof e);
 }
 
@@ -403,12 +422,60 @@ static void remote_param(drive_session* s, drive_param* p) {
     say(s, t);
 }
 
-// Apply one accepted panel change to the running simulation.
-static void apply_param(drive_session* s, int i) {
+// An applied panel change of the model document (not the solver or its
+// step, which a saved model does not hold): one more unsaved entry.
+static void note_unsaved(drive_session* s, const drive_param* p) {
+    if (!p->json[0] || p->kind == PK_SOLVER || p->kind == PK_STEP) return;
+    char name[160];
+    snprintf(name, sizeof name, "%s/%s", p->group, p->label);
+    // Each entry once, however many steps its drag took.
+    for (const char* q = s->unsaved_names; (q = strstr(q, name)) != NULL; q += strlen(name)) {
+        const char end = q[strlen(name)];
+        if ((q == s->unsaved_names || q[-1] == ' ') && (end == ',' || end == '\0')) return;
+    }
+    const size_t n = strlen(s->unsaved_names);
+    if (n + strlen(name) + 3 < sizeof s->unsaved_names)
+        snprintf(s->unsaved_names + n, sizeof s->unsaved_names - n, "%s%s", n ? ", " : "", name);
+    ++s->unsaved;
+}
+
+static void saved(drive_session* s) {
+    s->unsaved = 0;
+    s->unsaved_names[0] = '\0';
+}
+
+// After a circuit entry was set to si: an entry that followed the fluid has
+// its own value now (or follows it again when set to 0); a fluid value moves
+// the entries that follow it.
+static void follow_fluid(drive_session* s, drive_param* p, double si) {
+    char fp[96];
+    snprintf(fp, sizeof fp, "fluid.%s", p->label);
+    for (int i = 0; i < s->nparam; ++i) {
+        drive_param* q = &s->param[i];
+        if (q->kind != PK_HYD) continue;
+        if (q == p && si != 0 && q->inherit[0]) {
+            q->inherit[0] = '\0';
+            panel_set_note(s->pn, s->pid[i], "");
+        } else if (q == p && si == 0) {
+            double fv;
+            if (hyd_model_get(engine_circuit(s->l), fp, &fv) == 0 && strcmp(fp, p->hyd_path)) {
+                snprintf(q->inherit, sizeof q->inherit, "%s", fp);
+                q->value = fv / q->scale;
+                panel_set_note(s->pn, s->pid[i], "fluid's");
+            }
+        } else if (q != p && q->inherit[0] && !strcmp(q->inherit, p->hyd_path)) {
+            q->value = si / q->scale;
+        }
+    }
+}
+
+// Apply one accepted panel change to the running simulation; -1 when the
+// circuit rejected it (the panel shows the old value again).
+static int apply_param(drive_session* s, int i) {
     drive_param* p = &s->param[i];
     if (s->remote) {
-        remote_param(s, p);
-        return;
+        remote_param(s, p); // set on the server, not in this drive's model
+        return 0;
     }
     const double si = p->value * p->scale;
     char e[256];
@@ -421,8 +488,11 @@ static void apply_param(drive_session* s, int i) {
             snprintf(s->status, sizeof s->status, "rejected: %s", e);
             double old;
             if (!hyd_model_get(engine_circuit(s->l), p->hyd_path, &old)) p->value = old / p->scale;
-            return;
+            if (p->inherit[0] && old == 0 && !hyd_model_get(engine_circuit(s->l), p->inherit, &old))
+                p->value = old / p->scale; // still the fluid's
+            return -1;
         }
+        follow_fluid(s, p, si);
         break;
     case PK_MECH: {
         crane_mech* me = &s->m->mech;
@@ -471,7 +541,7 @@ static void apply_param(drive_session* s, int i) {
         s->rebuild = true;
         snprintf(s->rebuild_why, sizeof s->rebuild_why, "solver %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
         snprintf(s->status, sizeof s->status, "solver/method = %s", k_solver_name[k >= 0 && k < NSOLVER ? k : 0]);
-        return;
+        return 0;
     }
     case PK_STEP: {
         // A backend that sub-steps the hydraulics in a rigid-body step (the
@@ -487,7 +557,9 @@ static void apply_param(drive_session* s, int i) {
     }
     }
     sync_json(s, p);
+    note_unsaved(s, p);
     snprintf(s->status, sizeof s->status, "%s/%s = %.4g %s", p->group, p->label, p->value, p->unit);
+    return 0;
 }
 
 static void rebuild_world(drive_session* s, bool at_start) {
@@ -688,6 +760,7 @@ static int setup_panel(drive_session* s) {
                         ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
                         : panel_add_param(s->pn, &d);
         if (p->kind != PK_SOLVER) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
+        if (p->inherit[0]) panel_set_note(s->pn, s->pid[i], "fluid's");
     }
     panel_add_text(s->pn, "model file", s->load_path, sizeof s->load_path);
     panel_add_action(s->pn, "reset run", act_reset, s);
@@ -747,6 +820,7 @@ static void load_model(drive_session* s) {
     ++s->st.rebuilds;
     rebind_charts(s);
     setup_panel(s);
+    saved(s); // the panel now edits the loaded file's model
     snprintf(s->status, sizeof s->status, "loaded %s (%s)", nm->file, nm->name);
     panel_set_message(s->pn, s->status);
 }
@@ -809,6 +883,7 @@ static void act_save(void* user) {
         if (!s->o.save_as) remove(path); // the empty file reserved for it
     } else {
         snprintf(s->status, sizeof s->status, "model saved to %s%s", path, s->o.save_as ? " (--save-as, replaced)" : "");
+        saved(s);
     }
 }
 
@@ -1078,6 +1153,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         return NULL;
     }
     s->wall_last_frame = -1.0;
+    s->esc_armed = -1.0;
     // Warm-up frame before the caller starts its clock: the first frame
     // compiles the shaders and loads the meshes (well over 100 ms on
     // llvmpipe), which would otherwise count as a missed deadline.
@@ -1247,6 +1323,18 @@ int drive_session_screenshot(drive_session* s, const char* png, char* err, size_
 
 const world_snapshot* drive_session_snapshot(const drive_session* s) { return s->snap; }
 
+// Esc out of the panel quits; with panel changes not saved, the first Esc
+// says which and how to keep them, and only a second one within
+// DRIVE_QUIT_CONFIRM_S quits.
+static bool quit_confirmed(drive_session* s, double wall) {
+    if (!s->unsaved || (s->esc_armed >= 0 && wall - s->esc_armed <= DRIVE_QUIT_CONFIRM_S)) return true;
+    s->esc_armed = wall;
+    snprintf(s->status, sizeof s->status, "%d panel change%s not saved (%s): Esc again quits without %s, "
+             "the panel's \"save model\" keeps %s", s->unsaved, s->unsaved == 1 ? "" : "s", s->unsaved_names,
+             s->unsaved == 1 ? "it" : "them", s->unsaved == 1 ? "it" : "them");
+    return false;
+}
+
 int drive_session_tick(drive_session* s, double wall) {
     double dt_wall = wall - s->wall_last;
     if (dt_wall < 0) dt_wall = 0;
@@ -1272,6 +1360,18 @@ int drive_session_tick(drive_session* s, double wall) {
                 if (start_recording(s, path) == 0) snprintf(s->status, sizeof s->status, "recording to %s", path);
             }
             continue;
+        }
+        if (ev.type == SDL_KEYDOWN && ev.key.keysym.scancode == SDL_SCANCODE_ESCAPE) {
+            if (ev.key.repeat) continue; // a held Esc is one Esc
+            // Esc in the panel (its window clicked, dragged in or typed in)
+            // only leaves the panel: ImGui drops a value being typed, and the
+            // panel gives the keyboard back at its next frame. It quit the
+            // drive at once, and the panel's edits with it.
+            if (panel_gui_has_focus(s->pn) || panel_gui_wants_keyboard(s->pn)) {
+                render_handle_event(s->r, &ev);
+                continue;
+            }
+            if (!quit_confirmed(s, wall)) continue;
         }
         // The panel may take an event (typing a value); a key release still
         // goes to the input layer, or a crane axis held when the panel took
@@ -1310,7 +1410,7 @@ int drive_session_tick(drive_session* s, double wall) {
     if (nchanged) session_end(s, "a panel change");
     for (int k = 0; k < nchanged; ++k) {
         s->param[s->changed[k].i].value = s->changed[k].v;
-        apply_param(s, s->changed[k].i);
+        apply_param(s, s->changed[k].i); // a rejection says so in the status line
     }
     if (s->load_pending) {
         s->load_pending = false;
@@ -1571,6 +1671,9 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     }
     if (s->rp)
         printf("  replayed %ld of %ld command updates of %s\n", s->rp_next, s->rp->ntick, s->rp->path);
+    if (s->unsaved) // closed by Esc twice, the window's close button or a signal
+        fprintf(stderr, "cranesim drive: quit with %d panel change%s not saved: %s\n", s->unsaved,
+                s->unsaved == 1 ? "" : "s", s->unsaved_names);
     long rows = 0;
     if (drive_session_finish_record(s, &rows, err, sizeof err)) {
         fprintf(stderr, "cranesim drive: %s\n", err);

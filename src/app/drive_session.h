@@ -28,6 +28,9 @@ struct panel;
 /// not given over less wall time than this [s]: a ratio of two tiny times
 /// reads millions.
 #define DRIVE_MIN_RATE_S 0.1
+/// With panel changes not saved, Esc asks first: a second Esc within this
+/// wall time quits [s].
+#define DRIVE_QUIT_CONFIRM_S 3.0
 
 typedef struct drive_opts {
     int width, height;        ///< window or offscreen size [px] (default 1280 x 720)

@@ -84,6 +84,79 @@ void app_tick_label(double v, double step, char* buf, size_t n) {
     if (!strncmp(buf, "-0", 2) && strspn(buf + 1, "0.") == strlen(buf + 1)) memmove(buf, buf + 1, strlen(buf));
 }
 
+// ------------------------------------------------------ point labels --
+//
+// Labels of many points (the work-precision plot: ~30 steps and tolerances,
+// a dozen of them within a decade) were set at fixed offsets per method and
+// ran into each other. app_place_labels tries the positions around each
+// point, nearest first, and takes the first that is free.
+
+static void label_box(const app_label* l, double b[4]) {
+    b[0] = l->lx - l->just * l->w;
+    b[2] = b[0] + l->w;
+    b[1] = l->ly - 0.5 * l->h;
+    b[3] = l->ly + 0.5 * l->h;
+}
+
+double app_label_overlap(const app_label* a, const app_label* b) {
+    double p[4], q[4];
+    label_box(a, p);
+    label_box(b, q);
+    const double w = fmin(p[2], q[2]) - fmax(p[0], q[0]), h = fmin(p[3], q[3]) - fmax(p[1], q[1]);
+    return w > 0 && h > 0 ? w * h : 0.0;
+}
+
+// How badly label k sits where it is: overlap with the labels placed before
+// it, markers under it, and its part outside the area (weighted: a label cut
+// by the frame is worse than one touching another).
+static double label_cost(const app_label* l, int k, const double area[4], const double* px, const double* py, int np,
+                         double r) {
+    double b[4], c = 0;
+    label_box(&l[k], b);
+    for (int j = 0; j < k; ++j) c += app_label_overlap(&l[k], &l[j]);
+    for (int j = 0; j < np; ++j) {
+        const double w = fmin(b[2], px[j] + r) - fmax(b[0], px[j] - r);
+        const double h = fmin(b[3], py[j] + r) - fmax(b[1], py[j] - r);
+        if (w > 0 && h > 0) c += w * h;
+    }
+    if (b[0] < area[0] || b[1] < area[1] || b[2] > area[2] || b[3] > area[3]) {
+        const double in_w = fmax(0, fmin(b[2], area[2]) - fmax(b[0], area[0]));
+        const double in_h = fmax(0, fmin(b[3], area[3]) - fmax(b[1], area[1]));
+        c += 10 * fmax(l[k].w * l[k].h - in_w * in_h, 1e-9 * l[k].w * l[k].h);
+    }
+    return c;
+}
+
+int app_place_labels(app_label* l, int nfixed, int n, const double area[4], const double* px, const double* py,
+                     int np, double r) {
+    // Directions around the point: right, left, above, below, then the
+    // diagonals; (dx, dy) per unit of distance, and the justification.
+    static const double dir[8][3] = {{1, 0, 0},    {-1, 0, 1},    {0, 1, 0.5},  {0, -1, 0.5},
+                                     {0.7, 0.7, 0}, {0.7, -0.7, 0}, {-0.7, 0.7, 1}, {-0.7, -0.7, 1}};
+    // Distances in label heights beyond the marker: beside it, then farther
+    // out (with a leader line from 2 on).
+    static const double dist[] = {0.35, 1.0, 2.0, 3.0, 4.5, 6.0};
+    int failed = 0;
+    for (int k = nfixed; k < n; ++k) {
+        double best = INFINITY, bx = 0, by = 0, bj = 0;
+        int bd = 0;
+        for (int d = 0; d < (int)(sizeof dist / sizeof dist[0]) && best > 0; ++d)
+            for (int i = 0; i < 8 && best > 0; ++i) {
+                const double reach = r + dist[d] * l[k].h;
+                l[k].lx = l[k].x + dir[i][0] * reach;
+                // Above and below: the text's centre a half height farther.
+                l[k].ly = l[k].y + dir[i][1] * (reach + (dir[i][0] == 0 ? 0.5 * l[k].h : 0));
+                l[k].just = dir[i][2];
+                const double c = label_cost(l, k, area, px, py, np, r);
+                if (c < best) best = c, bx = l[k].lx, by = l[k].ly, bj = l[k].just, bd = d;
+            }
+        l[k].lx = bx, l[k].ly = by, l[k].just = bj;
+        l[k].leader = bd >= 2;
+        failed += best > 0;
+    }
+    return failed;
+}
+
 #ifdef CRANESIM_HAVE_PLPLOT
 #include <plplot.h>
 
@@ -179,6 +252,47 @@ static void draw_series(const sim_trace* tr, int xcol, double xs, int ycol, doub
     plline(tr->nrow, xb, yb);
 }
 
+// ------------------------------------------------------ page of panels --
+//
+// The trace plots are a 2 x 2 grid of panels under a title that spans the
+// page. PLplot's subpages (plstar(2, 2)) gave the title only the first
+// panel's width, centred there: a replay's title ran off both sides of it.
+// The panels are placed here instead, each in its cell of the page below
+// the title band, in the order they are drawn (as pladv did).
+
+#define PAGE_TITLE_BAND 0.055 // top band of the page for the title [page height]
+
+static int g_cell; // the next panel's cell, row-major
+
+// Start a page of 2 x 2 panels under title: as wide as the page allows,
+// smaller type for a title that would not fit at the normal size.
+static void page_begin(const char* title) {
+    plstar(1, 1);
+    pladv(0);
+    g_cell = 0;
+    plvpor(0.0, 1.0, 0.0, 1.0);
+    plwind(0.0, 1.0, 0.0, 1.0);
+    // The title at 0.8 of PLplot's default size holds about 100 characters
+    // across the page with a margin (measured: 182 characters at 0.8 x 105 /
+    // 182 filled the 1400 px); a longer one is set smaller to fit.
+    const double fit = 95.0, n = (double)strlen(title);
+    plschr(0, n > fit ? fmax(0.4, 0.8 * fit / n) : 0.8);
+    plcol0(15);
+    plmtex("t", -1.5, 0.5, 0.5, title);
+    // The panels' type: what plstar(2, 2) scaled 0.9 to.
+    plschr(0, 0.6);
+}
+
+// The viewport of the next panel: its cell less room for the tick labels and
+// axis titles (left, bottom) and the panel's own title (top).
+static void page_panel_viewport(void) {
+    const int col = g_cell % 2, row = g_cell / 2;
+    ++g_cell;
+    const double h = (1.0 - PAGE_TITLE_BAND) / 2.0;
+    const double x0 = 0.5 * col, y1 = 1.0 - PAGE_TITLE_BAND - h * row;
+    plvpor(x0 + 0.085, x0 + 0.48, y1 - h + 0.085, y1 - 0.05);
+}
+
 // One panel: columns cols[0..nc) of up to two traces, the second dashed.
 static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, const int* cols, int nc,
                   double ys, const char* xlabel, const char* ylabel, const char* title, const char* const* names,
@@ -204,8 +318,7 @@ static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, c
     static double step[2];
     step[0] = app_tick_step(xlo, xhi, MAX_TICKS);
     step[1] = app_tick_step(ylo - pad, yhi + pad, MAX_TICKS);
-    pladv(0);
-    plvsta();
+    page_panel_viewport();
     plwind(xlo, xhi, ylo - pad, yhi + pad);
     plslabelfunc(tick_label_cb, step);
     plbox("abcgnsto", step[0], 0, "abcgnstvo", step[1], 0);
@@ -249,16 +362,13 @@ static void draw_traces(void* user) {
     const traces_plot* p = user;
     const sim_trace *a = p->a, *b = p->b;
     PLFLT *xb = p->xb, *yb = p->yb;
-    plstar(2, 2);
-    plschr(0, 0.9);
+    page_begin(p->title);
     int xs[APP_PLOT_MAXSERIES], ps[APP_PLOT_MAXSERIES], us[APP_PLOT_MAXSERIES];
     const char *xn[APP_PLOT_MAXSERIES], *pn[APP_PLOT_MAXSERIES], *un[APP_PLOT_MAXSERIES];
     const int nx = app_plot_run_channels(0, p->slew, xs, xn), np = app_plot_run_channels(1, p->slew, ps, pn),
               nu = app_plot_run_channels(2, p->slew, us, un);
     const int tz[] = {COL_TIP_Z};
-    char t1[300];
-    snprintf(t1, sizeof t1, "Cylinder strokes - %s", p->title);
-    panel(a, b, COL_T, 1, xs, nx, 1e3, "t [s]", "stroke [mm]", t1, xn, xb, yb);
+    panel(a, b, COL_T, 1, xs, nx, 1e3, "t [s]", "stroke [mm]", "Cylinder strokes", xn, xb, yb);
     panel(a, b, COL_T, 1, ps, np, 1e-6, "t [s]", "pressure [MPa abs]", "Chamber pressures", pn, xb, yb);
     panel(a, b, COL_T, 1, us, nu, 100, "t [s]", "opening [%]", "Valve spools and commands", un, xb, yb);
     char t4[200];

@@ -70,24 +70,33 @@ typedef struct heat_plot {
 static void draw_heat(void* user) {
     const heat_plot* p = user;
     plinit();
+    pladv(0);
     plschr(0, 0.9);
     double lo = INFINITY, hi = -INFINITY;
-    for (long k = 0; k < p->nx * p->ny; ++k)
+    bool failed = false;
+    for (long k = 0; k < p->nx * p->ny; ++k) {
         if (isfinite(p->z[k])) {
             lo = fmin(lo, p->z[k]);
             hi = fmax(hi, p->z[k]);
+        } else {
+            failed = true;
         }
+    }
     if (!(hi > lo)) {
         lo = isfinite(lo) ? lo - 1 : 0;
         hi = lo + 2;
     }
-    // One cell per design, centred on its grid values.
+    // One cell per design, centred on its grid values. The map leaves the
+    // right of the page to its colour bar and the top to the title (the
+    // title and the old one-line scale above the map ran into each other).
     const double dx = p->nx > 1 ? (p->x1 - p->x0) / (double)(p->nx - 1) : fabs(p->x0) * 0.1 + 1e-9;
     const double dy = p->ny > 1 ? (p->y1 - p->y0) / (double)(p->ny - 1) : fabs(p->y0) * 0.1 + 1e-9;
     plcol0(15);
-    plenv(p->x0 - dx / 2, p->x1 + dx / 2, p->y0 - dy / 2, p->y1 + dy / 2, 0, 0);
-    pllab(p->xlab, p->ylab, p->title);
+    plvpor(0.13, 0.80, 0.11, 0.88);
+    plwind(p->x0 - dx / 2, p->x1 + dx / 2, p->y0 - dy / 2, p->y1 + dy / 2);
     plspal1("cmap1_blue_red.pal", 1);
+    // Each cell's value on it when the cells are large enough to read.
+    const bool values = p->nx <= 12 && p->ny <= 16;
     for (long i = 0; i < p->nx; ++i)
         for (long j = 0; j < p->ny; ++j) {
             // The grid's rows have the second parameter fastest.
@@ -99,17 +108,43 @@ static void draw_heat(void* user) {
             plcol1((z - lo) / (hi - lo));
             plfill(4, xs, ys);
         }
-    // The colour scale: the metric's range, low (blue) to high (red).
-    char lab[160];
-    snprintf(lab, sizeof lab, "blue %.5g .. red %.5g; blank: failed design", lo, hi);
+    if (values) {
+        plschr(0, 0.7);
+        for (long i = 0; i < p->nx; ++i)
+            for (long j = 0; j < p->ny; ++j) {
+                const double z = p->z[(size_t)i * (size_t)p->ny + (size_t)j];
+                if (!isfinite(z)) continue;
+                char v[32];
+                snprintf(v, sizeof v, "%.4g", z);
+                // White (colour 0, the background) on the dark blue low end.
+                plcol0((z - lo) / (hi - lo) < 0.2 ? 0 : 15);
+                plptex(p->x0 + dx * (double)i, p->y0 + dy * (double)j, 1, 0, 0.5, v);
+            }
+        plschr(0, 0.9);
+    }
     plcol0(15);
-    plmtex("t", 0.5, 0.5, 0.5, lab);
+    plbox("bcnst", 0, 0, "bcnstv", 0, 0);
+    pllab(p->xlab, p->ylab, "");
+    plmtex("t", 1.5, 0.5, 0.5, p->title);
+    if (failed) plmtex("b", 3.2, 1.0, 1.0, "blank: failed design");
+    // The colour bar right of the map: the metric's range, low (blue) to
+    // high (red), in the title's unit.
+    PLINT lopt[1] = {PL_COLORBAR_LABEL_BOTTOM};
+    const char* lab[1] = {""};
+    const char* axis[1] = {"bcvmst"};
+    PLFLT ticks[1] = {0};
+    PLINT sub[1] = {0}, nv[1] = {2};
+    PLFLT range[2] = {lo, hi};
+    const PLFLT* vals[1] = {range};
+    PLFLT cw, ch;
+    plcolorbar(&cw, &ch, PL_COLORBAR_GRADIENT, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.03,
+               0.0, 0.04, 1.0, 0, 15, 1, 0, 0, 0, 0, 1, lopt, lab, 1, axis, ticks, sub, nv, vals);
 }
 
 int app_plot_heat(const char* png, const char* title, const char* xlab, const char* ylab, const double* z,
                   long nx, long ny, double x0, double x1, double y0, double y1, char* err, size_t errsz) {
     heat_plot p = {title, xlab, ylab, z, nx, ny, x0, x1, y0, y1};
-    return app_png_render(png, "1000x800", draw_heat, &p, err, errsz);
+    return app_png_render(png, "1100x800", draw_heat, &p, err, errsz);
 }
 typedef struct conv_plot {
     const char *title, *ylab;

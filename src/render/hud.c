@@ -316,10 +316,9 @@ static float draw_readouts(render* r, const world_snapshot* s) {
             const world_snap_cylinder* c = &s->cyl[i];
             double v[7] = {c->x * 1e3, c->v * 1e3,     c->pA * 1e-6,   c->pB * 1e-6,
                            c->u * 100, c->u_cmd * 100, c->force * 1e-3};
-            const char* fmt = row == 4 || row == 5   ? "%+.0f"
-                              : row == 0 || row == 1 ? "%.1f"
-                                                     : "%.2f";
-            snprintf(buf, sizeof buf, fmt, v[row]);
+            // Never "-0.0" (a stroke or rate of a few micrometres).
+            render_fmt_fixed(buf, sizeof buf, v[row], row == 4 || row == 5 ? 0 : row == 0 || row == 1 ? 1 : 2,
+                             row == 4 || row == 5);
             // u_cmd in amber where the limiter cut the operator's demand (the
             // warning line gives the demand beside it).
             const float* colr = ((row == 2 || row == 3) && c->relief_open) || (row == 5 && c->rcl_cut) ? k_amber : k_white;
@@ -328,15 +327,20 @@ static float draw_readouts(render* r, const world_snapshot* s) {
         y += lh;
     }
     y += 4;
-    snprintf(buf, sizeof buf, "tip  x %.2f  y %.2f  z %.2f m", s->tip[0], s->tip[1], s->tip[2]);
+    char f0[32], f1[32], f2[32];
+    snprintf(buf, sizeof buf, "tip  x %s  y %s  z %s m", render_fmt_fixed(f0, sizeof f0, s->tip[0], 2, false),
+             render_fmt_fixed(f1, sizeof f1, s->tip[1], 2, false), render_fmt_fixed(f2, sizeof f2, s->tip[2], 2, false));
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh;
-    snprintf(buf, sizeof buf, "hook z %.2f m   load %.0f kg%s", s->hook[2], s->load_mass,
+    snprintf(buf, sizeof buf, "hook z %s m   load %.0f kg%s", render_fmt_fixed(f0, sizeof f0, s->hook[2], 2, false),
+             s->load_mass,
              s->attached ? " (on hook)" : "");
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh;
-    snprintf(buf, sizeof buf, "slew %.1f deg  tilt %.1f deg  p_s %.1f MPa", s->slew * 180.0 / M_PI,
-             s->truck_tilt * 180.0 / M_PI, s->p_supply * 1e-6);
+    snprintf(buf, sizeof buf, "slew %s deg  tilt %s deg  p_s %s MPa",
+             render_fmt_fixed(f0, sizeof f0, s->slew * 180.0 / M_PI, 1, false),
+             render_fmt_fixed(f1, sizeof f1, s->truck_tilt * 180.0 / M_PI, 1, false),
+             render_fmt_fixed(f2, sizeof f2, s->p_supply * 1e-6, 1, false));
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh;
     if (s->npad) {
@@ -346,7 +350,7 @@ static float draw_readouts(render* r, const world_snapshot* s) {
         float px = x;
         px += render_hud_text(h, px, y, sc, k_dim, "pads kN");
         for (int i = 0; i < s->npad && i < 4; ++i) {
-            snprintf(buf, sizeof buf, "  %s %.1f", render_pad_name(i), s->pad_F[i] * 1e-3);
+            snprintf(buf, sizeof buf, "  %s %s", render_pad_name(i), render_fmt_fixed(f0, sizeof f0, s->pad_F[i] * 1e-3, 1, false));
             px += render_hud_text(h, px, y, sc, (s->pad_lifted >> i & 1) ? k_amber : k_white, buf);
         }
         pad_margin_text(s, buf, sizeof buf);
@@ -358,7 +362,9 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     for (int i = 0; i < r->nreadout; ++i) {
         // No value (NaN): the unit field says why ("not sent": a remote view's circuit channel).
         if (isnan(r->readout[i].value)) snprintf(buf, sizeof buf, "%s: %s", r->readout[i].name, r->readout[i].unit);
-        else snprintf(buf, sizeof buf, "%s %.4g %s", r->readout[i].name, r->readout[i].value, r->readout[i].unit);
+        else
+            snprintf(buf, sizeof buf, "%s %s %s", r->readout[i].name,
+                     render_fmt_unit(f0, sizeof f0, r->readout[i].value, r->readout[i].unit), r->readout[i].unit);
         render_hud_text(h, x, y, sc, k_white, buf);
         y += lh;
     }
@@ -502,12 +508,14 @@ static void draw_warnings(render* r, char w[][RENDER_WARN_LEN], int n) {
 // The rated capacity limiter's utilisation as a bar, bottom right: green
 // below 90 %, amber to 100 %, red beyond (the fill stops at 120 %).
 static void draw_rcl_bar(render* r, const world_snapshot* s) {
+    r->hud.rcl_rect[2] = 0;
     if (!s->rcl_have) return;
     render_hud* h = &r->hud;
     const float w = 220, hh = 14, x = (float)h->w - w - 14, y = (float)h->h - hh - 150;
     const float green[4] = {0.2f, 0.8f, 0.3f, 1}, red[4] = {1.0f, 0.1f, 0.1f, 1};
     const double u = s->rcl_util > 0 ? s->rcl_util : 0;
     render_hud_rect(h, x - 6, y - 18, w + 12, hh + 24, k_panel);
+    h->rcl_rect[0] = x - 6, h->rcl_rect[1] = y - 18, h->rcl_rect[2] = w + 12, h->rcl_rect[3] = hh + 24;
     char buf[64];
     snprintf(buf, sizeof buf, "load moment %.0f %% of rated%s", 100 * u, s->rcl_on ? "" : " (RCL off)");
     render_hud_text(h, x, y - 14, 1.0f, u >= 0.9 ? k_amber : k_white, buf);

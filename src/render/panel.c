@@ -292,6 +292,15 @@ void panel_set_slider_range(panel* p, int id, double min, double max) {
     if (!(q->smin < q->smax)) q->smin = q->min, q->smax = q->max;
 }
 
+void panel_set_note(panel* p, int id, const char* note) {
+    if (!p || id < 0 || id >= p->nparam) return;
+    snprintf(p->param[id].note, sizeof p->param[id].note, "%s", note ? note : "");
+}
+
+const char* panel_note(const panel* p, int id) {
+    return p && id >= 0 && id < p->nparam ? p->param[id].note : NULL;
+}
+
 void panel_slider_range(const panel* p, int id, double* min, double* max) {
     if (!p || id < 0 || id >= p->nparam) return;
     if (min) *min = p->param[id].smin;

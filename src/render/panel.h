@@ -123,6 +123,10 @@ bool panel_run_action_id(panel* p, int id);
 /// within which the widget keeps a dragged value; a typed value may leave
 /// it and is checked against [min, max] only. By default [min, max].
 void panel_set_slider_range(panel* p, int id, double min, double max);
+/// A note shown after the value and unit ("1400 MPa (fluid's)"), or NULL or
+/// "" for none: a value that follows another one until it is set.
+void panel_set_note(panel* p, int id, const char* note);
+const char* panel_note(const panel* p, int id);
 void panel_slider_range(const panel* p, int id, double* min, double* max);
 /// Register a one-line text field (a file path) of n bytes at buf, shown
 /// above the parameters; the app reads buf when one of its actions runs.
@@ -160,9 +164,19 @@ bool panel_gui_visible(const panel* p);
 /// Whether the window has the keyboard (a value is being typed): keys then
 /// go to it, not to the crane. Enter or Escape gives the keyboard back.
 bool panel_gui_wants_keyboard(const panel* p);
+/// The panel's window has the focus (it was clicked, or a value is typed):
+/// Esc then leaves the panel instead of reaching the crane's keys.
+bool panel_gui_has_focus(const panel* p);
 /// Screen rectangle (x, y, w, h [px]) of parameter id's widget as last drawn;
 /// false if it was not drawn (hidden window, collapsed group).
 bool panel_gui_item_rect(const panel* p, int id, float rect[4]);
+/// The same for action button id, and for the panel's window.
+bool panel_gui_action_rect(const panel* p, int id, float rect[4]);
+bool panel_gui_window_rect(const panel* p, float rect[4]);
+/// The panel's window ends this far above the bottom of the view [px]: the
+/// strip charts (124 px and margins) and the load-moment bar above them (its
+/// box starts 182 px above the bottom, hud.c) stay uncovered.
+#define PANEL_BOTTOM_CLEAR 196.0f
 
 #ifdef __cplusplus
 }

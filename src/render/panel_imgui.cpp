@@ -22,10 +22,13 @@ ImGuiContext* ctx_of(panel* p) {
     return static_cast<ImGuiContext*>(p->imgui_ctx);
 }
 
-/// Slider format showing the unit; a literal '%' must be doubled.
-void unit_format(char* out, size_t n, const char* unit) {
+/// Slider format showing the unit and the note ("fluid's"); a literal '%'
+/// must be doubled.
+void unit_format(char* out, size_t n, const char* unit, const char* note) {
     size_t k = (size_t)snprintf(out, n, "%%.4g ");
-    for (const char* u = unit; *u && k + 3 < n; ++u) {
+    char both[64];
+    std::snprintf(both, sizeof both, note && *note ? "%s (%s)" : "%s", unit, note);
+    for (const char* u = both; *u && k + 3 < n; ++u) {
         if (*u == '%') out[k++] = '%';
         out[k++] = *u;
     }
@@ -62,8 +65,8 @@ void draw_group(panel* p, const char* group, float label_w) {
                 ImGui::EndCombo();
             }
         } else {
-            char fmt[40];
-            unit_format(fmt, sizeof fmt, q->unit);
+            char fmt[80];
+            unit_format(fmt, sizeof fmt, q->unit, q->note);
             double v = q->has_pending ? q->pending : *q->value;
             // Drag (or Ctrl+click / double-click to type): the speed is a
             // fraction of the value per pixel. A slider mapped the whole
@@ -168,6 +171,20 @@ extern "C" bool panel_gui_visible(const panel* p) { return p && p->visible; }
 
 extern "C" bool panel_gui_wants_keyboard(const panel* p) { return p && p->visible && p->wants_keyboard; }
 
+extern "C" bool panel_gui_has_focus(const panel* p) { return p && p->visible && p->focused; }
+
+extern "C" bool panel_gui_action_rect(const panel* p, int id, float rect[4]) {
+    if (!p || id < 0 || id >= p->naction || !p->visible || !p->action[id].drawn) return false;
+    std::memcpy(rect, p->action[id].rect, 4 * sizeof(float));
+    return true;
+}
+
+extern "C" bool panel_gui_window_rect(const panel* p, float rect[4]) {
+    if (!p || !p->visible || !(p->win_rect[2] > 0)) return false;
+    std::memcpy(rect, p->win_rect, 4 * sizeof(float));
+    return true;
+}
+
 extern "C" bool panel_gui_item_rect(const panel* p, int id, float rect[4]) {
     if (!p || id < 0 || id >= p->nparam || !p->visible || !p->param[id].drawn) return false;
     std::memcpy(rect, p->param[id].rect, 4 * sizeof(float));
@@ -198,6 +215,8 @@ extern "C" void panel_gui_draw(panel* p) {
     }
     p->ndeferred_up = 0;
     for (int i = 0; i < p->nparam; ++i) p->param[i].drawn = false;
+    for (int a = 0; a < p->naction; ++a) p->action[a].drawn = false;
+    p->win_rect[2] = 0;
     if (p->visible) {
         // The label column is as wide as the longest label.
         float label_w = 0.0f;
@@ -213,14 +232,27 @@ extern "C" void panel_gui_draw(panel* p) {
         const ImVec2 disp = ImGui::GetIO().DisplaySize;
         const float win_w = label_w + 190.0f;
         ImGui::SetNextWindowPos(ImVec2(disp.x - win_w - 10.0f, 10.0f), ImGuiCond_FirstUseEver);
-        // Down to the strip charts (124 px + margins at the bottom), so they
-        // stay visible; the list scrolls.
-        const float win_h = disp.y - 175.0f > 200.0f ? disp.y - 175.0f : 200.0f;
+        // Down to above the load-moment bar and the strip charts, so they
+        // stay visible (it covered the bar); the list scrolls.
+        const float win_h = disp.y - 10.0f - PANEL_BOTTOM_CLEAR > 200.0f ? disp.y - 10.0f - PANEL_BOTTOM_CLEAR : 200.0f;
         ImGui::SetNextWindowSize(ImVec2(win_w, win_h), ImGuiCond_FirstUseEver);
         ImGui::Begin("Parameters", &p->visible);
+        {
+            const ImVec2 wp = ImGui::GetWindowPos(), ws = ImGui::GetWindowSize();
+            p->win_rect[0] = wp.x, p->win_rect[1] = wp.y, p->win_rect[2] = ws.x, p->win_rect[3] = ws.y;
+        }
+        // The buttons in rows as wide as the window: in one row the last
+        // ("load model") was cut off at the window's edge.
+        const ImGuiStyle& style = ImGui::GetStyle();
+        const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
         for (int a = 0; a < p->naction; ++a) {
-            if (a) ImGui::SameLine();
+            const float bw = ImGui::CalcTextSize(p->action[a].label).x + 2.0f * style.FramePadding.x;
+            if (a && ImGui::GetItemRectMax().x + style.ItemSpacing.x + bw <= right) ImGui::SameLine();
             if (ImGui::Button(p->action[a].label)) panel_run_action_id(p, a);
+            const ImVec2 r0 = ImGui::GetItemRectMin(), r1 = ImGui::GetItemRectMax();
+            panel_action* act = &p->action[a];
+            act->rect[0] = r0.x, act->rect[1] = r0.y, act->rect[2] = r1.x - r0.x, act->rect[3] = r1.y - r0.y;
+            act->drawn = true;
         }
         for (int t = 0; t < p->ntext; ++t) {
             ImGui::PushID(1000 + t);
@@ -236,11 +268,13 @@ extern "C" void panel_gui_draw(panel* p) {
             ImGui::PopTextWrapPos();
         }
         // Who has the keyboard: while a value is typed the crane's keys go
-        // here; Enter or Escape gives them back (below).
+        // here; Enter or Escape gives them back (below). Esc in the panel
+        // never quits the drive (drive_session.c).
         ImGui::PushTextWrapPos(0.0f);
         if (p->wants_keyboard)
             ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.2f, 1.0f),
-                               "The panel has the keyboard: Enter or Esc gives it back to the crane.");
+                               "The panel has the keyboard: Enter applies the value, Esc drops it; both give "
+                               "the keyboard back to the crane.");
         if (any_release) ImGui::TextDisabled("* applied on release; rebuilds the world (loads back at their start)");
         ImGui::PopTextWrapPos();
         // Groups in the order they were first registered.
@@ -268,6 +302,9 @@ extern "C" void panel_gui_draw(panel* p) {
         const bool focused = ImGui::IsWindowFocused(ImGuiFocusedFlags_RootAndChildWindows);
         ImGui::End();
         if ((enter || esc) && focused) ImGui::SetWindowFocus(nullptr);
+        p->focused = focused && !enter && !esc;
+    } else {
+        p->focused = false;
     }
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());

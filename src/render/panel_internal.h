@@ -22,6 +22,7 @@ typedef struct panel_param {
     int nchoice;
     bool drawn;                 ///< drawn in the last frame, at rect
     float rect[4];              ///< x, y, w, h [px]
+    char note[24];              ///< shown after the unit ("fluid's"), or ""
 } panel_param;
 
 typedef struct panel_text {
@@ -34,6 +35,8 @@ typedef struct panel_action {
     char label[64];
     panel_action_fn fn;
     void* user;
+    bool drawn;     ///< drawn in the last frame, at rect
+    float rect[4];  ///< x, y, w, h [px]
 } panel_action;
 
 struct panel {
@@ -50,6 +53,8 @@ struct panel {
     char last_error[256];
     bool visible;
     bool wants_keyboard;  ///< ImGui had the keyboard at the last frame
+    bool focused;         ///< the panel's window had the focus at the end of the last frame
+    float win_rect[4];    ///< the window as last drawn, x y w h [px] (w 0: not drawn)
     bool have_mouse;      ///< mouse_x/y hold the last mouse event's position
     /// Keys pressed since the last frame (SDL scancodes), and key-ups held
     /// back for after it: ImGui 1.86 reads key states once per frame, so a

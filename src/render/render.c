@@ -237,6 +237,12 @@ bool render_hud_bar_rect(const render* r, int cyl, int chamber, int rect[4]) {
     return true;
 }
 
+bool render_hud_rcl_rect(const render* r, float rect[4]) {
+    if (!(r->hud.rcl_rect[2] > 0)) return false;
+    memcpy(rect, r->hud.rcl_rect, 4 * sizeof(float));
+    return true;
+}
+
 bool render_hud_readouts_rect(const render* r, float rect[4]) {
     if (!(r->hud.readouts_rect[2] > 0)) return false;
     memcpy(rect, r->hud.readouts_rect, 4 * sizeof(float));

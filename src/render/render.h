@@ -164,6 +164,20 @@ bool render_hud_bar_rect(const render* r, int cyl, int chamber, int rect[4]);
 /// at the top left as drawn in the last frame; false before the first HUD.
 bool render_hud_readouts_rect(const render* r, float rect[4]);
 
+/// Screen rectangle (x, y, w, h [px]) of the load-moment bar's box, bottom
+/// right, as drawn in the last frame; false when it was not drawn.
+bool render_hud_rcl_rect(const render* r, float rect[4]);
+
+/// The HUD's numbers (hud_fmt.c): v with `decimals` decimals (a leading +
+/// with sign), never "-0.0": a value that is zero at that precision prints
+/// unsigned. render_fmt_unit takes the decimals for the unit (MPa 2, mm 1,
+/// L/min 1, % 1, kN 2, ...; another unit four significant digits, at most
+/// six decimals), so a readout never shows an exponent ("x2 0.0 mm", not
+/// "x2 -3.81e-05 mm").
+const char* render_fmt_fixed(char* buf, size_t n, double v, int decimals, bool sign);
+int render_unit_decimals(const char* unit, double v);
+const char* render_fmt_unit(char* buf, size_t n, double v, const char* unit);
+
 /// Current framebuffer size [px].
 void render_size(const render* r, int* w, int* h);
 render_stats render_get_stats(const render* r);

@@ -171,6 +171,7 @@ typedef struct render_hud {
     int bar_rect[WORLD_SNAP_MAX_CYLINDERS][2][4]; ///< last frame's bar frames, x y w h [px]
     bool bar_valid[WORLD_SNAP_MAX_CYLINDERS];
     float readouts_rect[4]; ///< last frame's readouts box, x y w h [px]
+    float rcl_rect[4];      ///< last frame's load-moment bar box, x y w h [px] (w 0: none)
 } render_hud;
 
 bool render_hud_create(render_hud* h);

@@ -167,7 +167,9 @@ static void draw_box(render_hud* h, const render_charts* c, int group, double t1
         // Legend with the latest value and unit, wrapped inside the box.
         if (ch->count) {
             int last = (ch->head + RENDER_CHART_CAP - 1) % RENDER_CHART_CAP;
-            snprintf(buf, sizeof buf, "%s %.3g %s", ch->label, ch->v[last], ch->unit);
+            char v[32]; // decimals by unit, no exponent, no -0 (hud_fmt.c)
+            snprintf(buf, sizeof buf, "%s %s %s", ch->label, render_fmt_unit(v, sizeof v, ch->v[last], ch->unit),
+                     ch->unit);
         } else {
             snprintf(buf, sizeof buf, "%s", ch->label);
         }

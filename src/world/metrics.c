@@ -41,6 +41,12 @@ static const metric_def k_metric[MET_COUNT] = {
     [MET_COLLISIONS] = {"collision_count", "count", COL_TRUCK_TILT},
 };
 
+// A time summed from row or step intervals, to 1 ns: far below any step,
+// and the sum then prints as the decimal the steps add up to (7.431 s, not
+// the 7.431000000000001 s that summing 1 ms in binary leaves). An integer
+// count of ns over 1e9 is the double nearest that decimal.
+static double metric_time(double t) { return round(t * 1e9) / 1e9; }
+
 bool metrics_present(metric_id id, int ncol) { return id >= 0 && id < MET_COUNT && k_metric[id].col < ncol; }
 const char* metric_name(metric_id id) { return k_metric[id].name; }
 const char* metric_unit(metric_id id) { return k_metric[id].unit; }
@@ -74,7 +80,14 @@ void metrics_row(run_metrics* m, const double* row) {
         if (m->present[i]) m->value[i] = fmax(m->value[i], row[k_metric[i].col]);
     const int stops = (int)row[COL_END_STOP];
     if (m->rows > 0) {
-        if (row[COL_RELIEF_OPEN] > 0) m->value[MET_RELIEF_TIME] += row[COL_T] - m->t_prev;
+        if (row[COL_RELIEF_OPEN] > 0) {
+            // Neumaier's compensated sum: a long run's many small intervals
+            // lose nothing to rounding before metric_time.
+            const double dt = row[COL_T] - m->t_prev, s = m->relief_sum + dt;
+            m->relief_c += fabs(m->relief_sum) >= fabs(dt) ? (m->relief_sum - s) + dt : (dt - s) + m->relief_sum;
+            m->relief_sum = s;
+            m->value[MET_RELIEF_TIME] = metric_time(m->relief_sum + m->relief_c);
+        }
     }
     const int rising = stops & ~(m->rows > 0 ? m->stop_prev : 0);
     for (int k = 0; k < 3; ++k)
@@ -141,7 +154,7 @@ void metrics_energy(run_metrics* m, const sim_energy* e) {
     for (int i = 0; i < sim_energy_ncol(e) && m->nrelief < METRICS_MAXRELIEF; ++i) {
         if (sim_energy_col_group(e, i) != SIM_EG_RELIEF) continue;
         snprintf(m->relief_name[m->nrelief], sizeof m->relief_name[0], "%s", sim_energy_col_name(e, i));
-        m->relief_time[m->nrelief++] = sim_energy_col_open_time(e, i);
+        m->relief_time[m->nrelief++] = metric_time(sim_energy_col_open_time(e, i));
     }
 }
 

@@ -299,6 +299,52 @@ static void test_sweep_threads_same_file(void) {
               mets[k], csv_field(r3, csv_col(a, mets[k])), json_metric(json, mets[k]));
 }
 
+// The results file's numbers are the decimals they stand for (docs/sweep.md):
+// the grid point 0.08 + 3 x 0.01 is 0.11, the value `run --set ...=0.11`
+// runs (its metrics equal bit for bit), not 0.11000000000000001, a design
+// 1 ulp away; the relief time of 1 ms rows is the count of open row
+// intervals over 1000, counted here in the run's CSV (7.431, not
+// 7.431000000000001).
+static void test_sweep_numbers_are_decimals(void) {
+    static char a[1 << 15], json[8192], line[8192];
+    CHECK(cli_run("sweep --scenario overload --param hydraulics.components.lift_cyl.bore=0.08:0.14:7 "
+                  "--out sweep_dec.csv -q",
+                  out, sizeof out) == 0,
+          "%s", out);
+    CHECK(cli_read_file("sweep_dec.csv", a, sizeof a) > 0, "no sweep_dec.csv");
+    const char* want[] = {"\n1,0.09,", "\n2,0.1,", "\n3,0.11,", "\n4,0.12,", "\n5,0.13,", "\n6,0.14,"};
+    for (int k = 0; k < 6; ++k) CHECK(strstr(a, want[k]) != NULL, "no row '%s' in:\n%s", want[k] + 1, a);
+    CHECK(cli_run("run --scenario overload --set hydraulics.components.lift_cyl.bore=0.11 --out sweep_dec_run.csv "
+                  "--metrics sweep_dec_run.json -q",
+                  out, sizeof out) == 0,
+          "%s", out);
+    CHECK(cli_read_file("sweep_dec_run.json", json, sizeof json) > 0, "no sweep_dec_run.json");
+    const char* r3 = strstr(a, "\n3,");
+    const char* mets[] = {"peak_p1A", "peak_p1B", "peak_p2A", "peak_p_pump", "relief_open_time"};
+    for (int k = 0; k < 5 && r3; ++k)
+        CHECK(csv_field(r3 + 1, csv_col(a, mets[k])) == json_metric(json, mets[k]), "%s: sweep %.17g, run %.17g",
+              mets[k], csv_field(r3 + 1, csv_col(a, mets[k])), json_metric(json, mets[k]));
+    FILE* f = fopen("sweep_dec_run.csv", "r");
+    CHECK(f != NULL, "no sweep_dec_run.csv");
+    if (!f) return;
+    long open = 0, rows = 0;
+    int cr = -1;
+    while (fgets(line, sizeof line, f)) {
+        if (cr < 0) {
+            cr = csv_col(line, "relief_open");
+            continue;
+        }
+        if (rows++ > 0 && csv_field(line, cr) > 0) ++open;
+    }
+    fclose(f);
+    const double t = json_metric(json, "relief_open_time");
+    CHECK(open > 100 && t == (double)open / 1000.0, "relief open %.17g s, %ld open 1 ms row intervals", t, open);
+    // As text: the CSV cell is that decimal.
+    char cell[64];
+    snprintf(cell, sizeof cell, ",%.15g,", (double)open / 1000.0);
+    CHECK(r3 && strstr(r3, cell) != NULL, "row 3 has no cell '%s': %.200s", cell, r3 ? r3 : "");
+}
+
 // A design the model refuses (a bore <= 0) is a row with exit 2 and the
 // model's message, one that blows up a row with exit 1; the others run and
 // the sweep exits 0. --fail-fast stops
@@ -447,6 +493,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_sway_metrics_match_csv);
     RUN_TEST(test_drive_summary_collisions_match_run);
     RUN_TEST(test_sweep_threads_same_file);
+    RUN_TEST(test_sweep_numbers_are_decimals);
     RUN_TEST(test_sweep_failing_design_is_a_row);
     RUN_TEST(test_sweep_bad_input);
     RUN_TEST(test_sweep_lhs_strata);
