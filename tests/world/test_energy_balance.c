@@ -176,16 +176,25 @@ static void order(void) {
               adaptive ? "rtol 1e-4" : "h = 0.05 ms", shrink);
     }
     // CVODE (the reference) integrates the terms with its BDF steps as
-    // quadratures (hyd_cvode.h). At its default rtol 1e-3 its own states are
-    // off on hold (the pump line overshoots to 22.5 MPa and the relief
-    // opens), and so is the balance; at rtol 1e-5 it closes within the bound.
+    // quadratures (hyd_cvode.h), outside its error test, so the residual is
+    // its states' own error and must shrink with its tolerance. At its
+    // default rtol 1e-3 its states are off on hold (the pump line overshoots
+    // to 22.5 MPa and the relief opens); at 1e-5 the shipped crane's seals
+    // hold the booms still and CVODE strides 85 steps over the 10 s of
+    // `hold`, its pump line 53 kPa off (-1.9 % of the 0.037 kJ turned
+    // over); at 1e-6 it closes within the bound.
     if (sim_have_cvode()) {
         const char* sc[] = {"hold", "step"};
         for (int i = 0; i < 2; ++i) {
-            const run_cfg c = {"hiab031.json", sc[i], SIM_LAGRANGE, NULL, HYD_KRUS, true, 0, 1e-5};
+            const run_cfg c = {"hiab031.json", sc[i], SIM_LAGRANGE, NULL, HYD_KRUS, true, 0, 1e-6};
             const double r = residual(&c);
-            CHECK(fabs(r) < BOUND_PCT, "cvode rtol 1e-5 %s: residual %.4f %%", sc[i], r);
+            CHECK(fabs(r) < BOUND_PCT, "cvode rtol 1e-6 %s: residual %.4f %%", sc[i], r);
         }
+        const run_cfg c5 = {"hiab031.json", "hold", SIM_LAGRANGE, NULL, HYD_KRUS, true, 0, 1e-5};
+        const run_cfg c7 = {"hiab031.json", "hold", SIM_LAGRANGE, NULL, HYD_KRUS, true, 0, 1e-7};
+        const double r5 = residual(&c5), r7 = residual(&c7);
+        CHECK(fabs(r7) <= 0.2 * fabs(r5), "cvode hold: residual %.4f %% at rtol 1e-5, %.4f %% at 1e-7: not below 0.2 of it",
+              r5, r7);
     }
 }
 

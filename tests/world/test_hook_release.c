@@ -13,10 +13,16 @@
 //  - the hook stays below the boom tip it hangs from (every row of the run);
 //  - the rope's angle grows by no more than the hook tipping over on what it
 //    rests on can make it (its bottom point moves by at most its own length);
-//  - no pad's force leaves the band of the second before by more than the
-//    weight of the hook and rope (moved wholly onto the tip or off it, that
-//    weight changes a pad's reaction by at most 0.73 of itself here, by
-//    statics: the tip 1.5 m outboard of the right pads' line, 4 m from the left);
+//  - no pad's force leaves the band of the second before by more than twice
+//    the weight of the hook and rope: moved wholly onto the tip or off it,
+//    that weight changes a pad's reaction by at most 0.73 of itself here, by
+//    statics (the tip 1.5 m outboard of the right pads' line, 4 m from the
+//    left), and a load that comes off an elastic structure at once (the hook
+//    sliding off the rope onto the stack) swings its reactions by up to twice
+//    their static change (the dynamic factor of a step load, undamped). With
+//    the shipped seal friction pad 4 dips 0.55 kN below its band as the hook
+//    lands, 1.4 of the 0.40 kN weight; the throw this guards against moved a
+//    rear pad by 7 kN;
 //  - the run's reported figures: no pad lift-off, the largest sway below 90 deg.
 // On the run path `cranesim run --scenario sandbox_pick_place` takes
 // (engine_run); the energies on the stepped path (the drivers' engine), whose
@@ -159,9 +165,9 @@ static void check_window(const window* wd, const world_desc* d, const char* what
             if (i < b) lo0 = fmin(lo0, f), hi0 = fmax(hi0, f);
             else lo1 = fmin(lo1, f), hi1 = fmax(hi1, f);
         }
-        CHECK(lo1 >= lo0 - W && hi1 <= hi0 + W,
+        CHECK(lo1 >= lo0 - 2 * W && hi1 <= hi0 + 2 * W,
               "%s: pad %d carried %.2f..%.2f kN after the release, %.2f..%.2f kN before (allowed +-%.2f kN)", what,
-              p + 1, lo1 * 1e-3, hi1 * 1e-3, lo0 * 1e-3, hi0 * 1e-3, W * 1e-3);
+              p + 1, lo1 * 1e-3, hi1 * 1e-3, lo0 * 1e-3, hi0 * 1e-3, 2 * W * 1e-3);
     }
 }
 
