@@ -364,8 +364,9 @@ int app_plot_heat(const char* png, const char* title, const char* xlab, const ch
 /// feasible or not, and the best feasible so far. 0, or -1 with a message.
 int app_plot_convergence(const char* png, const char* title, const char* ylab, const double* f, const bool* feasible,
                          long n, char* err, size_t errsz);
-/// Overlay two runs (a: solid, b: dashed) to a PNG.
+/// Overlay two runs (a: solid, b: dashed) to a PNG; slew: both runs' worlds
+/// have a slew drive, whose channels are drawn too.
 int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb,
-                     const char* title, const char* png, char* err, size_t errsz);
+                     const char* title, bool slew, const char* png, char* err, size_t errsz);
 
 #endif

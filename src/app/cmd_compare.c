@@ -481,7 +481,8 @@ int cmd_compare(int argc, char** argv) {
     if (plot) {
         char err[512], title[320];
         snprintf(title, sizeof title, "%s: %s vs %s", sc.name, label[0], label[1]);
-        if (app_plot_compare(&tr[0], label[0], &tr[1], label[1], title, plot, err, sizeof err)) {
+        if (app_plot_compare(&tr[0], label[0], &tr[1], label[1], title,
+                             app_world_has_slew(&side[0]) && app_world_has_slew(&side[1]), plot, err, sizeof err)) {
             fprintf(stderr, "cranesim compare: plot: %s\n", err);
             code = EXIT_RUNTIME;
         } else {

@@ -21,8 +21,9 @@ static void replay_help(FILE* f) {
             "world, solver, rated capacity limiter and start. On the recorded design the rows are those\n"
             "of the drive, bit for bit; with --model or --set the same operator input (the operator's\n"
             "own demands, through the same limiter) drives another design. Prints the\n"
-            "recorded and the replayed run's metrics side by side with their differences, and how many\n"
-            "rows are identical to the recording.\n"
+            "recorded and the replayed run's metrics side by side with their differences, how many\n"
+            "rows are identical to the recording, and the replay's energy balance (as run prints it;\n"
+            "a session records no balance of the drive; docs/energy.md).\n"
             "\n"
             "options:\n"
             "  --model FILE        replay on this model file instead of the one recorded in the session\n"
@@ -329,7 +330,7 @@ int cmd_replay(int argc, char** argv) {
     if (plot) {
         char title[640];
         snprintf(title, sizeof title, "replay of %s: recorded vs %s", path, model_path || nset ? "changed design" : "replay");
-        if (app_plot_compare(&tr[0], "recorded", &tr[1], "replay", title, plot, err, sizeof err)) {
+        if (app_plot_compare(&tr[0], "recorded", &tr[1], "replay", title, app_world_has_slew(&s.sim), plot, err, sizeof err)) {
             fprintf(stderr, "cranesim replay: plot: %s\n", err);
             code = EXIT_RUNTIME;
         } else {

@@ -399,9 +399,9 @@ int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* 
     return plot_traces(tr, "", NULL, "", title, slew, png, err, errsz);
 }
 
-int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb, const char* title,
+int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb, const char* title, bool slew,
                      const char* png, char* err, size_t errsz) {
-    return plot_traces(a, la, b, lb, title, false, png, err, errsz);
+    return plot_traces(a, la, b, lb, title, slew, png, err, errsz);
 }
 
 typedef struct bars_plot {
@@ -461,9 +461,9 @@ int app_plot_energy(const char* const* names, const double* kj, int n, const cha
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
     return -1;
 }
-int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb, const char* title,
+int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb, const char* title, bool slew,
                      const char* png, char* err, size_t errsz) {
-    (void)a, (void)la, (void)b, (void)lb, (void)title, (void)png;
+    (void)a, (void)la, (void)b, (void)lb, (void)title, (void)slew, (void)png;
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
     return -1;
 }
