@@ -61,7 +61,8 @@ static void test_trace_title_whole(void) {
                             "/yet_more_text_here/pick_and_place_session.session: recorded vs changed design"};
     for (int t = 0; t < 2; ++t) {
         char err[256];
-        CHECK(app_plot_compare(&a, "recorded", &b, "replay", titles[t], "test_plots_traces.png", err, sizeof err) ==
+        CHECK(app_plot_compare(&a, "recorded", &b, "replay", titles[t], t == 1, "test_plots_traces.png", err,
+                               sizeof err) ==
                   0,
               "%s", err);
         image im;
