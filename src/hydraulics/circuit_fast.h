@@ -54,6 +54,11 @@ int hyd_fast_nfallback(const hyd_fast* k);
 /// SSE2 form even with AVX (for tests), < 0 leaves it. Returns 1 when the
 /// circuit has that layout.
 int hyd_fast_lanes(hyd_fast* k, int on);
+/// Why the circuit does not have that layout ("" when it has): the first
+/// component of a type the layout has no place for, a count or a connection
+/// that differs from it (say "component 'x' (accumulator): the load-sensing
+/// layout has no place for this type").
+const char* hyd_fast_lanes_why(const hyd_fast* k);
 /// Evaluations the one-pass layout path has taken so far.
 unsigned long hyd_fast_lanes_count(const hyd_fast* k);
 
