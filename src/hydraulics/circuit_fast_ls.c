@@ -11,7 +11,11 @@
 // into chamber A, its pilot volume fed from hose B through a damping orifice;
 // hose B into chamber B; the cylinder. Reliefs and checks anywhere between
 // these nodes and tanks. Recognised at hyd_fast_create / hyd_fast_map
-// (hyd_fast_ls_pack); any other circuit keeps the per-type loops.
+// (hyd_fast_ls_pack) by an allow-list, ls_allowed: the exact count of each
+// type above and no component of any other type, so that a component the
+// pass has no place for (a type added later, with or without a fast loop)
+// refuses the layout instead of being left out of the sums. Any other
+// circuit keeps the per-type loops, the reason in hyd_fast_lanes_why.
 //
 // Why it is the loops bit for bit:
 // - every law is its component header's own text: the + - * macros
