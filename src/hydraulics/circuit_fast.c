@@ -112,8 +112,13 @@ static void take_records(hyd_fast* k) {
     hyd_shuttle_c* sh = k->rec[HYD_SHUTTLE];
     for (int i = 0; i < k->nrec[HYD_SHUTTLE]; ++i)
         if (sh[i].su >= 0) sh[i].su = k->smap[sh[i].su]; // spool mode: the valve's spool
-    if (k->nfb_comp) k->ls.ok = 0;
-    else hyd_fast_ls_pack(m, k->smap, k->ns, &k->ls);
+    if (k->nfb_comp) {
+        memset(&k->ls, 0, sizeof k->ls);
+        snprintf(k->ls.why, sizeof k->ls.why, "%d components fall back to their reference loops",
+                 k->nfb_comp);
+    } else {
+        hyd_fast_ls_pack(m, k->smap, k->ns, &k->ls);
+    }
     if (k->lanes == 2) hyd_fast_ls_avx(&k->ls, 0);
     k->rev = m->revision;
 }
@@ -602,6 +607,8 @@ int hyd_fast_lanes(hyd_fast* k, int on) {
 }
 
 unsigned long hyd_fast_lanes_count(const hyd_fast* k) { return k->nls; }
+
+const char* hyd_fast_lanes_why(const hyd_fast* k) { return k->ls.ok ? "" : k->ls.why; }
 
 void hyd_fast_jacobian(hyd_fast* k, hyd_data* d, const double* y, double* ydot, double* J, int ldj) {
     const hyd_model* m = k->m;

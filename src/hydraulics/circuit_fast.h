@@ -10,9 +10,16 @@
 // loops (hyd_eval, hyd_jacobian) to rounding; only the summation order of a
 // node's inflows differs.
 //
-// It refuses nothing silently: a component of a type it has no loop for is
-// either evaluated by that type's reference loop (fallback) or the kernel is
-// not built, with a message naming the component and its type.
+// No component is left out of its sums: a component of a type it has no
+// loop for is either evaluated by that type's reference loop (fallback) or
+// the kernel is not built, with a message naming the component and its
+// type. Its one shape-specific path, the load-sensing layout in one pass
+// (circuit_fast_ls.c, hyd_fast_lanes), is an allow-list: the exact number
+// of components of each type it packs and none of any other type (also a
+// type with a fast loop here, or one added to the library later); any other
+// circuit runs the loops, and hyd_fast_lanes_why says why.
+// tests/hydraulics/test_every_type.c adds each type to each shipped circuit
+// and compares every path with the reference loops.
 #ifndef HYD_CIRCUIT_FAST_H
 #define HYD_CIRCUIT_FAST_H
 
@@ -46,7 +53,8 @@ int hyd_fast_nfallback(const hyd_fast* k);
 
 /// The load-sensing crane layout (an LS pump, LS shuttle and two
 /// compensated sections with counterbalance valves, as
-/// assets/models/hiab031_ls.json) has a one-pass evaluation with its two
+/// assets/models/hiab031_ls.json, and nothing else but reliefs and checks)
+/// has a one-pass evaluation with its two
 /// sections in two SSE2 lanes, bit for bit the loops' (circuit_fast_ls.c);
 /// hyd_fast_eval takes it whenever no end stop is touched and every pressure
 /// is on the Be table (in AVX form where the CPU has it, else SSE2; the
@@ -54,6 +62,11 @@ int hyd_fast_nfallback(const hyd_fast* k);
 /// SSE2 form even with AVX (for tests), < 0 leaves it. Returns 1 when the
 /// circuit has that layout.
 int hyd_fast_lanes(hyd_fast* k, int on);
+/// Why the circuit does not have that layout ("" when it has): the first
+/// component of a type the layout has no place for, a count or a connection
+/// that differs from it (say "component 'x' (accumulator): the load-sensing
+/// layout has no place for this type").
+const char* hyd_fast_lanes_why(const hyd_fast* k);
 /// Evaluations the one-pass layout path has taken so far.
 unsigned long hyd_fast_lanes_count(const hyd_fast* k);
 

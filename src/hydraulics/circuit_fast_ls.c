@@ -11,7 +11,11 @@
 // into chamber A, its pilot volume fed from hose B through a damping orifice;
 // hose B into chamber B; the cylinder. Reliefs and checks anywhere between
 // these nodes and tanks. Recognised at hyd_fast_create / hyd_fast_map
-// (hyd_fast_ls_pack); any other circuit keeps the per-type loops.
+// (hyd_fast_ls_pack) by an allow-list, ls_allowed: the exact count of each
+// type above and no component of any other type, so that a component the
+// pass has no place for (a type added later, with or without a fast loop)
+// refuses the layout instead of being left out of the sums. Any other
+// circuit keeps the per-type loops, the reason in hyd_fast_lanes_why.
 //
 // Why it is the loops bit for bit:
 // - every law is its component header's own text: the + - * macros
@@ -133,18 +137,67 @@ static int ramp_bound(const hyd_fast_ls_ramp* r, int relief, double* b) {
 
 #endif
 
+// The layout's allow-list: how many components of type t it packs (-1: any
+// number, the reliefs and checks, which the pack places by their nodes, up to
+// LSK_MAXRAMP together). Every other type, and every type added to the
+// library after this list, is 0: a component the pass has no place for would
+// be left out of its sums, so its presence refuses the layout and the loops
+// (or their fallback) run.
+static int ls_allowed(hyd_type t) {
+    switch (t) {
+    case HYD_LS_PUMP:
+        return 1;
+    case HYD_SHUTTLE:
+        return 3; // the LS line's max-select and one per section
+    case HYD_COMPENSATOR:
+        return 2;
+    case HYD_COUNTERBALANCE:
+        return 2;
+    case HYD_VALVE:
+        return 2;
+    case HYD_CYLINDER:
+        return 2;
+    case HYD_HOSE:
+        return 4;
+    case HYD_ORIFICE:
+        return 2; // the counterbalance valves' pilot damping
+    case HYD_RELIEF:
+    case HYD_CHECK:
+        return -1;
+    default:
+        return 0;
+    }
+}
+
+// The reason the layout was refused, kept for hyd_fast_lanes_why.
+#define REFUSE(...) return (void)snprintf(L->why, sizeof L->why, __VA_ARGS__)
+
 void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fast_ls* L) {
     memset(L, 0, sizeof *L);
 #ifndef LSK_LANES
-    (void)m, (void)smap, (void)ns;
-    return;
+    (void)m, (void)smap, (void)ns, (void)ls_allowed;
+    REFUSE("the one-pass layout needs SSE2");
 #else
-    if (!m->air.use) return; // the lanes take Be from the tables only
+    if (!m->air.use) REFUSE("the air tables are off (the lanes take Be from them only)");
+    // The allow-list, component by component (not by the counts of the types
+    // the pack knows: a type it does not know must refuse too).
+    int cnt[HYD_TYPE_COUNT] = {0};
+    for (int c = 0; c < m->ncomp; ++c) {
+        const hyd_type t = m->comp[c].type;
+        if ((unsigned)t >= HYD_TYPE_COUNT || ls_allowed(t) == 0)
+            REFUSE("component '%s' (%s): the load-sensing layout has no place for this type",
+                   m->comp[c].name, hyd_type_name(t));
+        ++cnt[t];
+    }
+    for (int t = 0; t < HYD_TYPE_COUNT; ++t) {
+        const int want = ls_allowed((hyd_type)t);
+        if (want >= 0 && cnt[t] != want)
+            REFUSE("%d components of type %s, the load-sensing layout has %d", cnt[t],
+                   hyd_type_name((hyd_type)t), want);
+    }
+    if (m->nvol != LSK_NSLOT)
+        REFUSE("%d volume nodes, the load-sensing layout has %d", m->nvol, LSK_NSLOT);
     const int* nr = m->nrec;
-    if (nr[HYD_PUMP] || nr[HYD_ACCUMULATOR] || nr[HYD_LS_PUMP] != 1 || nr[HYD_SHUTTLE] != 3 ||
-        nr[HYD_COMPENSATOR] != 2 || nr[HYD_COUNTERBALANCE] != 2 || nr[HYD_VALVE] != 2 || nr[HYD_CYLINDER] != 2 ||
-        nr[HYD_HOSE] != 4 || nr[HYD_ORIFICE] != 2 || m->nvol != LSK_NSLOT)
-        return;
     const hyd_ls_pump_c* pu = RECS(m, HYD_LS_PUMP, hyd_ls_pump_c);
     const hyd_shuttle_c* sh = RECS(m, HYD_SHUTTLE, hyd_shuttle_c);
     const hyd_comp_c* co = RECS(m, HYD_COMPENSATOR, hyd_comp_c);
@@ -154,41 +207,47 @@ void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fa
     const hyd_hose_c* ho = RECS(m, HYD_HOSE, hyd_hose_c);
     const hyd_orifice_c* orf = RECS(m, HYD_ORIFICE, hyd_orifice_c);
     const int pl = pu->out, ll = pu->ls;
-    if (m->node_state[pu->in] >= 0) return; // the pump draws from a tank
+    if (m->node_state[pu->in] >= 0) REFUSE("the LS pump does not draw from a tank");
     // The LS shuttle: the one in max-select mode, first among the shuttles
     // (the section LS nodes get its flow before their own shuttle's).
-    if (sh[0].su >= 0 || sh[1].su < 0 || sh[2].su < 0 || sh[0].out != ll) return;
+    if (sh[0].su >= 0 || sh[1].su < 0 || sh[2].su < 0 || sh[0].out != ll)
+        REFUSE("the shuttles are not a max-select one into the LS line, then two spool-mode ones");
     L->node[LSK_PL] = pl, L->node[LSK_LL] = ll;
     for (int l = 0; l < 2; ++l) {
         // Lane l is compensator l: the pump line loses compensator 0's flow
         // before compensator 1's, as the loops subtract them.
         const hyd_comp_c* c = &co[l];
-        if (c->in != pl || c->ref != ll) return;
+        if (c->in != pl || c->ref != ll)
+            REFUSE("compensator %d is not fed from the pump line with the LS line as its reference",
+                   l);
         const hyd_valve_c* v = NULL;
         for (int i = 0; i < 2; ++i)
             if (va[i].P == c->out) v = &va[i];
-        if (!v || m->node_state[v->T] >= 0) return;
+        if (!v || m->node_state[v->T] >= 0)
+            REFUSE("compensator %d feeds no valve draining to a tank", l);
         const hyd_shuttle_c* s = NULL;
         for (int i = 1; i < 3; ++i)
             if (sh[i].su == v->adr) s = &sh[i];
-        if (!s || s->a != v->A || s->b != v->B || s->t != v->T || s->out != c->load) return;
+        if (!s || s->a != v->A || s->b != v->B || s->t != v->T || s->out != c->load)
+            REFUSE("section %d has no spool-mode shuttle of its valve's ports into its LS node", l);
         const hyd_hose_c *ha = NULL, *hb = NULL;
         for (int i = 0; i < 4; ++i) {
             if (ho[i].node == v->A) ha = &ho[i];
             if (ho[i].node == v->B) hb = &ho[i];
         }
-        if (!ha || !hb) return;
+        if (!ha || !hb) REFUSE("a valve port of section %d is not a hose", l);
         const hyd_cyl_c* y = NULL;
         for (int i = 0; i < 2; ++i)
             if (cy[i].nB == hb->to) y = &cy[i];
         const hyd_cb_c* b = NULL;
         for (int i = 0; i < 2; ++i)
             if (cb[i].v == ha->to) b = &cb[i];
-        if (!y || !b || b->l != y->nA) return;
+        if (!y || !b || b->l != y->nA)
+            REFUSE("section %d: hose A does not reach chamber A through a counterbalance valve", l);
         const hyd_orifice_c* o = NULL;
         for (int i = 0; i < 2; ++i)
             if (orf[i].in == v->B && orf[i].out == b->p) o = &orf[i];
-        if (!o) return;
+        if (!o) REFUSE("section %d: no damping orifice from hose B to the counterbalance pilot", l);
         const int nodes[LSK_NSEC] = {v->P, c->load, v->A, v->B, b->v, b->p, y->nA, y->nB};
         for (int j = 0; j < LSK_NSEC; ++j) L->node[2 * j + l] = nodes[j];
         L->su[l] = smap[v->adr], L->sx[l] = smap[c->adr], L->sc[l] = smap[b->adr];
@@ -215,15 +274,17 @@ void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fa
         set_mask(&L->seal_m[l], L->seal_l[l]);
         L->seal |= L->seal_l[l];
     }
-    if (sh[0].a != L->node[2 * LSK_LS] || sh[0].b != L->node[2 * LSK_LS + 1]) return;
+    if (sh[0].a != L->node[2 * LSK_LS] || sh[0].b != L->node[2 * LSK_LS + 1])
+        REFUSE("the LS shuttle does not select between the two sections' LS nodes");
     // Every slot a distinct volume node (nvol == LSK_NSLOT: then every volume
     // node is one of them, and each flow above reaches its node only here).
     int slot_of[256];
-    if (m->nnode > 256) return;
+    if (m->nnode > 256) REFUSE("more than 256 nodes");
     for (int i = 0; i < m->nnode; ++i) slot_of[i] = -1;
     for (int i = 0; i < LSK_NSLOT; ++i) {
         const int nd = L->node[i];
-        if (nd < 0 || nd >= m->nnode || ns[nd] < 0 || slot_of[nd] >= 0) return;
+        if (nd < 0 || nd >= m->nnode || ns[nd] < 0 || slot_of[nd] >= 0)
+            REFUSE("the layout's nodes are not %d distinct volumes", LSK_NSLOT);
         slot_of[nd] = i;
         L->s[i] = ns[nd];
         L->bel[i] = m->node_bel[nd], L->bec[i] = m->node_bec[nd], L->V0[i] = m->node_V0[nd];
@@ -234,7 +295,7 @@ void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fa
         const hyd_type t = pass ? HYD_CHECK : HYD_RELIEF;
         const hyd_ramp_c* r = RECS(m, t, hyd_ramp_c);
         for (int i = 0; i < nr[t]; ++i) {
-            if (L->nramp == LSK_MAXRAMP) return;
+            if (L->nramp == LSK_MAXRAMP) REFUSE("more than %d reliefs and checks", LSK_MAXRAMP);
             hyd_fast_ls_ramp* q = &L->ramp[L->nramp++];
             q->in = slot_of[r[i].in], q->out = slot_of[r[i].out];
             q->pin = m->node_pfix[r[i].in], q->pout = m->node_pfix[r[i].out];
@@ -261,6 +322,7 @@ void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fa
     hyd_fast_ls_avx(L, 1);
 #endif
 }
+#undef REFUSE
 
 #ifdef LSK_LANES
 #include "hyd_lanes.h"

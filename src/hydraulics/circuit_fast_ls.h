@@ -30,6 +30,7 @@ typedef struct hyd_fast_ls_ramp {
 /// each section type, the lift; lane 1: the second, the jib).
 typedef struct hyd_fast_ls {
     int ok;                    ///< the layout was recognised (else the loops run)
+    char why[160];             ///< why not, when !ok (hyd_fast_lanes_why)
     int node[LSK_NSLOT];       ///< model node of each slot
     int s[LSK_NSLOT];          ///< its state in the caller's order
     double bel[LSK_NSLOT], bec[LSK_NSLOT], V0[LSK_NSLOT];
@@ -66,8 +67,11 @@ typedef struct hyd_fast_ls {
 } hyd_fast_ls;
 
 /// Recognise the layout on model m with the caller's state order smap and
-/// node states ns (hyd_fast's), and pack it into L; L->ok = 0 when m is of any
-/// other shape (or the air tables are off, or SSE2 is missing).
+/// node states ns (hyd_fast's), and pack it into L; L->ok = 0 with the reason
+/// in L->why when m is of any other shape (or the air tables are off, or SSE2
+/// is missing). The recognition is an allow-list: the exact number of
+/// components of each type the pass packs (reliefs and checks: any, up to
+/// LSK_MAXRAMP), none of any other type, and every connection checked.
 void hyd_fast_ls_pack(const hyd_model* m, const int* smap, const int* ns, hyd_fast_ls* L);
 
 /// Take the AVX form of the one-pass kernel (on, and the CPU has AVX) or the
