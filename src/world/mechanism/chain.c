@@ -609,6 +609,9 @@ void chain_inverse_dynamics(const chain* c, chain_ws* w, const double* qdd, int 
 
 void chain_mass_matrix(const chain* c, chain_ws* w, double* M) {
     const int nb = c->nbody, nd = c->ndof;
+    // Only ancestor-descendant pairs are written below; two DOFs on
+    // different branches of a tree do not couple.
+    memset(M, 0, (size_t)nd * (size_t)nd * sizeof *M);
     for (int i = 0; i < nb; ++i) {
         double* I = &w->Ic[13 * i];
         I[0] = c->m[i];
