@@ -250,7 +250,7 @@ static void check_model(const model* m, int trials, double* worst_M, double* wor
         const double sB = maxabs(Bn, nd);
         for (int k = 0; k < nd; ++k) {
             *worst_b = fmax(*worst_b, fabs(B[k] - Bn[k]) / sB);
-            CHECK_NEAR(B[k], Bn[k], 1e-9 * sB);
+            CHECK_NEAR(B[k], Bn[k], 1e-10 * sB);
         }
         // Inverse and forward dynamics are each other's inverse: tau = M qdd + C + G.
         double qdd[NB_MAX], tau[NB_MAX], back[NB_MAX];
