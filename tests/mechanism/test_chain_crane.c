@@ -177,6 +177,12 @@ static void test_cylinders_match_crane(void) {
                 CHECK(close_rel(dLd, wantd, 2, 1e-11, &worst), "cyl %d d/dt dL/dq %g %g vs %g %g", a, dLd[0], dLd[1],
                       wantd[0], wantd[1]);
                 CHECK_NEAR(Ld, r * qd[a], 1e-12 * (fabs(r * qd[a]) + 1e-3));
+                // Hessian: d2x/dq2 on the cylinder's own joint, nothing else.
+                double H[4];
+                chain_cylinder_hessian(c, w, y->body_a, y->pa, y->body_b, y->pb, H);
+                const double Hw[4] = {a == 0 ? r2 : 0.0, 0.0, 0.0, a == 1 ? r2 : 0.0};
+                CHECK(close_rel(H, Hw, 4, 1e-11, &worst), "cyl %d Hessian %g %g %g %g vs %g %g %g %g", a, H[0],
+                      H[1], H[2], H[3], Hw[0], Hw[1], Hw[2], Hw[3]);
                 // Stroke: the chain's length minus the closed length is crane_stroke's.
                 CHECK_NEAR(L - y->closed_length, crane_stroke(ac, q[a]), 1e-12);
             }

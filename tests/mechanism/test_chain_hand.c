@@ -150,6 +150,13 @@ static void test_extension_on_swinging_boom(void) {
         CHECK_REL(dL[1], dx / L, 1e-13);
         CHECK_NEAR(dLd[0], 0, 1e-13);
         CHECK_NEAR(dLd[1], dz * dz / (L * L * L) * sd, 1e-13 / L);
+        // Hessian: only d2L/ds2 = dz^2 / L^3 (L does not depend on a).
+        double Hc[4];
+        chain_cylinder_hessian(c, w, 1, pa, 2, pb, Hc);
+        CHECK_NEAR(Hc[0], 0, 1e-13);
+        CHECK_NEAR(Hc[1], 0, 1e-13);
+        CHECK_NEAR(Hc[2], 0, 1e-13);
+        CHECK_NEAR(Hc[3], dz * dz / (L * L * L), 1e-13 / L);
         chain_ws_free(w);
         chain_free(c);
     }

@@ -201,8 +201,8 @@ static double maxabs(const double* x, int n) {
 // column) and a tree with a locked joint and a jib extension on the knuckle.
 static const spec RRP[] = {{-1, CHAIN_REVOLUTE, 0}, {0, CHAIN_REVOLUTE, 0}, {1, CHAIN_REVOLUTE, 0}, {2, CHAIN_PRISMATIC, 0}};
 static const spec TREE[] = {{-1, CHAIN_REVOLUTE, 0}, {0, CHAIN_REVOLUTE, 0},  {1, CHAIN_REVOLUTE, 0},
-                            {2, CHAIN_PRISMATIC, 0}, {3, CHAIN_REVOLUTE, 1},  {4, CHAIN_PRISMATIC, 0},
-                            {2, CHAIN_REVOLUTE, 0},  {6, CHAIN_PRISMATIC, 0}, {1, CHAIN_PRISMATIC, 1}};
+                            {2, CHAIN_PRISMATIC, 0}, {3, CHAIN_REVOLUTE, 0},  {4, CHAIN_PRISMATIC, 0},
+                            {2, CHAIN_REVOLUTE, 0},  {6, CHAIN_PRISMATIC, 0}, {1, CHAIN_REVOLUTE, 1}};
 
 static void check_model(const model* m, int trials, double* worst_M, double* worst_b) {
     chain* c = make(m);
@@ -338,6 +338,30 @@ static void check_model(const model* m, int trials, double* worst_M, double* wor
             }
             chain_update(c, w, q, qd);
             for (int k = 0; k < nd; ++k) CHECK_NEAR(dLd[k], Dn[k], 1e-9 * (1 + fabs(Dn[k])));
+            // The Hessian: column j by central differences of dL/dq in q_j;
+            // H qd is d/dt(dL/dq).
+            double H[NB_MAX * NB_MAX];
+            chain_cylinder_hessian(c, w, a, pa, b, pbb, H);
+            for (int j = 0; j < nd; ++j) {
+                for (int r = 0; r < 2; ++r) {
+                    memcpy(qp, q, sizeof(double) * (size_t)nd);
+                    memcpy(qm, q, sizeof(double) * (size_t)nd);
+                    qp[j] += hs[r], qm[j] -= hs[r];
+                    chain_update(c, w, qp, qd);
+                    chain_cylinder(c, w, a, pa, b, pbb, NULL, gp, NULL);
+                    chain_update(c, w, qm, qd);
+                    chain_cylinder(c, w, a, pa, b, pbb, NULL, gm, NULL);
+                    for (int k = 0; k < nd; ++k) {
+                        const double dd = (gp[k] - gm[k]) / (2 * hs[r]);
+                        Dn[k] = r == 0 ? dd : (4 * dd - Dn[k]) / 3;
+                    }
+                }
+                for (int k = 0; k < nd; ++k) CHECK_NEAR(H[k * nd + j], Dn[k], 1e-9 * (1 + fabs(Dn[k])));
+                double hq = 0;
+                for (int k = 0; k < nd; ++k) hq += H[j * nd + k] * qd[k];
+                CHECK_NEAR(hq, dLd[j], 1e-12 * (1 + fabs(dLd[j])));
+            }
+            chain_update(c, w, q, qd);
         }
     }
     chain_ws_free(w);

@@ -510,6 +510,57 @@ double chain_cylinder(const chain* c, const chain_ws* w, int a, const double pa[
     return L;
 }
 
+// d(J_k)/dq_j for a point on body i, J_k its Jacobian column of DOF k, for
+// DOFs j and k whose bodies are both i or its ancestors (else 0): of the two
+// joints the one nearer the root (e, the smaller body index) moves the
+// other's axis, origin and the point together, so for a rotation e the
+// derivative is s_e x J_l (l the other DOF; e = l included: s x (s x (p - o))),
+// and for a slide e it is 0 (a translation changes no column).
+static void jac_second(const chain* c, const chain_ws* w, int i, int j, int k, const double* Jcols, double o[3]) {
+    const size_t nb = (size_t)c->nbody;
+    const int bj = c->dof_body[j], bk = c->dof_body[k];
+    o[0] = o[1] = o[2] = 0;
+    if (!c->anc[(size_t)i * nb + (size_t)bj] || !c->anc[(size_t)i * nb + (size_t)bk]) return;
+    const int e = bj < bk ? bj : bk, l = bj < bk ? k : j;
+    if (c->kind[e] == K_PRIS) return;
+    cross(&w->s[3 * e], &Jcols[3 * l], o);
+}
+
+void chain_cylinder_hessian(const chain* c, chain_ws* w, int a, const double pa[3], int b, const double pb[3],
+                            double* H) {
+    const int nd = c->ndof;
+    const size_t nb = (size_t)c->nbody;
+    double xa[3], xb[3];
+    chain_world_point(c, w, a, pa, xa, NULL);
+    chain_world_point(c, w, b, pb, xb, NULL);
+    const double d[3] = {xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]};
+    const double L = sqrt(dot(d, d));
+    const double u[3] = {d[0] / L, d[1] / L, d[2] / L};
+    // Both points' Jacobian columns in the Newton-Euler scratch (3 ndof <= 6 nbody each).
+    double* Ja = w->a;
+    double* Jb = w->f;
+    for (int k = 0; k < nd; ++k) {
+        const int body = c->dof_body[k];
+        double* ja = &Ja[3 * k];
+        double* jb = &Jb[3 * k];
+        ja[0] = ja[1] = ja[2] = jb[0] = jb[1] = jb[2] = 0;
+        if (c->anc[(size_t)a * nb + (size_t)body]) jac_col(c, w, body, xa, xa, ja, NULL);
+        if (c->anc[(size_t)b * nb + (size_t)body]) jac_col(c, w, body, xb, xb, jb, NULL);
+    }
+    // L = |d|: d2L/dqj dqk = (Dj . Dk - (u . Dj)(u . Dk)) / L + u . dDk/dqj, D = Jb - Ja.
+    for (int j = 0; j < nd; ++j)
+        for (int k = j; k < nd; ++k) {
+            const double Dj[3] = {Jb[3 * j] - Ja[3 * j], Jb[3 * j + 1] - Ja[3 * j + 1], Jb[3 * j + 2] - Ja[3 * j + 2]};
+            const double Dk[3] = {Jb[3 * k] - Ja[3 * k], Jb[3 * k + 1] - Ja[3 * k + 1], Jb[3 * k + 2] - Ja[3 * k + 2]};
+            double sa[3], sb[3];
+            jac_second(c, w, a, j, k, Ja, sa);
+            jac_second(c, w, b, j, k, Jb, sb);
+            const double ds[3] = {sb[0] - sa[0], sb[1] - sa[1], sb[2] - sa[2]};
+            const double h = (dot(Dj, Dk) - dot(u, Dj) * dot(u, Dk)) / L + dot(u, ds);
+            H[j * nd + k] = H[k * nd + j] = h;
+        }
+}
+
 /* ---- dynamics ---- */
 
 // (n, f) = I (w, v) for the spatial inertia (m, h, Ib).

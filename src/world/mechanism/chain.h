@@ -152,6 +152,13 @@ double chain_potential_energy(const chain* c, const chain_ws* w);
 double chain_cylinder(const chain* c, const chain_ws* w, int a, const double pa[3], int b, const double pb[3],
                       double* Ldot, double* dL_dq, double* dLdot_dq);
 
+/// Hessian d2L/dq2 (ndof x ndof, row-major, symmetric) of the same pin length
+/// [m/rad^2, 1/rad, 1/m]: the partials of the lever arms dL/dq, for the
+/// Jacobian of tau = F dL/dq. H qd equals chain_cylinder's dLdot_dq. Uses
+/// the workspace's scratch (not its kinematics), hence not const.
+void chain_cylinder_hessian(const chain* c, chain_ws* w, int a, const double pa[3], int b, const double pb[3],
+                            double* H);
+
 #ifdef __cplusplus
 }
 #endif
