@@ -302,10 +302,49 @@ static void test_refusals(void) {
     CHECK(chain_create(b, 0, NULL, err, sizeof err) == NULL && strstr(err, "at least one body"), "%s", err);
 }
 
+// A workspace in caller memory works as the malloc'ed one, and two
+// workspaces on one chain do not share state (one chain, several threads).
+static void test_workspaces(void) {
+    srand(24);
+    const ext_case e = random_ext();
+    chain* c = ext_chain(&e, 0, 0);
+    if (!c) return;
+    const size_t n = chain_ws_bytes(c);
+    CHECK(n > 0, "workspace size");
+    double* mem = malloc(n);
+    chain_ws* w1 = chain_ws_init(c, mem);
+    chain_ws* w2 = chain_ws_create(c);
+    const double q1[2] = {0.3, 0.5}, qd1[2] = {0.2, -0.1}, q2[2] = {-0.4, 1.2}, qd2[2] = {-0.3, 0.4};
+    chain_update(c, w1, q1, qd1);
+    chain_update(c, w2, q2, qd2);
+    double a1[2], a2[2], b1[2], b2[2];
+    CHECK(chain_forward_dynamics(c, w1, NULL, a1) == 0 && chain_forward_dynamics(c, w2, NULL, a2) == 0, "fd");
+    // Again in the other order: each workspace keeps its own state.
+    chain_ws* w3 = chain_ws_create(c);
+    chain_update(c, w3, q2, qd2);
+    CHECK(chain_forward_dynamics(c, w3, NULL, b2) == 0, "fd");
+    chain_update(c, w3, q1, qd1);
+    CHECK(chain_forward_dynamics(c, w3, NULL, b1) == 0, "fd");
+    for (int k = 0; k < 2; ++k) {
+        CHECK(a1[k] == b1[k] && a2[k] == b2[k], "workspaces differ: %g %g, %g %g", a1[k], b1[k], a2[k], b2[k]);
+    }
+    // qd NULL is at rest: the bias is gravity alone.
+    double G[2], B[2];
+    chain_update(c, w1, q1, NULL);
+    chain_inverse_dynamics(c, w1, NULL, CHAIN_GRAVITY, G);
+    chain_inverse_dynamics(c, w1, NULL, CHAIN_VELOCITY | CHAIN_GRAVITY, B);
+    CHECK(G[0] == B[0] && G[1] == B[1] && chain_kinetic_energy(c, w1) == 0, "at rest");
+    chain_ws_free(w2);
+    chain_ws_free(w3);
+    free(mem);
+    chain_free(c);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_extension_single_dof);
     RUN_TEST(test_extension_on_swinging_boom);
     RUN_TEST(test_slew_coupling);
     RUN_TEST(test_refusals);
+    RUN_TEST(test_workspaces);
     TEST_MAIN_END();
 }
