@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
     static const chain_joint pattern[10] = {CHAIN_REVOLUTE,  CHAIN_REVOLUTE,  CHAIN_REVOLUTE, CHAIN_PRISMATIC,
                                             CHAIN_PRISMATIC, CHAIN_REVOLUTE,  CHAIN_PRISMATIC, CHAIN_PRISMATIC,
                                             CHAIN_REVOLUTE,  CHAIN_PRISMATIC};
-    printf("bodies  dof  ns/update  ns/(update+forward dynamics)  ns/cylinder (L, dL/dq, d/dt dL/dq)\n");
+    printf("bodies  dof  update  mass matrix  bias  update+forward dynamics  cylinder  [ns per call]\n");
     volatile double sink = 0;
     for (int n = 2; n <= 10; ++n) {
         chain_body_def b[10];
@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
         double q[10], qd[10], qdd[10], tau[10], dL[10], dLd[10];
         for (int k = 0; k < nd; ++k) q[k] = 0.3 + 0.1 * k, qd[k] = 0.2, tau[k] = 100.0 * k;
         const double pa[3] = {0.3, 0, 0.2}, pb[3] = {0.9, 0, -0.1};
-        double t_up[5], t_fd[5], t_cy[5];
+        double t_up[5], t_fd[5], t_cy[5], t_m[5], t_b[5], M[100], B[10];
         for (int rep = 0; rep < 5; ++rep) {
             // The angles move a little each call, as in a run, so nothing is constant.
             double t0 = now();
@@ -69,6 +69,18 @@ int main(int argc, char** argv) {
                 sink += chain_cylinder(c, w, n - 2, pa, n - 1, pb, NULL, dL, dLd);
             }
             double t3 = now();
+            for (long k = 0; k < N; ++k) {
+                chain_mass_matrix(c, w, M);
+                sink += M[nd * nd - 1];
+            }
+            double t4 = now();
+            for (long k = 0; k < N; ++k) {
+                chain_inverse_dynamics(c, w, NULL, CHAIN_VELOCITY | CHAIN_GRAVITY, B);
+                sink += B[0];
+            }
+            double t5 = now();
+            t_m[rep] = (t4 - t3) / N * 1e9;
+            t_b[rep] = (t5 - t4) / N * 1e9;
             t_up[rep] = (t1 - t0) / N * 1e9;
             t_fd[rep] = (t2 - t1) / N * 1e9;
             t_cy[rep] = (t3 - t2) / N * 1e9;
@@ -76,7 +88,9 @@ int main(int argc, char** argv) {
         qsort(t_up, 5, sizeof(double), cmp);
         qsort(t_fd, 5, sizeof(double), cmp);
         qsort(t_cy, 5, sizeof(double), cmp);
-        printf("%6d  %3d  %9.0f  %28.0f  %9.0f\n", n, nd, t_up[2], t_fd[2], t_cy[2]);
+        qsort(t_m, 5, sizeof(double), cmp);
+        qsort(t_b, 5, sizeof(double), cmp);
+        printf("%6d  %3d  %6.0f  %11.0f  %4.0f  %23.0f  %8.0f\n", n, nd, t_up[2], t_m[2], t_b[2], t_fd[2], t_cy[2]);
         chain_ws_free(w);
         chain_free(c);
     }

@@ -33,6 +33,7 @@ struct chain {
     double* h;           // [3 nbody] m c [kg m]
     double* Ib;          // [9 nbody] inertia about the body origin, body axes [kg m^2]
     double* Ep;          // [9 nbody] prismatic: the constant E of the slide's angle
+    double* cs0;         // [2 nbody] its cosine and sine
     double g[3];         // gravity [m/s^2], base frame
 };
 
@@ -41,6 +42,7 @@ struct chain_ws {
     double *q, *qd;       // [ndof] as given to chain_update
     double* qdb;          // [nbody] joint rate (0 when fixed)
     double *E, *r;        // [9 nbody], [3 nbody] parent -> child
+    double* cs;           // [2 nbody] cosine and sine of E's angle (erot)
     double *R, *P;        // [9 nbody], [3 nbody] body axes and origin in the base frame
     double *wb, *vb;      // [3 nbody] body velocity in body coordinates (angular, origin)
     double *W, *V;        // [3 nbody] the same in base coordinates
@@ -48,6 +50,7 @@ struct chain_ws {
     double *a, *f;        // [6 nbody] Newton-Euler scratch
     double* Ic;           // [13 nbody] composite inertia: m, h[3], I[9]
     double *M, *L, *tmp;  // [ndof^2], [ndof^2], [ndof]
+    double* dinv;         // [ndof] 1 / L_ii
     int factored;         // L holds the Cholesky factor of M
 };
 
@@ -71,6 +74,30 @@ static inline void mtv(const double* A, const double x[3], double o[3]) {
     const double b = A[1] * x[0] + A[4] * x[1] + A[7] * x[2];
     const double c = A[2] * x[0] + A[5] * x[1] + A[8] * x[2];
     o[0] = a, o[1] = b, o[2] = c;
+}
+
+// Every joint's E is a rotation about one axis: z for the slew (body 0),
+// y for the boom-plane joints (a slide's constant angle too). With its
+// cosine and sine cs = {c, s}, E x and E^T x take 4 products instead of 9.
+static inline void erot(int slew, const double* cs, const double x[3], double o[3]) {
+    const double c = cs[0], s = cs[1];
+    if (slew) {
+        const double a = c * x[0] + s * x[1], b = -s * x[0] + c * x[1];
+        o[0] = a, o[1] = b, o[2] = x[2];
+    } else {
+        const double a = c * x[0] + s * x[2], b = -s * x[0] + c * x[2];
+        o[0] = a, o[1] = x[1], o[2] = b;
+    }
+}
+static inline void erot_t(int slew, const double* cs, const double x[3], double o[3]) {
+    const double c = cs[0], s = cs[1];
+    if (slew) {
+        const double a = c * x[0] - s * x[1], b = s * x[0] + c * x[1];
+        o[0] = a, o[1] = b, o[2] = x[2];
+    } else {
+        const double a = c * x[0] - s * x[2], b = s * x[0] + c * x[2];
+        o[0] = a, o[1] = x[1], o[2] = b;
+    }
 }
 
 // E of a boom-plane rotation by al (x towards z, about -y): rows are the
@@ -228,6 +255,7 @@ void chain_free(chain* c) {
     free(c->h);
     free(c->Ib);
     free(c->Ep);
+    free(c->cs0);
     free(c);
 }
 
@@ -258,7 +286,9 @@ chain* chain_create(const chain_body_def* body, int nbody, const double gravity[
     c->h = malloc(3 * n * sizeof(double));
     c->Ib = malloc(9 * n * sizeof(double));
     c->Ep = malloc(9 * n * sizeof(double));
-    if (!c->def || !c->parent || !c->dof || !c->dof_body || !c->kind || !c->anc || !c->m || !c->h || !c->Ib || !c->Ep)
+    c->cs0 = malloc(2 * n * sizeof(double));
+    if (!c->def || !c->parent || !c->dof || !c->dof_body || !c->kind || !c->anc || !c->m || !c->h || !c->Ib || !c->Ep ||
+        !c->cs0)
         goto oom;
     memcpy(c->def, body, n * sizeof *body);
     memcpy(c->g, gravity, sizeof c->g);
@@ -278,6 +308,7 @@ chain* chain_create(const chain_body_def* body, int nbody, const double gravity[
                 c->Ib[9 * i + 3 * r + k] = 0.5 * (b->inertia[r][k] + b->inertia[k][r]) +
                                            m * ((r == k) * cc - b->com[r] * b->com[k]);
         rot_plane(b->angle0, &c->Ep[9 * i]);
+        c->cs0[2 * i] = c->Ep[9 * i], c->cs0[2 * i + 1] = c->Ep[9 * i + 2];
     }
     return c;
 oom:
@@ -297,8 +328,8 @@ const chain_body_def* chain_body(const chain* c, int i) { return i >= 0 && i < c
 // Doubles in the workspace after its header.
 static size_t ws_doubles(int nb, int nd) {
     const size_t b = (size_t)nb, d = (size_t)nd;
-    // q, qd, tmp; qdb; E, r; R, P; wb, vb, W, V, s; a, f; Ic; M, L (as chain_ws_init takes them).
-    return 3 * d + b + 12 * b + 12 * b + 15 * b + 12 * b + 13 * b + 2 * d * d;
+    // q, qd, tmp, dinv; qdb; E, r; cs; R, P; wb, vb, W, V, s; a, f; Ic; M, L (as chain_ws_init takes them).
+    return 4 * d + b + 12 * b + 2 * b + 12 * b + 15 * b + 12 * b + 13 * b + 2 * d * d;
 }
 
 size_t chain_ws_bytes(const chain* c) {
@@ -322,6 +353,7 @@ chain_ws* chain_ws_init(const chain* c, void* mem) {
     TAKE(qdb, b);
     TAKE(E, 9 * b);
     TAKE(r, 3 * b);
+    TAKE(cs, 2 * b);
     TAKE(R, 9 * b);
     TAKE(P, 3 * b);
     TAKE(wb, 3 * b);
@@ -335,6 +367,7 @@ chain_ws* chain_ws_init(const chain* c, void* mem) {
     TAKE(M, d * d);
     TAKE(L, d * d);
     TAKE(tmp, d);
+    TAKE(dinv, d);
 #undef TAKE
     return w;
 }
@@ -359,17 +392,21 @@ void chain_update(const chain* c, chain_ws* w, const double* q, const double* qd
         w->qdb[i] = qdi;
         double* E = &w->E[9 * i];
         double* r = &w->r[3 * i];
+        double* cs = &w->cs[2 * i];
         if (kind == K_SLEW) {
             const double th = b->angle0 + qi, ct = cos(th), st = sin(th);
             E[0] = ct, E[1] = st, E[2] = 0;
             E[3] = -st, E[4] = ct, E[5] = 0;
             E[6] = 0, E[7] = 0, E[8] = 1;
+            cs[0] = ct, cs[1] = st;
             memcpy(r, b->origin, 3 * sizeof(double));
         } else if (kind == K_REV) {
             rot_plane(b->angle0 + qi, E);
+            cs[0] = E[0], cs[1] = E[2];
             memcpy(r, b->origin, 3 * sizeof(double));
         } else {
             memcpy(E, &c->Ep[9 * i], 9 * sizeof(double));
+            cs[0] = c->cs0[2 * i], cs[1] = c->cs0[2 * i + 1];
             // The slide runs along the child's x: row 0 of E in parent coordinates.
             const double sl = b->offset0 + qi;
             for (int k = 0; k < 3; ++k) r[k] = b->origin[k] + sl * E[k];
@@ -387,10 +424,15 @@ void chain_update(const chain* c, chain_ws* w, const double* q, const double* qd
             vi[0] = vi[1] = vi[2] = 0;
         } else {
             const double* Rp = &w->R[9 * p];
-            // R = Rp E^T
-            for (int x = 0; x < 3; ++x)
-                for (int y = 0; y < 3; ++y)
-                    R[3 * x + y] = Rp[3 * x] * E[3 * y] + Rp[3 * x + 1] * E[3 * y + 1] + Rp[3 * x + 2] * E[3 * y + 2];
+            // R = Rp E^T: E turns about y here (only body 0 slews), so
+            // R's x and z columns are Rp's turned, its y column Rp's.
+            const double ce = cs[0], se = cs[1];
+            for (int x = 0; x < 3; ++x) {
+                const double r0 = Rp[3 * x], r2 = Rp[3 * x + 2];
+                R[3 * x] = ce * r0 + se * r2;
+                R[3 * x + 1] = Rp[3 * x + 1];
+                R[3 * x + 2] = -se * r0 + ce * r2;
+            }
             double t[3];
             mv(Rp, r, t);
             for (int k = 0; k < 3; ++k) P[k] = w->P[3 * p + k] + t[k];
@@ -400,8 +442,8 @@ void chain_update(const chain* c, chain_ws* w, const double* q, const double* qd
             double u[3];
             cross(wp, r, u);
             for (int k = 0; k < 3; ++k) u[k] += vp[k];
-            mv(E, wp, wi);
-            mv(E, u, vi);
+            erot(0, cs, wp, wi);
+            erot(0, cs, u, vi);
         }
         // Joint axis in the body's coordinates -> base.
         double* s = &w->s[3 * i];
@@ -584,7 +626,7 @@ void chain_inverse_dynamics(const chain* c, chain_ws* w, const double* qdd, int 
     const int vel = (terms & CHAIN_VELOCITY) != 0;
     for (int i = 0; i < nb; ++i) {
         const int p = c->parent[i], kind = c->kind[i], d = c->dof[i];
-        const double* E = &w->E[9 * i];
+        const double* cs = &w->cs[2 * i];
         const double* r = &w->r[3 * i];
         double* a = &w->a[6 * i]; // angular 0..2, linear (of the body origin) 3..5
         if (p < 0) {
@@ -592,14 +634,14 @@ void chain_inverse_dynamics(const chain* c, chain_ws* w, const double* qdd, int 
             double ab[3] = {0, 0, 0};
             if (terms & CHAIN_GRAVITY) ab[0] = -c->g[0], ab[1] = -c->g[1], ab[2] = -c->g[2];
             a[0] = a[1] = a[2] = 0;
-            mv(E, ab, a + 3);
+            erot(1, cs, ab, a + 3);
         } else {
             const double* ap = &w->a[6 * p];
             double t[3];
             cross(ap, r, t); // linear acceleration of the child origin: ap_v + ap_w x r
             t[0] += ap[3], t[1] += ap[4], t[2] += ap[5];
-            mv(E, ap, a);
-            mv(E, t, a + 3);
+            erot(0, cs, ap, a);
+            erot(0, cs, t, a + 3);
         }
         const double qa = qdd && d >= 0 ? qdd[d] : 0.0;
         const double* wi = &w->wb[3 * i];
@@ -647,11 +689,11 @@ void chain_inverse_dynamics(const chain* c, chain_ws* w, const double* qdd, int 
         const int p = c->parent[i];
         if (p < 0) continue;
         // To the parent: f_p = E^T f, n_p = E^T n + r x f_p.
-        const double* E = &w->E[9 * i];
+        const double* cs = &w->cs[2 * i];
         const double* r = &w->r[3 * i];
         double fp[3], np[3], t[3];
-        mtv(E, f + 3, fp);
-        mtv(E, f, np);
+        erot_t(i == 0, cs, f + 3, fp);
+        erot_t(i == 0, cs, f, np);
         cross(r, fp, t);
         double* F = &w->f[6 * p];
         for (int k = 0; k < 3; ++k) F[k] += np[k] + t[k], F[3 + k] += fp[k];
@@ -711,11 +753,11 @@ void chain_mass_matrix(const chain* c, chain_ws* w, double* M) {
         }
         M[k * nd + k] = proj(kind, n, f);
         for (int j = i; c->parent[j] >= 0; j = c->parent[j]) {
-            const double* E = &w->E[9 * j];
+            const double* cs = &w->cs[2 * j];
             const double* r = &w->r[3 * j];
             double fp[3], np[3], t[3];
-            mtv(E, f, fp);
-            mtv(E, n, np);
+            erot_t(j == 0, cs, f, fp);
+            erot_t(j == 0, cs, n, np);
             cross(r, fp, t);
             for (int x = 0; x < 3; ++x) n[x] = np[x] + t[x], f[x] = fp[x];
             const int l = c->dof[c->parent[j]];
@@ -741,8 +783,9 @@ int chain_forward_dynamics(const chain* c, chain_ws* w, const double* tau, doubl
                     return -1;
                 }
                 L[i * nd + i] = sqrt(s);
+                w->dinv[i] = 1.0 / L[i * nd + i];
             } else {
-                L[i * nd + j] = s / L[j * nd + j];
+                L[i * nd + j] = s * w->dinv[j];
             }
         }
     }
@@ -758,12 +801,12 @@ void chain_solve(const chain* c, const chain_ws* w, const double* b, double* x) 
     for (int i = 0; i < nd; ++i) {
         double s = b[i];
         for (int k = 0; k < i; ++k) s -= L[i * nd + k] * x[k];
-        x[i] = s / L[i * nd + i];
+        x[i] = s * w->dinv[i];
     }
     for (int i = nd - 1; i >= 0; --i) {
         double s = x[i];
         for (int k = i + 1; k < nd; ++k) s -= L[k * nd + i] * x[k];
-        x[i] = s / L[i * nd + i];
+        x[i] = s * w->dinv[i];
     }
 }
 
