@@ -25,8 +25,9 @@ static crane_mech perturbed(void) {
         l->length *= urand(0.7, 1.4);
         l->mass *= urand(0.5, 2.0);
         l->com = l->length * urand(0.2, 0.8);
-        // Above m L^2/12 the box-derived Izz would break the triangle rule.
-        l->inertia = l->mass * l->length * l->length / 12.0 * urand(0.5, 1.0);
+        // With Ixx and Izz from the box (as the ODE world), the triangle rule
+        // holds for Iyy within m (L^2 -+ h^2) / 12 or so: stay inside.
+        l->inertia = l->mass * (l->length * l->length + urand(-0.5, 0.5) * l->height * l->height) / 12.0;
     }
     m.column_height *= urand(0.8, 1.2);
     m.gravity = urand(9.7, 9.9);
@@ -204,9 +205,42 @@ static void test_cylinders_match_crane(void) {
     printf("  worst lever-arm difference %.2e of the largest\n", worst);
 }
 
+// The adapter's bodies are the ODE world's (ode_world.c, boom_mass and the
+// column cylinder): the end arm with the tip load merged has mass m + mt,
+// centre c = (m e + mt L) / (m + mt) on its axis and, about it,
+// Ixx = m (w^2 + h^2) / 12, Iyy = I + m (e - c)^2 + mt (L - c)^2,
+// Izz = m (L^2 + w^2) / 12 + m (e - c)^2 + mt (L - c)^2; the column a solid
+// cylinder m (3 r^2 + h^2) / 12, m r^2 / 2.
+static void test_adapter_bodies(void) {
+    crane_mech m = crane_default_mech();
+    const double mt = 700, r = 0.12;
+    chain_crane cc;
+    chain_crane_opts o = {1, 0, r};
+    CHECK(chain_from_crane_mech(&m, mt, &o, &cc) == 0, "adapter");
+    const crane_link* l = &m.link[1];
+    const double M = l->mass + mt, c = (l->mass * l->com + mt * l->length) / M;
+    const double d1 = l->com - c, d2 = l->length - c, par = l->mass * d1 * d1 + mt * d2 * d2;
+    const chain_body_def* b = &cc.body[2];
+    CHECK_REL(b->mass, M, 1e-15);
+    CHECK_REL(b->com[0], c, 1e-14);
+    CHECK(b->com[1] == 0 && b->com[2] == 0, "tip load on the axis");
+    CHECK_REL(b->inertia[0][0], l->mass * (l->width * l->width + l->height * l->height) / 12, 1e-14);
+    CHECK_REL(b->inertia[1][1], l->inertia + par, 1e-14);
+    CHECK_REL(b->inertia[2][2], l->mass * (l->length * l->length + l->width * l->width) / 12 + par, 1e-14);
+    const crane_link* l0 = &m.link[0];
+    b = &cc.body[1];
+    CHECK_REL(b->inertia[2][2], l0->mass * (l0->length * l0->length + l0->width * l0->width) / 12, 1e-14);
+    b = &cc.body[0];
+    const double h = m.column_height;
+    CHECK_REL(b->inertia[0][0], m.column_mass * (3 * r * r + h * h) / 12, 1e-14);
+    CHECK_REL(b->inertia[2][2], m.column_mass * r * r / 2, 1e-14);
+    CHECK(!b->fixed && cc.body[1].origin[2] == h, "slew free, joint 1 at the column top");
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_terms_match_lagrange);
     RUN_TEST(test_slew_free_at_rest_matches);
     RUN_TEST(test_cylinders_match_crane);
+    RUN_TEST(test_adapter_bodies);
     TEST_MAIN_END();
 }

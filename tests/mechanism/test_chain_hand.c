@@ -340,11 +340,25 @@ static void test_workspaces(void) {
     chain_free(c);
 }
 
+// The section rule with a box's own Iyy gives the box.
+static void test_section_inertia(void) {
+    const double m = 180, L = 2.3, wd = 0.18, ht = 0.24;
+    double box[3][3], sec[3][3];
+    chain_inertia_box(m, L, wd, ht, box);
+    chain_inertia_section(m, m * (L * L + ht * ht) / 12, L, wd, ht, sec);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) CHECK_NEAR(sec[i][j], box[i][j], 1e-12 * box[1][1]);
+    CHECK_NEAR(box[0][0], m * (wd * wd + ht * ht) / 12, 1e-12);
+    CHECK_NEAR(box[1][1], m * (L * L + ht * ht) / 12, 1e-12);
+    CHECK_NEAR(box[2][2], m * (L * L + wd * wd) / 12, 1e-12);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_extension_single_dof);
     RUN_TEST(test_extension_on_swinging_boom);
     RUN_TEST(test_slew_coupling);
     RUN_TEST(test_refusals);
     RUN_TEST(test_workspaces);
+    RUN_TEST(test_section_inertia);
     TEST_MAIN_END();
 }

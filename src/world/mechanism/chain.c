@@ -126,6 +126,11 @@ void chain_inertia_box(double mass, double lx, double ly, double lz, double I[3]
     I[2][2] = mass * (lx * lx + ly * ly) / 12.0;
 }
 
+void chain_inertia_section(double mass, double Iyy, double length, double width, double height, double I[3][3]) {
+    chain_inertia_box(mass, length, width, height, I);
+    I[1][1] = Iyy;
+}
+
 void chain_body_add_point_mass(chain_body_def* b, double m, const double p[3]) {
     const double M = b->mass + m;
     if (!(M > 0)) return;

@@ -71,6 +71,13 @@ void chain_body_init(chain_body_def* b, int parent);
 /// size along x, y, z [m] (a boom's box section: length, width, height).
 void chain_inertia_box(double mass, double lx, double ly, double lz, double I[3][3]);
 
+/// Inertia about the centre of a boom whose model gives only the moment
+/// about its joint axis, Iyy [kg m^2]: the other two from its box, length
+/// (x), width (y), height (z) [m]: Ixx = m (w^2 + h^2) / 12, Izz = m (L^2 +
+/// w^2) / 12, as the ODE world builds its booms today. Only an Iyy near the
+/// box's gives a rigid body's moments (chain_create refuses others).
+void chain_inertia_section(double mass, double Iyy, double length, double width, double height, double I[3][3]);
+
 /// Merges a point mass m [kg] at p (body frame) [m] into the body: new mass,
 /// centre of mass and inertia about it (parallel-axis theorem). A load
 /// rigidly at a boom tip.

@@ -40,16 +40,9 @@ int chain_from_crane_mech(const crane_mech* m, double tip_mass, const chain_cran
         b->angle0 = i ? 0.0 : -0.5 * M_PI;
         b->mass = l->mass;
         b->com[0] = l->com;
-        // About the joint axis (y) as given; about x from the box section;
-        // about z the given one plus the box's Izz - Iyy = m (w^2 - h^2) / 12.
-        // For a uniform box (the default, I = m L^2 / 12) this is the ODE
-        // world's m (L^2 + w^2) / 12; for another I it keeps the three moments
-        // a rigid body's (triangle rule) where the box Izz with the given Iyy
-        // would not.
-        const double w2 = l->width * l->width, h2 = l->height * l->height;
-        b->inertia[0][0] = l->mass * (w2 + h2) / 12.0;
-        b->inertia[1][1] = l->inertia;
-        b->inertia[2][2] = l->inertia + l->mass * (w2 - h2) / 12.0;
+        // About the joint axis (y) as given, the others from the box, as
+        // the ODE world's boom_mass: the same crane, the same bodies.
+        chain_inertia_section(l->mass, l->inertia, l->length, l->width, l->height, b->inertia);
     }
     if (tip_mass > 0) {
         const double tip[3] = {m->link[1].length, 0, 0};

@@ -36,10 +36,8 @@ typedef struct chain_crane {
 /// Fills out from m and a point mass tip_mass [kg] at the end-arm tip. The
 /// column's origin is the base origin (the truck bed), joint 1 is at
 /// column_height above it; q1 and q2 keep their meaning (angle0 = -pi/2 and
-/// 0). The booms' inertia: the link's about the joint axis (y); about x from
-/// its box section; about z the given one plus the box's m (w^2 - h^2) / 12
-/// (the ODE world's box value when the link's inertia is m L^2 / 12, as the
-/// defaults are). opt NULL: clamped at
+/// 0). The booms' inertia: the link's about the joint axis (y), about x and
+/// z the box's (chain_inertia_section, as the ODE world's booms). opt NULL: clamped at
 /// slew 0, column radius 0.1 m. Returns 0, or -1 if an actuator's joint is
 /// not 0 or 1.
 int chain_from_crane_mech(const crane_mech* m, double tip_mass, const chain_crane_opts* opt, chain_crane* out);
