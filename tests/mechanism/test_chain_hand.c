@@ -270,6 +270,12 @@ static void test_refusals(void) {
     char err[256];
     chain* c = chain_create(b, 3, NULL, err, sizeof err);
     CHECK(c != NULL, "the good chain: %s", err);
+    if (c) {
+        CHECK(chain_find_body(c, "ext1") == 2 && chain_find_body(c, "ext2") == -1 && chain_find_body(c, "") == -1,
+              "find by name");
+        CHECK(chain_body(c, 2) && !strcmp(chain_body(c, 2)->name, "ext1") && chain_body(c, 3) == NULL, "bodies");
+        CHECK(chain_body_dof(c, 0) == 0 && chain_dof_body(c, 2) == 2 && chain_dof_body(c, 3) == -1, "dofs");
+    }
     chain_free(c);
     chain_body_def x[3];
 #define REFUSE(stmt, want)                                                                             \

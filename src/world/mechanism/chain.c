@@ -328,6 +328,13 @@ int chain_body_dof(const chain* c, int i) { return i >= 0 && i < c->nbody ? c->d
 int chain_dof_body(const chain* c, int k) { return k >= 0 && k < c->ndof ? c->dof_body[k] : -1; }
 const chain_body_def* chain_body(const chain* c, int i) { return i >= 0 && i < c->nbody ? &c->def[i] : NULL; }
 
+int chain_find_body(const chain* c, const char* name) {
+    if (!name || !name[0]) return -1;
+    for (int i = 0; i < c->nbody; ++i)
+        if (!strncmp(c->def[i].name, name, CHAIN_NAME)) return i;
+    return -1;
+}
+
 /* ---- workspace ---- */
 
 // Doubles in the workspace after its header.

@@ -100,6 +100,9 @@ int chain_body_dof(const chain* c, int i);
 int chain_dof_body(const chain* c, int k);
 /// The copied description of body i.
 const chain_body_def* chain_body(const chain* c, int i);
+/// The index of the body named name (the first one), or -1 (a model file's
+/// actuators name their bodies).
+int chain_find_body(const chain* c, const char* name);
 
 /// Workspace size [bytes] and set-up in caller memory (aligned as malloc's);
 /// chain_ws_create does both with one malloc (free with chain_ws_free).
