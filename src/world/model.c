@@ -200,6 +200,11 @@ static const json_range R_LINK_COM = {0, 30, 0, 10, "m"};
 static const json_range R_LINK_INERTIA = {1e-3, 1e7, 1, 1e5, "kg m^2"};
 static const json_range R_LINK_SECTION = {0.01, 2, 0.05, 0.6, "m"};
 static const json_range R_LOAD = {0, CRANE_LOAD_MAX, 0, CRANE_LOAD_TYPICAL, "kg"};
+// The maker's rating (the load chart's cap, docs/safety.md): loader cranes
+// are sold from under 1 t m (10 kN m) to about 100 t m; a rated load from a
+// few hundred kg to some tens of tonnes.
+static const json_range R_RATED_MOMENT = {0.1, 1e4, 5, 1000, "kN m"};
+static const json_range R_RATED_LOAD = {1, 1e5, 100, 30000, "kg"};
 static const json_range R_MOUNT = {-10, 10, -3, 3, "m"};
 static const json_range R_CLOSED_LENGTH = {0.05, 20, 0.3, 5, "m"};
 
@@ -282,7 +287,8 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
 
     crane_mech* me = &m->mech;
     const cJSON* mech = json_obj(&c, root, "", "mechanics", true);
-    static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", NULL};
+    static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", "rated_moment",
+                                         "rated_load", NULL};
     json_only_keys(&c, mech, "mechanics", mkeys);
     me->gravity = json_num_r(&c, mech, "mechanics", "gravity", false, 9.81, &R_GRAVITY);
     const cJSON* col = json_obj(&c, mech, "mechanics", "column", true);
@@ -297,6 +303,9 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     if (!c.failed && !strcmp(me->link[0].name, me->link[1].name))
         json_fail(&c, "mechanics.links[1].name", "\"%s\" is already the name of links[0]", me->link[1].name);
     me->load_mass = json_num_r(&c, mech, "mechanics", "load_mass", true, 0, &R_LOAD);
+    // Optional: absent (0) means no rating, the chart is the physical envelope.
+    m->rated_moment = 1e3 * json_num_r(&c, mech, "mechanics", "rated_moment", false, 0, &R_RATED_MOMENT);
+    m->rated_load = json_num_r(&c, mech, "mechanics", "rated_load", false, 0, &R_RATED_LOAD);
     const cJSON* acts = json_arr(&c, mech, "mechanics", "actuators", true);
     if (acts && cJSON_GetArraySize(acts) != 2)
         json_fail(&c, "mechanics.actuators", "must list exactly 2 actuators (lift, jib)");

@@ -21,6 +21,8 @@ typedef struct model {
     int cyl[2];          ///< hydraulic cylinder index of actuator k (lift, jib)
     int valve[2];        ///< hydraulic valve index of actuator k
     double stroke[2];    ///< cylinder strokes [m]
+    double rated_moment; ///< the maker's rated load moment [N m] (file: mechanics.rated_moment in kN m); 0: none
+    double rated_load;   ///< the maker's rated load, the cap close in [kg] (mechanics.rated_load); 0: none
     cJSON* json;         ///< the document after --set overrides (owned), for saving
 } model;
 
