@@ -25,9 +25,14 @@ static void help(FILE* f) {
             "    support polygon's edges, times --stability-factor (> 1; default 1.25), stays below the\n"
             "    restoring moment of truck and crane, in K slew sectors over 0..180 deg (centred on\n"
             "    0 = over the cab, ..., 180 = over the rear; default 3: cab, side, rear).\n"
+            "  raw envelope: the smaller of the two, per sector (what the crane can do);\n"
+            "  chart: the raw envelope capped by the model's rating (mechanics.rated_load [kg] and\n"
+            "    rated_moment [kN m], less the hook), never rising with outreach: what the limiter uses.\n"
+            "  Each point names what governs it (lift, jib, stability, rated), at which outreach, and\n"
+            "    the pose (q1, q2, slew in deg) to check it by simulation.\n"
             "  --world W     sandbox (default) or validation (no truck: hydraulic limit only), or a file\n"
             "  --outreach    LO:HI:N metres and points (default: the crane's reach from 0.5 m, 50 points)\n"
-            "  --out FILE    CSV (default loadchart.csv); --plot FILE: PNG chart, governing limit marked\n"
+            "  --out FILE    CSV (default loadchart.csv); --plot FILE: PNG of the charts and the raw limits\n"
             "  --set PATH=V  change a model value (as for run)\n"
             "See docs/safety.md.\n");
 }

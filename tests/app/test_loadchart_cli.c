@@ -1,7 +1,9 @@
 // test_loadchart_cli.c: `cranesim loadchart` end to end: the chart's CSV
-// against the library's own numbers (hydraulic limit, monotone sectors), and
-// bad input (a stability factor <= 1, a margin outside [0, 50 %], an
-// outreach the crane cannot reach): one line naming the option, exit 2.
+// (raw envelope, the model's rating by hand, the printed chart under both
+// and never rising, what governs each point and its pose), its plot's lines
+// told apart by colour in the PNG, and bad input (a stability factor <= 1, a
+// margin outside [0, 50 %], an outreach the crane cannot reach, a rating out
+// of range): one line naming the option or field, exit 2.
 #include "check.h"
 #include "cli_util.h"
 
@@ -29,6 +31,8 @@ static void test_bad_input(void) {
         {"loadchart --outreach 1:2 --out lc_bad.csv", "--outreach"},
         {"loadchart --sectors 0 --out lc_bad.csv", "--sectors"},
         {"loadchart --margin abc --out lc_bad.csv", "--margin"},
+        {"loadchart --set mechanics.rated_moment=1e5 --out lc_bad.csv", "mechanics.rated_moment: must be in [0.1, 1e4] kN m"},
+        {"loadchart --set mechanics.rated_load=-5 --out lc_bad.csv", "mechanics.rated_load: must be > 0"},
     };
     remove("lc_bad.csv");
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {

@@ -302,6 +302,21 @@ static void test_printed_chart(void) {
     CHECK(c.gov[30 * 3 + 1] == LC_GOV_JIB && c.gov_at[30 * 3 + 1] == 0, "2.0 m: held by the jib at 0.5 m");
     CHECK_NEAR(c.chart[50 * 3 + 1], 29.4e3 / (9.81 * 3.0) - hook, 1e-6);
     CHECK(c.gov[80 * 3 + 0] == LC_GOV_RATED, "4.5 m over the cab: the rating governs");
+    // Without a rating (a model that gives none) the printed chart is the
+    // raw envelope made non-increasing: nothing is "rated".
+    loadchart_free(&c);
+    m->rated_moment = m->rated_load = 0;
+    CHECK(loadchart_compute(m, &t, &o, &c, err, sizeof err) == 0, "%s", err);
+    for (int i = 0; i < c.n; ++i)
+        for (int s = 0; s < c.nsec; ++s) {
+            const size_t k = (size_t)i * c.nsec + s;
+            CHECK(isinf(c.rating[i]) && c.gov[k] != LC_GOV_RATED, "no rating, yet %s at %.2f m", lc_gov_name(c.gov[k]),
+                  c.R[i]);
+            CHECK_NEAR(c.chart[k], i ? fmin(c.env[k], c.chart[k - c.nsec]) : c.env[k], 1e-9);
+        }
+    loadchart_free(&c);
+    m->rated_moment = 29.4e3, m->rated_load = 2000;
+    CHECK(loadchart_compute(m, &t, &o, &c, err, sizeof err) == 0, "%s", err);
     // loadchart_capacity is the printed chart (what the limiter holds the
     // crane to), the envelope the raw one.
     CHECK_NEAR(loadchart_capacity(&c, 2.0, 0.5 * M_PI, NULL), c.chart[30 * 3 + 1], 1e-9);
