@@ -72,11 +72,11 @@ static const int k_light[LC_NCOL][3] = {{140, 175, 255}, {130, 220, 130}, {245, 
 // hydraulic limit or the rating governs in each) every one shows as a
 // stripe of its own instead of the last one hiding the others.
 static double sector_width(int s, int nsec) {
-    return nsec > 1 ? 2.5 + 9.0 * (nsec - 1 - s) / (nsec - 1) : 3.0;
+    return nsec > 1 ? 2.5 + 9.0 * (nsec - 1 - s) / (nsec - 1) : 4.0;
 }
 
 static void legend_line(double y, int col, int style, double width, const char* text) {
-    const PLFLT x[2] = {0.02, 0.20}, yy[2] = {y, y};
+    const PLFLT x[2] = {0.02, 0.16}, yy[2] = {y, y};
     plcol0(col);
     pllsty(style);
     plwidth(width);
@@ -84,7 +84,7 @@ static void legend_line(double y, int col, int style, double width, const char* 
     pllsty(1);
     plwidth(1);
     plcol0(15);
-    plptex(0.24, y, 1, 0, 0, text);
+    plptex(0.19, y, 1, 0, 0, text);
 }
 
 static void draw_chart(void* user) {
@@ -174,13 +174,24 @@ static void draw_chart(void* user) {
     plschr(0, 0.75);
     double yl = 0.97;
     char nm[96];
-    for (int s = 0; s < c->nsec && s < 12; ++s, yl -= 0.05) {
+    // Up to 6 sectors named (their colours repeat beyond 6).
+    const int nleg = c->nsec < LC_NCOL ? c->nsec : LC_NCOL;
+    for (int s = 0; s < nleg; ++s, yl -= 0.05) {
         snprintf(nm, sizeof nm, "chart %.0f-%.0f deg slew", c->sec_lo[s] * 180 / M_PI, c->sec_hi[s] * 180 / M_PI);
         legend_line(yl, LC_COL_DARK + s % LC_NCOL, 1, sector_width(s, c->nsec), nm);
     }
-    for (int s = 0; s < c->nsec && c->stab && s < 12; ++s, yl -= 0.05) {
-        snprintf(nm, sizeof nm, "stability %.0f-%.0f (raw)", c->sec_lo[s] * 180 / M_PI, c->sec_hi[s] * 180 / M_PI);
+    for (int s = 0; s < nleg && c->stab; ++s, yl -= 0.05) {
+        // A stability limit that stays above the plot everywhere says so.
+        bool shown = false;
+        for (int i = 0; i < c->n; ++i) shown = shown || c->stab[(size_t)i * c->nsec + s] <= 1.08 * ymax;
+        snprintf(nm, sizeof nm, shown ? "stability %.0f-%.0f (raw)" : "stability %.0f-%.0f: above", c->sec_lo[s] * 180 / M_PI,
+                 c->sec_hi[s] * 180 / M_PI);
         legend_line(yl, LC_COL_LIGHT + s % LC_NCOL, 1, 2, nm);
+    }
+    if (c->nsec > nleg) {
+        snprintf(nm, sizeof nm, "(%d sectors: colours repeat)", c->nsec);
+        plcol0(15);
+        plptex(0.02, yl, 1, 0, 0, nm), yl -= 0.05;
     }
     legend_line(yl, LC_COL_HYD, 2, 2, "hydraulic limit (raw)"), yl -= 0.05;
     if (isfinite(c->rating[0]) || isfinite(c->rating[c->n - 1])) {
@@ -188,7 +199,7 @@ static void draw_chart(void* user) {
         legend_line(yl, LC_COL_RATING, 5, 2, nm), yl -= 0.05;
     }
     plcol0(15);
-    plptex(0.02, yl, 1, 0, 0, "o: stability governs"), yl -= 0.05;
+    if (c->stab) plptex(0.02, yl, 1, 0, 0, "o: stability governs"), yl -= 0.05;
     plptex(0.02, yl, 1, 0, 0, "chart: min(raw, rating),"), yl -= 0.04;
     plptex(0.02, yl, 1, 0, 0, "never rising with outreach");
 }
@@ -346,8 +357,11 @@ int cmd_loadchart(int argc, char** argv) {
     int rc = 0;
     if (png) {
         char title[200];
-        snprintf(title, sizeof title, "load chart: %s, relief margin %.0f %%, stability factor %.2f",
-                 ch.truck ? "truck on outriggers" : "no truck", 100 * lo.margin, lo.sf);
+        if (ch.truck)
+            snprintf(title, sizeof title, "load chart: truck on outriggers, relief margin %.0f %%, stability factor %.2f",
+                     100 * lo.margin, lo.sf);
+        else
+            snprintf(title, sizeof title, "load chart: no truck, relief margin %.0f %%", 100 * lo.margin);
         if (plot_chart(png, &ch, title, err, sizeof err)) {
             fprintf(stderr, "cranesim loadchart: %s\n", err);
             rc = EXIT_RUNTIME;
