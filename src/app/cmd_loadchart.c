@@ -27,7 +27,9 @@ static void help(FILE* f) {
             "    0 = over the cab, ..., 180 = over the rear; default 3: cab, side, rear).\n"
             "  raw envelope: the smaller of the two, per sector (what the crane can do);\n"
             "  chart: the raw envelope capped by the model's rating (mechanics.rated_load [kg] and\n"
-            "    rated_moment [kN m], less the hook), never rising with outreach: what the limiter uses.\n"
+            "    rated_moment [kN m], less the hook), from the minimum outreach (where that is largest)\n"
+            "    outward, never rising with outreach; closer in not printed (empty), the capacity column\n"
+            "    (what the limiter uses) is the capped envelope there.\n"
             "  Each point names what governs it (lift, jib, stability, rated), at which outreach, and\n"
             "    the pose (q1, q2, slew in deg) to check it by simulation.\n"
             "  --world W     sandbox (default) or validation (no truck: hydraulic limit only), or a file\n"
@@ -66,13 +68,14 @@ static const int k_light[LC_NCOL][3] = {{140, 175, 255}, {130, 220, 130}, {245, 
 #define LC_COL_RATING 2 // dark gold: the model's rating
 #define LC_COL_DARK 3   // 3..8: the sectors' printed charts
 #define LC_COL_LIGHT 9  // 9..14: the sectors' stability limits
+#define LC_COL_INSIDE 16 // grey: closer than the minimum outreach (not printed; what the limiter uses)
 
 // Width of sector s's printed chart [PLplot width units, about a pixel]:
 // nested, widest first, so where the sectors' charts coincide (where the
 // hydraulic limit or the rating governs in each) every one shows as a
 // stripe of its own instead of the last one hiding the others.
 static double sector_width(int s, int nsec) {
-    return nsec > 1 ? 2.5 + 9.0 * (nsec - 1 - s) / (nsec - 1) : 4.0;
+    return nsec > 1 ? 5.0 + 9.0 * (nsec - 1 - s) / (nsec - 1) : 5.0;
 }
 
 static void legend_line(double y, int col, int style, double width, const char* text) {
@@ -90,6 +93,9 @@ static void legend_line(double y, int col, int style, double width, const char* 
 static void draw_chart(void* user) {
     const chart_plot* p = user;
     const loadchart* c = p->c;
+    plscmap0n(17);
+    plscol0(15, 0, 0, 0);
+    plscol0(LC_COL_INSIDE, 150, 150, 150);
     plscol0(LC_COL_HYD, 220, 0, 0);
     plscol0(LC_COL_RATING, 150, 110, 0);
     for (int k = 0; k < LC_NCOL; ++k) {
@@ -117,12 +123,29 @@ static void draw_chart(void* user) {
     pllab("outreach [m]", "payload [kg]", p->title);
     static PLFLT x[LOADCHART_MAX_POINTS], y[LOADCHART_MAX_POINTS];
     for (int i = 0; i < c->n; ++i) x[i] = c->R[i];
-    // 1. The printed chart of each sector, bold, nested widths.
+    // 1. The printed chart of each sector, bold, nested widths, from the
+    // sector's minimum outreach; closer in (not printed) what the limiter
+    // uses there, min(envelope, rating), thin grey, and the minimum
+    // outreach marked by a vertical tick of the sector's colour.
     for (int s = 0; s < c->nsec; ++s) {
+        const int i0 = c->imin[s];
         plcol0(LC_COL_DARK + s % LC_NCOL);
         plwidth(sector_width(s, c->nsec));
-        for (int i = 0; i < c->n; ++i) y[i] = c->chart[(size_t)i * c->nsec + s];
-        plline(c->n, x, y);
+        for (int i = 0; i < c->n; ++i) y[i] = c->cap[(size_t)i * c->nsec + s];
+        if (c->n - i0 > 1) plline(c->n - i0, x + i0, y + i0);
+        PLFLT tx[2] = {c->R[i0], c->R[i0]}, ty[2] = {0, y[i0]};
+        plwidth(1.5);
+        pllsty(3);
+        plline(2, tx, ty);
+        pllsty(1);
+    }
+    for (int s = 0; s < c->nsec; ++s) {
+        if (c->imin[s] < 1) continue;
+        for (int i = 0; i < c->n; ++i) y[i] = c->cap[(size_t)i * c->nsec + s];
+        // Wide, under the thin raw lines (the hydraulic limit often lies on it).
+        plcol0(LC_COL_INSIDE);
+        plwidth(6);
+        plline(c->imin[s] + 1, x, y);
     }
     plwidth(1);
     // 2. The raw envelope's parts over it, thin and light: each sector's
@@ -177,9 +200,13 @@ static void draw_chart(void* user) {
     // Up to 6 sectors named (their colours repeat beyond 6).
     const int nleg = c->nsec < LC_NCOL ? c->nsec : LC_NCOL;
     for (int s = 0; s < nleg; ++s, yl -= 0.05) {
-        snprintf(nm, sizeof nm, "chart %.0f-%.0f deg slew", c->sec_lo[s] * 180 / M_PI, c->sec_hi[s] * 180 / M_PI);
+        snprintf(nm, sizeof nm, "chart %.0f-%.0f, from %.2f m", c->sec_lo[s] * 180 / M_PI,
+                 c->sec_hi[s] * 180 / M_PI, c->R[c->imin[s]]);
         legend_line(yl, LC_COL_DARK + s % LC_NCOL, 1, sector_width(s, c->nsec), nm);
     }
+    bool inside = false;
+    for (int s = 0; s < c->nsec; ++s) inside = inside || c->imin[s] > 0;
+    if (inside) legend_line(yl, LC_COL_INSIDE, 1, 6, "inside it: the limiter's"), yl -= 0.05;
     for (int s = 0; s < nleg && c->stab; ++s, yl -= 0.05) {
         // A stability limit that stays above the plot everywhere says so.
         bool shown = false;
@@ -200,8 +227,9 @@ static void draw_chart(void* user) {
     }
     plcol0(15);
     if (c->stab) plptex(0.02, yl, 1, 0, 0, "o: stability governs"), yl -= 0.05;
-    plptex(0.02, yl, 1, 0, 0, "chart: min(raw, rating),"), yl -= 0.04;
-    plptex(0.02, yl, 1, 0, 0, "never rising with outreach");
+    plptex(0.02, yl, 1, 0, 0, "chart: min(raw, rating), from its"), yl -= 0.04;
+    plptex(0.02, yl, 1, 0, 0, "peak (dotted: minimum outreach)"), yl -= 0.04;
+    plptex(0.02, yl, 1, 0, 0, "outward never rising");
 }
 
 static int plot_chart(const char* png, const loadchart* c, const char* title, char* err, size_t errsz) {
@@ -325,8 +353,10 @@ int cmd_loadchart(int argc, char** argv) {
     }
     fprintf(f, ",rating_kg");
     for (int s = 0; s < ch.nsec; ++s)
-        fprintf(f, ",envelope_s%d_kg,chart_s%d_kg,governs_s%d,gov_outreach_s%d_m,q1_s%d_deg,q2_s%d_deg,slew_s%d_deg", s,
-                s, s, s, s, s, s);
+        fprintf(f,
+                ",envelope_s%d_kg,chart_s%d_kg,capacity_s%d_kg,governs_s%d,gov_outreach_s%d_m,q1_s%d_deg,q2_s%d_deg,"
+                "slew_s%d_deg",
+                s, s, s, s, s, s, s, s);
     fprintf(f, "\n");
     for (int i = 0; i < ch.n; ++i) {
         fprintf(f, "%.4f,%.1f,%s,%.3f,%.3f", ch.R[i], ch.hyd[i], ch.hyd_cyl[i] ? "jib" : "lift",
@@ -342,8 +372,13 @@ int cmd_loadchart(int argc, char** argv) {
             const size_t k = (size_t)i * ch.nsec + s;
             double q[3];
             loadchart_point_pose(&ch, i, s, q);
-            fprintf(f, ",%.1f,%.1f,%s,%.4f,%.3f,%.3f,%.3f", ch.env[k], ch.chart[k], lc_gov_name(ch.gov[k]),
-                    ch.R[ch.gov_at[k]], q[0] * 180 / M_PI, q[1] * 180 / M_PI, q[2] * 180 / M_PI);
+            // Closer than the sector's minimum outreach the chart is not
+            // printed (an empty field); the capacity is what the limiter
+            // uses there, min(envelope, rating) at that outreach.
+            fprintf(f, ",%.1f,", ch.env[k]);
+            if (i >= ch.imin[s]) fprintf(f, "%.1f", ch.chart[k]);
+            fprintf(f, ",%.1f,%s,%.4f,%.3f,%.3f,%.3f", ch.cap[k], lc_gov_name(ch.gov[k]), ch.R[ch.gov_at[k]],
+                    q[0] * 180 / M_PI, q[1] * 180 / M_PI, q[2] * 180 / M_PI);
         }
         fprintf(f, "\n");
     }
@@ -373,19 +408,26 @@ int cmd_loadchart(int argc, char** argv) {
         printf("  %d outreach points %.2f..%.2f m, %d slew sector%s, computed in %.3f s\n", ch.n, ch.R[0],
                ch.R[ch.n - 1], ch.nsec, ch.nsec > 1 ? "s" : "", wall);
         if (ch.rated_moment > 0 || ch.rated_load > 0)
-            printf("  rating (the model's): %.0f kg, %.1f kN m; chart = min(raw envelope, rating), never rising with "
-                   "outreach\n",
+            printf("  rating (the model's): %.0f kg, %.1f kN m; chart = min(raw envelope, rating), from its peak (the "
+                   "minimum outreach) never rising with outreach\n",
                    ch.rated_load, ch.rated_moment / 1e3);
         else
-            printf("  no rating in the model (mechanics.rated_load, rated_moment): chart = raw envelope, never rising "
-                   "with outreach\n");
+            printf("  no rating in the model (mechanics.rated_load, rated_moment): chart = raw envelope, from its peak "
+                   "(the minimum outreach) never rising with outreach\n");
+        printf("  minimum outreach:");
+        for (int s = 0; s < ch.nsec; ++s)
+            printf("%s sector %d %.2f m (%.0f kg)", s ? "," : "", s, ch.R[ch.imin[s]],
+                   ch.chart[(size_t)ch.imin[s] * ch.nsec + s]);
+        printf("\n");
         const int idx[3] = {0, ch.n / 2, ch.n - 1};
         for (int j = 0; j < 3; ++j) {
             const int i = idx[j];
             printf("  at %.2f m: hydraulic %.0f kg", ch.R[i], ch.hyd[i]);
             for (int s = 0; s < ch.nsec; ++s) {
                 const size_t k = (size_t)i * ch.nsec + s;
-                printf(", sector %d chart %.0f kg (%s", s, ch.chart[k], lc_gov_name(ch.gov[k]));
+                if (i < ch.imin[s]) printf(", sector %d inside the minimum outreach: %.0f kg (%s", s, ch.cap[k],
+                                           lc_gov_name(ch.gov[k]));
+                else printf(", sector %d chart %.0f kg (%s", s, ch.chart[k], lc_gov_name(ch.gov[k]));
                 if (ch.gov_at[k] != i) printf(" at %.2f m", ch.R[ch.gov_at[k]]);
                 printf(")");
             }

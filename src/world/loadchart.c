@@ -246,13 +246,14 @@ int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadc
     const size_t nn = (size_t)c->n * (size_t)c->nsec;
     c->env = malloc(sizeof *c->env * nn);
     c->chart = malloc(sizeof *c->chart * nn);
+    c->cap = malloc(sizeof *c->cap * nn);
     c->gov = malloc(sizeof *c->gov * nn);
     c->gov_at = malloc(sizeof *c->gov_at * nn);
     if (c->truck) {
         c->stab = malloc(sizeof *c->stab * nn);
         c->stab_q = malloc(sizeof *c->stab_q * nn);
     }
-    if (!c->env || !c->chart || !c->gov || !c->gov_at || (c->truck && (!c->stab || !c->stab_q))) {
+    if (!c->env || !c->chart || !c->cap || !c->gov || !c->gov_at || (c->truck && (!c->stab || !c->stab_q))) {
         snprintf(err, errsz, "out of memory for the load chart");
         loadchart_free(c);
         return -1;
@@ -296,13 +297,23 @@ int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadc
         }
         c->rating[i] = loadchart_rating(c, R);
     }
-    // The printed chart, per sector: the raw envelope capped by the rating,
-    // then held down by every closer outreach (a running minimum), since a
-    // chart that rises with outreach invites the operator to reach out to
-    // lift more (the limiter rates outreach, not the way the booms got
-    // there). The running minimum is the largest non-increasing curve under
-    // the capped envelope; the raw envelope is kept beside it.
-    for (int s = 0; s < c->nsec; ++s)
+    // The printed chart, per sector. First min(raw envelope, rating) at each
+    // point, what the crane may lift there. The chart starts at the
+    // sector's minimum working outreach, where that value is largest (the
+    // first such point: a plateau at the rated load starts where the crane
+    // first holds it), and from there outward it is the running minimum
+    // (held down by every closer outreach of the chart): a chart that rises
+    // with outreach invites the operator to reach out to lift more (the
+    // limiter rates outreach, not the way the booms got there), and the
+    // running minimum is the largest non-increasing curve under the capped
+    // envelope. Closer in than the peak the value falls towards the column
+    // (on the shipped crane the folded jib: 1183 kg at 0.5 m); a running
+    // minimum from there would hold the whole chart down to it (out to
+    // 2.45 m), so those points are not printed (NAN) and the limiter takes
+    // min(envelope, rating) at the point itself (cap). The raw envelope is
+    // kept beside it.
+    for (int s = 0; s < c->nsec; ++s) {
+        int i0 = 0;
         for (int i = 0; i < c->n; ++i) {
             const size_t k = (size_t)i * c->nsec + s;
             const double st = c->stab ? c->stab[k] : INFINITY;
@@ -310,12 +321,23 @@ int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadc
             c->env[k] = fmin(c->hyd[i], st);
             double v = c->env[k];
             if (c->rating[i] < v) v = c->rating[i], g = LC_GOV_RATED;
-            c->chart[k] = v, c->gov[k] = g, c->gov_at[k] = i;
-            if (i > 0 && c->chart[k - c->nsec] < v) {
-                c->chart[k] = c->chart[k - c->nsec];
+            c->cap[k] = v, c->gov[k] = g, c->gov_at[k] = i;
+            if (v > c->cap[(size_t)i0 * c->nsec + s]) i0 = i;
+        }
+        c->imin[s] = i0;
+        for (int i = 0; i < c->n; ++i) {
+            const size_t k = (size_t)i * c->nsec + s;
+            if (i < i0) {
+                c->chart[k] = NAN;
+                continue;
+            }
+            if (i > i0 && c->cap[k - c->nsec] < c->cap[k]) {
+                c->cap[k] = c->cap[k - c->nsec];
                 c->gov[k] = c->gov[k - c->nsec], c->gov_at[k] = c->gov_at[k - c->nsec];
             }
+            c->chart[k] = c->cap[k];
         }
+    }
     return 0;
 }
 
@@ -351,8 +373,8 @@ const char* lc_gov_name(int gov) {
 }
 
 void loadchart_free(loadchart* c) {
-    free(c->stab), free(c->stab_q), free(c->env), free(c->chart), free(c->gov), free(c->gov_at);
-    c->stab = NULL, c->stab_q = NULL, c->env = c->chart = NULL, c->gov = c->gov_at = NULL;
+    free(c->stab), free(c->stab_q), free(c->env), free(c->chart), free(c->cap), free(c->gov), free(c->gov_at);
+    c->stab = NULL, c->stab_q = NULL, c->env = c->chart = c->cap = NULL, c->gov = c->gov_at = NULL;
 }
 
 int loadchart_sector(const loadchart* c, double slew) {
@@ -383,10 +405,11 @@ static double interp(const loadchart* c, const double* col, int i, double w, int
 double loadchart_capacity(const loadchart* c, double R, double slew, int* gov) {
     double w;
     const int i = interval(c, R, &w), s = loadchart_sector(c, slew);
-    // The chart is non-increasing, so is its interpolation; the rating is
-    // convex in R (M / (g R)), so its chord lies above it: capped by the
-    // rating at R itself.
-    const double v = fmin(interp(c, c->chart, i, w, s), loadchart_rating(c, R));
+    // From the minimum outreach on the chart is non-increasing, so is its
+    // interpolation; closer in, min(envelope, rating) interpolated as the
+    // envelope always was. The rating is convex in R (M / (g R)), so its
+    // chord lies above it: capped by the rating at R itself.
+    const double v = fmin(interp(c, c->cap, i, w, s), loadchart_rating(c, R));
     if (gov) *gov = c->gov[(size_t)(w >= 1 ? i + 1 : i) * c->nsec + s];
     return v;
 }

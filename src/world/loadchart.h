@@ -64,10 +64,16 @@ typedef struct loadchart {
     double rating[LOADCHART_MAX_POINTS]; ///< the model's rated capacity at R, payload [kg]: min(rated_load,
                                          ///< rated_moment / (g R)) less the hook (INFINITY: the model gives none)
     double* env;   ///< n x nsec raw envelope: min(hydraulic, stability) [kg], what the crane can do
-    double* chart; ///< n x nsec printed chart: min(envelope, rating), made non-increasing with outreach [kg]
-    int* gov;      ///< n x nsec: what governs the printed chart (lc_gov)
-    int* gov_at;   ///< n x nsec: the point (index <= i) where that limit is met; < i where a closer
-                   ///< outreach's lower value holds the chart down (it may not rise with outreach)
+    double* chart; ///< n x nsec printed chart [kg]: from the sector's minimum outreach (imin) outward the
+                   ///< running minimum of min(envelope, rating); NAN closer than imin (not printed)
+    double* cap;   ///< n x nsec what the limiter holds the crane to [kg]: the chart from imin outward,
+                   ///< min(envelope, rating) at the point itself closer than imin
+    int* gov;      ///< n x nsec: what governs cap (lc_gov)
+    int* gov_at;   ///< n x nsec: the point where that limit is met: i itself closer than imin; from
+                   ///< imin on a point in [imin, i], < i where a closer outreach's lower value holds
+                   ///< the chart down (it may not rise with outreach)
+    int imin[LOADCHART_MAX_SECTORS]; ///< per sector, the chart's minimum outreach: the first point where
+                                     ///< min(envelope, rating) is largest (the chart's peak)
     double sec_lo[LOADCHART_MAX_SECTORS], sec_hi[LOADCHART_MAX_SECTORS]; ///< sector bounds [rad], 0..pi
     double reach_min, reach_max;      ///< outreach the workspace covers [m]
     bool truck;
@@ -98,10 +104,12 @@ double loadchart_stab_pose(const model* m, const lc_truck* t, double q1, double 
 
 /// The sector of slew angle slew [rad] (any value; folded to 0..pi).
 int loadchart_sector(const loadchart* c, double slew);
-/// Rated capacity [kg] at outreach R [m] and slew [rad]: the printed chart,
-/// interpolated linearly (clamped to the chart's range) and capped by the
-/// model's rating at R itself; *gov (may be NULL): what governs at the chart
-/// point at or below R (lc_gov). What the limiter holds the crane to.
+/// Rated capacity [kg] at outreach R [m] and slew [rad], what the limiter
+/// holds the crane to: the column cap (the printed chart from the sector's
+/// minimum outreach outward, min(envelope, rating) closer in), interpolated
+/// linearly (clamped to the chart's range) and capped by the model's rating
+/// at R itself; *gov (may be NULL): what governs at the chart point at or
+/// below R (lc_gov).
 double loadchart_capacity(const loadchart* c, double R, double slew, int* gov);
 /// The raw envelope [kg] at R and slew: min(hydraulic, stability), no
 /// rating, not made monotone; interpolated as loadchart_capacity.

@@ -60,11 +60,15 @@ static int split(char* line, char** f, int max) {
 }
 
 // A chart over three sectors: the CSV has its header with units and a row
-// per point. Per sector the raw envelope is min(hydraulic, stability), the
-// printed chart is at or under the envelope and the model's rating (2000 kg,
-// 29.4 kN m / (g R), less the 40.72 kg hook) and never rises with outreach;
-// each point names what governs it (lift, jib, stability, rated), the
-// outreach where it does (at or before its own) and a pose that reaches it;
+// per point. Per sector the raw envelope is min(hydraulic, stability); the
+// capacity (what the limiter uses) is at or under the envelope and the
+// model's rating (2000 kg, 29.4 kN m / (g R), less the 40.72 kg hook); the
+// printed chart is empty closer than the minimum outreach (there the
+// capacity is min(envelope, rating) itself; at 1.0 m the folded end arm
+// holds less than the rating), from there equal to the capacity and never
+// rising with outreach; each point names what governs it (lift, jib,
+// stability, rated), the outreach where it does (its own closer than the
+// minimum outreach, else at or before its own) and a pose that reaches it;
 // the side sector (pads 2 m out) is never weaker than over the cab (pads
 // 0.1 m ahead of the column).
 static void test_chart_csv(void) {
@@ -74,46 +78,62 @@ static void test_chart_csv(void) {
     CHECK(cli_read_file("lc_ok.csv", csv, sizeof csv) > 0, "no CSV");
     static const char k_head[] =
         "outreach_m,hydraulic_kg,hyd_cylinder,hyd_q1_deg,hyd_q2_deg,stability_s0_0_45deg_kg,stability_s1_45_135deg_kg,"
-        "stability_s2_135_180deg_kg,rating_kg,envelope_s0_kg,chart_s0_kg,governs_s0,gov_outreach_s0_m,q1_s0_deg,"
-        "q2_s0_deg,slew_s0_deg,envelope_s1_kg,";
+        "stability_s2_135_180deg_kg,rating_kg,envelope_s0_kg,chart_s0_kg,capacity_s0_kg,governs_s0,gov_outreach_s0_m,"
+        "q1_s0_deg,q2_s0_deg,slew_s0_deg,envelope_s1_kg,";
     CHECK(strncmp(csv, k_head, sizeof k_head - 1) == 0, "header: %.300s", csv);
     CHECK(cli_count_lines(csv) == 8, "%d lines, expected 8", cli_count_lines(csv));
     double prev[3] = {INFINITY, INFINITY, INFINITY};
+    int inside[3] = {0, 0, 0};
     char* line = strchr(csv, '\n');
     while (line && line[1]) {
         char* next = strchr(line + 1, '\n');
         if (next) *next = '\0';
         char* f[40];
         const int n = split(line + 1, f, 40);
-        CHECK(n == 9 + 3 * 7, "row has %d fields, expected 30", n);
-        if (n == 30) {
+        CHECK(n == 9 + 3 * 8, "row has %d fields, expected 33", n);
+        if (n == 33) {
             const double R = atof(f[0]), hyd = atof(f[1]), rating = atof(f[8]);
             const double hand_rating = fmin(2000.0, 29.4e3 / (9.81 * R)) - 40.72;
             CHECK(fabs(rating - hand_rating) < 0.06, "rating %g, hand %g at %g m", rating, hand_rating, R);
             CHECK(atof(f[6]) >= atof(f[5]), "side %s kg weaker than over the cab %s kg at %g m", f[6], f[5], R);
             for (int s = 0; s < 3; ++s) {
-                char** g = f + 9 + 7 * s;
-                const double env = atof(g[0]), chart = atof(g[1]), at = atof(g[3]);
+                char** g = f + 9 + 8 * s;
+                const double env = atof(g[0]), cap = atof(g[2]), at = atof(g[4]);
                 const double stab = strcmp(f[5 + s], "inf") ? atof(f[5 + s]) : INFINITY;
                 CHECK(fabs(env - fmin(hyd, stab)) < 0.06, "envelope %g != min(%g, %g) at %g m", env, hyd, stab, R);
-                CHECK(chart <= env + 0.05 && chart <= rating + 0.05, "chart %g over envelope %g or rating %g at %g m",
-                      chart, env, rating, R);
-                CHECK(chart <= prev[s] + 1e-9, "sector %d: chart rises %g -> %g kg at %g m", s, prev[s], chart, R);
-                prev[s] = chart;
-                CHECK(!strcmp(g[2], "lift") || !strcmp(g[2], "jib") || !strcmp(g[2], "stability") ||
-                          !strcmp(g[2], "rated"),
-                      "governs '%s'", g[2]);
+                CHECK(cap <= env + 0.05 && cap <= rating + 0.05, "capacity %g over envelope %g or rating %g at %g m",
+                      cap, env, rating, R);
+                if (!g[1][0]) {
+                    // Closer than the minimum outreach: not printed, and only
+                    // before the chart's first point.
+                    CHECK(isinf(prev[s]), "sector %d: chart empty at %g m after it began", s, R);
+                    CHECK(fabs(cap - fmin(env, rating)) < 0.06 && fabs(at - R) < 1e-9,
+                          "inside at %g m: capacity %g, min(envelope %g, rating %g), governs at %g m", R, cap, env,
+                          rating, at);
+                    ++inside[s];
+                } else {
+                    const double chart = atof(g[1]);
+                    CHECK(fabs(chart - cap) < 1e-9, "chart %g, capacity %g at %g m", chart, cap, R);
+                    CHECK(chart <= prev[s] + 1e-9, "sector %d: chart rises %g -> %g kg at %g m", s, prev[s], chart, R);
+                    prev[s] = chart;
+                }
+                CHECK(!strcmp(g[3], "lift") || !strcmp(g[3], "jib") || !strcmp(g[3], "stability") ||
+                          !strcmp(g[3], "rated"),
+                      "governs '%s'", g[3]);
                 CHECK(at <= R + 1e-9 && at >= 1.0 - 1e-9, "governs at %g m for the point at %g m", at, R);
                 // The pose reaches that outreach: L1 sin q1 + L2 sin(q1 + q2).
-                const double q1 = atof(g[4]) * M_PI / 180, q2 = atof(g[5]) * M_PI / 180;
-                CHECK(fabs(2.3 * sin(q1) + 2.5 * sin(q1 + q2) - at) < 1e-3, "pose (%s, %s) does not reach %g m", g[4],
-                      g[5], at);
-                const double sl = atof(g[6]);
+                const double q1 = atof(g[5]) * M_PI / 180, q2 = atof(g[6]) * M_PI / 180;
+                CHECK(fabs(2.3 * sin(q1) + 2.5 * sin(q1 + q2) - at) < 1e-3, "pose (%s, %s) does not reach %g m", g[5],
+                      g[6], at);
+                const double sl = atof(g[7]);
                 CHECK(sl >= 90.0 * s - 45 - 1e-6 && sl <= 90.0 * s + 45 + 1e-6, "slew %g deg outside sector %d", sl, s);
             }
         }
         line = next;
     }
+    for (int s = 0; s < 3; ++s)
+        CHECK(inside[s] == 1 && isfinite(prev[s]), "sector %d: %d rows inside the minimum outreach, expected 1 (1.0 m)",
+              s, inside[s]);
     remove("lc_ok.csv");
 }
 
@@ -133,12 +153,13 @@ static int count_colour(const unsigned char* px, int w, int h, const int c[3]) {
 }
 
 // The plot draws every line so that it shows: on the shipped crane the three
-// sectors' printed charts coincide over the whole range (the folded jib at
-// 0.5 m, then the rating, govern in every sector) and the hydraulic limit
-// lies on them out to 0.5 m; each must still have its own pixels in the
-// plot area, not only in the legend: the three sector colours, the
-// stability limits of the cab and side sectors (light), the hydraulic limit
-// (red, dashed) and the rating (dark gold).
+// sectors' printed charts coincide over the whole range (the rating governs
+// in every sector from the minimum outreach, 1.07 m) and closer in the
+// limiter's capacity lies on the hydraulic limit; each must still have its
+// own pixels in the plot area, not only in the legend: the three sector
+// colours, the stability limits of the cab and side sectors (light), the
+// hydraulic limit (red, dashed), the rating (dark gold) and the capacity
+// closer than the minimum outreach (grey, under the hydraulic limit).
 static void test_chart_plot_lines_visible(void) {
     remove("lc_plot.png");
     const int rc = cli_run("loadchart --out lc_plot.csv --plot lc_plot.png --quiet", out, sizeof out);
@@ -154,7 +175,7 @@ static void test_chart_plot_lines_visible(void) {
         {{0, 60, 200}, "chart 0-45 deg"},      {{0, 140, 0}, "chart 45-135 deg"},
         {{190, 0, 190}, "chart 135-180 deg"},  {{140, 175, 255}, "stability 0-45 deg"},
         {{130, 220, 130}, "stability 45-135 deg"}, {{220, 0, 0}, "hydraulic limit"},
-        {{150, 110, 0}, "rating"},
+        {{150, 110, 0}, "rating"},             {{150, 150, 150}, "inside min. outreach"},
     };
     for (size_t i = 0; i < sizeof lines / sizeof lines[0]; ++i) {
         const int n = count_colour(px, w, h, lines[i].c);

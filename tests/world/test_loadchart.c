@@ -237,12 +237,13 @@ static void test_stability_chart_counts_hook_once(void) {
     model_free(m);
 }
 
-// The printed chart: min(raw envelope, the model's rating), never rising
-// with outreach. The rating by hand: 2000 kg, or 29.4 kN m / (9.81 m/s^2 x
-// R) beyond 1.47 m, less the sandbox's hook and rope (40.72 kg). Each point
-// names what governs it and where: the chart there equals that limit at
-// that outreach, and every point is at or under its own raw envelope and
-// rating.
+// The printed chart: min(raw envelope, the model's rating), from the
+// sector's minimum outreach (where that is largest) never rising with
+// outreach, not printed closer in. The rating by hand: 2000 kg, or 29.4 kN m
+// / (9.81 m/s^2 x R) beyond 1.50 m, less the sandbox's hook and rope
+// (40.72 kg). Each point names what governs it and where: the limiter's
+// capacity there equals that limit at that outreach, and every point is at
+// or under its own raw envelope and rating.
 static void test_printed_chart(void) {
     model* m = load(NULL, 0);
     if (!m) return;
@@ -267,15 +268,14 @@ static void test_printed_chart(void) {
             const size_t k = (size_t)i * c.nsec + s;
             const double st = c.stab[k];
             CHECK_NEAR(c.env[k], fmin(c.hyd[i], st), 1e-9);
-            CHECK(c.chart[k] <= c.env[k] + 1e-9 && c.chart[k] <= c.rating[i] + 1e-9,
-                  "%.2f m sector %d: chart %.1f over envelope %.1f or rating %.1f", c.R[i], s, c.chart[k], c.env[k],
+            CHECK(c.cap[k] <= c.env[k] + 1e-9 && c.cap[k] <= c.rating[i] + 1e-9,
+                  "%.2f m sector %d: capacity %.1f over envelope %.1f or rating %.1f", c.R[i], s, c.cap[k], c.env[k],
                   c.rating[i]);
-            if (i > 0)
-                CHECK(c.chart[k] <= c.chart[k - c.nsec], "%.2f m sector %d: chart rises %.1f -> %.1f kg", c.R[i], s,
-                      c.chart[k - c.nsec], c.chart[k]);
+            CHECK(i < c.imin[s] ? isnan(c.chart[k]) : c.chart[k] == c.cap[k], "%.2f m sector %d: chart %g, capacity %g",
+                  c.R[i], s, c.chart[k], c.cap[k]);
             // What governs, at the outreach it names.
             const int j = c.gov_at[k];
-            CHECK(j >= 0 && j <= i, "gov_at %d at point %d", j, i);
+            CHECK(j >= 0 && j <= i && (i < c.imin[s] ? j == i : j >= c.imin[s]), "gov_at %d at point %d", j, i);
             const size_t kj = (size_t)j * c.nsec + s;
             double lim = NAN;
             switch (c.gov[k]) {
@@ -284,7 +284,7 @@ static void test_printed_chart(void) {
             case LC_GOV_STAB: lim = c.stab[kj]; break;
             case LC_GOV_RATED: lim = c.rating[j]; break;
             }
-            CHECK_NEAR(c.chart[k], lim, 1e-9);
+            CHECK_NEAR(c.cap[k], lim, 1e-9);
             n_rated += c.gov[k] == LC_GOV_RATED, n_held += j < i, n_hyd += c.gov[k] == LC_GOV_JIB;
             // The pose of the point reaches the outreach where its limit governs.
             double q[3];
@@ -292,28 +292,33 @@ static void test_printed_chart(void) {
             CHECK_NEAR(m->mech.link[0].length * sin(q[0]) + m->mech.link[1].length * sin(q[0] + q[1]), c.R[j], 1e-9);
         }
     }
-    // The shipped crane: at 0.5 m the folded jib holds 1183 kg; the chart
-    // keeps that until the rating falls below it (3000 / R - 40.7 = 1183 kg
-    // at R = 2.45 m), then follows the rating.
-    printf("  printed chart: %d points rated, %d held by a closer outreach, %d jib; 0.5 m %.0f kg, 2.0 m %.0f kg, "
-           "3.0 m %.0f kg, 4.5 m %.0f kg (raw envelope over the side %.0f, %.0f, %.0f, %.0f kg)\n",
-           n_rated, n_held, n_hyd, c.chart[0 * 3 + 1], c.chart[30 * 3 + 1], c.chart[50 * 3 + 1], c.chart[80 * 3 + 1],
-           c.env[0 * 3 + 1], c.env[30 * 3 + 1], c.env[50 * 3 + 1], c.env[80 * 3 + 1]);
-    CHECK(c.gov[30 * 3 + 1] == LC_GOV_JIB && c.gov_at[30 * 3 + 1] == 0, "2.0 m: held by the jib at 0.5 m");
+    // The shipped crane: the rating (1959 kg) from where the raw envelope
+    // first holds it (1.10 m on this grid) to 1.50 m, then 3000 / R - 40.7;
+    // closer than 1.10 m the folded jib (1183 kg at 0.5 m).
+    printf("  printed chart: %d points rated, %d held by a closer outreach, %d jib; minimum outreach %.2f m; 0.5 m "
+           "(inside) %.0f kg, 2.0 m %.0f kg, 3.0 m %.0f kg, 4.5 m %.0f kg (raw envelope over the side %.0f, %.0f, "
+           "%.0f, %.0f kg)\n",
+           n_rated, n_held, n_hyd, c.R[c.imin[1]], c.cap[0 * 3 + 1], c.chart[30 * 3 + 1], c.chart[50 * 3 + 1],
+           c.chart[80 * 3 + 1], c.env[0 * 3 + 1], c.env[30 * 3 + 1], c.env[50 * 3 + 1], c.env[80 * 3 + 1]);
+    CHECK(c.gov[0 * 3 + 1] == LC_GOV_JIB, "0.5 m: the folded jib governs");
+    CHECK(c.gov[30 * 3 + 1] == LC_GOV_RATED && c.gov_at[30 * 3 + 1] == 30, "2.0 m: the rating at 2.0 m");
+    CHECK_NEAR(c.chart[30 * 3 + 1], 29.4e3 / (9.81 * 2.0) - hook, 1e-6);
     CHECK_NEAR(c.chart[50 * 3 + 1], 29.4e3 / (9.81 * 3.0) - hook, 1e-6);
     CHECK(c.gov[80 * 3 + 0] == LC_GOV_RATED, "4.5 m over the cab: the rating governs");
     // Without a rating (a model that gives none) the printed chart is the
-    // raw envelope made non-increasing: nothing is "rated".
+    // raw envelope from its peak, made non-increasing: nothing is "rated".
     loadchart_free(&c);
     m->rated_moment = m->rated_load = 0;
     CHECK(loadchart_compute(m, &t, &o, &c, err, sizeof err) == 0, "%s", err);
-    for (int i = 0; i < c.n; ++i)
-        for (int s = 0; s < c.nsec; ++s) {
+    for (int s = 0; s < c.nsec; ++s)
+        for (int i = 0; i < c.n; ++i) {
             const size_t k = (size_t)i * c.nsec + s;
             CHECK(isinf(c.rating[i]) && c.gov[k] != LC_GOV_RATED, "no rating, yet %s at %.2f m", lc_gov_name(c.gov[k]),
                   c.R[i]);
-            CHECK_NEAR(c.chart[k], i ? fmin(c.env[k], c.chart[k - c.nsec]) : c.env[k], 1e-9);
+            CHECK_NEAR(c.cap[k], i > c.imin[s] ? fmin(c.env[k], c.cap[k - c.nsec]) : c.env[k], 1e-9);
         }
+    printf("  without the rating: minimum outreach %.2f m over the side (%.0f kg)\n", c.R[c.imin[1]],
+           c.chart[(size_t)c.imin[1] * 3 + 1]);
     loadchart_free(&c);
     m->rated_moment = 29.4e3, m->rated_load = 2000;
     CHECK(loadchart_compute(m, &t, &o, &c, err, sizeof err) == 0, "%s", err);
@@ -329,14 +334,80 @@ static void test_printed_chart(void) {
     model_free(m);
 }
 
-// A printed chart point checked by simulation through the pose the chart
-// writes for it (the validation world, no truck; the reliefs' override band
-// widened as in sim_check): at 1.5 m the chart (margin 10 %) is held down by
-// the folded jib at 0.5 m, the pose the CSV names. That pose with the
-// chart's load holds (no relief opens, the booms stay); with 110 % of the
-// pose's hydraulic limit at the relief setting itself (margin 0), the jib's
-// port relief opens (its chamber reaches the 25 MPa setting) and the end arm
-// sinks. Both backends.
+// The chart starts at the crane's minimum working outreach (the outreach
+// where min(raw envelope, rating) is largest), not at the closest outreach
+// the booms reach: per sector the chart never rises from there, the point
+// there is the peak, and closer in the limiter's capacity is
+// min(envelope, rating) at that outreach itself, checked by hand at 0.5 m
+// (the hydraulic limit by the torque balance of hand_hyd, the rating
+// 2000 kg, both less the hook; the stability limit there is over 12 t). And
+// the limiter's own chart (rcl_init: from 0.5 m, 8 sectors) at 1.73 m, where
+// the overload tests start, rates the crane by the rating there, 3000 kg m /
+// 1.73 m less the hook, not by the folded jib's 1183 kg at 0.5 m: a running
+// minimum from 0.5 m held the whole chart to that out to 2.45 m.
+static void test_chart_minimum_outreach(void) {
+    model* m = load(NULL, 0);
+    if (!m) return;
+    world_desc wd;
+    char err[300];
+    CHECK(world_desc_load(CRANESIM_ASSETS "/worlds/sandbox.json", &wd, err, sizeof err) == 0, "%s", err);
+    lc_truck t;
+    lc_truck_from_world(&wd, &t);
+    lc_opts o = lc_default_opts();
+    o.lo = 0.5, o.hi = 4.5, o.n = 81, o.sectors = 3;
+    loadchart c;
+    CHECK(loadchart_compute(m, &t, &o, &c, err, sizeof err) == 0, "%s", err);
+    const double hook = 40 + 0.6 * 1.2;
+    for (int s = 0; s < c.nsec; ++s) {
+        const int i0 = c.imin[s];
+        const double peak = c.cap[(size_t)i0 * c.nsec + s];
+        for (int i = 0; i < c.n; ++i) {
+            const size_t k = (size_t)i * c.nsec + s;
+            const double own = fmin(c.env[k], c.rating[i]);
+            // The peak: no point offers more, no point closer in as much.
+            CHECK(own <= peak && (i >= i0 || own < peak), "sector %d: %.1f kg at %.2f m, peak %.1f kg at %.2f m", s,
+                  own, c.R[i], peak, c.R[i0]);
+            if (i > i0)
+                CHECK(c.chart[k] <= c.chart[k - c.nsec], "sector %d: chart rises %.1f -> %.1f kg at %.2f m", s,
+                      c.chart[k - c.nsec], c.chart[k], c.R[i]);
+            if (i < i0) CHECK(c.cap[k] == own, "sector %d, %.2f m inside: capacity %.1f, own %.1f", s, c.R[i], c.cap[k], own);
+        }
+        printf("  sector %d: minimum outreach %.2f m, %.1f kg\n", s, c.R[i0], peak);
+        CHECK(c.R[i0] > 1.0 && c.R[i0] < 1.5, "sector %d: minimum outreach %.2f m", s, c.R[i0]);
+        CHECK_NEAR(peak, 2000 - hook, 1e-9);
+        // Closer in, by hand at 0.5 m.
+        const double hand = fmin(hand_hyd(m, 0.5, 0.10) - hook, 2000 - hook);
+        const double got = loadchart_capacity(&c, 0.5, 0.5 * (c.sec_lo[s] + c.sec_hi[s]), NULL);
+        CHECK(got <= hand * 1.002 && got >= hand * 0.99, "sector %d, 0.5 m: capacity %.1f kg, hand %.1f kg", s, got,
+              hand);
+        if (s == 1) printf("  0.50 m (inside): capacity %.1f kg, hand %.1f kg\n", got, hand);
+    }
+    loadchart_free(&c);
+    // The limiter's chart at 1.73 m: sandbox (every sector) and validation.
+    for (int w = 0; w < 2; ++w) {
+        rcl r;
+        CHECK(rcl_init(&r, m, w ? NULL : &wd, err, sizeof err) == 0, "%s", err);
+        const double h = w ? 0.0 : hook, R = 1.73, rated = 29.4e3 / (9.81 * R) - h;
+        for (int s = 0; s < r.chart.nsec; ++s) {
+            const double slew = 0.5 * (r.chart.sec_lo[s] + r.chart.sec_hi[s]);
+            const double cap = loadchart_capacity(&r.chart, R, slew, NULL);
+            if (s == 0) printf("  limiter (%s) at 1.73 m: %.1f kg, rating %.1f kg\n", w ? "validation" : "sandbox", cap, rated);
+            CHECK_NEAR(cap, rated, 1e-6);
+        }
+        rcl_free(&r);
+    }
+    world_desc_free(&wd);
+    model_free(m);
+}
+
+// A chart point checked by simulation through the pose the chart writes for
+// it (the validation world, no truck; the reliefs' override band widened as
+// in sim_check): at 0.5 m, closer than the minimum outreach, the limiter's
+// capacity (margin 10 %) is the folded jib's limit there, in the pose the
+// CSV names. That pose with that load holds (no relief opens, the booms
+// stay); with 110 % of the pose's hydraulic limit at the relief setting
+// itself (margin 0), the jib's port relief opens (its chamber reaches the
+// 25 MPa setting) and the end arm sinks. Both backends.
 static void chart_point_pose_sim(sim_mechanics mech) {
     static const char* const sets[] = {"hydraulics.components.lift_relief_A.dp_override=5e6",
                                        "hydraulics.components.lift_relief_B.dp_override=5e6",
@@ -349,9 +420,9 @@ static void chart_point_pose_sim(sim_mechanics mech) {
     loadchart c;
     char err[300];
     CHECK(loadchart_compute(m, NULL, &o, &c, err, sizeof err) == 0, "%s", err);
-    const int i = 10; // 1.5 m
-    CHECK(c.gov[i] == LC_GOV_JIB && c.gov_at[i] == 0, "1.5 m: governs %s at %.2f m", lc_gov_name(c.gov[i]),
-          c.R[c.gov_at[i]]);
+    const int i = 0; // 0.5 m
+    CHECK(c.gov[i] == LC_GOV_JIB && c.gov_at[i] == 0 && i < c.imin[0], "0.5 m: governs %s at %.2f m (minimum "
+          "outreach %.2f m)", lc_gov_name(c.gov[i]), c.R[c.gov_at[i]], c.R[c.imin[0]]);
     double q[3], pj[2];
     loadchart_point_pose(&c, i, 0, q);
     int g = -1;
@@ -363,7 +434,7 @@ static void chart_point_pose_sim(sim_mechanics mech) {
         memset(&sc, 0, sizeof sc);
         snprintf(sc.name, sizeof sc.name, "chart point pose");
         sc.duration = 2.0;
-        sc.load_mass = over ? 1.10 * at_relief : c.chart[i];
+        sc.load_mass = over ? 1.10 * at_relief : c.cap[i];
         sc.q0[0] = q[0], sc.q0[1] = q[1];
         sim_opts so = sim_default_opts();
         so.mechanics = mech;
@@ -378,17 +449,17 @@ static void chart_point_pose_sim(sim_mechanics mech) {
             dq = fmax(dq, fmax(fabs(row[COL_Q1] - sc.q0[0]), fabs(row[COL_Q2] - sc.q0[1])));
             p2 = fmax(p2, fmax(row[COL_P2A], row[COL_P2B]));
         }
-        printf("  %s, 1.50 m, chart %.0f kg (jib at 0.50 m, q %.1f, %.1f deg); %.0f kg (%s): relief_open %g, jib "
+        printf("  %s, 0.50 m, capacity %.0f kg (jib, q %.1f, %.1f deg); %.0f kg (%s): relief_open %g, jib "
                "chamber max %.2f MPa (setting %.1f), booms moved %.3f deg\n",
-               mech == SIM_ODE ? "ode" : "lagrange", c.chart[i], q[0] * 180 / M_PI, q[1] * 180 / M_PI, sc.load_mass,
-               over ? "110 % of the limit at the relief" : "the chart's load", relief, p2 / 1e6,
+               mech == SIM_ODE ? "ode" : "lagrange", c.cap[i], q[0] * 180 / M_PI, q[1] * 180 / M_PI, sc.load_mass,
+               over ? "110 % of the limit at the relief" : "the capacity", relief, p2 / 1e6,
                fmin(pj[0], pj[1]) / 1e6, dq * 180 / M_PI);
         if (over) {
             CHECK(relief > 0 && p2 >= 0.99 * fmin(pj[0], pj[1]), "+10 %%: no jib relief opened (%.2f MPa)", p2 / 1e6);
             CHECK(dq > 0.2 * M_PI / 180, "+10 %%: the end arm did not sink (%.3f deg)", dq * 180 / M_PI);
         } else {
-            CHECK(relief == 0, "the chart's load opened a relief");
-            CHECK(dq < 0.2 * M_PI / 180, "the chart's load: the booms moved %.3f deg", dq * 180 / M_PI);
+            CHECK(relief == 0, "the capacity's load opened a relief");
+            CHECK(dq < 0.2 * M_PI / 180, "the capacity's load: the booms moved %.3f deg", dq * 180 / M_PI);
         }
         sim_trace_free(&tr);
     }
@@ -640,7 +711,7 @@ static double overload_attempt(const model* m, sim_mechanics mech, bool off, dou
 static void test_limiter_overload_attempt(void) {
     model* m = load(NULL, 0);
     if (!m) return;
-    static const double loads[2] = {1000, 800};
+    static const double loads[2] = {1300, 1100};
     for (int b = 0; b < 2; ++b) {
         const sim_mechanics mech = b ? SIM_LAGRANGE : SIM_ODE;
         for (int k = 0; k < 2; ++k) {
@@ -942,6 +1013,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_stability_limit_matches_hand_calculation);
     RUN_TEST(test_stability_chart_counts_hook_once);
     RUN_TEST(test_printed_chart);
+    RUN_TEST(test_chart_minimum_outreach);
     RUN_TEST(test_chart_point_pose_by_simulation);
     RUN_TEST(test_limiter_filter);
     RUN_TEST(test_limiter_slew_towards_weaker_sector);
