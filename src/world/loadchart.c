@@ -242,7 +242,7 @@ int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadc
             c->sec_lo[s] = fmax(0.0, (s - 0.5) * w), c->sec_hi[s] = fmin(M_PI, (s + 0.5) * w);
         }
     }
-    c->rated_moment = m->rated_moment, c->rated_load = m->rated_load, c->gravity = m->mech.gravity;
+    c->rated_moment = 1e3 * m->mech.rated_moment, c->rated_load = m->mech.rated_load, c->gravity = m->mech.gravity;
     const size_t nn = (size_t)c->n * (size_t)c->nsec;
     c->env = malloc(sizeof *c->env * nn);
     c->chart = malloc(sizeof *c->chart * nn);
