@@ -126,7 +126,7 @@ static void draw_chart(void* user) {
     // 1. The printed chart of each sector, bold, nested widths, from the
     // sector's minimum outreach; closer in (not printed) what the limiter
     // uses there, min(envelope, rating), thin grey, and the minimum
-    // outreach marked by a vertical tick of the sector's colour.
+    // outreach marked by a vertical dashed line of the sector's colour.
     for (int s = 0; s < c->nsec; ++s) {
         const int i0 = c->imin[s];
         plcol0(LC_COL_DARK + s % LC_NCOL);
@@ -228,7 +228,7 @@ static void draw_chart(void* user) {
     plcol0(15);
     if (c->stab) plptex(0.02, yl, 1, 0, 0, "o: stability governs"), yl -= 0.05;
     plptex(0.02, yl, 1, 0, 0, "chart: min(raw, rating), from its"), yl -= 0.04;
-    plptex(0.02, yl, 1, 0, 0, "peak (dotted: minimum outreach)"), yl -= 0.04;
+    plptex(0.02, yl, 1, 0, 0, "peak (vertical: minimum outreach)"), yl -= 0.04;
     plptex(0.02, yl, 1, 0, 0, "outward never rising");
 }
 
