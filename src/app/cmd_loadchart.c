@@ -68,7 +68,7 @@ static const int k_light[LC_NCOL][3] = {{140, 175, 255}, {130, 220, 130}, {245, 
 #define LC_COL_RATING 2 // dark gold: the model's rating
 #define LC_COL_DARK 3   // 3..8: the sectors' printed charts
 #define LC_COL_LIGHT 9  // 9..14: the sectors' stability limits
-#define LC_COL_INSIDE 16 // grey: closer than the minimum outreach (not printed; what the limiter uses)
+#define LC_COL_INSIDE 16 // warm grey: closer than the minimum outreach (not printed; what the limiter uses)
 
 // Width of sector s's printed chart [PLplot width units, about a pixel]:
 // nested, widest first, so where the sectors' charts coincide (where the
@@ -95,7 +95,7 @@ static void draw_chart(void* user) {
     const loadchart* c = p->c;
     plscmap0n(17);
     plscol0(15, 0, 0, 0);
-    plscol0(LC_COL_INSIDE, 150, 150, 150);
+    plscol0(LC_COL_INSIDE, 165, 155, 140); // warm grey: not the neutral grey of antialiased black lines
     plscol0(LC_COL_HYD, 220, 0, 0);
     plscol0(LC_COL_RATING, 150, 110, 0);
     for (int k = 0; k < LC_NCOL; ++k) {
@@ -125,8 +125,18 @@ static void draw_chart(void* user) {
     for (int i = 0; i < c->n; ++i) x[i] = c->R[i];
     // 1. The printed chart of each sector, bold, nested widths, from the
     // sector's minimum outreach; closer in (not printed) what the limiter
-    // uses there, min(envelope, rating), thin grey, and the minimum
+    // uses there, min(envelope, rating), grey (drawn first), and the minimum
     // outreach marked by a vertical dashed line of the sector's colour.
+    for (int s = 0; s < c->nsec; ++s) {
+        if (c->imin[s] < 1) continue;
+        for (int i = 0; i < c->n; ++i) y[i] = c->cap[(size_t)i * c->nsec + s];
+        // Wide, under the thin raw lines (the hydraulic limit often lies on
+        // it), and first: a sector's bold chart is never covered by another's
+        // inside part.
+        plcol0(LC_COL_INSIDE);
+        plwidth(6);
+        plline(c->imin[s] + 1, x, y);
+    }
     for (int s = 0; s < c->nsec; ++s) {
         const int i0 = c->imin[s];
         plcol0(LC_COL_DARK + s % LC_NCOL);
@@ -138,14 +148,6 @@ static void draw_chart(void* user) {
         pllsty(3);
         plline(2, tx, ty);
         pllsty(1);
-    }
-    for (int s = 0; s < c->nsec; ++s) {
-        if (c->imin[s] < 1) continue;
-        for (int i = 0; i < c->n; ++i) y[i] = c->cap[(size_t)i * c->nsec + s];
-        // Wide, under the thin raw lines (the hydraulic limit often lies on it).
-        plcol0(LC_COL_INSIDE);
-        plwidth(6);
-        plline(c->imin[s] + 1, x, y);
     }
     plwidth(1);
     // 2. The raw envelope's parts over it, thin and light: each sector's

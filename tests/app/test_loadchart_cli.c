@@ -175,7 +175,7 @@ static void test_chart_plot_lines_visible(void) {
         {{0, 60, 200}, "chart 0-45 deg"},      {{0, 140, 0}, "chart 45-135 deg"},
         {{190, 0, 190}, "chart 135-180 deg"},  {{140, 175, 255}, "stability 0-45 deg"},
         {{130, 220, 130}, "stability 45-135 deg"}, {{220, 0, 0}, "hydraulic limit"},
-        {{150, 110, 0}, "rating"},             {{150, 150, 150}, "inside min. outreach"},
+        {{150, 110, 0}, "rating"},             {{165, 155, 140}, "inside min. outreach"},
     };
     for (size_t i = 0; i < sizeof lines / sizeof lines[0]; ++i) {
         const int n = count_colour(px, w, h, lines[i].c);
