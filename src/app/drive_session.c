@@ -292,6 +292,7 @@ static void build_params(drive_session* s) {
     for (int k = 0; k < model_param_count(); ++k) {
         model_param mp;
         model_param_info(k, &mp);
+        if (!model_param_present(me, k)) continue; // an optional field the model lacks (its rating)
         char group[64];
         mech_group(me, &mp, group, sizeof group);
         const bool load = !strcmp(mp.path, "mechanics.load_mass");
@@ -349,6 +350,7 @@ static void sync_mech_json(drive_session* s) {
     for (int k = 0; k < model_param_count(); ++k) {
         model_param mp;
         model_param_info(k, &mp);
+        if (!model_param_present(&s->m->mech, k)) continue; // not in the file; --set adds no field
         char a[240], e[200];
         snprintf(a, sizeof a, "%s=%.10g", mp.path, *model_param_ptr(&s->m->mech, k));
         json_set_path(s->m->json, a, e, sizeof e);

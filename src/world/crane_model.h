@@ -66,6 +66,11 @@ typedef struct crane_mech {
     crane_link link[2];   ///< lifting arm, end arm
     double load_mass;     ///< mass rigidly at the end-arm tip (lagrange, validation world) [kg]
     crane_actuator act[2];
+    // The maker's rating, the load chart's cap (docs/safety.md), optional:
+    // 0 when the model file gives none. In the file's units (the mechanics
+    // parameter table writes values back to the file as they are).
+    double rated_moment; ///< rated load moment m g R [kN m] (mechanics.rated_moment)
+    double rated_load;   ///< rated load close in [kg] (mechanics.rated_load)
 } crane_mech;
 
 /// Fill with the built-in HIAB-031-class defaults (docs/model.md).

@@ -144,11 +144,15 @@ double loadchart_stab_pose(const model* m, const lc_truck* t, double q1, double 
     for (int edge = 0; edge < 4; ++edge) {
         const double dl = edge_moment(t, edge, rt, slew, 1.0); // m: tip's distance inside
         if (dl >= 0) continue;                                  // a load there cannot tip over this edge
+        // Truck and crane only: the hook and rope hang at the tip with the
+        // payload, so they are part of the tipping mass m (and of its
+        // factor), subtracted once from the chart (loadchart_compute).
+        // Counting them here too, as a negative restoring moment, had the
+        // chart 40.7 / 1.25 = 32.6 kg low at every outreach.
         const double restoring = edge_moment(t, edge, -t->column_x, 0.0, t->mass) // truck COM at the chassis centre
                                  + edge_moment(t, edge, 0.0, slew, me->column_mass)
                                  + edge_moment(t, edge, r1, slew, me->link[0].mass)
-                                 + edge_moment(t, edge, r2, slew, me->link[1].mass)
-                                 + edge_moment(t, edge, rt, slew, t->hook_mass);
+                                 + edge_moment(t, edge, r2, slew, me->link[1].mass);
         // sf * m (-dl) <= restoring
         const double lim = restoring > 0 ? restoring / (sf * -dl) : 0.0;
         best = fmin(best, lim);
@@ -238,12 +242,21 @@ int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadc
             c->sec_lo[s] = fmax(0.0, (s - 0.5) * w), c->sec_hi[s] = fmin(M_PI, (s + 0.5) * w);
         }
     }
+    c->rated_moment = 1e3 * m->mech.rated_moment, c->rated_load = m->mech.rated_load, c->gravity = m->mech.gravity;
+    const size_t nn = (size_t)c->n * (size_t)c->nsec;
+    c->env = malloc(sizeof *c->env * nn);
+    c->chart = malloc(sizeof *c->chart * nn);
+    c->cap = malloc(sizeof *c->cap * nn);
+    c->gov = malloc(sizeof *c->gov * nn);
+    c->gov_at = malloc(sizeof *c->gov_at * nn);
     if (c->truck) {
-        c->stab = malloc(sizeof *c->stab * (size_t)c->n * (size_t)c->nsec);
-        if (!c->stab) {
-            snprintf(err, errsz, "out of memory for the load chart");
-            return -1;
-        }
+        c->stab = malloc(sizeof *c->stab * nn);
+        c->stab_q = malloc(sizeof *c->stab_q * nn);
+    }
+    if (!c->env || !c->chart || !c->cap || !c->gov || !c->gov_at || (c->truck && (!c->stab || !c->stab_q))) {
+        snprintf(err, errsz, "out of memory for the load chart");
+        loadchart_free(c);
+        return -1;
     }
     static double pose[LC_NQ1 * 10 + 40][2];
     for (int i = 0; i < c->n; ++i) {
@@ -268,20 +281,100 @@ int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadc
             return -1;
         }
         for (int s = 0; s < c->nsec && c->truck; ++s) {
+            const size_t k = (size_t)i * c->nsec + s;
             double st = INFINITY;
+            c->stab_q[k][0] = c->hyd_q[i][0], c->stab_q[k][1] = c->hyd_q[i][1];
+            c->stab_q[k][2] = 0.5 * (c->sec_lo[s] + c->sec_hi[s]);
             for (int j = 0; j < LC_NSLEW; ++j) {
                 const double sl = c->sec_lo[s] + (c->sec_hi[s] - c->sec_lo[s]) * j / (LC_NSLEW - 1);
-                for (int p = 0; p < np; ++p) st = fmin(st, loadchart_stab_pose(m, t, pose[p][0], pose[p][1], sl, o->sf));
+                for (int p = 0; p < np; ++p) {
+                    const double l = loadchart_stab_pose(m, t, pose[p][0], pose[p][1], sl, o->sf);
+                    if (l < st) st = l, c->stab_q[k][0] = pose[p][0], c->stab_q[k][1] = pose[p][1], c->stab_q[k][2] = sl;
+                }
             }
-            c->stab[(size_t)i * c->nsec + s] = isinf(st) ? INFINITY : fmax(0.0, st - c->hook_mass);
+            // The hook and rope once: the pose's limit is the whole tip mass.
+            c->stab[k] = isinf(st) ? INFINITY : fmax(0.0, st - c->hook_mass);
+        }
+        c->rating[i] = loadchart_rating(c, R);
+    }
+    // The printed chart, per sector. First min(raw envelope, rating) at each
+    // point, what the crane may lift there. The chart starts at the
+    // sector's minimum working outreach, where that value is largest (the
+    // first such point: a plateau at the rated load starts where the crane
+    // first holds it), and from there outward it is the running minimum
+    // (held down by every closer outreach of the chart): a chart that rises
+    // with outreach invites the operator to reach out to lift more (the
+    // limiter rates outreach, not the way the booms got there), and the
+    // running minimum is the largest non-increasing curve under the capped
+    // envelope. Closer in than the peak the value falls towards the column
+    // (on the shipped crane the folded jib: 1183 kg at 0.5 m); a running
+    // minimum from there would hold the whole chart down to it (out to
+    // 2.45 m), so those points are not printed (NAN) and the limiter takes
+    // min(envelope, rating) at the point itself (cap). The raw envelope is
+    // kept beside it.
+    for (int s = 0; s < c->nsec; ++s) {
+        int i0 = 0;
+        for (int i = 0; i < c->n; ++i) {
+            const size_t k = (size_t)i * c->nsec + s;
+            const double st = c->stab ? c->stab[k] : INFINITY;
+            int g = st < c->hyd[i] ? LC_GOV_STAB : (c->hyd_cyl[i] ? LC_GOV_JIB : LC_GOV_LIFT);
+            c->env[k] = fmin(c->hyd[i], st);
+            double v = c->env[k];
+            if (c->rating[i] < v) v = c->rating[i], g = LC_GOV_RATED;
+            c->cap[k] = v, c->gov[k] = g, c->gov_at[k] = i;
+            if (v > c->cap[(size_t)i0 * c->nsec + s]) i0 = i;
+        }
+        c->imin[s] = i0;
+        for (int i = 0; i < c->n; ++i) {
+            const size_t k = (size_t)i * c->nsec + s;
+            if (i < i0) {
+                c->chart[k] = NAN;
+                continue;
+            }
+            if (i > i0 && c->cap[k - c->nsec] < c->cap[k]) {
+                c->cap[k] = c->cap[k - c->nsec];
+                c->gov[k] = c->gov[k - c->nsec], c->gov_at[k] = c->gov_at[k - c->nsec];
+            }
+            c->chart[k] = c->cap[k];
         }
     }
     return 0;
 }
 
+double loadchart_rating(const loadchart* c, double R) {
+    double r = INFINITY;
+    if (c->rated_load > 0) r = c->rated_load;
+    // The rated moment is the maker's load moment M = m g R, about the slew
+    // axis (R: outreach [m], g from the model).
+    if (c->rated_moment > 0 && R > 0) r = fmin(r, c->rated_moment / (c->gravity * R));
+    return isinf(r) ? r : fmax(0.0, r - c->hook_mass);
+}
+
+void loadchart_point_pose(const loadchart* c, int i, int s, double q[3]) {
+    const size_t k = (size_t)i * c->nsec + s;
+    const int j = c->gov_at[k];
+    const size_t kj = (size_t)j * c->nsec + s;
+    const bool stab = c->gov[k] == LC_GOV_STAB || (c->gov[k] == LC_GOV_RATED && c->stab && c->stab[kj] < c->hyd[j]);
+    if (stab) {
+        q[0] = c->stab_q[kj][0], q[1] = c->stab_q[kj][1], q[2] = c->stab_q[kj][2];
+    } else {
+        q[0] = c->hyd_q[j][0], q[1] = c->hyd_q[j][1], q[2] = 0.5 * (c->sec_lo[s] + c->sec_hi[s]);
+    }
+}
+
+const char* lc_gov_name(int gov) {
+    switch (gov) {
+    case LC_GOV_LIFT: return "lift";
+    case LC_GOV_JIB: return "jib";
+    case LC_GOV_STAB: return "stability";
+    case LC_GOV_RATED: return "rated";
+    default: return "?";
+    }
+}
+
 void loadchart_free(loadchart* c) {
-    free(c->stab);
-    c->stab = NULL;
+    free(c->stab), free(c->stab_q), free(c->env), free(c->chart), free(c->cap), free(c->gov), free(c->gov_at);
+    c->stab = NULL, c->stab_q = NULL, c->env = c->chart = c->cap = NULL, c->gov = c->gov_at = NULL;
 }
 
 int loadchart_sector(const loadchart* c, double slew) {
@@ -292,20 +385,37 @@ int loadchart_sector(const loadchart* c, double slew) {
     return c->nsec - 1;
 }
 
-double loadchart_capacity(const loadchart* c, double R, double slew, bool* stab_governs) {
+// The chart's interval for outreach R: i and the weight w of point i + 1.
+static int interval(const loadchart* c, double R, double* w) {
     double f = (R - c->R[0]) / (c->R[c->n - 1] - c->R[0]) * (c->n - 1);
-    if (f < 0) f = 0;
+    if (!(f > 0)) f = 0;
     if (f > c->n - 1) f = c->n - 1;
     int i = (int)floor(f);
     if (i >= c->n - 1) i = c->n - 2;
-    const double w = f - i;
-    const double h = c->hyd[i] * (1 - w) + c->hyd[i + 1] * w;
-    double s = INFINITY;
-    if (c->stab) {
-        const int k = loadchart_sector(c, slew);
-        const double a = c->stab[(size_t)i * c->nsec + k], b = c->stab[(size_t)(i + 1) * c->nsec + k];
-        s = (isinf(a) || isinf(b)) ? fmin(a, b) : a * (1 - w) + b * w;
-    }
-    if (stab_governs) *stab_governs = s < h;
-    return fmin(h, s);
+    *w = f - i;
+    return i;
+}
+
+// Linear interpolation of an n x nsec column, INFINITY kept as such.
+static double interp(const loadchart* c, const double* col, int i, double w, int s) {
+    const double a = col[(size_t)i * c->nsec + s], b = col[(size_t)(i + 1) * c->nsec + s];
+    return (isinf(a) || isinf(b)) ? fmin(a, b) : a * (1 - w) + b * w;
+}
+
+double loadchart_capacity(const loadchart* c, double R, double slew, int* gov) {
+    double w;
+    const int i = interval(c, R, &w), s = loadchart_sector(c, slew);
+    // From the minimum outreach on the chart is non-increasing, so is its
+    // interpolation; closer in, min(envelope, rating) interpolated as the
+    // envelope always was. The rating is convex in R (M / (g R)), so its
+    // chord lies above it: capped by the rating at R itself.
+    const double v = fmin(interp(c, c->cap, i, w, s), loadchart_rating(c, R));
+    if (gov) *gov = c->gov[(size_t)(w >= 1 ? i + 1 : i) * c->nsec + s];
+    return v;
+}
+
+double loadchart_envelope(const loadchart* c, double R, double slew) {
+    double w;
+    const int i = interval(c, R, &w);
+    return interp(c, c->env, i, w, loadchart_sector(c, slew));
 }

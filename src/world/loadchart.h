@@ -43,17 +43,43 @@ lc_opts lc_default_opts(void);
 /// Check options: one line "--name: problem" in err, -1; else 0.
 int lc_check_opts(const lc_opts* o, char* err, size_t errsz);
 
+/// What governs a point of the printed chart.
+typedef enum lc_gov {
+    LC_GOV_LIFT = 0, ///< hydraulic limit, the lift cylinder
+    LC_GOV_JIB,      ///< hydraulic limit, the jib cylinder
+    LC_GOV_STAB,     ///< stability limit of the sector
+    LC_GOV_RATED,    ///< the model's rated capacity (rated_load, rated_moment)
+} lc_gov;
+/// "lift", "jib", "stability", "rated".
+const char* lc_gov_name(int gov);
+
 typedef struct loadchart {
     int n, nsec;
     double R[LOADCHART_MAX_POINTS];   ///< outreach [m]
     double hyd[LOADCHART_MAX_POINTS]; ///< hydraulic limit, payload [kg] (NAN: not reachable)
     int hyd_cyl[LOADCHART_MAX_POINTS];///< the cylinder that governs it (0 lift, 1 jib)
     double hyd_q[LOADCHART_MAX_POINTS][2]; ///< the pose that governs it (q1, q2) [rad]
-    double* stab;                     ///< n x nsec stability limit [kg] (INFINITY: cannot tip); NULL without truck
+    double* stab;                     ///< n x nsec stability limit, payload [kg] (INFINITY: cannot tip); NULL without truck
+    double (*stab_q)[3];              ///< n x nsec: the pose and slew that govern it (q1, q2, slew) [rad]; NULL without truck
+    double rating[LOADCHART_MAX_POINTS]; ///< the model's rated capacity at R, payload [kg]: min(rated_load,
+                                         ///< rated_moment / (g R)) less the hook (INFINITY: the model gives none)
+    double* env;   ///< n x nsec raw envelope: min(hydraulic, stability) [kg], what the crane can do
+    double* chart; ///< n x nsec printed chart [kg]: from the sector's minimum outreach (imin) outward the
+                   ///< running minimum of min(envelope, rating); NAN closer than imin (not printed)
+    double* cap;   ///< n x nsec what the limiter holds the crane to [kg]: the chart from imin outward,
+                   ///< min(envelope, rating) at the point itself closer than imin
+    int* gov;      ///< n x nsec: what governs cap (lc_gov)
+    int* gov_at;   ///< n x nsec: the point where that limit is met: i itself closer than imin; from
+                   ///< imin on a point in [imin, i], < i where a closer outreach's lower value holds
+                   ///< the chart down (it may not rise with outreach)
+    int imin[LOADCHART_MAX_SECTORS]; ///< per sector, the chart's minimum outreach: the first point where
+                                     ///< min(envelope, rating) is largest (the chart's peak)
     double sec_lo[LOADCHART_MAX_SECTORS], sec_hi[LOADCHART_MAX_SECTORS]; ///< sector bounds [rad], 0..pi
     double reach_min, reach_max;      ///< outreach the workspace covers [m]
     bool truck;
     double hook_mass;                 ///< subtracted from the tip load (payload under the hook) [kg]
+    double rated_moment, rated_load;  ///< the model's rating [N m], [kg]; 0: none
+    double gravity;                   ///< the model's g [m/s^2], for the rated moment
 } loadchart;
 
 /// Compute the chart. Returns 0, or -1 with one line in err (an outreach
@@ -70,17 +96,34 @@ void loadchart_reach(const model* m, double* rmin, double* rmax);
 double loadchart_hyd_pose(const model* m, double q1, double q2, double margin, int* gov);
 
 /// Stability limit of one pose at slew angle slew [rad] (0: over the cab):
-/// the largest tip mass [kg] (besides the hook) with sf times the tipping
-/// moment below the restoring moment about every support edge; INFINITY
-/// when the tip is inside the support polygon.
+/// the largest mass hanging at the tip [kg] (hook, rope and payload
+/// together) with sf times its tipping moment below the restoring moment of
+/// truck and crane about every support edge; INFINITY when the tip is
+/// inside the support polygon. The chart subtracts the hook once.
 double loadchart_stab_pose(const model* m, const lc_truck* t, double q1, double q2, double slew, double sf);
 
 /// The sector of slew angle slew [rad] (any value; folded to 0..pi).
 int loadchart_sector(const loadchart* c, double slew);
-/// Rated capacity [kg] at outreach R [m] and slew [rad]: the smaller limit,
-/// interpolated linearly (clamped to the chart's range); *stab_governs when
-/// the stability limit is the smaller.
-double loadchart_capacity(const loadchart* c, double R, double slew, bool* stab_governs);
+/// Rated capacity [kg] at outreach R [m] and slew [rad], what the limiter
+/// holds the crane to: the column cap (the printed chart from the sector's
+/// minimum outreach outward, min(envelope, rating) closer in), interpolated
+/// linearly (clamped to the chart's range) and capped by the model's rating
+/// at R itself; *gov (may be NULL): what governs at the chart point at or
+/// below R (lc_gov).
+double loadchart_capacity(const loadchart* c, double R, double slew, int* gov);
+/// The raw envelope [kg] at R and slew: min(hydraulic, stability), no
+/// rating, not made monotone; interpolated as loadchart_capacity.
+double loadchart_envelope(const loadchart* c, double R, double slew);
+/// The pose that governs point i of sector s of the printed chart, to check
+/// it by simulation: q[0], q[1] the joint angles [rad], q[2] the slew [rad].
+/// Hydraulic limit: its weakest pose at the outreach where it governs
+/// (gov_at), slewed to the sector's middle (the hydraulic limit does not
+/// depend on the slew); stability: the weakest pose and slew angle; rated:
+/// the weakest pose of the raw envelope there.
+void loadchart_point_pose(const loadchart* c, int i, int s, double q[3]);
+/// The model's rated capacity [kg] at R [m] (payload: the hook subtracted);
+/// INFINITY when the model gives no rating.
+double loadchart_rating(const loadchart* c, double R);
 
 /// Port relief cracking setting [Pa] of each chamber (A, B) of actuator k.
 int loadchart_reliefs(const model* m, int k, double p[2]);

@@ -200,6 +200,11 @@ static const json_range R_LINK_COM = {0, 30, 0, 10, "m"};
 static const json_range R_LINK_INERTIA = {1e-3, 1e7, 1, 1e5, "kg m^2"};
 static const json_range R_LINK_SECTION = {0.01, 2, 0.05, 0.6, "m"};
 static const json_range R_LOAD = {0, CRANE_LOAD_MAX, 0, CRANE_LOAD_TYPICAL, "kg"};
+// The maker's rating (the load chart's cap, docs/safety.md): loader cranes
+// are sold from under 1 t m (10 kN m) to about 100 t m; a rated load from a
+// few hundred kg to some tens of tonnes.
+static const json_range R_RATED_MOMENT = {0.1, 1e4, 5, 1000, "kN m"};
+static const json_range R_RATED_LOAD = {1, 1e5, 100, 30000, "kg"};
 static const json_range R_MOUNT = {-10, 10, -3, 3, "m"};
 static const json_range R_CLOSED_LENGTH = {0.05, 20, 0.3, 5, "m"};
 
@@ -282,7 +287,8 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
 
     crane_mech* me = &m->mech;
     const cJSON* mech = json_obj(&c, root, "", "mechanics", true);
-    static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", NULL};
+    static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", "rated_moment",
+                                         "rated_load", NULL};
     json_only_keys(&c, mech, "mechanics", mkeys);
     me->gravity = json_num_r(&c, mech, "mechanics", "gravity", false, 9.81, &R_GRAVITY);
     const cJSON* col = json_obj(&c, mech, "mechanics", "column", true);
@@ -297,6 +303,9 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     if (!c.failed && !strcmp(me->link[0].name, me->link[1].name))
         json_fail(&c, "mechanics.links[1].name", "\"%s\" is already the name of links[0]", me->link[1].name);
     me->load_mass = json_num_r(&c, mech, "mechanics", "load_mass", true, 0, &R_LOAD);
+    // Optional: absent (0) means no rating, the chart is the physical envelope.
+    me->rated_moment = json_num_r(&c, mech, "mechanics", "rated_moment", false, 0, &R_RATED_MOMENT);
+    me->rated_load = json_num_r(&c, mech, "mechanics", "rated_load", false, 0, &R_RATED_LOAD);
     const cJSON* acts = json_arr(&c, mech, "mechanics", "actuators", true);
     if (acts && cJSON_GetArraySize(acts) != 2)
         json_fail(&c, "mechanics.actuators", "must list exactly 2 actuators (lift, jib)");
@@ -359,6 +368,8 @@ fail: // err already holds the one-line message
     return NULL;
 }
 
+static const char* optional_param(const char* assignment);
+
 // The file with the first n overrides applied, or NULL with the message.
 static cJSON* load_with_sets(const char* path, const char* const* sets, int n, char* err, size_t errsz) {
     cJSON* root = json_load_file(path, err, errsz);
@@ -368,7 +379,15 @@ static cJSON* load_with_sets(const char* path, const char* const* sets, int n, c
         if (json_set_path(root, sets[i], e, sizeof e)) {
             // The file's base name, as every other message of the loader.
             const char* base = strrchr(path, '/');
-            snprintf(err, errsz, "%s: %s", base ? base + 1 : path, e);
+            const char* opt = optional_param(sets[i]);
+            if (opt && !cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(root, "mechanics"), opt))
+                // An optional field the model does not have: --set edits
+                // fields, it does not add them (a typo would add one too).
+                snprintf(err, errsz, "%s: %s '%s': this model has no mechanics.%s (an optional field: without it the "
+                         "model gives no rating, docs/model.md); add it to the model file to set it",
+                         base ? base + 1 : path, sim_param_name(SIM_PARAM_SET), sets[i], opt);
+            else
+                snprintf(err, errsz, "%s: %s", base ? base + 1 : path, e);
             cJSON_Delete(root);
             return NULL;
         }
@@ -440,17 +459,21 @@ int model_save(const model* m, const char* path, char* err, size_t errsz) {
 // Every scalar the mechanics section holds, with the ranges the loader
 // checks it against (the R_* above), so a panel or a sweep can list them
 // without knowing the file's layout.
-#define MP_(path, group, name, field, r) {path, group, name, offsetof(crane_mech, field), &r}
+#define MP_(path, group, name, field, r) {path, group, name, offsetof(crane_mech, field), &r, 0}
 typedef struct mech_entry {
     const char* path, *group, *name;
     size_t off;
     const json_range* r;
+    int optional; // a model may lack it: 0 then
 } mech_entry;
 static const mech_entry k_mech[] = {
     MP_("mechanics.gravity", "mechanics", "gravity", gravity, R_GRAVITY),
     MP_("mechanics.column.height", "mechanics", "column height", column_height, R_COLUMN_HEIGHT),
     MP_("mechanics.column.mass", "mechanics", "column mass", column_mass, R_COLUMN_MASS),
     MP_("mechanics.load_mass", "mechanics", "tip load", load_mass, R_LOAD),
+    // The rating (optional): the load chart's cap and so the limiter's.
+    {"mechanics.rated_moment", "mechanics", "rated moment", offsetof(crane_mech, rated_moment), &R_RATED_MOMENT, 1},
+    {"mechanics.rated_load", "mechanics", "rated load", offsetof(crane_mech, rated_load), &R_RATED_LOAD, 1},
 #define MP_LINK_(i)                                                                           \
     MP_("mechanics.links[" #i "].length", "links[" #i "]", "length", link[i].length, R_LINK_LENGTH), \
     MP_("mechanics.links[" #i "].mass", "links[" #i "]", "mass", link[i].mass, R_LINK_MASS),         \
@@ -476,6 +499,19 @@ static const mech_entry k_mech[] = {
 
 int model_param_count(void) { return (int)(sizeof k_mech / sizeof k_mech[0]); }
 
+// The key under mechanics of the optional table entry an assignment
+// PATH=VALUE sets, or NULL.
+static const char* optional_param(const char* assignment) {
+    const char* eq = strchr(assignment, '=');
+    if (!eq) return NULL;
+    for (int k = 0; k < model_param_count(); ++k) {
+        const size_t L = strlen(k_mech[k].path);
+        if (k_mech[k].optional && (size_t)(eq - assignment) == L && !strncmp(assignment, k_mech[k].path, L))
+            return k_mech[k].path + strlen("mechanics.");
+    }
+    return NULL;
+}
+
 int model_param_info(int k, model_param* out) {
     if (k < 0 || k >= model_param_count()) return -1;
     const mech_entry* e = &k_mech[k];
@@ -487,7 +523,13 @@ int model_param_info(int k, model_param* out) {
     out->hi = e->r->hi;
     out->tlo = e->r->tlo;
     out->thi = e->r->thi;
+    out->optional = e->optional;
     return 0;
+}
+
+int model_param_present(const crane_mech* me, int k) {
+    if (k < 0 || k >= model_param_count()) return 0;
+    return !k_mech[k].optional || *(const double*)((const char*)me + k_mech[k].off) != 0;
 }
 
 double* model_param_ptr(crane_mech* me, int k) {

@@ -47,11 +47,15 @@ typedef struct model_param {
     const char* unit;  ///< SI unit ("kg", "m", "kg m^2", "m/s^2")
     double lo, hi;     ///< hard range: outside it a file is refused [unit]
     double tlo, thi;   ///< typical range: outside it the loader notes it [unit]
+    int optional;      ///< 1: a model may lack the field (the rating); it then reads 0, outside [lo, hi]
 } model_param;
 /// The mechanics parameter table: model_param_count() entries.
 int model_param_count(void);
 /// Entry k into *out; 0, or -1 when k is out of range.
 int model_param_info(int k, model_param* out);
+/// Whether the model has entry k's field: every required one; an optional
+/// one when it is in the file (nonzero). 0 also when k is out of range.
+int model_param_present(const crane_mech* me, int k);
 /// The field entry k names in me, or NULL when k is out of range.
 double* model_param_ptr(crane_mech* me, int k);
 /// The default model file: $CRANESIM_ASSETS/models/hiab031.json, else the

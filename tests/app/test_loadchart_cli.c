@@ -1,11 +1,19 @@
 // test_loadchart_cli.c: `cranesim loadchart` end to end: the chart's CSV
-// against the library's own numbers (hydraulic limit, monotone sectors), and
-// bad input (a stability factor <= 1, a margin outside [0, 50 %], an
-// outreach the crane cannot reach): one line naming the option, exit 2.
+// (raw envelope, the model's rating by hand, the printed chart under both
+// and never rising, what governs each point and its pose), its plot's lines
+// told apart by colour in the PNG, and bad input (a stability factor <= 1, a
+// margin outside [0, 50 %], an outreach the crane cannot reach, a rating out
+// of range): one line naming the option or field, exit 2.
 #include "check.h"
 #include "cli_util.h"
 
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 static char out[1 << 16];
 
@@ -23,6 +31,8 @@ static void test_bad_input(void) {
         {"loadchart --outreach 1:2 --out lc_bad.csv", "--outreach"},
         {"loadchart --sectors 0 --out lc_bad.csv", "--sectors"},
         {"loadchart --margin abc --out lc_bad.csv", "--margin"},
+        {"loadchart --set mechanics.rated_moment=1e5 --out lc_bad.csv", "mechanics.rated_moment: must be in [0.1, 1e4] kN m"},
+        {"loadchart --set mechanics.rated_load=-5 --out lc_bad.csv", "mechanics.rated_load: must be > 0"},
     };
     remove("lc_bad.csv");
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
@@ -36,37 +46,153 @@ static void test_bad_input(void) {
     if (f) fclose(f);
 }
 
+// Split a CSV line (in place) into at most max fields; returns the count.
+static int split(char* line, char** f, int max) {
+    int n = 0;
+    char* p = line;
+    while (n < max) {
+        f[n++] = p;
+        p = strchr(p, ',');
+        if (!p) break;
+        *p++ = '\0';
+    }
+    return n;
+}
+
 // A chart over three sectors: the CSV has its header with units and a row
-// per point; the rated capacity never exceeds the hydraulic limit, and the
-// side sector (pads 2 m out) is never weaker than over the cab (pads 0.1 m
-// ahead of the column).
+// per point. Per sector the raw envelope is min(hydraulic, stability); the
+// capacity (what the limiter uses) is at or under the envelope and the
+// model's rating (2000 kg, 29.4 kN m / (g R), less the 40.72 kg hook); the
+// printed chart is empty closer than the minimum outreach (there the
+// capacity is min(envelope, rating) itself; at 1.0 m the folded end arm
+// holds less than the rating), from there equal to the capacity and never
+// rising with outreach; each point names what governs it (lift, jib,
+// stability, rated), the outreach where it does (its own closer than the
+// minimum outreach, else at or before its own) and a pose that reaches it;
+// the side sector (pads 2 m out) is never weaker than over the cab (pads
+// 0.1 m ahead of the column).
 static void test_chart_csv(void) {
     const int rc = cli_run("loadchart --outreach 1:4:7 --sectors 3 --out lc_ok.csv --quiet", out, sizeof out);
     CHECK(rc == 0, "exit %d: %s", rc, out);
     static char csv[1 << 16];
     CHECK(cli_read_file("lc_ok.csv", csv, sizeof csv) > 0, "no CSV");
-    static const char k_head[] = "outreach_m,hydraulic_kg,hyd_cylinder,stability_s0_0_45deg_kg";
-    CHECK(strncmp(csv, k_head, sizeof k_head - 1) == 0, "header: %.120s", csv);
+    static const char k_head[] =
+        "outreach_m,hydraulic_kg,hyd_cylinder,hyd_q1_deg,hyd_q2_deg,stability_s0_0_45deg_kg,stability_s1_45_135deg_kg,"
+        "stability_s2_135_180deg_kg,rating_kg,envelope_s0_kg,chart_s0_kg,capacity_s0_kg,governs_s0,gov_outreach_s0_m,"
+        "q1_s0_deg,q2_s0_deg,slew_s0_deg,envelope_s1_kg,";
+    CHECK(strncmp(csv, k_head, sizeof k_head - 1) == 0, "header: %.300s", csv);
     CHECK(cli_count_lines(csv) == 8, "%d lines, expected 8", cli_count_lines(csv));
+    double prev[3] = {INFINITY, INFINITY, INFINITY};
+    int inside[3] = {0, 0, 0};
     char* line = strchr(csv, '\n');
     while (line && line[1]) {
-        double R, hyd, s0, s1, s2, r0, r1, r2;
-        char cyl[8], g0[16], g1[16], g2[16];
-        const int n = sscanf(line + 1, "%lf,%lf,%7[^,],%lf,%lf,%lf,%lf,%15[^,],%lf,%15[^,],%lf,%15[^,\n]", &R, &hyd, cyl,
-                             &s0, &s1, &s2, &r0, g0, &r1, g1, &r2, g2);
-        CHECK(n == 12, "row not parsed (%d fields): %.100s", n, line + 1);
-        if (n == 12) {
-            CHECK(r0 <= hyd + 0.05 && r1 <= hyd + 0.05 && r2 <= hyd + 0.05, "rated above hydraulic at %g m", R);
-            CHECK(s1 >= s0, "side %g kg weaker than over the cab %g kg at %g m", s1, s0, R);
-            CHECK(fabs(r0 - fmin(hyd, s0)) < 0.11, "rated %g != min(%g, %g) at %g m", r0, hyd, s0, R);
+        char* next = strchr(line + 1, '\n');
+        if (next) *next = '\0';
+        char* f[40];
+        const int n = split(line + 1, f, 40);
+        CHECK(n == 9 + 3 * 8, "row has %d fields, expected 33", n);
+        if (n == 33) {
+            const double R = atof(f[0]), hyd = atof(f[1]), rating = atof(f[8]);
+            const double hand_rating = fmin(2000.0, 29.4e3 / (9.81 * R)) - 40.72;
+            CHECK(fabs(rating - hand_rating) < 0.06, "rating %g, hand %g at %g m", rating, hand_rating, R);
+            CHECK(atof(f[6]) >= atof(f[5]), "side %s kg weaker than over the cab %s kg at %g m", f[6], f[5], R);
+            for (int s = 0; s < 3; ++s) {
+                char** g = f + 9 + 8 * s;
+                const double env = atof(g[0]), cap = atof(g[2]), at = atof(g[4]);
+                const double stab = strcmp(f[5 + s], "inf") ? atof(f[5 + s]) : INFINITY;
+                CHECK(fabs(env - fmin(hyd, stab)) < 0.06, "envelope %g != min(%g, %g) at %g m", env, hyd, stab, R);
+                CHECK(cap <= env + 0.05 && cap <= rating + 0.05, "capacity %g over envelope %g or rating %g at %g m",
+                      cap, env, rating, R);
+                if (!g[1][0]) {
+                    // Closer than the minimum outreach: not printed, and only
+                    // before the chart's first point.
+                    CHECK(isinf(prev[s]), "sector %d: chart empty at %g m after it began", s, R);
+                    CHECK(fabs(cap - fmin(env, rating)) < 0.06 && fabs(at - R) < 1e-9,
+                          "inside at %g m: capacity %g, min(envelope %g, rating %g), governs at %g m", R, cap, env,
+                          rating, at);
+                    ++inside[s];
+                } else {
+                    const double chart = atof(g[1]);
+                    CHECK(fabs(chart - cap) < 1e-9, "chart %g, capacity %g at %g m", chart, cap, R);
+                    CHECK(chart <= prev[s] + 1e-9, "sector %d: chart rises %g -> %g kg at %g m", s, prev[s], chart, R);
+                    prev[s] = chart;
+                }
+                CHECK(!strcmp(g[3], "lift") || !strcmp(g[3], "jib") || !strcmp(g[3], "stability") ||
+                          !strcmp(g[3], "rated"),
+                      "governs '%s'", g[3]);
+                CHECK(at <= R + 1e-9 && at >= 1.0 - 1e-9, "governs at %g m for the point at %g m", at, R);
+                // The pose reaches that outreach: L1 sin q1 + L2 sin(q1 + q2).
+                const double q1 = atof(g[5]) * M_PI / 180, q2 = atof(g[6]) * M_PI / 180;
+                CHECK(fabs(2.3 * sin(q1) + 2.5 * sin(q1 + q2) - at) < 1e-3, "pose (%s, %s) does not reach %g m", g[5],
+                      g[6], at);
+                const double sl = atof(g[7]);
+                CHECK(sl >= 90.0 * s - 45 - 1e-6 && sl <= 90.0 * s + 45 + 1e-6, "slew %g deg outside sector %d", sl, s);
+            }
         }
-        line = strchr(line + 1, '\n');
+        line = next;
     }
+    for (int s = 0; s < 3; ++s)
+        CHECK(inside[s] == 1 && isfinite(prev[s]), "sector %d: %d rows inside the minimum outreach, expected 1 (1.0 m)",
+              s, inside[s]);
     remove("lc_ok.csv");
 }
+
+#ifdef LC_TEST_PLOT
+#include <stb/stb_image.h>
+
+// Pixels of the plot area (left of the legend, which sits right of 70 %
+// of the width) within 10 per channel of colour c.
+static int count_colour(const unsigned char* px, int w, int h, const int c[3]) {
+    int n = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < (int)(0.68 * w); ++x) {
+            const unsigned char* p = px + 3 * ((size_t)y * w + x);
+            if (abs(p[0] - c[0]) <= 10 && abs(p[1] - c[1]) <= 10 && abs(p[2] - c[2]) <= 10) ++n;
+        }
+    return n;
+}
+
+// The plot draws every line so that it shows: on the shipped crane the three
+// sectors' printed charts coincide over the whole range (the rating governs
+// in every sector from the minimum outreach, 1.07 m) and closer in the
+// limiter's capacity lies on the hydraulic limit; each must still have its
+// own pixels in the plot area, not only in the legend: the three sector
+// colours, the stability limits of the cab and side sectors (light), the
+// hydraulic limit (red, dashed), the rating (dark gold) and the capacity
+// closer than the minimum outreach (grey, under the hydraulic limit).
+static void test_chart_plot_lines_visible(void) {
+    remove("lc_plot.png");
+    const int rc = cli_run("loadchart --out lc_plot.csv --plot lc_plot.png --quiet", out, sizeof out);
+    CHECK(rc == 0, "exit %d: %s", rc, out);
+    int w, h, nc;
+    unsigned char* px = stbi_load("lc_plot.png", &w, &h, &nc, 3);
+    CHECK(px != NULL, "cannot read lc_plot.png");
+    if (!px) return;
+    static const struct {
+        int c[3];
+        const char* what;
+    } lines[] = {
+        {{0, 60, 200}, "chart 0-45 deg"},      {{0, 140, 0}, "chart 45-135 deg"},
+        {{190, 0, 190}, "chart 135-180 deg"},  {{140, 175, 255}, "stability 0-45 deg"},
+        {{130, 220, 130}, "stability 45-135 deg"}, {{220, 0, 0}, "hydraulic limit"},
+        {{150, 110, 0}, "rating"},             {{165, 155, 140}, "inside min. outreach"},
+    };
+    for (size_t i = 0; i < sizeof lines / sizeof lines[0]; ++i) {
+        const int n = count_colour(px, w, h, lines[i].c);
+        printf("  %-22s %6d pixels in the plot area\n", lines[i].what, n);
+        CHECK(n >= 200, "%s: only %d pixels of its colour in the plot area: hidden", lines[i].what, n);
+    }
+    stbi_image_free(px);
+    remove("lc_plot.png");
+    remove("lc_plot.csv");
+}
+#endif
 
 int main(int argc, char** argv) {
     RUN_TEST(test_bad_input);
     RUN_TEST(test_chart_csv);
+#ifdef LC_TEST_PLOT
+    RUN_TEST(test_chart_plot_lines_visible);
+#endif
     TEST_MAIN_END();
 }
