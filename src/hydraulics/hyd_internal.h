@@ -121,6 +121,13 @@ typedef struct hyd_component {
     /// are not diagonal (hyd_model_jacobian_pattern). 0: a lag on its own
     /// state only (the valve spool).
     int states_sense_ports;
+    /// NULL, or per states[] entry the magnitude [the state's unit] below
+    /// which hyd_model_flush sets it to exactly 0 (0: never). For states
+    /// whose lag closes towards 0 (a spool's opening, a pump's
+    /// displacement): it decays geometrically, never gets there, and ends
+    /// in subnormal numbers (about 5e-322), on which every operation of a
+    /// step is slow. The magnitude is one that means nothing physically.
+    const double* state_flush;
     /// Fill def with the documented defaults (name and ports NULL).
     void (*defaults)(void* def);
     /// Cross-field value rules a parameter table cannot express (rod < bore):
@@ -228,6 +235,12 @@ typedef struct hyd_cyl_c {
 } hyd_cyl_c;
 
 /// calloc of n (at least 1) elements into p; true on success.
+/// A fraction (of a full spool opening, of a pump's full displacement)
+/// that is none [-]: hyd_component.state_flush sets such states to 0 below
+/// it. 1e-12 of an orifice's area passes 1e-12 of its flow; a lag of 10-30
+/// ms reaches it 28 time constants after closing, under a second.
+#define HYD_STATE_FLUSH 1e-12
+
 #define HYD_ALLOC(p, n) ((p) = calloc((size_t)((n) > 0 ? (n) : 1), sizeof *(p)), (p) != NULL)
 
 /// Segments per octave of the air-ratio table (a power of two).
@@ -306,6 +319,11 @@ struct hyd_model {
 
     char** state_name; ///< (nstate)
     double* y0;        ///< (nstate) initial state
+    /// The states hyd_model_flush sets to 0 below flush_below (their
+    /// descriptors' state_flush), in state order.
+    int nflush;
+    int* flush_state;    ///< (nflush)
+    double* flush_below; ///< (nflush) [the state's unit]
 };
 
 /// Recompute every derived array from the definitions (after compile or a
