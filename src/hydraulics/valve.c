@@ -138,8 +138,6 @@ static const hyd_param_info valve_params[] = {
 static const hyd_port_info valve_ports[] = {HYD_PORT(hyd_valve_def, P), HYD_PORT(hyd_valve_def, T),
                                             HYD_PORT(hyd_valve_def, A), HYD_PORT(hyd_valve_def, B)};
 static const char* const valve_states[] = {"spool"};
-// It closes on a lag towards 0: flushed to 0 below HYD_STATE_FLUSH (the spool opening, of full [-]).
-static const double valve_flush[] = {HYD_STATE_FLUSH};
 
 static void valve_defaults(void* def) { *(hyd_valve_def*)def = hyd_default_valve_def(); }
 
@@ -148,7 +146,7 @@ const hyd_component hyd_valve_component = {
     .type = HYD_VALVE, .name = "valve", .def_size = sizeof(hyd_valve_def),
     .params = valve_params, .nparam = HYD_COUNT(valve_params),
     .ports = valve_ports, .nport = HYD_COUNT(valve_ports),
-    .states = valve_states, .nstate = HYD_COUNT(valve_states), .state_flush = valve_flush,
+    .states = valve_states, .nstate = HYD_COUNT(valve_states),
     .rec_size = sizeof(hyd_valve_c),
     .defaults = valve_defaults, .check_ports = valve_check_ports, .bind = valve_bind,
     .derive = valve_derive, .initial = valve_initial, .eval = valves_eval, .jacobian = valves_jacobian,

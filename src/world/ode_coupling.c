@@ -102,14 +102,25 @@ static unsigned long events_fused(void* user, double t, const double* y) {
     return hyd_fused_events_update(&w->fz_ev, &w->fz, y, x, cmd);
 }
 
-// hyd_problem.settle: a spool (valve, compensator, counterbalance) or pump
-// displacement closing on a lag towards 0 decays for ever, into subnormal
-// numbers that slow every step; below 1e-12 of full it is set to 0
-// (hyd_model_flush, as lsim_settle).
+// hyd_problem.settle: a spool whose command is 0 decays towards 0 for ever,
+// into subnormal numbers that slow every step; within HYD_SPOOL_SETTLE of
+// 0 it is set to 0 (as lsim_settle), and so are the other states that
+// close on a lag towards 0 (compensator and counterbalance spools:
+// hyd_model_flush).
 static int settle(void* user, double t, double* y) {
     (void)t;
-    const ode_world* w = user;
-    return hyd_model_flush(w->hm, y, NULL);
+    ode_world* w = user;
+    int changed = hyd_model_flush(w->hm, y, NULL) > 0;
+    for (int k = 0; k < ODE_NACT; ++k) {
+        const ow_act* c = &w->act[k];
+        if (c->valve < 0) continue;
+        double* u = &y[hyd_model_valve_state(w->hm, c->valve)];
+        if (*u != 0.0 && fabs(*u) < HYD_SPOOL_SETTLE && fabs(w->u_cmd[k]) < HYD_SPOOL_SETTLE) {
+            *u = 0.0;
+            changed = 1;
+        }
+    }
+    return changed;
 }
 
 // hyd_problem.outside: a node pressure below absolute zero (the adaptive
