@@ -245,7 +245,6 @@ typedef struct hyd_cyl_c {
 #define HYD_STATE_FLUSH 1e-10
 
 /// calloc of n (at least 1) elements into p; true on success.
-
 #define HYD_ALLOC(p, n) ((p) = calloc((size_t)((n) > 0 ? (n) : 1), sizeof *(p)), (p) != NULL)
 
 /// Segments per octave of the air-ratio table (a power of two).

@@ -380,7 +380,7 @@ void hyd_model_initial_state(const hyd_model* m, double* y);
 /// its magnitude is below one that means nothing physically (1e-10 of the
 /// full opening or displacement). A lag towards 0 decays geometrically and
 /// never gets there: without this it ends in subnormal numbers, on which
-/// every later step is slower (1.23-1.26x per step on the LS crane's long
+/// every later step is slower (1.2-1.6x per step on the LS crane's long
 /// holds). Call after an accepted step (hyd_problem.settle); state i is
 /// y[pos ? pos[i] : i]. Returns the number of states changed.
 int hyd_model_flush(const hyd_model* m, double* y, const int* pos);

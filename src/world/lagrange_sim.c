@@ -354,7 +354,7 @@ const double* lsim_wstage(void* user) { return ((const lsim*)user)->ystage; }
 // partials of u = 0 exactly, and ROS34PW2 at rtol 1e-2 on the LS crane's
 // ramp went 0.80 mm RMS off in stroke instead of 0.23. The other states
 // that close on a lag towards 0 (the LS crane's compensator and
-// counterbalance spools, 5e-322 after a long hold: 1.2-1.4x per step) are
+// counterbalance spools, 5e-322 after a long hold: 1.2-1.6x per step) are
 // flushed by the circuit (hyd_model_flush).
 int lsim_settle(void* user, double t, double* y) {
     lsim* s = user;
