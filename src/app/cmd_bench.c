@@ -46,9 +46,10 @@ static void bench_help(FILE* f) {
             "  rodas3-1pct  adaptive RODAS3, rtol 1e-2 (the paper's 1 %% tolerance)\n"
             "  rodas3-2e-3  adaptive RODAS3, rtol 2e-3: the loosest tolerance whose max chamber-\n"
             "               pressure error on ramp stays below 1 %% of peak (0.98 %%, cranesim study)\n"
-            "  krus-length  Krus, h = 0.1 ms, the scenario for its duration T and for 4 T (the valves\n"
-            "               closed for the rest): ns per step of each and their ratio, which stays\n"
-            "               near 1 when the cost of a step does not grow with run length\n"
+            "  krus-length  Krus, h = 0.1 ms, on every shipped model (or --model): the scenario for its\n"
+            "               duration T and for 4 T (a long hold after the motion, the valves closed),\n"
+            "               runs interleaved: ns per step of each and their ratio, which stays near\n"
+            "               1 when the cost of a step does not grow with run length\n"
             "  sandbox-ode1ms    ode sandbox (pick and place), ODE step 1 ms, hydraulics Krus 0.1 ms\n"
             "  sandbox-ode0.1ms  the same with ODE step 0.1 ms\n"
             "  soak         not in the default set: --duration seconds (default 600) of seeded random\n"
@@ -609,42 +610,69 @@ static int bench_mesh(const app_common* c, const model* m, int repeat) {
     return rc;
 }
 
-// krus-length: the cost of a step against the length of the run. Spool
-// states used to decay into subnormal numbers some 20 s after their valve
-// closed and stay there, which made every later step dearer (issue 13: 280
-// ns per step over 20 s of ramp, 355 over 80 s; on this machine 384 against
-// 867); hyd_problem.settle now sets them to 0. Returns 0, or -1 after
-// printing an error line.
-static int bench_length(const app_common* c, const model* m, const scenario* sc, int repeat) {
+// krus-length: the cost of a step against the length of the run, on every
+// shipped model (or the --model given): the scenario for its duration T,
+// and the same motion followed by a hold to 4 T (the last commands kept;
+// the shipped scenarios end with the valves closed), runs interleaved,
+// medians. States that close on a lag towards 0 used to decay into
+// subnormal numbers during such a hold and stay there, which made every
+// later step dearer: the valve spools (issue 13: 384 against 867 ns per
+// step on ramp, 20 s against 80 s), then the LS crane's compensator and
+// counterbalance spools (issue 25: 1.23-1.35); hyd_problem.settle now
+// sets them to 0 (hyd_model_flush). Returns 0, or -1 after printing an
+// error line.
+static int bench_length_one(const app_common* c, const model* m, const char* mname, const scenario* sc,
+                            int repeat) {
     const bench_cfg b = {"krus-length", HYD_KRUS, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL};
     sim_opts o = bench_opts(&c->sim, &b);
     const double T = c->sim.duration > 0 ? c->sim.duration : sc->duration;
-    double ns[2], t_end[2];
-    long steps[2];
-    for (int k = 0; k < 2; ++k) {
-        o.duration = k ? 4.0 * T : T;
-        double walls[100];
-        sim_result r;
-        // Interleaved would be fairer on a noisy machine, but each length's
-        // runs are short (under a second): medians of back-to-back runs.
-        for (int i = 0; i < repeat; ++i) {
+    double walls[2][100], ns[2], t_end[2];
+    long steps[2] = {0, 0};
+    // Interleaved (short, long, short, ...): a noisy machine's load drifts
+    // over seconds, and a ratio of two lengths timed minutes apart would
+    // measure the drift.
+    for (int i = 0; i < repeat; ++i)
+        for (int k = 0; k < 2; ++k) {
+            o.duration = k ? 4.0 * T : T;
+            sim_result r;
             sim_run(m, sc, &o, NULL, NULL, NULL, NULL, NULL, &r);
-            walls[i] = r.wall;
             if (r.status) {
-                printf("{\"config\":\"%s\",\"error\":\"%s\"}\n", b.name, r.message);
+                printf("{\"config\":\"%s\",\"model\":\"%s\",\"error\":\"%s\"}\n", b.name, mname, r.message);
                 return -1;
             }
+            walls[k][i] = r.wall;
+            steps[k] = r.stats.steps;
+            t_end[k] = r.t_end;
         }
-        steps[k] = r.stats.steps;
-        t_end[k] = r.t_end;
-        ns[k] = 1e9 * app_median(walls, repeat) / (double)(r.stats.steps ? r.stats.steps : 1);
-    }
-    printf("{\"config\":\"%s\",\"scenario\":\"%s\",\"solver\":\"krus\",\"h_s\":%g,\"repeat\":%d,"
-           "\"sim_time_short_s\":%.6g,\"steps_short\":%ld,\"ns_per_step_short\":%.1f,"
+    for (int k = 0; k < 2; ++k) ns[k] = 1e9 * app_median(walls[k], repeat) / (double)(steps[k] ? steps[k] : 1);
+    printf("{\"config\":\"%s\",\"model\":\"%s\",\"scenario\":\"%s\",\"solver\":\"krus\",\"h_s\":%g,"
+           "\"repeat\":%d,\"sim_time_short_s\":%.6g,\"steps_short\":%ld,\"ns_per_step_short\":%.1f,"
            "\"sim_time_long_s\":%.6g,\"steps_long\":%ld,\"ns_per_step_long\":%.1f,\"ratio_long_short\":%.3f}\n",
-           b.name, sc->name, o.h, repeat, t_end[0], steps[0], ns[0], t_end[1], steps[1], ns[1], ns[1] / ns[0]);
+           b.name, mname, sc->name, o.h, repeat, t_end[0], steps[0], ns[0], t_end[1], steps[1], ns[1], ns[1] / ns[0]);
     fflush(stdout);
     return 0;
+}
+
+static int bench_length(const app_common* c, const model* m, const scenario* sc, int repeat) {
+    if (c->model_path) {
+        const char* slash = strrchr(c->model_path, '/');
+        return bench_length_one(c, m, slash ? slash + 1 : c->model_path, sc, repeat);
+    }
+    static const char* const files[2] = {"hiab031.json", "hiab031_ls.json"};
+    int rc = 0;
+    for (int k = 0; k < 2; ++k) {
+        char path[1024], err[512];
+        snprintf(path, sizeof path, "%s/models/%s", model_assets_dir(), files[k]);
+        model* mk = model_load(path, c->sets, c->nset, err, sizeof err);
+        if (!mk) {
+            printf("{\"config\":\"krus-length\",\"model\":\"%s\",\"error\":\"%s\"}\n", files[k], err);
+            rc = -1;
+            continue;
+        }
+        if (bench_length_one(c, mk, files[k], sc, repeat)) rc = -1;
+        model_free(mk);
+    }
+    return rc;
 }
 
 // circuit-sizes: the cost of one circuit evaluation on synthetic circuits of

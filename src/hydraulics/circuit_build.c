@@ -191,6 +191,8 @@ void hyd_model_free(hyd_model* m) {
     free(m->vol_flow);
     free(m->state_name);
     free(m->y0);
+    free(m->flush_state);
+    free(m->flush_below);
     free(m);
 }
 
@@ -306,7 +308,8 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
              HYD_ALLOC(m->tank_node, nnode) && HYD_ALLOC(m->comp_node0, b->ncomp) &&
              HYD_ALLOC(m->comp_slot, HYD_MAXSLOT * b->ncomp) && HYD_ALLOC(m->comp_state0, b->ncomp) &&
              HYD_ALLOC(m->comp_sub, b->ncomp) && HYD_ALLOC(m->state_name, nstate) &&
-             HYD_ALLOC(m->y0, nstate);
+             HYD_ALLOC(m->y0, nstate) && HYD_ALLOC(m->flush_state, nstate) &&
+             HYD_ALLOC(m->flush_below, nstate);
     for (int t = 0; t < HYD_TYPE_COUNT && ok; ++t) {
         const hyd_component* d = hyd_component_of((hyd_type)t);
         if (d && d->rec_size) {
@@ -352,8 +355,13 @@ hyd_model* hyd_compile_ex(const hyd_builder* b, hyd_build_error* e) {
                 m->state_name[is++] = joinname(el->name, on->state);
             }
         }
-        for (int k = 0; k < d->nstate; ++k)
+        for (int k = 0; k < d->nstate; ++k) {
+            if (d->state_flush && d->state_flush[k] > 0.0) {
+                m->flush_state[m->nflush] = is;
+                m->flush_below[m->nflush++] = d->state_flush[k];
+            }
             m->state_name[is++] = joinname(el->name, d->states[k]);
+        }
     }
     for (int i = 0; i < nnode; ++i)
         if (!m->node_name[i])

@@ -209,3 +209,16 @@ double hyd_model_fastest_rate(const hyd_model* m, double p, double u) {
     hyd_data_free(d);
     return rate;
 }
+
+int hyd_model_flush(const hyd_model* m, double* y, const int* pos) {
+    int changed = 0;
+    for (int k = 0; k < m->nflush; ++k) {
+        double* v = &y[pos ? pos[m->flush_state[k]] : m->flush_state[k]];
+        // Exactly 0 already is the common case once settled.
+        if (*v != 0.0 && fabs(*v) < m->flush_below[k]) {
+            *v = 0.0;
+            ++changed;
+        }
+    }
+    return changed;
+}

@@ -115,6 +115,8 @@ static const hyd_param_info compensator_params[] = {
     HYD_PARAM(hyd_compensator_def, tau, "s", HYD_R_POS, 0, 1e-4, 1, 1e-3, 0.05),
 };
 static const char* const compensator_states[] = {"spool"};
+// It closes on a lag towards 0: flushed to 0 below HYD_STATE_FLUSH (the spool opening, of full [-]).
+static const double compensator_flush[] = {HYD_STATE_FLUSH};
 static const hyd_port_info compensator_ports[] = {
     HYD_PORT(hyd_compensator_def, inlet), HYD_PORT(hyd_compensator_def, outlet),
     HYD_PORT(hyd_compensator_def, load), HYD_PORT(hyd_compensator_def, ref)};
@@ -126,7 +128,7 @@ const hyd_component hyd_compensator_component = {
     .type = HYD_COMPENSATOR, .name = "compensator", .def_size = sizeof(hyd_compensator_def),
     .params = compensator_params, .nparam = HYD_COUNT(compensator_params),
     .ports = compensator_ports, .nport = HYD_COUNT(compensator_ports),
-    .states = compensator_states, .nstate = HYD_COUNT(compensator_states),
+    .states = compensator_states, .nstate = HYD_COUNT(compensator_states), .state_flush = compensator_flush,
     .rec_size = sizeof(hyd_comp_c), .states_sense_ports = 1,
     .defaults = compensator_defaults, .validate = compensator_validate, .bind = compensator_bind,
     .derive = compensator_derive, .initial = compensator_initial, .eval = compensators_eval,

@@ -126,6 +126,8 @@ static const hyd_port_info cb_ports[] = {HYD_PORT(hyd_counterbalance_def, valve)
                                          HYD_PORT(hyd_counterbalance_def, load),
                                          HYD_PORT(hyd_counterbalance_def, pilot)};
 static const char* const cb_states[] = {"spool"};
+// It closes on a lag towards 0: flushed to 0 below HYD_STATE_FLUSH (the spool opening, of full [-]).
+static const double cb_flush[] = {HYD_STATE_FLUSH};
 
 static void cb_defaults(void* def) { *(hyd_counterbalance_def*)def = hyd_default_counterbalance_def(); }
 
@@ -134,7 +136,7 @@ const hyd_component hyd_counterbalance_component = {
     .type = HYD_COUNTERBALANCE, .name = "counterbalance", .def_size = sizeof(hyd_counterbalance_def),
     .params = cb_params, .nparam = HYD_COUNT(cb_params),
     .ports = cb_ports, .nport = HYD_COUNT(cb_ports),
-    .states = cb_states, .nstate = HYD_COUNT(cb_states),
+    .states = cb_states, .nstate = HYD_COUNT(cb_states), .state_flush = cb_flush,
     .rec_size = sizeof(hyd_cb_c), .states_sense_ports = 1,
     .defaults = cb_defaults, .validate = cb_validate, .bind = cb_bind, .derive = cb_derive, .initial = cb_initial,
     .eval = cbs_eval, .jacobian = cbs_jacobian,

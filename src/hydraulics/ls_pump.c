@@ -137,6 +137,8 @@ static const hyd_port_info ls_pump_ports[] = {HYD_PORT(hyd_ls_pump_def, inlet),
                                               HYD_PORT(hyd_ls_pump_def, ls)};
 static const hyd_node_role ls_pump_roles[] = {HYD_NODE_LINE, HYD_NODE_SUPPLY, HYD_NODE_LS};
 static const char* const ls_pump_states[] = {"disp"};
+// It closes on a lag towards 0: flushed to 0 below HYD_STATE_FLUSH (the displacement, of full [-]).
+static const double ls_pump_flush[] = {HYD_STATE_FLUSH};
 
 static void ls_pump_defaults(void* def) { *(hyd_ls_pump_def*)def = hyd_default_ls_pump_def(); }
 
@@ -145,7 +147,7 @@ const hyd_component hyd_ls_pump_component = {
     .type = HYD_LS_PUMP, .name = "ls_pump", .def_size = sizeof(hyd_ls_pump_def),
     .params = ls_pump_params, .nparam = HYD_COUNT(ls_pump_params),
     .ports = ls_pump_ports, .nport = HYD_COUNT(ls_pump_ports),
-    .states = ls_pump_states, .nstate = HYD_COUNT(ls_pump_states),
+    .states = ls_pump_states, .nstate = HYD_COUNT(ls_pump_states), .state_flush = ls_pump_flush,
     .rec_size = sizeof(hyd_ls_pump_c), .states_sense_ports = 1, .port_roles = ls_pump_roles,
     .defaults = ls_pump_defaults, .check_ports = ls_pump_check_ports, .bind = ls_pump_bind,
     .derive = ls_pump_derive, .initial = ls_pump_initial, .eval = ls_pumps_eval,

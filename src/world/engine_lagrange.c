@@ -46,7 +46,8 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
         free(l);
         return NULL;
     }
-    if (lsim_check_pose(&l->ls, q0, err, errsz) || sim_check_fixed_step(m->hyd, o, o->h, 0.0, err, errsz)) {
+    if (lsim_check_pose(&l->ls, q0, err, errsz) || sim_check_fixed_step(m->hyd, o, o->h, 0.0, err, errsz) ||
+        sim_check_step_probe(m, o, o->h, err, errsz)) {
         lsim_free(&l->ls);
         free(l);
         return NULL;

@@ -60,6 +60,7 @@ static engine* ode_create(const model* m, const sim_opts* o, const double q0[2],
     sim_ode_row(l->w, row0);
     const sim_start_load ld = start_load(m, l->w, q0, m3);
     if (sim_check_fixed_step(ode_world_circuit(l->w), o, h, 0.0, err, errsz) ||
+        sim_check_step_probe(m, o, h, err, errsz) ||
         sim_check_start(ode_world_circuit(l->w), row0, SIM_NCOL, &ld, err, errsz)) {
         ode_world_destroy(l->w);
         free(l);

@@ -197,8 +197,10 @@ int lsim_rhs(void* user, double t, const double* y, double* dydt);
 /// corner of its law, a pressure below the bulk modulus' knee changing
 /// octave.
 unsigned long lsim_events(void* user, double t, const double* y);
-/// hyd_problem.settle: a spool within HYD_SPOOL_SETTLE of 0 while its
-/// command is as close to 0 is set to exactly 0.
+/// hyd_problem.settle: a valve spool within HYD_SPOOL_SETTLE of 0 while its
+/// command is as close to 0 is set to exactly 0, and so is every other
+/// state that closes on a lag towards 0 below 1e-10 of full (compensator
+/// and counterbalance spools, a LS pump's displacement: hyd_model_flush).
 int lsim_settle(void* user, double t, double* y);
 /// hyd_problem.wstage: lsim.ystage, the last split step's stage point.
 const double* lsim_wstage(void* user);

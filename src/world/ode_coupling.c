@@ -104,11 +104,13 @@ static unsigned long events_fused(void* user, double t, const double* y) {
 
 // hyd_problem.settle: a spool whose command is 0 decays towards 0 for ever,
 // into subnormal numbers that slow every step; within HYD_SPOOL_SETTLE of
-// 0 it is set to 0 (as lsim_settle).
+// 0 it is set to 0 (as lsim_settle), and so are the other states that
+// close on a lag towards 0 (compensator and counterbalance spools:
+// hyd_model_flush).
 static int settle(void* user, double t, double* y) {
     (void)t;
     ode_world* w = user;
-    int changed = 0;
+    int changed = hyd_model_flush(w->hm, y, NULL) > 0;
     for (int k = 0; k < ODE_NACT; ++k) {
         const ow_act* c = &w->act[k];
         if (c->valve < 0) continue;

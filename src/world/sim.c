@@ -339,6 +339,78 @@ int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, doubl
     return 0;
 }
 
+// The probe: the `step` scenario's commands (assets/scenarios/step.json):
+// the lift valve opened and closed as steps, then the jib's, then the
+// lift lowering, 500 kg from the pose (100, -110) deg. These are the
+// transients on which the shipped cranes' fixed steps fail first (the LS
+// crane at Krus 0.2 ms, ROS2 0.5 ms; issue 25).
+static const char probe_json[] =
+    "{\"name\": \"step probe\", \"description\": \"abrupt valve steps\", \"duration\": 6.5, \"load_mass\": 500,"
+    " \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110},"
+    " \"commands\": {\"lift\": [[0, 0], [1, 0], [1, 0.8], [3, 0.8], [3, 0], [5, 0], [5, -0.6], [6, -0.6], [6, 0]],"
+    " \"jib\": [[0, 0], [3.5, 0], [3.5, 0.8], [5.5, 0.8], [5.5, 0]]}}";
+
+// 0 when the probe runs through at step h, 1 on a numerical failure (what
+// in why), -1 when it could not be run (then nothing is refused).
+static int probe_at(const model* m, const scenario* sc, const sim_opts* o, double h, char* why, size_t whysz) {
+    sim_opts p = sim_default_opts();
+    p.solver = o->solver;
+    p.h = h;
+    p.dt_out = h > 1e-3 ? h : 1e-3;
+    p.jac_every = o->jac_every;
+    p.dense_jac = o->dense_jac;
+    p.kernel = o->kernel;
+    p.variant = o->variant;
+    p.no_step_probe = true;
+    sim_result r;
+    const int rc = sim_run(m, sc, &p, NULL, NULL, NULL, NULL, NULL, &r);
+    if (rc == SIM_OK) return 0;
+    if (rc != SIM_FAILED) return -1;
+    // "numerical blow-up: state X = V Pa (...) at t = T s (solver ...": up to the solver.
+    const char* cut = strstr(r.message, " (solver");
+    snprintf(why, whysz, "%.*s", cut ? (int)(cut - r.message) : (int)strlen(r.message), r.message);
+    return 1;
+}
+
+int sim_check_step_probe(const model* m, const sim_opts* o, double h, char* err, size_t errsz) {
+    if (o->no_step_probe || o->cvode || (o->solver != HYD_KRUS && o->solver != HYD_ROS2)) return 0;
+    if (!(h > SIM_PROBE_ABOVE * (1.0 + 1e-9))) return 0;
+    cJSON* root = cJSON_Parse(probe_json);
+    scenario sc;
+    char why[256] = "", e2[256];
+    int rc = -1;
+    if (root && scenario_from_json(root, "(step probe)", &sc, e2, sizeof e2) == 0) rc = probe_at(m, &sc, o, h, why, sizeof why);
+    if (rc != 1) {
+        if (root) cJSON_Delete(root);
+        return 0;
+    }
+    // The largest {5, 2, 1} x 10^k below h dividing the output period that
+    // passes; SIM_PROBE_ABOVE (not probed) when none above it does.
+    double ok = SIM_PROBE_ABOVE;
+    char w2[256];
+    for (double p10 = pow(10.0, floor(log10(h))); p10 > SIM_PROBE_ABOVE * 0.999 && ok == SIM_PROBE_ABOVE; p10 /= 10.0)
+        for (int k = 0; k < 3; ++k) {
+            static const double lead[3] = {5.0, 2.0, 1.0};
+            const double c = lead[k] * p10;
+            const double r = o->dt_out / c;
+            if (!(c < h * (1.0 - 1e-9)) || !(c > SIM_PROBE_ABOVE * (1.0 + 1e-9)) ||
+                fabs(r - floor(r + 0.5)) > 1e-9 * r)
+                continue;
+            if (probe_at(m, &sc, o, c, w2, sizeof w2) == 0) {
+                ok = c;
+                break;
+            }
+        }
+    cJSON_Delete(root);
+    const int which = o->h > h ? SIM_PARAM_DT_ODE : SIM_PARAM_DT;
+    snprintf(err, errsz,
+             "%s at %s %g s blows up on this model's abrupt valve steps (the `step` scenario's commands, 500 kg, "
+             "probed before the drive: %s); the largest step that runs them is %g s: use %s %g or an adaptive "
+             "solver (ros34pw2, rodas3)",
+             hyd_method_name(o->solver), sim_param_name(which), h, why, ok, sim_param_name(SIM_PARAM_DT), ok);
+    return SIM_REFUSED;
+}
+
 void sim_lagrange_row(double t, const lsim_out* o, double* row) {
     const double v[SIM_NCOL] = {
         t, o->x[0], o->x[1], o->pA[0], o->pB[0], o->pA[1], o->pB[1], o->u[0], o->u[1], o->q[0], o->q[1],
