@@ -21,6 +21,11 @@ extern "C" {
 /// costs ODE well under a millisecond per contact query; a million would cost
 /// memory and load time for no gain in a crane yard).
 #define MESH_MAX_TRIANGLES 200000
+/// Largest mesh file [bytes] (256 MiB): an ASCII STL of MESH_MAX_TRIANGLES
+/// facets takes about 60 MB, an OBJ with normals and texture coordinates
+/// less. Checked, with the file being a regular file, before anything reads
+/// it (a link to /dev/zero would otherwise be read for ever).
+#define MESH_MAX_FILE_BYTES (256L << 20)
 
 typedef struct mesh_tri {
     int nv, nt;

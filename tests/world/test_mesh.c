@@ -15,7 +15,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdint.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -627,6 +629,159 @@ static void test_bad_meshes(void) {
     expect_bad(NULL, buf, "obstacles[0].size", "not used with a mesh");
 }
 
+// ---- files that are not whole meshes (issue 25 items 24, 25, 11c, 16b) ----
+
+// The unit cube's 12 triangles, wound outward.
+static void cube_tris(float t[12][9]) {
+    static const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (int f = 0; f < 6; ++f)
+        for (int h = 0; h < 2; ++h) {
+            const int c[3] = {q[f][0], q[f][1 + h], q[f][2 + h]};
+            for (int k = 0; k < 3; ++k)
+                for (int a = 0; a < 3; ++a) t[2 * f + h][3 * k + a] = (float)(c[k] >> a & 1);
+        }
+}
+
+// A binary STL of `write` facets (the cube's, repeated) under a header that
+// says `count`; `extra` bytes of a further facet appended. Returns the size.
+static long write_stl_bin(const char* name, uint32_t count, int write, int extra, char* path, size_t n) {
+    snprintf(path, n, "%s/%s", g_dir, name);
+    FILE* f = fopen(path, "wb");
+    if (!f) return -1;
+    unsigned char head[84] = "solid but binary";
+    for (int k = 0; k < 4; ++k) head[80 + k] = (unsigned char)(count >> 8 * k);
+    fwrite(head, 1, 84, f);
+    float t[12][9];
+    cube_tris(t);
+    for (int i = 0; i < write; ++i) {
+        unsigned char rec[50] = {0};
+        for (int k = 0; k < 9; ++k) memcpy(rec + 12 + 4 * k, &t[i % 12][k], 4); // little-endian host (x86, arm)
+        fwrite(rec, 1, 50, f);
+    }
+    for (int i = 0; i < extra; ++i) fputc(0, f);
+    const long size = ftell(f);
+    fclose(f);
+    return size;
+}
+
+// An ASCII STL of the cube, cut in the middle of its cut_vertex-th "vertex"
+// line (1-based; whole if 0).
+static void write_stl_ascii(const char* name, int cut_vertex, char* path, size_t n) {
+    char text[8192] = "solid cube exported by a CAD program\n";
+    float t[12][9];
+    cube_tris(t);
+    for (int i = 0; i < 12; ++i) {
+        char fac[512];
+        snprintf(fac, sizeof fac,
+                 "  facet normal 0 0 0\n    outer loop\n      vertex %g %g %g\n      vertex %g %g %g\n"
+                 "      vertex %g %g %g\n    endloop\n  endfacet\n",
+                 t[i][0], t[i][1], t[i][2], t[i][3], t[i][4], t[i][5], t[i][6], t[i][7], t[i][8]);
+        strcat(text, fac);
+    }
+    strcat(text, "endsolid cube\n");
+    size_t keep = strlen(text);
+    const char* q = text;
+    for (int i = 0; i < cut_vertex && q; ++i) q = strstr(q + 1, "vertex");
+    if (cut_vertex > 0 && q) keep = (size_t)(q - text) + 10; // "vertex 0 0" of "vertex 0 0 1"
+    snprintf(path, n, "%s/%s", g_dir, name);
+    FILE* f = fopen(path, "wb");
+    if (!f) return;
+    fwrite(text, 1, keep, f);
+    fclose(f);
+}
+
+static void expect_load(const char* path, const char* want1, const char* want2) {
+    char err[512] = "";
+    mesh_tri t;
+    const int rc = mesh_load(path, 1, 2, &t, err, sizeof err);
+    CHECK(rc == -1, "%s refused (%s)", path, want1);
+    if (!rc) mesh_free(&t);
+    CHECK(strstr(err, want1) && (!want2 || strstr(err, want2)), "%s: message: %s", path, err);
+    CHECK(!strstr(err, "no triangles"), "%s: says no triangles: %s", path, err);
+}
+
+static void test_bad_files(void) {
+    char path[600], buf[1400];
+    mesh_tri t;
+    char err[512];
+    // The whole files load: 12 triangles, 8 vertices.
+    write_stl_bin("cube_bin.stl", 12, 12, 0, path, sizeof path);
+    CHECK(mesh_load(path, 1, 2, &t, err, sizeof err) == 0 && t.nt == 12 && t.nv == 8, "binary cube: %s", err);
+    mesh_free(&t);
+    write_stl_ascii("cube_ascii.stl", 0, path, sizeof path);
+    CHECK(mesh_load(path, 1, 2, &t, err, sizeof err) == 0 && t.nt == 12 && t.nv == 8, "ASCII cube: %s", err);
+    if (!err[0]) mesh_free(&t);
+    // Item 25: 10 whole facets under a header saying 1000, or 0xffffffff.
+    write_stl_bin("count1000.stl", 1000, 10, 0, path, sizeof path);
+    expect_load(path, "binary STL truncated: the header says 1000 facets (50084 bytes)", "584 bytes (10 whole facets)");
+    write_stl_bin("countmax.stl", 0xffffffffu, 10, 0, path, sizeof path);
+    expect_load(path, "the header says 4294967295 facets", "(10 whole facets)");
+    // A count of 0 with facets after it.
+    write_stl_bin("count0.stl", 0, 10, 0, path, sizeof path);
+    expect_load(path, "the header says 0 facets (84 bytes) but the file has 584 bytes", "500 more");
+    // Item 16b: cut short, 12 whole triangles and part of the 13th of 20.
+    write_stl_bin("cut.stl", 20, 12, 17, path, sizeof path);
+    expect_load(path, "binary STL truncated: the header says 20 facets (1084 bytes)",
+                "the file has 701 bytes (12 whole facets and a part of one)");
+    // Items 25 and 11c: an ASCII STL cut inside a facet (in the 5th facet's
+    // second vertex line), and one cut between facets (no endsolid).
+    write_stl_ascii("cut_ascii.stl", 14, path, sizeof path);
+    expect_load(path, "ASCII STL truncated: the file ends at line 33 inside facet 5", NULL);
+    snprintf(path, sizeof path, "%s/noend_ascii.stl", g_dir);
+    {
+        FILE* f = fopen(path, "wb");
+        if (f) fputs("solid cube\n", f), fclose(f);
+        f = fopen(path, "ab");
+        if (f) {
+            fputs("  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n      vertex 0 1 0\n"
+                  "    endloop\n  endfacet\n",
+                  f);
+            fclose(f);
+        }
+    }
+    expect_load(path, "ASCII STL truncated: the file ends at line 9 after 1 facets without \"endsolid\"", NULL);
+    // A facet with a fourth vertex, and a word that is not a number.
+    snprintf(path, sizeof path, "%s/quad_ascii.stl", g_dir);
+    FILE* f = fopen(path, "wb");
+    if (f) {
+        fputs("solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n"
+              "endloop\nendfacet\nendsolid q\n", f);
+        fclose(f);
+    }
+    expect_load(path, "ASCII STL: line 7 (facet 1): expected \"endloop\", found \"vertex\"", NULL);
+    // Item 25: a directory given as the mesh.
+    snprintf(path, sizeof path, "%s/adir.stl", g_dir);
+    mkdir(path, 0755);
+    expect_load(path, "is a directory", NULL);
+    // Item 24: a mesh that never ends (a link to /dev/zero and to
+    // /dev/urandom): refused before any read, so this returns at once.
+    snprintf(path, sizeof path, "%s/zero.stl", g_dir);
+    unlink(path);
+    CHECK(symlink("/dev/zero", path) == 0, "symlink");
+    expect_load(path, "is not a regular file", NULL);
+    snprintf(path, sizeof path, "%s/random.obj", g_dir);
+    unlink(path);
+    CHECK(symlink("/dev/urandom", path) == 0, "symlink");
+    expect_load(path, "is not a regular file", NULL);
+    expect_load("/dev/zero", "is not a regular file", NULL);
+    // Over the size limit (a sparse file: no disk used).
+    snprintf(path, sizeof path, "%s/huge_sparse.obj", g_dir);
+    f = fopen(path, "wb");
+    if (f) {
+        fclose(f);
+        CHECK(truncate(path, MESH_MAX_FILE_BYTES + 1) == 0, "truncate");
+    }
+    expect_load(path, "more than the 256 MiB a mesh file may have", NULL);
+    unlink(path);
+    // Through a world file: the field, the file and the problem on one line.
+    snprintf(buf, sizeof buf, "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s/zero.stl\"}, \"position\": [-6, -9]}]",
+             g_dir);
+    expect_bad(NULL, buf, "obstacles[0].mesh.file: ", "zero.stl: is not a regular file");
+    snprintf(buf, sizeof buf,
+             "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s/cut.stl\"}, \"mass\": 50, \"position\": [-6, -9]}]", g_dir);
+    expect_bad(buf, NULL, "loads[0].mesh.file: ", "cut.stl: binary STL truncated");
+}
+
 // The per-process cache: a second load of an unchanged file parses nothing
 // and gives the same mesh; another scale is a different entry; a rewrite of
 // equal size (same tick possible) is parsed again and gives the new mesh;
@@ -692,6 +847,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_box_vs_mesh_box);
     RUN_TEST(test_boom_mesh_wall);
     RUN_TEST(test_bad_meshes);
+    RUN_TEST(test_bad_files);
     RUN_TEST(test_cache);
     RUN_TEST(test_merge_flat_box);
     RUN_TEST(test_merge_keeps_shape);
