@@ -89,10 +89,25 @@ typedef struct mesh_hull {
     double* v;      ///< 3 nv [m]
     int* f;         ///< 3 nf
     double* plane;  ///< 4 nf: nx, ny, nz, d
+    double tol;     ///< points at most this far outside may be left out [m]
 } mesh_hull;
 
-/// Hull of the mesh's vertices (incremental). Returns 0, or -1 if the points
-/// are flat (no volume) or memory ran out.
+/// Most faces a loose body's hull may have. ODE's convex colliders test
+/// every face and edge pair (a 1,000-face hull against a box is about 1e7
+/// operations a contact query); a finely tessellated round load is kept under
+/// it by the tolerance below, a hull that needs more is refused.
+#define MESH_HULL_MAX_FACES 2000
+/// The hull's first tolerance, relative to the points' extent: a point less
+/// than this above the hull of the others is left out (float coordinates of
+/// a flat face scatter by 6e-8 of the size); multiplied by 10 while the hull
+/// has more than MESH_HULL_MAX_FACES faces, up to 1e-2 (a sphere of 100,000
+/// points then has about 440 faces).
+#define MESH_HULL_TOL_REL 1e-7
+
+/// Hull of the points (quickhull on exact predicates, mesh_geom.c). Returns
+/// 0; -1 if the points are flat (no volume), not finite or memory ran out;
+/// -2 if even at 1e-2 of the extent the hull has more than
+/// MESH_HULL_MAX_FACES faces.
 int mesh_hull_build(const double* pts, int n, mesh_hull* h);
 void mesh_hull_free(mesh_hull* h);
 

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <stdint.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #define PI 3.14159265358979323846
@@ -548,6 +549,111 @@ static void test_boom_mesh_wall(void) {
     boom_mesh_wall(path, nt);
 }
 
+// ---- the convex hull bounded (issue 25, item 23) ----
+
+static double now_s(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// The hull as a mesh: closed and consistently wound (every edge twice, once
+// each way), Euler V - E + F = 2, every point inside or within the hull's
+// tolerance of every plane; its volume returned.
+static double check_hull(const mesh_hull* h, const double* P, int n) {
+    mesh_tri t = {.nv = h->nv, .nt = h->nf};
+    t.v = malloc((size_t)3 * h->nv * sizeof *t.v);
+    t.idx = malloc((size_t)3 * h->nf * sizeof *t.idx);
+    for (int i = 0; i < 3 * h->nv; ++i) t.v[i] = (float)h->v[i];
+    memcpy(t.idx, h->f, (size_t)3 * h->nf * sizeof *t.idx);
+    CHECK(mesh_open_edges(&t) == 0, "the hull is closed and consistently wound");
+    const int E = 3 * h->nf / 2;
+    CHECK(3 * h->nf % 2 == 0 && h->nv - E + h->nf == 2, "Euler: V %d - E %d + F %d = %d", h->nv, E, h->nf,
+          h->nv - E + h->nf);
+    double worst = -INFINITY;
+    for (int i = 0; i < n; ++i) {
+        double w = -INFINITY;
+        for (int f = 0; f < h->nf; ++f) {
+            const double* pl = h->plane + 4 * f;
+            const double s = pl[0] * P[3 * i] + pl[1] * P[3 * i + 1] + pl[2] * P[3 * i + 2] - pl[3];
+            if (s > w) w = s;
+        }
+        if (w > worst) worst = w;
+    }
+    CHECK(worst <= h->tol + 1e-12, "a point %g m outside the hull (tolerance %g m)", worst, h->tol);
+    double V = 0, c[3], I[9];
+    CHECK(mesh_mass_props(&t, &V, c, I) == 0, "hull volume");
+    mesh_free(&t);
+    return V;
+}
+
+static void test_hull_bounded(void) {
+    // 505 points: the corners of a 2 x 1 x 0.5 m box and 497 points on its
+    // faces with float rounding (6e-8 of the size off the face, as a finely
+    // cut CAD face in float coordinates): the earlier hull built 79,151
+    // faces from such a cloud in 13.6 s (and more from 200 such points).
+    enum { N = 505 };
+    static double P[3 * N];
+    const double L[3] = {2, 1, 0.5};
+    unsigned r = 12345;
+    for (int i = 0; i < N; ++i) {
+        double q[3];
+        if (i < 8) {
+            for (int k = 0; k < 3; ++k) q[k] = (i >> k & 1) ? L[k] / 2 : -L[k] / 2;
+        } else {
+            const int face = i % 6, ax = face / 2;
+            for (int k = 0; k < 3; ++k) {
+                r = r * 1103515245u + 12345u;
+                q[k] = ((r >> 8) / 16777216.0 - 0.5) * L[k];
+            }
+            r = r * 1103515245u + 12345u;
+            q[ax] = (face & 1 ? 0.5 : -0.5) * L[ax] + ((r >> 8) / 16777216.0 - 0.5) * 2.4e-7;
+        }
+        for (int k = 0; k < 3; ++k) P[3 * i + k] = (float)q[k];
+    }
+    mesh_hull h;
+    double t0 = now_s();
+    CHECK(mesh_hull_build(P, N, &h) == 0, "hull of 505 points");
+    const double dt = now_s() - t0;
+    CHECK(dt < 0.5, "505 points took %.3f s", dt);
+    CHECK(h.nf <= MESH_HULL_MAX_FACES && h.nf <= 2 * h.nv - 4, "%d faces for %d vertices", h.nf, h.nv);
+    // The box: 8 corners; the face points lie within the tolerance.
+    CHECK(h.nv == 8 && h.nf == 12, "the box's hull: %d vertices, %d faces (tolerance %g m)", h.nv, h.nf, h.tol);
+    CHECK_REL(check_hull(&h, P, N), L[0] * L[1] * L[2], 1e-6);
+    mesh_hull_free(&h);
+    // The same points with no noise, and exactly on the faces: the same box.
+    for (int i = 8; i < N; ++i) {
+        const int ax = i % 6 / 2;
+        P[3 * i + ax] = (i % 6 & 1 ? 0.5 : -0.5) * L[ax];
+    }
+    CHECK(mesh_hull_build(P, N, &h) == 0, "hull, exact faces");
+    CHECK_REL(check_hull(&h, P, N), L[0] * L[1] * L[2], 1e-9);
+    CHECK(h.nf <= 2 * h.nv - 4 && h.nf <= MESH_HULL_MAX_FACES, "%d faces for %d vertices", h.nf, h.nv);
+    mesh_hull_free(&h);
+    // 20,000 points on a sphere of radius 1 m (a Fibonacci lattice): every
+    // one is a hull vertex, 39,996 faces exactly; bounded to the cap by the
+    // tolerance, the volume between the ball's and that of the ball shrunk
+    // by the tolerance.
+    enum { M = 20000 };
+    static double S[3 * M];
+    for (int i = 0; i < M; ++i) {
+        const double z = 1 - (2.0 * i + 1) / M, rr = sqrt(1 - z * z), a = i * PI * (3 - sqrt(5.0));
+        S[3 * i] = rr * cos(a), S[3 * i + 1] = rr * sin(a), S[3 * i + 2] = z;
+    }
+    t0 = now_s();
+    CHECK(mesh_hull_build(S, M, &h) == 0, "hull of 20,000 sphere points");
+    const double ds = now_s() - t0;
+    CHECK(ds < 2.0, "20,000 points took %.3f s", ds);
+    CHECK(h.nf <= MESH_HULL_MAX_FACES, "%d faces", h.nf);
+    CHECK(h.tol <= 0.02 * 1.0001, "tolerance %g m", h.tol);
+    const double Vs = check_hull(&h, S, M), Vball = 4.0 / 3.0 * PI;
+    CHECK(Vs <= Vball && Vs >= 4.0 / 3.0 * PI * pow(1 - h.tol, 3) * 0.98, "sphere hull volume %g (ball %g)", Vs, Vball);
+    mesh_hull_free(&h);
+    // Four points on a plane: no volume.
+    const double flat[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    CHECK(mesh_hull_build(flat, 4, &h) == -1, "flat refused");
+}
+
 // ---- bad meshes ----
 
 static void expect_bad(const char* loads, const char* obst, const char* want1, const char* want2) {
@@ -842,6 +948,7 @@ int main(int argc, char** argv) {
     }
     RUN_TEST(test_mass_cube);
     RUN_TEST(test_mass_cylinder);
+    RUN_TEST(test_hull_bounded);
     RUN_TEST(test_load_mass_in_world);
     RUN_TEST(test_rest_on_wedge);
     RUN_TEST(test_box_vs_mesh_box);
