@@ -192,7 +192,8 @@ static void assign(qhull* h, int q, int from) {
     if (best >= 0) h->next[q] = h->F[best].head, h->F[best].head = q;
 }
 
-// One hull at tolerance tol; 0, -1 out of memory, -2 more than max_faces.
+// One hull at tolerance tol; 0, -1 out of memory, -2 more than max_faces,
+// -3 cancelled.
 static int quickhull(qhull* h, const int i4[4], int max_faces) {
     h->nf = 0;
     const int tet[4][3] = {{i4[0], i4[1], i4[2]}, {i4[0], i4[3], i4[1]}, {i4[1], i4[3], i4[2]}, {i4[0], i4[2], i4[3]}};
@@ -212,13 +213,16 @@ static int quickhull(qhull* h, const int i4[4], int max_faces) {
                 for (int j = 0; j < 3; ++j)
                     if (g != f && h->F[g].v[j] == b && h->F[g].v[(j + 1) % 3] == a) h->F[f].adj[k] = g;
         }
-    for (int q = 0; q < h->n; ++q)
+    for (int q = 0; q < h->n; ++q) {
+        if (q % 65536 == 65535 && mesh_cancelled()) return -3;
         if (q != i4[0] && q != i4[1] && q != i4[2] && q != i4[3]) assign(h, q, 0);
+    }
     int alive = 4, stamp = 0;
     int *stack = NULL, *vis = NULL, *hor = NULL;
     int scap = 0, vcap = 0, hcap = 0, rc = 0;
     for (int cur = 0; cur < h->nf; ++cur) {
         if (!h->F[cur].alive || h->F[cur].head < 0) continue;
+        if (mesh_cancelled()) { rc = -3; goto done; }
         // The farthest point above this face.
         int p = -1;
         double pd = -INFINITY;

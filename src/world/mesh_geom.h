@@ -41,6 +41,15 @@ typedef struct mesh_tri {
 typedef int (*mesh_import_fn)(const char* path, mesh_tri* out, char* err, size_t errsz);
 void mesh_set_importer(mesh_import_fn fn);
 
+/// A function the long mesh loops (parsing, the hull) poll: when it returns
+/// non-zero they stop and the load fails with "interrupted" (mesh_hull_build
+/// returns -3). NULL (the default): never. The application installs its
+/// SIGINT/SIGTERM flag, so Ctrl-C stops a load within milliseconds.
+typedef int (*mesh_cancel_fn)(void);
+void mesh_set_cancel(mesh_cancel_fn fn);
+/// Non-zero when the installed function says stop.
+int mesh_cancelled(void);
+
 /// Load path (OBJ/STL here, others through the importer), scale [m/unit],
 /// up 1 = y-up (mesh y becomes z, mesh z becomes -y), 2 = z-up. Returns 0, or
 /// -1 with the problem in err (without the file name).
@@ -107,7 +116,7 @@ typedef struct mesh_hull {
 /// Hull of the points (quickhull on exact predicates, mesh_geom.c). Returns
 /// 0; -1 if the points are flat (no volume), not finite or memory ran out;
 /// -2 if even at 1e-2 of the extent the hull has more than
-/// MESH_HULL_MAX_FACES faces.
+/// MESH_HULL_MAX_FACES faces; -3 if mesh_cancelled() said stop.
 int mesh_hull_build(const double* pts, int n, mesh_hull* h);
 void mesh_hull_free(mesh_hull* h);
 

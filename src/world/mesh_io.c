@@ -17,6 +17,10 @@ static mesh_import_fn g_importer;
 
 void mesh_set_importer(mesh_import_fn fn) { g_importer = fn; }
 
+static mesh_cancel_fn g_cancel;
+void mesh_set_cancel(mesh_cancel_fn fn) { g_cancel = fn; }
+int mesh_cancelled(void) { return g_cancel && g_cancel(); }
+
 void mesh_free(mesh_tri* m) {
     if (!m) return;
     free(m->v);
@@ -67,7 +71,7 @@ static int read_obj(FILE* f, mesh_tri* m, char* err, size_t errsz) {
     char line[4096];
     int vcap = 0, tcap = 0, lineno = 0;
     while (fgets(line, sizeof line, f)) {
-        ++lineno;
+        if (++lineno % 4096 == 0 && mesh_cancelled()) goto cancelled;
         char* s = line;
         while (*s == ' ' || *s == '\t') ++s;
         if (s[0] == 'v' && (s[1] == ' ' || s[1] == '\t')) {
@@ -112,6 +116,9 @@ static int read_obj(FILE* f, mesh_tri* m, char* err, size_t errsz) {
         }
     }
     return 0;
+cancelled:
+    snprintf(err, errsz, "interrupted");
+    return -1;
 too_big:
     snprintf(err, errsz, "more than %d vertices (the limit is %d triangles; docs/ode_world.md, \"CAD meshes\")",
              MESH_MAX_VERTICES, MESH_MAX_TRIANGLES);
@@ -163,6 +170,10 @@ static int read_stl_binary(FILE* f, long long size, mesh_tri* m, char* err, size
     int vcap = 0, tcap = 0;
     unsigned char rec[50];
     for (uint32_t t = 0; t < n; ++t) {
+        if (t % 4096 == 4095 && mesh_cancelled()) {
+            snprintf(err, errsz, "interrupted");
+            return -1;
+        }
         if (fread(rec, 1, 50, f) != 50) {
             snprintf(err, errsz, "binary STL: cannot read facet %u of %u (the file changed or is unreadable)", t + 1,
                      n);
@@ -247,7 +258,10 @@ static int read_stl_ascii(FILE* f, mesh_tri* m, char* err, size_t errsz) {
                      lx.tok);
             return -1;
         }
-        ++facet;
+        if (++facet % 1024 == 0 && mesh_cancelled()) {
+            snprintf(err, errsz, "interrupted");
+            return -1;
+        }
         // "normal nx ny nz": the normal is not used (the winding gives it).
         static const char* const seq[] = {"normal", NULL, NULL, NULL, "outer", "loop"};
         for (int i = 0; i < 6; ++i) {

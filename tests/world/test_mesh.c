@@ -654,6 +654,38 @@ static void test_hull_bounded(void) {
     CHECK(mesh_hull_build(flat, 4, &h) == -1, "flat refused");
 }
 
+// Cancelling (the app's SIGINT flag): the hull and the parser stop at the
+// next poll. The flag is raised after a few polls, so the loops are under way.
+static int g_polls, g_stop_after;
+static int cancel_after(void) { return ++g_polls > g_stop_after; }
+
+static void test_cancel(void) {
+    enum { M = 20000 };
+    static double S[3 * M];
+    for (int i = 0; i < M; ++i) {
+        const double z = 1 - (2.0 * i + 1) / M, rr = sqrt(1 - z * z), a = i * PI * (3 - sqrt(5.0));
+        S[3 * i] = rr * cos(a), S[3 * i + 1] = rr * sin(a), S[3 * i + 2] = z;
+    }
+    mesh_hull h;
+    g_polls = 0, g_stop_after = 50;
+    mesh_set_cancel(cancel_after);
+    CHECK(mesh_hull_build(S, M, &h) == -3 && h.nf == 0, "hull cancelled");
+    CHECK(g_polls == 51, "stopped at the first poll after the flag (%d polls)", g_polls);
+    // A 20,000-triangle OBJ (a dense box) stops in its parse.
+    char path[600], err[256];
+    write_dense_box("cancel_box.obj", (const double[3]){0, 0, 0}, (const double[3]){1, 1, 1}, 0.02, 0, path,
+                    sizeof path);
+    mesh_cache_clear();
+    g_polls = 0, g_stop_after = 2;
+    mesh_tri t;
+    CHECK(mesh_load(path, 1, 2, &t, err, sizeof err) == -1 && !strcmp(err, "interrupted"), "parse cancelled: %s", err);
+    mesh_set_cancel(NULL);
+    CHECK(mesh_load(path, 1, 2, &t, err, sizeof err) == 0, "loads without the flag: %s", err);
+    mesh_free(&t);
+    CHECK(mesh_hull_build(S, M, &h) == 0, "hull without the flag");
+    mesh_hull_free(&h);
+}
+
 // ---- bad meshes ----
 
 static void expect_bad(const char* loads, const char* obst, const char* want1, const char* want2) {
@@ -949,6 +981,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_mass_cube);
     RUN_TEST(test_mass_cylinder);
     RUN_TEST(test_hull_bounded);
+    RUN_TEST(test_cancel);
     RUN_TEST(test_load_mass_in_world);
     RUN_TEST(test_rest_on_wedge);
     RUN_TEST(test_box_vs_mesh_box);
