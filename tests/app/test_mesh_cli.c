@@ -72,6 +72,27 @@ static void test_bad_mesh_exit_codes(void) {
         fclose(f);
     }
     expect("empty.stl", "no triangles");
+    // Issue 25 items 24 and 25: a directory, and a link to a file that
+    // never ends, refused before reading (a hang before); a binary STL cut
+    // short says so (item 16b; "no triangles" before).
+    snprintf(path, sizeof path, "%s/dir.stl", g_dir);
+    mkdir(path, 0755);
+    expect("dir.stl", "is a directory");
+    snprintf(path, sizeof path, "%s/zero.stl", g_dir);
+    unlink(path);
+    if (symlink("/dev/zero", path)) perror("symlink");
+    expect("zero.stl", "is not a regular file");
+    snprintf(path, sizeof path, "%s/cut.stl", g_dir);
+    f = fopen(path, "wb");
+    if (f) {
+        unsigned char head[84] = {0};
+        head[80] = 20; // 20 facets said, 12 there
+        fwrite(head, 1, 84, f);
+        for (int i = 0; i < 12 * 50; ++i) fputc(i % 50 < 12 ? 0 : 0x3f, f);
+        fclose(f);
+    }
+    expect("cut.stl", "binary STL truncated: the header says 20 facets (1084 bytes) but the file has 684 bytes (12 "
+                      "whole facets)");
 }
 
 static double now_s(void) {
