@@ -284,7 +284,8 @@ static int quickhull(qhull* h, const int i4[4], int max_faces) {
                     // Enter g through the edge it shares with f; its next edge
                     // around the shared vertex.
                     int j = 0;
-                    while (h->F[g].adj[j] != f) ++j;
+                    while (j < 3 && h->F[g].adj[j] != f) ++j;
+                    if (j == 3) { rc = -1; goto done; } // cannot happen on exact signs
                     f = g, kk = (j + 1) % 3;
                 }
                 k = kk;
