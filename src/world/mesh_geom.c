@@ -111,7 +111,7 @@ int mesh_mass_props(const mesh_tri* m, double* volume, double com[3], double I[9
 // points, so float noise on a flat face makes no slivers; the hull then may
 // leave out points at most tol outside it. mesh_hull_build starts at
 // MESH_HULL_TOL_REL of the size and, while the hull has more than
-// MESH_HULL_MAX_FACES faces, tries ten times that (up to 1e-2 of the size).
+// MESH_HULL_MAX_FACES faces, tries sqrt(10) times that (up to 1e-2 of the size).
 
 #define GRID_STEPS 67108864.0 // 2^26
 
@@ -397,7 +397,7 @@ int mesh_hull_build(const double* P, int n, mesh_hull* h) {
     }
     if (i4[3] < 0 || best < flat) goto out; // flat: no volume
     rc = -2;
-    for (double rel = MESH_HULL_TOL_REL; rc == -2 && rel <= 1.001e-2; rel *= 10) {
+    for (double rel = MESH_HULL_TOL_REL; rc == -2 && rel <= 1.001e-2; rel *= 3.1622776601683795) {
         q.tol = rel * size;
         rc = quickhull(&q, i4, MESH_HULL_MAX_FACES);
     }
