@@ -231,7 +231,7 @@ static void test_sigint_during_load(void) {
         const int ok = st >= 0 && ((WIFEXITED(st) && WEXITSTATUS(st) == 130) ||
                                    (WIFSIGNALED(st) && WTERMSIG(st) == SIGINT));
         CHECK(ok, "SIGINT %d: status %#x: %s", k, st, text);
-        CHECK(took < 2.0, "SIGINT %d: ended %.2f s after the signal", k, took);
+        CHECK(took < 5.0, "SIGINT %d: ended %.2f s after the signal", k, took); // 0.2 s at most in Release
         CHECK(!WIFEXITED(st) || strstr(text, "interrupted (SIGINT)"), "SIGINT %d: message: %s", k, text);
         if (st >= 0)
             printf("  SIGINT %d: ended %.3f s after it, %s %d\n", k, took, WIFEXITED(st) ? "exit" : "signal",
