@@ -902,6 +902,11 @@ static void test_bad_files(void) {
     CHECK(symlink("/dev/urandom", path) == 0, "symlink");
     expect_load(path, "is not a regular file", NULL);
     expect_load("/dev/zero", "is not a regular file", NULL);
+    // A named pipe with no writer: opening it would block for ever.
+    snprintf(path, sizeof path, "%s/pipe.obj", g_dir);
+    unlink(path);
+    CHECK(mkfifo(path, 0644) == 0, "mkfifo");
+    expect_load(path, "is not a regular file", NULL);
     // Over the size limit (a sparse file: no disk used).
     snprintf(path, sizeof path, "%s/huge_sparse.obj", g_dir);
     f = fopen(path, "wb");
