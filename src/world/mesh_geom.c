@@ -220,23 +220,6 @@ static int quickhull(qhull* h, const int i4[4], int max_faces) {
     int alive = 4, stamp = 0;
     int *stack = NULL, *vis = NULL, *hor = NULL;
     int scap = 0, vcap = 0, hcap = 0, rc = 0;
-    for (int cur = 0; cur < h->nf; ++cur) {
-        if (!h->F[cur].alive || h->F[cur].head < 0) continue;
-        if (mesh_cancelled()) { rc = -3; goto done; }
-        // The farthest point above this face.
-        int p = -1;
-        double pd = -INFINITY;
-        for (int q = h->F[cur].head; q >= 0; q = h->next[q]) {
-            const double d = dist(h, &h->F[cur], q);
-            if (d > pd) pd = d, p = q;
-        }
-        if (pd <= h->tol) { // all within tol of the face: dropped
-            h->F[cur].head = -1;
-            continue;
-        }
-        // The patch p sees: faces reached through faces p is above (exact).
-        ++stamp;
-        int nvis = 0, sp = 0;
 #define PUSH(arr, n, cap, x)                                                   \
     do {                                                                       \
         if ((n) == (cap)) {                                                    \
@@ -247,6 +230,56 @@ static int quickhull(qhull* h, const int i4[4], int max_faces) {
         }                                                                      \
         (arr)[(n)++] = (x);                                                    \
     } while (0)
+    int again = 1;
+    while (again) {
+    again = 0;
+    for (int cur = 0; cur < h->nf; ++cur) {
+        if (!h->F[cur].alive || h->F[cur].head < 0) continue;
+        if (mesh_cancelled()) { rc = -3; goto done; }
+        // The farthest point above this face.
+        int p = -1;
+        double pd = -INFINITY;
+        for (int q = h->F[cur].head; q >= 0; q = h->next[q]) {
+            const double d = dist(h, &h->F[cur], q);
+            if (d > pd) pd = d, p = q;
+        }
+        if (pd <= h->tol) {
+            // Within tol of this face: dropped, unless the point is farther
+            // above another face (the faces a point is above form one patch
+            // with this one; near a crease it may be above a neighbour by
+            // more). Then it goes there, and the scan runs again if that
+            // face is behind it.
+            int q = h->F[cur].head, nx;
+            h->F[cur].head = -1;
+            for (; q >= 0; q = nx) {
+                nx = h->next[q];
+                ++stamp;
+                int nst = 0, best = -1;
+                double bd = h->tol;
+                h->F[cur].stamp = stamp;
+                PUSH(stack, nst, scap, cur);
+                while (nst) {
+                    const int f = stack[--nst];
+                    const double d = dist(h, &h->F[f], q);
+                    if (d > bd) bd = d, best = f;
+                    for (int k = 0; k < 3; ++k) {
+                        const int g = h->F[f].adj[k];
+                        if (h->F[g].stamp != stamp && above(h, &h->F[g], q)) {
+                            h->F[g].stamp = stamp;
+                            PUSH(stack, nst, scap, g);
+                        }
+                    }
+                }
+                if (best >= 0 && best != cur) {
+                    h->next[q] = h->F[best].head, h->F[best].head = q;
+                    if (best < cur) again = 1;
+                }
+            }
+            continue;
+        }
+        // The patch p sees: faces reached through faces p is above (exact).
+        ++stamp;
+        int nvis = 0, sp = 0;
         h->F[cur].stamp = stamp;
         PUSH(stack, sp, scap, cur);
         while (sp) {
@@ -319,6 +352,7 @@ static int quickhull(qhull* h, const int i4[4], int max_faces) {
                 if (q != p) assign(h, q, first);
             }
         if (alive > max_faces) { rc = -2; goto done; }
+    }
     }
 #undef PUSH
 done:
