@@ -131,6 +131,7 @@ typedef struct qhull {
     int n, nf, cap;
     qface* F;
     int* next;      // per point: the next in its face's list
+    double lo[3], step; // grid: x = lo + Q step [m]
     double tol;
 } qhull;
 
@@ -164,17 +165,19 @@ static int add_face(qhull* h, int a, int b, int c) {
     const long long u[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]}, w[3] = {C[0] - A[0], C[1] - A[1], C[2] - A[2]};
     f->ni[0] = u[1] * w[2] - u[2] * w[1], f->ni[1] = u[2] * w[0] - u[0] * w[2], f->ni[2] = u[0] * w[1] - u[1] * w[0];
     f->di = (__int128)f->ni[0] * A[0] + (__int128)f->ni[1] * A[1] + (__int128)f->ni[2] * A[2];
-    double e1[3], e2[3], nn[3];
-    sub3(h->P + 3 * b, h->P + 3 * a, e1);
-    sub3(h->P + 3 * c, h->P + 3 * a, e2);
-    cross3(e1, e2, nn);
-    double l = sqrt(dot3(nn, nn));
-    if (!(l > 0)) { // a sliver too thin for doubles: the grid normal's direction
-        for (int k = 0; k < 3; ++k) nn[k] = (double)f->ni[k];
-        l = sqrt(dot3(nn, nn));
-    }
+    // The plane in metres is the grid plane's, not one through the three
+    // points as given: on a sliver (three points almost on a line) the
+    // snapping tilts the plane a lot, and a plane through the given points
+    // would disagree with the exact decisions (a point 8e-5 of the size
+    // above it, found by a stress test). Through the grid point of a, every
+    // point is within half a grid diagonal (1.3e-8 of the size) of the
+    // exact hull's planes.
+    double nn[3], ga[3];
+    for (int k = 0; k < 3; ++k) nn[k] = (double)f->ni[k], ga[k] = h->lo[k] + (double)A[k] * h->step;
+    const double l = sqrt(dot3(nn, nn));
+    if (!(l > 0)) return -1; // cannot happen: the caller's faces are not degenerate on the grid
     for (int k = 0; k < 3; ++k) f->n[k] = nn[k] / l;
-    f->d = dot3(f->n, h->P + 3 * a);
+    f->d = dot3(f->n, ga);
     f->head = -1;
     f->alive = 1;
     return h->nf++;
@@ -231,6 +234,7 @@ static int quickhull(qhull* h, const int i4[4], int max_faces) {
         (arr)[(n)++] = (x);                                                    \
     } while (0)
     int again = 1;
+rescan:
     while (again) {
     again = 0;
     for (int cur = 0; cur < h->nf; ++cur) {
@@ -354,6 +358,27 @@ static int quickhull(qhull* h, const int i4[4], int max_faces) {
         if (alive > max_faces) { rc = -2; goto done; }
     }
     }
+    // Points were dropped by their distance to the planes of the hull so far;
+    // a point just off a sharp edge may be farther from a plane the hull
+    // gets later. Every point is checked against the final planes; one more
+    // than tol above a face goes back to it, and the scan runs again. The
+    // hull only grows, so this ends. O(n f): 0.1 s for 100,000 points and
+    // 1,400 faces.
+    for (int q = 0; q < h->n; ++q) {
+        if (q % 4096 == 4095 && mesh_cancelled()) { rc = -3; goto done; }
+        int best = -1;
+        double bd = h->tol;
+        for (int f = 0; f < h->nf; ++f)
+            if (h->F[f].alive) {
+                const double d = dist(h, &h->F[f], q);
+                if (d > bd && above(h, &h->F[f], q)) bd = d, best = f;
+            }
+        if (best >= 0) {
+            h->next[q] = h->F[best].head, h->F[best].head = q;
+            again = 1;
+        }
+    }
+    if (again) goto rescan;
 #undef PUSH
 done:
     free(stack);
@@ -383,7 +408,7 @@ int mesh_hull_build(const double* P, int n, mesh_hull* h) {
     const double size = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
     if (!(size > 0)) return -1;
     const double step = size / GRID_STEPS;
-    qhull q = {.P = P, .n = n};
+    qhull q = {.P = P, .n = n, .lo = {lo[0], lo[1], lo[2]}, .step = step};
     q.Q = malloc((size_t)3 * n * sizeof *q.Q);
     q.next = malloc((size_t)n * sizeof *q.next);
     q.cap = 64;
