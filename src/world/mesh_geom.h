@@ -110,7 +110,7 @@ typedef struct mesh_hull {
 /// than this above the hull of the others is left out (float coordinates of
 /// a flat face scatter by 6e-8 of the size); multiplied by sqrt(10) while the
 /// hull has more than MESH_HULL_MAX_FACES faces, up to 1e-2 (100,000 points
-/// on a sphere then have about 1,370 faces at 3.2e-3 of the size, in 1.6 s).
+/// on a sphere then have about 1,370 faces at 3.2e-3 of the size, in about 2 s).
 #define MESH_HULL_TOL_REL 1e-7
 
 /// Hull of the points (quickhull on exact predicates, mesh_geom.c). Returns
