@@ -453,6 +453,11 @@ int cmd_run(int argc, char** argv) {
             fprintf(stderr, "cranesim run: interrupted (%s) at t = %.6g s; %ld rows kept in %s\n",
                     app_signal_name(app_signal_caught()), sink.t_last, sink.rows, out);
         code = 128 + app_signal_caught();
+    } else if (app_signal_caught() && res.status == SIM_REFUSED) {
+        // Interrupted while setting up (a long mesh load): nothing written.
+        fprintf(stderr, "cranesim run: interrupted (%s) while setting up; nothing written\n",
+                app_signal_name(app_signal_caught()));
+        code = 128 + app_signal_caught();
     } else if (res.status == SIM_FAILED) {
         fprintf(stderr, "cranesim run: %s; %ld rows up to t = %.6g s kept in %s\n", res.message, res.rows,
                 res.t_end, out);

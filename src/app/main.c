@@ -67,6 +67,9 @@ int main(int argc, char** argv) {
     // reads OBJ and STL itself).
     mesh_set_importer(render_mesh_import);
 #endif
+    // A long mesh load (parsing, a loose body's hull) stops at SIGINT or
+    // SIGTERM while a command catches them, as a run's steps do.
+    mesh_set_cancel(app_signal_caught);
     if (argc < 2) {
         usage(stderr);
         return EXIT_USAGE;

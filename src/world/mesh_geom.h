@@ -21,6 +21,11 @@ extern "C" {
 /// costs ODE well under a millisecond per contact query; a million would cost
 /// memory and load time for no gain in a crane yard).
 #define MESH_MAX_TRIANGLES 200000
+/// Largest mesh file [bytes] (256 MiB): an ASCII STL of MESH_MAX_TRIANGLES
+/// facets takes about 60 MB, an OBJ with normals and texture coordinates
+/// less. Checked, with the file being a regular file, before anything reads
+/// it (a link to /dev/zero would otherwise be read for ever).
+#define MESH_MAX_FILE_BYTES (256L << 20)
 
 typedef struct mesh_tri {
     int nv, nt;
@@ -35,6 +40,15 @@ typedef struct mesh_tri {
 /// (no file name; the caller adds it).
 typedef int (*mesh_import_fn)(const char* path, mesh_tri* out, char* err, size_t errsz);
 void mesh_set_importer(mesh_import_fn fn);
+
+/// A function the long mesh loops (parsing, the hull) poll: when it returns
+/// non-zero they stop and the load fails with "interrupted" (mesh_hull_build
+/// returns -3). NULL (the default): never. The application installs its
+/// SIGINT/SIGTERM flag, so Ctrl-C stops a load within milliseconds.
+typedef int (*mesh_cancel_fn)(void);
+void mesh_set_cancel(mesh_cancel_fn fn);
+/// Non-zero when the installed function says stop.
+int mesh_cancelled(void);
 
 /// Load path (OBJ/STL here, others through the importer), scale [m/unit],
 /// up 1 = y-up (mesh y becomes z, mesh z becomes -y), 2 = z-up. Returns 0, or
@@ -84,10 +98,25 @@ typedef struct mesh_hull {
     double* v;      ///< 3 nv [m]
     int* f;         ///< 3 nf
     double* plane;  ///< 4 nf: nx, ny, nz, d
+    double tol;     ///< points at most this far outside may be left out [m]
 } mesh_hull;
 
-/// Hull of the mesh's vertices (incremental). Returns 0, or -1 if the points
-/// are flat (no volume) or memory ran out.
+/// Most faces a loose body's hull may have. ODE's convex colliders test
+/// every face and edge pair (a 1,000-face hull against a box is about 1e7
+/// operations a contact query); a finely tessellated round load is kept under
+/// it by the tolerance below, a hull that needs more is refused.
+#define MESH_HULL_MAX_FACES 2000
+/// The hull's first tolerance, relative to the points' extent: a point less
+/// than this above the hull of the others is left out (float coordinates of
+/// a flat face scatter by 6e-8 of the size); multiplied by sqrt(10) while the
+/// hull has more than MESH_HULL_MAX_FACES faces, up to 1e-2 (100,000 points
+/// on a sphere then have about 1,370 faces at 3.2e-3 of the size, in about 2 s).
+#define MESH_HULL_TOL_REL 1e-7
+
+/// Hull of the points (quickhull on exact predicates, mesh_geom.c). Returns
+/// 0; -1 if the points are flat (no volume), not finite or memory ran out;
+/// -2 if even at 1e-2 of the extent the hull has more than
+/// MESH_HULL_MAX_FACES faces; -3 if mesh_cancelled() said stop.
 int mesh_hull_build(const double* pts, int n, mesh_hull* h);
 void mesh_hull_free(mesh_hull* h);
 

@@ -3,6 +3,7 @@
 #include "mesh_geom.h"
 
 #include <ctype.h>
+#include <errno.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdint.h>
@@ -15,6 +16,10 @@
 static mesh_import_fn g_importer;
 
 void mesh_set_importer(mesh_import_fn fn) { g_importer = fn; }
+
+static mesh_cancel_fn g_cancel;
+void mesh_set_cancel(mesh_cancel_fn fn) { g_cancel = fn; }
+int mesh_cancelled(void) { return g_cancel && g_cancel(); }
 
 void mesh_free(mesh_tri* m) {
     if (!m) return;
@@ -66,7 +71,7 @@ static int read_obj(FILE* f, mesh_tri* m, char* err, size_t errsz) {
     char line[4096];
     int vcap = 0, tcap = 0, lineno = 0;
     while (fgets(line, sizeof line, f)) {
-        ++lineno;
+        if (++lineno % 4096 == 0 && mesh_cancelled()) goto cancelled;
         char* s = line;
         while (*s == ' ' || *s == '\t') ++s;
         if (s[0] == 'v' && (s[1] == ' ' || s[1] == '\t')) {
@@ -111,6 +116,9 @@ static int read_obj(FILE* f, mesh_tri* m, char* err, size_t errsz) {
         }
     }
     return 0;
+cancelled:
+    snprintf(err, errsz, "interrupted");
+    return -1;
 too_big:
     snprintf(err, errsz, "more than %d vertices (the limit is %d triangles; docs/ode_world.md, \"CAD meshes\")",
              MESH_MAX_VERTICES, MESH_MAX_TRIANGLES);
@@ -127,70 +135,211 @@ static float rd_f32(const unsigned char* p) {
     return x;
 }
 
-// STL, binary (80-byte header, count, 50 bytes a facet) or ASCII ("solid",
-// "vertex x y z" lines). Binary is recognised by its exact size, since some
-// exporters start binary headers with "solid" too.
-static int read_stl(FILE* f, mesh_tri* m, char* err, size_t errsz) {
-    if (fseek(f, 0, SEEK_END)) goto unreadable;
-    long size = ftell(f);
-    rewind(f);
+// Binary STL: 80-byte header, a little-endian facet count, 50 bytes a facet
+// (normal, three corners as float32, a 2-byte attribute). The count and the
+// file's size must agree: a file cut short or a count that is wrong would
+// otherwise load as a partial mesh (or as none) without a word.
+static int read_stl_binary(FILE* f, long long size, mesh_tri* m, char* err, size_t errsz) {
     unsigned char head[84];
+    if (size < 84 || fread(head, 1, 84, f) != 84) {
+        snprintf(err, errsz, "binary STL: %lld bytes, shorter than its 84-byte header (truncated)", size);
+        return -1;
+    }
+    const uint32_t n =
+        (uint32_t)head[80] | (uint32_t)head[81] << 8 | (uint32_t)head[82] << 16 | (uint32_t)head[83] << 24;
+    const unsigned long long want = 84ull + 50ull * n;
+    const long long whole = (size - 84) / 50, rest = (size - 84) % 50;
+    if ((unsigned long long)size < want) {
+        snprintf(err, errsz,
+                 "binary STL truncated: the header says %u facets (%llu bytes) but the file has %lld bytes "
+                 "(%lld whole facets%s)",
+                 n, want, size, whole, rest ? " and a part of one" : "");
+        return -1;
+    }
+    if ((unsigned long long)size > want) {
+        snprintf(err, errsz,
+                 "binary STL: the header says %u facets (%llu bytes) but the file has %lld bytes (%lld more than "
+                 "the facets need)",
+                 n, want, size, (long long)((unsigned long long)size - want));
+        return -1;
+    }
+    if (n > MESH_MAX_TRIANGLES) {
+        snprintf(err, errsz, "more than %d triangles (%u; docs/ode_world.md, \"CAD meshes\")", MESH_MAX_TRIANGLES, n);
+        return -1;
+    }
     int vcap = 0, tcap = 0;
-    if (size >= 84 && fread(head, 1, 84, f) == 84) {
-        uint32_t n = (uint32_t)head[80] | (uint32_t)head[81] << 8 | (uint32_t)head[82] << 16 | (uint32_t)head[83] << 24;
-        if ((uint64_t)size == 84 + 50ull * n) {
-            if (n > MESH_MAX_TRIANGLES) {
-                snprintf(err, errsz, "more than %d triangles (%u; docs/ode_world.md, \"CAD meshes\")",
-                         MESH_MAX_TRIANGLES, n);
+    unsigned char rec[50];
+    for (uint32_t t = 0; t < n; ++t) {
+        if (t % 4096 == 4095 && mesh_cancelled()) {
+            snprintf(err, errsz, "interrupted");
+            return -1;
+        }
+        if (fread(rec, 1, 50, f) != 50) {
+            snprintf(err, errsz, "binary STL: cannot read facet %u of %u (the file changed or is unreadable)", t + 1,
+                     n);
+            return -1;
+        }
+        int id[3];
+        for (int k = 0; k < 3; ++k) {
+            float x = rd_f32(rec + 12 + 12 * k), y = rd_f32(rec + 16 + 12 * k), z = rd_f32(rec + 20 + 12 * k);
+            if (!isfinite(x) || !isfinite(y) || !isfinite(z)) {
+                snprintf(err, errsz, "facet %u: vertex coordinates must be finite", t + 1);
                 return -1;
             }
-            unsigned char rec[50];
-            for (uint32_t t = 0; t < n; ++t) {
-                if (fread(rec, 1, 50, f) != 50) goto unreadable;
-                int id[3];
-                for (int k = 0; k < 3; ++k) {
-                    float x = rd_f32(rec + 12 + 12 * k), y = rd_f32(rec + 16 + 12 * k), z = rd_f32(rec + 20 + 12 * k);
-                    if (!isfinite(x) || !isfinite(y) || !isfinite(z)) {
-                        snprintf(err, errsz, "facet %u: vertex coordinates must be finite", t);
-                        return -1;
-                    }
-                    if ((id[k] = add_vertex(m, &vcap, x, y, z)) < 0) goto oom;
-                }
-                if (add_tri(m, &tcap, id[0], id[1], id[2])) goto oom;
-            }
-            return 0;
+            if ((id[k] = add_vertex(m, &vcap, x, y, z)) < 0) goto oom;
         }
-    }
-    rewind(f);
-    char line[1024];
-    int id[3], k = 0;
-    while (fgets(line, sizeof line, f)) {
-        char* s = line;
-        while (isspace((unsigned char)*s)) ++s;
-        if (strncasecmp(s, "vertex", 6)) continue;
-        double x, y, z;
-        if (sscanf(s + 6, "%lf %lf %lf", &x, &y, &z) != 3 || !isfinite(x) || !isfinite(y) || !isfinite(z) ||
-            fabs(x) > 1e30 || fabs(y) > 1e30 || fabs(z) > 1e30) {
-            snprintf(err, errsz, "a vertex line needs three finite numbers");
-            return -1;
-        }
-        if ((id[k] = add_vertex(m, &vcap, (float)x, (float)y, (float)z)) == -2) {
-            snprintf(err, errsz, "more than %d triangles (docs/ode_world.md, \"CAD meshes\")", MESH_MAX_TRIANGLES);
-            return -1;
-        }
-        if (id[k++] < 0) goto oom;
-        if (k == 3) {
-            if (add_tri(m, &tcap, id[0], id[1], id[2])) goto oom;
-            k = 0;
-        }
+        if (add_tri(m, &tcap, id[0], id[1], id[2])) goto oom;
     }
     return 0;
-unreadable:
-    snprintf(err, errsz, "cannot read the file");
+oom:
+    snprintf(err, errsz, "out of memory");
+    return -1;
+}
+
+// ASCII STL tokens: whitespace-separated words, with the line each starts on.
+typedef struct stl_lex {
+    FILE* f;
+    int line, c;
+    char tok[256];
+} stl_lex;
+
+// The next word into lx->tok (cut at 255 bytes); 0 at the end of the file.
+static int stl_next(stl_lex* lx) {
+    int c = lx->c;
+    while (c != EOF && isspace(c)) {
+        if (c == '\n') ++lx->line;
+        c = getc(lx->f);
+    }
+    if (c == EOF) {
+        lx->c = EOF;
+        lx->tok[0] = 0;
+        return 0;
+    }
+    size_t n = 0;
+    while (c != EOF && !isspace(c)) {
+        if (n + 1 < sizeof lx->tok) lx->tok[n++] = (char)c;
+        c = getc(lx->f);
+    }
+    lx->tok[n] = 0;
+    lx->c = c;
+    return 1;
+}
+
+// The rest of the current line skipped (the solid's name, which may hold spaces).
+static void stl_skip_line(stl_lex* lx) {
+    int c = lx->c;
+    while (c != EOF && c != '\n') c = getc(lx->f);
+    lx->c = c;
+}
+
+// ASCII STL, the whole grammar: "solid name", then facets ("facet normal
+// nx ny nz", "outer loop", three "vertex x y z", "endloop", "endfacet"), then
+// "endsolid". Anything else, or the end of the file before "endsolid", is
+// refused with the line and the facet: a file cut short must not pass as a
+// smaller mesh.
+static int read_stl_ascii(FILE* f, mesh_tri* m, char* err, size_t errsz) {
+    stl_lex lx = {.f = f, .line = 1, .c = ' '};
+    int vcap = 0, tcap = 0, facet = 0;
+    if (!stl_next(&lx) || strcasecmp(lx.tok, "solid")) {
+        snprintf(err, errsz, "ASCII STL: line %d: expected \"solid\"", lx.line);
+        return -1;
+    }
+    stl_skip_line(&lx);
+    const char* want;
+    for (;;) {
+        if (!stl_next(&lx)) {
+            snprintf(err, errsz, "ASCII STL truncated: the file ends at line %d after %d facets without \"endsolid\"",
+                     lx.line, facet);
+            return -1;
+        }
+        if (!strcasecmp(lx.tok, "endsolid")) break;
+        if (strcasecmp(lx.tok, "facet")) {
+            snprintf(err, errsz, "ASCII STL: line %d: expected \"facet\" or \"endsolid\", found \"%s\"", lx.line,
+                     lx.tok);
+            return -1;
+        }
+        if (++facet % 1024 == 0 && mesh_cancelled()) {
+            snprintf(err, errsz, "interrupted");
+            return -1;
+        }
+        // "normal nx ny nz": the normal is not used (the winding gives it).
+        static const char* const seq[] = {"normal", NULL, NULL, NULL, "outer", "loop"};
+        for (int i = 0; i < 6; ++i) {
+            if (!stl_next(&lx)) goto cut;
+            if (seq[i] && strcasecmp(lx.tok, seq[i])) {
+                want = seq[i];
+                goto bad;
+            }
+        }
+        int id[3];
+        for (int k = 0; k < 3; ++k) {
+            if (!stl_next(&lx)) goto cut;
+            if (strcasecmp(lx.tok, "vertex")) {
+                want = "vertex";
+                goto bad;
+            }
+            double x[3];
+            for (int j = 0; j < 3; ++j) {
+                if (!stl_next(&lx)) goto cut;
+                char* end;
+                x[j] = strtod(lx.tok, &end);
+                if (end == lx.tok || *end || !isfinite(x[j]) || fabs(x[j]) > 1e30) {
+                    snprintf(err, errsz, "ASCII STL: line %d (facet %d): a vertex needs three finite numbers, found "
+                             "\"%s\"", lx.line, facet, lx.tok);
+                    return -1;
+                }
+            }
+            id[k] = add_vertex(m, &vcap, (float)x[0], (float)x[1], (float)x[2]);
+            if (id[k] == -2) {
+                snprintf(err, errsz, "more than %d triangles (docs/ode_world.md, \"CAD meshes\")", MESH_MAX_TRIANGLES);
+                return -1;
+            }
+            if (id[k] < 0) goto oom;
+        }
+        static const char* const tail[] = {"endloop", "endfacet"};
+        for (int i = 0; i < 2; ++i) {
+            if (!stl_next(&lx)) goto cut;
+            if (strcasecmp(lx.tok, tail[i])) {
+                want = tail[i];
+                goto bad;
+            }
+        }
+        if (add_tri(m, &tcap, id[0], id[1], id[2])) goto oom;
+    }
+    return 0;
+cut:
+    snprintf(err, errsz, "ASCII STL truncated: the file ends at line %d inside facet %d", lx.line, facet);
+    return -1;
+bad:
+    snprintf(err, errsz, "ASCII STL: line %d (facet %d): expected \"%s\", found \"%s\"", lx.line, facet, want,
+             lx.tok);
     return -1;
 oom:
     snprintf(err, errsz, "out of memory");
     return -1;
+}
+
+// STL, binary or ASCII. A binary file whose size matches its facet count is
+// binary whatever its header says (some exporters start binary headers with
+// "solid" too); else a file that starts with "solid" and whose first bytes
+// are text is ASCII; anything else is binary, and its size is checked
+// against its count there.
+static int read_stl(FILE* f, long long size, mesh_tri* m, char* err, size_t errsz) {
+    unsigned char head[512];
+    const size_t got = fread(head, 1, sizeof head, f);
+    rewind(f);
+    if (got >= 84) {
+        const uint32_t n =
+            (uint32_t)head[80] | (uint32_t)head[81] << 8 | (uint32_t)head[82] << 16 | (uint32_t)head[83] << 24;
+        if ((unsigned long long)size == 84ull + 50ull * n) return read_stl_binary(f, size, m, err, errsz);
+    }
+    size_t i = 0;
+    while (i < got && isspace(head[i])) ++i;
+    int text = got - i >= 5 && !strncasecmp((const char*)head + i, "solid", 5);
+    for (size_t j = 0; j < got && text; ++j)
+        if ((head[j] < 0x20 && !isspace(head[j])) || head[j] == 0x7f) text = 0; // UTF-8 names pass
+    if (text) return read_stl_ascii(f, m, err, errsz);
+    return read_stl_binary(f, size, m, err, errsz);
 }
 
 // Weld vertices with identical coordinates (after conversion), so shared
@@ -272,24 +421,72 @@ static void drop_degenerate(mesh_tri* m) {
     m->nt = n;
 }
 
+// Keep only the vertices some triangle uses, in their order. A vertex no
+// triangle names is not part of the surface: it would widen the bounds and
+// the convex hull of a loose body (a closed cube with 505 stray vertices had
+// a hull of 79,151 faces, item 23 of issue 25) without being in the solid.
+static int drop_unused(mesh_tri* m) {
+    int* map = malloc((size_t)(m->nv ? m->nv : 1) * sizeof *map);
+    if (!map) return -1;
+    for (int i = 0; i < m->nv; ++i) map[i] = -1;
+    for (int i = 0; i < 3 * m->nt; ++i) map[m->idx[i]] = 0;
+    int nu = 0;
+    for (int i = 0; i < m->nv; ++i)
+        if (map[i] == 0) {
+            memmove(m->v + 3 * nu, m->v + 3 * i, 3 * sizeof(float));
+            map[i] = nu++;
+        }
+    for (int i = 0; i < 3 * m->nt; ++i) m->idx[i] = map[m->idx[i]];
+    m->nv = nu;
+    free(map);
+    return 0;
+}
+
 static const char* ext_of(const char* path) {
     const char* slash = strrchr(path, '/');
     const char* dot = strrchr(path, '.');
     return dot && (!slash || dot > slash) ? dot : "";
 }
 
+// A mesh file must be a regular file (a directory, a device such as
+// /dev/zero, a pipe or a socket is refused before it is opened: reading one
+// may never end) of at most MESH_MAX_FILE_BYTES. Returns 0 with its status
+// in st, or -1 with the problem in err.
+static int check_file(const char* path, struct stat* st, char* err, size_t errsz) {
+    if (stat(path, st)) {
+        snprintf(err, errsz, "cannot open the mesh file (%s)", strerror(errno));
+        return -1;
+    }
+    if (S_ISDIR(st->st_mode)) {
+        snprintf(err, errsz, "is a directory, not a mesh file");
+        return -1;
+    }
+    if (!S_ISREG(st->st_mode)) {
+        snprintf(err, errsz, "is not a regular file (a device, pipe or socket); a mesh must be a file");
+        return -1;
+    }
+    if (st->st_size > MESH_MAX_FILE_BYTES) {
+        snprintf(err, errsz, "the file is %.1f MiB, more than the %d MiB a mesh file may have (docs/ode_world.md, "
+                 "\"CAD meshes\")", (double)st->st_size / (1 << 20), (int)(MESH_MAX_FILE_BYTES >> 20));
+        return -1;
+    }
+    return 0;
+}
+
 static int load_uncached(const char* path, double scale, int up, mesh_tri* out, char* err, size_t errsz) {
     memset(out, 0, sizeof *out);
     const char* ext = ext_of(path);
     const int obj = !strcasecmp(ext, ".obj"), stl = !strcasecmp(ext, ".stl");
+    struct stat st;
+    if (check_file(path, &st, err, errsz)) return -1;
     FILE* f = fopen(path, "rb");
     if (!f) {
-        snprintf(err, errsz, "cannot open the mesh file");
+        snprintf(err, errsz, "cannot open the mesh file (%s)", strerror(errno));
         return -1;
     }
     int rc;
     if (obj || stl) {
-        rc = obj ? read_obj(f, out, err, errsz) : read_stl(f, out, err, errsz);
+        rc = obj ? read_obj(f, out, err, errsz) : read_stl(f, (long long)st.st_size, out, err, errsz);
         fclose(f);
     } else {
         fclose(f);
@@ -331,6 +528,11 @@ static int load_uncached(const char* path, double scale, int up, mesh_tri* out, 
     if (out->nt == 0) {
         snprintf(err, errsz, "all %d triangles are degenerate (zero area)", out->dropped);
         mesh_free(out);
+        return -1;
+    }
+    if (drop_unused(out)) {
+        mesh_free(out);
+        snprintf(err, errsz, "out of memory");
         return -1;
     }
     return 0;
@@ -400,7 +602,9 @@ unsigned long long mesh_cache_parses(void) {
 }
 
 // FNV-1a over the file's bytes, 8 at a time (as 64-bit words) for speed;
-// 0 if unreadable (then the file is not cached).
+// 0 if unreadable or longer than MESH_MAX_FILE_BYTES (then the file is not
+// cached; the loader says what is wrong). Called after check_file, but the
+// file may have grown since: it reads no more than the limit either way.
 static unsigned long long file_hash(const char* path) {
     FILE* f = fopen(path, "rb");
     if (!f) return 0;
@@ -408,7 +612,12 @@ static unsigned long long file_hash(const char* path) {
     unsigned long long h = 14695981039346656037ULL;
     unsigned char buf[65536];
     size_t n;
+    long long total = 0;
     while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
+        if ((total += (long long)n) > MESH_MAX_FILE_BYTES) {
+            fclose(f);
+            return 0;
+        }
         size_t i = 0;
         for (; i + 8 <= n; i += 8) {
             uint64_t w;
@@ -422,14 +631,16 @@ static unsigned long long file_hash(const char* path) {
     return bad ? 0 : (h ? h : 1);
 }
 
-// The cache key of a file as it is now: 0, or -1 when it cannot be read.
+// The cache key of a file as it is now: 0, or -1 when it is not a regular
+// file within the size limit or cannot be read.
 typedef struct {
     long long mt, sz;
     unsigned long long hash;
 } file_key;
 static int key_of(const char* path, file_key* k) {
     struct stat st;
-    k->hash = stat(path, &st) ? 0 : file_hash(path);
+    char why[256];
+    k->hash = check_file(path, &st, why, sizeof why) ? 0 : file_hash(path);
     if (!k->hash) return -1;
     k->mt = (long long)st.st_mtim.tv_sec * 1000000000LL + st.st_mtim.tv_nsec, k->sz = (long long)st.st_size;
     return 0;
@@ -450,6 +661,8 @@ int mesh_load_flat(const char* path, double scale, int up, mesh_tri* out, char* 
     // The merge costs about half a parse on the 51,104-triangle wall (0.2 G
     // instructions) and a world is built once per run: a sweep or the bench
     // building it again gets the merged mesh from the cache.
+    struct stat st;
+    if (check_file(path, &st, err, errsz)) return -1;
     file_key k;
     if (!key_of(path, &k)) {
         pthread_mutex_lock(&g_cache_mu);
@@ -479,6 +692,8 @@ int mesh_load_flat(const char* path, double scale, int up, mesh_tri* out, char* 
 }
 
 int mesh_load(const char* path, double scale, int up, mesh_tri* out, char* err, size_t errsz) {
+    struct stat st;
+    if (check_file(path, &st, err, errsz)) return -1;
     file_key k;
     if (key_of(path, &k)) return load_uncached(path, scale, up, out, err, errsz); // gives the error
     const long long mt = k.mt, sz = k.sz;

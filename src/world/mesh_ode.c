@@ -106,6 +106,17 @@ dGeomID ow_mesh_hull(ode_world* w, dSpaceID space, const world_obj_mesh* om, dou
     mesh_hull h;
     int rc = mesh_hull_build(p, nv, &h);
     free(p);
+    if (rc == -3) {
+        snprintf(err, errsz, "%s: interrupted while building its convex hull", coll_path(om));
+        return NULL;
+    }
+    if (rc == -2) {
+        snprintf(err, errsz,
+                 "%s: the convex hull of its %d vertices needs more than %d faces even within 1 %% of its size; give "
+                 "a simpler \"collision\" mesh",
+                 coll_path(om), nv, MESH_HULL_MAX_FACES);
+        return NULL;
+    }
     if (rc) {
         snprintf(err, errsz, "%s: the mesh is flat: its convex hull has no volume", coll_path(om));
         return NULL;

@@ -15,7 +15,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdint.h>
 #include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -546,6 +549,198 @@ static void test_boom_mesh_wall(void) {
     boom_mesh_wall(path, nt);
 }
 
+// ---- the convex hull bounded (issue 25, item 23) ----
+
+static double now_s(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// The hull as a mesh: closed and consistently wound (every edge twice, once
+// each way), Euler V - E + F = 2, every point inside or within the hull's
+// tolerance of every plane; its volume returned.
+static double check_hull(const mesh_hull* h, const double* P, int n) {
+    mesh_tri t = {.nv = h->nv, .nt = h->nf};
+    t.v = malloc((size_t)3 * h->nv * sizeof *t.v);
+    t.idx = malloc((size_t)3 * h->nf * sizeof *t.idx);
+    for (int i = 0; i < 3 * h->nv; ++i) t.v[i] = (float)h->v[i];
+    memcpy(t.idx, h->f, (size_t)3 * h->nf * sizeof *t.idx);
+    CHECK(mesh_open_edges(&t) == 0, "the hull is closed and consistently wound");
+    const int E = 3 * h->nf / 2;
+    CHECK(3 * h->nf % 2 == 0 && h->nv - E + h->nf == 2, "Euler: V %d - E %d + F %d = %d", h->nv, E, h->nf,
+          h->nv - E + h->nf);
+    double worst = -INFINITY;
+    for (int i = 0; i < n; ++i) {
+        double w = -INFINITY;
+        for (int f = 0; f < h->nf; ++f) {
+            const double* pl = h->plane + 4 * f;
+            const double s = pl[0] * P[3 * i] + pl[1] * P[3 * i + 1] + pl[2] * P[3 * i + 2] - pl[3];
+            if (s > w) w = s;
+        }
+        if (w > worst) worst = w;
+    }
+    CHECK(worst <= h->tol + 1e-12, "a point %g m outside the hull (tolerance %g m)", worst, h->tol);
+    double V = 0, c[3], I[9];
+    CHECK(mesh_mass_props(&t, &V, c, I) == 0, "hull volume");
+    mesh_free(&t);
+    return V;
+}
+
+static void test_hull_bounded(void) {
+    // 505 points: the corners of a 2 x 1 x 0.5 m box and 497 points on its
+    // faces with float rounding (6e-8 of the size off the face, as a finely
+    // cut CAD face in float coordinates): the earlier hull built 79,151
+    // faces from such a cloud in 13.6 s (and more from 200 such points).
+    enum { N = 505 };
+    static double P[3 * N];
+    const double L[3] = {2, 1, 0.5};
+    unsigned r = 12345;
+    for (int i = 0; i < N; ++i) {
+        double q[3];
+        if (i < 8) {
+            for (int k = 0; k < 3; ++k) q[k] = (i >> k & 1) ? L[k] / 2 : -L[k] / 2;
+        } else {
+            const int face = i % 6, ax = face / 2;
+            for (int k = 0; k < 3; ++k) {
+                r = r * 1103515245u + 12345u;
+                q[k] = ((r >> 8) / 16777216.0 - 0.5) * L[k];
+            }
+            r = r * 1103515245u + 12345u;
+            q[ax] = (face & 1 ? 0.5 : -0.5) * L[ax] + ((r >> 8) / 16777216.0 - 0.5) * 2.4e-7;
+        }
+        for (int k = 0; k < 3; ++k) P[3 * i + k] = (float)q[k];
+    }
+    mesh_hull h;
+    double t0 = now_s();
+    CHECK(mesh_hull_build(P, N, &h) == 0, "hull of 505 points");
+    const double dt = now_s() - t0;
+    CHECK(dt < 0.5, "505 points took %.3f s", dt);
+    CHECK(h.nf <= MESH_HULL_MAX_FACES && h.nf <= 2 * h.nv - 4, "%d faces for %d vertices", h.nf, h.nv);
+    // The box: 8 corners; the face points lie within the tolerance.
+    CHECK(h.nv == 8 && h.nf == 12, "the box's hull: %d vertices, %d faces (tolerance %g m)", h.nv, h.nf, h.tol);
+    CHECK_REL(check_hull(&h, P, N), L[0] * L[1] * L[2], 1e-6);
+    mesh_hull_free(&h);
+    // The same points with no noise, and exactly on the faces: the same box.
+    for (int i = 8; i < N; ++i) {
+        const int ax = i % 6 / 2;
+        P[3 * i + ax] = (i % 6 & 1 ? 0.5 : -0.5) * L[ax];
+    }
+    CHECK(mesh_hull_build(P, N, &h) == 0, "hull, exact faces");
+    CHECK_REL(check_hull(&h, P, N), L[0] * L[1] * L[2], 1e-9);
+    CHECK(h.nf <= 2 * h.nv - 4 && h.nf <= MESH_HULL_MAX_FACES, "%d faces for %d vertices", h.nf, h.nv);
+    mesh_hull_free(&h);
+    // 20,000 points on a sphere of radius 1 m (a Fibonacci lattice): every
+    // one is a hull vertex, 39,996 faces exactly; bounded to the cap by the
+    // tolerance, the volume between the ball's and that of the ball shrunk
+    // by the tolerance.
+    enum { M = 20000 };
+    static double S[3 * M];
+    for (int i = 0; i < M; ++i) {
+        const double z = 1 - (2.0 * i + 1) / M, rr = sqrt(1 - z * z), a = i * PI * (3 - sqrt(5.0));
+        S[3 * i] = rr * cos(a), S[3 * i + 1] = rr * sin(a), S[3 * i + 2] = z;
+    }
+    t0 = now_s();
+    CHECK(mesh_hull_build(S, M, &h) == 0, "hull of 20,000 sphere points");
+    const double ds = now_s() - t0;
+    CHECK(ds < 20.0, "20,000 points took %.3f s", ds); // 0.24 s in Release; 56.7 s before
+    CHECK(h.nf <= MESH_HULL_MAX_FACES, "%d faces", h.nf);
+    CHECK(h.tol <= 0.02 * 1.0001, "tolerance %g m", h.tol);
+    const double Vs = check_hull(&h, S, M), Vball = 4.0 / 3.0 * PI;
+    CHECK(Vs <= Vball && Vs >= 4.0 / 3.0 * PI * pow(1 - h.tol, 3) * 0.98, "sphere hull volume %g (ball %g)", Vs, Vball);
+    mesh_hull_free(&h);
+    // Four points on a plane: no volume.
+    const double flat[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    CHECK(mesh_hull_build(flat, 4, &h) == -1, "flat refused");
+}
+
+// Many clouds of the kinds that find faults: points on the faces of a unit
+// cube scattered by 1e-7 (float CAD faces), and very flat boxes (1e-3 by 1 by
+// 1e3 m). Each hull closed, Euler, at most 2n - 4 faces, and every point
+// within its tolerance of every plane (before the planes were taken from the
+// exact grid, a sliver's plane through the given points had a point 8e-5 of
+// the size above it, and 52 of 3,000 clouds one more than 1e-9 above).
+static void test_hull_stress(void) {
+    int clouds = 0, faults = 0, flat = 0;
+    static double P[3 * 3004];
+    for (int seed = 1; seed <= 2100; ++seed) {
+        if (seed % 9 != 4 && seed % 9 != 7) continue;
+        unsigned r = (unsigned)seed;
+#define RND() (r = r * 1103515245u + 12345u, (r >> 8) / 16777216.0)
+        const int n = 4 + (int)(RND() * (seed % 7 == 0 ? 3000 : 200));
+        for (int i = 0; i < n; ++i) {
+            double q[3];
+            for (int k = 0; k < 3; ++k) q[k] = RND();
+            if (seed % 9 == 4) {
+                const int ax = i % 6 / 2;
+                q[ax] = (i % 6 & 1) ? 1 : 0;
+                q[ax] += 1e-7 * (RND() - 0.5);
+                for (int k = 0; k < 3; ++k) q[k] = (float)q[k];
+            } else {
+                q[0] *= 1e-3, q[1] *= 1e3;
+            }
+            for (int k = 0; k < 3; ++k) P[3 * i + k] = q[k];
+        }
+#undef RND
+        mesh_hull h;
+        const int rc = mesh_hull_build(P, n, &h);
+        // A flat box is 1e-3 m thick on 1e3 m: at the flatness threshold
+        // (1e-6 of the size), so some are refused as flat; no cube may be.
+        if (rc == -1 && seed % 9 == 7) {
+            ++flat;
+            continue;
+        }
+        if (rc) {
+            ++faults;
+            fprintf(stderr, "  seed %d: hull %d\n", seed, rc);
+            continue;
+        }
+        ++clouds;
+        const int before = check_failures_;
+        (void)check_hull(&h, P, n);
+        if (h.nf > 2 * h.nv - 4) CHECK(0, "seed %d: %d faces for %d vertices", seed, h.nf, h.nv);
+        if (check_failures_ != before) {
+            ++faults;
+            fprintf(stderr, "  (seed %d, %d points)\n", seed, n);
+        }
+        mesh_hull_free(&h);
+    }
+    CHECK(faults == 0 && clouds > 300, "%d of %d clouds faulty (%d flat)", faults, clouds, flat);
+    printf("  %d clouds, %d flat boxes refused as flat\n", clouds, flat);
+}
+
+// Cancelling (the app's SIGINT flag): the hull and the parser stop at the
+// next poll. The flag is raised after a few polls, so the loops are under way.
+static int g_polls, g_stop_after;
+static int cancel_after(void) { return ++g_polls > g_stop_after; }
+
+static void test_cancel(void) {
+    enum { M = 20000 };
+    static double S[3 * M];
+    for (int i = 0; i < M; ++i) {
+        const double z = 1 - (2.0 * i + 1) / M, rr = sqrt(1 - z * z), a = i * PI * (3 - sqrt(5.0));
+        S[3 * i] = rr * cos(a), S[3 * i + 1] = rr * sin(a), S[3 * i + 2] = z;
+    }
+    mesh_hull h;
+    g_polls = 0, g_stop_after = 50;
+    mesh_set_cancel(cancel_after);
+    CHECK(mesh_hull_build(S, M, &h) == -3 && h.nf == 0, "hull cancelled");
+    CHECK(g_polls == 51, "stopped at the first poll after the flag (%d polls)", g_polls);
+    // A 20,000-triangle OBJ (a dense box) stops in its parse.
+    char path[600], err[256];
+    write_dense_box("cancel_box.obj", (const double[3]){0, 0, 0}, (const double[3]){1, 1, 1}, 0.02, 0, path,
+                    sizeof path);
+    mesh_cache_clear();
+    g_polls = 0, g_stop_after = 2;
+    mesh_tri t;
+    CHECK(mesh_load(path, 1, 2, &t, err, sizeof err) == -1 && !strcmp(err, "interrupted"), "parse cancelled: %s", err);
+    mesh_set_cancel(NULL);
+    CHECK(mesh_load(path, 1, 2, &t, err, sizeof err) == 0, "loads without the flag: %s", err);
+    mesh_free(&t);
+    CHECK(mesh_hull_build(S, M, &h) == 0, "hull without the flag");
+    mesh_hull_free(&h);
+}
+
 // ---- bad meshes ----
 
 static void expect_bad(const char* loads, const char* obst, const char* want1, const char* want2) {
@@ -627,6 +822,164 @@ static void test_bad_meshes(void) {
     expect_bad(NULL, buf, "obstacles[0].size", "not used with a mesh");
 }
 
+// ---- files that are not whole meshes (issue 25 items 24, 25, 11c, 16b) ----
+
+// The unit cube's 12 triangles, wound outward.
+static void cube_tris(float t[12][9]) {
+    static const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (int f = 0; f < 6; ++f)
+        for (int h = 0; h < 2; ++h) {
+            const int c[3] = {q[f][0], q[f][1 + h], q[f][2 + h]};
+            for (int k = 0; k < 3; ++k)
+                for (int a = 0; a < 3; ++a) t[2 * f + h][3 * k + a] = (float)(c[k] >> a & 1);
+        }
+}
+
+// A binary STL of `write` facets (the cube's, repeated) under a header that
+// says `count`; `extra` bytes of a further facet appended. Returns the size.
+static long write_stl_bin(const char* name, uint32_t count, int write, int extra, char* path, size_t n) {
+    snprintf(path, n, "%s/%s", g_dir, name);
+    FILE* f = fopen(path, "wb");
+    if (!f) return -1;
+    unsigned char head[84] = "solid but binary";
+    for (int k = 0; k < 4; ++k) head[80 + k] = (unsigned char)(count >> 8 * k);
+    fwrite(head, 1, 84, f);
+    float t[12][9];
+    cube_tris(t);
+    for (int i = 0; i < write; ++i) {
+        unsigned char rec[50] = {0};
+        for (int k = 0; k < 9; ++k) memcpy(rec + 12 + 4 * k, &t[i % 12][k], 4); // little-endian host (x86, arm)
+        fwrite(rec, 1, 50, f);
+    }
+    for (int i = 0; i < extra; ++i) fputc(0, f);
+    const long size = ftell(f);
+    fclose(f);
+    return size;
+}
+
+// An ASCII STL of the cube, cut in the middle of its cut_vertex-th "vertex"
+// line (1-based; whole if 0).
+static void write_stl_ascii(const char* name, int cut_vertex, char* path, size_t n) {
+    char text[8192] = "solid cube exported by a CAD program\n";
+    float t[12][9];
+    cube_tris(t);
+    for (int i = 0; i < 12; ++i) {
+        char fac[512];
+        snprintf(fac, sizeof fac,
+                 "  facet normal 0 0 0\n    outer loop\n      vertex %g %g %g\n      vertex %g %g %g\n"
+                 "      vertex %g %g %g\n    endloop\n  endfacet\n",
+                 t[i][0], t[i][1], t[i][2], t[i][3], t[i][4], t[i][5], t[i][6], t[i][7], t[i][8]);
+        strcat(text, fac);
+    }
+    strcat(text, "endsolid cube\n");
+    size_t keep = strlen(text);
+    const char* q = text;
+    for (int i = 0; i < cut_vertex && q; ++i) q = strstr(q + 1, "vertex");
+    if (cut_vertex > 0 && q) keep = (size_t)(q - text) + 10; // "vertex 0 0" of "vertex 0 0 1"
+    snprintf(path, n, "%s/%s", g_dir, name);
+    FILE* f = fopen(path, "wb");
+    if (!f) return;
+    fwrite(text, 1, keep, f);
+    fclose(f);
+}
+
+static void expect_load(const char* path, const char* want1, const char* want2) {
+    char err[512] = "";
+    mesh_tri t;
+    const int rc = mesh_load(path, 1, 2, &t, err, sizeof err);
+    CHECK(rc == -1, "%s refused (%s)", path, want1);
+    if (!rc) mesh_free(&t);
+    CHECK(strstr(err, want1) && (!want2 || strstr(err, want2)), "%s: message: %s", path, err);
+    CHECK(!strstr(err, "no triangles"), "%s: says no triangles: %s", path, err);
+}
+
+static void test_bad_files(void) {
+    char path[600], buf[1400];
+    mesh_tri t;
+    char err[512];
+    // The whole files load: 12 triangles, 8 vertices.
+    write_stl_bin("cube_bin.stl", 12, 12, 0, path, sizeof path);
+    CHECK(mesh_load(path, 1, 2, &t, err, sizeof err) == 0 && t.nt == 12 && t.nv == 8, "binary cube: %s", err);
+    mesh_free(&t);
+    write_stl_ascii("cube_ascii.stl", 0, path, sizeof path);
+    CHECK(mesh_load(path, 1, 2, &t, err, sizeof err) == 0 && t.nt == 12 && t.nv == 8, "ASCII cube: %s", err);
+    if (!err[0]) mesh_free(&t);
+    // Item 25: 10 whole facets under a header saying 1000, or 0xffffffff.
+    write_stl_bin("count1000.stl", 1000, 10, 0, path, sizeof path);
+    expect_load(path, "binary STL truncated: the header says 1000 facets (50084 bytes)", "584 bytes (10 whole facets)");
+    write_stl_bin("countmax.stl", 0xffffffffu, 10, 0, path, sizeof path);
+    expect_load(path, "the header says 4294967295 facets", "(10 whole facets)");
+    // A count of 0 with facets after it.
+    write_stl_bin("count0.stl", 0, 10, 0, path, sizeof path);
+    expect_load(path, "the header says 0 facets (84 bytes) but the file has 584 bytes", "500 more");
+    // Item 16b: cut short, 12 whole triangles and part of the 13th of 20.
+    write_stl_bin("cut.stl", 20, 12, 17, path, sizeof path);
+    expect_load(path, "binary STL truncated: the header says 20 facets (1084 bytes)",
+                "the file has 701 bytes (12 whole facets and a part of one)");
+    // Items 25 and 11c: an ASCII STL cut inside a facet (in the 5th facet's
+    // second vertex line), and one cut between facets (no endsolid).
+    write_stl_ascii("cut_ascii.stl", 14, path, sizeof path);
+    expect_load(path, "ASCII STL truncated: the file ends at line 33 inside facet 5", NULL);
+    snprintf(path, sizeof path, "%s/noend_ascii.stl", g_dir);
+    {
+        FILE* f = fopen(path, "wb");
+        if (f) fputs("solid cube\n", f), fclose(f);
+        f = fopen(path, "ab");
+        if (f) {
+            fputs("  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n      vertex 0 1 0\n"
+                  "    endloop\n  endfacet\n",
+                  f);
+            fclose(f);
+        }
+    }
+    expect_load(path, "ASCII STL truncated: the file ends at line 9 after 1 facets without \"endsolid\"", NULL);
+    // A facet with a fourth vertex, and a word that is not a number.
+    snprintf(path, sizeof path, "%s/quad_ascii.stl", g_dir);
+    FILE* f = fopen(path, "wb");
+    if (f) {
+        fputs("solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n"
+              "endloop\nendfacet\nendsolid q\n", f);
+        fclose(f);
+    }
+    expect_load(path, "ASCII STL: line 7 (facet 1): expected \"endloop\", found \"vertex\"", NULL);
+    // Item 25: a directory given as the mesh.
+    snprintf(path, sizeof path, "%s/adir.stl", g_dir);
+    mkdir(path, 0755);
+    expect_load(path, "is a directory", NULL);
+    // Item 24: a mesh that never ends (a link to /dev/zero and to
+    // /dev/urandom): refused before any read, so this returns at once.
+    snprintf(path, sizeof path, "%s/zero.stl", g_dir);
+    unlink(path);
+    CHECK(symlink("/dev/zero", path) == 0, "symlink");
+    expect_load(path, "is not a regular file", NULL);
+    snprintf(path, sizeof path, "%s/random.obj", g_dir);
+    unlink(path);
+    CHECK(symlink("/dev/urandom", path) == 0, "symlink");
+    expect_load(path, "is not a regular file", NULL);
+    expect_load("/dev/zero", "is not a regular file", NULL);
+    // A named pipe with no writer: opening it would block for ever.
+    snprintf(path, sizeof path, "%s/pipe.obj", g_dir);
+    unlink(path);
+    CHECK(mkfifo(path, 0644) == 0, "mkfifo");
+    expect_load(path, "is not a regular file", NULL);
+    // Over the size limit (a sparse file: no disk used).
+    snprintf(path, sizeof path, "%s/huge_sparse.obj", g_dir);
+    f = fopen(path, "wb");
+    if (f) {
+        fclose(f);
+        CHECK(truncate(path, MESH_MAX_FILE_BYTES + 1) == 0, "truncate");
+    }
+    expect_load(path, "more than the 256 MiB a mesh file may have", NULL);
+    unlink(path);
+    // Through a world file: the field, the file and the problem on one line.
+    snprintf(buf, sizeof buf, "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s/zero.stl\"}, \"position\": [-6, -9]}]",
+             g_dir);
+    expect_bad(NULL, buf, "obstacles[0].mesh.file: ", "zero.stl: is not a regular file");
+    snprintf(buf, sizeof buf,
+             "[{\"name\": \"x\", \"mesh\": {\"file\": \"%s/cut.stl\"}, \"mass\": 50, \"position\": [-6, -9]}]", g_dir);
+    expect_bad(buf, NULL, "loads[0].mesh.file: ", "cut.stl: binary STL truncated");
+}
+
 // The per-process cache: a second load of an unchanged file parses nothing
 // and gives the same mesh; another scale is a different entry; a rewrite of
 // equal size (same tick possible) is parsed again and gives the new mesh;
@@ -687,11 +1040,15 @@ int main(int argc, char** argv) {
     }
     RUN_TEST(test_mass_cube);
     RUN_TEST(test_mass_cylinder);
+    RUN_TEST(test_hull_bounded);
+    RUN_TEST(test_hull_stress);
+    RUN_TEST(test_cancel);
     RUN_TEST(test_load_mass_in_world);
     RUN_TEST(test_rest_on_wedge);
     RUN_TEST(test_box_vs_mesh_box);
     RUN_TEST(test_boom_mesh_wall);
     RUN_TEST(test_bad_meshes);
+    RUN_TEST(test_bad_files);
     RUN_TEST(test_cache);
     RUN_TEST(test_merge_flat_box);
     RUN_TEST(test_merge_keeps_shape);
