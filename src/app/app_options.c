@@ -56,6 +56,7 @@ void app_name_params(void) {
     names[SIM_PARAM_RTOL] = app_opt_name[APP_OPT_RTOL];
     names[SIM_PARAM_SET] = app_opt_name[APP_OPT_SET];
     names[SIM_PARAM_WORLD] = app_opt_name[APP_OPT_WORLD];
+    names[SIM_PARAM_MODEL] = app_opt_name[APP_OPT_MODEL];
     sim_name_params(names);
 }
 
@@ -373,7 +374,7 @@ static const struct {
     int opt;
     const char* text;
 } common_help[] = {
-    {APP_OPT_MODEL, "  --model FILE         crane model JSON (default: assets/models/hiab031.json)\n"},
+    {APP_OPT_MODEL, "  --model M            crane model JSON file, or a name in assets/models (default hiab031)\n"},
     {APP_OPT_SCENARIO, "  --scenario S         scenario JSON file, or a name in assets/scenarios (default ramp)\n"},
     {APP_OPT_SET, "  --set PATH=VALUE     override any model value (repeatable), e.g.\n"
                   "                       --set mechanics.links[0].mass=200 or\n"

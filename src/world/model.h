@@ -26,8 +26,10 @@ typedef struct model {
 
 /// Load a model file and apply "path=value" overrides (see json_set_path) in
 /// order. NULL path loads the built-in default (assets/models/hiab031.json as
-/// found by model_default_path). Returns NULL with one line
-/// "file: field: problem" in err.
+/// found by model_default_path); a path without '/' that is no file and does
+/// not end in .json is a name in <assets>/models (model_path). Returns NULL
+/// with one line "file: field: problem" in err (a name that is no model
+/// lists the models there).
 model* model_load(const char* path, const char* const* sets, int nset, char* err, size_t errsz);
 
 /// Build from a parsed document (ownership of root passes to the model, also
@@ -57,6 +59,11 @@ double* model_param_ptr(crane_mech* me, int k);
 /// The default model file: $CRANESIM_ASSETS/models/hiab031.json, else the
 /// source tree's assets folder compiled in, else ./assets/models/hiab031.json.
 const char* model_default_path(void);
+
+/// The file a model argument names: arg itself if it is a regular file, has
+/// a '/' or ends in ".json", else <assets>/models/<arg>.json in buf (as
+/// scenarios and worlds are named). NULL arg: model_default_path().
+const char* model_path(const char* arg, char* buf, size_t n);
 
 /// The assets folder in use (same search as model_default_path).
 const char* model_assets_dir(void);

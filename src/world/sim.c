@@ -113,7 +113,7 @@ static const double P_IMPLAUSIBLE = -1e5;
 
 static const char* const k_param_field[SIM_PARAM_COUNT] = {"h",         "dt_ode",    "duration", "dt_out",
                                                            "load_mass", "mechanics", "rtol",     "set",
-                                                           "world"};
+                                                           "world",     "model"};
 static const char* const* g_param_names;
 
 void sim_name_params(const char* const names[SIM_PARAM_COUNT]) { g_param_names = names; }

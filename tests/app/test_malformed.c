@@ -329,6 +329,21 @@ static void test_messages(void) {
     CHECK(rc == 2 && strstr(out_buf, "no element named 'nosuch' in hydraulics.components"), "exit %d: %s", rc, out_buf);
 }
 
+// --model takes a name in assets/models as --scenario and --world do, and a
+// name that is no model lists the shipped ones.
+static void test_model_names(void) {
+    int rc = cli_run("run --quiet --model hiab031_ls --scenario hold --duration 0.01 --out /dev/null", out_buf,
+                     sizeof out_buf);
+    CHECK(rc == 0, "--model hiab031_ls: exit %d: %s", rc, out_buf);
+    rc = cli_run("run --quiet --model nosuch --scenario hold --out /dev/null", out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "--model nosuch: no such file or model (models: hiab031, hiab031_ls;") &&
+              cli_count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    // A path stays a path: a missing file is not looked up as a name.
+    rc = cli_run("run --quiet --model nosuch.json --scenario hold --out /dev/null", out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "nosuch.json: cannot open"), "exit %d: %s", rc, out_buf);
+}
+
 // --set gets the same ranges (it edits the document before loading), and
 // --load the tip-load range.
 static void test_set_and_load(void) {
@@ -476,6 +491,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_ls_components);
     RUN_TEST(test_corpus);
     RUN_TEST(test_messages);
+    RUN_TEST(test_model_names);
     RUN_TEST(test_oversize);
     RUN_TEST(test_set_and_load);
     RUN_TEST(test_typical_notes);
