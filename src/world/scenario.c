@@ -138,7 +138,9 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
     s->q0[1] = json_num(&c, ini, "initial", "q2_deg", true, 0, -360, 360) * M_PI / 180.0;
     s->slew0 = json_num(&c, ini, "initial", "slew_deg", false, 0, -360, 360) * M_PI / 180.0;
 
-    const cJSON* cmds = json_obj(&c, root, "", "commands", true);
+    // Optional: a scenario that only holds the start pose (a fault, a
+    // settling test) has no command to give; absent, every valve is centred.
+    const cJSON* cmds = json_obj(&c, root, "", "commands", false);
     json_only_keys(&c, cmds, "commands", (const char* const[]){"lift", "jib", "slew", NULL});
     for (int k = 0; k < SCENARIO_NCMD; ++k) {
         char p[64];

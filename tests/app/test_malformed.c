@@ -11,6 +11,7 @@
 #include "fixture_edit.h"
 #include "json_util.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -329,6 +330,38 @@ static void test_messages(void) {
     CHECK(rc == 2 && strstr(out_buf, "no element named 'nosuch' in hydraulics.components"), "exit %d: %s", rc, out_buf);
 }
 
+// A scenario without "commands" is a hold (every valve centred), as
+// docs/files.md says: it runs, and the crane holds its start pose (the lift
+// stroke moves less than 0.1 mm in 0.5 s). The loader used to require it.
+static void test_scenario_without_commands(void) {
+    char path[600], csv[600], cmd[1400];
+    snprintf(path, sizeof path, "%s/no_commands.json", dir());
+    snprintf(csv, sizeof csv, "%s/no_commands.csv", dir());
+    cli_write_file(path, "{\"duration\": 0.5, \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110}}\n");
+    snprintf(cmd, sizeof cmd, "run --quiet --scenario %s --out %s", path, csv);
+    const int rc = cli_run(cmd, out_buf, sizeof out_buf);
+    CHECK(rc == 0 && !strstr(out_buf, "commands"), "exit %d: %s", rc, out_buf);
+    if (rc) return;
+    // The x1 column of the first and the last row.
+    static char text[1 << 20];
+    CHECK(cli_read_file(csv, text, sizeof text) > 0, "no %s", csv);
+    const char* h = text;
+    int col = 0;
+    for (const char* q = h; *q && *q != '\n' && strncmp(q, "x1,", 3); ++q) col += *q == ',';
+    double first = NAN, last = NAN;
+    for (const char* line = strchr(text, '\n'); line && line[1]; line = strchr(line + 1, '\n')) {
+        const char* q = line + 1;
+        for (int k = 0; k < col && q; ++k) q = strchr(q, ',') ? strchr(q, ',') + 1 : NULL;
+        if (!q) break;
+        const double v = strtod(q, NULL);
+        if (isnan(first)) first = v;
+        last = v;
+    }
+    CHECK(isfinite(first) && fabs(last - first) < 1e-4, "x1 from %g to %g m", first, last);
+    remove(csv);
+    remove(path);
+}
+
 // --model takes a name in assets/models as --scenario and --world do, and a
 // name that is no model lists the shipped ones.
 static void test_model_names(void) {
@@ -492,6 +525,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_corpus);
     RUN_TEST(test_messages);
     RUN_TEST(test_model_names);
+    RUN_TEST(test_scenario_without_commands);
     RUN_TEST(test_oversize);
     RUN_TEST(test_set_and_load);
     RUN_TEST(test_typical_notes);
