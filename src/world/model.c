@@ -350,7 +350,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         double AA, AB;
         hyd_model_cylinder_geometry(m->hyd, m->cyl[k], &AA, &AB, &m->stroke[k]);
     }
-    char cerr[256];
+    char cerr[512];
     if (crane_mech_check(me, m->stroke, cerr, (int)sizeof cerr)) {
         snprintf(err, errsz, "%s: %s", file, cerr);
         goto fail;

@@ -362,6 +362,28 @@ static void test_scenario_without_commands(void) {
     remove(path);
 }
 
+// Mounts that cannot reach the cylinder's pin lengths are reported against
+// the mounts, not only closed_length (a rod_mount copied from base_mount
+// used to read "closed_length: pin length ... outside the reachable ...").
+static void test_mount_message(void) {
+    int rc = cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null "
+                     "--set 'mechanics.actuators[0].rod_mount=[0.2113, -0.4532]'",
+                     out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "mechanics.actuators[0]: base_mount") && strstr(out_buf, "rod_mount") &&
+              strstr(out_buf, "given the same coordinates") && strstr(out_buf, "pin lengths 0.000..1.000 m") &&
+              cli_count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    // A closed length too long for good mounts says what would fit: the lift
+    // mounts (0.5 m, 1.56 m) reach 1.06..2.06 m; with 0.7 m of stroke the
+    // closed length must lie in 1.06..1.36 m.
+    rc = cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null "
+                 "--set 'mechanics.actuators[0].closed_length=3'",
+                 out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "closed_length would have to lie in 1.060..1.360 m") &&
+              !strstr(out_buf, "same coordinates") && cli_count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+}
+
 // --model takes a name in assets/models as --scenario and --world do, and a
 // name that is no model lists the shipped ones.
 static void test_model_names(void) {
@@ -525,6 +547,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_corpus);
     RUN_TEST(test_messages);
     RUN_TEST(test_model_names);
+    RUN_TEST(test_mount_message);
     RUN_TEST(test_scenario_without_commands);
     RUN_TEST(test_oversize);
     RUN_TEST(test_set_and_load);
