@@ -142,6 +142,49 @@ static int ls_section_fault(json_ctx* c, const hyd_model* m) {
     return bad;
 }
 
+// Whether port k of a component of type t can put oil into its node: an
+// outlet of a pump, relief, check or compensator, either end of an orifice,
+// hose, counterbalance valve or accumulator, and a valve's T, A or B (a
+// series circuit feeds one valve from another's work port). Not: a valve's
+// P (it draws from it), an inlet, and the signal ports of shuttles, LS
+// pumps, compensators and counterbalance pilots.
+static int port_feeds(hyd_type t, int k) {
+    switch (t) {
+    case HYD_PUMP:
+    case HYD_LS_PUMP:
+    case HYD_RELIEF:
+    case HYD_CHECK:
+    case HYD_COMPENSATOR: return k == 1;
+    case HYD_ORIFICE:
+    case HYD_HOSE:
+    case HYD_ACCUMULATOR: return 1;
+    case HYD_COUNTERBALANCE: return k == 0 || k == 1;
+    case HYD_VALVE: return k != 0;
+    default: return 0;
+    }
+}
+
+// A valve's P must be fed: a node that only valves draw from (and reliefs
+// drain) holds whatever it had at the start, so the valve has no supply and
+// its cylinder moves only by that trapped oil. That is the load-sensing
+// crane with its compensators deleted: a wiring mistake, never a design.
+// A node a component owns (a hose's volume, a chamber) is fed by it; the
+// tank is a fixed pressure. Returns the first such valve, or -1.
+static int valve_unfed(const hyd_model* m) {
+    const int nc = hyd_model_ncomp(m);
+    for (int v = 0; v < nc; ++v) {
+        if (hyd_model_comp_type(m, v) != HYD_VALVE) continue;
+        const int p = hyd_model_port_node(m, v, 0);
+        if (p < 0 || hyd_model_node_role(m, p) == HYD_NODE_TANK || hyd_model_node_owner(m, p) >= 0) continue;
+        int fed = 0;
+        for (int k = 0; k < nc && !fed; ++k)
+            for (int j = 0; j < 4 && !fed; ++j)
+                fed = hyd_model_port_node(m, k, j) == p && port_feeds(hyd_model_comp_type(m, k), j);
+        if (!fed) return v;
+    }
+    return -1;
+}
+
 static double comp_param(const hyd_model* m, int comp, const char* field) {
     char path[160];
     double v = NAN;
@@ -323,6 +366,17 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
             goto fail;
         }
         if (ls_section_fault(&c, m->hyd)) goto fail;
+        const int unfed = valve_unfed(m->hyd);
+        if (unfed >= 0) {
+            char f[64];
+            snprintf(f, sizeof f, "hydraulics.components[%d].P", unfed);
+            json_fail(&c, f,
+                      "node '%s' is fed by nothing (no pump, compensator, hose or other line puts oil into it): "
+                      "valve '%s' has no supply",
+                      hyd_model_node_name(m->hyd, hyd_model_port_node(m->hyd, unfed, 0)),
+                      hyd_model_comp_name(m->hyd, unfed));
+            goto fail;
+        }
         ls_param_notes(&c, m->hyd);
         json_flush_notes(&c);
     }

@@ -32,6 +32,15 @@ typedef struct bad_case {
     const char* msg;   ///< must appear in the message too (NULL: no check)
 } bad_case;
 
+// A section compensator of the LS crane as the file writes it (sec: "lift",
+// "jib"), with the line break and indent before the next component: deleting
+// it leaves the section valve's P on a node nothing feeds.
+#define LS_COMP(sec)                                                                                                   \
+    "{\n        \"name\": \"" sec "_comp\",\n        \"type\": \"compensator\",\n        \"inlet\": \"pump_line\",\n"     \
+    "        \"outlet\": \"" sec "_P\",\n        \"load\": \"" sec "_ls\",\n        \"ref\": \"ls_line\",\n"              \
+    "        \"area\": 3e-05,\n        \"setting\": 200000.0,\n        \"mode\": 1,\n        \"band\": 20000.0,\n"       \
+    "        \"tau\": 0.02\n      },\n      "
+
 // Cases that need a second text replacement after the first (a node declared,
 // then wired in), by file name.
 static const struct {
@@ -39,6 +48,7 @@ static const struct {
 } second_edit[] = {
     {"m_ls_orphan_out.json", "\"out\": \"lift_ls\",", "\"out\": \"lift_ls_orphan\","},
     {"m_ls_orphan_load.json", "\"load\": \"lift_ls\",", "\"load\": \"lift_ls_orphan\","},
+    {"m_ls_no_comps.json", LS_COMP("jib"), ""},
 };
 
 static char out_buf[16384];
@@ -178,6 +188,12 @@ static const bad_case ls_cases[] = {
      "node 'lift_ls_orphan' leads through no shuttle"},
     {MODEL, "m_ls_comp_ref_tank.json", ML, NULL, "\"ref\": \"ls_line\",", "\"ref\": \"tank\",",
      "hydraulics.components[3].ref", "must be the ls node 'ls_line' of pump 'pump'"},
+    // A cut-off below the margin: the pump never reaches its standby pressure.
+    {MODEL, "m_ls_cutoff_margin.json", ML, "hydraulics.components.pump.p_cutoff=1e6", NULL, NULL,
+     "hydraulics.components[0].p_cutoff", "must be above the margin (2e6 Pa), got 1e6 Pa"},
+    // Both compensators deleted: the valves' P nodes are fed by nothing.
+    {MODEL, "m_ls_no_comps.json", ML, NULL, LS_COMP("lift"), "", "hydraulics.components[3].P",
+     "node 'lift_P' is fed by nothing"},
 };
 
 static void test_ls_components(void) {
