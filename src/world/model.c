@@ -236,6 +236,35 @@ static void ls_param_notes(json_ctx* c, const hyd_model* m) {
     }
 }
 
+// A main relief (on a pressure-compensated pump's outlet) that cracks below
+// the pump's setting plus its band opens before the pump destrokes: the
+// relief, not the pump, sets the pressure, and the delivery the valves do not
+// take goes over it to the tank. A note, not a refusal: that is how a fixed
+// pump with a relief is modelled (a pump setting above the relief), and a
+// sweep over p_crack must be able to cross the setting. The note says what
+// will happen, in MPa (main relief at 5 MPa under a 20 MPa pump: open 17 s of
+// the 20 s ramp, the lift pressure held near 6 MPa).
+static void pump_relief_notes(json_ctx* c, const hyd_model* m) {
+    const int nc = hyd_model_ncomp(m);
+    for (int p = 0; p < nc; ++p) {
+        if (hyd_model_comp_type(m, p) != HYD_PUMP) continue;
+        const int out = hyd_model_port_node(m, p, 1);
+        const double set = comp_param(m, p, "p_set"), band = comp_param(m, p, "band");
+        for (int k = 0; k < nc; ++k) {
+            if (hyd_model_comp_type(m, k) != HYD_RELIEF || hyd_model_port_node(m, k, 0) != out) continue;
+            const double crack = comp_param(m, k, "p_crack"), over = comp_param(m, k, "dp_override");
+            if (!(crack < set + band)) continue;
+            char f[80];
+            snprintf(f, sizeof f, "hydraulics.components[%d].p_crack", k);
+            json_note(c, f,
+                      "%.3g MPa is below the setting of pump '%s' plus its band (%.3g + %.3g MPa): the relief, not "
+                      "the pump, limits the pressure to about %.3g MPa, and the pump's flow the valves do not take "
+                      "goes over it to the tank",
+                      crack / 1e6, hyd_model_comp_name(m, p), set / 1e6, band / 1e6, (crack + over) / 1e6);
+        }
+    }
+}
+
 static const json_range R_GRAVITY = {0, 30, 9.7, 9.9, "m/s^2"};
 static const json_range R_COLUMN_HEIGHT = {0.1, 10, 0.5, 4, "m"};
 static const json_range R_COLUMN_MASS = {1, 1e5, 50, 5000, "kg"};
@@ -378,6 +407,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
             goto fail;
         }
         ls_param_notes(&c, m->hyd);
+        pump_relief_notes(&c, m->hyd);
         json_flush_notes(&c);
     }
 

@@ -507,6 +507,23 @@ static void test_typical_notes(void) {
                               "of LS pump 'pump' (2e6 Pa)") &&
               cli_count_lines(out_buf) == 2, // and the typical range [1e5, 1.5e6] Pa
           "exit %d: %s", rc, out_buf);
+    // The same for a pressure-compensated pump (issue 25, 11a: a main relief
+    // at 5 MPa under a 20 MPa pump ran without a word, the relief open 17 s
+    // of 20): the note says the relief limits the pressure, at p_crack +
+    // dp_override = 6 MPa. Above the setting plus band (20.5 MPa): no note.
+    rc = cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null "
+                 "--set hydraulics.components.main_relief.p_crack=5e6",
+                 out_buf, sizeof out_buf);
+    CHECK(rc == 0 &&
+              strstr(out_buf, "note: hiab031.json: hydraulics.components[1].p_crack: 5 MPa is below the setting of "
+                              "pump 'pump' plus its band (20 + 0.5 MPa): the relief, not the pump, limits the "
+                              "pressure to about 6 MPa") &&
+              cli_count_lines(out_buf) == 1,
+          "exit %d: %s", rc, out_buf);
+    rc = cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null "
+                 "--set hydraulics.components.main_relief.p_crack=20.6e6",
+                 out_buf, sizeof out_buf);
+    CHECK(rc == 0 && !out_buf[0], "exit %d: %s", rc, out_buf);
     rc = cli_run("run --quiet --scenario ramp --duration 0.01 --out /dev/null --load 4000", out_buf, sizeof out_buf);
     CHECK(rc == 0 && strstr(out_buf, "note:") && strstr(out_buf, "--load 4000 kg") && cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
