@@ -542,6 +542,7 @@ void model_free(model* m) {
     if (!m) return;
     hyd_model_free(m->hyd);
     cJSON_Delete(m->json);
+    cJSON_Delete(m->world_bursts);
     free(m);
 }
 

@@ -22,6 +22,12 @@ typedef struct model {
     int valve[2];        ///< hydraulic valve index of actuator k
     double stroke[2];    ///< cylinder strokes [m]
     cJSON* json;         ///< the document after --set overrides (owned), for saving
+    /// Hose-burst orifices ("fault<i>_burst") at nodes the model's circuit
+    /// lacks, for the world's circuit to add (engine_fault_model; the sandbox
+    /// adds the slew's). Owned; NULL when none. A backend without a world
+    /// circuit refuses a model that has them (engine_world_bursts).
+    cJSON* world_bursts;
+    char world_bursts_src[128]; ///< the scenario file they come from (messages)
 } model;
 
 /// Load a model file and apply "path=value" overrides (see json_set_path) in

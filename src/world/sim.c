@@ -458,6 +458,20 @@ ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* d
     wo.model_file = m->file;
     wo.circuit = m->hyd; // the run's one circuit unless the world adds to it
     const cJSON* hyd = cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics");
+    if (m->world_bursts) {
+        // Bursts at nodes of the world's circuit (the sandbox's slew) open
+        // there: their orifices join the world's part of the circuit, which
+        // only the sandbox appends (ow_hyd_create).
+        cJSON* frag = wd.kind == WORLD_SANDBOX ? (cJSON*)world_desc_circuit_for(&wd, hyd) : NULL;
+        const char* wf = strrchr(wpath, '/') ? strrchr(wpath, '/') + 1 : wpath;
+        cJSON* comps = frag ? cJSON_GetObjectItemCaseSensitive(frag, "components") : NULL;
+        if (engine_world_bursts(m, cJSON_IsArray(comps) ? frag : NULL, wf, err, errsz)) {
+            world_desc_free(&wd);
+            return NULL;
+        }
+        const cJSON* o;
+        cJSON_ArrayForEach(o, m->world_bursts) cJSON_AddItemToArray(comps, cJSON_Duplicate(o, 1));
+    }
     ode_world* w = ode_world_create(&m->mech, hyd, &wd, &wo, err, errsz);
     world_desc_free(&wd);
     return w;

@@ -392,6 +392,83 @@ static void csv_x1(const char* csv, double* first, double* last) {
     }
 }
 
+// Column name of a run's CSV at the last row with t <= tq (NAN when it
+// cannot be read).
+static double csv_at(const char* csv, const char* name, double tq) {
+    static char text[1 << 22];
+    if (cli_read_file(csv, text, sizeof text) <= 0) return NAN;
+    char key[64];
+    snprintf(key, sizeof key, ",%s,", name);
+    const char* hit = strstr(text, key);
+    const char* eol = strchr(text, '\n');
+    if (!hit || !eol || hit > eol) return NAN;
+    int col = 1;
+    for (const char* q = text; q < hit; ++q) col += *q == ',';
+    double v = NAN;
+    for (const char* line = eol; line && line[1]; line = strchr(line + 1, '\n')) {
+        const char* q = line + 1;
+        if (strtod(q, NULL) > tq + 1e-9) break;
+        for (int k = 0; k < col && q; ++k) q = strchr(q, ',') ? strchr(q, ',') + 1 : NULL;
+        if (!q) break;
+        v = strtod(q, NULL);
+    }
+    return v;
+}
+
+// A burst at a node the world's circuit adds (the sandbox's slew cylinder)
+// opens there: it was refused as "no node 'slew_cyl.A' in the circuit of
+// hiab031.json" although the running circuit has it. Before the burst the
+// run is the run without it (but for the closed hole's trace of a leak);
+// after a 1e-4 m^2 hole the chamber sits at the
+// tank: the slew valve's 1e-4 m^3/s through the hole drops only
+// rho/2 (Q / (cd A))^2 = 1 kPa, so p3A stays below 0.2 MPa, where the intact
+// run drives the slew at over 5 MPa. Where no world circuit is (lagrange),
+// or the world lacks the node, the refusal names both.
+static void test_burst_in_world_circuit(void) {
+    char path[600], csv[600], cmd[1600];
+    snprintf(path, sizeof path, "%s/slew_burst.json", dir());
+    snprintf(csv, sizeof csv, "%s/slew_burst.csv", dir());
+    double p3A[2][2], x3[2];
+    for (int with = 0; with < 2; ++with) {
+        char text[1000];
+        snprintf(text, sizeof text,
+                 "{\"duration\": 2, \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110, \"slew_deg\": -90},"
+                 " \"commands\": {\"slew\": [[0, 0], [1, 0], [1.1, 0.6]]}%s}\n",
+                 with ? ", \"faults\": [{\"t\": 1, \"kind\": \"hose_burst\", \"at\": \"slew_cyl.A\", \"area\": 1e-4}]" : "");
+        cli_write_file(path, text);
+        snprintf(cmd, sizeof cmd, "run --quiet --mechanics ode --world sandbox --scenario %s --out %s", path, csv);
+        const int rc = cli_run(cmd, out_buf, sizeof out_buf);
+        CHECK(rc == 0, "burst %s: exit %d: %s", with ? "on" : "off", rc, out_buf);
+        p3A[with][0] = csv_at(csv, "p3A", 0.99);
+        p3A[with][1] = csv_at(csv, "p3A", 1.9);
+        x3[with] = csv_at(csv, "x3", 0.99);
+    }
+    printf("  p3A at 0.99 s: %.4g / %.4g Pa, at 1.9 s: intact %.4g Pa, burst %.4g Pa\n", p3A[0][0], p3A[1][0], p3A[0][1],
+           p3A[1][1]);
+    // Before it the closed hole (1e-10 m^2) leaks a trace: 25 Pa in 1 s.
+    CHECK(fabs(p3A[0][0] - p3A[1][0]) < 1e3 && fabs(x3[0] - x3[1]) < 1e-6,
+          "before the burst the runs differ: p3A %g / %g Pa, x3 %g / %g m", p3A[0][0], p3A[1][0], x3[0], x3[1]);
+    CHECK(p3A[0][1] > 5e6 && p3A[1][1] < 0.2e6, "at 1.9 s p3A intact %g Pa, burst %g Pa", p3A[0][1], p3A[1][1]);
+    // No world circuit: refused, naming the model's circuit.
+    cli_write_file(path, "{\"duration\": 1, \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110},"
+                         " \"faults\": [{\"t\": 0.5, \"kind\": \"hose_burst\", \"at\": \"slew_cyl.A\", \"area\": 1e-6}]}\n");
+    snprintf(cmd, sizeof cmd, "run --quiet --mechanics lagrange --scenario %s --out /dev/null", path);
+    int rc = cli_run(cmd, out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "slew_burst.json: faults[0].at: no node 'slew_cyl.A' in the circuit of hiab031.json") &&
+              cli_count_lines(out_buf) == 1,
+          "lagrange: exit %d: %s", rc, out_buf);
+    // The sandbox without such a node: both circuits named.
+    cli_write_file(path, "{\"duration\": 1, \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110},"
+                         " \"faults\": [{\"t\": 0.5, \"kind\": \"hose_burst\", \"at\": \"slew_cyl.C\", \"area\": 1e-6}]}\n");
+    snprintf(cmd, sizeof cmd, "run --quiet --mechanics ode --world sandbox --scenario %s --out /dev/null", path);
+    rc = cli_run(cmd, out_buf, sizeof out_buf);
+    CHECK(rc == 2 && strstr(out_buf, "no node 'slew_cyl.C' in the circuit of hiab031.json or of sandbox.json") &&
+              cli_count_lines(out_buf) == 1,
+          "sandbox: exit %d: %s", rc, out_buf);
+    remove(path);
+    remove(csv);
+}
+
 // A scenario without "commands" is a hold (every valve centred), as
 // docs/files.md says: it runs, and the crane holds its start pose (the lift
 // stroke moves less than 0.1 mm in 0.5 s). The loader used to require it.
@@ -650,6 +727,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_corpus);
     RUN_TEST(test_messages);
     RUN_TEST(test_model_names);
+    RUN_TEST(test_burst_in_world_circuit);
     RUN_TEST(test_burst_max_area_runs);
     RUN_TEST(test_mount_message);
     RUN_TEST(test_scenario_without_commands);
