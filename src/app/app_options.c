@@ -56,6 +56,7 @@ void app_name_params(void) {
     names[SIM_PARAM_RTOL] = app_opt_name[APP_OPT_RTOL];
     names[SIM_PARAM_SET] = app_opt_name[APP_OPT_SET];
     names[SIM_PARAM_WORLD] = app_opt_name[APP_OPT_WORLD];
+    names[SIM_PARAM_MODEL] = app_opt_name[APP_OPT_MODEL];
     sim_name_params(names);
 }
 
@@ -86,12 +87,12 @@ static const struct {
     {"compare", {"--backends", "--solvers", "--variants", "--dts", "--tol-stroke", "--tol-pressure", "--plot",
                  "--set-a", "--set-b", "--out", NULL}},
     {"replay", {"--out", "--metrics", "--plot", "--rcl", NULL}},
-    {"study", {"--out-dir", "--repeat", NULL}},
+    {"study", {"--out-dir", "--repeat", "--only", NULL}},
     {"bench", {"--repeat", "--config", "--seed", NULL}},
     {"drive",
      {"--record", "--charts", "--mapping", "--screenshot", "--screenshot-at", "--size", "--frame-rate", "--save-as",
       "--readouts", "--session", "--replay", "--rcl", "--connect", NULL}},
-    {"serve", {"--listen", "--rate", "--max-clients", "--queue", "--timeout", "--rcl", NULL}},
+    {"serve", {"--listen", "--rate", "--max-clients", "--queue", "--timeout", "--rcl", "--spin", NULL}},
 };
 
 // The value options a command documents as repeatable (each use adds one);
@@ -106,6 +107,7 @@ static const struct {
     {"optimize", {"--param", "--constraint", NULL}},
     {"compare", {"--model", "--set-a", "--set-b", NULL}}, // --model: design A's and B's
     {"bench", {"--config", NULL}},
+    {"study", {"--only", NULL}},
 };
 
 static bool is_repeatable(const char* cmd, const char* a) {
@@ -117,6 +119,41 @@ static bool is_repeatable(const char* cmd, const char* a) {
     return false;
 }
 
+// Each command's flags (options without a value). A flag may also be given
+// as --flag=1|true (the flag) or --flag=0|false (as if not given): scripts
+// write flags that way, and "--quiet=1" used to be an unknown option. Every
+// flag is off unless given, so =0 is the default. "*": every command that
+// parses the common options (all but replay, which has --quiet only).
+static const struct {
+    const char* cmd;
+    const char* opts[6];
+} own_flags[] = {
+    {"*", {"--quiet", "--dense-jac", NULL}},
+    {"study", {"--quick", NULL}},
+    {"sweep", {"--fail-fast", NULL}},
+    {"drive", {"--headless", "--scripted", "--collision-view", NULL}},
+    {"serve", {"--lockstep", "--realtime", "--log-misses", NULL}},
+};
+
+// Whether the first len characters of a are a flag of cmd.
+static bool is_flag(const char* cmd, const char* a, size_t len) {
+    const bool replay = !strcmp(cmd, "replay");
+    if (replay) return len == 7 && !strncmp(a, "--quiet", 7);
+    for (size_t k = 0; k < sizeof own_flags / sizeof own_flags[0]; ++k) {
+        if (strcmp(own_flags[k].cmd, "*") && strcmp(own_flags[k].cmd, cmd)) continue;
+        for (int j = 0; own_flags[k].opts[j]; ++j)
+            if (strlen(own_flags[k].opts[j]) == len && !strncmp(a, own_flags[k].opts[j], len)) return true;
+    }
+    return false;
+}
+
+// 1 for "1"/"true", 0 for "0"/"false", -1 for anything else.
+static int flag_word(const char* v) {
+    if (!strcmp(v, "1") || !strcmp(v, "true")) return 1;
+    if (!strcmp(v, "0") || !strcmp(v, "false")) return 0;
+    return -1;
+}
+
 int app_check_values(const char* cmd, int argc, char** argv) {
     const char* const* own = NULL;
     for (size_t k = 0; k < sizeof own_values / sizeof own_values[0]; ++k)
@@ -124,6 +161,13 @@ int app_check_values(const char* cmd, int argc, char** argv) {
     for (int i = 0; i < argc; ++i) {
         const char* a = argv[i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) return 0; // the command prints its help
+        const char* eq = strncmp(a, "--", 2) ? NULL : strchr(a, '=');
+        if (eq && is_flag(cmd, a, (size_t)(eq - a))) {
+            // app_split_equals took 1/true/0/false; this is another word.
+            fprintf(stderr, "cranesim %s: %.*s takes no value (or 1, 0, true, false), got '%s'\n", cmd,
+                    (int)(eq - a), a, eq + 1);
+            return EXIT_USAGE;
+        }
         bool takes = false;
         for (int k = 0; k <= APP_OPT_KERNEL && !takes; ++k) takes = !strcmp(a, app_opt_name[k]);
         for (int k = 0; own && own[k] && !takes; ++k) takes = !strcmp(a, own[k]);
@@ -165,12 +209,19 @@ char** app_split_equals(const char* cmd, int* argc, char** argv) {
     for (int i = 0; i < *argc; ++i) {
         char* a = argv[i];
         char* eq = strncmp(a, "--", 2) ? NULL : strchr(a, '=');
-        // Only a value option is split: "--quiet=1" stays unknown, and the
-        // value of a value option is never split.
+        // A value option is split; the value of a value option never is.
         if (!value_next && eq && takes_value(own, a, (size_t)(eq - a))) {
             *eq = 0; // argv's strings are ours to change (C11 5.1.2.2.1)
             out[n++] = a;
             out[n++] = eq + 1;
+            continue;
+        }
+        // A flag with 1/true is the flag, with 0/false it is left out; any
+        // other word stays as it is for app_check_values to refuse.
+        if (!value_next && eq && is_flag(cmd, a, (size_t)(eq - a)) && flag_word(eq + 1) >= 0) {
+            if (flag_word(eq + 1) == 0) continue;
+            *eq = 0;
+            out[n++] = a;
             continue;
         }
         value_next = !value_next && takes_value(own, a, strlen(a));
@@ -323,7 +374,7 @@ static const struct {
     int opt;
     const char* text;
 } common_help[] = {
-    {APP_OPT_MODEL, "  --model FILE         crane model JSON (default: assets/models/hiab031.json)\n"},
+    {APP_OPT_MODEL, "  --model M            crane model JSON file, or a name in assets/models (default hiab031)\n"},
     {APP_OPT_SCENARIO, "  --scenario S         scenario JSON file, or a name in assets/scenarios (default ramp)\n"},
     {APP_OPT_SET, "  --set PATH=VALUE     override any model value (repeatable), e.g.\n"
                   "                       --set mechanics.links[0].mass=200 or\n"

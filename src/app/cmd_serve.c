@@ -1043,7 +1043,8 @@ int cmd_serve(int argc, char** argv) {
     // The model as a path the viewer can resolve: absolute (the model keeps
     // only its file's base name, which names no file from another working
     // directory), and relative to the assets folder when it is in it.
-    const char* mpath = c.model_path ? c.model_path : model_default_path();
+    char mbuf[512]; // a model name (--model hiab031_ls) is its file in the assets
+    const char* mpath = model_path(c.model_path, mbuf, sizeof mbuf);
     if (!realpath(mpath, g_desc_file)) snprintf(g_desc_file, sizeof g_desc_file, "%s", mpath);
     char assets[PATH_MAX];
     const char* asset = "";

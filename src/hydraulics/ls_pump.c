@@ -111,6 +111,27 @@ static int ls_pump_check_ports(const hyd_model* m, const char* const* port_name,
     return 0;
 }
 
+// The cut-off must lie above the margin: at standby the pump holds p_out -
+// p_ls = margin with p_ls at tank, so a cut-off at or below the margin
+// destrokes it before it reaches even its standby pressure; the LS control
+// never acts and the pump delivers nothing above p_cutoff (1 MPa: no crane
+// load). Refused as a slip, not a design (a margin/cut-off swap, MPa vs bar).
+static int ls_pump_validate(const void* def, char* field, size_t fsz, char* msg, size_t msz) {
+    const hyd_ls_pump_def* d = def;
+    if (!(d->p_cutoff > d->margin)) {
+        char a[24], b[24];
+        hyd_fmt_num(a, sizeof a, d->p_cutoff);
+        hyd_fmt_num(b, sizeof b, d->margin);
+        snprintf(field, fsz, "p_cutoff");
+        snprintf(msg, msz,
+                 "must be above the margin (%s Pa), got %s Pa: the pump would cut off before it reaches its standby "
+                 "pressure and deliver nothing against a load",
+                 b, a);
+        return -1;
+    }
+    return 0;
+}
+
 static void ls_pump_bind(void* rec, int comp, const int* port, const int* own, const int* state) {
     (void)own;
     hyd_ls_pump_c* c = rec;
@@ -149,7 +170,8 @@ const hyd_component hyd_ls_pump_component = {
     .ports = ls_pump_ports, .nport = HYD_COUNT(ls_pump_ports),
     .states = ls_pump_states, .nstate = HYD_COUNT(ls_pump_states), .state_flush = ls_pump_flush,
     .rec_size = sizeof(hyd_ls_pump_c), .states_sense_ports = 1, .port_roles = ls_pump_roles,
-    .defaults = ls_pump_defaults, .check_ports = ls_pump_check_ports, .bind = ls_pump_bind,
+    .defaults = ls_pump_defaults, .validate = ls_pump_validate, .check_ports = ls_pump_check_ports,
+    .bind = ls_pump_bind,
     .derive = ls_pump_derive, .initial = ls_pump_initial, .eval = ls_pumps_eval,
     .jacobian = ls_pumps_jacobian,
 };

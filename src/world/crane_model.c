@@ -149,9 +149,25 @@ int crane_mech_check(const crane_mech* m, const double stroke[2], char* err, int
         double lo = a->closed_length, hi = a->closed_length + stroke[k];
         double xmin = fabs(a->a - a->b), xmax = a->a + a->b;
         if (lo <= xmin || hi >= xmax) {
+            // The mounts fix the reachable pin lengths |a - b|..a + b; the
+            // closed length and the stroke must fit inside. Which of the
+            // three is wrong only the user knows, so the message names all
+            // three and the closed lengths these mounts would take (a
+            // rod_mount copied from base_mount used to read as a wrong
+            // closed_length).
+            char fit[160];
+            if (xmax - stroke[k] > xmin)
+                snprintf(fit, sizeof fit, "for these mounts closed_length would have to lie in %.3f..%.3f m", xmin,
+                         xmax - stroke[k]);
+            else
+                snprintf(fit, sizeof fit, "no closed_length fits a %.3f m stroke between these mounts", stroke[k]);
+            const bool same = a->base_mount[0] == a->rod_mount[0] && a->base_mount[1] == a->rod_mount[1];
             snprintf(err, (size_t)errsz,
-                     "mechanics.actuators[%d].closed_length: pin length %.3f..%.3f m is outside the reachable %.3f..%.3f m",
-                     k, lo, hi, xmin, xmax);
+                     "mechanics.actuators[%d]: base_mount (%.3f m from the joint) and rod_mount (%.3f m)%s reach "
+                     "pin lengths %.3f..%.3f m only, but closed_length %.3f m and the %.3f m stroke of %s need %.3f..%.3f m "
+                     "(%s)",
+                     k, a->a, a->b, same ? ", given the same coordinates," : "", xmin, xmax, lo, stroke[k], a->cylinder, lo, hi,
+                     fit);
             return -1;
         }
         for (int e = 0; e < 2; ++e) {

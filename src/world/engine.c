@@ -83,8 +83,53 @@ static void fill_rcl(engine* e, double* row) {
 // The orifice of scenario fault i: "fault<i>_burst".
 static void burst_name(char* out, size_t n, int i) { snprintf(out, n, "fault%d_burst", i); }
 
+// Whether the circuit fragment declares a pressure node called name: one
+// of its volumes, a hose (its own node) or a cylinder's chamber.
+static bool fragment_has_node(const cJSON* frag, const char* name) {
+    const cJSON* e;
+    cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(frag, "nodes")) {
+        const cJSON* n = cJSON_GetObjectItemCaseSensitive(e, "name");
+        const cJSON* t = cJSON_GetObjectItemCaseSensitive(e, "type");
+        if (cJSON_IsString(n) && !strcmp(n->valuestring, name) && !(cJSON_IsString(t) && !strcmp(t->valuestring, "tank")))
+            return true;
+    }
+    cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(frag, "components")) {
+        const cJSON* n = cJSON_GetObjectItemCaseSensitive(e, "name");
+        const cJSON* t = cJSON_GetObjectItemCaseSensitive(e, "type");
+        if (!cJSON_IsString(n) || !cJSON_IsString(t)) continue;
+        const size_t L = strlen(n->valuestring);
+        if (!strcmp(t->valuestring, "hose") && !strcmp(n->valuestring, name)) return true;
+        if (!strcmp(t->valuestring, "cylinder") && !strncmp(name, n->valuestring, L) &&
+            (!strcmp(name + L, ".A") || !strcmp(name + L, ".B")))
+            return true;
+    }
+    return false;
+}
+
+int engine_world_bursts(const model* m, const cJSON* fragment, const char* world_file, char* err, size_t errsz) {
+    const cJSON* o;
+    cJSON_ArrayForEach(o, m->world_bursts) {
+        const cJSON* at = cJSON_GetObjectItemCaseSensitive(o, "inlet");
+        const cJSON* nm = cJSON_GetObjectItemCaseSensitive(o, "name");
+        if (!cJSON_IsString(at) || !cJSON_IsString(nm)) continue;
+        if (fragment && fragment_has_node(fragment, at->valuestring)) continue;
+        int i = -1;
+        sscanf(nm->valuestring, "fault%d_burst", &i);
+        snprintf(err, errsz, "%s: faults[%d].at: no node '%s' in the circuit of %s%s%s (a burst needs a hose or a "
+                             "cylinder chamber)",
+                 m->world_bursts_src[0] ? m->world_bursts_src : "scenario", i, at->valuestring,
+                 m->file[0] ? m->file : "the model", fragment ? " or of " : "", fragment ? world_file : "");
+        return -1;
+    }
+    return 0;
+}
+
 // The model with a closed orifice to the tank at each node a burst names
 // (so model files stay clean), or NULL with "file: faults[i].at: problem".
+// A node the model's circuit lacks may be one a world adds (the sandbox's
+// slew_cyl.A): its orifice waits in world_bursts for the ode world to append
+// to the world's part of the circuit, and a backend without that part
+// refuses it (engine_world_bursts) with the message a missing node had here.
 model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t errsz) {
     const hyd_model* hm = m->hyd;
     const char* tank = NULL;
@@ -94,10 +139,10 @@ model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t 
         const scenario_fault* f = &sc->fault[i];
         if (f->kind != SCENARIO_HOSE_BURST) continue;
         const int node = hyd_model_find_node(hm, f->at);
-        if (node < 0 || hyd_model_node_state(hm, node) < 0) {
-            snprintf(err, errsz, "%s: faults[%d].at: %s '%s' in the circuit of %s (a burst needs a hose or a cylinder chamber)",
-                     sc->file[0] ? sc->file : "scenario", i, node < 0 ? "no node" : "a burst cannot open at the tank node",
-                     f->at, m->file[0] ? m->file : "the model");
+        if (node >= 0 && hyd_model_node_state(hm, node) < 0) {
+            snprintf(err, errsz, "%s: faults[%d].at: a burst cannot open at the tank node '%s' in the circuit of %s "
+                                 "(a burst needs a hose or a cylinder chamber)",
+                     sc->file[0] ? sc->file : "scenario", i, f->at, m->file[0] ? m->file : "the model");
             return NULL;
         }
         if (!tank) {
@@ -113,11 +158,18 @@ model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t 
         snprintf(err, errsz, "%s: the model document has no hydraulics.components to add the bursts to", m->file);
         return NULL;
     }
+    cJSON* world = NULL; // the orifices at nodes the model's circuit lacks
     for (int i = 0; i < sc->nfault; ++i) {
         const scenario_fault* f = &sc->fault[i];
         if (f->kind != SCENARIO_HOSE_BURST) continue;
         char name[32];
         burst_name(name, sizeof name, i);
+        const bool in_model = hyd_model_find_node(hm, f->at) >= 0;
+        if (!in_model && !world && !(world = cJSON_CreateArray())) {
+            cJSON_Delete(doc);
+            snprintf(err, errsz, "out of memory");
+            return NULL;
+        }
         cJSON* o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "name", name);
         cJSON_AddStringToObject(o, "type", "orifice");
@@ -127,11 +179,17 @@ model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t 
         // loader has nothing to note), closed below once compiled.
         cJSON_AddNumberToObject(o, "area", f->area);
         cJSON_AddNumberToObject(o, "cd", f->cd);
-        cJSON_AddItemToArray(comps, o);
+        cJSON_AddItemToArray(in_model ? comps : world, o);
     }
     model* fm = model_from_json(doc, m->file, err, errsz);
+    if (!fm) {
+        cJSON_Delete(world);
+        return NULL;
+    }
+    fm->world_bursts = world;
+    snprintf(fm->world_bursts_src, sizeof fm->world_bursts_src, "%s", sc->file[0] ? sc->file : "scenario");
     for (int i = 0; fm && i < sc->nfault; ++i) {
-        if (sc->fault[i].kind != SCENARIO_HOSE_BURST) continue;
+        if (sc->fault[i].kind != SCENARIO_HOSE_BURST || hyd_model_find_node(hm, sc->fault[i].at) < 0) continue;
         char path[64];
         burst_name(path, sizeof path, i);
         strcat(path, ".area");

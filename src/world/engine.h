@@ -148,6 +148,13 @@ int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engi
 /// makes it itself; a stepped driver passes it to engine_create). NULL with
 /// "file: faults[i].at: problem" in err.
 model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t errsz);
+/// The bursts of m at nodes the model's circuit lacks (model.world_bursts)
+/// against the world circuit fragment that a backend appends (NULL: none,
+/// as in the lagrange backend and the validation world): 0 when each of
+/// their nodes is declared there (a volume, a hose, "<cylinder>.A"/".B"),
+/// else -1 with "scenario: faults[i].at: no node 'X' in the circuit of
+/// model.json" (and "or of world.json" when there is a fragment) in err.
+int engine_world_bursts(const model* m, const cJSON* fragment, const char* world_file, char* err, size_t errsz);
 /// The note for a dip below absolute zero the checks saw (sim_checks_note),
 /// or "".
 void engine_note(const engine* e, char* note, size_t n);

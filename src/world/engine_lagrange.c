@@ -35,6 +35,8 @@ static void lag_destroy(engine* e);
 static engine* lag_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           char* err, size_t errsz) {
     (void)slew0; // the planar crane does not slew
+    // No world circuit here: a burst at a node the model lacks has nowhere to open.
+    if (engine_world_bursts(m, NULL, NULL, err, errsz)) return NULL;
     eng_lagrange* l = calloc(1, sizeof *l);
     if (!l) {
         snprintf(err, errsz, "out of memory");
@@ -297,6 +299,7 @@ static const char* state_name(const lsim* ls, int i, char* buf, size_t n) {
 static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
     lsim ls;
     double m3 = sim_load_mass(m, sc, o);
+    if (engine_world_bursts(m, NULL, NULL, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     if (lsim_init(&ls, m, o->variant, m3, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     ls.scn = sc;
     const bool reference = o->kernel == SIM_KERNEL_GENERAL;

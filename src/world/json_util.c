@@ -501,6 +501,14 @@ static int parse_set_path(const char* path, path_seg* seg, int maxseg, char* why
                 return -1;
             }
         }
+        // An index is written as JSON writes numbers: "[01]" (or ".01") is
+        // no index anyone writes on purpose, and reading it as [1] hides a
+        // slip (links[01] vs links[0]).
+        if (k > 1 && start[0] == '0' && strspn(start, "0123456789") >= k) {
+            snprintf(why, whysz, "index '%.*s' at character %d has a leading zero (write %s%ld%s)", (int)k, start,
+                     (int)(start - path) + 1, index ? "[" : ".", strtol(start, NULL, 10), index ? "]" : "");
+            return -1;
+        }
         if (n == maxseg || k >= sizeof seg[0].key) {
             snprintf(why, whysz, "path too deep or a name too long");
             return -1;

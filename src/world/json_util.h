@@ -23,7 +23,7 @@ typedef struct json_ctx {
     size_t errsz;
     bool failed;
     int nnotes; ///< queued notes (json_note), sent by json_flush_notes
-    char notes[JSON_MAX_NOTES][200];
+    char notes[JSON_MAX_NOTES][400]; // a note that says what will happen takes up to ~300 characters
 } json_ctx;
 
 /// Record an error "file: path: message" (printf-style message). First one wins.

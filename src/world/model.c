@@ -9,6 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #ifndef CRANESIM_ASSETS_DIR
@@ -140,6 +142,49 @@ static int ls_section_fault(json_ctx* c, const hyd_model* m) {
     return bad;
 }
 
+// Whether port k of a component of type t can put oil into its node: an
+// outlet of a pump, relief, check or compensator, either end of an orifice,
+// hose, counterbalance valve or accumulator, and a valve's T, A or B (a
+// series circuit feeds one valve from another's work port). Not: a valve's
+// P (it draws from it), an inlet, and the signal ports of shuttles, LS
+// pumps, compensators and counterbalance pilots.
+static int port_feeds(hyd_type t, int k) {
+    switch (t) {
+    case HYD_PUMP:
+    case HYD_LS_PUMP:
+    case HYD_RELIEF:
+    case HYD_CHECK:
+    case HYD_COMPENSATOR: return k == 1;
+    case HYD_ORIFICE:
+    case HYD_HOSE:
+    case HYD_ACCUMULATOR: return 1;
+    case HYD_COUNTERBALANCE: return k == 0 || k == 1;
+    case HYD_VALVE: return k != 0;
+    default: return 0;
+    }
+}
+
+// A valve's P must be fed: a node that only valves draw from (and reliefs
+// drain) holds whatever it had at the start, so the valve has no supply and
+// its cylinder moves only by that trapped oil. That is the load-sensing
+// crane with its compensators deleted: a wiring mistake, never a design.
+// A node a component owns (a hose's volume, a chamber) is fed by it; the
+// tank is a fixed pressure. Returns the first such valve, or -1.
+static int valve_unfed(const hyd_model* m) {
+    const int nc = hyd_model_ncomp(m);
+    for (int v = 0; v < nc; ++v) {
+        if (hyd_model_comp_type(m, v) != HYD_VALVE) continue;
+        const int p = hyd_model_port_node(m, v, 0);
+        if (p < 0 || hyd_model_node_role(m, p) == HYD_NODE_TANK || hyd_model_node_owner(m, p) >= 0) continue;
+        int fed = 0;
+        for (int k = 0; k < nc && !fed; ++k)
+            for (int j = 0; j < 4 && !fed; ++j)
+                fed = hyd_model_port_node(m, k, j) == p && port_feeds(hyd_model_comp_type(m, k), j);
+        if (!fed) return v;
+    }
+    return -1;
+}
+
 static double comp_param(const hyd_model* m, int comp, const char* field) {
     char path[160];
     double v = NAN;
@@ -187,6 +232,35 @@ static void ls_param_notes(json_ctx* c, const hyd_model* m) {
                           "setting <= 0 and the section no flow",
                           a, hyd_model_comp_name(m, p), b);
             }
+        }
+    }
+}
+
+// A main relief (on a pressure-compensated pump's outlet) that cracks below
+// the pump's setting plus its band opens before the pump destrokes: the
+// relief, not the pump, sets the pressure, and the delivery the valves do not
+// take goes over it to the tank. A note, not a refusal: that is how a fixed
+// pump with a relief is modelled (a pump setting above the relief), and a
+// sweep over p_crack must be able to cross the setting. The note says what
+// will happen, in MPa (main relief at 5 MPa under a 20 MPa pump: open 17 s of
+// the 20 s ramp, the lift pressure held near 6 MPa).
+static void pump_relief_notes(json_ctx* c, const hyd_model* m) {
+    const int nc = hyd_model_ncomp(m);
+    for (int p = 0; p < nc; ++p) {
+        if (hyd_model_comp_type(m, p) != HYD_PUMP) continue;
+        const int out = hyd_model_port_node(m, p, 1);
+        const double set = comp_param(m, p, "p_set"), band = comp_param(m, p, "band");
+        for (int k = 0; k < nc; ++k) {
+            if (hyd_model_comp_type(m, k) != HYD_RELIEF || hyd_model_port_node(m, k, 0) != out) continue;
+            const double crack = comp_param(m, k, "p_crack"), over = comp_param(m, k, "dp_override");
+            if (!(crack < set + band)) continue;
+            char f[80];
+            snprintf(f, sizeof f, "hydraulics.components[%d].p_crack", k);
+            json_note(c, f,
+                      "%.3g MPa is below the setting of pump '%s' plus its band (%.3g + %.3g MPa): the relief, not "
+                      "the pump, limits the pressure to about %.3g MPa, and the pump's flow the valves do not take "
+                      "goes over it to the tank",
+                      crack / 1e6, hyd_model_comp_name(m, p), set / 1e6, band / 1e6, (crack + over) / 1e6);
         }
     }
 }
@@ -330,7 +404,19 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
             goto fail;
         }
         if (ls_section_fault(&c, m->hyd)) goto fail;
+        const int unfed = valve_unfed(m->hyd);
+        if (unfed >= 0) {
+            char f[64];
+            snprintf(f, sizeof f, "hydraulics.components[%d].P", unfed);
+            json_fail(&c, f,
+                      "node '%s' is fed by nothing (no pump, compensator, hose or other line puts oil into it): "
+                      "valve '%s' has no supply",
+                      hyd_model_node_name(m->hyd, hyd_model_port_node(m->hyd, unfed, 0)),
+                      hyd_model_comp_name(m->hyd, unfed));
+            goto fail;
+        }
         ls_param_notes(&c, m->hyd);
+        pump_relief_notes(&c, m->hyd);
         json_flush_notes(&c);
     }
 
@@ -357,7 +443,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         double AA, AB;
         hyd_model_cylinder_geometry(m->hyd, m->cyl[k], &AA, &AB, &m->stroke[k]);
     }
-    char cerr[256];
+    char cerr[512];
     if (crane_mech_check(me, m->stroke, cerr, (int)sizeof cerr)) {
         snprintf(err, errsz, "%s: %s", file, cerr);
         goto fail;
@@ -410,8 +496,52 @@ static int first_bad_set(const char* path, const char* file, const char* const* 
     return -1;
 }
 
-model* model_load(const char* path, const char* const* sets, int nset, char* err, size_t errsz) {
-    if (!path) path = model_default_path();
+const char* model_path(const char* arg, char* buf, size_t n) {
+    if (!arg) return model_default_path();
+    struct stat st;
+    const size_t L = strlen(arg);
+    if ((stat(arg, &st) == 0 && S_ISREG(st.st_mode)) || strchr(arg, '/') || (L >= 5 && !strcmp(arg + L - 5, ".json")))
+        return arg;
+    snprintf(buf, n, "%s/models/%s.json", model_assets_dir(), arg);
+    return buf;
+}
+
+static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
+
+// A name (model_path) that is no model in the assets: say which there are,
+// instead of "cannot open". Returns 1 with the message, else 0.
+static int missing_named_model(const char* arg, const char* path, char* err, size_t errsz) {
+    struct stat st;
+    if (!arg || path == arg || stat(path, &st) == 0) return 0;
+    char folder[512];
+    snprintf(folder, sizeof folder, "%s/models", model_assets_dir());
+    char* names[64];
+    int k = 0;
+    DIR* d = opendir(folder);
+    for (struct dirent* e; d && k < 64 && (e = readdir(d));) {
+        const size_t L = strlen(e->d_name);
+        if (L > 5 && !strcmp(e->d_name + L - 5, ".json") && (names[k] = malloc(L - 4))) {
+            snprintf(names[k], L - 4, "%s", e->d_name);
+            ++k;
+        }
+    }
+    if (d) closedir(d);
+    qsort(names, (size_t)k, sizeof *names, cmp_str);
+    char list[512] = "";
+    for (int i = 0; i < k; ++i) {
+        const size_t L = strlen(list);
+        snprintf(list + L, sizeof list - L, "%s%s", i ? ", " : "", names[i]);
+        free(names[i]);
+    }
+    snprintf(err, errsz, "%s %s: no such file or model (models: %s; or the path of a model file)",
+             sim_param_name(SIM_PARAM_MODEL), arg, k ? list : "none");
+    return 1;
+}
+
+model* model_load(const char* arg, const char* const* sets, int nset, char* err, size_t errsz) {
+    char buf[512];
+    const char* path = model_path(arg, buf, sizeof buf);
+    if (missing_named_model(arg, path, err, errsz)) return NULL;
     cJSON* root = load_with_sets(path, sets, nset, err, errsz);
     if (!root) return NULL;
     const char* base = strrchr(path, '/');
@@ -431,6 +561,7 @@ void model_free(model* m) {
     if (!m) return;
     hyd_model_free(m->hyd);
     cJSON_Delete(m->json);
+    cJSON_Delete(m->world_bursts);
     free(m);
 }
 

@@ -22,12 +22,20 @@ typedef struct model {
     int valve[2];        ///< hydraulic valve index of actuator k
     double stroke[2];    ///< cylinder strokes [m]
     cJSON* json;         ///< the document after --set overrides (owned), for saving
+    /// Hose-burst orifices ("fault<i>_burst") at nodes the model's circuit
+    /// lacks, for the world's circuit to add (engine_fault_model; the sandbox
+    /// adds the slew's). Owned; NULL when none. A backend without a world
+    /// circuit refuses a model that has them (engine_world_bursts).
+    cJSON* world_bursts;
+    char world_bursts_src[128]; ///< the scenario file they come from (messages)
 } model;
 
 /// Load a model file and apply "path=value" overrides (see json_set_path) in
 /// order. NULL path loads the built-in default (assets/models/hiab031.json as
-/// found by model_default_path). Returns NULL with one line
-/// "file: field: problem" in err.
+/// found by model_default_path); a path without '/' that is no file and does
+/// not end in .json is a name in <assets>/models (model_path). Returns NULL
+/// with one line "file: field: problem" in err (a name that is no model
+/// lists the models there).
 model* model_load(const char* path, const char* const* sets, int nset, char* err, size_t errsz);
 
 /// Build from a parsed document (ownership of root passes to the model, also
@@ -61,6 +69,11 @@ double* model_param_ptr(crane_mech* me, int k);
 /// The default model file: $CRANESIM_ASSETS/models/hiab031.json, else the
 /// source tree's assets folder compiled in, else ./assets/models/hiab031.json.
 const char* model_default_path(void);
+
+/// The file a model argument names: arg itself if it is a regular file, has
+/// a '/' or ends in ".json", else <assets>/models/<arg>.json in buf (as
+/// scenarios and worlds are named). NULL arg: model_default_path().
+const char* model_path(const char* arg, char* buf, size_t n);
 
 /// The assets folder in use (same search as model_default_path).
 const char* model_assets_dir(void);

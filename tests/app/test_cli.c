@@ -136,6 +136,17 @@ static void test_bad_set(void) {
         CHECK(rc == 2 && strstr(out, quoted) && cli_count_lines(out) == 1, "--set '%s': exit %d, want 2 naming it: %s",
               junk[i], rc, out);
     }
+    // An index with a leading zero is refused, not read as another index
+    // (links[01] was links[1]).
+    const char* const zero[] = {"mechanics.links[01].mass=200", "mechanics.links.01.mass=200",
+                                "mechanics.links[00].mass=200"};
+    for (size_t i = 0; i < sizeof zero / sizeof zero[0]; ++i) {
+        char a[512];
+        snprintf(a, sizeof a, "run --quiet --scenario hold --duration 0.01 --out /dev/null --set '%s'", zero[i]);
+        int rc = cli_run(a, out, sizeof out);
+        CHECK(rc == 2 && strstr(out, "leading zero") && cli_count_lines(out) == 1, "--set '%s': exit %d: %s", zero[i],
+              rc, out);
+    }
     // A range error found by the loader says which --set caused it.
     CHECK(cli_run("run --quiet --scenario hold --duration 0.01 --out /dev/null --set hydraulics.components.lift_cyl.bore=-0.1",
               out, sizeof out) == 2 &&

@@ -68,9 +68,37 @@ static void test_compare_mixed_pairs(void) {
     CHECK(rc == 2 && strstr(out, "--dt and --dts") && cli_count_lines(out) == 1, "rc %d: %s", rc, out);
 }
 
+// A flag takes =1/=true (the flag) and =0/=false (not given); any other
+// value says the flag takes none. "--quiet=1" was an unknown option.
+static void test_flag_values(void) {
+    // Quiet: no summary on stdout+stderr but for notes; not quiet: a summary.
+    int rc = cli_run("run --scenario hold --duration 0.05 --out /dev/null --quiet=1", out, sizeof out);
+    CHECK(rc == 0 && !strstr(out, "unknown") && !strstr(out, "energy:"), "--quiet=1: rc %d: %s", rc, out);
+    rc = cli_run("run --scenario hold --duration 0.05 --out /dev/null --quiet=true --dense-jac=true", out, sizeof out);
+    CHECK(rc == 0 && !strstr(out, "energy:"), "--quiet=true: rc %d: %s", rc, out);
+    rc = cli_run("run --scenario hold --duration 0.05 --out /dev/null --quiet=0", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "energy:"), "--quiet=0 is not quiet: rc %d: %s", rc, out);
+    rc = cli_run("run --scenario hold --duration 0.05 --out /dev/null --quiet=false", out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "energy:"), "--quiet=false is not quiet: rc %d: %s", rc, out);
+    rc = cli_run("run --scenario hold --duration 0.05 --out /dev/null --quiet=yes", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "--quiet takes no value") && strstr(out, "'yes'") && cli_count_lines(out) == 1,
+          "--quiet=yes: rc %d: %s", rc, out);
+    // A command's own flag, and an unknown one stays unknown (=0 too: never
+    // dropped without a word).
+    rc = cli_run("sweep --scenario hold --duration 0.05 --param hydraulics.fluid.bulk_modulus=1e9:1.2e9:2 "
+                 "--threads 1 --out /dev/null --fail-fast=1 -q",
+                 out, sizeof out);
+    CHECK(rc == 0 && !strstr(out, "unknown"), "--fail-fast=1: rc %d: %s", rc, out);
+    rc = cli_run("run --scenario hold --duration 0.05 --out /dev/null --nosuch=0", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "unknown option '--nosuch=0'"), "--nosuch=0: rc %d: %s", rc, out);
+    rc = cli_run("run --scenario hold --duration 0.05 --out /dev/null --fail-fast=0", out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "unknown option"), "run has no --fail-fast: rc %d: %s", rc, out);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_repeated_option_refused);
     RUN_TEST(test_headless_window_options_noted);
     RUN_TEST(test_compare_mixed_pairs);
+    RUN_TEST(test_flag_values);
     TEST_MAIN_END();
 }

@@ -272,6 +272,39 @@ static void test_ls_pump_cutoff(void) {
     }
 }
 
+// A cut-off at or below the margin is refused by the component's own rule,
+// at compile and as a live edit (the pump would destroke before standby).
+static void test_ls_pump_cutoff_below_margin(void) {
+    hyd_builder* b = hyd_builder_create();
+    add_tank(b, "t", PT);
+    add_volume(b, "sig", 1e-4);
+    add_volume(b, "pl", 1e-3);
+    hyd_ls_pump_def p = hyd_default_ls_pump_def();
+    p.name = "pump", p.inlet = "t", p.outlet = "pl", p.ls = "sig", p.q_max = 1e-3;
+    p.margin = 2e6, p.p_cutoff = 1e6;
+    hyd_add(b, HYD_LS_PUMP, &p);
+    char err[300] = "";
+    hyd_model* m = hyd_compile(b, err, sizeof err);
+    CHECK(!m && strstr(err, "p_cutoff") && strstr(err, "must be above the margin (2e6 Pa), got 1e6 Pa"), "%s", err);
+    hyd_model_free(m);
+    hyd_builder_free(b);
+    // The default (22 MPa over 2 MPa) compiles; a margin raised to the
+    // cut-off is refused, one just below it taken.
+    b = hyd_builder_create();
+    add_tank(b, "t", PT);
+    add_volume(b, "sig", 1e-4);
+    add_volume(b, "pl", 1e-3);
+    p.p_cutoff = 22e6;
+    hyd_add(b, HYD_LS_PUMP, &p);
+    m = hyd_compile(b, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    hyd_builder_free(b);
+    if (!m) return;
+    CHECK(hyd_model_set(m, "pump.p_cutoff", 2e6, err, sizeof err) != 0 && strstr(err, "above the margin"), "%s", err);
+    CHECK(hyd_model_set(m, "pump.p_cutoff", 2.1e6, err, sizeof err) == 0, "%s", err);
+    hyd_model_free(m);
+}
+
 // Standby with the pump's internal leakage: every section closed (no load
 // orifice), the LS line held at a load pressure. The leak c (p_out - p_in)
 // is the only flow out of the pump line, so at steady state the pump
@@ -979,6 +1012,7 @@ static void test_json(void) {
 int main(int argc, char** argv) {
     RUN_TEST(test_ls_pump_margin);
     RUN_TEST(test_ls_pump_cutoff);
+    RUN_TEST(test_ls_pump_cutoff_below_margin);
     RUN_TEST(test_ls_pump_standby);
     RUN_TEST(test_ls_pump_jacobian);
     RUN_TEST(test_shuttle);
