@@ -4,10 +4,12 @@
   random_drives.py gen SEED [--duration T] [--out FILE]
       write the scenario of SEED (JSON) to FILE or stdout
   random_drives.py run --seeds 1-10[,12,...] [--model M ...] [--duration T]
-                       [--cranesim PATH] [--keep DIR] [-- extra run options]
+                       [--stop T] [--cranesim PATH] [--keep DIR] [-- extra run options]
       generate each seed's scenario, run `cranesim run` on it with each model,
       print one line per drive and a summary per model; exit 1 when a drive
       failed (cranesim exit 1), 2 on bad usage or a refused scenario.
+      --stop T runs only the first T seconds of the T-second scenarios
+      (the same drive, cut short: --duration would make other scenarios).
 
 A drive is an operator working the sticks at random for T seconds (default
 120) in the sandbox world: lift, jib and slew each hold a random opening for
@@ -181,6 +183,7 @@ def main(argv):
     r.add_argument("--seeds", required=True, help="e.g. 1-10 or 3,7,12-14")
     r.add_argument("--model", action="append", help="model file (repeatable; default: cranesim's default model)")
     r.add_argument("--duration", type=float, default=120.0)
+    r.add_argument("--stop", type=float, help="stop each run at this time [s] (cranesim run --duration)")
     r.add_argument("--cranesim", default="build/cranesim")
     r.add_argument("--keep", help="write the scenarios (and the last CSV) to this folder")
     r.add_argument("extra", nargs="*", help="after --: more `cranesim run` options (e.g. --dt 5e-5)")
@@ -199,6 +202,12 @@ def main(argv):
     if not (0 < a.duration <= 3600):
         print("random_drives.py: --duration: must be in (0, 3600] s, got %g" % a.duration, file=sys.stderr)
         return 2
+    if a.stop is not None:
+        if not (0 < a.stop <= a.duration):
+            print("random_drives.py: --stop: must be in (0, %g] s (the drives' duration), got %g" % (a.duration, a.stop),
+                  file=sys.stderr)
+            return 2
+        a.extra = ["--duration", repr(a.stop)] + a.extra
     return cmd_run(a)
 
 

@@ -157,6 +157,15 @@ typedef struct hyd_solver_opts {
     /// pressures of a run summary). NULL (default): no call, no cost.
     void (*on_step)(void* user, double t, const double* y);
     void* on_step_user;
+    /// Fixed-step methods: a step whose W is singular, whose new state is
+    /// not finite or (with hyd_problem.outside) leaves the domain is taken
+    /// again as 2, 4, ... 2^retry_halvings sub-steps with a fresh J each
+    /// (default 4: down to h/16); 0: no retry. A singular or non-finite
+    /// step that still fails at the finest level is reported as before
+    /// (hyd_solver_bad_state names the state and time); one that only
+    /// leaves the domain is accepted at the finest level (docs/solvers.md,
+    /// "Step failures of the fixed-step methods").
+    int retry_halvings;
 } hyd_solver_opts;
 
 hyd_solver_opts hyd_default_solver_opts(void);
@@ -170,6 +179,8 @@ typedef struct hyd_solver_stats {
     long jevents;   ///< of them, taken early because hyd_problem.events reported a switch
     long lus;       ///< LU factorisations of W (a block-diagonal W counts once)
     long outside;   ///< trial steps rejected for leaving the domain (hyd_problem.outside; adaptive)
+    long retried;   ///< fixed steps retried in sub-steps (hyd_solver_opts.retry_halvings)
+    long substeps;  ///< sub-steps those retries took (all levels tried)
 } hyd_solver_stats;
 
 enum {

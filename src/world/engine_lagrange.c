@@ -620,8 +620,11 @@ static void lag_describe(const sim_opts* o, engine_desc* d) {
 
 static void lag_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n) {
     (void)o;
-    snprintf(buf, n, "%ld steps, %ld rejected, %ld f evals, %ld LU", r->stats.steps, r->stats.rejected,
-             r->stats.fevals, r->stats.lus);
+    const int k = snprintf(buf, n, "%ld steps, %ld rejected, %ld f evals, %ld LU", r->stats.steps,
+                           r->stats.rejected, r->stats.fevals, r->stats.lus);
+    // A fixed step the method could not take whole (docs/solvers.md).
+    if (r->stats.retried > 0 && k >= 0 && (size_t)k < n)
+        snprintf(buf + k, n - (size_t)k, ", %ld retried as %ld shorter steps", r->stats.retried, r->stats.substeps);
 }
 
 const engine_ops engine_lagrange_ops = {
