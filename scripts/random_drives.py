@@ -122,7 +122,7 @@ def parse_seeds(text):
 
 def run_one(cranesim, scen_path, model, extra, csv_path):
     """Runs one drive; returns (exit code, wall s, failure line or '')."""
-    cmd = [cranesim, "run", "--scenario", scen_path, "--out", csv_path, "--every", "0.1", "--quiet"]
+    cmd = [cranesim, "run", "--scenario", scen_path, "--out", csv_path, "--every", "0.1"]
     if model:
         cmd += ["--model", model]
     cmd += extra
@@ -130,7 +130,11 @@ def run_one(cranesim, scen_path, model, extra, csv_path):
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     wall = time.monotonic() - t0
     lines = [l for l in p.stderr.splitlines() if l.strip() and "note:" not in l]
-    return p.returncode, wall, (lines[-1] if lines else "")
+    # The summary's work line says when fixed steps had to be retried in
+    # sub-steps (docs/solvers.md, "Step failures of the fixed-step methods").
+    m = re.search(r"(\d+) retried as (\d+) shorter steps", p.stdout)
+    retried = "%s retried (%s sub-steps)" % (m.group(1), m.group(2)) if m else ""
+    return p.returncode, wall, (lines[-1] if lines else ""), retried
 
 
 def cmd_run(a):
@@ -152,11 +156,12 @@ def cmd_run(a):
         with open(sp, "w") as f:
             json.dump(scenario(seed, a.duration), f, indent=1)
         for m in models:
-            rc, wall, msg = run_one(a.cranesim, sp, m, a.extra, os.path.join(work, "run.csv"))
+            rc, wall, msg, retried = run_one(a.cranesim, sp, m, a.extra, os.path.join(work, "run.csv"))
             name = os.path.splitext(os.path.basename(m))[0] if m else "default"
             status = {0: "ok", 1: "FAILED"}.get(rc, "exit %d" % rc)
-            print("seed %d model %s: %s (%.1f s wall)%s" % (seed, name, status, wall, (": " + msg) if rc else ""),
-                  flush=True)
+            print("seed %d model %s: %s (%.1f s wall%s)%s" % (seed, name, status, wall,
+                                                            (", steps " + retried) if retried else "",
+                                                            (": " + msg) if rc else ""), flush=True)
             if rc == 1:
                 fails[m].append(seed)
             elif rc != 0:
