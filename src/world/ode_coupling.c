@@ -123,12 +123,16 @@ static int settle(void* user, double t, double* y) {
 
 // hyd_problem.outside: a node pressure below absolute zero (the adaptive
 // methods then retry with a shorter step; see lagrange_sim.c).
+// Every fixed sub-step asks too (the solver's retry of a failed step), so
+// the node pressure states are listed once (w->pres) and tested in one
+// pass without a branch per state.
 static int outside(void* user, const double* y) {
     const ode_world* w = user;
-    for (int i = 0; i < hyd_model_nnode(w->hm); ++i) {
-        const int s = hyd_model_node_state(w->hm, i);
-        if (s >= 0 && !(y[s] >= 0.0)) return s + 1;
-    }
+    int any = 0;
+    for (int k = 0; k < w->npres; ++k) any |= !(y[w->pres[k]] >= 0.0);
+    if (!any) return 0;
+    for (int k = 0; k < w->npres; ++k)
+        if (!(y[w->pres[k]] >= 0.0)) return w->pres[k] + 1;
     return 0;
 }
 
@@ -382,6 +386,11 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, con
     }
     w->hp.n = w->nh;
     w->hp.user = w;
+    w->npres = 0;
+    for (int i = 0; i < hyd_model_nnode(w->hm); ++i) {
+        const int st = hyd_model_node_state(w->hm, i);
+        if (st >= 0 && w->npres < OW_MAX_HYD) w->pres[w->npres++] = st;
+    }
     w->hp.outside = outside;
     w->hp.settle = settle;
     fused_setup(w);
