@@ -431,7 +431,7 @@ static int current_f(hyd_solver* s, double t, const double* y, const double** f0
 // One trial of a fixed step of h from (t, y) into ynew, nothing committed.
 // force_j: take a new J whatever the schedule says (a retry). Returns
 // HYD_OK, an error of f or W, HYD_ERR_NONFINITE (bad_i, bad_t set) or
-// HYD_ERR_DOMAIN (a finite state outside hyd_problem.outside; bad_i, bad_t set).
+// HYD_ERR_DOMAIN (a finite state hyd_problem.implausible refuses; bad_i, bad_t set).
 static int fixed_trial(hyd_solver* s, double t, const double* y, double h, double t_new, int force_j,
                        double* ynew) {
     const int n = s->n;
@@ -464,10 +464,10 @@ static int fixed_trial(hyd_solver* s, double t, const double* y, double h, doubl
         s->bad_t = t_new;
         return HYD_ERR_NONFINITE;
     }
-    // Only a retry can do anything about a state outside the domain, so
-    // the test costs nothing when retries are off.
-    if (s->o.retry_halvings > 0 && s->p->outside) {
-        const int out = s->p->outside(s->p->user, ynew);
+    // Only a retry can do anything about an implausible state, so the test
+    // costs nothing when retries are off.
+    if (s->o.retry_halvings > 0 && s->p->implausible) {
+        const int out = s->p->implausible(s->p->user, ynew);
         if (out) {
             s->bad_i = out - 1;
             s->bad_t = t_new;
@@ -483,10 +483,10 @@ static int fixed_trial(hyd_solver* s, double t, const double* y, double h, doubl
 // near 1/gamma that makes W singular) is legitimate physics the step is
 // merely too long for. The first level whose sub-steps all pass gives the
 // new state in ynew. rc0 is the full step's failure. Returns HYD_OK, or
-// the failure of the finest level; a finest level that failed only by
-// leaving the domain (finite, W regular) is accepted with its state, as
-// the full step was before retries existed: the caller's checks judge how
-// far outside it is. The sub-steps' own times are t + k h / m (the last
+// the failure of the finest level; a finest level that failed only by an
+// implausible state (finite, W regular) is accepted with that state, as
+// the full step was before retries existed: the caller's checks report it
+// (the crane's runs fail there, naming the state and time). The sub-steps' own times are t + k h / m (the last
 // one lands on t_new exactly).
 static int fixed_retry(hyd_solver* s, double t, const double* y, double h, double t_new, int rc0,
                        double* ynew) {

@@ -136,6 +136,19 @@ static int outside(void* user, const double* y) {
     return 0;
 }
 
+// hyd_problem.implausible: a node pressure more than 0.1 MPa below absolute
+// zero, where the run checks would stop the run (sim.c, P_IMPLAUSIBLE): the
+// fixed sub-step is retried shorter first (solver.c).
+static int implausible(void* user, const double* y) {
+    const ode_world* w = user;
+    int any = 0;
+    for (int k = 0; k < w->npres; ++k) any |= !(y[w->pres[k]] > -1e5);
+    if (!any) return 0;
+    for (int k = 0; k < w->npres; ++k)
+        if (!(y[w->pres[k]] > -1e5)) return w->pres[k] + 1;
+    return 0;
+}
+
 // (Re)pack the straight-line kernel for the present parameters, or take
 // the fast kernel when the circuit does not have its shape.
 static void fused_setup(ode_world* w) {
@@ -392,6 +405,7 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, con
         if (st >= 0 && w->npres < OW_MAX_HYD) w->pres[w->npres++] = st;
     }
     w->hp.outside = outside;
+    w->hp.implausible = implausible;
     w->hp.settle = settle;
     fused_setup(w);
     const int adaptive = hyd_method_is_adaptive(w->opt.solver);

@@ -492,7 +492,47 @@ static int grow_jac(void* user, double t, const double* y, double* J) {
     return 0;
 }
 
+// y' = -60 y, and a state below -0.1 is implausible: Krus at h = 0.1
+// (z = -6) gives R = (1 - 3) / (1 + 3) = -0.5, h/2 gives -0.2 at once
+// (still implausible), h/4 gives R(-1.5) = 0.25 / 1.75 = 1/7 four times.
+static int decay_f(void* user, double t, const double* y, double* dy) {
+    (void)user, (void)t;
+    dy[0] = -60.0 * y[0];
+    return 0;
+}
+static int decay_jac(void* user, double t, const double* y, double* J) {
+    (void)user, (void)t, (void)y;
+    J[0] = -60.0;
+    return 0;
+}
+static int below_tenth(void* user, const double* y) {
+    (void)user;
+    return y[0] > -0.1 ? 0 : 1;
+}
+
 static void test_fixed_retry(void) {
+    {
+        hyd_problem p = {0};
+        p.n = 1, p.f = decay_f, p.jac = decay_jac, p.implausible = below_tenth;
+        hyd_solver_opts o = hyd_default_solver_opts();
+        o.h = 0.1;
+        hyd_solver* s = hyd_solver_create(&p, HYD_KRUS, &o);
+        double t = 0.0, y[1] = {1.0};
+        CHECK(hyd_solver_step(s, &t, y, 0.1) == HYD_OK, "implausible step retried");
+        CHECK_NEAR(y[0], 1.0 / 2401.0, 1e-15);
+        CHECK(hyd_solver_get_stats(s)->retried == 1 && hyd_solver_get_stats(s)->substeps == 1 + 4,
+              "h/2 failed at its first sub-step, h/4 took 4: %ld", hyd_solver_get_stats(s)->substeps);
+        hyd_solver_destroy(s);
+        // Still implausible at the finest level (retry_halvings = 1: h/2,
+        // whose first sub-step ends at -0.2): accepted there, as the
+        // caller's checks judge such a state.
+        o.retry_halvings = 1;
+        s = hyd_solver_create(&p, HYD_KRUS, &o);
+        t = 0.0, y[0] = 1.0;
+        CHECK(hyd_solver_step(s, &t, y, 0.1) == HYD_OK, "accepted at the finest level");
+        CHECK_NEAR(y[0], 0.04, 1e-15); // two steps of R(-3) = -0.2
+        hyd_solver_destroy(s);
+    }
     hyd_problem p = {0};
     p.n = 1, p.f = grow_f, p.jac = grow_jac;
     hyd_solver_opts o = hyd_default_solver_opts();
