@@ -73,6 +73,7 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
     so.rtol = o->rtol;
     so.atol = o->atol;
     so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    if (o->no_retry) so.retry_halvings = 0;
     l->solver = hyd_solver_create(&l->prob, o->solver, &so);
     if (!l->solver) {
         snprintf(err, errsz, "cannot create the %s solver", hyd_method_name(o->solver));
@@ -340,6 +341,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     so.atol = o->atol;
     so.h_max = 0.5;
     so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    if (o->no_retry) so.retry_halvings = 0;
     // A fixed-step run ends by construction (check_fixed_step bounds it to
     // 1e12 steps): no per-call budget, which at 1e8 stopped a 1 ns step at
     // 0.1 s. The adaptive budget guards against a controller that stalls.

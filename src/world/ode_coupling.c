@@ -422,6 +422,7 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, con
     if (w->opt.rtol > 0) so.rtol = w->opt.rtol;
     if (w->opt.atol > 0) so.atol = w->opt.atol;
     so.jac_every = adaptive ? 1 : (w->opt.jac_every > 0 ? w->opt.jac_every : 1);
+    if (w->opt.no_retry) so.retry_halvings = 0;
     w->hs = hyd_solver_create(&w->hp, w->opt.solver, &so);
     if (!w->hs) {
         snprintf(err, errsz, "ode world: cannot create the %s solver", hyd_method_name(w->opt.solver));
