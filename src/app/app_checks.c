@@ -126,6 +126,12 @@ void app_note_unused(const char* cmd, unsigned given, const sim_opts* o, int n) 
                     w = buf;
                 }
                 break;
+            case APP_OPT_NO_RETRY:
+                if (is_adaptive(r)) {
+                    snprintf(buf, sizeof buf, "with the adaptive solver %s (fixed-step solvers only)", solver_name(r));
+                    w = buf;
+                }
+                break;
             case APP_OPT_JAC_EVERY:
             case APP_OPT_DENSE_JAC:
                 if (is_adaptive(r)) {

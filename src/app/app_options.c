@@ -43,7 +43,7 @@ int app_parse_double(const char* s, double* v) {
 
 const char* const app_opt_name[APP_OPT_COUNT] = {
     "--model", "--scenario", "--mechanics", "--variant", "--solver", "--dt", "--rtol", "--atol", "--duration",
-    "--every", "--set", "--jac-every", "--load", "--world", "--dt-ode", "--kernel", "--dense-jac", "--quiet"};
+    "--every", "--set", "--jac-every", "--load", "--world", "--dt-ode", "--kernel", "--dense-jac", "--no-retry", "--quiet"};
 
 void app_name_params(void) {
     static const char* names[SIM_PARAM_COUNT];
@@ -288,6 +288,11 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
         c->given |= APP_GIVEN(APP_OPT_DENSE_JAC);
         return 1;
     }
+    if (!strcmp(a, "--no-retry")) {
+        c->sim.no_retry = 1;
+        c->given |= APP_GIVEN(APP_OPT_NO_RETRY);
+        return 1;
+    }
     int k = -1;
     for (int j = 0; j <= APP_OPT_KERNEL; ++j)
         if (!strcmp(a, app_opt_name[j])) k = j;
@@ -393,6 +398,9 @@ static const struct {
     {APP_OPT_RTOL, "  --rtol R, --atol A   adaptive tolerances (default 1e-3, 1e-6)\n"},
     {APP_OPT_JAC_EVERY, "  --jac-every N        fixed-step: new Jacobian every N steps (1..1000000, default 10)\n"},
     {APP_OPT_DENSE_JAC, "  --dense-jac          fixed-step: dense Jacobian instead of the block pattern\n"},
+    {APP_OPT_NO_RETRY, "  --no-retry           fixed-step: report a step that fails (singular W, a non-finite state,\n"
+                       "                       a pressure below -0.1 MPa) at once instead of retrying it as\n"
+                       "                       2..16 shorter steps (docs/solvers.md)\n"},
     {APP_OPT_KERNEL, "  --kernel K           lagrange, when the circuit has the standard shape:\n"
                      "                       split (default): one-pass circuit, block-eliminated W, and\n"
                      "                         for krus/ros2 the mechanics once per step (docs/lagrange.md);\n"
@@ -422,7 +430,7 @@ void app_common_help(FILE* f, bool with_solver) {
     unsigned all = APP_GIVEN(APP_OPT_COUNT) - 1u;
     const unsigned solver = APP_GIVEN(APP_OPT_SOLVER) | APP_GIVEN(APP_OPT_DT) | APP_GIVEN(APP_OPT_RTOL) |
                             APP_GIVEN(APP_OPT_JAC_EVERY) | APP_GIVEN(APP_OPT_DENSE_JAC) |
-                            APP_GIVEN(APP_OPT_KERNEL) | APP_GIVEN(APP_OPT_DURATION) | APP_GIVEN(APP_OPT_EVERY);
+                            APP_GIVEN(APP_OPT_NO_RETRY) | APP_GIVEN(APP_OPT_KERNEL) | APP_GIVEN(APP_OPT_DURATION) | APP_GIVEN(APP_OPT_EVERY);
     app_options_help(f, with_solver ? all : all & ~solver);
 }
 

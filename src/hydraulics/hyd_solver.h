@@ -89,6 +89,14 @@ typedef struct hyd_problem {
     /// solution never gets there, a step too long for its error estimate
     /// can). NULL: every finite y is admissible.
     int (*outside)(void* user, const double* y);
+    /// Optional, for the fixed-step methods: returns 0, else 1 + the index
+    /// of a state no step may produce at all (the crane's circuits: an
+    /// absolute pressure more than 0.1 MPa below zero, where the run checks
+    /// fail a run). Such a step is retried in sub-steps like a non-finite
+    /// one (hyd_solver_opts.retry_halvings). Shallower exits from the
+    /// domain (a Krus step ringing a few kPa below zero at a stiff event)
+    /// are left to the caller, as before. NULL: only W and finiteness.
+    int (*implausible)(void* user, const double* y);
     /// Optional event counter for the Jacobian schedule. Called with the
     /// state (t, y) at the start of a step, it returns a count that the
     /// problem increases whenever f has switched since its previous call: a
@@ -157,6 +165,15 @@ typedef struct hyd_solver_opts {
     /// pressures of a run summary). NULL (default): no call, no cost.
     void (*on_step)(void* user, double t, const double* y);
     void* on_step_user;
+    /// Fixed-step methods: a step whose W is singular, whose new state is
+    /// not finite or (hyd_problem.implausible) implausible is taken
+    /// again as 2, 4, ... 2^retry_halvings sub-steps with a fresh J each
+    /// (default 4: down to h/16); 0: no retry. A singular or non-finite
+    /// step that still fails at the finest level is reported as before
+    /// (hyd_solver_bad_state names the state and time); one that is only
+    /// implausible is accepted at the finest level (docs/solvers.md,
+    /// "Step failures of the fixed-step methods").
+    int retry_halvings;
 } hyd_solver_opts;
 
 hyd_solver_opts hyd_default_solver_opts(void);
@@ -170,6 +187,8 @@ typedef struct hyd_solver_stats {
     long jevents;   ///< of them, taken early because hyd_problem.events reported a switch
     long lus;       ///< LU factorisations of W (a block-diagonal W counts once)
     long outside;   ///< trial steps rejected for leaving the domain (hyd_problem.outside; adaptive)
+    long retried;   ///< fixed steps retried in sub-steps (hyd_solver_opts.retry_halvings)
+    long substeps;  ///< sub-steps those retries took (all levels tried)
 } hyd_solver_stats;
 
 enum {

@@ -45,6 +45,14 @@ int hyd_solver_step_quadrature(hyd_solver* s, double t0, const double* y0, const
     for (int l = 0; l < nq; ++l) dq[l] = 0.0;
     if (!(h > 0.0)) return HYD_OK; // no step taken yet
 
+    if (s->last_split) {
+        // A fixed step retried in sub-steps (solver.c, fixed_retry): no one
+        // set of stages describes it, so the trapezoid of P at its ends,
+        // which is what Krus's own quadrature is (below). Rare: a step the
+        // method could not take whole.
+        for (int l = 0; l < nq; ++l) dq[l] = 0.5 * h * (P0[l] + P1[l]);
+        return HYD_OK;
+    }
     if (s->method == HYD_RK4) {
         // The explicit method's own weights at its stage points; its k_2..k_4
         // hold f there and fc_f the f0 of the step (fixed_step).

@@ -53,6 +53,7 @@ hyd_solver_opts hyd_default_solver_opts(void) {
     o.jac_max_age = 0.01; // older J diverged at larger h [s]; <= 0: no limit
     o.max_steps = 100000000;
     o.h_hold = 0.0;       // no step hysteresis
+    o.retry_halvings = 4; // a failed fixed step is retried down to h/16
     o.out_states = NULL;  // interpolate every state at output times
     o.n_out_states = 0;
     return o;
@@ -427,42 +428,112 @@ static int current_f(hyd_solver* s, double t, const double* y, const double** f0
     return HYD_OK;
 }
 
-// One fixed step with the bookkeeping shared by step() and the fixed driver.
-// On failure y and t are untouched.
-static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_new) {
+// One trial of a fixed step of h from (t, y) into ynew, nothing committed.
+// force_j: take a new J whatever the schedule says (a retry). Returns
+// HYD_OK, an error of f or W, HYD_ERR_NONFINITE (bad_i, bad_t set) or
+// HYD_ERR_DOMAIN (a finite state hyd_problem.implausible refuses; bad_i, bad_t set).
+static int fixed_trial(hyd_solver* s, double t, const double* y, double h, double t_new, int force_j,
+                       double* ynew) {
     const int n = s->n;
-    // Fixed-step methods never leave f(t_{n+1}, y_{n+1}) behind, so skip the
-    // cache check (and its copy of y) unless an adaptive run just filled it.
     int rc;
+    if (force_j) s->j_force = 1;
     const int ws = s->p->wstep && (s->method == HYD_KRUS || s->method == HYD_ROS2);
     if (ws) {
         // The problem's own step kernel (hyd_problem.wstep).
-        const int need_j = jacobian_due(s, *t, y);
-        rc = s->p->wstep(s->p->user, *t, y, h, hydKrusGamma(s->method), need_j, s->ynew);
+        const int need_j = jacobian_due(s, t, y);
+        rc = s->p->wstep(s->p->user, t, y, h, hydKrusGamma(s->method), need_j, ynew);
         if (rc < 0) return rc;
         s->st.fevals += 2;
         s->st.lus += rc;
-        if (need_j) mark_jacobian(s, *t);
+        if (need_j) mark_jacobian(s, t);
     } else {
+        // Fixed-step methods never leave f(t_{n+1}, y_{n+1}) behind, so skip
+        // the cache check (and its copy of y) unless an adaptive run just
+        // filled it.
         const double* f0 = s->fc_f;
-        rc = s->fc_valid ? current_f(s, *t, y, &f0) : hydEvalF(s, *t, y, s->fc_f);
+        rc = s->fc_valid ? current_f(s, t, y, &f0) : hydEvalF(s, t, y, s->fc_f);
         if (rc != HYD_OK) return rc;
-        rc = trial_step(s, *t, y, f0, h, s->ynew, NULL);
+        s->fc_valid = 0; // f0 is of (t, y): a retry from the same point re-evaluates it anyway
+        rc = trial_step(s, t, y, f0, h, ynew, NULL);
         if (rc != HYD_OK) return rc;
     }
-    int bad = first_nonfinite(s->ynew, n);
+    s->last_wstep = ws;
+    const int bad = first_nonfinite(ynew, n);
     if (bad >= 0) {
         s->bad_i = bad;
         s->bad_t = t_new;
         return HYD_ERR_NONFINITE;
     }
+    // Only a retry can do anything about an implausible state, so the test
+    // costs nothing when retries are off.
+    if (s->o.retry_halvings > 0 && s->p->implausible) {
+        const int out = s->p->implausible(s->p->user, ynew);
+        if (out) {
+            s->bad_i = out - 1;
+            s->bad_t = t_new;
+            return HYD_ERR_DOMAIN;
+        }
+    }
+    return HYD_OK;
+}
+
+// A failed fixed step of h from (t, y) taken again as 2, 4, ... 2^L
+// sub-steps (L = retry_halvings), each with a fresh J: a stiff transient
+// (a relief or a shuttle switching within one step, a mode with h lambda
+// near 1/gamma that makes W singular) is legitimate physics the step is
+// merely too long for. The first level whose sub-steps all pass gives the
+// new state in ynew. rc0 is the full step's failure. Returns HYD_OK, or
+// the failure of the finest level; a finest level that failed only by an
+// implausible state (finite, W regular) is accepted with that state, as
+// the full step was before retries existed: the caller's checks report it
+// (the crane's runs fail there, naming the state and time). The sub-steps' own times are t + k h / m (the last
+// one lands on t_new exactly).
+static int fixed_retry(hyd_solver* s, double t, const double* y, double h, double t_new, int rc0,
+                       double* ynew) {
+    const int n = s->n;
+    double* ysub = s->yout; // unused by the fixed-step methods
+    int rc = rc0;
+    s->st.retried++;
+    for (int level = 1; level <= s->o.retry_halvings; ++level) {
+        const int m = 1 << level;
+        const double hs = h / m;
+        memcpy(ysub, y, (size_t)n * sizeof *y);
+        double ts = t;
+        rc = HYD_OK;
+        for (int i = 1; i <= m; ++i) {
+            const double tn = i == m ? t_new : t + (double)i * hs;
+            s->st.substeps++;
+            rc = fixed_trial(s, ts, ysub, tn - ts, tn, 1, ynew);
+            if (rc == HYD_ERR_DOMAIN && level == s->o.retry_halvings) rc = HYD_OK; // see above
+            else if (rc != HYD_OK)
+                break;
+            memcpy(ysub, ynew, (size_t)n * sizeof *y);
+            ts = tn;
+        }
+        if (rc == HYD_OK) {
+            memcpy(ynew, ysub, (size_t)n * sizeof *y);
+            s->last_split = 1;
+            return HYD_OK;
+        }
+        if (rc == HYD_ERR_RHS) return rc;
+    }
+    return rc;
+}
+
+// One fixed step with the bookkeeping shared by step() and the fixed driver.
+// On failure y and t are untouched.
+static int fixed_step(hyd_solver* s, double* t, double* y, double h, double t_new) {
+    const int n = s->n;
+    s->last_split = 0;
+    int rc = fixed_trial(s, *t, y, h, t_new, 0, s->ynew);
+    if (rc != HYD_OK && rc != HYD_ERR_RHS && s->o.retry_halvings > 0) rc = fixed_retry(s, *t, y, h, t_new, rc, s->ynew);
+    if (rc != HYD_OK) return rc;
     memcpy(y, s->ynew, (size_t)n * sizeof *y);
     *t = t_new;
     s->fc_valid = 0;
     s->st.steps++;
     s->j_steps++;
     s->last_h = h;
-    s->last_wstep = ws;
     if (s->p->settle) s->p->settle(s->p->user, *t, y);
     return HYD_OK;
 }

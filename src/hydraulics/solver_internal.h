@@ -125,6 +125,7 @@ struct hyd_solver {
     int last_rejected;
     double last_h;   ///< last accepted step [s]
     int last_wstep;  ///< the last step was the problem's wstep (hyd_solver_step_quadrature)
+    int last_split;  ///< the last fixed step was retried in sub-steps (its stages are not one step's)
 
     hyd_solver_stats st;
     int bad_i;

@@ -76,6 +76,7 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
     so.rtol = o->rtol;
     so.atol = o->atol;
     so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    if (o->no_retry) so.retry_halvings = 0;
     l->solver = hyd_solver_create(&l->prob, o->solver, &so);
     if (!l->solver) {
         snprintf(err, errsz, "cannot create the %s solver", hyd_method_name(o->solver));
@@ -344,6 +345,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     so.atol = o->atol;
     so.h_max = 0.5;
     so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    if (o->no_retry) so.retry_halvings = 0;
     // A fixed-step run ends by construction (check_fixed_step bounds it to
     // 1e12 steps): no per-call budget, which at 1e8 stopped a 1 ns step at
     // 0.1 s. The adaptive budget guards against a controller that stalls.
@@ -624,8 +626,11 @@ static void lag_describe(const sim_opts* o, engine_desc* d) {
 
 static void lag_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n) {
     (void)o;
-    snprintf(buf, n, "%ld steps, %ld rejected, %ld f evals, %ld LU", r->stats.steps, r->stats.rejected,
-             r->stats.fevals, r->stats.lus);
+    const int k = snprintf(buf, n, "%ld steps, %ld rejected, %ld f evals, %ld LU", r->stats.steps,
+                           r->stats.rejected, r->stats.fevals, r->stats.lus);
+    // A fixed step the method could not take whole (docs/solvers.md).
+    if (r->stats.retried > 0 && k >= 0 && (size_t)k < n)
+        snprintf(buf + k, n - (size_t)k, ", %ld retried as %ld shorter steps", r->stats.retried, r->stats.substeps);
 }
 
 const engine_ops engine_lagrange_ops = {

@@ -337,8 +337,11 @@ static void ode_describe(const sim_opts* o, engine_desc* d) {
 
 static void ode_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n) {
     const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
-    snprintf(buf, n, "ODE step %g ms, %ld hydraulic %s", o->dt_ode * 1e3, r->stats.steps,
-             adaptive ? "steps" : "sub-steps");
+    const int k = snprintf(buf, n, "ODE step %g ms, %ld hydraulic %s", o->dt_ode * 1e3, r->stats.steps,
+                           adaptive ? "steps" : "sub-steps");
+    // A fixed step the method could not take whole (docs/solvers.md).
+    if (r->stats.retried > 0 && k >= 0 && (size_t)k < n)
+        snprintf(buf + k, n - (size_t)k, ", %ld retried as %ld shorter steps", r->stats.retried, r->stats.substeps);
 }
 
 const engine_ops engine_ode_ops = {

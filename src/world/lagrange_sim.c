@@ -225,10 +225,21 @@ static int lsim_outside(void* user, const double* y) {
     return 0;
 }
 
+// hyd_problem.implausible: an absolute pressure more than 0.1 MPa below
+// zero, where the run checks would stop the run (sim.c, P_IMPLAUSIBLE): the
+// fixed step is retried shorter first (solver.c).
+static int lsim_implausible(void* user, const double* y) {
+    const lsim* s = user;
+    for (int i = 0; i < s->nh; ++i)
+        if (s->is_pressure[i] && !(y[i] > -1e5)) return i + 1;
+    return 0;
+}
+
 hyd_problem lsim_problem(lsim* s, bool blocks) {
     hyd_problem p;
     memset(&p, 0, sizeof p);
     p.outside = lsim_outside;
+    p.implausible = lsim_implausible;
     p.n = s->n;
     const bool fz = s->use_fused && s->have_fused;
     p.f = fz ? lsim_rhs_fused : lsim_rhs;

@@ -125,12 +125,29 @@ static int settle(void* user, double t, double* y) {
 
 // hyd_problem.outside: a node pressure below absolute zero (the adaptive
 // methods then retry with a shorter step; see lagrange_sim.c).
+// Every fixed sub-step asks too (the solver's retry of a failed step), so
+// the node pressure states are listed once (w->pres) and tested in one
+// pass without a branch per state.
 static int outside(void* user, const double* y) {
     const ode_world* w = user;
-    for (int i = 0; i < hyd_model_nnode(w->hm); ++i) {
-        const int s = hyd_model_node_state(w->hm, i);
-        if (s >= 0 && !(y[s] >= 0.0)) return s + 1;
-    }
+    int any = 0;
+    for (int k = 0; k < w->npres; ++k) any |= !(y[w->pres[k]] >= 0.0);
+    if (!any) return 0;
+    for (int k = 0; k < w->npres; ++k)
+        if (!(y[w->pres[k]] >= 0.0)) return w->pres[k] + 1;
+    return 0;
+}
+
+// hyd_problem.implausible: a node pressure more than 0.1 MPa below absolute
+// zero, where the run checks would stop the run (sim.c, P_IMPLAUSIBLE): the
+// fixed sub-step is retried shorter first (solver.c).
+static int implausible(void* user, const double* y) {
+    const ode_world* w = user;
+    int any = 0;
+    for (int k = 0; k < w->npres; ++k) any |= !(y[w->pres[k]] > -1e5);
+    if (!any) return 0;
+    for (int k = 0; k < w->npres; ++k)
+        if (!(y[w->pres[k]] > -1e5)) return w->pres[k] + 1;
     return 0;
 }
 
@@ -384,7 +401,13 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, con
     }
     w->hp.n = w->nh;
     w->hp.user = w;
+    w->npres = 0;
+    for (int i = 0; i < hyd_model_nnode(w->hm); ++i) {
+        const int st = hyd_model_node_state(w->hm, i);
+        if (st >= 0 && w->npres < OW_MAX_HYD) w->pres[w->npres++] = st;
+    }
     w->hp.outside = outside;
+    w->hp.implausible = implausible;
     w->hp.settle = settle;
     fused_setup(w);
     const int adaptive = hyd_method_is_adaptive(w->opt.solver);
@@ -401,6 +424,7 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, con
     if (w->opt.rtol > 0) so.rtol = w->opt.rtol;
     if (w->opt.atol > 0) so.atol = w->opt.atol;
     so.jac_every = adaptive ? 1 : (w->opt.jac_every > 0 ? w->opt.jac_every : 1);
+    if (w->opt.no_retry) so.retry_halvings = 0;
     w->hs = hyd_solver_create(&w->hp, w->opt.solver, &so);
     if (!w->hs) {
         snprintf(err, errsz, "ode world: cannot create the %s solver", hyd_method_name(w->opt.solver));

@@ -46,6 +46,7 @@ typedef struct ode_world_opts {
     double rtol, atol;    ///< adaptive hydraulics: tolerances [-], [state units]; 0: 1e-3, 1e-6
     int dense_jac;        ///< fixed-step: 1 = dense W; 0 (default) = block-diagonal W from the
                           ///< circuit's stiff couplings (W-methods keep their order for any W)
+    int no_retry;         ///< fixed-step methods: no retry of a failed sub-step in shorter ones (sim_opts.no_retry)
     int jac_every;        ///< reuse the hydraulic Jacobian for this many sub-steps; default 10 (1 ms of J age at 0.1 ms; up to 10 ms of age is allowed)
     double q0[2];         ///< initial joint angles q1, q2 [rad], paper convention; default 95, -130 deg
     double slew0;         ///< initial slew angle [rad]; default 0

@@ -220,6 +220,8 @@ struct ode_world {
     int block[OW_MAX_HYD];
     int nh;
     double y[OW_MAX_HYD];
+    int npres;           ///< node pressure states, listed in pres (hyd_problem.outside)
+    int pres[OW_MAX_HYD];
     double th;           ///< hydraulic time [s]
     int nsub;            ///< sub-steps per ODE step
     double u_cmd[ODE_NACT];

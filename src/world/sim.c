@@ -518,6 +518,7 @@ ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* d
     }
     wo.solver = o->solver;
     wo.jac_every = o->jac_every > 0 ? o->jac_every : 1;
+    wo.no_retry = o->no_retry;
     wo.rtol = o->rtol;
     wo.atol = o->atol;
     wo.dense_jac = o->dense_jac;

@@ -50,6 +50,7 @@ typedef struct sim_opts {
     double duration;   ///< [s]; 0 = the scenario's
     bool dense_jac;    ///< fixed-step methods: dense J instead of the block pattern
     int jac_every;     ///< fixed-step methods: J every N steps (default 10)
+    int no_retry;      ///< fixed-step methods: report a failed step at once instead of retrying it in sub-steps (hyd_solver_opts.retry_halvings = 0; tests)
     double load_mass;  ///< tip load [kg]; < 0: the scenario's, else the model's
     const char* world; ///< ode: world file (NULL: assets/worlds/validation.json)
     double dt_ode;     ///< ode: rigid-body step [s] (default 1e-3; hydraulics sub-step at h)

@@ -268,7 +268,9 @@ static void test_gen_nonfinite_jacobian(void) {
     double t = 0.0;
     CHECK(hyd_solver_advance(sv, &t, y, 1e-3) == HYD_ERR_NONFINITE, "the solver does not see the breakdown");
     double tb = -1.0;
-    CHECK(hyd_solver_bad_state(sv, &tb) == want && fabs(tb - 1e-4) < 1e-12, "bad state %d at %g s",
+    // The step is retried in sub-steps down to h/16 before it is reported
+    // (docs/solvers.md): the time is the end of the first h/16 sub-step.
+    CHECK(hyd_solver_bad_state(sv, &tb) == want && fabs(tb - 1e-4 / 16) < 1e-12, "bad state %d at %g s",
           hyd_solver_bad_state(sv, &tb), tb);
     CHECK(isnan(y[ia]) && t == 0.0, "the state before the step is kept");
     hyd_solver_destroy(sv);

@@ -451,14 +451,111 @@ static void test_nonfinite(void) {
             CHECK_NEAR(t_bad, 0.57, 1e-6);
             CHECK(t <= 0.57 && t > 0.57 - 1e-6, "%s stopped at %.12g", hyd_method_name(m), t);
         } else {
-            CHECK_NEAR(t_bad, 0.6, 1e-12); // the step 0.5 -> 0.6 went bad
-            CHECK_NEAR(t, 0.5, 1e-12);     // y kept at the last good state
+            // The step 0.5 -> 0.6 went bad, and so did its retries: the
+            // time is the end of the finest sub-step (h/16) that did,
+            // 0.575, the first after 0.57.
+            CHECK_NEAR(t_bad, 0.575, 1e-12);
+            CHECK_NEAR(t, 0.5, 1e-12); // y kept at the last good state
         }
         CHECK(isfinite(y[0]) && isfinite(y[1]) && isfinite(y[2]), "y kept finite");
         CHECK_NEAR(y[0], t, 1e-9);
         CHECK_NEAR(y[1], t, 1e-9);
         hyd_solver_destroy(s);
+        if (hyd_method_is_adaptive((hyd_method)m)) continue;
+        // Without retries the whole step is the one reported.
+        o.retry_halvings = 0;
+        s = hyd_solver_create(&p, (hyd_method)m, &o);
+        t = 0.0, y[0] = y[1] = 0.0, y[2] = 1.0;
+        rc = hyd_solver_advance(s, &t, y, 1.0);
+        i_bad = hyd_solver_bad_state(s, &t_bad);
+        CHECK(rc == HYD_ERR_NONFINITE && i_bad == 1, "%s without retries: rc %d, bad %d", hyd_method_name(m), rc,
+              i_bad);
+        CHECK_NEAR(t_bad, 0.6, 1e-12);
+        CHECK_NEAR(t, 0.5, 1e-12);
+        CHECK(hyd_solver_get_stats(s)->retried == 0, "no retry when they are off");
+        hyd_solver_destroy(s);
     }
+}
+
+// y' = lam y with lam = 2 / h = 1 / (gamma h) for Krus at h = 0.1: W = 1 -
+// gamma h lam is exactly singular at the step; two half steps have W = 1/2
+// and amplify by R(1) = (1 + 1/2) / (1 - 1/2) = 3 each (the trapezoidal
+// rule's R(z) = (1 + z/2) / (1 - z/2) at z = h lam / 2 = 1).
+static int grow_f(void* user, double t, const double* y, double* dy) {
+    (void)user, (void)t;
+    dy[0] = 20.0 * y[0];
+    return 0;
+}
+static int grow_jac(void* user, double t, const double* y, double* J) {
+    (void)user, (void)t, (void)y;
+    J[0] = 20.0;
+    return 0;
+}
+
+// y' = -60 y, and a state below -0.1 is implausible: Krus at h = 0.1
+// (z = -6) gives R = (1 - 3) / (1 + 3) = -0.5, h/2 gives -0.2 at once
+// (still implausible), h/4 gives R(-1.5) = 0.25 / 1.75 = 1/7 four times.
+static int decay_f(void* user, double t, const double* y, double* dy) {
+    (void)user, (void)t;
+    dy[0] = -60.0 * y[0];
+    return 0;
+}
+static int decay_jac(void* user, double t, const double* y, double* J) {
+    (void)user, (void)t, (void)y;
+    J[0] = -60.0;
+    return 0;
+}
+static int below_tenth(void* user, const double* y) {
+    (void)user;
+    return y[0] > -0.1 ? 0 : 1;
+}
+
+static void test_fixed_retry(void) {
+    {
+        hyd_problem p = {0};
+        p.n = 1, p.f = decay_f, p.jac = decay_jac, p.implausible = below_tenth;
+        hyd_solver_opts o = hyd_default_solver_opts();
+        o.h = 0.1;
+        hyd_solver* s = hyd_solver_create(&p, HYD_KRUS, &o);
+        double t = 0.0, y[1] = {1.0};
+        CHECK(hyd_solver_step(s, &t, y, 0.1) == HYD_OK, "implausible step retried");
+        CHECK_NEAR(y[0], 1.0 / 2401.0, 1e-15);
+        CHECK(hyd_solver_get_stats(s)->retried == 1 && hyd_solver_get_stats(s)->substeps == 1 + 4,
+              "h/2 failed at its first sub-step, h/4 took 4: %ld", hyd_solver_get_stats(s)->substeps);
+        hyd_solver_destroy(s);
+        // Still implausible at the finest level (retry_halvings = 1: h/2,
+        // whose first sub-step ends at -0.2): accepted there, as the
+        // caller's checks judge such a state.
+        o.retry_halvings = 1;
+        s = hyd_solver_create(&p, HYD_KRUS, &o);
+        t = 0.0, y[0] = 1.0;
+        CHECK(hyd_solver_step(s, &t, y, 0.1) == HYD_OK, "accepted at the finest level");
+        CHECK_NEAR(y[0], 0.04, 1e-15); // two steps of R(-3) = -0.2
+        hyd_solver_destroy(s);
+    }
+    hyd_problem p = {0};
+    p.n = 1, p.f = grow_f, p.jac = grow_jac;
+    hyd_solver_opts o = hyd_default_solver_opts();
+    o.h = 0.1;
+    hyd_solver* s = hyd_solver_create(&p, HYD_KRUS, &o);
+    double t = 0.0, y[1] = {1.0};
+    int rc = hyd_solver_step(s, &t, y, 0.1);
+    CHECK(rc == HYD_OK, "the singular step retried in halves: rc %d", rc);
+    CHECK_NEAR(t, 0.1, 1e-15);
+    CHECK_NEAR(y[0], 9.0, 1e-12);
+    CHECK(hyd_solver_get_stats(s)->retried == 1 && hyd_solver_get_stats(s)->substeps == 2,
+          "one retry of 2 sub-steps, got %ld, %ld", hyd_solver_get_stats(s)->retried,
+          hyd_solver_get_stats(s)->substeps);
+    CHECK(hyd_solver_get_stats(s)->steps == 1, "counted as one step");
+    hyd_solver_destroy(s);
+    // Off: the singular W is reported, y and t untouched.
+    o.retry_halvings = 0;
+    s = hyd_solver_create(&p, HYD_KRUS, &o);
+    t = 0.0, y[0] = 1.0;
+    rc = hyd_solver_step(s, &t, y, 0.1);
+    CHECK(rc == HYD_ERR_SINGULAR, "without retries: rc %d", rc);
+    CHECK(t == 0.0 && y[0] == 1.0, "y and t untouched");
+    hyd_solver_destroy(s);
 }
 
 // Reset drops step history: after it, the first step is opts.h again.
@@ -505,6 +602,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_events_hook);
     RUN_TEST(test_inputs_changed);
     RUN_TEST(test_nonfinite);
+    RUN_TEST(test_fixed_retry);
     RUN_TEST(test_reset);
     RUN_TEST(test_bad_arguments);
     TEST_MAIN_END();
