@@ -127,6 +127,7 @@ void app_note_unused(const char* cmd, unsigned given, const sim_opts* o, int n) 
                 }
                 break;
             case APP_OPT_NO_RETRY:
+            case APP_OPT_NO_STEP_PROBE:
                 if (is_adaptive(r)) {
                     snprintf(buf, sizeof buf, "with the adaptive solver %s (fixed-step solvers only)", solver_name(r));
                     w = buf;

@@ -43,7 +43,8 @@ int app_parse_double(const char* s, double* v) {
 
 const char* const app_opt_name[APP_OPT_COUNT] = {
     "--model", "--scenario", "--mechanics", "--variant", "--solver", "--dt", "--rtol", "--atol", "--duration",
-    "--every", "--set", "--jac-every", "--load", "--world", "--dt-ode", "--kernel", "--dense-jac", "--no-retry", "--quiet"};
+    "--every", "--set", "--jac-every", "--load", "--world", "--dt-ode", "--kernel", "--dense-jac", "--no-retry",
+    "--no-step-probe", "--quiet"};
 
 void app_name_params(void) {
     static const char* names[SIM_PARAM_COUNT];
@@ -57,6 +58,7 @@ void app_name_params(void) {
     names[SIM_PARAM_SET] = app_opt_name[APP_OPT_SET];
     names[SIM_PARAM_WORLD] = app_opt_name[APP_OPT_WORLD];
     names[SIM_PARAM_MODEL] = app_opt_name[APP_OPT_MODEL];
+    names[SIM_PARAM_NO_STEP_PROBE] = app_opt_name[APP_OPT_NO_STEP_PROBE];
     sim_name_params(names);
 }
 
@@ -128,7 +130,7 @@ static const struct {
     const char* cmd;
     const char* opts[6];
 } own_flags[] = {
-    {"*", {"--quiet", "--dense-jac", NULL}},
+    {"*", {"--quiet", "--dense-jac", "--no-retry", "--no-step-probe", NULL}},
     {"study", {"--quick", NULL}},
     {"sweep", {"--fail-fast", NULL}},
     {"drive", {"--headless", "--scripted", "--collision-view", NULL}},
@@ -293,6 +295,11 @@ int app_parse_common(app_common* c, int argc, char** argv, int* i) {
         c->given |= APP_GIVEN(APP_OPT_NO_RETRY);
         return 1;
     }
+    if (!strcmp(a, "--no-step-probe")) {
+        c->sim.no_step_probe = true;
+        c->given |= APP_GIVEN(APP_OPT_NO_STEP_PROBE);
+        return 1;
+    }
     int k = -1;
     for (int j = 0; j <= APP_OPT_KERNEL; ++j)
         if (!strcmp(a, app_opt_name[j])) k = j;
@@ -401,6 +408,10 @@ static const struct {
     {APP_OPT_NO_RETRY, "  --no-retry           fixed-step: report a step that fails (singular W, a non-finite state,\n"
                        "                       a pressure below -0.1 MPa) at once instead of retrying it as\n"
                        "                       2..16 shorter steps (docs/solvers.md)\n"},
+    {APP_OPT_NO_STEP_PROBE, "  --no-step-probe      krus/ros2 above 0.1 ms: run the step even where the probe of the\n"
+                            "                       model's abrupt valve steps refuses it (it blows up there or is\n"
+                            "                       off the 0.1 ms run by more than 5 % in a stroke, 15 % in a\n"
+                            "                       pressure); the results are then unchecked (docs/solvers.md)\n"},
     {APP_OPT_KERNEL, "  --kernel K           lagrange, when the circuit has the standard shape:\n"
                      "                       split (default): one-pass circuit, block-eliminated W, and\n"
                      "                         for krus/ros2 the mechanics once per step (docs/lagrange.md);\n"
@@ -430,7 +441,8 @@ void app_common_help(FILE* f, bool with_solver) {
     unsigned all = APP_GIVEN(APP_OPT_COUNT) - 1u;
     const unsigned solver = APP_GIVEN(APP_OPT_SOLVER) | APP_GIVEN(APP_OPT_DT) | APP_GIVEN(APP_OPT_RTOL) |
                             APP_GIVEN(APP_OPT_JAC_EVERY) | APP_GIVEN(APP_OPT_DENSE_JAC) |
-                            APP_GIVEN(APP_OPT_NO_RETRY) | APP_GIVEN(APP_OPT_KERNEL) | APP_GIVEN(APP_OPT_DURATION) | APP_GIVEN(APP_OPT_EVERY);
+                            APP_GIVEN(APP_OPT_NO_RETRY) |
+                            APP_GIVEN(APP_OPT_NO_STEP_PROBE) | APP_GIVEN(APP_OPT_KERNEL) | APP_GIVEN(APP_OPT_DURATION) | APP_GIVEN(APP_OPT_EVERY);
     app_options_help(f, with_solver ? all : all & ~solver);
 }
 

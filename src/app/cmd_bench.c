@@ -776,6 +776,9 @@ static int bench_check_drive_world(const char* world) {
 
 int cmd_bench(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
+    // No step probe: a benchmark times the steps it is given, so a long
+    // step is what it measures, not a refusal.
+    c.sim.no_step_probe = true;
     int repeat = 3;
     uint64_t seed = 1;
     const char* only[16];

@@ -312,7 +312,8 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     res->fast = ls.use_fast;
     double y[LSIM_MAX_STATES];
     if (lsim_check_pose(&ls, sc->q0, res->message, sizeof res->message) ||
-        check_fixed_step(m->hyd, o, o->h, o->duration > 0 ? o->duration : sc->duration, res)) {
+        check_fixed_step(m->hyd, o, o->h, o->duration > 0 ? o->duration : sc->duration, res) ||
+        (res->status = sim_check_step_probe(m, o, o->h, res->message, sizeof res->message))) {
         lsim_free(&ls);
         return res->status = SIM_REFUSED;
     }

@@ -180,7 +180,8 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     const long ode_msgs = ode_world_messages(NULL);
     const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
     if ((res->status = sim_check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res->message,
-                                            sizeof res->message))) {
+                                            sizeof res->message)) ||
+        (res->status = sim_check_step_probe(m, o, h_hyd, res->message, sizeof res->message))) {
         ode_world_destroy(w);
         return res->status;
     }

@@ -24,6 +24,7 @@ typedef enum sim_param {
     SIM_PARAM_SET,       ///< a model edit PATH=VALUE (json_set_path, model_load)
     SIM_PARAM_WORLD,     ///< sim_opts.world, a world file or name (world_desc_load)
     SIM_PARAM_MODEL,     ///< a model file or name (model_load)
+    SIM_PARAM_NO_STEP_PROBE, ///< sim_opts.no_step_probe: run a step the probe refuses
     SIM_PARAM_COUNT
 } sim_param;
 /// Name the settings for every later message (names[p] may be NULL: the

@@ -59,7 +59,7 @@ typedef struct sim_opts {
     sim_kernel kernel;   ///< how the circuit is evaluated (default SIM_KERNEL_SPLIT, the fastest)
     bool rcl;            ///< the rated capacity limiter cuts commands (rcl.h); off (the library default):
                          ///< it only measures rcl_util. run and drive turn it on unless --rcl off
-    bool no_step_probe;  ///< internal: the step probe's own run (sim_check_step_probe) is not probed again
+    bool no_step_probe;  ///< no step probe (sim_check_step_probe): the probe's own runs, --no-step-probe, study, bench
 } sim_opts;
 
 // The settings its messages name: sim_param, sim_name_params, sim_param_name (param_names.h).
@@ -74,22 +74,20 @@ int sim_check_fixed_step(const hyd_model* hm, const sim_opts* o, double h, doubl
 /// probed [s]: the default step, at which every shipped model and scenario
 /// runs (their tests), is not.
 #define SIM_PROBE_ABOVE 1e-4
-/// Refuse, before a stepped engine starts (engine_create: drive, serve,
-/// replay, whose commands are not known in advance), a Krus or ROS2 step h
-/// [s] that blows up on model m's abrupt valve steps: for h above
-/// SIM_PROBE_ABOVE, the `step` scenario's commands (lift, jib, lowering;
-/// 500 kg, 6.5 s) are run on the lagrange backend at h with o's solver and
-/// Jacobian settings. No bound on the circuit's fastest mode separates the
-/// steps that survive from those that do not (docs/solvers.md: the LS
-/// crane at Krus 0.2 ms fails where the standard crane at 1 ms, h|lambda|
-/// as large, runs). On a blow-up the message says where, and names the
-/// largest step of {5, 2, 1} x 10^k dividing o->dt_out that passes (else
-/// SIM_PROBE_ABOVE). Scripted runs are not probed: their commands are
-/// known, and a model-wide refusal would refuse scenarios that run (the
-/// LS crane's `ramp` at Krus 0.2 ms); they stop at a blow-up with its
-/// state, time and cure. Returns SIM_OK, or SIM_REFUSED with one line in
-/// err. Other methods, CVODE, h <= SIM_PROBE_ABOVE and o->no_step_probe
-/// always pass.
+/// Refuse, before a run starts (scripted, or a stepped engine: drive,
+/// serve, replay), a Krus or ROS2 step h [s] above SIM_PROBE_ABOVE that
+/// blows up on model m's abrupt valve steps or integrates them too far off:
+/// the `step` scenario's commands (lift, jib, lowering; 500 kg, 6.5 s) are
+/// run on the lagrange backend at h and at SIM_PROBE_ABOVE with o's solver
+/// and Jacobian settings, and a stroke more than 5 % RMS of its peak off,
+/// or a chamber pressure more than 15 %, refuses h. No bound on the
+/// circuit's fastest mode separates the steps that work from those that do
+/// not (docs/solvers.md: the LS crane at Krus 0.2 ms is 25 % off where the
+/// standard crane at 1 ms, h|lambda| as large, is 0.2 %). The message says
+/// where, and names the largest step of {5, 2, 1} x 10^k dividing
+/// o->dt_out that passes (else SIM_PROBE_ABOVE). Returns SIM_OK, or
+/// SIM_REFUSED with one line in err. Other methods, CVODE, h <=
+/// SIM_PROBE_ABOVE and o->no_step_probe always pass.
 int sim_check_step_probe(const model* m, const sim_opts* o, double h, char* err, size_t errsz);
 /// The advice of a numerical blow-up: a pressure state with value [Pa abs]
 /// found implausible at time t [s] of a run with an adaptive (or CVODE) or a

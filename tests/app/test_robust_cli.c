@@ -168,7 +168,7 @@ static void test_failed_run_keeps_rows(void) {
     // 10 ms hydraulic steps in the ode world: the pump line goes far below
     // absolute zero in the first step (test_robust.c, test_live_checks),
     // unless the step is retried in shorter ones (then it runs through).
-    rc = cli_run("run --quiet --mechanics ode --scenario step --dt-ode 0.01 --dt 0.01 --every 0.01 --no-retry"
+    rc = cli_run("run --quiet --mechanics ode --scenario step --dt-ode 0.01 --dt 0.01 --every 0.01 --no-retry --no-step-probe"
                  " --out fail.csv",
                  out, sizeof out);
     CHECK(rc == 1 && strstr(out, "kept in fail.csv"), "exit %d: %s", rc, out);

@@ -365,7 +365,7 @@ static void test_sweep_failing_design_is_a_row(void) {
     // the stiff one (1 GPa) of the step scenario's valve steps: exit 1, the
     // run's message, no metrics; the sweep still exits 0 (--no-retry: with
     // the retry of a failed step in shorter ones it may run through).
-    CHECK(cli_run("sweep --scenario step --duration 2 --solver ros2 --dt 5e-3 --no-retry --metrics peak_p1A "
+    CHECK(cli_run("sweep --scenario step --duration 2 --solver ros2 --dt 5e-3 --no-retry --no-step-probe --metrics peak_p1A "
                   "--param hydraulics.fluid.bulk_modulus=1e8:1e9:2 --out sweep_blowup.csv",
                   out, sizeof out) == 0,
           "%s", out);

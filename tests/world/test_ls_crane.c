@@ -305,16 +305,15 @@ static void test_ls_neutral(void) {
 // absolute zero): its max-select shuttles charged the 5 mL LS nodes from
 // 0.1 MPa to the work lines' holding pressures through 2e-11 m^3/(s Pa) at
 // t = 0. With the LS ports following the spool the initial state is
-// consistent (in neutral the LS network sits at tank pressure). Krus and
-// ROS2 at 0.2 ms and ROS2 at 0.5 ms integrate the whole ramp. Krus at
-// 0.5 ms is at the edge where the booms start lowering (12.5-13.5 s: the
-// valve drains the 50 mL node before a closed counterbalance valve, and
-// Krus's R(-inf) = -1 rings there): it got through with the ideal pump and
-// with a leakage of 3e-13 m^3/(s Pa), and blows up with 1e-13, 2e-13,
-// 4e-13 and the shipped 5.6e-13 (docs/model.md). So it is not required to
-// get through, only, if it does not, to stop as a blow-up that names the
-// state and the time and keeps the rows up to it; at 1 ms both blow up
-// there.
+// consistent (in neutral the LS network sits at tank pressure).
+// Krus above 0.1 ms integrates `ramp` but not abrupt valve steps: on the
+// `step` commands its spools ring (R(-inf) = -1) and the jib's stroke is
+// 25-35 % RMS of its peak off the 0.1 ms run at 0.2-1 ms, without a
+// blow-up once a failed step is retried in shorter ones. A run is therefore
+// refused before it starts (the step probe, sim_check_step_probe, issue 25
+// item 7), naming 0.1 ms; with the probe off Krus 0.2 ms still runs the
+// whole ramp, as it always did. ROS2 (L-stable) passes the probe at 0.2,
+// 0.5 and 1 ms (1.2 % and 5 % off at 1 ms) and runs the whole ramp.
 static void test_long_steps(void) {
     scenario sc;
     if (load_scenario("ramp", &sc)) return;
@@ -322,25 +321,29 @@ static void test_long_steps(void) {
     model* m = model_load(CRANESIM_ASSETS "/models/hiab031_ls.json", NULL, 0, err, sizeof err);
     CHECK(m != NULL, "%s", err);
     if (!m) return;
-    const struct { hyd_method s; double h; bool must; } runs[] = {
-        {HYD_KRUS, 2e-4, true}, {HYD_ROS2, 2e-4, true}, {HYD_ROS2, 5e-4, true}, {HYD_KRUS, 5e-4, false}};
+    enum { RUNS, REFUSED };
+    const struct { hyd_method s; double h; bool no_probe; int want; } runs[] = {
+        {HYD_KRUS, 2e-4, false, REFUSED}, {HYD_KRUS, 5e-4, false, REFUSED}, {HYD_KRUS, 1e-3, false, REFUSED},
+        {HYD_KRUS, 2e-4, true, RUNS},     {HYD_ROS2, 2e-4, false, RUNS},    {HYD_ROS2, 5e-4, false, RUNS},
+        {HYD_ROS2, 1e-3, false, RUNS}};
     for (size_t j = 0; j < sizeof runs / sizeof runs[0]; ++j) {
         sim_opts o = sim_default_opts();
         o.solver = runs[j].s, o.h = runs[j].h, o.dt_out = runs[j].h > 1e-3 ? runs[j].h : 1e-3;
+        o.no_step_probe = runs[j].no_probe;
         sim_trace tr = {0};
         sim_result r;
         const int rc = sim_run(m, &sc, &o, NULL, NULL, &tr, NULL, NULL, &r);
         const char* name = runs[j].s == HYD_KRUS ? "krus" : "ros2";
         const double t_end = tr.nrow > 0 ? tr.v[(size_t)(tr.nrow - 1) * SIM_NCOL + COL_T] : -1;
-        if (runs[j].must || rc == 0) {
-            CHECK(rc == 0, "%s h = %g: %s", name, runs[j].h, r.message);
+        if (runs[j].want == RUNS) {
+            CHECK(rc == 0, "%s h = %g%s: %s", name, runs[j].h, runs[j].no_probe ? " (no probe)" : "", r.message);
             CHECK(t_end > 19.99, "%s h = %g: stopped early", name, runs[j].h);
         } else {
             printf("  %s h = %g ms: %s\n", name, 1e3 * runs[j].h, r.message);
-            CHECK(strstr(r.message, "blow-up: state ") && strstr(r.message, " at t = "),
-                  "%s h = %g: not a clear blow-up: %s", name, runs[j].h, r.message);
-            CHECK(t_end > 12.0 && t_end < 20.0, "%s h = %g: rows up to %g s kept (the failure is at the lowering)",
-                  name, runs[j].h, t_end);
+            CHECK(rc == SIM_REFUSED && tr.nrow == 0 && strstr(r.message, "is inaccurate") &&
+                      strstr(r.message, "is 0.0001 s"),
+                  "%s h = %g: want refused before the run naming 0.1 ms: rc %d, %d rows: %s", name, runs[j].h, rc,
+                  tr.nrow, r.message);
         }
         sim_trace_free(&tr);
     }
