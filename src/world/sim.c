@@ -111,18 +111,6 @@ const char* sim_world_path(const char* arg, char* buf, size_t n) {
 // (hyd_problem.outside).
 static const double P_IMPLAUSIBLE = -1e5;
 
-static const char* const k_param_field[SIM_PARAM_COUNT] = {"h",         "dt_ode",    "duration", "dt_out",
-                                                           "load_mass", "mechanics", "rtol",     "set",
-                                                           "world",     "model",     "no_step_probe"};
-static const char* const* g_param_names;
-
-void sim_name_params(const char* const names[SIM_PARAM_COUNT]) { g_param_names = names; }
-
-const char* sim_param_name(sim_param p) {
-    const char* n = g_param_names ? g_param_names[p] : NULL;
-    return n ? n : k_param_field[p];
-}
-
 void sim_checks_init(sim_checks* k) { memset(k, 0, sizeof *k); }
 
 int sim_check_value(sim_checks* k, const char* name, double v, bool pressure, double t, char* msg, size_t n) {
