@@ -1,5 +1,5 @@
 // cmd_loadchart.c: `cranesim loadchart`: the rated capacity against outreach
-// (src/world/loadchart.h) as a CSV and a PNG chart.
+// (src/world/safety/loadchart.h) as a CSV and a PNG chart.
 #include "app.h"
 #include "loadchart.h"
 

@@ -2,7 +2,7 @@
 // read itself (glTF/GLB, Collada, FBX, ...), through assimp. The application
 // installs it with mesh_set_importer (main.c); the core stays free of assimp.
 #include "render.h"
-#include "world/mesh_geom.h"
+#include "world/sandbox/mesh_geom.h"
 
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>

@@ -1,4 +1,4 @@
-// test_split.c: the split Krus/ROS2 step (src/world/lagrange_split_step.c), which
+// test_split.c: the split Krus/ROS2 step (src/world/lagrange/lagrange_split_step.c), which
 // evaluates the mechanics once per step, against
 // - an independent reference (CVODE at rtol 1e-10, else the generic RODAS3 at
 //   rtol 1e-9 on the exact f): the error falls by about 4 when h is halved

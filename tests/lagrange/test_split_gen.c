@@ -1,5 +1,5 @@
 // test_split_gen.c: the split Krus/ROS2 step for any circuit on the fast
-// kernel (src/world/lagrange_split_gen.c), on the load-sensing crane
+// kernel (src/world/lagrange/lagrange_split_gen.c), on the load-sensing crane
 // (assets/models/hiab031_ls.json: 21 circuit states, no one-pass kernel),
 // against
 // - an independent reference (CVODE at rtol 1e-10, else the generic RODAS3

@@ -6,6 +6,7 @@
 #include <cjson/cJSON.h>
 #include <stddef.h>
 
+#include "crane_chain.h"
 #include "crane_model.h"
 #include "hydraulics.h"
 
@@ -16,7 +17,8 @@ extern "C" {
 typedef struct model {
     char name[96];
     char file[256];      ///< path it was loaded from ("" if built in)
-    crane_mech mech;     ///< mechanics (derived fields filled)
+    crane_mech mech;     ///< mechanics of the two-link shorthand (derived fields filled; chain.two_link)
+    crane_chain chain;   ///< the crane as a chain: bodies, actuators, functions (every model; owned)
     hyd_model* hyd;      ///< compiled circuit (owned)
     int cyl[2];          ///< hydraulic cylinder index of actuator k (lift, jib)
     int valve[2];        ///< hydraulic valve index of actuator k

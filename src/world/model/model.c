@@ -448,6 +448,11 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         snprintf(err, errsz, "%s: %s", file, cerr);
         goto fail;
     }
+    // The same crane as a chain (crane_chain.h), which the general paths use.
+    if (crane_chain_from_mech(me, &m->chain, cerr, sizeof cerr) || crane_chain_bind(&m->chain, m->hyd, cerr, sizeof cerr)) {
+        snprintf(err, errsz, "%s: %s", file, cerr);
+        goto fail;
+    }
     return m;
 fail: // err already holds the one-line message
     model_free(m);
@@ -560,6 +565,7 @@ model* model_load(const char* arg, const char* const* sets, int nset, char* err,
 void model_free(model* m) {
     if (!m) return;
     hyd_model_free(m->hyd);
+    crane_chain_free(&m->chain);
     cJSON_Delete(m->json);
     cJSON_Delete(m->world_bursts);
     free(m);

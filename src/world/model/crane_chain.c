@@ -1,0 +1,159 @@
+// crane_chain.c: the crane as a chain (crane_chain.h): the two-link
+// shorthand converted, the binding to the circuit, the mechanism built.
+#include "crane_chain.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "chain_crane.h"
+#include "hydraulics.h"
+
+void crane_chain_free(crane_chain* cc) {
+    if (!cc) return;
+    free(cc->body);
+    free(cc->act);
+    free(cc->fn);
+    memset(cc, 0, sizeof *cc);
+}
+
+static int alloc_arrays(crane_chain* cc, int nbody, int nact, int nfn) {
+    cc->body = calloc((size_t)(nbody > 0 ? nbody : 1), sizeof *cc->body);
+    cc->act = calloc((size_t)(nact > 0 ? nact : 1), sizeof *cc->act);
+    cc->fn = calloc((size_t)(nfn > 0 ? nfn : 1), sizeof *cc->fn);
+    if (!cc->body || !cc->act || !cc->fn) {
+        crane_chain_free(cc);
+        return -1;
+    }
+    cc->nbody = nbody, cc->nact = nact, cc->nfn = nfn;
+    return 0;
+}
+
+int crane_chain_copy(crane_chain* dst, const crane_chain* src) {
+    crane_chain c = *src;
+    if (alloc_arrays(&c, src->nbody, src->nact, src->nfn)) return -1;
+    memcpy(c.body, src->body, (size_t)src->nbody * sizeof *c.body);
+    memcpy(c.act, src->act, (size_t)src->nact * sizeof *c.act);
+    memcpy(c.fn, src->fn, (size_t)src->nfn * sizeof *c.fn);
+    *dst = c;
+    return 0;
+}
+
+int crane_chain_from_mech(const crane_mech* m, crane_chain* out, char* err, size_t errsz) {
+    memset(out, 0, sizeof *out);
+    chain_crane cr;
+    if (chain_from_crane_mech(m, 0.0, NULL, &cr)) {
+        snprintf(err, errsz, "mechanics.actuators: each actuator's joint must be 0 or 1");
+        return -1;
+    }
+    if (alloc_arrays(out, 3, 2, 2)) {
+        snprintf(err, errsz, "out of memory");
+        return -1;
+    }
+    // The column's drawing: its height along z, a 0.2 m diameter (the
+    // radius chain_from_crane_mech gives its inertia).
+    out->body[0].def = cr.body[0];
+    out->body[0].length = m->column_height;
+    out->body[0].width = out->body[0].height = 0.2;
+    for (int i = 0; i < 2; ++i) {
+        crane_body* b = &out->body[i + 1];
+        b->def = cr.body[i + 1];
+        b->length = m->link[i].length;
+        b->width = m->link[i].width;
+        b->height = m->link[i].height;
+    }
+    for (int k = 0; k < 2; ++k) {
+        const crane_actuator* a = &m->act[k];
+        crane_act* c = &out->act[k];
+        snprintf(c->name, sizeof c->name, "%s", a->name);
+        snprintf(c->cylinder, sizeof c->cylinder, "%s", a->cylinder);
+        snprintf(c->valve, sizeof c->valve, "%s", a->valve);
+        c->kind = CRANE_ACT_CYLINDER;
+        c->body_a = cr.cyl[k].body_a;
+        c->body_b = cr.cyl[k].body_b;
+        memcpy(c->pa, cr.cyl[k].pa, sizeof c->pa);
+        memcpy(c->pb, cr.cyl[k].pb, sizeof c->pb);
+        c->closed_length = a->closed_length;
+        c->cyl = -1;
+        c->function = k;
+        crane_function* f = &out->fn[k];
+        snprintf(f->name, sizeof f->name, "%s", a->name);
+        snprintf(f->valve, sizeof f->valve, "%s", a->valve);
+        f->valve_idx = -1;
+    }
+    out->tip_body = 2;
+    out->tip[0] = m->link[1].length;
+    out->gravity = m->gravity;
+    out->slew_free = false;
+    out->two_link = true;
+    return 0;
+}
+
+int crane_chain_bind(crane_chain* cc, const hyd_model* h, char* err, size_t errsz) {
+    for (int f = 0; f < cc->nfn; ++f) {
+        crane_function* fn = &cc->fn[f];
+        fn->valve_idx = hyd_model_valve(h, fn->valve);
+        if (fn->valve_idx < 0) {
+            snprintf(err, errsz, "mechanics.functions[%d].valve: no valve '%s' in the circuit", f, fn->valve);
+            return -1;
+        }
+    }
+    for (int k = 0; k < cc->nact; ++k) {
+        crane_act* a = &cc->act[k];
+        a->cyl = hyd_model_cylinder(h, a->cylinder);
+        if (a->cyl < 0) {
+            snprintf(err, errsz, "mechanics.actuators[%d].cylinder: no cylinder '%s' in the circuit", k,
+                     a->cylinder);
+            return -1;
+        }
+        double AA, AB;
+        hyd_model_cylinder_geometry(h, a->cyl, &AA, &AB, &a->stroke);
+        a->function = -1;
+        for (int f = 0; f < cc->nfn; ++f)
+            if (!strcmp(cc->fn[f].valve, a->valve)) a->function = f;
+        if (a->function < 0) {
+            snprintf(err, errsz,
+                     "mechanics.actuators[%d].valve: no function commands valve '%s' (list it in "
+                     "mechanics.functions)",
+                     k, a->valve);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+chain* crane_chain_mechanism(const crane_chain* cc, double tip_mass, bool slew_free, double slew, char* err,
+                             size_t errsz) {
+    chain_body_def* defs = malloc((size_t)cc->nbody * sizeof *defs);
+    if (!defs) {
+        snprintf(err, errsz, "out of memory");
+        return NULL;
+    }
+    for (int i = 0; i < cc->nbody; ++i) defs[i] = cc->body[i].def;
+    defs[0].fixed = !slew_free;
+    defs[0].q_fixed = slew;
+    if (tip_mass > 0 && cc->tip_body >= 0 && cc->tip_body < cc->nbody)
+        chain_body_add_point_mass(&defs[cc->tip_body], tip_mass, cc->tip);
+    const double g[3] = {0.0, 0.0, -cc->gravity};
+    chain* c = chain_create(defs, cc->nbody, g, err, errsz);
+    free(defs);
+    return c;
+}
+
+int crane_chain_find_body(const crane_chain* cc, const char* name) {
+    for (int i = 0; i < cc->nbody; ++i)
+        if (!strcmp(cc->body[i].def.name, name)) return i;
+    return -1;
+}
+
+int crane_chain_find_act(const crane_chain* cc, const char* name) {
+    for (int i = 0; i < cc->nact; ++i)
+        if (!strcmp(cc->act[i].name, name)) return i;
+    return -1;
+}
+
+int crane_chain_find_function(const crane_chain* cc, const char* name) {
+    for (int i = 0; i < cc->nfn; ++i)
+        if (!strcmp(cc->fn[i].name, name)) return i;
+    return -1;
+}

@@ -1,0 +1,123 @@
+// crane_chain.h: the crane as data: a chain of bodies (the column, booms,
+// telescopic extensions), the hydraulic actuators between them and the
+// functions the operator commands (docs/model.md "The crane as a chain").
+//
+// Every model has one, whatever its file says: the two-link shorthand
+// (mechanics.links, mechanics.actuators by joint) is converted by
+// crane_chain_from_mech, a chain file (mechanics.bodies) is read as it is.
+// Both backends build their mechanics from it (the analytic mode through
+// the mechanism library, chain.h; the ODE world as hinges and sliders), so
+// nothing downstream assumes a count: every array here is sized by the file.
+//
+// Units are SI: m, kg, s, rad, N. Body frames and joints are chain.h's: body
+// 0 is the column (its joint the slew, about the base z axis), every other
+// body has a parent with a smaller index and a revolute joint (in the boom
+// plane) or a prismatic one (sliding along its x axis inside the parent).
+#ifndef CRANE_CHAIN_H
+#define CRANE_CHAIN_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "chain.h"
+#include "crane_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// One body of the chain: the mechanism's description (joint, mass, centre of
+/// mass, inertia, limits; def.name is the body's name) and what the ODE world
+/// and the renderer need besides.
+typedef struct crane_body {
+    chain_body_def def;
+    double length; ///< extent along the body's x from its origin [m] (a boom: joint to tip; the
+                   ///< column: its height, along z)
+    double width;  ///< box section across the boom plane (y) [m]
+    double height; ///< box section in the boom plane (z) [m]; the column: its diameter
+} crane_body;
+
+typedef enum crane_act_kind {
+    CRANE_ACT_CYLINDER = 0 ///< a hydraulic cylinder between two pins (force along the pins)
+} crane_act_kind;
+
+/// One actuator: a circuit's cylinder between a pin on body_a (the barrel)
+/// and a pin on body_b (the rod). Any two bodies of the chain; several may act
+/// across one joint. stroke = |pin_b - pin_a| - closed_length.
+typedef struct crane_act {
+    char name[CRANE_NAME];     ///< "lift", "jib", "ext1"
+    crane_act_kind kind;
+    char cylinder[CRANE_NAME]; ///< the circuit's cylinder component
+    char valve[CRANE_NAME];    ///< the circuit's directional valve that feeds it (its function's)
+    int body_a;                ///< barrel pin's body
+    double pa[3];              ///< barrel pin in body_a's frame [m]
+    int body_b;                ///< rod pin's body
+    double pb[3];              ///< rod pin in body_b's frame [m]
+    double closed_length;      ///< pin-to-pin length at zero stroke [m]
+    // Resolved against the circuit by crane_chain_bind:
+    int cyl;                   ///< the circuit's cylinder index
+    int function;              ///< the function with the same valve
+    double stroke;             ///< the cylinder's stroke [m]
+} crane_act;
+
+/// One function: what the operator commands, a valve section of the circuit.
+typedef struct crane_function {
+    char name[CRANE_NAME];  ///< "lift", "jib", "ext", "slew"
+    char valve[CRANE_NAME]; ///< the circuit's directional valve
+    int valve_idx;          ///< its index (crane_chain_bind)
+} crane_function;
+
+/// The crane: bodies in chain order (body 0 the column), actuators, functions.
+typedef struct crane_chain {
+    int nbody;
+    crane_body* body;
+    int nact;
+    crane_act* act;
+    int nfn;
+    crane_function* fn;
+    int tip_body;     ///< the body that carries the tip (the hook point, the tip load)
+    double tip[3];    ///< the tip in that body's frame [m]
+    double gravity;   ///< [m/s^2], along -z of the base frame
+    bool slew_free;   ///< the column slews (a degree of freedom where the model has a slew drive)
+    /// True when the chain came from the two-link shorthand: the analytic
+    /// backend may then run its closed-form fast path (lagrange.h), which
+    /// handles exactly that shape and nothing else.
+    bool two_link;
+} crane_chain;
+
+/// The chain of a two-link crane_mech: the column (fixed at slew 0, a solid
+/// cylinder of radius 0.1 m), the lifting arm and the end arm as
+/// chain_from_crane_mech builds them (without the tip load: the tip is the
+/// end arm's tip), both actuators with their mounts, and one function per
+/// actuator named as the actuator, on its valve. Returns 0, or -1 with one
+/// line in err (out of memory, an actuator's joint not 0 or 1).
+int crane_chain_from_mech(const crane_mech* m, crane_chain* out, char* err, size_t errsz);
+
+/// Resolves the actuators' cylinders and the functions' valves in circuit h
+/// (struct hyd_model, hydraulics.h): cyl, stroke, valve_idx, and each
+/// actuator's function (the one on the same valve). Returns 0, or -1 with
+/// "mechanics.actuators[i].cylinder: no cylinder 'x' in the circuit" (or
+/// .valve, or functions[i].valve; or an actuator whose valve no function
+/// commands) in err.
+struct hyd_model;
+int crane_chain_bind(crane_chain* cc, const struct hyd_model* h, char* err, size_t errsz);
+
+/// The mechanism of the chain (chain.h) with a point mass tip_mass [kg] at
+/// the tip, the column free to slew when slew_free (else fixed at slew
+/// [rad]). NULL with chain_create's message in err.
+chain* crane_chain_mechanism(const crane_chain* cc, double tip_mass, bool slew_free, double slew, char* err,
+                             size_t errsz);
+
+/// A deep copy (dst's arrays are new). 0, or -1 when out of memory.
+int crane_chain_copy(crane_chain* dst, const crane_chain* src);
+void crane_chain_free(crane_chain* cc);
+
+/// Index of the body, actuator or function of that name, or -1.
+int crane_chain_find_body(const crane_chain* cc, const char* name);
+int crane_chain_find_act(const crane_chain* cc, const char* name);
+int crane_chain_find_function(const crane_chain* cc, const char* name);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
