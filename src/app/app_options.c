@@ -242,15 +242,25 @@ static int positive(const char* opt, const char* s, double* v) {
     return 0;
 }
 
-const char* app_default_drive_scenario(sim_mechanics mech) {
-    return mech == SIM_ODE ? "sandbox_pick_place" : "drive_demo";
+const engine_backend* app_backend(const sim_opts* o) {
+    const engine_backend* b = engine_backend_of(o);
+    if (!b) {
+        char known[128];
+        fprintf(stderr, "cranesim: internal error: backend %d is none of %s\n", (int)o->mechanics,
+                engine_backend_names(known, sizeof known, NULL));
+        exit(EXIT_RUNTIME);
+    }
+    return b;
 }
 
+void app_use_backend(sim_opts* o, const engine_backend* b) { o->mechanics = b->id; }
+
+const char* app_default_drive_scenario(const sim_opts* o) { return app_backend(o)->drive_scenario; }
+
 int app_set_mechanics(sim_opts* o, const char* opt, const char* v) {
-    if (!strcmp(v, "lagrange")) o->mechanics = SIM_LAGRANGE;
-    else if (!strcmp(v, "ode")) o->mechanics = SIM_ODE;
-    else {
-        fprintf(stderr, "cranesim: %s: expected lagrange or ode, got '%s'\n", opt, v);
+    char err[256];
+    if (engine_backend_select(o, v, err, sizeof err)) {
+        fprintf(stderr, "cranesim: %s: %s\n", opt, err);
         return -1;
     }
     return 0;

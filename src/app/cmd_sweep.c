@@ -98,7 +98,7 @@ typedef struct sweep {
     int nmet;
     int ncol;
     bool fail_fast;
-    bool ode;
+    bool process_wide;  ///< the backend's library is process-wide (engine_backend.h): one design at a time per process
     bool energy;        ///< a tabulated metric needs the energy accounting
     // Dispatch and results (under mu).
     pthread_mutex_t mu;
@@ -236,9 +236,9 @@ static char* run_design(const sweep* s, long i, bool* failed) {
     if (m) {
         sim_result res;
         sim_energy* en = s->energy ? sim_energy_create() : NULL;
-        if (s->ode) pthread_mutex_lock(&g_ode_mu);
+        if (s->process_wide) pthread_mutex_lock(&g_ode_mu);
         sim_run_energy(m, &s->sc, &s->c.sim, design_row, &met, NULL, NULL, NULL, en, &res);
-        if (s->ode) pthread_mutex_unlock(&g_ode_mu);
+        if (s->process_wide) pthread_mutex_unlock(&g_ode_mu);
         model_free(m);
         if (res.status == SIM_REFUSED && app_signal_caught()) {
             sim_energy_free(en);
@@ -811,7 +811,7 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
         for (int k = 0; k < s->nmet; ++k) fprintf(o->f, ",%s", metric_name((metric_id)s->met[k]));
         fprintf(o->f, ",exit,error\n");
     }
-    if (s->ode && nrank == 1 && threads > 1) {
+    if (s->process_wide && nrank == 1 && threads > 1) {
         const int rc = sweep_procs(s, threads, o);
         out_rest(s, o);
         return rc;
@@ -1132,7 +1132,7 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
         model_free(s.base);
         return rc;
     }
-    s.ode = s.c.sim.mechanics == SIM_ODE;
+    s.process_wide = app_backend(&s.c.sim)->process_wide;
     s.ncol = sim_ncol(&s.c.sim);
     // Every path must name a number in the model: a typo is bad input, not
     // a sweep of refused designs. (Its values are checked per design.)
@@ -1232,7 +1232,7 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
                         snprintf(shape + n, sizeof shape - n, "%s%ld", k ? " x " : "grid ", s.par[k].n);
                     }
                 // ode designs on more than one thread run on worker processes (sweep_procs).
-                const char* unit = s.ode && nrank == 1 && threads > 1 ? "worker process" : "thread";
+                const char* unit = s.process_wide && nrank == 1 && threads > 1 ? "worker process" : "thread";
                 printf("cranesim sweep: %s, %ld designs (%s) on %ld %s%s%s in %.2f s -> %s\n", s.sc.name, s.ndesign,
                        shape, threads, unit, threads == 1 ? "" : strcmp(unit, "thread") ? "es" : "s",
                        nrank > 1 ? " per rank" : "", wall, out);
