@@ -85,7 +85,8 @@ int app_check_sim(const char* cmd, const sim_opts* o, unsigned given) {
         const double lo = floor(o->dt_out / step) * step, hi = lo + step;
         const bool given_every = given & APP_GIVEN(APP_OPT_EVERY);
         char what[96], why[96], alt[96];
-        snprintf(what, sizeof what, "the %s %s", outer ? b->step_name : "fixed step", outer ? b->outer_step_opt : "--dt");
+        snprintf(what, sizeof what, "the %s %s", outer ? b->step_name : "fixed step",
+                 outer ? b->outer_step_opt : "--dt");
         if (outer) snprintf(why, sizeof why, "rows come at whole %ss", b->step_name);
         else snprintf(why, sizeof why, "the solver would shorten steps to land on the output times");
         snprintf(alt, sizeof alt, ", or a %s that divides it", outer ? b->outer_step_opt : "--dt");

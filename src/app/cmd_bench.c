@@ -242,7 +242,8 @@ static int bench_sweep(const app_common* c, int repeat) {
             for (int t = 1; t <= 2; ++t) {
                 char th[8];
                 snprintf(th, sizeof th, "%d", t);
-                char* args[] = {"cranesim", "sweep", "--scenario", (char*)scen, "--mechanics", (char*)bench_world_backend()->name, "--param",
+                char* args[] = {"cranesim", "sweep", "--scenario", (char*)scen, "--mechanics",
+                                (char*)bench_world_backend()->name, "--param",
                                 "hydraulics.components.lift_cyl.bore=0.08:0.12:16", "--threads", th, "--out",
                                 "/dev/null", "--quiet", dur[0] ? "--duration" : NULL, dur, NULL};
                 long rss;

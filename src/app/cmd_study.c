@@ -357,7 +357,8 @@ int cmd_study(int argc, char** argv) {
                                                  "1 ms output grid"
                                                : "the study sets the solver, step and tolerances of each "
                                                  "configuration itself";
-        if (k == APP_OPT_MECHANICS) fprintf(stderr, "cranesim study: --mechanics %s: %s\n", app_backend(&c.sim)->name, why);
+        if (k == APP_OPT_MECHANICS)
+            fprintf(stderr, "cranesim study: --mechanics %s: %s\n", app_backend(&c.sim)->name, why);
         else fprintf(stderr, "cranesim study: %s is not an option of study: %s\n", app_opt_name[k], why);
         return EXIT_USAGE;
     }

@@ -33,7 +33,7 @@ static const engine_backend backends[] = {
     {
         .id = SIM_ODE,
         .name = "ode",
-        .help = "3D rigid bodies (ODE) in a world",
+        .help = "3D rigid bodies in a world",
         .crane = "ode",
         .ops = &engine_ode_ops,
         .world = true,
@@ -96,7 +96,8 @@ int engine_backend_select(sim_opts* o, const char* name, char* err, size_t errsz
     const engine_backend* b = engine_backend_find(name);
     if (!b) {
         char known[128];
-        snprintf(err, errsz, "unknown backend '%s' (known: %s)", name ? name : "", engine_backend_names(known, sizeof known, NULL));
+        snprintf(err, errsz, "unknown backend '%s' (known: %s)", name ? name : "",
+                 engine_backend_names(known, sizeof known, NULL));
         return -1;
     }
     o->mechanics = b->id;
