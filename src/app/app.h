@@ -163,9 +163,10 @@ double app_output_period(const sim_opts* o);
 /// it, EXIT_USAGE. Returns 0 when o runs it as written.
 /// drive's counterpart: the scenario is a scripted operator there, so a
 /// slew it commands in a world without one (lagrange, the validation world)
-/// is not refused but said, once, on stderr. world_kind: the ode world's
-/// kind, or -1 for lagrange. (Hook events are said as they happen.)
-void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind);
+/// is not refused but said, once, on stderr. world_kind: the kind of o's
+/// world where its backend has one (else not read). (Hook events are said
+/// as they happen.)
+void app_note_scenario_slew(const char* cmd, const sim_opts* o, const scenario* sc, int world_kind);
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
                        bool* switched);
 /// app_scenario_world with the advice after the refusal given by the caller

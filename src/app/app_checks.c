@@ -226,14 +226,19 @@ static const char* slew_use(const scenario* sc) {
 // What in a scenario needs the sandbox (NULL: nothing): the hook, the slew.
 static const char* sandbox_use(const scenario* sc) { return sc->nevent > 0 ? "works the hook" : slew_use(sc); }
 
-void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind) {
-    const char* why = world_kind == WORLD_SANDBOX ? NULL : slew_use(sc);
+void app_note_scenario_slew(const char* cmd, const sim_opts* o, const scenario* sc, int world_kind) {
+    const engine_backend* b = app_backend(o);
+    const char* why = b->world && world_kind == WORLD_SANDBOX ? NULL : slew_use(sc);
     if (!why) return;
-    fprintf(stderr,
-            "cranesim %s: note: scenario %s %s, which the %s has not: its slew is ignored (the sandbox has one: "
-            "--mechanics ode --world sandbox)\n",
-            cmd, sc->name[0] ? sc->name : "the scenario", why,
-            world_kind < 0 ? "lagrange 2-DOF crane" : "validation world");
+    const engine_backend* wb = engine_backend_with_world();
+    char crane[96], remedy[128] = "";
+    if (b->world) snprintf(crane, sizeof crane, "validation world");
+    else snprintf(crane, sizeof crane, "%s crane", b->crane);
+    if (wb)
+        snprintf(remedy, sizeof remedy, " (the %s has one: --mechanics %s --world %s)", wb->drive_world, wb->name,
+                 wb->drive_world);
+    fprintf(stderr, "cranesim %s: note: scenario %s %s, which the %s has not: its slew is ignored%s\n", cmd,
+            sc->name[0] ? sc->name : "the scenario", why, crane, remedy);
 }
 
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
