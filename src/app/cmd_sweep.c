@@ -112,9 +112,10 @@ typedef struct sweep {
     long failed;
 } sweep;
 
-// The ODE library and the ode world's error trap are process-wide: one ode
-// design at a time per process (threads still overlap loading and writing).
-static pthread_mutex_t g_ode_mu = PTHREAD_MUTEX_INITIALIZER;
+// A backend whose library is process-wide (engine_backend.process_wide: the
+// ODE library and the ode world's error trap): one design at a time per
+// process (threads still overlap loading and writing).
+static pthread_mutex_t g_process_wide_mu = PTHREAD_MUTEX_INITIALIZER;
 
 // The design values drop the model's range notes ("outside the typical
 // range"): thousands of designs would repeat them, and the row has the value.
@@ -236,9 +237,9 @@ static char* run_design(const sweep* s, long i, bool* failed) {
     if (m) {
         sim_result res;
         sim_energy* en = s->energy ? sim_energy_create() : NULL;
-        if (s->process_wide) pthread_mutex_lock(&g_ode_mu);
+        if (s->process_wide) pthread_mutex_lock(&g_process_wide_mu);
         sim_run_energy(m, &s->sc, &s->c.sim, design_row, &met, NULL, NULL, NULL, en, &res);
-        if (s->process_wide) pthread_mutex_unlock(&g_ode_mu);
+        if (s->process_wide) pthread_mutex_unlock(&g_process_wide_mu);
         model_free(m);
         if (res.status == SIM_REFUSED && app_signal_caught()) {
             sim_energy_free(en);
@@ -491,11 +492,11 @@ static void out_rest(sweep* s, sweep_out* o) {
 }
 
 // ---------------------------------------------------------------------------
-// ode designs on worker processes
+// designs of a process-wide backend (ode) on worker processes
 // ---------------------------------------------------------------------------
 
 // The ODE library is process-wide, so threads run ode designs one at a time.
-// To use every core without MPI, a sweep on the ode backend forks worker
+// To use every core without MPI, a sweep on such a backend forks worker
 // processes instead (after the setup: each inherits the loaded model, the
 // scenario and the options, copy-on-write). The parent stays single-threaded
 // (fork is then safe, also to replace a worker that died) and keeps the
