@@ -1611,8 +1611,9 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
         return code;
     }
     char where[96];
-    if (!app_backend(&c->sim)->world) snprintf(where, sizeof where, "the %s view", app_backend(&c->sim)->crane);
-    else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : "sandbox");
+    const engine_backend* be = app_backend(&c->sim);
+    if (!be->world) snprintf(where, sizeof where, "the %s view", be->crane);
+    else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : be->drive_world);
     printf("cranesim drive: %s in %s%s; %s%s%s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
            o->replay_path ? "replaying " : "", o->replay_path ? o->replay_path : o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
                                                "R reset, C camera, F5 record, F12 screenshot, Esc quit)",
