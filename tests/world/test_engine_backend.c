@@ -6,6 +6,7 @@
 #include "crane_fixture.h"
 #include "engine.h"
 #include "engine_impl.h"
+#include "world_desc.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -50,6 +51,35 @@ static void test_table_matches_backends(void) {
     CHECK(engine_backend_default() == engine_backend_of(&d), "default");
     const engine_backend* w = engine_backend_with_world();
     CHECK(w && w->world, "a backend with a world");
+}
+
+// The defaults a row names exist, and fit each other: its worlds load, and
+// the scenario drive plays by default needs no hook where its drive world
+// (or the lack of one) has none.
+static void test_defaults_exist(void) {
+    for (int i = 0; i < engine_backend_count(); ++i) {
+        const engine_backend* b = engine_backend_at(i);
+        char path[512], err[512];
+        scenario sc;
+        snprintf(path, sizeof path, "%s/scenarios/%s.json", CRANESIM_ASSETS, b->drive_scenario);
+        const int sc_rc = scenario_load(path, &sc, err, sizeof err);
+        CHECK(sc_rc == 0, "%s: drive_scenario: %s", b->name, err);
+        int drive_kind = -1;
+        const char* worlds[2] = {b->run_world, b->drive_world};
+        for (int k = 0; k < 2; ++k) {
+            if (!worlds[k]) continue;
+            world_desc wd;
+            snprintf(path, sizeof path, "%s/worlds/%s.json", CRANESIM_ASSETS, worlds[k]);
+            const int rc = world_desc_load(path, &wd, err, sizeof err);
+            CHECK(rc == 0, "%s: %s: %s", b->name, worlds[k], err);
+            if (rc) continue;
+            if (k == 1) drive_kind = (int)wd.kind;
+            world_desc_free(&wd);
+        }
+        if (sc_rc == 0)
+            CHECK(sc.nevent == 0 || drive_kind == WORLD_SANDBOX, "%s: %s works the hook, its drive world has none",
+                  b->name, b->drive_scenario);
+    }
 }
 
 // An unknown name: refused with the known ones listed, the options untouched.
@@ -108,6 +138,7 @@ static void test_unknown_id_refused(void) {
 
 int main(int argc, char** argv) {
     RUN_TEST(test_table_matches_backends);
+    RUN_TEST(test_defaults_exist);
     RUN_TEST(test_unknown_name_refused);
     RUN_TEST(test_unknown_id_refused);
     TEST_MAIN_END();
