@@ -55,7 +55,8 @@ engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2],
     // The limiter filters every command a stepped driver sets (drive, the
     // window's tick, the soak bench, serve): one place for all of them.
     if (r) rcl_reset(r);
-    e->rcl = r ? r : engine_rcl_create(m, o, "sandbox");
+    // A stepped engine's world, when o names none, is its drive world.
+    e->rcl = r ? r : engine_rcl_create(m, o, engine_backend_of(o)->drive_world);
     return e;
 }
 
