@@ -232,10 +232,12 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
            app_fmt_speed(speed, sizeof speed, r->wall > 0 ? r->t_end / r->wall : 0.0), work);
     printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
            1e3 * xmax[1]);
+    char rcl_scripted_off[96]; // a backend whose scripted runs only measure the limiter
+    snprintf(rcl_scripted_off, sizeof rcl_scripted_off, "measuring only (%s scripted run)", app_backend(o)->name);
     if (st->rcl_have)
         printf("  rated capacity limiter %s: utilisation max %.0f %%, %.3f s at or above 90 %%\n",
                !o->rcl ? "off (measuring only)"
-                       : (o->mechanics == SIM_LAGRANGE ? "measuring only (lagrange scripted run)" : "on"),
+                       : (!app_backend(o)->rcl_scripted ? rcl_scripted_off : "on"),
                100 * st->rcl_max, st->rcl_t90);
     // The peaks over every integration step when sim.c tracked them (between
     // coarse rows the true peak can be far higher than any row's); else

@@ -1015,7 +1015,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     }
     *code = EXIT_RUNTIME;
     if (!s->c.scenario_path)
-        s->c.scenario_path = app_default_drive_scenario(s->c.sim.mechanics);
+        s->c.scenario_path = app_default_drive_scenario(&s->c.sim);
     if (app_load_msg(&s->c, &s->m, &s->sc, err, errsz)) {
         drive_session_destroy(s);
         *code = EXIT_USAGE;
@@ -1611,8 +1611,9 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
         return code;
     }
     char where[96];
-    if (c->sim.mechanics != SIM_ODE) snprintf(where, sizeof where, "the lagrange 2-DOF view");
-    else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : "sandbox");
+    const engine_backend* be = app_backend(&c->sim);
+    if (!be->world) snprintf(where, sizeof where, "the %s view", be->crane);
+    else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : be->drive_world);
     printf("cranesim drive: %s in %s%s; %s%s%s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
            o->replay_path ? "replaying " : "", o->replay_path ? o->replay_path : o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
                                                "R reset, C camera, F5 record, F12 screenshot, Esc quit)",
@@ -1720,7 +1721,8 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
     // The world the engine was built on (c->sim.world, the sandbox when
     // none is named), and the bodies of its last snapshot, so a reader can
     // tell the worlds apart by what ran, not only by name.
-    const char* world = c->sim.mechanics != SIM_ODE ? "lagrange" : c->sim.world ? c->sim.world : "sandbox";
+    const engine_backend* be = app_backend(&c->sim);
+    const char* world = !be->world ? be->name : c->sim.world ? c->sim.world : be->drive_world;
     take_snapshot(s);
     int n = st->nframe_ms < 4096 ? st->nframe_ms : 4096;
     double* ms = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1));

@@ -2,6 +2,7 @@
 // backend's engine_ops, and the run checks every engine applies after a step.
 #include "engine_impl.h"
 #include "energy_acc.h"
+#include "engine_backend.h"
 
 #include "model.h"
 #include "rcl.h"
@@ -24,9 +25,18 @@ static int play_hook(void* user, int attach) {
     return got;
 }
 
-// The backend o->mechanics names: the one place that chooses by it.
+// The backend o->mechanics names (engine_backend.c's table), or NULL for a
+// value that names none: every caller refuses that, none picks a default.
 static const engine_ops* backend(const sim_opts* o) {
-    return o->mechanics == SIM_ODE ? &engine_ode_ops : &engine_lagrange_ops;
+    const engine_backend* b = engine_backend_of(o);
+    return b ? b->ops : NULL;
+}
+
+// The one line for a value of sim_opts.mechanics that names no backend.
+static void unknown_backend(const sim_opts* o, char* err, size_t errsz) {
+    char known[128];
+    snprintf(err, errsz, "sim_opts.mechanics: %d names no backend (known: %s)", (int)o->mechanics,
+             engine_backend_names(known, sizeof known, NULL));
 }
 
 engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
@@ -36,12 +46,17 @@ engine* engine_create(const model* m, const sim_opts* o, const double q0[2], dou
 
 engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           struct rcl* r, char* err, size_t errsz) {
+    if (!backend(o)) {
+        unknown_backend(o, err, errsz);
+        return NULL;
+    }
     engine* e = backend(o)->create(m, o, q0, slew0, m3, err, errsz);
     if (!e) return NULL;
     // The limiter filters every command a stepped driver sets (drive, the
     // window's tick, the soak bench, serve): one place for all of them.
     if (r) rcl_reset(r);
-    e->rcl = r ? r : engine_rcl_create(m, o, "sandbox");
+    // A stepped engine's world, when o names none, is its drive world.
+    e->rcl = r ? r : engine_rcl_create(m, o, engine_backend_of(o)->drive_world);
     return e;
 }
 
@@ -54,7 +69,9 @@ struct rcl* engine_rcl_detach(engine* e) {
 struct rcl* engine_rcl_create(const model* m, const sim_opts* o, const char* default_world) {
     char err[300], buf[512];
     const char* wp = NULL;
-    if (o->mechanics == SIM_ODE) wp = sim_world_path(o->world ? o->world : default_world, buf, sizeof buf);
+    const engine_backend* b = engine_backend_of(o);
+    if (!b) return NULL;
+    if (b->world) wp = sim_world_path(o->world ? o->world : default_world, buf, sizeof buf);
     rcl* r = malloc(sizeof *r);
     if (r && rcl_init_world(r, m, wp, err, sizeof err)) {
         free(r);
@@ -255,6 +272,10 @@ int engine_faults_apply(const engine_faults* f, hyd_model* hm, const scenario* s
 }
 
 int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
+    if (!backend(o)) {
+        unknown_backend(o, res->message, sizeof res->message);
+        return res->status = SIM_REFUSED;
+    }
     if (sc->nfault == 0) return backend(o)->run(m, sc, o, k, res);
     // The bursts' orifices go into a copy; the caller's model stays as it is
     // (compare and study run it again).
@@ -292,12 +313,19 @@ const char* engine_backend_name(const engine* e) { return e->ops->name; }
 
 void engine_describe(const sim_opts* o, engine_desc* d) {
     memset(d, 0, sizeof *d);
+    if (!backend(o)) { // reported as what it is, never as another backend
+        d->backend = d->world = d->step_name = "";
+        unknown_backend(o, d->label, sizeof d->label);
+        unknown_backend(o, d->title, sizeof d->title);
+        return;
+    }
     d->backend = backend(o)->name;
     backend(o)->describe(o, d);
 }
 
 void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n) {
-    backend(o)->describe_work(o, r, buf, n);
+    if (!backend(o)) unknown_backend(o, buf, n);
+    else backend(o)->describe_work(o, r, buf, n);
 }
 void engine_set_commands(engine* e, const double u[3]) {
     // The operator's demand and what was let through, for the HUD (it shows
@@ -390,7 +418,8 @@ const sim_channel* engine_channels(const engine* e, int* n) {
 }
 
 const sim_channel* engine_channels_for(const sim_opts* o, int* n) {
-    *n = backend(o)->nchannel;
+    // None for a value that names no backend (engine_run refuses it).
+    *n = backend(o) ? backend(o)->nchannel : 0;
     return sim_channels;
 }
 double engine_time(const engine* e) { return e->ops->time(e); }

@@ -5,9 +5,12 @@
 // clock, read its row and its snapshot, and never ask which backend runs:
 // what differs is behind engine_ops (engine_impl.h). Scripted runs (run,
 // compare, study, bench) go through engine_run, which plays a scenario.
+// What they must know of a backend before one exists (its options, its
+// world, its defaults) is its row in engine_backend.h.
 #ifndef ENGINE_H
 #define ENGINE_H
 
+#include "engine_backend.h"
 #include "scenario.h"
 #include "sim.h"
 #include "world_snapshot.h"
