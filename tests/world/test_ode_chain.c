@@ -16,7 +16,9 @@
 #include "model.h"
 #include "ode_chain.h"
 #include "ode_world.h"
+#include "engine.h"
 #include "scenario.h"
+#include "sim.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -583,6 +585,40 @@ static void test_refusals(void) {
     model_free(m);
 }
 
+// ---- 5. the ode engine refuses a chain it would run as the two-link crane ----
+
+static void test_engine_refuses_chain(void) {
+    char err[512] = "";
+    model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "model: %s", err);
+    if (!m) return;
+    sim_opts o = sim_default_opts();
+    o.mechanics = SIM_ODE;
+    const double q0[2] = {100 * DEG, -110 * DEG};
+    // The default model runs (the guard lets the two-link crane through).
+    engine* e = engine_create(m, &o, q0, 0.0, 500, err, sizeof err);
+    CHECK(e != NULL, "two-link engine: %s", err);
+    engine_destroy(e);
+    // The same file marked as a general chain (as a chain model file reads).
+    m->chain.two_link = false;
+    err[0] = 0;
+    e = engine_create(m, &o, q0, 0.0, 500, err, sizeof err);
+    CHECK(e == NULL, "a chain model got an ode engine");
+    engine_destroy(e);
+    CHECK(strstr(err, "hiab031.json: mechanics: a chain of 3 bodies and 2 functions: the ode backend runs it in "
+                      "neither world yet") != NULL,
+          "message: %s", err);
+    scenario sc;
+    CHECK(scenario_load(CRANESIM_ASSETS "/scenarios/ramp.json", &sc, err, sizeof err) == 0, "scenario: %s", err);
+    sim_result res;
+    memset(&res, 0, sizeof res);
+    engine_sink k = {0};
+    k.t_end = 1.0;
+    CHECK(engine_run(m, &sc, &o, &k, &res) == SIM_REFUSED, "the scripted run was not refused");
+    CHECK(strstr(res.message, "a chain of 3 bodies") != NULL, "message: %s", res.message);
+    model_free(m);
+}
+
 static void test_two_link_ramp(void) { two_link_vs_ode_world(0); }
 static void test_two_link_stops(void) { two_link_vs_ode_world(1); }
 
@@ -592,5 +628,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_two_link_stops);
     RUN_TEST(test_static_hold);
     RUN_TEST(test_refusals);
+    RUN_TEST(test_engine_refuses_chain);
     TEST_MAIN_END();
 }
