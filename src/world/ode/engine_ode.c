@@ -40,8 +40,24 @@ static sim_start_load start_load(const model* m, const ode_world* w, const doubl
     return ld;
 }
 
+// A model whose crane is a chain of other shape than the two-link one
+// (crane_chain.two_link false): its crane_mech does not describe it, and
+// the ODE world of ode_world.h builds that two-link crane alone. The chain
+// world (ode_chain.h) builds any chain, but the engine's rows, commands and
+// views are still the two-link crane's: refused here, in one line, rather
+// than run as the wrong crane.
+static int refuse_chain(const model* m, char* err, size_t errsz) {
+    if (m->chain.two_link) return 0;
+    snprintf(err, errsz,
+             "%s: mechanics: a chain of %d bodies and %d functions: the ode backend runs it in neither world yet (its "
+             "engine reads the two-link crane's strokes and commands); the chain's ODE world is ode_chain.h",
+             m->file[0] ? m->file : "model", m->chain.nbody, m->chain.nfn);
+    return -1;
+}
+
 static engine* ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           char* err, size_t errsz) {
+    if (refuse_chain(m, err, errsz)) return NULL;
     eng_ode* l = calloc(1, sizeof *l);
     if (!l) {
         snprintf(err, errsz, "out of memory");
@@ -172,6 +188,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
                  sim_param_name(SIM_PARAM_MECHANICS));
         return res->status = SIM_REFUSED;
     }
+    if (refuse_chain(m, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     ode_world* w = sim_ode_world_create(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
                                         sizeof res->message);
     if (!w) return res->status = SIM_REFUSED;
