@@ -271,8 +271,8 @@ int sim_check_start(const hyd_model* hm, const double* row, int ncol, const sim_
         double share = NAN; // the tip mass's share of joint k's torque
         if (ld->mech && k < 2) {
             double G[2], G0[2];
-            lagrange_gravity(ld->mech, LAGRANGE_FULL, ld->m_tip, ld->q, G);
-            lagrange_gravity(ld->mech, LAGRANGE_FULL, 0.0, ld->q, G0);
+            crane_gravity(ld->mech, ld->m_tip, ld->q, G);
+            crane_gravity(ld->mech, 0.0, ld->q, G0);
             if (fabs(G[k]) > 0) share = fmin(fmax((G[k] - G0[k]) / G[k], 0.0), 1.0);
         }
         static const char* const joint[2] = {"lift", "jib"};

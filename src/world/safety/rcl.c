@@ -5,7 +5,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "lagrange.h"
 #include "sim.h"
 
 // Outreach below which the load moment is divided by this lever instead
@@ -60,7 +59,7 @@ static double load_moment(const rcl* r, const double* row, double* R) {
     const double q[2] = {row[COL_Q1], row[COL_Q2]};
     double lever, G0[2], z;
     crane_pin_length(&me->act[0], q[0], &lever);
-    lagrange_gravity(me, LAGRANGE_FULL, 0.0, q, G0);
+    crane_gravity(me, 0.0, q, G0);
     crane_tip(me, q[0], q[1], R, &z);
     const double F = row[COL_P1A] * r->AA - row[COL_P1B] * r->AB;
     return F * lever - G0[0] - r->chart.hook_mass * me->gravity * *R;
