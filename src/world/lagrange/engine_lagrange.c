@@ -29,6 +29,16 @@ typedef struct eng_lagrange {
     struct sim_energy* energy; ///< engine_follow_energy's balance, or NULL
 } eng_lagrange;
 
+// One row (all SIM_NCOL columns; the world extras 0) from the lagrange
+// crane's outputs o at time t [s]: the one place its rows are assembled.
+static void lagrange_row(double t, const lsim_out* o, double* row) {
+    const double v[SIM_NCOL] = {
+        t, o->x[0], o->x[1], o->pA[0], o->pB[0], o->pA[1], o->pB[1], o->u[0], o->u[1], o->q[0], o->q[1],
+        o->tip[0], o->tip[1], o->F[0], o->F[1], o->u_cmd[0], o->u_cmd[1],
+        o->v[0], o->v[1], o->p_pump, o->relief_open, o->end_stop};
+    memcpy(row, v, sizeof v);
+}
+
 static void lag_row(engine* e, double row[SIM_NCOL]);
 static void lag_destroy(engine* e);
 
@@ -154,7 +164,7 @@ static void lag_row(engine* e, double row[SIM_NCOL]) {
     eng_lagrange* l = (eng_lagrange*)e;
     lsim_out o;
     lsim_outputs(&l->ls, l->t, l->y, &o);
-    sim_lagrange_row(l->t, &o, row);
+    lagrange_row(l->t, &o, row);
 }
 
 // ---- Scripted runs (sim_run) ----
@@ -275,7 +285,7 @@ static int emit(void* user, double t, const double* y) {
     lsim_out o;
     lsim_outputs(c->ls, t, y, &o);
     double row[SIM_NCOL];
-    sim_lagrange_row(t, &o, row);
+    lagrange_row(t, &o, row);
     // The derived columns too (a force or a tip position can overflow while
     // the states are finite).
     const int rc = sim_check_row(&c->chk, row, SIM_NCOL_BASE, c->bad, sizeof c->bad);

@@ -347,19 +347,6 @@ void sim_csv_row(FILE* f, const double* row, int ncol);
 /// assets/worlds/<name>.json ("validation", "sandbox").
 const char* sim_world_path(const char* arg, char* buf, size_t n);
 
-/// One row (all SIM_NCOL columns; the world extras 0) from the lagrange
-/// crane's outputs o at time t [s]: the one place its rows are assembled.
-void sim_lagrange_row(double t, const lsim_out* o, double* row);
-struct ode_world;
-/// One row (all SIM_NCOL columns) from an ode world's current state.
-void sim_ode_row(struct ode_world* w, double* row);
-/// The ode world for a run or a live session: world file o->world (else
-/// default_world, a name in assets/worlds), steps, solver and tolerances from
-/// o, joints at q0 [rad], slew at slew0 [rad], tip load m3 [kg]. NULL with a
-/// one-line message naming the file or option at fault.
-struct ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* default_world,
-                                       const double q0[2], double slew0, double m3, char* err, size_t errsz);
-
 /// Wall clock [s], monotonic.
 double sim_wall_time(void);
 
