@@ -2,6 +2,7 @@
 // 2-DOF crane and its full circuit as one ODE system) behind engine.h,
 // stepped by an outside loop with commands set between steps.
 #include "engine_impl.h"
+#include "lagrange_sim.h"
 #include "energy_acc.h"
 
 #include "snap_reliefs.h"

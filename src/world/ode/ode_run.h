@@ -1,12 +1,12 @@
 // ode_run.h: the ODE world of a run or a live session, built from the model
 // and the run's options (world file, steps, solver), and its row of the
-// run's channels (sim.h). The ode engine (engine_ode.c) is its user.
+// run's channels (sim_base.h). The ode engine (engine_ode.c) is its user.
 #ifndef ODE_RUN_H
 #define ODE_RUN_H
 
 #include "model.h"
 #include "ode_world.h"
-#include "sim.h"
+#include "sim_base.h"
 
 #ifdef __cplusplus
 extern "C" {

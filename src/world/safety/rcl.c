@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "sim.h"
+#include "sim_base.h"
 
 // Outreach below which the load moment is divided by this lever instead
 // [m]: close to the column the moment, and its measurement, go to zero.
