@@ -359,3 +359,21 @@ void sim_collisions_text(const sim_collisions* c, char* buf, size_t n) {
         L += (size_t)snprintf(buf + L, n - L, "%s%s at %.3f s", k ? ", " : " (", c->pair[k], c->first_t[k]);
     if (c->npair && L < n) snprintf(buf + L, n - L, ")");
 }
+
+void sim_trace_free(sim_trace* tr) {
+    free(tr->v);
+    memset(tr, 0, sizeof *tr);
+}
+
+int sim_trace_push(sim_trace* tr, const double* row) {
+    if (tr->nrow == tr->cap) {
+        int cap = tr->cap ? 2 * tr->cap : 4096;
+        double* v = realloc(tr->v, (size_t)cap * SIM_NCOL * sizeof(double));
+        if (!v) return -1;
+        tr->v = v;
+        tr->cap = cap;
+    }
+    memcpy(tr->v + (size_t)tr->nrow * SIM_NCOL, row, SIM_NCOL * sizeof(double));
+    ++tr->nrow;
+    return 0;
+}

@@ -299,6 +299,15 @@ const char* sim_world_path(const char* arg, char* buf, size_t n);
 /// Wall clock [s], monotonic.
 double sim_wall_time(void);
 
+/// A recorded run held in memory (for plots and comparisons).
+typedef struct sim_trace {
+    int nrow, cap;
+    double* v; ///< nrow x SIM_NCOL, row-major
+} sim_trace;
+void sim_trace_free(sim_trace* tr);
+/// Append one row (SIM_NCOL values) to tr; 0, or -1 when out of memory.
+int sim_trace_push(sim_trace* tr, const double* row);
+
 #ifdef __cplusplus
 }
 #endif

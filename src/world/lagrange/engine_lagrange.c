@@ -1,7 +1,7 @@
 // engine_lagrange.c: the lagrange crane (lagrange_sim.h: the analytic
 // 2-DOF crane and its full circuit as one ODE system) behind engine.h,
 // stepped by an outside loop with commands set between steps.
-#include "engine_impl.h"
+#include "engine_lagrange.h"
 #include "lagrange_sim.h"
 #include "energy_acc.h"
 
@@ -55,12 +55,13 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
     }
     l->base.ops = &engine_lagrange_ops;
     l->base.o = *o;
+    l->base.h_probe = o->h;
     if (lsim_init(&l->ls, m, o->variant, m3, err, errsz)) {
         free(l);
         return NULL;
     }
-    if (lsim_check_pose(&l->ls, q0, err, errsz) || sim_check_fixed_step(m->hyd, o, o->h, 0.0, err, errsz) ||
-        sim_check_step_probe(m, o, o->h, err, errsz)) {
+    // The step probe follows in engine.c (engine_create_rcl), on h_probe.
+    if (lsim_check_pose(&l->ls, q0, err, errsz) || sim_check_fixed_step(m->hyd, o, o->h, 0.0, err, errsz)) {
         lsim_free(&l->ls);
         free(l);
         return NULL;
@@ -324,7 +325,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     double y[LSIM_MAX_STATES];
     if (lsim_check_pose(&ls, sc->q0, res->message, sizeof res->message) ||
         check_fixed_step(m->hyd, o, o->h, o->duration > 0 ? o->duration : sc->duration, res) ||
-        (res->status = sim_check_step_probe(m, o, o->h, res->message, sizeof res->message))) {
+        (k->probe && (res->status = k->probe(m, o, o->h, res->message, sizeof res->message)))) {
         lsim_free(&ls);
         return res->status = SIM_REFUSED;
     }

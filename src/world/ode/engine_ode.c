@@ -1,7 +1,7 @@
 // engine_ode.c: the ODE world (ode_world.h: truck, slewing column, booms,
 // rope, hook, loads, terrain; the circuit sub-stepped inside each ODE step)
 // behind engine.h.
-#include "engine_impl.h"
+#include "engine_ode.h"
 #include "energy_acc.h"
 
 #include "ode_run.h"
@@ -59,8 +59,8 @@ static engine* ode_create(const model* m, const sim_opts* o, const double q0[2],
     double row0[SIM_NCOL];
     ode_world_row(l->w, row0);
     const sim_start_load ld = start_load(m, l->w, q0, m3);
+    l->base.h_probe = h; // the step probe follows in engine.c (engine_create_rcl)
     if (sim_check_fixed_step(ode_world_circuit(l->w), o, h, 0.0, err, errsz) ||
-        sim_check_step_probe(m, o, h, err, errsz) ||
         sim_check_start(ode_world_circuit(l->w), row0, SIM_NCOL, &ld, err, errsz)) {
         ode_world_destroy(l->w);
         free(l);
@@ -181,7 +181,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as ode_world_for_run
     if ((res->status = sim_check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res->message,
                                             sizeof res->message)) ||
-        (res->status = sim_check_step_probe(m, o, h_hyd, res->message, sizeof res->message))) {
+        (k->probe && (res->status = k->probe(m, o, h_hyd, res->message, sizeof res->message)))) {
         ode_world_destroy(w);
         return res->status;
     }
@@ -240,7 +240,8 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     if (en) sim_energy_mech(en, ode_world_energy(w));
     // The rated capacity limiter between the scenario and the world, as
     // engine_set_commands has it for the stepped drivers.
-    struct rcl* lim = engine_rcl_create(m, o, "validation");
+    char wbuf[512];
+    struct rcl* lim = rcl_create(m, sim_world_path(o->world ? o->world : "validation", wbuf, sizeof wbuf));
     if (lim) row[COL_RCL_UTIL] = rcl_utilisation(lim, row);
     deliver(c, row);
     ++c->rows;
@@ -305,7 +306,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     res->rows = c->rows;
     res->t_end = c->t_last_row;
     if (en) sim_energy_finish(en);
-    engine_rcl_destroy(lim);
+    rcl_destroy(lim);
     ode_world_destroy(w);
     res->peak_steps = true;
     const char* last;

@@ -7,7 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "engine_impl.h"
+#include "engine_faults.h"
 
 void ode_world_row(ode_world* w, double* row) {
     ode_world_state st;

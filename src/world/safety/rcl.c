@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "sim_base.h"
@@ -44,6 +45,20 @@ int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, si
 }
 
 void rcl_free(rcl* r) { loadchart_free(&r->chart); }
+
+rcl* rcl_create(const model* m, const char* world_path) {
+    char err[300];
+    rcl* r = malloc(sizeof *r);
+    if (r && rcl_init_world(r, m, world_path, err, sizeof err)) {
+        free(r);
+        r = NULL;
+    }
+    return r;
+}
+
+void rcl_destroy(rcl* r) {
+    if (r) rcl_free(r), free(r);
+}
 
 void rcl_reset(rcl* r) {
     const rcl keep = *r;
