@@ -43,8 +43,8 @@ engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2],
     engine* e = backend(o)->create(m, o, q0, slew0, m3, err, errsz);
     if (!e) return NULL;
     // The step probe on the backend's hydraulic step, after its own start
-    // checks (it runs the analytic backend through sim_run, the layer above
-    // the backends, so the backend does not call it itself).
+    // checks: it runs the analytic backend (step_probe.c), which a backend
+    // may not call, so the engine applies it for every backend.
     if (sim_check_step_probe(m, o, e->h_probe, err, errsz)) {
         e->ops->destroy(e);
         return NULL;
