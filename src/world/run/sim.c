@@ -1,6 +1,7 @@
-// sim.c: headless runs of a model on a scenario (the CSV, the trace, the
-// step probe), whatever the backend: sim_run drives engine_run. The run
-// checks and the channel list are sim_base.c's.
+// sim.c: headless runs of a model on a scenario (their rows to a callback,
+// a trace, a progress bar; the CSV), whatever the backend: sim_run drives
+// engine_run. The run checks, the channel list and the trace are
+// sim_base.c's, the step probe step_probe.c's.
 #include "sim.h"
 
 #include <math.h>
