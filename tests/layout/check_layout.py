@@ -238,7 +238,28 @@ def main():
     # Modules: a .c and the header of its stem. A header without a .c of its
     # stem (engine_impl.h, world_snapshot.h, an _internal.h) is part of no
     # module: a module depends through it on the modules it includes, so
-    # X.c -> X_internal.h -> X.h is no circle.
+    # X.c -> X_internal.h -> X.h is no circle. So is a header no file
+    # outside its own folder includes (src, tests, examples, tools): it is
+    # the folder's own business, one part split in files (a loader in two
+    # .c files, its second's header read only by the first), not an
+    # interface a circle can run through.
+    outside = defaultdict(set)  # header basename -> folders (or trees) that include it
+    for top in ("src", "tests", "examples", "tools"):
+        for d, _, names in os.walk(os.path.join(root, top)):
+            for n in names:
+                if not n.endswith((".c", ".h", ".cpp", ".hpp", ".cc")):
+                    continue
+                full = os.path.join(d, n)
+                rel = os.path.relpath(full, root)
+                where = files.get(rel, "(" + rel.split(os.sep)[0] + "/" + rel.split(os.sep)[1] + ")")
+                try:
+                    text = open(full, encoding="utf-8", errors="replace").read()
+                except OSError:
+                    continue
+                for name in INCLUDE_RE.findall(text):
+                    outside[os.path.basename(name)].add(where)
+    internal = {p for p in files if p.endswith(".h") and files[p] != "hydraulics"
+                and outside.get(os.path.basename(p), set()) <= {files[p]}}
     real = {module_of(p) for p in files if p.endswith(".c")}
     modules = defaultdict(set)
     for p in sorted(files):
@@ -252,11 +273,11 @@ def main():
                 continue
             seen.add(t)
             mt = module_of(t)
-            if mt in real:
+            if mt in real and t not in internal:
                 if mt != me:
                     modules[me].add(mt)
             else:
-                todo.extend(inc.get(t, ()))
+                todo.extend(inc.get(t, ()))  # passed through: its includes are the includer's
     # Headers among themselves: a circle of #include (only guards stop it).
     headers = {p: {t for t in inc.get(p, ()) if t.endswith(".h")} for p in files if p.endswith(".h")}
 

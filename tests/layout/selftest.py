@@ -3,8 +3,10 @@
 
 Builds small source trees in a scratch folder, each with a folder map in its
 docs/architecture.md, and runs check_layout.py on them: a tree that follows
-its map passes; a tree with known mistakes (a folder cycle, a module circle
-through a header of its own, an include the map forbids, a header circle, an
+its map passes (with a loader split in two files of one folder, whose second
+header only its folder includes); a tree with known mistakes (a folder
+cycle, a module circle across folders, a module circle through a header
+another folder includes, an include the map forbids, a header circle, an
 include that names no file, a folder missing from the map) fails naming each
 of them, and nothing else.
 """
@@ -54,7 +56,13 @@ CLEAN = {
     # An internal header that includes its module's header: no circle.
     "src/world/mid/b_internal.h": '#include "b.h"\n',
     "src/world/top/c.c": '#include "b.h"\n  #  include "a.h"\n#include <stdio.h>\n',
+    # One part split in two files: q.c uses b's interface and b.c calls q's,
+    # whose header no file outside mid includes: no circle.
+    "src/world/mid/q.h": '#include "b.h"\n',
+    "src/world/mid/q.c": '#include "q.h"\n',
 }
+CLEAN["src/world/mid/b.c"] = '#include "b.h"\n#include "b_internal.h"\n#include "q.h"\n'
+
 
 BAD = dict(CLEAN)
 BAD.update({
@@ -68,6 +76,12 @@ BAD.update({
     "src/world/top/d.c": '#include "nowhere.h"\n',
     # A folder the map does not list.
     "src/world/extra/e.c": '#include "a.h"\n',
+    # The same split, but r.h is an interface (top includes it): r <-> b2r.
+    "src/world/mid/r.h": '#include "b2r.h"\n',
+    "src/world/mid/r.c": '#include "r.h"\n',
+    "src/world/mid/b2r.h": "",
+    "src/world/mid/b2r.c": '#include "b2r.h"\n#include "r.h"\n',
+    "src/world/top/f.c": '#include "r.h"\n#include "b2r.h"\n',
 })
 
 EXPECT_BAD = [
@@ -78,6 +92,7 @@ EXPECT_BAD = [
     "module cycle (2 modules: low/a, mid/b): low/a -> mid/b -> low/a",
     "header cycle (2 headers: top/h1.h, top/h2.h): top/h1.h -> top/h2.h -> top/h1.h",
     'src/world/top/d.c: #include "nowhere.h" is no file of src/world or src/hydraulics',
+    "module cycle (2 modules: mid/b2r, mid/r): mid/b2r -> mid/r -> mid/b2r",
 ]
 
 
@@ -114,7 +129,7 @@ def main():
         print("FAIL:", f)
     if fails:
         return 1
-    print("layout selftest: the clean tree passes, each of the 7 mistakes is reported, a missing map refused")
+    print("layout selftest: the clean tree passes, each of the 8 mistakes is reported, a missing map refused")
     return 0
 
 
