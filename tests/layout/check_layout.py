@@ -9,10 +9,11 @@ folders, or in none, is an error: the include path would pick one silently)
 and builds three graphs:
 
   - modules: a .c file and the header of the same stem are one module
-    (engine.c + engine.h); a header with no .c of its stem is a module of its
-    own. An edge A -> B: a file of A includes a header of B. A cycle here is
-    the "include circle" (issue 26): files that cannot be read, built or
-    tested one without the other.
+    (engine.c + engine.h). An edge A -> B: a file of A includes a header of
+    B. A header with no .c of its stem, or one that no file outside its own
+    folder includes, is passed through: A depends on what it includes. A
+    cycle here is the "include circle" (issue 26): files that cannot be
+    read, built or tested one without the other.
   - folders: an edge from a file's folder to each folder of a header it
     includes. Every edge must be one the folder map allows, and there must be
     no cycle.
