@@ -1,7 +1,8 @@
 // engine_lagrange.c: the lagrange crane (lagrange_sim.h: the analytic
 // 2-DOF crane and its full circuit as one ODE system) behind engine.h,
 // stepped by an outside loop with commands set between steps.
-#include "engine_impl.h"
+#include "engine_lagrange.h"
+#include "lagrange_sim.h"
 #include "energy_acc.h"
 
 #include "snap_reliefs.h"
@@ -29,6 +30,16 @@ typedef struct eng_lagrange {
     struct sim_energy* energy; ///< engine_follow_energy's balance, or NULL
 } eng_lagrange;
 
+// One row (all SIM_NCOL columns; the world extras 0) from the lagrange
+// crane's outputs o at time t [s]: the one place its rows are assembled.
+static void lagrange_row(double t, const lsim_out* o, double* row) {
+    const double v[SIM_NCOL] = {
+        t, o->x[0], o->x[1], o->pA[0], o->pB[0], o->pA[1], o->pB[1], o->u[0], o->u[1], o->q[0], o->q[1],
+        o->tip[0], o->tip[1], o->F[0], o->F[1], o->u_cmd[0], o->u_cmd[1],
+        o->v[0], o->v[1], o->p_pump, o->relief_open, o->end_stop};
+    memcpy(row, v, sizeof v);
+}
+
 static void lag_row(engine* e, double row[SIM_NCOL]);
 static void lag_destroy(engine* e);
 
@@ -44,12 +55,13 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
     }
     l->base.ops = &engine_lagrange_ops;
     l->base.o = *o;
+    l->base.h_probe = o->h;
     if (lsim_init(&l->ls, m, o->variant, m3, err, errsz)) {
         free(l);
         return NULL;
     }
-    if (lsim_check_pose(&l->ls, q0, err, errsz) || sim_check_fixed_step(m->hyd, o, o->h, 0.0, err, errsz) ||
-        sim_check_step_probe(m, o, o->h, err, errsz)) {
+    // The step probe follows in engine.c (engine_create_rcl), on h_probe.
+    if (lsim_check_pose(&l->ls, q0, err, errsz) || sim_check_fixed_step(m->hyd, o, o->h, 0.0, err, errsz)) {
         lsim_free(&l->ls);
         free(l);
         return NULL;
@@ -154,7 +166,7 @@ static void lag_row(engine* e, double row[SIM_NCOL]) {
     eng_lagrange* l = (eng_lagrange*)e;
     lsim_out o;
     lsim_outputs(&l->ls, l->t, l->y, &o);
-    sim_lagrange_row(l->t, &o, row);
+    lagrange_row(l->t, &o, row);
 }
 
 // ---- Scripted runs (sim_run) ----
@@ -275,7 +287,7 @@ static int emit(void* user, double t, const double* y) {
     lsim_out o;
     lsim_outputs(c->ls, t, y, &o);
     double row[SIM_NCOL];
-    sim_lagrange_row(t, &o, row);
+    lagrange_row(t, &o, row);
     // The derived columns too (a force or a tip position can overflow while
     // the states are finite).
     const int rc = sim_check_row(&c->chk, row, SIM_NCOL_BASE, c->bad, sizeof c->bad);
@@ -313,7 +325,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     double y[LSIM_MAX_STATES];
     if (lsim_check_pose(&ls, sc->q0, res->message, sizeof res->message) ||
         check_fixed_step(m->hyd, o, o->h, o->duration > 0 ? o->duration : sc->duration, res) ||
-        (res->status = sim_check_step_probe(m, o, o->h, res->message, sizeof res->message))) {
+        (k->probe && (res->status = k->probe(m, o, o->h, res->message, sizeof res->message)))) {
         lsim_free(&ls);
         return res->status = SIM_REFUSED;
     }

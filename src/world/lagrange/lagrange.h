@@ -17,6 +17,10 @@ typedef enum lagrange_variant {
     LAGRANGE_PAPER_TYPO ///< as printed: G1 uses (m2 + m3) L2 where L1 belongs
 } lagrange_variant;
 
+// sim_default_opts (sim_base.c, which knows no backend) leaves
+// sim_opts.variant 0: the full model must stay the first.
+_Static_assert(LAGRANGE_FULL == 0, "sim_opts.variant defaults to 0, which must be LAGRANGE_FULL");
+
 const char* lagrange_variant_name(lagrange_variant v);
 /// "full", "paper", "paper-typo"; -1 if unknown.
 int lagrange_variant_parse(const char* s);

@@ -3,6 +3,8 @@
 // drivers read these rows instead of testing which backend runs.
 #include "engine_backend.h"
 #include "engine_impl.h"
+#include "engine_lagrange.h"
+#include "engine_ode.h"
 
 #include <stdio.h>
 #include <string.h>

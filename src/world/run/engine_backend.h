@@ -8,7 +8,7 @@
 #ifndef ENGINE_BACKEND_H
 #define ENGINE_BACKEND_H
 
-#include "sim.h"
+#include "sim_base.h"
 
 #include <stdbool.h>
 #include <stddef.h>
