@@ -548,6 +548,9 @@ void sim_ode_row(ode_world* w, double* row) {
 
 ode_world* sim_ode_world_create(const model* m, const sim_opts* o, const char* default_world, const double q0[2],
                                 double slew0, double m3, char* err, size_t errsz) {
+    // The ODE world is built from the two-link crane_mech (issue 26: the
+    // chain world replaces this).
+    if (model_require_two_link(m, "ODE world (--mechanics ode)", err, errsz)) return NULL;
     char wbuf[512];
     const char* wpath = sim_world_path(o->world ? o->world : default_world, wbuf, sizeof wbuf);
     world_desc wd;
