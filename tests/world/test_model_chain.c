@@ -384,6 +384,54 @@ static void test_bad_files(void) {
     }
 }
 
+// The loader's stroke check against the mechanism library: for a revolute
+// (jib2) and a prismatic (ext) actuator, the pin length range over the
+// joint's limits from chain_cylinder; a closed length 2 mm past either end of
+// what the cylinder can reach is refused, 2 mm inside it loads.
+static void test_stroke_check_edges(void) {
+    model* m = load(CHAIN_3BOOM);
+    if (!m) return;
+    char err[1024];
+    chain* ch = crane_chain_mechanism(&m->chain, 0.0, false, 0.0, err, sizeof err);
+    chain_ws* w = ch ? chain_ws_create(ch) : NULL;
+    CHECK(ch && w, "%s", err);
+    const char* names[] = {"jib2", "ext"};
+    for (int t = 0; t < 2 && w; ++t) {
+        const crane_act* a = &m->chain.act[crane_chain_find_act(&m->chain, names[t])];
+        const int jb = a->body_b, dof = chain_body_dof(ch, jb);
+        const chain_body_def* d = chain_body(ch, jb);
+        double q[16] = {0}, Lmin = INFINITY, Lmax = -INFINITY;
+        for (int s = 0; s <= 4000; ++s) {
+            q[dof] = d->q_min + (d->q_max - d->q_min) * s / 4000.0;
+            chain_update(ch, w, q, NULL);
+            const double L = chain_cylinder(ch, w, a->body_a, a->pa, a->body_b, a->pb, NULL, NULL, NULL);
+            Lmin = fmin(Lmin, L), Lmax = fmax(Lmax, L);
+        }
+        // closed > Lmax: never reached; closed + stroke < Lmin: never reached.
+        const double cl[4] = {Lmax + 0.002, Lmax - 0.002, Lmin - a->stroke - 0.002, Lmin - a->stroke + 0.002};
+        for (int k = 0; k < 4; ++k) {
+            char set[128], path[1024], name[64];
+            snprintf(set, sizeof set, "mechanics.actuators.%s.closed_length=%.6f", names[t], cl[k]);
+            snprintf(name, sizeof name, "c_edge_%s_%d.json", names[t], k);
+            snprintf(path, sizeof path, "%s/%s", out_dir(), name);
+            if (fixture_edit(CHAIN_3BOOM, path, set, NULL, NULL)) {
+                CHECK(0, "%s: could not make the file", name);
+                continue;
+            }
+            err[0] = 0;
+            model* e = model_load(path, NULL, 0, err, sizeof err);
+            const int refused = e == NULL;
+            model_free(e);
+            CHECK(refused == (k % 2 == 0) && (!refused || strstr(err, "reaches no pose")),
+                  "%s: %s: %s (pins %.4f..%.4f m, stroke %.4f m)", names[t], set, refused ? err : "loaded", Lmin, Lmax,
+                  a->stroke);
+        }
+    }
+    chain_ws_free(w);
+    chain_free(ch);
+    model_free(m);
+}
+
 // Every two-link consumer refuses a chain model with the one line, rather
 // than read the empty two-link fields; the shorthand passes them all.
 static void test_two_link_consumers_refuse(void) {
@@ -433,6 +481,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_models_load);
     RUN_TEST(test_cylinders_cover_and_hold);
     RUN_TEST(test_bad_files);
+    RUN_TEST(test_stroke_check_edges);
     RUN_TEST(test_two_link_consumers_refuse);
     TEST_MAIN_END();
 }

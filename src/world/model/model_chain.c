@@ -455,45 +455,50 @@ int model_chain_read(json_ctx* c, const cJSON* mech, model* m) {
     return 0;
 }
 
+// A point p of body `child` in its parent's frame at joint coordinate q
+// (chain.h's joints, in the boom plane): revolute, the child's frame turned
+// by angle0 + q about y (x towards z) at the joint origin; prismatic, turned
+// by angle0 and slid by offset0 + q along its own x.
+static void child_to_parent(const chain_body_def* d, double q, const double p[3], double out[3]) {
+    const bool pris = d->joint == CHAIN_PRISMATIC;
+    const double th = d->angle0 + (pris ? 0.0 : q), c = cos(th), s = sin(th);
+    const double x = p[0] + (pris ? d->offset0 + q : 0.0);
+    out[0] = d->origin[0] + c * x - s * p[2];
+    out[1] = d->origin[1] + p[1];
+    out[2] = d->origin[2] + s * x + c * p[2];
+}
+
 // The pin length range [m] of actuator a over the limits of the one joint it
-// spans (its two bodies are parent and child), the other joints anywhere (the
-// length depends on that joint only). Returns 0, or -1 when the actuator
-// spans more than one joint (not checked: a multi-joint range is no cheap
-// interval) or the mechanism cannot be evaluated.
-static int pin_range(const crane_chain* cc, const chain* ch, const crane_act* a, double* Lmin, double* Lmax) {
-    int child = -1;
-    if (cc->body[a->body_b].def.parent == a->body_a) child = a->body_b;
-    else if (cc->body[a->body_a].def.parent == a->body_b) child = a->body_a;
-    if (child < 0) return -1;
-    const int dof = chain_body_dof(ch, child), n = chain_ndof(ch);
-    if (dof < 0) return -1;
+// spans (its two bodies are parent and child): the length depends on that
+// joint only, so it is evaluated in the parent's frame, O(1) a sample (a
+// file of thousands of bodies and actuators checks in linear time). Returns
+// 0, or -1 when the actuator spans more than one joint (not checked: a
+// multi-joint range is no cheap interval).
+static int pin_range(const crane_chain* cc, const crane_act* a, double* Lmin, double* Lmax) {
+    int child;
+    const double *pc, *pp; // the pin on the child, the pin on the parent
+    if (cc->body[a->body_b].def.parent == a->body_a) child = a->body_b, pc = a->pb, pp = a->pa;
+    else if (cc->body[a->body_a].def.parent == a->body_b) child = a->body_a, pc = a->pa, pp = a->pb;
+    else return -1;
     const chain_body_def* d = &cc->body[child].def;
     double lo = d->q_min, hi = d->q_max;
     // An unbounded revolute joint: one turn covers every pose.
     if (!isfinite(lo)) lo = -M_PI;
     if (!isfinite(hi)) hi = M_PI;
     if (hi - lo > 2 * M_PI) hi = lo + 2 * M_PI;
-    double* q = calloc((size_t)n, sizeof *q);
-    chain_ws* w = chain_ws_create(ch);
-    if (!q || !w) {
-        free(q);
-        chain_ws_free(w);
-        return -1;
-    }
     // 720 samples: 0.5 deg on a full turn, 1.4 mm on a 1 m slide; the
     // length is smooth, so its extremes are found to well under the
     // millimetres a stroke is designed to.
     const int N = 720;
     *Lmin = INFINITY, *Lmax = -INFINITY;
     for (int s = 0; s <= N; ++s) {
-        q[dof] = lo + (hi - lo) * s / N;
-        chain_update(ch, w, q, NULL);
-        const double L = chain_cylinder(ch, w, a->body_a, a->pa, a->body_b, a->pb, NULL, NULL, NULL);
+        double w[3];
+        child_to_parent(d, lo + (hi - lo) * s / N, pc, w);
+        const double L = sqrt((w[0] - pp[0]) * (w[0] - pp[0]) + (w[1] - pp[1]) * (w[1] - pp[1]) +
+                              (w[2] - pp[2]) * (w[2] - pp[2]));
         if (L < *Lmin) *Lmin = L;
         if (L > *Lmax) *Lmax = L;
     }
-    free(q);
-    chain_ws_free(w);
     return 0;
 }
 
@@ -554,13 +559,14 @@ int model_chain_bind(json_ctx* c, model* m) {
         fail_under_mechanics(c, e);
         return -1;
     }
+    chain_free(ch);
     // Each cylinder across one joint must reach a pose within that joint's
     // limits: its pin length range there must overlap [closed, closed +
     // stroke]. A pin pair that never fits is a wrong mount or limit.
     for (int k = 0; k < cc->nact && !c->failed; ++k) {
         const crane_act* a = &cc->act[k];
         double Lmin, Lmax;
-        if (pin_range(cc, ch, a, &Lmin, &Lmax)) continue;
+        if (pin_range(cc, a, &Lmin, &Lmax)) continue;
         const double L0 = a->closed_length, L1 = a->closed_length + a->stroke;
         if (Lmax < L0 || Lmin > L1) {
             const int child = cc->body[a->body_b].def.parent == a->body_a ? a->body_b : a->body_a;
@@ -571,7 +577,6 @@ int model_chain_bind(json_ctx* c, model* m) {
                       Lmin, Lmax, cc->body[child].def.name, L0, L1, a->stroke);
         }
     }
-    chain_free(ch);
     return c->failed ? -1 : 0;
 }
 
