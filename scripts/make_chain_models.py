@@ -281,13 +281,16 @@ def chain_3boom_ext(base):
          "com": [1.25, 0, 0], "inertia": 72.916667, "width": 0.15, "height": 0.2, "limits": [-2.35, -0.65]},
         # A third boom (knuckle jib) on the end arm's tip, lighter.
         {"name": "jib2", "joint": "revolute", "origin": [2.5, 0, 0], "length": 2.0, "mass": 90.0,
-         "com": [1.0, 0, 0], "inertia": 30.0, "width": 0.13, "height": 0.17, "limits": [-0.5, 1.2]},
+         "com": [1.0, 0, 0], "width": 0.13, "height": 0.17, "limits": [-0.5, 1.2]},
         # A telescopic extension sliding inside the third boom: 1 m stroke,
         # flush with its tip when retracted.
         {"name": "ext", "joint": "prismatic", "parent": "jib2", "origin": [0, 0, 0], "offset0": 0.4,
-         "length": 1.6, "mass": 45.0, "com": [0.8, 0, 0], "inertia": 9.6, "width": 0.1, "height": 0.13,
+         "length": 1.6, "mass": 45.0, "com": [0.8, 0, 0], "width": 0.1, "height": 0.13,
          "limits": [0.0, 1.0]},
     ]
+    for b in bodies[3:]:
+        # A uniform box about its centre, about y: m (L^2 + h^2) / 12.
+        b["inertia"] = round(b["mass"] * (b["length"] ** 2 + b["height"] ** 2) / 12, 4)
     tip_body, tip = 4, [1.6, 0, 0]
     acts = [
         {"name": "lift", "cylinder": "lift_cyl", "valve": "lift_valve",

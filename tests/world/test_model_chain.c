@@ -432,6 +432,71 @@ static void test_stroke_check_edges(void) {
     model_free(m);
 }
 
+// No fixed maximum: a chain of 1 + N bodies, each boom driven by its own
+// cylinder and valve section (N functions), built in memory, loads, binds
+// and builds its mechanism; --set reaches its bodies by name.
+static void test_large_chain(void) {
+    enum { N = 120 };
+    size_t cap = 4096 + (size_t)N * 900, n = 0;
+    char* t = malloc(cap);
+    if (!t) return;
+#define PUT(...) (n += (size_t)snprintf(t + n, cap - n, __VA_ARGS__))
+    PUT("{\"name\": \"big\", \"mechanics\": {\"load_mass\": 10, \"bodies\": [");
+    PUT("{\"name\": \"column\", \"joint\": \"slew\", \"height\": 1.6, \"mass\": 250}");
+    for (int i = 1; i <= N; ++i)
+        PUT(", {\"name\": \"b%d\", \"joint\": \"revolute\", \"origin\": %s, \"length\": 1.0, \"mass\": 20, "
+            "\"com\": [0.5, 0, 0], \"inertia\": 1.76, \"limits\": [-0.5, 0.5]}",
+            i, i == 1 ? "[0, 0, 1.6]" : "[1.0, 0, 0]");
+    PUT("], \"actuators\": [");
+    for (int i = 1; i <= N; ++i)
+        PUT("%s{\"name\": \"a%d\", \"cylinder\": \"c%d\", \"valve\": \"v%d\", \"base\": {\"body\": \"%s%.0d\", "
+            "\"point\": %s}, \"rod\": {\"body\": \"b%d\", \"point\": [0.2, 0, 0.12]}, \"closed_length\": 0.5}",
+            i > 1 ? ", " : "", i, i, i, i == 1 ? "column" : "b", i == 1 ? 0 : i - 1,
+            i == 1 ? "[0.2, 0, 1.2]" : "[0.5, 0, 0.12]", i);
+    PUT("]}, \"hydraulics\": {\"nodes\": [{\"name\": \"tank\", \"type\": \"tank\", \"pressure\": 100000}, "
+        "{\"name\": \"pump_line\", \"type\": \"volume\", \"volume\": 0.001, \"p0\": 2e7}], \"components\": ["
+        "{\"name\": \"pump\", \"type\": \"pump\", \"inlet\": \"tank\", \"outlet\": \"pump_line\", \"q_max\": 0.0006, "
+        "\"p_set\": 2e7, \"band\": 500000}, {\"name\": \"main_relief\", \"type\": \"relief\", \"inlet\": \"pump_line\", "
+        "\"outlet\": \"tank\", \"p_crack\": 2.2e7, \"dp_override\": 1e6, \"q_rated\": 0.0007}");
+    for (int i = 1; i <= N; ++i)
+        PUT(", {\"name\": \"v%d\", \"type\": \"valve\", \"P\": \"pump_line\", \"T\": \"tank\", \"A\": \"h%dA\", "
+            "\"B\": \"h%dB\", \"q_nominal\": 0.0006, \"dp_nominal\": 1e6}, {\"name\": \"h%dA\", \"type\": \"hose\", "
+            "\"to\": \"c%d.A\", \"length\": 2, \"diameter\": 0.0127}, {\"name\": \"h%dB\", \"type\": \"hose\", "
+            "\"to\": \"c%d.B\", \"length\": 2, \"diameter\": 0.0127}, {\"name\": \"c%d\", \"type\": \"cylinder\", "
+            "\"bore\": 0.05, \"rod\": 0.03, \"stroke\": 0.4}",
+            i, i, i, i, i, i, i, i);
+    PUT("]}}");
+#undef PUT
+    CHECK(n < cap, "buffer");
+    char err[1024] = "";
+    cJSON* root = cJSON_Parse(t);
+    free(t);
+    CHECK(root != NULL, "the generated document does not parse");
+    model* m = root ? model_from_json(root, "big.json", err, sizeof err) : NULL;
+    CHECK(m && m->chain.nbody == N + 1 && m->chain.nact == N && m->chain.nfn == N, "%s", m ? "wrong counts" : err);
+    if (m) {
+        chain* ch = crane_chain_mechanism(&m->chain, m->mech.load_mass, false, 0.0, err, sizeof err);
+        CHECK(ch && chain_ndof(ch) == N, "%s", ch ? "wrong size" : err);
+        chain_free(ch);
+        CHECK(!strcmp(m->chain.fn[N - 1].name, "a120") && m->chain.act[N - 1].body_a == N - 1 &&
+                  m->chain.act[N - 1].body_b == N,
+              "last function %s, last actuator on %d-%d", m->chain.fn[N - 1].name, m->chain.act[N - 1].body_a,
+              m->chain.act[N - 1].body_b);
+    }
+    model_free(m);
+    // --set by name on a chain file: a body's mass, an actuator's pin.
+    const char* sets[] = {"mechanics.bodies.jib2.mass=89", "mechanics.actuators.ext.rod.point=[1.2,0,0.02]"};
+    model* s = model_load(CHAIN_3BOOM, sets, 2, err, sizeof err);
+    CHECK(s && s->chain.body[3].def.mass == 89 && s->chain.act[3].pb[0] == 1.2, "%s", s ? "not applied" : err);
+    model_free(s);
+    const char* bad[] = {"mechanics.bodies.jib2.mass=-1"};
+    s = model_load(CHAIN_3BOOM, bad, 1, err, sizeof err);
+    CHECK(!s && strstr(err, "chain_3boom_ext.json: mechanics.bodies[3].mass:") &&
+              strstr(err, "mechanics.bodies.jib2.mass=-1')"),
+          "%s", s ? "loaded" : err);
+    model_free(s);
+}
+
 // Every two-link consumer refuses a chain model with the one line, rather
 // than read the empty two-link fields; the shorthand passes them all.
 static void test_two_link_consumers_refuse(void) {
@@ -482,6 +547,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_cylinders_cover_and_hold);
     RUN_TEST(test_bad_files);
     RUN_TEST(test_stroke_check_edges);
+    RUN_TEST(test_large_chain);
     RUN_TEST(test_two_link_consumers_refuse);
     TEST_MAIN_END();
 }
