@@ -96,6 +96,21 @@ def resolve(bodies, acts):
         a["_b"] = names.index(a["rod"]["body"])
 
 
+def box_inertia_list(bodies):
+    """The bodies with an "inertia" (after "com") of a uniform box about its
+    centre, about y: m (L^2 + h^2) / 12."""
+    res = []
+    for b in bodies:
+        I = round(b["mass"] * (b["length"] ** 2 + b["height"] ** 2) / 12, 4)
+        out = {}
+        for k, v in b.items():
+            out[k] = v
+            if k == "com":
+                out["inertia"] = I
+        res.append(out)
+    return res
+
+
 def strip(o):
     """The document without the script's working fields (keys starting _)."""
     if isinstance(o, dict):
@@ -288,9 +303,7 @@ def chain_3boom_ext(base):
          "length": 1.6, "mass": 45.0, "com": [0.8, 0, 0], "width": 0.1, "height": 0.13,
          "limits": [0.0, 1.0]},
     ]
-    for b in bodies[3:]:
-        # A uniform box about its centre, about y: m (L^2 + h^2) / 12.
-        b["inertia"] = round(b["mass"] * (b["length"] ** 2 + b["height"] ** 2) / 12, 4)
+    bodies[3:] = box_inertia_list(bodies[3:])
     tip_body, tip = 4, [1.6, 0, 0]
     acts = [
         {"name": "lift", "cylinder": "lift_cyl", "valve": "lift_valve",
@@ -352,9 +365,7 @@ def chain_8fn_10link(base):
         {"name": "jib_ext3", "joint": "prismatic", "origin": [0, 0, 0], "offset0": 0.3, "length": 1.0, "mass": 20.0,
          "com": [0.5, 0, 0], "width": 0.07, "height": 0.09, "limits": [0.0, 0.5]},
     ]
-    for b in bodies[3:]:
-        # A uniform box about its centre, about y: m (L^2 + h^2) / 12.
-        b["inertia"] = round(b["mass"] * (b["length"] ** 2 + b["height"] ** 2) / 12, 4)
+    bodies[3:] = box_inertia_list(bodies[3:])
     tip_body, tip = 9, [1.0, 0, 0]
     ext = lambda name, parent, body, bx, rx: {
         "name": name, "cylinder": name + "_cyl", "valve": name + "_valve",
