@@ -296,6 +296,8 @@ static const bad_case k_bad[] = {
      "mechanics.actuators[2].rod.point", "outside its reach", NULL},
     {"c_com_far.json", CHAIN_3BOOM, "mechanics.bodies.jib2.com=[0,0,3]", NULL, NULL, "mechanics.bodies[3].com",
      "outside its reach", NULL},
+    {"c_column_com_far.json", CHAIN_3BOOM, NULL, "\"radius\": 0.1}", "\"radius\": 0.1, \"com\": [0, 0, 2.5]}",
+     "mechanics.bodies[0].com", "outside its reach of 1.7 m", NULL},
     {"c_tip_far.json", CHAIN_3BOOM, "mechanics.tip.point=[9,0,0]", NULL, NULL, "mechanics.tip.point",
      "outside its reach", NULL},
     {"c_act_body_missing.json", CHAIN_3BOOM, "mechanics.actuators.ext.rod.body=ghost", NULL, NULL,

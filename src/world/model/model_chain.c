@@ -181,6 +181,8 @@ static void read_body(json_ctx* c, const cJSON* bodies, int i, crane_chain* cc) 
         // two-link shorthand's column).
         d->com[2] = 0.5 * b->length;
         json_vec_r(c, o, p, "com", false, d->com, 3, &R_POINT);
+        json_path(f, sizeof f, p, "com");
+        check_reach(c, f, cc, 0, d->com, "the centre of mass");
         if (!c->failed && !read_inertia(c, o, p, b, true)) {
             memset(d->inertia, 0, sizeof d->inertia);
             d->inertia[0][0] = d->inertia[1][1] = d->mass * (3.0 * r * r + b->length * b->length) / 12.0;
