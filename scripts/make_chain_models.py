@@ -11,6 +11,8 @@
 
 Run from the repository root: python3 scripts/make_chain_models.py. The
 generated files are kept in git; the script is how they are changed.
+With --check it writes nothing and fails when a file differs from what it
+would write (ctest test_chain_models_current).
 
 Every geometric value is an estimate for a knuckle-boom crane of the class of
 the shipped HIAB 031 model (docs/model.md says which). The cylinders are not
@@ -230,10 +232,26 @@ def dumps(o, ind=0):
     return json.dumps(o, separators=(", ", ": "))
 
 
+CHECK = "--check" in sys.argv[1:]
+STALE = []
+
+
 def write(name, doc):
     path = os.path.join(OUT, name)
+    text = dumps(strip(doc)) + "\n"
+    if CHECK:
+        # The files in git must be what this script writes (edit the script,
+        # not the files).
+        try:
+            with open(path) as f:
+                same = f.read() == text
+        except OSError:
+            same = False
+        if not same:
+            STALE.append(os.path.relpath(path, ROOT))
+        return
     with open(path, "w") as f:
-        f.write(dumps(strip(doc)) + "\n")
+        f.write(text)
     print("wrote", os.path.relpath(path, ROOT))
 
 
@@ -421,10 +439,13 @@ def main():
     for name, make in (("chain_3boom_ext.json", chain_3boom_ext), ("chain_8fn_10link.json", chain_8fn_10link)):
         doc, sizes = make(base)
         write(name, doc)
-        for a, (closed, stroke, bore, rod, worst) in sizes.items():
+        for a, (closed, stroke, bore, rod, worst) in sizes.items() if not CHECK else ():
             print(f"  {a:9s} closed {closed:.3f} m  stroke {stroke:.3f} m  bore {bore * 1e3:.0f} mm  "
                   f"rod {rod * 1e3:.0f} mm  worst holding force {worst / 1e3:.1f} kN")
 
 
 if __name__ == "__main__":
     main()
+    if STALE:
+        sys.exit("not what scripts/make_chain_models.py writes (run it, or edit it instead of the file): "
+                 + ", ".join(STALE))
