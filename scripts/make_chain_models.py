@@ -73,22 +73,6 @@ def world(pose, p):
     return add(o, rot(th, tuple(p)))
 
 
-def pin_length(bodies, q, act):
-    ps = poses(bodies, q)
-    a = world(ps[act["_a"]], act["base"]["point"])
-    b = world(ps[act["_b"]], act["rod"]["point"])
-    return math.dist(a, b)
-
-
-def potential(bodies, q, tip_body, tip, load):
-    ps = poses(bodies, q)
-    V = 0.0
-    for i, b in enumerate(bodies):
-        com = b.get("com", [0, 0, 0.5 * b.get("height", 0)]) if i == 0 else b["com"]
-        V += b["mass"] * G * world(ps[i], com)[2]
-    return V + load * G * world(ps[tip_body], tip)[2]
-
-
 def resolve(bodies, acts):
     names = [b["name"] for b in bodies]
     for i, b in enumerate(bodies[1:], start=1):
@@ -124,51 +108,75 @@ def strip(o):
 
 # ---- cylinders fitted to the joint ranges --------------------------------
 
+def local_pin_length(bodies, a, child, qj):
+    """Pin length of actuator a across the joint of `child` at qj [m]: the
+    child's pin in the parent's frame (the other joints do not matter)."""
+    b = bodies[child]
+    pc, pp = (a["rod"]["point"], a["base"]["point"]) if a["_b"] == child else (a["base"]["point"], a["rod"]["point"])
+    a0, o = b.get("angle0", 0.0), tuple(b.get("origin", [0, 0, 0]))
+    if b["joint"] == "revolute":
+        w = add(o, rot(a0 + qj, tuple(pc)))
+    else:
+        w = add(o, rot(a0, (pc[0] + b.get("offset0", 0.0) + qj, pc[1], pc[2])))
+    return math.dist(w, tuple(pp))
+
+
 def size_cylinders(bodies, acts, tip_body, tip, load):
     """closed_length and stroke over each actuator's joint range; the bore
     that holds the worst static joint load. Returns {actuator: (closed,
     stroke, bore, rod, worst force N)}."""
     resolve(bodies, acts)
     n = len(bodies) - 1
-    mid = [0.5 * (b["limits"][0] + b["limits"][1]) for b in bodies[1:]]
-    out = {}
+    # The bodies each joint carries (itself and its descendants).
+    carried = [{i} for i in range(len(bodies))]
+    for i in range(len(bodies) - 1, 0, -1):
+        carried[bodies[i]["_parent"]] |= carried[i]
+    coms = [b.get("com", [0, 0, 0.5 * b.get("height", 0)]) if i == 0 else b["com"] for i, b in enumerate(bodies)]
+    fit = []
     for a in acts:
         child = a["_b"] if bodies[a["_b"]]["_parent"] == a["_a"] else a["_a"]
-        j = child - 1
         lo, hi = bodies[child]["limits"]
-        Ls = []
-        for s in range(401):
-            q = list(mid)
-            q[j] = lo + (hi - lo) * s / 400
-            Ls.append(pin_length(bodies, q, a))
-        closed = min(Ls) - END_MARGIN
-        stroke = max(Ls) - min(Ls) + 2 * END_MARGIN
-        # Worst static force: every pose of a coarse grid over the limits,
-        # F = tau_j / (dL/dq_j) with tau_j = -dV/dq_j (virtual work).
-        # (5 points a joint up to 4 joints, else 3: 3^9 poses for 9 joints.)
-        npt = 5 if n <= 4 else 3
-        grid = [[b["limits"][0] + (b["limits"][1] - b["limits"][0]) * k / (npt - 1) for k in range(npt)]
-                for b in bodies[1:]]
-        worst = 0.0
-        h = 1e-6
-        for q in itertools.product(*grid):
-            q = list(q)
-            qp, qm = list(q), list(q)
-            qp[j] += h
-            qm[j] -= h
-            tau = -(potential(bodies, qp, tip_body, tip, load) - potential(bodies, qm, tip_body, tip, load)) / (2 * h)
-            dL = (pin_length(bodies, qp, a) - pin_length(bodies, qm, a)) / (2 * h)
+        Ls = [local_pin_length(bodies, a, child, lo + (hi - lo) * s / 400) for s in range(401)]
+        fit.append((child, min(Ls) - END_MARGIN, max(Ls) - min(Ls) + 2 * END_MARGIN))
+    # Worst static force of each cylinder over a grid of poses within the
+    # limits (5 points a joint up to 4 joints, else 3: 3^9 poses for 9):
+    # F = tau_j / (dL/dq_j), tau_j = -dV/dq_j by virtual work (a rotation
+    # about the joint raises a point by its horizontal distance from the
+    # joint, a slide by the sine of its angle).
+    npt = 5 if n <= 4 else 3
+    grid = [[b["limits"][0] + (b["limits"][1] - b["limits"][0]) * k / (npt - 1) for k in range(npt)]
+            for b in bodies[1:]]
+    worst = [0.0] * len(acts)
+    h = 1e-6
+    for q in itertools.product(*grid):
+        ps = poses(bodies, q)
+        r = [world(ps[i], coms[i]) for i in range(len(bodies))]
+        rt = world(ps[tip_body], tip)
+        for k, a in enumerate(acts):
+            child = fit[k][0]
+            th, o = ps[child]
+            if bodies[child]["joint"] == "revolute":
+                dV = sum(bodies[i]["mass"] * G * (r[i][0] - o[0]) for i in carried[child])
+                dV += load * G * (rt[0] - o[0]) if tip_body in carried[child] else 0.0
+            else:
+                m = sum(bodies[i]["mass"] for i in carried[child]) + (load if tip_body in carried[child] else 0.0)
+                dV = m * G * math.sin(th)
+            qj = q[child - 1]
+            dL = (local_pin_length(bodies, a, child, qj + h) - local_pin_length(bodies, a, child, qj - h)) / (2 * h)
             if abs(dL) < 1e-9:
                 sys.exit(f"{a['name']}: no lever arm at {q}")
-            worst = max(worst, abs(tau / dL))
+            worst[k] = max(worst[k], abs(dV / dL))
+    out = {}
+    for k, a in enumerate(acts):
+        _, closed, stroke = fit[k]
         for bore in BORES:
             rod = round(0.6 * bore, 4)
             ann = math.pi / 4 * (bore * bore - rod * rod)
-            if worst <= HOLD_FRACTION * P_PUMP * ann:
+            if worst[k] <= HOLD_FRACTION * P_PUMP * ann:
                 break
         else:
-            sys.exit(f"{a['name']}: {worst:.0f} N needs a bore over {BORES[-1]} m")
-        out[a["name"]] = (closed, stroke, bore, rod, worst)
+            sys.exit(f"{a['name']}: {worst[k]:.0f} N needs a bore over {BORES[-1]} m")
+        out[a["name"]] = (closed, stroke, bore, rod, worst[k])
         if closed < stroke + 0.2:
             print(f"note: {a['name']}: closed length {closed:.3f} m < stroke {stroke:.3f} m + 0.2 m", file=sys.stderr)
     return out
