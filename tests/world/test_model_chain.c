@@ -514,6 +514,12 @@ static void test_two_link_consumers_refuse(void) {
     char err[1024] = "";
     const char* line = "chain_3boom_ext.json: a chain of 5 bodies and 4 functions; the ";
     CHECK(model_require_two_link(d, "x", err, sizeof err) == 0, "the default crane refused: %s", err);
+    // The two-link fields of a chain model are poison, not zeros.
+    CHECK(isnan(m->mech.link[0].length) && isnan(m->mech.link[1].mass) && isnan(m->mech.act[1].closed_length) &&
+              isnan(m->stroke[0]) && m->cyl[0] == -1 && m->valve[1] == -1 && m->mech.load_mass == 300 &&
+              m->mech.column_height == 1.6,
+          "two-link fields of a chain model: link length %g, stroke %g, cyl %d", m->mech.link[0].length, m->stroke[0],
+          m->cyl[0]);
     CHECK(model_require_two_link(m, "test path", err, sizeof err) == -1 && strstr(err, line) == err &&
               strstr(err, "test path handles the two-link crane only"),
           "%s", err);

@@ -19,13 +19,14 @@ typedef struct model {
     char file[256];      ///< path it was loaded from ("" if built in)
     /// Mechanics of the two-link shorthand (derived fields filled) when
     /// chain.two_link; for a chain model only gravity, load_mass, the rating
-    /// and the column's height and mass are set (model_require_two_link).
+    /// and the column's height and mass are set, the links' and actuators'
+    /// numbers are NaN (model_require_two_link).
     crane_mech mech;
     crane_chain chain;   ///< the crane as a chain: bodies, actuators, functions (every model; owned)
     hyd_model* hyd;      ///< compiled circuit (owned)
     int cyl[2];          ///< hydraulic cylinder index of actuator k (lift, jib); -1 for a chain model
     int valve[2];        ///< hydraulic valve index of actuator k; -1 for a chain model
-    double stroke[2];    ///< cylinder strokes [m]; 0 for a chain model
+    double stroke[2];    ///< cylinder strokes [m]; NaN for a chain model
     cJSON* json;         ///< the document after --set overrides (owned), for saving
     /// Hose-burst orifices ("fault<i>_burst") at nodes the model's circuit
     /// lacks, for the world's circuit to add (engine_fault_model; the sandbox

@@ -451,9 +451,20 @@ int model_chain_read(json_ctx* c, const cJSON* mech, model* m) {
     if (c->failed) return -1;
     cc->slew_free = false;
     cc->two_link = false;
-    // The two-link fields stay empty: nothing may read them for a chain
-    // (model_require_two_link).
-    for (int k = 0; k < 2; ++k) m->cyl[k] = m->valve[k] = -1;
+    // The two-link fields are not this crane: nothing may read them for a
+    // chain (model_require_two_link). Their geometry is NaN, so a path that
+    // missed the gate computes NaN (which every run check refuses) rather
+    // than a plausible answer for a crane of zero-length links.
+    for (int k = 0; k < 2; ++k) {
+        crane_link* l = &me->link[k];
+        l->length = l->mass = l->com = l->inertia = l->width = l->height = NAN;
+        crane_actuator* a = &me->act[k];
+        a->joint = -1;
+        a->base_mount[0] = a->base_mount[1] = a->rod_mount[0] = a->rod_mount[1] = NAN;
+        a->closed_length = a->a = a->b = a->phi_offset = a->sin_offset = a->cos_offset = NAN;
+        m->cyl[k] = m->valve[k] = -1;
+        m->stroke[k] = NAN;
+    }
     return 0;
 }
 
