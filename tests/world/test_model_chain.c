@@ -497,6 +497,14 @@ static void test_large_chain(void) {
               s->chain.act[3].pb[0] == 1.2,
           "%s", s ? "not applied" : err);
     model_free(s);
+    // A cylinder between bodies further apart than parent and child (the
+    // jib's barrel moved onto the column): loads, its pins where the file
+    // puts them (its stroke range spans two joints and is not checked).
+    const char* far[] = {"mechanics.actuators.jib.base.body=column", "mechanics.actuators.jib.base.point=[0.3,0,1.5]"};
+    s = model_load(CHAIN_3BOOM, far, 2, err, sizeof err);
+    CHECK(s && s->chain.act[1].body_a == 0 && s->chain.act[1].body_b == 2 && s->chain.act[1].pa[2] == 1.5, "%s",
+          s ? "wrong pins" : err);
+    model_free(s);
     const char* bad[] = {"mechanics.bodies.jib2.mass=-1"};
     s = model_load(CHAIN_3BOOM, bad, 1, err, sizeof err);
     CHECK(!s && strstr(err, "chain_3boom_ext.json: mechanics.bodies[3].mass:") &&
