@@ -800,6 +800,12 @@ static void rebuild_world(drive_session* s, bool at_start);
 static void load_model(drive_session* s) {
     char e[400];
     model* nm = model_load(s->load_path[0] ? s->load_path : NULL, NULL, 0, e, sizeof e);
+    // The panel edits the two-link fields (the mechanics table) and puts
+    // them back on a failed rebuild: a chain model is refused before that.
+    if (nm && model_require_two_link(nm, "drive panel", e, sizeof e)) {
+        model_free(nm);
+        nm = NULL;
+    }
     if (!nm) {
         snprintf(s->status, sizeof s->status, "load failed (model kept): %s", e);
         panel_set_message(s->pn, s->status);

@@ -47,12 +47,8 @@ static sim_start_load start_load(const model* m, const ode_world* w, const doubl
 // views are still the two-link crane's: refused here, in one line, rather
 // than run as the wrong crane.
 static int refuse_chain(const model* m, char* err, size_t errsz) {
-    if (m->chain.two_link) return 0;
-    snprintf(err, errsz,
-             "%s: mechanics: a chain of %d bodies and %d functions: the ode backend runs it in neither world yet (its "
-             "engine reads the two-link crane's strokes and commands); the chain's ODE world is ode_chain.h",
-             m->file[0] ? m->file : "model", m->chain.nbody, m->chain.nfn);
-    return -1;
+    return model_require_two_link(m, "ode backend (its engine reads the two-link crane's strokes and commands)", err,
+                                  errsz);
 }
 
 static engine* ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,

@@ -35,6 +35,9 @@ void ode_world_row(ode_world* w, double* row) {
 
 ode_world* ode_world_for_run(const model* m, const sim_opts* o, const char* default_world, const double q0[2],
                               double slew0, double m3, char* err, size_t errsz) {
+    // The ODE world is built from the two-link crane_mech (a chain model
+    // gets the chain world, ode_chain.h, where an engine runs one).
+    if (model_require_two_link(m, "ODE world (--mechanics ode)", err, errsz)) return NULL;
     char wbuf[512];
     const char* wpath = sim_world_path(o->world ? o->world : default_world, wbuf, sizeof wbuf);
     world_desc wd;

@@ -212,6 +212,7 @@ static int poses_at(const model* m, double R, double (*pose)[2], int cap) {
 
 int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz) {
     memset(c, 0, sizeof *c);
+    if (model_require_two_link(m, "load chart", err, errsz)) return -1;
     if (lc_check_opts(o, err, errsz)) return -1;
     for (int k = 0; k < 2; ++k) {
         double pr[2];

@@ -17,6 +17,7 @@
 int rcl_init(rcl* r, const model* m, const world_desc* wd, char* err, size_t errsz) {
     memset(r, 0, sizeof *r);
     r->m = m;
+    if (model_require_two_link(m, "rated capacity limiter", err, errsz)) return -1;
     double st;
     hyd_model_cylinder_geometry(m->hyd, m->cyl[0], &r->AA, &r->AB, &st);
     r->stroke = st;
