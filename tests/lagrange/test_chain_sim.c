@@ -42,7 +42,7 @@ static double scn_cmd(void* user, int k, double t) {
 
 typedef struct cmp {
     double x, p, q; // largest difference relative to the largest value of the run
-    double xmax, pmax, qmax, dx, dp, dq;
+    double xmax, pmax, qmax, dx, dp, dq, dE;
 } cmp;
 
 // The two-link crane through both paths with method meth (RK4 at 20 us, else 0.1 ms); the
@@ -108,6 +108,18 @@ static cmp two_link_compare(hyd_method meth, bool blocks) {
     r.x = diff[0] / peak[0], r.p = diff[1] / peak[1], r.q = diff[2] / peak[2];
     r.dx = diff[0], r.dp = diff[1], r.dq = diff[2];
     r.xmax = peak[0], r.pmax = peak[1], r.qmax = peak[2];
+    // The mechanical energy's change over the run: the same on both paths
+    // (the chain's potential has another zero, so the changes).
+    {
+        double yl0[LSIM_MAX_STATES], yc0[64];
+        lsim_initial_state(&ls, sc.q0, 0.5e6, yl0);
+        chain_sim_initial_state(&cs, sc.q0, 0.5e6, yc0, err, sizeof err);
+        const double dEl = lagrange_energy(&m->mech, sc.load_mass, yl + ls.iq, yl + ls.iq + 2) -
+                           lagrange_energy(&m->mech, sc.load_mass, yl0 + ls.iq, yl0 + ls.iq + 2);
+        const double dEc = chain_sim_energy(&cs, yc) - chain_sim_energy(&cs, yc0);
+        printf("  mechanical energy change: closed form %.9g J, general %.9g J\n", dEl, dEc);
+        r.dE = fabs(dEl - dEc) / fabs(dEl);
+    }
     // The run moved both cylinders.
     lsim_out lo;
     lsim_outputs(&ls, tl, yl, &lo);
@@ -132,6 +144,7 @@ static cmp two_link_compare(hyd_method meth, bool blocks) {
 static void test_two_link_rk4(void) {
     const cmp r = two_link_compare(HYD_RK4, false);
     CHECK(r.x < 1e-9 && r.p < 1e-9 && r.q < 1e-9, "relative differences %.3g %.3g %.3g", r.x, r.p, r.q);
+    CHECK(r.dE < 1e-9, "mechanical energy changes differ by %.3g relative", r.dE);
 }
 
 // Krus at 0.1 ms with the full W on both sides: the Jacobians differ only

@@ -2,6 +2,7 @@
 // analytic Jacobian and its start state. Derivation in docs/lagrange.md,
 // "The general formulation".
 #include "chain_sim.h"
+#include "circuit_kernel.h" // HYD_SPOOL_SETTLE
 
 #include <math.h>
 #include <stdio.h>
@@ -270,6 +271,21 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
     return 0;
 }
 
+// hyd_problem.settle (as lsim_settle): a spool within HYD_SPOOL_SETTLE of 0
+// while its command is as close is set to exactly 0, and the circuit's other
+// lags towards 0 are flushed (hyd_model_flush): a geometric decay otherwise
+// ends in subnormal numbers, on which every step is slower.
+static int chain_sim_settle(void* user, double t, double* y) {
+    chain_sim* s = user;
+    int changed = hyd_model_flush(s->hm, y, NULL) > 0;
+    for (int f = 0; f < s->nfn; ++f) {
+        double* u = s->iu[f] >= 0 ? &y[s->iu[f]] : NULL;
+        if (!u || *u == 0.0 || !(fabs(*u) < HYD_SPOOL_SETTLE)) continue;
+        if (fabs(command(s, f, t)) < HYD_SPOOL_SETTLE) *u = 0.0, changed = 1;
+    }
+    return changed;
+}
+
 hyd_problem chain_sim_problem(chain_sim* s) {
     hyd_problem p;
     memset(&p, 0, sizeof p);
@@ -278,6 +294,7 @@ hyd_problem chain_sim_problem(chain_sim* s) {
     p.jac = chain_sim_jac;
     p.jac_full = 1;
     p.user = s;
+    p.settle = chain_sim_settle;
     return p;
 }
 

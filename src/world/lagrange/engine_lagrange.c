@@ -2,6 +2,7 @@
 // 2-DOF crane and its full circuit as one ODE system) behind engine.h,
 // stepped by an outside loop with commands set between steps.
 #include "engine_impl.h"
+#include "engine_chain.h"
 #include "energy_acc.h"
 
 #include "snap_reliefs.h"
@@ -35,6 +36,15 @@ static void lag_destroy(engine* e);
 static engine* lag_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           char* err, size_t errsz) {
     (void)slew0; // the planar crane does not slew
+    // The stepped engine is the closed form's (the fast path's allow-list:
+    // the two-link shorthand, variant full, paper or paper-typo).
+    if (!m->chain.two_link || o->variant == LAGRANGE_GENERAL) {
+        snprintf(err, errsz,
+                 "the stepped lagrange engine runs the two-link crane's closed form only; the general analytic "
+                 "mode (%s) runs scripted (cranesim run)",
+                 m->chain.two_link ? "--variant general" : "this model's chain");
+        return NULL;
+    }
     // No world circuit here: a burst at a node the model lacks has nowhere to open.
     if (engine_world_bursts(m, NULL, NULL, err, errsz)) return NULL;
     eng_lagrange* l = calloc(1, sizeof *l);
@@ -298,6 +308,10 @@ static const char* state_name(const lsim* ls, int i, char* buf, size_t n) {
 // apply, integrated between the command breakpoints with rows at the
 // output times.
 static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
+    // The closed form is the fast path of exactly the two-link shorthand
+    // (its allow-list); every other chain, and --variant general, runs the
+    // general formulation (docs/lagrange.md).
+    if (!m->chain.two_link || o->variant == LAGRANGE_GENERAL) return engine_chain_run(m, sc, o, k, res);
     lsim ls;
     double m3 = sim_load_mass(m, sc, o);
     if (engine_world_bursts(m, NULL, NULL, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
