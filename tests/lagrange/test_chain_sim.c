@@ -2,6 +2,7 @@
 // closed-form two-link crane (lagrange_sim.h), an energy invariant on a
 // five-body chain, and its analytic Jacobian against finite differences.
 #include "chain_sim.h"
+#include "engine_chain.h"
 #include "check.h"
 #include "crane_chain_synth.h"
 #include "crane_fixture.h"
@@ -308,7 +309,71 @@ static void test_chain_run_and_jacobian(void) {
     hyd_model_free(hm);
 }
 
+typedef struct csv_rows {
+    FILE* ref;    // the previous main's CSV, every 100th row
+    long row;     // rows seen
+    long checked; // rows compared
+    long differ;  // of them, not byte-identical
+    char first[600];
+} csv_rows;
+
+static int compare_row(void* user, const double* row) {
+    csv_rows* c = user;
+    if (c->row++ % 100) return 0;
+    char* got = NULL;
+    size_t n = 0;
+    FILE* m = open_memstream(&got, &n);
+    sim_csv_row(m, row, SIM_NCOL_BASE);
+    fclose(m);
+    char want[1024];
+    if (!fgets(want, sizeof want, c->ref)) want[0] = 0;
+    ++c->checked;
+    if (strcmp(got, want) && !c->differ++) snprintf(c->first, sizeof c->first, "got  %swant %s", got, want);
+    free(got);
+    return 0;
+}
+
+// The default scripted run (hiab031, ramp, Krus 0.1 ms, rows at 1 ms) takes
+// the closed form's fast path unchanged: its CSV rows byte-identical to
+// those of the previous main (b752397, `cranesim run`, every 100th row
+// kept in tests/lagrange/data).
+static void test_default_run_unchanged(void) {
+    scenario sc;
+    model* m = load_crane("ramp", &sc);
+    if (!m) return;
+    csv_rows c = {fopen(CRANESIM_TESTDATA "/ramp_b752397_every100.csv", "r"), 0, 0, 0, ""};
+    CHECK(c.ref != NULL, "reference CSV");
+    if (!c.ref) return;
+    char hdr[1024];
+    CHECK(fgets(hdr, sizeof hdr, c.ref) != NULL, "header");
+    sim_opts o = sim_default_opts();
+    sim_result res;
+    CHECK(sim_run(m, &sc, &o, compare_row, &c, NULL, NULL, NULL, &res) == 0, "%s", res.message);
+    CHECK(res.fused && res.split, "the fast path ran (fused %d, split %d)", res.fused, res.split);
+    CHECK(c.checked == 201 && c.differ == 0, "%ld of %ld rows differ; first:\n%s", c.differ, c.checked, c.first);
+    fclose(c.ref);
+    model_free(m);
+}
+
+// The general path refuses the paper's equations, which are the two-link
+// crane's, with one line that says so.
+static void test_general_refuses_paper(void) {
+    scenario sc;
+    model* m = load_crane("ramp", &sc);
+    if (!m) return;
+    sim_opts o = sim_default_opts();
+    o.variant = LAGRANGE_PAPER;
+    engine_sink k = {.t_end = 1.0};
+    sim_result res;
+    memset(&res, 0, sizeof res);
+    CHECK(engine_chain_run(m, &sc, &o, &k, &res) == SIM_REFUSED, "refused");
+    CHECK(strstr(res.message, "two-link") && !strchr(res.message, '\n'), "message: %s", res.message);
+    model_free(m);
+}
+
 int main(int argc, char** argv) {
+    RUN_TEST(test_default_run_unchanged);
+    RUN_TEST(test_general_refuses_paper);
     RUN_TEST(test_two_link_rk4);
     RUN_TEST(test_two_link_krus);
     RUN_TEST(test_energy_ideal_forces);
