@@ -17,7 +17,10 @@ void engine_chain_start_pose(const crane_chain* cc, const scenario* sc, double* 
         // The column is a DOF only when it slews (crane_chain_mechanism).
         if (i == 0 ? !cc->slew_free : b->fixed) continue;
         double q = i == 0 ? sc->slew0 : boom < 2 ? sc->q0[boom] : 0.0;
-        if (i > 0 && boom >= 2) q = fmin(fmax(q, b->q_min), b->q_max);
+        // A DOF the scenario does not place: the middle of its joint
+        // limits, or 0 when they are open.
+        if (i > 0 && boom >= 2 && isfinite(b->q_min) && isfinite(b->q_max)) q = 0.5 * (b->q_min + b->q_max);
+        else if (i > 0 && boom >= 2) q = fmin(fmax(q, b->q_min), b->q_max);
         if (i > 0) ++boom;
         q0[d++] = q;
     }
@@ -41,8 +44,8 @@ typedef struct chain_run_ctx {
     double *x, *v, *pA, *pB, *F, *u, *ucmd, *q, *qd;
 } chain_run_ctx;
 
-// The scenario's commands by function name: lift, jib, slew (scenario.h's
-// columns); a function without a column stays at 0.
+// The scenario's commands by function name (scenario_find_command: lift,
+// jib, slew and the file's named columns); a function without one stays at 0.
 static double scn_cmd(void* user, int k, double t) {
     const chain_run_ctx* c = user;
     return c->fcol[k] < 0 ? 0.0 : scenario_command(c->sc, c->fcol[k], t);
@@ -165,9 +168,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     c.x = q0 + nd, c.v = c.x + na, c.pA = c.v + na, c.pB = c.pA + na, c.F = c.pB + na;
     c.u = c.F + na, c.ucmd = c.u + nf, c.q = c.ucmd + nf, c.qd = c.q + nd;
     for (int f = 0; f < nf; ++f) {
-        c.fcol[f] = -1;
-        for (int j = 0; j < SCENARIO_NCMD; ++j)
-            if (!strcmp(m->chain.fn[f].name, scenario_cmd_name[j])) c.fcol[f] = j;
+        c.fcol[f] = scenario_find_command(sc, m->chain.fn[f].name);
     }
     c.cs = &cs;
     c.sc = sc;
@@ -222,7 +223,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     c.o = &oo;
     // Between the command breakpoints (rounded to the output grid), the
     // solver reset at each, as engine_lagrange.c's run.
-    double bp[2 * SCENARIO_MAX_POINTS * SCENARIO_NCMD + SCENARIO_MAX_EVENTS + 2];
+    double bp[SCENARIO_MAX_POINTS * SCENARIO_MAX_CMD + SCENARIO_MAX_EVENTS + 9 * SCENARIO_MAX_FAULTS + 2];
     const int nbp = scenario_breakpoints(sc, bp, (int)(sizeof bp / sizeof bp[0]) - 1);
     engine_faults ef;
     engine_faults_init(&ef, m->hyd);

@@ -20,8 +20,8 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
 
 /// The start pose of chain cc [chain_ndof of its mechanism, slew first when
 /// it slews] for scenario sc: the slew at sc->slew0, the first two boom DOFs
-/// at sc->q0 (the paper's q1, q2), every other DOF at 0 clamped into its
-/// joint limits.
+/// at sc->q0 (the paper's q1, q2), every other DOF at the middle of its
+/// joint limits (0 when either is open, clamped into the other).
 void engine_chain_start_pose(const crane_chain* cc, const scenario* sc, double* q0);
 
 #ifdef __cplusplus

@@ -75,11 +75,16 @@ int crane_chain_synthetic(const char* joints, bool slew_free, crane_chain* out, 
             a->pa[0] = 0.1 * p->length, a->pa[2] = 0.1;
             a->pb[0] = 0.5 * b->length, a->pb[2] = 0.1;
             q0[k - 1] = 0.3;
-        } else { // knuckle: over the joint, from the body before to this one
+        } else { // knuckle: from above the body before to below this one
+            // (a lever arm of 0.24 to 0.35 m about the joint, folded down)
             a->pa[0] = 0.6 * p->length, a->pa[2] = 0.25;
-            a->pb[0] = 0.4, a->pb[2] = 0.25;
-            q0[k - 1] = (k % 2) ? 0.6 : -0.9;
+            a->pb[0] = 0.4, a->pb[2] = -0.25;
+            q0[k - 1] = (k % 2) ? -0.5 : -0.9;
         }
+        // Joint limits: 0.5 rad either side of the start, an extension
+        // [0, 0.6] m (the start pose in their middle).
+        b->def.q_min = pr ? 0.0 : q0[k - 1] - 0.5;
+        b->def.q_max = pr ? 0.6 : q0[k - 1] + 0.5;
         crane_function* f = &out->fn[k - 1];
         snprintf(f->name, sizeof f->name, "f%d", k);
         snprintf(f->valve, sizeof f->valve, "act%d_valve", k);

@@ -24,7 +24,8 @@ extern "C" {
 /// boom's length. q0 [n] receives the start pose (the lifting arm near
 /// horizontal, the knuckles folded, the extensions at 0.3 m), and each
 /// cylinder's closed length is set so its stroke there is half its
-/// stroke. The chain is bound to *hm. Returns 0, or -1 with one line in err.
+/// stroke; the joint limits put q0 in their middle (0.5 rad either side, an
+/// extension [0, 0.6] m). The chain is bound to *hm. Returns 0, or -1 with one line in err.
 int crane_chain_synthetic(const char* joints, bool slew_free, crane_chain* out, hyd_model** hm, double* q0,
                           char* err, size_t errsz);
 

@@ -74,6 +74,7 @@ struct engine {
     struct rcl* rcl;      ///< the rated capacity limiter (engine.c), or NULL where its chart failed
     double u_op[3];       ///< the operator's last commands lift, jib, slew, as given to engine_set_commands [-]
     double u_lim[3];      ///< what the limiter let through of them [-] (u_op when it cut nothing)
+    const model* mdl;     ///< the model it was made from (its chain's functions: engine_function_name)
 };
 
 extern const engine_ops engine_lagrange_ops, engine_ode_ops;
