@@ -445,7 +445,10 @@ void chain_sim_outputs(chain_sim* s, double t, const double* y, chain_sim_out* o
         if (o->q) o->q[i] = y[s->iq + i];
         if (o->qd) o->qd[i] = y[s->iq + nd + i];
     }
-    chain_world_point(s->ch, s->ws, s->cc->tip_body, s->cc->tip, o->tip, NULL);
+    if (s->cc->tip_body >= 0 && s->cc->tip_body < s->cc->nbody)
+        chain_world_point(s->ch, s->ws, s->cc->tip_body, s->cc->tip, o->tip, NULL);
+    else
+        o->tip[0] = o->tip[1] = o->tip[2] = 0.0;
     const int pl = hyd_model_supply_node(s->hm);
     o->p_pump = pl >= 0 ? d->node_p[pl] : 0.0;
 }

@@ -178,7 +178,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     engine_chain_start_pose(&m->chain, sc, q0);
     const double t_end = o->duration > 0 ? o->duration : sc->duration;
     if (chain_sim_check_pose(&cs, q0, msg, msz) || chain_sim_initial_state(&cs, q0, 0.5e6, y, msg, msz) ||
-        sim_check_fixed_step(m->hyd, o, o->h, t_end, msg, msz)) {
+        sim_check_fixed_step(m->hyd, o, o->h, t_end, msg, msz) || sim_check_step_probe(m, o, o->h, msg, msz)) {
         res->status = SIM_REFUSED;
         goto done;
     }
