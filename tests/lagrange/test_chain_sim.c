@@ -436,7 +436,7 @@ static void test_engine_named_functions(void) {
     snprintf(sc.cmd_name[6], sizeof sc.cmd_name[6], "winch");
     memset(&res, 0, sizeof res);
     CHECK(engine_run(m, &sc, &o, &k, &res) == SIM_REFUSED, "refused");
-    CHECK(strstr(res.message, "fns.json: commands.winch: no function 'winch'") && strstr(res.message, "f4"),
+    CHECK(strstr(res.message, "fns.json: commands.winch: unknown field 'winch'") && strstr(res.message, "f4"),
           "message: %s", res.message);
     m->chain = keep_cc;
     m->hyd = keep_hm;

@@ -258,7 +258,9 @@ int engine_faults_apply(const engine_faults* f, hyd_model* hm, const scenario* s
 int engine_check_scenario(const model* m, const scenario* sc, char* err, size_t errsz) {
     for (int k = SCENARIO_NCMD; k < scenario_ncmd(sc); ++k) {
         if (crane_chain_find_function(&m->chain, sc->cmd_name[k]) >= 0) continue;
-        int n = snprintf(err, errsz, "%s: commands.%s: no function '%s' in the model (its functions: lift, jib, slew",
+        int n = snprintf(err, errsz,
+                         "%s: commands.%s: unknown field '%s': the model has no function of that name (its functions: "
+                         "lift, jib, slew",
                          sc->file[0] ? sc->file : "scenario", sc->cmd_name[k], sc->cmd_name[k]);
         for (int f = 0; f < m->chain.nfn && n > 0 && (size_t)n < errsz; ++f) {
             const char* fn = m->chain.fn[f].name;

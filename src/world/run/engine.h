@@ -67,8 +67,8 @@ const char* engine_function_name(const engine* e, int k);
 /// functions these three are.
 void engine_set_function_commands(engine* e, const double* u);
 /// 0 when every command column of sc names a function of m (lift, jib and
-/// slew always do), else -1 with "FILE: commands.X: no function 'X' in the
-/// model (its functions: ...)" in err. engine_run checks it.
+/// slew always do), else -1 with "FILE: commands.X: unknown field 'X': the
+/// model has no function of that name (its functions: ...)" in err. engine_run checks it.
 int engine_check_scenario(const model* m, const scenario* sc, char* err, size_t errsz);
 /// Hook: 1 attach the nearest load in reach, 0 release. Returns the load
 /// index attached, or -1 (also where the world has no hook).
