@@ -269,7 +269,7 @@ int app_set_mechanics(sim_opts* o, const char* opt, const char* v) {
 int app_set_variant(sim_opts* o, const char* opt, const char* v) {
     const int var = lagrange_variant_parse(v);
     if (var < 0) {
-        fprintf(stderr, "cranesim: %s: expected full, paper or paper-typo, got '%s'\n", opt, v);
+        fprintf(stderr, "cranesim: %s: expected full, general, paper or paper-typo, got '%s'\n", opt, v);
         return -1;
     }
     o->variant = (lagrange_variant)var;
@@ -405,7 +405,7 @@ static const struct {
                    "                       a --set of mechanics.load_mass counts only when neither sets one);\n"
                    "                       not with the sandbox world, whose loads are world objects\n"},
     {APP_OPT_MECHANICS, NULL}, // from the backend table: mechanics_help
-    {APP_OPT_VARIANT, "  --variant V          lagrange equations: full (default), paper, paper-typo\n"},
+    {APP_OPT_VARIANT, "  --variant V          lagrange equations: full (default), general, paper, paper-typo\n"},
     {APP_OPT_WORLD, "  --world W            ode: world file or name: validation (default for run), sandbox\n"},
     {APP_OPT_DT_ODE, "  --dt-ode H           ode: rigid-body step [s] (default 1e-3); the hydraulics sub-step\n"
                      "                       there is min(--dt, --dt-ode) and must divide it\n"},

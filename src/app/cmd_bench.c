@@ -5,7 +5,9 @@
 // honest figures. Benchmarks measure; tests never time anything.
 #define _DEFAULT_SOURCE // wait4
 #include "app.h"
+#include "chain_sim.h"
 #include "circuit_fast.h"
+#include "crane_chain_synth.h"
 #include "engine.h"
 #include "loadchart.h"
 #include "json_util.h"
@@ -64,6 +66,8 @@ static void bench_help(FILE* f) {
             "               mesh of the same shape, in one run: both real-time factors and their ratio\n"
             "  circuit-sizes  not in the default set: one circuit evaluation (fast kernel, reference)\n"
             "               on synthetic circuits of 1, 2, 4, 8, 16 actuators, ns per eval and per state\n"
+            "  chain-sizes  not in the default set: whole crane steps of the general analytic mode\n"
+            "               (Krus 0.1 ms) on synthetic chains of 2, 3, 4, 6, 8 functions, ns per state\n"
             "  sweep        not in the default set: cranesim sweep of 64 designs of the scenario (lift\n"
             "               bore 80..120 mm) on 1 and 2 threads: designs per minute and their ratio;\n"
             "               16 designs on the ode backend on 1 and 2 worker processes, interleaved\n"
@@ -757,6 +761,82 @@ static int bench_circuit_sizes(int repeat) {
     return 0;
 }
 
+// chain-sizes: whole crane steps (mechanics and circuit, Krus at 0.1 ms,
+// the dense analytic Jacobian every step) of the general analytic mode
+// (chain_sim.h) on synthetic chains of 2, 3, 4, 6 and 8 functions
+// (crane_chain_synthetic: booms, knuckles and extensions, each with its
+// own cylinder and valve section), every function moving; ns per step and
+// per state, and the ratio of the largest per-state cost to the smallest.
+static double chain_wave(void* user, int k, double t) {
+    (void)user;
+    return 0.5 * sin(2.0 * 3.14159265358979 * t / (2.0 + 0.5 * k));
+}
+
+static int bench_chain_sizes(int repeat) {
+    static const char* const shapes[5] = {"RR", "RRR", "RRRP", "RRRPRP", "RRRPRPRP"};
+    double per_state[5] = {0};
+    for (int s = 0; s < 5; ++s) {
+        char err[256];
+        crane_chain cc;
+        hyd_model* hm = NULL;
+        double q0[8];
+        chain_sim cs;
+        memset(&cs, 0, sizeof cs);
+        if (crane_chain_synthetic(shapes[s], false, &cc, &hm, q0, err, sizeof err) ||
+            chain_sim_init(&cs, &cc, hm, 100.0, 0.0, err, sizeof err)) {
+            printf("{\"config\":\"chain-sizes\",\"functions\":%d,\"error\":\"%s\"}\n", (int)strlen(shapes[s]), err);
+            if (hm) crane_chain_free(&cc), hyd_model_free(hm);
+            return EXIT_RUNTIME;
+        }
+        cs.cmd_fn = chain_wave;
+        const int n = cs.n;
+        double* y0 = calloc((size_t)n, sizeof *y0);
+        double* y = calloc((size_t)n, sizeof *y);
+        int rc = !y0 || !y ? -1 : chain_sim_initial_state(&cs, q0, 0.5e6, y0, err, sizeof err);
+        hyd_problem p = chain_sim_problem(&cs);
+        hyd_solver_opts so = hyd_default_solver_opts();
+        so.h = 1e-4;
+        so.max_steps = 0;
+        hyd_solver* sol = rc ? NULL : hyd_solver_create(&p, HYD_KRUS, &so);
+        if (!sol) {
+            printf("{\"config\":\"chain-sizes\",\"functions\":%d,\"error\":\"%s\"}\n", cs.nfn,
+                   rc ? err : "solver");
+            free(y0), free(y), chain_sim_free(&cs), crane_chain_free(&cc), hyd_model_free(hm);
+            return EXIT_RUNTIME;
+        }
+        // 1 s of crane (10,000 steps) per repetition, from the same start.
+        const int reps = repeat < 1 ? 1 : (repeat > 16 ? 16 : repeat);
+        double tw[16];
+        long steps = 0;
+        for (int r = 0; r < reps; ++r) {
+            memcpy(y, y0, (size_t)n * sizeof *y);
+            hyd_solver_reset(sol);
+            hyd_solver_clear_stats(sol);
+            double t = 0.0;
+            const double w0 = sim_wall_time();
+            rc = hyd_solver_advance(sol, &t, y, 1.0);
+            tw[r] = sim_wall_time() - w0;
+            steps = hyd_solver_get_stats(sol)->steps;
+            if (rc != HYD_OK) break;
+        }
+        for (int a = 1; a < reps; ++a)
+            for (int b = a; b > 0 && tw[b] < tw[b - 1]; --b) { double t = tw[b]; tw[b] = tw[b - 1]; tw[b - 1] = t; }
+        const double ns_step = tw[reps / 2] * 1e9 / (double)(steps > 0 ? steps : 1);
+        per_state[s] = ns_step / n;
+        printf("{\"config\":\"chain-sizes\",\"functions\":%d,\"dof\":%d,\"states\":%d,\"repeat\":%d,"
+               "\"steps\":%ld,\"ns_per_step\":%.0f,\"ns_per_state\":%.1f,\"ok\":%s}\n",
+               cs.nfn, cs.ndof, n, reps, steps, ns_step, ns_step / n, rc == HYD_OK ? "true" : "false");
+        hyd_solver_destroy(sol);
+        free(y0), free(y), chain_sim_free(&cs), crane_chain_free(&cc), hyd_model_free(hm);
+        if (rc != HYD_OK) return EXIT_RUNTIME;
+    }
+    double lo = per_state[0], hi = per_state[0];
+    for (int s = 1; s < 5; ++s) lo = fmin(lo, per_state[s]), hi = fmax(hi, per_state[s]);
+    printf("{\"config\":\"chain-sizes\",\"ns_per_state_max_over_min\":%.3f}\n", hi / lo);
+    fflush(stdout);
+    return 0;
+}
+
 // The drive configuration runs the pick-and-place operator, which needs a
 // hook and loads: a world of the sandbox type (sandbox, site). 0, or
 // EXIT_USAGE with one line naming the world and the problem.
@@ -873,6 +953,7 @@ int cmd_bench(int argc, char** argv) {
             continue;
         }
         if (!strcmp(only[j], "circuit-sizes")) { if (bench_circuit_sizes(repeat)) return EXIT_RUNTIME; continue; }
+        if (!strcmp(only[j], "chain-sizes")) { if (bench_chain_sizes(repeat)) return EXIT_RUNTIME; continue; }
         if (!strcmp(only[j], "loadchart")) {
             if (bench_loadchart(&c, repeat)) return EXIT_RUNTIME;
             continue;

@@ -67,6 +67,7 @@ struct engine {
                           ///< engine.c applies the step probe (sim_check_step_probe) to it
     double u_op[3];       ///< the operator's last commands lift, jib, slew, as given to engine_set_commands [-]
     double u_lim[3];      ///< what the limiter let through of them [-] (u_op when it cut nothing)
+    const model* mdl;     ///< the model it was made from (its chain's functions: engine_function_name)
 };
 
 // Each backend declares its engine_ops in its own folder (engine_lagrange.h,

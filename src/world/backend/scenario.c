@@ -149,11 +149,37 @@ int scenario_from_json(const cJSON* root, const char* file, scenario* s, char* e
     // Optional: a scenario that only holds the start pose (a fault, a
     // settling test) has no command to give; absent, every valve is centred.
     const cJSON* cmds = json_obj(&c, root, "", "commands", false);
-    json_only_keys(&c, cmds, "commands", (const char* const[]){"lift", "jib", "slew", NULL});
     for (int k = 0; k < SCENARIO_NCMD; ++k) {
         char p[64];
         json_path(p, sizeof p, "commands", scenario_cmd_name[k]);
         load_signal(&c, json_arr(&c, cmds, "commands", scenario_cmd_name[k], false), p, &s->cmd[k]);
+    }
+    s->ncmd = SCENARIO_NCMD;
+    // Any other column names a function of the model's chain (checked
+    // against the model when a run starts: engine_check_scenario).
+    const cJSON* col = cmds ? cmds->child : NULL;
+    for (; col && !c.failed; col = col->next) {
+        const char* nm = col->string ? col->string : "";
+        bool std = false;
+        for (int k = 0; k < SCENARIO_NCMD; ++k) std |= !strcmp(nm, scenario_cmd_name[k]);
+        if (std) continue;
+        char p[160];
+        json_path(p, sizeof p, "commands", nm);
+        if (!*nm || strlen(nm) >= SCENARIO_CMD_NAME) {
+            json_fail(&c, p, "a function name of 1 to %d characters", SCENARIO_CMD_NAME - 1);
+            break;
+        }
+        if (s->ncmd >= SCENARIO_MAX_CMD) {
+            json_fail(&c, p, "at most %d command columns besides lift, jib and slew", SCENARIO_MAX_CMD - SCENARIO_NCMD);
+            break;
+        }
+        if (!cJSON_IsArray(col)) {
+            json_fail(&c, p, "must be an array of [t, u] pairs");
+            break;
+        }
+        snprintf(s->cmd_name[s->ncmd], SCENARIO_CMD_NAME, "%s", nm);
+        load_signal(&c, col, p, &s->cmd[s->ncmd]);
+        ++s->ncmd;
     }
 
     const cJSON* hook = json_arr(&c, root, "", "hook", false);
@@ -250,9 +276,19 @@ static int cmp_double(const void* a, const void* b) {
     return (x > y) - (x < y);
 }
 
+int scenario_ncmd(const scenario* s) { return s->ncmd > SCENARIO_NCMD ? s->ncmd : SCENARIO_NCMD; }
+
+int scenario_find_command(const scenario* s, const char* name) {
+    for (int k = 0; k < SCENARIO_NCMD; ++k)
+        if (!strcmp(name, scenario_cmd_name[k])) return k;
+    for (int k = SCENARIO_NCMD; k < s->ncmd && k < SCENARIO_MAX_CMD; ++k)
+        if (!strcmp(name, s->cmd_name[k])) return k;
+    return -1;
+}
+
 int scenario_breakpoints(const scenario* s, double* t, int cap) {
     int n = 0;
-    for (int k = 0; k < SCENARIO_NCMD; ++k)
+    for (int k = 0; k < scenario_ncmd(s); ++k)
         for (int i = 0; i < s->cmd[k].n && n < cap; ++i) t[n++] = s->cmd[k].t[i];
     for (int i = 0; i < s->nevent && n < cap; ++i) t[n++] = s->event[i].t;
     // Faults change the circuit: a run reapplies them at each breakpoint

@@ -13,6 +13,10 @@ extern "C" {
 #define SCENARIO_MAX_POINTS 64
 #define SCENARIO_MAX_EVENTS 32
 #define SCENARIO_NCMD 3 ///< lift, jib, slew
+/// Command columns in all: lift, jib, slew, then up to 13 more named after
+/// any function of the model's chain (crane_chain.h: "ext", "jib_ext").
+#define SCENARIO_MAX_CMD 16
+#define SCENARIO_CMD_NAME 48
 
 /// A piecewise-linear signal u(t), held constant before the first and after
 /// the last point. A step is two points with the same t.
@@ -52,7 +56,11 @@ typedef struct scenario {
     double load_mass;          ///< [kg]; < 0 means "use the model's"
     double q0[2];              ///< initial joint angles, paper convention [rad]
     double slew0;              ///< initial slew angle [rad]
-    scenario_signal cmd[SCENARIO_NCMD]; ///< lift, jib, slew
+    scenario_signal cmd[SCENARIO_MAX_CMD]; ///< lift, jib, slew, then the named columns
+    /// Columns in cmd: 0 or 3 (lift, jib, slew only), or 3 + the named ones.
+    int ncmd;
+    /// Names of columns 3 .. ncmd - 1 (0 .. 2 are scenario_cmd_name's).
+    char cmd_name[SCENARIO_MAX_CMD][SCENARIO_CMD_NAME];
     int nevent;
     scenario_event event[SCENARIO_MAX_EVENTS];
     int nfault;
@@ -62,6 +70,13 @@ typedef struct scenario {
 
 /// Names of the command channels: "lift", "jib", "slew".
 extern const char* const scenario_cmd_name[SCENARIO_NCMD];
+
+/// The column commanding the function named name: lift, jib, slew are 0, 1,
+/// 2 (every scenario has them, empty tables hold 0), the others as the file
+/// names them; -1 when the scenario has no such column.
+int scenario_find_command(const scenario* s, const char* name);
+/// Columns in s->cmd (at least SCENARIO_NCMD).
+int scenario_ncmd(const scenario* s);
 
 /// Load from a file. Returns 0, or -1 with "file: field: problem" in err.
 int scenario_load(const char* path, scenario* s, char* err, size_t errsz);

@@ -3,6 +3,7 @@
 // stepped by an outside loop with commands set between steps.
 #include "engine_lagrange.h"
 #include "lagrange_sim.h"
+#include "engine_chain.h"
 #include "energy_acc.h"
 
 #include "snap_reliefs.h"
@@ -30,22 +31,25 @@ typedef struct eng_lagrange {
     struct sim_energy* energy; ///< engine_follow_energy's balance, or NULL
 } eng_lagrange;
 
-// One row (all SIM_NCOL columns; the world extras 0) from the lagrange
-// crane's outputs o at time t [s]: the one place its rows are assembled.
-static void lagrange_row(double t, const lsim_out* o, double* row) {
-    const double v[SIM_NCOL] = {
-        t, o->x[0], o->x[1], o->pA[0], o->pB[0], o->pA[1], o->pB[1], o->u[0], o->u[1], o->q[0], o->q[1],
-        o->tip[0], o->tip[1], o->F[0], o->F[1], o->u_cmd[0], o->u_cmd[1],
-        o->v[0], o->v[1], o->p_pump, o->relief_open, o->end_stop};
-    memcpy(row, v, sizeof v);
-}
-
 static void lag_row(engine* e, double row[SIM_NCOL]);
 static void lag_destroy(engine* e);
 
 static engine* lag_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           char* err, size_t errsz) {
     (void)slew0; // the planar crane does not slew
+    // The stepped engine is the closed form's (the fast path's allow-list:
+    // the two-link shorthand, variant full, paper or paper-typo).
+    if (model_require_two_link(m,
+                               "stepped engine of the closed-form analytic mode (the general analytic mode of a "
+                               "chain runs scripted: cranesim run)",
+                               err, errsz))
+        return NULL;
+    if (o->variant == LAGRANGE_GENERAL) {
+        snprintf(err, errsz,
+                 "the stepped lagrange engine runs the two-link crane's closed form only; the general analytic "
+                 "mode (--variant general) runs scripted (cranesim run)");
+        return NULL;
+    }
     // No world circuit here: a burst at a node the model lacks has nowhere to open.
     if (engine_world_bursts(m, NULL, NULL, err, errsz)) return NULL;
     eng_lagrange* l = calloc(1, sizeof *l);
@@ -310,6 +314,10 @@ static const char* state_name(const lsim* ls, int i, char* buf, size_t n) {
 // apply, integrated between the command breakpoints with rows at the
 // output times.
 static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
+    // The closed form is the fast path of exactly the two-link shorthand
+    // (its allow-list); every other chain, and --variant general, runs the
+    // general formulation (docs/lagrange.md).
+    if (!m->chain.two_link || o->variant == LAGRANGE_GENERAL) return engine_chain_run(m, sc, o, k, res);
     lsim ls;
     double m3 = sim_load_mass(m, sc, o);
     if (engine_world_bursts(m, NULL, NULL, res->message, sizeof res->message)) return res->status = SIM_REFUSED;

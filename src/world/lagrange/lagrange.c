@@ -4,14 +4,14 @@
 #include <math.h>
 #include <string.h>
 
-static const char* const variant_names[] = {"full", "paper", "paper-typo"};
+static const char* const variant_names[] = {"full", "paper", "paper-typo", "general"};
 
 const char* lagrange_variant_name(lagrange_variant v) {
-    return (unsigned)v < 3 ? variant_names[v] : "?";
+    return (unsigned)v < 4 ? variant_names[v] : "?";
 }
 
 int lagrange_variant_parse(const char* s) {
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 4; ++i)
         if (!strcmp(s, variant_names[i])) return i;
     return -1;
 }
@@ -24,6 +24,7 @@ void lagrange_eval_terms(const crane_mech* m, lagrange_variant v, double m3, con
 
 void lagrange_eval_terms_trig(const crane_mech* m, lagrange_variant v, double m3, const double trig[4],
                               const double qd[2], lagrange_terms* o) {
+    if (v == LAGRANGE_GENERAL) v = LAGRANGE_FULL; // the same equations
     // The paper's Eq. 2 is the point-mass special case (I = 0 in the constants).
     lagrange_consts lk;
     lagrange_consts_init(m, v, m3, &lk);
@@ -79,6 +80,7 @@ void lagrange_accel(const lagrange_terms* t, const double tau[2], double qdd[2])
 }
 
 void lagrange_consts_init(const crane_mech* m, lagrange_variant v, double m3, lagrange_consts* k) {
+    if (v == LAGRANGE_GENERAL) v = LAGRANGE_FULL; // the same equations
     const double g = m->gravity;
     const double L1 = m->link[0].length, L2 = m->link[1].length;
     const double m1 = m->link[0].mass, m2 = m->link[1].mass;
@@ -165,6 +167,7 @@ double lagrange_energy(const crane_mech* m, double m3, const double q[2], const 
 }
 
 void lagrange_gravity(const crane_mech* m, lagrange_variant v, double m3, const double q[2], double G[2]) {
+    if (v == LAGRANGE_GENERAL) v = LAGRANGE_FULL; // the same equations
     lagrange_terms t;
     const double qd[2] = {0, 0};
     lagrange_eval_terms(m, v, m3, q, qd, &t);

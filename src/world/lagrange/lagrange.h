@@ -14,7 +14,12 @@ extern "C" {
 typedef enum lagrange_variant {
     LAGRANGE_FULL = 0,  ///< link inertias and Coriolis/centrifugal terms (default; matches ode)
     LAGRANGE_PAPER,     ///< paper Eqs. 2-3: point masses (I = 0), C = 0, G1 typo corrected
-    LAGRANGE_PAPER_TYPO ///< as printed: G1 uses (m2 + m3) L2 where L1 belongs
+    LAGRANGE_PAPER_TYPO, ///< as printed: G1 uses (m2 + m3) L2 where L1 belongs
+    /// The general formulation for any chain (chain_sim.h), asked for on the
+    /// two-link crane too (whose `full` otherwise takes the closed form, the
+    /// fast path): the same equations, evaluated by CRBA and RNEA. Not a
+    /// variant of the closed-form terms: lagrange_eval_terms takes it as full.
+    LAGRANGE_GENERAL
 } lagrange_variant;
 
 // sim_default_opts (sim_base.c, which knows no backend) leaves

@@ -54,6 +54,7 @@ engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2],
     }
     engine* e = backend(o)->create(m, o, q0, slew0, m3, err, errsz);
     if (!e) return NULL;
+    e->mdl = m;
     // The step probe on the backend's hydraulic step, after its own start
     // checks: it runs the analytic backend (step_probe.c), which a backend
     // may not call, so the engine applies it for every backend.
@@ -92,6 +93,48 @@ static void fill_rcl(engine* e, double* row) {
     if (e->rcl && e->ops->nchannel > COL_RCL_UTIL) row[COL_RCL_UTIL] = rcl_utilisation(e->rcl, row);
 }
 
+int engine_check_scenario(const model* m, const scenario* sc, char* err, size_t errsz) {
+    for (int k = SCENARIO_NCMD; k < scenario_ncmd(sc); ++k) {
+        if (crane_chain_find_function(&m->chain, sc->cmd_name[k]) >= 0) continue;
+        int n = snprintf(err, errsz,
+                         "%s: commands.%s: unknown field '%s': the model has no function of that name (its functions: "
+                         "lift, jib, slew",
+                         sc->file[0] ? sc->file : "scenario", sc->cmd_name[k], sc->cmd_name[k]);
+        for (int f = 0; f < m->chain.nfn && n > 0 && (size_t)n < errsz; ++f) {
+            const char* fn = m->chain.fn[f].name;
+            if (strcmp(fn, "lift") && strcmp(fn, "jib") && strcmp(fn, "slew"))
+                n += snprintf(err + n, errsz - (size_t)n, ", %s", fn);
+        }
+        if (n > 0 && (size_t)n < errsz) snprintf(err + n, errsz - (size_t)n, ")");
+        return -1;
+    }
+    return 0;
+}
+
+int engine_nfunction(const engine* e) {
+    const crane_chain* cc = &e->mdl->chain;
+    return cc->nfn + (crane_chain_find_function(cc, "slew") < 0 ? 1 : 0);
+}
+
+const char* engine_function_name(const engine* e, int k) {
+    const crane_chain* cc = &e->mdl->chain;
+    if (k >= 0 && k < cc->nfn) return cc->fn[k].name;
+    return k == cc->nfn && crane_chain_find_function(cc, "slew") < 0 ? "slew" : NULL;
+}
+
+void engine_set_function_commands(engine* e, const double* u) {
+    // The stepped engines are the two-link crane's (lift, jib) and the
+    // world's slew: their commands go through engine_set_commands (and its
+    // limiter). A function of another name has no stepped engine yet.
+    double u3[3] = {e->u_op[0], e->u_op[1], e->u_op[2]};
+    for (int k = 0; k < engine_nfunction(e); ++k) {
+        const char* nm = engine_function_name(e, k);
+        for (int c = 0; c < SCENARIO_NCMD; ++c)
+            if (!strcmp(nm, scenario_cmd_name[c])) u3[c] = u[k];
+    }
+    engine_set_commands(e, u3);
+}
+
 int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k0, sim_result* res) {
     // Every scripted run is probed (engine_sink.probe): the backend applies
     // it after its own start checks.
@@ -102,6 +145,7 @@ int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engi
         unknown_backend(o, res->message, sizeof res->message);
         return res->status = SIM_REFUSED;
     }
+    if (engine_check_scenario(m, sc, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     if (sc->nfault == 0) return backend(o)->run(m, sc, o, k, res);
     // The bursts' orifices go into a copy; the caller's model stays as it is
     // (compare and study run it again).

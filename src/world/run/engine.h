@@ -44,6 +44,22 @@ void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, siz
 /// Valve commands lift, jib, slew in [-1, 1] (clamped; slew ignored where
 /// the crane does not slew), held until changed.
 void engine_set_commands(engine* e, const double u[3]);
+/// The functions the operator commands (the model chain's: lift, jib, ...,
+/// then "slew" where the chain has no function of that name, as
+/// engine_set_commands' third command), their count and names (NULL out of
+/// range). The two-link crane: lift, jib, slew.
+int engine_nfunction(const engine* e);
+const char* engine_function_name(const engine* e, int k);
+/// Commands of the engine_nfunction functions in [-1, 1], in their order,
+/// held until changed; through engine_set_commands for lift, jib and slew
+/// (clamped, filtered by the limiter). The stepped engines exist for the
+/// two-link crane only (engine_create refuses other chains), whose
+/// functions these three are.
+void engine_set_function_commands(engine* e, const double* u);
+/// 0 when every command column of sc names a function of m (lift, jib and
+/// slew always do), else -1 with "FILE: commands.X: unknown field 'X': the
+/// model has no function of that name (its functions: ...)" in err. engine_run checks it.
+int engine_check_scenario(const model* m, const scenario* sc, char* err, size_t errsz);
 /// Hook: 1 attach the nearest load in reach, 0 release. Returns the load
 /// index attached, or -1 (also where the world has no hook).
 int engine_hook(engine* e, int attach);

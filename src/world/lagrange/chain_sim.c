@@ -1,0 +1,459 @@
+// chain_sim.c: the crane chain and its circuit as one ODE system, its
+// analytic Jacobian and its start state. Derivation in docs/lagrange.md,
+// "The general formulation".
+#include "chain_sim.h"
+#include "circuit_kernel.h" // HYD_SPOOL_SETTLE
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+// The pressure state of the hose feeding chamber state ic, or -1 when no
+// hose ends at that chamber (as lagrange_sim.c: by the circuit's
+// connections, not by names).
+static int hose_of_chamber(const hyd_model* hm, int ic) {
+    const int hose = hyd_model_feed_hose(hm, hyd_model_state_node(hm, ic));
+    return hose < 0 ? -1 : hyd_model_node_state(hm, hyd_model_comp_node(hm, hose, 0));
+}
+
+int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, double m3, double slew, char* err,
+                   size_t errsz) {
+    memset(s, 0, sizeof *s);
+    s->cc = cc;
+    s->hm = hm;
+    s->m3 = m3;
+    s->nact = cc->nact;
+    s->nfn = cc->nfn;
+    const int ncyl = hyd_model_ncylinder(hm), nvalve = hyd_model_nvalve(hm);
+    // Bound and one actuator per cylinder: two actuators writing one
+    // cylinder's stroke would silently keep only the last.
+    for (int k = 0; k < cc->nact; ++k) {
+        const crane_act* a = &cc->act[k];
+        if (a->cyl < 0 || a->cyl >= ncyl || a->function < 0 || a->function >= cc->nfn) {
+            snprintf(err, errsz, "mechanics.actuators[%d] (%s): not bound to the circuit", k, a->name);
+            return -1;
+        }
+        if (a->body_a < 0 || a->body_a >= cc->nbody || a->body_b < 0 || a->body_b >= cc->nbody) {
+            snprintf(err, errsz, "mechanics.actuators[%d] (%s): a mount on a body not in the chain", k, a->name);
+            return -1;
+        }
+        for (int j = 0; j < k; ++j)
+            if (cc->act[j].cyl == a->cyl) {
+                snprintf(err, errsz,
+                         "mechanics.actuators[%d].cylinder: '%s' already drives actuator '%s' (one actuator per "
+                         "cylinder)",
+                         k, a->cylinder, cc->act[j].name);
+                return -1;
+            }
+    }
+    for (int f = 0; f < cc->nfn; ++f)
+        if (cc->fn[f].valve_idx < 0 || cc->fn[f].valve_idx >= nvalve) {
+            snprintf(err, errsz, "mechanics.functions[%d] (%s): not bound to the circuit", f, cc->fn[f].name);
+            return -1;
+        }
+    s->ch = crane_chain_mechanism(cc, m3, cc->slew_free, slew, err, errsz);
+    if (!s->ch) return -1;
+    s->ndof = chain_ndof(s->ch);
+    s->nh = hyd_model_nstate(hm);
+    s->iq = s->nh;
+    s->n = s->nh + 2 * s->ndof;
+    const size_t nd = (size_t)s->ndof, na = (size_t)s->nact;
+    s->ws = chain_ws_create(s->ch);
+    s->hd = hyd_data_create(hm);
+    s->cmd = calloc((size_t)s->nfn + 1, sizeof *s->cmd);
+    s->iu = calloc((size_t)s->nfn + 1, sizeof *s->iu);
+    s->ipA = calloc(na + 1, sizeof *s->ipA);
+    s->ipB = calloc(na + 1, sizeof *s->ipB);
+    s->is_pressure = calloc((size_t)s->nh + 1, sizeof *s->is_pressure);
+    s->L = calloc(2 * na + 2 * na * nd + 1, sizeof(double));
+    s->tau = calloc(10 * nd + 3 * nd * nd + (size_t)s->nh + 1, sizeof(double));
+    if (!s->ws || !s->hd || !s->cmd || !s->iu || !s->ipA || !s->ipB || !s->is_pressure || !s->L || !s->tau) {
+        snprintf(err, errsz, "out of memory");
+        chain_sim_free(s);
+        return -1;
+    }
+    s->Ld = s->L + na;
+    s->dL = s->Ld + na;
+    s->dLd = s->dL + na * nd;
+    s->qdd = s->tau + nd;
+    s->id0 = s->qdd + nd;
+    s->id1 = s->id0 + nd;
+    s->qp = s->id1 + nd; // 2 nd: q and q' perturbed
+    s->g = s->qp + 2 * nd; // 2 nd: a right-hand side and its solution
+    s->H = s->g + 2 * nd;  // 3 nd^2: a Hessian, d tau/dq, d tau/dq'
+    s->ydot = s->H + 3 * nd * nd; // n = nh + 2 nd: a whole f for the outputs
+    for (int f = 0; f < s->nfn; ++f) s->iu[f] = hyd_model_valve_state(hm, cc->fn[f].valve_idx);
+    for (int k = 0; k < s->nact; ++k) hyd_model_cylinder_states(hm, cc->act[k].cyl, &s->ipA[k], &s->ipB[k]);
+    for (int i = 0; i < s->nh; ++i) s->is_pressure[i] = hyd_model_state_kind(hm, i) == HYD_STATE_PRESSURE;
+    return 0;
+}
+
+void chain_sim_free(chain_sim* s) {
+    chain_ws_free(s->ws);
+    chain_free(s->ch);
+    hyd_data_free(s->hd);
+    free(s->cmd);
+    free(s->iu);
+    free(s->ipA);
+    free(s->ipB);
+    free(s->is_pressure);
+    free(s->L);
+    free(s->tau);
+    memset(s, 0, sizeof *s);
+}
+
+static double command(const chain_sim* s, int k, double t) {
+    const double u = s->cmd_fn ? s->cmd_fn(s->cmd_user, k, t) : s->cmd[k];
+    return u < -1.0 ? -1.0 : u > 1.0 ? 1.0 : u;
+}
+
+// Shared by rhs and Jacobian: the kinematics at (q, q'), every actuator's
+// pin length, rate, lever arms and d(L')/dq, and the circuit's inputs at t.
+static void prepare(chain_sim* s, double t, const double* y) {
+    const crane_chain* cc = s->cc;
+    const int nd = s->ndof;
+    chain_update(s->ch, s->ws, y + s->iq, y + s->iq + nd);
+    hyd_data* d = s->hd;
+    for (int k = 0; k < s->nact; ++k) {
+        const crane_act* a = &cc->act[k];
+        s->L[k] = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, &s->Ld[k], s->dL + (size_t)k * nd,
+                                 s->dLd + (size_t)k * nd);
+        d->cyl_x[a->cyl] = s->L[k] - a->closed_length;
+        d->cyl_v[a->cyl] = s->Ld[k];
+    }
+    for (int f = 0; f < s->nfn; ++f) d->valve_cmd[cc->fn[f].valve_idx] = command(s, f, t);
+}
+
+// The ideal forces of the energy tests (chain_sim.ideal_F) into cyl_F.
+static void ideal_forces(chain_sim* s) {
+    for (int k = 0; k < s->nact; ++k) {
+        const int c = s->cc->act[k].cyl;
+        s->hd->cyl_F[c] = s->ideal_F[k] - (s->ideal_K ? s->ideal_K[k] * s->hd->cyl_x[c] : 0.0);
+    }
+}
+
+// tau = sum_k F_k dL_k/dq [N m or N] from the circuit's last forces.
+static void joint_forces(chain_sim* s) {
+    const int nd = s->ndof;
+    for (int i = 0; i < nd; ++i) s->tau[i] = 0.0;
+    for (int k = 0; k < s->nact; ++k) {
+        const double F = s->hd->cyl_F[s->cc->act[k].cyl];
+        const double* r = s->dL + (size_t)k * nd;
+        for (int i = 0; i < nd; ++i) s->tau[i] += F * r[i];
+    }
+}
+
+int chain_sim_rhs(void* user, double t, const double* y, double* dydt) {
+    chain_sim* s = user;
+    const int nd = s->ndof, iq = s->iq;
+    ++s->nrhs;
+    prepare(s, t, y);
+    if (s->ideal_F) {
+        memset(dydt, 0, (size_t)s->nh * sizeof *dydt);
+        ideal_forces(s);
+    } else {
+        hyd_eval(s->hm, s->hd, t, y, dydt);
+    }
+    joint_forces(s);
+    const double* qd = y + iq + nd;
+    for (int i = 0; i < nd; ++i) dydt[iq + i] = qd[i];
+    // M not positive definite (a body of no mass on a DOF): no finite q''.
+    if (chain_forward_dynamics(s->ch, s->ws, s->tau, dydt + iq + nd)) return 1;
+    return 0;
+}
+
+// Central differences of the inverse dynamics ID(q, q', a) = M(q) a +
+// C(q, q') + G(q) at a = q'' in coordinate j of q (which = 0) or q' (which =
+// 1), into out [ndof]. C is quadratic in q', so the q' differences are
+// exact to rounding; in q the step 1e-6 (1 + |q_j|) [rad or m] leaves a
+// truncation of about 1e-12 relative, below the rounding.
+static void id_partial(chain_sim* s, const double* y, int which, int j, double* out) {
+    const int nd = s->ndof;
+    double* q = s->qp;
+    double* qd = s->qp + nd;
+    memcpy(q, y + s->iq, (size_t)nd * sizeof *q);
+    memcpy(qd, y + s->iq + nd, (size_t)nd * sizeof *qd);
+    double* z = which ? qd : q;
+    const double z0 = z[j], h = 1e-6 * (1.0 + fabs(z0));
+    z[j] = z0 + h;
+    const double hp = z[j] - z0; // the step as represented
+    chain_update(s->ch, s->ws, q, qd);
+    chain_inverse_dynamics(s->ch, s->ws, s->qdd, CHAIN_VELOCITY | CHAIN_GRAVITY, s->id0);
+    z[j] = z0 - h;
+    const double hm = z0 - z[j];
+    chain_update(s->ch, s->ws, q, qd);
+    chain_inverse_dynamics(s->ch, s->ws, s->qdd, CHAIN_VELOCITY | CHAIN_GRAVITY, s->id1);
+    for (int i = 0; i < nd; ++i) out[i] = (s->id0[i] - s->id1[i]) / (hp + hm);
+}
+
+int chain_sim_jac(void* user, double t, const double* y, double* J) {
+    chain_sim* s = user;
+    const int nd = s->ndof, iq = s->iq, n = s->n, nh = s->nh;
+    const crane_chain* cc = s->cc;
+    hyd_data* d = s->hd;
+    memset(J, 0, (size_t)n * (size_t)n * sizeof *J);
+    prepare(s, t, y);
+    if (s->ideal_F) { // constant forces: no partials, the circuit stands still
+        const size_t nc = (size_t)hyd_model_ncylinder(s->hm);
+        memset(d->dydx, 0, nc * (size_t)nh * sizeof *d->dydx);
+        memset(d->dydv, 0, nc * (size_t)nh * sizeof *d->dydv);
+        memset(d->dFdy, 0, nc * (size_t)nh * sizeof *d->dFdy);
+        memset(d->dFdx, 0, nc * sizeof *d->dFdx);
+        memset(d->dFdv, 0, nc * sizeof *d->dFdv);
+        ideal_forces(s);
+        for (int k = 0; k < s->nact; ++k) d->dFdx[cc->act[k].cyl] = s->ideal_K ? -s->ideal_K[k] : 0.0;
+    } else {
+        hyd_jacobian(s->hm, d, t, y, NULL, J, n, 0, 0);
+    }
+    joint_forces(s);
+    if (chain_forward_dynamics(s->ch, s->ws, s->tau, s->qdd)) return 1;
+    const double* qd = y + iq + nd;
+    double* dtq = s->H + (size_t)nd * nd;  // d tau / dq
+    double* dtqd = dtq + (size_t)nd * nd;  // d tau / dq'
+    memset(dtq, 0, 2 * (size_t)nd * nd * sizeof *dtq);
+    for (int k = 0; k < s->nact; ++k) {
+        const crane_act* a = &cc->act[k];
+        const int c = a->cyl;
+        const double* r = s->dL + (size_t)k * nd;
+        const double* rd = s->dLd + (size_t)k * nd;
+        const double* dydx = d->dydx + (size_t)c * nh;
+        const double* dydv = d->dydv + (size_t)c * nh;
+        // The circuit's rows: x = L(q) - closed, v = L'(q, q') = dL/dq q'.
+        for (int i = 0; i < nh; ++i) {
+            if (dydx[i] == 0.0 && dydv[i] == 0.0) continue;
+            double* row = J + (size_t)i * n;
+            for (int j = 0; j < nd; ++j) {
+                row[iq + j] += dydx[i] * r[j] + dydv[i] * rd[j];
+                row[iq + nd + j] += dydv[i] * r[j];
+            }
+        }
+        // tau's partials through F(x, v) and the lever arms' Hessian.
+        const double F = d->cyl_F[c], Fx = d->dFdx[c], Fv = d->dFdv[c];
+        chain_cylinder_hessian(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, s->H);
+        for (int i = 0; i < nd; ++i)
+            for (int j = 0; j < nd; ++j) {
+                dtq[i * nd + j] += F * s->H[i * nd + j] + r[i] * (Fx * r[j] + Fv * rd[j]);
+                dtqd[i * nd + j] += r[i] * Fv * r[j];
+            }
+    }
+    for (int i = 0; i < nd; ++i) J[(size_t)(iq + i) * n + iq + nd + i] = 1.0;
+    // The mechanics' rows: d q''/dz = M^-1 (d tau/dz - d ID/dz at fixed q'').
+    // The kinematics are perturbed by id_partial and restored after; the
+    // Cholesky factor of M at y stays in the workspace for chain_solve.
+    double* b = s->g;
+    double* x = s->g + nd;
+    for (int which = 0; which < 2; ++which)
+        for (int j = 0; j < nd; ++j) {
+            id_partial(s, y, which, j, b);
+            const double* dt = which ? dtqd : dtq;
+            for (int i = 0; i < nd; ++i) b[i] = dt[i * nd + j] - b[i];
+            chain_solve(s->ch, s->ws, b, x);
+            for (int i = 0; i < nd; ++i) J[(size_t)(iq + nd + i) * n + iq + which * nd + j] = x[i];
+        }
+    chain_update(s->ch, s->ws, y + iq, qd);
+    // The circuit's columns: only states the forces depend on (the chamber
+    // pressures, typically).
+    for (int m = 0; m < nh; ++m) {
+        bool any = false;
+        for (int i = 0; i < nd; ++i) b[i] = 0.0;
+        for (int k = 0; k < s->nact; ++k) {
+            const double dF = d->dFdy[(size_t)cc->act[k].cyl * nh + m];
+            if (dF == 0.0) continue;
+            any = true;
+            const double* r = s->dL + (size_t)k * nd;
+            for (int i = 0; i < nd; ++i) b[i] += r[i] * dF;
+        }
+        if (!any) continue;
+        chain_solve(s->ch, s->ws, b, x);
+        for (int i = 0; i < nd; ++i) J[(size_t)(iq + nd + i) * n + m] = x[i];
+    }
+    return 0;
+}
+
+// hyd_problem.settle (as lsim_settle): a spool within HYD_SPOOL_SETTLE of 0
+// while its command is as close is set to exactly 0, and the circuit's other
+// lags towards 0 are flushed (hyd_model_flush): a geometric decay otherwise
+// ends in subnormal numbers, on which every step is slower.
+static int chain_sim_settle(void* user, double t, double* y) {
+    chain_sim* s = user;
+    int changed = hyd_model_flush(s->hm, y, NULL) > 0;
+    for (int f = 0; f < s->nfn; ++f) {
+        double* u = s->iu[f] >= 0 ? &y[s->iu[f]] : NULL;
+        if (!u || *u == 0.0 || !(fabs(*u) < HYD_SPOOL_SETTLE)) continue;
+        if (fabs(command(s, f, t)) < HYD_SPOOL_SETTLE) *u = 0.0, changed = 1;
+    }
+    return changed;
+}
+
+hyd_problem chain_sim_problem(chain_sim* s) {
+    hyd_problem p;
+    memset(&p, 0, sizeof p);
+    p.n = s->n;
+    p.f = chain_sim_rhs;
+    p.jac = chain_sim_jac;
+    p.jac_full = 1;
+    p.user = s;
+    p.settle = chain_sim_settle;
+    return p;
+}
+
+int chain_sim_check_pose(chain_sim* s, const double* q0, char* err, size_t errsz) {
+    chain_update(s->ch, s->ws, q0, NULL);
+    for (int k = 0; k < s->nact; ++k) {
+        const crane_act* a = &s->cc->act[k];
+        const double x = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, NULL, NULL, NULL) -
+                         a->closed_length;
+        // The same tolerance as crane_check_pose: a stroke a rounding
+        // outside its range is at its end stop, not beyond it.
+        if (!(x >= -1e-9 && x <= a->stroke + 1e-9)) {
+            snprintf(err, errsz,
+                     "start pose: actuator '%s' (cylinder '%s') would need a stroke of %.4f m, outside [0, %.4f] m",
+                     a->name, a->cylinder, x, a->stroke);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+// Solves the r x r system A x = b (row-major, overwritten) by Gaussian
+// elimination with partial pivoting; -1 when a pivot is below 1e-12 of the
+// largest entry (singular to working accuracy).
+static int solve_dense(double* A, double* b, int r) {
+    double amax = 0.0;
+    for (int i = 0; i < r * r; ++i) amax = fmax(amax, fabs(A[i]));
+    for (int c = 0; c < r; ++c) {
+        int p = c;
+        for (int i = c + 1; i < r; ++i)
+            if (fabs(A[i * r + c]) > fabs(A[p * r + c])) p = i;
+        if (!(fabs(A[p * r + c]) > 1e-12 * amax)) return -1;
+        if (p != c) {
+            for (int j = 0; j < r; ++j) {
+                const double tmp = A[c * r + j];
+                A[c * r + j] = A[p * r + j], A[p * r + j] = tmp;
+            }
+            const double tb = b[c];
+            b[c] = b[p], b[p] = tb;
+        }
+        for (int i = c + 1; i < r; ++i) {
+            const double f = A[i * r + c] / A[c * r + c];
+            for (int j = c; j < r; ++j) A[i * r + j] -= f * A[c * r + j];
+            b[i] -= f * b[c];
+        }
+    }
+    for (int i = r - 1; i >= 0; --i) {
+        double v = b[i];
+        for (int j = i + 1; j < r; ++j) v -= A[i * r + j] * b[j];
+        b[i] = v / A[i * r + i];
+    }
+    return 0;
+}
+
+int chain_sim_initial_state(chain_sim* s, const double* q0, double p_low, double* y, char* err, size_t errsz) {
+    const int nd = s->ndof, na = s->nact, iq = s->iq;
+    const hyd_model* hm = s->hm;
+    hyd_model_initial_state(hm, y);
+    for (int i = 0; i < nd; ++i) y[iq + i] = q0[i], y[iq + nd + i] = 0.0;
+    chain_update(s->ch, s->ws, q0, NULL);
+    double* G = s->id0;
+    chain_inverse_dynamics(s->ch, s->ws, NULL, CHAIN_GRAVITY, G);
+    for (int k = 0; k < na; ++k) {
+        const crane_act* a = &s->cc->act[k];
+        chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, NULL, s->dL + (size_t)k * nd, NULL);
+    }
+    // The DOFs some actuator moves (a lever arm above 1e-12 of the largest)
+    // take the square system; the others must carry no gravity load.
+    double gmax = 0.0, amax = 0.0;
+    for (int i = 0; i < nd; ++i) gmax = fmax(gmax, fabs(G[i]));
+    for (int i = 0; i < na * nd; ++i) amax = fmax(amax, fabs(s->dL[i]));
+    int* rows = malloc(((size_t)nd + 1) * sizeof *rows);
+    double* A = malloc(((size_t)nd * (size_t)(na > nd ? na : nd) + 1) * sizeof *A);
+    double* F = malloc(((size_t)(na > nd ? na : nd) + 1) * sizeof *F);
+    int rc = -1;
+    if (!rows || !A || !F) {
+        snprintf(err, errsz, "out of memory");
+        goto done;
+    }
+    int r = 0;
+    for (int i = 0; i < nd; ++i) {
+        bool moved = false;
+        for (int k = 0; k < na; ++k) moved |= fabs(s->dL[(size_t)k * nd + i]) > 1e-12 * amax;
+        if (moved) {
+            rows[r++] = i;
+        } else if (fabs(G[i]) > 1e-9 * gmax && gmax > 0.0) {
+            snprintf(err, errsz,
+                     "start state: the joint of body '%s' carries a gravity load of %.6g and no actuator moves it",
+                     chain_body(s->ch, chain_dof_body(s->ch, i))->name, G[i]);
+            goto done;
+        }
+    }
+    if (r != na) {
+        snprintf(err, errsz,
+                 "start state: %d actuators for %d actuated degrees of freedom; the analytic mode's start "
+                 "equilibrium takes one actuator per actuated degree of freedom",
+                 na, r);
+        goto done;
+    }
+    for (int i = 0; i < r; ++i) {
+        for (int k = 0; k < na; ++k) A[i * na + k] = s->dL[(size_t)k * nd + rows[i]];
+        F[i] = G[rows[i]];
+    }
+    if (solve_dense(A, F, r)) {
+        snprintf(err, errsz, "start state: the actuators' lever arms are singular at the start pose");
+        goto done;
+    }
+    for (int k = 0; k < na; ++k) {
+        // Static balance with the unloaded chamber at p_low (as lsim_initial_state).
+        double AA, AB, st;
+        hyd_model_cylinder_geometry(hm, s->cc->act[k].cyl, &AA, &AB, &st);
+        double pA = p_low, pB = p_low;
+        if (F[k] >= 0) pA = (F[k] + p_low * AB) / AA;
+        else pB = (p_low * AA - F[k]) / AB;
+        y[s->ipA[k]] = pA;
+        y[s->ipB[k]] = pB;
+        // The hoses start at their chambers' pressures: no flow at t = 0.
+        const int hA = hose_of_chamber(hm, s->ipA[k]), hB = hose_of_chamber(hm, s->ipB[k]);
+        if (hA >= 0) y[hA] = pA;
+        if (hB >= 0) y[hB] = pB;
+    }
+    rc = 0;
+done:
+    free(rows);
+    free(A);
+    free(F);
+    return rc;
+}
+
+void chain_sim_outputs(chain_sim* s, double t, const double* y, chain_sim_out* o) {
+    const int nd = s->ndof;
+    chain_sim_rhs(s, t, y, s->ydot);
+    --s->nrhs; // an output evaluation is not solver work
+    const hyd_data* d = s->hd;
+    for (int k = 0; k < s->nact; ++k) {
+        const int c = s->cc->act[k].cyl;
+        if (o->x) o->x[k] = d->cyl_x[c];
+        if (o->v) o->v[k] = d->cyl_v[c];
+        if (o->pA) o->pA[k] = y[s->ipA[k]];
+        if (o->pB) o->pB[k] = y[s->ipB[k]];
+        if (o->F) o->F[k] = d->cyl_F[c];
+    }
+    for (int f = 0; f < s->nfn; ++f) {
+        if (o->u) o->u[f] = s->iu[f] >= 0 ? y[s->iu[f]] : 0.0;
+        if (o->u_cmd) o->u_cmd[f] = d->valve_cmd[s->cc->fn[f].valve_idx];
+    }
+    for (int i = 0; i < nd; ++i) {
+        if (o->q) o->q[i] = y[s->iq + i];
+        if (o->qd) o->qd[i] = y[s->iq + nd + i];
+    }
+    if (s->cc->tip_body >= 0 && s->cc->tip_body < s->cc->nbody)
+        chain_world_point(s->ch, s->ws, s->cc->tip_body, s->cc->tip, o->tip, NULL);
+    else
+        o->tip[0] = o->tip[1] = o->tip[2] = 0.0;
+    const int pl = hyd_model_supply_node(s->hm);
+    o->p_pump = pl >= 0 ? d->node_p[pl] : 0.0;
+}
+
+double chain_sim_energy(chain_sim* s, const double* y) {
+    chain_update(s->ch, s->ws, y + s->iq, y + s->iq + s->ndof);
+    return chain_kinetic_energy(s->ch, s->ws) + chain_potential_energy(s->ch, s->ws);
+}

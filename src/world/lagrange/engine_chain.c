@@ -1,0 +1,276 @@
+// engine_chain.c: scripted runs of the general analytic mode (engine_chain.h).
+#include "engine_chain.h"
+#include "chain_sim.h"
+#include "energy_acc.h"
+#include "engine_impl.h"
+#include "lagrange_sim.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void engine_chain_start_pose(const crane_chain* cc, const scenario* sc, double* q0) {
+    int d = 0, boom = 0;
+    for (int i = 0; i < cc->nbody; ++i) {
+        const chain_body_def* b = &cc->body[i].def;
+        // The column is a DOF only when it slews (crane_chain_mechanism).
+        if (i == 0 ? !cc->slew_free : b->fixed) continue;
+        double q = i == 0 ? sc->slew0 : boom < 2 ? sc->q0[boom] : 0.0;
+        // A DOF the scenario does not place: the middle of its joint
+        // limits, or 0 when they are open.
+        if (i > 0 && boom >= 2 && isfinite(b->q_min) && isfinite(b->q_max)) q = 0.5 * (b->q_min + b->q_max);
+        else if (i > 0 && boom >= 2) q = fmin(fmax(q, b->q_min), b->q_max);
+        if (i > 0) ++boom;
+        q0[d++] = q;
+    }
+}
+
+typedef struct chain_run_ctx {
+    chain_sim* cs;
+    const scenario* sc;
+    int* fcol;              // [nfn] scenario column of function k, or -1
+    const sim_opts* o;
+    const engine_sink* sink;
+    sim_checks chk;
+    double t_last_row, bad_t;
+    long rows;
+    int stop;
+    char bad[200];
+    double peak[4];
+    struct sim_energy* energy; ///< NULL, or the balance accumulated at the steps
+    hyd_solver* solver;
+    // Output buffers, sized by the chain.
+    double *x, *v, *pA, *pB, *F, *u, *ucmd, *q, *qd;
+} chain_run_ctx;
+
+// The scenario's commands by function name (scenario_find_command: lift,
+// jib, slew and the file's named columns); a function without one stays at 0.
+static double scn_cmd(void* user, int k, double t) {
+    const chain_run_ctx* c = user;
+    return c->fcol[k] < 0 ? 0.0 : scenario_command(c->sc, c->fcol[k], t);
+}
+
+// The row sim.h's base columns hold: the first two actuators, functions
+// and boom DOFs; the tip relative to the first boom's joint.
+static void make_row(chain_run_ctx* c, double t, const double* y, double* row) {
+    chain_sim* cs = c->cs;
+    chain_sim_out co = {.x = c->x, .v = c->v, .pA = c->pA, .pB = c->pB, .F = c->F, .u = c->u, .u_cmd = c->ucmd,
+                        .q = c->q, .qd = c->qd};
+    chain_sim_outputs(cs, t, y, &co);
+    lsim_out o;
+    memset(&o, 0, sizeof o);
+    for (int k = 0; k < 2 && k < cs->nact; ++k) {
+        o.x[k] = c->x[k], o.v[k] = c->v[k], o.pA[k] = c->pA[k], o.pB[k] = c->pB[k], o.F[k] = c->F[k];
+        const int f = cs->cc->act[k].function;
+        o.u[k] = c->u[f], o.u_cmd[k] = c->ucmd[f];
+        if (cs->hd->cyl_stop[cs->cc->act[k].cyl]) o.end_stop |= 1 << k;
+    }
+    const int d0 = cs->cc->slew_free ? 1 : 0;
+    for (int k = 0; k < 2 && d0 + k < cs->ndof; ++k) {
+        o.q[k] = c->q[d0 + k], o.qd[k] = c->qd[d0 + k];
+        // tau of the joint: sum over the actuators of F dL/dq.
+        for (int a = 0; a < cs->nact; ++a) o.tau[k] += c->F[a] * cs->dL[(size_t)a * cs->ndof + d0 + k];
+    }
+    double p1[3];
+    chain_body_pose(cs->ch, cs->ws, cs->cc->nbody > 1 ? 1 : 0, NULL, p1);
+    o.tip[0] = hypot(co.tip[0] - p1[0], co.tip[1] - p1[1]);
+    o.tip[1] = co.tip[2] - p1[2];
+    o.p_pump = co.p_pump;
+    const hyd_model* hm = cs->hm;
+    for (int i = 0; i < hyd_model_ncomp(hm); ++i)
+        if (hyd_model_comp_type(hm, i) == HYD_RELIEF && cs->hd->comp_open[i]) ++o.relief_open;
+    lagrange_row(t, &o, row);
+}
+
+static void track_peaks(chain_run_ctx* c, const double* y) {
+    const chain_sim* cs = c->cs;
+    for (int k = 0; k < 2 && k < cs->nact; ++k) {
+        c->peak[2 * k] = fmax(c->peak[2 * k], y[cs->ipA[k]]);
+        c->peak[2 * k + 1] = fmax(c->peak[2 * k + 1], y[cs->ipB[k]]);
+    }
+}
+
+// sim_energy_eval_fn: the circuit at (t, y) with every output filled.
+static const hyd_data* energy_eval(void* user, double t, const double* y) {
+    chain_sim* cs = user;
+    chain_sim_rhs(cs, t, y, cs->ydot);
+    --cs->nrhs; // not solver work
+    return cs->hd;
+}
+
+// hyd_solver_opts.on_step: the peaks and the energy balance at every step.
+static void on_step(void* user, double t, const double* y) {
+    chain_run_ctx* c = user;
+    track_peaks(c, y);
+    if (c->energy) sim_energy_follow_step(c->energy, c->solver, t, y, chain_sim_energy(c->cs, y));
+}
+
+static int emit(void* user, double t, const double* y) {
+    chain_run_ctx* c = user;
+    if (c->rows > 0 && t <= c->t_last_row + 1e-9 * c->o->dt_out) return 0;
+    chain_sim* cs = c->cs;
+    for (int i = 0; i < cs->n; ++i) {
+        const bool p = i < cs->nh && cs->is_pressure[i];
+        if (isfinite(y[i]) && (!p || y[i] >= 0.0)) continue;
+        const char* name = i < cs->nh ? hyd_model_state_name(cs->hm, i) : i < cs->iq + cs->ndof ? "q" : "q_dot";
+        if (sim_check_value(&c->chk, name, y[i], p, t, c->bad, sizeof c->bad)) {
+            c->bad_t = t;
+            return (c->stop = 3);
+        }
+    }
+    track_peaks(c, y);
+    c->t_last_row = t;
+    ++c->rows;
+    if (!c->sink->rows) return 0;
+    double row[SIM_NCOL];
+    make_row(c, t, y, row);
+    if (sim_check_row(&c->chk, row, SIM_NCOL_BASE, c->bad, sizeof c->bad)) {
+        --c->rows;
+        c->bad_t = t;
+        return (c->stop = 3);
+    }
+    if (c->sink->row && c->sink->row(c->sink->user, row)) return (c->stop = 2);
+    return 0;
+}
+
+int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
+    char* msg = res->message;
+    const size_t msz = sizeof res->message;
+    if (o->variant == LAGRANGE_PAPER || o->variant == LAGRANGE_PAPER_TYPO) {
+        snprintf(msg, msz,
+                 "--variant %s: the paper's equations are for the two-link crane only; this run takes the general "
+                 "formulation (full or general)",
+                 lagrange_variant_name(o->variant));
+        return res->status = SIM_REFUSED;
+    }
+    if (o->cvode) {
+        snprintf(msg, msz, "--solver cvode: the general analytic mode runs the in-house solvers");
+        return res->status = SIM_REFUSED;
+    }
+    if (engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
+    const double m3 = sim_load_mass(m, sc, o);
+    chain_sim cs;
+    if (chain_sim_init(&cs, &m->chain, m->hyd, m3, sc->slew0, msg, msz)) return res->status = SIM_REFUSED;
+    const int nd = cs.ndof, na = cs.nact, nf = cs.nfn;
+    chain_run_ctx c;
+    memset(&c, 0, sizeof c);
+    double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + 1, sizeof *buf);
+    c.fcol = calloc((size_t)nf + 1, sizeof *c.fcol);
+    hyd_solver* s = NULL;
+    if (!buf || !c.fcol) {
+        snprintf(msg, msz, "out of memory");
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    double* y = buf;
+    double* q0 = y + cs.n;
+    c.x = q0 + nd, c.v = c.x + na, c.pA = c.v + na, c.pB = c.pA + na, c.F = c.pB + na;
+    c.u = c.F + na, c.ucmd = c.u + nf, c.q = c.ucmd + nf, c.qd = c.q + nd;
+    for (int f = 0; f < nf; ++f) {
+        c.fcol[f] = scenario_find_command(sc, m->chain.fn[f].name);
+    }
+    c.cs = &cs;
+    c.sc = sc;
+    c.sink = k;
+    cs.cmd_fn = scn_cmd;
+    cs.cmd_user = &c;
+    engine_chain_start_pose(&m->chain, sc, q0);
+    const double t_end = o->duration > 0 ? o->duration : sc->duration;
+    if (chain_sim_check_pose(&cs, q0, msg, msz) || chain_sim_initial_state(&cs, q0, 0.5e6, y, msg, msz) ||
+        sim_check_fixed_step(m->hyd, o, o->h, t_end, msg, msz) || (k->probe && k->probe(m, o, o->h, msg, msz))) {
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    {
+        double row0[SIM_NCOL];
+        chain_run_ctx c0 = c;
+        make_row(&c0, 0.0, y, row0);
+        const sim_start_load ld = {m->chain.two_link ? &m->mech : NULL, {sc->q0[0], sc->q0[1]}, m3, false};
+        if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, &ld, msg, msz)) {
+            res->status = SIM_REFUSED;
+            goto done;
+        }
+    }
+    const bool adaptive = hyd_method_is_adaptive(o->solver);
+    hyd_problem prob = chain_sim_problem(&cs);
+    hyd_solver_opts so = hyd_default_solver_opts();
+    so.h = adaptive ? 0.0 : o->h;
+    so.rtol = o->rtol;
+    so.atol = o->atol;
+    so.h_max = 0.5;
+    so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    if (o->no_retry) so.retry_halvings = 0;
+    if (!adaptive) so.max_steps = 0;
+    if (k->energy && (sim_energy_bind(k->energy, m->hyd) || sim_energy_follow(k->energy, cs.n, energy_eval, &cs))) {
+        snprintf(msg, msz, "out of memory for the energy balance");
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    c.energy = k->energy;
+    so.on_step = on_step;
+    so.on_step_user = &c;
+    s = hyd_solver_create(&prob, o->solver, &so);
+    c.solver = s;
+    if (!s) {
+        snprintf(msg, msz, "cannot create the %s solver", hyd_method_name(o->solver));
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    sim_opts oo = *o;
+    if (!adaptive && oo.h > oo.dt_out) oo.dt_out = oo.h;
+    if (oo.dt_out > t_end && t_end > 0) oo.dt_out = t_end;
+    c.o = &oo;
+    // Between the command breakpoints (rounded to the output grid), the
+    // solver reset at each, as engine_lagrange.c's run.
+    double bp[SCENARIO_MAX_POINTS * SCENARIO_MAX_CMD + SCENARIO_MAX_EVENTS + 9 * SCENARIO_MAX_FAULTS + 2];
+    const int nbp = scenario_breakpoints(sc, bp, (int)(sizeof bp / sizeof bp[0]) - 1);
+    engine_faults ef;
+    engine_faults_init(&ef, m->hyd);
+    double t = 0.0;
+    int rc = HYD_OK;
+    const double w0 = sim_wall_time();
+    if (c.energy) sim_energy_follow_sample(c.energy, 0.0, y, chain_sim_energy(&cs, y));
+    emit(&c, 0.0, y);
+    for (int i = 0; i <= nbp && rc == HYD_OK && !c.stop && t < t_end; ++i) {
+        double tb = i < nbp ? ceil(bp[i] / oo.dt_out - 1e-9) * oo.dt_out : t_end;
+        if (tb > t_end) tb = t_end;
+        if (tb <= t + 1e-12) continue;
+        engine_faults_apply(&ef, m->hyd, sc, 0.5 * (t + tb));
+        hyd_solver_reset(s);
+        if (c.energy && t > 0.0) sim_energy_follow_inputs(c.energy, t, y);
+        rc = hyd_solver_integrate(s, t, y, tb, oo.dt_out, emit, &c);
+        if (rc == HYD_OK && !c.stop) t = tb;
+    }
+    res->wall = sim_wall_time() - w0;
+    res->stats = *hyd_solver_get_stats(s);
+    res->rows = c.rows;
+    res->t_end = c.t_last_row;
+    if (c.stop == 3) {
+        res->status = c.bad_t > 0 ? SIM_FAILED : SIM_REFUSED;
+        char how[96];
+        snprintf(how, sizeof how, "solver %s, h = %g s", hyd_method_name(o->solver),
+                 adaptive ? hyd_solver_last_h(s) : o->h);
+        sim_check_message(msg, msz, c.bad, res->status == SIM_REFUSED ? NULL : how, adaptive, c.bad_t,
+                          c.chk.bad_value);
+    } else if (c.stop) {
+        res->status = SIM_REFUSED;
+        snprintf(msg, msz, "stopped at t = %.6g s", c.t_last_row);
+    } else if (rc != HYD_OK) {
+        res->status = SIM_FAILED;
+        snprintf(msg, msz, "solver %s stopped near t = %.6g s: %s", hyd_method_name(o->solver), c.t_last_row,
+                 hyd_error_text(rc));
+    } else {
+        res->status = SIM_OK;
+    }
+    memcpy(res->p_peak, c.peak, sizeof res->p_peak);
+    res->peak_steps = k->summary;
+    if (!res->status) sim_checks_note(&c.chk, adaptive, res->note, sizeof res->note);
+    if (k->energy) sim_energy_finish(k->energy);
+done:
+    hyd_solver_destroy(s);
+    free(buf);
+    free(c.fcol);
+    chain_sim_free(&cs);
+    return res->status;
+}

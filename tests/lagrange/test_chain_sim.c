@@ -1,0 +1,489 @@
+// test_chain_sim.c: the general analytic mode (chain_sim.h) against the
+// closed-form two-link crane (lagrange_sim.h), an energy invariant on a
+// five-body chain, and its analytic Jacobian against finite differences.
+#include "chain_sim.h"
+#include "engine_chain.h"
+#include "engine.h"
+#include "check.h"
+#include "crane_chain_synth.h"
+#include "crane_fixture.h"
+#include "lagrange_sim.h"
+
+#include <stdlib.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+// A few seconds moving both functions together and apart, both ways.
+static void two_link_scenario(scenario* sc) {
+    memset(sc, 0, sizeof *sc);
+    snprintf(sc->name, sizeof sc->name, "both");
+    sc->duration = 4.0;
+    sc->load_mass = 500.0;
+    sc->q0[0] = 100 * M_PI / 180;
+    sc->q0[1] = -110 * M_PI / 180;
+    const double tl[] = {0, 0.3, 1.3, 1.8, 2.8, 3.2}, ul[] = {0, 0.7, 0.7, -0.5, -0.5, 0};
+    const double tj[] = {0, 0.6, 1.6, 2.2, 3.0, 3.6}, uj[] = {0, 0.6, 0.6, -0.6, -0.6, 0};
+    sc->cmd[0].n = sc->cmd[1].n = 6;
+    for (int i = 0; i < 6; ++i) {
+        sc->cmd[0].t[i] = tl[i], sc->cmd[0].u[i] = ul[i];
+        sc->cmd[1].t[i] = tj[i], sc->cmd[1].u[i] = uj[i];
+    }
+}
+
+// chain_sim's commands from the scenario column named as the function.
+typedef struct scn_cmds {
+    const scenario* sc;
+    int col[8];
+} scn_cmds;
+static double scn_cmd(void* user, int k, double t) {
+    const scn_cmds* c = user;
+    return c->col[k] < 0 ? 0.0 : scenario_command(c->sc, c->col[k], t);
+}
+
+typedef struct cmp {
+    double x, p, q; // largest difference relative to the largest value of the run
+    double xmax, pmax, qmax, dx, dp, dq, dE;
+} cmp;
+
+// The two-link crane through both paths with method meth (RK4 at 20 us, else 0.1 ms); the
+// largest differences of strokes, chamber pressures and angles over the run.
+static cmp two_link_compare(hyd_method meth, bool blocks) {
+    cmp r = {0};
+    scenario sc;
+    two_link_scenario(&sc);
+    model* m = load_model("hiab031.json");
+    if (!m) return r;
+    char err[256];
+    lsim ls;
+    CHECK(lsim_init(&ls, m, LAGRANGE_FULL, sc.load_mass, err, sizeof err) == 0, "%s", err);
+    ls.scn = &sc;
+    chain_sim cs;
+    CHECK(m->chain.two_link, "the default model is the two-link shorthand");
+    CHECK(chain_sim_init(&cs, &m->chain, m->hyd, sc.load_mass, 0.0, err, sizeof err) == 0, "%s", err);
+    CHECK(cs.ndof == 2 && cs.nact == 2 && cs.nfn == 2, "sizes %d %d %d", cs.ndof, cs.nact, cs.nfn);
+    scn_cmds sk = {&sc, {-1, -1, -1, -1, -1, -1, -1, -1}};
+    for (int k = 0; k < cs.nfn; ++k)
+        for (int c = 0; c < SCENARIO_NCMD; ++c)
+            if (!strcmp(m->chain.fn[k].name, scenario_cmd_name[c])) sk.col[k] = c;
+    CHECK(sk.col[0] == 0 && sk.col[1] == 1, "functions lift, jib");
+    cs.cmd_fn = scn_cmd;
+    cs.cmd_user = &sk;
+    double* yl = calloc(LSIM_MAX_STATES, sizeof *yl);
+    double* yc = calloc((size_t)cs.n, sizeof *yc);
+    lsim_initial_state(&ls, sc.q0, 0.5e6, yl);
+    CHECK(chain_sim_check_pose(&cs, sc.q0, err, sizeof err) == 0, "%s", err);
+    CHECK(chain_sim_initial_state(&cs, sc.q0, 0.5e6, yc, err, sizeof err) == 0, "%s", err);
+    for (int h = 0; h < cs.nh; ++h) CHECK_REL(yc[h], yl[ls.hpos[h]], 1e-12);
+    // The closed form with its fused kernel; blocks: its split step (as the
+    // engine runs Krus), else the full W (its structured elimination).
+    hyd_problem pl = lsim_problem(&ls, blocks);
+    hyd_problem pc = chain_sim_problem(&cs);
+    hyd_solver_opts so = hyd_default_solver_opts();
+    // RK4 is unstable at 0.1 ms on this circuit (its fastest mode, the hoses
+    // and chambers, needs h < 2.785 / rate: both paths ring to 9 MPa
+    // differences there), so at 20 us; Krus at 0.1 ms.
+    so.h = meth == HYD_RK4 ? 2e-5 : 1e-4;
+    hyd_solver* sl = hyd_solver_create(&pl, meth, &so);
+    hyd_solver* sg = hyd_solver_create(&pc, meth, &so);
+    double tl = 0, tg = 0;
+    double diff[3] = {0}, peak[3] = {0};
+    for (int i = 1; i <= 40; ++i) {
+        const double t1 = 0.1 * i;
+        CHECK(hyd_solver_advance(sl, &tl, yl, t1) == HYD_OK, "closed form failed at %g", tl);
+        CHECK(hyd_solver_advance(sg, &tg, yc, t1) == HYD_OK, "general failed at %g", tg);
+        lsim_out lo;
+        lsim_outputs(&ls, tl, yl, &lo);
+        double x[2], pA[2], pB[2], q[2];
+        chain_sim_out co = {.x = x, .pA = pA, .pB = pB, .q = q};
+        chain_sim_outputs(&cs, tg, yc, &co);
+        for (int k = 0; k < 2; ++k) {
+            diff[0] = fmax(diff[0], fabs(x[k] - lo.x[k]));
+            peak[0] = fmax(peak[0], fabs(lo.x[k]));
+            diff[1] = fmax(diff[1], fmax(fabs(pA[k] - lo.pA[k]), fabs(pB[k] - lo.pB[k])));
+            peak[1] = fmax(peak[1], fmax(lo.pA[k], lo.pB[k]));
+            diff[2] = fmax(diff[2], fabs(q[k] - lo.q[k]));
+            peak[2] = fmax(peak[2], fabs(lo.q[k]));
+        }
+    }
+    r.x = diff[0] / peak[0], r.p = diff[1] / peak[1], r.q = diff[2] / peak[2];
+    r.dx = diff[0], r.dp = diff[1], r.dq = diff[2];
+    r.xmax = peak[0], r.pmax = peak[1], r.qmax = peak[2];
+    // The mechanical energy's change over the run: the same on both paths
+    // (the chain's potential has another zero, so the changes).
+    {
+        double yl0[LSIM_MAX_STATES], yc0[64];
+        lsim_initial_state(&ls, sc.q0, 0.5e6, yl0);
+        chain_sim_initial_state(&cs, sc.q0, 0.5e6, yc0, err, sizeof err);
+        const double dEl = lagrange_energy(&m->mech, sc.load_mass, yl + ls.iq, yl + ls.iq + 2) -
+                           lagrange_energy(&m->mech, sc.load_mass, yl0 + ls.iq, yl0 + ls.iq + 2);
+        const double dEc = chain_sim_energy(&cs, yc) - chain_sim_energy(&cs, yc0);
+        printf("  mechanical energy change: closed form %.9g J, general %.9g J\n", dEl, dEc);
+        r.dE = fabs(dEl - dEc) / fabs(dEl);
+    }
+    // The run moved both cylinders.
+    lsim_out lo;
+    lsim_outputs(&ls, tl, yl, &lo);
+    CHECK(fabs(lo.q[0] - sc.q0[0]) > 0.05 && fabs(lo.q[1] - sc.q0[1]) > 0.05, "both joints moved: %g %g",
+          lo.q[0] - sc.q0[0], lo.q[1] - sc.q0[1]);
+    printf("  %s %g ms%s: general vs closed form: stroke %.3g m (%.3g rel), pressure %.3g Pa (%.3g rel), "
+           "angle %.3g rad (%.3g rel)\n",
+           hyd_method_name(meth), so.h * 1e3, blocks ? " (closed form: split step)" : "", r.dx, r.x, r.dp, r.p, r.dq, r.q);
+    hyd_solver_destroy(sl);
+    hyd_solver_destroy(sg);
+    free(yl);
+    free(yc);
+    chain_sim_free(&cs);
+    lsim_free(&ls);
+    model_free(m);
+    return r;
+}
+
+// RK4 (explicit: the Jacobians do not enter): the same trajectory to rounding.
+// The 1e-9 bound is far above rounding (1e-15 measured), far below any
+// modelling difference (a lever arm off by 1e-6 of itself fails it).
+static void test_two_link_rk4(void) {
+    const cmp r = two_link_compare(HYD_RK4, false);
+    CHECK(r.x < 1e-9 && r.p < 1e-9 && r.q < 1e-9, "relative differences %.3g %.3g %.3g", r.x, r.p, r.q);
+    CHECK(r.dE < 1e-9, "mechanical energy changes differ by %.3g relative", r.dE);
+}
+
+// Krus at 0.1 ms with the full W on both sides: the Jacobians differ only
+// by the general path's differences of the inverse dynamics (1e-10 of a
+// row), which a W-method's result depends on at second order: close to
+// rounding. Against the closed form's split step (block-diagonal W, the
+// mechanics at the step's midpoint: what the engine runs) two different
+// W-methods' errors: close, the bounds of its accuracy study's order.
+static void test_two_link_krus(void) {
+    cmp r = two_link_compare(HYD_KRUS, false);
+    CHECK(r.x < 1e-7 && r.p < 1e-7 && r.q < 1e-7, "relative differences %.3g %.3g %.3g", r.x, r.p, r.q);
+    r = two_link_compare(HYD_KRUS, true);
+    CHECK(r.dx < 5e-4 && r.p < 1e-2 && r.q < 1e-3, "differences %.3g m, %.3g, %.3g", r.dx, r.p, r.q);
+}
+
+// The five-body chain of the tests: a column, a lifting arm, an end arm, a
+// jib and a telescopic extension in the jib, each moved by its own cylinder.
+static int five_body(bool slew_free, crane_chain* cc, hyd_model** hm, double* q0) {
+    char err[256];
+    const int rc = crane_chain_synthetic("RRRP", slew_free, cc, hm, q0, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    return rc;
+}
+
+// Moving every function at once: sines of different periods.
+static double wave(void* user, int k, double t) {
+    (void)user;
+    return 0.6 * sin(2 * M_PI * t / (3.0 + k));
+}
+
+// Energy: the cylinders replaced by ideal springs along their pins, F_k =
+// F0_k - K_k x_k, conservative (potential -F0 x + K x^2 / 2): E_mech -
+// sum (F0 x - K x^2 / 2) stays constant. The springs hold the start pose
+// (F0 from its chamber pressures), each as stiff as its load over 50 mm;
+// started with every joint moving, the column slewing: all five bodies
+// swing, the extension slides.
+static void test_energy_ideal_forces(void) {
+    crane_chain cc;
+    hyd_model* hm;
+    double qb[4];
+    if (five_body(true, &cc, &hm, qb)) return;
+    chain_sim cs;
+    char err[256];
+    CHECK(chain_sim_init(&cs, &cc, hm, 100.0, 0.0, err, sizeof err) == 0, "%s", err);
+    CHECK(cs.ndof == 5, "ndof %d", cs.ndof);
+    const double q0[5] = {0.0, qb[0], qb[1], qb[2], qb[3]};
+    double* y = calloc((size_t)cs.n, sizeof *y);
+    CHECK(chain_sim_initial_state(&cs, q0, 0.5e6, y, err, sizeof err) == 0, "%s", err);
+    double F0[4], K[4], x[4];
+    chain_sim_out o = {.x = x};
+    chain_sim_outputs(&cs, 0.0, y, &o);
+    for (int k = 0; k < 4; ++k) {
+        double AA, AB, st;
+        hyd_model_cylinder_geometry(hm, cc.act[k].cyl, &AA, &AB, &st);
+        const double Feq = y[cs.ipA[k]] * AA - y[cs.ipB[k]] * AB;
+        K[k] = fabs(Feq) / 0.05;
+        F0[k] = Feq + K[k] * x[k];
+    }
+    cs.ideal_F = F0;
+    cs.ideal_K = K;
+    const double qd0[5] = {0.3, 0.2, -0.3, 0.4, 0.1};
+    for (int i = 0; i < 5; ++i) y[cs.iq + 5 + i] = qd0[i];
+    double E0 = 0, Emax = 0, Kmax = 0, travel[5] = {0};
+    hyd_problem p = chain_sim_problem(&cs);
+    hyd_solver_opts so = hyd_default_solver_opts();
+    so.h = 1e-3;
+    hyd_solver* s = hyd_solver_create(&p, HYD_RK4, &so);
+    double t = 0;
+    for (int i = 0; i <= 100; ++i) {
+        if (i) CHECK(hyd_solver_advance(s, &t, y, 0.1 * i) == HYD_OK, "advance at %g", t);
+        chain_sim_outputs(&cs, t, y, &o);
+        double E = chain_sim_energy(&cs, y);
+        Kmax = fmax(Kmax, chain_kinetic_energy(cs.ch, cs.ws));
+        for (int k = 0; k < 4; ++k) E -= F0[k] * x[k] - 0.5 * K[k] * x[k] * x[k];
+        for (int j = 0; j < 5; ++j) travel[j] = fmax(travel[j], fabs(y[cs.iq + j] - q0[j]));
+        if (!i) E0 = E;
+        Emax = fmax(Emax, fabs(E - E0));
+    }
+    // Relative to the largest kinetic energy, the energy that moved.
+    CHECK(Emax / Kmax < 1e-6, "energy drift %.3g J of %.3g J kinetic (%.3g relative)", Emax, Kmax, Emax / Kmax);
+    for (int j = 0; j < 5; ++j) CHECK(travel[j] > 0.01, "joint %d moved only %g", j, travel[j]);
+    printf("  energy drift %.3g relative over 10 s (kinetic up to %.3g J)\n", Emax / Kmax, Kmax);
+    hyd_solver_destroy(s);
+    free(y);
+    chain_sim_free(&cs);
+    crane_chain_free(&cc);
+    hyd_model_free(hm);
+}
+
+// The five-body chain with its circuit, every function moving, 10 s of
+// Krus at 0.1 ms (the analytic Jacobian in every W): no blow-up, every
+// joint moved, and the Jacobian at t = 5 s against central differences.
+static void test_chain_run_and_jacobian(void) {
+    crane_chain cc;
+    hyd_model* hm;
+    double q0[4];
+    if (five_body(false, &cc, &hm, q0)) return;
+    chain_sim cs;
+    char err[256];
+    CHECK(chain_sim_init(&cs, &cc, hm, 100.0, 0.0, err, sizeof err) == 0, "%s", err);
+    cs.cmd_fn = wave;
+    const int n = cs.n;
+    double* y = calloc((size_t)n, sizeof *y);
+    CHECK(chain_sim_check_pose(&cs, q0, err, sizeof err) == 0, "%s", err);
+    CHECK(chain_sim_initial_state(&cs, q0, 0.5e6, y, err, sizeof err) == 0, "%s", err);
+    // The start is one the circuit can hold: every chamber below the reliefs.
+    for (int k = 0; k < 4; ++k)
+        CHECK(y[cs.ipA[k]] < 20e6 && y[cs.ipB[k]] < 20e6, "act %d starts at %g / %g Pa", k, y[cs.ipA[k]], y[cs.ipB[k]]);
+    // At rest at t = 0 with closed valves: q'' = 0 (the equilibrium holds).
+    double* f = calloc((size_t)n, sizeof *f);
+    cs.cmd_fn = NULL;
+    chain_sim_rhs(&cs, 0.0, y, f);
+    for (int i = 0; i < 4; ++i) CHECK(fabs(f[cs.iq + 4 + i]) < 1e-6, "q''[%d] = %g at the start", i, f[cs.iq + 4 + i]);
+    cs.cmd_fn = wave;
+    hyd_problem p = chain_sim_problem(&cs);
+    hyd_solver_opts so = hyd_default_solver_opts();
+    so.h = 1e-4;
+    hyd_solver* s = hyd_solver_create(&p, HYD_KRUS, &so);
+    double t = 0, travel[4] = {0};
+    for (int i = 1; i <= 100; ++i) {
+        const int rc = hyd_solver_advance(s, &t, y, 0.1 * i);
+        CHECK(rc == HYD_OK, "advance failed at %g (%d)", t, rc);
+        if (rc) break;
+        for (int k = 0; k < 4; ++k) travel[k] = fmax(travel[k], fabs(y[cs.iq + k] - q0[k]));
+        if (i == 50) {
+            // Jacobian at t = 5 s against central differences of f.
+            double* Ja = calloc((size_t)n * n, sizeof *Ja);
+            double* fp = calloc((size_t)n, sizeof *fp);
+            double* fm = calloc((size_t)n, sizeof *fm);
+            double* yy = calloc((size_t)n, sizeof *yy);
+            CHECK(chain_sim_jac(&cs, t, y, Ja) == 0, "jac");
+            double worst = 0;
+            int wi = 0, wj = 0;
+            for (int j = 0; j < n; ++j) {
+                memcpy(yy, y, (size_t)n * sizeof *yy);
+                const double h = 1e-6 * (1.0 + fabs(y[j]));
+                yy[j] = y[j] + h;
+                chain_sim_rhs(&cs, t, yy, fp);
+                yy[j] = y[j] - h;
+                chain_sim_rhs(&cs, t, yy, fm);
+                for (int i2 = 0; i2 < n; ++i2) {
+                    double rowmax = 0;
+                    for (int c = 0; c < n; ++c) rowmax = fmax(rowmax, fabs(Ja[i2 * n + c]) * (1.0 + fabs(y[c])));
+                    const double fd = (fp[i2] - fm[i2]) / (2 * h);
+                    // Scaled by the row's largest term |J_ic| (1 + |y_c|): a
+                    // change of 1e-6 in every state moves f_i by about that.
+                    const double e = fabs(Ja[i2 * n + j] - fd) * (1.0 + fabs(y[j])) / (rowmax + 1e-300);
+                    if (e > worst) worst = e, wi = i2, wj = j;
+                }
+            }
+            CHECK(worst < 1e-6, "Jacobian entry (%d, %d): %.6g analytic vs differences, %.3g of its row", wi, wj,
+                  Ja[wi * n + wj], worst);
+            printf("  Jacobian vs central differences at t = 5 s: worst %.3g of its row (n = %d)\n", worst, n);
+            free(Ja), free(fp), free(fm), free(yy);
+        }
+    }
+    for (int k = 0; k < 4; ++k) CHECK(travel[k] > 0.02, "joint %d moved only %g", k, travel[k]);
+    for (int i = 0; i < n; ++i) CHECK(isfinite(y[i]), "state %d not finite", i);
+    hyd_solver_destroy(s);
+    free(y);
+    free(f);
+    chain_sim_free(&cs);
+    crane_chain_free(&cc);
+    hyd_model_free(hm);
+}
+
+typedef struct csv_rows {
+    FILE* ref;    // the previous main's CSV, every 100th row
+    long row;     // rows seen
+    long checked; // rows compared
+    long differ;  // of them, not byte-identical
+    char first[600];
+} csv_rows;
+
+static int compare_row(void* user, const double* row) {
+    csv_rows* c = user;
+    if (c->row++ % 100) return 0;
+    char* got = NULL;
+    size_t n = 0;
+    FILE* m = open_memstream(&got, &n);
+    sim_csv_row(m, row, SIM_NCOL_BASE);
+    fclose(m);
+    char want[1024];
+    if (!fgets(want, sizeof want, c->ref)) want[0] = 0;
+    ++c->checked;
+    if (strcmp(got, want) && !c->differ++) snprintf(c->first, sizeof c->first, "got  %swant %s", got, want);
+    free(got);
+    return 0;
+}
+
+// The default scripted run (hiab031, ramp, Krus 0.1 ms, rows at 1 ms) takes
+// the closed form's fast path unchanged: its CSV rows byte-identical to
+// those of the previous main (b752397, `cranesim run`, every 100th row
+// kept in tests/lagrange/data).
+static void test_default_run_unchanged(void) {
+    scenario sc;
+    model* m = load_crane("ramp", &sc);
+    if (!m) return;
+    csv_rows c = {fopen(CRANESIM_TESTDATA "/ramp_b752397_every100.csv", "r"), 0, 0, 0, ""};
+    CHECK(c.ref != NULL, "reference CSV");
+    if (!c.ref) return;
+    char hdr[1024];
+    CHECK(fgets(hdr, sizeof hdr, c.ref) != NULL, "header");
+    sim_opts o = sim_default_opts();
+    sim_result res;
+    CHECK(sim_run(m, &sc, &o, compare_row, &c, NULL, NULL, NULL, &res) == 0, "%s", res.message);
+    CHECK(res.fused && res.split, "the fast path ran (fused %d, split %d)", res.fused, res.split);
+    CHECK(c.checked == 201 && c.differ == 0, "%ld of %ld rows differ; first:\n%s", c.differ, c.checked, c.first);
+    fclose(c.ref);
+    model_free(m);
+}
+
+// The general path refuses the paper's equations, which are the two-link
+// crane's, with one line that says so.
+static void test_general_refuses_paper(void) {
+    scenario sc;
+    model* m = load_crane("ramp", &sc);
+    if (!m) return;
+    sim_opts o = sim_default_opts();
+    o.variant = LAGRANGE_PAPER;
+    engine_sink k = {.t_end = 1.0};
+    sim_result res;
+    memset(&res, 0, sizeof res);
+    CHECK(engine_chain_run(m, &sc, &o, &k, &res) == SIM_REFUSED, "refused");
+    CHECK(strstr(res.message, "two-link") && !strchr(res.message, '\n'), "message: %s", res.message);
+    model_free(m);
+}
+
+typedef struct rows_seen {
+    long n;
+    double x0[2], xmin[2], xmax[2];
+} rows_seen;
+
+static int see_row(void* user, const double* row) {
+    rows_seen* r = user;
+    for (int k = 0; k < 2; ++k) {
+        const double x = row[k == 0 ? COL_X1 : COL_X2];
+        if (!r->n) r->x0[k] = r->xmin[k] = r->xmax[k] = x;
+        r->xmin[k] = fmin(r->xmin[k], x), r->xmax[k] = fmax(r->xmax[k], x);
+    }
+    ++r->n;
+    return 0;
+}
+
+// A four-function chain (lifting arm, knuckle, jib, extension) through the
+// engine (engine_run on the lagrange backend: the general path, as the
+// chain is not the two-link shorthand), commanded by a scenario whose
+// columns name the functions; a column naming no function is refused with
+// one line naming the file and the column.
+static void test_engine_named_functions(void) {
+    model* m = load_model("hiab031.json");
+    if (!m) return;
+    crane_chain cc;
+    hyd_model* hm;
+    double q0[4];
+    if (five_body(false, &cc, &hm, q0)) return;
+    // The model's chain and circuit swapped for the synthetic ones (and back).
+    const crane_chain keep_cc = m->chain;
+    hyd_model* keep_hm = m->hyd;
+    m->chain = cc;
+    m->hyd = hm;
+    char js[1024], err[256];
+    snprintf(js, sizeof js,
+             "{\"name\": \"fns\", \"duration\": 2, \"load_mass\": 100,"
+             " \"initial\": {\"q1_deg\": %.9g, \"q2_deg\": %.9g},"
+             " \"commands\": {\"f1\": [[0, 0], [0.2, 0.5], [1, 0.5], [1.2, 0]],"
+             " \"f2\": [[0, 0], [0.3, -0.5], [1.5, -0.5], [1.7, 0]],"
+             " \"f3\": [[0, 0.4]], \"f4\": [[0, -0.4]]}}",
+             q0[0] * 180 / M_PI, q0[1] * 180 / M_PI);
+    cJSON* root = cJSON_Parse(js);
+    scenario sc;
+    CHECK(scenario_from_json(root, "fns.json", &sc, err, sizeof err) == 0, "%s", err);
+    cJSON_Delete(root);
+    CHECK(scenario_ncmd(&sc) == 7 && scenario_find_command(&sc, "f3") == 5, "columns %d", scenario_ncmd(&sc));
+    sim_opts o = sim_default_opts();
+    o.no_step_probe = true;
+    rows_seen r = {0};
+    engine_sink k = {.row = see_row, .user = &r, .rows = true, .t_end = 2.0};
+    sim_result res;
+    memset(&res, 0, sizeof res);
+    CHECK(engine_run(m, &sc, &o, &k, &res) == SIM_OK, "%s", res.message);
+    CHECK(r.n == 2001, "rows %ld", r.n);
+    // f1 raises its cylinder (+0.5), f2 retracts its own (-0.5).
+    CHECK(r.xmax[0] - r.x0[0] > 0.02 && r.x0[1] - r.xmin[1] > 0.02, "x1 up %g, x2 in %g", r.xmax[0] - r.x0[0],
+          r.x0[1] - r.xmin[1]);
+    // The same scenario with a column the chain has no function for.
+    snprintf(sc.cmd_name[6], sizeof sc.cmd_name[6], "winch");
+    memset(&res, 0, sizeof res);
+    CHECK(engine_run(m, &sc, &o, &k, &res) == SIM_REFUSED, "refused");
+    CHECK(strstr(res.message, "fns.json: commands.winch: unknown field 'winch'") && strstr(res.message, "f4"),
+          "message: %s", res.message);
+    m->chain = keep_cc;
+    m->hyd = keep_hm;
+    crane_chain_free(&cc);
+    hyd_model_free(hm);
+    model_free(m);
+}
+
+// The stepped engine's functions are the model chain's (lift, jib) and the
+// slew; their commands by function land on the valves engine_set_commands
+// drives; a chain that is not the two-link crane has no stepped engine yet.
+static void test_engine_function_commands(void) {
+    model* m = load_model("hiab031.json");
+    if (!m) return;
+    sim_opts o = sim_default_opts();
+    o.no_step_probe = true;
+    const double q0[2] = {100 * M_PI / 180, -110 * M_PI / 180};
+    char err[512];
+    engine* e = engine_create(m, &o, q0, 0.0, 500.0, err, sizeof err);
+    CHECK(e != NULL, "%s", err);
+    if (!e) return;
+    CHECK(engine_nfunction(e) == 3, "functions %d", engine_nfunction(e));
+    CHECK(!strcmp(engine_function_name(e, 0), "lift") && !strcmp(engine_function_name(e, 1), "jib") &&
+              !strcmp(engine_function_name(e, 2), "slew") && engine_function_name(e, 3) == NULL,
+          "names");
+    const double u[3] = {0.4, -0.3, 0.2};
+    engine_set_function_commands(e, u);
+    CHECK(engine_advance(e, 0.01) == 0, "%s", engine_error(e));
+    double row[SIM_NCOL];
+    engine_row(e, row);
+    CHECK(row[COL_U1_CMD] == 0.4 && row[COL_U2_CMD] == -0.3, "commands %g %g", row[COL_U1_CMD], row[COL_U2_CMD]);
+    engine_destroy(e);
+    o.variant = LAGRANGE_GENERAL;
+    e = engine_create(m, &o, q0, 0.0, 500.0, err, sizeof err);
+    CHECK(e == NULL && strstr(err, "--variant general"), "general stepped: %s", e ? "created" : err);
+    engine_destroy(e);
+    model_free(m);
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_engine_function_commands);
+    RUN_TEST(test_engine_named_functions);
+    RUN_TEST(test_default_run_unchanged);
+    RUN_TEST(test_general_refuses_paper);
+    RUN_TEST(test_two_link_rk4);
+    RUN_TEST(test_two_link_krus);
+    RUN_TEST(test_energy_ideal_forces);
+    RUN_TEST(test_chain_run_and_jacobian);
+    TEST_MAIN_END();
+}
