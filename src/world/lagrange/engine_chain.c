@@ -131,6 +131,11 @@ static int emit(void* user, double t, const double* y) {
         return (c->stop = 3);
     }
     if (c->sink->row && c->sink->row(c->sink->user, row)) return (c->stop = 2);
+    if (c->sink->chain_row) {
+        const engine_chain_row cr = {t,      cs->nact, cs->nfn, cs->ndof, c->x, c->v,
+                                     c->pA,  c->pB,    c->F,    c->u,     c->ucmd, c->q};
+        if (c->sink->chain_row(c->sink->user, &cr)) return (c->stop = 2);
+    }
     return 0;
 }
 

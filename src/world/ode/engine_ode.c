@@ -4,6 +4,7 @@
 #include "engine_ode.h"
 #include "energy_acc.h"
 
+#include "engine_ode_chain.h"
 #include "ode_run.h"
 #include "rcl.h"
 
@@ -42,13 +43,15 @@ static sim_start_load start_load(const model* m, const ode_world* w, const doubl
 
 // A model whose crane is a chain of other shape than the two-link one
 // (crane_chain.two_link false): its crane_mech does not describe it, and
-// the ODE world of ode_world.h builds that two-link crane alone. The chain
-// world (ode_chain.h) builds any chain, but the engine's rows, commands and
-// views are still the two-link crane's: refused here, in one line, rather
-// than run as the wrong crane.
+// the ODE world of ode_world.h builds that two-link crane alone. Scripted
+// runs take the chain world (engine_ode_chain.c); the stepped engine's
+// commands, views and limiter are still the two-link crane's: refused
+// here, in one line, rather than run as the wrong crane.
 static int refuse_chain(const model* m, char* err, size_t errsz) {
-    return model_require_two_link(m, "ode backend (its engine reads the two-link crane's strokes and commands)", err,
-                                  errsz);
+    return model_require_two_link(m,
+                                  "stepped engine of the ode backend (a chain model runs scripted in the ODE chain "
+                                  "world: cranesim run)",
+                                  err, errsz);
 }
 
 static engine* ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
@@ -184,7 +187,8 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
                  sim_param_name(SIM_PARAM_MECHANICS));
         return res->status = SIM_REFUSED;
     }
-    if (refuse_chain(m, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
+    // Every chain that is not the two-link shorthand runs in the chain world.
+    if (!m->chain.two_link) return engine_ode_chain_run(m, sc, o, k, res);
     ode_world* w = ode_world_for_run(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
                                         sizeof res->message);
     if (!w) return res->status = SIM_REFUSED;

@@ -21,6 +21,7 @@
 #include "ode_chain.h"
 
 #include "ode_world_internal.h"
+#include "energy_acc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -80,6 +81,7 @@ struct ode_chain {
     double* ydot;
     int* pres;
     double th, step_t0;
+    struct sim_energy* energy; ///< ode_chain_follow_energy's balance, or NULL
 };
 
 ode_chain_opts ode_chain_default_opts(void) {
@@ -519,10 +521,15 @@ static int hyd_init_state(ode_chain* w, char* err, size_t errsz) {
 
 static int hyd_step(ode_chain* w, double H) {
     w->step_t0 = w->th;
+    // The strokes, rates and commands this step integrates start here (as
+    // ode_coupling.c): the balance's next step starts from their powers.
+    if (w->energy) sim_energy_follow_inputs(w->energy, w->th, w->y);
     hyd_solver_inputs_changed(w->hs);
     const double h = H / w->nsub;
     for (int i = 0; i < w->nsub; ++i) {
         const int rc = hyd_solver_step(w->hs, &w->th, w->y, h);
+        // hyd_solver_step calls no on_step: each sub-step's balance here.
+        if (rc == HYD_OK && w->energy) sim_energy_follow_step(w->energy, w->hs, w->th, w->y, NAN);
         if (rc != HYD_OK) {
             double tb = w->th;
             const int bad = rc == HYD_ERR_NONFINITE || rc == HYD_ERR_DOMAIN ? hyd_solver_bad_state(w->hs, &tb) : -1;
@@ -956,4 +963,62 @@ int ode_chain_act_at_stop(const ode_chain* w, int k) {
     const oc_act* a = &w->a[k];
     if (a->stop_body >= 0 && at_stop(&w->b[a->stop_body])) return 1;
     return w->hm && w->hd->cyl_stop[w->cc.act[k].cyl] != 0;
+}
+
+void ode_chain_circuit_state(const ode_chain* w, const double** y, const hyd_data** hd) {
+    if (y) *y = w->hm ? w->y : NULL;
+    if (hd) *hd = w->hm ? w->hd : NULL;
+}
+
+// sim_energy_eval_fn: the circuit at (t, y) with the inputs the sub-steps
+// integrate there (set_inputs' extrapolated strokes), into the balance's
+// own data, so the world's hd is left as the last step had it.
+static const hyd_data* energy_eval(void* user, double t, const double* y) {
+    ode_chain* w = user;
+    hyd_data* d = sim_energy_data(w->energy);
+    const double tau = t - w->step_t0;
+    for (int k = 0; k < w->nact; ++k) {
+        const int c = w->cc.act[k].cyl;
+        d->cyl_x[c] = w->a[k].x0 + w->a[k].v0 * tau;
+        d->cyl_v[c] = w->a[k].v0;
+    }
+    for (int f = 0; f < w->nfn; ++f) d->valve_cmd[w->cc.fn[f].valve_idx] = w->u[f];
+    hyd_eval(w->hm, d, t, y, w->ydot);
+    return d;
+}
+
+int ode_chain_follow_energy(ode_chain* w, struct sim_energy* e) {
+    if (!w->hm || !e) return -1;
+    w->energy = e;
+    if (sim_energy_follow(e, w->nh, energy_eval, w) || sim_energy_follow_sample(e, w->th, w->y, NAN)) {
+        w->energy = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+// Kinetic energy of an ODE body (translation of its centre of mass and
+// rotation about it, the inertia turned into the world frame) plus its
+// height's potential energy, m g z [J].
+static double body_energy(dBodyID b, double g) {
+    dMass m;
+    dBodyGetMass(b, &m);
+    const dReal* v = dBodyGetLinearVel(b);
+    const dReal* om = dBodyGetAngularVel(b);
+    const dReal* R = dBodyGetRotation(b); // rows of 4
+    // omega in body axes: R^T omega; then 1/2 w_b . I w_b.
+    double wb[3];
+    for (int c = 0; c < 3; ++c) wb[c] = R[c] * om[0] + R[4 + c] * om[1] + R[8 + c] * om[2];
+    double rot = 0.0;
+    for (int r = 0; r < 3; ++r) rot += wb[r] * (m.I[4 * r] * wb[0] + m.I[4 * r + 1] * wb[1] + m.I[4 * r + 2] * wb[2]);
+    const double ke = 0.5 * m.mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + 0.5 * rot;
+    return ke + m.mass * g * dBodyGetPosition(b)[2];
+}
+
+double ode_chain_energy(const ode_chain* w) {
+    if (w->dead) return NAN;
+    double e = 0.0;
+    for (int i = 0; i < w->nbody; ++i)
+        if (w->b[i].body) e += body_energy(w->b[i].body, w->g);
+    return e;
 }

@@ -89,6 +89,19 @@ void ode_chain_body_pose(const ode_chain* w, int i, double R[9], double p[3]);
 /// 1 when actuator k is at an end stop (its joint's stop or the cylinder's own).
 int ode_chain_act_at_stop(const ode_chain* w, int k);
 
+/// The circuit's state now (hyd_model_nstate of the circuit) and the
+/// hydraulic data of the last evaluation (its strokes, commands, flows,
+/// relief states); both NULL without a circuit. Borrowed, valid until the
+/// next step.
+void ode_chain_circuit_state(const ode_chain* w, const double** y, const hyd_data** hd);
+struct sim_energy;
+/// Integrate the energy balance e (energy_acc.h, bound to the circuit) at
+/// every hydraulic sub-step from now on; 0, or -1 (no circuit, no memory).
+int ode_chain_follow_energy(ode_chain* w, struct sim_energy* e);
+/// The bodies' kinetic and potential energy (m g z, z up from the ground)
+/// [J]; NaN once ODE failed.
+double ode_chain_energy(const ode_chain* w);
+
 #ifdef __cplusplus
 }
 #endif

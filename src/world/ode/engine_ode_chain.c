@@ -1,0 +1,299 @@
+// engine_ode_chain.c: scripted runs (engine_run) of the ode backend for a
+// chain model, in the chain world (ode_chain.h), engine_ode_chain.h.
+#include "engine_ode_chain.h"
+#include "energy_acc.h"
+#include "ode_chain.h"
+#include "world_desc.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+// The start pose of chain cc [one per mechanism DOF, slew first when the
+// column slews] for scenario sc, as the analytic mode's general path takes
+// it (engine_chain_start_pose), so both backends start from one pose: the
+// slew at sc->slew0, the first two boom DOFs at sc->q0, every other DOF at
+// the middle of its joint limits (clamped 0 where one is open).
+static void start_pose(const crane_chain* cc, const scenario* sc, double* q0) {
+    int d = 0, boom = 0;
+    for (int i = 0; i < cc->nbody; ++i) {
+        const chain_body_def* b = &cc->body[i].def;
+        if (i == 0 ? !cc->slew_free : b->fixed) continue;
+        double q = i == 0 ? sc->slew0 : boom < 2 ? sc->q0[boom] : 0.0;
+        if (i > 0 && boom >= 2 && isfinite(b->q_min) && isfinite(b->q_max)) q = 0.5 * (b->q_min + b->q_max);
+        else if (i > 0 && boom >= 2) q = fmin(fmax(q, b->q_min), b->q_max);
+        if (i > 0) ++boom;
+        q0[d++] = q;
+    }
+}
+
+typedef struct chain_run {
+    ode_chain* w;
+    const crane_chain* cc;
+    const hyd_model* hm;
+    int na, nf, nd;
+    int* iu;     ///< [nf] the spool state of function f's valve, or -1
+    int ipump;   ///< the supply node, or -1
+    double *x, *v, *pA, *pB, *F, *u, *ucmd, *q; ///< the outputs, sized by the chain
+} chain_run;
+
+// Every actuator's and function's outputs now, into r's arrays.
+static void outputs(chain_run* r) {
+    const double* y;
+    const hyd_data* hd;
+    ode_chain_circuit_state(r->w, &y, &hd);
+    for (int k = 0; k < r->na; ++k) {
+        r->x[k] = ode_chain_act_length(r->w, k, &r->v[k]) - r->cc->act[k].closed_length;
+        r->F[k] = ode_chain_act_force(r->w, k, &r->pA[k], &r->pB[k]);
+    }
+    for (int f = 0; f < r->nf; ++f) {
+        r->u[f] = r->iu[f] >= 0 ? y[r->iu[f]] : 0.0;
+        r->ucmd[f] = hd->valve_cmd[r->cc->fn[f].valve_idx];
+    }
+    ode_chain_q(r->w, r->q, NULL);
+}
+
+// The row: the base columns hold the first two actuators, their functions
+// and the first two boom DOFs (as the analytic general path's rows, so
+// compare pairs the same quantities), the tip relative to the first boom's
+// joint in the boom plane; of the world extras the slew where the column
+// slews, the rest 0 (the validation world has no hook, truck or contacts).
+static void make_row(chain_run* r, double t, double* row) {
+    outputs(r);
+    memset(row, 0, SIM_NCOL * sizeof *row);
+    row[COL_T] = t;
+    const int colx[2] = {COL_X1, COL_X2}, colv[2] = {COL_V1, COL_V2}, colF[2] = {COL_F1, COL_F2};
+    const int colA[2] = {COL_P1A, COL_P2A}, colB[2] = {COL_P1B, COL_P2B};
+    const int colu[2] = {COL_U1, COL_U2}, colc[2] = {COL_U1_CMD, COL_U2_CMD}, colq[2] = {COL_Q1, COL_Q2};
+    int end_stop = 0;
+    for (int k = 0; k < 2 && k < r->na; ++k) {
+        row[colx[k]] = r->x[k], row[colv[k]] = r->v[k], row[colF[k]] = r->F[k];
+        row[colA[k]] = r->pA[k], row[colB[k]] = r->pB[k];
+        const int f = r->cc->act[k].function;
+        row[colu[k]] = r->u[f], row[colc[k]] = r->ucmd[f];
+        if (ode_chain_act_at_stop(r->w, k)) end_stop |= 1 << k;
+    }
+    const int d0 = r->cc->slew_free ? 1 : 0;
+    for (int k = 0; k < 2 && d0 + k < r->nd; ++k) row[colq[k]] = r->q[d0 + k];
+    if (d0) row[COL_SLEW] = r->q[0];
+    double tip[3], p1[3];
+    ode_chain_tip(r->w, tip, NULL);
+    ode_chain_body_pose(r->w, r->cc->nbody > 1 ? 1 : 0, NULL, p1);
+    row[COL_TIP_X] = hypot(tip[0] - p1[0], tip[1] - p1[1]);
+    row[COL_TIP_Z] = tip[2] - p1[2];
+    const double* y;
+    const hyd_data* hd;
+    ode_chain_circuit_state(r->w, &y, &hd);
+    row[COL_P_PUMP] = r->ipump >= 0 ? hd->node_p[r->ipump] : 0.0;
+    int open = 0;
+    for (int i = 0; i < hyd_model_ncomp(r->hm); ++i)
+        if (hyd_model_comp_type(r->hm, i) == HYD_RELIEF && hd->comp_open[i]) ++open;
+    row[COL_RELIEF_OPEN] = open;
+    row[COL_END_STOP] = end_stop;
+}
+
+// Every actuator's outputs to the sink's chain_row (the row's base columns
+// hold two).
+static int deliver(const engine_sink* k, chain_run* r, const double* row) {
+    if (k->row && k->row(k->user, row)) return 1;
+    if (k->chain_row) {
+        const engine_chain_row cr = {row[COL_T], r->na, r->nf, r->nd, r->x, r->v, r->pA, r->pB, r->F, r->u, r->ucmd, r->q};
+        if (k->chain_row(k->user, &cr)) return 1;
+    }
+    return 0;
+}
+
+// The world o names must be the validation world: the chain world stands
+// the column on the ground with the load at the tip and has no sandbox
+// (truck, rope, hook, loads, terrain).
+static int check_world(const sim_opts* o, char* err, size_t errsz) {
+    if (!o->world) return 0;
+    char buf[512];
+    const char* wp = sim_world_path(o->world, buf, sizeof buf);
+    world_desc wd;
+    if (world_desc_load(wp, &wd, err, errsz)) return -1;
+    const world_kind kind = wd.kind;
+    world_desc_free(&wd);
+    if (kind == WORLD_VALIDATION) return 0;
+    snprintf(err, errsz,
+             "%s %s: the sandbox runs the two-link crane only; use %s validation (a chain model runs in the ODE "
+             "chain world, docs/ode_world.md)",
+             sim_param_name(SIM_PARAM_WORLD), o->world, sim_param_name(SIM_PARAM_WORLD));
+    return -1;
+}
+
+int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
+                         sim_result* res) {
+    char* msg = res->message;
+    const size_t msz = sizeof res->message;
+    if (check_world(o, msg, msz)) return res->status = SIM_REFUSED;
+    if (hyd_method_is_adaptive(o->solver)) {
+        snprintf(msg, msz,
+                 "solver %s is adaptive: the ODE chain world sub-steps its circuit with a fixed-step method (krus, "
+                 "ros2, rk4)",
+                 hyd_method_name(o->solver));
+        return res->status = SIM_REFUSED;
+    }
+    // No world circuit here: a burst at a node the model lacks has nowhere to open.
+    if (engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
+    const double dt = o->dt_ode > 0 ? o->dt_ode : 1e-3;
+    // As ode_world_for_run: the forces lag the bodies by one ODE step.
+    if (dt > 0.01 + 1e-12) {
+        snprintf(msg, msz,
+                 "%s %g s is too long: the cylinder forces lag the bodies by one ODE step, which beyond 0.01 s "
+                 "distorts the pressures by more than 15 %% and then goes unstable (docs/ode_world.md)",
+                 sim_param_name(SIM_PARAM_DT_ODE), dt);
+        return res->status = SIM_REFUSED;
+    }
+    const double h = o->h < dt ? o->h : dt;
+    const double ratio = dt / h;
+    if (fabs(ratio - floor(ratio + 0.5)) > 1e-6) {
+        snprintf(msg, msz, "%s %g s must divide the ODE step %g s (hydraulic sub-steps)", sim_param_name(SIM_PARAM_DT),
+                 h, dt);
+        return res->status = SIM_REFUSED;
+    }
+    const double t_end = k->t_end;
+    if (t_end / dt > 1e12) {
+        snprintf(msg, msz, "%s %g s over %g s is %.3g steps, more than 1e12: use a larger %s or a shorter run",
+                 sim_param_name(SIM_PARAM_DT_ODE), dt, t_end, t_end / dt, sim_param_name(SIM_PARAM_DT_ODE));
+        return res->status = SIM_REFUSED;
+    }
+    const crane_chain* cc = &m->chain;
+    chain_run r;
+    memset(&r, 0, sizeof r);
+    r.cc = cc;
+    r.hm = m->hyd;
+    // The mechanism's DOFs: the joints that are not fixed, the column's
+    // when it slews.
+    int nd = cc->slew_free ? 1 : 0;
+    for (int i = 1; i < cc->nbody; ++i) nd += !cc->body[i].def.fixed;
+    r.na = cc->nact, r.nf = cc->nfn, r.nd = nd;
+    const size_t na = (size_t)r.na, nf = (size_t)r.nf;
+    double* buf = calloc(6 * na + 2 * nf + 2 * (size_t)nd + 1, sizeof *buf);
+    int* ibuf = calloc(2 * nf + 1, sizeof *ibuf);
+    ode_chain* w = NULL;
+    if (!buf || !ibuf) {
+        snprintf(msg, msz, "out of memory");
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    r.x = buf, r.v = r.x + na, r.pA = r.v + na, r.pB = r.pA + na, r.F = r.pB + na;
+    r.u = r.F + na, r.ucmd = r.u + nf, r.q = r.ucmd + nf;
+    double* q0 = r.q + nd;
+    r.iu = ibuf;
+    int* fcol = ibuf + nf;
+    for (int f = 0; f < r.nf; ++f) {
+        r.iu[f] = hyd_model_valve_state(m->hyd, cc->fn[f].valve_idx);
+        fcol[f] = scenario_find_command(sc, cc->fn[f].name);
+    }
+    r.ipump = hyd_model_supply_node(m->hyd);
+    start_pose(cc, sc, q0);
+    ode_chain_opts co = ode_chain_default_opts();
+    co.dt_ode = dt;
+    co.dt_hyd = h;
+    co.solver = o->solver;
+    co.jac_every = o->jac_every > 0 ? o->jac_every : 1;
+    const double m3 = sim_load_mass(m, sc, o);
+    co.tip_mass = m3;
+    co.q0 = q0;
+    co.slew0 = sc->slew0;
+    co.circuit = m->hyd;
+    co.p_low = 0.5e6; // as the analytic mode's start state, so both start from the same pressures
+    co.model_file = m->file[0] ? m->file : "model";
+    w = ode_chain_create(cc, &co, msg, msz);
+    if (!w) {
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    r.w = w;
+    if ((res->status = sim_check_fixed_step(m->hyd, o, h, t_end, msg, msz)) ||
+        (k->probe && (res->status = k->probe(m, o, h, msg, msz))))
+        goto done;
+    sim_checks chk;
+    memset(&chk, 0, sizeof chk);
+    double row[SIM_NCOL];
+    make_row(&r, 0.0, row);
+    for (int j = 0; j < 4; ++j) res->p_peak[j] = row[COL_P1A + j];
+    {
+        // The start state: a model value that overflows shows at t = 0.
+        char what[200];
+        if (sim_check_row(&chk, row, SIM_NCOL_BASE, what, sizeof what)) {
+            sim_check_message(msg, msz, what, NULL, false, 0.0, chk.bad_value);
+            res->status = SIM_REFUSED;
+            goto done;
+        }
+        const sim_start_load ld = {NULL, {sc->q0[0], sc->q0[1]}, m3, false};
+        if (sim_check_start(m->hyd, row, SIM_NCOL_BASE, &ld, msg, msz)) {
+            res->status = SIM_REFUSED;
+            goto done;
+        }
+    }
+    sim_energy* en = k->energy;
+    if (en && (sim_energy_bind(en, m->hyd) || ode_chain_follow_energy(w, en))) {
+        snprintf(msg, msz, "out of memory for the energy balance");
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    if (en) sim_energy_mech(en, ode_chain_energy(w));
+    const long nstep = (long)floor(t_end / dt + 0.5);
+    long nout = (long)floor(fmin(o->dt_out, t_end) / dt + 0.5);
+    if (nout < 1) nout = 1;
+    engine_faults ef;
+    engine_faults_init(&ef, m->hyd);
+    const double w0 = sim_wall_time();
+    int stop = deliver(k, &r, row);
+    long rows = 1;
+    double t_last = 0.0;
+    for (long i = 0; i < nstep && !stop; ++i) {
+        // Commands at the step's midpoint, by function name (a function the
+        // scenario does not command stays at 0), as the two-link world.
+        const double tm = ((double)i + 0.5) * dt;
+        for (int f = 0; f < r.nf; ++f) r.u[f] = fcol[f] >= 0 ? scenario_command(sc, fcol[f], tm) : 0.0;
+        engine_faults_apply(&ef, m->hyd, sc, tm);
+        ode_chain_set_commands(w, r.u);
+        if (ode_chain_step(w, dt)) {
+            res->status = SIM_FAILED;
+            snprintf(msg, msz, "numerical blow-up: %s", ode_chain_error(w));
+            break;
+        }
+        if (en) sim_energy_mech(en, ode_chain_energy(w));
+        // Peaks at every ODE step, not only at the rows.
+        for (int a = 0; a < 2 && a < r.na; ++a) {
+            double pA, pB;
+            ode_chain_act_force(w, a, &pA, &pB);
+            res->p_peak[2 * a] = fmax(res->p_peak[2 * a], pA);
+            res->p_peak[2 * a + 1] = fmax(res->p_peak[2 * a + 1], pB);
+        }
+        if ((i + 1) % nout && i + 1 != nstep) continue;
+        make_row(&r, (double)(i + 1) * dt, row); // exact grid times
+        char what[200];
+        if (sim_check_row(&chk, row, SIM_NCOL_BASE, what, sizeof what)) {
+            res->status = SIM_FAILED;
+            char how[96];
+            snprintf(how, sizeof how, "solver %s, h = %g s, ODE step %g s", hyd_method_name(o->solver), h, dt);
+            sim_check_message(msg, msz, what, how, false, row[COL_T], chk.bad_value);
+            break;
+        }
+        t_last = row[COL_T];
+        ++rows;
+        stop = deliver(k, &r, row);
+    }
+    res->wall = sim_wall_time() - w0;
+    // The fixed hydraulic sub-steps taken: nsub per ODE step done.
+    res->stats.steps = (long)floor(ode_chain_time(w) / dt + 0.5) * (long)floor(ratio + 0.5);
+    res->rows = rows;
+    res->t_end = t_last;
+    res->peak_steps = true;
+    if (en) sim_energy_finish(en);
+    if (stop && !res->status) {
+        res->status = SIM_REFUSED;
+        snprintf(msg, msz, "stopped at t = %.6g s", t_last);
+    }
+    if (!res->status && chk.dip) sim_checks_note(&chk, false, res->note, sizeof res->note);
+done:
+    ode_chain_destroy(w);
+    free(buf);
+    free(ibuf);
+    return res->status;
+}
