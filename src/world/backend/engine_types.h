@@ -35,20 +35,6 @@ typedef int (*engine_row_fn)(void* user, const double* row);
 /// o: SIM_OK, or SIM_REFUSED with one line in err (sim_check_step_probe).
 typedef int (*engine_probe_fn)(const model* m, const sim_opts* o, double h, char* err, size_t errsz);
 
-/// Every actuator's and function's outputs at one row of a scripted run of
-/// a chain model (engine_sink.chain_row), in the chain's order
-/// (crane_chain.h: act, fn; the mechanism's DOFs); borrowed for the call.
-typedef struct engine_chain_row {
-    double t;                          ///< the row's time [s]
-    int nact, nfn, ndof;
-    const double *x, *v;               ///< strokes [m] and their rates [m/s], [nact]
-    const double *pA, *pB;             ///< chamber pressures [Pa abs], [nact]
-    const double* F;                   ///< cylinder forces [N], + extends, [nact]
-    const double *u, *u_cmd;           ///< spool positions and valve commands [-], [nfn]
-    const double* q;                   ///< joint coordinates [rad or m], [ndof]
-} engine_chain_row;
-typedef int (*engine_chain_row_fn)(void* user, const engine_chain_row* r);
-
 /// Where a scripted run's rows go (engine_run).
 typedef struct engine_sink {
     /// Each output row (may be NULL); non-zero stops the run. A row holds the
@@ -69,12 +55,6 @@ typedef struct engine_sink {
     /// (sim.h), which runs the analytic backend through the run layer: passed
     /// in here, so a backend needs nothing of the layer that chooses it.
     engine_probe_fn probe;
-    /// NULL, or called after row (same user) at each row of a run of a
-    /// chain model that is not the two-link shorthand, on the backends that
-    /// run one (the analytic general path, the ODE chain world): the
-    /// outputs of every actuator and function, which the row's base
-    /// columns hold for the first two only. Non-zero stops the run.
-    engine_chain_row_fn chain_row;
 } engine_sink;
 
 #ifdef __cplusplus

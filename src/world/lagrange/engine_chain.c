@@ -42,6 +42,7 @@ typedef struct chain_run_ctx {
     hyd_solver* solver;
     // Output buffers, sized by the chain.
     double *x, *v, *pA, *pB, *F, *u, *ucmd, *q, *qd;
+    double* row; ///< SIM_NCOL_BASE base columns, then the chain's own (crane_chain_row)
 } chain_run_ctx;
 
 // The scenario's commands by function name (scenario_find_command: lift,
@@ -81,6 +82,10 @@ static void make_row(chain_run_ctx* c, double t, const double* y, double* row) {
     for (int i = 0; i < hyd_model_ncomp(hm); ++i)
         if (hyd_model_comp_type(hm, i) == HYD_RELIEF && cs->hd->comp_open[i]) ++o.relief_open;
     lagrange_row(t, &o, row);
+    // Every actuator, function and DOF after the backend's channels (the
+    // base list), under the chain's column names.
+    const crane_chain_sample smp = {c->x, c->v, c->pA, c->pB, c->F, c->u, c->ucmd, c->q, c->qd};
+    crane_chain_row(cs->cc, &smp, row + SIM_NCOL_BASE);
 }
 
 static void track_peaks(chain_run_ctx* c, const double* y) {
@@ -123,7 +128,7 @@ static int emit(void* user, double t, const double* y) {
     c->t_last_row = t;
     ++c->rows;
     if (!c->sink->rows) return 0;
-    double row[SIM_NCOL];
+    double* row = c->row;
     make_row(c, t, y, row);
     if (sim_check_row(&c->chk, row, SIM_NCOL_BASE, c->bad, sizeof c->bad)) {
         --c->rows;
@@ -131,11 +136,6 @@ static int emit(void* user, double t, const double* y) {
         return (c->stop = 3);
     }
     if (c->sink->row && c->sink->row(c->sink->user, row)) return (c->stop = 2);
-    if (c->sink->chain_row) {
-        const engine_chain_row cr = {t,      cs->nact, cs->nfn, cs->ndof, c->x, c->v,
-                                     c->pA,  c->pB,    c->F,    c->u,     c->ucmd, c->q};
-        if (c->sink->chain_row(c->sink->user, &cr)) return (c->stop = 2);
-    }
     return 0;
 }
 
@@ -160,7 +160,10 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     const int nd = cs.ndof, na = cs.nact, nf = cs.nfn;
     chain_run_ctx c;
     memset(&c, 0, sizeof c);
-    double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + 1, sizeof *buf);
+    // The row: SIM_NCOL (lagrange_row writes every column) and the chain's.
+    double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + 1 + SIM_NCOL +
+                             (size_t)m->chain.ncol,
+                         sizeof *buf);
     c.fcol = calloc((size_t)nf + 1, sizeof *c.fcol);
     hyd_solver* s = NULL;
     if (!buf || !c.fcol) {
@@ -172,6 +175,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     double* q0 = y + cs.n;
     c.x = q0 + nd, c.v = c.x + na, c.pA = c.v + na, c.pB = c.pA + na, c.F = c.pB + na;
     c.u = c.F + na, c.ucmd = c.u + nf, c.q = c.ucmd + nf, c.qd = c.q + nd;
+    c.row = c.qd + nd;
     for (int f = 0; f < nf; ++f) {
         c.fcol[f] = scenario_find_command(sc, m->chain.fn[f].name);
     }
@@ -188,7 +192,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
         goto done;
     }
     {
-        double row0[SIM_NCOL];
+        double* row0 = c.row;
         chain_run_ctx c0 = c;
         make_row(&c0, 0.0, y, row0);
         const sim_start_load ld = {m->chain.two_link ? &m->mech : NULL, {sc->q0[0], sc->q0[1]}, m3, false};

@@ -35,7 +35,7 @@ typedef struct chain_run {
     int na, nf, nd;
     int* iu;     ///< [nf] the spool state of function f's valve, or -1
     int ipump;   ///< the supply node, or -1
-    double *x, *v, *pA, *pB, *F, *u, *ucmd, *q; ///< the outputs, sized by the chain
+    double *x, *v, *pA, *pB, *F, *u, *ucmd, *q, *qd; ///< the outputs, sized by the chain
 } chain_run;
 
 // Every actuator's and function's outputs now, into r's arrays.
@@ -51,17 +51,21 @@ static void outputs(chain_run* r) {
         r->u[f] = r->iu[f] >= 0 ? y[r->iu[f]] : 0.0;
         r->ucmd[f] = hd->valve_cmd[r->cc->fn[f].valve_idx];
     }
-    ode_chain_q(r->w, r->q, NULL);
+    ode_chain_q(r->w, r->q, r->qd);
 }
 
 // The row: the base columns hold the first two actuators, their functions
 // and the first two boom DOFs (as the analytic general path's rows, so
 // compare pairs the same quantities), the tip relative to the first boom's
 // joint in the boom plane; of the world extras the slew where the column
-// slews, the rest 0 (the validation world has no hook, truck or contacts).
+// slews, the rest 0 (the validation world has no hook, truck or contacts);
+// then every actuator, function and DOF under the chain's column names
+// (crane_chain_row), after the backend's SIM_NCOL channels.
 static void make_row(chain_run* r, double t, double* row) {
     outputs(r);
     memset(row, 0, SIM_NCOL * sizeof *row);
+    const crane_chain_sample smp = {r->x, r->v, r->pA, r->pB, r->F, r->u, r->ucmd, r->q, r->qd};
+    crane_chain_row(r->cc, &smp, row + SIM_NCOL);
     row[COL_T] = t;
     const int colx[2] = {COL_X1, COL_X2}, colv[2] = {COL_V1, COL_V2}, colF[2] = {COL_F1, COL_F2};
     const int colA[2] = {COL_P1A, COL_P2A}, colB[2] = {COL_P1B, COL_P2B};
@@ -93,16 +97,8 @@ static void make_row(chain_run* r, double t, double* row) {
     row[COL_END_STOP] = end_stop;
 }
 
-// Every actuator's outputs to the sink's chain_row (the row's base columns
-// hold two).
-static int deliver(const engine_sink* k, chain_run* r, const double* row) {
-    if (k->row && k->row(k->user, row)) return 1;
-    if (k->chain_row) {
-        const engine_chain_row cr = {row[COL_T], r->na, r->nf, r->nd, r->x, r->v, r->pA, r->pB, r->F, r->u, r->ucmd, r->q};
-        if (k->chain_row(k->user, &cr)) return 1;
-    }
-    return 0;
-}
+// Hand a finished row to the driver's sink; non-zero: stop.
+static int deliver(const engine_sink* k, const double* row) { return k->row && k->row(k->user, row); }
 
 // The world o names must be the validation world: the chain world stands
 // the column on the ground with the load at the tip and has no sandbox
@@ -166,11 +162,10 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
     r.hm = m->hyd;
     // The mechanism's DOFs: the joints that are not fixed, the column's
     // when it slews.
-    int nd = cc->slew_free ? 1 : 0;
-    for (int i = 1; i < cc->nbody; ++i) nd += !cc->body[i].def.fixed;
+    const int nd = crane_chain_ndof(cc);
     r.na = cc->nact, r.nf = cc->nfn, r.nd = nd;
     const size_t na = (size_t)r.na, nf = (size_t)r.nf;
-    double* buf = calloc(6 * na + 2 * nf + 2 * (size_t)nd + 1, sizeof *buf);
+    double* buf = calloc(5 * na + 2 * nf + 3 * (size_t)nd + SIM_NCOL + (size_t)cc->ncol + 1, sizeof *buf);
     int* ibuf = calloc(2 * nf + 1, sizeof *ibuf);
     ode_chain* w = NULL;
     if (!buf || !ibuf) {
@@ -179,8 +174,9 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         goto done;
     }
     r.x = buf, r.v = r.x + na, r.pA = r.v + na, r.pB = r.pA + na, r.F = r.pB + na;
-    r.u = r.F + na, r.ucmd = r.u + nf, r.q = r.ucmd + nf;
-    double* q0 = r.q + nd;
+    r.u = r.F + na, r.ucmd = r.u + nf, r.q = r.ucmd + nf, r.qd = r.q + nd;
+    double* q0 = r.qd + nd;
+    double* row = q0 + nd; // SIM_NCOL channels, then the chain's columns
     r.iu = ibuf;
     int* fcol = ibuf + nf;
     for (int f = 0; f < r.nf; ++f) {
@@ -212,7 +208,6 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         goto done;
     sim_checks chk;
     memset(&chk, 0, sizeof chk);
-    double row[SIM_NCOL];
     make_row(&r, 0.0, row);
     for (int j = 0; j < 4; ++j) res->p_peak[j] = row[COL_P1A + j];
     {
@@ -242,7 +237,7 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
     engine_faults ef;
     engine_faults_init(&ef, m->hyd);
     const double w0 = sim_wall_time();
-    int stop = deliver(k, &r, row);
+    int stop = deliver(k, row);
     long rows = 1;
     double t_last = 0.0;
     for (long i = 0; i < nstep && !stop; ++i) {
@@ -277,7 +272,7 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         }
         t_last = row[COL_T];
         ++rows;
-        stop = deliver(k, &r, row);
+        stop = deliver(k, row);
     }
     res->wall = sim_wall_time() - w0;
     // The fixed hydraulic sub-steps taken: nsub per ODE step done.
