@@ -177,6 +177,12 @@ static void test_3boom_ext_against_analytic(void) {
         // The rows' base columns x1, x2 are the first two actuators' x_ columns.
         CHECK(a.base_diff == 0.0 && b.base_diff == 0.0, "x1, x2 against x_lift, x_jib: %g, %g", a.base_diff,
               b.base_diff);
+        // One start pose (crane_chain_start_pose) and one start state: the
+        // strokes and chamber pressures of row 0 agree.
+        for (int k = 0; k < a.nact && a.n > 0 && b.n > 0; ++k)
+            CHECK(fabs(a.x[k] - b.x[k]) < 1e-9 && fabs(a.pA[k] - b.pA[k]) < 1.0 && fabs(a.pB[k] - b.pB[k]) < 1.0,
+                  "%s at t = 0: x %.9g and %.9g m, pA %.6g and %.6g Pa, pB %.6g and %.6g Pa", m->chain.act[k].name,
+                  a.x[k], b.x[k], a.pA[k], b.pA[k], a.pB[k], b.pB[k]);
         for (int k = 0; k < MAXA; ++k) rx[h][k] = rA[h][k] = rB[h][k] = span[h][k] = NAN;
         compare(&a, &b, o.dt_ode, &m->chain, rx[h], rA[h], rB[h], span[h]);
         trace_free(&b);

@@ -11,19 +11,7 @@
 #include <string.h>
 
 void engine_chain_start_pose(const crane_chain* cc, const scenario* sc, double* q0) {
-    int d = 0, boom = 0;
-    for (int i = 0; i < cc->nbody; ++i) {
-        const chain_body_def* b = &cc->body[i].def;
-        // The column is a DOF only when it slews (crane_chain_mechanism).
-        if (i == 0 ? !cc->slew_free : b->fixed) continue;
-        double q = i == 0 ? sc->slew0 : boom < 2 ? sc->q0[boom] : 0.0;
-        // A DOF the scenario does not place: the middle of its joint
-        // limits, or 0 when they are open.
-        if (i > 0 && boom >= 2 && isfinite(b->q_min) && isfinite(b->q_max)) q = 0.5 * (b->q_min + b->q_max);
-        else if (i > 0 && boom >= 2) q = fmin(fmax(q, b->q_min), b->q_max);
-        if (i > 0) ++boom;
-        q0[d++] = q;
-    }
+    crane_chain_start_pose(cc, sc->q0, sc->slew0, q0);
 }
 
 typedef struct chain_run_ctx {

@@ -2,6 +2,7 @@
 // shorthand converted, the binding to the circuit, the mechanism built.
 #include "crane_chain.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -152,6 +153,21 @@ int crane_chain_dof_body(const crane_chain* cc, int k) {
     for (int i = 0; i < cc->nbody; ++i)
         if (dof_joint(cc, i) && k-- == 0) return i;
     return -1;
+}
+
+void crane_chain_start_pose(const crane_chain* cc, const double q12[2], double slew0, double* q0) {
+    int d = 0, boom = 0;
+    for (int i = 0; i < cc->nbody; ++i) {
+        if (!dof_joint(cc, i)) continue;
+        const chain_body_def* b = &cc->body[i].def;
+        double q = i == 0 ? slew0 : boom < 2 ? q12[boom] : 0.0;
+        // A DOF the scenario does not place: the middle of its joint
+        // limits, or 0 when they are open.
+        if (i > 0 && boom >= 2 && isfinite(b->q_min) && isfinite(b->q_max)) q = 0.5 * (b->q_min + b->q_max);
+        else if (i > 0 && boom >= 2) q = fmin(fmax(q, b->q_min), b->q_max);
+        if (i > 0) ++boom;
+        q0[d++] = q;
+    }
 }
 
 int crane_chain_columns(crane_chain* cc) {

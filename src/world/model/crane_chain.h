@@ -136,6 +136,13 @@ int crane_chain_ndof(const crane_chain* cc);
 /// Body of DOF k (crane_chain_ndof order), or -1.
 int crane_chain_dof_body(const crane_chain* cc, int k);
 
+/// The start pose of the chain's DOFs [crane_chain_ndof of them, rad or m,
+/// slew first when the column slews] for a scenario's start: the slew at
+/// slew0, the first two boom DOFs at q12 (the paper's q1, q2), every other
+/// DOF at the middle of its joint limits (0 clamped into them when either
+/// is open). Both backends' chain runs start from it.
+void crane_chain_start_pose(const crane_chain* cc, const double q12[2], double slew0, double* q0);
+
 /// Makes the chain's output columns (cc->col, cc->ncol): none when
 /// two_link, else per actuator, per function and per DOF as crane_column
 /// says. 0, or -1 when out of memory. crane_chain_bind calls it.

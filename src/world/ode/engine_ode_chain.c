@@ -10,24 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-// The start pose of chain cc [one per mechanism DOF, slew first when the
-// column slews] for scenario sc, as the analytic mode's general path takes
-// it (engine_chain_start_pose), so both backends start from one pose: the
-// slew at sc->slew0, the first two boom DOFs at sc->q0, every other DOF at
-// the middle of its joint limits (clamped 0 where one is open).
-static void start_pose(const crane_chain* cc, const scenario* sc, double* q0) {
-    int d = 0, boom = 0;
-    for (int i = 0; i < cc->nbody; ++i) {
-        const chain_body_def* b = &cc->body[i].def;
-        if (i == 0 ? !cc->slew_free : b->fixed) continue;
-        double q = i == 0 ? sc->slew0 : boom < 2 ? sc->q0[boom] : 0.0;
-        if (i > 0 && boom >= 2 && isfinite(b->q_min) && isfinite(b->q_max)) q = 0.5 * (b->q_min + b->q_max);
-        else if (i > 0 && boom >= 2) q = fmin(fmax(q, b->q_min), b->q_max);
-        if (i > 0) ++boom;
-        q0[d++] = q;
-    }
-}
-
 typedef struct chain_run {
     ode_chain* w;
     const crane_chain* cc;
@@ -184,7 +166,8 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         fcol[f] = scenario_find_command(sc, cc->fn[f].name);
     }
     r.ipump = hyd_model_supply_node(m->hyd);
-    start_pose(cc, sc, q0);
+    // The analytic general path's start pose, so both start from one state.
+    crane_chain_start_pose(cc, sc->q0, sc->slew0, q0);
     ode_chain_opts co = ode_chain_default_opts();
     co.dt_ode = dt;
     co.dt_hyd = h;
