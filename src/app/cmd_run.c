@@ -187,9 +187,11 @@ static int csv_row(void* user, const double* row) {
     }
     {
         // The limiter's utilisation: the rows' column (ode), else measured
-        // from the row as the limiter measures it (lagrange).
+        // from the row as the limiter measures it (lagrange). A chain model
+        // has no limiter yet (rcl.c is the two-link crane's): its column is
+        // 0, not a measurement.
         double u = NAN;
-        if (s->ncol > COL_RCL_UTIL) u = row[COL_RCL_UTIL];
+        if (s->ncol > COL_RCL_UTIL && !s->chain) u = row[COL_RCL_UTIL];
         else if (s->mon) u = rcl_utilisation(s->mon, row);
         if (isfinite(u)) {
             if (s->st.rcl_have && u >= RCL_WARN) s->st.rcl_t90 += row[COL_T] - s->st.t_prev;
