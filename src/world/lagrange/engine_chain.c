@@ -113,7 +113,7 @@ static int emit(void* user, double t, const double* y) {
     for (int i = 0; i < cs->n; ++i) {
         const bool p = i < cs->nh && cs->is_pressure[i];
         if (isfinite(y[i]) && (!p || y[i] >= 0.0)) continue;
-        const char* name = i < cs->nh ? hyd_model_state_name(cs->hm, i) : i < cs->iq + cs->ndof ? "q" : "q_dot";
+        const char* name = i < cs->nh ? hyd_model_state_name(cs->hm, cs->perm[i]) : i < cs->iq + cs->ndof ? "q" : "q_dot";
         if (sim_check_value(&c->chk, name, y[i], p, t, c->bad, sizeof c->bad)) {
             c->bad_t = t;
             return (c->stop = 3);
@@ -193,7 +193,8 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
         }
     }
     const bool adaptive = hyd_method_is_adaptive(o->solver);
-    hyd_problem prob = chain_sim_problem(&cs);
+    // The block-diagonal W for the fixed-step methods, as the closed form's.
+    hyd_problem prob = chain_sim_problem(&cs, !adaptive && !o->dense_jac);
     hyd_solver_opts so = hyd_default_solver_opts();
     so.h = adaptive ? 0.0 : o->h;
     so.rtol = o->rtol;
