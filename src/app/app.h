@@ -7,6 +7,7 @@
 #include <signal.h>
 #include <stdio.h>
 
+#include "engine_backend.h"
 #include "model.h"
 #include "scenario.h"
 #include "sim.h"
@@ -162,9 +163,10 @@ double app_output_period(const sim_opts* o);
 /// it, EXIT_USAGE. Returns 0 when o runs it as written.
 /// drive's counterpart: the scenario is a scripted operator there, so a
 /// slew it commands in a world without one (lagrange, the validation world)
-/// is not refused but said, once, on stderr. world_kind: the ode world's
-/// kind, or -1 for lagrange. (Hook events are said as they happen.)
-void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind);
+/// is not refused but said, once, on stderr. world_kind: the kind of o's
+/// world where its backend has one (else not read). (Hook events are said
+/// as they happen.)
+void app_note_scenario_slew(const char* cmd, const sim_opts* o, const scenario* sc, int world_kind);
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
                        bool* switched);
 /// app_scenario_world with the advice after the refusal given by the caller
@@ -190,9 +192,11 @@ void app_progress_done(void);
 
 /// Parse a double with a unit-less strict check; returns 0 on success.
 int app_parse_double(const char* s, double* v);
-/// Set one sim_opts field from its option value ("lagrange"/"ode"; "full",
-/// "paper", "paper-typo"; a solver name or "cvode"). opt names the option in
-/// the one-line error on stderr. Return 0, or -1 on a bad value.
+/// Set one sim_opts field from its option value (a backend's name,
+/// engine_backend.h: "lagrange", "ode"; "full", "paper", "paper-typo"; a
+/// solver name or "cvode"). opt names the option in the one-line error on
+/// stderr ("--mechanics: unknown backend 'foo' (known: lagrange, ode)").
+/// Return 0, or -1 on a bad value.
 int app_set_mechanics(sim_opts* o, const char* opt, const char* v);
 int app_set_variant(sim_opts* o, const char* opt, const char* v);
 int app_set_solver(sim_opts* o, const char* opt, const char* v);
@@ -224,9 +228,20 @@ int app_metric_unit_scale(int met, const char* unit, double* si, char* err, size
 /// A simulated-to-wall time ratio for "Nx real time": whole numbers from 1,
 /// two significant digits below (0.42); returns buf.
 const char* app_fmt_speed(char* buf, size_t n, double ratio);
-/// The scenario drive uses when none is given: the sandbox pick-and-place for
-/// the ode world, the scripted lagrange demo otherwise.
-const char* app_default_drive_scenario(sim_mechanics mech);
+/// The backend o runs (engine_backend.h): what the drivers ask instead of
+/// testing which one it is. o->mechanics is set only from the table (by
+/// name, or a session's value checked against it); a value that names none
+/// ends the program with one line (exit 1), never runs another backend.
+const engine_backend* app_backend(const sim_opts* o);
+/// Run o on backend b (o->mechanics = b's).
+void app_use_backend(sim_opts* o, const engine_backend* b);
+/// The scenario a stepped driver (drive, serve) plays when none is given:
+/// its backend's (the sandbox pick-and-place for the ode world, the
+/// scripted lift-and-jib demo without a world).
+const char* app_default_drive_scenario(const sim_opts* o);
+/// The scripted lift-and-jib demo: the operator of a crane without a hook or
+/// a slew (the validation world, a headless link).
+#define APP_DEMO_SCENARIO "drive_demo"
 
 int cmd_run(int argc, char** argv);
 int cmd_bench(int argc, char** argv);

@@ -30,10 +30,20 @@ static int world_kind_of(const sim_opts* o, char* err, size_t errsz) {
     return kind;
 }
 
-bool app_world_has_slew(const sim_opts* o) {
+// The run o is in a world (its backend takes one) that is a sandbox: the
+// hook, the loads as bodies, the slewing column.
+static bool in_sandbox(const sim_opts* o) {
     char err[512];
-    return o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX;
+    return app_backend(o)->world && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX;
 }
+
+bool app_world_has_slew(const sim_opts* o) { return in_sandbox(o); }
+
+// Filters for engine_backend_names: the backends an option applies to.
+static bool takes_world(const engine_backend* b) { return b->world; }
+static bool takes_outer_step(const engine_backend* b) { return b->outer_step_opt != NULL; }
+static bool takes_variant(const engine_backend* b) { return b->variant; }
+static bool takes_cvode(const engine_backend* b) { return b->no_cvode == NULL; }
 
 // |a / b - round(a / b)| within 1e-9 relative: a is a whole multiple of b.
 static bool whole_multiple(double a, double b) {
@@ -42,7 +52,7 @@ static bool whole_multiple(double a, double b) {
 }
 
 double app_output_period(const sim_opts* o) {
-    if (o->mechanics == SIM_ODE) {
+    if (app_backend(o)->outer_step_opt) { // rows at whole outer steps
         const double n = floor(o->dt_out / o->dt_ode + 0.5);
         return (n < 1 ? 1 : n) * o->dt_ode;
     }
@@ -56,11 +66,12 @@ int app_check_sim(const char* cmd, const sim_opts* o, unsigned given) {
                 cmd);
         return EXIT_USAGE;
     }
-    if (o->cvode && o->mechanics == SIM_ODE) {
-        fprintf(stderr,
-                "cranesim %s: --solver cvode works with --mechanics lagrange only (the ode world steps its hydraulics "
-                "inside each ODE step): use krus, ros2, rk4, ros34pw2 or rodas3\n",
-                cmd);
+    const engine_backend* b = app_backend(o);
+    if (o->cvode && b->no_cvode) {
+        char names[128];
+        fprintf(stderr, "cranesim %s: --solver cvode works with --mechanics %s only (%s): use krus, ros2, rk4, "
+                        "ros34pw2 or rodas3\n",
+                cmd, engine_backend_names(names, sizeof names, takes_cvode), b->no_cvode);
         return EXIT_USAGE;
     }
     // Fixed steps land on every output time: an output period that is not a
@@ -68,20 +79,23 @@ int app_check_sim(const char* cmd, const sim_opts* o, unsigned given) {
     // different results than the --dt asked for); the ode world writes rows
     // at whole ODE steps only. A step longer than the period gives one row
     // per step (decision 7).
-    const bool ode = o->mechanics == SIM_ODE;
-    const double step = ode ? o->dt_ode : o->h;
-    if ((ode || !is_adaptive(o)) && o->dt_out > step && !whole_multiple(o->dt_out, step)) {
+    const bool outer = b->outer_step_opt != NULL; // rows at whole steps of the backend's own step
+    const double step = outer ? o->dt_ode : o->h;
+    if ((outer || !is_adaptive(o)) && o->dt_out > step && !whole_multiple(o->dt_out, step)) {
         const double lo = floor(o->dt_out / step) * step, hi = lo + step;
         const bool given_every = given & APP_GIVEN(APP_OPT_EVERY);
-        fprintf(stderr,
-                "cranesim %s: %s %g s is not a whole multiple of %s %g s (%s): use --every %g or %g%s\n", cmd,
-                given_every ? "--every" : "the default output period --every", o->dt_out,
-                ode ? "the ODE step --dt-ode" : "the fixed step --dt", step,
-                ode ? "rows come at whole ODE steps" : "the solver would shorten steps to land on the output times",
-                lo, hi, given_every ? "" : ode ? ", or a --dt-ode that divides it" : ", or a --dt that divides it");
+        char what[96], why[96], alt[96];
+        snprintf(what, sizeof what, "the %s %s", outer ? b->step_name : "fixed step",
+                 outer ? b->outer_step_opt : "--dt");
+        if (outer) snprintf(why, sizeof why, "rows come at whole %ss", b->step_name);
+        else snprintf(why, sizeof why, "the solver would shorten steps to land on the output times");
+        snprintf(alt, sizeof alt, ", or a %s that divides it", outer ? b->outer_step_opt : "--dt");
+        fprintf(stderr, "cranesim %s: %s %g s is not a whole multiple of %s %g s (%s): use --every %g or %g%s\n",
+                cmd, given_every ? "--every" : "the default output period --every", o->dt_out, what, step, why, lo,
+                hi, given_every ? "" : alt);
         return EXIT_USAGE;
     }
-    if (ode && (given & APP_GIVEN(APP_OPT_LOAD))) {
+    if (b->world && (given & APP_GIVEN(APP_OPT_LOAD))) {
         char err[512];
         const int kind = world_kind_of(o, err, sizeof err);
         if (kind < 0) {
@@ -100,7 +114,7 @@ int app_check_sim(const char* cmd, const sim_opts* o, unsigned given) {
 }
 
 void app_settle_unused(sim_opts* o) {
-    if (o->mechanics == SIM_ODE && is_adaptive(o)) o->h = o->dt_ode;
+    if (app_backend(o)->outer_step_opt && is_adaptive(o)) o->h = o->dt_ode;
 }
 
 void app_note_unused(const char* cmd, unsigned given, const sim_opts* o, int n) {
@@ -143,11 +157,24 @@ void app_note_unused(const char* cmd, unsigned given, const sim_opts* o, int n) 
                 }
                 break;
             case APP_OPT_WORLD:
-            case APP_OPT_DT_ODE:
-                if (r->mechanics == SIM_LAGRANGE) w = "with --mechanics lagrange (ode only)";
+            case APP_OPT_DT_ODE: {
+                const engine_backend* b = app_backend(r);
+                const bool world = opt == APP_OPT_WORLD;
+                if (world ? !b->world : !b->outer_step_opt) {
+                    char names[128];
+                    snprintf(buf, sizeof buf, "with --mechanics %s (%s only)", b->name,
+                             engine_backend_names(names, sizeof names, world ? takes_world : takes_outer_step));
+                    w = buf;
+                }
                 break;
+            }
             case APP_OPT_VARIANT:
-                if (r->mechanics == SIM_ODE) w = "with --mechanics ode (the Lagrange equations are lagrange's)";
+                if (!app_backend(r)->variant) {
+                    char names[128];
+                    snprintf(buf, sizeof buf, "with --mechanics %s (the Lagrange equations are %s's)",
+                             app_backend(r)->name, engine_backend_names(names, sizeof names, takes_variant));
+                    w = buf;
+                }
                 break;
             default: break;
             }
@@ -167,17 +194,16 @@ void app_note_load(const char* cmd, const app_common* c, const sim_opts* o, cons
     static const char path[] = "mechanics.load_mass=";
     for (int i = 0; i < c->nset; ++i)
         if (!strncmp(c->sets[i], path, sizeof path - 1)) set = c->sets[i];
-    char err[512];
     // A scenario written for the tip load (overload, hold) run in the
     // sandbox: its load_mass does not apply there either.
-    if (!set && sc->load_mass >= 0 && o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX)
+    if (!set && sc->load_mass >= 0 && in_sandbox(o))
         fprintf(stderr,
                 "cranesim %s: note: scenario %s's load_mass (%g kg) has no effect: the sandbox world's loads are "
                 "world objects\n",
                 cmd, sc->name, sc->load_mass);
     if (!set) return;
     const char* v = set + sizeof path - 1;
-    if (o->mechanics == SIM_ODE && world_kind_of(o, err, sizeof err) == WORLD_SANDBOX)
+    if (in_sandbox(o))
         fprintf(stderr, "cranesim %s: note: --set %s has no effect: the sandbox world's loads are world objects\n", cmd,
                 set);
     else if (o->load_mass >= 0)
@@ -200,14 +226,19 @@ static const char* slew_use(const scenario* sc) {
 // What in a scenario needs the sandbox (NULL: nothing): the hook, the slew.
 static const char* sandbox_use(const scenario* sc) { return sc->nevent > 0 ? "works the hook" : slew_use(sc); }
 
-void app_note_scenario_slew(const char* cmd, const scenario* sc, int world_kind) {
-    const char* why = world_kind == WORLD_SANDBOX ? NULL : slew_use(sc);
+void app_note_scenario_slew(const char* cmd, const sim_opts* o, const scenario* sc, int world_kind) {
+    const engine_backend* b = app_backend(o);
+    const char* why = b->world && world_kind == WORLD_SANDBOX ? NULL : slew_use(sc);
     if (!why) return;
-    fprintf(stderr,
-            "cranesim %s: note: scenario %s %s, which the %s has not: its slew is ignored (the sandbox has one: "
-            "--mechanics ode --world sandbox)\n",
-            cmd, sc->name[0] ? sc->name : "the scenario", why,
-            world_kind < 0 ? "lagrange 2-DOF crane" : "validation world");
+    const engine_backend* wb = engine_backend_with_world();
+    char crane[96], remedy[128] = "";
+    if (b->world) snprintf(crane, sizeof crane, "validation world");
+    else snprintf(crane, sizeof crane, "%s crane", b->crane);
+    if (wb)
+        snprintf(remedy, sizeof remedy, " (the %s has one: --mechanics %s --world %s)", wb->drive_world, wb->name,
+                 wb->drive_world);
+    fprintf(stderr, "cranesim %s: note: scenario %s %s, which the %s has not: its slew is ignored%s\n", cmd,
+            sc->name[0] ? sc->name : "the scenario", why, crane, remedy);
 }
 
 int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
@@ -223,41 +254,51 @@ int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, cons
     const char* name = sc->name[0] ? sc->name : "the scenario";
     const bool world_given = given & APP_GIVEN(APP_OPT_WORLD), mech_given = given & APP_GIVEN(APP_OPT_MECHANICS);
     char err[512];
-    // A world is the ode backend's: --world without --mechanics asks for an
-    // ode run as much as --mechanics ode does.
-    if (o->mechanics == SIM_ODE || (world_given && !mech_given)) {
+    const engine_backend* b = app_backend(o);
+    // The backend with a world: --world without --mechanics asks for it as
+    // much as --mechanics naming it does.
+    const engine_backend* wb = engine_backend_with_world();
+    if (!wb) {
+        fprintf(stderr, "cranesim %s: scenario %s %s: no backend has a world\n", cmd, name, why);
+        return EXIT_USAGE;
+    }
+    if (b->world || (world_given && !mech_given)) {
         const int kind = world_kind_of(o, err, sizeof err);
         // A world file that does not load is the first thing wrong: say that,
         // not that the scenario needs another world.
-        if (kind < 0 && (o->mechanics == SIM_ODE || world_given)) {
+        if (kind < 0 && (b->world || world_given)) {
             fprintf(stderr, "cranesim %s: %s\n", cmd, err);
             return EXIT_USAGE;
         }
         if (kind == WORLD_SANDBOX) {
-            if (o->mechanics != SIM_ODE) {
-                o->mechanics = SIM_ODE;
+            if (!b->world) {
+                app_use_backend(o, wb);
                 if (switched) *switched = true;
                 if (!quiet)
-                    fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs with --mechanics ode in --world %s\n",
-                            cmd, name, why, o->world);
+                    fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs with --mechanics %s in --world %s\n",
+                            cmd, name, why, wb->name, o->world);
             }
             return 0;
         }
     }
-    // No world chosen (--world), and no backend or the ode one: its world.
-    if (may_switch && !world_given && (!mech_given || o->mechanics == SIM_ODE)) {
-        o->mechanics = SIM_ODE;
-        o->world = "sandbox";
+    // No world chosen (--world), and no backend or one with a world: the
+    // world the scenario needs, that backend's drive world.
+    if (may_switch && !world_given && (!mech_given || b->world)) {
+        const engine_backend* to = b->world ? b : wb;
+        app_use_backend(o, to);
+        o->world = to->drive_world;
         if (switched) *switched = true;
         if (!quiet)
-            fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs in its world, --mechanics ode --world sandbox\n",
-                    cmd, name, why);
+            fprintf(stderr, "cranesim %s: note: scenario %s %s: it runs in its world, --mechanics %s --world %s\n",
+                    cmd, name, why, to->name, to->drive_world);
         return 0;
     }
-    fprintf(stderr,
-            "cranesim %s: scenario %s %s, which the %s has not: %s\n", cmd, name, why,
-            o->mechanics == SIM_ODE || (world_given && !mech_given) ? "validation world" : "lagrange 2-DOF crane",
-            remedy ? remedy : "run it with --mechanics ode --world sandbox");
+    char crane[96], dflt[160];
+    if (b->world || (world_given && !mech_given)) snprintf(crane, sizeof crane, "validation world");
+    else snprintf(crane, sizeof crane, "%s crane", b->crane);
+    snprintf(dflt, sizeof dflt, "run it with --mechanics %s --world %s", wb->name, wb->drive_world);
+    fprintf(stderr, "cranesim %s: scenario %s %s, which the %s has not: %s\n", cmd, name, why, crane,
+            remedy ? remedy : dflt);
     return EXIT_USAGE;
 }
 

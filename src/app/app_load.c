@@ -62,6 +62,12 @@ int app_load_msg(const app_common* c, model** m, scenario* sc, char* err, size_t
     }
     // The start pose against this model's joint ranges, here where the file
     // name is known (the engines check again, for callers without a file).
+    // The scenario's q0[2] is the two-link crane's pose.
+    if (model_require_two_link(*m, "start-pose check of the scenario's q0", err, errsz)) {
+        model_free(*m);
+        *m = NULL;
+        return EXIT_USAGE;
+    }
     for (int k = 0; k < 2; ++k) {
         const crane_actuator* a = &(*m)->mech.act[k];
         char why[400];

@@ -242,15 +242,25 @@ static int positive(const char* opt, const char* s, double* v) {
     return 0;
 }
 
-const char* app_default_drive_scenario(sim_mechanics mech) {
-    return mech == SIM_ODE ? "sandbox_pick_place" : "drive_demo";
+const engine_backend* app_backend(const sim_opts* o) {
+    const engine_backend* b = engine_backend_of(o);
+    if (!b) {
+        char known[128];
+        fprintf(stderr, "cranesim: internal error: backend %d is none of %s\n", (int)o->mechanics,
+                engine_backend_names(known, sizeof known, NULL));
+        exit(EXIT_RUNTIME);
+    }
+    return b;
 }
 
+void app_use_backend(sim_opts* o, const engine_backend* b) { o->mechanics = b->id; }
+
+const char* app_default_drive_scenario(const sim_opts* o) { return app_backend(o)->drive_scenario; }
+
 int app_set_mechanics(sim_opts* o, const char* opt, const char* v) {
-    if (!strcmp(v, "lagrange")) o->mechanics = SIM_LAGRANGE;
-    else if (!strcmp(v, "ode")) o->mechanics = SIM_ODE;
-    else {
-        fprintf(stderr, "cranesim: %s: expected lagrange or ode, got '%s'\n", opt, v);
+    char err[256];
+    if (engine_backend_select(o, v, err, sizeof err)) {
+        fprintf(stderr, "cranesim: %s: %s\n", opt, err);
         return -1;
     }
     return 0;
@@ -394,7 +404,7 @@ static const struct {
     {APP_OPT_LOAD, "  --load KG            tip load [kg] (default: the scenario's, else the model's;\n"
                    "                       a --set of mechanics.load_mass counts only when neither sets one);\n"
                    "                       not with the sandbox world, whose loads are world objects\n"},
-    {APP_OPT_MECHANICS, "  --mechanics M        lagrange (analytic 2-DOF, default) or ode\n"},
+    {APP_OPT_MECHANICS, NULL}, // from the backend table: mechanics_help
     {APP_OPT_VARIANT, "  --variant V          lagrange equations: full (default), general, paper, paper-typo\n"},
     {APP_OPT_WORLD, "  --world W            ode: world file or name: validation (default for run), sandbox\n"},
     {APP_OPT_DT_ODE, "  --dt-ode H           ode: rigid-body step [s] (default 1e-3); the hydraulics sub-step\n"
@@ -432,9 +442,25 @@ static const struct {
     {APP_OPT_QUIET, "  --quiet              no progress bar or summary (notes and errors still go to stderr)\n"},
 };
 
+// --mechanics: every backend of the table with its phrase, the default
+// marked: "lagrange (analytic 2-DOF, default) or ode (3D rigid bodies in a world)".
+static void mechanics_help(FILE* f) {
+    fputs("  --mechanics M        ", f);
+    const int n = engine_backend_count();
+    for (int i = 0; i < n; ++i) {
+        const engine_backend* b = engine_backend_at(i);
+        fprintf(f, "%s%s (%s%s)", i == 0 ? "" : i == n - 1 ? " or " : ", ", b->name, b->help,
+                b == engine_backend_default() ? ", default" : "");
+    }
+    fputc('\n', f);
+}
+
 void app_options_help(FILE* f, unsigned which) {
-    for (size_t k = 0; k < sizeof common_help / sizeof common_help[0]; ++k)
-        if (which & APP_GIVEN(common_help[k].opt)) fputs(common_help[k].text, f);
+    for (size_t k = 0; k < sizeof common_help / sizeof common_help[0]; ++k) {
+        if (!(which & APP_GIVEN(common_help[k].opt))) continue;
+        if (common_help[k].opt == APP_OPT_MECHANICS) mechanics_help(f);
+        else fputs(common_help[k].text, f);
+    }
 }
 
 void app_common_help(FILE* f, bool with_solver) {

@@ -143,25 +143,36 @@ typedef struct bench_cfg {
     double h;
     bool dense;
     double rtol;
-    sim_mechanics mech;
-    const char* world;    ///< ode only
-    double dt_ode;        ///< ode only [s]
+    bool in_world;        ///< the backend with a world (engine_backend_with_world), else the default one
+    const char* world;    ///< with in_world only
+    double dt_ode;        ///< with in_world only: its outer step [s]
     const char* scenario; ///< NULL: the --scenario option (default ramp)
 } bench_cfg;
+
+// The backend of the configurations in a world: the sandbox's. A build
+// without one cannot run them (the table has one; this says so if not).
+static const engine_backend* bench_world_backend(void) {
+    const engine_backend* b = engine_backend_with_world();
+    if (!b) {
+        fprintf(stderr, "cranesim bench: no backend has a world\n");
+        exit(EXIT_RUNTIME);
+    }
+    return b;
+}
 
 // The lagrange set runs the chosen scenario; the sandbox set runs the
 // pick-and-place scenario (truck, booms, rope, hook, load, 16 obstacles).
 static const bench_cfg configs[] = {
-    {"krus-0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL},
-    {"krus-dense", HYD_KRUS, 1e-4, true, 0, SIM_LAGRANGE, NULL, 0, NULL},
-    {"ros2-0.1ms", HYD_ROS2, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL},
-    {"krus-1ms", HYD_KRUS, 1e-3, false, 0, SIM_LAGRANGE, NULL, 0, NULL},
-    {"ros34pw2", HYD_ROS34PW2, 0, false, 1e-3, SIM_LAGRANGE, NULL, 0, NULL},
-    {"rodas3", HYD_RODAS3, 0, false, 1e-3, SIM_LAGRANGE, NULL, 0, NULL},
-    {"rodas3-1pct", HYD_RODAS3, 0, false, 1e-2, SIM_LAGRANGE, NULL, 0, NULL},
-    {"rodas3-2e-3", HYD_RODAS3, 0, false, 2e-3, SIM_LAGRANGE, NULL, 0, NULL},
-    {"sandbox-ode1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-3, "sandbox_pick_place"},
-    {"sandbox-ode0.1ms", HYD_KRUS, 1e-4, false, 0, SIM_ODE, "sandbox", 1e-4, "sandbox_pick_place"},
+    {"krus-0.1ms", HYD_KRUS, 1e-4, false, 0, false, NULL, 0, NULL},
+    {"krus-dense", HYD_KRUS, 1e-4, true, 0, false, NULL, 0, NULL},
+    {"ros2-0.1ms", HYD_ROS2, 1e-4, false, 0, false, NULL, 0, NULL},
+    {"krus-1ms", HYD_KRUS, 1e-3, false, 0, false, NULL, 0, NULL},
+    {"ros34pw2", HYD_ROS34PW2, 0, false, 1e-3, false, NULL, 0, NULL},
+    {"rodas3", HYD_RODAS3, 0, false, 1e-3, false, NULL, 0, NULL},
+    {"rodas3-1pct", HYD_RODAS3, 0, false, 1e-2, false, NULL, 0, NULL},
+    {"rodas3-2e-3", HYD_RODAS3, 0, false, 2e-3, false, NULL, 0, NULL},
+    {"sandbox-ode1ms", HYD_KRUS, 1e-4, false, 0, true, "sandbox", 1e-3, "sandbox_pick_place"},
+    {"sandbox-ode0.1ms", HYD_KRUS, 1e-4, false, 0, true, "sandbox", 1e-4, "sandbox_pick_place"},
 };
 
 // ls: the cost of a Krus step on the load-sensing crane against the
@@ -236,7 +247,8 @@ static int bench_sweep(const app_common* c, int repeat) {
             for (int t = 1; t <= 2; ++t) {
                 char th[8];
                 snprintf(th, sizeof th, "%d", t);
-                char* args[] = {"cranesim", "sweep", "--scenario", (char*)scen, "--mechanics", "ode", "--param",
+                char* args[] = {"cranesim", "sweep", "--scenario", (char*)scen, "--mechanics",
+                                (char*)bench_world_backend()->name, "--param",
                                 "hydraulics.components.lift_cyl.bore=0.08:0.12:16", "--threads", th, "--out",
                                 "/dev/null", "--quiet", dur[0] ? "--duration" : NULL, dur, NULL};
                 long rss;
@@ -380,7 +392,7 @@ static int bench_soak(app_common* c, double duration, uint64_t seed) {
     scenario sc;
     if (app_load(&sc_c, &m, &sc)) return EXIT_USAGE;
     sim_opts o = c->sim;
-    o.mechanics = SIM_ODE;
+    app_use_backend(&o, bench_world_backend());
     o.world = "sandbox";
     o.solver = HYD_KRUS;
     o.cvode = false;
@@ -461,7 +473,7 @@ static sim_opts bench_opts(const sim_opts* common, const bench_cfg* b) {
     o.solver = b->solver;
     o.cvode = false;
     o.dense_jac = b->dense;
-    o.mechanics = b->mech;
+    app_use_backend(&o, b->in_world ? bench_world_backend() : engine_backend_default());
     if (b->h > 0) o.h = b->h;
     if (b->rtol > 0) o.rtol = b->rtol;
     o.world = b->world;
@@ -471,7 +483,7 @@ static sim_opts bench_opts(const sim_opts* common, const bench_cfg* b) {
 
 static int bench_ls(const app_common* c, const scenario* sc, int repeat) {
     static const char* const files[2] = {"hiab031.json", "hiab031_ls.json"};
-    const bench_cfg b = {"ls", HYD_KRUS, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL};
+    const bench_cfg b = {"ls", HYD_KRUS, 1e-4, false, 0, false, NULL, 0, NULL};
     sim_opts o = bench_opts(&c->sim, &b);
     model* m[2] = {NULL, NULL};
     int rc = 0;
@@ -587,7 +599,7 @@ static int bench_mesh(const app_common* c, const model* m, int repeat) {
     }
     double rt[2] = {0, 0};
     for (int k = 0; k < 2 && rc == 0; ++k) {
-        const bench_cfg b = {"mesh-50k", HYD_KRUS, 1e-4, false, 0, SIM_ODE, k ? wpath : "sandbox", 1e-3, NULL};
+        const bench_cfg b = {"mesh-50k", HYD_KRUS, 1e-4, false, 0, true, k ? wpath : "sandbox", 1e-3, NULL};
         sim_opts o = bench_opts(&c->sim, &b);
         double walls[100];
         sim_result r;
@@ -628,7 +640,7 @@ static int bench_mesh(const app_common* c, const model* m, int repeat) {
 // error line.
 static int bench_length_one(const app_common* c, const model* m, const char* mname, const scenario* sc,
                             int repeat) {
-    const bench_cfg b = {"krus-length", HYD_KRUS, 1e-4, false, 0, SIM_LAGRANGE, NULL, 0, NULL};
+    const bench_cfg b = {"krus-length", HYD_KRUS, 1e-4, false, 0, false, NULL, 0, NULL};
     sim_opts o = bench_opts(&c->sim, &b);
     const double T = c->sim.duration > 0 ? c->sim.duration : sc->duration;
     double walls[2][100], ns[2], t_end[2];
@@ -1050,7 +1062,7 @@ int cmd_bench(int argc, char** argv) {
     if (want_drive) {
 #ifdef CRANESIM_HAVE_RENDER
         app_common dc = c;
-        dc.sim.mechanics = SIM_ODE;
+        app_use_backend(&dc.sim, bench_world_backend());
         dc.scenario_path = "sandbox_pick_place";
         int dcode = drive_bench(&dc, 1280, 720, c.sim.duration > 0 ? c.sim.duration : 60.0);
         if (dcode) code = dcode;

@@ -171,7 +171,7 @@ static void loose_tolerance(const model* m, const scenario* sc, const sim_opts* 
 int cmd_compare(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
     sim_opts side[2];
-    char label[2][96] = {"lagrange", "ode"};
+    char label[2][96] = {"", ""};
     bool any_pair = false;
     double tol_stroke = -1, tol_pressure = -1;
     const char* plot = NULL;
@@ -319,11 +319,19 @@ int cmd_compare(int argc, char** argv) {
                 "compare one change at a time to tell them apart\n",
                 nmodel == 2 ? "--model A --model B" : "--set-a/--set-b", which);
     }
-    if (!any_pair && !designs) { // the default comparison: lagrange full vs the ode validation world
-        side[0].mechanics = SIM_LAGRANGE;
-        side[1].mechanics = SIM_ODE;
-        snprintf(label[0], sizeof label[0], "lagrange");
-        snprintf(label[1], sizeof label[1], "ode");
+    // The default comparison: the default backend (the analytic reference,
+    // lagrange full) against the backend with a world (ode, its validation
+    // world).
+    const engine_backend* pair[2] = {engine_backend_default(), engine_backend_with_world()};
+    if (!any_pair && !designs) {
+        if (!pair[1] || pair[1] == pair[0]) {
+            fprintf(stderr, "cranesim compare: no second backend to compare with: give --backends A,B\n");
+            return EXIT_USAGE;
+        }
+        for (int s = 0; s < 2; ++s) {
+            app_use_backend(&side[s], pair[s]);
+            snprintf(label[s], sizeof label[s], "%s", pair[s]->name);
+        }
     }
     // Both runs and the plot file are checked before anything runs.
     if (plot && app_check_output("compare", "--plot", plot, ".png")) return EXIT_USAGE;
@@ -380,15 +388,22 @@ int cmd_compare(int argc, char** argv) {
     for (int s = 0; s < 2 && !rc; ++s) {
         char remedy[400];
         const char* ab = s ? "B" : "A";
-        if (side[s].mechanics == SIM_LAGRANGE && (pairs[0] || (!any_pair && !designs)))
+        const engine_backend* b = app_backend(&side[s]);
+        const engine_backend* wb = engine_backend_with_world();
+        char dflt[96];
+        snprintf(dflt, sizeof dflt, "the default --backends %s,%s", pair[0]->name, pair[1] ? pair[1]->name : "?");
+        if (b->world)
+            snprintf(remedy, sizeof remedy, "give --world %s (side %s runs the %s backend)", b->drive_world, ab,
+                     b->name);
+        else if (!wb)
+            snprintf(remedy, sizeof remedy, "no backend has a world");
+        else if (pairs[0] || (!any_pair && !designs))
             snprintf(remedy, sizeof remedy,
-                     "side %s runs there because of %s; to compare in the sandbox, keep both sides there: "
-                     "--mechanics ode --world sandbox with another pair (--dts H1,H2, or --set-a/--set-b)",
-                     ab, pairs[0] ? "--backends" : "the default --backends lagrange,ode");
-        else if (side[s].mechanics == SIM_ODE)
-            snprintf(remedy, sizeof remedy, "give --world sandbox (side %s runs the ode backend)", ab);
+                     "side %s runs there because of %s; to compare in the %s, keep both sides there: "
+                     "--mechanics %s --world %s with another pair (--dts H1,H2, or --set-a/--set-b)",
+                     ab, pairs[0] ? "--backends" : dflt, wb->drive_world, wb->name, wb->drive_world);
         else
-            snprintf(remedy, sizeof remedy, "run it with --mechanics ode --world sandbox");
+            snprintf(remedy, sizeof remedy, "run it with --mechanics %s --world %s", wb->name, wb->drive_world);
         const unsigned given =
             c.given | (pairs[0] || (!any_pair && !designs) ? APP_GIVEN(APP_OPT_MECHANICS) : 0u);
         rc = app_scenario_world_remedy("compare", &side[s], given, &sc, true, &switched[s], remedy,

@@ -187,11 +187,11 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
                           const char* why, int kind, const char* world_name) {
     model* m;
     scenario sc;
-    const bool ode = c->sim.mechanics == SIM_ODE;
-    if (!c->scenario_path) c->scenario_path = app_default_drive_scenario(c->sim.mechanics);
+    const bool world = app_backend(&c->sim)->world;
+    if (!c->scenario_path) c->scenario_path = app_default_drive_scenario(&c->sim);
     int rc = app_load(c, &m, &sc);
     if (rc) return rc;
-    app_note_scenario_slew("drive", &sc, ode ? kind : -1);
+    app_note_scenario_slew("drive", &c->sim, &sc, kind);
     double duration = c->sim.duration > 0 ? c->sim.duration : sc.duration;
     // At most SIM_MAX_DURATION (the option is capped by app_parse_common, a
     // scenario's here) at <= 1000 frames/s: at most 1e9 frames, counted in a long.
@@ -254,15 +254,17 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     }
     // The sandbox has the truck, the slew and the hook; loads only if its
     // file has some. The validation world and the lagrange view have none.
-    const bool sandbox = ode && kind == WORLD_SANDBOX;
+    const bool sandbox = world && kind == WORLD_SANDBOX;
     const bool loads = sandbox && engine_load_name(l, 0, NULL) != NULL;
     drive_world dw = {.hook = sandbox, .held = -1, .sess = session_path ? &sw : NULL};
     int wr = 0; // errno of the first failed write to the record
     if (f) sim_csv_header(f, ncol);
     if (f && ferror(f)) wr = errno ? errno : EIO;
     printf("cranesim drive: %s: driving %s headless in real time for %.1f s\n", why, m->name, duration);
+    char nowhere[96];
+    snprintf(nowhere, sizeof nowhere, "%s (no world)", app_backend(&c->sim)->crane);
     printf("  world: %s; operator input: scripted (%s), %.0f commands/s; hydraulics %s at h = %g ms\n",
-           ode ? world_name : "lagrange 2-DOF (no world)", sc.name, frame_rate, hyd_method_name(c->sim.solver),
+           world ? world_name : nowhere, sc.name, frame_rate, hyd_method_name(c->sim.solver),
            c->sim.h * 1e3);
     const double frame = 1.0 / frame_rate;
     const long nframes = (long)ceil(duration * frame_rate - 1e-9);
@@ -381,7 +383,8 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
 
 int cmd_drive(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
-    c.sim.mechanics = SIM_ODE; // drive's default: the sandbox world
+    // drive's default: the backend with a world, in its drive world (the sandbox)
+    app_use_backend(&c.sim, engine_backend_with_world() ? engine_backend_with_world() : engine_backend_default());
     c.sim.rcl = true;          // the rated capacity limiter, unless --rcl off
     bool headless = false, scripted = false, rate_given = false, rcl_given = false;
     double frame_rate = 75.0, shot_at = 2.0;
@@ -557,7 +560,7 @@ int cmd_drive(int argc, char** argv) {
             o.offscreen = !cdisplay;
             o.scripted = scripted || o.offscreen;
             char err[600];
-            if (c.sim.mechanics == SIM_ODE && !c.sim.world) c.sim.world = "sandbox";
+            if (app_backend(&c.sim)->world && !c.sim.world) c.sim.world = app_backend(&c.sim)->drive_world;
             int rc = drive_opts_check(&c, &o, err, sizeof err);
             if (rc) {
                 fprintf(stderr, "cranesim drive: %s\n", err);
@@ -585,7 +588,7 @@ int cmd_drive(int argc, char** argv) {
             return EXIT_USAGE;
         }
 #endif
-        if (!c.scenario_path) c.scenario_path = app_default_drive_scenario(SIM_LAGRANGE);
+        if (!c.scenario_path) c.scenario_path = APP_DEMO_SCENARIO;
         model* m;
         scenario sc;
         int rc = app_load(&c, &m, &sc);
@@ -596,13 +599,14 @@ int cmd_drive(int argc, char** argv) {
     }
     // drive's ode world is the sandbox unless --world says otherwise (run's
     // is the validation world): name it, so the checks see the same world.
-    if (c.sim.mechanics == SIM_ODE && !c.sim.world) c.sim.world = "sandbox";
+    const engine_backend* be = app_backend(&c.sim);
+    if (be->world && !c.sim.world) c.sim.world = be->drive_world;
     if (app_check_sim("drive", &c.sim, c.given)) return EXIT_USAGE;
     app_note_unused("drive", c.given, &c.sim, 1);
     app_settle_unused(&c.sim);
     char err[600], wname[64] = "";
     int kind = -1;
-    if (c.sim.mechanics == SIM_ODE) {
+    if (be->world) {
         kind = world_info(&c, wname, sizeof wname, err, sizeof err);
         if (kind < 0) {
             fprintf(stderr, "cranesim drive: %s\n", err);
@@ -610,7 +614,7 @@ int cmd_drive(int argc, char** argv) {
         }
         // The validation world has no hook, loads or slew: its scripted
         // operator is the 2-DOF demo (lift and jib), not the pick-and-place.
-        if (!c.scenario_path && kind == WORLD_VALIDATION) c.scenario_path = app_default_drive_scenario(SIM_LAGRANGE);
+        if (!c.scenario_path && kind == WORLD_VALIDATION) c.scenario_path = APP_DEMO_SCENARIO;
     }
     char why[700];
     const bool display = have_display(why, sizeof why);
@@ -622,7 +626,7 @@ int cmd_drive(int argc, char** argv) {
     o.replay_rcl = replay && rcl_given ? c.sim.rcl : -1;
     o.save_as = save_as;
     o.collision_view = collision_view;
-    o.world_name = c.sim.mechanics == SIM_ODE ? wname : NULL;
+    o.world_name = be->world ? wname : NULL;
     int rc = drive_opts_check(&c, &o, err, sizeof err);
     if (rc) {
         fprintf(stderr, "cranesim drive: %s\n", err);

@@ -301,8 +301,9 @@ int cmd_loadchart(int argc, char** argv) {
     if (app_check_distinct("loadchart", (const char* const[]){"--out", "--plot"}, (const char* const[]){out, png}, 2))
         return EXIT_USAGE;
     model* m = model_load(c.model_path, c.sets, c.nset, err, sizeof err);
-    if (!m) {
+    if (!m || model_require_two_link(m, "load chart", err, sizeof err)) {
         fprintf(stderr, "cranesim loadchart: %s\n", err);
+        model_free(m);
         return EXIT_USAGE;
     }
     char wbuf[512];

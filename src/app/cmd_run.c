@@ -141,6 +141,10 @@ typedef struct csv_sink {
     FILE* f;     ///< opened at the first row
     long rows;
     int ncol;
+    /// A chain model's own columns (per actuator, function and degree of
+    /// freedom), which its rows carry after the ncol base columns; NULL for
+    /// the two-link crane.
+    const crane_chain* chain;
     int err;     ///< errno of the first failed open or write, 0 if none
     bool opened; ///< the file was created (as a temporary, renamed at the end)
     plot_keep keep;
@@ -165,10 +169,11 @@ static int csv_row(void* user, const double* row) {
             return 1;
         }
         s->opened = true;
-        sim_csv_header(s->f, s->ncol);
+        if (s->chain) sim_csv_header_ext(s->f, s->ncol, s->chain->col, s->chain->ncol);
+        else sim_csv_header(s->f, s->ncol);
     }
     errno = 0;
-    sim_csv_row(s->f, row, s->ncol);
+    sim_csv_row(s->f, row, s->ncol + (s->chain ? s->chain->ncol : 0));
     ++s->rows;
     s->t_last = row[COL_T];
     if (ferror(s->f)) {
@@ -232,10 +237,12 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
            app_fmt_speed(speed, sizeof speed, r->wall > 0 ? r->t_end / r->wall : 0.0), work);
     printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
            1e3 * xmax[1]);
+    char rcl_scripted_off[96]; // a backend whose scripted runs only measure the limiter
+    snprintf(rcl_scripted_off, sizeof rcl_scripted_off, "measuring only (%s scripted run)", app_backend(o)->name);
     if (st->rcl_have)
         printf("  rated capacity limiter %s: utilisation max %.0f %%, %.3f s at or above 90 %%\n",
                !o->rcl ? "off (measuring only)"
-                       : (o->mechanics == SIM_LAGRANGE ? "measuring only (lagrange scripted run)" : "on"),
+                       : (!app_backend(o)->rcl_scripted ? rcl_scripted_off : "on"),
                100 * st->rcl_max, st->rcl_t90);
     // The peaks over every integration step when sim.c tracked them (between
     // coarse rows the true peak can be far higher than any row's); else
@@ -386,7 +393,7 @@ int cmd_run(int argc, char** argv) {
     app_settle_unused(&c.sim);
     c.sim.rcl = rcl_on;
 
-    csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim),
+    csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim), .chain = m->chain.ncol > 0 ? &m->chain : NULL,
                      .st = {.xmin = {INFINITY, INFINITY}, .xmax = {-INFINITY, -INFINITY}}};
     static rcl mon;
     if (sink.ncol <= COL_RCL_UTIL) {

@@ -397,10 +397,11 @@ static char* describe(server* s, const char* model_file, const char* model_asset
     engine_describe(s->o, &d);
     cJSON_AddStringToObject(j, "world", d.world);
     char wb[512];
-    cJSON_AddStringToObject(j, "world_file", s->o->mechanics == SIM_ODE ? sim_world_path(s->o->world, wb, sizeof wb) : "");
+    const engine_backend* be = app_backend(s->o);
+    cJSON_AddStringToObject(j, "world_file", be->world ? sim_world_path(s->o->world, wb, sizeof wb) : "");
     cJSON_AddStringToObject(j, "solver", hyd_method_name(s->o->solver));
     cJSON_AddNumberToObject(j, "h", s->o->h);
-    cJSON_AddNumberToObject(j, "dt_ode", s->o->mechanics == SIM_ODE ? s->o->dt_ode : 0);
+    cJSON_AddNumberToObject(j, "dt_ode", be->outer_step_opt ? s->o->dt_ode : 0);
     cJSON_AddNumberToObject(j, "frame", s->frame);
     cJSON* ch = cJSON_AddArrayToObject(j, "channels");
     int nch = 0;
@@ -906,7 +907,8 @@ static int serve_loop(server* s, int lfd, double duration) {
 
 int cmd_serve(int argc, char** argv) {
     app_common c = {.sim = sim_default_opts()};
-    c.sim.mechanics = SIM_ODE;
+    // serve's default, as drive's: the backend with a world, in its drive world
+    app_use_backend(&c.sim, engine_backend_with_world() ? engine_backend_with_world() : engine_backend_default());
     c.sim.rcl = true; // the rated capacity limiter, as a local drive's, unless --rcl off
     const char* listen_at = "127.0.0.1:7575";
     double rate = 75, timeout = 5;
@@ -1003,7 +1005,8 @@ int cmd_serve(int argc, char** argv) {
         fprintf(stderr, "cranesim serve: --realtime: a --lockstep server has no frame deadlines (drop one of them)\n");
         return EXIT_USAGE;
     }
-    if (c.sim.mechanics == SIM_ODE && !c.sim.world) c.sim.world = "sandbox";
+    const engine_backend* be = app_backend(&c.sim);
+    if (be->world && !c.sim.world) c.sim.world = be->drive_world;
     if (c.sim.cvode) {
         fprintf(stderr, "cranesim serve: --solver cvode: serve steps the hydraulics in real time with the in-house "
                         "solvers: use krus, ros2, rk4, ros34pw2 or rodas3\n");
@@ -1013,9 +1016,10 @@ int cmd_serve(int argc, char** argv) {
     app_note_unused("serve", c.given, &c.sim, 1);
     app_settle_unused(&c.sim);
     if (!c.scenario_path) {
-        c.scenario_path = app_default_drive_scenario(c.sim.mechanics);
-        if (c.sim.mechanics == SIM_ODE && strcmp(c.sim.world, "sandbox"))
-            c.scenario_path = app_default_drive_scenario(SIM_LAGRANGE);
+        // Its drive scenario in its drive world; another world may have no
+        // hook or slew: the lift-and-jib demo.
+        c.scenario_path = app_default_drive_scenario(&c.sim);
+        if (be->world && strcmp(c.sim.world, be->drive_world)) c.scenario_path = APP_DEMO_SCENARIO;
     }
     model* m;
     scenario sc;

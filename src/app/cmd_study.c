@@ -345,14 +345,20 @@ int cmd_study(int argc, char** argv) {
     // Refuse, before any run, what the study cannot honour.
     for (int k = 0; k < APP_OPT_COUNT; ++k) {
         if (!(c.given & APP_GIVEN(k)) || (study_opts & APP_GIVEN(k))) continue;
-        if (k == APP_OPT_MECHANICS && c.sim.mechanics == SIM_LAGRANGE) continue; // what it runs anyway
+        // The study runs the default backend (its CVODE reference is that
+        // backend's): --mechanics naming it is what it runs anyway.
+        const engine_backend* ref = engine_backend_default();
+        if (k == APP_OPT_MECHANICS && app_backend(&c.sim) == ref) continue;
+        char ref_only[128];
+        snprintf(ref_only, sizeof ref_only, "the study's CVODE reference runs the %s model only", ref->name);
         const char* why = k == APP_OPT_MECHANICS || k == APP_OPT_WORLD || k == APP_OPT_DT_ODE
-                              ? "the study's CVODE reference runs the lagrange model only"
+                              ? ref_only
                           : k == APP_OPT_EVERY ? "the study compares every configuration with the reference on the "
                                                  "1 ms output grid"
                                                : "the study sets the solver, step and tolerances of each "
                                                  "configuration itself";
-        if (k == APP_OPT_MECHANICS) fprintf(stderr, "cranesim study: --mechanics ode: %s\n", why);
+        if (k == APP_OPT_MECHANICS)
+            fprintf(stderr, "cranesim study: --mechanics %s: %s\n", app_backend(&c.sim)->name, why);
         else fprintf(stderr, "cranesim study: %s is not an option of study: %s\n", app_opt_name[k], why);
         return EXIT_USAGE;
     }

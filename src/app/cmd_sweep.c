@@ -98,7 +98,7 @@ typedef struct sweep {
     int nmet;
     int ncol;
     bool fail_fast;
-    bool ode;
+    bool process_wide;  ///< the backend's library is process-wide (engine_backend.h): one design at a time per process
     bool energy;        ///< a tabulated metric needs the energy accounting
     // Dispatch and results (under mu).
     pthread_mutex_t mu;
@@ -112,9 +112,10 @@ typedef struct sweep {
     long failed;
 } sweep;
 
-// The ODE library and the ode world's error trap are process-wide: one ode
-// design at a time per process (threads still overlap loading and writing).
-static pthread_mutex_t g_ode_mu = PTHREAD_MUTEX_INITIALIZER;
+// A backend whose library is process-wide (engine_backend.process_wide: the
+// ODE library and the ode world's error trap): one design at a time per
+// process (threads still overlap loading and writing).
+static pthread_mutex_t g_process_wide_mu = PTHREAD_MUTEX_INITIALIZER;
 
 // The design values drop the model's range notes ("outside the typical
 // range"): thousands of designs would repeat them, and the row has the value.
@@ -236,9 +237,9 @@ static char* run_design(const sweep* s, long i, bool* failed) {
     if (m) {
         sim_result res;
         sim_energy* en = s->energy ? sim_energy_create() : NULL;
-        if (s->ode) pthread_mutex_lock(&g_ode_mu);
+        if (s->process_wide) pthread_mutex_lock(&g_process_wide_mu);
         sim_run_energy(m, &s->sc, &s->c.sim, design_row, &met, NULL, NULL, NULL, en, &res);
-        if (s->ode) pthread_mutex_unlock(&g_ode_mu);
+        if (s->process_wide) pthread_mutex_unlock(&g_process_wide_mu);
         model_free(m);
         if (res.status == SIM_REFUSED && app_signal_caught()) {
             sim_energy_free(en);
@@ -491,11 +492,11 @@ static void out_rest(sweep* s, sweep_out* o) {
 }
 
 // ---------------------------------------------------------------------------
-// ode designs on worker processes
+// designs of a process-wide backend (ode) on worker processes
 // ---------------------------------------------------------------------------
 
 // The ODE library is process-wide, so threads run ode designs one at a time.
-// To use every core without MPI, a sweep on the ode backend forks worker
+// To use every core without MPI, a sweep on such a backend forks worker
 // processes instead (after the setup: each inherits the loaded model, the
 // scenario and the options, copy-on-write). The parent stays single-threaded
 // (fork is then safe, also to replace a worker that died) and keeps the
@@ -811,7 +812,7 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
         for (int k = 0; k < s->nmet; ++k) fprintf(o->f, ",%s", metric_name((metric_id)s->met[k]));
         fprintf(o->f, ",exit,error\n");
     }
-    if (s->ode && nrank == 1 && threads > 1) {
+    if (s->process_wide && nrank == 1 && threads > 1) {
         const int rc = sweep_procs(s, threads, o);
         out_rest(s, o);
         return rc;
@@ -1132,7 +1133,7 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
         model_free(s.base);
         return rc;
     }
-    s.ode = s.c.sim.mechanics == SIM_ODE;
+    s.process_wide = app_backend(&s.c.sim)->process_wide;
     s.ncol = sim_ncol(&s.c.sim);
     // Every path must name a number in the model: a typo is bad input, not
     // a sweep of refused designs. (Its values are checked per design.)
@@ -1232,7 +1233,7 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
                         snprintf(shape + n, sizeof shape - n, "%s%ld", k ? " x " : "grid ", s.par[k].n);
                     }
                 // ode designs on more than one thread run on worker processes (sweep_procs).
-                const char* unit = s.ode && nrank == 1 && threads > 1 ? "worker process" : "thread";
+                const char* unit = s.process_wide && nrank == 1 && threads > 1 ? "worker process" : "thread";
                 printf("cranesim sweep: %s, %ld designs (%s) on %ld %s%s%s in %.2f s -> %s\n", s.sc.name, s.ndesign,
                        shape, threads, unit, threads == 1 ? "" : strcmp(unit, "thread") ? "es" : "s",
                        nrank > 1 ? " per rank" : "", wall, out);

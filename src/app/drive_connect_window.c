@@ -420,7 +420,15 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     snprintf(model_buf, sizeof model_buf, "%s", model_file ? model_file : "");
     snprintf(world_buf, sizeof world_buf, "%s", world_file ? world_file : "");
     model_file = model_buf, world_file = world_buf;
-    c.sim.mechanics = strcmp(backend, "ode") ? SIM_LAGRANGE : SIM_ODE;
+    // The server's backend by name: one this build does not know is refused,
+    // not drawn as another.
+    char berr[256];
+    if (engine_backend_select(&c.sim, backend, berr, sizeof berr)) {
+        fprintf(stderr, "cranesim drive: --connect %s: server hello: backend: %s\n", addr, berr);
+        code = EXIT_USAGE;
+        goto done;
+    }
+    const engine_backend* be = app_backend(&c.sim);
     // The server's files where this computer has them (the same install);
     // else this drive's --model and --world, which must describe the same crane.
     // Version 2 servers before "model_asset" sent the model's bare base name:
@@ -438,15 +446,15 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     else if (model_file && model_file[0])
         printf("cranesim drive: the server's model %s is not here: drawing %s\n", model_file,
                c.model_path ? c.model_path : "the default model");
-    if (c.sim.mechanics == SIM_ODE) {
+    if (be->world) {
         if (file_exists(world_file)) c.sim.world = world_file;
         else {
-            if (!c.sim.world) c.sim.world = "sandbox";
+            if (!c.sim.world) c.sim.world = be->drive_world;
             printf("cranesim drive: the server's world %s is not here: drawing %s\n", world_file ? world_file : "?",
                    c.sim.world);
         }
     }
-    if (!c.scenario_path) c.scenario_path = app_default_drive_scenario(c.sim.mechanics);
+    if (!c.scenario_path) c.scenario_path = app_default_drive_scenario(&c.sim);
     int ccode;
     s = drive_session_create(&c, o, err, sizeof err, &ccode);
     if (!s) {
@@ -462,7 +470,7 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     if (nb != w->nbody) {
         fprintf(stderr, "cranesim drive: --connect %s: the server's world has %d bodies, this one (%s) %d: give "
                         "--model and --world as the server runs them\n", addr, nb,
-                c.sim.mechanics == SIM_ODE ? c.sim.world : "lagrange", w->nbody);
+                be->world ? c.sim.world : be->name, w->nbody);
         code = EXIT_USAGE;
         goto done;
     }

@@ -800,6 +800,12 @@ static void rebuild_world(drive_session* s, bool at_start);
 static void load_model(drive_session* s) {
     char e[400];
     model* nm = model_load(s->load_path[0] ? s->load_path : NULL, NULL, 0, e, sizeof e);
+    // The panel edits the two-link fields (the mechanics table) and puts
+    // them back on a failed rebuild: a chain model is refused before that.
+    if (nm && model_require_two_link(nm, "drive panel", e, sizeof e)) {
+        model_free(nm);
+        nm = NULL;
+    }
     if (!nm) {
         snprintf(s->status, sizeof s->status, "load failed (model kept): %s", e);
         panel_set_message(s->pn, s->status);
@@ -1015,7 +1021,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     }
     *code = EXIT_RUNTIME;
     if (!s->c.scenario_path)
-        s->c.scenario_path = app_default_drive_scenario(s->c.sim.mechanics);
+        s->c.scenario_path = app_default_drive_scenario(&s->c.sim);
     if (app_load_msg(&s->c, &s->m, &s->sc, err, errsz)) {
         drive_session_destroy(s);
         *code = EXIT_USAGE;
@@ -1611,8 +1617,9 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
         return code;
     }
     char where[96];
-    if (c->sim.mechanics != SIM_ODE) snprintf(where, sizeof where, "the lagrange 2-DOF view");
-    else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : "sandbox");
+    const engine_backend* be = app_backend(&c->sim);
+    if (!be->world) snprintf(where, sizeof where, "the %s view", be->crane);
+    else snprintf(where, sizeof where, "the %s world", o->world_name ? o->world_name : be->drive_world);
     printf("cranesim drive: %s in %s%s; %s%s%s\n", s->m->name, where, o->offscreen ? " (offscreen)" : "",
            o->replay_path ? "replaying " : "", o->replay_path ? o->replay_path : o->scripted ? "scripted operator" : "joystick or keyboard (arrows/WS/AD, H hook, Tab parameters, P pause, "
                                                "R reset, C camera, F5 record, F12 screenshot, Esc quit)",
@@ -1720,7 +1727,8 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
     // The world the engine was built on (c->sim.world, the sandbox when
     // none is named), and the bodies of its last snapshot, so a reader can
     // tell the worlds apart by what ran, not only by name.
-    const char* world = c->sim.mechanics != SIM_ODE ? "lagrange" : c->sim.world ? c->sim.world : "sandbox";
+    const engine_backend* be = app_backend(&c->sim);
+    const char* world = !be->world ? be->name : c->sim.world ? c->sim.world : be->drive_world;
     take_snapshot(s);
     int n = st->nframe_ms < 4096 ? st->nframe_ms : 4096;
     double* ms = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1));

@@ -1,6 +1,7 @@
 // session.c: the session file of a drive (session.h; format in docs/replay.md).
 #include "session.h"
 
+#include "engine_backend.h"
 #include "json_util.h"
 
 #include <errno.h>
@@ -248,7 +249,15 @@ int session_load(const char* path, session* s, char* err, size_t errsz) {
         s->m3 = num(in, "load_mass", &ok);
         s->ncol = (int)num(h, "ncol", &ok);
     }
-    if (!ok || s->ncol < 1 || s->ncol > SIM_NCOL || s->sim.mechanics > SIM_ODE || !(s->sim.h > 0)) {
+    if (ok && !engine_backend_of(&s->sim)) { // a backend this build does not have: never replayed on another
+        fclose(f);
+        free(line);
+        char known[128], msg[256];
+        snprintf(msg, sizeof msg, "header: sim.mechanics: %d names no backend (known: %s)", (int)s->sim.mechanics,
+                 engine_backend_names(known, sizeof known, NULL));
+        return fail(s, err, errsz, "%s", msg, 2);
+    }
+    if (!ok || s->ncol < 1 || s->ncol > SIM_NCOL || !(s->sim.h > 0)) {
         fclose(f);
         free(line);
         return fail(s, err, errsz, "%s", "header: sim, initial and ncol are required and must be valid", 2);

@@ -31,7 +31,7 @@
 
 #include <SDL2/SDL.h>
 
-#include "world/run/world_snapshot.h"
+#include "world/backend/world_snapshot.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -112,10 +112,57 @@ static void reconnect_resends_set(bool window) {
     else serve_stop(&a);
 }
 
+// A server whose hello names a backend this build does not have (a newer
+// build's): the view refuses it by name, exit 2, instead of drawing it as
+// another backend. The server here is a fake: a child process that answers
+// the client's hello with a hello naming backend "mujoco" and waits for the
+// client to hang up.
+static void unknown_backend_refused(void) {
+    const int lfd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_addr.s_addr = htonl(INADDR_LOOPBACK), .sin_port = 0};
+    socklen_t sl = sizeof sa;
+    CHECK(lfd >= 0 && bind(lfd, (struct sockaddr*)&sa, sizeof sa) == 0 && listen(lfd, 1) == 0 &&
+              getsockname(lfd, (struct sockaddr*)&sa, &sl) == 0,
+          "listen");
+    const pid_t child = fork();
+    if (child == 0) {
+        alarm(60); // never outlives a broken test
+        const int fd = accept(lfd, NULL, NULL);
+        uint8_t b[4096];
+        struct pollfd pf = {.fd = fd, .events = POLLIN};
+        if (fd < 0 || poll(&pf, 1, 10000) <= 0 || recv(fd, b, sizeof b, 0) <= 0) _exit(3); // the client's hello
+        static const char json[] = "{\"protocol\":2,\"model\":\"x\",\"model_file\":\"\",\"backend\":\"mujoco\","
+                                   "\"world\":\"\",\"world_file\":\"\",\"channels\":[],\"bodies\":[]}";
+        const proto_server_hello h = {.version = PROTO_VERSION, .role = 1, .lockstep = 1, .rate = 75,
+                                      .json = json, .json_len = (uint32_t)strlen(json)};
+        const size_t n = proto_put_server_hello(b, sizeof b, &h);
+        if (!n || send_all(fd, b, n)) _exit(4);
+        while (poll(&pf, 1, 10000) > 0 && recv(fd, b, sizeof b, 0) > 0) {} // until the client hangs up
+        _exit(0);
+    }
+    close(lfd);
+    char cmd[1024], line[1024], all[8192] = "";
+    snprintf(cmd, sizeof cmd,
+             "%s/cranesim drive --connect 127.0.0.1:%d --size 320x180 --screenshot connect_unknown.png 2>&1",
+             CRANESIM_BINARY_DIR, ntohs(sa.sin_port));
+    FILE* p = popen(cmd, "r");
+    while (p && fgets(line, sizeof line, p)) {
+        fputs(line, stdout);
+        strncat(all, line, sizeof all - strlen(all) - 1);
+    }
+    const int st = p ? pclose(p) : -1;
+    CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 2, "exit %d", WIFEXITED(st) ? WEXITSTATUS(st) : -1);
+    CHECK(strstr(all, "server hello: backend: unknown backend 'mujoco' (known: lagrange, ode)") != NULL, "%s", all);
+    int cst = 0;
+    CHECK(child > 0 && waitpid(child, &cst, 0) == child && WIFEXITED(cst) && WEXITSTATUS(cst) == 0,
+          "the fake server: %d", WIFEXITED(cst) ? WEXITSTATUS(cst) : -1);
+}
+
 static void hook_cb(void* user, engine* e, int attach, int got) { (void)user, (void)e, (void)attach, (void)got; }
 
 int main(void) {
     const char* scen = "sandbox_pick_place";
+    unknown_backend_refused();
     const char* args[] = {"--mechanics", "ode", "--scenario", scen, "--lockstep", NULL};
     served sv = {0};
     CHECK(serve_start(&sv, "test_drive_connect_serve.log", args) == 0, "server started");

@@ -95,10 +95,46 @@ static void test_flag_values(void) {
     CHECK(rc == 2 && strstr(out, "unknown option"), "run has no --fail-fast: rc %d: %s", rc, out);
 }
 
+// An unknown backend name: one line naming the option, the name and the
+// known ones, exit 2, before anything runs (issue 26: never run as another
+// backend). Every command that takes a backend.
+static void test_unknown_backend_refused(void) {
+    static const struct {
+        const char* args;
+        const char* want;
+    } cases[] = {
+        {"run --mechanics foo --scenario hold --duration 0.1 --out /dev/null -q",
+         "cranesim: --mechanics: unknown backend 'foo' (known: lagrange, ode)"},
+        {"compare --mechanics foo --scenario hold --duration 0.1 -q",
+         "cranesim: --mechanics: unknown backend 'foo' (known: lagrange, ode)"},
+        {"compare --backends lagrange,bar --scenario hold --duration 0.1 -q",
+         "cranesim: --backends: unknown backend 'bar' (known: lagrange, ode)"},
+        {"sweep --mechanics Ode --scenario hold --duration 0.1 --param hydraulics.fluid.bulk_modulus=1e9:1.2e9:2 "
+         "--out /dev/null -q",
+         "cranesim: --mechanics: unknown backend 'Ode' (known: lagrange, ode)"},
+        {"drive --headless --mechanics mujoco --duration 0.1",
+         "cranesim: --mechanics: unknown backend 'mujoco' (known: lagrange, ode)"},
+        {"serve --mechanics foo --listen 127.0.0.1:0",
+         "cranesim: --mechanics: unknown backend 'foo' (known: lagrange, ode)"},
+        {"study --mechanics foo", "cranesim: --mechanics: unknown backend 'foo' (known: lagrange, ode)"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        const int rc = cli_run(cases[k].args, out, sizeof out);
+        CHECK(rc == 2 && cli_count_lines(out) == 1 && !strncmp(out, cases[k].want, strlen(cases[k].want)),
+              "%s: rc %d: %s", cases[k].args, rc, out);
+    }
+    // The known names still run.
+    int rc = cli_run("run --mechanics lagrange --scenario hold --duration 0.05 --out /dev/null -q", out, sizeof out);
+    CHECK(rc == 0, "lagrange: rc %d: %s", rc, out);
+    rc = cli_run("run --mechanics ode --scenario hold --duration 0.05 --out /dev/null -q", out, sizeof out);
+    CHECK(rc == 0, "ode: rc %d: %s", rc, out);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_repeated_option_refused);
     RUN_TEST(test_headless_window_options_noted);
     RUN_TEST(test_compare_mixed_pairs);
     RUN_TEST(test_flag_values);
+    RUN_TEST(test_unknown_backend_refused);
     TEST_MAIN_END();
 }

@@ -160,6 +160,15 @@ static void check_bad_sessions(void) {
         memcpy(bore, "\"bore\":0.2,", 11);
         check_refused("model hash", a, "model_hash");
     }
+    // A backend this build does not have (a newer build's, a corrupt file):
+    // refused by name, never replayed on another.
+    n = cli_read_file("rp_hold.session", a, sizeof a);
+    char* mech = n > 0 ? strstr(a, "\"sim\":{\"mechanics\":") : NULL;
+    CHECK(mech && (mech[19] == '0' || mech[19] == '1') && mech[20] == ',', "no sim.mechanics in the session");
+    if (mech && mech[20] == ',') {
+        mech[19] = '7';
+        check_refused("backend", a, "header: sim.mechanics: 7 names no backend (known: lagrange, ode)");
+    }
 }
 
 // compare on two designs: its CSV of both holds each design's own run rows

@@ -9,7 +9,7 @@
 #include "engine.h"
 #include "lagrange.h"
 #include "loadchart.h"
-#include "ode_world.h"
+#include "ode_run.h"
 #include "rcl.h"
 #include "sim.h"
 
@@ -847,7 +847,7 @@ static double sandbox_overload(const model* m, double mass, bool on, double* x2_
     CHECK(rc == 0, "%s", err);
     double umax = 0, row[SIM_NCOL];
     for (int i = 0; w && !rc && i < 10000; ++i) {
-        sim_ode_row(w, row);
+        ode_world_row(w, row);
         row[COL_T] = i * 1e-3;
         double u[3] = {0, i >= 2000 ? 1 : 0, 0}, v[3];
         if (on) {

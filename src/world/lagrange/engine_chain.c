@@ -3,6 +3,7 @@
 #include "chain_sim.h"
 #include "energy_acc.h"
 #include "engine_impl.h"
+#include "lagrange_row.h"
 #include "lagrange_sim.h"
 
 #include <math.h>
@@ -42,6 +43,7 @@ typedef struct chain_run_ctx {
     hyd_solver* solver;
     // Output buffers, sized by the chain.
     double *x, *v, *pA, *pB, *F, *u, *ucmd, *q, *qd;
+    double* row; ///< SIM_NCOL_BASE base columns, then the chain's (crane_chain_row), at least SIM_NCOL
 } chain_run_ctx;
 
 // The scenario's commands by function name (scenario_find_command: lift,
@@ -80,7 +82,10 @@ static void make_row(chain_run_ctx* c, double t, const double* y, double* row) {
     const hyd_model* hm = cs->hm;
     for (int i = 0; i < hyd_model_ncomp(hm); ++i)
         if (hyd_model_comp_type(hm, i) == HYD_RELIEF && cs->hd->comp_open[i]) ++o.relief_open;
-    sim_lagrange_row(t, &o, row);
+    lagrange_row(t, &o, row);
+    // The chain's own columns right after the backend's (engine_sink.row).
+    const crane_chain_sample cs_s = {c->x, c->v, c->pA, c->pB, c->F, c->u, c->ucmd, c->q, c->qd};
+    crane_chain_row(cs->cc, &cs_s, row + SIM_NCOL_BASE);
 }
 
 static void track_peaks(chain_run_ctx* c, const double* y) {
@@ -123,7 +128,7 @@ static int emit(void* user, double t, const double* y) {
     c->t_last_row = t;
     ++c->rows;
     if (!c->sink->rows) return 0;
-    double row[SIM_NCOL];
+    double* row = c->row;
     make_row(c, t, y, row);
     if (sim_check_row(&c->chk, row, SIM_NCOL_BASE, c->bad, sizeof c->bad)) {
         --c->rows;
@@ -155,7 +160,9 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     const int nd = cs.ndof, na = cs.nact, nf = cs.nfn;
     chain_run_ctx c;
     memset(&c, 0, sizeof c);
-    double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + 1, sizeof *buf);
+    const size_t nrow = SIM_NCOL_BASE + (size_t)m->chain.ncol > SIM_NCOL ? SIM_NCOL_BASE + (size_t)m->chain.ncol
+                                                                         : (size_t)SIM_NCOL;
+    double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + nrow + 1, sizeof *buf);
     c.fcol = calloc((size_t)nf + 1, sizeof *c.fcol);
     hyd_solver* s = NULL;
     if (!buf || !c.fcol) {
@@ -167,6 +174,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     double* q0 = y + cs.n;
     c.x = q0 + nd, c.v = c.x + na, c.pA = c.v + na, c.pB = c.pA + na, c.F = c.pB + na;
     c.u = c.F + na, c.ucmd = c.u + nf, c.q = c.ucmd + nf, c.qd = c.q + nd;
+    c.row = c.qd + nd;
     for (int f = 0; f < nf; ++f) {
         c.fcol[f] = scenario_find_command(sc, m->chain.fn[f].name);
     }
@@ -178,13 +186,13 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     engine_chain_start_pose(&m->chain, sc, q0);
     const double t_end = o->duration > 0 ? o->duration : sc->duration;
     if (chain_sim_check_pose(&cs, q0, msg, msz) || chain_sim_initial_state(&cs, q0, 0.5e6, y, msg, msz) ||
-        sim_check_fixed_step(m->hyd, o, o->h, t_end, msg, msz) || sim_check_step_probe(m, o, o->h, msg, msz)) {
+        sim_check_fixed_step(m->hyd, o, o->h, t_end, msg, msz) || (k->probe && k->probe(m, o, o->h, msg, msz))) {
         res->status = SIM_REFUSED;
         goto done;
     }
     {
-        double row0[SIM_NCOL];
         chain_run_ctx c0 = c;
+        double* row0 = c.row;
         make_row(&c0, 0.0, y, row0);
         const sim_start_load ld = {m->chain.two_link ? &m->mech : NULL, {sc->q0[0], sc->q0[1]}, m3, false};
         if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, &ld, msg, msz)) {

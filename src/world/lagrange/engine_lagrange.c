@@ -1,8 +1,10 @@
 // engine_lagrange.c: the lagrange crane (lagrange_sim.h: the analytic
 // 2-DOF crane and its full circuit as one ODE system) behind engine.h,
 // stepped by an outside loop with commands set between steps.
-#include "engine_impl.h"
+#include "engine_lagrange.h"
 #include "engine_chain.h"
+#include "lagrange_row.h"
+#include "lagrange_sim.h"
 #include "energy_acc.h"
 
 #include "snap_reliefs.h"
@@ -38,11 +40,14 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
     (void)slew0; // the planar crane does not slew
     // The stepped engine is the closed form's (the fast path's allow-list:
     // the two-link shorthand, variant full, paper or paper-typo).
-    if (!m->chain.two_link || o->variant == LAGRANGE_GENERAL) {
+    if (model_require_two_link(m, "stepped closed-form analytic mode (drive, serve; a scripted run of this model "
+                                  "takes the general formulation)",
+                               err, errsz))
+        return NULL;
+    if (o->variant == LAGRANGE_GENERAL) {
         snprintf(err, errsz,
-                 "the stepped lagrange engine runs the two-link crane's closed form only; the general analytic "
-                 "mode (%s) runs scripted (cranesim run)",
-                 m->chain.two_link ? "--variant general" : "this model's chain");
+                 "--variant general: the stepped lagrange engine (drive, serve) runs the two-link crane's closed "
+                 "form only; the general formulation runs scripted (cranesim run)");
         return NULL;
     }
     // No world circuit here: a burst at a node the model lacks has nowhere to open.
@@ -54,12 +59,13 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
     }
     l->base.ops = &engine_lagrange_ops;
     l->base.o = *o;
+    l->base.h_probe = o->h;
     if (lsim_init(&l->ls, m, o->variant, m3, err, errsz)) {
         free(l);
         return NULL;
     }
-    if (lsim_check_pose(&l->ls, q0, err, errsz) || sim_check_fixed_step(m->hyd, o, o->h, 0.0, err, errsz) ||
-        sim_check_step_probe(m, o, o->h, err, errsz)) {
+    // The step probe follows in engine.c (engine_create_rcl), on h_probe.
+    if (lsim_check_pose(&l->ls, q0, err, errsz) || sim_check_fixed_step(m->hyd, o, o->h, 0.0, err, errsz)) {
         lsim_free(&l->ls);
         free(l);
         return NULL;
@@ -164,7 +170,7 @@ static void lag_row(engine* e, double row[SIM_NCOL]) {
     eng_lagrange* l = (eng_lagrange*)e;
     lsim_out o;
     lsim_outputs(&l->ls, l->t, l->y, &o);
-    sim_lagrange_row(l->t, &o, row);
+    lagrange_row(l->t, &o, row);
 }
 
 // ---- Scripted runs (sim_run) ----
@@ -285,7 +291,7 @@ static int emit(void* user, double t, const double* y) {
     lsim_out o;
     lsim_outputs(c->ls, t, y, &o);
     double row[SIM_NCOL];
-    sim_lagrange_row(t, &o, row);
+    lagrange_row(t, &o, row);
     // The derived columns too (a force or a tip position can overflow while
     // the states are finite).
     const int rc = sim_check_row(&c->chk, row, SIM_NCOL_BASE, c->bad, sizeof c->bad);
@@ -327,7 +333,7 @@ static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const 
     double y[LSIM_MAX_STATES];
     if (lsim_check_pose(&ls, sc->q0, res->message, sizeof res->message) ||
         check_fixed_step(m->hyd, o, o->h, o->duration > 0 ? o->duration : sc->duration, res) ||
-        (res->status = sim_check_step_probe(m, o, o->h, res->message, sizeof res->message))) {
+        (k->probe && (res->status = k->probe(m, o, o->h, res->message, sizeof res->message)))) {
         lsim_free(&ls);
         return res->status = SIM_REFUSED;
     }

@@ -22,6 +22,10 @@ typedef enum lagrange_variant {
     LAGRANGE_GENERAL
 } lagrange_variant;
 
+// sim_default_opts (sim_base.c, which knows no backend) leaves
+// sim_opts.variant 0: the full model must stay the first.
+_Static_assert(LAGRANGE_FULL == 0, "sim_opts.variant defaults to 0, which must be LAGRANGE_FULL");
+
 const char* lagrange_variant_name(lagrange_variant v);
 /// "full", "paper", "paper-typo"; -1 if unknown.
 int lagrange_variant_parse(const char* s);

@@ -66,6 +66,7 @@ static void events_setup(lsim* s) {
 
 int lsim_init(lsim* s, const model* m, lagrange_variant v, double m3, char* err, size_t errsz) {
     memset(s, 0, sizeof *s);
+    if (model_require_two_link(m, "closed-form analytic mode (--mechanics lagrange)", err, errsz)) return -1;
     s->mdl = m;
     s->variant = v;
     s->m3 = m3;

@@ -126,6 +126,22 @@ void crane_tip(const crane_mech* m, double q1, double q2, double* x, double* z) 
     *z = -m->link[0].length * cos(q1) - m->link[1].length * cos(q1 + q2);
 }
 
+void crane_gravity(const crane_mech* m, double m3, const double q[2], double G[2]) {
+    const double g = m->gravity;
+    const double L1 = m->link[0].length, L2 = m->link[1].length;
+    const double m1 = m->link[0].mass, m2 = m->link[1].mass;
+    const double e1 = m->link[0].com, e2 = m->link[1].com;
+    // The moments of the masses beyond each joint, times g [N m]: A of the
+    // lifting arm and everything it carries at L1, B of the end arm and the
+    // tip mass about joint 2 (docs/lagrange.md, G).
+    const double A = (m1 * e1 + (m2 + m3) * L1) * g;
+    const double B = (m2 * e2 + m3 * L2) * g;
+    const double s1 = sin(q[0]), c1 = cos(q[0]), s2 = sin(q[1]), c2 = cos(q[1]);
+    const double s12 = s1 * c2 + c1 * s2; // sin(q1 + q2), as the analytic backend forms it
+    G[0] = A * s1 + B * s12;
+    G[1] = B * s12;
+}
+
 int crane_mech_check(const crane_mech* m, const double stroke[2], char* err, int errsz) {
     static const char* const lname[2] = {"links[0]", "links[1]"};
     for (int i = 0; i < 2; ++i) {

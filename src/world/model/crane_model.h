@@ -98,6 +98,14 @@ int crane_check_pose(const crane_actuator* a, double stroke, double q, char* err
 /// Tip position relative to joint 1 (x reach, z height) [m].
 void crane_tip(const crane_mech* m, double q1, double q2, double* x, double* z);
 
+/// Gravity torques G(q) about joints 1 and 2 [N m] at joint angles q [rad]
+/// with mass m3 [kg] at the tip: the static holding torques, which the load
+/// chart, the limiter and the start checks weigh the crane by. The same
+/// expressions and order of operations as the analytic backend's G
+/// (lagrange_gravity with LAGRANGE_FULL), so the two agree bit for bit; it is
+/// here so that those users need the crane model, not a backend.
+void crane_gravity(const crane_mech* m, double m3, const double q[2], double G[2]);
+
 /// Problem found by crane_mech_check, written as "field: message".
 /// Returns 0 if the geometry is usable: phi inside (15, 165) deg over the
 /// stroke [0, stroke_k] of each actuator, positive lengths, masses and

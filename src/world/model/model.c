@@ -1,5 +1,6 @@
 // model.c: load and validate a crane model file.
 #include "model.h"
+#include "model_chain.h"
 #include "param_names.h"
 
 #include "hydraulics.h"
@@ -265,22 +266,22 @@ static void pump_relief_notes(json_ctx* c, const hyd_model* m) {
     }
 }
 
-static const json_range R_GRAVITY = {0, 30, 9.7, 9.9, "m/s^2"};
-static const json_range R_COLUMN_HEIGHT = {0.1, 10, 0.5, 4, "m"};
-static const json_range R_COLUMN_MASS = {1, 1e5, 50, 5000, "kg"};
-static const json_range R_LINK_LENGTH = {0.1, 30, 0.5, 10, "m"};
-static const json_range R_LINK_MASS = {1, 1e5, 20, 5000, "kg"};
-static const json_range R_LINK_COM = {0, 30, 0, 10, "m"};
-static const json_range R_LINK_INERTIA = {1e-3, 1e7, 1, 1e5, "kg m^2"};
-static const json_range R_LINK_SECTION = {0.01, 2, 0.05, 0.6, "m"};
-static const json_range R_LOAD = {0, CRANE_LOAD_MAX, 0, CRANE_LOAD_TYPICAL, "kg"};
+const json_range MODEL_R_GRAVITY = {0, 30, 9.7, 9.9, "m/s^2"};
+const json_range MODEL_R_COLUMN_HEIGHT = {0.1, 10, 0.5, 4, "m"};
+const json_range MODEL_R_COLUMN_MASS = {1, 1e5, 50, 5000, "kg"};
+const json_range MODEL_R_LINK_LENGTH = {0.1, 30, 0.5, 10, "m"};
+const json_range MODEL_R_LINK_MASS = {1, 1e5, 20, 5000, "kg"};
+const json_range MODEL_R_LINK_COM = {0, 30, 0, 10, "m"};
+const json_range MODEL_R_LINK_INERTIA = {1e-3, 1e7, 1, 1e5, "kg m^2"};
+const json_range MODEL_R_LINK_SECTION = {0.01, 2, 0.05, 0.6, "m"};
+const json_range MODEL_R_LOAD = {0, CRANE_LOAD_MAX, 0, CRANE_LOAD_TYPICAL, "kg"};
 // The maker's rating (the load chart's cap, docs/safety.md): loader cranes
 // are sold from under 1 t m (10 kN m) to about 100 t m; a rated load from a
 // few hundred kg to some tens of tonnes.
-static const json_range R_RATED_MOMENT = {0.1, 1e4, 5, 1000, "kN m"};
-static const json_range R_RATED_LOAD = {1, 1e5, 100, 30000, "kg"};
-static const json_range R_MOUNT = {-10, 10, -3, 3, "m"};
-static const json_range R_CLOSED_LENGTH = {0.05, 20, 0.3, 5, "m"};
+const json_range MODEL_R_RATED_MOMENT = {0.1, 1e4, 5, 1000, "kN m"};
+const json_range MODEL_R_RATED_LOAD = {1, 1e5, 100, 30000, "kg"};
+const json_range MODEL_R_MOUNT = {-10, 10, -3, 3, "m"};
+const json_range MODEL_R_CLOSED_LENGTH = {0.05, 20, 0.3, 5, "m"};
 
 static void load_link(json_ctx* c, const cJSON* arr, int i, crane_link* l) {
     char p[64];
@@ -293,9 +294,9 @@ static void load_link(json_ctx* c, const cJSON* arr, int i, crane_link* l) {
     static const char* const keys[] = {"name", "length", "mass", "com", "inertia", "width", "height", NULL};
     json_only_keys(c, o, p, keys);
     json_str(c, o, p, "name", false, i ? "end_arm" : "lifting_arm", l->name, sizeof l->name);
-    l->length = json_num_r(c, o, p, "length", true, 0, &R_LINK_LENGTH);
-    l->mass = json_num_r(c, o, p, "mass", true, 0, &R_LINK_MASS);
-    l->com = json_num_r(c, o, p, "com", true, 0, &R_LINK_COM);
+    l->length = json_num_r(c, o, p, "length", true, 0, &MODEL_R_LINK_LENGTH);
+    l->mass = json_num_r(c, o, p, "mass", true, 0, &MODEL_R_LINK_MASS);
+    l->com = json_num_r(c, o, p, "com", true, 0, &MODEL_R_LINK_COM);
     // A centre of mass past the link's end is a typo (a point mass beyond the
     // tip belongs in load_mass), and a zero inertia is a body ODE cannot
     // integrate (its mass matrix must be positive definite).
@@ -303,9 +304,9 @@ static void load_link(json_ctx* c, const cJSON* arr, int i, crane_link* l) {
     json_path(f, sizeof f, p, "com");
     if (!c->failed && l->com > l->length)
         json_fail(c, f, "must lie on the link (0..length %g m), got %g m", l->length, l->com);
-    l->inertia = json_num_r(c, o, p, "inertia", true, 0, &R_LINK_INERTIA);
-    l->width = json_num_r(c, o, p, "width", false, 0.18, &R_LINK_SECTION);
-    l->height = json_num_r(c, o, p, "height", false, 0.24, &R_LINK_SECTION);
+    l->inertia = json_num_r(c, o, p, "inertia", true, 0, &MODEL_R_LINK_INERTIA);
+    l->width = json_num_r(c, o, p, "width", false, 0.18, &MODEL_R_LINK_SECTION);
+    l->height = json_num_r(c, o, p, "height", false, 0.24, &MODEL_R_LINK_SECTION);
     // A boom's inertia about its centre of mass is near that of a uniform
     // box, m (length^2 + height^2) / 12: a thin-walled section is at most
     // about 1.3 times it, mass gathered at both ends 3 times, a point mass
@@ -338,9 +339,43 @@ static void load_actuator(json_ctx* c, const cJSON* arr, int i, crane_actuator* 
     if (!c->failed && a->joint != i) json_fail(c, p, "actuator %d must act on joint %d", i, i);
     json_str(c, o, p, "cylinder", true, "", a->cylinder, sizeof a->cylinder);
     json_str(c, o, p, "valve", true, "", a->valve, sizeof a->valve);
-    json_vec_r(c, o, p, "base_mount", true, a->base_mount, 2, &R_MOUNT);
-    json_vec_r(c, o, p, "rod_mount", true, a->rod_mount, 2, &R_MOUNT);
-    a->closed_length = json_num_r(c, o, p, "closed_length", true, 0, &R_CLOSED_LENGTH);
+    json_vec_r(c, o, p, "base_mount", true, a->base_mount, 2, &MODEL_R_MOUNT);
+    json_vec_r(c, o, p, "rod_mount", true, a->rod_mount, 2, &MODEL_R_MOUNT);
+    a->closed_length = json_num_r(c, o, p, "closed_length", true, 0, &MODEL_R_CLOSED_LENGTH);
+}
+
+// The two-link shorthand of the mechanics section: column, two links,
+// two actuators by joint (hiab031.json). 0, or -1 with the error in c.
+static int read_shorthand(json_ctx* c, const cJSON* mech, crane_mech* me) {
+    static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", "rated_moment",
+                                         "rated_load", NULL};
+    json_only_keys(c, mech, "mechanics", mkeys);
+    me->gravity = json_num_r(c, mech, "mechanics", "gravity", false, 9.81, &MODEL_R_GRAVITY);
+    const cJSON* col = json_obj(c, mech, "mechanics", "column", true);
+    json_only_keys(c, col, "mechanics.column", (const char* const[]){"height", "mass", NULL});
+    me->column_height = json_num_r(c, col, "mechanics.column", "height", true, 0, &MODEL_R_COLUMN_HEIGHT);
+    me->column_mass = json_num_r(c, col, "mechanics.column", "mass", false, 250, &MODEL_R_COLUMN_MASS);
+    const cJSON* links = json_arr(c, mech, "mechanics", "links", true);
+    if (links && cJSON_GetArraySize(links) != 2) json_fail(c, "mechanics.links", "must list exactly 2 links");
+    for (int i = 0; i < 2 && !c->failed; ++i) load_link(c, links, i, &me->link[i]);
+    // Names pick elements in --set paths (mechanics.links.end_arm.mass): two
+    // equal names would make the second unreachable.
+    if (!c->failed && !strcmp(me->link[0].name, me->link[1].name))
+        json_fail(c, "mechanics.links[1].name", "\"%s\" is already the name of links[0]", me->link[1].name);
+    me->load_mass = json_num_r(c, mech, "mechanics", "load_mass", true, 0, &MODEL_R_LOAD);
+    // Optional: absent (0) means no rating, the chart is the physical envelope.
+    me->rated_moment = json_num_r(c, mech, "mechanics", "rated_moment", false, 0, &MODEL_R_RATED_MOMENT);
+    me->rated_load = json_num_r(c, mech, "mechanics", "rated_load", false, 0, &MODEL_R_RATED_LOAD);
+    const cJSON* acts = json_arr(c, mech, "mechanics", "actuators", true);
+    if (acts && cJSON_GetArraySize(acts) != 2)
+        json_fail(c, "mechanics.actuators", "must list exactly 2 actuators (lift, jib)");
+    for (int i = 0; i < 2 && !c->failed; ++i) load_actuator(c, acts, i, &me->act[i]);
+    if (!c->failed && !strcmp(me->act[0].name, me->act[1].name))
+        json_fail(c, "mechanics.actuators[1].name", "\"%s\" is already the name of actuators[0]", me->act[1].name);
+    if (c->failed) return -1;
+    json_flush_notes(c);
+    crane_mech_derive(me);
+    return 0;
 }
 
 model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
@@ -361,34 +396,16 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
 
     crane_mech* me = &m->mech;
     const cJSON* mech = json_obj(&c, root, "", "mechanics", true);
-    static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", "rated_moment",
-                                         "rated_load", NULL};
-    json_only_keys(&c, mech, "mechanics", mkeys);
-    me->gravity = json_num_r(&c, mech, "mechanics", "gravity", false, 9.81, &R_GRAVITY);
-    const cJSON* col = json_obj(&c, mech, "mechanics", "column", true);
-    json_only_keys(&c, col, "mechanics.column", (const char* const[]){"height", "mass", NULL});
-    me->column_height = json_num_r(&c, col, "mechanics.column", "height", true, 0, &R_COLUMN_HEIGHT);
-    me->column_mass = json_num_r(&c, col, "mechanics.column", "mass", false, 250, &R_COLUMN_MASS);
-    const cJSON* links = json_arr(&c, mech, "mechanics", "links", true);
-    if (links && cJSON_GetArraySize(links) != 2) json_fail(&c, "mechanics.links", "must list exactly 2 links");
-    for (int i = 0; i < 2 && !c.failed; ++i) load_link(&c, links, i, &me->link[i]);
-    // Names pick elements in --set paths (mechanics.links.end_arm.mass): two
-    // equal names would make the second unreachable.
-    if (!c.failed && !strcmp(me->link[0].name, me->link[1].name))
-        json_fail(&c, "mechanics.links[1].name", "\"%s\" is already the name of links[0]", me->link[1].name);
-    me->load_mass = json_num_r(&c, mech, "mechanics", "load_mass", true, 0, &R_LOAD);
-    // Optional: absent (0) means no rating, the chart is the physical envelope.
-    me->rated_moment = json_num_r(&c, mech, "mechanics", "rated_moment", false, 0, &R_RATED_MOMENT);
-    me->rated_load = json_num_r(&c, mech, "mechanics", "rated_load", false, 0, &R_RATED_LOAD);
-    const cJSON* acts = json_arr(&c, mech, "mechanics", "actuators", true);
-    if (acts && cJSON_GetArraySize(acts) != 2)
-        json_fail(&c, "mechanics.actuators", "must list exactly 2 actuators (lift, jib)");
-    for (int i = 0; i < 2 && !c.failed; ++i) load_actuator(&c, acts, i, &me->act[i]);
-    if (!c.failed && !strcmp(me->act[0].name, me->act[1].name))
-        json_fail(&c, "mechanics.actuators[1].name", "\"%s\" is already the name of actuators[0]", me->act[1].name);
-    if (c.failed) goto fail;
-    json_flush_notes(&c);
-    crane_mech_derive(me);
+    // Two forms of the mechanics section: the chain (mechanics.bodies, any
+    // shape, model_chain.c) and the two-link shorthand (column, links and
+    // actuators by joint) that hiab031.json and every older file use.
+    const bool chain_form = model_chain_form(mech);
+    if (chain_form) {
+        if (model_chain_read(&c, mech, m)) goto fail;
+        json_flush_notes(&c);
+    } else if (read_shorthand(&c, mech, me)) {
+        goto fail;
+    }
 
     const cJSON* hyd = json_obj(&c, root, "", "hydraulics", true);
     if (c.failed) goto fail;
@@ -418,6 +435,10 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         ls_param_notes(&c, m->hyd);
         pump_relief_notes(&c, m->hyd);
         json_flush_notes(&c);
+    }
+    if (chain_form) {
+        if (model_chain_bind(&c, m)) goto fail;
+        return m;
     }
 
     for (int k = 0; k < 2; ++k) {
@@ -604,29 +625,29 @@ typedef struct mech_entry {
     int optional; // a model may lack it: 0 then
 } mech_entry;
 static const mech_entry k_mech[] = {
-    MP_("mechanics.gravity", "mechanics", "gravity", gravity, R_GRAVITY),
-    MP_("mechanics.column.height", "mechanics", "column height", column_height, R_COLUMN_HEIGHT),
-    MP_("mechanics.column.mass", "mechanics", "column mass", column_mass, R_COLUMN_MASS),
-    MP_("mechanics.load_mass", "mechanics", "tip load", load_mass, R_LOAD),
+    MP_("mechanics.gravity", "mechanics", "gravity", gravity, MODEL_R_GRAVITY),
+    MP_("mechanics.column.height", "mechanics", "column height", column_height, MODEL_R_COLUMN_HEIGHT),
+    MP_("mechanics.column.mass", "mechanics", "column mass", column_mass, MODEL_R_COLUMN_MASS),
+    MP_("mechanics.load_mass", "mechanics", "tip load", load_mass, MODEL_R_LOAD),
     // The rating (optional): the load chart's cap and so the limiter's.
-    {"mechanics.rated_moment", "mechanics", "rated moment", offsetof(crane_mech, rated_moment), &R_RATED_MOMENT, 1},
-    {"mechanics.rated_load", "mechanics", "rated load", offsetof(crane_mech, rated_load), &R_RATED_LOAD, 1},
+    {"mechanics.rated_moment", "mechanics", "rated moment", offsetof(crane_mech, rated_moment), &MODEL_R_RATED_MOMENT, 1},
+    {"mechanics.rated_load", "mechanics", "rated load", offsetof(crane_mech, rated_load), &MODEL_R_RATED_LOAD, 1},
 #define MP_LINK_(i)                                                                           \
-    MP_("mechanics.links[" #i "].length", "links[" #i "]", "length", link[i].length, R_LINK_LENGTH), \
-    MP_("mechanics.links[" #i "].mass", "links[" #i "]", "mass", link[i].mass, R_LINK_MASS),         \
-    MP_("mechanics.links[" #i "].com", "links[" #i "]", "com", link[i].com, R_LINK_COM),             \
-    MP_("mechanics.links[" #i "].inertia", "links[" #i "]", "inertia", link[i].inertia, R_LINK_INERTIA), \
-    MP_("mechanics.links[" #i "].width", "links[" #i "]", "width", link[i].width, R_LINK_SECTION),   \
-    MP_("mechanics.links[" #i "].height", "links[" #i "]", "height", link[i].height, R_LINK_SECTION)
+    MP_("mechanics.links[" #i "].length", "links[" #i "]", "length", link[i].length, MODEL_R_LINK_LENGTH), \
+    MP_("mechanics.links[" #i "].mass", "links[" #i "]", "mass", link[i].mass, MODEL_R_LINK_MASS),         \
+    MP_("mechanics.links[" #i "].com", "links[" #i "]", "com", link[i].com, MODEL_R_LINK_COM),             \
+    MP_("mechanics.links[" #i "].inertia", "links[" #i "]", "inertia", link[i].inertia, MODEL_R_LINK_INERTIA), \
+    MP_("mechanics.links[" #i "].width", "links[" #i "]", "width", link[i].width, MODEL_R_LINK_SECTION),   \
+    MP_("mechanics.links[" #i "].height", "links[" #i "]", "height", link[i].height, MODEL_R_LINK_SECTION)
     MP_LINK_(0),
     MP_LINK_(1),
 #define MP_ACT_(i)                                                                                              \
-    MP_("mechanics.actuators[" #i "].base_mount[0]", "actuators[" #i "]", "base mount x", act[i].base_mount[0], R_MOUNT), \
-    MP_("mechanics.actuators[" #i "].base_mount[1]", "actuators[" #i "]", "base mount z", act[i].base_mount[1], R_MOUNT), \
-    MP_("mechanics.actuators[" #i "].rod_mount[0]", "actuators[" #i "]", "rod mount x", act[i].rod_mount[0], R_MOUNT),   \
-    MP_("mechanics.actuators[" #i "].rod_mount[1]", "actuators[" #i "]", "rod mount z", act[i].rod_mount[1], R_MOUNT),   \
+    MP_("mechanics.actuators[" #i "].base_mount[0]", "actuators[" #i "]", "base mount x", act[i].base_mount[0], MODEL_R_MOUNT), \
+    MP_("mechanics.actuators[" #i "].base_mount[1]", "actuators[" #i "]", "base mount z", act[i].base_mount[1], MODEL_R_MOUNT), \
+    MP_("mechanics.actuators[" #i "].rod_mount[0]", "actuators[" #i "]", "rod mount x", act[i].rod_mount[0], MODEL_R_MOUNT),   \
+    MP_("mechanics.actuators[" #i "].rod_mount[1]", "actuators[" #i "]", "rod mount z", act[i].rod_mount[1], MODEL_R_MOUNT),   \
     MP_("mechanics.actuators[" #i "].closed_length", "actuators[" #i "]", "closed length", act[i].closed_length,         \
-        R_CLOSED_LENGTH)
+        MODEL_R_CLOSED_LENGTH)
     MP_ACT_(0),
     MP_ACT_(1),
 };

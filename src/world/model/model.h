@@ -17,12 +17,16 @@ extern "C" {
 typedef struct model {
     char name[96];
     char file[256];      ///< path it was loaded from ("" if built in)
-    crane_mech mech;     ///< mechanics of the two-link shorthand (derived fields filled; chain.two_link)
+    /// Mechanics of the two-link shorthand (derived fields filled) when
+    /// chain.two_link; for a chain model only gravity, load_mass, the rating
+    /// and the column's height and mass are set, the links' and actuators'
+    /// numbers are NaN (model_require_two_link).
+    crane_mech mech;
     crane_chain chain;   ///< the crane as a chain: bodies, actuators, functions (every model; owned)
     hyd_model* hyd;      ///< compiled circuit (owned)
-    int cyl[2];          ///< hydraulic cylinder index of actuator k (lift, jib)
-    int valve[2];        ///< hydraulic valve index of actuator k
-    double stroke[2];    ///< cylinder strokes [m]
+    int cyl[2];          ///< hydraulic cylinder index of actuator k (lift, jib); -1 for a chain model
+    int valve[2];        ///< hydraulic valve index of actuator k; -1 for a chain model
+    double stroke[2];    ///< cylinder strokes [m]; NaN for a chain model
     cJSON* json;         ///< the document after --set overrides (owned), for saving
     /// Hose-burst orifices ("fault<i>_burst") at nodes the model's circuit
     /// lacks, for the world's circuit to add (engine_fault_model; the sandbox
@@ -45,6 +49,17 @@ model* model_load(const char* path, const char* const* sets, int nset, char* err
 model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz);
 
 void model_free(model* m);
+
+/// The one gate for every consumer of the two-link fields (mech's links and
+/// actuators, cyl, valve, stroke): the closed-form analytic path, the ODE
+/// world, the load chart, the limiter, the start-pose check. A chain model
+/// (mechanics.bodies: model.chain.two_link false) leaves those fields empty,
+/// so each such entry point calls this first and refuses the model rather
+/// than run the wrong crane. Returns 0 for a two-link model, else -1 with
+/// "model.json: a chain of 5 bodies and 4 functions; the <what> handles the
+/// two-link crane (mechanics.links) only" in err. When a path
+/// learns the chain, its call goes (grep model_require_two_link).
+int model_require_two_link(const model* m, const char* what, char* err, size_t errsz);
 
 /// Write the model's JSON (with overrides applied) to path. Returns 0 or -1.
 int model_save(const model* m, const char* path, char* err, size_t errsz);

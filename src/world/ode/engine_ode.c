@@ -1,10 +1,10 @@
 // engine_ode.c: the ODE world (ode_world.h: truck, slewing column, booms,
 // rope, hook, loads, terrain; the circuit sub-stepped inside each ODE step)
 // behind engine.h.
-#include "engine_impl.h"
+#include "engine_ode.h"
 #include "energy_acc.h"
 
-#include "ode_world.h"
+#include "ode_run.h"
 #include "rcl.h"
 
 #include <math.h>
@@ -40,8 +40,20 @@ static sim_start_load start_load(const model* m, const ode_world* w, const doubl
     return ld;
 }
 
+// A model whose crane is a chain of other shape than the two-link one
+// (crane_chain.two_link false): its crane_mech does not describe it, and
+// the ODE world of ode_world.h builds that two-link crane alone. The chain
+// world (ode_chain.h) builds any chain, but the engine's rows, commands and
+// views are still the two-link crane's: refused here, in one line, rather
+// than run as the wrong crane.
+static int refuse_chain(const model* m, char* err, size_t errsz) {
+    return model_require_two_link(m, "ode backend (its engine reads the two-link crane's strokes and commands)", err,
+                                  errsz);
+}
+
 static engine* ode_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           char* err, size_t errsz) {
+    if (refuse_chain(m, err, errsz)) return NULL;
     eng_ode* l = calloc(1, sizeof *l);
     if (!l) {
         snprintf(err, errsz, "out of memory");
@@ -49,18 +61,18 @@ static engine* ode_create(const model* m, const sim_opts* o, const double q0[2],
     }
     l->base.ops = &engine_ode_ops;
     l->base.o = *o;
-    l->w = sim_ode_world_create(m, o, "sandbox", q0, slew0, m3, err, errsz);
+    l->w = ode_world_for_run(m, o, "sandbox", q0, slew0, m3, err, errsz);
     if (!l->w) {
         free(l);
         return NULL;
     }
-    // The hydraulic sub-step is min(--dt, ODE step), as sim_ode_world_create sets it.
+    // The hydraulic sub-step is min(--dt, ODE step), as ode_world_for_run sets it.
     const double dt = ode_world_dt(l->w), h = o->h < dt ? o->h : dt;
     double row0[SIM_NCOL];
-    sim_ode_row(l->w, row0);
+    ode_world_row(l->w, row0);
     const sim_start_load ld = start_load(m, l->w, q0, m3);
+    l->base.h_probe = h; // the step probe follows in engine.c (engine_create_rcl)
     if (sim_check_fixed_step(ode_world_circuit(l->w), o, h, 0.0, err, errsz) ||
-        sim_check_step_probe(m, o, h, err, errsz) ||
         sim_check_start(ode_world_circuit(l->w), row0, SIM_NCOL, &ld, err, errsz)) {
         ode_world_destroy(l->w);
         free(l);
@@ -141,7 +153,7 @@ static const sim_collisions* ode_collisions(const engine* e) {
 static void ode_part_energy(const engine* e, double E[2]) { ode_world_part_energy(W(e), &E[0], &E[1]); }
 
 static double ode_time(const engine* e) { return ode_world_time(W(e)); }
-static void ode_row(engine* e, double row[SIM_NCOL]) { sim_ode_row(W(e), row); }
+static void ode_row(engine* e, double row[SIM_NCOL]) { ode_world_row(W(e), row); }
 static void ode_snapshot(engine* e, world_snapshot* s) { ode_world_snapshot(W(e), s); }
 
 // ---- Scripted runs (sim_run) ----
@@ -172,16 +184,17 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
                  sim_param_name(SIM_PARAM_MECHANICS));
         return res->status = SIM_REFUSED;
     }
-    ode_world* w = sim_ode_world_create(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
+    if (refuse_chain(m, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
+    ode_world* w = ode_world_for_run(m, o, "validation", sc->q0, sc->slew0, sim_load_mass(m, sc, o), res->message,
                                         sizeof res->message);
     if (!w) return res->status = SIM_REFUSED;
     res->fused = ode_world_fused(w);
     res->fast = ode_world_fast(w);
     const long ode_msgs = ode_world_messages(NULL);
-    const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as sim_ode_world_create
+    const double h_hyd = o->h < ode_world_dt(w) ? o->h : ode_world_dt(w); // as ode_world_for_run
     if ((res->status = sim_check_fixed_step(ode_world_circuit(w), o, h_hyd, c->t_end, res->message,
                                             sizeof res->message)) ||
-        (res->status = sim_check_step_probe(m, o, h_hyd, res->message, sizeof res->message))) {
+        (k->probe && (res->status = k->probe(m, o, h_hyd, res->message, sizeof res->message)))) {
         ode_world_destroy(w);
         return res->status;
     }
@@ -204,7 +217,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     engine_faults ef;
     engine_faults_init(&ef, ode_world_circuit(w));
     double w0 = sim_wall_time();
-    sim_ode_row(w, row);
+    ode_world_row(w, row);
     for (int k = 0; k < 4; ++k) res->p_peak[k] = row[COL_P1A + k];
     {
         // The start state too: a model value that overflows shows at t = 0.
@@ -240,7 +253,8 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     if (en) sim_energy_mech(en, ode_world_energy(w));
     // The rated capacity limiter between the scenario and the world, as
     // engine_set_commands has it for the stepped drivers.
-    struct rcl* lim = engine_rcl_create(m, o, "validation");
+    char wbuf[512];
+    struct rcl* lim = rcl_create(m, sim_world_path(o->world ? o->world : "validation", wbuf, sizeof wbuf));
     if (lim) row[COL_RCL_UTIL] = rcl_utilisation(lim, row);
     deliver(c, row);
     ++c->rows;
@@ -254,7 +268,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
         engine_faults_apply(&ef, ode_world_circuit(w), sc, tm);
         if (lim && o->rcl) {
             double now[SIM_NCOL], v[3];
-            sim_ode_row(w, now);
+            ode_world_row(w, now);
             rcl_filter(lim, now, u, v);
             memcpy(u, v, sizeof u);
         }
@@ -279,7 +293,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
             for (int k = 0; k < 4; ++k) res->p_peak[k] = fmax(res->p_peak[k], p[k]);
         }
         if ((i + 1) % nout && i + 1 != nstep) continue;
-        sim_ode_row(w, row);
+        ode_world_row(w, row);
         row[COL_T] = (double)(i + 1) * dt; // exact grid times, no accumulated round-off
         if (lim) row[COL_RCL_UTIL] = rcl_utilisation(lim, row);
         {
@@ -305,7 +319,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
     res->rows = c->rows;
     res->t_end = c->t_last_row;
     if (en) sim_energy_finish(en);
-    engine_rcl_destroy(lim);
+    rcl_destroy(lim);
     ode_world_destroy(w);
     res->peak_steps = true;
     const char* last;
@@ -326,7 +340,7 @@ static int ode_run(const model* m, const scenario* sc, const sim_opts* o, const 
 
 // An ode run is named by its world: a world given as a file path reads
 // "ode world FILE", a name "ode/NAME". The hydraulics are sub-stepped at
-// min(h, ODE step) (sim_ode_world_create).
+// min(h, ODE step) (ode_world_for_run).
 static void ode_describe(const sim_opts* o, engine_desc* d) {
     d->world = o->world ? o->world : "validation";
     snprintf(d->label, sizeof d->label, "ode%s%s", o->world && strchr(o->world, '/') ? " world " : "/", d->world);

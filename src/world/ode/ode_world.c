@@ -56,7 +56,7 @@ static void ode_fatal(int num, const char* msg, va_list ap) {
     exit(1);
 }
 
-static void ode_acquire(void) {
+void ow_ode_acquire(void) {
     if (g_ode.users++ == 0) {
         dInitODE2(0);
         dSetMessageHandler(ode_message);
@@ -65,7 +65,7 @@ static void ode_acquire(void) {
     }
 }
 
-static void ode_release(void) {
+void ow_ode_release(void) {
     if (--g_ode.users == 0) dCloseODE();
 }
 
@@ -74,7 +74,6 @@ static void ode_release(void) {
 // only ode_world_destroy may touch it. Nothing in fn may rely on running to
 // its end (the jump skips the rest of fn and of ODE's own frames): fn only
 // steps or reads the world, which is then discarded whole.
-enum { OW_ODE_FAILED = -1000 };
 typedef int (*ow_fn)(ode_world* w, void* arg);
 static int ow_trapped(ode_world* w, const char* what, ow_fn fn, void* arg) {
     jmp_buf jb;
@@ -96,6 +95,20 @@ static int ow_trapped(ode_world* w, const char* what, ow_fn fn, void* arg) {
     }
     g_ode.trap = &jb;
     const int rc = fn(w, arg);
+    g_ode.trap = prev;
+    return rc;
+}
+
+int ow_ode_call(int (*fn)(void* arg), void* arg, char* fatal, size_t n) {
+    jmp_buf jb;
+    jmp_buf* const prev = g_ode.trap;
+    if (setjmp(jb)) {
+        g_ode.trap = prev;
+        snprintf(fatal, n, "%s", g_ode.fatal);
+        return OW_ODE_FAILED;
+    }
+    g_ode.trap = &jb;
+    const int rc = fn(arg);
     g_ode.trap = prev;
     return rc;
 }
@@ -617,7 +630,7 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
         snprintf(err, errsz, "ode world: out of memory");
         return NULL;
     }
-    ode_acquire();
+    ow_ode_acquire();
     w->opt = opt;
     w->mech = *mech;
     crane_mech_derive(&w->mech);
@@ -674,7 +687,7 @@ void ode_world_destroy(ode_world* w) {
     ow_mesh_free(w);
     free(w->terrain);
     free(w);
-    ode_release();
+    ow_ode_release();
 }
 
 // ---- stepping ----

@@ -5,11 +5,16 @@
 // clock, read its row and its snapshot, and never ask which backend runs:
 // what differs is behind engine_ops (engine_impl.h). Scripted runs (run,
 // compare, study, bench) go through engine_run, which plays a scenario.
+// What they must know of a backend before one exists (its options, its
+// world, its defaults) is its row in engine_backend.h.
 #ifndef ENGINE_H
 #define ENGINE_H
 
+#include "engine_backend.h"
+#include "engine_faults.h"
+#include "engine_types.h"
 #include "scenario.h"
-#include "sim.h"
+#include "sim_base.h"
 #include "world_snapshot.h"
 
 #include <stdbool.h>
@@ -17,8 +22,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-typedef struct engine engine;
 
 /// The engine o->mechanics names, at joint angles q0 [rad], slew angle
 /// slew0 [rad] (ode only) and tip load m3 [kg] (lagrange, and the ode
@@ -32,19 +35,6 @@ void engine_destroy(engine* e);
 /// "lagrange" or "ode".
 const char* engine_backend_name(const engine* e);
 
-/// What the backend o->mechanics chooses says about a run with options o,
-/// for the drivers' reports: they print these fields instead of asking which
-/// backend runs.
-typedef struct engine_desc {
-    const char* backend;   ///< "lagrange", "ode"
-    const char* world;     ///< the world the options name ("validation" when none); "" without a world
-    char label[320];       ///< the run in summaries: "ode/validation", "ode world FILE" (a path), "lagrange/full"
-    char title[160];       ///< the run in plot titles: "ode/validation", "full"
-    double dt_outer;       ///< the rigid-body step the hydraulics are sub-stepped in [s] (the
-                           ///< options' value); 0: no such step
-    bool h_reduced;        ///< the fixed hydraulic step asked for is longer than dt_outer, which is used
-    const char* step_name; ///< what a peak over every step is taken over: "ODE step", "step"
-} engine_desc;
 void engine_describe(const sim_opts* o, engine_desc* d);
 /// The work a finished run r did, as its summary says it after "real time; ":
 /// "ODE step 1 ms, 30000 hydraulic sub-steps" or "200000 steps, 0 rejected,
@@ -130,10 +120,8 @@ void engine_circuit_state(engine* e, double* y, const hyd_data** in);
 /// The number of engine_channels.
 int engine_ncol(const engine* e);
 
-/// Called for each row engine_advance_to produces; non-zero stops it.
-typedef int (*engine_row_fn)(void* user, const double* row);
 /// Advance to simulated time t_to [s] (the ode world takes whole ODE steps:
-/// it ends on the step nearest t_to), then apply the run checks of sim.h
+/// it ends on the step nearest t_to), then apply the run checks of sim_base.h
 /// (sim_check_row) to the state reached and hand its row to row_fn (may be
 /// NULL). Returns 0; 1 on a numerical failure or a failed check (message
 /// from engine_error), after which the engine stays stopped and every
@@ -142,41 +130,18 @@ int engine_advance_to(engine* e, double t_to, engine_row_fn row_fn, void* user);
 /// Advance by dt [s], as engine_advance_to without a row callback.
 int engine_advance(engine* e, double dt);
 
-/// Where a scripted run's rows go (engine_run).
-typedef struct engine_sink {
-    engine_row_fn row; ///< each output row (may be NULL); non-zero stops the run
-    void* user;
-    bool rows;         ///< someone consumes rows: else (benchmarks) the output evaluation is skipped
-    bool summary;      ///< someone reads the summary: peaks over every step, not only the rows
-    double t_end;      ///< the run's end [s] (> 0; checked by the caller, sim_check_times)
-    /// NULL, or the energy balance to accumulate at every integration step
-    /// (energy_acc.h; at the rows with CVODE, whose steps are its own).
-    struct sim_energy* energy;
-} engine_sink;
 /// A scripted run from t = 0 to k->t_end: the engine o->mechanics names,
 /// built for scenario sc (its start pose, load and world), plays the
 /// scenario and hands a row every o->dt_out to k. The run checks and their
-/// messages are sim.h's; res as sim_run's (status 0, 1 numerical failure,
+/// messages are sim_base.h's; res as sim_run's (status 0, 1 numerical failure,
 /// 2 refused or stopped).
 int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
-/// The model a scenario with fault events runs on: a copy of m with a
-/// closed orifice to the tank at each node a hose burst names (engine_run
-/// makes it itself; a stepped driver passes it to engine_create). NULL with
-/// "file: faults[i].at: problem" in err.
-model* engine_fault_model(const model* m, const scenario* sc, char* err, size_t errsz);
-/// The bursts of m at nodes the model's circuit lacks (model.world_bursts)
-/// against the world circuit fragment that a backend appends (NULL: none,
-/// as in the lagrange backend and the validation world): 0 when each of
-/// their nodes is declared there (a volume, a hose, "<cylinder>.A"/".B"),
-/// else -1 with "scenario: faults[i].at: no node 'X' in the circuit of
-/// model.json" (and "or of world.json" when there is a fragment) in err.
-int engine_world_bursts(const model* m, const cJSON* fragment, const char* world_file, char* err, size_t errsz);
 /// The note for a dip below absolute zero the checks saw (sim_checks_note),
 /// or "".
 void engine_note(const engine* e, char* note, size_t n);
 const char* engine_error(const engine* e);
 /// The collisions since the engine was created (the ode sandbox: checked at
-/// every ODE step, as a scripted run counts them; sim.h), or NULL where the
+/// every ODE step, as a scripted run counts them; sim_base.h), or NULL where the
 /// world reports none (the lagrange view, the ode validation world).
 const sim_collisions* engine_collisions(const engine* e);
 
@@ -196,7 +161,7 @@ void engine_apply_faults(engine* e, const scenario* sc, double tm);
 
 /// Simulated time [s].
 double engine_time(const engine* e);
-/// The CSV row at the current time (sim.h columns; engine_ncol of them are set).
+/// The CSV row at the current time (sim_base.h columns; engine_ncol of them are set).
 void engine_row(engine* e, double row[SIM_NCOL]);
 struct rcl;
 /// The engine's rated capacity limiter (rcl.h), or NULL: it filters

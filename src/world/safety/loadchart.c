@@ -6,7 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "lagrange.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -96,8 +95,8 @@ static void joint_range(const model* m, int k, double* lo, double* hi) {
 double loadchart_hyd_pose(const model* m, double q1, double q2, double margin, int* gov) {
     const double q[2] = {q1, q2};
     double G0[2], G1[2];
-    lagrange_gravity(&m->mech, LAGRANGE_FULL, 0.0, q, G0);
-    lagrange_gravity(&m->mech, LAGRANGE_FULL, 1.0, q, G1);
+    crane_gravity(&m->mech, 0.0, q, G0);
+    crane_gravity(&m->mech, 1.0, q, G1);
     double best = INFINITY;
     int g = 0;
     for (int k = 0; k < 2; ++k) {
@@ -213,6 +212,7 @@ static int poses_at(const model* m, double R, double (*pose)[2], int cap) {
 
 int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz) {
     memset(c, 0, sizeof *c);
+    if (model_require_two_link(m, "load chart", err, errsz)) return -1;
     if (lc_check_opts(o, err, errsz)) return -1;
     for (int k = 0; k < 2; ++k) {
         double pr[2];

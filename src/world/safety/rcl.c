@@ -3,10 +3,10 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
-#include "lagrange.h"
-#include "sim.h"
+#include "sim_base.h"
 
 // Outreach below which the load moment is divided by this lever instead
 // [m]: close to the column the moment, and its measurement, go to zero.
@@ -17,6 +17,7 @@
 int rcl_init(rcl* r, const model* m, const world_desc* wd, char* err, size_t errsz) {
     memset(r, 0, sizeof *r);
     r->m = m;
+    if (model_require_two_link(m, "rated capacity limiter", err, errsz)) return -1;
     double st;
     hyd_model_cylinder_geometry(m->hyd, m->cyl[0], &r->AA, &r->AB, &st);
     r->stroke = st;
@@ -46,6 +47,20 @@ int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, si
 
 void rcl_free(rcl* r) { loadchart_free(&r->chart); }
 
+rcl* rcl_create(const model* m, const char* world_path) {
+    char err[300];
+    rcl* r = malloc(sizeof *r);
+    if (r && rcl_init_world(r, m, world_path, err, sizeof err)) {
+        free(r);
+        r = NULL;
+    }
+    return r;
+}
+
+void rcl_destroy(rcl* r) {
+    if (r) rcl_free(r), free(r);
+}
+
 void rcl_reset(rcl* r) {
     const rcl keep = *r;
     memset(r, 0, sizeof *r);
@@ -60,7 +75,7 @@ static double load_moment(const rcl* r, const double* row, double* R) {
     const double q[2] = {row[COL_Q1], row[COL_Q2]};
     double lever, G0[2], z;
     crane_pin_length(&me->act[0], q[0], &lever);
-    lagrange_gravity(me, LAGRANGE_FULL, 0.0, q, G0);
+    crane_gravity(me, 0.0, q, G0);
     crane_tip(me, q[0], q[1], R, &z);
     const double F = row[COL_P1A] * r->AA - row[COL_P1B] * r->AB;
     return F * lever - G0[0] - r->chart.hook_mass * me->gravity * *R;

@@ -60,6 +60,11 @@ int rcl_init(rcl* r, const model* m, const world_desc* wd, char* err, size_t err
 /// As rcl_init, for the world file of an ode run (NULL: no world, lagrange).
 int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, size_t errsz);
 void rcl_free(rcl* r);
+/// rcl_init_world on a new limiter (world_path NULL: no world), or NULL
+/// when its chart cannot be made or memory is short; rcl_destroy frees it
+/// (NULL is fine). The engine and the ode run make theirs this way.
+rcl* rcl_create(const model* m, const char* world_path);
+void rcl_destroy(rcl* r);
 /// Start again: the state rcl_init leaves (no measurement, nothing cut),
 /// keeping the chart.
 void rcl_reset(rcl* r);

@@ -4,7 +4,12 @@
 #ifndef ENGINE_IMPL_H
 #define ENGINE_IMPL_H
 
-#include "engine.h"
+#include "engine_faults.h"
+#include "engine_types.h"
+#include "model.h"
+#include "scenario.h"
+#include "sim_base.h"
+#include "world_snapshot.h"
 
 typedef struct engine_ops {
     const char* name; ///< "lagrange", "ode"
@@ -49,35 +54,24 @@ typedef struct engine_ops {
     int (*follow_energy)(engine* e, struct sim_energy* en);
 } engine_ops;
 
-/// Fault events of a scenario (scenario.h) applied to a running circuit:
-/// each backend's scripted run calls engine_faults_apply at every step or
-/// breakpoint with the circuit it integrates. The bursts' orifices were
-/// added, closed, by engine_run (engine_fault_model).
-typedef struct engine_faults {
-    int pump;      ///< the pump component, or -1
-    double qmax0;  ///< its flow before any stop [m^3/s]
-} engine_faults;
-void engine_faults_init(engine_faults* f, const hyd_model* hm);
-/// Sets the burst areas and the pump's flow for time t [s]; only values
-/// that change are set (each set re-derives the circuit). Returns 1 if any
-/// changed.
-int engine_faults_apply(const engine_faults* f, hyd_model* hm, const scenario* sc, double t);
-
 struct engine {
     const engine_ops* ops;
     sim_opts o;
     char err[512];
-    sim_checks chk; ///< the run checks every driver applies (sim.h)
+    sim_checks chk; ///< the run checks every driver applies (sim_base.h)
     bool failed;    ///< a check or the step failed: the engine stays stopped
     engine_faults faults; ///< for engine_play's fault events (faults_ready once initialised)
     bool faults_ready;
     struct rcl* rcl;      ///< the rated capacity limiter (engine.c), or NULL where its chart failed
+    double h_probe;       ///< the fixed hydraulic step the backend integrates with [s], set by its create:
+                          ///< engine.c applies the step probe (sim_check_step_probe) to it
     double u_op[3];       ///< the operator's last commands lift, jib, slew, as given to engine_set_commands [-]
     double u_lim[3];      ///< what the limiter let through of them [-] (u_op when it cut nothing)
     const model* mdl;     ///< the model it was made from (its chain's functions: engine_function_name)
 };
 
-extern const engine_ops engine_lagrange_ops, engine_ode_ops;
+// Each backend declares its engine_ops in its own folder (engine_lagrange.h,
+// engine_ode.h); engine.c, which chooses among them, includes those.
 
 
 #endif

@@ -1,0 +1,95 @@
+// ode_chain.h: the ODE world built from a crane chain (crane_chain.h): one
+// ODE body per chain body, a hinge per revolute joint, a slider per
+// prismatic one, the column fixed (or slewing on a hinge about z), joint
+// limits and the cylinders' end stops as ODE stops, each actuator's force
+// applied at its two pins; the model's circuit sub-stepped inside each ODE
+// step as ode_coupling.c does for the two-link world (docs/ode_world.md,
+// "The chain world").
+//
+// The validation world only: the column stands on the fixed ground, the tip
+// load is merged into the tip body, no contacts. Units SI (m, kg, s, rad, N);
+// joint coordinates and their order are the mechanism's (chain.h: the DOFs
+// are the joints that are not fixed, in body order; q from each joint's
+// angle0 and offset0, as chain_update reads it).
+#ifndef ODE_CHAIN_H
+#define ODE_CHAIN_H
+
+#include <stddef.h>
+
+#include "crane_chain.h"
+#include "hyd_solver.h"
+#include "hydraulics.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct ode_chain ode_chain;
+
+typedef struct ode_chain_opts {
+    double dt_ode;         ///< ODE step [s]; default 1e-3
+    double dt_hyd;         ///< hydraulic sub-step [s]; default 1e-4; dt_ode must be a whole multiple
+    hyd_method solver;     ///< hydraulic integrator, a fixed-step one; default HYD_KRUS
+    int jac_every;         ///< reuse the hydraulic Jacobian for this many sub-steps; default 1 (see docs)
+    double tip_mass;       ///< point mass at the chain's tip, merged into its body [kg]; default 0
+    const double* q0;      ///< start joint coordinates [rad or m], one per DOF; NULL: all 0
+    double slew0;          ///< a fixed column: its slew [rad]; default 0
+    double erp, cfm;       ///< ODE's joint error reduction and mixing; default 0.2, 1e-10 (the validation world's)
+    int stop_limits;       ///< 1 (default): the cylinders' stroke ends as joint stops where they can be
+    hyd_model* circuit;    ///< the compiled circuit (borrowed); NULL: no hydraulics (forces from
+                           ///< ode_chain_set_forces)
+    int init_hold;         ///< 1 (default): start pressures that hold the start pose under gravity
+    double p_low;          ///< init_hold: pressure of the unloaded side [Pa abs]; default 2e6
+    const char* model_file; ///< in messages; default "model"
+} ode_chain_opts;
+
+ode_chain_opts ode_chain_default_opts(void);
+
+/// Builds the world from cc (copied; its actuators bound to o->circuit when
+/// given). NULL with one line "file: field: problem" in err: a chain the
+/// mechanism refuses, a body ODE cannot move (no mass), a joint limit more
+/// than half a turn from a hinge's start, an actuator's start stroke outside
+/// [0, stroke], two actuators on one cylinder, a q0 ODE cannot build.
+ode_chain* ode_chain_create(const crane_chain* cc, const ode_chain_opts* o, char* err, size_t errsz);
+void ode_chain_destroy(ode_chain* w);
+
+int ode_chain_ndof(const ode_chain* w);
+int ode_chain_nact(const ode_chain* w);
+int ode_chain_nfn(const ode_chain* w);
+
+/// Valve commands, one per function, in [-1, 1] (clamped; NaN reads 0), held.
+void ode_chain_set_commands(ode_chain* w, const double* u);
+/// Actuator forces [N] (+ pushes the pins apart), held; only without a
+/// circuit (the circuit's forces replace them at every step).
+void ode_chain_set_forces(ode_chain* w, const double* F);
+/// Extra generalized joint forces, one per DOF (torque [N m] about a
+/// revolute joint in the direction of +q, force [N] along a slide), held.
+void ode_chain_set_joint_forces(ode_chain* w, const double* tau);
+
+/// Advance by dt [s] (a whole number of ODE steps, at least one). 0, or -1
+/// once a body or a hydraulic state went non-finite or ODE failed
+/// (ode_chain_error says which and when); the world then stays stopped.
+int ode_chain_step(ode_chain* w, double dt);
+const char* ode_chain_error(const ode_chain* w);
+double ode_chain_time(const ode_chain* w);
+
+/// Joint coordinates q and rates qd (ndof each; either may be NULL).
+void ode_chain_q(const ode_chain* w, double* q, double* qd);
+/// Actuator k's pin length [m] and its rate [m/s] (rate may be NULL);
+/// stroke = length - closed_length.
+double ode_chain_act_length(const ode_chain* w, int k, double* rate);
+/// Actuator k's force as applied over the last step [N], and its chamber
+/// pressures [Pa abs] (0 without a circuit; pA, pB may be NULL).
+double ode_chain_act_force(const ode_chain* w, int k, double* pA, double* pB);
+/// The tip in the base frame [m] and its velocity [m/s] (v may be NULL).
+void ode_chain_tip(const ode_chain* w, double p[3], double v[3]);
+/// Body i's pose: rotation R (row-major, columns its axes) and origin p [m]
+/// (its joint, not its centre of mass), as chain_body_pose gives them.
+void ode_chain_body_pose(const ode_chain* w, int i, double R[9], double p[3]);
+/// 1 when actuator k is at an end stop (its joint's stop or the cylinder's own).
+int ode_chain_act_at_stop(const ode_chain* w, int k);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
