@@ -348,7 +348,7 @@ static void load_actuator(json_ctx* c, const cJSON* arr, int i, crane_actuator* 
 // two actuators by joint (hiab031.json). 0, or -1 with the error in c.
 static int read_shorthand(json_ctx* c, const cJSON* mech, crane_mech* me) {
     static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", "rated_moment",
-                                         "rated_load", NULL};
+                                         "rated_load", "slew", NULL};
     json_only_keys(c, mech, "mechanics", mkeys);
     me->gravity = json_num_r(c, mech, "mechanics", "gravity", false, 9.81, &MODEL_R_GRAVITY);
     const cJSON* col = json_obj(c, mech, "mechanics", "column", true);
@@ -390,7 +390,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     json_ctx c = {.file = file, .err = err, .errsz = errsz};
     if (!cJSON_IsObject(root)) json_fail(&c, "", "a model must be a JSON object");
     if (json_wrong_kind(&c, root, "model")) goto fail;
-    static const char* const keys[] = {"name", "description", "mechanics", "hydraulics", NULL};
+    static const char* const keys[] = {"name", "description", "mechanics", "hydraulics", "hydraulics_slew", NULL};
     json_only_keys(&c, root, "", keys);
     json_str(&c, root, "", "name", false, "crane", m->name, sizeof m->name);
 
@@ -406,6 +406,10 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     } else if (read_shorthand(&c, mech, me)) {
         goto fail;
     }
+    // The slew drive, the same in both forms; it joins the chain once that
+    // is built (both builders start from an empty chain).
+    crane_slew slew;
+    if (model_slew_read(&c, root, mech, &slew)) goto fail;
 
     const cJSON* hyd = json_obj(&c, root, "", "hydraulics", true);
     if (c.failed) goto fail;
@@ -436,8 +440,11 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         pump_relief_notes(&c, m->hyd);
         json_flush_notes(&c);
     }
+    if (model_slew_check(&c, root, &slew)) goto fail;
+    json_flush_notes(&c);
     if (chain_form) {
         if (model_chain_bind(&c, m)) goto fail;
+        m->chain.slew = slew;
         return m;
     }
 
@@ -474,6 +481,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         snprintf(err, errsz, "%s: %s", file, cerr);
         goto fail;
     }
+    m->chain.slew = slew;
     return m;
 fail: // err already holds the one-line message
     model_free(m);
