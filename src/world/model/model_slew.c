@@ -73,56 +73,67 @@ static void check_part(json_ctx* c, const cJSON* frag, const char* field, const 
                   cJSON_IsString(t) ? t->valuestring : "component without a type", type);
 }
 
-int model_slew_check(json_ctx* c, const cJSON* root, const crane_slew* s) {
-    if (!s->present) return 0;
-    const cJSON* frag = cJSON_GetObjectItemCaseSensitive(root, "hydraulics_slew");
-    check_part(c, frag, "cylinder", s->cylinder, "cylinder");
-    check_part(c, frag, "valve", s->valve, "valve");
-    if (c->failed) return -1;
+hyd_model* model_circuit_with_fragment(const cJSON* hydraulics, const char* mfile, const cJSON* frag,
+                                       const char* ffile, const char* fpart, char* err, size_t errsz) {
+    cJSON* h = cJSON_Duplicate(hydraulics, 1);
+    cJSON* fx = cJSON_Duplicate(frag, 1);
+    if (!h || !fx) {
+        snprintf(err, errsz, "%s: %s: out of memory", ffile, fpart);
+        cJSON_Delete(h);
+        cJSON_Delete(fx);
+        return NULL;
+    }
     // The patch rewires the model's own components ("component.field":
     // "node", the LS shuttle's output): the component must exist and the
     // field name a node already, so a patch moves a port and nothing else.
-    cJSON* h = cJSON_Duplicate(cJSON_GetObjectItemCaseSensitive(root, "hydraulics"), 1);
-    cJSON* fx = cJSON_Duplicate(frag, 1);
-    if (!h || !fx) {
-        json_fail(c, "hydraulics_slew", "out of memory");
-        cJSON_Delete(h);
-        cJSON_Delete(fx);
-        return -1;
-    }
+    bool bad = false;
     const cJSON* it;
     cJSON_ArrayForEach(it, cJSON_GetObjectItemCaseSensitive(frag, "patch")) {
-        char f[160], comp[128];
-        snprintf(f, sizeof f, "hydraulics_slew.patch.%s", it->string);
+        char comp[128];
         const char* dot = strchr(it->string, '.');
         if (!dot || dot == it->string || !dot[1]) {
-            json_fail(c, f, "expected \"component.field\" as the key");
+            snprintf(err, errsz, "%s: %s.patch.%s: expected \"component.field\" as the key", ffile, fpart, it->string);
+            bad = true;
             break;
         }
         if (!cJSON_IsString(it) || !it->valuestring[0]) {
-            json_fail(c, f, "expected a node name (a string)");
+            snprintf(err, errsz, "%s: %s.patch.%s: expected a node name (a string)", ffile, fpart, it->string);
+            bad = true;
             break;
         }
         snprintf(comp, sizeof comp, "%.*s", (int)(dot - it->string), it->string);
         cJSON* e = find_comp(cJSON_GetObjectItemCaseSensitive(h, "components"), comp);
         const cJSON* fv = e ? cJSON_GetObjectItemCaseSensitive(e, dot + 1) : NULL;
         if (!cJSON_IsString(fv)) {
-            json_fail(c, f, e ? "hydraulics.components %s has no port field %s" : "no component %s in hydraulics%s",
-                      comp, e ? dot + 1 : "");
+            // The wording of the sandbox's own check (ode_coupling.c).
+            snprintf(err, errsz, "%s: %s.patch.%s: %s %s in %s", ffile, fpart, it->string,
+                     e ? "no port field" : "no component", e ? dot + 1 : comp, mfile);
+            bad = true;
             break;
         }
         cJSON_ReplaceItemInObjectCaseSensitive(e, dot + 1, cJSON_CreateString(it->valuestring));
     }
     cJSON_DeleteItemFromObjectCaseSensitive(fx, "patch");
-    hyd_model* hm = NULL;
-    if (!c->failed) {
-        // The merged circuit as the sandbox compiles it: an error in the
-        // fragment names hydraulics_slew and its own index.
-        hm = hyd_model_from_json_extra(h, c->file, "hydraulics", fx, c->file, "hydraulics_slew", c->err, c->errsz);
-        if (!hm) c->failed = true;
-    }
-    hyd_model_free(hm);
+    // An error in the fragment names its own file, field and index.
+    hyd_model* hm = bad ? NULL : hyd_model_from_json_extra(h, mfile, "hydraulics", fx, ffile, fpart, err, errsz);
     cJSON_Delete(h);
     cJSON_Delete(fx);
-    return c->failed ? -1 : 0;
+    return hm;
+}
+
+int model_slew_check(json_ctx* c, const cJSON* root, const crane_slew* s) {
+    if (!s->present) return 0;
+    const cJSON* frag = cJSON_GetObjectItemCaseSensitive(root, "hydraulics_slew");
+    check_part(c, frag, "cylinder", s->cylinder, "cylinder");
+    check_part(c, frag, "valve", s->valve, "valve");
+    if (c->failed) return -1;
+    // The merged circuit as the sandbox compiles it.
+    hyd_model* hm = model_circuit_with_fragment(cJSON_GetObjectItemCaseSensitive(root, "hydraulics"), c->file, frag,
+                                                c->file, "hydraulics_slew", c->err, c->errsz);
+    if (!hm) {
+        c->failed = true;
+        return -1;
+    }
+    hyd_model_free(hm);
+    return 0;
 }

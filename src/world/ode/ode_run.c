@@ -47,11 +47,21 @@ int ode_world_take_model_slew(const model* m, world_desc* wd, char* err, size_t 
     // The model's drive wins: it is the crane's hardware, the world's is the
     // fallback for models without one. Said once where it changes something.
     const cJSON* own = world_desc_circuit_for(wd, hyd);
+    const char* wf = wd->file[0] ? wd->file : "world";
+    const char* part = own == wd->circuit_ls ? "circuit_ls" : "circuit";
+    if (own) {
+        // The world's own fragment is still checked against this model, as
+        // it was when it was used: a world file that was refused before is
+        // refused now, whichever slew runs.
+        hyd_model* hm = model_circuit_with_fragment(hyd, m->file, own, wf, part, err, errsz);
+        if (!hm) return -1;
+        hyd_model_free(hm);
+    }
     if (own && (!same_slew(&wd->slew, sl) || !cJSON_Compare(own, frag, 1))) {
         char line[768];
         snprintf(line, sizeof line,
-                 "%s: slew, %s: the model's slew drive (%s: mechanics.slew, hydraulics_slew) is used instead",
-                 wd->file[0] ? wd->file : "world", own == wd->circuit_ls ? "circuit_ls" : "circuit", m->file);
+                 "%s: slew, %s: the model's slew drive (%s: mechanics.slew, hydraulics_slew) is used instead", wf,
+                 part, m->file);
         hyd_note(line);
     }
     cJSON* dup = cJSON_Duplicate(frag, 1);
@@ -134,8 +144,9 @@ ode_world* ode_world_for_run(const model* m, const sim_opts* o, const char* defa
         // there: their orifices join the world's part of the circuit, which
         // only the sandbox appends (ow_hyd_create).
         cJSON* frag = wd.kind == WORLD_SANDBOX ? (cJSON*)world_desc_circuit_for(&wd, hyd) : NULL;
-        const char* src = wd.slew_file[0] ? wd.slew_file : wpath; // the model's, where its slew is used
-        const char* wf = strrchr(src, '/') ? strrchr(src, '/') + 1 : src;
+        // The world's part of the circuit, or the model's hydraulics_slew
+        // where the model's slew drive replaced it.
+        const char* wf = wd.slew_file[0] ? "its hydraulics_slew" : strrchr(wpath, '/') ? strrchr(wpath, '/') + 1 : wpath;
         cJSON* comps = frag ? cJSON_GetObjectItemCaseSensitive(frag, "components") : NULL;
         if (engine_world_bursts(m, cJSON_IsArray(comps) ? frag : NULL, wf, err, errsz)) {
             world_desc_free(&wd);
