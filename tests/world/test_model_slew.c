@@ -90,8 +90,8 @@ static void test_chain_form(void) {
     model_free(m);
 }
 
-// The model edited by the assignments (NULL-terminated; "-key" deletes a
-// top-level or mechanics member) must fail with every needle in one line.
+// The model edited by the assignments (NULL-terminated; "-path" deletes a
+// member, "@key" adds a patch entry, "+name" a component) must fail with every needle in one line.
 static void expect_error(const char* base, const char* const* edits, const char* needle1, const char* needle2) {
     cJSON* root = shipped(base);
     if (!root) {
@@ -100,11 +100,17 @@ static void expect_error(const char* base, const char* const* edits, const char*
     }
     for (const char* const* e = edits; *e; ++e) {
         if ((*e)[0] == '-') {
-            cJSON* mech = cJSON_GetObjectItemCaseSensitive(root, "mechanics");
-            if (!strncmp(*e + 1, "mechanics.", 10))
-                cJSON_DeleteItemFromObjectCaseSensitive(mech, *e + 11);
-            else
-                cJSON_DeleteItemFromObjectCaseSensitive(root, *e + 1);
+            // "-a.b.c" deletes member c of object a.b.
+            char path[128];
+            snprintf(path, sizeof path, "%s", *e + 1);
+            cJSON* o = root;
+            char* key = path;
+            for (char* dot; (dot = strchr(key, '.')); key = dot + 1) {
+                *dot = 0;
+                o = cJSON_GetObjectItemCaseSensitive(o, key);
+            }
+            CHECK(cJSON_GetObjectItemCaseSensitive(o, key) != NULL, "%s exists", *e);
+            cJSON_DeleteItemFromObjectCaseSensitive(o, key);
         } else if ((*e)[0] == '@') {
             // "@key" patches a port of a component the model does not have.
             cJSON* patch = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(root, "hydraulics_slew"),
@@ -139,6 +145,7 @@ static void test_bad_slew(void) {
     expect_error("hiab031.json", E("-mechanics.slew"), "hydraulics_slew", "mechanics has no slew");
     expect_error("hiab031.json", E("mechanics.slew.pinion_radius=5"), "mechanics.slew.pinion_radius", "1] m");
     expect_error("hiab031.json", E("mechanics.slew.column_radius=0"), "mechanics.slew.column_radius", "m");
+    expect_error("hiab031.json", E("-mechanics.slew.pinion_radius"), "mechanics.slew.pinion_radius", "missing");
     expect_error("hiab031.json", E("mechanics.slew.damping=-1"), "mechanics.slew.damping", "N m s/rad");
     expect_error("hiab031.json", E("mechanics.slew.cylinder=nope"), "mechanics.slew.cylinder",
                  "no cylinder named \"nope\" in hydraulics_slew");

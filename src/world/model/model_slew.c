@@ -37,8 +37,10 @@ int model_slew_read(json_ctx* c, const cJSON* root, const cJSON* mech, crane_sle
     s->pinion_radius = json_num_r(c, o, "mechanics.slew", "pinion_radius", true, 0, &R_PINION);
     json_str(c, o, "mechanics.slew", "cylinder", true, "", s->cylinder, sizeof s->cylinder);
     json_str(c, o, "mechanics.slew", "valve", true, "", s->valve, sizeof s->valve);
-    s->column_radius = json_num_r(c, o, "mechanics.slew", "column_radius", true, 0, &R_COLUMN_RADIUS);
-    s->damping = json_num_r(c, o, "mechanics.slew", "damping", false, 0, &R_SLEW_DAMPING);
+    // Absent: the defaults a world's slew section has (world_desc.c), so a
+    // section moved from a world into a model keeps its crane.
+    s->column_radius = json_num_r(c, o, "mechanics.slew", "column_radius", false, 0.16, &R_COLUMN_RADIUS);
+    s->damping = json_num_r(c, o, "mechanics.slew", "damping", false, 2000.0, &R_SLEW_DAMPING);
     json_only_keys(c, frag, "hydraulics_slew", (const char* const[]){"nodes", "components", "patch", NULL});
     json_arr(c, frag, "hydraulics_slew", "nodes", false);
     json_arr(c, frag, "hydraulics_slew", "components", true);
