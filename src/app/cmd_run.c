@@ -141,6 +141,10 @@ typedef struct csv_sink {
     FILE* f;     ///< opened at the first row
     long rows;
     int ncol;
+    /// A chain model's own columns (per actuator, function and degree of
+    /// freedom), which its rows carry after the ncol base columns; NULL for
+    /// the two-link crane.
+    const crane_chain* chain;
     int err;     ///< errno of the first failed open or write, 0 if none
     bool opened; ///< the file was created (as a temporary, renamed at the end)
     plot_keep keep;
@@ -165,10 +169,11 @@ static int csv_row(void* user, const double* row) {
             return 1;
         }
         s->opened = true;
-        sim_csv_header(s->f, s->ncol);
+        if (s->chain) sim_csv_header_ext(s->f, s->ncol, s->chain->col, s->chain->ncol);
+        else sim_csv_header(s->f, s->ncol);
     }
     errno = 0;
-    sim_csv_row(s->f, row, s->ncol);
+    sim_csv_row(s->f, row, s->ncol + (s->chain ? s->chain->ncol : 0));
     ++s->rows;
     s->t_last = row[COL_T];
     if (ferror(s->f)) {
@@ -388,7 +393,7 @@ int cmd_run(int argc, char** argv) {
     app_settle_unused(&c.sim);
     c.sim.rcl = rcl_on;
 
-    csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim),
+    csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim), .chain = m->chain.ncol > 0 ? &m->chain : NULL,
                      .st = {.xmin = {INFINITY, INFINITY}, .xmax = {-INFINITY, -INFINITY}}};
     static rcl mon;
     if (sink.ncol <= COL_RCL_UTIL) {

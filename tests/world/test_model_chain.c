@@ -563,6 +563,49 @@ out:
     model_free(d);
 }
 
+// A chain model's own output columns (crane_chain_columns): five per
+// actuator, two per function, two per degree of freedom, named after them
+// with their units; none for the two-link shorthand; crane_chain_row puts
+// each value under its name.
+static void test_chain_columns(void) {
+    model* m = load(CHAIN_3BOOM);
+    if (!m) return;
+    const crane_chain* cc = &m->chain;
+    const int ndof = crane_chain_ndof(cc);
+    // The column is fixed: lifting arm, end arm, jib2 and the extension move.
+    CHECK(ndof == 4 && crane_chain_dof_body(cc, 0) == 1 && crane_chain_dof_body(cc, 3) == 4, "ndof %d", ndof);
+    CHECK(cc->ncol == 5 * 4 + 2 * 4 + 2 * 4, "%d columns", cc->ncol);
+    static const struct {
+        int k;
+        const char *name, *unit;
+        bool p;
+    } want[] = {{0, "x_lift", "m", false},   {2, "pA_lift", "Pa", true},   {4, "F_lift", "N", false},
+                {19, "F_ext", "N", false},   {20, "u_lift", "-", false},   {27, "ucmd_ext", "-", false},
+                {28, "q_lifting_arm", "rad", false}, {33, "qd_jib2", "rad/s", false}, {34, "q_ext", "m", false},
+                {35, "qd_ext", "m/s", false}};
+    for (size_t i = 0; i < sizeof want / sizeof want[0] && cc->ncol == 36; ++i) {
+        const crane_column* c = &cc->col[want[i].k];
+        CHECK(!strcmp(c->name, want[i].name) && !strcmp(c->unit, want[i].unit) && c->pressure == want[i].p,
+              "column %d: %s [%s] pressure %d, want %s [%s]", want[i].k, c->name, c->unit, c->pressure, want[i].name,
+              want[i].unit);
+    }
+    // Each value lands under its name: value = 100 * group + index.
+    double x[4], v[4], pA[4], pB[4], F[4], u[4], uc[4], q[4], qd[4], out[36];
+    for (int i = 0; i < 4; ++i)
+        x[i] = 100 + i, v[i] = 200 + i, pA[i] = 300 + i, pB[i] = 400 + i, F[i] = 500 + i, u[i] = 600 + i,
+        uc[i] = 700 + i, q[i] = 800 + i, qd[i] = 900 + i;
+    const crane_chain_sample smp = {x, v, pA, pB, F, u, uc, q, qd};
+    crane_chain_row(cc, &smp, out);
+    CHECK(out[0] == 100 && out[3] == 400 && out[19] == 503 && out[20] == 600 && out[27] == 703 && out[28] == 800 &&
+              out[35] == 903,
+          "row %g %g %g %g %g %g %g", out[0], out[3], out[19], out[20], out[27], out[28], out[35]);
+    model_free(m);
+    char err[512];
+    model* h = model_load(NULL, NULL, 0, err, sizeof err);
+    CHECK(h && h->chain.two_link && h->chain.ncol == 0, "the shorthand has %d chain columns", h ? h->chain.ncol : -1);
+    model_free(h);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_hiab031_chain_equals_shorthand);
     RUN_TEST(test_models_load);
@@ -571,5 +614,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_stroke_check_edges);
     RUN_TEST(test_large_chain);
     RUN_TEST(test_two_link_consumers_refuse);
+    RUN_TEST(test_chain_columns);
     TEST_MAIN_END();
 }

@@ -37,7 +37,11 @@ typedef int (*engine_probe_fn)(const model* m, const sim_opts* o, double h, char
 
 /// Where a scripted run's rows go (engine_run).
 typedef struct engine_sink {
-    engine_row_fn row; ///< each output row (may be NULL); non-zero stops the run
+    /// Each output row (may be NULL); non-zero stops the run. A row holds the
+    /// backend's channels (engine_channels_for), and for a chain model
+    /// (model.chain.ncol > 0) the chain's own columns right after them
+    /// (crane_chain_row: per actuator, function and degree of freedom).
+    engine_row_fn row;
     void* user;
     bool rows;         ///< someone consumes rows: else (benchmarks) the output evaluation is skipped
     bool summary;      ///< someone reads the summary: peaks over every step, not only the rows

@@ -14,6 +14,7 @@ void crane_chain_free(crane_chain* cc) {
     free(cc->body);
     free(cc->act);
     free(cc->fn);
+    free(cc->col);
     memset(cc, 0, sizeof *cc);
 }
 
@@ -35,6 +36,17 @@ int crane_chain_copy(crane_chain* dst, const crane_chain* src) {
     memcpy(c.body, src->body, (size_t)src->nbody * sizeof *c.body);
     memcpy(c.act, src->act, (size_t)src->nact * sizeof *c.act);
     memcpy(c.fn, src->fn, (size_t)src->nfn * sizeof *c.fn);
+    c.col = NULL;
+    c.ncol = 0;
+    if (src->ncol > 0) {
+        c.col = malloc((size_t)src->ncol * sizeof *c.col);
+        if (!c.col) {
+            crane_chain_free(&c);
+            return -1;
+        }
+        memcpy(c.col, src->col, (size_t)src->ncol * sizeof *c.col);
+        c.ncol = src->ncol;
+    }
     *dst = c;
     return 0;
 }
@@ -119,7 +131,86 @@ int crane_chain_bind(crane_chain* cc, const hyd_model* h, char* err, size_t errs
             return -1;
         }
     }
+    if (crane_chain_columns(cc)) {
+        snprintf(err, errsz, "out of memory");
+        return -1;
+    }
     return 0;
+}
+
+// Body i's joint is a degree of freedom: the column's when it slews, any
+// other's unless locked (as crane_chain_mechanism builds the mechanism).
+static bool dof_joint(const crane_chain* cc, int i) { return i == 0 ? cc->slew_free : !cc->body[i].def.fixed; }
+
+int crane_chain_ndof(const crane_chain* cc) {
+    int n = 0;
+    for (int i = 0; i < cc->nbody; ++i) n += dof_joint(cc, i);
+    return n;
+}
+
+int crane_chain_dof_body(const crane_chain* cc, int k) {
+    for (int i = 0; i < cc->nbody; ++i)
+        if (dof_joint(cc, i) && k-- == 0) return i;
+    return -1;
+}
+
+int crane_chain_columns(crane_chain* cc) {
+    free(cc->col);
+    cc->col = NULL;
+    cc->ncol = 0;
+    if (cc->two_link) return 0;
+    const int ndof = crane_chain_ndof(cc);
+    const int n = 5 * cc->nact + 2 * cc->nfn + 2 * ndof;
+    if (n == 0) return 0;
+    crane_column* c = calloc((size_t)n, sizeof *c);
+    if (!c) return -1;
+    int k = 0;
+    for (int a = 0; a < cc->nact; ++a) {
+        static const char* const what[5] = {"x", "v", "pA", "pB", "F"};
+        static const char* const unit[5] = {"m", "m/s", "Pa", "Pa", "N"};
+        for (int j = 0; j < 5; ++j, ++k) {
+            snprintf(c[k].name, sizeof c[k].name, "%s_%s", what[j], cc->act[a].name);
+            c[k].unit = unit[j];
+            c[k].pressure = j == 2 || j == 3;
+        }
+    }
+    for (int f = 0; f < cc->nfn; ++f)
+        for (int j = 0; j < 2; ++j, ++k) {
+            snprintf(c[k].name, sizeof c[k].name, "%s_%s", j ? "ucmd" : "u", cc->fn[f].name);
+            c[k].unit = "-";
+        }
+    for (int d = 0; d < ndof; ++d) {
+        const crane_body* b = &cc->body[crane_chain_dof_body(cc, d)];
+        const bool slide = b->def.joint == CHAIN_PRISMATIC;
+        for (int j = 0; j < 2; ++j, ++k) {
+            snprintf(c[k].name, sizeof c[k].name, "%s_%s", j ? "qd" : "q", b->def.name);
+            c[k].unit = j ? (slide ? "m/s" : "rad/s") : (slide ? "m" : "rad");
+        }
+    }
+    cc->col = c;
+    cc->ncol = n;
+    return 0;
+}
+
+void crane_chain_row(const crane_chain* cc, const crane_chain_sample* s, double* out) {
+    if (cc->ncol == 0) return;
+    int k = 0;
+    for (int a = 0; a < cc->nact; ++a) {
+        out[k++] = s->x[a];
+        out[k++] = s->v[a];
+        out[k++] = s->pA[a];
+        out[k++] = s->pB[a];
+        out[k++] = s->F[a];
+    }
+    for (int f = 0; f < cc->nfn; ++f) {
+        out[k++] = s->u[f];
+        out[k++] = s->ucmd[f];
+    }
+    const int ndof = crane_chain_ndof(cc);
+    for (int d = 0; d < ndof; ++d) {
+        out[k++] = s->q[d];
+        out[k++] = s->qd[d];
+    }
 }
 
 chain* crane_chain_mechanism(const crane_chain* cc, double tip_mass, bool slew_free, double slew, char* err,

@@ -91,6 +91,24 @@ static inline double crane_slew_stroke(const crane_slew* sl, double theta, doubl
 /// Torque [N m] about the slew axis of a rack force F [N].
 static inline double crane_slew_torque(const crane_slew* sl, double F) { return F * sl->pinion_radius; }
 
+/// One output column of a chain crane beyond the run's base columns
+/// (crane_chain_columns): per actuator x_<a> [m], v_<a> [m/s], pA_<a>,
+/// pB_<a> [Pa], F_<a> [N]; per function u_<f>, ucmd_<f> [-]; per degree of
+/// freedom q_<body> [rad or m] and qd_<body> [rad/s or m/s].
+typedef struct crane_column {
+    char name[CRANE_NAME + 8];
+    const char* unit;
+    bool pressure; ///< an absolute pressure (the run checks judge it as one)
+} crane_column;
+
+/// The values of one row's chain columns, as a backend has them (arrays of
+/// nact, nfn and ndof entries; ndof as crane_chain_ndof).
+typedef struct crane_chain_sample {
+    const double *x, *v, *pA, *pB, *F; ///< per actuator [m, m/s, Pa, Pa, N]
+    const double *u, *ucmd;            ///< per function: spool, command [-]
+    const double *q, *qd;              ///< per degree of freedom
+} crane_chain_sample;
+
 /// The crane: bodies in chain order (body 0 the column), actuators, functions.
 typedef struct crane_chain {
     int nbody;
@@ -108,6 +126,10 @@ typedef struct crane_chain {
     /// backend may then run its closed-form fast path (lagrange.h), which
     /// handles exactly that shape and nothing else.
     bool two_link;
+    /// The chain's own output columns (crane_chain_columns; none for the
+    /// two-link shorthand, whose base columns say everything). Owned.
+    int ncol;
+    crane_column* col;
 } crane_chain;
 
 /// The chain of a two-link crane_mech: the column (fixed at slew 0, a solid
@@ -132,6 +154,19 @@ int crane_chain_bind(crane_chain* cc, const struct hyd_model* h, char* err, size
 /// [rad]). NULL with chain_create's message in err.
 chain* crane_chain_mechanism(const crane_chain* cc, double tip_mass, bool slew_free, double slew, char* err,
                              size_t errsz);
+
+/// The degrees of freedom of the chain as the backends integrate it: every
+/// body whose joint is not fixed, the column only when slew_free.
+int crane_chain_ndof(const crane_chain* cc);
+/// Body of DOF k (crane_chain_ndof order), or -1.
+int crane_chain_dof_body(const crane_chain* cc, int k);
+
+/// Makes the chain's output columns (cc->col, cc->ncol): none when
+/// two_link, else per actuator, per function and per DOF as crane_column
+/// says. 0, or -1 when out of memory. crane_chain_bind calls it.
+int crane_chain_columns(crane_chain* cc);
+/// Writes one row's chain columns (cc->ncol values) from s into out.
+void crane_chain_row(const crane_chain* cc, const crane_chain_sample* s, double* out);
 
 /// A deep copy (dst's arrays are new). 0, or -1 when out of memory.
 int crane_chain_copy(crane_chain* dst, const crane_chain* src);

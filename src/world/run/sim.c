@@ -21,6 +21,12 @@ void sim_csv_header(FILE* f, int ncol) {
     fputc('\n', f);
 }
 
+void sim_csv_header_ext(FILE* f, int ncol, const crane_column* ext, int next) {
+    for (int c = 0; c < ncol; ++c) fprintf(f, "%s%s", c ? "," : "", sim_channels[c].name);
+    for (int c = 0; c < next; ++c) fprintf(f, ",%s", ext[c].name);
+    fputc('\n', f);
+}
+
 void sim_csv_row(FILE* f, const double* row, int ncol) {
     // %.9g keeps 1e-9 relative precision: sub-micrometre strokes, mPa pressures.
     for (int c = 0; c < ncol; ++c) fprintf(f, "%s%.9g", c ? "," : "", row[c]);

@@ -39,6 +39,10 @@ int sim_run_energy(const model* m, const scenario* sc, const sim_opts* o, sim_ro
 int sim_ncol(const sim_opts* o);
 /// Write the CSV header line (the first ncol column names) to f.
 void sim_csv_header(FILE* f, int ncol);
+/// The header of ncol base columns followed by a chain model's own columns
+/// (crane_chain.col, next of them: per actuator, function and degree of
+/// freedom), as a chain backend's rows carry them after its base columns.
+void sim_csv_header_ext(FILE* f, int ncol, const crane_column* ext, int next);
 /// Write one row of ncol values; full precision, C locale.
 void sim_csv_row(FILE* f, const double* row, int ncol);
 
