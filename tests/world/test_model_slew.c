@@ -5,6 +5,8 @@
 // the world, the model's winning over a different one in the world.
 #include "check.h"
 
+#include "chain.h"
+#include "chain_crane.h"
 #include "json_util.h"
 #include "model.h"
 #include "ode_run.h"
@@ -362,6 +364,28 @@ static void test_slew_by_hand(void) {
         const double r = x_joint + l->com * cos(a[i]);
         I += Ixx * sin(a[i]) * sin(a[i]) + Izz * cos(a[i]) * cos(a[i]) + l->mass * r * r;
         x_joint += l->length * cos(a[i]);
+    }
+    // The mechanism library's slew inertia (the analytic mode's, once the
+    // slew is its degree of freedom): the same crane with the column free
+    // and of the drive's radius, q = {slew, q1, q2}; M[0][0] is I_zz.
+    {
+        chain_crane cr;
+        const chain_crane_opts co = {1, 0.0, rc};
+        CHECK(chain_from_crane_mech(me, 0.0, &co, &cr) == 0, "chain_from_crane_mech");
+        char cerr[256] = "";
+        chain* ch = chain_create(cr.body, 3, (const double[3]){0, 0, -me->gravity}, cerr, sizeof cerr);
+        CHECK(ch != NULL, "%s", cerr);
+        if (ch) {
+            chain_ws* ws = chain_ws_create(ch);
+            const double q[3] = {0.0, o.q0[0], o.q0[1]}, qd[3] = {0, 0, 0};
+            chain_update(ch, ws, q, qd);
+            double M[9];
+            chain_mass_matrix(ch, ws, M);
+            printf("  slew inertia: by hand %.6f, mechanism M[0][0] %.6f kg m^2\n", I, M[0]);
+            CHECK_REL(M[0], I, 1e-12);
+            chain_ws_free(ws);
+            chain_free(ch);
+        }
     }
     const double r = 0.12, c = 500, h = 1e-3;
     const double u[3] = {0, 0, 1.0};
