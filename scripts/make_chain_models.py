@@ -302,7 +302,10 @@ def hiab031_chain(base):
             "rod": {"body": L[j]["name"], "point": [rm[0], 0, rm[1]]},
             "closed_length": a["closed_length"]})
         doc["mechanics"]["functions"].append({"name": a["name"], "valve": a["valve"]})
+    # The slew drive, as the shorthand has it (both forms take it as it is).
+    doc["mechanics"]["slew"] = m["slew"]
     doc["hydraulics"] = base["hydraulics"]
+    doc["hydraulics_slew"] = base["hydraulics_slew"]
     return doc
 
 
