@@ -276,7 +276,9 @@ def hiab031_chain(base):
         "mechanics": {
             "gravity": m["gravity"], "load_mass": m["load_mass"],
             "rated_moment": m["rated_moment"], "rated_load": m["rated_load"],
-            "bodies": [{"name": "column", "joint": "slew", "height": h, "mass": m["column"]["mass"], "radius": 0.1}],
+            "bodies": [{"name": "column", "joint": "slew", "height": h, "mass": m["column"]["mass"],
+                        # the slew drive's column: one column, one radius
+                        "radius": m["slew"]["column_radius"] if "slew" in m else 0.1}],
             "tip": {"body": L[1]["name"], "point": [L[1]["length"], 0, 0]},
             "actuators": [], "functions": []}}
     for i, l in enumerate(L):

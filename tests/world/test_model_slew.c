@@ -6,7 +6,6 @@
 #include "check.h"
 
 #include "chain.h"
-#include "chain_crane.h"
 #include "json_util.h"
 #include "model.h"
 #include "ode_run.h"
@@ -86,6 +85,14 @@ static void test_chain_form(void) {
     CHECK(cc.slew.present && !strcmp(cc.slew.cylinder, "slew_cyl") && !strcmp(cc.slew.valve, "slew_valve"),
           "copied slew");
     crane_chain_free(&cc);
+    model_free(m);
+    // One column, one radius.
+    cJSON* two = load_json(CRANESIM_TESTDATA "/hiab031_chain.json");
+    set(two, "mechanics.slew.column_radius=0.2");
+    m = model_from_json(two, "chain_bad.json", err, sizeof err);
+    CHECK(m == NULL && strstr(err, "chain_bad.json: mechanics.slew.column_radius: 0.2 m is not the column's radius "
+                                   "(mechanics.bodies[0].radius, 0.16 m)"),
+          "chain form radius: \"%s\"", err);
     model_free(m);
     // The chain form's errors name the same fields.
     cJSON* bad = load_json(CRANESIM_TESTDATA "/hiab031_chain.json");
@@ -369,15 +376,12 @@ static void test_slew_by_hand(void) {
         I += Ixx * sin(a[i]) * sin(a[i]) + Izz * cos(a[i]) * cos(a[i]) + l->mass * r * r;
         x_joint += l->length * cos(a[i]);
     }
-    // The mechanism library's slew inertia (the analytic mode's, once the
-    // slew is its degree of freedom): the same crane with the column free
-    // and of the drive's radius, q = {slew, q1, q2}; M[0][0] is I_zz.
+    // The model's chain with its column freed (the analytic mode's, once
+    // the slew is its degree of freedom), q = {slew, q1, q2}: M[0][0] is
+    // I_zz. Its column is the drive's (column_radius), as the sandbox's.
     {
-        chain_crane cr;
-        const chain_crane_opts co = {1, 0.0, rc};
-        CHECK(chain_from_crane_mech(me, 0.0, &co, &cr) == 0, "chain_from_crane_mech");
         char cerr[256] = "";
-        chain* ch = chain_create(cr.body, 3, (const double[3]){0, 0, -me->gravity}, cerr, sizeof cerr);
+        chain* ch = crane_chain_mechanism(&m->chain, 0.0, true, 0.0, cerr, sizeof cerr);
         CHECK(ch != NULL, "%s", cerr);
         if (ch) {
             chain_ws* ws = chain_ws_create(ch);
@@ -385,7 +389,7 @@ static void test_slew_by_hand(void) {
             chain_update(ch, ws, q, qd);
             double M[9];
             chain_mass_matrix(ch, ws, M);
-            printf("  slew inertia: by hand %.6f, mechanism M[0][0] %.6f kg m^2\n", I, M[0]);
+            printf("  slew inertia: by hand %.6f, the model's chain M[0][0] %.6f kg m^2\n", I, M[0]);
             CHECK_REL(M[0], I, 1e-12);
             chain_ws_free(ws);
             chain_free(ch);

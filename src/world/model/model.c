@@ -3,6 +3,7 @@
 #include "model_chain.h"
 #include "param_names.h"
 
+#include "chain_crane.h"
 #include "hydraulics.h"
 #include "json_util.h"
 
@@ -410,6 +411,14 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     // is built (both builders start from an empty chain).
     crane_slew slew;
     if (model_slew_read(&c, root, mech, &slew)) goto fail;
+    // One column, one radius: the chain form gives the column's body its own
+    // (its inertia about the slew axis, 1/2 m r^2, is what the drive turns).
+    if (chain_form && slew.present && 0.5 * m->chain.body[0].width != slew.column_radius) {
+        json_fail(&c, "mechanics.slew.column_radius",
+                  "%g m is not the column's radius (mechanics.bodies[0].radius, %g m): one column, one radius",
+                  slew.column_radius, 0.5 * m->chain.body[0].width);
+        goto fail;
+    }
 
     const cJSON* hyd = json_obj(&c, root, "", "hydraulics", true);
     if (c.failed) goto fail;
@@ -480,6 +489,16 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     if (crane_chain_from_mech(me, &m->chain, cerr, sizeof cerr) || crane_chain_bind(&m->chain, m->hyd, cerr, sizeof cerr)) {
         snprintf(err, errsz, "%s: %s", file, cerr);
         goto fail;
+    }
+    if (slew.present) {
+        // The shorthand's column as the sandbox builds it: a solid cylinder
+        // of the drive's column radius (crane_chain_from_mech's is 0.1 m),
+        // so that the chain's inertia about the slew axis is the sandbox's.
+        chain_crane cr;
+        const chain_crane_opts co = {0, 0.0, slew.column_radius};
+        chain_from_crane_mech(me, 0.0, &co, &cr); // its actuators were checked above
+        m->chain.body[0].def = cr.body[0];
+        m->chain.body[0].width = m->chain.body[0].height = 2.0 * slew.column_radius;
     }
     m->chain.slew = slew;
     return m;
