@@ -315,6 +315,37 @@ static void test_sandbox_same_crane(const char* name) {
     printf("  %s: %s\n", name, g_note);
     world_desc_free(&d2);
     if (!r0 && !r2) same_runs(ref, got, "model's slew over a different world slew");
+    // A world without a slew drive of its own (no slew section, no circuit):
+    // the model brings it, no note; the same crane.
+    world_desc d4 = sandbox();
+    cJSON_Delete(d4.circuit);
+    cJSON_Delete(d4.circuit_ls);
+    d4.circuit = d4.circuit_ls = NULL;
+    d4.slew.pinion_radius = 0.2;
+    g_notes = 0;
+    const int r4 = run(m, &d4, got);
+    CHECK(g_notes == 0, "%s: no note on a world without a slew (%s)", name, g_note);
+    world_desc_free(&d4);
+    if (!r0 && !r4) same_runs(ref, got, "model's slew on a world without one");
+    // Neither has one: the sandbox's refusal, as before, naming the world.
+    {
+        world_desc d5 = sandbox();
+        cJSON_Delete(d5.circuit);
+        cJSON_Delete(d5.circuit_ls);
+        d5.circuit = d5.circuit_ls = NULL;
+        char err[512] = "";
+        CHECK(ode_world_take_model_slew(m0, &d5, err, sizeof err) == 0, "%s", err);
+        ode_world_opts o = ode_world_default_opts();
+        o.q0[0] = 125 * 3.14159265358979323846 / 180;
+        o.q0[1] = -60 * 3.14159265358979323846 / 180;
+        o.model_file = m0->file;
+        ode_world* w = ode_world_create(&m0->mech, cJSON_GetObjectItemCaseSensitive(m0->json, "hydraulics"), &d5, &o,
+                                        err, sizeof err);
+        CHECK(w == NULL && strstr(err, "sandbox.json: slew.cylinder: no cylinder named \"slew_cyl\""),
+              "%s: neither has a slew: \"%s\"", name, err);
+        ode_world_destroy(w);
+        world_desc_free(&d5);
+    }
     // And that world's own slew does change the crane (the check above can fail).
     world_desc d3 = sandbox();
     d3.slew.pinion_radius = 0.15;
