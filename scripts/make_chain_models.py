@@ -276,7 +276,9 @@ def hiab031_chain(base):
         "mechanics": {
             "gravity": m["gravity"], "load_mass": m["load_mass"],
             "rated_moment": m["rated_moment"], "rated_load": m["rated_load"],
-            "bodies": [{"name": "column", "joint": "slew", "height": h, "mass": m["column"]["mass"], "radius": 0.1}],
+            "bodies": [{"name": "column", "joint": "slew", "height": h, "mass": m["column"]["mass"],
+                        # the slew drive's column: one column, one radius
+                        "radius": m["slew"]["column_radius"] if "slew" in m else 0.1}],
             "tip": {"body": L[1]["name"], "point": [L[1]["length"], 0, 0]},
             "actuators": [], "functions": []}}
     for i, l in enumerate(L):
@@ -302,7 +304,10 @@ def hiab031_chain(base):
             "rod": {"body": L[j]["name"], "point": [rm[0], 0, rm[1]]},
             "closed_length": a["closed_length"]})
         doc["mechanics"]["functions"].append({"name": a["name"], "valve": a["valve"]})
+    # The slew drive, as the shorthand has it (both forms take it as it is).
+    doc["mechanics"]["slew"] = m["slew"]
     doc["hydraulics"] = base["hydraulics"]
+    doc["hydraulics_slew"] = base["hydraulics_slew"]
     return doc
 
 

@@ -67,7 +67,8 @@ static void bench_help(FILE* f) {
             "  circuit-sizes  not in the default set: one circuit evaluation (fast kernel, reference)\n"
             "               on synthetic circuits of 1, 2, 4, 8, 16 actuators, ns per eval and per state\n"
             "  chain-sizes  not in the default set: whole crane steps of the general analytic mode\n"
-            "               (Krus 0.1 ms) on synthetic chains of 2, 3, 4, 6, 8 functions, ns per state\n"
+            "               (Krus 0.1 ms, block and dense W) on synthetic chains of 2, 3, 4, 6, 8\n"
+            "               functions, ns per state\n"
             "  sweep        not in the default set: cranesim sweep of 64 designs of the scenario (lift\n"
             "               bore 80..120 mm) on 1 and 2 threads: designs per minute and their ratio;\n"
             "               16 designs on the ode backend on 1 and 2 worker processes, interleaved\n"
@@ -762,11 +763,12 @@ static int bench_circuit_sizes(int repeat) {
 }
 
 // chain-sizes: whole crane steps (mechanics and circuit, Krus at 0.1 ms,
-// the dense analytic Jacobian every step) of the general analytic mode
+// the analytic Jacobian every 10 steps as a run takes it) of the general analytic mode
 // (chain_sim.h) on synthetic chains of 2, 3, 4, 6 and 8 functions
 // (crane_chain_synthetic: booms, knuckles and extensions, each with its
 // own cylinder and valve section), every function moving; ns per step and
-// per state, and the ratio of the largest per-state cost to the smallest.
+// per state, and the ratio of the largest per-state cost to the smallest;
+// with the block-diagonal W (the engine's) and with the dense W.
 static double chain_wave(void* user, int k, double t) {
     (void)user;
     return 0.5 * sin(2.0 * 3.14159265358979 * t / (2.0 + 0.5 * k));
@@ -774,6 +776,10 @@ static double chain_wave(void* user, int k, double t) {
 
 static int bench_chain_sizes(int repeat) {
     static const char* const shapes[5] = {"RR", "RRR", "RRRP", "RRRPRP", "RRRPRPRP"};
+    for (int pass = 0; pass < 2; ++pass) {
+    // The block-diagonal W the engine's fixed-step runs use, then the dense W.
+    const bool blocks = pass == 0;
+    const char* wname = blocks ? "blocks" : "dense";
     double per_state[5] = {0};
     for (int s = 0; s < 5; ++s) {
         char err[256];
@@ -793,10 +799,11 @@ static int bench_chain_sizes(int repeat) {
         double* y0 = calloc((size_t)n, sizeof *y0);
         double* y = calloc((size_t)n, sizeof *y);
         int rc = !y0 || !y ? -1 : chain_sim_initial_state(&cs, q0, 0.5e6, y0, err, sizeof err);
-        hyd_problem p = chain_sim_problem(&cs);
+        hyd_problem p = chain_sim_problem(&cs, blocks);
         hyd_solver_opts so = hyd_default_solver_opts();
         so.h = 1e-4;
         so.max_steps = 0;
+        so.jac_every = sim_default_opts().jac_every; // as a run: J every 10 steps
         hyd_solver* sol = rc ? NULL : hyd_solver_create(&p, HYD_KRUS, &so);
         if (!sol) {
             printf("{\"config\":\"chain-sizes\",\"functions\":%d,\"error\":\"%s\"}\n", cs.nfn,
@@ -823,17 +830,18 @@ static int bench_chain_sizes(int repeat) {
             for (int b = a; b > 0 && tw[b] < tw[b - 1]; --b) { double t = tw[b]; tw[b] = tw[b - 1]; tw[b - 1] = t; }
         const double ns_step = tw[reps / 2] * 1e9 / (double)(steps > 0 ? steps : 1);
         per_state[s] = ns_step / n;
-        printf("{\"config\":\"chain-sizes\",\"functions\":%d,\"dof\":%d,\"states\":%d,\"repeat\":%d,"
-               "\"steps\":%ld,\"ns_per_step\":%.0f,\"ns_per_state\":%.1f,\"ok\":%s}\n",
-               cs.nfn, cs.ndof, n, reps, steps, ns_step, ns_step / n, rc == HYD_OK ? "true" : "false");
+        printf("{\"config\":\"chain-sizes\",\"w\":\"%s\",\"functions\":%d,\"dof\":%d,\"states\":%d,"
+               "\"repeat\":%d,\"steps\":%ld,\"ns_per_step\":%.0f,\"ns_per_state\":%.1f,\"ok\":%s}\n",
+               wname, cs.nfn, cs.ndof, n, reps, steps, ns_step, ns_step / n, rc == HYD_OK ? "true" : "false");
         hyd_solver_destroy(sol);
         free(y0), free(y), chain_sim_free(&cs), crane_chain_free(&cc), hyd_model_free(hm);
         if (rc != HYD_OK) return EXIT_RUNTIME;
     }
     double lo = per_state[0], hi = per_state[0];
     for (int s = 1; s < 5; ++s) lo = fmin(lo, per_state[s]), hi = fmax(hi, per_state[s]);
-    printf("{\"config\":\"chain-sizes\",\"ns_per_state_max_over_min\":%.3f}\n", hi / lo);
+    printf("{\"config\":\"chain-sizes\",\"w\":\"%s\",\"ns_per_state_max_over_min\":%.3f}\n", wname, hi / lo);
     fflush(stdout);
+    }
     return 0;
 }
 

@@ -82,6 +82,13 @@ static void test_hiab031_chain_equals_shorthand(void) {
               same(a->tip[2], b->tip[2]) && same(a->gravity, b->gravity) && a->slew_free == b->slew_free,
           "tip %d (%g %g %g) / %d (%g %g %g), gravity %g / %g", a->tip_body, a->tip[0], a->tip[1], a->tip[2],
           b->tip_body, b->tip[0], b->tip[1], b->tip[2], a->gravity, b->gravity);
+    // The slew drive (mechanics.slew), read alike by both forms.
+    const crane_slew *sa = &a->slew, *sb = &b->slew;
+    CHECK(sa->present && sb->present && !strcmp(sa->cylinder, sb->cylinder) && !strcmp(sa->valve, sb->valve) &&
+              same(sa->pinion_radius, sb->pinion_radius) && same(sa->column_radius, sb->column_radius) &&
+              same(sa->damping, sb->damping),
+          "slew drive: %d %s %s %g / %d %s %s %g", sa->present, sa->cylinder, sa->valve, sa->pinion_radius,
+          sb->present, sb->cylinder, sb->valve, sb->pinion_radius);
     CHECK(s->mech.load_mass == c->mech.load_mass && s->mech.rated_moment == c->mech.rated_moment &&
               s->mech.rated_load == c->mech.rated_load && s->mech.column_height == c->mech.column_height &&
               s->mech.column_mass == c->mech.column_mass,

@@ -66,9 +66,13 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     s->ipA = calloc(na + 1, sizeof *s->ipA);
     s->ipB = calloc(na + 1, sizeof *s->ipB);
     s->is_pressure = calloc((size_t)s->nh + 1, sizeof *s->is_pressure);
+    s->perm = calloc(2 * (size_t)s->nh + 1, sizeof *s->perm);
+    s->block = calloc((size_t)s->nh + 2, sizeof *s->block);
+    s->jh = calloc((size_t)s->nh * (size_t)s->nh + (size_t)s->nh + 1, sizeof *s->jh);
     s->L = calloc(2 * na + 2 * na * nd + 1, sizeof(double));
     s->tau = calloc(10 * nd + 3 * nd * nd + (size_t)s->nh + 1, sizeof(double));
-    if (!s->ws || !s->hd || !s->cmd || !s->iu || !s->ipA || !s->ipB || !s->is_pressure || !s->L || !s->tau) {
+    if (!s->ws || !s->hd || !s->cmd || !s->iu || !s->ipA || !s->ipB || !s->is_pressure || !s->L || !s->tau || !s->perm ||
+        !s->block || !s->jh) {
         snprintf(err, errsz, "out of memory");
         chain_sim_free(s);
         return -1;
@@ -83,9 +87,47 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     s->g = s->qp + 2 * nd; // 2 nd: a right-hand side and its solution
     s->H = s->g + 2 * nd;  // 3 nd^2: a Hessian, d tau/dq, d tau/dq'
     s->ydot = s->H + 3 * nd * nd; // n = nh + 2 nd: a whole f for the outputs
-    for (int f = 0; f < s->nfn; ++f) s->iu[f] = hyd_model_valve_state(hm, cc->fn[f].valve_idx);
-    for (int k = 0; k < s->nact; ++k) hyd_model_cylinder_states(hm, cc->act[k].cyl, &s->ipA[k], &s->ipB[k]);
-    for (int i = 0; i < s->nh; ++i) s->is_pressure[i] = hyd_model_state_kind(hm, i) == HYD_STATE_PRESSURE;
+    s->hpos = s->perm + s->nh;
+    s->yh = s->jh + (size_t)s->nh * (size_t)s->nh;
+    // The block order (as lagrange_sim.c's for the standard circuit): per
+    // actuator its valve's spool, then [hose, chamber] on each side; the
+    // other circuit states after, each its own block.
+    bool* used = calloc((size_t)s->nh + 1, sizeof *used);
+    if (!used) {
+        snprintf(err, errsz, "out of memory");
+        chain_sim_free(s);
+        return -1;
+    }
+    int o = 0;
+    for (int k = 0; k < s->nact; ++k) {
+        int iA, iB;
+        hyd_model_cylinder_states(hm, cc->act[k].cyl, &iA, &iB);
+        const int iu = hyd_model_valve_state(hm, cc->fn[cc->act[k].function].valve_idx);
+        if (iu >= 0 && !used[iu]) used[iu] = true, s->perm[o++] = iu, s->block[s->nblock++] = 1;
+        const int side[2] = {iA, iB};
+        for (int e = 0; e < 2; ++e) {
+            const int ic = side[e], ih = hose_of_chamber(hm, ic);
+            int m = 0;
+            if (ih >= 0 && !used[ih]) used[ih] = true, s->perm[o++] = ih, ++m;
+            if (ic >= 0 && !used[ic]) used[ic] = true, s->perm[o++] = ic, ++m;
+            if (m) s->block[s->nblock++] = m;
+        }
+    }
+    for (int h = 0; h < s->nh; ++h)
+        if (!used[h]) s->perm[o++] = h, s->block[s->nblock++] = 1;
+    free(used);
+    if (s->ndof > 0) s->block[s->nblock++] = 2 * s->ndof;
+    for (int i = 0; i < s->nh; ++i) s->hpos[s->perm[i]] = i;
+    for (int f = 0; f < s->nfn; ++f) {
+        const int iu = hyd_model_valve_state(hm, cc->fn[f].valve_idx);
+        s->iu[f] = iu >= 0 ? s->hpos[iu] : -1;
+    }
+    for (int k = 0; k < s->nact; ++k) {
+        int iA, iB;
+        hyd_model_cylinder_states(hm, cc->act[k].cyl, &iA, &iB);
+        s->ipA[k] = s->hpos[iA], s->ipB[k] = s->hpos[iB];
+    }
+    for (int i = 0; i < s->nh; ++i) s->is_pressure[i] = hyd_model_state_kind(hm, s->perm[i]) == HYD_STATE_PRESSURE;
     return 0;
 }
 
@@ -98,6 +140,9 @@ void chain_sim_free(chain_sim* s) {
     free(s->ipA);
     free(s->ipB);
     free(s->is_pressure);
+    free(s->perm);
+    free(s->block);
+    free(s->jh);
     free(s->L);
     free(s->tau);
     memset(s, 0, sizeof *s);
@@ -109,8 +154,9 @@ static double command(const chain_sim* s, int k, double t) {
 }
 
 // Shared by rhs and Jacobian: the kinematics at (q, q'), every actuator's
-// pin length, rate, lever arms and d(L')/dq, and the circuit's inputs at t.
-static void prepare(chain_sim* s, double t, const double* y) {
+// pin length, rate, lever arms and (jac: only the Jacobian needs them)
+// d(L')/dq, and the circuit's inputs at t.
+static void prepare(chain_sim* s, double t, const double* y, bool jac) {
     const crane_chain* cc = s->cc;
     const int nd = s->ndof;
     chain_update(s->ch, s->ws, y + s->iq, y + s->iq + nd);
@@ -118,7 +164,7 @@ static void prepare(chain_sim* s, double t, const double* y) {
     for (int k = 0; k < s->nact; ++k) {
         const crane_act* a = &cc->act[k];
         s->L[k] = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, &s->Ld[k], s->dL + (size_t)k * nd,
-                                 s->dLd + (size_t)k * nd);
+                                 jac ? s->dLd + (size_t)k * nd : NULL);
         d->cyl_x[a->cyl] = s->L[k] - a->closed_length;
         d->cyl_v[a->cyl] = s->Ld[k];
     }
@@ -148,12 +194,12 @@ int chain_sim_rhs(void* user, double t, const double* y, double* dydt) {
     chain_sim* s = user;
     const int nd = s->ndof, iq = s->iq;
     ++s->nrhs;
-    prepare(s, t, y);
+    prepare(s, t, y, false);
     if (s->ideal_F) {
         memset(dydt, 0, (size_t)s->nh * sizeof *dydt);
         ideal_forces(s);
     } else {
-        hyd_eval(s->hm, s->hd, t, y, dydt);
+        hyd_eval_mapped(s->hm, s->hd, t, y, dydt, s->hpos);
     }
     joint_forces(s);
     const double* qd = y + iq + nd;
@@ -193,7 +239,7 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
     const crane_chain* cc = s->cc;
     hyd_data* d = s->hd;
     memset(J, 0, (size_t)n * (size_t)n * sizeof *J);
-    prepare(s, t, y);
+    prepare(s, t, y, true);
     if (s->ideal_F) { // constant forces: no partials, the circuit stands still
         const size_t nc = (size_t)hyd_model_ncylinder(s->hm);
         memset(d->dydx, 0, nc * (size_t)nh * sizeof *d->dydx);
@@ -204,7 +250,14 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
         ideal_forces(s);
         for (int k = 0; k < s->nact; ++k) d->dFdx[cc->act[k].cyl] = s->ideal_K ? -s->ideal_K[k] : 0.0;
     } else {
-        hyd_jacobian(s->hm, d, t, y, NULL, J, n, 0, 0);
+        // In the circuit's order, then permuted into the system's.
+        for (int h = 0; h < nh; ++h) s->yh[h] = y[s->hpos[h]];
+        hyd_jacobian(s->hm, d, t, s->yh, NULL, s->jh, nh, 0, 0);
+        for (int i = 0; i < nh; ++i) {
+            const double* src = s->jh + (size_t)s->perm[i] * nh;
+            double* row = J + (size_t)i * n;
+            for (int j = 0; j < nh; ++j) row[j] = src[s->perm[j]];
+        }
     }
     joint_forces(s);
     if (chain_forward_dynamics(s->ch, s->ws, s->tau, s->qdd)) return 1;
@@ -220,9 +273,10 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
         const double* dydx = d->dydx + (size_t)c * nh;
         const double* dydv = d->dydv + (size_t)c * nh;
         // The circuit's rows: x = L(q) - closed, v = L'(q, q') = dL/dq q'.
-        for (int i = 0; i < nh; ++i) {
-            if (dydx[i] == 0.0 && dydv[i] == 0.0) continue;
-            double* row = J + (size_t)i * n;
+        for (int h = 0; h < nh; ++h) {
+            if (dydx[h] == 0.0 && dydv[h] == 0.0) continue;
+            const int i = h; // dydx, dydv are in the circuit's order
+            double* row = J + (size_t)s->hpos[h] * n;
             for (int j = 0; j < nd; ++j) {
                 row[iq + j] += dydx[i] * r[j] + dydv[i] * rd[j];
                 row[iq + nd + j] += dydv[i] * r[j];
@@ -266,7 +320,7 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
         }
         if (!any) continue;
         chain_solve(s->ch, s->ws, b, x);
-        for (int i = 0; i < nd; ++i) J[(size_t)(iq + nd + i) * n + m] = x[i];
+        for (int i = 0; i < nd; ++i) J[(size_t)(iq + nd + i) * n + s->hpos[m]] = x[i];
     }
     return 0;
 }
@@ -277,7 +331,7 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
 // ends in subnormal numbers, on which every step is slower.
 static int chain_sim_settle(void* user, double t, double* y) {
     chain_sim* s = user;
-    int changed = hyd_model_flush(s->hm, y, NULL) > 0;
+    int changed = hyd_model_flush(s->hm, y, s->hpos) > 0;
     for (int f = 0; f < s->nfn; ++f) {
         double* u = s->iu[f] >= 0 ? &y[s->iu[f]] : NULL;
         if (!u || *u == 0.0 || !(fabs(*u) < HYD_SPOOL_SETTLE)) continue;
@@ -286,7 +340,7 @@ static int chain_sim_settle(void* user, double t, double* y) {
     return changed;
 }
 
-hyd_problem chain_sim_problem(chain_sim* s) {
+hyd_problem chain_sim_problem(chain_sim* s, bool blocks) {
     hyd_problem p;
     memset(&p, 0, sizeof p);
     p.n = s->n;
@@ -295,6 +349,10 @@ hyd_problem chain_sim_problem(chain_sim* s) {
     p.jac_full = 1;
     p.user = s;
     p.settle = chain_sim_settle;
+    if (blocks) {
+        p.nblock = s->nblock;
+        p.block_size = s->block;
+    }
     return p;
 }
 
@@ -352,7 +410,8 @@ static int solve_dense(double* A, double* b, int r) {
 int chain_sim_initial_state(chain_sim* s, const double* q0, double p_low, double* y, char* err, size_t errsz) {
     const int nd = s->ndof, na = s->nact, iq = s->iq;
     const hyd_model* hm = s->hm;
-    hyd_model_initial_state(hm, y);
+    hyd_model_initial_state(hm, s->yh);
+    for (int h = 0; h < s->nh; ++h) y[s->hpos[h]] = s->yh[h];
     for (int i = 0; i < nd; ++i) y[iq + i] = q0[i], y[iq + nd + i] = 0.0;
     chain_update(s->ch, s->ws, q0, NULL);
     double* G = s->id0;
@@ -412,9 +471,9 @@ int chain_sim_initial_state(chain_sim* s, const double* q0, double p_low, double
         y[s->ipA[k]] = pA;
         y[s->ipB[k]] = pB;
         // The hoses start at their chambers' pressures: no flow at t = 0.
-        const int hA = hose_of_chamber(hm, s->ipA[k]), hB = hose_of_chamber(hm, s->ipB[k]);
-        if (hA >= 0) y[hA] = pA;
-        if (hB >= 0) y[hB] = pB;
+        const int hA = hose_of_chamber(hm, s->perm[s->ipA[k]]), hB = hose_of_chamber(hm, s->perm[s->ipB[k]]);
+        if (hA >= 0) y[s->hpos[hA]] = pA;
+        if (hB >= 0) y[s->hpos[hB]] = pB;
     }
     rc = 0;
 done:

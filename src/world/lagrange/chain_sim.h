@@ -3,10 +3,12 @@
 // its full hydraulic circuit as one ODE system y' = f(t, y) for the generic
 // integrators (hyd_solver.h).
 //
-// State layout (n = nh + 2 ndof): the circuit's states in the circuit's own
-// order, then the joint coordinates q [rad or m] of the chain's degrees of
-// freedom (chain.h: the joints that are not fixed, in body order), then
-// their rates q' [rad/s or m/s].
+// State layout (n = nh + 2 ndof): the circuit's states in a block order
+// (per actuator its valve's spool, [hose A, chamber A], [hose B, chamber
+// B], then the other circuit states; perm and hpos map it), then the joint
+// coordinates q [rad or m] of the chain's degrees of freedom (chain.h: the
+// joints that are not fixed, in body order), then their rates q' [rad/s or
+// m/s].
 //
 // Per evaluation: the chain's kinematics at (q, q'); per actuator the pin
 // length L, its rate and lever arms dL/dq (chain_cylinder), the stroke
@@ -50,10 +52,16 @@ typedef struct chain_sim {
     double* cmd;            ///< [nfn] the functions' commands when cmd_fn is NULL [-]
     chain_sim_cmd_fn cmd_fn;
     void* cmd_user;
-    int* iu;                ///< [nfn] state of the function's valve spool (-1: none)
-    int* ipA;               ///< [nact] state of the actuator's chamber A pressure
+    int* iu;                ///< [nfn] system index of the function's valve spool (-1: none)
+    int* ipA;               ///< [nact] system index of the actuator's chamber A pressure
     int* ipB;               ///< [nact] chamber B
-    bool* is_pressure;      ///< [nh] circuit state i is a pressure [Pa abs]
+    bool* is_pressure;      ///< [nh] system state i is a pressure [Pa abs]
+    int* perm;              ///< [nh] system index -> circuit state
+    int* hpos;              ///< [nh] circuit state -> system index
+    int nblock;             ///< diagonal blocks of the block pattern (chain_sim_problem(s, true))
+    int* block;             ///< their sizes: 1 (spool), 2 (hose, chamber), 1 (others), 2 ndof (q, q')
+    double* jh;             ///< [nh x nh] the circuit's Jacobian in its own order (scratch)
+    double* yh;             ///< [nh] the circuit's states in its own order (scratch)
     /// NULL, or [nact] ideal cylinder forces in place of the circuit's: F_k
     /// = ideal_F[k] - ideal_K[k] x_k [N] (x the stroke; ideal_K NULL: 0), a
     /// spring along the pins, conservative: E_mech - sum (ideal_F x -
@@ -79,8 +87,11 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
                    size_t errsz);
 void chain_sim_free(chain_sim* s);
 
-/// The problem for hyd_solver_create: f and the analytic Jacobian (dense).
-hyd_problem chain_sim_problem(chain_sim* s);
+/// The problem for hyd_solver_create: f and the analytic Jacobian; blocks:
+/// with the block-diagonal pattern (per actuator [spool] [hose A, chamber
+/// A] [hose B, chamber B], 1x1 for the other circuit states, [q, q']), as
+/// the closed form's for its fixed-step runs; else W is dense.
+hyd_problem chain_sim_problem(chain_sim* s, bool blocks);
 int chain_sim_rhs(void* user, double t, const double* y, double* dydt);
 /// The analytic Jacobian (docs/lagrange.md): the circuit block by
 /// hyd_jacobian; the coupling columns from its dydx, dydv with dL/dq and

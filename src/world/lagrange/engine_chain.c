@@ -3,6 +3,7 @@
 #include "chain_sim.h"
 #include "energy_acc.h"
 #include "engine_impl.h"
+#include "lagrange_row.h"
 #include "lagrange_sim.h"
 
 #include <math.h>
@@ -11,6 +12,7 @@
 #include <string.h>
 
 void engine_chain_start_pose(const crane_chain* cc, const scenario* sc, double* q0) {
+    // One rule for both backends' chain runs (crane_chain.h).
     crane_chain_start_pose(cc, sc->q0, sc->slew0, q0);
 }
 
@@ -30,7 +32,7 @@ typedef struct chain_run_ctx {
     hyd_solver* solver;
     // Output buffers, sized by the chain.
     double *x, *v, *pA, *pB, *F, *u, *ucmd, *q, *qd;
-    double* row; ///< SIM_NCOL_BASE base columns, then the chain's own (crane_chain_row)
+    double* row; ///< SIM_NCOL_BASE base columns, then the chain's (crane_chain_row), at least SIM_NCOL
 } chain_run_ctx;
 
 // The scenario's commands by function name (scenario_find_command: lift,
@@ -70,10 +72,9 @@ static void make_row(chain_run_ctx* c, double t, const double* y, double* row) {
     for (int i = 0; i < hyd_model_ncomp(hm); ++i)
         if (hyd_model_comp_type(hm, i) == HYD_RELIEF && cs->hd->comp_open[i]) ++o.relief_open;
     lagrange_row(t, &o, row);
-    // Every actuator, function and DOF after the backend's channels (the
-    // base list), under the chain's column names.
-    const crane_chain_sample smp = {c->x, c->v, c->pA, c->pB, c->F, c->u, c->ucmd, c->q, c->qd};
-    crane_chain_row(cs->cc, &smp, row + SIM_NCOL_BASE);
+    // The chain's own columns right after the backend's (engine_sink.row).
+    const crane_chain_sample cs_s = {c->x, c->v, c->pA, c->pB, c->F, c->u, c->ucmd, c->q, c->qd};
+    crane_chain_row(cs->cc, &cs_s, row + SIM_NCOL_BASE);
 }
 
 static void track_peaks(chain_run_ctx* c, const double* y) {
@@ -106,7 +107,7 @@ static int emit(void* user, double t, const double* y) {
     for (int i = 0; i < cs->n; ++i) {
         const bool p = i < cs->nh && cs->is_pressure[i];
         if (isfinite(y[i]) && (!p || y[i] >= 0.0)) continue;
-        const char* name = i < cs->nh ? hyd_model_state_name(cs->hm, i) : i < cs->iq + cs->ndof ? "q" : "q_dot";
+        const char* name = i < cs->nh ? hyd_model_state_name(cs->hm, cs->perm[i]) : i < cs->iq + cs->ndof ? "q" : "q_dot";
         if (sim_check_value(&c->chk, name, y[i], p, t, c->bad, sizeof c->bad)) {
             c->bad_t = t;
             return (c->stop = 3);
@@ -148,10 +149,9 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     const int nd = cs.ndof, na = cs.nact, nf = cs.nfn;
     chain_run_ctx c;
     memset(&c, 0, sizeof c);
-    // The row: SIM_NCOL (lagrange_row writes every column) and the chain's.
-    double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + 1 + SIM_NCOL +
-                             (size_t)m->chain.ncol,
-                         sizeof *buf);
+    const size_t nrow = SIM_NCOL_BASE + (size_t)m->chain.ncol > SIM_NCOL ? SIM_NCOL_BASE + (size_t)m->chain.ncol
+                                                                         : (size_t)SIM_NCOL;
+    double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + nrow + 1, sizeof *buf);
     c.fcol = calloc((size_t)nf + 1, sizeof *c.fcol);
     hyd_solver* s = NULL;
     if (!buf || !c.fcol) {
@@ -180,8 +180,8 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
         goto done;
     }
     {
-        double* row0 = c.row;
         chain_run_ctx c0 = c;
+        double* row0 = c.row;
         make_row(&c0, 0.0, y, row0);
         const sim_start_load ld = {m->chain.two_link ? &m->mech : NULL, {sc->q0[0], sc->q0[1]}, m3, false};
         if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, &ld, msg, msz)) {
@@ -190,7 +190,8 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
         }
     }
     const bool adaptive = hyd_method_is_adaptive(o->solver);
-    hyd_problem prob = chain_sim_problem(&cs);
+    // The block-diagonal W for the fixed-step methods, as the closed form's.
+    hyd_problem prob = chain_sim_problem(&cs, !adaptive && !o->dense_jac);
     hyd_solver_opts so = hyd_default_solver_opts();
     so.h = adaptive ? 0.0 : o->h;
     so.rtol = o->rtol;

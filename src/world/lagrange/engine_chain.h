@@ -11,10 +11,10 @@
 extern "C" {
 #endif
 
-/// As engine_ops.run. The rows are sim.h's base columns: the first two
+/// As engine_ops.run. The rows are sim.h's base columns (the first two
 /// actuators and functions in the x1 .. F2 columns, the first two boom DOFs
-/// in q1, q2 (the per-function columns of a longer chain are not yet in the
-/// row). Refuses (SIM_REFUSED, one line) CVODE and the
+/// in q1, q2), then for a chain model the chain's own columns
+/// (crane_chain_row: per actuator, function and DOF). Refuses (SIM_REFUSED, one line) CVODE and the
 /// variants paper and paper-typo (the paper's two-link equations).
 int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res);
 

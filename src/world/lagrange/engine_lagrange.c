@@ -2,8 +2,9 @@
 // 2-DOF crane and its full circuit as one ODE system) behind engine.h,
 // stepped by an outside loop with commands set between steps.
 #include "engine_lagrange.h"
-#include "lagrange_sim.h"
 #include "engine_chain.h"
+#include "lagrange_row.h"
+#include "lagrange_sim.h"
 #include "energy_acc.h"
 
 #include "snap_reliefs.h"
@@ -39,15 +40,14 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
     (void)slew0; // the planar crane does not slew
     // The stepped engine is the closed form's (the fast path's allow-list:
     // the two-link shorthand, variant full, paper or paper-typo).
-    if (model_require_two_link(m,
-                               "stepped engine of the closed-form analytic mode (the general analytic mode of a "
-                               "chain runs scripted: cranesim run)",
+    if (model_require_two_link(m, "stepped closed-form analytic mode (drive, serve; a scripted run of this model "
+                                  "takes the general formulation)",
                                err, errsz))
         return NULL;
     if (o->variant == LAGRANGE_GENERAL) {
         snprintf(err, errsz,
-                 "the stepped lagrange engine runs the two-link crane's closed form only; the general analytic "
-                 "mode (--variant general) runs scripted (cranesim run)");
+                 "--variant general: the stepped lagrange engine (drive, serve) runs the two-link crane's closed "
+                 "form only; the general formulation runs scripted (cranesim run)");
         return NULL;
     }
     // No world circuit here: a burst at a node the model lacks has nowhere to open.

@@ -3,7 +3,6 @@
 #include "lagrange_sim.h"
 #include "lsim_split.h"
 #include "lsim_kin.h"
-#include "sim_base.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -634,15 +633,4 @@ void lsim_outputs(lsim* s, double t, const double* y, lsim_out* o) {
         if (hyd_model_comp_type(hm, c) == HYD_RELIEF && d->comp_open[c]) ++o->relief_open;
     const int pl = hyd_model_supply_node(hm); // the pump's delivery node, whatever its name
     if (pl >= 0) o->p_pump = d->node_p[pl];
-}
-
-// One row (all SIM_NCOL columns; the world extras 0) from the lagrange
-// crane's outputs o at time t [s]: the one place its rows are assembled
-// (engine_lagrange.c's and engine_chain.c's).
-void lagrange_row(double t, const lsim_out* o, double* row) {
-    const double v[SIM_NCOL] = {
-        t, o->x[0], o->x[1], o->pA[0], o->pB[0], o->pA[1], o->pB[1], o->u[0], o->u[1], o->q[0], o->q[1],
-        o->tip[0], o->tip[1], o->F[0], o->F[1], o->u_cmd[0], o->u_cmd[1],
-        o->v[0], o->v[1], o->p_pump, o->relief_open, o->end_stop};
-    memcpy(row, v, sizeof v);
 }

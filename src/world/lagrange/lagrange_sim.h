@@ -227,12 +227,6 @@ typedef struct lsim_out {
     int relief_open;       ///< number of relief valves passing flow
     int end_stop;          ///< bit k set when cylinder k is at an end stop
 } lsim_out;
-
-/// One row (all SIM_NCOL columns of sim_base.h; the world extras 0) from
-/// the analytic crane's outputs o at time t [s]: the closed form's rows
-/// (engine_lagrange.c) and the general path's (engine_chain.c), assembled
-/// in one place.
-void lagrange_row(double t, const lsim_out* o, double* row);
 void lsim_outputs(lsim* s, double t, const double* y, lsim_out* o);
 
 #ifdef __cplusplus

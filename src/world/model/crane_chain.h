@@ -67,6 +67,30 @@ typedef struct crane_function {
     int valve_idx;          ///< its index (crane_chain_bind)
 } crane_function;
 
+/// The slew drive: a rack-and-pinion cylinder on the column's slew joint
+/// (body 0's joint, about the base z axis). The rack is the cylinder's rod: a
+/// stroke x turns the pinion (radius r) to slew = (x - stroke/2) / r, so
+/// mid-stroke is slew 0 (crane_slew_stroke), and a rack force F [N] is a
+/// torque F r [N m] on the column (crane_slew_torque). It is kept apart from
+/// act[] (cylinders between two pins): every consumer of act[] handles pin
+/// cylinders only, and the drive is used where a run slews (the ODE sandbox).
+typedef struct crane_slew {
+    bool present;              ///< the model has a slew drive (mechanics.slew)
+    char cylinder[CRANE_NAME]; ///< the rack cylinder, a component of hydraulics_slew
+    char valve[CRANE_NAME];    ///< its directional valve (the slew function), in hydraulics_slew
+    double pinion_radius;      ///< [m]
+    double column_radius;      ///< column tube radius (collision, drawing) [m]
+    double damping;            ///< slewing-ring bearing viscous friction [N m s/rad]
+} crane_slew;
+
+/// Rack stroke [m] at slew angle theta [rad] for a cylinder of full stroke
+/// s [m]: r theta + s/2 (the ODE world's convention).
+static inline double crane_slew_stroke(const crane_slew* sl, double theta, double s) {
+    return sl->pinion_radius * theta + 0.5 * s;
+}
+/// Torque [N m] about the slew axis of a rack force F [N].
+static inline double crane_slew_torque(const crane_slew* sl, double F) { return F * sl->pinion_radius; }
+
 /// One output column of a chain crane beyond the run's base columns
 /// (crane_chain_columns): per actuator x_<a> [m], v_<a> [m/s], pA_<a>,
 /// pB_<a> [Pa], F_<a> [N]; per function u_<f>, ucmd_<f> [-]; per degree of
@@ -97,6 +121,7 @@ typedef struct crane_chain {
     double tip[3];    ///< the tip in that body's frame [m]
     double gravity;   ///< [m/s^2], along -z of the base frame
     bool slew_free;   ///< the column slews (a degree of freedom where the model has a slew drive)
+    crane_slew slew;  ///< the slew drive, if the model has one (slew.present)
     /// True when the chain came from the two-link shorthand: the analytic
     /// backend may then run its closed-form fast path (lagrange.h), which
     /// handles exactly that shape and nothing else.

@@ -3,6 +3,7 @@
 #include "model_chain.h"
 #include "param_names.h"
 
+#include "chain_crane.h"
 #include "hydraulics.h"
 #include "json_util.h"
 
@@ -348,7 +349,7 @@ static void load_actuator(json_ctx* c, const cJSON* arr, int i, crane_actuator* 
 // two actuators by joint (hiab031.json). 0, or -1 with the error in c.
 static int read_shorthand(json_ctx* c, const cJSON* mech, crane_mech* me) {
     static const char* const mkeys[] = {"gravity", "column", "links", "load_mass", "actuators", "rated_moment",
-                                         "rated_load", NULL};
+                                         "rated_load", "slew", NULL};
     json_only_keys(c, mech, "mechanics", mkeys);
     me->gravity = json_num_r(c, mech, "mechanics", "gravity", false, 9.81, &MODEL_R_GRAVITY);
     const cJSON* col = json_obj(c, mech, "mechanics", "column", true);
@@ -390,7 +391,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     json_ctx c = {.file = file, .err = err, .errsz = errsz};
     if (!cJSON_IsObject(root)) json_fail(&c, "", "a model must be a JSON object");
     if (json_wrong_kind(&c, root, "model")) goto fail;
-    static const char* const keys[] = {"name", "description", "mechanics", "hydraulics", NULL};
+    static const char* const keys[] = {"name", "description", "mechanics", "hydraulics", "hydraulics_slew", NULL};
     json_only_keys(&c, root, "", keys);
     json_str(&c, root, "", "name", false, "crane", m->name, sizeof m->name);
 
@@ -404,6 +405,18 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         if (model_chain_read(&c, mech, m)) goto fail;
         json_flush_notes(&c);
     } else if (read_shorthand(&c, mech, me)) {
+        goto fail;
+    }
+    // The slew drive, the same in both forms; it joins the chain once that
+    // is built (both builders start from an empty chain).
+    crane_slew slew;
+    if (model_slew_read(&c, root, mech, &slew)) goto fail;
+    // One column, one radius: the chain form gives the column's body its own
+    // (its inertia about the slew axis, 1/2 m r^2, is what the drive turns).
+    if (chain_form && slew.present && 0.5 * m->chain.body[0].width != slew.column_radius) {
+        json_fail(&c, "mechanics.slew.column_radius",
+                  "%g m is not the column's radius (mechanics.bodies[0].radius, %g m): one column, one radius",
+                  slew.column_radius, 0.5 * m->chain.body[0].width);
         goto fail;
     }
 
@@ -436,8 +449,11 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         pump_relief_notes(&c, m->hyd);
         json_flush_notes(&c);
     }
+    if (model_slew_check(&c, root, &slew)) goto fail;
+    json_flush_notes(&c);
     if (chain_form) {
         if (model_chain_bind(&c, m)) goto fail;
+        m->chain.slew = slew;
         return m;
     }
 
@@ -474,6 +490,17 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         snprintf(err, errsz, "%s: %s", file, cerr);
         goto fail;
     }
+    if (slew.present) {
+        // The shorthand's column as the sandbox builds it: a solid cylinder
+        // of the drive's column radius (crane_chain_from_mech's is 0.1 m),
+        // so that the chain's inertia about the slew axis is the sandbox's.
+        chain_crane cr;
+        const chain_crane_opts co = {0, 0.0, slew.column_radius};
+        chain_from_crane_mech(me, 0.0, &co, &cr); // its actuators were checked above
+        m->chain.body[0].def = cr.body[0];
+        m->chain.body[0].width = m->chain.body[0].height = 2.0 * slew.column_radius;
+    }
+    m->chain.slew = slew;
     return m;
 fail: // err already holds the one-line message
     model_free(m);

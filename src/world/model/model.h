@@ -61,6 +61,14 @@ void model_free(model* m);
 /// learns the chain, its call goes (grep model_require_two_link).
 int model_require_two_link(const model* m, const char* what, char* err, size_t errsz);
 
+/// The circuit of a model's hydraulics section (file mfile) with a fragment
+/// appended (frag: {nodes, components[, patch]} from file ffile, field fpart:
+/// "hydraulics_slew", a world's "circuit" or "circuit_ls"), its patch
+/// ("component.field": "node") applied to the model's components first:
+/// what the sandbox runs. NULL with one line "file: field: problem" in err.
+hyd_model* model_circuit_with_fragment(const cJSON* hydraulics, const char* mfile, const cJSON* frag,
+                                       const char* ffile, const char* fpart, char* err, size_t errsz);
+
 /// Write the model's JSON (with overrides applied) to path. Returns 0 or -1.
 int model_save(const model* m, const char* path, char* err, size_t errsz);
 

@@ -387,7 +387,7 @@ int model_chain_read(json_ctx* c, const cJSON* mech, model* m) {
             return -1;
         }
     static const char* const keys[] = {"gravity", "load_mass", "rated_moment", "rated_load", "bodies",
-                                       "tip",     "actuators", "functions",    NULL};
+                                       "tip",     "actuators", "functions",    "slew",       NULL};
     json_only_keys(c, mech, "mechanics", keys);
     crane_mech* me = &m->mech;
     me->gravity = json_num_r(c, mech, "mechanics", "gravity", false, 9.81, &MODEL_R_GRAVITY);

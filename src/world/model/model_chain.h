@@ -35,6 +35,16 @@ int model_chain_read(json_ctx* c, const cJSON* mech, model* m);
 /// Returns 0, or -1 with the one-line error in c.
 int model_chain_bind(json_ctx* c, model* m);
 
+/// Reads the optional slew drive (mechanics.slew, either form) into *s and
+/// checks the shape of its circuit fragment (root's hydraulics_slew; one
+/// without the other is an error). s->present is false without one.
+/// Returns 0, or -1 with the one-line error in c (model_slew.c).
+int model_slew_read(json_ctx* c, const cJSON* root, const cJSON* mech, crane_slew* s);
+/// Checks a present slew drive against its fragment: the cylinder and the
+/// valve are the fragment's, its patch names ports of the model's circuit,
+/// and the model's circuit with the fragment appended compiles. 0, or -1.
+int model_slew_check(json_ctx* c, const cJSON* root, const crane_slew* s);
+
 #ifdef __cplusplus
 }
 #endif

@@ -263,8 +263,8 @@ static void block_pattern(ode_world* w) {
 // of the model's hydraulics section: each named component must exist there
 // and the field must already name a node (a string), so a patch can rewire
 // a port and nothing else. Returns the copy, or NULL with the error.
-static cJSON* patched_hydraulics(const cJSON* hydraulics, const cJSON* patch, const char* wf, const char* mfile,
-                                 char* err, size_t errsz) {
+static cJSON* patched_hydraulics(const cJSON* hydraulics, const cJSON* patch, const char* wf, const char* part,
+                                 const char* mfile, char* err, size_t errsz) {
     cJSON* h = cJSON_Duplicate(hydraulics, 1);
     if (!h) {
         snprintf(err, errsz, "ode world: out of memory");
@@ -283,7 +283,7 @@ static cJSON* patched_hydraulics(const cJSON* hydraulics, const cJSON* patch, co
         }
         const cJSON* f = c ? cJSON_GetObjectItemCaseSensitive(c, dot + 1) : NULL;
         if (!c || !cJSON_IsString(f)) {
-            snprintf(err, errsz, "%s: circuit_ls.patch.%s: %s %s in %s", wf, it->string,
+            snprintf(err, errsz, "%s: %s.patch.%s: %s %s in %s", wf, part, it->string,
                      c ? "no port field" : "no component", c ? dot + 1 : comp, mfile);
             cJSON_Delete(h);
             return NULL;
@@ -346,12 +346,12 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, con
         snprintf(err, errsz, "%s: hydraulics: missing (required by the ode world)", mfile);
         return -1;
     } else {
-        const char* wf = w->desc.file[0] ? w->desc.file : "world";
+        const char* wf = w->desc.slew_file[0] ? w->desc.slew_file : w->desc.file[0] ? w->desc.file : "world";
         const cJSON* patch = extra ? cJSON_GetObjectItemCaseSensitive(extra, "patch") : NULL;
         cJSON* ph = NULL; // the patched model section, and the fragment without its patch
         cJSON* fx = NULL;
         if (patch) {
-            if (!(ph = patched_hydraulics(hydraulics, patch, wf, mfile, err, errsz))) return -1;
+            if (!(ph = patched_hydraulics(hydraulics, patch, wf, part, mfile, err, errsz))) return -1;
             fx = cJSON_Duplicate(extra, 1);
             if (fx) cJSON_DeleteItemFromObjectCaseSensitive(fx, "patch");
             hydraulics = ph, extra = fx;
@@ -374,8 +374,11 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, con
         if (bind_actuator(w, k, w->mech.act[k].cylinder, w->mech.act[k].valve, mfile, f, err, errsz)) return -1;
     }
     if (sandbox) {
-        const char* wf = w->desc.file[0] ? w->desc.file : "world";
-        if (bind_actuator(w, ODE_SLEW, w->desc.slew.cylinder, w->desc.slew.valve, wf, "slew", err, errsz)) return -1;
+        // The slew drive is the world's, or the model's where it has one.
+        const bool from_model = w->desc.slew_file[0] != 0;
+        const char* wf = from_model ? w->desc.slew_file : w->desc.file[0] ? w->desc.file : "world";
+        const char* sf = from_model ? "mechanics.slew" : "slew";
+        if (bind_actuator(w, ODE_SLEW, w->desc.slew.cylinder, w->desc.slew.valve, wf, sf, err, errsz)) return -1;
         // One cylinder or valve driving two functions would couple them
         // through one set of states: a slew that moves the boom.
         for (int k = 0; k < 2; ++k) {
@@ -383,8 +386,8 @@ int ow_hyd_create(ode_world* w, const cJSON* hydraulics, const cJSON* extra, con
                                : w->act[ODE_SLEW].valve == w->act[k].valve ? "valve"
                                                                            : NULL;
             if (what) {
-                snprintf(err, errsz, "%s: slew.%s: \"%s\" already drives the %s boom (%s mechanics.actuators[%d])", wf,
-                         what, what[0] == 'c' ? w->desc.slew.cylinder : w->desc.slew.valve, k ? "end" : "lifting",
+                snprintf(err, errsz, "%s: %s.%s: \"%s\" already drives the %s boom (%s mechanics.actuators[%d])", wf,
+                         sf, what, what[0] == 'c' ? w->desc.slew.cylinder : w->desc.slew.valve, k ? "end" : "lifting",
                          mfile, k);
                 return -1;
             }

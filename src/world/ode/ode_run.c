@@ -33,6 +33,58 @@ void ode_world_row(ode_world* w, double* row) {
     }
 }
 
+// The slew parameters of a world's slew section and a model's drive agree.
+static bool same_slew(const world_slew* w, const crane_slew* m) {
+    return w->pinion_radius == m->pinion_radius && w->column_radius == m->column_radius && w->damping == m->damping &&
+           !strcmp(w->cylinder, m->cylinder) && !strcmp(w->valve, m->valve);
+}
+
+int ode_world_take_model_slew(const model* m, world_desc* wd, char* err, size_t errsz) {
+    const crane_slew* sl = &m->chain.slew;
+    if (!sl->present || wd->kind != WORLD_SANDBOX) return 0;
+    const cJSON* frag = cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics_slew");
+    const cJSON* hyd = cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics");
+    // The model's drive wins: it is the crane's hardware, the world's is the
+    // fallback for models without one. Said once where it changes something.
+    const cJSON* own = world_desc_circuit_for(wd, hyd);
+    const char* wf = wd->file[0] ? wd->file : "world";
+    const char* part = own == wd->circuit_ls ? "circuit_ls" : "circuit";
+    if (own) {
+        // The world's own fragment is still checked against this model, as
+        // it was when it was used: a world file that was refused before is
+        // refused now, whichever slew runs.
+        hyd_model* hm = model_circuit_with_fragment(hyd, m->file, own, wf, part, err, errsz);
+        if (!hm) return -1;
+        hyd_model_free(hm);
+    }
+    if (own && (!same_slew(&wd->slew, sl) || !cJSON_Compare(own, frag, 1))) {
+        char line[768];
+        snprintf(line, sizeof line,
+                 "%s: slew, %s: the model's slew drive (%s: mechanics.slew, hydraulics_slew) is used instead", wf,
+                 part, m->file);
+        hyd_note(line);
+    }
+    cJSON* dup = cJSON_Duplicate(frag, 1);
+    if (!dup) {
+        snprintf(err, errsz, "%s: hydraulics_slew: out of memory", m->file);
+        return -1;
+    }
+    cJSON_Delete(wd->circuit);
+    cJSON_Delete(wd->circuit_ls);
+    // One fragment made for this model's circuit (its patch included): the
+    // sandbox appends it whatever the pump (world_desc_circuit_for falls back
+    // to circuit when there is no circuit_ls).
+    wd->circuit = dup;
+    wd->circuit_ls = NULL;
+    wd->slew.pinion_radius = sl->pinion_radius;
+    wd->slew.column_radius = sl->column_radius;
+    wd->slew.damping = sl->damping;
+    snprintf(wd->slew.cylinder, sizeof wd->slew.cylinder, "%s", sl->cylinder);
+    snprintf(wd->slew.valve, sizeof wd->slew.valve, "%s", sl->valve);
+    snprintf(wd->slew_file, sizeof wd->slew_file, "%s", m->file);
+    return 0;
+}
+
 ode_world* ode_world_for_run(const model* m, const sim_opts* o, const char* default_world, const double q0[2],
                               double slew0, double m3, char* err, size_t errsz) {
     // The ODE world is built from the two-link crane_mech (a chain model
@@ -42,6 +94,10 @@ ode_world* ode_world_for_run(const model* m, const sim_opts* o, const char* defa
     const char* wpath = sim_world_path(o->world ? o->world : default_world, wbuf, sizeof wbuf);
     world_desc wd;
     if (world_desc_load(wpath, &wd, err, errsz)) return NULL;
+    if (ode_world_take_model_slew(m, &wd, err, errsz)) {
+        world_desc_free(&wd);
+        return NULL;
+    }
     ode_world_opts wo = ode_world_default_opts();
     wo.dt_ode = o->dt_ode > 0 ? o->dt_ode : 1e-3;
     // The bodies feel the cylinder forces one ODE step late (explicit
@@ -88,7 +144,9 @@ ode_world* ode_world_for_run(const model* m, const sim_opts* o, const char* defa
         // there: their orifices join the world's part of the circuit, which
         // only the sandbox appends (ow_hyd_create).
         cJSON* frag = wd.kind == WORLD_SANDBOX ? (cJSON*)world_desc_circuit_for(&wd, hyd) : NULL;
-        const char* wf = strrchr(wpath, '/') ? strrchr(wpath, '/') + 1 : wpath;
+        // The world's part of the circuit, or the model's hydraulics_slew
+        // where the model's slew drive replaced it.
+        const char* wf = wd.slew_file[0] ? "its hydraulics_slew" : strrchr(wpath, '/') ? strrchr(wpath, '/') + 1 : wpath;
         cJSON* comps = frag ? cJSON_GetObjectItemCaseSensitive(frag, "components") : NULL;
         if (engine_world_bursts(m, cJSON_IsArray(comps) ? frag : NULL, wf, err, errsz)) {
             world_desc_free(&wd);

@@ -21,6 +21,14 @@ void ode_world_row(ode_world* w, double* row);
 ode_world* ode_world_for_run(const model* m, const sim_opts* o, const char* default_world, const double q0[2],
                              double slew0, double m3, char* err, size_t errsz);
 
+/// Where the model has a slew drive (model.chain.slew) and wd is a sandbox:
+/// the world's slew section and circuit fragments are replaced by the
+/// model's (mechanics.slew, hydraulics_slew; wd->slew_file names the model
+/// for messages). The model's wins over a world's own; where they differ a
+/// note says so once. A model without one keeps the world's. 0, or -1 (out
+/// of memory) with the message in err.
+int ode_world_take_model_slew(const model* m, world_desc* wd, char* err, size_t errsz);
+
 #ifdef __cplusplus
 }
 #endif

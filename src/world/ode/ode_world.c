@@ -588,7 +588,9 @@ static int build_world(ode_world* w, void* arg) {
     if (w->opt.hydraulics) {
         // An LS model takes the world's LS slew section where it has one.
         const cJSON* frag = world_desc_circuit_for(a->desc, a->hydraulics);
-        const char* part = a->desc && frag && frag == a->desc->circuit_ls ? "circuit_ls" : "circuit";
+        const char* part = a->desc && a->desc->slew_file[0]                  ? "hydraulics_slew"
+                           : a->desc && frag && frag == a->desc->circuit_ls ? "circuit_ls"
+                                                                             : "circuit";
         if (ow_hyd_create(w, a->hydraulics, frag, part, a->err, a->errsz)) return -1;
     } else {
         // Without a circuit, strokes come from nowhere; hinge limits are off.

@@ -183,6 +183,11 @@ typedef struct world_desc {
     /// "component.field": "node" that rewires the model's own components
     /// (its LS shuttle's output) so the slew's signal joins the LS network.
     cJSON* circuit_ls;
+    /// Where slew and circuit came from, for messages: "" for this world's
+    /// own sections (slew, circuit, circuit_ls); else the model file whose
+    /// slew drive replaced them (mechanics.slew, hydraulics_slew; see
+    /// ode_world_take_model_slew).
+    char slew_file[256];
 } world_desc;
 
 /// The fragment for a model's hydraulics section: circuit_ls when the
