@@ -44,6 +44,7 @@ typedef struct trace {
     int base;                // the backend's channels: where the chain's columns start
     int ix[MAXA], ipA[MAXA], ipB[MAXA]; // row index of each actuator's x, pA, pB
     double *t, *x, *pA, *pB; // [cap], [cap * MAXA] ...
+    double p_pump0;          // the pump pressure of row 0 [Pa]
     double base_diff;        // largest |x1 - x_<act 0>|, |x2 - x_<act 1>| over the rows [m]
     int finite;
 } trace;
@@ -68,6 +69,7 @@ static int on_row(void* user, const double* row) {
     }
     const long i = tr->n++;
     tr->t[i] = row[COL_T];
+    if (i == 0) tr->p_pump0 = row[COL_P_PUMP];
     for (int k = 0; k < tr->nact; ++k) {
         tr->x[i * MAXA + k] = row[tr->ix[k]];
         tr->pA[i * MAXA + k] = row[tr->ipA[k]];
@@ -178,7 +180,9 @@ static void test_3boom_ext_against_analytic(void) {
         CHECK(a.base_diff == 0.0 && b.base_diff == 0.0, "x1, x2 against x_lift, x_jib: %g, %g", a.base_diff,
               b.base_diff);
         // One start pose (crane_chain_start_pose) and one start state: the
-        // strokes and chamber pressures of row 0 agree.
+        // strokes and chamber pressures of row 0 agree, and its pump pressure.
+        CHECK(fabs(a.p_pump0 - b.p_pump0) < 1.0 && a.p_pump0 > 1e6, "p_pump at t = 0: %.6g and %.6g Pa", a.p_pump0,
+              b.p_pump0);
         for (int k = 0; k < a.nact && a.n > 0 && b.n > 0; ++k)
             CHECK(fabs(a.x[k] - b.x[k]) < 1e-9 && fabs(a.pA[k] - b.pA[k]) < 1.0 && fabs(a.pB[k] - b.pB[k]) < 1.0,
                   "%s at t = 0: x %.9g and %.9g m, pA %.6g and %.6g Pa, pB %.6g and %.6g Pa", m->chain.act[k].name,
