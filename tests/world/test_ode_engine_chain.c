@@ -243,8 +243,9 @@ static void test_8fn_10link_runs(void) {
         char csv[512], args[2048], out[8192];
         snprintf(csv, sizeof csv, "%s/test_ode_engine_chain_%d_%s.csv", tmp, (int)getpid(), mech[b]);
         // The analytic general path at Krus 0.1 ms blows up on this
-        // scenario at t = 3.004 s (a hose of jib_ext1 below absolute zero,
-        // when ext1's valve closes; 0.05 ms runs): an adaptive step here.
+        // scenario (main at eceb32d: jib_ext2_cyl.pB below absolute zero at
+        // t = 7.926 s; before chainlag's last merge a hose of jib_ext1 at
+        // 3.004 s; 0.05 ms runs): an adaptive step here.
         snprintf(args, sizeof args, "run --model %s --scenario %s --mechanics %s%s --out %s", CHAIN_8FN,
                  CHAIN_8FN_SCN, mech[b], b ? " --solver ros34pw2" : "", csv);
         const int rc = cli_run(args, out, sizeof out);
