@@ -22,6 +22,7 @@
 
 #include "ode_world_internal.h"
 #include "energy_acc.h"
+#include "hyd_cylinder.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -42,6 +43,8 @@ typedef struct oc_body {
     double q0;         ///< joint coordinate at build time (the ODE joint's zero) [rad or m]
     double raw, turns; ///< hinge: angle at the last read and the whole turns counted [rad]
     double lo, hi;     ///< stops relative to the joint's zero, continuous [rad or m] (+-inf: none)
+    int seal;          ///< implicit_seal: a cylinder's seal friction acts as this joint's motor
+    double fmax;       ///< that motor's force limit this step [N m or N]
 } oc_body;
 
 typedef struct oc_act {
@@ -50,6 +53,10 @@ typedef struct oc_act {
     double x0, v0;    ///< stroke [m] and rate [m/s] at the start of the step
     double F;         ///< force over the step [N], + extends
     int stop_body;    ///< the body whose joint carries this cylinder's stroke ends, or -1
+    int seal;         ///< implicit_seal: its seal friction is a motor on the joint of seal_body
+    int seal_body;    ///< the body whose joint the cylinder spans (implicit_seal), or -1
+    double Fc, Fs, vst, vsm; ///< its seal friction's parameters [N, N, m/s, m/s]
+    double seal_max;  ///< the seal friction's magnitude at the step's rate [N]
 } oc_act;
 
 struct ode_chain {
@@ -549,6 +556,16 @@ static int hyd_step(ode_chain* w, double H) {
     w->th = (double)(w->nstep + 1) * H; // on the step count: no drift from the mechanical clock
     for (int k = 0; k < w->nact; ++k) {
         w->a[k].F = w->hd->cyl_F[w->cc.act[k].cyl];
+        oc_act* a = &w->a[k];
+        if (a->seal) {
+            // The circuit subtracted the seal friction at the step's rate
+            // v0; it is added back here and held by the joint's motor
+            // (apply_seal) instead. Its magnitude at v0 is the motor's limit.
+            double d;
+            a->F += hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, a->v0, &d);
+            const double r = a->v0 / a->vst;
+            a->seal_max = a->Fc + a->Fs * exp(-r * r);
+        }
         if (!isfinite(w->a[k].F)) {
             snprintf(w->err, sizeof w->err, "hydraulics: the force of actuator %s became non-finite at t = %.6f s",
                      w->cc.act[k].name, w->th);
@@ -688,6 +705,29 @@ static int build(void* arg) {
     }
     for (int i = 0; i < w->nbody; ++i)
         if (w->b[i].dof >= 0) apply_stops(&w->b[i]);
+    // implicit_seal: a cylinder across one moving joint with seal friction.
+    for (int k = 0; k < w->nact && w->hm && w->opt.implicit_seal; ++k) {
+        oc_act* a = &w->a[k];
+        const crane_act* c = &w->cc.act[k];
+        const int jb = chain_body(w->mech, c->body_b)->parent == c->body_a   ? c->body_b
+                       : chain_body(w->mech, c->body_a)->parent == c->body_b ? c->body_a
+                                                                            : -1;
+        if (jb < 0 || w->b[jb].dof < 0) continue;
+        const char* cyl = c->cylinder; // the circuit's component of that name (crane_chain_bind)
+        char path[160];
+        double v[4] = {0, 0, 0, 0};
+        static const char* const par[4] = {"coulomb", "stribeck", "v_stribeck", "v_smooth"};
+        int ok = 1;
+        for (int j = 0; j < 4; ++j) {
+            snprintf(path, sizeof path, "%s.%s", cyl, par[j]);
+            ok &= hyd_model_get(w->hm, path, &v[j]) == 0;
+        }
+        if (!ok || !(v[0] > 0.0 || v[1] > 0.0) || !(v[2] > 0.0)) continue;
+        a->seal = 1, a->seal_body = jb;
+        a->Fc = v[0], a->Fs = v[1], a->vst = v[2], a->vsm = v[3];
+        a->seal_max = v[0] + v[1];
+        w->b[jb].seal = 1;
+    }
     return 0;
 }
 
@@ -837,6 +877,41 @@ static void apply_forces(ode_chain* w) {
     }
 }
 
+// implicit_seal: each joint's motor at zero speed, its force limit the sum
+// of its cylinders' seal friction times their lever arm |dL/dq| at the
+// present pose (a torque [N m] on a hinge, a force [N] on a slider), so
+// ODE's solver holds the joint still up to that friction and resists
+// motion with it, in the same step.
+static void apply_seal(ode_chain* w) {
+    int any = 0;
+    for (int k = 0; k < w->nact; ++k) any |= w->a[k].seal;
+    if (!any) return;
+    ode_chain_q(w, w->qs, NULL);
+    for (int i = 0; i < w->nbody; ++i) w->b[i].fmax = 0.0;
+    for (int k = 0; k < w->nact; ++k) {
+        const oc_act* a = &w->a[k];
+        if (!a->seal) continue;
+        oc_body* b = &w->b[a->seal_body];
+        const crane_act* c = &w->cc.act[k];
+        // dL/dq by central differences of the mechanism's pin length.
+        const double q = w->qs[b->dof], h = 1e-6 * (1.0 + fabs(q));
+        w->qs[b->dof] = q + h;
+        chain_update(w->mech, w->ws, w->qs, NULL);
+        const double Lp = chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, NULL, NULL);
+        w->qs[b->dof] = q - h;
+        chain_update(w->mech, w->ws, w->qs, NULL);
+        const double Lm = chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, NULL, NULL);
+        w->qs[b->dof] = q;
+        b->fmax += a->seal_max * fabs(Lp - Lm) / (2.0 * h);
+    }
+    for (int i = 0; i < w->nbody; ++i) {
+        oc_body* b = &w->b[i];
+        if (b->dof < 0 || !b->seal) continue;
+        set_param(b, dParamVel, 0.0);
+        set_param(b, dParamFMax, b->fmax);
+    }
+}
+
 static int body_finite(dBodyID b) {
     const dReal* p = dBodyGetPosition(b);
     const dReal* v = dBodyGetLinearVel(b);
@@ -860,6 +935,7 @@ static int step_n(void* arg) {
             w->a[k].x0 = act_geometry(w, k, &w->a[k].v0, NULL, NULL, NULL) - w->cc.act[k].closed_length;
         if (w->hm && hyd_step(w, H)) return -1;
         apply_forces(w);
+        apply_seal(w);
         dWorldStep(w->world, H);
         ++w->nstep;
         w->t = (double)w->nstep * H;

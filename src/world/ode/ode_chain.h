@@ -41,6 +41,12 @@ typedef struct ode_chain_opts {
     int init_hold;         ///< 1 (default): start pressures that hold the start pose under gravity
     double p_low;          ///< init_hold: pressure of the unloaded side [Pa abs]; default 2e6
     const char* model_file; ///< in messages; default "model"
+    /// 1: a cylinder across one joint has its seal friction (Coulomb +
+    /// Stribeck, hyd_cyl_seal) held by ODE's solver, as a joint motor at
+    /// zero speed whose force limit is that friction over the cylinder's
+    /// lever arm, instead of in the force applied a step late (which cannot
+    /// hold a load still); 0 (default): every force through the coupling.
+    int implicit_seal;
 } ode_chain_opts;
 
 ode_chain_opts ode_chain_default_opts(void);
