@@ -209,28 +209,28 @@ int chain_sim_rhs(void* user, double t, const double* y, double* dydt) {
     return 0;
 }
 
-// Central differences of the inverse dynamics ID(q, q', a) = M(q) a +
+// Forward differences of the inverse dynamics ID(q, q', a) = M(q) a +
 // C(q, q') + G(q) at a = q'' in coordinate j of q (which = 0) or q' (which =
-// 1), into out [ndof]. C is quadratic in q', so the q' differences are
-// exact to rounding; in q the step 1e-6 (1 + |q_j|) [rad or m] leaves a
-// truncation of about 1e-12 relative, below the rounding.
-static void id_partial(chain_sim* s, const double* y, int which, int j, double* out) {
+// 1), into out [ndof], from base = ID at y. One evaluation per coordinate
+// (central differences took two, a fifth of an 8-function chain's whole
+// step): with the step 3e-8 (1 + |z_j|) [rad, m, rad/s or m/s] the
+// truncation (C is quadratic in q', smooth in q) and the rounding are both
+// near 3e-8 of the term, far inside what a W-method's Jacobian needs (its
+// accuracy does not enter the order; test_chain_sim checks the Jacobian
+// against central differences of f to 1e-6 of its row).
+static void id_partial(chain_sim* s, const double* y, int which, int j, const double* base, double* out) {
     const int nd = s->ndof;
     double* q = s->qp;
     double* qd = s->qp + nd;
     memcpy(q, y + s->iq, (size_t)nd * sizeof *q);
     memcpy(qd, y + s->iq + nd, (size_t)nd * sizeof *qd);
     double* z = which ? qd : q;
-    const double z0 = z[j], h = 1e-6 * (1.0 + fabs(z0));
+    const double z0 = z[j], h = 3e-8 * (1.0 + fabs(z0));
     z[j] = z0 + h;
     const double hp = z[j] - z0; // the step as represented
     chain_update(s->ch, s->ws, q, qd);
     chain_inverse_dynamics(s->ch, s->ws, s->qdd, CHAIN_VELOCITY | CHAIN_GRAVITY, s->id0);
-    z[j] = z0 - h;
-    const double hm = z0 - z[j];
-    chain_update(s->ch, s->ws, q, qd);
-    chain_inverse_dynamics(s->ch, s->ws, s->qdd, CHAIN_VELOCITY | CHAIN_GRAVITY, s->id1);
-    for (int i = 0; i < nd; ++i) out[i] = (s->id0[i] - s->id1[i]) / (hp + hm);
+    for (int i = 0; i < nd; ++i) out[i] = (s->id0[i] - base[i]) / hp;
 }
 
 int chain_sim_jac(void* user, double t, const double* y, double* J) {
@@ -297,9 +297,11 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
     // Cholesky factor of M at y stays in the workspace for chain_solve.
     double* b = s->g;
     double* x = s->g + nd;
+    // ID at y itself, from the kinematics chain_forward_dynamics left at y.
+    chain_inverse_dynamics(s->ch, s->ws, s->qdd, CHAIN_VELOCITY | CHAIN_GRAVITY, s->id1);
     for (int which = 0; which < 2; ++which)
         for (int j = 0; j < nd; ++j) {
-            id_partial(s, y, which, j, b);
+            id_partial(s, y, which, j, s->id1, b);
             const double* dt = which ? dtqd : dtq;
             for (int i = 0; i < nd; ++i) b[i] = dt[i * nd + j] - b[i];
             chain_solve(s->ch, s->ws, b, x);

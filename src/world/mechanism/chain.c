@@ -551,9 +551,20 @@ double chain_cylinder(const chain* c, const chain_ws* w, int a, const double pa[
     const size_t nb = (size_t)c->nbody;
     for (int k = 0; k < c->ndof; ++k) {
         const int body = c->dof_body[k];
+        const int on_a = c->anc[(size_t)a * nb + (size_t)body], on_b = c->anc[(size_t)b * nb + (size_t)body];
+        if (on_a == on_b) {
+            // A joint that carries both pins (or neither) moves them
+            // together: L does not depend on it at any q, so both partials
+            // are exactly 0 (computed, they would be rounding noise). Only
+            // the joints between the two bodies cost anything, which keeps
+            // a long chain's lever arms linear in its length.
+            if (dL_dq) dL_dq[k] = 0.0;
+            if (dLdot_dq) dLdot_dq[k] = 0.0;
+            continue;
+        }
         double ja[3] = {0, 0, 0}, jda[3] = {0, 0, 0}, jb[3] = {0, 0, 0}, jdb[3] = {0, 0, 0};
-        if (c->anc[(size_t)a * nb + (size_t)body]) jac_col(c, w, body, xa, va, ja, dLdot_dq ? jda : NULL);
-        if (c->anc[(size_t)b * nb + (size_t)body]) jac_col(c, w, body, xb, vb, jb, dLdot_dq ? jdb : NULL);
+        if (on_a) jac_col(c, w, body, xa, va, ja, dLdot_dq ? jda : NULL);
+        if (on_b) jac_col(c, w, body, xb, vb, jb, dLdot_dq ? jdb : NULL);
         const double dj[3] = {jb[0] - ja[0], jb[1] - ja[1], jb[2] - ja[2]};
         if (dL_dq) dL_dq[k] = dot(u, dj);
         if (dLdot_dq) {
@@ -593,17 +604,26 @@ void chain_cylinder_hessian(const chain* c, chain_ws* w, int a, const double pa[
     // Both points' Jacobian columns in the Newton-Euler scratch (3 ndof <= 6 nbody each).
     double* Ja = w->a;
     double* Jb = w->f;
+    // The joints between the two bodies (carrying exactly one pin): L does
+    // not depend on any other at any q, so their rows and columns are 0.
+    double* act = w->tmp; // DOF indices of those joints (the solve's scratch; exact as doubles)
+    int na = 0;
     for (int k = 0; k < nd; ++k) {
         const int body = c->dof_body[k];
         double* ja = &Ja[3 * k];
         double* jb = &Jb[3 * k];
         ja[0] = ja[1] = ja[2] = jb[0] = jb[1] = jb[2] = 0;
-        if (c->anc[(size_t)a * nb + (size_t)body]) jac_col(c, w, body, xa, xa, ja, NULL);
-        if (c->anc[(size_t)b * nb + (size_t)body]) jac_col(c, w, body, xb, xb, jb, NULL);
+        const int on_a = c->anc[(size_t)a * nb + (size_t)body], on_b = c->anc[(size_t)b * nb + (size_t)body];
+        if (on_a == on_b) continue;
+        act[na++] = k;
+        if (on_a) jac_col(c, w, body, xa, xa, ja, NULL);
+        if (on_b) jac_col(c, w, body, xb, xb, jb, NULL);
     }
+    memset(H, 0, (size_t)nd * (size_t)nd * sizeof *H);
     // L = |d|: d2L/dqj dqk = (Dj . Dk - (u . Dj)(u . Dk)) / L + u . dDk/dqj, D = Jb - Ja.
-    for (int j = 0; j < nd; ++j)
-        for (int k = j; k < nd; ++k) {
+    for (int jj = 0; jj < na; ++jj)
+        for (int kk = jj; kk < na; ++kk) {
+            const int j = (int)act[jj], k = (int)act[kk];
             const double Dj[3] = {Jb[3 * j] - Ja[3 * j], Jb[3 * j + 1] - Ja[3 * j + 1], Jb[3 * j + 2] - Ja[3 * j + 2]};
             const double Dk[3] = {Jb[3 * k] - Ja[3 * k], Jb[3 * k + 1] - Ja[3 * k + 1], Jb[3 * k + 2] - Ja[3 * k + 2]};
             double sa[3], sb[3];
