@@ -153,7 +153,7 @@ static void compare(const trace* a, const trace* b, double dt_ode, const crane_c
 // The ODE chain world against the analytic mode on a scenario that moves
 // every function (issue 26: stroke RMS <= 0.5 mm, pressure RMS <= 1 % of
 // peak). At the default ODE step of 1 ms the lift, jib and jib2 meet it;
-// the extension does not: 2.52 mm and 3.55 % (pB), from where its
+// the extension does not: 2.38 mm and 2.47 % (pB), from where its
 // retraction ends with the A side near cavitation (9-9.5 s) and the two
 // backends come to rest 5.7 mm apart, held by the cylinder's friction. Its
 // bounds here are that measured gap (a regression guard, not the issue's
@@ -248,9 +248,9 @@ static void test_8fn_10link_runs(void) {
         char csv[512], args[2048], out[8192];
         snprintf(csv, sizeof csv, "%s/test_ode_engine_chain_%d_%s.csv", tmp, (int)getpid(), mech[b]);
         // The analytic general path at Krus 0.1 ms blows up on this
-        // scenario (main at eceb32d: jib_ext2_cyl.pB below absolute zero at
-        // t = 7.926 s; before chainlag's last merge a hose of jib_ext1 at
-        // 3.004 s; 0.05 ms runs): an adaptive step here.
+        // scenario (main at ece8b24: jib_ext2_cyl.pA below absolute zero at
+        // t = 7.943 s; earlier a hose of jib_ext1 at 3.004 s; 0.05 ms
+        // runs): an adaptive step here.
         snprintf(args, sizeof args, "run --model %s --scenario %s --mechanics %s%s --out %s", CHAIN_8FN,
                  CHAIN_8FN_SCN, mech[b], b ? " --solver ros34pw2" : "", csv);
         const int rc = cli_run(args, out, sizeof out);
