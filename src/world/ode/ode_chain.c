@@ -594,16 +594,7 @@ static int build(void* arg) {
     build_args* ba = arg;
     ode_chain* w = ba->w;
     const char* mf = w->opt.model_file;
-    w->world = dWorldCreate();
-    // The world's own step jobs (see ode_world.c, build_world: an ODE error
-    // leaves jobs queued that must not reach another world).
-    w->threading = dThreadingAllocateSelfThreadedImplementation();
-    if (w->threading)
-        dWorldSetStepThreadingImplementation(w->world, dThreadingImplementationGetFunctions(w->threading),
-                                             w->threading);
-    dWorldSetGravity(w->world, 0, 0, -w->g);
-    dWorldSetERP(w->world, w->opt.erp);
-    dWorldSetCFM(w->world, w->opt.cfm);
+    w->world = ow_world_new(w->g, w->opt.erp, w->opt.cfm, &w->threading);
     dWorldSetAutoDisableFlag(w->world, 0);
 
     chain_update(w->mech, w->ws, w->qstart, NULL);

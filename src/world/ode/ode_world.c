@@ -561,20 +561,24 @@ typedef struct create_args {
 } create_args;
 
 // The ODE part of ode_world_create (run under ow_trapped): 0, or -1 with err set.
-static int build_world(ode_world* w, void* arg) {
-    const create_args* a = arg;
-    w->world = dWorldCreate();
+dWorldID ow_world_new(double g, double erp, double cfm, dThreadingImplementationID* threading) {
+    dWorldID world = dWorldCreate();
     // Each world queues its step jobs on its own self-threaded implementation,
     // not on ODE's process-wide default: an ODE error jumps out of a step
     // with jobs still queued (ow_trapped), and on the shared one those would
     // be run by the next world's step and fail ODE's check at dCloseODE.
-    w->threading = dThreadingAllocateSelfThreadedImplementation();
-    if (w->threading)
-        dWorldSetStepThreadingImplementation(w->world, dThreadingImplementationGetFunctions(w->threading),
-                                             w->threading);
-    dWorldSetGravity(w->world, 0, 0, -w->g);
-    dWorldSetERP(w->world, w->desc.ode.erp);
-    dWorldSetCFM(w->world, w->desc.ode.cfm);
+    *threading = dThreadingAllocateSelfThreadedImplementation();
+    if (*threading)
+        dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(*threading), *threading);
+    dWorldSetGravity(world, 0, 0, -g);
+    dWorldSetERP(world, erp);
+    dWorldSetCFM(world, cfm);
+    return world;
+}
+
+static int build_world(ode_world* w, void* arg) {
+    const create_args* a = arg;
+    w->world = ow_world_new(w->g, w->desc.ode.erp, w->desc.ode.cfm, &w->threading);
     dWorldSetContactSurfaceLayer(w->world, w->desc.ode.surface_layer);
     // No automatic disabling by default: a resting crane must react to the
     // next command at once. Loads and obstacles opt in per body

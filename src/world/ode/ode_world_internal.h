@@ -261,6 +261,11 @@ enum { OW_ODE_FAILED = -1000 };
 /// when ODE failed inside it (its message in fatal). The jump skips the rest
 /// of fn: its world must then only be destroyed.
 int ow_ode_call(int (*fn)(void* arg), void* arg, char* fatal, size_t n);
+/// A new ODE world with gravity g [m/s^2] along -z, ERP and CFM, stepping on
+/// a self-threaded implementation of its own (*threading; NULL when none
+/// could be made): an ODE error jumps out of a step with jobs still queued,
+/// and on ODE's shared default those would reach the next world's step.
+dWorldID ow_world_new(double g, double erp, double cfm, dThreadingImplementationID* threading);
 void ow_frame_point(const ode_world* w, int f, const double p[3], double out[3]);
 void ow_frame_point_vel(const ode_world* w, int f, const double p[3], double out[3]);
 void ow_frame_rot(const ode_world* w, int f, double R[9]);
