@@ -1,5 +1,6 @@
 // engine_chain.c: scripted runs of the general analytic mode (engine_chain.h).
 #include "engine_chain.h"
+#include "chain_problem.h"
 #include "chain_sim.h"
 #include "energy_acc.h"
 #include "engine_impl.h"
@@ -149,6 +150,8 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     const int nd = cs.ndof, na = cs.nact, nf = cs.nfn;
     chain_run_ctx c;
     memset(&c, 0, sizeof c);
+    chain_problem cp;
+    memset(&cp, 0, sizeof cp);
     const size_t nrow = SIM_NCOL_BASE + (size_t)m->chain.ncol > SIM_NCOL ? SIM_NCOL_BASE + (size_t)m->chain.ncol
                                                                          : (size_t)SIM_NCOL;
     double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + nrow + 1, sizeof *buf);
@@ -190,8 +193,23 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
         }
     }
     const bool adaptive = hyd_method_is_adaptive(o->solver);
-    // The block-diagonal W for the fixed-step methods, as the closed form's.
-    hyd_problem prob = chain_sim_problem(&cs, !adaptive && !o->dense_jac);
+    // The block-diagonal W for the fixed-step methods only on the two-link
+    // chain (an allow-list): it treats the oil-column springs between the
+    // chambers and the bodies explicitly, which holds where they are slow
+    // (the two-link crane: 2-12 Hz, docs/lagrange.md). A chain of light
+    // telescopic stages has them fast: on chain_8fn_10link.json Krus at
+    // 0.1 ms with the block W, even with a new J at every step, ends 5 mm
+    // RMS off ROS34PW2 in a stroke, with the whole W 0.1 mm. Every other
+    // chain takes the whole W (the solver's sparse LU). With the event
+    // counter and the implausible-state test (chain_problem.h).
+    const bool blocks = !adaptive && !o->dense_jac && m->chain.two_link;
+    hyd_problem prob;
+    if (chain_problem_init(&cp, &cs, blocks, &prob)) {
+        snprintf(msg, msz, "cannot set up the chain's problem (out of memory, or a hook of chain_sim's problem "
+                           "that chain_problem.c does not forward)");
+        res->status = SIM_REFUSED;
+        goto done;
+    }
     hyd_solver_opts so = hyd_default_solver_opts();
     so.h = adaptive ? 0.0 : o->h;
     so.rtol = o->rtol;
@@ -267,6 +285,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     if (k->energy) sim_energy_finish(k->energy);
 done:
     hyd_solver_destroy(s);
+    chain_problem_free(&cp);
     free(buf);
     free(c.fcol);
     chain_sim_free(&cs);

@@ -1,0 +1,103 @@
+// chain_problem.c: chain_sim's problem with the event counter and the
+// implausible-state test (chain_problem.h).
+#include "chain_problem.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int cp_f(void* user, double t, const double* y, double* dydt) {
+    chain_problem* cp = user;
+    return cp->base.f(cp->base.user, t, y, dydt);
+}
+
+static int cp_jac(void* user, double t, const double* y, double* J) {
+    chain_problem* cp = user;
+    return cp->base.jac(cp->base.user, t, y, J);
+}
+
+static int cp_settle(void* user, double t, double* y) {
+    chain_problem* cp = user;
+    return cp->base.settle ? cp->base.settle(cp->base.user, t, y) : 0;
+}
+
+static int cp_dfdt(void* user, double t, const double* y, double* dfdt) {
+    chain_problem* cp = user;
+    return cp->base.dfdt(cp->base.user, t, y, dfdt);
+}
+
+static int cp_outside(void* user, const double* y) {
+    chain_problem* cp = user;
+    return cp->base.outside(cp->base.user, y);
+}
+
+// More than 0.1 MPa below absolute zero: as lagrange_sim.c's lsim_implausible
+// (the run checks' failure threshold, sim.c).
+static int cp_implausible(void* user, const double* y) {
+    const chain_problem* cp = user;
+    const chain_sim* s = cp->cs;
+    if (cp->base.implausible) return cp->base.implausible(cp->base.user, y);
+    for (int i = 0; i < s->nh; ++i)
+        if (s->is_pressure[i] && !(y[i] > -1e5)) return i + 1;
+    return 0;
+}
+
+unsigned long chain_problem_events(void* user, double t, const double* y) {
+    chain_problem* cp = user;
+    chain_sim* s = cp->cs;
+    const crane_chain* cc = s->cc;
+    const int nd = s->ndof;
+    // The strokes and rates at y (the kinematics alone; f and the Jacobian
+    // take their own at every call, so the workspace left at y is harmless).
+    chain_update(s->ch, s->ws, y + s->iq, y + s->iq + nd);
+    for (int k = 0; k < s->nact; ++k) {
+        const crane_act* a = &cc->act[k];
+        double Ld = 0.0;
+        const double L = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, &Ld, NULL, NULL);
+        cp->x[a->cyl] = L - a->closed_length;
+        cp->v[a->cyl] = Ld;
+    }
+    // The commands as chain_sim's f takes them (clamped to [-1, 1]).
+    for (int f = 0; f < s->nfn; ++f) {
+        double u = s->cmd_fn ? s->cmd_fn(s->cmd_user, f, t) : s->cmd[f];
+        u = u < -1.0 ? -1.0 : u > 1.0 ? 1.0 : u;
+        cp->cmd[cc->fn[f].valve_idx] = u;
+    }
+    const unsigned long own = cp->base.events ? cp->base.events(cp->base.user, t, y) : 0;
+    return own + hyd_events_update(cp->ev, s->hm, y, s->hpos, cp->x, cp->v, cp->cmd);
+}
+
+int chain_problem_init(chain_problem* cp, chain_sim* cs, bool blocks, hyd_problem* out) {
+    memset(cp, 0, sizeof *cp);
+    cp->cs = cs;
+    cp->base = chain_sim_problem(cs, blocks);
+    // Allow-list: the hooks forwarded below. A problem with its own step
+    // kernel (wstep, wfactor, ...) would see the wrong user: refused.
+    const hyd_problem* b = &cp->base;
+    if (b->wfactor || b->wsolve || b->wstep || b->wstage || !b->f) return -1;
+    const int nc = hyd_model_ncylinder(cs->hm), nv = hyd_model_nvalve(cs->hm);
+    cp->ev = hyd_events_create(cs->hm);
+    cp->x = calloc(2 * (size_t)nc + (size_t)nv + 1, sizeof *cp->x);
+    if (!cp->ev || !cp->x) {
+        chain_problem_free(cp);
+        return -1;
+    }
+    cp->v = cp->x + nc;
+    cp->cmd = cp->v + nc;
+    *out = cp->base;
+    out->user = cp;
+    out->f = cp_f;
+    out->jac = b->jac ? cp_jac : NULL;
+    out->settle = cp_settle;
+    out->dfdt = b->dfdt ? cp_dfdt : NULL;
+    out->outside = b->outside ? cp_outside : NULL;
+    out->implausible = cp_implausible;
+    out->events = chain_problem_events;
+    return 0;
+}
+
+void chain_problem_free(chain_problem* cp) {
+    hyd_events_free(cp->ev);
+    free(cp->x);
+    memset(cp, 0, sizeof *cp);
+}
