@@ -777,7 +777,9 @@ static double chain_wave(void* user, int k, double t) {
 static int bench_chain_sizes(int repeat) {
     static const char* const shapes[5] = {"RR", "RRR", "RRRP", "RRRPRP", "RRRPRPRP"};
     for (int pass = 0; pass < 2; ++pass) {
-    // The block-diagonal W the engine's fixed-step runs use, then the dense W.
+    // The block-diagonal W, then the dense W. (The engine's fixed-step runs
+    // take the block W on the two-link chain only, the dense W with the
+    // event counter of chain_problem.h on every other: engine_chain.c.)
     const bool blocks = pass == 0;
     const char* wname = blocks ? "blocks" : "dense";
     double per_state[5] = {0};
