@@ -15,13 +15,13 @@
 //   F_seal = (F_c + F_s exp(-(v/v_st)^2)) tanh(v/v_sm)      (cylinder.c)
 //
 // has the slope (F_c + F_s)/v_sm at rest and about 4 (F_c + F_s)/v_sm
-// exp(-2|v|/v_sm) away from it: a damping that grows 1e4-fold as a piston
+// exp(-2|v|/v_sm) away from it: a damping that grows 5e3-fold as a piston
 // slows from 5 v_sm to rest. On a light body (a telescopic stage of 20 kg
 // between two sliding joints) it is a mode of (F_c + F_s)/(v_sm m) = 2.2e5
 // 1/s for the seal of the test models (4.5 kN, 1 mm/s): h |lambda| = 22 at
 // 0.1 ms. A J taken while the piston moved, reused as it comes to rest or
 // reverses through zero, underestimates that mode 100-fold and Krus rings
-// up (the 8-function model: a blow-up at 7.943 s, docs/solvers.md).
+// up (the 8-function model: a blow-up at 7.943 s, docs/lagrange.md).
 #ifndef HYD_EVENTS_H
 #define HYD_EVENTS_H
 

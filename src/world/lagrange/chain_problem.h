@@ -8,7 +8,7 @@
 //     stiffer than it describes. Without it Krus at 0.1 ms rang up on the
 //     8-function model's telescopic stages (a seal's friction steepening
 //     100-fold as a light stage came to rest under a J taken while it
-//     moved) and blew up at 7.943 s (docs/solvers.md);
+//     moved) and blew up at 7.943 s (docs/lagrange.md);
 //   - implausible (hyd_problem.implausible): an absolute pressure more than
 //     0.1 MPa below zero, where the run checks stop the run, so that such a
 //     fixed step is retried in shorter ones first (solver.c).
