@@ -190,6 +190,10 @@ static void test_slew_only(void) {
     const double AA = 0.25 * M_PI * bore * bore, AB = AA - 0.25 * M_PI * rod * rod;
     const double rp = cc->slew.pinion_radius, c = cc->slew.damping;
     CHECK(isfinite(AA) && isfinite(bv) && rp > 0, "rack %g m^2, %g N s/m, pinion %g m", AA, bv, rp);
+    // The rack starts unloaded as the sandbox starts it: A at the low
+    // pressure (0.5 MPa), B at 0.5 MPa A_A / A_B.
+    CHECK(fabs(at(&r, 0, cA) - 0.5e6) < 1e-3 && fabs(at(&r, 0, cB) - 0.5e6 * AA / AB) < 1e-3,
+          "rack start pA %.9g, pB %.9g Pa (want 5e5, %.9g)", at(&r, 0, cA), at(&r, 0, cB), 0.5e6 * AA / AB);
     // I_zz theta'' = r (pA A_A - pB A_B - b r theta') - c theta', by RK4
     // over each row interval with the pressures linear in between and I_zz
     // at the interval's start pose.
@@ -275,6 +279,9 @@ static void test_slew_only(void) {
     od.world = CRANESIM_ASSETS "/worlds/sandbox.json";
     rows ro = {.ode = true};
     if (run(m, &sc, &od, &ro, NULL) == SIM_OK) {
+        CHECK(fabs(at(&ro, 0, COL_P3A) - at(&r, 0, cA)) < 1e-3 && fabs(at(&ro, 0, COL_P3B) - at(&r, 0, cB)) < 1e-3,
+              "start: sandbox p3A %.9g, p3B %.9g Pa; analytic %.9g, %.9g", at(&ro, 0, COL_P3A), at(&ro, 0, COL_P3B),
+              at(&r, 0, cA), at(&r, 0, cB));
         // Rows at 1 ms in both: the analytic run's every tenth.
         double dmax = 0.0, dmax_drive = 0.0, sq = 0.0;
         long n = 0;
