@@ -31,9 +31,27 @@ int engine_chain_slew_setup(const model* m, crane_chain* cc, hyd_model** hm, cha
                  file);
         return -1;
     }
+    // A scenario's hose bursts at nodes of the slew's circuit (engine_fault_model
+    // left them in world_bursts) open there, as in the sandbox (ode_run.c):
+    // their orifices join the fragment; a node it lacks too is refused.
+    if (engine_world_bursts(m, frag, "its hydraulics_slew", err, errsz)) return -1;
+    cJSON* fx = NULL;
+    if (m->world_bursts) {
+        fx = cJSON_Duplicate(frag, 1);
+        cJSON* comps = fx ? cJSON_GetObjectItemCaseSensitive(fx, "components") : NULL;
+        if (!cJSON_IsArray(comps)) {
+            snprintf(err, errsz, "out of memory");
+            cJSON_Delete(fx);
+            return -1;
+        }
+        const cJSON* o;
+        cJSON_ArrayForEach(o, m->world_bursts) cJSON_AddItemToArray(comps, cJSON_Duplicate(o, 1));
+        frag = fx;
+    }
     // The circuit as the sandbox compiles it (model_slew_check checked it
     // at load), from the document with the run's overrides.
     *hm = model_circuit_with_fragment(h, file, frag, file, "hydraulics_slew", err, errsz);
+    cJSON_Delete(fx);
     if (!*hm) return -1;
     if (crane_chain_copy(cc, &m->chain)) {
         snprintf(err, errsz, "out of memory");
@@ -194,7 +212,8 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
         snprintf(msg, msz, "--solver cvode: the general analytic mode runs the in-house solvers");
         return res->status = SIM_REFUSED;
     }
-    if (engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
+    // (A slewing run checks the bursts against the slew's circuit, which it appends.)
+    if (!slews && engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
     const double m3 = sim_load_mass(m, sc, o);
     crane_chain slew_cc;
     hyd_model* slew_hm = NULL;
