@@ -577,11 +577,65 @@ static void test_slew_burst(void) {
     model_free(m);
 }
 
+// The default crane in the chain form (tests/world/data/hiab031_chain.json,
+// mechanics.bodies with the same slew section) slews as the two-link form
+// does: its chain columns are the chain's actuators, the rack, the
+// functions, the slew function, then the slew and boom DOFs, and the slew's
+// values equal the two-link run's (the same chain, the same equations).
+static void test_chain_form(void) {
+    char err[512];
+    model* mc = model_load(CRANESIM_TESTDATA "/../../world/data/hiab031_chain.json", NULL, 0, err, sizeof err);
+    CHECK(mc != NULL, "%s", err);
+    model* m2 = load_model("hiab031.json");
+    scenario sc;
+    if (!mc || !m2 || scenario_of(SLEW_ONLY, &sc)) {
+        model_free(mc);
+        model_free(m2);
+        return;
+    }
+    sim_opts o = sim_default_opts();
+    o.no_step_probe = true;
+    o.duration = 3.0;
+    rows rc = {0}, r2 = {0};
+    if (run(mc, &sc, &o, &rc, NULL) == SIM_OK && run(m2, &sc, &o, &r2, NULL) == SIM_OK) {
+        static const char* const want[] = {"x_lift", "v_lift",  "pA_lift",   "pB_lift",        "F_lift",
+                                           "x_jib",  "v_jib",   "pA_jib",    "pB_jib",         "F_jib",
+                                           "x_slew", "v_slew",  "pA_slew",   "pB_slew",        "F_slew",
+                                           "u_lift", "ucmd_lift", "u_jib",   "ucmd_jib",       "u_slew",
+                                           "ucmd_slew", "q_column", "qd_column", "q_lifting_arm", "qd_lifting_arm",
+                                           "q_end_arm", "qd_end_arm"};
+        const int nw = (int)(sizeof want / sizeof want[0]);
+        bool same = rc.nname == nw;
+        for (int i = 0; same && i < nw; ++i) same = !strcmp(rc.name[i], want[i]);
+        CHECK(same, "chain form's columns: %d, first %s", rc.nname, rc.nname ? rc.name[0] : "-");
+        static const char* const cols[] = {"q_column", "qd_column", "pA_slew", "pB_slew", "F_slew"};
+        double worst = 0;
+        for (int j = 0; j < 5; ++j) {
+            const int a = chain_col(&rc, cols[j]), b = chain_col(&r2, cols[j]);
+            CHECK(a >= 0 && b >= 0 && rc.n == r2.n, "%s in both", cols[j]);
+            if (a < 0 || b < 0 || rc.n != r2.n) continue;
+            double dmax = 0, vmax = 0;
+            for (long i = 0; i < rc.n; ++i) {
+                dmax = fmax(dmax, fabs(at(&rc, i, a) - at(&r2, i, b)));
+                vmax = fmax(vmax, fabs(at(&r2, i, b)));
+            }
+            worst = fmax(worst, dmax / vmax);
+        }
+        printf("  chain form against the two-link form, slewing: worst %.3g relative\n", worst);
+        CHECK(worst < 1e-12, "chain form vs two-link: %.3g relative", worst);
+    }
+    free(rc.v);
+    free(r2.v);
+    model_free(mc);
+    model_free(m2);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_slew_only);
     RUN_TEST(test_energy_ideal);
     RUN_TEST(test_hydraulic_slew_and_booms);
     RUN_TEST(test_routing);
     RUN_TEST(test_slew_burst);
+    RUN_TEST(test_chain_form);
     TEST_MAIN_END();
 }
