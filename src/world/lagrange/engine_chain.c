@@ -60,6 +60,7 @@ int engine_chain_slew_setup(const model* m, crane_chain* cc, hyd_model** hm, cha
         return -1;
     }
     cc->slew_free = true;
+    cc->slew_rack_columns = true; // chain_sim's outputs have the rack last
     // Bound anew: the indices are the merged circuit's; the columns gain
     // the rack's (crane_chain_columns).
     char e[300];

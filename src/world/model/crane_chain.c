@@ -176,7 +176,7 @@ int crane_chain_columns(crane_chain* cc) {
     cc->ncol = 0;
     // The slew rack, where the column slews by its drive: an actuator and a
     // function named "slew" after the chain's (chain_sim.h).
-    const bool rack = cc->slew_free && cc->slew.present;
+    const bool rack = cc->slew_rack_columns && cc->slew_free && cc->slew.present;
     if (cc->two_link && !rack) return 0;
     // The two-link shorthand's base columns say everything but the slew's:
     // then only the rack, its function and the slew DOF.
@@ -219,7 +219,7 @@ void crane_chain_row(const crane_chain* cc, const crane_chain_sample* s, double*
     int k = 0;
     // As crane_chain_columns: the rack and its function (index nact, nfn of
     // the sample) after the chain's, and the two-link shorthand's only them.
-    const bool rack = cc->slew_free && cc->slew.present;
+    const bool rack = cc->slew_rack_columns && cc->slew_free && cc->slew.present;
     for (int a = cc->two_link ? cc->nact : 0; a < cc->nact + rack; ++a) {
         out[k++] = s->x[a];
         out[k++] = s->v[a];
