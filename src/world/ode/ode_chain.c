@@ -575,7 +575,29 @@ static int hyd_init_state(ode_chain* w, char* err, size_t errsz) {
         snprintf(err, errsz, "ode chain world: out of memory");
         return -1;
     }
-    if (w->nact && holding_forces(w, F)) {
+    int bad = 0;
+    if (w->nact && w->opt.hold_tip_mass > 0) {
+        // The forces of the pose with the hanging mass at the tip: from a
+        // mechanism with it merged (the world's bodies stay without it).
+        char e[320];
+        chain* held = crane_chain_mechanism(&w->cc, w->opt.tip_mass + w->opt.hold_tip_mass, w->cc.slew_free,
+                                            w->opt.slew0, e, sizeof e);
+        chain_ws* hws = held ? chain_ws_create(held) : NULL;
+        chain* m0 = w->mech;
+        chain_ws* ws0 = w->ws;
+        if (hws) {
+            w->mech = held, w->ws = hws;
+            bad = holding_forces(w, F);
+            w->mech = m0, w->ws = ws0;
+        } else {
+            bad = 1;
+        }
+        chain_ws_free(hws);
+        chain_free(held);
+    } else if (w->nact) {
+        bad = holding_forces(w, F);
+    }
+    if (bad) {
         snprintf(err, errsz,
                  "%s: mechanics.actuators: the cylinders' lever arms at the start pose are dependent; no set of "
                  "forces holds it (start with init_hold off)",
@@ -1111,6 +1133,16 @@ struct dxBody* ode_chain_body_id(const ode_chain* w, int i, double org[3]) {
     if (i < 0 || i >= w->nbody) return NULL;
     if (org) memcpy(org, w->b[i].org, sizeof w->b[i].org);
     return w->b[i].body;
+}
+
+const crane_chain* ode_chain_chain(const ode_chain* w) { return &w->cc; }
+
+void ode_chain_act_pins(const ode_chain* w, int k, double pa[3], double pb[3]) {
+    if (w->dead || k < 0 || k >= w->nact) {
+        for (int i = 0; i < 3; ++i) pa[i] = pb[i] = NAN;
+        return;
+    }
+    act_geometry(w, k, NULL, NULL, pa, pb);
 }
 
 void ode_chain_set_slew_command(ode_chain* w, double u) { w->slew_u = u > 1 ? 1 : u < -1 ? -1 : (u == u ? u : 0); }

@@ -67,6 +67,10 @@ typedef struct ode_chain_opts {
     /// F r minus the bearing's damping on it, the rack's ends as the hinge's
     /// stops; commanded by ode_chain_set_slew_command. 0 (default): none.
     int slew_drive;
+    /// init_hold: a point mass [kg] at the tip counted in the start's
+    /// holding forces only (the sandbox's rope and hook, which hang from
+    /// the tip as bodies of their own); default 0.
+    double hold_tip_mass;
 } ode_chain_opts;
 
 ode_chain_opts ode_chain_default_opts(void);
@@ -110,6 +114,12 @@ int ode_chain_host_post(ode_chain* w);
 /// the frame origin (the joint) in that body's coordinates [m] (org may be
 /// NULL): a point p of the frame is org + p in the body.
 struct dxBody* ode_chain_body_id(const ode_chain* w, int i, double org[3]);
+/// The chain as built (the copy: slew_free set where a slew drive turns the
+/// column; its actuators bound to the circuit).
+const crane_chain* ode_chain_chain(const ode_chain* w);
+/// Actuator k's barrel and rod pins in the world [m] (hosted) or the base
+/// frame; NaN once ODE failed.
+void ode_chain_act_pins(const ode_chain* w, int k, double pa[3], double pb[3]);
 /// The slew command [-1, 1] (opts.slew_drive), held.
 void ode_chain_set_slew_command(ode_chain* w, double u);
 /// The slew drive now: rack stroke [m] and rate [m/s] (from the hinge),

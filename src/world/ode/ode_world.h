@@ -22,6 +22,7 @@
 #include <cjson/cJSON.h>
 #include <stddef.h>
 
+#include "crane_chain.h"
 #include "crane_model.h"
 #include "hyd_solver.h"
 #include "world_desc.h"
@@ -64,6 +65,14 @@ typedef struct ode_world_opts {
                           ///< world's own when the world adds no circuit of its own, so a run
                           ///< and its panel share one hyd_model; NULL (default) compiles the
                           ///< "hydraulics" section
+    /// The model's chain (borrowed while the world is created). A chain that
+    /// is not two_link builds the sandbox's crane from it (ode_chain.h,
+    /// hosted on the truck, the model's or the world's slew drive on the
+    /// column; docs/ode_world.md "The sandbox from the chain"); NULL
+    /// (default) or a two_link chain: the two-link crane from mech, as
+    /// always. Only the sandbox takes a chain (the validation world of a
+    /// chain is ode_chain's own).
+    const crane_chain* chain;
 } ode_world_opts;
 
 ode_world_opts ode_world_default_opts(void);
@@ -186,6 +195,15 @@ void ode_world_chamber_pressures(const ode_world* w, double pA[ODE_NACT], double
 /// Non-fatal messages ODE has sent so far in this process (a degenerate
 /// contact LCP), and the last one's text in *last (may be NULL).
 long ode_world_messages(const char** last);
+
+/// The chain crane's world (opts.chain), for its per-actuator and per-DOF
+/// state (ode_chain_q, ode_chain_act_length, ...; read only, never stepped
+/// alone); NULL for the two-link crane. With a chain, ode_world_state's
+/// two-link fields hold: x, v, F, pA, pB, u, u_cmd [ODE_LIFT], [ODE_JIB] the
+/// chain's first two actuators, [ODE_SLEW] the slew rack; q, qd the first
+/// two boom DOFs; tip relative to body 1's joint. ode_world_set_commands
+/// then drives the functions of the first two actuators and the slew.
+struct ode_chain* ode_world_chain(const ode_world* w);
 
 /// Simulated time [s].
 double ode_world_time(const ode_world* w);

@@ -11,6 +11,7 @@
 #include "circuit_fast.h"
 #include "hyd_fused.h"
 #include "hyd_solver.h"
+#include "ode_chain.h"
 #include "ode_world.h"
 
 #define OW_MAX_GEOMS 256
@@ -247,6 +248,16 @@ struct ode_world {
     // edits by itself (the circuit's revision).
     hyd_fast* fk;
     int use_fast;
+
+    // A chain crane (opts.chain, not two_link): its bodies, joints and
+    // circuit are ode_chain's, hosted in this world on the truck; frame[0]
+    // is its column, frame[1] its first boom, frame[2] the tip's body (the
+    // rope's anchor). The two-link fields above (act[] except the slew's
+    // display copy, j1, j2, hm, y) stay unused.
+    ode_chain* chain;
+    hyd_model* chain_hm;   ///< its circuit (the model's with the world's part appended)
+    int chain_own_hm;      ///< 1: compiled here, freed with the world
+    double* chain_q;       ///< scratch: joint coordinates and rates (2 ndof)
 };
 
 // ode_world.c
@@ -283,6 +294,17 @@ double ow_slew_angle(const ode_world* w);
 /// Give ODE the slew stops (slew_lim) as hinge angles of the current turn.
 void ow_slew_stops(ode_world* w);
 void ow_apply_forces(ode_world* w);
+
+/// The sandbox's chain crane (w->chain) on the truck, its column foot at
+/// base [m] with the truck's rotation R: the hosted ode_chain, a collision
+/// geom and a drawing per body, frames 0 to 2 for the rope and the column.
+int ow_build_chain_crane(ode_world* w, const double base[3], const double R[9], char* err, size_t errsz);
+/// The crane's tip (the rope's anchor) in the world [m] and its velocity
+/// (v may be NULL).
+void ow_tip(const ode_world* w, double p[3], double v[3]);
+/// The crane's moving bodies (column and booms, of either crane) into b;
+/// returns their count (at most max).
+int ow_crane_bodies(const ode_world* w, dBodyID* b, int max);
 
 // ode_sandbox.c
 int ow_build_sandbox(ode_world* w, char* err, size_t errsz);
