@@ -497,6 +497,18 @@ int ow_build_chain_crane(ode_world* w, const double base[3], const double R[9], 
         snprintf(err, errsz, "ode world: out of memory");
         return -1;
     }
+    {
+        // The slew drive's parts in the circuit, named where they were given.
+        const bool from_model = w->desc.slew_file[0] != 0;
+        const char* wf = from_model ? w->desc.slew_file : w->desc.file[0] ? w->desc.file : "world";
+        const char* sf = from_model ? "mechanics.slew" : "slew";
+        const int nc = hyd_model_cylinder(w->chain_hm, ds->cylinder) < 0, nv = hyd_model_valve(w->chain_hm, ds->valve) < 0;
+        if (nc || nv) {
+            snprintf(err, errsz, "%s: %s.%s: no %s named \"%s\" in the circuit", wf, sf, nc ? "cylinder" : "valve",
+                     nc ? "cylinder" : "valve", nc ? ds->cylinder : ds->valve);
+            return -1;
+        }
+    }
     // The scenario's start (q1, q2, slew0) as the chain's start pose, every
     // other joint at the middle of its limits (crane_chain_start_pose).
     crane_chain_start_pose(&cc, w->opt.q0, w->opt.slew0, w->chain_q);
