@@ -1,5 +1,7 @@
 // engine_ode_chain.c: scripted runs (engine_run) of the ode backend for a
-// chain model, in the chain world (ode_chain.h), engine_ode_chain.h.
+// chain model, in the chain world (ode_chain.h) or, for a sandbox world, in
+// the sandbox with the crane from the chain (ode_world.h opts.chain),
+// engine_ode_chain.h.
 #include "engine_ode_chain.h"
 #include "energy_acc.h"
 #include "engine_faults.h"
