@@ -256,6 +256,48 @@ static void test_pick_statics(void) {
         chain_ws_free(ws);
         chain_free(c);
     }
+    {
+        // The picture: every chain body drawn under its name, at its pose;
+        // the first three actuators' cylinders and the slew's rack between
+        // their pins; the rope from the tip to the hook.
+        static world_snapshot snap;
+        ode_world_snapshot(w, &snap);
+        for (int i = 0; i < cc->nbody; ++i) {
+            int found = -1;
+            for (int j = 0; j < snap.nbody; ++j)
+                if (!strcmp(snap.body[j].name, cc->body[i].def.name)) found = j;
+            CHECK(found >= 0, "body %s not drawn", cc->body[i].def.name);
+            if (found < 0) continue;
+            // The primitive's centre: half the length from the joint along
+            // the body's x (the column: along z).
+            double R[9], p[3];
+            ode_chain_body_pose(cw, i, R, p);
+            const double h = 0.5 * cc->body[i].length;
+            for (int k = 0; k < 3; ++k)
+                CHECK_NEAR(snap.body[found].pos[k], p[k] + h * R[3 * k + (i == 0 ? 2 : 0)], 1e-9);
+        }
+        CHECK(snap.ncyl == 4, "cylinders drawn: %d", snap.ncyl);
+        for (int k = 0; k < 3 && k < snap.ncyl; ++k) {
+            double pa[3], pb[3];
+            ode_chain_act_pins(cw, k, pa, pb);
+            CHECK(!strcmp(snap.cyl[k].name, cc->act[k].name), "cylinder %d is %s", k, snap.cyl[k].name);
+            for (int j = 0; j < 3; ++j) {
+                CHECK_NEAR(snap.cyl[k].base[j], pa[j], 1e-12);
+                CHECK_NEAR(snap.cyl[k].rod_end[j], pb[j], 1e-12);
+            }
+        }
+        CHECK(snap.ncyl == 4 && !strcmp(snap.cyl[3].name, "slew"), "the slew's rack");
+        double tip[3];
+        ode_chain_tip(cw, tip, NULL);
+        CHECK(snap.nrope >= 2, "rope points %d", snap.nrope);
+        for (int j = 0; j < 3; ++j) CHECK_NEAR(snap.tip[j], tip[j], 1e-12);
+        // The rope's top joint at the tip (ODE's joint error: well below 1 mm).
+        if (snap.nrope >= 2)
+            CHECK(hypot(hypot(snap.rope[0][0] - tip[0], snap.rope[0][1] - tip[1]), snap.rope[0][2] - tip[2]) < 1e-3,
+                  "rope top %g %g %g, tip %g %g %g", snap.rope[0][0], snap.rope[0][1], snap.rope[0][2], tip[0], tip[1],
+                  tip[2]);
+        CHECK(snap.attached == 1, "the snapshot's hook holds no load");
+    }
     ode_world_destroy(w);
     model_free(m);
 }
