@@ -1129,6 +1129,11 @@ int ode_chain_host_post(ode_chain* w) {
     return w->failed ? -1 : 0;
 }
 
+void ode_chain_host_failed(ode_chain* w) {
+    w->dead = w->failed = 1;
+    if (!w->err[0]) snprintf(w->err, sizeof w->err, "ode chain world: its host's world failed in ODE");
+}
+
 struct dxBody* ode_chain_body_id(const ode_chain* w, int i, double org[3]) {
     if (i < 0 || i >= w->nbody) return NULL;
     if (org) memcpy(org, w->b[i].org, sizeof w->b[i].org);

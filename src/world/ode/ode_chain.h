@@ -110,6 +110,9 @@ int ode_chain_step(ode_chain* w, double dt);
 /// which); the chain then stays stopped.
 int ode_chain_host_pre(ode_chain* w);
 int ode_chain_host_post(ode_chain* w);
+/// The host's world failed inside ODE: the chain's bodies are not asked
+/// again (its readers give NaN, as after a failure of its own world).
+void ode_chain_host_failed(ode_chain* w);
 /// The ODE body of chain body i (NULL for a column fixed to the ground), and
 /// the frame origin (the joint) in that body's coordinates [m] (org may be
 /// NULL): a point p of the frame is org + p in the body.

@@ -83,6 +83,7 @@ static int ow_trapped(ode_world* w, const char* what, ow_fn fn, void* arg) {
         g_ode.trap = prev;
         w->dead = 1;
         w->failed = 1;
+        if (w->chain) ode_chain_host_failed(w->chain); // its bodies are this world's
         if (w->world_built)
             snprintf(w->err, sizeof w->err,
                      "ode world: ODE failed %s at t = %.6f s (%.150s): a mass, size or position far outside the "
