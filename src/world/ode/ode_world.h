@@ -179,7 +179,8 @@ void ode_world_circuit_state(const ode_world* w, double* y, const hyd_data** in)
 /// Give boom k (0 lifting arm, 1 end arm) link ln's mass and inertia in
 /// place (dBodySetMass), keeping its motion. Returns 0, or -1 (nothing
 /// changed) when that needs a rebuild: another length, section or centre of
-/// mass than the body was built with (its origin is its centre of mass).
+/// mass than the body was built with (its origin is its centre of mass), or
+/// a chain crane (ode_world_chain).
 int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln);
 /// 1 when the hydraulic solver runs on the straight-line circuit kernel
 /// (hyd_fused.h), 0 on the component loops (opts.general_circuit, or a
@@ -223,6 +224,9 @@ int ode_world_obstacle_pos(const ode_world* w, const char* name, double pos[3]);
 
 /// Extra joint torques [N m] added every step at joints 1, 2 (in the q
 /// directions), e.g. the analytic holding torque G(q) with hydraulics off.
+/// The two-link crane only, as the other hooks of joints 1, 2 below
+/// (hold_crane, lock_booms, set_joint_rates): they do nothing for a chain
+/// crane (ode_world_chain; ode_chain_set_joint_forces for this one).
 void ode_world_set_joint_torques(ode_world* w, const double tau[2]);
 /// 1: freeze the truck, column and booms (kinematic, at rest) so only rope,
 /// hook and loads move; 0: release them.
