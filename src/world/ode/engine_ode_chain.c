@@ -179,6 +179,17 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
             res->status = SIM_REFUSED;
             goto done;
         }
+        // The start pressures against the circuit's limits, with the world's
+        // rope and hook at the tip (the booms' share is not split out: the
+        // two-link statics do not describe this chain).
+        int nl;
+        double len, lm, li, hkm, hc, hi;
+        ode_world_rope_info(w, &nl, &len, &lm, &li, &hkm, &hc, &hi);
+        const sim_start_load ld = {NULL, {sc->q0[0], sc->q0[1]}, nl * lm + hkm, true};
+        if (sim_check_start(hm, row, SIM_NCOL, &ld, msg, msz)) {
+            res->status = SIM_REFUSED;
+            goto done;
+        }
     }
     sim_energy* en = k->energy;
     if (en && (sim_energy_bind(en, r.hm) || ode_world_follow_energy(w, en))) {
