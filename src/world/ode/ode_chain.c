@@ -20,7 +20,8 @@
 // ODE step.
 #include "ode_chain.h"
 
-#include "ode_world_internal.h"
+#include "ode_common.h"
+#include "circuit_kernel.h"
 #include "energy_acc.h"
 #include "hyd_cylinder.h"
 

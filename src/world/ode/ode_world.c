@@ -15,110 +15,42 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-// ODE keeps global tables (collider registry, thread-local data); it must be
-// initialised once before the first world and closed after the last. A
-// counter lets several worlds coexist (tests, compare runs). This is the one
-// piece of global mutable state the project allows; worlds must be created
-// and destroyed from one thread.
-// The ODE library's state: its users, and the non-fatal messages it sends
-// (dMessage: "LCP internal error, s <= 0" on a degenerate contact set),
-// which it would print to stderr itself, outside our one-line messages and
-// unrelated to the run. They are counted here and reported by the caller
-// (ode_world_messages).
-// ODE's errors and failed internal checks (dError, dDebug: an assertion such
-// as "!bSafeNormalize4Fault" in dxNormalize4 on a quaternion that a 1e-300 kg
-// link or a 1e308 kg truck has turned into NaN) call abort() by default, and
-// their handler must not return. Every entry point that runs ODE code arms a
-// trap (ow_trapped); the handler jumps back to it, the world is marked dead
-// and from then on only destroyed. The caller sees an ordinary runtime
-// failure (exit 1, rows kept) instead of SIGABRT.
-static struct {
-    int users;
-    long messages;
-    char last[160];
-    jmp_buf* trap; ///< the armed entry point, or NULL
-    char fatal[200]; ///< text of the last ODE error
-} g_ode;
-
-static void ode_message(int num, const char* msg, va_list ap) {
-    (void)num;
-    vsnprintf(g_ode.last, sizeof g_ode.last, msg, ap);
-    g_ode.messages++;
-}
-
-static void ode_fatal(int num, const char* msg, va_list ap) {
-    (void)num;
-    vsnprintf(g_ode.fatal, sizeof g_ode.fatal, msg, ap);
-    if (g_ode.trap) longjmp(*g_ode.trap, 1);
-    // No world call is running (cannot happen through this module's API):
-    // nothing to return to. exit, not abort, so the rows already written are
-    // flushed.
-    fprintf(stderr, "cranesim: ODE error outside a world call: %s\n", g_ode.fatal);
-    exit(1);
-}
-
-void ow_ode_acquire(void) {
-    if (g_ode.users++ == 0) {
-        dInitODE2(0);
-        dSetMessageHandler(ode_message);
-        dSetErrorHandler(ode_fatal);
-        dSetDebugHandler(ode_fatal);
-    }
-}
-
-void ow_ode_release(void) {
-    if (--g_ode.users == 0) dCloseODE();
-}
-
-// Run fn(w, arg) with ODE's errors caught. Returns fn's result, or
-// OW_ODE_FAILED after an ODE error; then w is dead (w->err says why) and
-// only ode_world_destroy may touch it. Nothing in fn may rely on running to
-// its end (the jump skips the rest of fn and of ODE's own frames): fn only
-// steps or reads the world, which is then discarded whole.
+// Run fn(w, arg) with ODE's errors caught (ow_ode_call). Returns fn's
+// result, or OW_ODE_FAILED after an ODE error; then w is dead (w->err says
+// why) and only ode_world_destroy may touch it. Nothing in fn may rely on
+// running to its end (the jump skips the rest of fn and of ODE's own
+// frames): fn only steps or reads the world, which is then discarded whole.
 typedef int (*ow_fn)(ode_world* w, void* arg);
+typedef struct trap_args {
+    ode_world* w;
+    ow_fn fn;
+    void* arg;
+} trap_args;
+static int trap_call(void* p) {
+    trap_args* t = p;
+    return t->fn(t->w, t->arg);
+}
 static int ow_trapped(ode_world* w, const char* what, ow_fn fn, void* arg) {
-    jmp_buf jb;
-    jmp_buf* const prev = g_ode.trap;
-    if (setjmp(jb)) {
-        g_ode.trap = prev;
-        w->dead = 1;
-        w->failed = 1;
-        if (w->chain) ode_chain_host_failed(w->chain); // its bodies are this world's
-        if (w->world_built)
-            snprintf(w->err, sizeof w->err,
-                     "ode world: ODE failed %s at t = %.6f s (%.150s): a mass, size or position far outside the "
-                     "physical range; the world was stopped",
-                     what, w->t, g_ode.fatal);
-        else
-            snprintf(w->err, sizeof w->err,
-                     "ode world: ODE failed %s (%.150s): a mass, size or position far outside the physical range",
-                     what, g_ode.fatal);
-        return OW_ODE_FAILED;
-    }
-    g_ode.trap = &jb;
-    const int rc = fn(w, arg);
-    g_ode.trap = prev;
-    return rc;
+    trap_args t = {w, fn, arg};
+    char fatal[200];
+    const int rc = ow_ode_call(trap_call, &t, fatal, sizeof fatal);
+    if (rc != OW_ODE_FAILED) return rc;
+    w->dead = 1;
+    w->failed = 1;
+    if (w->chain) ode_chain_host_failed(w->chain); // its bodies are this world's
+    if (w->world_built)
+        snprintf(w->err, sizeof w->err,
+                 "ode world: ODE failed %s at t = %.6f s (%.150s): a mass, size or position far outside the "
+                 "physical range; the world was stopped",
+                 what, w->t, fatal);
+    else
+        snprintf(w->err, sizeof w->err,
+                 "ode world: ODE failed %s (%.150s): a mass, size or position far outside the physical range",
+                 what, fatal);
+    return OW_ODE_FAILED;
 }
 
-int ow_ode_call(int (*fn)(void* arg), void* arg, char* fatal, size_t n) {
-    jmp_buf jb;
-    jmp_buf* const prev = g_ode.trap;
-    if (setjmp(jb)) {
-        g_ode.trap = prev;
-        snprintf(fatal, n, "%s", g_ode.fatal);
-        return OW_ODE_FAILED;
-    }
-    g_ode.trap = &jb;
-    const int rc = fn(arg);
-    g_ode.trap = prev;
-    return rc;
-}
-
-long ode_world_messages(const char** last) {
-    if (last) *last = g_ode.last;
-    return g_ode.messages;
-}
+long ode_world_messages(const char** last) { return ow_ode_messages(last); }
 
 ode_world_opts ode_world_default_opts(void) {
     ode_world_opts o;
@@ -734,21 +666,6 @@ typedef struct create_args {
 } create_args;
 
 // The ODE part of ode_world_create (run under ow_trapped): 0, or -1 with err set.
-dWorldID ow_world_new(double g, double erp, double cfm, dThreadingImplementationID* threading) {
-    dWorldID world = dWorldCreate();
-    // Each world queues its step jobs on its own self-threaded implementation,
-    // not on ODE's process-wide default: an ODE error jumps out of a step
-    // with jobs still queued (ow_trapped), and on the shared one those would
-    // be run by the next world's step and fail ODE's check at dCloseODE.
-    *threading = dThreadingAllocateSelfThreadedImplementation();
-    if (*threading)
-        dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(*threading), *threading);
-    dWorldSetGravity(world, 0, 0, -g);
-    dWorldSetERP(world, erp);
-    dWorldSetCFM(world, cfm);
-    return world;
-}
-
 static int build_world(ode_world* w, void* arg) {
     const create_args* a = arg;
     w->world = ow_world_new(w->g, w->desc.ode.erp, w->desc.ode.cfm, &w->threading);

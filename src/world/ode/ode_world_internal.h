@@ -12,6 +12,7 @@
 #include "hyd_fused.h"
 #include "hyd_solver.h"
 #include "ode_chain.h"
+#include "ode_common.h"
 #include "ode_world.h"
 
 #define OW_MAX_GEOMS 256
@@ -261,22 +262,6 @@ struct ode_world {
 };
 
 // ode_world.c
-/// ODE's process-wide set-up, counted: the first user initialises ODE and
-/// installs its message and error handlers, the last one closes it. Every
-/// ODE world (ode_world, ode_chain) holds one use while it lives.
-void ow_ode_acquire(void);
-void ow_ode_release(void);
-/// ow_ode_call's result after an ODE error.
-enum { OW_ODE_FAILED = -1000 };
-/// Runs fn(arg) with ODE's errors caught: fn's result, or OW_ODE_FAILED
-/// when ODE failed inside it (its message in fatal). The jump skips the rest
-/// of fn: its world must then only be destroyed.
-int ow_ode_call(int (*fn)(void* arg), void* arg, char* fatal, size_t n);
-/// A new ODE world with gravity g [m/s^2] along -z, ERP and CFM, stepping on
-/// a self-threaded implementation of its own (*threading; NULL when none
-/// could be made): an ODE error jumps out of a step with jobs still queued,
-/// and on ODE's shared default those would reach the next world's step.
-dWorldID ow_world_new(double g, double erp, double cfm, dThreadingImplementationID* threading);
 void ow_frame_point(const ode_world* w, int f, const double p[3], double out[3]);
 void ow_frame_point_vel(const ode_world* w, int f, const double p[3], double out[3]);
 void ow_frame_rot(const ode_world* w, int f, double R[9]);
