@@ -7,7 +7,8 @@
 // - the 3-boom + extension model picking up a load with the hook: the
 //   cylinder forces holding it at rest against the statics of the chain
 //   (the mechanism's gravity load with load, hook and rope at the tip,
-//   solved for the four cylinders' forces through their lever arms);
+//   solved for the four cylinders' forces through their lever arms) and
+//   against the same mass as a tip load in the validation world;
 // - every function and the slew of that model in the sandbox: the rows carry
 //   the chain's columns, the collisions are named after the chain's bodies;
 // - what the chain sandbox does not build is refused in one line.
@@ -255,6 +256,43 @@ static void test_pick_statics(void) {
             CHECK(fabs(Fm[k] - F[k]) <= 0.002 * Fmax, "%s: %g N held, statics %g N", cc->act[k].name, Fm[k], F[k]);
         chain_ws_free(ws);
         chain_free(c);
+        // The same mass as a tip load in the validation world (the chain
+        // world on the ground, the column fixed at the slew, the load merged
+        // into the tip body) at the sandbox's mean pose, valves closed: its
+        // cylinders hold it with the same forces as the hook's load.
+        ode_chain_opts vo = ode_chain_default_opts();
+        vo.tip_mass = m_tip;
+        vo.q0 = qm + 1; // the boom DOFs (the model's column does not slew)
+        vo.slew0 = qm[0];
+        vo.circuit = m->hyd;
+        vo.p_low = 0.5e6;
+        vo.model_file = "chain_3boom_ext.json";
+        CHECK(!m->chain.slew_free && crane_chain_ndof(&m->chain) == nd - 1, "the model's column is fixed");
+        ode_chain* vw = ode_chain_create(&m->chain, &vo, err, sizeof err);
+        CHECK(vw != NULL, "validation: %s", err);
+        if (vw) {
+            double Fv[8] = {0};
+            const double zero[8] = {0};
+            ode_chain_set_commands(vw, zero);
+            int nv = 0;
+            for (int s = 0; s < 3000; ++s) {
+                if (ode_chain_step(vw, 1e-3)) {
+                    CHECK(0, "validation step: %s", ode_chain_error(vw));
+                    break;
+                }
+                if (s < 1000) continue;
+                for (int k = 0; k < na; ++k) Fv[k] += ode_chain_act_force(vw, k, NULL, NULL);
+                ++nv;
+            }
+            for (int k = 0; k < na; ++k) {
+                Fv[k] /= nv;
+                printf("  %-5s tip load in the validation world %10.1f N, hook load in the sandbox %10.1f N\n",
+                       cc->act[k].name, Fv[k], Fm[k]);
+                CHECK(fabs(Fv[k] - Fm[k]) <= 0.002 * Fmax, "%s: %g N validation, %g N sandbox", cc->act[k].name,
+                      Fv[k], Fm[k]);
+            }
+        }
+        ode_chain_destroy(vw);
     }
     {
         // The picture: every chain body drawn under its name, at its pose;
