@@ -50,18 +50,24 @@ unsigned long chain_problem_events(void* user, double t, const double* y) {
     // The strokes and rates at y (the kinematics alone; f and the Jacobian
     // take their own at every call, so the workspace left at y is harmless).
     chain_update(s->ch, s->ws, y + s->iq, y + s->iq + nd);
-    for (int k = 0; k < s->nact; ++k) {
+    for (int k = 0; k < cc->nact; ++k) {
         const crane_act* a = &cc->act[k];
         double Ld = 0.0;
         const double L = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, &Ld, NULL, NULL);
         cp->x[a->cyl] = L - a->closed_length;
         cp->v[a->cyl] = Ld;
     }
+    // The slew rack (chain_sim.rack, the last actuator when the column
+    // slews with a drive): stroke r theta + s/2, rate r theta' (chain_sim.c).
+    if (s->rack >= 0) {
+        cp->x[s->acyl[s->rack]] = s->rack_r * y[s->iq] + 0.5 * s->rack_stroke;
+        cp->v[s->acyl[s->rack]] = s->rack_r * y[s->iq + nd];
+    }
     // The commands as chain_sim's f takes them (clamped to [-1, 1]).
     for (int f = 0; f < s->nfn; ++f) {
         double u = s->cmd_fn ? s->cmd_fn(s->cmd_user, f, t) : s->cmd[f];
         u = u < -1.0 ? -1.0 : u > 1.0 ? 1.0 : u;
-        cp->cmd[cc->fn[f].valve_idx] = u;
+        cp->cmd[s->fvalve[f]] = u;
     }
     const unsigned long own = cp->base.events ? cp->base.events(cp->base.user, t, y) : 0;
     return own + hyd_events_update(cp->ev, s->hm, y, s->hpos, cp->x, cp->v, cp->cmd);

@@ -20,7 +20,8 @@
 // ODE step.
 #include "ode_chain.h"
 
-#include "ode_world_internal.h"
+#include "ode_common.h"
+#include "circuit_kernel.h"
 #include "energy_acc.h"
 #include "hyd_cylinder.h"
 
@@ -89,6 +90,17 @@ struct ode_chain {
     int* pres;
     double th, step_t0;
     struct sim_energy* energy; ///< ode_chain_follow_energy's balance, or NULL
+    // Hosted (opts.host_world): the world is the host's.
+    int hosted;
+    double Rb[9], pb[3]; ///< base frame to world: rotation (row-major), origin [m]
+    // The slew drive (opts.slew_drive): the rack cylinder on body 0's hinge.
+    int slew_on;
+    int slew_cyl, slew_valve;   ///< the circuit's rack cylinder and its valve
+    int slew_iA, slew_iB;       ///< their chamber pressure states
+    double slew_AA, slew_AB, slew_stroke; ///< [m^2, m^2, m]
+    double slew_x0, slew_v0;    ///< rack stroke [m] and rate [m/s] at the step start
+    double slew_F;              ///< rack force over the step [N]
+    double slew_u;              ///< the slew command [-1, 1]
 };
 
 ode_chain_opts ode_chain_default_opts(void) {
@@ -277,6 +289,21 @@ static void set_inputs(ode_chain* w, double t) {
         w->hd->cyl_v[c] = w->a[k].v0;
     }
     for (int f = 0; f < w->nfn; ++f) w->hd->valve_cmd[w->cc.fn[f].valve_idx] = w->u[f];
+    if (w->slew_on) {
+        w->hd->cyl_x[w->slew_cyl] = w->slew_x0 + w->slew_v0 * tau;
+        w->hd->cyl_v[w->slew_cyl] = w->slew_v0;
+        w->hd->valve_cmd[w->slew_valve] = w->slew_u;
+    }
+}
+
+// The rack's stroke [m] and rate [m/s] from the column's hinge (slew q and
+// its rate): r q + s/2 (crane_slew_stroke), r qd.
+static double slew_kinematics(const ode_chain* w, double* rate) {
+    const oc_body* b = &w->b[0];
+    double qd;
+    const double q = joint_q(w, b, &qd);
+    if (rate) *rate = w->cc.slew.pinion_radius * qd;
+    return crane_slew_stroke(&w->cc.slew, q, w->slew_stroke);
 }
 
 static int rhs(void* user, double t, const double* y, double* dydt) {
@@ -319,6 +346,13 @@ static int settle(void* user, double t, double* y) {
     for (int f = 0; f < w->nfn; ++f) {
         double* u = &y[hyd_model_valve_state(w->hm, w->cc.fn[f].valve_idx)];
         if (*u != 0.0 && fabs(*u) < HYD_SPOOL_SETTLE && fabs(w->u[f]) < HYD_SPOOL_SETTLE) {
+            *u = 0.0;
+            changed = 1;
+        }
+    }
+    if (w->slew_on) {
+        double* u = &y[hyd_model_valve_state(w->hm, w->slew_valve)];
+        if (*u != 0.0 && fabs(*u) < HYD_SPOOL_SETTLE && fabs(w->slew_u) < HYD_SPOOL_SETTLE) {
             *u = 0.0;
             changed = 1;
         }
@@ -444,6 +478,36 @@ static int hyd_create(ode_chain* w, char* err, size_t errsz) {
                          mf, k, w->cc.act[k].cylinder, j, w->cc.act[j].name);
                 return -1;
             }
+    if (w->opt.slew_drive) {
+        const crane_slew* sl = &w->cc.slew;
+        w->slew_cyl = hyd_model_cylinder(w->hm, sl->cylinder);
+        w->slew_valve = hyd_model_valve(w->hm, sl->valve);
+        if (!sl->present) {
+            snprintf(err, errsz, "%s: mechanics.slew: missing (the column's slew drive is needed here)", mf);
+            return -1;
+        }
+        if (w->slew_cyl < 0 || w->slew_valve < 0) {
+            snprintf(err, errsz, "%s: mechanics.slew.%s: no %s named \"%s\" in the circuit (hydraulics_slew)", mf,
+                     w->slew_cyl < 0 ? "cylinder" : "valve", w->slew_cyl < 0 ? "cylinder" : "valve",
+                     w->slew_cyl < 0 ? sl->cylinder : sl->valve);
+            return -1;
+        }
+        // One cylinder or valve on two functions would couple them through
+        // one set of states: a slew that moves a boom.
+        for (int k = 0; k < w->nact; ++k)
+            if (w->cc.act[k].cyl == w->slew_cyl || w->cc.fn[w->cc.act[k].function].valve_idx == w->slew_valve) {
+                snprintf(err, errsz, "%s: mechanics.slew: \"%s\" already drives actuators[%d] (%s)", mf,
+                         w->cc.act[k].cyl == w->slew_cyl ? sl->cylinder : sl->valve, k, w->cc.act[k].name);
+                return -1;
+            }
+        if (!(sl->pinion_radius > 0)) {
+            snprintf(err, errsz, "%s: mechanics.slew.pinion_radius: %g m; must be > 0", mf, sl->pinion_radius);
+            return -1;
+        }
+        hyd_model_cylinder_states(w->hm, w->slew_cyl, &w->slew_iA, &w->slew_iB);
+        hyd_model_cylinder_geometry(w->hm, w->slew_cyl, &w->slew_AA, &w->slew_AB, &w->slew_stroke);
+        w->slew_on = 1;
+    }
     if (hyd_method_is_adaptive(w->opt.solver)) {
         snprintf(err, errsz, "ode chain world: the %s solver is adaptive; this world sub-steps a fixed-step one (krus, ros2)",
                  hyd_method_name(w->opt.solver));
@@ -495,13 +559,46 @@ static int hyd_init_state(ode_chain* w, char* err, size_t errsz) {
     hyd_model_initial_state(w->hm, w->y);
     w->th = 0.0;
     for (int k = 0; k < w->nact; ++k) w->a[k].x0 = act_geometry(w, k, &w->a[k].v0, NULL, NULL, NULL) - w->cc.act[k].closed_length;
+    if (w->slew_on) w->slew_x0 = slew_kinematics(w, &w->slew_v0);
     if (!w->opt.init_hold) return 0;
+    if (w->slew_on) {
+        // The rack balanced with both chambers at p_low (no static torque on
+        // a level base), as the two-link sandbox starts its slew.
+        const double p = w->opt.p_low;
+        w->y[w->slew_iA] = p;
+        w->y[w->slew_iB] = p * w->slew_AA / w->slew_AB;
+        const int hA = hose_of(w, w->slew_iA), hB = hose_of(w, w->slew_iB);
+        if (hA >= 0) w->y[hA] = w->y[w->slew_iA];
+        if (hB >= 0) w->y[hB] = w->y[w->slew_iB];
+    }
     double* F = calloc((size_t)(w->nact + w->ndof), sizeof *F);
     if (!F) {
         snprintf(err, errsz, "ode chain world: out of memory");
         return -1;
     }
-    if (w->nact && holding_forces(w, F)) {
+    int bad = 0;
+    if (w->nact && w->opt.hold_tip_mass > 0) {
+        // The forces of the pose with the hanging mass at the tip: from a
+        // mechanism with it merged (the world's bodies stay without it).
+        char e[320];
+        chain* held = crane_chain_mechanism(&w->cc, w->opt.tip_mass + w->opt.hold_tip_mass, w->cc.slew_free,
+                                            w->opt.slew0, e, sizeof e);
+        chain_ws* hws = held ? chain_ws_create(held) : NULL;
+        chain* m0 = w->mech;
+        chain_ws* ws0 = w->ws;
+        if (hws) {
+            w->mech = held, w->ws = hws;
+            bad = holding_forces(w, F);
+            w->mech = m0, w->ws = ws0;
+        } else {
+            bad = 1;
+        }
+        chain_ws_free(hws);
+        chain_free(held);
+    } else if (w->nact) {
+        bad = holding_forces(w, F);
+    }
+    if (bad) {
         snprintf(err, errsz,
                  "%s: mechanics.actuators: the cylinders' lever arms at the start pose are dependent; no set of "
                  "forces holds it (start with init_hold off)",
@@ -572,6 +669,13 @@ static int hyd_step(ode_chain* w, double H) {
             return -1;
         }
     }
+    if (w->slew_on) {
+        w->slew_F = w->hd->cyl_F[w->slew_cyl];
+        if (!isfinite(w->slew_F)) {
+            snprintf(w->err, sizeof w->err, "hydraulics: the slew rack's force became non-finite at t = %.6f s", w->th);
+            return -1;
+        }
+    }
     return 0;
 }
 
@@ -594,8 +698,12 @@ static int build(void* arg) {
     build_args* ba = arg;
     ode_chain* w = ba->w;
     const char* mf = w->opt.model_file;
-    w->world = ow_world_new(w->g, w->opt.erp, w->opt.cfm, &w->threading);
-    dWorldSetAutoDisableFlag(w->world, 0);
+    if (w->hosted) {
+        w->world = (dWorldID)w->opt.host_world;
+    } else {
+        w->world = ow_world_new(w->g, w->opt.erp, w->opt.cfm, &w->threading);
+        dWorldSetAutoDisableFlag(w->world, 0);
+    }
 
     chain_update(w->mech, w->ws, w->qstart, NULL);
     for (int i = 0; i < w->nbody; ++i) {
@@ -604,8 +712,21 @@ static int build(void* arg) {
         b->dof = chain_body_dof(w->mech, i);
         b->revolute = d->joint == CHAIN_REVOLUTE;
         b->lo = -INFINITY, b->hi = INFINITY;
-        chain_body_pose(w->mech, w->ws, i, b->R, b->p);
-        if (i == 0 && d->fixed) continue; // the column on the ground: a fixed frame
+        double Rl[9], pl[3]; // in the base frame
+        chain_body_pose(w->mech, w->ws, i, Rl, pl);
+        // Into the world: R = Rb Rl, p = pb + Rb pl (the identity unhosted).
+        for (int r = 0; r < 3; ++r) {
+            b->p[r] = w->pb[r];
+            for (int c = 0; c < 3; ++c) {
+                b->p[r] += w->Rb[3 * r + c] * pl[c];
+                double v = 0.0;
+                for (int k = 0; k < 3; ++k) v += w->Rb[3 * r + k] * Rl[3 * k + c];
+                b->R[3 * r + c] = v;
+            }
+        }
+        // The column on the ground: a fixed frame (hosted on a body it is a
+        // body, so that it moves with its base).
+        if (i == 0 && d->fixed && !(w->hosted && w->opt.host_base)) continue;
         if (!(d->mass > 0)) {
             snprintf(ba->err, ba->errsz, "%s: bodies[%d] (%s).mass: %g kg; the ODE world moves only bodies with mass",
                      mf, i, d->name, d->mass);
@@ -636,7 +757,7 @@ static int build(void* arg) {
         const chain_body_def* d = chain_body(w->mech, i);
         oc_body* b = &w->b[i];
         if (!b->body) continue;
-        dBodyID parent = i == 0 ? 0 : w->b[d->parent].body;
+        dBodyID parent = i == 0 ? (dBodyID)w->opt.host_base : w->b[d->parent].body;
         if (d->fixed) {
             b->joint = dJointCreateFixed(w->world, 0);
             dJointAttach(b->joint, b->body, parent);
@@ -646,7 +767,8 @@ static int build(void* arg) {
         b->q0 = w->qstart[b->dof];
         if (b->revolute) {
             // The slew turns about base z; a boom about its frame's -y.
-            const double ax[3] = {i == 0 ? 0.0 : -b->R[1], i == 0 ? 0.0 : -b->R[4], i == 0 ? 1.0 : -b->R[7]};
+            const double ax[3] = {i == 0 ? w->Rb[2] : -b->R[1], i == 0 ? w->Rb[5] : -b->R[4],
+                                  i == 0 ? w->Rb[8] : -b->R[7]};
             b->joint = dJointCreateHinge(w->world, 0);
             dJointAttach(b->joint, b->body, parent);
             dJointSetHingeAnchor(b->joint, b->p[0], b->p[1], b->p[2]);
@@ -666,6 +788,20 @@ static int build(void* arg) {
         }
         b->lo = d->q_min - q;
         b->hi = d->q_max - q;
+        if (i == 0 && w->slew_on && w->slew_stroke > 0) {
+            // The rack's ends: slew within +-s/(2 r) (crane_slew_stroke).
+            const double smax = 0.5 * w->slew_stroke / w->cc.slew.pinion_radius;
+            if (q < -smax - 1e-12 || q > smax + 1e-12) {
+                snprintf(ba->err, ba->errsz,
+                         "initial slew %.1f deg is outside the slew cylinder's range +-%.1f deg", q * 180.0 / M_PI,
+                         smax * 180.0 / M_PI);
+                return -1;
+            }
+            if (w->opt.stop_limits) {
+                if (-smax - q > b->lo) b->lo = -smax - q;
+                if (smax - q < b->hi) b->hi = smax - q;
+            }
+        }
     }
     // The cylinders' stroke ends as stops on the joint between their two
     // bodies (the only joint that changes their length), where one is the
@@ -749,8 +885,29 @@ ode_chain* ode_chain_create(const crane_chain* cc, const ode_chain_opts* o, char
         snprintf(err, errsz, "ode chain world: out of memory");
         return NULL;
     }
+    w->hosted = opt.host_world != NULL;
+    {
+        int any = 0;
+        for (int k = 0; k < 9; ++k) any |= opt.base_rot[k] != 0.0;
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) w->Rb[3 * r + c] = any ? opt.base_rot[3 * r + c] : r == c ? 1.0 : 0.0;
+        for (int k = 0; k < 3; ++k) w->pb[k] = w->hosted ? opt.base_pos[k] : 0.0;
+        if (!w->hosted && any) {
+            snprintf(err, errsz, "ode chain world: base_rot is for a hosted world only");
+            free_world(w);
+            return NULL;
+        }
+    }
+    // A slew drive turns the column: its joint is then a DOF (the copy's
+    // slew_free, so everything sized by the chain counts it).
+    if (opt.slew_drive) w->cc.slew_free = true;
+    if (opt.slew_drive && !opt.circuit) {
+        snprintf(err, errsz, "ode chain world: a slew drive needs the circuit");
+        free_world(w);
+        return NULL;
+    }
     char e[320];
-    w->mech = crane_chain_mechanism(&w->cc, opt.tip_mass, cc->slew_free, opt.slew0, e, sizeof e);
+    w->mech = crane_chain_mechanism(&w->cc, opt.tip_mass, w->cc.slew_free, opt.slew0, e, sizeof e);
     if (!w->mech) {
         snprintf(err, errsz, "%s: mechanics.%s", opt.model_file, e);
         free_world(w);
@@ -812,7 +969,8 @@ ode_chain* ode_chain_create(const crane_chain* cc, const ode_chain_opts* o, char
 
 static int destroy_ode(void* arg) {
     ode_chain* w = arg;
-    if (w->world) {
+    // Hosted: the bodies and joints are the host's world's, gone with it.
+    if (w->world && !w->hosted) {
         dWorldSetStepThreadingImplementation(w->world, NULL, NULL);
         dWorldDestroy(w->world);
     }
@@ -866,6 +1024,12 @@ static void apply_forces(ode_chain* w) {
         if (b->revolute) dJointAddHingeTorque(b->joint, w->tau[b->dof]);
         else dJointAddSliderForce(b->joint, w->tau[b->dof]);
     }
+    if (w->slew_on) {
+        // The rack's force F r (crane_slew_torque) and the slewing ring's
+        // viscous friction [N m s/rad] on the column's hinge.
+        dJointAddHingeTorque(w->b[0].joint, crane_slew_torque(&w->cc.slew, w->slew_F) -
+                                                w->cc.slew.damping * dJointGetHingeAngleRate(w->b[0].joint));
+    }
 }
 
 // implicit_seal: each joint's motor at zero speed, its force limit the sum
@@ -917,27 +1081,88 @@ typedef struct step_args {
     long n;
 } step_args;
 
+// One step's work before ODE's step: the strokes read, the hydraulic
+// sub-steps, the forces on the bodies.
+static int pre_step(ode_chain* w) {
+    for (int k = 0; k < w->nact; ++k)
+        w->a[k].x0 = act_geometry(w, k, &w->a[k].v0, NULL, NULL, NULL) - w->cc.act[k].closed_length;
+    if (w->slew_on) w->slew_x0 = slew_kinematics(w, &w->slew_v0);
+    if (w->hm && hyd_step(w, w->opt.dt_ode)) return -1;
+    apply_forces(w);
+    apply_seal(w);
+    return 0;
+}
+
+// And after it: the clock, the hinges' turns, the bodies' check.
+static int post_step(ode_chain* w) {
+    ++w->nstep;
+    w->t = (double)w->nstep * w->opt.dt_ode;
+    read_turns(w);
+    for (int i = 0; i < w->nbody; ++i)
+        if (w->b[i].body && !body_finite(w->b[i].body)) {
+            snprintf(w->err, sizeof w->err, "ode chain world: body %s became non-finite at t = %.6f s",
+                     w->cc.body[i].def.name, w->t);
+            return -1;
+        }
+    return 0;
+}
+
 static int step_n(void* arg) {
     step_args* sa = arg;
     ode_chain* w = sa->w;
-    const double H = w->opt.dt_ode;
     for (long s = 0; s < sa->n; ++s) {
-        for (int k = 0; k < w->nact; ++k)
-            w->a[k].x0 = act_geometry(w, k, &w->a[k].v0, NULL, NULL, NULL) - w->cc.act[k].closed_length;
-        if (w->hm && hyd_step(w, H)) return -1;
-        apply_forces(w);
-        apply_seal(w);
-        dWorldStep(w->world, H);
-        ++w->nstep;
-        w->t = (double)w->nstep * H;
-        read_turns(w);
-        for (int i = 0; i < w->nbody; ++i)
-            if (w->b[i].body && !body_finite(w->b[i].body)) {
-                snprintf(w->err, sizeof w->err, "ode chain world: body %s became non-finite at t = %.6f s",
-                         w->cc.body[i].def.name, w->t);
-                return -1;
-            }
+        if (pre_step(w)) return -1;
+        dWorldStep(w->world, w->opt.dt_ode);
+        if (post_step(w)) return -1;
     }
+    return 0;
+}
+
+int ode_chain_host_pre(ode_chain* w) {
+    if (w->failed) return -1;
+    if (pre_step(w)) w->failed = 1;
+    return w->failed ? -1 : 0;
+}
+
+int ode_chain_host_post(ode_chain* w) {
+    if (w->failed) return -1;
+    if (post_step(w)) w->failed = 1;
+    return w->failed ? -1 : 0;
+}
+
+void ode_chain_host_failed(ode_chain* w) {
+    w->dead = w->failed = 1;
+    if (!w->err[0]) snprintf(w->err, sizeof w->err, "ode chain world: its host's world failed in ODE");
+}
+
+struct dxBody* ode_chain_body_id(const ode_chain* w, int i, double org[3]) {
+    if (i < 0 || i >= w->nbody) return NULL;
+    if (org) memcpy(org, w->b[i].org, sizeof w->b[i].org);
+    return w->b[i].body;
+}
+
+const crane_chain* ode_chain_chain(const ode_chain* w) { return &w->cc; }
+
+void ode_chain_act_pins(const ode_chain* w, int k, double pa[3], double pb[3]) {
+    if (w->dead || k < 0 || k >= w->nact) {
+        for (int i = 0; i < 3; ++i) pa[i] = pb[i] = NAN;
+        return;
+    }
+    act_geometry(w, k, NULL, NULL, pa, pb);
+}
+
+void ode_chain_set_slew_command(ode_chain* w, double u) { w->slew_u = u > 1 ? 1 : u < -1 ? -1 : (u == u ? u : 0); }
+
+int ode_chain_slew_state(const ode_chain* w, double* x, double* v, double* F, double* pA, double* pB, int* at_stop_) {
+    if (!w->slew_on) return -1;
+    double xx = NAN, vv = NAN;
+    if (!w->dead) xx = slew_kinematics(w, &vv);
+    if (x) *x = xx;
+    if (v) *v = vv;
+    if (F) *F = w->slew_F;
+    if (pA) *pA = w->y[w->slew_iA];
+    if (pB) *pB = w->y[w->slew_iB];
+    if (at_stop_) *at_stop_ = !w->dead && (at_stop(&w->b[0]) || w->hd->cyl_stop[w->slew_cyl] != 0);
     return 0;
 }
 
@@ -945,6 +1170,11 @@ int ode_chain_step(ode_chain* w, double dt) {
     if (w->failed) return -1;
     const double steps = floor(dt / w->opt.dt_ode + 0.5);
     step_args sa = {w, steps > 1e12 ? (long)1e12 : steps < 1 ? 1 : (long)steps};
+    if (w->hosted) {
+        snprintf(w->err, sizeof w->err, "ode chain world: hosted; its host steps it (ode_chain_host_pre, _post)");
+        w->failed = 1;
+        return -1;
+    }
     char fatal[200];
     const int rc = ow_ode_call(step_n, &sa, fatal, sizeof fatal);
     if (rc == OW_ODE_FAILED) {
@@ -1058,6 +1288,11 @@ static const hyd_data* energy_eval(void* user, double t, const double* y) {
         d->cyl_v[c] = w->a[k].v0;
     }
     for (int f = 0; f < w->nfn; ++f) d->valve_cmd[w->cc.fn[f].valve_idx] = w->u[f];
+    if (w->slew_on) {
+        d->cyl_x[w->slew_cyl] = w->slew_x0 + w->slew_v0 * tau;
+        d->cyl_v[w->slew_cyl] = w->slew_v0;
+        d->valve_cmd[w->slew_valve] = w->slew_u;
+    }
     hyd_eval(w->hm, d, t, y, w->ydot);
     return d;
 }
