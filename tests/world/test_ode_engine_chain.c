@@ -152,13 +152,14 @@ static void compare(const trace* a, const trace* b, double dt_ode, const crane_c
 
 // The ODE chain world against the analytic mode on a scenario that moves
 // every function (issue 26: stroke RMS <= 0.5 mm, pressure RMS <= 1 % of
-// peak). At the default ODE step of 1 ms the lift, jib and jib2 meet it;
-// the extension does not: 2.38 mm and 2.47 % (pB), from where its
-// retraction ends with the A side near cavitation (9-9.5 s) and the two
-// backends come to rest 5.7 mm apart, held by the cylinder's friction. Its
-// bounds here are that measured gap (a regression guard, not the issue's
-// bound), and the gap shrinks with the ODE step (the explicit coupling's
-// one-step lag): 1.39 mm at 0.5 ms, 0.09 mm at 0.1 ms.
+// peak), on every function at the ODE world's default step of 1 ms. The
+// extension is the hard one: 345 kg (its own 45 kg and the 300 kg load)
+// against its seal friction's slope of 4.5e6 N s/m near zero speed, which
+// the chain world holds in ODE's solver (ode_chain_opts.implicit_seal, on
+// by default). With that friction applied a step late instead (main before
+// this coupling) the extension crept where the analytic mode holds it:
+// 2.38 mm and 2.47 % of peak at 1 ms. Every function's gap is the
+// coupling's first-order error: it shrinks with the ODE step.
 static void test_3boom_ext_against_analytic(void) {
     model* m = load(CHAIN_3BOOM);
     scenario sc;
@@ -198,17 +199,15 @@ static void test_3boom_ext_against_analytic(void) {
     }
     for (int k = 0; k < 4 && a.nact == 4; ++k) {
         const char* nm = m->chain.act[k].name;
-        const bool ext = k == 3;
         // Every function moves its cylinder (else the bounds say nothing).
         CHECK(span[0][k] > 0.03, "%s: stroke range %g m", nm, span[0][k]);
-        const double bx = ext ? 3e-3 : 0.5e-3, bp = ext ? 0.04 : 0.01;
-        CHECK(rx[0][k] <= bx, "%s: stroke RMS %g mm > %g mm", nm, rx[0][k] * 1e3, bx * 1e3);
-        CHECK(rA[0][k] <= bp && rB[0][k] <= bp, "%s: pressure RMS %.3f %%, %.3f %% of peak > %g %%", nm,
-              rA[0][k] * 100, rB[0][k] * 100, bp * 100);
+        CHECK(rx[0][k] <= 0.5e-3, "%s: stroke RMS %g mm > 0.5 mm", nm, rx[0][k] * 1e3);
+        CHECK(rA[0][k] <= 0.01 && rB[0][k] <= 0.01, "%s: pressure RMS %.3f %%, %.3f %% of peak > 1 %%", nm,
+              rA[0][k] * 100, rB[0][k] * 100);
+        // The gap is the coupling's: it shrinks with the step.
+        CHECK(rx[1][k] < 0.7 * rx[0][k], "%s: stroke RMS %g mm at 0.5 ms, %g mm at 1 ms", nm, rx[1][k] * 1e3,
+              rx[0][k] * 1e3);
     }
-    // The extension's gap is the coupling's: it shrinks with the step.
-    CHECK(rx[1][3] < 0.7 * rx[0][3], "ext: stroke RMS %g mm at 0.5 ms, %g mm at 1 ms", rx[1][3] * 1e3,
-          rx[0][3] * 1e3);
     trace_free(&a);
     model_free(m);
 }
@@ -324,10 +323,11 @@ static void test_two_link_ode_unchanged(void) {
 
 // The seal friction held in ODE's solver (ode_chain_opts.implicit_seal):
 // the 8-function model's ext1 and ext2, two cylinders on one valve, held
-// still with every valve closed for 2 s. The analytic mode holds them
-// (its implicit step; 0.1 mm); the chain world with the friction applied a
-// step late lets the pair trade oil (ext1 out 31 mm in the first second);
-// with implicit_seal it holds them within 1 mm.
+// still with every valve closed for 2 s. The analytic mode holds them (its
+// implicit step; about 0.1 mm); the chain world with the friction applied a
+// step late lets the pair trade oil (84 mm); with the friction's law
+// linearised and solved by ODE at the step's end velocities the pair creeps
+// as the regularised law lets it (0.17 mm): within 1 mm.
 static double pair_drift(const model* m, int implicit) {
     ode_chain_opts co = ode_chain_default_opts();
     const int nd = crane_chain_ndof(&m->chain);

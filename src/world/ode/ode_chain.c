@@ -44,6 +44,9 @@ typedef struct oc_body {
     double raw, turns; ///< hinge: angle at the last read and the whole turns counted [rad]
     double lo, hi;     ///< stops relative to the joint's zero, continuous [rad or m] (+-inf: none)
     int seal;          ///< implicit_seal: a cylinder's seal friction acts as this joint's motor
+    int motor;         ///< the motor runs this step (apply_seal), else the friction is explicit
+    double qd0;        ///< joint rate at the step's start [rad/s or m/s]
+    double C, vel;     ///< the motor's damping sum l^2 dF/dv [N m s or N s/m] and target rate
     double fmax;       ///< that motor's force limit this step [N m or N]
 } oc_body;
 
@@ -56,7 +59,9 @@ typedef struct oc_act {
     int seal;         ///< implicit_seal: its seal friction is a motor on the joint of seal_body
     int seal_body;    ///< the body whose joint the cylinder spans (implicit_seal), or -1
     double Fc, Fs, vst, vsm; ///< its seal friction's parameters [N, N, m/s, m/s]
-    double seal_max;  ///< the seal friction's magnitude at the step's rate [N]
+    double Fs0, dFs;  ///< the seal friction at the step's rate v0 [N] and its slope dF/dv there, >= 0 [N s/m]
+    double lever;     ///< dL/dq of its joint at the step's start [m/rad or -]
+    double Fp;        ///< the force at its pins this step [N] (F without the seal friction when the motor holds it)
 } oc_act;
 
 struct ode_chain {
@@ -71,6 +76,7 @@ struct ode_chain {
     double* u;      ///< valve commands (nfn)
     double* qstart; ///< start coordinates (ndof)
     double* qs;     ///< scratch (ndof)
+    double* dL;     ///< implicit_seal: lever arms (ndof), NULL when no cylinder's friction is held so
     dWorldID world;
     dThreadingImplementationID threading;
     double g;
@@ -104,6 +110,7 @@ ode_chain_opts ode_chain_default_opts(void) {
     o.init_hold = 1;
     o.p_low = 2e6;
     o.model_file = "model";
+    o.implicit_seal = 1;
     return o;
 }
 
@@ -555,16 +562,15 @@ static int hyd_step(ode_chain* w, double H) {
     rhs(w, w->th, w->y, w->ydot);
     w->th = (double)(w->nstep + 1) * H; // on the step count: no drift from the mechanical clock
     for (int k = 0; k < w->nact; ++k) {
-        w->a[k].F = w->hd->cyl_F[w->cc.act[k].cyl];
         oc_act* a = &w->a[k];
+        a->F = a->Fp = w->hd->cyl_F[w->cc.act[k].cyl];
         if (a->seal) {
-            // The circuit subtracted the seal friction at the step's rate
-            // v0; it is added back here and held by the joint's motor
-            // (apply_seal) instead. Its magnitude at v0 is the motor's limit.
+            // The circuit subtracted the seal friction at the step's rate v0
+            // (its rate input); apply_seal may hold it in ODE's solver
+            // instead, from its value and slope there.
             double d;
-            a->F += hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, a->v0, &d);
-            const double r = a->v0 / a->vst;
-            a->seal_max = a->Fc + a->Fs * exp(-r * r);
+            a->Fs0 = hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, a->v0, &d);
+            a->dFs = d > 0.0 ? d : 0.0;
         }
         if (!isfinite(w->a[k].F)) {
             snprintf(w->err, sizeof w->err, "hydraulics: the force of actuator %s became non-finite at t = %.6f s",
@@ -713,11 +719,16 @@ static int build(void* arg) {
             snprintf(path, sizeof path, "%s.%s", cyl, par[j]);
             ok &= hyd_model_get(w->hm, path, &v[j]) == 0;
         }
-        if (!ok || !(v[0] > 0.0 || v[1] > 0.0) || !(v[2] > 0.0)) continue;
+        if (!ok || !(v[0] >= 0.0 && v[1] >= 0.0) || !(v[0] + v[1] > 0.0) || !(v[2] > 0.0) || !(v[3] > 0.0))
+            continue;
         a->seal = 1, a->seal_body = jb;
         a->Fc = v[0], a->Fs = v[1], a->vst = v[2], a->vsm = v[3];
-        a->seal_max = v[0] + v[1];
         w->b[jb].seal = 1;
+        // apply_seal's lever arms, one per DOF.
+        if (!w->dL && !(w->dL = calloc((size_t)w->ndof, sizeof *w->dL))) {
+            snprintf(ba->err, ba->errsz, "ode chain world: out of memory");
+            return -1;
+        }
     }
     return 0;
 }
@@ -839,6 +850,7 @@ static void free_world(ode_chain* w) {
     free(w->u);
     free(w->qstart);
     free(w->qs);
+    free(w->dL);
     crane_chain_free(&w->cc);
     free(w);
 }
@@ -851,7 +863,7 @@ void ode_chain_destroy(ode_chain* w) {
 
 static void apply_forces(ode_chain* w) {
     for (int k = 0; k < w->nact; ++k) {
-        const double F = w->a[k].F;
+        const double F = w->a[k].Fp;
         if (F == 0.0) continue;
         const crane_act* c = &w->cc.act[k];
         double u[3], pa[3], pb[3];
@@ -868,38 +880,106 @@ static void apply_forces(ode_chain* w) {
     }
 }
 
-// implicit_seal: each joint's motor at zero speed, its force limit the sum
-// of its cylinders' seal friction times their lever arm |dL/dq| at the
-// present pose (a torque [N m] on a hinge, a force [N] on a slider), so
-// ODE's solver holds the joint still up to that friction and resists
-// motion with it, in the same step.
+// implicit_seal: the seal friction of each cylinder across one joint, by
+// the circuit's own law (hyd_cyl_seal: (F_c + F_s exp(-(v/v_st)^2))
+// tanh(v/v_sm), smooth through zero), linearised about the step's start and
+// solved by ODE with the step's end velocities: a linearly implicit Euler
+// step of the friction, where the analytic mode's implicit solver holds the
+// same law in the cylinder's equation of motion. On joint j with cylinders
+// k of lever arm l_k = dL_k/dq (m/rad on a hinge, - on a slider) the
+// friction's generalized force is
+//   tau(qd) = -sum_k l_k [F_k(v0_k) + c_k l_k (qd - qd0)],  c_k = max(dF_k/dv(v0_k), 0)
+// [N m or N]. A joint motor with target rate vel and constraint force
+// mixing CFM gives ODE's row lambda = (vel - qd_new)/CFM, a damper implicit
+// in the new rate: C = sum l_k^2 c_k = 1/CFM and vel = qd0 - sum l_k F_k / C
+// reproduce tau. Its force limit is the law's largest value, sum |l_k|
+// (F_c + F_s): the linearisation cannot give more friction than the seal
+// has. Kept explicit (in the force at the pins, as the circuit gives it):
+// a joint at one of its ODE stops (ODE then applies a powered motor as a
+// fixed force, not a damper), a cylinder's negative slope (the Stribeck
+// fall, a negative damping held at its step-start value), and a joint
+// whose C is below 1e-9 of its cylinders' steepest slope (l^2 (F_c + F_s)
+// / v_sm), where the implicit part is nothing and vel would overflow.
+static int stop_active(const oc_body* b) {
+    double x, lo, hi;
+    if (b->revolute) {
+        x = dJointGetHingeAngle(b->joint);
+        lo = dJointGetHingeParam(b->joint, dParamLoStop), hi = dJointGetHingeParam(b->joint, dParamHiStop);
+    } else {
+        x = dJointGetSliderPosition(b->joint);
+        lo = dJointGetSliderParam(b->joint, dParamLoStop), hi = dJointGetSliderParam(b->joint, dParamHiStop);
+    }
+    // As ODE's own test (dxJointLimitMotor::testRotationalLimit and the
+    // slider's): at or beyond a stop the limit row replaces the motor's.
+    return x <= lo || x >= hi;
+}
+
 static void apply_seal(ode_chain* w) {
-    int any = 0;
-    for (int k = 0; k < w->nact; ++k) any |= w->a[k].seal;
-    if (!any) return;
+    if (!w->dL) return; // no cylinder's friction held this way
+    for (int i = 0; i < w->nbody; ++i) {
+        oc_body* b = &w->b[i];
+        b->motor = 0, b->C = b->vel = b->fmax = 0.0;
+    }
     ode_chain_q(w, w->qs, NULL);
-    for (int i = 0; i < w->nbody; ++i) w->b[i].fmax = 0.0;
+    chain_update(w->mech, w->ws, w->qs, NULL);
+    // Per joint: C, sum l F0 (in vel until the end), the force limit, and
+    // the steepest slope (in qd0 until the end).
+    for (int i = 0; i < w->nbody; ++i)
+        if (w->b[i].seal) w->b[i].qd0 = 0.0;
     for (int k = 0; k < w->nact; ++k) {
-        const oc_act* a = &w->a[k];
+        oc_act* a = &w->a[k];
         if (!a->seal) continue;
         oc_body* b = &w->b[a->seal_body];
         const crane_act* c = &w->cc.act[k];
-        // dL/dq by central differences of the mechanism's pin length.
-        const double q = w->qs[b->dof], h = 1e-6 * (1.0 + fabs(q));
-        w->qs[b->dof] = q + h;
-        chain_update(w->mech, w->ws, w->qs, NULL);
-        const double Lp = chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, NULL, NULL);
-        w->qs[b->dof] = q - h;
-        chain_update(w->mech, w->ws, w->qs, NULL);
-        const double Lm = chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, NULL, NULL);
-        w->qs[b->dof] = q;
-        b->fmax += a->seal_max * fabs(Lp - Lm) / (2.0 * h);
+        chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, w->dL, NULL);
+        const double l = w->dL[b->dof];
+        a->lever = l;
+        b->C += l * l * a->dFs;
+        b->vel += l * a->Fs0;
+        b->fmax += fabs(l) * (a->Fc + a->Fs);
+        b->qd0 += l * l * (a->Fc + a->Fs) / a->vsm;
     }
     for (int i = 0; i < w->nbody; ++i) {
         oc_body* b = &w->b[i];
         if (b->dof < 0 || !b->seal) continue;
-        set_param(b, dParamVel, 0.0);
-        set_param(b, dParamFMax, b->fmax);
+        const double slope = b->qd0, lF0 = b->vel;
+        b->motor = b->C > 1e-9 * slope && !stop_active(b);
+        if (b->motor) {
+            double qd;
+            joint_q(w, b, &qd);
+            b->qd0 = qd;
+            b->vel = qd - lF0 / b->C;
+            set_param(b, dParamCFM, 1.0 / b->C);
+            set_param(b, dParamVel, b->vel);
+        }
+        // fmax 0 switches the motor off (ODE adds no row).
+        set_param(b, dParamFMax, b->motor ? b->fmax : 0.0);
+    }
+    // The force at the pins: without the seal friction where the motor
+    // holds it.
+    for (int k = 0; k < w->nact; ++k) {
+        oc_act* a = &w->a[k];
+        a->Fp = a->seal && w->b[a->seal_body].motor ? a->F + a->Fs0 : a->F;
+    }
+}
+
+// After the step: the seal friction the motor applied, shared out to its
+// cylinders by their linearised laws (scaled where the force limit cut the
+// sum), so each cylinder's F is its force over the step, friction included,
+// as the analytic mode reports it.
+static void seal_applied(ode_chain* w) {
+    if (!w->dL) return;
+    for (int k = 0; k < w->nact; ++k) {
+        oc_act* a = &w->a[k];
+        if (!a->seal || !w->b[a->seal_body].motor) continue;
+        const oc_body* b = &w->b[a->seal_body];
+        double qd;
+        joint_q(w, b, &qd);
+        // ODE's row: lambda = C (vel - qd), within +-fmax.
+        const double lin = b->C * (b->vel - qd);
+        const double lam = lin > b->fmax ? b->fmax : lin < -b->fmax ? -b->fmax : lin;
+        const double scale = lin != 0.0 ? lam / lin : 1.0;
+        a->F = a->Fp - scale * (a->Fs0 + a->dFs * a->lever * (qd - b->qd0));
     }
 }
 
@@ -925,9 +1005,10 @@ static int step_n(void* arg) {
         for (int k = 0; k < w->nact; ++k)
             w->a[k].x0 = act_geometry(w, k, &w->a[k].v0, NULL, NULL, NULL) - w->cc.act[k].closed_length;
         if (w->hm && hyd_step(w, H)) return -1;
-        apply_forces(w);
         apply_seal(w);
+        apply_forces(w);
         dWorldStep(w->world, H);
+        seal_applied(w);
         ++w->nstep;
         w->t = (double)w->nstep * H;
         read_turns(w);
@@ -970,7 +1051,7 @@ void ode_chain_set_commands(ode_chain* w, const double* u) {
 
 void ode_chain_set_forces(ode_chain* w, const double* F) {
     if (w->hm) return; // the circuit's forces
-    for (int k = 0; k < w->nact; ++k) w->a[k].F = isfinite(F[k]) ? F[k] : 0.0;
+    for (int k = 0; k < w->nact; ++k) w->a[k].F = w->a[k].Fp = isfinite(F[k]) ? F[k] : 0.0;
 }
 
 void ode_chain_set_joint_forces(ode_chain* w, const double* tau) {
