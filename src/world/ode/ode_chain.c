@@ -59,7 +59,10 @@ typedef struct oc_act {
     int seal;         ///< implicit_seal: its seal friction is a motor on the joint of seal_body
     int seal_body;    ///< the body whose joint the cylinder spans (implicit_seal), or -1
     double Fc, Fs, vst, vsm; ///< its seal friction's parameters [N, N, m/s, m/s]
-    double Fs0, dFs;  ///< the seal friction at the step's rate v0 [N] and its slope dF/dv there, >= 0 [N s/m]
+    double Fsc;       ///< the circuit's seal friction at the step's rate v0 [N]
+    /// The friction as a line ODE holds (apply_seal): Fs0 + dFs (v - v0)
+    /// within +-Fmax [N, N s/m, N].
+    double Fs0, dFs, Fmax;
     double lever;     ///< dL/dq of its joint at the step's start [m/rad or -]
     double Fp;        ///< the force at its pins this step [N] (F without the seal friction when the motor holds it)
 } oc_act;
@@ -533,6 +536,10 @@ static int hyd_init_state(ode_chain* w, char* err, size_t errsz) {
     return 0;
 }
 
+// The seal friction's tanh is within 1e-4 of 1 beyond |v| = atanh(1 - 1e-4)
+// v_sm = 4.95 v_sm: sliding (hyd_step).
+#define SEAL_SLIDING 4.95
+
 static int hyd_step(ode_chain* w, double H) {
     w->step_t0 = w->th;
     // The strokes, rates and commands this step integrates start here (as
@@ -565,12 +572,25 @@ static int hyd_step(ode_chain* w, double H) {
         oc_act* a = &w->a[k];
         a->F = a->Fp = w->hd->cyl_F[w->cc.act[k].cyl];
         if (a->seal) {
-            // The circuit subtracted the seal friction at the step's rate v0
-            // (its rate input); apply_seal may hold it in ODE's solver
-            // instead, from its value and slope there.
+            // The circuit subtracted its seal friction at the step's rate
+            // v0 (its rate input), Fsc: added back at the pins where
+            // apply_seal holds the friction in ODE's solver instead, as the
+            // line Fs0 + dFs (v - v0) within +-Fmax.
             double d;
-            a->Fs0 = hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, a->v0, &d);
-            a->dFs = d > 0.0 ? d : 0.0;
+            a->Fsc = hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, a->v0, &d);
+            if (fabs(a->v0) < SEAL_SLIDING * a->vsm) {
+                // At rest and through the knee: the law's tangent at v0,
+                // its negative part (the Stribeck fall) left out.
+                a->Fs0 = a->Fsc, a->dFs = d > 0.0 ? d : 0.0, a->Fmax = a->Fc + a->Fs;
+            } else {
+                // Sliding: the law is mag(v0) sign(v) to 1e-4. As a damper
+                // of its slope at zero, mag(v0)/v_sm, saturating at
+                // mag(v0), it stays that while the step keeps sliding and
+                // follows the law through zero when the step stops it
+                // (the tangent, flat here, would hold +mag past zero).
+                const double r = a->v0 / a->vst, mag = a->Fc + a->Fs * exp(-r * r);
+                a->dFs = mag / a->vsm, a->Fs0 = a->dFs * a->v0, a->Fmax = mag;
+            }
         }
         if (!isfinite(w->a[k].F)) {
             snprintf(w->err, sizeof w->err, "hydraulics: the force of actuator %s became non-finite at t = %.6f s",
@@ -882,24 +902,28 @@ static void apply_forces(ode_chain* w) {
 
 // implicit_seal: the seal friction of each cylinder across one joint, by
 // the circuit's own law (hyd_cyl_seal: (F_c + F_s exp(-(v/v_st)^2))
-// tanh(v/v_sm), smooth through zero), linearised about the step's start and
-// solved by ODE with the step's end velocities: a linearly implicit Euler
-// step of the friction, where the analytic mode's implicit solver holds the
-// same law in the cylinder's equation of motion. On joint j with cylinders
-// k of lever arm l_k = dL_k/dq (m/rad on a hinge, - on a slider) the
-// friction's generalized force is
-//   tau(qd) = -sum_k l_k [F_k(v0_k) + c_k l_k (qd - qd0)],  c_k = max(dF_k/dv(v0_k), 0)
+// tanh(v/v_sm), smooth through zero), as a line solved by ODE with the
+// step's end velocities: a linearly implicit step of the friction, where
+// the analytic mode's implicit solver holds the same law in the cylinder's
+// equation of motion. hyd_step gives each cylinder its line F_k(v) = Fs0_k
+// + c_k (v - v0_k) within +-Fmax_k: at rest and through the knee the law's
+// tangent at the step's rate v0 (c_k >= 0, the Stribeck fall explicit);
+// sliding (|v0| >= 4.95 v_sm, the tanh within 1e-4 of 1) a damper of the
+// law's slope at zero saturating at the law's magnitude at v0 (the tangent
+// is flat there, and a step that stops the cylinder would carry the
+// sliding friction past zero: explicit Coulomb friction's chatter). On
+// joint j with cylinders k of lever arm l_k = dL_k/dq (m/rad on a hinge, -
+// on a slider) the friction's generalized force is
+//   tau(qd) = -sum_k l_k [Fs0_k + c_k l_k (qd - qd0)]
 // [N m or N]. A joint motor with target rate vel and constraint force
-// mixing CFM gives ODE's row lambda = (vel - qd_new)/CFM, a damper implicit
-// in the new rate: C = sum l_k^2 c_k = 1/CFM and vel = qd0 - sum l_k F_k / C
-// reproduce tau. Its force limit is the law's largest value, sum |l_k|
-// (F_c + F_s): the linearisation cannot give more friction than the seal
-// has. Kept explicit (in the force at the pins, as the circuit gives it):
-// a joint at one of its ODE stops (ODE then applies a powered motor as a
-// fixed force, not a damper), a cylinder's negative slope (the Stribeck
-// fall, a negative damping held at its step-start value), and a joint
-// whose C is below 1e-9 of its cylinders' steepest slope (l^2 (F_c + F_s)
-// / v_sm), where the implicit part is nothing and vel would overflow.
+// mixing CFM gives ODE's row lambda = (vel - qd_new)/CFM within +-fmax, a
+// damper implicit in the new rate: C = sum l_k^2 c_k = 1/CFM and vel = qd0
+// - sum l_k Fs0_k / C reproduce tau, fmax = sum |l_k| Fmax_k its
+// saturation. Kept explicit (the circuit's friction at v0, in the force at
+// the pins): a joint at one of its ODE stops (ODE then applies a powered
+// motor as a fixed force, not a damper), and a joint whose C is below 1e-9
+// of its cylinders' steepest slope (l^2 (F_c + F_s) / v_sm), where the
+// implicit part is nothing and vel would overflow.
 static int stop_active(const oc_body* b) {
     double x, lo, hi;
     if (b->revolute) {
@@ -936,7 +960,7 @@ static void apply_seal(ode_chain* w) {
         a->lever = l;
         b->C += l * l * a->dFs;
         b->vel += l * a->Fs0;
-        b->fmax += fabs(l) * (a->Fc + a->Fs);
+        b->fmax += fabs(l) * a->Fmax;
         b->qd0 += l * l * (a->Fc + a->Fs) / a->vsm;
     }
     for (int i = 0; i < w->nbody; ++i) {
@@ -959,7 +983,7 @@ static void apply_seal(ode_chain* w) {
     // holds it.
     for (int k = 0; k < w->nact; ++k) {
         oc_act* a = &w->a[k];
-        a->Fp = a->seal && w->b[a->seal_body].motor ? a->F + a->Fs0 : a->F;
+        a->Fp = a->seal && w->b[a->seal_body].motor ? a->F + a->Fsc : a->F;
     }
 }
 
