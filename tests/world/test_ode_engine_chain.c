@@ -8,7 +8,10 @@
 //   channels, whose base columns x1, x2 are its first two;
 // - chain_8fn_10link.json (8 functions, 10 bodies) through `cranesim run`
 //   on both backends: exit 0, every row finite; and through engine_run on
-//   the ode backend: every function moves its cylinders;
+//   the ode backend: every function moves its cylinders; its ext1/ext2
+//   pair (one valve) against the analytic mode within the bounds;
+// - the seal friction held in ODE's solver holds that pair with its valves
+//   closed, and a slider's rate on a turning boom is its position's rate;
 // - refusals in one line: the sandbox world, an adaptive solver, and the
 //   stepped engine for a chain model.
 // The two-link default's ODE runs keep the two-link world: its rows are
