@@ -47,6 +47,7 @@ typedef struct oc_body {
     int motor;         ///< the motor runs this step (apply_seal), else the friction is explicit
     double qd0;        ///< joint rate at the step's start [rad/s or m/s]
     double C, vel;     ///< the motor's damping sum l^2 dF/dv [N m s or N s/m] and target rate
+    double steep;      ///< its cylinders' steepest slope sum l^2 (F_c + F_s)/v_sm [N m s or N s/m]
     double fmax;       ///< that motor's force limit this step [N m or N]
 } oc_body;
 
@@ -966,14 +967,12 @@ static void apply_seal(ode_chain* w) {
     if (!w->dL) return; // no cylinder's friction held this way
     for (int i = 0; i < w->nbody; ++i) {
         oc_body* b = &w->b[i];
-        b->motor = 0, b->C = b->vel = b->fmax = 0.0;
+        b->motor = 0, b->C = b->vel = b->fmax = b->steep = 0.0;
     }
     ode_chain_q(w, w->qs, NULL);
     chain_update(w->mech, w->ws, w->qs, NULL);
     // Per joint: C, sum l F0 (in vel until the end), the force limit, and
-    // the steepest slope (in qd0 until the end).
-    for (int i = 0; i < w->nbody; ++i)
-        if (w->b[i].seal) w->b[i].qd0 = 0.0;
+    // the steepest slope.
     for (int k = 0; k < w->nact; ++k) {
         oc_act* a = &w->a[k];
         if (!a->seal) continue;
@@ -985,13 +984,13 @@ static void apply_seal(ode_chain* w) {
         b->C += l * l * a->dFs;
         b->vel += l * a->Fs0;
         b->fmax += fabs(l) * a->Fmax;
-        b->qd0 += l * l * (a->Fc + a->Fs) / a->vsm;
+        b->steep += l * l * (a->Fc + a->Fs) / a->vsm;
     }
     for (int i = 0; i < w->nbody; ++i) {
         oc_body* b = &w->b[i];
         if (b->dof < 0 || !b->seal) continue;
-        const double slope = b->qd0, lF0 = b->vel;
-        b->motor = b->C > 1e-9 * slope && !stop_active(b);
+        const double lF0 = b->vel;
+        b->motor = b->C > 1e-9 * b->steep && !stop_active(b);
         if (b->motor) {
             double qd;
             joint_q(w, b, &qd);
