@@ -45,6 +45,10 @@ typedef struct oc_body {
     double raw, turns; ///< hinge: angle at the last read and the whole turns counted [rad]
     double lo, hi;     ///< stops relative to the joint's zero, continuous [rad or m] (+-inf: none)
     int seal;          ///< implicit_seal: a cylinder's seal friction acts as this joint's motor
+    int motor;         ///< the motor runs this step (apply_seal), else the friction is explicit
+    double qd0;        ///< joint rate at the step's start [rad/s or m/s]
+    double C, vel;     ///< the motor's damping sum l^2 dF/dv [N m s or N s/m] and target rate
+    double steep;      ///< its cylinders' steepest slope sum l^2 (F_c + F_s)/v_sm [N m s or N s/m]
     double fmax;       ///< that motor's force limit this step [N m or N]
 } oc_body;
 
@@ -57,7 +61,12 @@ typedef struct oc_act {
     int seal;         ///< implicit_seal: its seal friction is a motor on the joint of seal_body
     int seal_body;    ///< the body whose joint the cylinder spans (implicit_seal), or -1
     double Fc, Fs, vst, vsm; ///< its seal friction's parameters [N, N, m/s, m/s]
-    double seal_max;  ///< the seal friction's magnitude at the step's rate [N]
+    double Fsc;       ///< the circuit's seal friction at the step's rate v0 [N]
+    /// The friction as a line ODE holds (apply_seal): Fs0 + dFs (v - v0)
+    /// within +-Fmax [N, N s/m, N].
+    double Fs0, dFs, Fmax;
+    double lever;     ///< dL/dq of its joint at the step's start [m/rad or -]
+    double Fp;        ///< the force at its pins this step [N] (F without the seal friction when the motor holds it)
 } oc_act;
 
 struct ode_chain {
@@ -72,6 +81,7 @@ struct ode_chain {
     double* u;      ///< valve commands (nfn)
     double* qstart; ///< start coordinates (ndof)
     double* qs;     ///< scratch (ndof)
+    double* dL;     ///< implicit_seal: lever arms (ndof), NULL when no cylinder's friction is held so
     dWorldID world;
     dThreadingImplementationID threading;
     double g;
@@ -116,6 +126,7 @@ ode_chain_opts ode_chain_default_opts(void) {
     o.init_hold = 1;
     o.p_low = 2e6;
     o.model_file = "model";
+    o.implicit_seal = 1;
     return o;
 }
 
@@ -217,6 +228,30 @@ static void read_turns(ode_chain* w) {
     }
 }
 
+// A slider's rate [m/s]: the relative velocity of its two bodies along the
+// axis, ax . (v1 - v2), plus the turning of that axis with the bodies,
+// (c x ax) . (w1 + w2) / 2 with c = p2 - p1 the line between their centres
+// of mass: the rate of dJointGetSliderPosition and the velocity ODE's
+// slider motor row holds (its linear torque decoupling). ODE's own
+// dJointGetSliderPositionRate leaves out the second term, which on a
+// turning boom is its angular rate times the offset of the centres of mass
+// across the axis (0.1 rad/s over 0.1 m: 10 mm/s).
+static double slider_rate(dJointID j) {
+    dVector3 ax;
+    dJointGetSliderAxis(j, ax);
+    const dBodyID b1 = dJointGetBody(j, 0), b2 = dJointGetBody(j, 1);
+    const dReal* v1 = dBodyGetLinearVel(b1);
+    if (!b2) return ax[0] * v1[0] + ax[1] * v1[1] + ax[2] * v1[2];
+    const dReal* v2 = dBodyGetLinearVel(b2);
+    const dReal *w1 = dBodyGetAngularVel(b1), *w2 = dBodyGetAngularVel(b2);
+    const dReal *p1 = dBodyGetPosition(b1), *p2 = dBodyGetPosition(b2);
+    const double c[3] = {p2[0] - p1[0], p2[1] - p1[1], p2[2] - p1[2]};
+    const double cx[3] = {c[1] * ax[2] - c[2] * ax[1], c[2] * ax[0] - c[0] * ax[2], c[0] * ax[1] - c[1] * ax[0]};
+    double r = 0.0;
+    for (int i = 0; i < 3; ++i) r += ax[i] * (v1[i] - v2[i]) + 0.5 * cx[i] * (w1[i] + w2[i]);
+    return r;
+}
+
 static double joint_q(const ode_chain* w, const oc_body* b, double* qd) {
     if (b->revolute) {
         const double raw = dJointGetHingeAngle(b->joint);
@@ -224,7 +259,7 @@ static double joint_q(const ode_chain* w, const oc_body* b, double* qd) {
         return b->q0 + raw + turns_at(b, raw);
     }
     (void)w;
-    if (qd) *qd = dJointGetSliderPositionRate(b->joint);
+    if (qd) *qd = slider_rate(b->joint);
     return b->q0 + dJointGetSliderPosition(b->joint);
 }
 
@@ -623,6 +658,10 @@ static int hyd_init_state(ode_chain* w, char* err, size_t errsz) {
     return 0;
 }
 
+// The seal friction's tanh is within 1e-4 of 1 beyond |v| = atanh(1 - 1e-4)
+// v_sm = 4.95 v_sm: sliding (hyd_step).
+#define SEAL_SLIDING 4.95
+
 static int hyd_step(ode_chain* w, double H) {
     w->step_t0 = w->th;
     // The strokes, rates and commands this step integrates start here (as
@@ -652,16 +691,28 @@ static int hyd_step(ode_chain* w, double H) {
     rhs(w, w->th, w->y, w->ydot);
     w->th = (double)(w->nstep + 1) * H; // on the step count: no drift from the mechanical clock
     for (int k = 0; k < w->nact; ++k) {
-        w->a[k].F = w->hd->cyl_F[w->cc.act[k].cyl];
         oc_act* a = &w->a[k];
+        a->F = a->Fp = w->hd->cyl_F[w->cc.act[k].cyl];
         if (a->seal) {
-            // The circuit subtracted the seal friction at the step's rate
-            // v0; it is added back here and held by the joint's motor
-            // (apply_seal) instead. Its magnitude at v0 is the motor's limit.
+            // The circuit subtracted its seal friction at the step's rate
+            // v0 (its rate input), Fsc: added back at the pins where
+            // apply_seal holds the friction in ODE's solver instead, as the
+            // line Fs0 + dFs (v - v0) within +-Fmax.
             double d;
-            a->F += hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, a->v0, &d);
-            const double r = a->v0 / a->vst;
-            a->seal_max = a->Fc + a->Fs * exp(-r * r);
+            a->Fsc = hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, a->v0, &d);
+            if (fabs(a->v0) < SEAL_SLIDING * a->vsm) {
+                // At rest and through the knee: the law's tangent at v0,
+                // its negative part (the Stribeck fall) left out.
+                a->Fs0 = a->Fsc, a->dFs = d > 0.0 ? d : 0.0, a->Fmax = a->Fc + a->Fs;
+            } else {
+                // Sliding: the law is mag(v0) sign(v) to 1e-4. As a damper
+                // of its slope at zero, mag(v0)/v_sm, saturating at
+                // mag(v0), it stays that while the step keeps sliding and
+                // follows the law through zero when the step stops it
+                // (the tangent, flat here, would hold +mag past zero).
+                const double r = a->v0 / a->vst, mag = a->Fc + a->Fs * exp(-r * r);
+                a->dFs = mag / a->vsm, a->Fs0 = a->dFs * a->v0, a->Fmax = mag;
+            }
         }
         if (!isfinite(w->a[k].F)) {
             snprintf(w->err, sizeof w->err, "hydraulics: the force of actuator %s became non-finite at t = %.6f s",
@@ -849,11 +900,16 @@ static int build(void* arg) {
             snprintf(path, sizeof path, "%s.%s", cyl, par[j]);
             ok &= hyd_model_get(w->hm, path, &v[j]) == 0;
         }
-        if (!ok || !(v[0] > 0.0 || v[1] > 0.0) || !(v[2] > 0.0)) continue;
+        if (!ok || !(v[0] >= 0.0 && v[1] >= 0.0) || !(v[0] + v[1] > 0.0) || !(v[2] > 0.0) || !(v[3] > 0.0))
+            continue;
         a->seal = 1, a->seal_body = jb;
         a->Fc = v[0], a->Fs = v[1], a->vst = v[2], a->vsm = v[3];
-        a->seal_max = v[0] + v[1];
         w->b[jb].seal = 1;
+        // apply_seal's lever arms, one per DOF.
+        if (!w->dL && !(w->dL = calloc((size_t)w->ndof, sizeof *w->dL))) {
+            snprintf(ba->err, ba->errsz, "ode chain world: out of memory");
+            return -1;
+        }
     }
     return 0;
 }
@@ -997,6 +1053,7 @@ static void free_world(ode_chain* w) {
     free(w->u);
     free(w->qstart);
     free(w->qs);
+    free(w->dL);
     crane_chain_free(&w->cc);
     free(w);
 }
@@ -1009,7 +1066,7 @@ void ode_chain_destroy(ode_chain* w) {
 
 static void apply_forces(ode_chain* w) {
     for (int k = 0; k < w->nact; ++k) {
-        const double F = w->a[k].F;
+        const double F = w->a[k].Fp;
         if (F == 0.0) continue;
         const crane_act* c = &w->cc.act[k];
         double u[3], pa[3], pb[3];
@@ -1032,38 +1089,108 @@ static void apply_forces(ode_chain* w) {
     }
 }
 
-// implicit_seal: each joint's motor at zero speed, its force limit the sum
-// of its cylinders' seal friction times their lever arm |dL/dq| at the
-// present pose (a torque [N m] on a hinge, a force [N] on a slider), so
-// ODE's solver holds the joint still up to that friction and resists
-// motion with it, in the same step.
+// implicit_seal: the seal friction of each cylinder across one joint, by
+// the circuit's own law (hyd_cyl_seal: (F_c + F_s exp(-(v/v_st)^2))
+// tanh(v/v_sm), smooth through zero), as a line solved by ODE with the
+// step's end velocities: a linearly implicit step of the friction, where
+// the analytic mode's implicit solver holds the same law in the cylinder's
+// equation of motion. hyd_step gives each cylinder its line F_k(v) = Fs0_k
+// + c_k (v - v0_k) within +-Fmax_k: at rest and through the knee the law's
+// tangent at the step's rate v0 (c_k >= 0, the Stribeck fall explicit);
+// sliding (|v0| >= 4.95 v_sm, the tanh within 1e-4 of 1) a damper of the
+// law's slope at zero saturating at the law's magnitude at v0 (the tangent
+// is flat there, and a step that stops the cylinder would carry the
+// sliding friction past zero: explicit Coulomb friction's chatter). On
+// joint j with cylinders k of lever arm l_k = dL_k/dq (m/rad on a hinge, -
+// on a slider) the friction's generalized force is
+//   tau(qd) = -sum_k l_k [Fs0_k + c_k l_k (qd - qd0)]
+// [N m or N]. A joint motor with target rate vel and constraint force
+// mixing CFM gives ODE's row lambda = (vel - qd_new)/CFM within +-fmax, a
+// damper implicit in the new rate: C = sum l_k^2 c_k = 1/CFM and vel = qd0
+// - sum l_k Fs0_k / C reproduce tau, fmax = sum |l_k| Fmax_k its
+// saturation. Kept explicit (the circuit's friction at v0, in the force at
+// the pins): a joint at one of its ODE stops (ODE then applies a powered
+// motor as a fixed force, not a damper), and a joint whose C is below 1e-9
+// of its cylinders' steepest slope (l^2 (F_c + F_s) / v_sm), where the
+// implicit part is nothing and vel would overflow.
+static int stop_active(const oc_body* b) {
+    double x, lo, hi;
+    if (b->revolute) {
+        x = dJointGetHingeAngle(b->joint);
+        lo = dJointGetHingeParam(b->joint, dParamLoStop), hi = dJointGetHingeParam(b->joint, dParamHiStop);
+    } else {
+        x = dJointGetSliderPosition(b->joint);
+        lo = dJointGetSliderParam(b->joint, dParamLoStop), hi = dJointGetSliderParam(b->joint, dParamHiStop);
+    }
+    // As ODE's own test (dxJointLimitMotor::testRotationalLimit and the
+    // slider's): at or beyond a stop the limit row replaces the motor's.
+    return x <= lo || x >= hi;
+}
+
 static void apply_seal(ode_chain* w) {
-    int any = 0;
-    for (int k = 0; k < w->nact; ++k) any |= w->a[k].seal;
-    if (!any) return;
+    if (!w->dL) return; // no cylinder's friction held this way
+    for (int i = 0; i < w->nbody; ++i) {
+        oc_body* b = &w->b[i];
+        b->motor = 0, b->C = b->vel = b->fmax = b->steep = 0.0;
+    }
     ode_chain_q(w, w->qs, NULL);
-    for (int i = 0; i < w->nbody; ++i) w->b[i].fmax = 0.0;
+    chain_update(w->mech, w->ws, w->qs, NULL);
+    // Per joint: C, sum l F0 (in vel until the end), the force limit, and
+    // the steepest slope.
     for (int k = 0; k < w->nact; ++k) {
-        const oc_act* a = &w->a[k];
+        oc_act* a = &w->a[k];
         if (!a->seal) continue;
         oc_body* b = &w->b[a->seal_body];
         const crane_act* c = &w->cc.act[k];
-        // dL/dq by central differences of the mechanism's pin length.
-        const double q = w->qs[b->dof], h = 1e-6 * (1.0 + fabs(q));
-        w->qs[b->dof] = q + h;
-        chain_update(w->mech, w->ws, w->qs, NULL);
-        const double Lp = chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, NULL, NULL);
-        w->qs[b->dof] = q - h;
-        chain_update(w->mech, w->ws, w->qs, NULL);
-        const double Lm = chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, NULL, NULL);
-        w->qs[b->dof] = q;
-        b->fmax += a->seal_max * fabs(Lp - Lm) / (2.0 * h);
+        chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, w->dL, NULL);
+        const double l = w->dL[b->dof];
+        a->lever = l;
+        b->C += l * l * a->dFs;
+        b->vel += l * a->Fs0;
+        b->fmax += fabs(l) * a->Fmax;
+        b->steep += l * l * (a->Fc + a->Fs) / a->vsm;
     }
     for (int i = 0; i < w->nbody; ++i) {
         oc_body* b = &w->b[i];
         if (b->dof < 0 || !b->seal) continue;
-        set_param(b, dParamVel, 0.0);
-        set_param(b, dParamFMax, b->fmax);
+        const double lF0 = b->vel;
+        b->motor = b->C > 1e-9 * b->steep && !stop_active(b);
+        if (b->motor) {
+            double qd;
+            joint_q(w, b, &qd);
+            b->qd0 = qd;
+            b->vel = qd - lF0 / b->C;
+            set_param(b, dParamCFM, 1.0 / b->C);
+            set_param(b, dParamVel, b->vel);
+        }
+        // fmax 0 switches the motor off (ODE adds no row).
+        set_param(b, dParamFMax, b->motor ? b->fmax : 0.0);
+    }
+    // The force at the pins: without the seal friction where the motor
+    // holds it.
+    for (int k = 0; k < w->nact; ++k) {
+        oc_act* a = &w->a[k];
+        a->Fp = a->seal && w->b[a->seal_body].motor ? a->F + a->Fsc : a->F;
+    }
+}
+
+// After the step: the seal friction the motor applied, shared out to its
+// cylinders by their linearised laws (scaled where the force limit cut the
+// sum), so each cylinder's F is its force over the step, friction included,
+// as the analytic mode reports it.
+static void seal_applied(ode_chain* w) {
+    if (!w->dL) return;
+    for (int k = 0; k < w->nact; ++k) {
+        oc_act* a = &w->a[k];
+        if (!a->seal || !w->b[a->seal_body].motor) continue;
+        const oc_body* b = &w->b[a->seal_body];
+        double qd;
+        joint_q(w, b, &qd);
+        // ODE's row: lambda = C (vel - qd), within +-fmax.
+        const double lin = b->C * (b->vel - qd);
+        const double lam = lin > b->fmax ? b->fmax : lin < -b->fmax ? -b->fmax : lin;
+        const double scale = lin != 0.0 ? lam / lin : 1.0;
+        a->F = a->Fp - scale * (a->Fs0 + a->dFs * a->lever * (qd - b->qd0));
     }
 }
 
@@ -1088,13 +1215,16 @@ static int pre_step(ode_chain* w) {
         w->a[k].x0 = act_geometry(w, k, &w->a[k].v0, NULL, NULL, NULL) - w->cc.act[k].closed_length;
     if (w->slew_on) w->slew_x0 = slew_kinematics(w, &w->slew_v0);
     if (w->hm && hyd_step(w, w->opt.dt_ode)) return -1;
-    apply_forces(w);
+    // The seal's motor first: apply_forces applies the part of the
+    // cylinder force ODE's solver does not hold (apply_seal splits it).
     apply_seal(w);
+    apply_forces(w);
     return 0;
 }
 
 // And after it: the clock, the hinges' turns, the bodies' check.
 static int post_step(ode_chain* w) {
+    seal_applied(w);
     ++w->nstep;
     w->t = (double)w->nstep * w->opt.dt_ode;
     read_turns(w);
@@ -1200,7 +1330,7 @@ void ode_chain_set_commands(ode_chain* w, const double* u) {
 
 void ode_chain_set_forces(ode_chain* w, const double* F) {
     if (w->hm) return; // the circuit's forces
-    for (int k = 0; k < w->nact; ++k) w->a[k].F = isfinite(F[k]) ? F[k] : 0.0;
+    for (int k = 0; k < w->nact; ++k) w->a[k].F = w->a[k].Fp = isfinite(F[k]) ? F[k] : 0.0;
 }
 
 void ode_chain_set_joint_forces(ode_chain* w, const double* tau) {

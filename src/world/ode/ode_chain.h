@@ -41,11 +41,15 @@ typedef struct ode_chain_opts {
     int init_hold;         ///< 1 (default): start pressures that hold the start pose under gravity
     double p_low;          ///< init_hold: pressure of the unloaded side [Pa abs]; default 2e6
     const char* model_file; ///< in messages; default "model"
-    /// 1: a cylinder across one joint has its seal friction (Coulomb +
-    /// Stribeck, hyd_cyl_seal) held by ODE's solver, as a joint motor at
-    /// zero speed whose force limit is that friction over the cylinder's
-    /// lever arm, instead of in the force applied a step late (which cannot
-    /// hold a load still); 0 (default): every force through the coupling.
+    /// 1 (default): a cylinder across one joint has its seal friction
+    /// (hyd_cyl_seal: Coulomb + Stribeck, tanh over v_smooth) held by
+    /// ODE's solver at the step's end velocity: the law as a line (its
+    /// tangent at the step's rate; a damper saturating at its magnitude
+    /// once sliding) in a joint motor whose constraint force mixing is the
+    /// line's damping, so a step that would stop or reverse the cylinder
+    /// meets the friction of the new rate (docs/ode_world.md, "The chain
+    /// world"). 0: every force through the coupling, the seal friction at
+    /// the step's start rate a step late (the two-link world's coupling).
     int implicit_seal;
     /// Hosted (the sandbox, docs/ode_world.md "The sandbox from the chain"):
     /// the bodies and joints are built into this world instead of a world
