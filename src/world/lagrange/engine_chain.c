@@ -1,5 +1,6 @@
 // engine_chain.c: scripted runs of the general analytic mode (engine_chain.h).
 #include "engine_chain.h"
+#include "chain_row.h"
 #include "chain_sim.h"
 #include "energy_acc.h"
 #include "engine_impl.h"
@@ -42,39 +43,11 @@ static double scn_cmd(void* user, int k, double t) {
     return c->fcol[k] < 0 ? 0.0 : scenario_command(c->sc, c->fcol[k], t);
 }
 
-// The row sim.h's base columns hold: the first two actuators, functions
-// and boom DOFs; the tip relative to the first boom's joint.
+// The row (chain_row.c, shared with the stepped engine).
 static void make_row(chain_run_ctx* c, double t, const double* y, double* row) {
-    chain_sim* cs = c->cs;
     chain_sim_out co = {.x = c->x, .v = c->v, .pA = c->pA, .pB = c->pB, .F = c->F, .u = c->u, .u_cmd = c->ucmd,
                         .q = c->q, .qd = c->qd};
-    chain_sim_outputs(cs, t, y, &co);
-    lsim_out o;
-    memset(&o, 0, sizeof o);
-    for (int k = 0; k < 2 && k < cs->nact; ++k) {
-        o.x[k] = c->x[k], o.v[k] = c->v[k], o.pA[k] = c->pA[k], o.pB[k] = c->pB[k], o.F[k] = c->F[k];
-        const int f = cs->cc->act[k].function;
-        o.u[k] = c->u[f], o.u_cmd[k] = c->ucmd[f];
-        if (cs->hd->cyl_stop[cs->cc->act[k].cyl]) o.end_stop |= 1 << k;
-    }
-    const int d0 = cs->cc->slew_free ? 1 : 0;
-    for (int k = 0; k < 2 && d0 + k < cs->ndof; ++k) {
-        o.q[k] = c->q[d0 + k], o.qd[k] = c->qd[d0 + k];
-        // tau of the joint: sum over the actuators of F dL/dq.
-        for (int a = 0; a < cs->nact; ++a) o.tau[k] += c->F[a] * cs->dL[(size_t)a * cs->ndof + d0 + k];
-    }
-    double p1[3];
-    chain_body_pose(cs->ch, cs->ws, cs->cc->nbody > 1 ? 1 : 0, NULL, p1);
-    o.tip[0] = hypot(co.tip[0] - p1[0], co.tip[1] - p1[1]);
-    o.tip[1] = co.tip[2] - p1[2];
-    o.p_pump = co.p_pump;
-    const hyd_model* hm = cs->hm;
-    for (int i = 0; i < hyd_model_ncomp(hm); ++i)
-        if (hyd_model_comp_type(hm, i) == HYD_RELIEF && cs->hd->comp_open[i]) ++o.relief_open;
-    lagrange_row(t, &o, row);
-    // The chain's own columns right after the backend's (engine_sink.row).
-    const crane_chain_sample cs_s = {c->x, c->v, c->pA, c->pB, c->F, c->u, c->ucmd, c->q, c->qd};
-    crane_chain_row(cs->cc, &cs_s, row + SIM_NCOL_BASE);
+    chain_sim_row(c->cs, t, y, &co, row);
 }
 
 static void track_peaks(chain_run_ctx* c, const double* y) {
@@ -149,8 +122,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     const int nd = cs.ndof, na = cs.nact, nf = cs.nfn;
     chain_run_ctx c;
     memset(&c, 0, sizeof c);
-    const size_t nrow = SIM_NCOL_BASE + (size_t)m->chain.ncol > SIM_NCOL ? SIM_NCOL_BASE + (size_t)m->chain.ncol
-                                                                         : (size_t)SIM_NCOL;
+    const size_t nrow = (size_t)chain_row_size(&m->chain);
     double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + nrow + 1, sizeof *buf);
     c.fcol = calloc((size_t)nf + 1, sizeof *c.fcol);
     hyd_solver* s = NULL;
