@@ -9,8 +9,8 @@
 // - chain_8fn_10link.json (8 functions, 10 bodies) through `cranesim run`
 //   on both backends: exit 0, every row finite; and through engine_run on
 //   the ode backend: every function moves its cylinders;
-// - refusals in one line: the sandbox world, an adaptive solver, and the
-//   stepped engine for a chain model.
+// - refusals in one line: the sandbox world (scripted and stepped), an
+//   adaptive solver.
 // The two-link default's ODE runs keep the two-link world: its rows are
 // byte-identical to the previous main's (ramp, every 100th row kept).
 #include "check.h"
@@ -391,12 +391,16 @@ static void test_refusals(void) {
               !strchr(res.message, '\n'),
           "adaptive: %s", res.message);
     trace_free(&tr);
-    // The stepped engine (drive, serve) is still the two-link crane's.
+    // The stepped engine (drive, bench soak) of a chain model runs in the
+    // chain world (engine_ode_chain_step.c, test_engine_chain_step.c): the
+    // sandbox is refused there too, in one line.
     o = sim_default_opts();
     o.mechanics = SIM_ODE;
+    o.world = "sandbox";
     const double q0[2] = {sc.q0[0], sc.q0[1]};
     engine* e = engine_create(m, &o, q0, 0.0, -1, err, sizeof err);
-    CHECK(e == NULL && strstr(err, "stepped engine of the ode backend") && !strchr(err, '\n'), "create: %s", err);
+    CHECK(e == NULL && strstr(err, "the sandbox runs the two-link crane only; use") && !strchr(err, '\n'),
+          "create: %s", err);
     engine_destroy(e);
     model_free(m);
 }

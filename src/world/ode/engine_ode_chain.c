@@ -33,20 +33,15 @@ static int check_world(const sim_opts* o, char* err, size_t errsz) {
     return -1;
 }
 
-int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
-                         sim_result* res) {
-    char* msg = res->message;
-    const size_t msz = sizeof res->message;
-    if (check_world(o, msg, msz)) return res->status = SIM_REFUSED;
+int engine_ode_chain_check(const sim_opts* o, double* dt_ode, double* h_hyd, char* msg, size_t msz) {
+    if (check_world(o, msg, msz)) return -1;
     if (hyd_method_is_adaptive(o->solver)) {
         snprintf(msg, msz,
                  "solver %s is adaptive: the ODE chain world sub-steps its circuit with a fixed-step method (krus, "
                  "ros2, rk4)",
                  hyd_method_name(o->solver));
-        return res->status = SIM_REFUSED;
+        return -1;
     }
-    // No world circuit here: a burst at a node the model lacks has nowhere to open.
-    if (engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
     const double dt = o->dt_ode > 0 ? o->dt_ode : 1e-3;
     // As ode_world_for_run: the forces lag the bodies by one ODE step.
     if (dt > 0.01 + 1e-12) {
@@ -54,15 +49,29 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
                  "%s %g s is too long: the cylinder forces lag the bodies by one ODE step, which beyond 0.01 s "
                  "distorts the pressures by more than 15 %% and then goes unstable (docs/ode_world.md)",
                  sim_param_name(SIM_PARAM_DT_ODE), dt);
-        return res->status = SIM_REFUSED;
+        return -1;
     }
     const double h = o->h < dt ? o->h : dt;
     const double ratio = dt / h;
     if (fabs(ratio - floor(ratio + 0.5)) > 1e-6) {
         snprintf(msg, msz, "%s %g s must divide the ODE step %g s (hydraulic sub-steps)", sim_param_name(SIM_PARAM_DT),
                  h, dt);
-        return res->status = SIM_REFUSED;
+        return -1;
     }
+    *dt_ode = dt;
+    *h_hyd = h;
+    return 0;
+}
+
+int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
+                         sim_result* res) {
+    char* msg = res->message;
+    const size_t msz = sizeof res->message;
+    double dt, h;
+    if (engine_ode_chain_check(o, &dt, &h, msg, msz)) return res->status = SIM_REFUSED;
+    // No world circuit here: a burst at a node the model lacks has nowhere to open.
+    if (engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
+    const double ratio = dt / h;
     const double t_end = k->t_end;
     if (t_end / dt > 1e12) {
         snprintf(msg, msz, "%s %g s over %g s is %.3g steps, more than 1e12: use a larger %s or a shorter run",

@@ -22,6 +22,13 @@ extern "C" {
 int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
                          sim_result* res);
 
+/// The options a chain world takes, as both its scripted run and its
+/// stepped engine (engine_ode_chain_step.c) check them: the validation world,
+/// a fixed-step solver, an ODE step of at most 10 ms that the hydraulic
+/// step divides. 0 with the ODE step and the hydraulic sub-step [s] in
+/// *dt_ode, *h_hyd; -1 with one line in msg.
+int engine_ode_chain_check(const sim_opts* o, double* dt_ode, double* h_hyd, char* msg, size_t msz);
+
 #ifdef __cplusplus
 }
 #endif
