@@ -243,9 +243,9 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     // and a limiter asked for by name (rcl.h refuses chains; on by default,
     // it is then off with a note below).
     engine* l = NULL;
-    if (session_path && engine_require(m, &c->sim, ENGINE_CAP_TWO_LINK, "drive --session", err, sizeof err)) {
+    if (session_path && engine_require(m, &c->sim, ENGINE_CAP_TWO_LINK, "--session", err, sizeof err)) {
     } else if (rcl_given && c->sim.rcl &&
-               engine_require(m, &c->sim, ENGINE_CAP_LIMITER, "drive --rcl on", err, sizeof err)) {
+               engine_require(m, &c->sim, ENGINE_CAP_LIMITER, "--rcl on", err, sizeof err)) {
     } else {
         l = engine_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
     }

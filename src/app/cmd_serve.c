@@ -244,7 +244,8 @@ static void log_collisions(const server* s, const char* when) {
 static int build_engine(server* s, struct rcl* lim, char* err, size_t errsz) {
     // The protocol carries the two-link crane (u[3], nine[9], its frames,
     // the snapshot); a crane chain waits for its version (issue 27).
-    if (engine_require(s->m, s->o, ENGINE_CAP_TWO_LINK | ENGINE_CAP_SNAPSHOT, "serve", err, errsz)) {
+    if (engine_require(s->m, s->o, ENGINE_CAP_TWO_LINK, "the serve protocol", err, errsz) ||
+        engine_require(s->m, s->o, ENGINE_CAP_SNAPSHOT, "the serve protocol", err, errsz)) {
         engine_rcl_destroy(lim);
         return -1;
     }

@@ -373,7 +373,7 @@ static engine* make_engine(drive_session* s, const double q0[2], double slew0) {
     // crane's (issue 27 sizes them by the model): a crane chain is refused
     // here, before the window opens (drive --headless runs it).
     if (engine_require(s->m, &s->c.sim, ENGINE_CAP_SNAPSHOT | ENGINE_CAP_TWO_LINK | ENGINE_CAP_SET_LINK,
-                       "drive window (drive --headless runs a crane chain)", s->err, sizeof s->err))
+                       "the window (--headless runs a crane chain)", s->err, sizeof s->err))
         return NULL;
     engine* l = engine_create(s->m, &s->c.sim, q0, slew0, m3, err, sizeof err);
     if (!l) snprintf(s->err, sizeof s->err, "%s", err);

@@ -18,6 +18,7 @@
 // (c) a command vector of the wrong length, an unknown function: refused,
 //     one line, nothing set; the channels and columns are the chain's.
 #include "check.h"
+#include "app/cli_util.h"
 #include "engine.h"
 #include "model.h"
 #include "scenario.h"
@@ -27,6 +28,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -314,6 +316,80 @@ static void test_closed_valves_hold(void) {
     }
 }
 
+static const char* out_dir(void) {
+    static char d[512];
+    if (!d[0]) {
+        snprintf(d, sizeof d, "%s/tests/world/engine_chain_step", CRANESIM_BINARY_DIR);
+        mkdir(d, 0755);
+    }
+    return d;
+}
+
+// The first line of file path into buf; "" when it cannot be read.
+static const char* first_line(const char* path, char* buf, size_t n) {
+    buf[0] = 0;
+    FILE* f = fopen(path, "r");
+    if (f) {
+        if (!fgets(buf, (int)n, f)) buf[0] = 0;
+        fclose(f);
+    }
+    return buf;
+}
+
+// The command line: a chain model drives headless (its CSV has the run's
+// columns) and soaks; what is two-link shaped refuses it, one line, exit 2,
+// before anything starts.
+static void test_command_line(void) {
+    const char* mdl = g_cases[0].model;
+    const char* scn = g_cases[0].scenario;
+    static char args[4096], out[8192], h1[8192], h2[8192];
+    char drv[600], run[600];
+    snprintf(drv, sizeof drv, "%s/drive.csv", out_dir());
+    snprintf(run, sizeof run, "%s/run.csv", out_dir());
+    for (int b = 0; b < 2; ++b) {
+        const char* mech = b ? "ode --world validation" : "lagrange";
+        snprintf(args, sizeof args,
+                 "drive --headless --quiet --model %s --scenario %s --mechanics %s --duration 0.2 --frame-rate 100 "
+                 "--rcl off --record %s",
+                 mdl, scn, mech, drv);
+        int rc = cli_run(args, out, sizeof out);
+        CHECK(rc == 0 && strstr(out, "final: strokes lift "), "drive %s: exit %d: %s", mech, rc, out);
+        snprintf(args, sizeof args, "run --quiet --model %s --scenario %s --mechanics %s --duration 0.2 --out %s", mdl,
+                 scn, mech, run);
+        rc = cli_run(args, out, sizeof out);
+        CHECK(rc == 0, "run %s: exit %d: %s", mech, rc, out);
+        CHECK(first_line(drv, h1, sizeof h1)[0] && !strcmp(h1, first_line(run, h2, sizeof h2)) &&
+                  strstr(h1, ",x_ext,") && strstr(h1, ",ucmd_jib2,"),
+              "drive %s header:\n%s\nrun header:\n%s", mech, h1, h2);
+    }
+    // Default --rcl on: runs without a limiter, and says so.
+    snprintf(args, sizeof args, "drive --headless --model %s --scenario %s --mechanics lagrange --duration 0.1", mdl,
+             scn);
+    int rc = cli_run(args, out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "rated capacity limiter: none for this crane chain yet"), "exit %d: %s", rc, out);
+    static const struct {
+        const char* args;
+        const char* says;
+    } refuse[] = {
+        {"drive --headless --mechanics lagrange --rcl on", "cranesim drive: --rcl on: "},
+        {"drive --headless --mechanics lagrange --session never.json", "cranesim drive: --session: "},
+        {"drive --headless", "cranesim drive: --world sandbox: the sandbox runs the two-link crane only"},
+        {"serve --mechanics lagrange --listen 127.0.0.1:0", "cranesim serve: the serve protocol: "},
+        {"serve --world validation --listen 127.0.0.1:0", "cranesim serve: the serve protocol: "},
+    };
+    for (size_t i = 0; i < sizeof refuse / sizeof refuse[0]; ++i) {
+        snprintf(args, sizeof args, "%s --model %s --scenario %s --duration 0.1", refuse[i].args, mdl, scn);
+        rc = cli_run(args, out, sizeof out);
+        const char* line = strstr(out, refuse[i].says);
+        CHECK(rc == 2 && line && cli_count_lines(line) == 1, "%s: exit %d: %s", refuse[i].args, rc, out);
+    }
+    snprintf(args, sizeof args, "bench --config soak --model %s --duration 1", mdl);
+    rc = cli_run(args, out, sizeof out);
+    CHECK(rc == 0 && strstr(out, "\"functions\":4") && strstr(out, "\"nonfinite_values\":0") &&
+              strstr(out, "\"exit_status\":0"),
+          "soak: exit %d: %s", rc, out);
+}
+
 // (c) commands of the wrong length and unknown functions are refused, one
 // line, nothing set; what the engine does not have yet answers clearly.
 static void test_refusals(void) {
@@ -378,6 +454,7 @@ static void test_refusals(void) {
 
 int main(int argc, char** argv) {
     RUN_TEST(test_refusals);
+    RUN_TEST(test_command_line);
     RUN_TEST(test_held_commands_match_run);
     RUN_TEST(test_closed_valves_hold);
     RUN_TEST(test_play_matches_run);

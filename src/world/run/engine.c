@@ -273,10 +273,9 @@ int engine_require(const model* m, const sim_opts* o, unsigned caps, const char*
     const unsigned miss = caps & ~engine_caps_for(m, o);
     if (!miss) return 0;
     // The first missing part, in the order a driver meets them.
-    const char* part = (miss & ENGINE_CAP_TWO_LINK)
-                           ? "the two-link shape this needs (commands lift, jib, slew and the two-link columns; a "
-                             "headless drive writes its rows by function)"
-                       : (miss & ENGINE_CAP_SNAPSHOT) ? "picture for the renderer"
+    const char* part = (miss & ENGINE_CAP_SNAPSHOT)   ? "picture for the renderer"
+                       : (miss & ENGINE_CAP_TWO_LINK) ? "two-link commands and rows (lift, jib, slew; a headless "
+                                                        "drive runs a chain by function)"
                        : (miss & ENGINE_CAP_LIMITER)  ? "rated capacity limiter"
                                                       : "boom edits (the drive panel)";
     snprintf(err, errsz, "%s: %s: the stepped %s engine for this crane chain (%d functions) has no %s yet", what,
