@@ -19,6 +19,7 @@
 //     one line, nothing set; the channels and columns are the chain's.
 #include "check.h"
 #include "app/cli_util.h"
+#include "channels.h"
 #include "engine.h"
 #include "model.h"
 #include "scenario.h"
@@ -435,6 +436,25 @@ static void test_refusals(void) {
         engine_row(e, row);
         CHECK(row[COL_U1_CMD] == 0.9 && row[COL_U2_CMD] == -0.8, "commands in the row: %g %g", row[COL_U1_CMD],
               row[COL_U2_CMD]);
+        // The channel list drive's charts read: the row's columns, then the
+        // circuit's; its row part is engine_row's.
+        chan_list* cl = chan_list_create(e);
+        CHECK(cl && chan_list_nrow(cl) == engine_ncol(e) && chan_list_count(cl) > engine_ncol(e) &&
+                  chan_list_find(cl, "x_ext") >= SIM_NCOL_BASE && chan_list_find(cl, "ext_valve.spool") > 0,
+              "%s: channel list", bname(o.mechanics));
+        if (cl) {
+            double* v = calloc((size_t)chan_list_count(cl), sizeof *v);
+            if (v) {
+                chan_list_values(cl, e, v, false);
+                CHECK(!memcmp(v, row, (size_t)engine_ncol(e) * sizeof *v), "%s: channel values differ from the row",
+                      bname(o.mechanics));
+                const int k = chan_list_find(cl, "ext_valve.spool");
+                CHECK(k < 0 || fabs(v[k] - v[chan_list_find(cl, "u_ext")]) < 1e-15, "%s: spool %g, u_ext %g",
+                      bname(o.mechanics), k < 0 ? 0 : v[k], v[chan_list_find(cl, "u_ext")]);
+                free(v);
+            }
+            chan_list_free(cl);
+        }
         // What a chain engine does not have yet: answered, not a crash.
         world_snapshot* snap = calloc(1, sizeof *snap);
         CHECK(snap && !engine_snapshot(e, snap), "a chain engine gave a snapshot");

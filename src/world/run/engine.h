@@ -1,6 +1,8 @@
 // engine.h: one crane engine, whatever the backend: the lagrange crane
 // (engine_lagrange.c, on lagrange_sim) or the ODE world (engine_ode.c, on
-// ode_world). Drivers (drive, the window's tick, the soak bench) create one
+// ode_world), and for a crane chain of any shape their chain engines
+// (engine_chain_step.c on chain_sim, engine_ode_chain_step.c on ode_chain),
+// sized by the model. Drivers (drive, the window's tick, the soak bench) create one
 // from the model and the options, set commands, advance it on the simulated
 // clock, read its row and its snapshot, and never ask which backend runs:
 // what differs is behind engine_ops (engine_impl.h). Scripted runs (run,
@@ -26,7 +28,11 @@ extern "C" {
 /// The engine o->mechanics names, at joint angles q0 [rad], slew angle
 /// slew0 [rad] (ode only) and tip load m3 [kg] (lagrange, and the ode
 /// validation world; the sandbox picks loads up with the hook). The ode world
-/// is o->world, else the sandbox. NULL with one line in err: the start the
+/// is o->world, else the sandbox. For a crane chain (not the two-link
+/// shorthand; lagrange also with --variant general) the backend's engine for
+/// chains (engine_ops.stepped): q0 are the first two boom DOFs, the others
+/// start mid-limits (crane_chain_start_pose), as the scripted runs start;
+/// it has what engine_caps says. NULL with one line in err: the start the
 /// run checks refuse (an unreachable pose, a step the method cannot take, a
 /// load the reliefs cannot hold), or the world file at fault.
 engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
@@ -89,9 +95,9 @@ typedef enum engine_cap {
 unsigned engine_caps(const engine* e);
 unsigned engine_caps_for(const model* m, const sim_opts* o);
 /// 0 when the stepped engine for m and o has every bit of caps; else -1
-/// with one line in err: "WHAT: <model file>: the stepped engine for this
-/// crane chain (N functions) has no <first missing part> yet (...)". what
-/// names the caller ("drive window", "serve").
+/// with one line in err: "WHAT: <model file>: the stepped <backend> engine
+/// for this crane chain (N functions) has no <first missing part> yet".
+/// what names the caller ("the window", "the serve protocol").
 int engine_require(const model* m, const sim_opts* o, unsigned caps, const char* what, char* err, size_t errsz);
 /// 0 when every command column of sc names a function of m (lift, jib and
 /// slew always do), else -1 with "FILE: commands.X: unknown field 'X': the
