@@ -384,6 +384,24 @@ static void test_command_line(void) {
         const char* line = strstr(out, refuse[i].says);
         CHECK(rc == 2 && line && cli_count_lines(line) == 1, "%s: exit %d: %s", refuse[i].args, rc, out);
     }
+    // Session files: a two-link drive's session replayed on the chain model.
+    char sess[600];
+    snprintf(sess, sizeof sess, "%s/two_link.session", out_dir());
+    snprintf(args, sizeof args, "drive --headless --quiet --mechanics lagrange --duration 0.2 --session %s", sess);
+    rc = cli_run(args, out, sizeof out);
+    CHECK(rc == 0, "two-link session: exit %d: %s", rc, out);
+    snprintf(args, sizeof args, "replay %s --model %s", sess, mdl);
+    rc = cli_run(args, out, sizeof out);
+    const char* rl = strstr(out, "cranesim replay: session files: ");
+    CHECK(rc == 2 && rl && strstr(rl, "chain_3boom_ext.json") && cli_count_lines(rl) == 1, "replay: exit %d: %s", rc,
+          out);
+    // The window, before it opens (a build without the render module says
+    // that instead).
+    snprintf(args, sizeof args, "drive --screenshot %s/never.png --model %s --world validation", out_dir(), mdl);
+    rc = cli_run(args, out, sizeof out);
+    const char* wl = strstr(out, "cranesim drive: the window (--headless runs a crane chain): ");
+    if (!wl) wl = strstr(out, "needs the render module");
+    CHECK(rc == 2 && wl && cli_count_lines(wl) == 1, "window: exit %d: %s", rc, out);
     snprintf(args, sizeof args, "bench --config soak --model %s --duration 1", mdl);
     rc = cli_run(args, out, sizeof out);
     CHECK(rc == 0 && strstr(out, "\"functions\":4") && strstr(out, "\"nonfinite_values\":0") &&
