@@ -292,12 +292,16 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     drive_world dw = {.hook = sandbox, .held = -1, .sess = session_path ? &sw : NULL};
     int wr = 0; // errno of the first failed write to the record
     const bool two_link = engine_caps(l) & ENGINE_CAP_TWO_LINK, limiter = engine_caps(l) & ENGINE_CAP_LIMITER;
+    const int nfn = engine_nfunction(l);
     if (f && two_link) sim_csv_header(f, ncol);
     else if (f) write_header(f, l);
     if (f && ferror(f)) wr = errno ? errno : EIO;
     printf("cranesim drive: %s: driving %s headless in real time for %.1f s\n", why, m->name, duration);
     char nowhere[96];
-    snprintf(nowhere, sizeof nowhere, "%s (no world)", app_backend(&c->sim)->crane);
+    // The backend's crane where it has no world is its two-link one; a
+    // chain engine says what it runs instead.
+    if (two_link) snprintf(nowhere, sizeof nowhere, "%s (no world)", app_backend(&c->sim)->crane);
+    else snprintf(nowhere, sizeof nowhere, "%s crane chain of %d functions (no world)", engine_backend_name(l), nfn);
     printf("  world: %s; operator input: scripted (%s), %.0f commands/s; hydraulics %s at h = %g ms\n",
            world ? world_name : nowhere, sc.name, frame_rate, hyd_method_name(c->sim.solver),
            c->sim.h * 1e3);
@@ -311,7 +315,6 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
                "this)\n");
     // A row of engine_ncol columns (a chain engine's are more than
     // SIM_NCOL), and the commands by function.
-    const int nfn = engine_nfunction(l);
     double* row = calloc((size_t)(ncol > SIM_NCOL ? ncol : SIM_NCOL), sizeof *row);
     double* uf = calloc((size_t)nfn + 1, sizeof *uf);
     if (!row || !uf) {
