@@ -192,8 +192,10 @@ static void write_header(FILE* f, const engine* l) {
     fputc('\n', f);
 }
 
-// The final strokes of a chain engine: every actuator's x_<name> column [mm].
-static void print_chain_strokes(const engine* l, const double* row) {
+// The final strokes of a chain engine: every actuator's x_<name> column
+// [mm]; the two-link chain (--variant general) has none: its first two
+// actuators' base columns x1, x2.
+static void print_chain_strokes(const engine* l, const model* m, const double* row) {
     int n;
     const sim_channel* ch = engine_channels(l, &n);
     printf("  final: strokes");
@@ -203,6 +205,8 @@ static void print_chain_strokes(const engine* l, const double* row) {
             printf("%s%s %.0f mm", sep, ch[k].name + 2, row[k] * 1e3);
             sep = ", ";
         }
+    for (int k = 0; k < 2 && k < m->chain.nact && !strcmp(sep, " "); ++k)
+        printf("%s%s %.0f mm", k ? ", " : " ", m->chain.act[k].name, row[k ? COL_X2 : COL_X1] * 1e3);
     printf("; tip at reach %.2f m, height %.2f m from the first boom's joint", row[COL_TIP_X], row[COL_TIP_Z]);
 }
 
@@ -415,7 +419,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (two_link)
         printf("  final: lift stroke %.0f mm, jib stroke %.0f mm, tip at reach %.2f m, height %.2f m",
                row[COL_X1] * 1e3, row[COL_X2] * 1e3, row[COL_TIP_X], row[COL_TIP_Z]);
-    else print_chain_strokes(l, row);
+    else print_chain_strokes(l, m, row);
     if (sandbox) printf("; slew %.1f deg", row[COL_SLEW] * 180 / M_PI);
     if (loads) printf("; load at (%.2f, %.2f, %.2f) m", row[COL_LOAD_X], row[COL_LOAD_Y], row[COL_LOAD_Z]);
     if (sandbox) printf("; truck tilt %.2f deg", row[COL_TRUCK_TILT] * 180 / M_PI);
