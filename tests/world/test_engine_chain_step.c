@@ -281,7 +281,11 @@ static void test_closed_valves_hold(void) {
             double* row = calloc((size_t)(nc > SIM_NCOL ? nc : SIM_NCOL), sizeof *row);
             double* x0 = calloc((size_t)nc, sizeof *x0);
             double* u = calloc((size_t)engine_nfunction(e) + 1, sizeof *u);
-            if (!row || !x0 || !u) return;
+            if (!row || !x0 || !u) {
+                free(row), free(x0), free(u);
+                engine_destroy(e);
+                continue;
+            }
             engine_row(e, row);
             memcpy(x0, row, (size_t)nc * sizeof *x0);
             CHECK(engine_set_function_commands(e, u, engine_nfunction(e), err, sizeof err) == 0, "%s", err);
@@ -524,7 +528,8 @@ static double closed_vs_general(hyd_method meth, double h, double t_end) {
         for (int c = 0; c < a.ncol; ++c) peak[c] = fmax(peak[c], fabs(a.v[(size_t)i * (size_t)a.ncol + (size_t)c]));
     for (long i = 0; peak && i < a.n && i < g.n; ++i)
         for (int c = 0; c < a.ncol; ++c) {
-            const double va = a.v[(size_t)i * (size_t)a.ncol + (size_t)c], vg = g.v[(size_t)i * (size_t)g.ncol + (size_t)c];
+            const double va = a.v[(size_t)i * (size_t)a.ncol + (size_t)c];
+            const double vg = g.v[(size_t)i * (size_t)g.ncol + (size_t)c];
             const double d = fabs(va - vg) / (peak[c] > 0 ? peak[c] : 1.0);
             if (!(d <= worst)) worst = d, wc = c;
         }

@@ -182,7 +182,7 @@ int engine_find_function(const engine* e, const char* name) {
     return -1;
 }
 
-// ", "-separated names of e's functions into buf, after prefix.
+// The names of e's functions, ", "-separated, into buf.
 static void function_list(const engine* e, char* buf, size_t n) {
     int w = 0;
     for (int k = 0; k < e->nfn && w >= 0 && (size_t)w < n; ++k)
@@ -444,7 +444,9 @@ void engine_set_load(engine* e, double m3) {
 bool engine_can_set_load(const engine* e) { return e->ops->set_load != NULL; }
 bool engine_can_resize_links(const engine* e) { return e->ops->resize_links; }
 
-int engine_set_link(engine* e, int k, const crane_link* ln) { return e->ops->set_link ? e->ops->set_link(e, k, ln) : -1; }
+int engine_set_link(engine* e, int k, const crane_link* ln) {
+    return e->ops->set_link ? e->ops->set_link(e, k, ln) : -1; // -1: no two-link booms (a chain engine)
+}
 int engine_ncol(const engine* e) { return e->ncol > 0 ? e->ncol : e->ops->nchannel; }
 
 void engine_circuit_state(engine* e, double* y, const hyd_data** in) {
