@@ -274,12 +274,15 @@ int engine_require(const model* m, const sim_opts* o, unsigned caps, const char*
     if (!miss) return 0;
     // The first missing part, in the order a driver meets them.
     const char* part = (miss & ENGINE_CAP_SNAPSHOT)   ? "picture for the renderer"
-                       : (miss & ENGINE_CAP_TWO_LINK) ? "two-link commands and rows (lift, jib, slew; a headless "
-                                                        "drive runs a chain by function)"
+                       : (miss & ENGINE_CAP_TWO_LINK) ? "fixed three commands and two-link rows (lift, jib, slew; "
+                                                        "a headless drive runs it by function)"
                        : (miss & ENGINE_CAP_LIMITER)  ? "rated capacity limiter"
                                                       : "boom edits (the drive panel)";
-    snprintf(err, errsz, "%s: %s: the stepped %s engine for this crane chain (%d functions) has no %s yet", what,
-             m->file[0] ? m->file : "model", engine_backend_of(o)->name, m->chain.nfn, part);
+    char crane[64];
+    if (m->chain.two_link) snprintf(crane, sizeof crane, "the two-link crane in the general formulation");
+    else snprintf(crane, sizeof crane, "this crane chain (%d functions)", m->chain.nfn);
+    snprintf(err, errsz, "%s: %s: the stepped %s engine for %s has no %s yet", what, m->file[0] ? m->file : "model",
+             engine_backend_of(o)->name, crane, part);
     return -1;
 }
 
