@@ -160,21 +160,26 @@ double app_output_period(const sim_opts* o);
 /// With may_switch, no --world and no --mechanics other than ode given, o
 /// becomes ode on the sandbox (the same): the scenario runs in its world.
 /// Otherwise a run o cannot honour is refused: one line saying how to run
-/// it, EXIT_USAGE. Returns 0 when o runs it as written.
+/// it, EXIT_USAGE. Returns 0 when o runs it as written; also when o names
+/// (--mechanics) a backend without a world whose scripted runs slew the
+/// column by the model m's slew drive (engine_backend.slew_dof) and the
+/// scenario slews without hook events: the slew is then a degree of
+/// freedom of that run.
 /// drive's counterpart: the scenario is a scripted operator there, so a
 /// slew it commands in a world without one (lagrange, the validation world)
 /// is not refused but said, once, on stderr. world_kind: the kind of o's
 /// world where its backend has one (else not read). (Hook events are said
 /// as they happen.)
-void app_note_scenario_slew(const char* cmd, const sim_opts* o, const scenario* sc, int world_kind);
-int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
-                       bool* switched);
+void app_note_scenario_slew(const char* cmd, const sim_opts* o, const model* m, const scenario* sc,
+                            int world_kind);
+int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const model* m, const scenario* sc,
+                       bool may_switch, bool* switched);
 /// app_scenario_world with the advice after the refusal given by the caller
 /// (NULL: "run it with --mechanics ode --world sandbox"), for a command whose
 /// own options put the run where it is (compare's --backends); quiet: no
 /// note of a switch (compare says it once for both sides).
-int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
-                              bool* switched, const char* remedy, bool quiet);
+int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const model* m, const scenario* sc,
+                              bool may_switch, bool* switched, const char* remedy, bool quiet);
 
 /// Resolve a scenario argument: an existing file, or assets/scenarios/<name>.json.
 const char* app_scenario_path(const char* arg, char* buf, size_t n);

@@ -226,28 +226,34 @@ static const char* slew_use(const scenario* sc) {
 // What in a scenario needs the sandbox (NULL: nothing): the hook, the slew.
 static const char* sandbox_use(const scenario* sc) { return sc->nevent > 0 ? "works the hook" : slew_use(sc); }
 
-void app_note_scenario_slew(const char* cmd, const sim_opts* o, const scenario* sc, int world_kind) {
+void app_note_scenario_slew(const char* cmd, const sim_opts* o, const model* m, const scenario* sc,
+                            int world_kind) {
     const engine_backend* b = app_backend(o);
     const char* why = b->world && world_kind == WORLD_SANDBOX ? NULL : slew_use(sc);
     if (!why) return;
     const engine_backend* wb = engine_backend_with_world();
-    char crane[96], remedy[128] = "";
+    char crane[96], remedy[256] = "";
     if (b->world) snprintf(crane, sizeof crane, "validation world");
     else snprintf(crane, sizeof crane, "%s crane", b->crane);
+    // A backend whose scripted runs slew the model's drive (the slew as a
+    // degree of freedom) still drives a column that stands still.
+    const bool scripted = b->slew_dof && !b->world && m->chain.slew.present && sc->nevent == 0 &&
+                          scenario_commands(sc, "slew");
     if (wb)
-        snprintf(remedy, sizeof remedy, " (the %s has one: --mechanics %s --world %s)", wb->drive_world, wb->name,
-                 wb->drive_world);
-    fprintf(stderr, "cranesim %s: note: scenario %s %s, which the %s has not: its slew is ignored%s\n", cmd,
-            sc->name[0] ? sc->name : "the scenario", why, crane, remedy);
+        snprintf(remedy, sizeof remedy, " (the %s has one: --mechanics %s --world %s%s%s%s)", wb->drive_world,
+                 wb->name, wb->drive_world, scripted ? "; cranesim run --mechanics " : "", scripted ? b->name : "",
+                 scripted ? " slews it" : "");
+    fprintf(stderr, "cranesim %s: note: scenario %s %s, which the %s has not%s: its slew is ignored%s\n", cmd,
+            sc->name[0] ? sc->name : "the scenario", why, crane, scripted ? " when driven" : "", remedy);
 }
 
-int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
-                       bool* switched) {
-    return app_scenario_world_remedy(cmd, o, given, sc, may_switch, switched, NULL, false);
+int app_scenario_world(const char* cmd, sim_opts* o, unsigned given, const model* m, const scenario* sc,
+                       bool may_switch, bool* switched) {
+    return app_scenario_world_remedy(cmd, o, given, m, sc, may_switch, switched, NULL, false);
 }
 
-int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const scenario* sc, bool may_switch,
-                              bool* switched, const char* remedy, bool quiet) {
+int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, const model* m, const scenario* sc,
+                              bool may_switch, bool* switched, const char* remedy, bool quiet) {
     if (switched) *switched = false;
     const char* why = sandbox_use(sc);
     if (!why) return 0;
@@ -255,6 +261,14 @@ int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, cons
     const bool world_given = given & APP_GIVEN(APP_OPT_WORLD), mech_given = given & APP_GIVEN(APP_OPT_MECHANICS);
     char err[512];
     const engine_backend* b = app_backend(o);
+    // A backend without a world asked for by name (--mechanics) that slews
+    // the model's drive as a degree of freedom runs a scenario that only
+    // slews (no hook events) as it is: the column turns by the rack and the
+    // scenario's slew commands (decisions.d/slewdof.md). Without --mechanics
+    // the scenario still goes to its world (decision 51).
+    if (b->slew_dof && !b->world && mech_given && !world_given && sc->nevent == 0 && m && m->chain.slew.present &&
+        scenario_commands(sc, "slew"))
+        return 0;
     // The backend with a world: --world without --mechanics asks for it as
     // much as --mechanics naming it does.
     const engine_backend* wb = engine_backend_with_world();

@@ -406,7 +406,10 @@ int cmd_compare(int argc, char** argv) {
             snprintf(remedy, sizeof remedy, "run it with --mechanics %s --world %s", wb->name, wb->drive_world);
         const unsigned given =
             c.given | (pairs[0] || (!any_pair && !designs) ? APP_GIVEN(APP_OPT_MECHANICS) : 0u);
-        rc = app_scenario_world_remedy("compare", &side[s], given, &sc, true, &switched[s], remedy,
+        // No model: a slewing scenario stays refused or goes to the sandbox
+        // as before (compare's sides are the validation world's crane; the
+        // analytic slew is for run, sweep and optimize).
+        rc = app_scenario_world_remedy("compare", &side[s], given, NULL, &sc, true, &switched[s], remedy,
                                        s == 1 && switched[0]);
         if (!rc && switched[s]) rc = app_check_sim("compare", &side[s], given);
     }

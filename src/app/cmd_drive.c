@@ -218,7 +218,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (!c->scenario_path) c->scenario_path = app_default_drive_scenario(&c->sim);
     int rc = app_load(c, &m, &sc);
     if (rc) return rc;
-    app_note_scenario_slew("drive", &c->sim, &sc, kind);
+    app_note_scenario_slew("drive", &c->sim, m, &sc, kind);
     double duration = c->sim.duration > 0 ? c->sim.duration : sc.duration;
     // At most SIM_MAX_DURATION (the option is capped by app_parse_common, a
     // scenario's here) at <= 1000 frames/s: at most 1e9 frames, counted in a long.

@@ -468,7 +468,7 @@ int cmd_optimize(int argc, char** argv) {
     rc = app_load(&o.c, &o.base, &o.sc);
     if (rc) return rc;
     bool switched;
-    rc = app_scenario_world("optimize", &o.c.sim, o.c.given, &o.sc, true, &switched);
+    rc = app_scenario_world("optimize", &o.c.sim, o.c.given, o.base, &o.sc, true, &switched);
     if (!rc && switched) rc = app_check_sim("optimize", &o.c.sim, o.c.given);
     o.ncol = sim_ncol(&o.c.sim);
     // Every path must name a number in the model: a typo is bad input.

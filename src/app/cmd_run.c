@@ -143,7 +143,8 @@ typedef struct csv_sink {
     int ncol;
     /// A chain model's own columns (per actuator, function and degree of
     /// freedom), which its rows carry after the ncol base columns; NULL for
-    /// the two-link crane.
+    /// the two-link crane, unless the run slews it in the analytic mode
+    /// (then the run's chain, with the slew rack's columns, set by the run).
     const crane_chain* chain;
     int err;     ///< errno of the first failed open or write, 0 if none
     bool opened; ///< the file was created (as a temporary, renamed at the end)
@@ -372,7 +373,7 @@ int cmd_run(int argc, char** argv) {
     if (rc) return rc;
     // A sandbox scenario runs in the sandbox unless the options say otherwise.
     bool switched;
-    rc = app_scenario_world("run", &c.sim, c.given, &sc, true, &switched);
+    rc = app_scenario_world("run", &c.sim, c.given, m, &sc, true, &switched);
     if (!rc && switched) rc = app_check_sim("run", &c.sim, c.given);
     if (rc) {
         model_free(m);
@@ -437,7 +438,12 @@ int cmd_run(int argc, char** argv) {
     // signal kills at once (SA_RESETHAND).
     app_signals sig;
     app_signals_catch(&sig);
-    sim_run_energy(m, &sc, &c.sim, csv_row, &sink, NULL, c.quiet ? NULL : app_progress, NULL, en, &res);
+    // A run with columns of its own (the analytic mode's slewing run: the
+    // slew rack's) puts its chain in sink.chain before the first row.
+    const crane_chain* model_chain = sink.chain;
+    sim_run_energy_chain(m, &sc, &c.sim, csv_row, &sink, NULL, c.quiet ? NULL : app_progress, NULL, en, &sink.chain,
+                         &res);
+    sink.chain = model_chain; // the run's chain lives only until the run returns
     keep_flush(&sink.keep);
     metrics_finish(&sink.met, &res);
     metrics_energy(&sink.met, en);

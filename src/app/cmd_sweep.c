@@ -1127,7 +1127,7 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
     rc = app_load(&s.c, &s.base, &s.sc);
     if (rc) return rc;
     bool switched;
-    rc = app_scenario_world("sweep", &s.c.sim, s.c.given, &s.sc, true, &switched);
+    rc = app_scenario_world("sweep", &s.c.sim, s.c.given, s.base, &s.sc, true, &switched);
     if (!rc && switched) rc = app_check_sim("sweep", &s.c.sim, s.c.given);
     if (rc) {
         model_free(s.base);

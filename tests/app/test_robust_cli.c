@@ -243,7 +243,8 @@ static void test_scenario_world(void) {
     CHECK(n > 38 && fabs(v[0] - 1.5) < 1e-9 && fabs(v[38] - 0.25) < 1e-3, "%d columns, t %g, u3_cmd %g", n, v[0],
           n > 38 ? v[38] : NAN);
     const char* const refused[] = {
-        "run --quiet --scenario sandbox_wall --mechanics lagrange --out world.csv",
+        // The hook: the analytic crane has none (its slew it has, below).
+        "run --quiet --scenario sandbox_pick_place --mechanics lagrange --out world.csv",
         "run --quiet --scenario sandbox_pick_place --mechanics ode --world validation --out world.csv",
         "compare --quiet --scenario sandbox_wall --duration 0.1",
         // Side A is on the lagrange crane because of the default pair, not
@@ -291,6 +292,32 @@ static void test_scenario_world(void) {
         // designs the hook's sway.
         CHECK(cli_read_file("world.csv", buf, sizeof buf) > 0 && (strstr(buf, ",hook_z") || strstr(buf, ",max_hook_sway,")),
               "%s: no sandbox columns: %.200s", accepted[i], buf);
+    }
+    // A scenario that only slews, on --mechanics lagrange: the slew is a
+    // degree of freedom of the analytic mode (the model's slew drive); the
+    // rows carry the rack's, the slew function's and the slew's columns.
+    remove("world.csv");
+    rc = cli_run("run --quiet --scenario sandbox_wall --mechanics lagrange --duration 2 --out world.csv", out,
+                 sizeof out);
+    CHECK(rc == 0 && !strstr(out, "has not") && !strstr(out, "note: scenario"), "slew dof: exit %d: %s", rc, out);
+    CHECK(cli_read_file("world.csv", buf, sizeof buf) > 0 &&
+              strstr(buf, ",end_stop,x_slew,v_slew,pA_slew,pB_slew,F_slew,u_slew,ucmd_slew,q_column,qd_column\n"),
+          "slew dof: columns %.400s", buf);
+    {
+        // At t = 2 s the command (0.5 from 1 to 2 s) has turned the column.
+        const char* last = buf + strlen(buf) - 1;
+        while (last > buf && last[-1] != '\n') --last;
+        double v[64];
+        int n = 0;
+        for (const char* p = last; n < 64 && *p && *p != '\n';) {
+            char* e;
+            v[n++] = strtod(p, &e);
+            p = *e == ',' ? e + 1 : e;
+            if (*e != ',') break;
+        }
+        CHECK(n >= 9 && fabs(v[0] - 2.0) < 1e-9 && v[n - 2] > 0.01 && v[n - 3] == 0.5,
+              "slew dof: %d columns, t %g, slew %g rad, ucmd_slew %g", n, v[0], n > 2 ? v[n - 2] : NAN,
+              n > 3 ? v[n - 3] : NAN);
     }
     // Options that contradict it are still refused, saying which.
     rc = cli_run("run --quiet --scenario sandbox_pick_place --mechanics lagrange --world sandbox --out world.csv", out,

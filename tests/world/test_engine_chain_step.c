@@ -379,7 +379,8 @@ static void test_command_line(void) {
     } refuse[] = {
         {"drive --headless --mechanics lagrange --rcl on", "cranesim drive: --rcl on: "},
         {"drive --headless --mechanics lagrange --session never.json", "cranesim drive: --session: "},
-        {"drive --headless", "cranesim drive: --world sandbox: the sandbox runs the two-link crane only"},
+        {"drive --headless", "cranesim drive: --world sandbox: the stepped engine of a crane chain runs the validation "
+                             "world only"},
         {"serve --mechanics lagrange --listen 127.0.0.1:0", "cranesim serve: the serve protocol: "},
         {"serve --world validation --listen 127.0.0.1:0", "cranesim serve: the serve protocol: "},
     };

@@ -572,14 +572,16 @@ static void test_two_link_consumers_refuse(void) {
     err[0] = 0;
     CHECK(rcl_init(&r, m, NULL, err, sizeof err) == -1 && strstr(err, "rated capacity limiter handles"), "%s", err);
     // The command line: the valid chain model runs (test_ode_engine_chain),
-    // but not in the sandbox, whose crane is the two-link one: exit 2.
+    // in the sandbox too (test_ode_sandbox_chain), but not from a start that
+    // puts its tip in the ground (the default scenario's q1 = 100 deg,
+    // q2 = -110 deg with jib2 at mid-range): exit 2, one line.
     char args[1600], out[4096];
     snprintf(args, sizeof args, "run --model %s --mechanics ode --world sandbox --out %s/never.csv", CHAIN_3BOOM,
              out_dir());
     const int rc = cli_run(args, out, sizeof out);
     // (The scenario's load_mass note comes first, on its own line.)
-    const char* ref = strstr(out, "cranesim run: --world sandbox: the sandbox runs the two-link crane only; use "
-                                  "--world validation");
+    const char* ref = strstr(out, "cranesim run: initial pose q1 = 100.0 deg, q2 = -110.0 deg leaves no room for the "
+                                  "rope and hook");
     CHECK(rc == 2 && ref && cli_count_lines(ref) == 1, "cranesim run: exit %d: %s", rc, out);
     snprintf(args, sizeof args, "loadchart --model %s --out %s/never.csv", CHAIN_8FN, out_dir());
     const int rc2 = cli_run(args, out, sizeof out);

@@ -11,6 +11,7 @@
 #include "check.h"
 
 #include "model.h"
+#include "ode_chain.h"
 #include "ode_world.h"
 
 #include <math.h>
@@ -102,6 +103,54 @@ static void test_ode_error_sandbox(void) {
     world_desc_free(&d);
 }
 
+// The sandbox with a chain crane (ode_world_opts.chain, the chain hosted in
+// the world) whose truck ODE cannot step (1e308 kg): the step fails, and
+// the dead world's state is read without asking ODE about the chain's
+// bodies again (its hosted chain is marked dead with the world).
+static void test_ode_error_sandbox_chain(void) {
+    char err[512] = "";
+    model* m = model_load(CRANESIM_TESTDATA "/chain_3boom_ext.json", NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "model: %s", err);
+    static world_desc d;
+    if (!m || load_sandbox(&d)) {
+        CHECK(0, "model or sandbox world");
+        model_free(m);
+        return;
+    }
+    d.truck.mass = 1e308;
+    ode_world_opts o = ode_world_default_opts();
+    o.model_file = "chain_3boom_ext.json";
+    o.q0[0] = 155 * PI / 180, o.q0[1] = -95 * PI / 180;
+    o.circuit = m->hyd;
+    o.chain = &m->chain;
+    ode_world* w = ode_world_create(&m->mech, cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics"), &d, &o, err,
+                                    sizeof err);
+    if (!w) {
+        CHECK(strstr(err, "ODE failed") != NULL, "create: %s", err);
+    } else {
+        CHECK(ode_world_chain(w) != NULL, "the crane is not the chain");
+        int rc = 0;
+        for (int k = 0; k < 200 && rc == 0; ++k) rc = ode_world_step(w, ode_world_dt(w));
+        CHECK(rc == -1, "a 1e308 kg truck should fail the step");
+        printf("  %s\n", ode_world_error(w));
+        CHECK(strstr(ode_world_error(w), "ODE failed") || strstr(ode_world_error(w), "non-finite"), "%s",
+              ode_world_error(w));
+        ode_world_state s;
+        ode_world_get_state(w, &s);
+        CHECK(s.t == ode_world_time(w), "state time %g", s.t);
+        CHECK(ode_world_step(w, ode_world_dt(w)) == -1, "a dead world must stay stopped");
+        // The chain's readers answer NaN: its bodies are not asked.
+        double x = 0, tip[3] = {0, 0, 0};
+        ode_chain_slew_state(ode_world_chain(w), &x, NULL, NULL, NULL, NULL, NULL);
+        ode_chain_tip(ode_world_chain(w), tip, NULL);
+        CHECK(isnan(x) && isnan(tip[0]), "the dead chain read its bodies: slew rack %g m, tip x %g m", x, tip[0]);
+        ode_world_destroy(w);
+    }
+    d.truck.mass = 6500;
+    world_desc_free(&d);
+    model_free(m);
+}
+
 int main(int argc, char** argv) {
     char err[512];
     g_model = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
@@ -111,6 +160,7 @@ int main(int argc, char** argv) {
     }
     RUN_TEST(test_ode_error_in_step);
     RUN_TEST(test_ode_error_sandbox);
+    RUN_TEST(test_ode_error_sandbox_chain);
     model_free(g_model);
     TEST_MAIN_END();
 }

@@ -55,6 +55,12 @@ typedef struct engine_sink {
     /// (sim.h), which runs the analytic backend through the run layer: passed
     /// in here, so a backend needs nothing of the layer that chooses it.
     engine_probe_fn probe;
+    /// NULL, or where a run whose rows carry other chain columns than the
+    /// model's (model.chain.col) puts the chain they follow, before its
+    /// first row; it lives until the run returns. The analytic mode's
+    /// slewing run (engine_chain.h) adds the slew rack's columns. Untouched
+    /// by a run whose columns are the model's.
+    const crane_chain** run_chain;
 } engine_sink;
 
 #ifdef __cplusplus

@@ -286,6 +286,14 @@ int scenario_find_command(const scenario* s, const char* name) {
     return -1;
 }
 
+bool scenario_commands(const scenario* s, const char* name) {
+    const int k = scenario_find_command(s, name);
+    if (k < 0) return false;
+    for (int i = 0; i < s->cmd[k].n; ++i)
+        if (s->cmd[k].u[i] != 0.0) return true;
+    return false;
+}
+
 int scenario_breakpoints(const scenario* s, double* t, int cap) {
     int n = 0;
     for (int k = 0; k < scenario_ncmd(s); ++k)

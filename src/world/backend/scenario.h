@@ -3,6 +3,7 @@
 #ifndef SCENARIO_H
 #define SCENARIO_H
 
+#include <stdbool.h>
 #include <cjson/cJSON.h>
 #include <stddef.h>
 
@@ -75,6 +76,9 @@ extern const char* const scenario_cmd_name[SCENARIO_NCMD];
 /// 2 (every scenario has them, empty tables hold 0), the others as the file
 /// names them; -1 when the scenario has no such column.
 int scenario_find_command(const scenario* s, const char* name);
+/// True when the scenario commands function name: it has that column and a
+/// command in it is not 0.
+bool scenario_commands(const scenario* s, const char* name);
 /// Columns in s->cmd (at least SCENARIO_NCMD).
 int scenario_ncmd(const scenario* s);
 

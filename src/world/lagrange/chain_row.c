@@ -18,13 +18,16 @@ void chain_sim_row(chain_sim* cs, double t, const double* y, chain_sim_out* co, 
     chain_sim_outputs(cs, t, y, co);
     lsim_out o;
     memset(&o, 0, sizeof o);
-    for (int k = 0; k < 2 && k < cs->nact; ++k) {
+    // The chain's actuators only: the slew rack of a slewing run (index
+    // cc->nact) has its own columns (crane_chain_row).
+    for (int k = 0; k < 2 && k < cs->cc->nact; ++k) {
         o.x[k] = co->x[k], o.v[k] = co->v[k], o.pA[k] = co->pA[k], o.pB[k] = co->pB[k], o.F[k] = co->F[k];
         const int f = cs->cc->act[k].function;
         o.u[k] = co->u[f], o.u_cmd[k] = co->u_cmd[f];
         if (cs->hd->cyl_stop[cs->cc->act[k].cyl]) o.end_stop |= 1 << k;
     }
     const int d0 = cs->cc->slew_free ? 1 : 0;
+    // (The rack's lever arm is 0 on every DOF but the slew's: no share here.)
     for (int k = 0; k < 2 && d0 + k < cs->ndof; ++k) {
         o.q[k] = co->q[d0 + k], o.qd[k] = co->qd[d0 + k];
         // tau of the joint: sum over the actuators of F dL/dq.

@@ -9,6 +9,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 // The pressure state of the hose feeding chamber state ic, or -1 when no
 // hose ends at that chamber (as lagrange_sim.c: by the circuit's
 // connections, not by names).
@@ -25,7 +29,41 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     s->m3 = m3;
     s->nact = cc->nact;
     s->nfn = cc->nfn;
+    s->rack = s->rack_fn = -1;
     const int ncyl = hyd_model_ncylinder(hm), nvalve = hyd_model_nvalve(hm);
+    // The slew drive's rack: an actuator and a function more, after the
+    // chain's (chain_sim.h). Its parts by name in hm, the circuit with
+    // hydraulics_slew appended.
+    int rack_cyl = -1, rack_valve = -1;
+    if (cc->slew_free && cc->slew.present) {
+        rack_cyl = hyd_model_cylinder(hm, cc->slew.cylinder);
+        rack_valve = hyd_model_valve(hm, cc->slew.valve);
+        if (rack_cyl < 0 || rack_valve < 0) {
+            snprintf(err, errsz, "mechanics.slew.%s: no %s '%s' in the run's circuit (the model's hydraulics with "
+                     "hydraulics_slew appended)", rack_cyl < 0 ? "cylinder" : "valve",
+                     rack_cyl < 0 ? "cylinder" : "valve", rack_cyl < 0 ? cc->slew.cylinder : cc->slew.valve);
+            return -1;
+        }
+        // The rack's function is "slew" (the scenario's command column):
+        // a chain function of that name would be a second slew.
+        if (crane_chain_find_function(cc, "slew") >= 0) {
+            snprintf(err, errsz, "mechanics.functions: a function is named \"slew\", the name of the slew drive's "
+                     "function (mechanics.slew)");
+            return -1;
+        }
+        for (int k = 0; k < cc->nact; ++k)
+            if (cc->act[k].cyl == rack_cyl || !strcmp(cc->act[k].valve, cc->slew.valve)) {
+                snprintf(err, errsz, "mechanics.slew: its %s is also actuator '%s''s",
+                         cc->act[k].cyl == rack_cyl ? "cylinder" : "valve", cc->act[k].name);
+                return -1;
+            }
+        s->rack = s->nact++;
+        s->rack_fn = s->nfn++;
+        s->rack_r = cc->slew.pinion_radius;
+        s->slew_c = cc->slew.damping;
+        double AA, AB;
+        hyd_model_cylinder_geometry(hm, rack_cyl, &AA, &AB, &s->rack_stroke);
+    }
     // Bound and one actuator per cylinder: two actuators writing one
     // cylinder's stroke would silently keep only the last.
     for (int k = 0; k < cc->nact; ++k) {
@@ -55,6 +93,12 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     s->ch = crane_chain_mechanism(cc, m3, cc->slew_free, slew, err, errsz);
     if (!s->ch) return -1;
     s->ndof = chain_ndof(s->ch);
+    // The rack turns DOF 0, the column's (its joint is the chain's first).
+    if (s->rack >= 0 && !(s->ndof > 0 && chain_dof_body(s->ch, 0) == 0)) {
+        snprintf(err, errsz, "mechanics.slew: the column does not slew in this mechanism");
+        chain_sim_free(s);
+        return -1;
+    }
     s->nh = hyd_model_nstate(hm);
     s->iq = s->nh;
     s->n = s->nh + 2 * s->ndof;
@@ -71,8 +115,9 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     s->jh = calloc((size_t)s->nh * (size_t)s->nh + (size_t)s->nh + 1, sizeof *s->jh);
     s->L = calloc(2 * na + 2 * na * nd + 1, sizeof(double));
     s->tau = calloc(10 * nd + 3 * nd * nd + (size_t)s->nh + 1, sizeof(double));
+    s->acyl = calloc(2 * na + (size_t)s->nfn + 1, sizeof *s->acyl);
     if (!s->ws || !s->hd || !s->cmd || !s->iu || !s->ipA || !s->ipB || !s->is_pressure || !s->L || !s->tau || !s->perm ||
-        !s->block || !s->jh) {
+        !s->block || !s->jh || !s->acyl) {
         snprintf(err, errsz, "out of memory");
         chain_sim_free(s);
         return -1;
@@ -89,6 +134,14 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     s->ydot = s->H + 3 * nd * nd; // n = nh + 2 nd: a whole f for the outputs
     s->hpos = s->perm + s->nh;
     s->yh = s->jh + (size_t)s->nh * (size_t)s->nh;
+    s->afn = s->acyl + na;
+    s->fvalve = s->afn + na;
+    for (int k = 0; k < cc->nact; ++k) s->acyl[k] = cc->act[k].cyl, s->afn[k] = cc->act[k].function;
+    for (int f = 0; f < cc->nfn; ++f) s->fvalve[f] = cc->fn[f].valve_idx;
+    if (s->rack >= 0) {
+        s->acyl[s->rack] = rack_cyl, s->afn[s->rack] = s->rack_fn;
+        s->fvalve[s->rack_fn] = rack_valve;
+    }
     // The block order (as lagrange_sim.c's for the standard circuit): per
     // actuator its valve's spool, then [hose, chamber] on each side; the
     // other circuit states after, each its own block.
@@ -101,8 +154,8 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     int o = 0;
     for (int k = 0; k < s->nact; ++k) {
         int iA, iB;
-        hyd_model_cylinder_states(hm, cc->act[k].cyl, &iA, &iB);
-        const int iu = hyd_model_valve_state(hm, cc->fn[cc->act[k].function].valve_idx);
+        hyd_model_cylinder_states(hm, s->acyl[k], &iA, &iB);
+        const int iu = hyd_model_valve_state(hm, s->fvalve[s->afn[k]]);
         if (iu >= 0 && !used[iu]) used[iu] = true, s->perm[o++] = iu, s->block[s->nblock++] = 1;
         const int side[2] = {iA, iB};
         for (int e = 0; e < 2; ++e) {
@@ -119,12 +172,12 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     if (s->ndof > 0) s->block[s->nblock++] = 2 * s->ndof;
     for (int i = 0; i < s->nh; ++i) s->hpos[s->perm[i]] = i;
     for (int f = 0; f < s->nfn; ++f) {
-        const int iu = hyd_model_valve_state(hm, cc->fn[f].valve_idx);
+        const int iu = hyd_model_valve_state(hm, s->fvalve[f]);
         s->iu[f] = iu >= 0 ? s->hpos[iu] : -1;
     }
     for (int k = 0; k < s->nact; ++k) {
         int iA, iB;
-        hyd_model_cylinder_states(hm, cc->act[k].cyl, &iA, &iB);
+        hyd_model_cylinder_states(hm, s->acyl[k], &iA, &iB);
         s->ipA[k] = s->hpos[iA], s->ipB[k] = s->hpos[iB];
     }
     for (int i = 0; i < s->nh; ++i) s->is_pressure[i] = hyd_model_state_kind(hm, s->perm[i]) == HYD_STATE_PRESSURE;
@@ -145,12 +198,31 @@ void chain_sim_free(chain_sim* s) {
     free(s->jh);
     free(s->L);
     free(s->tau);
+    free(s->acyl);
     memset(s, 0, sizeof *s);
 }
 
 static double command(const chain_sim* s, int k, double t) {
     const double u = s->cmd_fn ? s->cmd_fn(s->cmd_user, k, t) : s->cmd[k];
     return u < -1.0 ? -1.0 : u > 1.0 ? 1.0 : u;
+}
+
+// The slew rack (chain_sim.rack): its "pin length" is its stroke x = r
+// theta + s/2 [m] (crane_slew_stroke), its rate r theta' [m/s], its lever
+// arm dx/dq = r on DOF 0 (the column's) and 0 elsewhere, d(x')/dq = 0 (the
+// rate does not depend on the pose).
+static void rack_kinematics(chain_sim* s, const double* y, bool jac) {
+    const int nd = s->ndof, k = s->rack;
+    const double th = y[s->iq], thd = y[s->iq + nd];
+    double* r = s->dL + (size_t)k * nd;
+    for (int i = 0; i < nd; ++i) r[i] = 0.0;
+    r[0] = s->rack_r;
+    if (jac)
+        for (int i = 0; i < nd; ++i) s->dLd[(size_t)k * nd + i] = 0.0;
+    s->L[k] = s->rack_r * th + 0.5 * s->rack_stroke;
+    s->Ld[k] = s->rack_r * thd;
+    s->hd->cyl_x[s->acyl[k]] = s->L[k];
+    s->hd->cyl_v[s->acyl[k]] = s->Ld[k];
 }
 
 // Shared by rhs and Jacobian: the kinematics at (q, q'), every actuator's
@@ -161,33 +233,37 @@ static void prepare(chain_sim* s, double t, const double* y, bool jac) {
     const int nd = s->ndof;
     chain_update(s->ch, s->ws, y + s->iq, y + s->iq + nd);
     hyd_data* d = s->hd;
-    for (int k = 0; k < s->nact; ++k) {
+    for (int k = 0; k < cc->nact; ++k) {
         const crane_act* a = &cc->act[k];
         s->L[k] = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, &s->Ld[k], s->dL + (size_t)k * nd,
                                  jac ? s->dLd + (size_t)k * nd : NULL);
         d->cyl_x[a->cyl] = s->L[k] - a->closed_length;
         d->cyl_v[a->cyl] = s->Ld[k];
     }
-    for (int f = 0; f < s->nfn; ++f) d->valve_cmd[cc->fn[f].valve_idx] = command(s, f, t);
+    if (s->rack >= 0) rack_kinematics(s, y, jac);
+    for (int f = 0; f < s->nfn; ++f) d->valve_cmd[s->fvalve[f]] = command(s, f, t);
 }
 
 // The ideal forces of the energy tests (chain_sim.ideal_F) into cyl_F.
 static void ideal_forces(chain_sim* s) {
     for (int k = 0; k < s->nact; ++k) {
-        const int c = s->cc->act[k].cyl;
+        const int c = s->acyl[k];
         s->hd->cyl_F[c] = s->ideal_F[k] - (s->ideal_K ? s->ideal_K[k] * s->hd->cyl_x[c] : 0.0);
     }
 }
 
-// tau = sum_k F_k dL_k/dq [N m or N] from the circuit's last forces.
-static void joint_forces(chain_sim* s) {
+// tau = sum_k F_k dL_k/dq [N m or N] from the circuit's last forces (the
+// rack's F r on the column among them), and the slewing ring's damping -c
+// theta' [N m] at the rates qd.
+static void joint_forces(chain_sim* s, const double* qd) {
     const int nd = s->ndof;
     for (int i = 0; i < nd; ++i) s->tau[i] = 0.0;
     for (int k = 0; k < s->nact; ++k) {
-        const double F = s->hd->cyl_F[s->cc->act[k].cyl];
+        const double F = s->hd->cyl_F[s->acyl[k]];
         const double* r = s->dL + (size_t)k * nd;
         for (int i = 0; i < nd; ++i) s->tau[i] += F * r[i];
     }
+    if (s->rack >= 0) s->tau[0] -= s->slew_c * qd[0];
 }
 
 int chain_sim_rhs(void* user, double t, const double* y, double* dydt) {
@@ -201,8 +277,8 @@ int chain_sim_rhs(void* user, double t, const double* y, double* dydt) {
     } else {
         hyd_eval_mapped(s->hm, s->hd, t, y, dydt, s->hpos);
     }
-    joint_forces(s);
     const double* qd = y + iq + nd;
+    joint_forces(s, qd);
     for (int i = 0; i < nd; ++i) dydt[iq + i] = qd[i];
     // M not positive definite (a body of no mass on a DOF): no finite q''.
     if (chain_forward_dynamics(s->ch, s->ws, s->tau, dydt + iq + nd)) return 1;
@@ -248,7 +324,7 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
         memset(d->dFdx, 0, nc * sizeof *d->dFdx);
         memset(d->dFdv, 0, nc * sizeof *d->dFdv);
         ideal_forces(s);
-        for (int k = 0; k < s->nact; ++k) d->dFdx[cc->act[k].cyl] = s->ideal_K ? -s->ideal_K[k] : 0.0;
+        for (int k = 0; k < s->nact; ++k) d->dFdx[s->acyl[k]] = s->ideal_K ? -s->ideal_K[k] : 0.0;
     } else {
         // In the circuit's order, then permuted into the system's.
         for (int h = 0; h < nh; ++h) s->yh[h] = y[s->hpos[h]];
@@ -259,15 +335,14 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
             for (int j = 0; j < nh; ++j) row[j] = src[s->perm[j]];
         }
     }
-    joint_forces(s);
-    if (chain_forward_dynamics(s->ch, s->ws, s->tau, s->qdd)) return 1;
     const double* qd = y + iq + nd;
+    joint_forces(s, qd);
+    if (chain_forward_dynamics(s->ch, s->ws, s->tau, s->qdd)) return 1;
     double* dtq = s->H + (size_t)nd * nd;  // d tau / dq
     double* dtqd = dtq + (size_t)nd * nd;  // d tau / dq'
     memset(dtq, 0, 2 * (size_t)nd * nd * sizeof *dtq);
     for (int k = 0; k < s->nact; ++k) {
-        const crane_act* a = &cc->act[k];
-        const int c = a->cyl;
+        const int c = s->acyl[k];
         const double* r = s->dL + (size_t)k * nd;
         const double* rd = s->dLd + (size_t)k * nd;
         const double* dydx = d->dydx + (size_t)c * nh;
@@ -284,13 +359,20 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
         }
         // tau's partials through F(x, v) and the lever arms' Hessian.
         const double F = d->cyl_F[c], Fx = d->dFdx[c], Fv = d->dFdv[c];
-        chain_cylinder_hessian(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, s->H);
+        // The rack's lever arm r is constant: no Hessian.
+        if (k == s->rack) {
+            memset(s->H, 0, (size_t)nd * nd * sizeof *s->H);
+        } else {
+            const crane_act* a = &cc->act[k];
+            chain_cylinder_hessian(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, s->H);
+        }
         for (int i = 0; i < nd; ++i)
             for (int j = 0; j < nd; ++j) {
                 dtq[i * nd + j] += F * s->H[i * nd + j] + r[i] * (Fx * r[j] + Fv * rd[j]);
                 dtqd[i * nd + j] += r[i] * Fv * r[j];
             }
     }
+    if (s->rack >= 0) dtqd[0] -= s->slew_c; // the ring's damping -c theta'
     for (int i = 0; i < nd; ++i) J[(size_t)(iq + i) * n + iq + nd + i] = 1.0;
     // The mechanics' rows: d q''/dz = M^-1 (d tau/dz - d ID/dz at fixed q'').
     // The kinematics are perturbed by id_partial and restored after; the
@@ -314,7 +396,7 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
         bool any = false;
         for (int i = 0; i < nd; ++i) b[i] = 0.0;
         for (int k = 0; k < s->nact; ++k) {
-            const double dF = d->dFdy[(size_t)cc->act[k].cyl * nh + m];
+            const double dF = d->dFdy[(size_t)s->acyl[k] * nh + m];
             if (dF == 0.0) continue;
             any = true;
             const double* r = s->dL + (size_t)k * nd;
@@ -360,7 +442,7 @@ hyd_problem chain_sim_problem(chain_sim* s, bool blocks) {
 
 int chain_sim_check_pose(chain_sim* s, const double* q0, char* err, size_t errsz) {
     chain_update(s->ch, s->ws, q0, NULL);
-    for (int k = 0; k < s->nact; ++k) {
+    for (int k = 0; k < s->cc->nact; ++k) {
         const crane_act* a = &s->cc->act[k];
         const double x = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, NULL, NULL, NULL) -
                          a->closed_length;
@@ -370,6 +452,17 @@ int chain_sim_check_pose(chain_sim* s, const double* q0, char* err, size_t errsz
             snprintf(err, errsz,
                      "start pose: actuator '%s' (cylinder '%s') would need a stroke of %.4f m, outside [0, %.4f] m",
                      a->name, a->cylinder, x, a->stroke);
+            return -1;
+        }
+    }
+    if (s->rack >= 0) {
+        const double x = s->rack_r * q0[0] + 0.5 * s->rack_stroke;
+        if (!(x >= -1e-9 && x <= s->rack_stroke + 1e-9)) {
+            const double lim = 0.5 * s->rack_stroke / s->rack_r * 180.0 / M_PI;
+            snprintf(err, errsz,
+                     "start pose: slew %.1f deg needs a slew rack ('%s') stroke of %.4f m, outside [0, %.4f] m "
+                     "(slew within +-%.1f deg)",
+                     q0[0] * 180.0 / M_PI, s->cc->slew.cylinder, x, s->rack_stroke, lim);
             return -1;
         }
     }
@@ -418,10 +511,11 @@ int chain_sim_initial_state(chain_sim* s, const double* q0, double p_low, double
     chain_update(s->ch, s->ws, q0, NULL);
     double* G = s->id0;
     chain_inverse_dynamics(s->ch, s->ws, NULL, CHAIN_GRAVITY, G);
-    for (int k = 0; k < na; ++k) {
+    for (int k = 0; k < s->cc->nact; ++k) {
         const crane_act* a = &s->cc->act[k];
         chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, NULL, s->dL + (size_t)k * nd, NULL);
     }
+    if (s->rack >= 0) rack_kinematics(s, y, false);
     // The DOFs some actuator moves (a lever arm above 1e-12 of the largest)
     // take the square system; the others must carry no gravity load.
     double gmax = 0.0, amax = 0.0;
@@ -466,9 +560,10 @@ int chain_sim_initial_state(chain_sim* s, const double* q0, double p_low, double
     for (int k = 0; k < na; ++k) {
         // Static balance with the unloaded chamber at p_low (as lsim_initial_state).
         double AA, AB, st;
-        hyd_model_cylinder_geometry(hm, s->cc->act[k].cyl, &AA, &AB, &st);
+        hyd_model_cylinder_geometry(hm, s->acyl[k], &AA, &AB, &st);
         double pA = p_low, pB = p_low;
-        if (F[k] >= 0) pA = (F[k] + p_low * AB) / AA;
+        if (k == s->rack) pB = p_low * AA / AB; // no force, as the ODE sandbox starts it (ode_coupling.c)
+        else if (F[k] >= 0) pA = (F[k] + p_low * AB) / AA;
         else pB = (p_low * AA - F[k]) / AB;
         y[s->ipA[k]] = pA;
         y[s->ipB[k]] = pB;
@@ -491,7 +586,7 @@ void chain_sim_outputs(chain_sim* s, double t, const double* y, chain_sim_out* o
     --s->nrhs; // an output evaluation is not solver work
     const hyd_data* d = s->hd;
     for (int k = 0; k < s->nact; ++k) {
-        const int c = s->cc->act[k].cyl;
+        const int c = s->acyl[k];
         if (o->x) o->x[k] = d->cyl_x[c];
         if (o->v) o->v[k] = d->cyl_v[c];
         if (o->pA) o->pA[k] = y[s->ipA[k]];
@@ -500,7 +595,7 @@ void chain_sim_outputs(chain_sim* s, double t, const double* y, chain_sim_out* o
     }
     for (int f = 0; f < s->nfn; ++f) {
         if (o->u) o->u[f] = s->iu[f] >= 0 ? y[s->iu[f]] : 0.0;
-        if (o->u_cmd) o->u_cmd[f] = d->valve_cmd[s->cc->fn[f].valve_idx];
+        if (o->u_cmd) o->u_cmd[f] = d->valve_cmd[s->fvalve[f]];
     }
     for (int i = 0; i < nd; ++i) {
         if (o->q) o->q[i] = y[s->iq + i];
@@ -517,4 +612,20 @@ void chain_sim_outputs(chain_sim* s, double t, const double* y, chain_sim_out* o
 double chain_sim_energy(chain_sim* s, const double* y) {
     chain_update(s->ch, s->ws, y + s->iq, y + s->iq + s->ndof);
     return chain_kinetic_energy(s->ch, s->ws) + chain_potential_energy(s->ch, s->ws);
+}
+
+const char* chain_sim_function_name(const chain_sim* s, int k) {
+    if (k >= 0 && k < s->cc->nfn) return s->cc->fn[k].name;
+    return k >= 0 && k == s->rack_fn ? "slew" : NULL;
+}
+
+const char* chain_sim_actuator_name(const chain_sim* s, int k) {
+    if (k >= 0 && k < s->cc->nact) return s->cc->act[k].name;
+    return k >= 0 && k == s->rack ? "slew" : NULL;
+}
+
+double chain_sim_slew_damping_power(const chain_sim* s, const double* y) {
+    if (s->rack < 0) return 0.0;
+    const double w = y[s->iq + s->ndof];
+    return s->slew_c * w * w;
 }

@@ -16,6 +16,18 @@
 // (hyd_eval); the joint forces tau = sum_k F_k dL_k/dq; and
 // q'' = M^-1 (tau - C - G) by CRBA, RNEA and Cholesky
 // (chain_forward_dynamics). Sizes come from the chain: no fixed maximum.
+//
+// The slew drive (docs/lagrange.md, "The slew as a degree of freedom"):
+// when the column slews (cc->slew_free) and the model has a slew drive
+// (cc->slew.present), the drive's rack is one more actuator, the last
+// (index cc->nact), on the slew DOF (DOF 0): stroke x = r theta + s/2 and
+// rate r theta' (crane_slew_stroke), lever arm dx/dtheta = r, so its force F
+// is the torque F r (crane_slew_torque) on the column; the slewing ring's
+// viscous damping c adds -c theta'. Its valve is one more function, the
+// last (index cc->nfn), named "slew". Its cylinder and valve are looked up
+// by name in hm, which must then be the model's circuit with
+// hydraulics_slew appended (engine_chain_slew_setup). Without a drive
+// (chain_sim.rack < 0) nact and nfn are the chain's.
 #ifndef CHAIN_SIM_H
 #define CHAIN_SIM_H
 
@@ -48,7 +60,7 @@ typedef struct chain_sim {
     int ndof;               ///< degrees of freedom (q = y[iq ..], q' = y[iq + ndof ..])
     int n;                  ///< all states
     int iq;                 ///< index of q[0] (= nh)
-    int nact, nfn;
+    int nact, nfn;          ///< actuators and functions: the chain's, plus the slew rack and its function
     double* cmd;            ///< [nfn] the functions' commands when cmd_fn is NULL [-]
     chain_sim_cmd_fn cmd_fn;
     void* cmd_user;
@@ -77,12 +89,24 @@ typedef struct chain_sim {
     // right-hand side with its solution [2 ndof each]; a Hessian, d tau/dq,
     // d tau/dq' [ndof x ndof each]; a whole f [n].
     double *tau, *qdd, *g, *H, *id0, *id1, *qp, *ydot;
+    // The actuators' and functions' binding to the circuit, the chain's
+    // followed by the slew rack's (when rack >= 0).
+    int* acyl;              ///< [nact] circuit cylinder of actuator k
+    int* afn;               ///< [nact] function of actuator k
+    int* fvalve;            ///< [nfn] circuit valve of function k
+    int rack;               ///< the slew rack's actuator index (= cc->nact), or -1: no slew drive
+    int rack_fn;            ///< its function's index (= cc->nfn), or -1
+    double rack_r;          ///< pinion radius [m]
+    double rack_stroke;     ///< rack cylinder's full stroke [m]
+    double slew_c;          ///< slewing-ring viscous damping [N m s/rad]
 } chain_sim;
 
 /// Set up for chain cc (bound to circuit hm by crane_chain_bind) with a tip
 /// load m3 [kg] at the chain's tip; the column slews when cc->slew_free, else
-/// it is fixed at slew [rad]. Refuses (-1, one line in err) a chain whose
-/// actuators share a cylinder, or an actuator or function not bound.
+/// it is fixed at slew [rad]; with slew_free and a slew drive
+/// (cc->slew.present) the rack drives it (see above). Refuses (-1, one line
+/// in err) a chain whose actuators share a cylinder, an actuator or function
+/// not bound, or a slew drive whose cylinder or valve hm lacks.
 int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, double m3, double slew, char* err,
                    size_t errsz);
 void chain_sim_free(chain_sim* s);
@@ -102,7 +126,8 @@ int chain_sim_rhs(void* user, double t, const double* y, double* dydt);
 int chain_sim_jac(void* user, double t, const double* y, double* J);
 
 /// Returns 0 when every actuator's stroke at q0 [ndof] is within [0, its
-/// stroke], else -1 with one line naming the actuator, its stroke and range.
+/// stroke] (the slew rack's too), else -1 with one line naming the actuator,
+/// its stroke and range.
 int chain_sim_check_pose(chain_sim* s, const double* q0, char* err, size_t errsz);
 
 /// Initial state at q0 [ndof], at rest, with the chamber pressures that hold
@@ -110,7 +135,9 @@ int chain_sim_check_pose(chain_sim* s, const double* q0, char* err, size_t errsz
 /// [Pa abs]) and the other circuit states at their initial values. The
 /// actuators' forces F solve sum_k F_k dL_k/dq = G (the gravity forces):
 /// with as many actuators as the DOFs gravity loads, that square system; a
-/// DOF no actuator moves (the slew) must carry no gravity load. Returns 0,
+/// DOF no actuator moves (the slew) must carry no gravity load. The slew
+/// rack carries none either: its chambers start as the ODE sandbox's, A at
+/// p_low and B at p_low A_A / A_B (no force). Returns 0,
 /// or -1 with one line in err when there is no such F (more actuators than
 /// loaded DOFs, a loaded DOF without an actuator, a singular system).
 int chain_sim_initial_state(chain_sim* s, const double* q0, double p_low, double* y, char* err, size_t errsz);
@@ -134,6 +161,15 @@ void chain_sim_outputs(chain_sim* s, double t, const double* y, chain_sim_out* o
 
 /// Mechanical energy (kinetic + potential from the base origin) at y [J].
 double chain_sim_energy(chain_sim* s, const double* y);
+
+/// The name of function k (0 .. nfn - 1): the chain's, or "slew" for the
+/// slew rack's; the name of actuator k likewise.
+const char* chain_sim_function_name(const chain_sim* s, int k);
+const char* chain_sim_actuator_name(const chain_sim* s, int k);
+
+/// Power dissipated in the slewing ring's damping at y [W] (0 without a
+/// slew drive): c theta'^2.
+double chain_sim_slew_damping_power(const chain_sim* s, const double* y);
 
 #ifdef __cplusplus
 }

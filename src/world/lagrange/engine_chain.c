@@ -17,6 +17,64 @@ void engine_chain_start_pose(const crane_chain* cc, const scenario* sc, double* 
     crane_chain_start_pose(cc, sc->q0, sc->slew0, q0);
 }
 
+bool engine_chain_slews(const model* m, const scenario* sc) {
+    return m->chain.slew.present && scenario_commands(sc, "slew");
+}
+
+int engine_chain_slew_setup(const model* m, crane_chain* cc, hyd_model** hm, char* err, size_t errsz) {
+    memset(cc, 0, sizeof *cc);
+    *hm = NULL;
+    const char* file = m->file[0] ? m->file : "model";
+    const cJSON* h = m->json ? cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics") : NULL;
+    const cJSON* frag = m->json ? cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics_slew") : NULL;
+    if (!m->chain.slew.present || !h || !frag) {
+        snprintf(err, errsz, "%s: mechanics.slew: the model has no slew drive (mechanics.slew and hydraulics_slew)",
+                 file);
+        return -1;
+    }
+    // A scenario's hose bursts at nodes of the slew's circuit (engine_fault_model
+    // left them in world_bursts) open there, as in the sandbox (ode_run.c):
+    // their orifices join the fragment; a node it lacks too is refused.
+    if (engine_world_bursts(m, frag, "its hydraulics_slew", err, errsz)) return -1;
+    cJSON* fx = NULL;
+    if (m->world_bursts) {
+        fx = cJSON_Duplicate(frag, 1);
+        cJSON* comps = fx ? cJSON_GetObjectItemCaseSensitive(fx, "components") : NULL;
+        if (!cJSON_IsArray(comps)) {
+            snprintf(err, errsz, "out of memory");
+            cJSON_Delete(fx);
+            return -1;
+        }
+        const cJSON* o;
+        cJSON_ArrayForEach(o, m->world_bursts) cJSON_AddItemToArray(comps, cJSON_Duplicate(o, 1));
+        frag = fx;
+    }
+    // The circuit as the sandbox compiles it (model_slew_check checked it
+    // at load), from the document with the run's overrides.
+    *hm = model_circuit_with_fragment(h, file, frag, file, "hydraulics_slew", err, errsz);
+    cJSON_Delete(fx);
+    if (!*hm) return -1;
+    if (crane_chain_copy(cc, &m->chain)) {
+        snprintf(err, errsz, "out of memory");
+        hyd_model_free(*hm);
+        *hm = NULL;
+        return -1;
+    }
+    cc->slew_free = true;
+    cc->slew_rack_columns = true; // chain_sim's outputs have the rack last
+    // Bound anew: the indices are the merged circuit's; the columns gain
+    // the rack's (crane_chain_columns).
+    char e[300];
+    if (crane_chain_bind(cc, *hm, e, sizeof e)) {
+        snprintf(err, errsz, "%s: %s", file, e);
+        crane_chain_free(cc);
+        hyd_model_free(*hm);
+        *hm = NULL;
+        return -1;
+    }
+    return 0;
+}
+
 typedef struct chain_run_ctx {
     chain_sim* cs;
     const scenario* sc;
@@ -52,7 +110,7 @@ static void make_row(chain_run_ctx* c, double t, const double* y, double* row) {
 
 static void track_peaks(chain_run_ctx* c, const double* y) {
     const chain_sim* cs = c->cs;
-    for (int k = 0; k < 2 && k < cs->nact; ++k) {
+    for (int k = 0; k < 2 && k < cs->cc->nact; ++k) {
         c->peak[2 * k] = fmax(c->peak[2 * k], y[cs->ipA[k]]);
         c->peak[2 * k + 1] = fmax(c->peak[2 * k + 1], y[cs->ipB[k]]);
     }
@@ -104,25 +162,47 @@ static int emit(void* user, double t, const double* y) {
 int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
     char* msg = res->message;
     const size_t msz = sizeof res->message;
+    // A slewing run (the slew a degree of freedom, driven by the model's
+    // slew drive): the model's chain with the rack, on the model's circuit
+    // with hydraulics_slew appended.
+    const bool slews = engine_chain_slews(m, sc);
     if (o->variant == LAGRANGE_PAPER || o->variant == LAGRANGE_PAPER_TYPO) {
-        snprintf(msg, msz,
-                 "--variant %s: the paper's equations are for the two-link crane only; this run takes the general "
-                 "formulation (full or general)",
-                 lagrange_variant_name(o->variant));
+        if (slews && m->chain.two_link)
+            snprintf(msg, msz,
+                     "--variant %s: the paper's equations are for the planar two-link crane; scenario %s slews it, "
+                     "which takes the general formulation (full or general)",
+                     lagrange_variant_name(o->variant), sc->name[0] ? sc->name : "the scenario");
+        else
+            snprintf(msg, msz,
+                     "--variant %s: the paper's equations are for the two-link crane only; this run takes the "
+                     "general formulation (full or general)",
+                     lagrange_variant_name(o->variant));
         return res->status = SIM_REFUSED;
     }
     if (o->cvode) {
         snprintf(msg, msz, "--solver cvode: the general analytic mode runs the in-house solvers");
         return res->status = SIM_REFUSED;
     }
-    if (engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
+    // (A slewing run checks the bursts against the slew's circuit, which it appends.)
+    if (!slews && engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
     const double m3 = sim_load_mass(m, sc, o);
+    crane_chain slew_cc;
+    hyd_model* slew_hm = NULL;
+    const crane_chain* cc = &m->chain;
+    hyd_model* hm = m->hyd;
+    if (slews) {
+        if (engine_chain_slew_setup(m, &slew_cc, &slew_hm, msg, msz)) return res->status = SIM_REFUSED;
+        cc = &slew_cc, hm = slew_hm;
+    }
     chain_sim cs;
-    if (chain_sim_init(&cs, &m->chain, m->hyd, m3, sc->slew0, msg, msz)) return res->status = SIM_REFUSED;
+    if (chain_sim_init(&cs, cc, hm, m3, sc->slew0, msg, msz)) {
+        if (slews) crane_chain_free(&slew_cc), hyd_model_free(slew_hm);
+        return res->status = SIM_REFUSED;
+    }
     const int nd = cs.ndof, na = cs.nact, nf = cs.nfn;
     chain_run_ctx c;
     memset(&c, 0, sizeof c);
-    const size_t nrow = (size_t)chain_row_size(&m->chain);
+    const size_t nrow = (size_t)chain_row_size(cc);
     double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + nrow + 1, sizeof *buf);
     c.fcol = calloc((size_t)nf + 1, sizeof *c.fcol);
     hyd_solver* s = NULL;
@@ -136,18 +216,21 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     c.x = q0 + nd, c.v = c.x + na, c.pA = c.v + na, c.pB = c.pA + na, c.F = c.pB + na;
     c.u = c.F + na, c.ucmd = c.u + nf, c.q = c.ucmd + nf, c.qd = c.q + nd;
     c.row = c.qd + nd;
-    for (int f = 0; f < nf; ++f) {
-        c.fcol[f] = scenario_find_command(sc, m->chain.fn[f].name);
-    }
+    for (int f = 0; f < nf; ++f) c.fcol[f] = scenario_find_command(sc, chain_sim_function_name(&cs, f));
     c.cs = &cs;
     c.sc = sc;
     c.sink = k;
     cs.cmd_fn = scn_cmd;
     cs.cmd_user = &c;
-    engine_chain_start_pose(&m->chain, sc, q0);
+    engine_chain_start_pose(cc, sc, q0);
     const double t_end = o->duration > 0 ? o->duration : sc->duration;
+    engine_faults ef;
+    engine_faults_init(&ef, hm);
+    // The merged circuit is compiled from the document, where a scenario's
+    // hose bursts load open: closed (and the other faults set) as at t = 0.
+    if (slews) engine_faults_apply(&ef, hm, sc, 0.0);
     if (chain_sim_check_pose(&cs, q0, msg, msz) || chain_sim_initial_state(&cs, q0, 0.5e6, y, msg, msz) ||
-        sim_check_fixed_step(m->hyd, o, o->h, t_end, msg, msz) || (k->probe && k->probe(m, o, o->h, msg, msz))) {
+        sim_check_fixed_step(hm, o, o->h, t_end, msg, msz) || (k->probe && k->probe(m, o, o->h, msg, msz))) {
         res->status = SIM_REFUSED;
         goto done;
     }
@@ -156,7 +239,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
         double* row0 = c.row;
         make_row(&c0, 0.0, y, row0);
         const sim_start_load ld = {m->chain.two_link ? &m->mech : NULL, {sc->q0[0], sc->q0[1]}, m3, false};
-        if (sim_check_start(m->hyd, row0, SIM_NCOL_BASE, &ld, msg, msz)) {
+        if (sim_check_start(hm, row0, SIM_NCOL_BASE, &ld, msg, msz)) {
             res->status = SIM_REFUSED;
             goto done;
         }
@@ -172,7 +255,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
     if (o->no_retry) so.retry_halvings = 0;
     if (!adaptive) so.max_steps = 0;
-    if (k->energy && (sim_energy_bind(k->energy, m->hyd) || sim_energy_follow(k->energy, cs.n, energy_eval, &cs))) {
+    if (k->energy && (sim_energy_bind(k->energy, hm) || sim_energy_follow(k->energy, cs.n, energy_eval, &cs))) {
         snprintf(msg, msz, "out of memory for the energy balance");
         res->status = SIM_REFUSED;
         goto done;
@@ -195,18 +278,17 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     // solver reset at each, as engine_lagrange.c's run.
     double bp[SCENARIO_MAX_POINTS * SCENARIO_MAX_CMD + SCENARIO_MAX_EVENTS + 9 * SCENARIO_MAX_FAULTS + 2];
     const int nbp = scenario_breakpoints(sc, bp, (int)(sizeof bp / sizeof bp[0]) - 1);
-    engine_faults ef;
-    engine_faults_init(&ef, m->hyd);
     double t = 0.0;
     int rc = HYD_OK;
     const double w0 = sim_wall_time();
+    if (slews && k->run_chain) *k->run_chain = cc;
     if (c.energy) sim_energy_follow_sample(c.energy, 0.0, y, chain_sim_energy(&cs, y));
     emit(&c, 0.0, y);
     for (int i = 0; i <= nbp && rc == HYD_OK && !c.stop && t < t_end; ++i) {
         double tb = i < nbp ? ceil(bp[i] / oo.dt_out - 1e-9) * oo.dt_out : t_end;
         if (tb > t_end) tb = t_end;
         if (tb <= t + 1e-12) continue;
-        engine_faults_apply(&ef, m->hyd, sc, 0.5 * (t + tb));
+        engine_faults_apply(&ef, hm, sc, 0.5 * (t + tb));
         hyd_solver_reset(s);
         if (c.energy && t > 0.0) sim_energy_follow_inputs(c.energy, t, y);
         rc = hyd_solver_integrate(s, t, y, tb, oo.dt_out, emit, &c);
@@ -242,5 +324,9 @@ done:
     free(buf);
     free(c.fcol);
     chain_sim_free(&cs);
+    if (slews) {
+        crane_chain_free(&slew_cc);
+        hyd_model_free(slew_hm);
+    }
     return res->status;
 }

@@ -310,9 +310,12 @@ static const char* state_name(const lsim* ls, int i, char* buf, size_t n) {
 // output times.
 static int lag_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
     // The closed form is the fast path of exactly the two-link shorthand
-    // (its allow-list); every other chain, and --variant general, runs the
-    // general formulation (docs/lagrange.md).
-    if (!m->chain.two_link || o->variant == LAGRANGE_GENERAL) return engine_chain_run(m, sc, o, k, res);
+    // with a column that stands still (its allow-list); every other chain,
+    // a run that slews a model with a slew drive (the slew a degree of
+    // freedom) and --variant general run the general formulation
+    // (docs/lagrange.md).
+    if (!m->chain.two_link || o->variant == LAGRANGE_GENERAL || engine_chain_slews(m, sc))
+        return engine_chain_run(m, sc, o, k, res);
     lsim ls;
     double m3 = sim_load_mass(m, sc, o);
     if (engine_world_bursts(m, NULL, NULL, res->message, sizeof res->message)) return res->status = SIM_REFUSED;

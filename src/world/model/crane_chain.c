@@ -174,25 +174,31 @@ int crane_chain_columns(crane_chain* cc) {
     free(cc->col);
     cc->col = NULL;
     cc->ncol = 0;
-    if (cc->two_link) return 0;
-    const int ndof = crane_chain_ndof(cc);
-    const int n = 5 * cc->nact + 2 * cc->nfn + 2 * ndof;
+    // The slew rack, where the column slews by its drive: an actuator and a
+    // function named "slew" after the chain's (chain_sim.h).
+    const bool rack = cc->slew_rack_columns && cc->slew_free && cc->slew.present;
+    if (cc->two_link && !rack) return 0;
+    // The two-link shorthand's base columns say everything but the slew's:
+    // then only the rack, its function and the slew DOF.
+    const int na = cc->two_link ? 0 : cc->nact, nf = cc->two_link ? 0 : cc->nfn;
+    const int ndof = cc->two_link ? 1 : crane_chain_ndof(cc);
+    const int n = 5 * (na + rack) + 2 * (nf + rack) + 2 * ndof;
     if (n == 0) return 0;
     crane_column* c = calloc((size_t)n, sizeof *c);
     if (!c) return -1;
     int k = 0;
-    for (int a = 0; a < cc->nact; ++a) {
+    for (int a = 0; a < na + rack; ++a) {
         static const char* const what[5] = {"x", "v", "pA", "pB", "F"};
         static const char* const unit[5] = {"m", "m/s", "Pa", "Pa", "N"};
         for (int j = 0; j < 5; ++j, ++k) {
-            snprintf(c[k].name, sizeof c[k].name, "%s_%s", what[j], cc->act[a].name);
+            snprintf(c[k].name, sizeof c[k].name, "%s_%s", what[j], a < na ? cc->act[a].name : "slew");
             c[k].unit = unit[j];
             c[k].pressure = j == 2 || j == 3;
         }
     }
-    for (int f = 0; f < cc->nfn; ++f)
+    for (int f = 0; f < nf + rack; ++f)
         for (int j = 0; j < 2; ++j, ++k) {
-            snprintf(c[k].name, sizeof c[k].name, "%s_%s", j ? "ucmd" : "u", cc->fn[f].name);
+            snprintf(c[k].name, sizeof c[k].name, "%s_%s", j ? "ucmd" : "u", f < nf ? cc->fn[f].name : "slew");
             c[k].unit = "-";
         }
     for (int d = 0; d < ndof; ++d) {
@@ -211,18 +217,21 @@ int crane_chain_columns(crane_chain* cc) {
 void crane_chain_row(const crane_chain* cc, const crane_chain_sample* s, double* out) {
     if (cc->ncol == 0) return;
     int k = 0;
-    for (int a = 0; a < cc->nact; ++a) {
+    // As crane_chain_columns: the rack and its function (index nact, nfn of
+    // the sample) after the chain's, and the two-link shorthand's only them.
+    const bool rack = cc->slew_rack_columns && cc->slew_free && cc->slew.present;
+    for (int a = cc->two_link ? cc->nact : 0; a < cc->nact + rack; ++a) {
         out[k++] = s->x[a];
         out[k++] = s->v[a];
         out[k++] = s->pA[a];
         out[k++] = s->pB[a];
         out[k++] = s->F[a];
     }
-    for (int f = 0; f < cc->nfn; ++f) {
+    for (int f = cc->two_link ? cc->nfn : 0; f < cc->nfn + rack; ++f) {
         out[k++] = s->u[f];
         out[k++] = s->ucmd[f];
     }
-    const int ndof = crane_chain_ndof(cc);
+    const int ndof = cc->two_link ? 1 : crane_chain_ndof(cc);
     for (int d = 0; d < ndof; ++d) {
         out[k++] = s->q[d];
         out[k++] = s->qd[d];

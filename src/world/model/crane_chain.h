@@ -94,7 +94,10 @@ static inline double crane_slew_torque(const crane_slew* sl, double F) { return 
 /// One output column of a chain crane beyond the run's base columns
 /// (crane_chain_columns): per actuator x_<a> [m], v_<a> [m/s], pA_<a>,
 /// pB_<a> [Pa], F_<a> [N]; per function u_<f>, ucmd_<f> [-]; per degree of
-/// freedom q_<body> [rad or m] and qd_<body> [rad/s or m/s].
+/// freedom q_<body> [rad or m] and qd_<body> [rad/s or m/s]. Where the
+/// column slews by its drive (slew_rack_columns) the slew rack is
+/// one more actuator and function, both named "slew", after the chain's
+/// (x_slew .. F_slew, u_slew, ucmd_slew), and the slew its first DOF.
 typedef struct crane_column {
     char name[CRANE_NAME + 8];
     const char* unit;
@@ -122,6 +125,11 @@ typedef struct crane_chain {
     double gravity;   ///< [m/s^2], along -z of the base frame
     bool slew_free;   ///< the column slews (a degree of freedom where the model has a slew drive)
     crane_slew slew;  ///< the slew drive, if the model has one (slew.present)
+    /// The rows carry the slew rack's columns (crane_chain_columns, with
+    /// slew_free and slew.present): set by the analytic mode's slewing run
+    /// (engine_chain_slew_setup), whose samples have the rack last. A
+    /// backend that frees the column otherwise keeps its columns as they were.
+    bool slew_rack_columns;
     /// True when the chain came from the two-link shorthand: the analytic
     /// backend may then run its closed-form fast path (lagrange.h), which
     /// handles exactly that shape and nothing else.
@@ -170,9 +178,14 @@ void crane_chain_start_pose(const crane_chain* cc, const double q12[2], double s
 
 /// Makes the chain's output columns (cc->col, cc->ncol): none when
 /// two_link, else per actuator, per function and per DOF as crane_column
-/// says. 0, or -1 when out of memory. crane_chain_bind calls it.
+/// says; with the slew rack (slew_rack_columns) the rack's too,
+/// and for two_link only the rack's, its function's and the slew DOF's (the
+/// base columns have the rest). 0, or -1 when out of memory.
+/// crane_chain_bind calls it.
 int crane_chain_columns(crane_chain* cc);
-/// Writes one row's chain columns (cc->ncol values) from s into out.
+/// Writes one row's chain columns (cc->ncol values) from s into out; with
+/// the slew rack, s's actuator and function arrays have it last (index
+/// nact, nfn), as chain_sim's outputs.
 void crane_chain_row(const crane_chain* cc, const crane_chain_sample* s, double* out);
 
 /// A deep copy (dst's arrays are new). 0, or -1 when out of memory.

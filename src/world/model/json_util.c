@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/stat.h>
 
 void json_fail(json_ctx* c, const char* path, const char* fmt, ...) {
@@ -671,4 +672,27 @@ int json_set_path(cJSON* root, const char* assignment, char* err, size_t errsz) 
     if (cJSON_IsArray(parent)) cJSON_ReplaceItemViaPointer(parent, old, nv);
     else cJSON_ReplaceItemInObjectCaseSensitive(parent, last->key, nv);
     return 0;
+}
+
+static int cmp_name(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
+
+void json_list_files(const char* folder, char* out, size_t n) {
+    char* names[64];
+    int k = 0;
+    DIR* d = opendir(folder);
+    for (struct dirent* e; d && k < 64 && (e = readdir(d));) {
+        const size_t L = strlen(e->d_name);
+        if (L > 5 && !strcmp(e->d_name + L - 5, ".json") && (names[k] = malloc(L - 4))) {
+            snprintf(names[k], L - 4, "%s", e->d_name);
+            ++k;
+        }
+    }
+    if (d) closedir(d);
+    qsort(names, (size_t)k, sizeof *names, cmp_name);
+    snprintf(out, n, "%s", k ? "" : "none");
+    for (int i = 0; i < k; ++i) {
+        const size_t L = strlen(out);
+        snprintf(out + L, n - L, "%s%s", i ? ", " : "", names[i]);
+        free(names[i]);
+    }
 }

@@ -40,6 +40,12 @@ void json_fail(json_ctx* c, const char* path, const char* fmt, ...)
 /// "file: field.path: given twice (duplicate field)" for a repeated member.
 cJSON* json_load_file(const char* path, char* err, size_t errsz);
 
+/// The names of the .json files in folder, without the extension, sorted
+/// and comma-separated into out ("none" when there is none or the folder
+/// cannot be read; at most 64 names, cut at n bytes): what a message says
+/// when a model or world named on the command line does not exist.
+void json_list_files(const char* folder, char* out, size_t n);
+
 /// The checks of json_load_file on a text in memory (name is used in messages).
 cJSON* json_parse(const char* text, const char* name, char* err, size_t errsz);
 

@@ -11,7 +11,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -559,35 +558,16 @@ const char* model_path(const char* arg, char* buf, size_t n) {
     return buf;
 }
 
-static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
-
 // A name (model_path) that is no model in the assets: say which there are,
 // instead of "cannot open". Returns 1 with the message, else 0.
 static int missing_named_model(const char* arg, const char* path, char* err, size_t errsz) {
     struct stat st;
     if (!arg || path == arg || stat(path, &st) == 0) return 0;
-    char folder[512];
+    char folder[512], list[512];
     snprintf(folder, sizeof folder, "%s/models", model_assets_dir());
-    char* names[64];
-    int k = 0;
-    DIR* d = opendir(folder);
-    for (struct dirent* e; d && k < 64 && (e = readdir(d));) {
-        const size_t L = strlen(e->d_name);
-        if (L > 5 && !strcmp(e->d_name + L - 5, ".json") && (names[k] = malloc(L - 4))) {
-            snprintf(names[k], L - 4, "%s", e->d_name);
-            ++k;
-        }
-    }
-    if (d) closedir(d);
-    qsort(names, (size_t)k, sizeof *names, cmp_str);
-    char list[512] = "";
-    for (int i = 0; i < k; ++i) {
-        const size_t L = strlen(list);
-        snprintf(list + L, sizeof list - L, "%s%s", i ? ", " : "", names[i]);
-        free(names[i]);
-    }
+    json_list_files(folder, list, sizeof list);
     snprintf(err, errsz, "%s %s: no such file or model (models: %s; or the path of a model file)",
-             sim_param_name(SIM_PARAM_MODEL), arg, k ? list : "none");
+             sim_param_name(SIM_PARAM_MODEL), arg, list);
     return 1;
 }
 

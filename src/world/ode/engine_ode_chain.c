@@ -1,9 +1,13 @@
 // engine_ode_chain.c: scripted runs (engine_run) of the ode backend for a
-// chain model, in the chain world (ode_chain.h), engine_ode_chain.h.
+// chain model, in the chain world (ode_chain.h) or, for a sandbox world, in
+// the sandbox with the crane from the chain (ode_world.h opts.chain),
+// engine_ode_chain.h.
 #include "engine_ode_chain.h"
 #include "energy_acc.h"
+#include "engine_faults.h"
 #include "ode_chain.h"
 #include "ode_chain_row.h"
+#include "ode_run.h"
 #include "world_desc.h"
 
 #include <math.h>
@@ -14,27 +18,195 @@
 // Hand a finished row to the driver's sink; non-zero: stop.
 static int deliver(const engine_sink* k, const double* row) { return k->row && k->row(k->user, row); }
 
-// The world o names must be the validation world: the chain world stands
-// the column on the ground with the load at the tip and has no sandbox
-// (truck, rope, hook, loads, terrain).
-static int check_world(const sim_opts* o, char* err, size_t errsz) {
+// The kind of the world o names (the validation world when none): the
+// validation world runs in the chain world (the column on the ground, the
+// load at the tip), the sandbox in ode_world with the crane from the chain
+// (run_sandbox). -1 with the loader's message.
+int engine_ode_chain_world_kind(const sim_opts* o, world_kind* kind, char* err, size_t errsz) {
+    *kind = WORLD_VALIDATION;
     if (!o->world) return 0;
     char buf[512];
     const char* wp = sim_world_path(o->world, buf, sizeof buf);
     world_desc wd;
     if (world_desc_load(wp, &wd, err, errsz)) return -1;
-    const world_kind kind = wd.kind;
+    *kind = wd.kind;
     world_desc_free(&wd);
-    if (kind == WORLD_VALIDATION) return 0;
-    snprintf(err, errsz,
-             "%s %s: the sandbox runs the two-link crane only; use %s validation (a chain model runs in the ODE "
-             "chain world, docs/ode_world.md)",
-             sim_param_name(SIM_PARAM_WORLD), o->world, sim_param_name(SIM_PARAM_WORLD));
-    return -1;
+    return 0;
+}
+
+static int play_hook(void* user, int attach) { return ode_world_hook(user, attach); }
+
+// A scripted run in the sandbox (ode_world with the chain crane on its
+// truck, ode_world.h opts.chain): the scenario's functions by name and its
+// slew at each ODE step's midpoint, its hook events as the two-link
+// sandbox's; rows of the sandbox's base columns (ode_world_row: the first
+// two actuators, the first two boom DOFs, the slew, hook, truck, supports)
+// then the chain's columns. What the two-link run has and this one does not:
+// the rated capacity limiter (rcl.h reads the two-link crane: not applied,
+// rcl_util 0, and the run's note says so where it was on), the tip load (the
+// sandbox's loads hang on the hook).
+static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
+                       sim_result* res) {
+    char* msg = res->message;
+    const size_t msz = sizeof res->message;
+    ode_world* w = ode_world_for_run(m, o, "sandbox", sc->q0, sc->slew0, 0.0, msg, msz);
+    if (!w) return res->status = SIM_REFUSED;
+    ode_chain* cw = ode_world_chain(w);
+    const crane_chain* cc = &m->chain;
+    const crane_chain* hc = ode_chain_chain(cw); // the hosted copy: the column slews
+    hyd_model* hm = ode_world_circuit(w);
+    // The outputs of the hosted chain (ode_chain_row.c, as the chain
+    // world's runs read them), and a row.
+    ode_chain_rows r;
+    const int rows_rc = ode_chain_rows_init(&r, hc, hm, ode_chain_ndof(cw));
+    double* buf = calloc(SIM_NCOL + (size_t)cc->ncol + 1, sizeof *buf);
+    int* fcol = calloc((size_t)hc->nfn + 1, sizeof *fcol);
+    if (rows_rc || !buf || !fcol) {
+        snprintf(msg, msz, "out of memory");
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    double* row = buf;
+    for (int f = 0; f < r.nf; ++f) fcol[f] = scenario_find_command(sc, hc->fn[f].name);
+    // The model's DOF columns: the slew's only where the model's column slews.
+    const int d0 = cc->slew_free ? 0 : 1;
+    const double dt = ode_world_dt(w);
+    const double h = o->h < dt ? o->h : dt;
+    const double t_end = k->t_end;
+    if ((res->status = sim_check_fixed_step(r.hm, o, h, t_end, msg, msz)) ||
+        (k->probe && (res->status = k->probe(m, o, h, msg, msz))))
+        goto done;
+    if (t_end / dt > 1e12) {
+        snprintf(msg, msz, "%s %g s over %g s is %.3g steps, more than 1e12: use a larger %s or a shorter run",
+                 sim_param_name(SIM_PARAM_DT_ODE), dt, t_end, t_end / dt, sim_param_name(SIM_PARAM_DT_ODE));
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    sim_checks chk;
+    memset(&chk, 0, sizeof chk);
+    const long ode_msgs = ode_world_messages(NULL);
+    // One row: the sandbox's base columns, then the chain's.
+#define SANDBOX_ROW(t_)                                                                                    \
+    do {                                                                                                   \
+        ode_world_row(w, row);                                                                             \
+        ode_chain_rows_outputs(&r, cw);                                                                    \
+        const crane_chain_sample smp_ = {r.x, r.v, r.pA, r.pB, r.F, r.u, r.ucmd, r.q + d0, r.qd + d0};     \
+        crane_chain_row(cc, &smp_, row + SIM_NCOL);                                                        \
+        row[COL_T] = (t_);                                                                                 \
+    } while (0)
+    SANDBOX_ROW(0.0);
+    for (int j = 0; j < 4; ++j) res->p_peak[j] = row[COL_P1A + j];
+    {
+        char what[200];
+        if (sim_check_row(&chk, row, SIM_NCOL, what, sizeof what)) {
+            sim_check_message(msg, msz, what, NULL, false, 0.0, chk.bad_value);
+            res->status = SIM_REFUSED;
+            goto done;
+        }
+        // The start pressures against the circuit's limits, with the world's
+        // rope and hook at the tip (the booms' share is not split out: the
+        // two-link statics do not describe this chain).
+        int nl;
+        double len, lm, li, hkm, hc, hi;
+        ode_world_rope_info(w, &nl, &len, &lm, &li, &hkm, &hc, &hi);
+        const sim_start_load ld = {NULL, {sc->q0[0], sc->q0[1]}, nl * lm + hkm, true};
+        if (sim_check_start(hm, row, SIM_NCOL, &ld, msg, msz)) {
+            res->status = SIM_REFUSED;
+            goto done;
+        }
+    }
+    sim_energy* en = k->energy;
+    if (en && (sim_energy_bind(en, r.hm) || ode_world_follow_energy(w, en))) {
+        snprintf(msg, msz, "out of memory for the energy balance");
+        res->status = SIM_REFUSED;
+        goto done;
+    }
+    if (en) sim_energy_mech(en, ode_world_energy(w));
+    const long nstep = (long)floor(t_end / dt + 0.5);
+    long nout = (long)floor(fmin(o->dt_out, t_end) / dt + 0.5);
+    if (nout < 1) nout = 1;
+    engine_faults ef;
+    engine_faults_init(&ef, hm);
+    const double w0 = sim_wall_time();
+    int stop = deliver(k, row);
+    long rows = 1;
+    double t_last = 0.0;
+    int ev = 0;
+    for (long i = 0; i < nstep && !stop; ++i) {
+        // Commands at the step's midpoint: the functions by name, the slew
+        // and the hook's events as the two-link sandbox plays them.
+        const double tm = ((double)i + 0.5) * dt;
+        double u3[SCENARIO_NCMD];
+        scenario_play(sc, tm, &ev, u3, play_hook, w);
+        for (int f = 0; f < r.nf; ++f) r.u[f] = fcol[f] >= 0 ? scenario_command(sc, fcol[f], tm) : 0.0;
+        engine_faults_apply(&ef, hm, sc, tm);
+        ode_chain_set_commands(cw, r.u);
+        ode_chain_set_slew_command(cw, u3[2]);
+        if (ode_world_step(w, dt)) {
+            res->status = SIM_FAILED;
+            snprintf(msg, msz, "numerical blow-up: %s", ode_world_error(w));
+            break;
+        }
+        if (en) sim_energy_mech(en, ode_world_energy(w));
+        {
+            const char* pairs[16][2];
+            const int np = ode_world_collisions(w, pairs, 16);
+            if (np >= 0) sim_collisions_step(&res->coll, (double)(i + 1) * dt, (const char* const(*)[2])pairs, np);
+        }
+        {
+            double pA[ODE_NACT], pB[ODE_NACT];
+            ode_world_chamber_pressures(w, pA, pB);
+            const double p[4] = {pA[0], pB[0], pA[1], pB[1]};
+            for (int j = 0; j < 4; ++j) res->p_peak[j] = fmax(res->p_peak[j], p[j]);
+        }
+        if ((i + 1) % nout && i + 1 != nstep) continue;
+        SANDBOX_ROW((double)(i + 1) * dt); // exact grid times
+        char what[200];
+        if (sim_check_row(&chk, row, SIM_NCOL, what, sizeof what)) {
+            res->status = SIM_FAILED;
+            char how[96];
+            snprintf(how, sizeof how, "solver %s, h = %g s, ODE step %g s", hyd_method_name(o->solver), h, dt);
+            sim_check_message(msg, msz, what, how, false, row[COL_T], chk.bad_value);
+            break;
+        }
+        t_last = row[COL_T];
+        ++rows;
+        stop = deliver(k, row);
+    }
+#undef SANDBOX_ROW
+    res->wall = sim_wall_time() - w0;
+    res->stats.steps = (long)floor(ode_world_time(w) / dt + 0.5) * (long)floor(dt / h + 0.5);
+    res->rows = rows;
+    res->t_end = t_last;
+    res->peak_steps = true;
+    if (en) sim_energy_finish(en);
+    if (stop && !res->status) {
+        res->status = SIM_REFUSED;
+        snprintf(msg, msz, "stopped at t = %.6g s", t_last);
+    }
+    if (!res->status) {
+        const char* last;
+        const long msgs = ode_world_messages(&last) - ode_msgs;
+        if (o->rcl)
+            snprintf(res->note, sizeof res->note,
+                     "the rated capacity limiter follows the two-link crane only: not applied to this chain, rcl_util "
+                     "is 0");
+        if (chk.dip) sim_checks_note(&chk, false, res->note, sizeof res->note);
+        else if (msgs > 0)
+            snprintf(res->note, sizeof res->note,
+                     "ODE reported %ld solver message%s during the run (last: %.120s): a degenerate contact set, "
+                     "which ODE stepped through",
+                     msgs, msgs > 1 ? "s" : "", last);
+    }
+done:
+    ode_world_destroy(w);
+    free(buf);
+    free(fcol);
+    if (!rows_rc) ode_chain_rows_free(&r);
+    return res->status;
 }
 
 int engine_ode_chain_check(const sim_opts* o, double* dt_ode, double* h_hyd, char* msg, size_t msz) {
-    if (check_world(o, msg, msz)) return -1;
     if (hyd_method_is_adaptive(o->solver)) {
         snprintf(msg, msz,
                  "solver %s is adaptive: the ODE chain world sub-steps its circuit with a fixed-step method (krus, "
@@ -67,6 +239,9 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
                          sim_result* res) {
     char* msg = res->message;
     const size_t msz = sizeof res->message;
+    world_kind kind;
+    if (engine_ode_chain_world_kind(o, &kind, msg, msz)) return res->status = SIM_REFUSED;
+    if (kind == WORLD_SANDBOX) return run_sandbox(m, sc, o, k, res);
     double dt, h;
     if (engine_ode_chain_check(o, &dt, &h, msg, msz)) return res->status = SIM_REFUSED;
     // No world circuit here: a burst at a node the model lacks has nowhere to open.
@@ -85,7 +260,7 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
     // engine); here the start pose and the row: SIM_NCOL channels, then the
     // chain's columns.
     ode_chain_rows r;
-    const int rows_rc = ode_chain_rows_init(&r, cc, m->hyd);
+    const int rows_rc = ode_chain_rows_init(&r, cc, m->hyd, nd);
     double* buf = calloc((size_t)nd + (size_t)ode_chain_row_ncol(cc) + 1, sizeof *buf);
     int* fcol = calloc(nf + 1, sizeof *fcol);
     ode_chain* w = NULL;

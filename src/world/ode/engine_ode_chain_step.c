@@ -46,6 +46,17 @@ static engine* oc_create(const model* m, const sim_opts* o, const double q0[2], 
                              "(krus, ros2, rk4)");
         return NULL;
     }
+    // The chain world is the validation world; the sandbox built from the
+    // chain runs scripted (engine_ode_chain.c) but has no stepped engine yet.
+    world_kind kind;
+    if (engine_ode_chain_world_kind(o, &kind, err, errsz)) return NULL;
+    if (kind != WORLD_VALIDATION) {
+        snprintf(err, errsz,
+                 "%s %s: the stepped engine of a crane chain runs the validation world only (use %s validation; "
+                 "cranesim run takes a chain model into the sandbox)",
+                 sim_param_name(SIM_PARAM_WORLD), o->world, sim_param_name(SIM_PARAM_WORLD));
+        return NULL;
+    }
     double dt, h;
     if (engine_ode_chain_check(o, &dt, &h, err, errsz)) return NULL;
     // No world circuit here: a burst at a node the model lacks has nowhere to open.
@@ -54,7 +65,7 @@ static engine* oc_create(const model* m, const sim_opts* o, const double q0[2], 
     eng_ode_chain* c = calloc(1, sizeof *c);
     const int nd = crane_chain_ndof(cc), nc = ode_chain_row_ncol(cc);
     double* buf = calloc((size_t)nd + (size_t)nc + 1, sizeof *buf);
-    if (!c || !buf || ode_chain_rows_init(&c->r, cc, m->hyd)) {
+    if (!c || !buf || ode_chain_rows_init(&c->r, cc, m->hyd, nd)) {
         snprintf(err, errsz, "out of memory");
         free(c);
         free(buf);

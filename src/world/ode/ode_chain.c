@@ -20,7 +20,8 @@
 // ODE step.
 #include "ode_chain.h"
 
-#include "ode_world_internal.h"
+#include "ode_common.h"
+#include "circuit_kernel.h"
 #include "energy_acc.h"
 #include "hyd_cylinder.h"
 
@@ -44,6 +45,10 @@ typedef struct oc_body {
     double raw, turns; ///< hinge: angle at the last read and the whole turns counted [rad]
     double lo, hi;     ///< stops relative to the joint's zero, continuous [rad or m] (+-inf: none)
     int seal;          ///< implicit_seal: a cylinder's seal friction acts as this joint's motor
+    int motor;         ///< the motor runs this step (apply_seal), else the friction is explicit
+    double qd0;        ///< joint rate at the step's start [rad/s or m/s]
+    double C, vel;     ///< the motor's damping sum l^2 dF/dv [N m s or N s/m] and target rate
+    double steep;      ///< its cylinders' steepest slope sum l^2 (F_c + F_s)/v_sm [N m s or N s/m]
     double fmax;       ///< that motor's force limit this step [N m or N]
 } oc_body;
 
@@ -56,7 +61,12 @@ typedef struct oc_act {
     int seal;         ///< implicit_seal: its seal friction is a motor on the joint of seal_body
     int seal_body;    ///< the body whose joint the cylinder spans (implicit_seal), or -1
     double Fc, Fs, vst, vsm; ///< its seal friction's parameters [N, N, m/s, m/s]
-    double seal_max;  ///< the seal friction's magnitude at the step's rate [N]
+    double Fsc;       ///< the circuit's seal friction at the step's rate v0 [N]
+    /// The friction as a line ODE holds (apply_seal): Fs0 + dFs (v - v0)
+    /// within +-Fmax [N, N s/m, N].
+    double Fs0, dFs, Fmax;
+    double lever;     ///< dL/dq of its joint at the step's start [m/rad or -]
+    double Fp;        ///< the force at its pins this step [N] (F without the seal friction when the motor holds it)
 } oc_act;
 
 struct ode_chain {
@@ -71,6 +81,7 @@ struct ode_chain {
     double* u;      ///< valve commands (nfn)
     double* qstart; ///< start coordinates (ndof)
     double* qs;     ///< scratch (ndof)
+    double* dL;     ///< implicit_seal: lever arms (ndof), NULL when no cylinder's friction is held so
     dWorldID world;
     dThreadingImplementationID threading;
     double g;
@@ -89,6 +100,17 @@ struct ode_chain {
     int* pres;
     double th, step_t0;
     struct sim_energy* energy; ///< ode_chain_follow_energy's balance, or NULL
+    // Hosted (opts.host_world): the world is the host's.
+    int hosted;
+    double Rb[9], pb[3]; ///< base frame to world: rotation (row-major), origin [m]
+    // The slew drive (opts.slew_drive): the rack cylinder on body 0's hinge.
+    int slew_on;
+    int slew_cyl, slew_valve;   ///< the circuit's rack cylinder and its valve
+    int slew_iA, slew_iB;       ///< their chamber pressure states
+    double slew_AA, slew_AB, slew_stroke; ///< [m^2, m^2, m]
+    double slew_x0, slew_v0;    ///< rack stroke [m] and rate [m/s] at the step start
+    double slew_F;              ///< rack force over the step [N]
+    double slew_u;              ///< the slew command [-1, 1]
 };
 
 ode_chain_opts ode_chain_default_opts(void) {
@@ -104,6 +126,7 @@ ode_chain_opts ode_chain_default_opts(void) {
     o.init_hold = 1;
     o.p_low = 2e6;
     o.model_file = "model";
+    o.implicit_seal = 1;
     return o;
 }
 
@@ -205,6 +228,30 @@ static void read_turns(ode_chain* w) {
     }
 }
 
+// A slider's rate [m/s]: the relative velocity of its two bodies along the
+// axis, ax . (v1 - v2), plus the turning of that axis with the bodies,
+// (c x ax) . (w1 + w2) / 2 with c = p2 - p1 the line between their centres
+// of mass: the rate of dJointGetSliderPosition and the velocity ODE's
+// slider motor row holds (its linear torque decoupling). ODE's own
+// dJointGetSliderPositionRate leaves out the second term, which on a
+// turning boom is its angular rate times the offset of the centres of mass
+// across the axis (0.1 rad/s over 0.1 m: 10 mm/s).
+static double slider_rate(dJointID j) {
+    dVector3 ax;
+    dJointGetSliderAxis(j, ax);
+    const dBodyID b1 = dJointGetBody(j, 0), b2 = dJointGetBody(j, 1);
+    const dReal* v1 = dBodyGetLinearVel(b1);
+    if (!b2) return ax[0] * v1[0] + ax[1] * v1[1] + ax[2] * v1[2];
+    const dReal* v2 = dBodyGetLinearVel(b2);
+    const dReal *w1 = dBodyGetAngularVel(b1), *w2 = dBodyGetAngularVel(b2);
+    const dReal *p1 = dBodyGetPosition(b1), *p2 = dBodyGetPosition(b2);
+    const double c[3] = {p2[0] - p1[0], p2[1] - p1[1], p2[2] - p1[2]};
+    const double cx[3] = {c[1] * ax[2] - c[2] * ax[1], c[2] * ax[0] - c[0] * ax[2], c[0] * ax[1] - c[1] * ax[0]};
+    double r = 0.0;
+    for (int i = 0; i < 3; ++i) r += ax[i] * (v1[i] - v2[i]) + 0.5 * cx[i] * (w1[i] + w2[i]);
+    return r;
+}
+
 static double joint_q(const ode_chain* w, const oc_body* b, double* qd) {
     if (b->revolute) {
         const double raw = dJointGetHingeAngle(b->joint);
@@ -212,7 +259,7 @@ static double joint_q(const ode_chain* w, const oc_body* b, double* qd) {
         return b->q0 + raw + turns_at(b, raw);
     }
     (void)w;
-    if (qd) *qd = dJointGetSliderPositionRate(b->joint);
+    if (qd) *qd = slider_rate(b->joint);
     return b->q0 + dJointGetSliderPosition(b->joint);
 }
 
@@ -277,6 +324,21 @@ static void set_inputs(ode_chain* w, double t) {
         w->hd->cyl_v[c] = w->a[k].v0;
     }
     for (int f = 0; f < w->nfn; ++f) w->hd->valve_cmd[w->cc.fn[f].valve_idx] = w->u[f];
+    if (w->slew_on) {
+        w->hd->cyl_x[w->slew_cyl] = w->slew_x0 + w->slew_v0 * tau;
+        w->hd->cyl_v[w->slew_cyl] = w->slew_v0;
+        w->hd->valve_cmd[w->slew_valve] = w->slew_u;
+    }
+}
+
+// The rack's stroke [m] and rate [m/s] from the column's hinge (slew q and
+// its rate): r q + s/2 (crane_slew_stroke), r qd.
+static double slew_kinematics(const ode_chain* w, double* rate) {
+    const oc_body* b = &w->b[0];
+    double qd;
+    const double q = joint_q(w, b, &qd);
+    if (rate) *rate = w->cc.slew.pinion_radius * qd;
+    return crane_slew_stroke(&w->cc.slew, q, w->slew_stroke);
 }
 
 static int rhs(void* user, double t, const double* y, double* dydt) {
@@ -319,6 +381,13 @@ static int settle(void* user, double t, double* y) {
     for (int f = 0; f < w->nfn; ++f) {
         double* u = &y[hyd_model_valve_state(w->hm, w->cc.fn[f].valve_idx)];
         if (*u != 0.0 && fabs(*u) < HYD_SPOOL_SETTLE && fabs(w->u[f]) < HYD_SPOOL_SETTLE) {
+            *u = 0.0;
+            changed = 1;
+        }
+    }
+    if (w->slew_on) {
+        double* u = &y[hyd_model_valve_state(w->hm, w->slew_valve)];
+        if (*u != 0.0 && fabs(*u) < HYD_SPOOL_SETTLE && fabs(w->slew_u) < HYD_SPOOL_SETTLE) {
             *u = 0.0;
             changed = 1;
         }
@@ -444,6 +513,36 @@ static int hyd_create(ode_chain* w, char* err, size_t errsz) {
                          mf, k, w->cc.act[k].cylinder, j, w->cc.act[j].name);
                 return -1;
             }
+    if (w->opt.slew_drive) {
+        const crane_slew* sl = &w->cc.slew;
+        w->slew_cyl = hyd_model_cylinder(w->hm, sl->cylinder);
+        w->slew_valve = hyd_model_valve(w->hm, sl->valve);
+        if (!sl->present) {
+            snprintf(err, errsz, "%s: mechanics.slew: missing (the column's slew drive is needed here)", mf);
+            return -1;
+        }
+        if (w->slew_cyl < 0 || w->slew_valve < 0) {
+            snprintf(err, errsz, "%s: mechanics.slew.%s: no %s named \"%s\" in the circuit (hydraulics_slew)", mf,
+                     w->slew_cyl < 0 ? "cylinder" : "valve", w->slew_cyl < 0 ? "cylinder" : "valve",
+                     w->slew_cyl < 0 ? sl->cylinder : sl->valve);
+            return -1;
+        }
+        // One cylinder or valve on two functions would couple them through
+        // one set of states: a slew that moves a boom.
+        for (int k = 0; k < w->nact; ++k)
+            if (w->cc.act[k].cyl == w->slew_cyl || w->cc.fn[w->cc.act[k].function].valve_idx == w->slew_valve) {
+                snprintf(err, errsz, "%s: mechanics.slew: \"%s\" already drives actuators[%d] (%s)", mf,
+                         w->cc.act[k].cyl == w->slew_cyl ? sl->cylinder : sl->valve, k, w->cc.act[k].name);
+                return -1;
+            }
+        if (!(sl->pinion_radius > 0)) {
+            snprintf(err, errsz, "%s: mechanics.slew.pinion_radius: %g m; must be > 0", mf, sl->pinion_radius);
+            return -1;
+        }
+        hyd_model_cylinder_states(w->hm, w->slew_cyl, &w->slew_iA, &w->slew_iB);
+        hyd_model_cylinder_geometry(w->hm, w->slew_cyl, &w->slew_AA, &w->slew_AB, &w->slew_stroke);
+        w->slew_on = 1;
+    }
     if (hyd_method_is_adaptive(w->opt.solver)) {
         snprintf(err, errsz, "ode chain world: the %s solver is adaptive; this world sub-steps a fixed-step one (krus, ros2)",
                  hyd_method_name(w->opt.solver));
@@ -495,13 +594,46 @@ static int hyd_init_state(ode_chain* w, char* err, size_t errsz) {
     hyd_model_initial_state(w->hm, w->y);
     w->th = 0.0;
     for (int k = 0; k < w->nact; ++k) w->a[k].x0 = act_geometry(w, k, &w->a[k].v0, NULL, NULL, NULL) - w->cc.act[k].closed_length;
+    if (w->slew_on) w->slew_x0 = slew_kinematics(w, &w->slew_v0);
     if (!w->opt.init_hold) return 0;
+    if (w->slew_on) {
+        // The rack balanced with both chambers at p_low (no static torque on
+        // a level base), as the two-link sandbox starts its slew.
+        const double p = w->opt.p_low;
+        w->y[w->slew_iA] = p;
+        w->y[w->slew_iB] = p * w->slew_AA / w->slew_AB;
+        const int hA = hose_of(w, w->slew_iA), hB = hose_of(w, w->slew_iB);
+        if (hA >= 0) w->y[hA] = w->y[w->slew_iA];
+        if (hB >= 0) w->y[hB] = w->y[w->slew_iB];
+    }
     double* F = calloc((size_t)(w->nact + w->ndof), sizeof *F);
     if (!F) {
         snprintf(err, errsz, "ode chain world: out of memory");
         return -1;
     }
-    if (w->nact && holding_forces(w, F)) {
+    int bad = 0;
+    if (w->nact && w->opt.hold_tip_mass > 0) {
+        // The forces of the pose with the hanging mass at the tip: from a
+        // mechanism with it merged (the world's bodies stay without it).
+        char e[320];
+        chain* held = crane_chain_mechanism(&w->cc, w->opt.tip_mass + w->opt.hold_tip_mass, w->cc.slew_free,
+                                            w->opt.slew0, e, sizeof e);
+        chain_ws* hws = held ? chain_ws_create(held) : NULL;
+        chain* m0 = w->mech;
+        chain_ws* ws0 = w->ws;
+        if (hws) {
+            w->mech = held, w->ws = hws;
+            bad = holding_forces(w, F);
+            w->mech = m0, w->ws = ws0;
+        } else {
+            bad = 1;
+        }
+        chain_ws_free(hws);
+        chain_free(held);
+    } else if (w->nact) {
+        bad = holding_forces(w, F);
+    }
+    if (bad) {
         snprintf(err, errsz,
                  "%s: mechanics.actuators: the cylinders' lever arms at the start pose are dependent; no set of "
                  "forces holds it (start with init_hold off)",
@@ -525,6 +657,10 @@ static int hyd_init_state(ode_chain* w, char* err, size_t errsz) {
     free(F);
     return 0;
 }
+
+// The seal friction's tanh is within 1e-4 of 1 beyond |v| = atanh(1 - 1e-4)
+// v_sm = 4.95 v_sm: sliding (hyd_step).
+#define SEAL_SLIDING 4.95
 
 static int hyd_step(ode_chain* w, double H) {
     w->step_t0 = w->th;
@@ -555,20 +691,39 @@ static int hyd_step(ode_chain* w, double H) {
     rhs(w, w->th, w->y, w->ydot);
     w->th = (double)(w->nstep + 1) * H; // on the step count: no drift from the mechanical clock
     for (int k = 0; k < w->nact; ++k) {
-        w->a[k].F = w->hd->cyl_F[w->cc.act[k].cyl];
         oc_act* a = &w->a[k];
+        a->F = a->Fp = w->hd->cyl_F[w->cc.act[k].cyl];
         if (a->seal) {
-            // The circuit subtracted the seal friction at the step's rate
-            // v0; it is added back here and held by the joint's motor
-            // (apply_seal) instead. Its magnitude at v0 is the motor's limit.
+            // The circuit subtracted its seal friction at the step's rate
+            // v0 (its rate input), Fsc: added back at the pins where
+            // apply_seal holds the friction in ODE's solver instead, as the
+            // line Fs0 + dFs (v - v0) within +-Fmax.
             double d;
-            a->F += hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, a->v0, &d);
-            const double r = a->v0 / a->vst;
-            a->seal_max = a->Fc + a->Fs * exp(-r * r);
+            a->Fsc = hyd_cyl_seal(a->Fc, a->Fs, a->vst, a->vsm, a->v0, &d);
+            if (fabs(a->v0) < SEAL_SLIDING * a->vsm) {
+                // At rest and through the knee: the law's tangent at v0,
+                // its negative part (the Stribeck fall) left out.
+                a->Fs0 = a->Fsc, a->dFs = d > 0.0 ? d : 0.0, a->Fmax = a->Fc + a->Fs;
+            } else {
+                // Sliding: the law is mag(v0) sign(v) to 1e-4. As a damper
+                // of its slope at zero, mag(v0)/v_sm, saturating at
+                // mag(v0), it stays that while the step keeps sliding and
+                // follows the law through zero when the step stops it
+                // (the tangent, flat here, would hold +mag past zero).
+                const double r = a->v0 / a->vst, mag = a->Fc + a->Fs * exp(-r * r);
+                a->dFs = mag / a->vsm, a->Fs0 = a->dFs * a->v0, a->Fmax = mag;
+            }
         }
         if (!isfinite(w->a[k].F)) {
             snprintf(w->err, sizeof w->err, "hydraulics: the force of actuator %s became non-finite at t = %.6f s",
                      w->cc.act[k].name, w->th);
+            return -1;
+        }
+    }
+    if (w->slew_on) {
+        w->slew_F = w->hd->cyl_F[w->slew_cyl];
+        if (!isfinite(w->slew_F)) {
+            snprintf(w->err, sizeof w->err, "hydraulics: the slew rack's force became non-finite at t = %.6f s", w->th);
             return -1;
         }
     }
@@ -594,8 +749,12 @@ static int build(void* arg) {
     build_args* ba = arg;
     ode_chain* w = ba->w;
     const char* mf = w->opt.model_file;
-    w->world = ow_world_new(w->g, w->opt.erp, w->opt.cfm, &w->threading);
-    dWorldSetAutoDisableFlag(w->world, 0);
+    if (w->hosted) {
+        w->world = (dWorldID)w->opt.host_world;
+    } else {
+        w->world = ow_world_new(w->g, w->opt.erp, w->opt.cfm, &w->threading);
+        dWorldSetAutoDisableFlag(w->world, 0);
+    }
 
     chain_update(w->mech, w->ws, w->qstart, NULL);
     for (int i = 0; i < w->nbody; ++i) {
@@ -604,8 +763,21 @@ static int build(void* arg) {
         b->dof = chain_body_dof(w->mech, i);
         b->revolute = d->joint == CHAIN_REVOLUTE;
         b->lo = -INFINITY, b->hi = INFINITY;
-        chain_body_pose(w->mech, w->ws, i, b->R, b->p);
-        if (i == 0 && d->fixed) continue; // the column on the ground: a fixed frame
+        double Rl[9], pl[3]; // in the base frame
+        chain_body_pose(w->mech, w->ws, i, Rl, pl);
+        // Into the world: R = Rb Rl, p = pb + Rb pl (the identity unhosted).
+        for (int r = 0; r < 3; ++r) {
+            b->p[r] = w->pb[r];
+            for (int c = 0; c < 3; ++c) {
+                b->p[r] += w->Rb[3 * r + c] * pl[c];
+                double v = 0.0;
+                for (int k = 0; k < 3; ++k) v += w->Rb[3 * r + k] * Rl[3 * k + c];
+                b->R[3 * r + c] = v;
+            }
+        }
+        // The column on the ground: a fixed frame (hosted on a body it is a
+        // body, so that it moves with its base).
+        if (i == 0 && d->fixed && !(w->hosted && w->opt.host_base)) continue;
         if (!(d->mass > 0)) {
             snprintf(ba->err, ba->errsz, "%s: bodies[%d] (%s).mass: %g kg; the ODE world moves only bodies with mass",
                      mf, i, d->name, d->mass);
@@ -636,7 +808,7 @@ static int build(void* arg) {
         const chain_body_def* d = chain_body(w->mech, i);
         oc_body* b = &w->b[i];
         if (!b->body) continue;
-        dBodyID parent = i == 0 ? 0 : w->b[d->parent].body;
+        dBodyID parent = i == 0 ? (dBodyID)w->opt.host_base : w->b[d->parent].body;
         if (d->fixed) {
             b->joint = dJointCreateFixed(w->world, 0);
             dJointAttach(b->joint, b->body, parent);
@@ -646,7 +818,8 @@ static int build(void* arg) {
         b->q0 = w->qstart[b->dof];
         if (b->revolute) {
             // The slew turns about base z; a boom about its frame's -y.
-            const double ax[3] = {i == 0 ? 0.0 : -b->R[1], i == 0 ? 0.0 : -b->R[4], i == 0 ? 1.0 : -b->R[7]};
+            const double ax[3] = {i == 0 ? w->Rb[2] : -b->R[1], i == 0 ? w->Rb[5] : -b->R[4],
+                                  i == 0 ? w->Rb[8] : -b->R[7]};
             b->joint = dJointCreateHinge(w->world, 0);
             dJointAttach(b->joint, b->body, parent);
             dJointSetHingeAnchor(b->joint, b->p[0], b->p[1], b->p[2]);
@@ -666,6 +839,20 @@ static int build(void* arg) {
         }
         b->lo = d->q_min - q;
         b->hi = d->q_max - q;
+        if (i == 0 && w->slew_on && w->slew_stroke > 0) {
+            // The rack's ends: slew within +-s/(2 r) (crane_slew_stroke).
+            const double smax = 0.5 * w->slew_stroke / w->cc.slew.pinion_radius;
+            if (q < -smax - 1e-12 || q > smax + 1e-12) {
+                snprintf(ba->err, ba->errsz,
+                         "initial slew %.1f deg is outside the slew cylinder's range +-%.1f deg", q * 180.0 / M_PI,
+                         smax * 180.0 / M_PI);
+                return -1;
+            }
+            if (w->opt.stop_limits) {
+                if (-smax - q > b->lo) b->lo = -smax - q;
+                if (smax - q < b->hi) b->hi = smax - q;
+            }
+        }
     }
     // The cylinders' stroke ends as stops on the joint between their two
     // bodies (the only joint that changes their length), where one is the
@@ -713,11 +900,16 @@ static int build(void* arg) {
             snprintf(path, sizeof path, "%s.%s", cyl, par[j]);
             ok &= hyd_model_get(w->hm, path, &v[j]) == 0;
         }
-        if (!ok || !(v[0] > 0.0 || v[1] > 0.0) || !(v[2] > 0.0)) continue;
+        if (!ok || !(v[0] >= 0.0 && v[1] >= 0.0) || !(v[0] + v[1] > 0.0) || !(v[2] > 0.0) || !(v[3] > 0.0))
+            continue;
         a->seal = 1, a->seal_body = jb;
         a->Fc = v[0], a->Fs = v[1], a->vst = v[2], a->vsm = v[3];
-        a->seal_max = v[0] + v[1];
         w->b[jb].seal = 1;
+        // apply_seal's lever arms, one per DOF.
+        if (!w->dL && !(w->dL = calloc((size_t)w->ndof, sizeof *w->dL))) {
+            snprintf(ba->err, ba->errsz, "ode chain world: out of memory");
+            return -1;
+        }
     }
     return 0;
 }
@@ -749,8 +941,29 @@ ode_chain* ode_chain_create(const crane_chain* cc, const ode_chain_opts* o, char
         snprintf(err, errsz, "ode chain world: out of memory");
         return NULL;
     }
+    w->hosted = opt.host_world != NULL;
+    {
+        int any = 0;
+        for (int k = 0; k < 9; ++k) any |= opt.base_rot[k] != 0.0;
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) w->Rb[3 * r + c] = any ? opt.base_rot[3 * r + c] : r == c ? 1.0 : 0.0;
+        for (int k = 0; k < 3; ++k) w->pb[k] = w->hosted ? opt.base_pos[k] : 0.0;
+        if (!w->hosted && any) {
+            snprintf(err, errsz, "ode chain world: base_rot is for a hosted world only");
+            free_world(w);
+            return NULL;
+        }
+    }
+    // A slew drive turns the column: its joint is then a DOF (the copy's
+    // slew_free, so everything sized by the chain counts it).
+    if (opt.slew_drive) w->cc.slew_free = true;
+    if (opt.slew_drive && !opt.circuit) {
+        snprintf(err, errsz, "ode chain world: a slew drive needs the circuit");
+        free_world(w);
+        return NULL;
+    }
     char e[320];
-    w->mech = crane_chain_mechanism(&w->cc, opt.tip_mass, cc->slew_free, opt.slew0, e, sizeof e);
+    w->mech = crane_chain_mechanism(&w->cc, opt.tip_mass, w->cc.slew_free, opt.slew0, e, sizeof e);
     if (!w->mech) {
         snprintf(err, errsz, "%s: mechanics.%s", opt.model_file, e);
         free_world(w);
@@ -812,7 +1025,8 @@ ode_chain* ode_chain_create(const crane_chain* cc, const ode_chain_opts* o, char
 
 static int destroy_ode(void* arg) {
     ode_chain* w = arg;
-    if (w->world) {
+    // Hosted: the bodies and joints are the host's world's, gone with it.
+    if (w->world && !w->hosted) {
         dWorldSetStepThreadingImplementation(w->world, NULL, NULL);
         dWorldDestroy(w->world);
     }
@@ -839,6 +1053,7 @@ static void free_world(ode_chain* w) {
     free(w->u);
     free(w->qstart);
     free(w->qs);
+    free(w->dL);
     crane_chain_free(&w->cc);
     free(w);
 }
@@ -851,7 +1066,7 @@ void ode_chain_destroy(ode_chain* w) {
 
 static void apply_forces(ode_chain* w) {
     for (int k = 0; k < w->nact; ++k) {
-        const double F = w->a[k].F;
+        const double F = w->a[k].Fp;
         if (F == 0.0) continue;
         const crane_act* c = &w->cc.act[k];
         double u[3], pa[3], pb[3];
@@ -866,40 +1081,116 @@ static void apply_forces(ode_chain* w) {
         if (b->revolute) dJointAddHingeTorque(b->joint, w->tau[b->dof]);
         else dJointAddSliderForce(b->joint, w->tau[b->dof]);
     }
+    if (w->slew_on) {
+        // The rack's force F r (crane_slew_torque) and the slewing ring's
+        // viscous friction [N m s/rad] on the column's hinge.
+        dJointAddHingeTorque(w->b[0].joint, crane_slew_torque(&w->cc.slew, w->slew_F) -
+                                                w->cc.slew.damping * dJointGetHingeAngleRate(w->b[0].joint));
+    }
 }
 
-// implicit_seal: each joint's motor at zero speed, its force limit the sum
-// of its cylinders' seal friction times their lever arm |dL/dq| at the
-// present pose (a torque [N m] on a hinge, a force [N] on a slider), so
-// ODE's solver holds the joint still up to that friction and resists
-// motion with it, in the same step.
+// implicit_seal: the seal friction of each cylinder across one joint, by
+// the circuit's own law (hyd_cyl_seal: (F_c + F_s exp(-(v/v_st)^2))
+// tanh(v/v_sm), smooth through zero), as a line solved by ODE with the
+// step's end velocities: a linearly implicit step of the friction, where
+// the analytic mode's implicit solver holds the same law in the cylinder's
+// equation of motion. hyd_step gives each cylinder its line F_k(v) = Fs0_k
+// + c_k (v - v0_k) within +-Fmax_k: at rest and through the knee the law's
+// tangent at the step's rate v0 (c_k >= 0, the Stribeck fall explicit);
+// sliding (|v0| >= 4.95 v_sm, the tanh within 1e-4 of 1) a damper of the
+// law's slope at zero saturating at the law's magnitude at v0 (the tangent
+// is flat there, and a step that stops the cylinder would carry the
+// sliding friction past zero: explicit Coulomb friction's chatter). On
+// joint j with cylinders k of lever arm l_k = dL_k/dq (m/rad on a hinge, -
+// on a slider) the friction's generalized force is
+//   tau(qd) = -sum_k l_k [Fs0_k + c_k l_k (qd - qd0)]
+// [N m or N]. A joint motor with target rate vel and constraint force
+// mixing CFM gives ODE's row lambda = (vel - qd_new)/CFM within +-fmax, a
+// damper implicit in the new rate: C = sum l_k^2 c_k = 1/CFM and vel = qd0
+// - sum l_k Fs0_k / C reproduce tau, fmax = sum |l_k| Fmax_k its
+// saturation. Kept explicit (the circuit's friction at v0, in the force at
+// the pins): a joint at one of its ODE stops (ODE then applies a powered
+// motor as a fixed force, not a damper), and a joint whose C is below 1e-9
+// of its cylinders' steepest slope (l^2 (F_c + F_s) / v_sm), where the
+// implicit part is nothing and vel would overflow.
+static int stop_active(const oc_body* b) {
+    double x, lo, hi;
+    if (b->revolute) {
+        x = dJointGetHingeAngle(b->joint);
+        lo = dJointGetHingeParam(b->joint, dParamLoStop), hi = dJointGetHingeParam(b->joint, dParamHiStop);
+    } else {
+        x = dJointGetSliderPosition(b->joint);
+        lo = dJointGetSliderParam(b->joint, dParamLoStop), hi = dJointGetSliderParam(b->joint, dParamHiStop);
+    }
+    // As ODE's own test (dxJointLimitMotor::testRotationalLimit and the
+    // slider's): at or beyond a stop the limit row replaces the motor's.
+    return x <= lo || x >= hi;
+}
+
 static void apply_seal(ode_chain* w) {
-    int any = 0;
-    for (int k = 0; k < w->nact; ++k) any |= w->a[k].seal;
-    if (!any) return;
+    if (!w->dL) return; // no cylinder's friction held this way
+    for (int i = 0; i < w->nbody; ++i) {
+        oc_body* b = &w->b[i];
+        b->motor = 0, b->C = b->vel = b->fmax = b->steep = 0.0;
+    }
     ode_chain_q(w, w->qs, NULL);
-    for (int i = 0; i < w->nbody; ++i) w->b[i].fmax = 0.0;
+    chain_update(w->mech, w->ws, w->qs, NULL);
+    // Per joint: C, sum l F0 (in vel until the end), the force limit, and
+    // the steepest slope.
     for (int k = 0; k < w->nact; ++k) {
-        const oc_act* a = &w->a[k];
+        oc_act* a = &w->a[k];
         if (!a->seal) continue;
         oc_body* b = &w->b[a->seal_body];
         const crane_act* c = &w->cc.act[k];
-        // dL/dq by central differences of the mechanism's pin length.
-        const double q = w->qs[b->dof], h = 1e-6 * (1.0 + fabs(q));
-        w->qs[b->dof] = q + h;
-        chain_update(w->mech, w->ws, w->qs, NULL);
-        const double Lp = chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, NULL, NULL);
-        w->qs[b->dof] = q - h;
-        chain_update(w->mech, w->ws, w->qs, NULL);
-        const double Lm = chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, NULL, NULL);
-        w->qs[b->dof] = q;
-        b->fmax += a->seal_max * fabs(Lp - Lm) / (2.0 * h);
+        chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, w->dL, NULL);
+        const double l = w->dL[b->dof];
+        a->lever = l;
+        b->C += l * l * a->dFs;
+        b->vel += l * a->Fs0;
+        b->fmax += fabs(l) * a->Fmax;
+        b->steep += l * l * (a->Fc + a->Fs) / a->vsm;
     }
     for (int i = 0; i < w->nbody; ++i) {
         oc_body* b = &w->b[i];
         if (b->dof < 0 || !b->seal) continue;
-        set_param(b, dParamVel, 0.0);
-        set_param(b, dParamFMax, b->fmax);
+        const double lF0 = b->vel;
+        b->motor = b->C > 1e-9 * b->steep && !stop_active(b);
+        if (b->motor) {
+            double qd;
+            joint_q(w, b, &qd);
+            b->qd0 = qd;
+            b->vel = qd - lF0 / b->C;
+            set_param(b, dParamCFM, 1.0 / b->C);
+            set_param(b, dParamVel, b->vel);
+        }
+        // fmax 0 switches the motor off (ODE adds no row).
+        set_param(b, dParamFMax, b->motor ? b->fmax : 0.0);
+    }
+    // The force at the pins: without the seal friction where the motor
+    // holds it.
+    for (int k = 0; k < w->nact; ++k) {
+        oc_act* a = &w->a[k];
+        a->Fp = a->seal && w->b[a->seal_body].motor ? a->F + a->Fsc : a->F;
+    }
+}
+
+// After the step: the seal friction the motor applied, shared out to its
+// cylinders by their linearised laws (scaled where the force limit cut the
+// sum), so each cylinder's F is its force over the step, friction included,
+// as the analytic mode reports it.
+static void seal_applied(ode_chain* w) {
+    if (!w->dL) return;
+    for (int k = 0; k < w->nact; ++k) {
+        oc_act* a = &w->a[k];
+        if (!a->seal || !w->b[a->seal_body].motor) continue;
+        const oc_body* b = &w->b[a->seal_body];
+        double qd;
+        joint_q(w, b, &qd);
+        // ODE's row: lambda = C (vel - qd), within +-fmax.
+        const double lin = b->C * (b->vel - qd);
+        const double lam = lin > b->fmax ? b->fmax : lin < -b->fmax ? -b->fmax : lin;
+        const double scale = lin != 0.0 ? lam / lin : 1.0;
+        a->F = a->Fp - scale * (a->Fs0 + a->dFs * a->lever * (qd - b->qd0));
     }
 }
 
@@ -917,27 +1208,91 @@ typedef struct step_args {
     long n;
 } step_args;
 
+// One step's work before ODE's step: the strokes read, the hydraulic
+// sub-steps, the forces on the bodies.
+static int pre_step(ode_chain* w) {
+    for (int k = 0; k < w->nact; ++k)
+        w->a[k].x0 = act_geometry(w, k, &w->a[k].v0, NULL, NULL, NULL) - w->cc.act[k].closed_length;
+    if (w->slew_on) w->slew_x0 = slew_kinematics(w, &w->slew_v0);
+    if (w->hm && hyd_step(w, w->opt.dt_ode)) return -1;
+    // The seal's motor first: apply_forces applies the part of the
+    // cylinder force ODE's solver does not hold (apply_seal splits it).
+    apply_seal(w);
+    apply_forces(w);
+    return 0;
+}
+
+// And after it: the clock, the hinges' turns, the bodies' check.
+static int post_step(ode_chain* w) {
+    seal_applied(w);
+    ++w->nstep;
+    w->t = (double)w->nstep * w->opt.dt_ode;
+    read_turns(w);
+    for (int i = 0; i < w->nbody; ++i)
+        if (w->b[i].body && !body_finite(w->b[i].body)) {
+            snprintf(w->err, sizeof w->err, "ode chain world: body %s became non-finite at t = %.6f s",
+                     w->cc.body[i].def.name, w->t);
+            return -1;
+        }
+    return 0;
+}
+
 static int step_n(void* arg) {
     step_args* sa = arg;
     ode_chain* w = sa->w;
-    const double H = w->opt.dt_ode;
     for (long s = 0; s < sa->n; ++s) {
-        for (int k = 0; k < w->nact; ++k)
-            w->a[k].x0 = act_geometry(w, k, &w->a[k].v0, NULL, NULL, NULL) - w->cc.act[k].closed_length;
-        if (w->hm && hyd_step(w, H)) return -1;
-        apply_forces(w);
-        apply_seal(w);
-        dWorldStep(w->world, H);
-        ++w->nstep;
-        w->t = (double)w->nstep * H;
-        read_turns(w);
-        for (int i = 0; i < w->nbody; ++i)
-            if (w->b[i].body && !body_finite(w->b[i].body)) {
-                snprintf(w->err, sizeof w->err, "ode chain world: body %s became non-finite at t = %.6f s",
-                         w->cc.body[i].def.name, w->t);
-                return -1;
-            }
+        if (pre_step(w)) return -1;
+        dWorldStep(w->world, w->opt.dt_ode);
+        if (post_step(w)) return -1;
     }
+    return 0;
+}
+
+int ode_chain_host_pre(ode_chain* w) {
+    if (w->failed) return -1;
+    if (pre_step(w)) w->failed = 1;
+    return w->failed ? -1 : 0;
+}
+
+int ode_chain_host_post(ode_chain* w) {
+    if (w->failed) return -1;
+    if (post_step(w)) w->failed = 1;
+    return w->failed ? -1 : 0;
+}
+
+void ode_chain_host_failed(ode_chain* w) {
+    w->dead = w->failed = 1;
+    if (!w->err[0]) snprintf(w->err, sizeof w->err, "ode chain world: its host's world failed in ODE");
+}
+
+struct dxBody* ode_chain_body_id(const ode_chain* w, int i, double org[3]) {
+    if (i < 0 || i >= w->nbody) return NULL;
+    if (org) memcpy(org, w->b[i].org, sizeof w->b[i].org);
+    return w->b[i].body;
+}
+
+const crane_chain* ode_chain_chain(const ode_chain* w) { return &w->cc; }
+
+void ode_chain_act_pins(const ode_chain* w, int k, double pa[3], double pb[3]) {
+    if (w->dead || k < 0 || k >= w->nact) {
+        for (int i = 0; i < 3; ++i) pa[i] = pb[i] = NAN;
+        return;
+    }
+    act_geometry(w, k, NULL, NULL, pa, pb);
+}
+
+void ode_chain_set_slew_command(ode_chain* w, double u) { w->slew_u = u > 1 ? 1 : u < -1 ? -1 : (u == u ? u : 0); }
+
+int ode_chain_slew_state(const ode_chain* w, double* x, double* v, double* F, double* pA, double* pB, int* at_stop_) {
+    if (!w->slew_on) return -1;
+    double xx = NAN, vv = NAN;
+    if (!w->dead) xx = slew_kinematics(w, &vv);
+    if (x) *x = xx;
+    if (v) *v = vv;
+    if (F) *F = w->slew_F;
+    if (pA) *pA = w->y[w->slew_iA];
+    if (pB) *pB = w->y[w->slew_iB];
+    if (at_stop_) *at_stop_ = !w->dead && (at_stop(&w->b[0]) || w->hd->cyl_stop[w->slew_cyl] != 0);
     return 0;
 }
 
@@ -945,6 +1300,11 @@ int ode_chain_step(ode_chain* w, double dt) {
     if (w->failed) return -1;
     const double steps = floor(dt / w->opt.dt_ode + 0.5);
     step_args sa = {w, steps > 1e12 ? (long)1e12 : steps < 1 ? 1 : (long)steps};
+    if (w->hosted) {
+        snprintf(w->err, sizeof w->err, "ode chain world: hosted; its host steps it (ode_chain_host_pre, _post)");
+        w->failed = 1;
+        return -1;
+    }
     char fatal[200];
     const int rc = ow_ode_call(step_n, &sa, fatal, sizeof fatal);
     if (rc == OW_ODE_FAILED) {
@@ -970,7 +1330,7 @@ void ode_chain_set_commands(ode_chain* w, const double* u) {
 
 void ode_chain_set_forces(ode_chain* w, const double* F) {
     if (w->hm) return; // the circuit's forces
-    for (int k = 0; k < w->nact; ++k) w->a[k].F = isfinite(F[k]) ? F[k] : 0.0;
+    for (int k = 0; k < w->nact; ++k) w->a[k].F = w->a[k].Fp = isfinite(F[k]) ? F[k] : 0.0;
 }
 
 void ode_chain_set_joint_forces(ode_chain* w, const double* tau) {
@@ -1058,6 +1418,11 @@ static const hyd_data* energy_eval(void* user, double t, const double* y) {
         d->cyl_v[c] = w->a[k].v0;
     }
     for (int f = 0; f < w->nfn; ++f) d->valve_cmd[w->cc.fn[f].valve_idx] = w->u[f];
+    if (w->slew_on) {
+        d->cyl_x[w->slew_cyl] = w->slew_x0 + w->slew_v0 * tau;
+        d->cyl_v[w->slew_cyl] = w->slew_v0;
+        d->valve_cmd[w->slew_valve] = w->slew_u;
+    }
     hyd_eval(w->hm, d, t, y, w->ydot);
     return d;
 }

@@ -7,13 +7,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-int ode_chain_rows_init(ode_chain_rows* r, const crane_chain* cc, const hyd_model* hm) {
+int ode_chain_rows_init(ode_chain_rows* r, const crane_chain* cc, const hyd_model* hm, int ndof) {
     memset(r, 0, sizeof *r);
     r->cc = cc;
     r->hm = hm;
-    // The mechanism's DOFs: the joints that are not fixed, the column's
-    // when it slews.
-    r->na = cc->nact, r->nf = cc->nfn, r->nd = crane_chain_ndof(cc);
+    r->na = cc->nact, r->nf = cc->nfn, r->nd = ndof;
     const size_t na = (size_t)r->na, nf = (size_t)r->nf, nd = (size_t)r->nd;
     double* buf = calloc(5 * na + 2 * nf + 2 * nd + 1, sizeof *buf);
     r->iu = calloc(nf + 1, sizeof *r->iu);
@@ -38,8 +36,7 @@ void ode_chain_rows_free(ode_chain_rows* r) {
 
 int ode_chain_row_ncol(const crane_chain* cc) { return SIM_NCOL + cc->ncol; }
 
-// Every actuator's and function's outputs now, into r's arrays.
-static void outputs(ode_chain_rows* r, const ode_chain* w) {
+void ode_chain_rows_outputs(ode_chain_rows* r, const ode_chain* w) {
     const double* y;
     const hyd_data* hd;
     ode_chain_circuit_state(w, &y, &hd);
@@ -55,7 +52,7 @@ static void outputs(ode_chain_rows* r, const ode_chain* w) {
 }
 
 void ode_chain_make_row(ode_chain_rows* r, const ode_chain* w, double t, double* row) {
-    outputs(r, w);
+    ode_chain_rows_outputs(r, w);
     memset(row, 0, SIM_NCOL * sizeof *row);
     const crane_chain_sample smp = {r->x, r->v, r->pA, r->pB, r->F, r->u, r->ucmd, r->q, r->qd};
     crane_chain_row(r->cc, &smp, row + SIM_NCOL);

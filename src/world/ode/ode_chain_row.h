@@ -23,9 +23,14 @@ typedef struct ode_chain_rows {
     double *x, *v, *pA, *pB, *F, *u, *ucmd, *q, *qd; ///< the outputs, sized by the chain
 } ode_chain_rows;
 
-/// Buffers for chain cc on circuit hm (cc bound to it). 0, or -1 when out of memory.
-int ode_chain_rows_init(ode_chain_rows* r, const crane_chain* cc, const hyd_model* hm);
+/// Buffers for chain cc on circuit hm (cc bound to it) with nd degrees of
+/// freedom (the world's: ode_chain_ndof). 0, or -1 when out of memory.
+int ode_chain_rows_init(ode_chain_rows* r, const crane_chain* cc, const hyd_model* hm, int nd);
 void ode_chain_rows_free(ode_chain_rows* r);
+
+/// Every actuator's and function's outputs of world w now, into r's arrays
+/// (x, v, pA, pB, F, u, ucmd, q, qd).
+void ode_chain_rows_outputs(ode_chain_rows* r, const ode_chain* w);
 
 /// Columns of a row: the backend's SIM_NCOL channels, then the chain's own
 /// (cc->ncol).

@@ -325,6 +325,7 @@ static const hyd_data* energy_eval(void* user, double t, const double* y) {
 }
 
 int ode_world_follow_energy(ode_world* w, struct sim_energy* e) {
+    if (w->chain) return ode_chain_follow_energy(w->chain, e); // its own circuit
     if (!w->hm || !e) return -1;
     w->energy = e;
     if (sim_energy_follow(e, w->nh, energy_eval, w) || sim_energy_follow_sample(e, w->th, w->y, NAN)) {

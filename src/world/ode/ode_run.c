@@ -87,13 +87,17 @@ int ode_world_take_model_slew(const model* m, world_desc* wd, char* err, size_t 
 
 ode_world* ode_world_for_run(const model* m, const sim_opts* o, const char* default_world, const double q0[2],
                               double slew0, double m3, char* err, size_t errsz) {
-    // The ODE world is built from the two-link crane_mech (a chain model
-    // gets the chain world, ode_chain.h, where an engine runs one).
-    if (model_require_two_link(m, "ODE world (--mechanics ode)", err, errsz)) return NULL;
     char wbuf[512];
     const char* wpath = sim_world_path(o->world ? o->world : default_world, wbuf, sizeof wbuf);
     world_desc wd;
     if (world_desc_load(wpath, &wd, err, errsz)) return NULL;
+    // The validation world is built from the two-link crane_mech (a chain
+    // model's is the chain world, ode_chain.h); the sandbox from either (a
+    // chain that is not two_link: its crane from the chain, opts.chain).
+    if (wd.kind != WORLD_SANDBOX && model_require_two_link(m, "ODE world (--mechanics ode)", err, errsz)) {
+        world_desc_free(&wd);
+        return NULL;
+    }
     if (ode_world_take_model_slew(m, &wd, err, errsz)) {
         world_desc_free(&wd);
         return NULL;
@@ -138,6 +142,7 @@ ode_world* ode_world_for_run(const model* m, const sim_opts* o, const char* defa
     wo.p_low = 0.5e6; // as the lagrange backend, so both start from the same state
     wo.model_file = m->file;
     wo.circuit = m->hyd; // the run's one circuit unless the world adds to it
+    wo.chain = m->chain.two_link ? NULL : &m->chain;
     const cJSON* hyd = cJSON_GetObjectItemCaseSensitive(m->json, "hydraulics");
     if (m->world_bursts) {
         // Bursts at nodes of the world's circuit (the sandbox's slew) open

@@ -201,8 +201,8 @@ static void build_truck(ode_world* w, const double T[3], const double R[9]) {
 static void build_rope(ode_world* w) {
     const world_rope* r = &w->desc.rope;
     const world_hook* hk = &w->desc.hook;
-    double tip[3], tl[3] = {w->mech.link[1].length, 0, 0};
-    ow_frame_point(w, 2, tl, tip);
+    double tip[3];
+    ow_tip(w, tip, NULL);
     static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     int n = r->links;
     double l = r->length / n, ml = r->mass_per_m * l;
@@ -523,6 +523,7 @@ static int build_terrain_mesh(ode_world* w, char* err, size_t errsz) {
 }
 
 static double settle_rope(ode_world* w);
+static int build_two_link(ode_world* w, const double base[3], const double R[9], char* err, size_t errsz);
 
 int ow_build_sandbox(ode_world* w, char* err, size_t errsz) {
     const world_truck* k = &w->desc.truck;
@@ -534,7 +535,31 @@ int ow_build_sandbox(ode_world* w, char* err, size_t errsz) {
     ow_rot_z(k->yaw, R);
     build_truck(w, T, R);
 
-    // Column on the bed, slewed by slew0 about the truck's z axis.
+    double base_t[3] = {k->column_x, 0, k->bed_height}, base[3];
+    ow_mat_vec(R, base_t, base);
+    for (int i = 0; i < 3; ++i) base[i] += T[i];
+    if (w->chain_hm) {
+        // The crane from the model's chain, its column foot on the bed.
+        if (ow_build_chain_crane(w, base, R, err, errsz)) return -1;
+    } else if (build_two_link(w, base, R, err, errsz)) {
+        return -1;
+    }
+    build_rope(w);
+    if (build_loads(w, err, errsz) || build_obstacles(w, err, errsz)) return -1;
+    const double overlap = settle_rope(w);
+    if (overlap > 0) {
+        snprintf(err, errsz,
+                 "initial pose q1 = %.1f deg, q2 = %.1f deg leaves no room for the rope and hook: they would start "
+                 "%.2f m inside the ground, the truck, a boom or an obstacle (raise the boom tip)",
+                 w->opt.q0[0] * 180.0 / M_PI, w->opt.q0[1] * 180.0 / M_PI, overlap);
+        return -1;
+    }
+    return 0;
+}
+
+// The two-link crane on the truck: the column slewed by slew0 about the
+// truck's z axis, its foot at base [m], the slew hinge and its stops.
+static int build_two_link(ode_world* w, const double base[3], const double R[9], char* err, size_t errsz) {
     const ow_act* s = &w->act[ODE_SLEW];
     double r = w->desc.slew.pinion_radius, smax = s->stroke > 0 ? 0.5 * s->stroke / r : M_PI;
     if (s->present && fabs(w->opt.slew0) > smax) {
@@ -542,9 +567,6 @@ int ow_build_sandbox(ode_world* w, char* err, size_t errsz) {
                  w->opt.slew0 * 180.0 / M_PI, smax * 180.0 / M_PI);
         return -1;
     }
-    double base_t[3] = {k->column_x, 0, k->bed_height}, base[3];
-    ow_mat_vec(R, base_t, base);
-    for (int i = 0; i < 3; ++i) base[i] += T[i];
     double Rs[9], Rc[9];
     ow_rot_z(w->opt.slew0, Rs);
     ow_mat_mul(R, Rs, Rc);
@@ -575,16 +597,6 @@ int ow_build_sandbox(ode_world* w, char* err, size_t errsz) {
         dJointSetHingeParam(w->slew_joint, dParamBounce, 0.0);
     }
     ow_slew_stops(w);
-    build_rope(w);
-    if (build_loads(w, err, errsz) || build_obstacles(w, err, errsz)) return -1;
-    const double overlap = settle_rope(w);
-    if (overlap > 0) {
-        snprintf(err, errsz,
-                 "initial pose q1 = %.1f deg, q2 = %.1f deg leaves no room for the rope and hook: they would start "
-                 "%.2f m inside the ground, the truck, a boom or an obstacle (raise the boom tip)",
-                 w->opt.q0[0] * 180.0 / M_PI, w->opt.q0[1] * 180.0 / M_PI, overlap);
-        return -1;
-    }
     return 0;
 }
 
@@ -644,8 +656,8 @@ static double rope_overlap(const ode_world* w) {
 // within 2 ms).
 static double settle_rope(ode_world* w) {
     const int n = w->nrope;
-    double tip[3], tl[3] = {w->mech.link[1].length, 0, 0};
-    ow_frame_point(w, 2, tl, tip);
+    double tip[3];
+    ow_tip(w, tip, NULL);
     if (rope_overlap(w) <= 5e-3) return 0; // hangs free: as built
     const dReal* col = dBodyGetPosition(w->frame[0].body);
     double d0[2] = {tip[0] - col[0], tip[1] - col[1]};
@@ -850,6 +862,8 @@ double ow_stab_margin(const ode_world* w, double* weight) {
         c[0] += 0.25 * q[0], c[1] += 0.25 * q[1];
     }
     double margin = ODE_STAB_MARGIN_MAX, W = 0;
+    dBodyID cb[OW_MAX_GEOMS];
+    const int ncb = ow_crane_bodies(w, cb, OW_MAX_GEOMS);
     for (int e = 0; e < OW_NSUPPORT; ++e) {
         const double* a = P[e];
         const double* b = P[(e + 1) % OW_NSUPPORT];
@@ -861,7 +875,7 @@ double ow_stab_margin(const ode_world* w, double* weight) {
         double R = 0, T = 0;
         W = 0;
         line_moment(w->truck, w->g, a, n, &R, &T, &W);
-        for (int f = 0; f < 3; ++f) line_moment(w->frame[f].body, w->g, a, n, &R, &T, &W);
+        for (int f = 0; f < ncb; ++f) line_moment(cb[f], w->g, a, n, &R, &T, &W);
         for (int i = 0; i < w->nrope; ++i) line_moment(w->rope[i], w->g, a, n, &R, &T, &W);
         line_moment(w->hook, w->g, a, n, &R, &T, &W);
         if (w->attached >= 0) line_moment(w->load[w->attached], w->g, a, n, &R, &T, &W);
@@ -952,6 +966,19 @@ void ow_sandbox_snapshot(const ode_world* w, world_snapshot* s) {
             y->pB = w->y[c->iB];
             y->u = c->iu >= 0 ? w->y[c->iu] : 0;
         }
+        if (w->chain) {
+            // The chain's rack: its chambers and spool from the chain's circuit.
+            const crane_chain* cc = ode_chain_chain(w->chain);
+            const double* cy;
+            const hyd_data* hd;
+            ode_chain_circuit_state(w->chain, &cy, &hd);
+            ode_chain_slew_state(w->chain, NULL, NULL, NULL, &y->pA, &y->pB, NULL);
+            const int iv = hyd_model_valve(w->chain_hm, cc->slew.valve), iu = hyd_model_valve_state(w->chain_hm, iv);
+            y->u = iu >= 0 ? cy[iu] : 0.0;
+            y->u_cmd = hd->valve_cmd[iv];
+            y->bore = sqrt(4.0 * c->AA / M_PI);
+            y->rod = sqrt(4.0 * (c->AA - c->AB) / M_PI);
+        }
     }
 }
 
@@ -965,8 +992,8 @@ static void set_rigid_vel(dBodyID b, const double tip[3], const double om[3]) {
 void ode_world_swing_hook(ode_world* w, const double omega[3]) {
     if (w->dead) return;
     if (w->kind != WORLD_SANDBOX) return;
-    double tip[3], tl[3] = {w->mech.link[1].length, 0, 0};
-    ow_frame_point(w, 2, tl, tip);
+    double tip[3];
+    ow_tip(w, tip, NULL);
     for (int i = 0; i < w->nrope; ++i) set_rigid_vel(w->rope[i], tip, omega);
     set_rigid_vel(w->hook, tip, omega);
 }

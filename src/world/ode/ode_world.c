@@ -1,6 +1,7 @@
 // ode_world.c: ODE world lifecycle, the crane (column, lifting arm, end arm,
 // hinges, cylinder mounts), the step loop, state and snapshot.
 #include "ode_world_internal.h"
+#include "model.h"
 #include "snap_reliefs.h"
 
 #include <math.h>
@@ -14,109 +15,42 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-// ODE keeps global tables (collider registry, thread-local data); it must be
-// initialised once before the first world and closed after the last. A
-// counter lets several worlds coexist (tests, compare runs). This is the one
-// piece of global mutable state the project allows; worlds must be created
-// and destroyed from one thread.
-// The ODE library's state: its users, and the non-fatal messages it sends
-// (dMessage: "LCP internal error, s <= 0" on a degenerate contact set),
-// which it would print to stderr itself, outside our one-line messages and
-// unrelated to the run. They are counted here and reported by the caller
-// (ode_world_messages).
-// ODE's errors and failed internal checks (dError, dDebug: an assertion such
-// as "!bSafeNormalize4Fault" in dxNormalize4 on a quaternion that a 1e-300 kg
-// link or a 1e308 kg truck has turned into NaN) call abort() by default, and
-// their handler must not return. Every entry point that runs ODE code arms a
-// trap (ow_trapped); the handler jumps back to it, the world is marked dead
-// and from then on only destroyed. The caller sees an ordinary runtime
-// failure (exit 1, rows kept) instead of SIGABRT.
-static struct {
-    int users;
-    long messages;
-    char last[160];
-    jmp_buf* trap; ///< the armed entry point, or NULL
-    char fatal[200]; ///< text of the last ODE error
-} g_ode;
-
-static void ode_message(int num, const char* msg, va_list ap) {
-    (void)num;
-    vsnprintf(g_ode.last, sizeof g_ode.last, msg, ap);
-    g_ode.messages++;
-}
-
-static void ode_fatal(int num, const char* msg, va_list ap) {
-    (void)num;
-    vsnprintf(g_ode.fatal, sizeof g_ode.fatal, msg, ap);
-    if (g_ode.trap) longjmp(*g_ode.trap, 1);
-    // No world call is running (cannot happen through this module's API):
-    // nothing to return to. exit, not abort, so the rows already written are
-    // flushed.
-    fprintf(stderr, "cranesim: ODE error outside a world call: %s\n", g_ode.fatal);
-    exit(1);
-}
-
-void ow_ode_acquire(void) {
-    if (g_ode.users++ == 0) {
-        dInitODE2(0);
-        dSetMessageHandler(ode_message);
-        dSetErrorHandler(ode_fatal);
-        dSetDebugHandler(ode_fatal);
-    }
-}
-
-void ow_ode_release(void) {
-    if (--g_ode.users == 0) dCloseODE();
-}
-
-// Run fn(w, arg) with ODE's errors caught. Returns fn's result, or
-// OW_ODE_FAILED after an ODE error; then w is dead (w->err says why) and
-// only ode_world_destroy may touch it. Nothing in fn may rely on running to
-// its end (the jump skips the rest of fn and of ODE's own frames): fn only
-// steps or reads the world, which is then discarded whole.
+// Run fn(w, arg) with ODE's errors caught (ow_ode_call). Returns fn's
+// result, or OW_ODE_FAILED after an ODE error; then w is dead (w->err says
+// why) and only ode_world_destroy may touch it. Nothing in fn may rely on
+// running to its end (the jump skips the rest of fn and of ODE's own
+// frames): fn only steps or reads the world, which is then discarded whole.
 typedef int (*ow_fn)(ode_world* w, void* arg);
+typedef struct trap_args {
+    ode_world* w;
+    ow_fn fn;
+    void* arg;
+} trap_args;
+static int trap_call(void* p) {
+    trap_args* t = p;
+    return t->fn(t->w, t->arg);
+}
 static int ow_trapped(ode_world* w, const char* what, ow_fn fn, void* arg) {
-    jmp_buf jb;
-    jmp_buf* const prev = g_ode.trap;
-    if (setjmp(jb)) {
-        g_ode.trap = prev;
-        w->dead = 1;
-        w->failed = 1;
-        if (w->world_built)
-            snprintf(w->err, sizeof w->err,
-                     "ode world: ODE failed %s at t = %.6f s (%.150s): a mass, size or position far outside the "
-                     "physical range; the world was stopped",
-                     what, w->t, g_ode.fatal);
-        else
-            snprintf(w->err, sizeof w->err,
-                     "ode world: ODE failed %s (%.150s): a mass, size or position far outside the physical range",
-                     what, g_ode.fatal);
-        return OW_ODE_FAILED;
-    }
-    g_ode.trap = &jb;
-    const int rc = fn(w, arg);
-    g_ode.trap = prev;
-    return rc;
+    trap_args t = {w, fn, arg};
+    char fatal[200];
+    const int rc = ow_ode_call(trap_call, &t, fatal, sizeof fatal);
+    if (rc != OW_ODE_FAILED) return rc;
+    w->dead = 1;
+    w->failed = 1;
+    if (w->chain) ode_chain_host_failed(w->chain); // its bodies are this world's
+    if (w->world_built)
+        snprintf(w->err, sizeof w->err,
+                 "ode world: ODE failed %s at t = %.6f s (%.150s): a mass, size or position far outside the "
+                 "physical range; the world was stopped",
+                 what, w->t, fatal);
+    else
+        snprintf(w->err, sizeof w->err,
+                 "ode world: ODE failed %s (%.150s): a mass, size or position far outside the physical range",
+                 what, fatal);
+    return OW_ODE_FAILED;
 }
 
-int ow_ode_call(int (*fn)(void* arg), void* arg, char* fatal, size_t n) {
-    jmp_buf jb;
-    jmp_buf* const prev = g_ode.trap;
-    if (setjmp(jb)) {
-        g_ode.trap = prev;
-        snprintf(fatal, n, "%s", g_ode.fatal);
-        return OW_ODE_FAILED;
-    }
-    g_ode.trap = &jb;
-    const int rc = fn(arg);
-    g_ode.trap = prev;
-    return rc;
-}
-
-long ode_world_messages(const char** last) {
-    if (last) *last = g_ode.last;
-    return g_ode.messages;
-}
+long ode_world_messages(const char** last) { return ow_ode_messages(last); }
 
 ode_world_opts ode_world_default_opts(void) {
     ode_world_opts o;
@@ -448,6 +382,173 @@ int ow_build_crane(ode_world* w, const double col_pos[3], const double col_rot[9
     return 0;
 }
 
+// ---- the chain crane (opts.chain) ----
+
+void ow_tip(const ode_world* w, double p[3], double v[3]) {
+    if (w->chain) {
+        ode_chain_tip(w->chain, p, v);
+        return;
+    }
+    double tl[3] = {w->mech.link[1].length, 0, 0};
+    ow_frame_point(w, 2, tl, p);
+    if (v) ow_frame_point_vel(w, 2, tl, v);
+}
+
+int ow_crane_bodies(const ode_world* w, dBodyID* b, int max) {
+    int n = 0;
+    if (w->chain) {
+        const int nb = ode_chain_chain(w->chain)->nbody;
+        for (int i = 0; i < nb && n < max; ++i) {
+            dBodyID x = ode_chain_body_id(w->chain, i, NULL);
+            if (x) b[n++] = x;
+        }
+        return n;
+    }
+    for (int f = 0; f < 3 && n < max; ++f)
+        if (w->frame[f].body) b[n++] = w->frame[f].body;
+    return n;
+}
+
+int ow_build_chain_crane(ode_world* w, const double base[3], const double R[9], char* err, size_t errsz) {
+    // The chain as the model gives it, with the slew drive the run uses (the
+    // model's where it has one, else the world's: ode_world_take_model_slew
+    // has put it into desc.slew either way), and the column slewing.
+    crane_chain cc = *w->opt.chain; // shallow: ode_chain_create copies it
+    const world_slew* ds = &w->desc.slew;
+    cc.slew.present = true;
+    snprintf(cc.slew.cylinder, sizeof cc.slew.cylinder, "%s", ds->cylinder);
+    snprintf(cc.slew.valve, sizeof cc.slew.valve, "%s", ds->valve);
+    cc.slew.pinion_radius = ds->pinion_radius;
+    cc.slew.column_radius = ds->column_radius;
+    cc.slew.damping = ds->damping;
+    cc.slew_free = true;
+    cc.gravity = w->g; // the world's (a world file may set its own)
+    const int nd = crane_chain_ndof(&cc);
+    // q and qd, then the commands of ode_world_set_commands (nfn).
+    w->chain_q = calloc((size_t)(2 * nd + cc.nfn + 2), sizeof *w->chain_q);
+    if (!w->chain_q) {
+        snprintf(err, errsz, "ode world: out of memory");
+        return -1;
+    }
+    {
+        // The slew drive's parts in the circuit, named where they were given.
+        const bool from_model = w->desc.slew_file[0] != 0;
+        const char* wf = from_model ? w->desc.slew_file : w->desc.file[0] ? w->desc.file : "world";
+        const char* sf = from_model ? "mechanics.slew" : "slew";
+        const int nc = hyd_model_cylinder(w->chain_hm, ds->cylinder) < 0, nv = hyd_model_valve(w->chain_hm, ds->valve) < 0;
+        if (nc || nv) {
+            snprintf(err, errsz, "%s: %s.%s: no %s named \"%s\" in the circuit", wf, sf, nc ? "cylinder" : "valve",
+                     nc ? "cylinder" : "valve", nc ? ds->cylinder : ds->valve);
+            return -1;
+        }
+    }
+    // The scenario's start (q1, q2, slew0) as the chain's start pose, every
+    // other joint at the middle of its limits (crane_chain_start_pose).
+    crane_chain_start_pose(&cc, w->opt.q0, w->opt.slew0, w->chain_q);
+    ode_chain_opts co = ode_chain_default_opts();
+    co.dt_ode = w->opt.dt_ode;
+    co.dt_hyd = w->opt.dt_hyd;
+    co.solver = w->opt.solver;
+    co.jac_every = w->opt.jac_every > 0 ? w->opt.jac_every : 1;
+    co.q0 = w->chain_q;
+    co.slew0 = w->opt.slew0;
+    co.stop_limits = w->opt.stop_limits;
+    co.init_hold = w->opt.init_hold;
+    co.p_low = w->opt.p_low;
+    co.circuit = w->chain_hm;
+    co.model_file = w->opt.model_file;
+    // The seal friction a step late, as the two-link sandbox applies it:
+    // a design and its chain variant driven in the sandbox then differ by
+    // their design, not by how the world couples friction (the chain world's
+    // implicit seal, its default, is for the comparison with the analytic
+    // mode in the validation world; docs/ode_world.md).
+    co.implicit_seal = 0;
+    co.host_world = w->world;
+    co.host_base = w->truck;
+    memcpy(co.base_pos, base, sizeof co.base_pos);
+    memcpy(co.base_rot, R, sizeof co.base_rot);
+    co.slew_drive = 1;
+    // The rope and hook hang at the tip: the start pressures hold them too,
+    // as the two-link sandbox's (ow_hyd_init_state).
+    co.hold_tip_mass = w->desc.hook.mass + w->desc.rope.mass_per_m * w->desc.rope.length;
+    w->chain = ode_chain_create(&cc, &co, err, errsz);
+    if (!w->chain) return -1;
+    const crane_chain* c = ode_chain_chain(w->chain);
+    // A collision box (a cylinder for the column) and a drawing per body,
+    // named after it: the column over its height along z, a boom or an
+    // extension from its joint along x over its length, its section width
+    // x height. The two-link meshes fit the two-link crane's sizes only, so
+    // the chain's bodies are drawn as their primitives.
+    for (int i = 0; i < c->nbody; ++i) {
+        double org[3];
+        dBodyID b = ode_chain_body_id(w->chain, i, org);
+        const crane_body* cb = &c->body[i];
+        if (!b) continue;
+        const double L = cb->length;
+        const double r = i == 0 ? (c->slew.column_radius > 0 ? c->slew.column_radius : 0.5 * cb->height) : 0.0;
+        if (!(L > 0) || (i == 0 ? !(r > 0) : !(cb->width > 0 && cb->height > 0))) continue; // nothing to collide
+        double pos[3] = {org[0], org[1], org[2]}, sz[3];
+        dGeomID g;
+        if (i == 0) {
+            pos[2] += 0.5 * L;
+            g = dCreateCylinder(w->dyn_space, r, L);
+            sz[0] = r, sz[1] = L, sz[2] = 0;
+        } else {
+            pos[0] += 0.5 * L;
+            g = dCreateBox(w->dyn_space, L, cb->width, cb->height);
+            sz[0] = L, sz[1] = cb->width, sz[2] = cb->height;
+        }
+        dGeomSetBody(g, b);
+        dGeomSetOffsetPosition(g, pos[0], pos[1], pos[2]);
+        ow_geom_name(ow_add_geom(w, g, OW_CAT_CRANE, 0.5), cb->def.name);
+        const world_role role = i == 0 ? WORLD_ROLE_COLUMN : i == 1 ? WORLD_ROLE_BOOM1 : WORLD_ROLE_BOOM2;
+        const float* rgba = i == 0 ? RGBA_COLUMN : i == 1 ? RGBA_BOOM1 : RGBA_BOOM2;
+        ow_add_vis(w, cb->def.name, role, i == 0 ? WORLD_SHAPE_CYLINDER : WORLD_SHAPE_BOX, sz, rgba, -1, b, pos, NULL);
+    }
+    // Frames for the sandbox's column and rope (frame 1: the first boom).
+    memset(w->frame, 0, sizeof w->frame);
+    w->frame[0].body = ode_chain_body_id(w->chain, 0, w->frame[0].org);
+    if (c->nbody > 1) w->frame[1].body = ode_chain_body_id(w->chain, 1, w->frame[1].org);
+    w->frame[2].body = ode_chain_body_id(w->chain, c->tip_body, w->frame[2].org);
+    if (!w->frame[0].body || !w->frame[2].body) {
+        snprintf(err, errsz, "%s: mechanics: the sandbox needs a column and a tip body ODE moves", w->opt.model_file);
+        return -1;
+    }
+    // The slew's display copy (the snapshot's rack, ow_sandbox_snapshot).
+    ow_act* s = &w->act[ODE_SLEW];
+    s->present = 1;
+    hyd_model_cylinder_geometry(w->chain_hm, hyd_model_cylinder(w->chain_hm, c->slew.cylinder), &s->AA, &s->AB,
+                                &s->stroke);
+    ow_read_actuators(w);
+    return 0;
+}
+
+// The chain's compiled circuit: the model's hydraulics with the world's
+// part (the slew's) appended, as ow_hyd_create compiles it for the
+// two-link crane; the model's own circuit when the world adds none.
+static int chain_circuit(ode_world* w, const cJSON* hydraulics, const world_desc* desc, char* err, size_t errsz) {
+    const cJSON* frag = world_desc_circuit_for(desc, hydraulics);
+    const char* part = desc->slew_file[0] ? "hydraulics_slew" : frag && frag == desc->circuit_ls ? "circuit_ls"
+                                                                                                 : "circuit";
+    const char* wf = desc->slew_file[0] ? desc->slew_file : desc->file[0] ? desc->file : "world";
+    if (frag) {
+        if (!hydraulics) {
+            snprintf(err, errsz, "%s: hydraulics: missing (required by the ode world)", w->opt.model_file);
+            return -1;
+        }
+        w->chain_hm = model_circuit_with_fragment(hydraulics, w->opt.model_file, frag, wf, part, err, errsz);
+        w->chain_own_hm = 1;
+    } else if (w->opt.circuit) {
+        w->chain_hm = w->opt.circuit;
+    } else if (hydraulics) {
+        w->chain_hm = hyd_model_from_json(hydraulics, w->opt.model_file, "hydraulics", err, errsz);
+        w->chain_own_hm = 1;
+    } else {
+        snprintf(err, errsz, "%s: hydraulics: missing (required by the ode world)", w->opt.model_file);
+    }
+    return w->chain_hm ? 0 : -1;
+}
+
 // Stroke and rate of every actuator from the bodies' mount points (boom
 // cylinders) or the slew hinge (rack and pinion).
 static void boom_cyl_kinematics(const ode_world* w, const ow_act* c, double* x, double* v) {
@@ -477,6 +578,10 @@ static double slew_turns_at(const ode_world* w, double raw) {
 }
 
 double ow_slew_angle(const ode_world* w) {
+    if (w->chain) {
+        ode_chain_q(w->chain, w->chain_q, NULL);
+        return w->chain_q[0];
+    }
     if (!w->slew_joint) return 0.0;
     const double raw = dJointGetHingeAngle(w->slew_joint);
     return raw + slew_turns_at(w, raw) + w->slew_off;
@@ -502,6 +607,12 @@ void ow_slew_stops(ode_world* w) {
 }
 
 void ow_read_actuators(ode_world* w) {
+    if (w->chain) {
+        // The slew's display copy; the chain reads its own actuators.
+        ow_act* s = &w->act[ODE_SLEW];
+        ode_chain_slew_state(w->chain, &s->x, &s->v, &s->F, NULL, NULL, &s->at_stop);
+        return;
+    }
     if (w->slew_joint) {
         const double raw = dJointGetHingeAngle(w->slew_joint);
         const double turns = slew_turns_at(w, raw);
@@ -528,7 +639,7 @@ void ow_read_actuators(ode_world* w) {
 // any parent body), the slew force as torque F r on the slew hinge, and the
 // test torques.
 void ow_apply_forces(ode_world* w) {
-    if (w->held) return;
+    if (w->held || w->chain) return; // a chain applies its own (ode_chain_host_pre)
     for (int k = 0; k < 2; ++k) {
         ow_act* c = &w->act[k];
         if (c->F == 0) continue;
@@ -561,21 +672,6 @@ typedef struct create_args {
 } create_args;
 
 // The ODE part of ode_world_create (run under ow_trapped): 0, or -1 with err set.
-dWorldID ow_world_new(double g, double erp, double cfm, dThreadingImplementationID* threading) {
-    dWorldID world = dWorldCreate();
-    // Each world queues its step jobs on its own self-threaded implementation,
-    // not on ODE's process-wide default: an ODE error jumps out of a step
-    // with jobs still queued (ow_trapped), and on the shared one those would
-    // be run by the next world's step and fail ODE's check at dCloseODE.
-    *threading = dThreadingAllocateSelfThreadedImplementation();
-    if (*threading)
-        dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(*threading), *threading);
-    dWorldSetGravity(world, 0, 0, -g);
-    dWorldSetERP(world, erp);
-    dWorldSetCFM(world, cfm);
-    return world;
-}
-
 static int build_world(ode_world* w, void* arg) {
     const create_args* a = arg;
     w->world = ow_world_new(w->g, w->desc.ode.erp, w->desc.ode.cfm, &w->threading);
@@ -588,6 +684,12 @@ static int build_world(ode_world* w, void* arg) {
     w->static_space = dSimpleSpaceCreate(0);
     w->contacts = dJointGroupCreate(0);
 
+    if (w->opt.chain && !w->opt.chain->two_link) {
+        // The chain crane: its circuit, then the sandbox with the chain on
+        // the truck (ow_build_sandbox, ow_build_chain_crane).
+        if (chain_circuit(w, a->hydraulics, a->desc, a->err, a->errsz)) return -1;
+        return ow_build_sandbox(w, a->err, a->errsz);
+    }
     // The hydraulic circuit first: cylinder strokes are needed for the limits.
     if (w->opt.hydraulics) {
         // An LS model takes the world's LS slew section where it has one.
@@ -630,6 +732,28 @@ ode_world* ode_world_create(const crane_mech* mech, const cJSON* hydraulics, con
     if (opt.hydraulics && !hydraulics && !opt.circuit) {
         snprintf(err, errsz, "%s: hydraulics: missing (required by the ode world)", opt.model_file);
         return NULL;
+    }
+    if (opt.chain && !opt.chain->two_link) {
+        // The chain crane is built for the sandbox only, with its circuit.
+        if (!desc || desc->kind != WORLD_SANDBOX) {
+            snprintf(err, errsz,
+                     "%s: a chain crane's validation world is the ODE chain world (ode_chain.h); this world builds "
+                     "a chain in the sandbox only",
+                     opt.model_file);
+            return NULL;
+        }
+        if (!opt.hydraulics) {
+            snprintf(err, errsz, "%s: the sandbox's chain crane runs with its circuit only (hydraulics on)",
+                     opt.model_file);
+            return NULL;
+        }
+        if (hyd_method_is_adaptive(opt.solver)) {
+            snprintf(err, errsz,
+                     "solver %s is adaptive: the sandbox's chain crane sub-steps its circuit with a fixed-step method "
+                     "(krus, ros2, rk4)",
+                     hyd_method_name(opt.solver));
+            return NULL;
+        }
     }
     ode_world* w = calloc(1, sizeof *w);
     if (!w) {
@@ -686,6 +810,11 @@ static int destroy_ode(ode_world* w, void* arg) {
 void ode_world_destroy(ode_world* w) {
     if (!w) return;
     ow_hyd_destroy(w);
+    // The chain's bodies and joints are this world's (gone with it); the
+    // chain frees its own memory only.
+    ode_chain_destroy(w->chain);
+    if (w->chain_own_hm) hyd_model_free(w->chain_hm);
+    free(w->chain_q);
     // A dead world's ODE objects may fail ODE's checks once more as they are
     // torn down: then what is left of them is abandoned (a leak, once, at
     // the end of a failed run) rather than aborting.
@@ -708,7 +837,7 @@ static int body_finite(dBodyID b) {
 }
 
 static int check_finite(ode_world* w) {
-    for (int f = 0; f < 3; ++f)
+    for (int f = 0; f < 3 && !w->chain; ++f) // a chain checks its own (ode_chain_host_post)
         if (w->frame[f].body && !body_finite(w->frame[f].body)) {
             static const char* const n[3] = {"column", "boom1", "boom2"};
             snprintf(w->err, sizeof w->err, "ode world: body %s became non-finite at t = %.6f s", n[f], w->t);
@@ -747,12 +876,22 @@ static int step_ode(ode_world* w, void* arg) {
                 return -1;
             }
         }
+        if (w->chain && ode_chain_host_pre(w->chain)) {
+            snprintf(w->err, sizeof w->err, "%s", ode_chain_error(w->chain));
+            w->failed = 1;
+            return -1;
+        }
         ow_apply_forces(w);
         if (w->kind == WORLD_SANDBOX) ow_collide(w);
         dWorldStep(w->world, h);
         if (w->kind == WORLD_SANDBOX) {
             ow_support_forces(w);
             dJointGroupEmpty(w->contacts);
+        }
+        if (w->chain && ode_chain_host_post(w->chain)) {
+            snprintf(w->err, sizeof w->err, "%s", ode_chain_error(w->chain));
+            w->failed = 1;
+            return -1;
         }
         ++w->nstep;
         // Time as a step count times h, so long runs do not accumulate
@@ -793,15 +932,28 @@ void ode_world_set_commands(ode_world* w, const double u_cmd[ODE_NACT]) {
         double u = u_cmd[k];
         w->u_cmd[k] = u > 1 ? 1 : u < -1 ? -1 : (u == u ? u : 0);
     }
+    if (w->chain) {
+        // The functions of the chain's first two actuators, and the slew
+        // (ode_world_chain: a run of every function commands the chain).
+        const crane_chain* c = ode_chain_chain(w->chain);
+        double* cmd = w->chain_q + 2 * ode_chain_ndof(w->chain);
+        for (int f = 0; f < c->nfn; ++f) cmd[f] = 0.0;
+        for (int k = 0; k < 2 && k < c->nact; ++k) cmd[c->act[k].function] = w->u_cmd[k];
+        ode_chain_set_commands(w->chain, cmd);
+        ode_chain_set_slew_command(w->chain, w->u_cmd[ODE_SLEW]);
+    }
 }
 
+struct ode_chain* ode_world_chain(const ode_world* w) { return w->chain; }
+
 void ode_world_set_joint_torques(ode_world* w, const double tau[2]) {
+    if (w->chain) return; // two-link test hook (ode_chain_set_joint_forces for a chain)
     w->tau_extra[0] = tau[0];
     w->tau_extra[1] = tau[1];
 }
 
 void ode_world_set_joint_rates(ode_world* w, const double qd[2]) {
-    if (w->dead) return; // ODE failed on these bodies: not touched again
+    if (w->dead || w->chain) return; // ODE failed on these bodies: not touched again; a two-link test hook
     // Rigid-body velocities of the booms for joint rates qd about the fixed
     // joint 1 (validation column at rest): omega along the hinge axis.
     double axis_l[3] = {0, -1, 0}, R[9], ax[3];
@@ -858,8 +1010,9 @@ static double body_energy(dBodyID b, double g) {
 double ode_world_energy(const ode_world* w) {
     if (w->dead) return NAN;
     double e = 0;
-    for (int f = 0; f < 3; ++f)
-        if (w->frame[f].body) e += body_energy(w->frame[f].body, w->g);
+    dBodyID cb[OW_MAX_GEOMS];
+    const int ncb = ow_crane_bodies(w, cb, OW_MAX_GEOMS);
+    for (int f = 0; f < ncb; ++f) e += body_energy(cb[f], w->g);
     if (w->truck) e += body_energy(w->truck, w->g);
     for (int i = 0; i < w->nrope; ++i) e += body_energy(w->rope[i], w->g);
     if (w->hook) e += body_energy(w->hook, w->g);
@@ -871,8 +1024,9 @@ void ode_world_part_energy(const ode_world* w, double* crane, double* hook) {
     *crane = *hook = NAN;
     if (w->dead) return;
     double c = 0, h = 0;
-    for (int f = 0; f < 3; ++f)
-        if (w->frame[f].body) c += body_energy(w->frame[f].body, w->g);
+    dBodyID cb[OW_MAX_GEOMS];
+    const int ncb = ow_crane_bodies(w, cb, OW_MAX_GEOMS);
+    for (int f = 0; f < ncb; ++f) c += body_energy(cb[f], w->g);
     for (int i = 0; i < w->nrope; ++i) h += body_energy(w->rope[i], w->g);
     if (w->hook) h += body_energy(w->hook, w->g);
     *crane = c;
@@ -881,11 +1035,7 @@ void ode_world_part_energy(const ode_world* w, double* crane, double* hook) {
 
 // ---- state ----
 
-static void tip_point(const ode_world* w, double p[3], double v[3]) {
-    double tip[3] = {w->mech.link[1].length, 0, 0};
-    ow_frame_point(w, 2, tip, p);
-    if (v) ow_frame_point_vel(w, 2, tip, v);
-}
+static void tip_point(const ode_world* w, double p[3], double v[3]) { ow_tip(w, p, v); }
 
 static int get_state_ode(ode_world* w, void* arg);
 
@@ -901,8 +1051,14 @@ void ode_world_get_state(const ode_world* w, ode_world_state* s) {
     }
 }
 
+static void chain_state(ode_world* w, ode_world_state* s);
+
 static int get_state_ode(ode_world* w, void* arg) {
     ode_world_state* s = arg;
+    if (w->chain) {
+        chain_state(w, s);
+        return 0;
+    }
     for (int k = 0; k < ODE_NACT; ++k) {
         const ow_act* c = &w->act[k];
         if (!c->present) continue;
@@ -962,6 +1118,61 @@ static int get_state_ode(ode_world* w, void* arg) {
     return 0;
 }
 
+// The state of the chain crane in the two-link fields (ode_world_chain says
+// which), and the sandbox's as for the two-link crane.
+static void chain_state(ode_world* w, ode_world_state* s) {
+    const crane_chain* c = ode_chain_chain(w->chain);
+    const double* y;
+    const hyd_data* hd;
+    ode_chain_circuit_state(w->chain, &y, &hd);
+    for (int k = 0; k < 2 && k < c->nact; ++k) {
+        s->x[k] = ode_chain_act_length(w->chain, k, &s->v[k]) - c->act[k].closed_length;
+        s->F[k] = ode_chain_act_force(w->chain, k, &s->pA[k], &s->pB[k]);
+        const int iv = c->fn[c->act[k].function].valve_idx, iu = hyd_model_valve_state(w->chain_hm, iv);
+        s->u[k] = iu >= 0 ? y[iu] : 0.0;
+        s->u_cmd[k] = hd->valve_cmd[iv];
+        if (ode_chain_act_at_stop(w->chain, k)) s->end_stop |= 1 << k;
+    }
+    int stop = 0;
+    ode_chain_slew_state(w->chain, &s->x[ODE_SLEW], &s->v[ODE_SLEW], &s->F[ODE_SLEW], &s->pA[ODE_SLEW],
+                         &s->pB[ODE_SLEW], &stop);
+    {
+        const int iv = hyd_model_valve(w->chain_hm, c->slew.valve), iu = hyd_model_valve_state(w->chain_hm, iv);
+        s->u[ODE_SLEW] = iu >= 0 ? y[iu] : 0.0;
+        s->u_cmd[ODE_SLEW] = hd->valve_cmd[iv];
+    }
+    if (stop) s->end_stop |= 1 << ODE_SLEW;
+    double* q = w->chain_q;
+    const int nd = ode_chain_ndof(w->chain);
+    double* qd = q + nd;
+    ode_chain_q(w->chain, q, qd);
+    s->slew = q[0], s->slew_rate = qd[0];
+    for (int k = 0; k < 2 && 1 + k < nd; ++k) s->q[k] = q[1 + k], s->qd[k] = qd[1 + k];
+    // Tip relative to the first boom's joint in the column's boom plane.
+    double tp[3], j1[3], R[9];
+    ow_tip(w, tp, NULL);
+    ode_chain_body_pose(w->chain, c->nbody > 1 ? 1 : 0, NULL, j1);
+    ode_chain_body_pose(w->chain, 0, R, NULL);
+    const double d[3] = {tp[0] - j1[0], tp[1] - j1[1], tp[2] - j1[2]};
+    s->tip[0] = R[0] * d[0] + R[3] * d[1] + R[6] * d[2];
+    s->tip[1] = R[2] * d[0] + R[5] * d[1] + R[8] * d[2];
+    memcpy(s->tip_world, tp, sizeof tp);
+    ow_hook_point(w, s->hook, s->hook_vel);
+    const int ip = hyd_model_supply_node(w->chain_hm);
+    s->p_pump = ip >= 0 ? hd->node_p[ip] : 0.0;
+    for (int i = 0; i < hyd_model_ncomp(w->chain_hm); ++i)
+        if (hyd_model_comp_type(w->chain_hm, i) == HYD_RELIEF && hd->comp_open[i]) ++s->relief_open;
+    s->truck_tilt = ow_truck_tilt(w);
+    s->ncontact = w->ncontact;
+    s->max_depth = w->max_depth;
+    s->max_depth_crane = w->max_depth_crane;
+    s->attached = w->attached;
+    double weight = 0;
+    s->stab_margin = ow_stab_margin(w, &weight);
+    for (int i = 0; i < w->nsupport; ++i) s->pad_F[i] = w->support_F[i];
+    s->pad_lifted = ow_supports_lifted(w, weight);
+}
+
 int ode_world_nload(const ode_world* w) { return w->nload; }
 
 void ode_world_load_state(const ode_world* w, int i, double pos[3], double vel[3]) {
@@ -1003,7 +1214,7 @@ int ode_world_hook(ode_world* w, int attach) {
 void ode_world_hold_crane(ode_world* w, int hold) {
     if (w->dead) return;
     hold = hold != 0;
-    if (hold == w->held) return;
+    if (hold == w->held || w->chain) return; // a two-link test hook
     w->held = hold;
     dBodyID b[4] = {w->truck, w->frame[0].body, w->frame[1].body, w->frame[2].body};
     for (int i = 0; i < 4; ++i) {
@@ -1081,8 +1292,32 @@ static int snapshot_ode(ode_world* w, void* arg) {
     }
     s->nbody = n;
 
+    // A chain crane's cylinders: as many as the snapshot holds, one place
+    // kept for the slew's rack (ow_sandbox_snapshot).
+    for (int k = 0; w->chain && k < ode_chain_nact(w->chain) && s->ncyl < WORLD_SNAP_MAX_CYLINDERS - 1; ++k) {
+        const crane_chain* c = ode_chain_chain(w->chain);
+        const crane_act* ca = &c->act[k];
+        world_snap_cylinder* y = &s->cyl[s->ncyl++];
+        snprintf(y->name, sizeof y->name, "%s", ca->name);
+        ode_chain_act_pins(w->chain, k, y->base, y->rod_end);
+        y->closed_length = ca->closed_length;
+        y->stroke_max = ca->stroke;
+        y->x = ode_chain_act_length(w->chain, k, &y->v) - ca->closed_length;
+        y->force = ode_chain_act_force(w->chain, k, &y->pA, &y->pB);
+        const int iv = c->fn[ca->function].valve_idx, iu = hyd_model_valve_state(w->chain_hm, iv);
+        const double* cy;
+        const hyd_data* hd;
+        ode_chain_circuit_state(w->chain, &cy, &hd);
+        y->u_cmd = hd->valve_cmd[iv];
+        y->u = iu >= 0 ? cy[iu] : 0.0;
+        double AA, AB, st;
+        hyd_model_cylinder_geometry(w->chain_hm, ca->cyl, &AA, &AB, &st);
+        y->bore = sqrt(4.0 * AA / M_PI);
+        y->rod = sqrt(4.0 * (AA - AB) / M_PI);
+        y->end_stop = (uint8_t)ode_chain_act_at_stop(w->chain, k);
+    }
     // Boom cylinders.
-    for (int k = 0; k < 2; ++k) {
+    for (int k = 0; k < 2 && !w->chain; ++k) {
         const ow_act* c = &w->act[k];
         world_snap_cylinder* y = &s->cyl[s->ncyl++];
         snprintf(y->name, sizeof y->name, "%s", w->mech.act[k].name);
@@ -1113,6 +1348,13 @@ static int snapshot_ode(ode_world* w, void* arg) {
     memcpy(s->hook, tp, sizeof tp);
     s->load_mass = w->kind == WORLD_VALIDATION ? w->m3 : 0;
     if (w->hm && w->ipump >= 0) s->p_supply = w->y[w->ipump];
+    if (w->chain) {
+        const double* cy;
+        const hyd_data* hd;
+        ode_chain_circuit_state(w->chain, &cy, &hd);
+        const int ip = hyd_model_supply_node(w->chain_hm);
+        if (ip >= 0) s->p_supply = hd->node_p[ip];
+    }
     if (w->kind == WORLD_SANDBOX) ow_sandbox_snapshot(w, s);
     ow_collision_snapshot(w, s);
     if (w->hm) {
@@ -1122,11 +1364,24 @@ static int snapshot_ode(ode_world* w, void* arg) {
         if (w->act[ODE_SLEW].present) cyl_hyd[2] = w->act[ODE_SLEW].cyl;
         world_snap_reliefs(s, w->hm, w->hd->comp_open, cyl_hyd);
     }
+    if (w->chain) {
+        // The reliefs on the cylinders drawn (the chain's first ones, then
+        // the slew's rack, in ncyl order).
+        const crane_chain* c = ode_chain_chain(w->chain);
+        int cyl_hyd[WORLD_SNAP_MAX_CYLINDERS] = {-1, -1, -1, -1};
+        int n = 0;
+        for (int k = 0; k < c->nact && n < WORLD_SNAP_MAX_CYLINDERS - 1; ++k) cyl_hyd[n++] = c->act[k].cyl;
+        cyl_hyd[n] = hyd_model_cylinder(w->chain_hm, c->slew.cylinder);
+        const double* cy;
+        const hyd_data* hd;
+        ode_chain_circuit_state(w->chain, &cy, &hd);
+        world_snap_reliefs(s, w->chain_hm, hd->comp_open, cyl_hyd);
+    }
     return 0;
 }
 
 void ode_world_lock_booms(ode_world* w, int lock) {
-    if (w->dead) return;
+    if (w->dead || w->chain) return; // the two-link crane's hinges only
     dJointID j[2] = {w->j1, w->j2};
     for (int k = 0; k < 2; ++k) {
         // Set hi before lo (or lo before hi) so ODE never sees lo > hi.
@@ -1143,14 +1398,21 @@ void ode_world_lock_booms(ode_world* w, int lock) {
     }
 }
 
-hyd_model* ode_world_circuit(ode_world* w) { return w->hm; }
+hyd_model* ode_world_circuit(ode_world* w) { return w->chain ? w->chain_hm : w->hm; }
 
 void ode_world_circuit_state(const ode_world* w, double* y, const hyd_data** in) {
+    if (w->chain) {
+        const double* cy;
+        ode_chain_circuit_state(w->chain, &cy, in);
+        memcpy(y, cy, (size_t)hyd_model_nstate(w->chain_hm) * sizeof *y);
+        return;
+    }
     for (int i = 0; i < w->nh; ++i) y[i] = w->y[i];
     *in = w->hd;
 }
 
 int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln) {
+    if (w->chain) return -1; // the two-link crane's links: a chain is rebuilt
     if (k < 0 || k > 1 || !w->frame[k + 1].body) return -1;
     const crane_link* old = &w->mech.link[k];
     if (ln->length != old->length || ln->width != old->width || ln->height != old->height) return -1;
@@ -1167,6 +1429,16 @@ int ode_world_fused(const ode_world* w) { return w->hm && w->use_fused; }
 int ode_world_fast(const ode_world* w) { return w->hm && w->use_fast; }
 
 void ode_world_chamber_pressures(const ode_world* w, double pA[ODE_NACT], double pB[ODE_NACT]) {
+    if (w->chain) {
+        const int na = ode_chain_nact(w->chain);
+        for (int k = 0; k < 2; ++k) {
+            pA[k] = pB[k] = 0.0;
+            if (k < na) ode_chain_act_force(w->chain, k, &pA[k], &pB[k]);
+        }
+        if (ode_chain_slew_state(w->chain, NULL, NULL, NULL, &pA[ODE_SLEW], &pB[ODE_SLEW], NULL))
+            pA[ODE_SLEW] = pB[ODE_SLEW] = 0.0;
+        return;
+    }
     for (int k = 0; k < ODE_NACT; ++k) {
         const ow_act* c = &w->act[k];
         const bool on = w->hm && c->cyl >= 0;

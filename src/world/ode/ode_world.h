@@ -22,6 +22,7 @@
 #include <cjson/cJSON.h>
 #include <stddef.h>
 
+#include "crane_chain.h"
 #include "crane_model.h"
 #include "hyd_solver.h"
 #include "world_desc.h"
@@ -64,6 +65,14 @@ typedef struct ode_world_opts {
                           ///< world's own when the world adds no circuit of its own, so a run
                           ///< and its panel share one hyd_model; NULL (default) compiles the
                           ///< "hydraulics" section
+    /// The model's chain (borrowed while the world is created). A chain that
+    /// is not two_link builds the sandbox's crane from it (ode_chain.h,
+    /// hosted on the truck, the model's or the world's slew drive on the
+    /// column; docs/ode_world.md "The sandbox from the chain"); NULL
+    /// (default) or a two_link chain: the two-link crane from mech, as
+    /// always. Only the sandbox takes a chain (the validation world of a
+    /// chain is ode_chain's own).
+    const crane_chain* chain;
 } ode_world_opts;
 
 ode_world_opts ode_world_default_opts(void);
@@ -170,7 +179,8 @@ void ode_world_circuit_state(const ode_world* w, double* y, const hyd_data** in)
 /// Give boom k (0 lifting arm, 1 end arm) link ln's mass and inertia in
 /// place (dBodySetMass), keeping its motion. Returns 0, or -1 (nothing
 /// changed) when that needs a rebuild: another length, section or centre of
-/// mass than the body was built with (its origin is its centre of mass).
+/// mass than the body was built with (its origin is its centre of mass), or
+/// a chain crane (ode_world_chain).
 int ode_world_set_link_mass(ode_world* w, int k, const crane_link* ln);
 /// 1 when the hydraulic solver runs on the straight-line circuit kernel
 /// (hyd_fused.h), 0 on the component loops (opts.general_circuit, or a
@@ -186,6 +196,15 @@ void ode_world_chamber_pressures(const ode_world* w, double pA[ODE_NACT], double
 /// Non-fatal messages ODE has sent so far in this process (a degenerate
 /// contact LCP), and the last one's text in *last (may be NULL).
 long ode_world_messages(const char** last);
+
+/// The chain crane's world (opts.chain), for its per-actuator and per-DOF
+/// state (ode_chain_q, ode_chain_act_length, ...; read only, never stepped
+/// alone); NULL for the two-link crane. With a chain, ode_world_state's
+/// two-link fields hold: x, v, F, pA, pB, u, u_cmd [ODE_LIFT], [ODE_JIB] the
+/// chain's first two actuators, [ODE_SLEW] the slew rack; q, qd the first
+/// two boom DOFs; tip relative to body 1's joint. ode_world_set_commands
+/// then drives the functions of the first two actuators and the slew.
+struct ode_chain* ode_world_chain(const ode_world* w);
 
 /// Simulated time [s].
 double ode_world_time(const ode_world* w);
@@ -205,6 +224,9 @@ int ode_world_obstacle_pos(const ode_world* w, const char* name, double pos[3]);
 
 /// Extra joint torques [N m] added every step at joints 1, 2 (in the q
 /// directions), e.g. the analytic holding torque G(q) with hydraulics off.
+/// The two-link crane only, as the other hooks of joints 1, 2 below
+/// (hold_crane, lock_booms, set_joint_rates): they do nothing for a chain
+/// crane (ode_world_chain; ode_chain_set_joint_forces for this one).
 void ode_world_set_joint_torques(ode_world* w, const double tau[2]);
 /// 1: freeze the truck, column and booms (kinematic, at rest) so only rope,
 /// hook and loads move; 0: release them.

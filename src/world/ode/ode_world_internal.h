@@ -11,6 +11,8 @@
 #include "circuit_fast.h"
 #include "hyd_fused.h"
 #include "hyd_solver.h"
+#include "ode_chain.h"
+#include "ode_common.h"
 #include "ode_world.h"
 
 #define OW_MAX_GEOMS 256
@@ -247,25 +249,19 @@ struct ode_world {
     // edits by itself (the circuit's revision).
     hyd_fast* fk;
     int use_fast;
+
+    // A chain crane (opts.chain, not two_link): its bodies, joints and
+    // circuit are ode_chain's, hosted in this world on the truck; frame[0]
+    // is its column, frame[1] its first boom, frame[2] the tip's body (the
+    // rope's anchor). The two-link fields above (act[] except the slew's
+    // display copy, j1, j2, hm, y) stay unused.
+    ode_chain* chain;
+    hyd_model* chain_hm;   ///< its circuit (the model's with the world's part appended)
+    int chain_own_hm;      ///< 1: compiled here, freed with the world
+    double* chain_q;       ///< scratch: joint coordinates and rates (2 ndof)
 };
 
 // ode_world.c
-/// ODE's process-wide set-up, counted: the first user initialises ODE and
-/// installs its message and error handlers, the last one closes it. Every
-/// ODE world (ode_world, ode_chain) holds one use while it lives.
-void ow_ode_acquire(void);
-void ow_ode_release(void);
-/// ow_ode_call's result after an ODE error.
-enum { OW_ODE_FAILED = -1000 };
-/// Runs fn(arg) with ODE's errors caught: fn's result, or OW_ODE_FAILED
-/// when ODE failed inside it (its message in fatal). The jump skips the rest
-/// of fn: its world must then only be destroyed.
-int ow_ode_call(int (*fn)(void* arg), void* arg, char* fatal, size_t n);
-/// A new ODE world with gravity g [m/s^2] along -z, ERP and CFM, stepping on
-/// a self-threaded implementation of its own (*threading; NULL when none
-/// could be made): an ODE error jumps out of a step with jobs still queued,
-/// and on ODE's shared default those would reach the next world's step.
-dWorldID ow_world_new(double g, double erp, double cfm, dThreadingImplementationID* threading);
 void ow_frame_point(const ode_world* w, int f, const double p[3], double out[3]);
 void ow_frame_point_vel(const ode_world* w, int f, const double p[3], double out[3]);
 void ow_frame_rot(const ode_world* w, int f, double R[9]);
@@ -283,6 +279,17 @@ double ow_slew_angle(const ode_world* w);
 /// Give ODE the slew stops (slew_lim) as hinge angles of the current turn.
 void ow_slew_stops(ode_world* w);
 void ow_apply_forces(ode_world* w);
+
+/// The sandbox's chain crane (w->chain) on the truck, its column foot at
+/// base [m] with the truck's rotation R: the hosted ode_chain, a collision
+/// geom and a drawing per body, frames 0 to 2 for the rope and the column.
+int ow_build_chain_crane(ode_world* w, const double base[3], const double R[9], char* err, size_t errsz);
+/// The crane's tip (the rope's anchor) in the world [m] and its velocity
+/// (v may be NULL).
+void ow_tip(const ode_world* w, double p[3], double v[3]);
+/// The crane's moving bodies (column and booms, of either crane) into b;
+/// returns their count (at most max).
+int ow_crane_bodies(const ode_world* w, dBodyID* b, int max);
 
 // ode_sandbox.c
 int ow_build_sandbox(ode_world* w, char* err, size_t errsz);

@@ -23,6 +23,8 @@ static const engine_backend backends[] = {
         .drive_world = NULL,
         // The scripted lift-and-jib demo: no hook, no slew.
         .drive_scenario = "drive_demo",
+        // The general formulation slews the column by the model's drive.
+        .slew_dof = true,
         .outer_step_opt = NULL,
         .step_name = "step",
         .variant = true,
@@ -42,6 +44,7 @@ static const engine_backend backends[] = {
         .run_world = "validation", // the column and booms alone, as the lagrange crane
         .drive_world = "sandbox",  // the truck, the hook, the loads, the slew
         .drive_scenario = "sandbox_pick_place",
+        .slew_dof = false, // it slews in its sandbox world
         .outer_step_opt = "--dt-ode",
         .step_name = "ODE step",
         .variant = false,

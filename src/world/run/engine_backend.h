@@ -41,6 +41,11 @@ typedef struct engine_backend {
     /// The scenario a stepped driver's scripted operator plays when none is
     /// given, on its drive world (or without a world).
     const char* drive_scenario;
+    /// Without a world, its scripted runs (run, sweep, optimize) slew the
+    /// column as a degree of freedom where the model has a slew drive
+    /// (mechanics.slew) and the scenario commands the slew
+    /// (engine_chain_slews); its stepped engine (drive, serve) does not.
+    bool slew_dof;
 
     // ---- its options ----
     /// The option of its own rigid-body step ("--dt-ode", sim_opts.dt_ode):

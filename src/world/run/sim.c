@@ -67,12 +67,18 @@ int sim_run(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn ro
 int sim_run_energy(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
                    sim_trace* trace, sim_progress_fn progress, void* progress_user, struct sim_energy* energy,
                    sim_result* res) {
+    return sim_run_energy_chain(m, sc, o, row_fn, row_user, trace, progress, progress_user, energy, NULL, res);
+}
+
+int sim_run_energy_chain(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
+                         sim_trace* trace, sim_progress_fn progress, void* progress_user, struct sim_energy* energy,
+                         const crane_chain** run_chain, sim_result* res) {
     memset(res, 0, sizeof *res);
     const double t_end = o->duration > 0 ? o->duration : sc->duration;
     if (sim_check_times(t_end, o->dt_out, res->message, sizeof res->message)) return res->status = SIM_REFUSED;
     run_out out = {.row_fn = row_fn, .row_user = row_user, .trace = trace, .progress = progress,
                    .progress_user = progress_user, .t_end = t_end};
     const engine_sink k = {.row = deliver, .user = &out, .rows = trace || row_fn || progress,
-                           .summary = trace || row_fn, .t_end = t_end, .energy = energy};
+                           .summary = trace || row_fn, .t_end = t_end, .energy = energy, .run_chain = run_chain};
     return engine_run(m, sc, o, &k, res);
 }

@@ -33,6 +33,14 @@ struct sim_energy;
 int sim_run_energy(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
                    sim_trace* trace, sim_progress_fn progress, void* progress_user, struct sim_energy* energy,
                    sim_result* res);
+/// sim_run_energy that also says which chain the rows' own columns follow
+/// when it is not the model's (engine_sink.run_chain): *run_chain is set
+/// before the first row where the run adds columns (the analytic mode's
+/// slewing run, the slew rack's) and left as it is otherwise; the chain it
+/// points to lives until the run returns.
+int sim_run_energy_chain(const model* m, const scenario* sc, const sim_opts* o, sim_row_fn row_fn, void* row_user,
+                         sim_trace* trace, sim_progress_fn progress, void* progress_user, struct sim_energy* energy,
+                         const crane_chain** run_chain, sim_result* res);
 
 /// Number of CSV columns a run with these options writes (base, or base plus
 /// the world extras for the ode backend).

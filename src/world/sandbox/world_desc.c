@@ -7,7 +7,6 @@
 #include "model.h"
 #include "mesh_geom.h"
 
-#include <dirent.h>
 #include <limits.h>
 #include <stdlib.h>
 #include <sys/stat.h>
@@ -832,40 +831,19 @@ int world_desc_from_json(const cJSON* root, const char* file, world_desc* w, cha
     return from_json_in(root, file, "", w, err, errsz);
 }
 
-static int cmp_str(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
-
 // A world named on the command line (--world NAME is <assets>/worlds/NAME.json)
 // that does not exist: list the worlds there instead of "cannot open".
 static int missing_named_world(const char* path, char* err, size_t errsz) {
-    char folder[512];
+    char folder[512], list[512];
     snprintf(folder, sizeof folder, "%s/worlds/", model_assets_dir());
     const size_t n = strlen(folder);
     struct stat st;
     if (strncmp(path, folder, n) || strchr(path + n, '/') || stat(path, &st) == 0) return 0;
-    char* names[64];
-    int k = 0;
-    DIR* d = opendir(folder);
-    for (struct dirent* e; d && k < 64 && (e = readdir(d));) {
-        const size_t L = strlen(e->d_name);
-        if (L > 5 && !strcmp(e->d_name + L - 5, ".json")) {
-            names[k] = malloc(L - 4);
-            if (!names[k]) break;
-            snprintf(names[k], L - 4, "%s", e->d_name);
-            ++k;
-        }
-    }
-    if (d) closedir(d);
-    qsort(names, (size_t)k, sizeof *names, cmp_str);
-    char list[512] = "";
-    for (int i = 0; i < k; ++i) {
-        const size_t L = strlen(list);
-        snprintf(list + L, sizeof list - L, "%s%s", i ? ", " : "", names[i]);
-        free(names[i]);
-    }
+    json_list_files(folder, list, sizeof list);
     const char* base = path + n;
     const size_t bl = strlen(base) > 5 ? strlen(base) - 5 : strlen(base);
     snprintf(err, errsz, "%s %.*s: no such world (available: %s; or the path of a world file)",
-             sim_param_name(SIM_PARAM_WORLD), (int)bl, base, k ? list : "none");
+             sim_param_name(SIM_PARAM_WORLD), (int)bl, base, list);
     return 1;
 }
 
