@@ -183,8 +183,35 @@ static bool write_row(FILE* f, const double* row, int ncol) {
 }
 
 
+// The CSV header of engine l's row: its channels by name (a chain engine's
+// are the backend's, then the chain's, as a scripted run's CSV).
+static void write_header(FILE* f, const engine* l) {
+    int n;
+    const sim_channel* ch = engine_channels(l, &n);
+    for (int k = 0; k < n; ++k) fprintf(f, "%s%s", k ? "," : "", ch[k].name);
+    fputc('\n', f);
+}
+
+// The final strokes of a chain engine: every actuator's x_<name> column
+// [mm]; the two-link chain (--variant general) has none: its first two
+// actuators' base columns x1, x2.
+static void print_chain_strokes(const engine* l, const model* m, const double* row) {
+    int n;
+    const sim_channel* ch = engine_channels(l, &n);
+    printf("  final: strokes");
+    const char* sep = " ";
+    for (int k = SIM_NCOL_BASE; k < n; ++k)
+        if (!strncmp(ch[k].name, "x_", 2)) {
+            printf("%s%s %.0f mm", sep, ch[k].name + 2, row[k] * 1e3);
+            sep = ", ";
+        }
+    for (int k = 0; k < 2 && k < m->chain.nact && !strcmp(sep, " "); ++k)
+        printf("%s%s %.0f mm", k ? ", " : " ", m->chain.act[k].name, row[k ? COL_X2 : COL_X1] * 1e3);
+    printf("; tip at reach %.2f m, height %.2f m from the first boom's joint", row[COL_TIP_X], row[COL_TIP_Z]);
+}
+
 static int drive_headless(app_common* c, double frame_rate, const char* record, const char* session_path,
-                          const char* why, int kind, const char* world_name) {
+                          const char* why, int kind, const char* world_name, bool rcl_given) {
     model* m;
     scenario sc;
     const bool world = app_backend(&c->sim)->world;
@@ -215,7 +242,17 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         m = fm;
     }
     double m3 = sim_load_mass(m, &sc, &c->sim);
-    engine* l = engine_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
+    // A crane chain drives headless by function; what is still two-link
+    // shaped is refused before anything starts: session files (issue 27)
+    // and a limiter asked for by name (rcl.h refuses chains; on by default,
+    // it is then off with a note below).
+    engine* l = NULL;
+    if (session_path && engine_require(m, &c->sim, ENGINE_CAP_TWO_LINK, "--session", err, sizeof err)) {
+    } else if (rcl_given && c->sim.rcl &&
+               engine_require(m, &c->sim, ENGINE_CAP_LIMITER, "--rcl on", err, sizeof err)) {
+    } else {
+        l = engine_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
+    }
     if (!l) {
         fprintf(stderr, "cranesim drive: %s\n", err);
         model_free(m);
@@ -258,11 +295,17 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     const bool loads = sandbox && engine_load_name(l, 0, NULL) != NULL;
     drive_world dw = {.hook = sandbox, .held = -1, .sess = session_path ? &sw : NULL};
     int wr = 0; // errno of the first failed write to the record
-    if (f) sim_csv_header(f, ncol);
+    const bool two_link = engine_caps(l) & ENGINE_CAP_TWO_LINK, limiter = engine_caps(l) & ENGINE_CAP_LIMITER;
+    const int nfn = engine_nfunction(l);
+    if (f && two_link) sim_csv_header(f, ncol);
+    else if (f) write_header(f, l);
     if (f && ferror(f)) wr = errno ? errno : EIO;
     printf("cranesim drive: %s: driving %s headless in real time for %.1f s\n", why, m->name, duration);
     char nowhere[96];
-    snprintf(nowhere, sizeof nowhere, "%s (no world)", app_backend(&c->sim)->crane);
+    // The backend's crane where it has no world is its two-link one; a
+    // chain engine says what it runs instead.
+    if (two_link) snprintf(nowhere, sizeof nowhere, "%s (no world)", app_backend(&c->sim)->crane);
+    else snprintf(nowhere, sizeof nowhere, "%s crane chain of %d functions (no world)", engine_backend_name(l), nfn);
     printf("  world: %s; operator input: scripted (%s), %.0f commands/s; hydraulics %s at h = %g ms\n",
            world ? world_name : nowhere, sc.name, frame_rate, hyd_method_name(c->sim.solver),
            c->sim.h * 1e3);
@@ -271,7 +314,22 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     double w0 = sim_wall_time(), busy = 0, worst = 0;
     int missed = 0, code = 0, ev = 0, frames_done = 0;
     double rcl_max = 0, rcl_t90 = 0; // the limiter's utilisation [-] and the time at or above 90 % [s]
-    double row[SIM_NCOL];
+    if (!limiter && c->sim.rcl)
+        printf("  rated capacity limiter: none for this crane chain yet (rcl_util not measured; --rcl off silences "
+               "this)\n");
+    // A row of engine_ncol columns (a chain engine's are more than
+    // SIM_NCOL), and the commands by function.
+    double* row = calloc((size_t)(ncol > SIM_NCOL ? ncol : SIM_NCOL), sizeof *row);
+    double* uf = calloc((size_t)nfn + 1, sizeof *uf);
+    if (!row || !uf) {
+        fprintf(stderr, "cranesim drive: out of memory\n");
+        free(row);
+        free(uf);
+        app_out_close(&rec, 0, false);
+        engine_destroy(l);
+        model_free(m);
+        return EXIT_RUNTIME;
+    }
     engine_row(l, row);
     // As in run: the first signal stops the loop, a second kills at once.
     app_signals sig;
@@ -281,9 +339,14 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         double t = engine_time(l);
         // The operator's stick positions at the middle of this frame.
         const double tm = t + 0.5 * frame;
-        double u[3];
-        engine_play(l, &sc, tm, &ev, u, report_hook, &dw);
-        engine_set_commands(l, u);
+        double u[3] = {0, 0, 0};
+        if (two_link) {
+            engine_play(l, &sc, tm, &ev, u, report_hook, &dw);
+            engine_set_commands(l, u);
+        } else {
+            engine_play_functions(l, &sc, tm, &ev, uf, report_hook, &dw);
+            engine_set_function_commands(l, uf, nfn, NULL, 0);
+        }
         // Advance to the frame's end on the simulated clock (the ode world
         // steps whole ODE steps, so aim at the target, not at +frame).
         const double target = (i + 1) * frame;
@@ -297,7 +360,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         }
         engine_row(l, row);
         session_writer_tick(&sw, tm, target, u, row, ncol);
-        if (ncol > COL_RCL_UTIL) {
+        if (limiter && ncol > COL_RCL_UTIL) {
             if (row[COL_RCL_UTIL] >= RCL_WARN) rcl_t90 += frame;
             rcl_max = fmax(rcl_max, row[COL_RCL_UTIL]);
         }
@@ -353,14 +416,16 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
            app_fmt_speed(speed, sizeof speed, busy > 0 ? engine_time(l) / busy : 0.0));
     printf("  frames: %d of %.1f ms, worst frame %.2f ms, missed deadlines %d\n", frames_done, frame * 1e3,
            worst * 1e3, missed);
-    printf("  final: lift stroke %.0f mm, jib stroke %.0f mm, tip at reach %.2f m, height %.2f m", row[COL_X1] * 1e3,
-           row[COL_X2] * 1e3, row[COL_TIP_X], row[COL_TIP_Z]);
+    if (two_link)
+        printf("  final: lift stroke %.0f mm, jib stroke %.0f mm, tip at reach %.2f m, height %.2f m",
+               row[COL_X1] * 1e3, row[COL_X2] * 1e3, row[COL_TIP_X], row[COL_TIP_Z]);
+    else print_chain_strokes(l, m, row);
     if (sandbox) printf("; slew %.1f deg", row[COL_SLEW] * 180 / M_PI);
     if (loads) printf("; load at (%.2f, %.2f, %.2f) m", row[COL_LOAD_X], row[COL_LOAD_Y], row[COL_LOAD_Z]);
     if (sandbox) printf("; truck tilt %.2f deg", row[COL_TRUCK_TILT] * 180 / M_PI);
     if (!sandbox && m3 > 0) printf("; %.0f kg at the tip", m3);
     printf("\n");
-    if (ncol > COL_RCL_UTIL)
+    if (limiter && ncol > COL_RCL_UTIL)
         printf("  rated capacity limiter %s: utilisation max %.0f %%, %.2f s at or above 90 %%\n",
                c->sim.rcl ? "on" : "off (measuring only)", 100 * rcl_max, rcl_t90);
     // As a scripted run's metrics line counts them (the sandbox only).
@@ -378,6 +443,8 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
                "display\n");
     engine_destroy(l);
     model_free(m);
+    free(row);
+    free(uf);
     return code;
 }
 
@@ -702,5 +769,5 @@ int cmd_drive(int argc, char** argv) {
             fprintf(stderr, "cranesim drive: note: %s %s no effect headless (%s): %s only for the window\n", list,
                     n > 1 ? "have" : "has", why, n > 1 ? "they are" : "it is");
     }
-    return drive_headless(&c, frame_rate, record, session_path, why, kind, wname);
+    return drive_headless(&c, frame_rate, record, session_path, why, kind, wname, rcl_given);
 }

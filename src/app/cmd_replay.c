@@ -177,7 +177,11 @@ int cmd_replay(int argc, char** argv) {
         }
         m = fm;
     }
-    engine* l = engine_create(m, &s.sim, s.q0, s.slew0, s.m3, err, sizeof err);
+    // Session files carry the two-link crane's commands and rows (issue 27
+    // sizes them by the model); a chain model's session is refused whole.
+    engine* l = engine_require(m, &s.sim, ENGINE_CAP_TWO_LINK, "session files", err, sizeof err)
+                    ? NULL
+                    : engine_create(m, &s.sim, s.q0, s.slew0, s.m3, err, sizeof err);
     if (!l) {
         fprintf(stderr, "cranesim replay: %s\n", err);
         model_free(m);

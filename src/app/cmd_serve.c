@@ -242,6 +242,13 @@ static void log_collisions(const server* s, const char* when) {
 // chart depends only on the model and the world, neither of which a SET
 // changes: a SET acts on the engine's circuit), or NULL.
 static int build_engine(server* s, struct rcl* lim, char* err, size_t errsz) {
+    // The protocol carries the two-link crane (u[3], nine[9], its frames,
+    // the snapshot); a crane chain waits for its version (issue 27).
+    if (engine_require(s->m, s->o, ENGINE_CAP_TWO_LINK, "the serve protocol", err, errsz) ||
+        engine_require(s->m, s->o, ENGINE_CAP_SNAPSHOT, "the serve protocol", err, errsz)) {
+        engine_rcl_destroy(lim);
+        return -1;
+    }
     s->e = engine_create_rcl(s->m, s->o, s->sc->q0, s->sc->slew0, s->m3, lim, err, errsz);
     if (!s->e) {
         engine_rcl_destroy(lim);

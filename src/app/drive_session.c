@@ -369,6 +369,12 @@ static void refresh_mech_params(drive_session* s) {
 static engine* make_engine(drive_session* s, const double q0[2], double slew0) {
     char err[400];
     const double m3 = s->rp ? s->rp->m3 : sim_load_mass(s->m, &s->sc, &s->c.sim);
+    // The window draws the snapshot, the HUD and panel are the two-link
+    // crane's (issue 27 sizes them by the model): a crane chain is refused
+    // here, before the window opens (drive --headless runs it).
+    if (engine_require(s->m, &s->c.sim, ENGINE_CAP_SNAPSHOT | ENGINE_CAP_TWO_LINK | ENGINE_CAP_SET_LINK,
+                       "the window (--headless runs a crane chain)", s->err, sizeof s->err))
+        return NULL;
     engine* l = engine_create(s->m, &s->c.sim, q0, slew0, m3, err, sizeof err);
     if (!l) snprintf(s->err, sizeof s->err, "%s", err);
     return l;

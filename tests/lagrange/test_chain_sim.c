@@ -450,7 +450,8 @@ static void test_engine_named_functions(void) {
 
 // The stepped engine's functions are the model chain's (lift, jib) and the
 // slew; their commands by function land on the valves engine_set_commands
-// drives; a chain that is not the two-link crane has no stepped engine yet.
+// drives; --variant general steps the general formulation
+// (engine_chain_step.c; test_engine_chain_step.c tests it further).
 static void test_engine_function_commands(void) {
     model* m = load_model("hiab031.json");
     if (!m) return;
@@ -466,7 +467,7 @@ static void test_engine_function_commands(void) {
               !strcmp(engine_function_name(e, 2), "slew") && engine_function_name(e, 3) == NULL,
           "names");
     const double u[3] = {0.4, -0.3, 0.2};
-    engine_set_function_commands(e, u);
+    CHECK(engine_set_function_commands(e, u, 3, err, sizeof err) == 0, "%s", err);
     CHECK(engine_advance(e, 0.01) == 0, "%s", engine_error(e));
     double row[SIM_NCOL];
     engine_row(e, row);
@@ -474,7 +475,16 @@ static void test_engine_function_commands(void) {
     engine_destroy(e);
     o.variant = LAGRANGE_GENERAL;
     e = engine_create(m, &o, q0, 0.0, 500.0, err, sizeof err);
-    CHECK(e == NULL && strstr(err, "--variant general"), "general stepped: %s", e ? "created" : err);
+    CHECK(e != NULL, "general stepped: %s", err);
+    if (e) {
+        CHECK(engine_nfunction(e) == 3 && !(engine_caps(e) & ENGINE_CAP_TWO_LINK), "general: %d functions",
+              engine_nfunction(e));
+        CHECK(engine_set_function_commands(e, u, 3, err, sizeof err) == 0, "%s", err);
+        CHECK(engine_advance(e, 0.01) == 0, "%s", engine_error(e));
+        engine_row(e, row);
+        CHECK(row[COL_U1_CMD] == 0.4 && row[COL_U2_CMD] == -0.3, "general commands %g %g", row[COL_U1_CMD],
+              row[COL_U2_CMD]);
+    }
     engine_destroy(e);
     model_free(m);
 }

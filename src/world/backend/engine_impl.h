@@ -13,6 +13,11 @@
 
 typedef struct engine_ops {
     const char* name; ///< "lagrange", "ode"
+    /// NULL: create makes every stepped engine of this backend. Else the
+    /// ops whose create engine_create calls for model m and options o (this
+    /// backend's own, or its engine for crane chains): the one place that
+    /// chooses, also asked before an engine exists (engine_caps_for).
+    const struct engine_ops* (*stepped)(const model* m, const sim_opts* o);
     /// A stepped engine at q0 [rad], slew0 [rad] (where the crane slews), tip load m3 [kg].
     engine* (*create)(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
                       size_t errsz);
@@ -23,7 +28,12 @@ typedef struct engine_ops {
     void (*describe_work)(const sim_opts* o, const sim_result* r, char* buf, size_t n);
     int nchannel;     ///< the channels it publishes: sim_channels[0 .. nchannel), the columns its rows fill
     void (*destroy)(engine* e);
+    /// The commands lift, jib, slew (the two-link crane's); NULL where the
+    /// engine takes commands by function only (set_function_commands).
     void (*set_commands)(engine* e, const double u[3]);
+    /// NULL: the commands are set_commands'. Else the engine's commands by
+    /// function, engine_nfunction(e) of them in [-1, 1] (a chain engine).
+    void (*set_function_commands)(engine* e, const double* u);
     /// NULL: the backend has no hook (engine_hook returns -1, no loads).
     int (*hook)(engine* e, int attach);
     const char* (*load_name)(const engine* e, int i, double* mass);
@@ -38,12 +48,15 @@ typedef struct engine_ops {
     void (*circuit_state)(engine* e, double* y, const hyd_data** in);
     /// NULL: the tip load is not a parameter of this backend.
     void (*set_load)(engine* e, double m3);
+    /// NULL: no two-link booms to edit (a chain engine; engine_set_link returns -1).
     int (*set_link)(engine* e, int k, const crane_link* ln);
     bool resize_links; ///< set_link applies a new boom length in place
     /// Advance dt [s]; 0, or 1 with the reason in e->err.
     int (*step)(engine* e, double dt);
     double (*time)(const engine* e);
-    void (*row)(engine* e, double row[SIM_NCOL]);
+    /// The row now: engine.ncol values (at least SIM_NCOL are written to).
+    void (*row)(engine* e, double* row);
+    /// NULL: no picture for the renderer (a chain engine; engine_snapshot returns false).
     void (*snapshot)(engine* e, world_snapshot* s);
     /// NULL: no bodies to weigh (engine_part_energy).
     void (*part_energy)(const engine* e, double E[2]);
@@ -65,9 +78,18 @@ struct engine {
     struct rcl* rcl;      ///< the rated capacity limiter (engine.c), or NULL where its chart failed
     double h_probe;       ///< the fixed hydraulic step the backend integrates with [s], set by its create:
                           ///< engine.c applies the step probe (sim_check_step_probe) to it
-    double u_op[3];       ///< the operator's last commands lift, jib, slew, as given to engine_set_commands [-]
-    double u_lim[3];      ///< what the limiter let through of them [-] (u_op when it cut nothing)
     const model* mdl;     ///< the model it was made from (its chain's functions: engine_function_name)
+    // Set by engine.c after the backend's create, sized by the model:
+    int nfn;              ///< engine_nfunction: the commands it takes
+    double* u_op;         ///< [nfn] the operator's last commands by function (lift, jib, slew for the
+                          ///< two-link crane), as given to engine_set_commands or by function [-]
+    double* u_lim;        ///< [nfn] what the limiter let through of them [-] (u_op when it cut nothing)
+    /// Columns of its rows (engine_ncol): set by the backend's create when
+    /// its rows carry more than ops->nchannel (a chain engine: the chain's
+    /// columns after the backend's); 0: ops->nchannel.
+    int ncol;
+    sim_channel* chan;    ///< [ncol] its channels when ncol > ops->nchannel (engine.c), else NULL
+    double* rowbuf;       ///< [max(ncol, SIM_NCOL)] a row for the checks after each step (engine.c)
 };
 
 // Each backend declares its engine_ops in its own folder (engine_lagrange.h,

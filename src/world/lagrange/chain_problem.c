@@ -107,3 +107,44 @@ void chain_problem_free(chain_problem* cp) {
     free(cp->x);
     memset(cp, 0, sizeof *cp);
 }
+
+// The shape whose oil-column springs were measured slow (the block W's
+// allow-list below): the two-link shorthand, or a chain of that shape in the
+// chain form (column, two revolute booms one on the other, two actuators:
+// hiab031_chain.json), so that both forms of one crane take one W.
+static bool two_link_shape(const crane_chain* cc) {
+    if (cc->two_link) return true;
+    return cc->nbody == 3 && cc->nact == 2 && cc->body[1].def.joint == CHAIN_REVOLUTE && !cc->body[1].def.fixed &&
+           cc->body[2].def.joint == CHAIN_REVOLUTE && !cc->body[2].def.fixed && cc->body[2].def.parent == 1;
+}
+
+int chain_problem_setup(chain_problem* cp, chain_sim* cs, const crane_chain* mc, const sim_opts* o,
+                        hyd_problem* prob, hyd_solver_opts* so) {
+    const bool adaptive = hyd_method_is_adaptive(o->solver);
+    // The block-diagonal W for the fixed-step methods only on the two-link
+    // shape (an allow-list, two_link_shape): it treats the oil-column
+    // springs between the chambers and the bodies explicitly, which holds
+    // where they are slow (the two-link crane: 2-12 Hz, docs/lagrange.md).
+    // A chain of light telescopic stages has them fast: on
+    // chain_8fn_10link.json Krus at 0.1 ms with the block W, even with a new
+    // J at every step, ends 5 mm RMS off ROS34PW2 in a stroke, with the
+    // whole W 0.1 mm. Every other chain takes the whole W (the solver's
+    // sparse LU), with the event counter and the implausible-state test.
+    const bool blocks = !adaptive && !o->dense_jac && two_link_shape(mc);
+    if (chain_problem_init(cp, cs, blocks, prob)) return -1;
+    // The two-link shape keeps the Jacobian schedule it had (by age only):
+    // its seals' modes are slow against 1/h (hundreds of kg on each
+    // cylinder), and with the events its slewing runs moved by up to 4e-5
+    // of the pump line's peak for 13 % more Jacobians, no closer to
+    // ROS34PW2 (sandbox_swing: 3.06e-5 RMS of peak either way).
+    if (blocks) prob->events = NULL;
+    *so = hyd_default_solver_opts();
+    so->h = adaptive ? 0.0 : o->h;
+    so->rtol = o->rtol;
+    so->atol = o->atol;
+    so->h_max = 0.5;
+    so->jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
+    if (o->no_retry) so->retry_halvings = 0;
+    if (!adaptive) so->max_steps = 0;
+    return 0;
+}

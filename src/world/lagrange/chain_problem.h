@@ -21,6 +21,7 @@
 #include "chain_sim.h"
 #include "hyd_events.h"
 #include "hyd_solver.h"
+#include "sim_base.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -47,6 +48,16 @@ void chain_problem_free(chain_problem* cp);
 /// hyd_problem.events of chain_problem_init's problem (user: the
 /// chain_problem), for callers that step the chain themselves.
 unsigned long chain_problem_events(void* user, double t, const double* y);
+
+/// The problem and the solver options of a run of options o on cs, for the
+/// model's chain mc (its shape chooses the W): one set-up for the scripted
+/// runs (engine_chain.c) and the stepped engine (engine_chain_step.c), so the
+/// same commands give the same steps. The block-diagonal W and no Jacobian
+/// events on the two-link shape (the shorthand or that shape in chain form)
+/// with a fixed-step method, else the whole W with the events. 0, or -1 as
+/// chain_problem_init (cp then needs no chain_problem_free).
+int chain_problem_setup(chain_problem* cp, chain_sim* cs, const crane_chain* mc, const sim_opts* o,
+                        hyd_problem* prob, hyd_solver_opts* so);
 
 #ifdef __cplusplus
 }

@@ -1,6 +1,7 @@
 // engine_chain.c: scripted runs of the general analytic mode (engine_chain.h).
 #include "engine_chain.h"
 #include "chain_problem.h"
+#include "chain_row.h"
 #include "chain_sim.h"
 #include "energy_acc.h"
 #include "engine_impl.h"
@@ -103,42 +104,11 @@ static double scn_cmd(void* user, int k, double t) {
     return c->fcol[k] < 0 ? 0.0 : scenario_command(c->sc, c->fcol[k], t);
 }
 
-// The row sim.h's base columns hold: the first two actuators, functions
-// and boom DOFs; the tip relative to the first boom's joint.
+// The row (chain_row.c, shared with the stepped engine).
 static void make_row(chain_run_ctx* c, double t, const double* y, double* row) {
-    chain_sim* cs = c->cs;
     chain_sim_out co = {.x = c->x, .v = c->v, .pA = c->pA, .pB = c->pB, .F = c->F, .u = c->u, .u_cmd = c->ucmd,
                         .q = c->q, .qd = c->qd};
-    chain_sim_outputs(cs, t, y, &co);
-    lsim_out o;
-    memset(&o, 0, sizeof o);
-    // The chain's actuators only: the slew rack (index cc->nact) has its
-    // own columns (crane_chain_row).
-    for (int k = 0; k < 2 && k < cs->cc->nact; ++k) {
-        o.x[k] = c->x[k], o.v[k] = c->v[k], o.pA[k] = c->pA[k], o.pB[k] = c->pB[k], o.F[k] = c->F[k];
-        const int f = cs->cc->act[k].function;
-        o.u[k] = c->u[f], o.u_cmd[k] = c->ucmd[f];
-        if (cs->hd->cyl_stop[cs->cc->act[k].cyl]) o.end_stop |= 1 << k;
-    }
-    const int d0 = cs->cc->slew_free ? 1 : 0;
-    // (The rack's lever arm is 0 on every DOF but the slew's: no share here.)
-    for (int k = 0; k < 2 && d0 + k < cs->ndof; ++k) {
-        o.q[k] = c->q[d0 + k], o.qd[k] = c->qd[d0 + k];
-        // tau of the joint: sum over the actuators of F dL/dq.
-        for (int a = 0; a < cs->nact; ++a) o.tau[k] += c->F[a] * cs->dL[(size_t)a * cs->ndof + d0 + k];
-    }
-    double p1[3];
-    chain_body_pose(cs->ch, cs->ws, cs->cc->nbody > 1 ? 1 : 0, NULL, p1);
-    o.tip[0] = hypot(co.tip[0] - p1[0], co.tip[1] - p1[1]);
-    o.tip[1] = co.tip[2] - p1[2];
-    o.p_pump = co.p_pump;
-    const hyd_model* hm = cs->hm;
-    for (int i = 0; i < hyd_model_ncomp(hm); ++i)
-        if (hyd_model_comp_type(hm, i) == HYD_RELIEF && cs->hd->comp_open[i]) ++o.relief_open;
-    lagrange_row(t, &o, row);
-    // The chain's own columns right after the backend's (engine_sink.row).
-    const crane_chain_sample cs_s = {c->x, c->v, c->pA, c->pB, c->F, c->u, c->ucmd, c->q, c->qd};
-    crane_chain_row(cs->cc, &cs_s, row + SIM_NCOL_BASE);
+    chain_sim_row(c->cs, t, y, &co, row);
 }
 
 static void track_peaks(chain_run_ctx* c, const double* y) {
@@ -240,16 +210,6 @@ static int emit(void* user, double t, const double* y) {
     return 0;
 }
 
-// The shape whose oil-column springs were measured slow (the block W's
-// allow-list below): the two-link shorthand, or a chain of that shape in the
-// chain form (column, two revolute booms one on the other, two actuators:
-// hiab031_chain.json), so that both forms of one crane take one W.
-static bool two_link_shape(const crane_chain* cc) {
-    if (cc->two_link) return true;
-    return cc->nbody == 3 && cc->nact == 2 && cc->body[1].def.joint == CHAIN_REVOLUTE && !cc->body[1].def.fixed &&
-           cc->body[2].def.joint == CHAIN_REVOLUTE && !cc->body[2].def.fixed && cc->body[2].def.parent == 1;
-}
-
 int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k, sim_result* res) {
     char* msg = res->message;
     const size_t msz = sizeof res->message;
@@ -295,8 +255,7 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
     memset(&c, 0, sizeof c);
     chain_problem cp;
     memset(&cp, 0, sizeof cp);
-    const size_t nrow = SIM_NCOL_BASE + (size_t)cc->ncol > SIM_NCOL ? SIM_NCOL_BASE + (size_t)cc->ncol
-                                                                     : (size_t)SIM_NCOL;
+    const size_t nrow = (size_t)chain_row_size(cc);
     double* buf = calloc((size_t)cs.n + 5 * (size_t)na + 2 * (size_t)nf + 3 * (size_t)nd + nrow + (size_t)cs.nh + 1,
                          sizeof *buf);
     c.fcol = calloc((size_t)nf + 1, sizeof *c.fcol);
@@ -342,38 +301,14 @@ int engine_chain_run(const model* m, const scenario* sc, const sim_opts* o, cons
         }
     }
     const bool adaptive = hyd_method_is_adaptive(o->solver);
-    // The block-diagonal W for the fixed-step methods only on the two-link
-    // shape (an allow-list, two_link_shape): it treats the oil-column
-    // springs between the chambers and the bodies explicitly, which holds
-    // where they are slow (the two-link crane: 2-12 Hz, docs/lagrange.md).
-    // A chain of light telescopic stages has them fast: on
-    // chain_8fn_10link.json Krus at 0.1 ms with the block W, even with a new
-    // J at every step, ends 5 mm RMS off ROS34PW2 in a stroke, with the
-    // whole W 0.1 mm. Every other chain takes the whole W (the solver's
-    // sparse LU). With the event counter and the implausible-state test
-    // (chain_problem.h).
-    const bool blocks = !adaptive && !o->dense_jac && two_link_shape(&m->chain);
     hyd_problem prob;
-    if (chain_problem_init(&cp, &cs, blocks, &prob)) {
+    hyd_solver_opts so;
+    if (chain_problem_setup(&cp, &cs, &m->chain, o, &prob, &so)) {
         snprintf(msg, msz, "cannot set up the chain's problem (out of memory, or a hook of chain_sim's problem "
                            "that chain_problem.c does not forward)");
         res->status = SIM_REFUSED;
         goto done;
     }
-    // The two-link shape keeps the Jacobian schedule it had (by age only):
-    // its seals' modes are slow against 1/h (hundreds of kg on each
-    // cylinder), and with the events its slewing runs moved by up to 4e-5
-    // of the pump line's peak for 13 % more Jacobians, no closer to
-    // ROS34PW2 (sandbox_swing: 3.06e-5 RMS of peak either way).
-    if (blocks) prob.events = NULL;
-    hyd_solver_opts so = hyd_default_solver_opts();
-    so.h = adaptive ? 0.0 : o->h;
-    so.rtol = o->rtol;
-    so.atol = o->atol;
-    so.h_max = 0.5;
-    so.jac_every = adaptive ? 1 : (o->jac_every > 0 ? o->jac_every : 1);
-    if (o->no_retry) so.retry_halvings = 0;
-    if (!adaptive) so.max_steps = 0;
     if (k->energy && (sim_energy_bind(k->energy, hm) || sim_energy_follow(k->energy, cs.n, energy_eval, &cs))) {
         snprintf(msg, msz, "out of memory for the energy balance");
         res->status = SIM_REFUSED;

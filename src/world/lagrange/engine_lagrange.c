@@ -3,6 +3,7 @@
 // stepped by an outside loop with commands set between steps.
 #include "engine_lagrange.h"
 #include "engine_chain.h"
+#include "engine_chain_step.h"
 #include "lagrange_row.h"
 #include "lagrange_sim.h"
 #include "energy_acc.h"
@@ -44,12 +45,6 @@ static engine* lag_create(const model* m, const sim_opts* o, const double q0[2],
                                   "takes the general formulation)",
                                err, errsz))
         return NULL;
-    if (o->variant == LAGRANGE_GENERAL) {
-        snprintf(err, errsz,
-                 "--variant general: the stepped lagrange engine (drive, serve) runs the two-link crane's closed "
-                 "form only; the general formulation runs scripted (cranesim run)");
-        return NULL;
-    }
     // No world circuit here: a burst at a node the model lacks has nowhere to open.
     if (engine_world_bursts(m, NULL, NULL, err, errsz)) return NULL;
     eng_lagrange* l = calloc(1, sizeof *l);
@@ -657,7 +652,15 @@ static void lag_describe_work(const sim_opts* o, const sim_result* r, char* buf,
         snprintf(buf + k, n - (size_t)k, ", %ld retried as %ld shorter steps", r->stats.retried, r->stats.substeps);
 }
 
+// The stepped engine for m and o: the closed form's for exactly the
+// two-link shorthand (its allow-list, as lag_run's), the general
+// formulation's for every other chain and for --variant general.
+static const engine_ops* lag_stepped(const model* m, const sim_opts* o) {
+    return !m->chain.two_link || o->variant == LAGRANGE_GENERAL ? &engine_chain_step_ops : &engine_lagrange_ops;
+}
+
 const engine_ops engine_lagrange_ops = {
+    .stepped = lag_stepped,
     .describe = lag_describe,
     .describe_work = lag_describe_work,
     .name = "lagrange",

@@ -5,6 +5,7 @@
 #include "energy_acc.h"
 
 #include "engine_ode_chain.h"
+#include "engine_ode_chain_step.h"
 #include "ode_run.h"
 #include "rcl.h"
 
@@ -44,9 +45,10 @@ static sim_start_load start_load(const model* m, const ode_world* w, const doubl
 // A model whose crane is a chain of other shape than the two-link one
 // (crane_chain.two_link false): its crane_mech does not describe it, and
 // the ODE world of ode_world.h builds that two-link crane alone. Scripted
-// runs take the chain world (engine_ode_chain.c); the stepped engine's
-// commands, views and limiter are still the two-link crane's: refused
-// here, in one line, rather than run as the wrong crane.
+// runs take the chain world (engine_ode_chain.c), stepped engines
+// engine_ode_chain_step.c (ode_stepped chooses); this create refuses a
+// chain in one line should it ever be called with one, rather than run the
+// wrong crane.
 static int refuse_chain(const model* m, char* err, size_t errsz) {
     return model_require_two_link(m,
                                   "stepped engine of the ode backend (a chain model runs scripted in the ODE chain "
@@ -363,7 +365,15 @@ static void ode_describe_work(const sim_opts* o, const sim_result* r, char* buf,
         snprintf(buf + k, n - (size_t)k, ", %ld retried as %ld shorter steps", r->stats.retried, r->stats.substeps);
 }
 
+// The stepped engine for m: the two-link world's for exactly the two-link
+// shorthand (as ode_run's), the chain world's for every other chain.
+static const engine_ops* ode_stepped(const model* m, const sim_opts* o) {
+    (void)o;
+    return m->chain.two_link ? &engine_ode_ops : &engine_ode_chain_step_ops;
+}
+
 const engine_ops engine_ode_ops = {
+    .stepped = ode_stepped,
     .describe = ode_describe,
     .describe_work = ode_describe_work,
     .name = "ode",

@@ -6,6 +6,7 @@
 #include "energy_acc.h"
 #include "engine_faults.h"
 #include "ode_chain.h"
+#include "ode_chain_row.h"
 #include "ode_run.h"
 #include "world_desc.h"
 
@@ -14,75 +15,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct chain_run {
-    ode_chain* w;
-    const crane_chain* cc;
-    const hyd_model* hm;
-    int na, nf, nd;
-    int* iu;     ///< [nf] the spool state of function f's valve, or -1
-    int ipump;   ///< the supply node, or -1
-    double *x, *v, *pA, *pB, *F, *u, *ucmd, *q, *qd; ///< the outputs, sized by the chain
-} chain_run;
-
-// Every actuator's and function's outputs now, into r's arrays.
-static void outputs(chain_run* r) {
-    const double* y;
-    const hyd_data* hd;
-    ode_chain_circuit_state(r->w, &y, &hd);
-    for (int k = 0; k < r->na; ++k) {
-        r->x[k] = ode_chain_act_length(r->w, k, &r->v[k]) - r->cc->act[k].closed_length;
-        r->F[k] = ode_chain_act_force(r->w, k, &r->pA[k], &r->pB[k]);
-    }
-    for (int f = 0; f < r->nf; ++f) {
-        r->u[f] = r->iu[f] >= 0 ? y[r->iu[f]] : 0.0;
-        r->ucmd[f] = hd->valve_cmd[r->cc->fn[f].valve_idx];
-    }
-    ode_chain_q(r->w, r->q, r->qd);
-}
-
-// The row: the base columns hold the first two actuators, their functions
-// and the first two boom DOFs (as the analytic general path's rows, so
-// compare pairs the same quantities), the tip relative to the first boom's
-// joint in the boom plane; of the world extras the slew where the column
-// slews, the rest 0 (the validation world has no hook, truck or contacts);
-// then every actuator, function and DOF under the chain's column names
-// (crane_chain_row), after the backend's SIM_NCOL channels.
-static void make_row(chain_run* r, double t, double* row) {
-    outputs(r);
-    memset(row, 0, SIM_NCOL * sizeof *row);
-    const crane_chain_sample smp = {r->x, r->v, r->pA, r->pB, r->F, r->u, r->ucmd, r->q, r->qd};
-    crane_chain_row(r->cc, &smp, row + SIM_NCOL);
-    row[COL_T] = t;
-    const int colx[2] = {COL_X1, COL_X2}, colv[2] = {COL_V1, COL_V2}, colF[2] = {COL_F1, COL_F2};
-    const int colA[2] = {COL_P1A, COL_P2A}, colB[2] = {COL_P1B, COL_P2B};
-    const int colu[2] = {COL_U1, COL_U2}, colc[2] = {COL_U1_CMD, COL_U2_CMD}, colq[2] = {COL_Q1, COL_Q2};
-    int end_stop = 0;
-    for (int k = 0; k < 2 && k < r->na; ++k) {
-        row[colx[k]] = r->x[k], row[colv[k]] = r->v[k], row[colF[k]] = r->F[k];
-        row[colA[k]] = r->pA[k], row[colB[k]] = r->pB[k];
-        const int f = r->cc->act[k].function;
-        row[colu[k]] = r->u[f], row[colc[k]] = r->ucmd[f];
-        if (ode_chain_act_at_stop(r->w, k)) end_stop |= 1 << k;
-    }
-    const int d0 = r->cc->slew_free ? 1 : 0;
-    for (int k = 0; k < 2 && d0 + k < r->nd; ++k) row[colq[k]] = r->q[d0 + k];
-    if (d0) row[COL_SLEW] = r->q[0];
-    double tip[3], p1[3];
-    ode_chain_tip(r->w, tip, NULL);
-    ode_chain_body_pose(r->w, r->cc->nbody > 1 ? 1 : 0, NULL, p1);
-    row[COL_TIP_X] = hypot(tip[0] - p1[0], tip[1] - p1[1]);
-    row[COL_TIP_Z] = tip[2] - p1[2];
-    const double* y;
-    const hyd_data* hd;
-    ode_chain_circuit_state(r->w, &y, &hd);
-    row[COL_P_PUMP] = r->ipump >= 0 ? hd->node_p[r->ipump] : 0.0;
-    int open = 0;
-    for (int i = 0; i < hyd_model_ncomp(r->hm); ++i)
-        if (hyd_model_comp_type(r->hm, i) == HYD_RELIEF && hd->comp_open[i]) ++open;
-    row[COL_RELIEF_OPEN] = open;
-    row[COL_END_STOP] = end_stop;
-}
-
 // Hand a finished row to the driver's sink; non-zero: stop.
 static int deliver(const engine_sink* k, const double* row) { return k->row && k->row(k->user, row); }
 
@@ -90,7 +22,7 @@ static int deliver(const engine_sink* k, const double* row) { return k->row && k
 // validation world runs in the chain world (the column on the ground, the
 // load at the tip), the sandbox in ode_world with the crane from the chain
 // (run_sandbox). -1 with the loader's message.
-static int world_kind_of(const sim_opts* o, world_kind* kind, char* err, size_t errsz) {
+int engine_ode_chain_world_kind(const sim_opts* o, world_kind* kind, char* err, size_t errsz) {
     *kind = WORLD_VALIDATION;
     if (!o->world) return 0;
     char buf[512];
@@ -122,28 +54,20 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
     ode_chain* cw = ode_world_chain(w);
     const crane_chain* cc = &m->chain;
     const crane_chain* hc = ode_chain_chain(cw); // the hosted copy: the column slews
-    chain_run r;
-    memset(&r, 0, sizeof r);
     hyd_model* hm = ode_world_circuit(w);
-    r.w = cw, r.cc = hc, r.hm = hm;
-    r.na = hc->nact, r.nf = hc->nfn, r.nd = ode_chain_ndof(cw);
-    const size_t na = (size_t)r.na, nf = (size_t)r.nf, nd = (size_t)r.nd;
-    double* buf = calloc(5 * na + 2 * nf + 2 * nd + SIM_NCOL + (size_t)cc->ncol + 1, sizeof *buf);
-    int* ibuf = calloc(2 * nf + 1, sizeof *ibuf);
-    if (!buf || !ibuf) {
+    // The outputs of the hosted chain (ode_chain_row.c, as the chain
+    // world's runs read them), and a row.
+    ode_chain_rows r;
+    const int rows_rc = ode_chain_rows_init(&r, hc, hm, ode_chain_ndof(cw));
+    double* buf = calloc(SIM_NCOL + (size_t)cc->ncol + 1, sizeof *buf);
+    int* fcol = calloc((size_t)hc->nfn + 1, sizeof *fcol);
+    if (rows_rc || !buf || !fcol) {
         snprintf(msg, msz, "out of memory");
         res->status = SIM_REFUSED;
         goto done;
     }
-    r.x = buf, r.v = r.x + na, r.pA = r.v + na, r.pB = r.pA + na, r.F = r.pB + na;
-    r.u = r.F + na, r.ucmd = r.u + nf, r.q = r.ucmd + nf, r.qd = r.q + nd;
-    double* row = r.qd + nd;
-    r.iu = ibuf;
-    int* fcol = ibuf + nf;
-    for (int f = 0; f < r.nf; ++f) {
-        r.iu[f] = hyd_model_valve_state(r.hm, hc->fn[f].valve_idx);
-        fcol[f] = scenario_find_command(sc, hc->fn[f].name);
-    }
+    double* row = buf;
+    for (int f = 0; f < r.nf; ++f) fcol[f] = scenario_find_command(sc, hc->fn[f].name);
     // The model's DOF columns: the slew's only where the model's column slews.
     const int d0 = cc->slew_free ? 0 : 1;
     const double dt = ode_world_dt(w);
@@ -165,7 +89,7 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
 #define SANDBOX_ROW(t_)                                                                                    \
     do {                                                                                                   \
         ode_world_row(w, row);                                                                             \
-        outputs(&r);                                                                                       \
+        ode_chain_rows_outputs(&r, cw);                                                                    \
         const crane_chain_sample smp_ = {r.x, r.v, r.pA, r.pB, r.F, r.u, r.ucmd, r.q + d0, r.qd + d0};     \
         crane_chain_row(cc, &smp_, row + SIM_NCOL);                                                        \
         row[COL_T] = (t_);                                                                                 \
@@ -277,26 +201,19 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
 done:
     ode_world_destroy(w);
     free(buf);
-    free(ibuf);
+    free(fcol);
+    if (!rows_rc) ode_chain_rows_free(&r);
     return res->status;
 }
 
-int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
-                         sim_result* res) {
-    char* msg = res->message;
-    const size_t msz = sizeof res->message;
-    world_kind kind;
-    if (world_kind_of(o, &kind, msg, msz)) return res->status = SIM_REFUSED;
-    if (kind == WORLD_SANDBOX) return run_sandbox(m, sc, o, k, res);
+int engine_ode_chain_check(const sim_opts* o, double* dt_ode, double* h_hyd, char* msg, size_t msz) {
     if (hyd_method_is_adaptive(o->solver)) {
         snprintf(msg, msz,
                  "solver %s is adaptive: the ODE chain world sub-steps its circuit with a fixed-step method (krus, "
                  "ros2, rk4)",
                  hyd_method_name(o->solver));
-        return res->status = SIM_REFUSED;
+        return -1;
     }
-    // No world circuit here: a burst at a node the model lacks has nowhere to open.
-    if (engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
     const double dt = o->dt_ode > 0 ? o->dt_ode : 1e-3;
     // As ode_world_for_run: the forces lag the bodies by one ODE step.
     if (dt > 0.01 + 1e-12) {
@@ -304,15 +221,32 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
                  "%s %g s is too long: the cylinder forces lag the bodies by one ODE step, which beyond 0.01 s "
                  "distorts the pressures by more than 15 %% and then goes unstable (docs/ode_world.md)",
                  sim_param_name(SIM_PARAM_DT_ODE), dt);
-        return res->status = SIM_REFUSED;
+        return -1;
     }
     const double h = o->h < dt ? o->h : dt;
     const double ratio = dt / h;
     if (fabs(ratio - floor(ratio + 0.5)) > 1e-6) {
         snprintf(msg, msz, "%s %g s must divide the ODE step %g s (hydraulic sub-steps)", sim_param_name(SIM_PARAM_DT),
                  h, dt);
-        return res->status = SIM_REFUSED;
+        return -1;
     }
+    *dt_ode = dt;
+    *h_hyd = h;
+    return 0;
+}
+
+int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
+                         sim_result* res) {
+    char* msg = res->message;
+    const size_t msz = sizeof res->message;
+    world_kind kind;
+    if (engine_ode_chain_world_kind(o, &kind, msg, msz)) return res->status = SIM_REFUSED;
+    if (kind == WORLD_SANDBOX) return run_sandbox(m, sc, o, k, res);
+    double dt, h;
+    if (engine_ode_chain_check(o, &dt, &h, msg, msz)) return res->status = SIM_REFUSED;
+    // No world circuit here: a burst at a node the model lacks has nowhere to open.
+    if (engine_world_bursts(m, NULL, NULL, msg, msz)) return res->status = SIM_REFUSED;
+    const double ratio = dt / h;
     const double t_end = k->t_end;
     if (t_end / dt > 1e12) {
         snprintf(msg, msz, "%s %g s over %g s is %.3g steps, more than 1e12: use a larger %s or a shorter run",
@@ -320,34 +254,24 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         return res->status = SIM_REFUSED;
     }
     const crane_chain* cc = &m->chain;
-    chain_run r;
-    memset(&r, 0, sizeof r);
-    r.cc = cc;
-    r.hm = m->hyd;
-    // The mechanism's DOFs: the joints that are not fixed, the column's
-    // when it slews.
     const int nd = crane_chain_ndof(cc);
-    r.na = cc->nact, r.nf = cc->nfn, r.nd = nd;
-    const size_t na = (size_t)r.na, nf = (size_t)r.nf;
-    double* buf = calloc(5 * na + 2 * nf + 3 * (size_t)nd + SIM_NCOL + (size_t)cc->ncol + 1, sizeof *buf);
-    int* ibuf = calloc(2 * nf + 1, sizeof *ibuf);
+    const size_t nf = (size_t)cc->nfn;
+    // The outputs and the row (ode_chain_row.c, shared with the stepped
+    // engine); here the start pose and the row: SIM_NCOL channels, then the
+    // chain's columns.
+    ode_chain_rows r;
+    const int rows_rc = ode_chain_rows_init(&r, cc, m->hyd, nd);
+    double* buf = calloc((size_t)nd + (size_t)ode_chain_row_ncol(cc) + 1, sizeof *buf);
+    int* fcol = calloc(nf + 1, sizeof *fcol);
     ode_chain* w = NULL;
-    if (!buf || !ibuf) {
+    if (rows_rc || !buf || !fcol) {
         snprintf(msg, msz, "out of memory");
         res->status = SIM_REFUSED;
         goto done;
     }
-    r.x = buf, r.v = r.x + na, r.pA = r.v + na, r.pB = r.pA + na, r.F = r.pB + na;
-    r.u = r.F + na, r.ucmd = r.u + nf, r.q = r.ucmd + nf, r.qd = r.q + nd;
-    double* q0 = r.qd + nd;
-    double* row = q0 + nd; // SIM_NCOL channels, then the chain's columns
-    r.iu = ibuf;
-    int* fcol = ibuf + nf;
-    for (int f = 0; f < r.nf; ++f) {
-        r.iu[f] = hyd_model_valve_state(m->hyd, cc->fn[f].valve_idx);
-        fcol[f] = scenario_find_command(sc, cc->fn[f].name);
-    }
-    r.ipump = hyd_model_supply_node(m->hyd);
+    double* q0 = buf;
+    double* row = q0 + nd;
+    for (int f = 0; f < r.nf; ++f) fcol[f] = scenario_find_command(sc, cc->fn[f].name);
     // The analytic general path's start pose, so both start from one state.
     crane_chain_start_pose(cc, sc->q0, sc->slew0, q0);
     ode_chain_opts co = ode_chain_default_opts();
@@ -367,13 +291,12 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         res->status = SIM_REFUSED;
         goto done;
     }
-    r.w = w;
     if ((res->status = sim_check_fixed_step(m->hyd, o, h, t_end, msg, msz)) ||
         (k->probe && (res->status = k->probe(m, o, h, msg, msz))))
         goto done;
     sim_checks chk;
     memset(&chk, 0, sizeof chk);
-    make_row(&r, 0.0, row);
+    ode_chain_make_row(&r, w, 0.0, row);
     for (int j = 0; j < 4; ++j) res->p_peak[j] = row[COL_P1A + j];
     {
         // The start state: a model value that overflows shows at t = 0.
@@ -426,7 +349,7 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
             res->p_peak[2 * a + 1] = fmax(res->p_peak[2 * a + 1], pB);
         }
         if ((i + 1) % nout && i + 1 != nstep) continue;
-        make_row(&r, (double)(i + 1) * dt, row); // exact grid times
+        ode_chain_make_row(&r, w, (double)(i + 1) * dt, row); // exact grid times
         char what[200];
         if (sim_check_row(&chk, row, SIM_NCOL_BASE, what, sizeof what)) {
             res->status = SIM_FAILED;
@@ -454,6 +377,7 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
 done:
     ode_chain_destroy(w);
     free(buf);
-    free(ibuf);
+    free(fcol);
+    if (!rows_rc) ode_chain_rows_free(&r);
     return res->status;
 }

@@ -7,6 +7,7 @@
 #define ENGINE_ODE_CHAIN_H
 
 #include "engine_impl.h"
+#include "world_desc.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -27,6 +28,18 @@ extern "C" {
 /// the tip in the ground.
 int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
                          sim_result* res);
+
+/// The options the chain world (the validation world) takes, as both its
+/// scripted run and its stepped engine (engine_ode_chain_step.c) check
+/// them: a fixed-step solver, an ODE step of at most 10 ms that the
+/// hydraulic step divides. 0 with the ODE step and the hydraulic sub-step
+/// [s] in *dt_ode, *h_hyd; -1 with one line in msg.
+int engine_ode_chain_check(const sim_opts* o, double* dt_ode, double* h_hyd, char* msg, size_t msz);
+
+/// The kind of the world o names (the validation world when none): the
+/// validation world runs in the chain world, a sandbox in ode_world with
+/// the crane from the chain. -1 with the world loader's message.
+int engine_ode_chain_world_kind(const sim_opts* o, world_kind* kind, char* err, size_t errsz);
 
 #ifdef __cplusplus
 }

@@ -18,6 +18,7 @@ struct chan_list {
     int* idx;            ///< (n - nrow) node, state or flow slot (component * 2 + entry)
     hyd_data* hd;        ///< the list's own evaluation (the engine's is its own)
     double *y, *ydot;    ///< (nstate)
+    double* row;         ///< (max(nrow, SIM_NCOL)) engine_row's buffer
 };
 
 static int add(chan_list* c, int cap, const char* name, const char* unit, sim_channel_kind kind, chan_src src,
@@ -51,8 +52,9 @@ chan_list* chan_list_create(engine* e) {
     c->idx = calloc((size_t)(cap - c->nrow) + 1, sizeof *c->idx);
     c->y = calloc((size_t)ns + 1, sizeof *c->y);
     c->ydot = calloc((size_t)ns + 1, sizeof *c->ydot);
+    c->row = calloc((size_t)(c->nrow > SIM_NCOL ? c->nrow : SIM_NCOL), sizeof *c->row);
     c->hd = hyd_data_create(m);
-    if (!c->ch || !c->name || !c->src || !c->idx || !c->y || !c->ydot || !c->hd) {
+    if (!c->row || !c->ch || !c->name || !c->src || !c->idx || !c->y || !c->ydot || !c->hd) {
         chan_list_free(c);
         return NULL;
     }
@@ -101,6 +103,7 @@ void chan_list_free(chan_list* c) {
     free(c->idx);
     free(c->y);
     free(c->ydot);
+    free(c->row);
     if (c->hd) hyd_data_free(c->hd);
     free(c);
 }
@@ -120,9 +123,8 @@ int chan_list_find(const chan_list* c, const char* name) {
 
 void chan_list_values(chan_list* c, engine* e, double* out, bool row_done) {
     if (!row_done) {
-        double row[SIM_NCOL];
-        engine_row(e, row);
-        memcpy(out, row, sizeof *out * (size_t)c->nrow);
+        engine_row(e, c->row);
+        memcpy(out, c->row, sizeof *out * (size_t)c->nrow);
     }
     if (c->n == c->nrow) return;
     const hyd_data* in = NULL;

@@ -46,24 +46,76 @@ engine* engine_create(const model* m, const sim_opts* o, const double q0[2], dou
     return engine_create_rcl(m, o, q0, slew0, m3, NULL, err, errsz);
 }
 
+// The ops engine_create uses for m and o: the backend's own, or the one its
+// stepped() chooses (its engine for crane chains).
+static const engine_ops* stepped_ops(const model* m, const sim_opts* o) {
+    const engine_ops* b = backend(o);
+    if (!b) return NULL;
+    return b->stepped ? b->stepped(m, o) : b;
+}
+
+// The sizes engine.c owns: the commands by function, the channels and a
+// row buffer. 0, or -1 when out of memory.
+static int size_engine(engine* e, const model* m) {
+    e->mdl = m;
+    e->nfn = engine_nfunction(e);
+    e->u_op = calloc(2 * (size_t)e->nfn + 1, sizeof *e->u_op);
+    e->u_lim = e->u_op ? e->u_op + e->nfn : NULL;
+    const int nc = engine_ncol(e);
+    e->rowbuf = calloc((size_t)(nc > SIM_NCOL ? nc : SIM_NCOL), sizeof *e->rowbuf);
+    if (!e->u_op || !e->rowbuf) return -1;
+    const int nb = e->ops->nchannel;
+    if (nc > nb) {
+        // The backend's channels, then the chain's own (crane_chain_columns),
+        // named by the model (which outlives the engine).
+        e->chan = calloc((size_t)nc, sizeof *e->chan);
+        if (!e->chan) return -1;
+        memcpy(e->chan, sim_channels, (size_t)nb * sizeof *e->chan);
+        for (int c = nb; c < nc && c - nb < m->chain.ncol; ++c) {
+            const crane_column* cl = &m->chain.col[c - nb];
+            e->chan[c] = (sim_channel){cl->name, cl->unit, cl->pressure ? SIM_CH_PRESSURE : SIM_CH_OTHER};
+        }
+    }
+    return 0;
+}
+
+// Frees what size_engine allocated, then the backend's engine.
+static void free_engine(engine* e) {
+    free(e->u_op);
+    free(e->rowbuf);
+    free(e->chan);
+    e->ops->destroy(e);
+}
+
 engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           struct rcl* r, char* err, size_t errsz) {
-    if (!backend(o)) {
+    const engine_ops* ops = stepped_ops(m, o);
+    if (!ops) {
         unknown_backend(o, err, errsz);
         return NULL;
     }
-    engine* e = backend(o)->create(m, o, q0, slew0, m3, err, errsz);
+    engine* e = ops->create(m, o, q0, slew0, m3, err, errsz);
     if (!e) return NULL;
-    e->mdl = m;
+    if (size_engine(e, m)) {
+        snprintf(err, errsz, "out of memory");
+        free_engine(e);
+        return NULL;
+    }
     // The step probe on the backend's hydraulic step, after its own start
     // checks: it runs the analytic backend (step_probe.c), which a backend
     // may not call, so the engine applies it for every backend.
     if (sim_check_step_probe(m, o, e->h_probe, err, errsz)) {
-        e->ops->destroy(e);
+        free_engine(e);
         return NULL;
     }
     // The limiter filters every command a stepped driver sets (drive, the
-    // window's tick, the soak bench, serve): one place for all of them.
+    // window's tick, the soak bench, serve): one place for all of them. An
+    // engine without the two-link commands has none (rcl.h refuses chains);
+    // engine_caps says so, and a driver that needs one refuses first.
+    if (!(engine_caps(e) & ENGINE_CAP_LIMITER)) {
+        rcl_destroy(r);
+        return e;
+    }
     if (r) rcl_reset(r);
     // A stepped engine's world, when o names none, is its drive world.
     e->rcl = r ? r : engine_rcl_create(m, o, engine_backend_of(o)->drive_world);
@@ -113,26 +165,125 @@ int engine_check_scenario(const model* m, const scenario* sc, char* err, size_t 
 
 int engine_nfunction(const engine* e) {
     const crane_chain* cc = &e->mdl->chain;
-    return cc->nfn + (crane_chain_find_function(cc, "slew") < 0 ? 1 : 0);
+    // The two-link crane's third command is the slew (of the sandbox
+    // world); a chain engine takes exactly the model's functions.
+    return cc->nfn + (cc->two_link && crane_chain_find_function(cc, "slew") < 0 ? 1 : 0);
 }
 
 const char* engine_function_name(const engine* e, int k) {
     const crane_chain* cc = &e->mdl->chain;
     if (k >= 0 && k < cc->nfn) return cc->fn[k].name;
-    return k == cc->nfn && crane_chain_find_function(cc, "slew") < 0 ? "slew" : NULL;
+    return k >= 0 && k == engine_nfunction(e) - 1 ? "slew" : NULL;
 }
 
-void engine_set_function_commands(engine* e, const double* u) {
-    // The stepped engines are the two-link crane's (lift, jib) and the
-    // world's slew: their commands go through engine_set_commands (and its
-    // limiter). A function of another name has no stepped engine yet.
-    double u3[3] = {e->u_op[0], e->u_op[1], e->u_op[2]};
-    for (int k = 0; k < engine_nfunction(e); ++k) {
-        const char* nm = engine_function_name(e, k);
-        for (int c = 0; c < SCENARIO_NCMD; ++c)
-            if (!strcmp(nm, scenario_cmd_name[c])) u3[c] = u[k];
+int engine_find_function(const engine* e, const char* name) {
+    for (int k = 0; k < e->nfn; ++k)
+        if (!strcmp(engine_function_name(e, k), name)) return k;
+    return -1;
+}
+
+// The names of e's functions, ", "-separated, into buf.
+static void function_list(const engine* e, char* buf, size_t n) {
+    int w = 0;
+    for (int k = 0; k < e->nfn && w >= 0 && (size_t)w < n; ++k)
+        w += snprintf(buf + w, n - (size_t)w, "%s%s", k ? ", " : "", engine_function_name(e, k));
+}
+
+static double clamp1(double v) { return v < -1 ? -1 : v > 1 ? 1 : isnan(v) ? 0 : v; }
+
+// The commands by function, all nfn of them, to the engine.
+static void apply_function_commands(engine* e, const double* u) {
+    if (!e->ops->set_function_commands) {
+        // The two-link engines: lift, jib, slew through engine_set_commands
+        // (and its limiter), whatever the chain's function order.
+        double u3[3] = {e->u_op[0], e->u_op[1], e->u_op[2]};
+        for (int k = 0; k < e->nfn; ++k)
+            for (int c = 0; c < SCENARIO_NCMD; ++c)
+                if (!strcmp(engine_function_name(e, k), scenario_cmd_name[c])) u3[c] = u[k];
+        engine_set_commands(e, u3);
+        return;
     }
-    engine_set_commands(e, u3);
+    for (int k = 0; k < e->nfn; ++k) e->u_op[k] = e->u_lim[k] = clamp1(u[k]);
+    e->ops->set_function_commands(e, e->u_op);
+}
+
+int engine_set_function_commands(engine* e, const double* u, int n, char* err, size_t errsz) {
+    if (n != e->nfn) {
+        if (err && errsz) {
+            char names[400];
+            function_list(e, names, sizeof names);
+            snprintf(err, errsz, "%d commands for the %d functions %s", n, e->nfn, names);
+        }
+        return -1;
+    }
+    apply_function_commands(e, u);
+    return 0;
+}
+
+int engine_set_function_command(engine* e, const char* name, double u, char* err, size_t errsz) {
+    const int k = engine_find_function(e, name);
+    if (k < 0) {
+        if (err && errsz) {
+            char names[400];
+            function_list(e, names, sizeof names);
+            snprintf(err, errsz, "no function '%s' (functions: %s)", name, names);
+        }
+        return -1;
+    }
+    double* v = malloc(((size_t)e->nfn + 1) * sizeof *v);
+    if (!v) {
+        if (err && errsz) snprintf(err, errsz, "out of memory");
+        return -1;
+    }
+    memcpy(v, e->u_op, (size_t)e->nfn * sizeof *v);
+    v[k] = u;
+    apply_function_commands(e, v);
+    free(v);
+    return 0;
+}
+
+double engine_function_command(const engine* e, int k) { return k >= 0 && k < e->nfn ? e->u_op[k] : NAN; }
+
+unsigned engine_caps(const engine* e) {
+    const engine_ops* p = e->ops;
+    unsigned c = 0;
+    if (p->snapshot) c |= ENGINE_CAP_SNAPSHOT;
+    if (p->set_link) c |= ENGINE_CAP_SET_LINK;
+    // The limiter and everything shaped lift, jib, slew with SIM_NCOL
+    // columns: the engines that take set_commands' three commands.
+    if (p->set_commands && !p->set_function_commands) c |= ENGINE_CAP_TWO_LINK | ENGINE_CAP_LIMITER;
+    return c;
+}
+
+unsigned engine_caps_for(const model* m, const sim_opts* o) {
+    const engine_ops* p = stepped_ops(m, o);
+    if (!p) return 0;
+    // engine_caps reads only the ops: a stand-in engine with them.
+    engine tmp;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.ops = p;
+    return engine_caps(&tmp);
+}
+
+int engine_require(const model* m, const sim_opts* o, unsigned caps, const char* what, char* err, size_t errsz) {
+    if (!stepped_ops(m, o)) {
+        unknown_backend(o, err, errsz);
+        return -1;
+    }
+    const unsigned miss = caps & ~engine_caps_for(m, o);
+    if (!miss) return 0;
+    // The first missing part, in the order a driver meets them.
+    const char* part = (miss & ENGINE_CAP_SNAPSHOT)   ? "picture for the renderer"
+                       : (miss & ENGINE_CAP_TWO_LINK) ? "fixed three commands and two-link rows (lift, jib, slew; "
+                                                        "a headless drive runs it by function)"
+                       : (miss & ENGINE_CAP_LIMITER)  ? "rated capacity limiter"
+                                                      : "boom edits (the drive panel)";
+    char crane[64];
+    if (m->chain.two_link) snprintf(crane, sizeof crane, "the two-link crane in the general formulation");
+    else snprintf(crane, sizeof crane, "this crane chain (%d functions)", m->chain.nfn);
+    snprintf(err, errsz, "%s: %s: the stepped %s engine for %s has no %s yet", what, m->file[0] ? m->file : "model",
+             engine_backend_of(o)->name, crane, part);
+    return -1;
 }
 
 int engine_run(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k0, sim_result* res) {
@@ -163,6 +314,17 @@ void engine_play(engine* e, const scenario* sc, double tm, int* ev, double u[3],
     engine_apply_faults(e, sc, tm);
 }
 
+void engine_play_functions(engine* e, const scenario* sc, double tm, int* ev, double* u, engine_hook_fn on_hook,
+                           void* user) {
+    double u3[SCENARIO_NCMD];
+    engine_play(e, sc, tm, ev, u3, on_hook, user);
+    // By name, as the scripted runs read them (scenario_find_command).
+    for (int k = 0; k < e->nfn; ++k) {
+        const int c = scenario_find_command(sc, engine_function_name(e, k));
+        u[k] = c < 0 ? 0.0 : c < SCENARIO_NCMD ? u3[c] : scenario_command(sc, c, tm);
+    }
+}
+
 void engine_apply_faults(engine* e, const scenario* sc, double tm) {
     // Faults act on the engine's circuit at the same time as the commands
     // (bursts only if the engine was made from engine_fault_model's model).
@@ -176,7 +338,7 @@ void engine_apply_faults(engine* e, const scenario* sc, double tm) {
 void engine_destroy(engine* e) {
     if (!e) return;
     engine_rcl_destroy(e->rcl);
-    e->ops->destroy(e);
+    free_engine(e);
 }
 
 const char* engine_backend_name(const engine* e) { return e->ops->name; }
@@ -198,23 +360,35 @@ void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, siz
     else backend(o)->describe_work(o, r, buf, n);
 }
 void engine_set_commands(engine* e, const double u[3]) {
+    if (e->ops->set_function_commands) {
+        // By name onto the functions the model has (a chain engine).
+        double* v = malloc(((size_t)e->nfn + 1) * sizeof *v);
+        if (!v) return; // nothing set: the commands held stay
+        memcpy(v, e->u_op, (size_t)e->nfn * sizeof *v);
+        for (int c = 0; c < SCENARIO_NCMD; ++c) {
+            const int k = engine_find_function(e, scenario_cmd_name[c]);
+            if (k >= 0) v[k] = u[c];
+        }
+        apply_function_commands(e, v);
+        free(v);
+        return;
+    }
     // The operator's demand and what was let through, for the HUD (it shows
     // both where the limiter cut).
-    memcpy(e->u_op, u, sizeof e->u_op);
-    memcpy(e->u_lim, u, sizeof e->u_lim);
+    memcpy(e->u_op, u, 3 * sizeof *e->u_op);
+    memcpy(e->u_lim, u, 3 * sizeof *e->u_lim);
     if (!e->rcl || !e->o.rcl) {
         if (e->rcl) { // still measured, for the HUD and the record
-            double row[SIM_NCOL];
-            e->ops->row(e, row);
-            rcl_utilisation(e->rcl, row);
+            e->ops->row(e, e->rowbuf);
+            rcl_utilisation(e->rcl, e->rowbuf);
         }
         e->ops->set_commands(e, u);
         return;
     }
-    double row[SIM_NCOL], v[3];
-    e->ops->row(e, row);
-    rcl_filter(e->rcl, row, u, v);
-    memcpy(e->u_lim, v, sizeof e->u_lim);
+    double v[3];
+    e->ops->row(e, e->rowbuf);
+    rcl_filter(e->rcl, e->rowbuf, u, v);
+    memcpy(e->u_lim, v, 3 * sizeof *e->u_lim);
     e->ops->set_commands(e, v);
 }
 
@@ -273,8 +447,10 @@ void engine_set_load(engine* e, double m3) {
 bool engine_can_set_load(const engine* e) { return e->ops->set_load != NULL; }
 bool engine_can_resize_links(const engine* e) { return e->ops->resize_links; }
 
-int engine_set_link(engine* e, int k, const crane_link* ln) { return e->ops->set_link(e, k, ln); }
-int engine_ncol(const engine* e) { return e->ops->nchannel; }
+int engine_set_link(engine* e, int k, const crane_link* ln) {
+    return e->ops->set_link ? e->ops->set_link(e, k, ln) : -1; // -1: no two-link booms (a chain engine)
+}
+int engine_ncol(const engine* e) { return e->ncol > 0 ? e->ncol : e->ops->nchannel; }
 
 void engine_circuit_state(engine* e, double* y, const hyd_data** in) {
     const hyd_data* d = NULL;
@@ -283,8 +459,8 @@ void engine_circuit_state(engine* e, double* y, const hyd_data** in) {
 }
 
 const sim_channel* engine_channels(const engine* e, int* n) {
-    *n = e->ops->nchannel;
-    return sim_channels;
+    *n = engine_ncol(e);
+    return e->chan ? e->chan : sim_channels;
 }
 
 const sim_channel* engine_channels_for(const sim_opts* o, int* n) {
@@ -293,11 +469,12 @@ const sim_channel* engine_channels_for(const sim_opts* o, int* n) {
     return sim_channels;
 }
 double engine_time(const engine* e) { return e->ops->time(e); }
-void engine_row(engine* e, double row[SIM_NCOL]) {
+void engine_row(engine* e, double* row) {
     e->ops->row(e, row);
     fill_rcl(e, row);
 }
-void engine_snapshot(engine* e, world_snapshot* s) {
+bool engine_snapshot(engine* e, world_snapshot* s) {
+    if (!e->ops->snapshot) return false;
     e->ops->snapshot(e, s);
     s->rcl_have = e->rcl != NULL;
     s->rcl_on = e->rcl && e->o.rcl;
@@ -305,9 +482,10 @@ void engine_snapshot(engine* e, world_snapshot* s) {
     // Cylinder k (lift, jib, slew) carries command k.
     for (int k = 0; k < s->ncyl && k < WORLD_SNAP_MAX_CYLINDERS; ++k) {
         world_snap_cylinder* c = &s->cyl[k];
-        c->rcl_cut = k < 3 && s->rcl_on && e->u_lim[k] != e->u_op[k];
+        c->rcl_cut = k < 3 && k < e->nfn && s->rcl_on && e->u_lim[k] != e->u_op[k];
         c->u_op = c->rcl_cut ? e->u_op[k] : c->u_cmd;
     }
+    return true;
 }
 const char* engine_error(const engine* e) { return e->err; }
 const sim_collisions* engine_collisions(const engine* e) {
@@ -328,7 +506,7 @@ static int advance(engine* e, double dt, engine_row_fn row_fn, void* user) {
     // The same checks as run's, on the row the driver records and shows: a
     // drive that exits 0 while recording -26 MPa absolute is a wrong result
     // passing as valid.
-    double row[SIM_NCOL];
+    double* row = e->rowbuf;
     e->ops->row(e, row);
     fill_rcl(e, row);
     char what[200];

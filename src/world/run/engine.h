@@ -1,6 +1,8 @@
 // engine.h: one crane engine, whatever the backend: the lagrange crane
 // (engine_lagrange.c, on lagrange_sim) or the ODE world (engine_ode.c, on
-// ode_world). Drivers (drive, the window's tick, the soak bench) create one
+// ode_world), and for a crane chain of any shape their chain engines
+// (engine_chain_step.c on chain_sim, engine_ode_chain_step.c on ode_chain),
+// sized by the model. Drivers (drive, the window's tick, the soak bench) create one
 // from the model and the options, set commands, advance it on the simulated
 // clock, read its row and its snapshot, and never ask which backend runs:
 // what differs is behind engine_ops (engine_impl.h). Scripted runs (run,
@@ -26,7 +28,11 @@ extern "C" {
 /// The engine o->mechanics names, at joint angles q0 [rad], slew angle
 /// slew0 [rad] (ode only) and tip load m3 [kg] (lagrange, and the ode
 /// validation world; the sandbox picks loads up with the hook). The ode world
-/// is o->world, else the sandbox. NULL with one line in err: the start the
+/// is o->world, else the sandbox. For a crane chain (not the two-link
+/// shorthand; lagrange also with --variant general) the backend's engine for
+/// chains (engine_ops.stepped): q0 are the first two boom DOFs, the others
+/// start mid-limits (crane_chain_start_pose), as the scripted runs start;
+/// it has what engine_caps says. NULL with one line in err: the start the
 /// run checks refuse (an unreachable pose, a step the method cannot take, a
 /// load the reliefs cannot hold), or the world file at fault.
 engine* engine_create(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3, char* err,
@@ -42,20 +48,57 @@ void engine_describe(const sim_opts* o, engine_desc* d);
 void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, size_t n);
 
 /// Valve commands lift, jib, slew in [-1, 1] (clamped; slew ignored where
-/// the crane does not slew), held until changed.
+/// the crane does not slew), held until changed. On an engine that takes
+/// commands by function (a chain engine) each goes to the function of that
+/// name, if the model has one (else it is dropped); the other functions
+/// keep their commands.
 void engine_set_commands(engine* e, const double u[3]);
-/// The functions the operator commands (the model chain's: lift, jib, ...,
-/// then "slew" where the chain has no function of that name, as
-/// engine_set_commands' third command), their count and names (NULL out of
-/// range). The two-link crane: lift, jib, slew.
+/// The functions the operator commands: the model chain's (lift, jib,
+/// ...), for the two-link crane then "slew" where the chain has no function
+/// of that name (engine_set_commands' third command, the sandbox's slew);
+/// their count and names (NULL out of range). The two-link crane: lift,
+/// jib, slew; a chain model: its functions, in the model file's order.
 int engine_nfunction(const engine* e);
 const char* engine_function_name(const engine* e, int k);
-/// Commands of the engine_nfunction functions in [-1, 1], in their order,
-/// held until changed; through engine_set_commands for lift, jib and slew
-/// (clamped, filtered by the limiter). The stepped engines exist for the
-/// two-link crane only (engine_create refuses other chains), whose
-/// functions these three are.
-void engine_set_function_commands(engine* e, const double* u);
+/// The index of the function called name, or -1.
+int engine_find_function(const engine* e, const char* name);
+/// Commands of the engine_nfunction functions in [-1, 1] (clamped), n of
+/// them in their order, held until changed. 0, or -1 with one line in err
+/// (may be NULL) and nothing set when n is not engine_nfunction(e): "N
+/// commands for the M functions lift, jib, ...". The two-link crane's go
+/// through engine_set_commands (and its limiter).
+int engine_set_function_commands(engine* e, const double* u, int n, char* err, size_t errsz);
+/// The command of the function called name in [-1, 1], held; the others
+/// keep theirs. 0, or -1 with "no function 'X' (functions: lift, ...)" in
+/// err (may be NULL) and nothing set.
+int engine_set_function_command(engine* e, const char* name, double u, char* err, size_t errsz);
+/// The operator's last command of function k as given [-], or NaN out of range.
+double engine_function_command(const engine* e, int k);
+
+/// What a stepped engine supplies besides stepping, its rows and its
+/// commands by function: a driver whose output needs one asks before it
+/// starts (engine_require) instead of finding a NULL later.
+typedef enum engine_cap {
+    /// A picture for the renderer (engine_snapshot): the window, serve's frames.
+    ENGINE_CAP_SNAPSHOT = 1u << 0,
+    /// The rated capacity limiter (engine_rcl): its chart, the cut commands.
+    ENGINE_CAP_LIMITER = 1u << 1,
+    /// Boom edits in place or by rebuild (engine_set_link): the drive panel.
+    ENGINE_CAP_SET_LINK = 1u << 2,
+    /// The two-link shape: commands lift, jib, slew (u[3]) and rows of
+    /// SIM_NCOL columns, what the HUD, the serve protocol and session files
+    /// carry (issue 27 sizes them by the model).
+    ENGINE_CAP_TWO_LINK = 1u << 3,
+} engine_cap;
+/// The engine_cap bits of engine e, and of the engine engine_create would
+/// make for model m with options o (0 when o names no backend).
+unsigned engine_caps(const engine* e);
+unsigned engine_caps_for(const model* m, const sim_opts* o);
+/// 0 when the stepped engine for m and o has every bit of caps; else -1
+/// with one line in err: "WHAT: <model file>: the stepped <backend> engine
+/// for this crane chain (N functions) has no <first missing part> yet".
+/// what names the caller ("the window", "the serve protocol").
+int engine_require(const model* m, const sim_opts* o, unsigned caps, const char* what, char* err, size_t errsz);
 /// 0 when every command column of sc names a function of m (lift, jib and
 /// slew always do), else -1 with "FILE: commands.X: unknown field 'X': the
 /// model has no function of that name (its functions: ...)" in err. engine_run checks it.
@@ -98,17 +141,20 @@ bool engine_can_set_load(const engine* e);
 /// True when engine_set_link applies a new boom length in place (else the
 /// engine must be rebuilt for one).
 bool engine_can_resize_links(const engine* e);
-/// Boom k (0 lifting arm, 1 end arm) now has link ln (mass, com, inertia,
+/// Boom k (0 lifting arm, 1 end arm) of the two-link crane now has link ln (mass, com, inertia,
 /// length), applied in place at the next step where the engine can: the
 /// lagrange crane always (its constants are recomputed; ln is the model's
 /// link it reads), the ode world for a new mass and inertia about the same
 /// centre of mass. Returns 0 when applied, 1 when the engine must be
-/// rebuilt for it (a new length, or a centre of mass that moves).
+/// rebuilt for it (a new length, or a centre of mass that moves); -1 when
+/// the engine has no such booms (a chain engine: no ENGINE_CAP_SET_LINK).
 int engine_set_link(engine* e, int k, const crane_link* ln);
 
-/// The output channels the engine publishes, by name, unit and kind: the
-/// first *n entries of sim_channels (the base list; the ode world adds its
-/// extras), which are the columns engine_row fills.
+/// The output channels the engine publishes, by name, unit and kind, which
+/// are the columns engine_row fills: the first entries of sim_channels
+/// (the base list; the ode world adds its extras), then for a chain engine
+/// the chain's own columns (crane_chain_columns: per actuator, function and
+/// degree of freedom), as the scripted runs' rows. *n = engine_ncol(e).
 const sim_channel* engine_channels(const engine* e, int* n);
 /// The channels of the engine o->mechanics names, before one exists (a run
 /// writes its CSV header from them).
@@ -117,7 +163,8 @@ const sim_channel* engine_channels_for(const sim_opts* o, int* n);
 /// engine_circuit entries), into y; *in (may be NULL): the hydraulic data
 /// the engine last evaluated with (strokes, rates, valve commands).
 void engine_circuit_state(engine* e, double* y, const hyd_data** in);
-/// The number of engine_channels.
+/// The number of engine_channels: the columns of engine_row (SIM_NCOL at
+/// most for the two-link crane; a chain engine's more, sized by the model).
 int engine_ncol(const engine* e);
 
 /// Advance to simulated time t_to [s] (the ode world takes whole ODE steps:
@@ -155,14 +202,24 @@ typedef void (*engine_hook_fn)(void* user, engine* e, int attach, int got);
 void engine_play(engine* e, const scenario* sc, double tm, int* ev, double u[3], engine_hook_fn on_hook,
                  void* user);
 
+/// engine_play by function: the commands of sc at time tm [s] for each of
+/// the engine_nfunction functions into u (the scenario's column of that
+/// name, lift, jib, slew or a named one; 0 for a function it does not
+/// command), hook and fault events as engine_play. The two-link crane's u is
+/// engine_play's lift, jib, slew.
+void engine_play_functions(engine* e, const scenario* sc, double tm, int* ev, double* u, engine_hook_fn on_hook,
+                           void* user);
+
 /// The scenario's fault events as engine_play applies them at time tm [s]
 /// (a replay applies them at the recorded ticks, without the scenario's commands).
 void engine_apply_faults(engine* e, const scenario* sc, double tm);
 
 /// Simulated time [s].
 double engine_time(const engine* e);
-/// The CSV row at the current time (sim_base.h columns; engine_ncol of them are set).
-void engine_row(engine* e, double row[SIM_NCOL]);
+/// The CSV row at the current time: engine_ncol(e) columns
+/// (engine_channels). row must hold max(engine_ncol(e), SIM_NCOL) values: a
+/// caller with a SIM_NCOL buffer requires ENGINE_CAP_TWO_LINK.
+void engine_row(engine* e, double* row);
 struct rcl;
 /// The engine's rated capacity limiter (rcl.h), or NULL: it filters
 /// engine_set_commands when o->rcl, and fills the rows' rcl_util either way.
@@ -183,8 +240,9 @@ struct rcl* engine_rcl_detach(engine* e);
 /// as engine_create.
 engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           struct rcl* r, char* err, size_t errsz);
-/// Fill a snapshot for the renderer.
-void engine_snapshot(engine* e, world_snapshot* s);
+/// Fill a snapshot for the renderer; false, s untouched, where the engine
+/// has none (no ENGINE_CAP_SNAPSHOT: a chain engine).
+bool engine_snapshot(engine* e, world_snapshot* s);
 
 #ifdef __cplusplus
 }
