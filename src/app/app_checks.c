@@ -226,15 +226,28 @@ static const char* slew_use(const scenario* sc) {
 // What in a scenario needs the sandbox (NULL: nothing): the hook, the slew.
 static const char* sandbox_use(const scenario* sc) { return sc->nevent > 0 ? "works the hook" : slew_use(sc); }
 
+// The crane a backend runs for model m, as the slew messages name it: the
+// backend's own words for the two-link crane ("lagrange 2-DOF crane"), "the
+// lagrange crane chain" for any other chain, and why it cannot slew where
+// the backend could but the model has no slew drive.
+static void crane_words(const engine_backend* b, const model* m, char* out, size_t n) {
+    if (!m || m->chain.two_link) {
+        snprintf(out, n, "%s crane", b->crane);
+        return;
+    }
+    snprintf(out, n, "%s crane chain%s", b->name,
+             b->slew_dof && !m->chain.slew.present ? " (its model has no slew drive: mechanics.slew)" : "");
+}
+
 void app_note_scenario_slew(const char* cmd, const sim_opts* o, const model* m, const scenario* sc,
                             int world_kind) {
     const engine_backend* b = app_backend(o);
     const char* why = b->world && world_kind == WORLD_SANDBOX ? NULL : slew_use(sc);
     if (!why) return;
     const engine_backend* wb = engine_backend_with_world();
-    char crane[96], remedy[256] = "";
+    char crane[128], remedy[256] = "";
     if (b->world) snprintf(crane, sizeof crane, "validation world");
-    else snprintf(crane, sizeof crane, "%s crane", b->crane);
+    else crane_words(b, m, crane, sizeof crane);
     // A backend whose scripted runs slew the model's drive (the slew as a
     // degree of freedom) still drives a column that stands still.
     const bool scripted = b->slew_dof && !b->world && m->chain.slew.present && sc->nevent == 0 &&
@@ -307,9 +320,9 @@ int app_scenario_world_remedy(const char* cmd, sim_opts* o, unsigned given, cons
                     cmd, name, why, to->name, to->drive_world);
         return 0;
     }
-    char crane[96], dflt[160];
+    char crane[128], dflt[160];
     if (b->world || (world_given && !mech_given)) snprintf(crane, sizeof crane, "validation world");
-    else snprintf(crane, sizeof crane, "%s crane", b->crane);
+    else crane_words(b, m, crane, sizeof crane);
     snprintf(dflt, sizeof dflt, "run it with --mechanics %s --world %s", wb->name, wb->drive_world);
     fprintf(stderr, "cranesim %s: scenario %s %s, which the %s has not: %s\n", cmd, name, why, crane,
             remedy ? remedy : dflt);

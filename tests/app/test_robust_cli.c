@@ -323,6 +323,26 @@ static void test_scenario_world(void) {
     rc = cli_run("run --quiet --scenario sandbox_pick_place --mechanics lagrange --world sandbox --out world.csv", out,
                  sizeof out);
     CHECK(rc == 2 && strstr(out, "lagrange 2-DOF crane has not") && cli_count_lines(out) == 1, "exit %d: %s", rc, out);
+    // A crane chain whose model has no slew drive: the message names the
+    // chain and what it lacks, not the two-link crane.
+    static char cmd[1024];
+    FILE* f = fopen("slew_only.json", "w");
+    CHECK(f != NULL, "cannot write slew_only.json");
+    if (f) {
+        fputs("{\"name\": \"slew_only\", \"duration\": 1, \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110},"
+              " \"commands\": {\"slew\": [[0, 0], [1, 0.5]]}}\n",
+              f);
+        fclose(f);
+    }
+    snprintf(cmd, sizeof cmd,
+             "run --quiet --model %s/../../world/data/chain_8fn_10link.json --scenario slew_only.json --mechanics "
+             "lagrange --out world.csv",
+             CRANESIM_TESTDATA);
+    rc = cli_run(cmd, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "which the lagrange crane chain (its model has no slew drive: mechanics.slew) has not") &&
+              cli_count_lines(out) == 1,
+          "exit %d: %s", rc, out);
+    remove("slew_only.json");
     rc = cli_run("run --quiet --scenario sandbox_pick_place --world validation --out world.csv", out, sizeof out);
     CHECK(rc == 2 && strstr(out, "validation world has not") && cli_count_lines(out) == 1, "exit %d: %s", rc, out);
     remove("world.csv");
