@@ -6,6 +6,7 @@
 
 #include "engine_ode_chain.h"
 #include "engine_ode_chain_step.h"
+#include "engine_ode_sandbox_chain_step.h"
 #include "ode_run.h"
 #include "rcl.h"
 
@@ -366,10 +367,18 @@ static void ode_describe_work(const sim_opts* o, const sim_result* r, char* buf,
 }
 
 // The stepped engine for m: the two-link world's for exactly the two-link
-// shorthand (as ode_run's), the chain world's for every other chain.
+// shorthand (as ode_run's); for every other chain, as its scripted run
+// (engine_ode_chain_run) chooses, the sandbox hosting the chain where o's
+// world is a sandbox, else the chain world (the validation world; a world
+// file that does not load goes there too, whose create then refuses it
+// with the loader's message).
 static const engine_ops* ode_stepped(const model* m, const sim_opts* o) {
-    (void)o;
-    return m->chain.two_link ? &engine_ode_ops : &engine_ode_chain_step_ops;
+    if (m->chain.two_link) return &engine_ode_ops;
+    world_kind kind;
+    char err[512];
+    if (!engine_ode_chain_world_kind(o, &kind, err, sizeof err) && kind == WORLD_SANDBOX)
+        return &engine_ode_sandbox_chain_step_ops;
+    return &engine_ode_chain_step_ops;
 }
 
 const engine_ops engine_ode_ops = {

@@ -54,10 +54,11 @@ void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, siz
 /// keep their commands.
 void engine_set_commands(engine* e, const double u[3]);
 /// The functions the operator commands: the model chain's (lift, jib,
-/// ...), for the two-link crane then "slew" where the chain has no function
-/// of that name (engine_set_commands' third command, the sandbox's slew);
-/// their count and names (NULL out of range). The two-link crane: lift,
-/// jib, slew; a chain model: its functions, in the model file's order.
+/// ...), for the two-link crane and for a chain in the sandbox then "slew"
+/// where the chain has no function of that name (engine_set_commands' third
+/// command, the sandbox's slew drive); their count and names (NULL out of
+/// range). The two-link crane: lift, jib, slew; a chain model: its
+/// functions, in the model file's order (then slew in the sandbox).
 int engine_nfunction(const engine* e);
 const char* engine_function_name(const engine* e, int k);
 /// The index of the function called name, or -1.
