@@ -381,13 +381,12 @@ static double soak_command(soak_ramp* r, uint64_t* rng, double t) {
     return r->u0 + (r->u1 - r->u0) * (t - r->t0) / (r->t1 - r->t0);
 }
 
-// The soak of a crane chain: the chain world (the validation world: the
-// sandbox, its hook and loads are the two-link crane's until the sandbox
-// builds chains), random input on every function through the engine's
-// commands by function, every column of every row checked for non-finite
-// values. One JSON line, as the sandbox soak's where the fields apply.
+// The soak of a crane chain in the sandbox (the chain on the truck, its
+// slew drive the slew function: engine_ode_sandbox_chain_step.c), random
+// input on every function through the engine's commands by function, every
+// column of every row checked for non-finite values. One JSON line, as the
+// two-link soak's where the fields apply.
 static int bench_soak_chain(model* m, const scenario* sc, sim_opts* o, double duration, uint64_t seed) {
-    o->world = "validation";
     char err[512];
     engine* l = engine_create(m, o, sc->q0, sc->slew0, sim_load_mass(m, sc, o), err, sizeof err);
     if (!l) {
@@ -439,11 +438,12 @@ static int bench_soak_chain(model* m, const scenario* sc, sim_opts* o, double du
         for (char* p = msg; *p; ++p)
             if (*p == '"' || *p == '\\' || (unsigned char)*p < 0x20) *p = '\'';
     }
-    printf("{\"config\":\"soak\",\"world\":\"validation\",\"backend\":\"%s\",\"functions\":%d,\"seed\":%llu,"
+    printf("{\"config\":\"soak\",\"world\":\"%s\",\"backend\":\"%s\",\"functions\":%d,\"seed\":%llu,"
            "\"sim_time_s\":%.3f,\"duration_s\":%g,\"wall_s\":%.3f,\"exit_status\":%d,\"rows\":%ld,"
            "\"columns\":%d,\"nonfinite_values\":%ld,\"peak_pressure_mpa\":%.3f,\"peak_rss_kb\":%ld,"
            "\"failure\":\"%s\"}\n",
-           engine_backend_name(l), nfn, (unsigned long long)seed, engine_time(l), duration, wall, status, rows, ncol,
+           o->world, engine_backend_name(l), nfn, (unsigned long long)seed, engine_time(l), duration, wall, status,
+           rows, ncol,
            nonfinite, pmax * 1e-6, ru.ru_maxrss, msg);
     fflush(stdout);
     free(ramp), free(u), free(row);
@@ -467,7 +467,7 @@ static int bench_soak(app_common* c, double duration, uint64_t seed) {
     o.world = "sandbox";
     o.solver = HYD_KRUS;
     o.cvode = false;
-    // A crane chain soaks in its own world, by function.
+    // A crane chain soaks by function (its engine: the sandbox hosting the chain).
     if (!(engine_caps_for(m, &o) & ENGINE_CAP_TWO_LINK)) return bench_soak_chain(m, &sc, &o, duration, seed);
     char err[512];
     // ODE's non-fatal messages (a contact LCP its Dantzig solver could not
