@@ -162,7 +162,7 @@ static void play_vs_run(const char* scn, const char* world, bool hook) {
             ++compared;
             if (a == b || (a != a && b != b)) continue;
             ++differ;
-            const double r = fabs(a - b) / fmax(fabs(a), 1e-300);
+            const double r = fabs(a - b) / fmax(fmax(fabs(a), fabs(b)), 1e-300);
             if (!(r <= worst)) worst = r, wc = c;
         }
     printf("  %-28s %ld values compared, %ld differ (largest %.3g relative, column %d)\n", sc.name, compared, differ,
