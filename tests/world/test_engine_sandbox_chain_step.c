@@ -15,7 +15,8 @@
 //     no two-link commands, answered in one line;
 // (d) the command line: drive --headless of the chain model in the sandbox
 //     writes the scripted run's CSV header; the window still refuses a
-//     chain before it opens; the soak runs the chain in the sandbox.
+//     chain before it opens; the soak runs the chain in the sandbox, its
+//     hook toggled, the same seed twice the same run.
 #include "check.h"
 #include "app/cli_util.h"
 #include "energy_acc.h"
@@ -368,12 +369,22 @@ static void test_command_line(void) {
     const char* wl = strstr(out, "cranesim drive: the window (--headless runs a crane chain): ");
     if (!wl) wl = strstr(out, "needs the render module");
     CHECK(rc == 2 && wl && cli_count_lines(wl) == 1, "window: exit %d: %s", rc, out);
-    // The soak: the chain in the sandbox, every function and the slew.
-    snprintf(args, sizeof args, "bench --config soak --model %s --duration 1", MODEL);
+    // The soak: the chain in the sandbox, every function and the slew, the
+    // hook toggled (the first toggle falls 5 to 20 s in); the same
+    // seed twice gives the same run (all but the wall time and the RSS).
+    snprintf(args, sizeof args, "bench --config soak --model %s --duration 21 --seed 7", MODEL);
+    static char again[16384];
     rc = cli_run(args, out, sizeof out);
     CHECK(rc == 0 && strstr(out, "\"world\":\"sandbox\"") && strstr(out, "\"functions\":5") &&
-              strstr(out, "\"nonfinite_values\":0") && strstr(out, "\"exit_status\":0"),
+              strstr(out, "\"nonfinite_values\":0") && strstr(out, "\"exit_status\":0") &&
+              strstr(out, "\"hook_toggles\":") && !strstr(out, "\"hook_toggles\":0,"),
           "soak: exit %d: %s", rc, out);
+    rc = cli_run(args, again, sizeof again);
+    const char* pa = strstr(out, "\"peak_pressure_mpa\"");
+    const char* pb = strstr(again, "\"peak_pressure_mpa\"");
+    const char* ea = pa ? strstr(pa, "\"peak_rss_kb\"") : NULL;
+    CHECK(rc == 0 && pa && pb && ea && !strncmp(pa, pb, (size_t)(ea - pa)), "two soaks differ:\n%s%s", out, again);
+    printf("  %s", out);
 }
 
 int main(int argc, char** argv) {

@@ -46,8 +46,9 @@ static sim_start_load start_load(const model* m, const ode_world* w, const doubl
 // A model whose crane is a chain of other shape than the two-link one
 // (crane_chain.two_link false): its crane_mech does not describe it, and
 // the ODE world of ode_world.h builds that two-link crane alone. Scripted
-// runs take the chain world (engine_ode_chain.c), stepped engines
-// engine_ode_chain_step.c (ode_stepped chooses); this create refuses a
+// runs take the chain world or the sandbox hosting the chain
+// (engine_ode_chain.c), stepped engines engine_ode_chain_step.c or
+// engine_ode_sandbox_chain_step.c (ode_stepped chooses); this create refuses a
 // chain in one line should it ever be called with one, rather than run the
 // wrong crane.
 static int refuse_chain(const model* m, char* err, size_t errsz) {

@@ -1,7 +1,8 @@
 // ode_chain_row.h: one row of the ODE chain world (ode_chain.h) for any
-// crane chain, shared by its scripted run (engine_ode_chain.c) and its
-// stepped engine (engine_ode_chain_step.c), so that both write the same
-// columns from the same outputs.
+// crane chain, and of the sandbox hosting the chain, shared by the scripted
+// runs (engine_ode_chain.c) and the stepped engines
+// (engine_ode_chain_step.c, engine_ode_sandbox_chain_step.c), so that both
+// write the same columns from the same outputs.
 #ifndef ODE_CHAIN_ROW_H
 #define ODE_CHAIN_ROW_H
 

@@ -1,8 +1,9 @@
 // engine.h: one crane engine, whatever the backend: the lagrange crane
 // (engine_lagrange.c, on lagrange_sim) or the ODE world (engine_ode.c, on
 // ode_world), and for a crane chain of any shape their chain engines
-// (engine_chain_step.c on chain_sim, engine_ode_chain_step.c on ode_chain),
-// sized by the model. Drivers (drive, the window's tick, the soak bench) create one
+// (engine_chain_step.c on chain_sim, engine_ode_chain_step.c on ode_chain,
+// engine_ode_sandbox_chain_step.c on the sandbox hosting the chain), sized
+// by the model. Drivers (drive, the window's tick, the soak bench) create one
 // from the model and the options, set commands, advance it on the simulated
 // clock, read its row and its snapshot, and never ask which backend runs:
 // what differs is behind engine_ops (engine_impl.h). Scripted runs (run,
@@ -242,7 +243,7 @@ struct rcl* engine_rcl_detach(engine* e);
 engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           struct rcl* r, char* err, size_t errsz);
 /// Fill a snapshot for the renderer; false, s untouched, where the engine
-/// has none (no ENGINE_CAP_SNAPSHOT: a chain engine).
+/// has none (no ENGINE_CAP_SNAPSHOT: a chain engine outside the sandbox).
 bool engine_snapshot(engine* e, world_snapshot* s);
 
 #ifdef __cplusplus
