@@ -19,6 +19,7 @@
 //     hook toggled, the same seed twice the same run.
 #include "check.h"
 #include "app/cli_util.h"
+#include "channels.h"
 #include "energy_acc.h"
 #include "engine.h"
 #include "model.h"
@@ -286,6 +287,29 @@ static void test_has_and_has_not(void) {
     engine_row(e, row);
     printf("  slew 0.6 for 1 s: %.2f deg, u3_cmd %.2f\n", row[COL_SLEW] * 180 / M_PI, row[COL_U3_CMD]);
     CHECK(row[COL_SLEW] > 0.01 && row[COL_U3_CMD] == 0.6, "slew %g rad, u3_cmd %g", row[COL_SLEW], row[COL_U3_CMD]);
+    // The channels drive's charts read: the row's (the sandbox's, then the
+    // chain's by name), then the circuit's, the slew valve's among them.
+    int nch;
+    const sim_channel* ch = engine_channels(e, &nch);
+    const int lc = m->chain.ncol - 1;
+    CHECK(nch == engine_ncol(e) && !strcmp(ch[COL_HOOK_Z].name, "hook_z") &&
+              !strcmp(ch[SIM_NCOL].name, m->chain.col[0].name) && !strcmp(ch[nch - 1].name, m->chain.col[lc].name),
+          "channels %d", nch);
+    chan_list* cl = chan_list_create(e);
+    CHECK(cl && chan_list_nrow(cl) == engine_ncol(e) && chan_list_count(cl) > engine_ncol(e) &&
+              chan_list_find(cl, "x_ext") >= SIM_NCOL && chan_list_find(cl, "slew_valve.spool") > engine_ncol(e),
+          "channel list");
+    if (cl) {
+        double* v = calloc((size_t)chan_list_count(cl), sizeof *v);
+        if (v) {
+            chan_list_values(cl, e, v, false);
+            CHECK(!memcmp(v, row, (size_t)engine_ncol(e) * sizeof *v), "channel values differ from the row");
+            CHECK(fabs(v[chan_list_find(cl, "slew_valve.spool")] - row[COL_U3]) < 1e-15, "slew spool %g, u3 %g",
+                  v[chan_list_find(cl, "slew_valve.spool")], row[COL_U3]);
+            free(v);
+        }
+        chan_list_free(cl);
+    }
     world_snapshot* s = calloc(1, sizeof *s);
     CHECK(s && engine_snapshot(e, s), "no snapshot");
     if (s) {
@@ -303,8 +327,9 @@ static void test_has_and_has_not(void) {
     // The default sandbox's loads are out of the hook's reach here: the
     // attach says which is nearest, how far and the reach (nearest_load).
     char msg[200];
-    CHECK(engine_hook_report(e, 1, msg, sizeof msg) == -1 && strstr(msg, "H: no load in reach of the hook (nearest: ") &&
-              strstr(msg, " m away; reach ") && !engine_attached(e),
+    CHECK(engine_hook_report(e, 1, msg, sizeof msg) == -1 &&
+              strstr(msg, "H: no load in reach of the hook (nearest: ") && strstr(msg, " m away; reach ") &&
+              !engine_attached(e),
           "%s", msg);
     printf("  %s\n", msg);
     double E[2] = {NAN, NAN};

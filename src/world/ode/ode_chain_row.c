@@ -1,6 +1,6 @@
-// ode_chain_row.c: the ODE chain world's row (ode_chain_row.h), factored
-// out of engine_ode_chain.c's scripted run so that the stepped engine
-// writes the same columns.
+// ode_chain_row.c: the ODE chain world's row and the sandbox's row of a
+// hosted chain (ode_chain_row.h), factored out of engine_ode_chain.c's
+// scripted runs so that the stepped engines write the same columns.
 #include "ode_chain_row.h"
 #include "ode_run.h"
 #include "ode_world.h"
