@@ -381,13 +381,13 @@ static double soak_command(soak_ramp* r, uint64_t* rng, double t) {
     return r->u0 + (r->u1 - r->u0) * (t - r->t0) / (r->t1 - r->t0);
 }
 
-// The soak of a crane chain: the chain world (the validation world: the
-// sandbox, its hook and loads are the two-link crane's until the sandbox
-// builds chains), random input on every function through the engine's
-// commands by function, every column of every row checked for non-finite
-// values. One JSON line, as the sandbox soak's where the fields apply.
+// The soak of a crane chain in the sandbox (the chain on the truck, its
+// slew drive the slew function: engine_ode_sandbox_chain_step.c), random
+// input on every function through the engine's commands by function, hook
+// toggles as the two-link soak's, every column of every row checked for
+// non-finite values. One JSON line, the two-link soak's fields and the
+// function and column counts.
 static int bench_soak_chain(model* m, const scenario* sc, sim_opts* o, double duration, uint64_t seed) {
-    o->world = "validation";
     char err[512];
     engine* l = engine_create(m, o, sc->q0, sc->slew0, sim_load_mass(m, sc, o), err, sizeof err);
     if (!l) {
@@ -410,7 +410,10 @@ static int bench_soak_chain(model* m, const scenario* sc, sim_opts* o, double du
     }
     uint64_t rng = seed ? seed : 1;
     long rows = 0, nonfinite = 0;
-    double pmax = 0;
+    double pmax = 0, slew_lo = INFINITY, slew_hi = -INFINITY;
+    double next_hook = 5.0 + 15.0 * soak_rand(&rng);
+    int attach = 1, hooks = 0, picks = 0;
+    const long msgs0 = ode_world_messages(NULL);
     const double frame = 0.01;
     const long nframes = (long)ceil(duration / frame - 1e-9);
     int status = 0;
@@ -419,6 +422,14 @@ static int bench_soak_chain(model* m, const scenario* sc, sim_opts* o, double du
         const double tm = (i + 0.5) * frame;
         for (int k = 0; k < nfn; ++k) u[k] = soak_command(&ramp[k], &rng, tm);
         engine_set_function_commands(l, u, nfn, NULL, 0);
+        if (tm >= next_hook) {
+            // engine_hook is -1 without a hook: counted as a toggle, no pick.
+            const int got = engine_hook(l, attach);
+            ++hooks;
+            picks += attach && got >= 0;
+            attach = !attach;
+            next_hook = tm + 5.0 + 15.0 * soak_rand(&rng);
+        }
         if (engine_advance(l, (i + 1) * frame - engine_time(l))) {
             status = 1;
             break;
@@ -429,6 +440,8 @@ static int bench_soak_chain(model* m, const scenario* sc, sim_opts* o, double du
         // Every chamber of every actuator (the chain's pressure columns).
         for (int k = SIM_NCOL_BASE; k < nch; ++k)
             if (ch[k].kind == SIM_CH_PRESSURE) pmax = fmax(pmax, row[k]);
+        slew_lo = fmin(slew_lo, row[COL_SLEW]);
+        slew_hi = fmax(slew_hi, row[COL_SLEW]);
     }
     const double wall = sim_wall_time() - w0;
     struct rusage ru;
@@ -439,12 +452,14 @@ static int bench_soak_chain(model* m, const scenario* sc, sim_opts* o, double du
         for (char* p = msg; *p; ++p)
             if (*p == '"' || *p == '\\' || (unsigned char)*p < 0x20) *p = '\'';
     }
-    printf("{\"config\":\"soak\",\"world\":\"validation\",\"backend\":\"%s\",\"functions\":%d,\"seed\":%llu,"
+    printf("{\"config\":\"soak\",\"world\":\"%s\",\"backend\":\"%s\",\"functions\":%d,\"seed\":%llu,"
            "\"sim_time_s\":%.3f,\"duration_s\":%g,\"wall_s\":%.3f,\"exit_status\":%d,\"rows\":%ld,"
-           "\"columns\":%d,\"nonfinite_values\":%ld,\"peak_pressure_mpa\":%.3f,\"peak_rss_kb\":%ld,"
+           "\"columns\":%d,\"nonfinite_values\":%ld,\"peak_pressure_mpa\":%.3f,\"slew_range_deg\":[%.1f,%.1f],"
+           "\"hook_toggles\":%d,\"loads_picked\":%d,\"ode_messages\":%ld,\"peak_rss_kb\":%ld,"
            "\"failure\":\"%s\"}\n",
-           engine_backend_name(l), nfn, (unsigned long long)seed, engine_time(l), duration, wall, status, rows, ncol,
-           nonfinite, pmax * 1e-6, ru.ru_maxrss, msg);
+           o->world, engine_backend_name(l), nfn, (unsigned long long)seed, engine_time(l), duration, wall, status,
+           rows, ncol, nonfinite, pmax * 1e-6, slew_lo * 180 / M_PI, slew_hi * 180 / M_PI, hooks, picks,
+           ode_world_messages(NULL) - msgs0, ru.ru_maxrss, msg);
     fflush(stdout);
     free(ramp), free(u), free(row);
     engine_destroy(l);
@@ -467,7 +482,7 @@ static int bench_soak(app_common* c, double duration, uint64_t seed) {
     o.world = "sandbox";
     o.solver = HYD_KRUS;
     o.cvode = false;
-    // A crane chain soaks in its own world, by function.
+    // A crane chain soaks by function (its engine: the sandbox hosting the chain).
     if (!(engine_caps_for(m, &o) & ENGINE_CAP_TWO_LINK)) return bench_soak_chain(m, &sc, &o, duration, seed);
     char err[512];
     // ODE's non-fatal messages (a contact LCP its Dantzig solver could not

@@ -88,6 +88,11 @@ struct engine {
     /// its rows carry more than ops->nchannel (a chain engine: the chain's
     /// columns after the backend's); 0: ops->nchannel.
     int ncol;
+    /// Set by the backend's create: its commands by function end with a
+    /// "slew" the model's chain does not list (a chain crane in the sandbox,
+    /// whose slew drive is the world's or the model's mechanics.slew), as
+    /// the two-link crane's third command.
+    bool slew_function;
     sim_channel* chan;    ///< [ncol] its channels when ncol > ops->nchannel (engine.c), else NULL
     double* rowbuf;       ///< [max(ncol, SIM_NCOL)] a row for the checks after each step (engine.c)
 };

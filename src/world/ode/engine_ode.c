@@ -6,6 +6,7 @@
 
 #include "engine_ode_chain.h"
 #include "engine_ode_chain_step.h"
+#include "engine_ode_sandbox_chain_step.h"
 #include "ode_run.h"
 #include "rcl.h"
 
@@ -45,8 +46,9 @@ static sim_start_load start_load(const model* m, const ode_world* w, const doubl
 // A model whose crane is a chain of other shape than the two-link one
 // (crane_chain.two_link false): its crane_mech does not describe it, and
 // the ODE world of ode_world.h builds that two-link crane alone. Scripted
-// runs take the chain world (engine_ode_chain.c), stepped engines
-// engine_ode_chain_step.c (ode_stepped chooses); this create refuses a
+// runs take the chain world or the sandbox hosting the chain
+// (engine_ode_chain.c), stepped engines engine_ode_chain_step.c or
+// engine_ode_sandbox_chain_step.c (ode_stepped chooses); this create refuses a
 // chain in one line should it ever be called with one, rather than run the
 // wrong crane.
 static int refuse_chain(const model* m, char* err, size_t errsz) {
@@ -366,10 +368,18 @@ static void ode_describe_work(const sim_opts* o, const sim_result* r, char* buf,
 }
 
 // The stepped engine for m: the two-link world's for exactly the two-link
-// shorthand (as ode_run's), the chain world's for every other chain.
+// shorthand (as ode_run's); for every other chain, as its scripted run
+// (engine_ode_chain_run) chooses, the sandbox hosting the chain where o's
+// world is a sandbox, else the chain world (the validation world; a world
+// file that does not load goes there too, whose create then refuses it
+// with the loader's message).
 static const engine_ops* ode_stepped(const model* m, const sim_opts* o) {
-    (void)o;
-    return m->chain.two_link ? &engine_ode_ops : &engine_ode_chain_step_ops;
+    if (m->chain.two_link) return &engine_ode_ops;
+    world_kind kind;
+    char err[512];
+    if (!engine_ode_chain_world_kind(o, &kind, err, sizeof err) && kind == WORLD_SANDBOX)
+        return &engine_ode_sandbox_chain_step_ops;
+    return &engine_ode_chain_step_ops;
 }
 
 const engine_ops engine_ode_ops = {

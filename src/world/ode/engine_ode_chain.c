@@ -36,6 +36,25 @@ int engine_ode_chain_world_kind(const sim_opts* o, world_kind* kind, char* err, 
 
 static int play_hook(void* user, int attach) { return ode_world_hook(user, attach); }
 
+int engine_ode_chain_sandbox_start(ode_world* w, ode_chain_rows* r, const crane_chain* cc, const double q0[2],
+                                   sim_checks* chk, double* row, char* msg, size_t msz) {
+    // One row: the sandbox's base columns, then the chain's (ode_chain_row.c).
+    ode_chain_sandbox_row(r, w, cc, 0.0, row);
+    char what[200];
+    if (sim_check_row(chk, row, SIM_NCOL, what, sizeof what)) {
+        sim_check_message(msg, msz, what, NULL, false, 0.0, chk->bad_value);
+        return -1;
+    }
+    // The start pressures against the circuit's limits, with the world's
+    // rope and hook at the tip (the booms' share is not split out: the
+    // two-link statics do not describe this chain).
+    int nl;
+    double len, lm, li, hkm, hcom, hi;
+    ode_world_rope_info(w, &nl, &len, &lm, &li, &hkm, &hcom, &hi);
+    const sim_start_load ld = {NULL, {q0[0], q0[1]}, nl * lm + hkm, true};
+    return sim_check_start(ode_world_circuit(w), row, SIM_NCOL, &ld, msg, msz) ? -1 : 0;
+}
+
 // A scripted run in the sandbox (ode_world with the chain crane on its
 // truck, ode_world.h opts.chain): the scenario's functions by name and its
 // slew at each ODE step's midpoint, its hook events as the two-link
@@ -68,8 +87,6 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
     }
     double* row = buf;
     for (int f = 0; f < r.nf; ++f) fcol[f] = scenario_find_command(sc, hc->fn[f].name);
-    // The model's DOF columns: the slew's only where the model's column slews.
-    const int d0 = cc->slew_free ? 0 : 1;
     const double dt = ode_world_dt(w);
     const double h = o->h < dt ? o->h : dt;
     const double t_end = k->t_end;
@@ -85,36 +102,12 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
     sim_checks chk;
     memset(&chk, 0, sizeof chk);
     const long ode_msgs = ode_world_messages(NULL);
-    // One row: the sandbox's base columns, then the chain's.
-#define SANDBOX_ROW(t_)                                                                                    \
-    do {                                                                                                   \
-        ode_world_row(w, row);                                                                             \
-        ode_chain_rows_outputs(&r, cw);                                                                    \
-        const crane_chain_sample smp_ = {r.x, r.v, r.pA, r.pB, r.F, r.u, r.ucmd, r.q + d0, r.qd + d0};     \
-        crane_chain_row(cc, &smp_, row + SIM_NCOL);                                                        \
-        row[COL_T] = (t_);                                                                                 \
-    } while (0)
-    SANDBOX_ROW(0.0);
-    for (int j = 0; j < 4; ++j) res->p_peak[j] = row[COL_P1A + j];
-    {
-        char what[200];
-        if (sim_check_row(&chk, row, SIM_NCOL, what, sizeof what)) {
-            sim_check_message(msg, msz, what, NULL, false, 0.0, chk.bad_value);
-            res->status = SIM_REFUSED;
-            goto done;
-        }
-        // The start pressures against the circuit's limits, with the world's
-        // rope and hook at the tip (the booms' share is not split out: the
-        // two-link statics do not describe this chain).
-        int nl;
-        double len, lm, li, hkm, hc, hi;
-        ode_world_rope_info(w, &nl, &len, &lm, &li, &hkm, &hc, &hi);
-        const sim_start_load ld = {NULL, {sc->q0[0], sc->q0[1]}, nl * lm + hkm, true};
-        if (sim_check_start(hm, row, SIM_NCOL, &ld, msg, msz)) {
-            res->status = SIM_REFUSED;
-            goto done;
-        }
+    // The first row and the start checks (shared with the stepped engine).
+    if (engine_ode_chain_sandbox_start(w, &r, cc, sc->q0, &chk, row, msg, msz)) {
+        res->status = SIM_REFUSED;
+        goto done;
     }
+    for (int j = 0; j < 4; ++j) res->p_peak[j] = row[COL_P1A + j];
     sim_energy* en = k->energy;
     if (en && (sim_energy_bind(en, r.hm) || ode_world_follow_energy(w, en))) {
         snprintf(msg, msz, "out of memory for the energy balance");
@@ -160,7 +153,7 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
             for (int j = 0; j < 4; ++j) res->p_peak[j] = fmax(res->p_peak[j], p[j]);
         }
         if ((i + 1) % nout && i + 1 != nstep) continue;
-        SANDBOX_ROW((double)(i + 1) * dt); // exact grid times
+        ode_chain_sandbox_row(&r, w, cc, (double)(i + 1) * dt, row); // exact grid times
         char what[200];
         if (sim_check_row(&chk, row, SIM_NCOL, what, sizeof what)) {
             res->status = SIM_FAILED;
@@ -173,7 +166,6 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
         ++rows;
         stop = deliver(k, row);
     }
-#undef SANDBOX_ROW
     res->wall = sim_wall_time() - w0;
     res->stats.steps = (long)floor(ode_world_time(w) / dt + 0.5) * (long)floor(dt / h + 0.5);
     res->rows = rows;

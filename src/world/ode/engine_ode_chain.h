@@ -41,6 +41,18 @@ int engine_ode_chain_check(const sim_opts* o, double* dt_ode, double* h_hyd, cha
 /// the crane from the chain. -1 with the world loader's message.
 int engine_ode_chain_world_kind(const sim_opts* o, world_kind* kind, char* err, size_t errsz);
 
+struct ode_world;
+struct ode_chain_rows;
+/// The start of a sandbox w hosting the chain crane of model chain cc
+/// (ode_world_chain), as its scripted run and its stepped engine
+/// (engine_ode_sandbox_chain_step.c) check it: the row at t = 0 into row
+/// (ode_chain_sandbox_row, r bound to the hosted chain), the run checks
+/// (sim_check_row into chk) and the start pressures with the world's rope
+/// and hook at the tip (sim_check_start; q0 [rad] the scenario's pose, for
+/// its message). 0, or -1 with one line in msg.
+int engine_ode_chain_sandbox_start(struct ode_world* w, struct ode_chain_rows* r, const crane_chain* cc,
+                                   const double q0[2], sim_checks* chk, double* row, char* msg, size_t msz);
+
 #ifdef __cplusplus
 }
 #endif

@@ -46,15 +46,15 @@ static engine* oc_create(const model* m, const sim_opts* o, const double q0[2], 
                              "(krus, ros2, rk4)");
         return NULL;
     }
-    // The chain world is the validation world; the sandbox built from the
-    // chain runs scripted (engine_ode_chain.c) but has no stepped engine yet.
+    // The chain world is the validation world; ode_stepped takes a sandbox
+    // to engine_ode_sandbox_chain_step.c. A world that is neither (or a
+    // world file that does not load) is refused here.
     world_kind kind;
     if (engine_ode_chain_world_kind(o, &kind, err, errsz)) return NULL;
     if (kind != WORLD_VALIDATION) {
-        snprintf(err, errsz,
-                 "%s %s: the stepped engine of a crane chain runs the validation world only (use %s validation; "
-                 "cranesim run takes a chain model into the sandbox)",
-                 sim_param_name(SIM_PARAM_WORLD), o->world, sim_param_name(SIM_PARAM_WORLD));
+        snprintf(err, errsz, "%s %s: the ODE chain world is the validation world (a sandbox world runs the chain on "
+                             "its truck)",
+                 sim_param_name(SIM_PARAM_WORLD), o->world);
         return NULL;
     }
     double dt, h;

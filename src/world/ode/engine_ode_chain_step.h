@@ -2,7 +2,8 @@
 // soak) of the ode backend for a crane chain (crane_chain.two_link false),
 // in the ODE chain world (ode_chain.h, the validation world): what
 // engine_ode_ops.stepped chooses for every model that is not the two-link
-// shorthand.
+// shorthand in the validation world (a sandbox world takes
+// engine_ode_sandbox_chain_step.h).
 #ifndef ENGINE_ODE_CHAIN_STEP_H
 #define ENGINE_ODE_CHAIN_STEP_H
 

@@ -1,7 +1,9 @@
-// ode_chain_row.c: the ODE chain world's row (ode_chain_row.h), factored
-// out of engine_ode_chain.c's scripted run so that the stepped engine
-// writes the same columns.
+// ode_chain_row.c: the ODE chain world's row and the sandbox's row of a
+// hosted chain (ode_chain_row.h), factored out of engine_ode_chain.c's
+// scripted runs so that the stepped engines write the same columns.
 #include "ode_chain_row.h"
+#include "ode_run.h"
+#include "ode_world.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -85,4 +87,14 @@ void ode_chain_make_row(ode_chain_rows* r, const ode_chain* w, double t, double*
         if (hyd_model_comp_type(r->hm, i) == HYD_RELIEF && hd->comp_open[i]) ++open;
     row[COL_RELIEF_OPEN] = open;
     row[COL_END_STOP] = end_stop;
+}
+
+void ode_chain_sandbox_row(ode_chain_rows* r, struct ode_world* w, const crane_chain* cc, double t, double* row) {
+    ode_world_row(w, row);
+    ode_chain_rows_outputs(r, ode_world_chain(w));
+    // The model's DOF columns: the slew's only where the model's column slews.
+    const int d0 = cc->slew_free ? 0 : 1;
+    const crane_chain_sample smp = {r->x, r->v, r->pA, r->pB, r->F, r->u, r->ucmd, r->q + d0, r->qd + d0};
+    crane_chain_row(cc, &smp, row + SIM_NCOL);
+    row[COL_T] = t;
 }

@@ -1,7 +1,8 @@
 // ode_chain_row.h: one row of the ODE chain world (ode_chain.h) for any
-// crane chain, shared by its scripted run (engine_ode_chain.c) and its
-// stepped engine (engine_ode_chain_step.c), so that both write the same
-// columns from the same outputs.
+// crane chain, and of the sandbox hosting the chain, shared by the scripted
+// runs (engine_ode_chain.c) and the stepped engines
+// (engine_ode_chain_step.c, engine_ode_sandbox_chain_step.c), so that both
+// write the same columns from the same outputs.
 #ifndef ODE_CHAIN_ROW_H
 #define ODE_CHAIN_ROW_H
 
@@ -45,6 +46,18 @@ int ode_chain_row_ncol(const crane_chain* cc);
 /// actuator, function and DOF under the chain's column names
 /// (crane_chain_row).
 void ode_chain_make_row(ode_chain_rows* r, const ode_chain* w, double t, double* row);
+
+struct ode_world;
+/// The row of the sandbox w hosting a chain crane (ode_world_chain) at time
+/// t [s], as the scripted sandbox run (engine_ode_chain.c) and the stepped
+/// sandbox engine (engine_ode_sandbox_chain_step.c) both write it: the
+/// sandbox's SIM_NCOL base columns (ode_world_row: the first two actuators,
+/// the first two boom DOFs, the slew, hook, truck, supports), then the
+/// model chain cc's columns (crane_chain_row) from the hosted chain's
+/// outputs, r bound to the hosted chain (ode_chain_chain). The model's DOF
+/// columns start after the slew where the model's column does not slew
+/// (the hosted copy always slews).
+void ode_chain_sandbox_row(ode_chain_rows* r, struct ode_world* w, const crane_chain* cc, double t, double* row);
 
 #ifdef __cplusplus
 }

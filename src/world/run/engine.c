@@ -166,8 +166,9 @@ int engine_check_scenario(const model* m, const scenario* sc, char* err, size_t 
 int engine_nfunction(const engine* e) {
     const crane_chain* cc = &e->mdl->chain;
     // The two-link crane's third command is the slew (of the sandbox
-    // world); a chain engine takes exactly the model's functions.
-    return cc->nfn + (cc->two_link && crane_chain_find_function(cc, "slew") < 0 ? 1 : 0);
+    // world), as a chain engine's in the sandbox (engine.slew_function);
+    // elsewhere a chain engine takes exactly the model's functions.
+    return cc->nfn + ((cc->two_link || e->slew_function) && crane_chain_find_function(cc, "slew") < 0 ? 1 : 0);
 }
 
 const char* engine_function_name(const engine* e, int k) {

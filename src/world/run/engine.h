@@ -1,8 +1,9 @@
 // engine.h: one crane engine, whatever the backend: the lagrange crane
 // (engine_lagrange.c, on lagrange_sim) or the ODE world (engine_ode.c, on
 // ode_world), and for a crane chain of any shape their chain engines
-// (engine_chain_step.c on chain_sim, engine_ode_chain_step.c on ode_chain),
-// sized by the model. Drivers (drive, the window's tick, the soak bench) create one
+// (engine_chain_step.c on chain_sim, engine_ode_chain_step.c on ode_chain,
+// engine_ode_sandbox_chain_step.c on the sandbox hosting the chain), sized
+// by the model. Drivers (drive, the window's tick, the soak bench) create one
 // from the model and the options, set commands, advance it on the simulated
 // clock, read its row and its snapshot, and never ask which backend runs:
 // what differs is behind engine_ops (engine_impl.h). Scripted runs (run,
@@ -54,10 +55,11 @@ void engine_describe_work(const sim_opts* o, const sim_result* r, char* buf, siz
 /// keep their commands.
 void engine_set_commands(engine* e, const double u[3]);
 /// The functions the operator commands: the model chain's (lift, jib,
-/// ...), for the two-link crane then "slew" where the chain has no function
-/// of that name (engine_set_commands' third command, the sandbox's slew);
-/// their count and names (NULL out of range). The two-link crane: lift,
-/// jib, slew; a chain model: its functions, in the model file's order.
+/// ...), for the two-link crane and for a chain in the sandbox then "slew"
+/// where the chain has no function of that name (engine_set_commands' third
+/// command, the sandbox's slew drive); their count and names (NULL out of
+/// range). The two-link crane: lift, jib, slew; a chain model: its
+/// functions, in the model file's order (then slew in the sandbox).
 int engine_nfunction(const engine* e);
 const char* engine_function_name(const engine* e, int k);
 /// The index of the function called name, or -1.
@@ -241,7 +243,7 @@ struct rcl* engine_rcl_detach(engine* e);
 engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2], double slew0, double m3,
                           struct rcl* r, char* err, size_t errsz);
 /// Fill a snapshot for the renderer; false, s untouched, where the engine
-/// has none (no ENGINE_CAP_SNAPSHOT: a chain engine).
+/// has none (no ENGINE_CAP_SNAPSHOT: a chain engine outside the sandbox).
 bool engine_snapshot(engine* e, world_snapshot* s);
 
 #ifdef __cplusplus
