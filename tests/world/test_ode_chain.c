@@ -657,9 +657,9 @@ static void test_refusals(void) {
     model_free(m);
 }
 
-// ---- 5. the stepped ode engine never runs a chain as the two-link crane ----
+// ---- 5. the stepped ode engine of a chain model is a chain engine, never the two-link one ----
 
-static void test_engine_refuses_chain(void) {
+static void test_engine_for_a_chain(void) {
     char err[512] = "";
     model* m = model_load(CRANESIM_ASSETS "/models/hiab031.json", NULL, 0, err, sizeof err);
     CHECK(m != NULL, "model: %s", err);
@@ -928,7 +928,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_two_link_stops);
     RUN_TEST(test_static_hold);
     RUN_TEST(test_refusals);
-    RUN_TEST(test_engine_refuses_chain);
+    RUN_TEST(test_engine_for_a_chain);
     RUN_TEST(test_every_function_vs_reference);
     TEST_MAIN_END();
 }
