@@ -1,0 +1,280 @@
+// test_linkage.c: the knuckle's four-bar linkage (linkage.h) against a loop
+// solved by hand, against central differences on a crane-like linkage, its
+// inverse, and its refusals.
+#include "check.h"
+#include "linkage.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/*
+ * The hand-solved loop (all in the parent frame, (x, z), metres):
+ *   J = (0, 0), angle0 = 0, rocker pin c = (0.3, 0) in the child, so
+ *   C(q) = (0.3 cos q, 0.3 sin q);
+ *   A = (0, 0.2), link l1 = 0.3, rocker l2 = 0.2; cylinder base B = (0, -0.8).
+ * Since l1 = |JC| and l2 = |JA|, J-C-P-A closes as a parallelogram:
+ *   P = A + (C - J) = (0.3 cos q, 0.2 + 0.3 sin q)
+ * (|P - A| = 0.3 = l1 and |P - C| = |A - J| = 0.2 = l2). This P is on the
+ * counter-clockwise side of A->C: cross(C - A, P - A)
+ *   = 0.3 cos q * 0.3 sin q - (0.3 sin q - 0.2) * 0.3 cos q = 0.06 cos q > 0
+ * for |q| < pi/2, so branch = +1 (the toggle, where the cross is 0, is at
+ * q = +-pi/2: the range is [-1.2, 1.2]).
+ * The cylinder: P - B = (0.3 cos q, 1.0 + 0.3 sin q), so
+ *   L^2 = 0.09 cos^2 q + 1 + 0.6 sin q + 0.09 sin^2 q = 1.09 + 0.6 sin q
+ *   q = 0:     L^2 = 1.09, P = (0.3, 0.2)
+ *   q = pi/6:  L^2 = 1.09 + 0.3 = 1.39, P = (0.15 sqrt 3, 0.35)
+ *   q = -pi/6: L^2 = 1.09 - 0.3 = 0.79, P = (0.15 sqrt 3, 0.05)
+ * Differentiating L^2: 2 L L' = 0.6 cos q, so L' = 0.3 cos q / L; again:
+ *   L'^2 + L L'' = -0.3 sin q, so L'' = (-0.3 sin q - L'^2) / L.
+ * The link A->P points along q, the rocker C->P straight up (pi/2).
+ */
+static linkage_def hand_def(void) {
+    linkage_def d;
+    memset(&d, 0, sizeof d);
+    d.rocker_pin[0] = 0.3;
+    d.link_pin[1] = 0.2;
+    d.link_len = 0.3;
+    d.rocker_len = 0.2;
+    d.base[1] = -0.8;
+    d.branch = 1;
+    d.q_min = -1.2;
+    d.q_max = 1.2;
+    return d;
+}
+
+static void test_hand_three_angles(void) {
+    linkage_def d = hand_def();
+    linkage lk;
+    char err[256] = "";
+    CHECK(linkage_init(&lk, &d, err, sizeof err) == 0, "%s", err);
+    const double qs[3] = {0, M_PI / 6, -M_PI / 6};
+    const double L2[3] = {1.09, 1.39, 0.79};
+    const double Px[3] = {0.3, 0.15 * sqrt(3.0), 0.15 * sqrt(3.0)};
+    const double Pz[3] = {0.2, 0.35, 0.05};
+    for (int i = 0; i < 3; i++) {
+        double q = qs[i], L = sqrt(L2[i]);
+        double dL = 0.3 * cos(q) / L;
+        double d2L = (-0.3 * sin(q) - dL * dL) / L;
+        linkage_state s;
+        CHECK(linkage_eval(&lk, q, &s) == 0, "q = %g", q);
+        CHECK_NEAR(s.P[0], Px[i], 1e-12);
+        CHECK_NEAR(s.P[1], Pz[i], 1e-12);
+        CHECK_NEAR(s.L, L, 1e-9);
+        CHECK_NEAR(linkage_length(&lk, q), L, 1e-9);
+        CHECK_NEAR(s.dL, dL, 1e-9);
+        CHECK_NEAR(s.d2L, d2L, 1e-9);
+        CHECK_NEAR(s.link_angle, q, 1e-12);
+        CHECK_NEAR(s.rocker_angle, M_PI / 2, 1e-12);
+    }
+}
+
+/*
+ * The other branch of the same loop at q = 0: A = (0, 0.2), C = (0.3, 0), and
+ * P is the mirror of the parallelogram's (0.3, 0.2) in the line A-C. With
+ * X - A = (0.3, 0) and the line's direction v = (0.3, -0.2), |v|^2 = 0.13:
+ *   P = A + 2 ((X - A).v / |v|^2) v - (X - A)
+ *     = (0, 0.2) + (18/13) (0.3, -0.2) - (0.3, 0) = (3/26, -1/13)
+ * (check: |P - A|^2 = 9/676 + (18/65)^2 = 0.09, |P - C|^2 = (0.3 - 3/26)^2 +
+ * (1/13)^2 = (24/130)^2 + (10/130)^2 = 676/16900 = 0.04). It is on the
+ * clockwise side of A->C: branch = -1. L = |P - B| = |(3/26, 47/65)|.
+ */
+static void test_hand_other_branch(void) {
+    linkage_def d = hand_def();
+    d.branch = -1;
+    d.q_min = -0.1;
+    d.q_max = 0.1;
+    linkage lk;
+    char err[256] = "";
+    CHECK(linkage_init(&lk, &d, err, sizeof err) == 0, "%s", err);
+    linkage_state s;
+    CHECK(linkage_eval(&lk, 0, &s) == 0, "q = 0");
+    CHECK_NEAR(s.P[0], 3.0 / 26, 1e-12);
+    CHECK_NEAR(s.P[1], -1.0 / 13, 1e-12);
+    CHECK_NEAR(s.L, hypot(3.0 / 26, 47.0 / 65), 1e-9);
+}
+
+/*
+ * A crane-like knuckle (numbers of a 10 t m class crane's knuckle, for shape
+ * only): the lifting arm's tip joint J = (4.2, 0) in its frame, the end arm
+ * at angle0 = 0; cylinder base B = (1.2, 0.45) on top of the lifting arm;
+ * link pin A = (4.10, 0.27); rocker pin c = (0.39, 0.07) on the end arm;
+ * link 0.60 m, rocker 0.37 m, P on the clockwise side of A->C (branch -1);
+ * the end arm from -2.6 rad (folded under) to 0.3 rad. Over that range the
+ * cylinder runs 2.448 .. 3.354 m, its lever arm stays above 0.25 m and the
+ * transmission angle's sine above 0.76 (a scan made while choosing the
+ * numbers, not a checked value). Derivatives against central differences of
+ * L(q) itself (step 1e-4 rad: truncation ~ h^2 L'''/6 ~ 1e-9, rounding
+ * ~ 1e-16 / 1e-4 = 1e-12).
+ */
+static linkage_def crane_def(void) {
+    linkage_def d;
+    memset(&d, 0, sizeof d);
+    d.joint[0] = 4.2;
+    d.base[0] = 1.2;
+    d.base[1] = 0.45;
+    d.link_pin[0] = 4.10;
+    d.link_pin[1] = 0.27;
+    d.rocker_pin[0] = 0.39;
+    d.rocker_pin[1] = 0.07;
+    d.link_len = 0.60;
+    d.rocker_len = 0.37;
+    d.branch = -1;
+    d.q_min = -2.6;
+    d.q_max = 0.3;
+    d.link_mass = 18;
+    d.rocker_mass = 15;
+    return d;
+}
+
+static void test_central_differences(void) {
+    linkage_def d = crane_def();
+    linkage lk;
+    char err[256] = "";
+    CHECK(linkage_init(&lk, &d, err, sizeof err) == 0, "%s", err);
+    const double h = 1e-4;
+    for (int i = 0; i <= 20; i++) {
+        double q = d.q_min + 0.01 + (d.q_max - d.q_min - 0.02) * i / 20;
+        linkage_state s, sp, sm;
+        CHECK(linkage_eval(&lk, q, &s) == 0 && linkage_eval(&lk, q + h, &sp) == 0 &&
+                  linkage_eval(&lk, q - h, &sm) == 0,
+              "q = %g", q);
+        // The loop's constraints hold at the solved pin.
+        CHECK_NEAR(hypot(s.P[0] - d.link_pin[0], s.P[1] - d.link_pin[1]), d.link_len, 1e-12);
+        CHECK_NEAR(hypot(s.P[0] - s.C[0], s.P[1] - s.C[1]), d.rocker_len, 1e-12);
+        double cr = (s.C[0] - d.link_pin[0]) * (s.P[1] - d.link_pin[1]) -
+                    (s.C[1] - d.link_pin[1]) * (s.P[0] - d.link_pin[0]);
+        CHECK(cr < 0, "branch -1 left at q = %g (cross %g)", q, cr);
+        double dL = (sp.L - sm.L) / (2 * h);
+        double d2L = (sp.L - 2 * s.L + sm.L) / (h * h);
+        CHECK_NEAR(s.dL, dL, 1e-8);
+        CHECK_NEAR(s.d2L, d2L, 2e-6); // rounding of the second difference: ~ 1e-16 / h^2 = 1e-8
+        CHECK_NEAR(s.d2L, (sp.dL - sm.dL) / (2 * h), 1e-8);
+        for (int k = 0; k < 2; k++) {
+            CHECK_NEAR(s.dP[k], (sp.P[k] - sm.P[k]) / (2 * h), 1e-8);
+            CHECK_NEAR(s.d2P[k], (sp.dP[k] - sm.dP[k]) / (2 * h), 1e-8);
+        }
+    }
+}
+
+static void test_inverse(void) {
+    linkage_def dd[2] = {hand_def(), crane_def()};
+    for (int j = 0; j < 2; j++) {
+        linkage lk;
+        char err[256] = "";
+        CHECK(linkage_init(&lk, &dd[j], err, sizeof err) == 0, "%s", err);
+        for (int i = 0; i <= 50; i++) {
+            double q = dd[j].q_min + (dd[j].q_max - dd[j].q_min) * i / 50, qb = NAN;
+            double L = linkage_length(&lk, q);
+            CHECK(linkage_angle(&lk, L, &qb) == 0, "L = %g", L);
+            CHECK_NEAR(qb, q, 1e-12);
+        }
+        double Lmin = fmin(lk.L_qmin, lk.L_qmax), Lmax = fmax(lk.L_qmin, lk.L_qmax), qb = 7;
+        CHECK(linkage_angle(&lk, Lmin - 1e-6, &qb) == -1 && qb == 7, "below the stroke");
+        CHECK(linkage_angle(&lk, Lmax + 1e-6, &qb) == -1 && qb == 7, "above the stroke");
+        CHECK(linkage_angle(&lk, NAN, &qb) == -1, "NaN length");
+    }
+}
+
+static void expect_refusal(const linkage_def* d, const char* field, const char* words) {
+    linkage lk;
+    char err[256] = "";
+    CHECK(linkage_init(&lk, d, err, sizeof err) == -1, "accepted, expected %s", field);
+    CHECK(strstr(err, field) != NULL && strstr(err, words) != NULL, "err '%s' lacks '%s' / '%s'", err, field, words);
+    CHECK(strchr(err, '\n') == NULL, "one line: '%s'", err);
+}
+
+static void test_refusals(void) {
+    linkage_def d;
+    // Too short to reach: the link pin to rocker pin distance at q = 0 is
+    // |(0.3, -0.2)| = 0.36 m, more than 0.1 + 0.2 m.
+    d = hand_def();
+    d.link_len = 0.1;
+    expect_refusal(&d, "linkage.link_len", "cannot close");
+    // Closes at q = 0 but not over the whole range: the distance A-C is
+    // D^2 = 0.09 cos^2 q + (0.3 sin q - 0.2)^2 = 0.13 - 0.12 sin q. With
+    // l2 = 0.45 the loop needs D > |0.3 - 0.45| = 0.15 m, i.e. sin q <
+    // (0.13 - 0.0225) / 0.12 = 0.8958, q < 1.111 rad: refused on [-1.2, 1.2],
+    // named at the range's end where D is least.
+    d = hand_def();
+    d.rocker_len = 0.45;
+    expect_refusal(&d, "linkage.rocker_len", "cannot close at q = 1.2 rad");
+    // A range through the toggle at q = pi/2 (A, C, P collinear).
+    d = hand_def();
+    d.q_max = 2.0;
+    expect_refusal(&d, "linkage.", "cannot close");
+    // A dead centre: P moves on the circle of radius 0.3 about A, so dL/dq
+    // = 0 where B, A and P are in line; B = (-0.8, 0.2) puts it at q = 0
+    // (P = (0.3, 0.2), P' = (0, 0.3) normal to P - B = (1.1, 0)).
+    d = hand_def();
+    d.base[0] = -0.8;
+    d.base[1] = 0.2;
+    expect_refusal(&d, "linkage.base", "dead centre at q = ");
+    {
+        linkage lk;
+        char err[256] = "";
+        linkage_init(&lk, &d, err, sizeof err);
+        const char* at = strstr(err, "q = ");
+        double qd = at ? atof(at + 4) : NAN;
+        CHECK(fabs(qd) < 1e-5, "dead centre named at %g rad, expected 0: %s", qd, err);
+    }
+    d = hand_def();
+    d.link_len = 0;
+    expect_refusal(&d, "linkage.link_len", "> 0");
+    d = hand_def();
+    d.rocker_len = -1;
+    expect_refusal(&d, "linkage.rocker_len", "> 0");
+    d = hand_def();
+    d.branch = 0;
+    expect_refusal(&d, "linkage.branch", "+1 or -1");
+    d = hand_def();
+    d.q_min = 1.2;
+    expect_refusal(&d, "linkage.q_min", "< q_max");
+    d = hand_def();
+    d.base[0] = NAN;
+    expect_refusal(&d, "linkage.base[0]", "finite");
+    d = hand_def();
+    d.link_mass = -1;
+    expect_refusal(&d, "linkage.link_mass", ">= 0");
+}
+
+/*
+ * The lumped masses: the link's at A on the parent, the rocker's at c on the
+ * child. A parent of 100 kg at com (1, 0, 0) with the 18 kg link at
+ * (4.10, 0, 0.27) gets 118 kg at ((100 + 18 * 4.10) / 118, 0, 18 * 0.27 / 118);
+ * a child of 50 kg at its origin with the 15 kg rocker at (0.39, 0, 0.07)
+ * gets 65 kg at (15 * 0.39 / 65, 0, 15 * 0.07 / 65).
+ */
+static void test_lump(void) {
+    linkage_def d = crane_def();
+    linkage lk;
+    char err[256] = "";
+    CHECK(linkage_init(&lk, &d, err, sizeof err) == 0, "%s", err);
+    chain_body_def p, c;
+    chain_body_init(&p, 0);
+    chain_body_init(&c, 1);
+    p.mass = 100;
+    p.com[0] = 1;
+    c.mass = 50;
+    linkage_lump(&lk, &p, &c);
+    CHECK_NEAR(p.mass, 118, 1e-12);
+    CHECK_NEAR(p.com[0], (100 + 18 * 4.10) / 118, 1e-12);
+    CHECK_NEAR(p.com[2], 18 * 0.27 / 118, 1e-12);
+    CHECK_NEAR(c.mass, 65, 1e-12);
+    CHECK_NEAR(c.com[0], 15 * 0.39 / 65, 1e-12);
+    CHECK_NEAR(c.com[2], 15 * 0.07 / 65, 1e-12);
+}
+
+int main(int argc, char** argv) {
+    RUN_TEST(test_hand_three_angles);
+    RUN_TEST(test_hand_other_branch);
+    RUN_TEST(test_central_differences);
+    RUN_TEST(test_inverse);
+    RUN_TEST(test_refusals);
+    RUN_TEST(test_lump);
+    TEST_MAIN_END();
+}
