@@ -180,6 +180,55 @@ static void test_inverse(void) {
     }
 }
 
+/*
+ * Invariants of the description: (1) moving J, A and B together by any
+ * vector moves C and P by it and leaves L, its derivatives and the angles
+ * alone; (2) turning the child's frame, angle0 + a with the rocker's pin
+ * turned by -a in it, describes the same linkage (the same C for every q).
+ * The hand loop has J = 0 and angle0 = 0, so these cover the joint offset
+ * and angle0 that it cannot.
+ */
+static void test_frame_invariance(void) {
+    linkage_def d0 = crane_def(), d1 = d0, d2 = d0;
+    const double t[2] = {-1.7, 0.45};
+    for (int k = 0; k < 2; k++) {
+        d1.joint[k] += t[k];
+        d1.link_pin[k] += t[k];
+        d1.base[k] += t[k];
+    }
+    double a = 0.7, ca = cos(a), sa = sin(a);
+    d2.angle0 = a;
+    // c' = R(-a) c, so R(angle0 + a + q) c' = R(q) c.
+    d2.rocker_pin[0] = ca * d0.rocker_pin[0] + sa * d0.rocker_pin[1];
+    d2.rocker_pin[1] = -sa * d0.rocker_pin[0] + ca * d0.rocker_pin[1];
+    linkage l0, l1, l2;
+    char err[256] = "";
+    CHECK(linkage_init(&l0, &d0, err, sizeof err) == 0, "%s", err);
+    CHECK(linkage_init(&l1, &d1, err, sizeof err) == 0, "%s", err);
+    CHECK(linkage_init(&l2, &d2, err, sizeof err) == 0, "%s", err);
+    for (int i = 0; i <= 10; i++) {
+        double q = d0.q_min + (d0.q_max - d0.q_min) * i / 10;
+        linkage_state s0, s1, s2;
+        linkage_eval(&l0, q, &s0);
+        linkage_eval(&l1, q, &s1);
+        linkage_eval(&l2, q, &s2);
+        for (int k = 0; k < 2; k++) {
+            CHECK_NEAR(s1.P[k], s0.P[k] + t[k], 1e-12);
+            CHECK_NEAR(s1.C[k], s0.C[k] + t[k], 1e-12);
+            CHECK_NEAR(s2.P[k], s0.P[k], 1e-12);
+            CHECK_NEAR(s2.C[k], s0.C[k], 1e-12);
+        }
+        CHECK_NEAR(s1.L, s0.L, 1e-12);
+        CHECK_NEAR(s1.dL, s0.dL, 1e-12);
+        CHECK_NEAR(s1.d2L, s0.d2L, 1e-11);
+        CHECK_NEAR(s2.L, s0.L, 1e-12);
+        CHECK_NEAR(s2.dL, s0.dL, 1e-12);
+        CHECK_NEAR(s2.d2L, s0.d2L, 1e-11);
+        CHECK_NEAR(s1.link_angle, s0.link_angle, 1e-12);
+        CHECK_NEAR(s2.rocker_angle, s0.rocker_angle, 1e-12);
+    }
+}
+
 static void expect_refusal(const linkage_def* d, const char* field, const char* words) {
     linkage lk;
     char err[256] = "";
@@ -269,12 +318,63 @@ static void test_lump(void) {
     CHECK_NEAR(c.com[2], 15 * 0.07 / 65, 1e-12);
 }
 
+/*
+ * The links' exact share against the energies computed here from the pins
+ * alone: V(q) = -g.(m1 (A + P)/2 + m2 (C + P)/2) and, at qd = 1 rad/s,
+ * T = 1/2 [m1 |d(A + P)/2|^2 + m1 l1^2/12 (d phi1)^2 + m2 |d(C + P)/2|^2 +
+ * m2 l2^2/12 (d phi2)^2] with every d a central difference in q of the
+ * solved pins and the links' angles (atan2 of the pins here), so G = dV/dq
+ * and I = 2 T. The lumped terms: the rocker's mass at C, -m2 g.C' and
+ * m2 |C'|^2. Gravity is tilted in the parent frame (a raised lifting arm).
+ */
+static void test_links_terms(void) {
+    linkage_def d = crane_def();
+    linkage lk;
+    char err[256] = "";
+    CHECK(linkage_init(&lk, &d, err, sizeof err) == 0, "%s", err);
+    const double g[2] = {-9.81 * sin(0.6), -9.81 * cos(0.6)};
+    const double h = 1e-5;
+    double m1 = d.link_mass, m2 = d.rocker_mass, l1 = d.link_len, l2 = d.rocker_len;
+    for (int i = 0; i <= 12; i++) {
+        double q = d.q_min + 0.01 + (d.q_max - d.q_min - 0.02) * i / 12;
+        linkage_state sp, sm;
+        linkage_links_terms t;
+        CHECK(linkage_links(&lk, q, g, &t) == 0, "q = %g", q);
+        linkage_eval(&lk, q + h, &sp);
+        linkage_eval(&lk, q - h, &sm);
+        double r1p[2], r1m[2], r2p[2], r2m[2], v1[2], v2[2], vc[2];
+        for (int k = 0; k < 2; k++) {
+            r1p[k] = 0.5 * (d.link_pin[k] + sp.P[k]);
+            r1m[k] = 0.5 * (d.link_pin[k] + sm.P[k]);
+            r2p[k] = 0.5 * (sp.C[k] + sp.P[k]);
+            r2m[k] = 0.5 * (sm.C[k] + sm.P[k]);
+            v1[k] = (r1p[k] - r1m[k]) / (2 * h);
+            v2[k] = (r2p[k] - r2m[k]) / (2 * h);
+            vc[k] = (sp.C[k] - sm.C[k]) / (2 * h);
+        }
+        double Vp = -(g[0] * (m1 * r1p[0] + m2 * r2p[0]) + g[1] * (m1 * r1p[1] + m2 * r2p[1]));
+        double Vm = -(g[0] * (m1 * r1m[0] + m2 * r2m[0]) + g[1] * (m1 * r1m[1] + m2 * r2m[1]));
+        double w1 = (atan2(sp.P[1] - d.link_pin[1], sp.P[0] - d.link_pin[0]) -
+                     atan2(sm.P[1] - d.link_pin[1], sm.P[0] - d.link_pin[0])) / (2 * h);
+        double w2 = (atan2(sp.P[1] - sp.C[1], sp.P[0] - sp.C[0]) - atan2(sm.P[1] - sm.C[1], sm.P[0] - sm.C[0])) /
+                    (2 * h);
+        double I = m1 * (v1[0] * v1[0] + v1[1] * v1[1]) + m1 * l1 * l1 / 12 * w1 * w1 +
+                   m2 * (v2[0] * v2[0] + v2[1] * v2[1]) + m2 * l2 * l2 / 12 * w2 * w2;
+        CHECK_NEAR(t.G, (Vp - Vm) / (2 * h), 1e-6);
+        CHECK_NEAR(t.I, I, 1e-7);
+        CHECK_NEAR(t.G_lumped, -m2 * (g[0] * vc[0] + g[1] * vc[1]), 1e-6);
+        CHECK_NEAR(t.I_lumped, m2 * (vc[0] * vc[0] + vc[1] * vc[1]), 1e-7);
+    }
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_hand_three_angles);
     RUN_TEST(test_hand_other_branch);
     RUN_TEST(test_central_differences);
     RUN_TEST(test_inverse);
+    RUN_TEST(test_frame_invariance);
     RUN_TEST(test_refusals);
     RUN_TEST(test_lump);
+    RUN_TEST(test_links_terms);
     TEST_MAIN_END();
 }

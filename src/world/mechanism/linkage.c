@@ -258,3 +258,30 @@ void linkage_lump(const linkage* lk, chain_body_def* parent, chain_body_def* chi
         chain_body_add_point_mass(child, lk->d.rocker_mass, p);
     }
 }
+
+int linkage_links(const linkage* lk, double q, const double g[2], linkage_links_terms* t) {
+    linkage_state s;
+    if (eval(&lk->d, q, &s)) {
+        t->I = t->G = t->I_lumped = t->G_lumped = NAN;
+        return -1;
+    }
+    double m1 = lk->d.link_mass, m2 = lk->d.rocker_mass, l2 = lk->d.rocker_len;
+    const double* J = lk->d.joint;
+    // C' = perp(C - J) [m/rad]; the link's centre (A + P) / 2 moves at P'/2,
+    // the rocker's (C + P) / 2 at (C' + P') / 2.
+    double Cd[2] = {-(s.C[1] - J[1]), s.C[0] - J[0]};
+    double v2[2] = {0.5 * (Cd[0] + s.dP[0]), 0.5 * (Cd[1] + s.dP[1])};
+    // The link turns about A at |P'| / l1 (P' is normal to A-P), so its
+    // 1/2 m |P'/2|^2 + 1/2 (m l1^2 / 12) (|P'| / l1)^2 = 1/2 (m / 3) |P'|^2.
+    // The rocker turns at w2 = cross(P - C, P' - C') / l2^2 [rad/rad].
+    double r2[2] = {s.P[0] - s.C[0], s.P[1] - s.C[1]};
+    double rel[2] = {s.dP[0] - Cd[0], s.dP[1] - Cd[1]};
+    double w2 = cross2(r2, rel) / (l2 * l2);
+    t->I = m1 * dot2(s.dP, s.dP) / 3 + m2 * dot2(v2, v2) + m2 * l2 * l2 / 12 * w2 * w2;
+    // V = -sum m g.r, so dV/dq = -sum m g.dr/dq.
+    t->G = -(m1 * 0.5 * dot2(g, s.dP) + m2 * dot2(g, v2));
+    // Lumped: the link's mass at A does not move; the rocker's at C moves at C'.
+    t->I_lumped = m2 * dot2(Cd, Cd);
+    t->G_lumped = -m2 * dot2(g, Cd);
+    return 0;
+}

@@ -98,6 +98,21 @@ int linkage_angle(const linkage* lk, double L, double* q);
 /// with q are left out (docs/mechanism.md bounds the error).
 void linkage_lump(const linkage* lk, chain_body_def* parent, chain_body_def* child);
 
+/// The links' own share of the knuckle's equation with the parent boom held
+/// still, exactly (uniform links: the centre of mass at mid-length, m l^2 / 12
+/// about it) and as lumped by linkage_lump, so a caller can see what the
+/// lumping leaves out.
+typedef struct linkage_links_terms {
+    double I;         ///< effective inertia about the knuckle (kinetic energy 1/2 I qd^2) [kg m^2]
+    double G;         ///< gravity's generalized force dV/dq [N m]
+    double I_lumped;  ///< the same with the masses lumped at A and C [kg m^2]
+    double G_lumped;  ///< [N m]
+} linkage_links_terms;
+
+/// The terms at q for gravity g (x, z) in the parent frame [m/s^2]. Returns
+/// 0, or -1 where the loop cannot close (t is then NaN).
+int linkage_links(const linkage* lk, double q, const double g[2], linkage_links_terms* t);
+
 #ifdef __cplusplus
 }
 #endif
