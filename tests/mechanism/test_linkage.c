@@ -271,6 +271,17 @@ static void test_refusals(void) {
         double qd = at ? atof(at + 4) : NAN;
         CHECK(fabs(qd) < 1e-5, "dead centre named at %g rad, expected 0: %s", qd, err);
     }
+    // The cylinder's base on the common pin's path: at q = 1.2 rad P =
+    // (0.3 cos 1.2, 0.2 + 0.3 sin 1.2), so L = 0 there.
+    d = hand_def();
+    d.base[0] = 0.3 * cos(1.2);
+    d.base[1] = 0.2 + 0.3 * sin(1.2);
+    expect_refusal(&d, "linkage.base", "at q = 1.2 rad, must be > 0 m");
+    // Inside the range, where P(0) = (0.3, 0.2) = B, L has a kink (|P - B|
+    // falls to 0 and rises again): a dead centre.
+    d.base[0] = 0.3;
+    d.base[1] = 0.2;
+    expect_refusal(&d, "linkage.base", "dead centre at q = ");
     d = hand_def();
     d.link_len = 0;
     expect_refusal(&d, "linkage.link_len", "> 0");

@@ -176,8 +176,18 @@ int linkage_init(linkage* lk, const linkage_def* d, char* err, size_t errsz) {
 
     lk->d = *d;
     linkage_state s0, s1;
-    if (eval(d, d->q_min, &s0) || eval(d, d->q_max, &s1))
-        return fail(err, errsz, "linkage.base: the cylinder length is 0 m at q = %g rad", d->q_min, 0, 0);
+    // The closure check leaves only a cylinder length of (nearly) 0 to fail:
+    // the base on the common pin's path. Inside the range that is a kink of
+    // L (dL/dq flips sign), caught by the dead-centre scan below; at the
+    // range's ends it is refused here (1e-9 of the links' size: rounding).
+    eval(d, d->q_min, &s0);
+    eval(d, d->q_max, &s1);
+    if (!(s0.L > tol))
+        return fail(err, errsz, "linkage.base: the cylinder length is %.3g m at q = %g rad, must be > 0 m", s0.L,
+                    d->q_min, 0);
+    if (!(s1.L > tol))
+        return fail(err, errsz, "linkage.base: the cylinder length is %.3g m at q = %g rad, must be > 0 m", s1.L,
+                    d->q_max, 0);
     lk->L_qmin = s0.L;
     lk->L_qmax = s1.L;
     lk->sign = s1.L > s0.L ? 1 : -1;
@@ -190,7 +200,8 @@ int linkage_init(linkage* lk, const linkage_def* d, char* err, size_t errsz) {
     for (int i = 0; i <= LINKAGE_SCAN; i++) {
         double q = d->q_min + (d->q_max - d->q_min) * i / LINKAGE_SCAN;
         linkage_state s;
-        if (eval(d, q, &s)) return fail(err, errsz, "linkage.base: the cylinder length is 0 m at q = %g rad", q, 0, 0);
+        if (eval(d, q, &s))
+            return fail(err, errsz, "linkage.base: the cylinder length is 0 m at q = %g rad, must be > 0 m", q, 0, 0);
         if (fabs(s.dL) < lk->min_lever) lk->min_lever = fabs(s.dL);
         if (s.sin_mu < lk->min_sin_mu) lk->min_sin_mu = s.sin_mu;
         if (s.dL == 0 || (s.dL > 0) != (dprev > 0)) {
