@@ -378,6 +378,44 @@ static void test_links_terms(void) {
     }
 }
 
+/*
+ * The lengths and branch from a drawing's common pin: the crane linkage's P
+ * at q_ref gives back its lengths and branch (and so the same L(q)); for
+ * the hand loop at q = 0, P = (0.3, 0.2) gives l1 = 0.3, l2 = 0.2, branch
+ * +1, and its mirror (3/26, -1/13) branch -1 with the same lengths. A pin
+ * on the line A-C (the midpoint of A = (0, 0.2) and C = (0.3, 0)) is refused.
+ */
+static void test_from_pose(void) {
+    linkage_def d = crane_def(), e = crane_def();
+    linkage lk, lk2;
+    char err[256] = "";
+    CHECK(linkage_init(&lk, &d, err, sizeof err) == 0, "%s", err);
+    linkage_state s;
+    linkage_eval(&lk, -1.0, &s);
+    e.link_len = e.rocker_len = 0;
+    e.branch = 0;
+    CHECK(linkage_def_from_pose(&e, s.P, -1.0, err, sizeof err) == 0, "%s", err);
+    CHECK_NEAR(e.link_len, d.link_len, 1e-12);
+    CHECK_NEAR(e.rocker_len, d.rocker_len, 1e-12);
+    CHECK(e.branch == d.branch, "branch %d, expected %d", e.branch, d.branch);
+    CHECK(linkage_init(&lk2, &e, err, sizeof err) == 0, "%s", err);
+    CHECK_NEAR(linkage_length(&lk2, 0.2), linkage_length(&lk, 0.2), 1e-12);
+
+    linkage_def h = hand_def();
+    const double P1[2] = {0.3, 0.2}, P2[2] = {3.0 / 26, -1.0 / 13}, Pm[2] = {0.15, 0.1};
+    CHECK(linkage_def_from_pose(&h, P1, 0, err, sizeof err) == 0, "%s", err);
+    CHECK(h.branch == 1, "branch %d", h.branch);
+    CHECK_NEAR(h.link_len, 0.3, 1e-15);
+    CHECK_NEAR(h.rocker_len, 0.2, 1e-15);
+    CHECK(linkage_def_from_pose(&h, P2, 0, err, sizeof err) == 0, "%s", err);
+    CHECK(h.branch == -1, "branch %d", h.branch);
+    CHECK_NEAR(h.link_len, 0.3, 1e-15);
+    CHECK_NEAR(h.rocker_len, 0.2, 1e-15);
+    err[0] = 0;
+    CHECK(linkage_def_from_pose(&h, Pm, 0, err, sizeof err) == -1, "midpoint accepted");
+    CHECK(strstr(err, "linkage.common_pin") && strstr(err, "toggle"), "err '%s'", err);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_hand_three_angles);
     RUN_TEST(test_hand_other_branch);
@@ -387,5 +425,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_refusals);
     RUN_TEST(test_lump);
     RUN_TEST(test_links_terms);
+    RUN_TEST(test_from_pose);
     TEST_MAIN_END();
 }

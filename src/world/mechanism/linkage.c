@@ -296,3 +296,28 @@ int linkage_links(const linkage* lk, double q, const double g[2], linkage_links_
     t->G_lumped = -m2 * dot2(g, Cd);
     return 0;
 }
+
+int linkage_def_from_pose(linkage_def* d, const double P_ref[2], double q_ref, char* err, size_t errsz) {
+    double C[2];
+    rocker_point(d, q_ref, C);
+    double r1[2] = {P_ref[0] - d->link_pin[0], P_ref[1] - d->link_pin[1]};
+    double r2[2] = {P_ref[0] - C[0], P_ref[1] - C[1]};
+    double ac[2] = {C[0] - d->link_pin[0], C[1] - d->link_pin[1]};
+    double l1 = hypot(r1[0], r1[1]), l2 = hypot(r2[0], r2[1]);
+    // The side of A->C: the sign of cross(C - A, P - A); relative to l1 |AC|
+    // it is the sine of the angle at A, and near 0 the pin is at a toggle.
+    double side = cross2(ac, r1);
+    double scale = l1 * hypot(ac[0], ac[1]);
+    if (!isfinite(side) || !isfinite(l1) || !isfinite(l2) || !(l1 > 0) || !(l2 > 0) || !(fabs(side) > 1e-9 * scale)) {
+        if (err && errsz)
+            snprintf(err, errsz,
+                     "linkage.common_pin: (%g, %g) m at q = %g rad is on the line through the link's and the rocker's "
+                     "pins (a toggle: no assembly branch)",
+                     P_ref[0], P_ref[1], q_ref);
+        return -1;
+    }
+    d->link_len = l1;
+    d->rocker_len = l2;
+    d->branch = side > 0 ? 1 : -1;
+    return 0;
+}

@@ -80,6 +80,15 @@ typedef struct linkage_state {
 /// Returns 0, or -1 with one line "linkage.field: problem" in err.
 int linkage_init(linkage* lk, const linkage_def* d, char* err, size_t errsz);
 
+/// The lengths and the branch from the common pin's position P_ref (parent
+/// frame, (x, z)) [m] at the angle q_ref [rad], as a drawing gives them:
+/// link_len = |P_ref - A|, rocker_len = |P_ref - C(q_ref)|, branch the side
+/// of A->C(q_ref) P_ref is on. Reads joint, angle0, link_pin and
+/// rocker_pin from d and writes the three fields. Returns 0, or -1 with
+/// "linkage.common_pin: ..." when P_ref is on the line A-C (no branch: a
+/// toggle) or on A or C.
+int linkage_def_from_pose(linkage_def* d, const double P_ref[2], double q_ref, char* err, size_t errsz);
+
 /// The loop at q [rad] (any q, not only the range): returns 0, or -1 when
 /// the loop cannot close there or is at a toggle (s is then NaN).
 int linkage_eval(const linkage* lk, double q, linkage_state* s);
