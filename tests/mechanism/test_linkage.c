@@ -416,6 +416,98 @@ static void test_from_pose(void) {
     CHECK(strstr(err, "linkage.common_pin") && strstr(err, "toggle"), "err '%s'", err);
 }
 
+/*
+ * Random linkages (pins within 1 m, lengths 0.1..1 m, either branch, any
+ * angle0, ranges up to 3 rad): every accepted one closes at 2,001 angles
+ * over its range with the loop equations holding, its L' and L'' match
+ * central differences (Richardson, to 1e-8 of 1 + |L'| + |L''|) and
+ * q(L(q)) = q;
+ * every one refused as "cannot close" fails to close at the angle its
+ * message names, or is within 1e-5 m of the limit there (the message gives
+ * q to 6 digits); every dead centre named has |dL/dq| ~ 0 or L's extremum
+ * there.
+ */
+static double urand(double lo, double hi) { return lo + (hi - lo) * rand() / (double)RAND_MAX; }
+
+static void test_random_linkages(void) {
+    srand(27);
+    int accepted = 0, refused_close = 0, refused_dead = 0;
+    for (int n = 0; n < 400; n++) {
+        linkage_def d;
+        memset(&d, 0, sizeof d);
+        for (int k = 0; k < 2; k++) {
+            d.joint[k] = urand(-1, 1);
+            d.base[k] = urand(-1, 1);
+            d.link_pin[k] = urand(-1, 1);
+            d.rocker_pin[k] = urand(-0.5, 0.5);
+        }
+        d.angle0 = urand(-3, 3);
+        d.link_len = urand(0.1, 1);
+        d.rocker_len = urand(0.1, 1);
+        d.branch = rand() % 2 ? 1 : -1;
+        d.q_min = urand(-2, 1);
+        d.q_max = d.q_min + urand(0.1, 3);
+        linkage lk;
+        char err[256] = "";
+        if (linkage_init(&lk, &d, err, sizeof err)) {
+            const char* at = strstr(err, "at q = ");
+            if (strstr(err, "cannot close") && at) {
+                ++refused_close;
+                double q = atof(at + 7);
+                double C[2], th = d.angle0 + q;
+                C[0] = d.joint[0] + cos(th) * d.rocker_pin[0] - sin(th) * d.rocker_pin[1];
+                C[1] = d.joint[1] + sin(th) * d.rocker_pin[0] + cos(th) * d.rocker_pin[1];
+                double D = hypot(C[0] - d.link_pin[0], C[1] - d.link_pin[1]);
+                double lo = fabs(d.link_len - d.rocker_len), hi = d.link_len + d.rocker_len;
+                CHECK(q >= d.q_min - 1e-5 && q <= d.q_max + 1e-5, "named q %g outside [%g, %g]", q, d.q_min,
+                      d.q_max);
+                CHECK(D <= lo + 1e-5 || D >= hi - 1e-5, "refused at q = %g but D = %g in (%g, %g): %s", q, D, lo, hi,
+                      err);
+            } else if (strstr(err, "dead centre")) {
+                ++refused_dead;
+                double q = atof(at + 7), h = 1e-7;
+                linkage lk2 = {.d = d};
+                double Lp = linkage_length(&lk2, q + h), Lm = linkage_length(&lk2, q - h);
+                double L0 = linkage_length(&lk2, q);
+                CHECK(fabs(Lp - Lm) / (2 * h) < 1e-5 || (Lp - L0) * (L0 - Lm) <= 0,
+                      "dead centre at q = %g but dL/dq = %g", q, (Lp - Lm) / (2 * h));
+            }
+            continue;
+        }
+        ++accepted;
+        const double h = 1e-3;
+        for (int i = 0; i <= 2000; i++) {
+            double q = d.q_min + (d.q_max - d.q_min) * i / 2000;
+            linkage_state s;
+            CHECK(linkage_eval(&lk, q, &s) == 0, "linkage %d does not close at q = %g", n, q);
+            CHECK_NEAR(hypot(s.P[0] - d.link_pin[0], s.P[1] - d.link_pin[1]), d.link_len, 1e-12);
+            CHECK_NEAR(hypot(s.P[0] - s.C[0], s.P[1] - s.C[1]), d.rocker_len, 1e-12);
+            if (i % 100) continue;
+            // Central differences at h and h/2, Richardson-extrapolated
+            // (4 D(h/2) - D(h)) / 3: truncation O(h^4), so the large higher
+            // derivatives of a random loop near its toggle do not swamp it.
+            linkage_state sp, sm, sp2, sm2;
+            linkage_eval(&lk, q + h, &sp);
+            linkage_eval(&lk, q - h, &sm);
+            linkage_eval(&lk, q + h / 2, &sp2);
+            linkage_eval(&lk, q - h / 2, &sm2);
+            if (!(sp.sin_mu > 0.05 && sm.sin_mu > 0.05 && s.sin_mu > 0.05)) continue; // at a toggle's edge
+            double dL = (4 * (sp2.L - sm2.L) / h - (sp.L - sm.L) / (2 * h)) / 3;
+            double d2L = (4 * (sp2.dL - sm2.dL) / h - (sp.dL - sm.dL) / (2 * h)) / 3;
+            double scale = 1 + fabs(s.dL) + fabs(s.d2L);
+            CHECK_NEAR(s.dL, dL, 1e-8 * scale);
+            CHECK_NEAR(s.d2L, d2L, 1e-8 * scale);
+            double qb = NAN;
+            CHECK(linkage_angle(&lk, s.L, &qb) == 0, "L = %g", s.L);
+            CHECK_NEAR(qb, q, 1e-9 / fmax(lk.min_lever, 1e-3));
+        }
+    }
+    printf("random linkages: %d accepted, %d refused as not closing, %d with a dead centre\n", accepted, refused_close,
+           refused_dead);
+    CHECK(accepted >= 20 && refused_close >= 20 && refused_dead >= 5, "too few of a kind: %d %d %d", accepted,
+          refused_close, refused_dead);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_hand_three_angles);
     RUN_TEST(test_hand_other_branch);
@@ -426,5 +518,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_lump);
     RUN_TEST(test_links_terms);
     RUN_TEST(test_from_pose);
+    RUN_TEST(test_random_linkages);
     TEST_MAIN_END();
 }
