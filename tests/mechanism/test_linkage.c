@@ -419,7 +419,8 @@ static void test_from_pose(void) {
 /*
  * Random linkages (pins within 1 m, lengths 0.1..1 m, either branch, any
  * angle0, ranges up to 3 rad): every accepted one closes at 2,001 angles
- * over its range with the loop equations holding, its L' and L'' match
+ * over its range with the loop equations holding and L' of one sign (no
+ * dead centre missed between the scan's samples), its L' and L'' match
  * central differences (Richardson, to 1e-8 of 1 + |L'| + |L''|) and
  * q(L(q)) = q;
  * every one refused as "cannot close" fails to close at the angle its
@@ -482,6 +483,8 @@ static void test_random_linkages(void) {
             CHECK(linkage_eval(&lk, q, &s) == 0, "linkage %d does not close at q = %g", n, q);
             CHECK_NEAR(hypot(s.P[0] - d.link_pin[0], s.P[1] - d.link_pin[1]), d.link_len, 1e-12);
             CHECK_NEAR(hypot(s.P[0] - s.C[0], s.P[1] - s.C[1]), d.rocker_len, 1e-12);
+            CHECK(s.dL * lk.sign > 0, "linkage %d: dL/dq = %g at q = %g against the stroke's sign %d", n, s.dL, q,
+                  lk.sign);
             if (i % 100) continue;
             // Central differences at h and h/2, Richardson-extrapolated
             // (4 D(h/2) - D(h)) / 3: truncation O(h^4), so the large higher
