@@ -51,9 +51,11 @@ def bodies_and_actuators():
         {"name": "lifting_arm", "joint": "revolute", "origin": [0, 0, 1.9], "angle0": -0.5 * math.pi,
          "length": 2.9, "mass": 260.0, "com": [1.45, 0, 0], "width": 0.2, "height": 0.28,
          "limits": [1.23, 2.78]},
-        # Knuckle (outer) arm, the housing of the extensions; -135..-37 deg.
+        # Knuckle (outer) arm, the housing of the extensions: -126..-26 deg,
+        # what one direct cylinder covers with a closed length over its stroke
+        # + 0.25 m (docs/model.md; the linkage of item 2 widens it).
         {"name": "knuckle_arm", "joint": "revolute", "origin": [2.9, 0, 0], "length": 2.3, "mass": 170.0,
-         "com": [1.1, 0, 0], "width": 0.17, "height": 0.24, "limits": [-2.35, -0.65]},
+         "com": [1.1, 0, 0], "width": 0.17, "height": 0.24, "limits": [-2.2, -0.45]},
         # Two extensions, 1.3 m each, nested: flush-ish with the housing's
         # tip when retracted (offset0 + length = housing length - 0.2 m).
         {"name": "ext1", "joint": "prismatic", "parent": "knuckle_arm", "offset0": 0.3, "length": 2.0,
@@ -64,13 +66,13 @@ def bodies_and_actuators():
     bodies[1:] = mcm.box_inertia_list(bodies[1:])
     acts = [
         {"name": "lift", "cylinder": "lift_cyl", "valve": "lift_valve",
-         "base": {"body": "column", "point": [0.26, 0, 1.35]},
-         "rod": {"body": "lifting_arm", "point": [1.85, 0, -0.18]}},
+         "base": {"body": "column", "point": [0.32, 0, 1.2]},
+         "rod": {"body": "lifting_arm", "point": [1.85, 0, -0.25]}},
         # Direct jib cylinder for now (the four-bar linkage comes with
         # issue 27 item 2).
         {"name": "jib", "cylinder": "jib_cyl", "valve": "jib_valve",
-         "base": {"body": "lifting_arm", "point": [1.45, 0, 0.15]},
-         "rod": {"body": "knuckle_arm", "point": [0.45, 0, -0.14]}},
+         "base": {"body": "lifting_arm", "point": [1.2, 0, 0.15]},
+         "rod": {"body": "knuckle_arm", "point": [0.45, 0, -0.28]}},
         # One cylinder per stage, inside the booms, both on the ext section.
         {"name": "ext1", "cylinder": "ext1_cyl", "valve": "ext_valve",
          "base": {"body": "knuckle_arm", "point": [0.25, 0, 0.03]},
