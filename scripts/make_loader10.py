@@ -215,7 +215,7 @@ def main():
                        "each on one valve section; LS pump 40 L/min, 25 MPa cut-off, a post-compensated section each "
                        "for lift, jib, ext and slew, counterbalance valves on lift and jib. Figures and their sources: "
                        "docs/model.md, 'The second crane: loader10'.",
-        "mechanics": {"gravity": G, "load_mass": LOAD, "rated_moment": 98.0, "rated_load": 3900.0,
+        "mechanics": {"gravity": G, "load_mass": LOAD, "rated_moment": 98.0, "rated_load": 4000.0,
                       "bodies": bodies, "tip": {"body": bodies[tip_body]["name"], "point": tip},
                       "actuators": acts,
                       "functions": [{"name": "lift", "valve": "lift_valve"}, {"name": "jib", "valve": "jib_valve"},
