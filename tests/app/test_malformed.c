@@ -521,7 +521,7 @@ static void test_model_names(void) {
                      sizeof out_buf);
     CHECK(rc == 0, "--model hiab031_ls: exit %d: %s", rc, out_buf);
     rc = cli_run("run --quiet --model nosuch --scenario hold --out /dev/null", out_buf, sizeof out_buf);
-    CHECK(rc == 2 && strstr(out_buf, "--model nosuch: no such file or model (models: hiab031, hiab031_ls;") &&
+    CHECK(rc == 2 && strstr(out_buf, "--model nosuch: no such file or model (models: hiab031, hiab031_ls, loader10;") &&
               cli_count_lines(out_buf) == 1,
           "exit %d: %s", rc, out_buf);
     // A path stays a path: a missing file is not looked up as a name.
