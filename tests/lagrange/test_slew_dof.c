@@ -168,6 +168,7 @@ static void test_slew_only(void) {
     char err[512];
     CHECK(world_desc_load(CRANESIM_ASSETS "/worlds/sandbox.json", &wd, err, sizeof err) == 0, "%s", err);
     const double m3 = wd.hook.mass + wd.rope.mass_per_m * wd.rope.length;
+    world_desc_free(&wd); // only its masses were needed
 
     sim_opts o = sim_default_opts();
     o.no_step_probe = true;
