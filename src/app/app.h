@@ -389,4 +389,42 @@ int app_plot_convergence(const char* png, const char* title, const char* ylab, c
 int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb,
                      const char* title, bool slew, const char* png, char* err, size_t errsz);
 
+// A chain model's outputs by actuator and function (app_chain_out.c): read
+// from the rows' chain columns (crane_chain_columns) by name.
+#include "metrics.h"
+struct crane_chain;
+typedef struct app_act_stats {
+    char name[40];
+    int cx, cA, cB, cF;  ///< row columns of x_, pA_, pB_, F_<name>
+    double stroke;       ///< the cylinder's stroke [m]; NaN: not a chain actuator (the slew rack)
+    double xmin, xmax;   ///< [m]
+    double pA, pB, Fabs; ///< peaks [Pa abs, Pa abs, N]
+    int stops;           ///< entries into an end stop (x < 0 or x > stroke), at the rows
+    bool at_stop;
+} app_act_stats;
+typedef struct app_fn_stats {
+    char name[40];
+    int cu;      ///< row column of u_<name>
+    double umax; ///< largest |spool opening| [-]
+} app_fn_stats;
+typedef struct app_chain_stats {
+    bool bound;
+    int nact, nfn;
+    app_act_stats* act;
+    app_fn_stats* fn;
+    long rows;
+} app_chain_stats;
+/// Bind to a run's chain columns, which follow off base columns in its rows;
+/// nothing (nact = nfn = 0) for NULL or the two-link shorthand. 0, or -1
+/// out of memory.
+int app_chain_stats_bind(app_chain_stats* s, const struct crane_chain* cc, int off);
+void app_chain_stats_row(app_chain_stats* s, const double* row);
+/// The summary's lines by actuator (strokes, peak pressures, forces,
+/// end-stop hits); every: the output period [s], t_end the run's end [s].
+void app_chain_stats_print(const app_chain_stats* s, double every, double t_end, FILE* f);
+/// met's JSON document (metrics_write_json) with the per-actuator and
+/// per-function entries ("peak_pA.lift", ...) added. 0, or -1.
+int app_chain_stats_write_json(const app_chain_stats* s, const run_metrics* met, FILE* f);
+void app_chain_stats_free(app_chain_stats* s);
+
 #endif

@@ -153,6 +153,8 @@ typedef struct csv_sink {
     run_metrics met;
     double t_last; ///< time of the last row written [s]
     rcl* mon;      ///< the limiter's measurement where the rows have no rcl_util (lagrange), or NULL
+    app_chain_stats cst; ///< a chain model's summary and metrics by actuator and function
+    bool cst_oom;
 } csv_sink;
 
 // The CSV is opened at the first row (t = 0, before any step): a run refused
@@ -201,6 +203,10 @@ static int csv_row(void* user, const double* row) {
         }
         s->st.t_prev = row[COL_T];
     }
+    // Bound at the first row to the columns the run writes (its chain's,
+    // which may have the slew rack's besides the model's).
+    if (!s->cst.bound && app_chain_stats_bind(&s->cst, s->chain, s->ncol)) s->cst_oom = true;
+    app_chain_stats_row(&s->cst, row);
     keep_row(&s->keep, row, s->ncol);
     metrics_row(&s->met, row);
     return app_signal_caught() != 0;
@@ -216,7 +222,7 @@ static int csv_close(csv_sink* s) {
 }
 
 static void print_summary(const char* scen, const sim_opts* o, const sim_result* r, const row_stats* st,
-                          const run_metrics* met, const char* out) {
+                          const run_metrics* met, const app_chain_stats* cst, const char* out) {
     const double *pmax = st->pmax, *xmin = st->xmin, *xmax = st->xmax;
     const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
     // The backend names the run and its work (engine_describe).
@@ -238,8 +244,12 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     char speed[32];
     printf("  simulated %.3f s in %.3f s wall: %sx real time; %s\n", r->t_end, r->wall,
            app_fmt_speed(speed, sizeof speed, r->wall > 0 ? r->t_end / r->wall : 0.0), work);
-    printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
-           1e3 * xmax[1]);
+    // A chain model: every actuator by name (its strokes, peak pressures,
+    // forces and end-stop hits) instead of the first two by position.
+    const bool by_act = cst->nact > 0;
+    if (!by_act)
+        printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
+               1e3 * xmax[1]);
     char rcl_scripted_off[96]; // a backend whose scripted runs only measure the limiter
     snprintf(rcl_scripted_off, sizeof rcl_scripted_off, "measuring only (%s scripted run)", app_backend(o)->name);
     if (st->rcl_have)
@@ -251,7 +261,9 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     // coarse rows the true peak can be far higher than any row's); else
     // (CVODE) over the rows, and said so.
     const double every = app_output_period(o);
-    if (r->peak_steps) {
+    if (by_act) {
+        app_chain_stats_print(cst, every, r->t_end, stdout);
+    } else if (r->peak_steps) {
         printf("  peak pressures: p1A %.2f, p1B %.2f, p2A %.2f, p2B %.2f MPa (absolute, over every %s)",
                r->p_peak[0] * 1e-6, r->p_peak[1] * 1e-6, r->p_peak[2] * 1e-6, r->p_peak[3] * 1e-6, d.step_name);
     } else {
@@ -260,7 +272,7 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
         // The rows come every `every`, but never farther apart than the run.
         if (every > 1e-3 * (1 + 1e-9)) printf(", rows every %g ms", fmin(every, r->t_end) * 1e3);
     }
-    printf("\n");
+    if (!by_act) printf("\n");
     metrics_print(met, stdout);
     printf("  %ld rows -> %s\n", r->rows, out);
 }
@@ -490,6 +502,10 @@ int cmd_run(int argc, char** argv) {
         fprintf(stderr, "cranesim run: cannot write %s: %s\n", energy_csv, strerror(eerr));
         code = EXIT_RUNTIME;
     }
+    if (sink.cst_oom && code == EXIT_OK_) {
+        fprintf(stderr, "cranesim run: out of memory for the summary by actuator\n");
+        code = EXIT_RUNTIME;
+    }
     if (sink.keep.oom && code == EXIT_OK_) {
         fprintf(stderr, "cranesim run: plot: out of memory for the plotted rows\n");
         code = EXIT_RUNTIME;
@@ -497,7 +513,7 @@ int cmd_run(int argc, char** argv) {
     sim_energy_balance eb;
     sim_energy_result(en, &eb);
     if (code == EXIT_OK_ && !c.quiet) {
-        print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, &sink.met, out);
+        print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, &sink.met, &sink.cst, out);
         if (eb.samples > 1) app_print_energy(en, &eb, NULL);
         if (energy_csv) printf("  energy -> %s\n", energy_csv);
     }
@@ -506,7 +522,7 @@ int cmd_run(int argc, char** argv) {
         app_out mo;
         FILE* f = app_out_open(&mo, metrics_out, "w");
         int e = f ? 0 : errno;
-        if (f && metrics_write_json(&sink.met, f)) e = errno ? errno : EIO;
+        if (f && app_chain_stats_write_json(&sink.cst, &sink.met, f)) e = errno ? errno : EIO;
         if (f) e = app_out_close(&mo, e, true);
         if (e) {
             fprintf(stderr, "cranesim run: cannot write %s: %s\n", metrics_out, strerror(e));
@@ -538,6 +554,7 @@ int cmd_run(int argc, char** argv) {
             }
         }
     }
+    app_chain_stats_free(&sink.cst);
     sim_energy_free(en);
     sim_trace_free(&tr);
     if (sink.mon) rcl_free(sink.mon);
