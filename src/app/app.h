@@ -427,4 +427,23 @@ void app_chain_stats_print(const app_chain_stats* s, double every, double t_end,
 int app_chain_stats_write_json(const app_chain_stats* s, const run_metrics* met, FILE* f);
 void app_chain_stats_free(app_chain_stats* s);
 
+/// A run's chain columns, kept row by row (compare: its sim_trace has the
+/// base columns only). Set off (sim_ncol of the run), model_chain (the
+/// model's chain) and pass &run_chain to sim_run_energy_chain; rows via
+/// app_ext_rows_cb. Nothing is kept for the two-link shorthand (ncol 0).
+typedef struct app_ext_rows {
+    int off;
+    const struct crane_chain* model_chain;
+    const struct crane_chain* run_chain; ///< set by the run where its columns differ
+    bool bound, oom;
+    int ncol;                  ///< chain columns kept per row
+    struct crane_column* col;  ///< their names and units (a copy)
+    double* v;                 ///< nrow x ncol
+    long nrow, cap;
+} app_ext_rows;
+int app_ext_rows_cb(void* user, const double* row);
+/// The index of column name in r's columns, or -1.
+int app_ext_rows_find(const app_ext_rows* r, const char* name);
+void app_ext_rows_free(app_ext_rows* r);
+
 #endif

@@ -167,3 +167,53 @@ int app_chain_stats_write_json(const app_chain_stats* s, const run_metrics* met,
     free(buf);
     return ferror(f) ? -1 : 0;
 }
+
+// ---- A run's chain columns kept for compare (its sim_trace holds the base
+// columns only).
+
+int app_ext_rows_cb(void* user, const double* row) {
+    app_ext_rows* r = user;
+    if (!r->bound) {
+        r->bound = true;
+        const struct crane_chain* cc = r->run_chain ? r->run_chain : r->model_chain;
+        // The two-link shorthand's base columns are all compare needs.
+        if (cc && !cc->two_link && cc->ncol > 0) {
+            r->col = malloc((size_t)cc->ncol * sizeof *r->col);
+            if (!r->col) {
+                r->oom = true;
+                return 1;
+            }
+            memcpy(r->col, cc->col, (size_t)cc->ncol * sizeof *r->col);
+            r->ncol = cc->ncol;
+        }
+    }
+    if (r->ncol == 0) return 0;
+    if (r->nrow == r->cap) {
+        const long cap = r->cap ? 2 * r->cap : 4096;
+        double* v = realloc(r->v, (size_t)cap * (size_t)r->ncol * sizeof *v);
+        if (!v) {
+            r->oom = true;
+            return 1;
+        }
+        r->v = v;
+        r->cap = cap;
+    }
+    memcpy(r->v + (size_t)r->nrow * (size_t)r->ncol, row + r->off, (size_t)r->ncol * sizeof(double));
+    ++r->nrow;
+    return 0;
+}
+
+int app_ext_rows_find(const app_ext_rows* r, const char* name) {
+    for (int k = 0; k < r->ncol; ++k)
+        if (!strcmp(r->col[k].name, name)) return k;
+    return -1;
+}
+
+void app_ext_rows_free(app_ext_rows* r) {
+    free(r->col);
+    free(r->v);
+    r->col = NULL;
+    r->v = NULL;
+    r->ncol = 0;
+    r->nrow = r->cap = 0;
+}

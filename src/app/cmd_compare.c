@@ -96,6 +96,79 @@ void app_compare_pressure(const sim_trace* a, const sim_trace* b, double* rms_pa
     *pct = peak > 0 ? 100.0 * worst / peak : 0.0;
 }
 
+// A chain column's difference between the sides (ia in a, ib in b).
+static diff ext_diff(const app_ext_rows* a, int ia, const app_ext_rows* b, int ib, double scale) {
+    const long n = a->nrow < b->nrow ? a->nrow : b->nrow;
+    double s2 = 0, mx = 0;
+    for (long i = 0; i < n; ++i) {
+        const double d = (a->v[(size_t)i * (size_t)a->ncol + (size_t)ia] -
+                          b->v[(size_t)i * (size_t)b->ncol + (size_t)ib]) * scale;
+        s2 += d * d;
+        mx = fmax(mx, fabs(d));
+    }
+    diff r = {n ? sqrt(s2 / (double)n) : 0, mx};
+    return r;
+}
+
+static double ext_peak(const app_ext_rows* r, int k) {
+    double peak = 0;
+    for (long i = 0; i < r->nrow; ++i) peak = fmax(peak, r->v[(size_t)i * (size_t)r->ncol + (size_t)k]);
+    return peak;
+}
+
+// The difference table of two chain runs by name: every actuator's stroke
+// (x_) [mm], then its chamber pressures (pA_, pB_) [MPa], then every degree
+// of freedom (q_) [deg, or mm for a sliding one], then the tip; columns only
+// one side has (two designs of different shape) are listed as such. The
+// worst stroke RMS [mm], the worst pressure RMS [Pa], the higher peak of the
+// pressure columns [Pa] and whose it is (0 A, 1 B) come back.
+static void print_ext_table(const app_ext_rows ext[2], const sim_trace tr[2], double* stroke_rms, double* prms,
+                            double* ppeak, int* pside) {
+    int w = 8;
+    for (int s = 0; s < 2; ++s)
+        for (int k = 0; k < ext[s].ncol; ++k) w = w > (int)strlen(ext[s].col[k].name) ? w : (int)strlen(ext[s].col[k].name);
+    printf("  %-*s %12s %12s\n", w, "column", "RMS diff", "max diff");
+    static const char* const kinds[3][2] = {{"x_", NULL}, {"pA_", "pB_"}, {"q_", NULL}};
+    double pk[2] = {0, 0};
+    *stroke_rms = *prms = 0;
+    for (int g = 0; g < 3; ++g) {
+        for (int k = 0; k < ext[0].ncol; ++k) {
+            const crane_column* c = &ext[0].col[k];
+            const bool in = !strncmp(c->name, kinds[g][0], strlen(kinds[g][0])) ||
+                            (kinds[g][1] && !strncmp(c->name, kinds[g][1], strlen(kinds[g][1])));
+            if (!in) continue;
+            const int kb = app_ext_rows_find(&ext[1], c->name);
+            if (kb < 0) {
+                printf("  %-*s only in A\n", w, c->name);
+                continue;
+            }
+            double scale = 1e3;
+            const char* unit = "mm";
+            if (g == 1) scale = 1e-6, unit = "MPa";
+            else if (g == 2 && !strcmp(c->unit, "rad")) scale = 180 / M_PI, unit = "deg";
+            const diff d = ext_diff(&ext[0], k, &ext[1], kb, scale);
+            printf("  %-*s %9.4g %-3s %9.4g %-3s\n", w, c->name, d.rms, unit, d.max, unit);
+            if (g == 0) *stroke_rms = fmax(*stroke_rms, d.rms);
+            if (g == 1) {
+                *prms = fmax(*prms, d.rms / scale);
+                pk[0] = fmax(pk[0], ext_peak(&ext[0], k));
+                pk[1] = fmax(pk[1], ext_peak(&ext[1], kb));
+            }
+        }
+    }
+    for (int k = 0; k < ext[1].ncol; ++k)
+        if (app_ext_rows_find(&ext[0], ext[1].col[k].name) < 0 &&
+            (!strncmp(ext[1].col[k].name, "x_", 2) || !strncmp(ext[1].col[k].name, "pA_", 3) ||
+             !strncmp(ext[1].col[k].name, "pB_", 3) || !strncmp(ext[1].col[k].name, "q_", 2)))
+            printf("  %-*s only in B\n", w, ext[1].col[k].name);
+    for (int c = COL_TIP_X; c <= COL_TIP_Z; ++c) {
+        const diff d = column_diff(&tr[0], &tr[1], c, 1e3);
+        printf("  %-*s %9.4g %-3s %9.4g %-3s\n", w, sim_col_name[c], d.rms, "mm", d.max, "mm");
+    }
+    *ppeak = fmax(pk[0], pk[1]);
+    *pside = pk[1] > pk[0] ? 1 : 0;
+}
+
 // The designs' metrics side by side, B - A, in the units a reader compares.
 static void print_metrics(const sim_trace tr[2], const sim_result res[2], const sim_opts side[2], char label[2][96],
                           sim_energy* const en[2]) {
@@ -425,13 +498,23 @@ int cmd_compare(int argc, char** argv) {
     app_settle_unused(&side[1]);
     sim_trace tr[2] = {{0}, {0}};
     sim_result res[2];
+    // A chain model's own columns (every actuator, function and DOF by
+    // name), which the traces do not hold.
+    app_ext_rows ext[2] = {{.off = 0}, {.off = 0}};
     // Each side's energy balance, as run keeps it (docs/energy.md); NULL
     // when out of memory (the comparison runs without it).
     sim_energy* en[2] = {sim_energy_create(), sim_energy_create()};
     for (int s = 0; s < 2; ++s) {
         if (!c.quiet && isatty(2)) fprintf(stderr, "run %s:\n", label[s]);
-        sim_run_energy(s && mb ? mb : m, &sc, &side[s], NULL, NULL, &tr[s], c.quiet ? NULL : app_progress, NULL, en[s],
-                       &res[s]);
+        ext[s].off = sim_ncol(&side[s]);
+        ext[s].model_chain = &(s && mb ? mb : m)->chain;
+        sim_run_energy_chain(s && mb ? mb : m, &sc, &side[s], app_ext_rows_cb, &ext[s], &tr[s],
+                             c.quiet ? NULL : app_progress, NULL, en[s], &ext[s].run_chain, &res[s]);
+        ext[s].run_chain = NULL; // it lived until the run returned
+        if (ext[s].oom && !res[s].status) {
+            res[s].status = SIM_FAILED;
+            snprintf(res[s].message, sizeof res[s].message, "out of memory for the chain columns");
+        }
         if (!c.quiet) app_progress_done();
         if (res[s].note[0]) fprintf(stderr, "cranesim compare: %s: note: %s\n", label[s], res[s].note);
         if (res[s].status) {
@@ -442,6 +525,8 @@ int cmd_compare(int argc, char** argv) {
             sim_energy_free(en[1]);
             sim_trace_free(&tr[0]);
             sim_trace_free(&tr[1]);
+            app_ext_rows_free(&ext[0]);
+            app_ext_rows_free(&ext[1]);
             model_free(m);
             model_free(mb);
             return app_exit_code(res[s].status, 0);
@@ -449,27 +534,34 @@ int cmd_compare(int argc, char** argv) {
     }
     printf("cranesim compare: %s, A = %s, B = %s, %d rows\n", sc.name, label[0], label[1],
            tr[0].nrow < tr[1].nrow ? tr[0].nrow : tr[1].nrow);
-    printf("  %-8s %12s %12s\n", "column", "RMS diff", "max diff");
-    struct {
-        int col;
-        double scale;
-        const char* unit;
-    } rows[] = {{COL_X1, 1e3, "mm"},  {COL_X2, 1e3, "mm"},         {COL_P1A, 1e-6, "MPa"},
-                {COL_P1B, 1e-6, "MPa"}, {COL_P2A, 1e-6, "MPa"},    {COL_P2B, 1e-6, "MPa"},
-                {COL_Q1, 180 / M_PI, "deg"}, {COL_Q2, 180 / M_PI, "deg"}, {COL_TIP_X, 1e3, "mm"},
-                {COL_TIP_Z, 1e3, "mm"}};
-    double stroke_rms = 0;
-    for (size_t k = 0; k < sizeof rows / sizeof rows[0]; ++k) {
-        diff d = column_diff(&tr[0], &tr[1], rows[k].col, rows[k].scale);
-        printf("  %-8s %9.4g %-3s %9.4g %-3s\n", sim_col_name[rows[k].col], d.rms, rows[k].unit, d.max,
-               rows[k].unit);
-        if (rows[k].col == COL_X1 || rows[k].col == COL_X2) stroke_rms = fmax(stroke_rms, d.rms);
-    }
-    // No side is the reference: the figure is a difference between two
-    // runs, as a share of the higher peak (README.md, "compare").
-    double prms, ppeak, press_pct;
+    // Two chain runs: by name, every actuator and DOF; else the two-link
+    // crane's table by position, as it always was.
+    const bool by_name = ext[0].ncol > 0 && ext[1].ncol > 0;
+    double stroke_rms = 0, prms, ppeak, press_pct;
     int pside;
-    app_compare_pressure(&tr[0], &tr[1], &prms, &ppeak, &press_pct, &pside);
+    if (by_name) {
+        print_ext_table(ext, tr, &stroke_rms, &prms, &ppeak, &pside);
+        press_pct = ppeak > 0 ? 100.0 * prms / ppeak : 0.0;
+    } else {
+        printf("  %-8s %12s %12s\n", "column", "RMS diff", "max diff");
+        struct {
+            int col;
+            double scale;
+            const char* unit;
+        } rows[] = {{COL_X1, 1e3, "mm"},  {COL_X2, 1e3, "mm"},         {COL_P1A, 1e-6, "MPa"},
+                    {COL_P1B, 1e-6, "MPa"}, {COL_P2A, 1e-6, "MPa"},    {COL_P2B, 1e-6, "MPa"},
+                    {COL_Q1, 180 / M_PI, "deg"}, {COL_Q2, 180 / M_PI, "deg"}, {COL_TIP_X, 1e3, "mm"},
+                    {COL_TIP_Z, 1e3, "mm"}};
+        for (size_t k = 0; k < sizeof rows / sizeof rows[0]; ++k) {
+            diff d = column_diff(&tr[0], &tr[1], rows[k].col, rows[k].scale);
+            printf("  %-8s %9.4g %-3s %9.4g %-3s\n", sim_col_name[rows[k].col], d.rms, rows[k].unit, d.max,
+                   rows[k].unit);
+            if (rows[k].col == COL_X1 || rows[k].col == COL_X2) stroke_rms = fmax(stroke_rms, d.rms);
+        }
+        // No side is the reference: the figure is a difference between two
+        // runs, as a share of the higher peak (README.md, "compare").
+        app_compare_pressure(&tr[0], &tr[1], &prms, &ppeak, &press_pct, &pside);
+    }
     printf("  worst stroke RMS %.4g mm; worst pressure RMS %.4g MPa = %.3g %% of the higher peak %.2f MPa (%s = %s; "
            "no side is taken as the reference)\n",
            stroke_rms, prms * 1e-6, press_pct, ppeak * 1e-6, pside ? "B" : "A", label[pside]);
@@ -511,6 +603,8 @@ int cmd_compare(int argc, char** argv) {
     sim_energy_free(en[1]);
     sim_trace_free(&tr[0]);
     sim_trace_free(&tr[1]);
+    app_ext_rows_free(&ext[0]);
+    app_ext_rows_free(&ext[1]);
     model_free(m);
     model_free(mb);
     return code;
