@@ -67,19 +67,56 @@ static void run_help(FILE* f) {
 // last time), so a one-row pressure spike still reaches the plot. Without
 // --plot nothing is kept (a 600 s sandbox run held 203 MB of rows).
 enum { PLOT_FULL = 100000 };
+// A chain model's rows are kept wider: the SIM_NCOL base columns, then its
+// own (every actuator, function and DOF by name: the plot's page by
+// function, app_plot_chain_run).
 typedef struct plot_keep {
     sim_trace* tr; ///< NULL: no plot
     long stride;   ///< rows per bucket (1: every row)
     long inb;      ///< rows in the current bucket
-    double lo[SIM_NCOL], hi[SIM_NCOL], t0, t1;
+    int width;     ///< values a kept row holds: SIM_NCOL + next (0 until the first row)
+    int next;      ///< the chain's columns kept after the base ones (0: the two-link crane)
+    crane_column* col; ///< their names (a copy: the run's chain lives only until the run returns)
+    double *full, *lo, *hi; ///< width values each
+    double t0, t1;
     bool oom;
 } plot_keep;
+
+// At the first row: the row width, from the chain whose columns the run
+// writes (NULL or the two-link shorthand: the base columns only).
+static void keep_bind(plot_keep* k, const crane_chain* cc) {
+    if (!k->tr || k->width) return;
+    if (cc && !cc->two_link && cc->ncol > 0) {
+        k->col = malloc((size_t)cc->ncol * sizeof *k->col);
+        if (!k->col) {
+            k->oom = true;
+            return;
+        }
+        memcpy(k->col, cc->col, (size_t)cc->ncol * sizeof *k->col);
+        k->next = cc->ncol;
+    }
+    k->width = SIM_NCOL + k->next;
+    k->full = malloc(3 * (size_t)k->width * sizeof(double));
+    if (!k->full) {
+        k->oom = true;
+        return;
+    }
+    k->lo = k->full + k->width;
+    k->hi = k->lo + k->width;
+}
+
+static void keep_free(plot_keep* k) {
+    free(k->col);
+    free(k->full);
+    k->col = NULL;
+    k->full = NULL;
+}
 
 static void keep_push(plot_keep* k, const double* row) {
     sim_trace* tr = k->tr;
     if (tr->nrow == tr->cap) {
         const int cap = tr->cap ? 2 * tr->cap : 4096;
-        double* v = realloc(tr->v, (size_t)cap * SIM_NCOL * sizeof(double));
+        double* v = realloc(tr->v, (size_t)cap * (size_t)k->width * sizeof(double));
         if (!v) {
             k->oom = true;
             return;
@@ -87,7 +124,7 @@ static void keep_push(plot_keep* k, const double* row) {
         tr->v = v;
         tr->cap = cap;
     }
-    memcpy(tr->v + (size_t)tr->nrow * SIM_NCOL, row, SIM_NCOL * sizeof(double));
+    memcpy(tr->v + (size_t)tr->nrow * (size_t)k->width, row, (size_t)k->width * sizeof(double));
     ++tr->nrow;
 }
 
@@ -106,18 +143,20 @@ static void keep_flush(plot_keep* k) {
 
 static void keep_row(plot_keep* k, const double* row, int ncol) {
     if (!k->tr || k->oom) return;
-    double full[SIM_NCOL] = {0};
+    double* full = k->full;
+    memset(full, 0, (size_t)k->width * sizeof(double));
     memcpy(full, row, (size_t)ncol * sizeof(double));
+    if (k->next) memcpy(full + SIM_NCOL, row + ncol, (size_t)k->next * sizeof(double));
     if (k->stride <= 1) {
         keep_push(k, full);
         return;
     }
     if (k->inb == 0) {
-        memcpy(k->lo, full, sizeof full);
-        memcpy(k->hi, full, sizeof full);
+        memcpy(k->lo, full, (size_t)k->width * sizeof(double));
+        memcpy(k->hi, full, (size_t)k->width * sizeof(double));
         k->t0 = full[COL_T];
     } else {
-        for (int c = 0; c < SIM_NCOL; ++c) {
+        for (int c = 0; c < k->width; ++c) {
             k->lo[c] = fmin(k->lo[c], full[c]);
             k->hi[c] = fmax(k->hi[c], full[c]);
         }
@@ -207,6 +246,7 @@ static int csv_row(void* user, const double* row) {
     // which may have the slew rack's besides the model's).
     if (!s->cst.bound && app_chain_stats_bind(&s->cst, s->chain, s->ncol)) s->cst_oom = true;
     app_chain_stats_row(&s->cst, row);
+    keep_bind(&s->keep, s->chain);
     keep_row(&s->keep, row, s->ncol);
     metrics_row(&s->met, row);
     return app_signal_caught() != 0;
@@ -537,7 +577,13 @@ int cmd_run(int argc, char** argv) {
         engine_describe(&c.sim, &d);
         snprintf(title, sizeof title, "%s: %s, %s", sc.name, d.title,
                  c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
-        if (app_plot_run(&tr, title, app_world_has_slew(&c.sim), plot, err, sizeof err)) {
+        // A chain model: its page by actuator and function; else the
+        // two-link crane's plot as it always was.
+        const int prc = sink.keep.next
+                            ? app_plot_chain_run(tr.v, tr.nrow, sink.keep.width, sink.keep.col, sink.keep.next, title,
+                                                 plot, err, sizeof err)
+                            : app_plot_run(&tr, title, app_world_has_slew(&c.sim), plot, err, sizeof err);
+        if (prc) {
             fprintf(stderr, "cranesim run: plot: %s\n", err);
             if (code == EXIT_OK_) code = EXIT_RUNTIME;
         } else if (!c.quiet) {
@@ -555,6 +601,7 @@ int cmd_run(int argc, char** argv) {
         }
     }
     app_chain_stats_free(&sink.cst);
+    keep_free(&sink.keep);
     sim_energy_free(en);
     sim_trace_free(&tr);
     if (sink.mon) rcl_free(sink.mon);
