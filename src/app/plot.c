@@ -326,15 +326,17 @@ static void page_panel_viewport(void) {
 // The colours of a panel's series: distinct on white (PLplot's cmap0
 // without its yellow, wheat and aquamarine); beyond a dozen they repeat with
 // a dotted line.
-static const int k_colours[] = {1, 3, 9, 13, 8, 10, 11, 14, 12, 5, 7, 2};
+static const int k_colours[] = {1, 3, 9, 13, 8, 10, 11, 7, 14, 12, 5, 2};
 #define NCOLOURS ((int)(sizeof k_colours / sizeof k_colours[0]))
 
 // One panel: columns cols[0..nc) of up to two traces, the second dashed;
 // dashed: columns drawn dashed in the same colours as cols (a chain run's
-// commands beside its spools), or NULL.
+// commands beside its spools), or NULL; slot: each series' colour slot (a
+// chain run's: the actuator's, so that a name keeps its colour from panel to
+// panel), or NULL for the series' own index.
 static void panel_ex(const psrc* a, const psrc* b, int xcol, double xs, const int* cols, const int* dashed, int nc,
                      double ys, const char* xlabel, const char* ylabel, const char* title, const char* const* names,
-                     PLFLT* xb, PLFLT* yb) {
+                     const int* slot, PLFLT* xb, PLFLT* yb) {
     double xlo = 1e300, xhi = -1e300, ylo = 1e300, yhi = -1e300;
     const psrc* trs[2] = {a, b};
     for (int t = 0; t < 2; ++t) {
@@ -378,8 +380,9 @@ static void panel_ex(const psrc* a, const psrc* b, int xcol, double xs, const in
         // panel, in the model's order), its spool solid and its command
         // dashed; the names in a column right of the panel.
         for (int k = 0; k < nc; ++k) {
-            plcol0(k_colours[k % NCOLOURS]);
-            pllsty(k < NCOLOURS ? 1 : 3);
+            const int sl = slot ? slot[k] : k;
+            plcol0(k_colours[sl % NCOLOURS]);
+            pllsty(sl < NCOLOURS ? 1 : 3);
             draw_series(a, xcol, xs, cols[k], ys, xb, yb);
             if (dashed) {
                 pllsty(2);
@@ -389,7 +392,7 @@ static void panel_ex(const psrc* a, const psrc* b, int xcol, double xs, const in
         pllsty(1);
         const double step = 1.0 / (nc > 12 ? nc + 1 : 13); // of the panel's height
         for (int k = 0; k < nc && names; ++k) {
-            plcol0(k_colours[k % NCOLOURS]);
+            plcol0(k_colours[(slot ? slot[k] : k) % NCOLOURS]);
             plmtex("rv", 0.8, 1.0 - step * (k + 0.5), 0.0, names[k]);
         }
         plcol0(15);
@@ -416,7 +419,7 @@ static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, c
                   const char* xlabel, const char* ylabel, const char* title, const char* const* names, PLFLT* xb,
                   PLFLT* yb) {
     const psrc pa = {a->v, a->nrow, SIM_NCOL}, pb = {b ? b->v : NULL, b ? b->nrow : 0, SIM_NCOL};
-    panel_ex(&pa, b ? &pb : NULL, xcol, xs, cols, NULL, nc, ys, xlabel, ylabel, title, names, xb, yb);
+    panel_ex(&pa, b ? &pb : NULL, xcol, xs, cols, NULL, nc, ys, xlabel, ylabel, title, names, NULL, xb, yb);
 }
 
 typedef struct traces_plot {
@@ -478,40 +481,54 @@ typedef struct chain_plot {
     int ncol;
     const char* title;
     PLFLT *xb, *yb;
-    int* cols; ///< scratch: 2 x ncol
-    const char** names;
+    int* cols;          ///< scratch: 3 x ncol (columns, commands, colour slots)
+    const char** names; ///< scratch: 3 x ncol (actuators, a panel's names, commands)
 } chain_plot;
 
 // A chain run's page: 3 x 2 panels, every actuator's stroke and chamber
 // pressures (A and B chambers in a panel each, so that each holds one line
 // per actuator), every function's spool and command, the joint angles and
 // the tip path; a colour per actuator or function, legend by name.
+// Each legend name's colour slot: its index among the actuators (the
+// strokes' names) when it names one (a function named as its actuator),
+// else after them.
+static void chain_slots(const char* const* act, int na, const char* const* nm, int n, int* slot) {
+    for (int k = 0; k < n; ++k) {
+        slot[k] = na + k;
+        for (int i = 0; i < na; ++i)
+            if (!strcmp(nm[k], act[i])) slot[k] = i;
+    }
+}
+
 static void draw_chain(void* user) {
     const chain_plot* p = user;
     page_begin(p->title, 3, true);
     const int off = SIM_NCOL, n = p->ncol;
-    int *c = p->cols, *c2 = p->cols + n;
-    const char **nm = p->names, **nm2 = p->names + n;
-    int k = app_plot_chain_channels(p->col, n, off, 0, c, nm, n);
-    panel_ex(&p->src, NULL, COL_T, 1, c, NULL, k, 1e3, "t [s]", "stroke [mm]", "Cylinder strokes", nm, p->xb, p->yb);
+    int *c = p->cols, *c2 = p->cols + n, *slot = p->cols + 2 * n;
+    const char **act = p->names, **nm = p->names + n, **nm2 = p->names + 2 * n;
+    const int na = app_plot_chain_channels(p->col, n, off, 0, c, act, n);
+    chain_slots(act, na, act, na, slot);
+    panel_ex(&p->src, NULL, COL_T, 1, c, NULL, na, 1e3, "t [s]", "stroke [mm]", "Cylinder strokes", act, slot, p->xb,
+             p->yb);
     const int tz[] = {COL_TIP_Z};
     panel_ex(&p->src, NULL, COL_TIP_X, 1, tz, NULL, 1, 1, "reach [m]", "height [m]", "Tip path relative to joint 1",
-             NULL, p->xb, p->yb);
-    k = app_plot_chain_channels(p->col, n, off, 1, c, nm, n);
-    panel_ex(&p->src, NULL, COL_T, 1, c, NULL, k, 1e-6, "t [s]", "pressure [MPa abs]", "Chamber A pressures", nm,
-             p->xb, p->yb);
-    k = app_plot_chain_channels(p->col, n, off, 2, c, nm, n);
-    panel_ex(&p->src, NULL, COL_T, 1, c, NULL, k, 1e-6, "t [s]", "pressure [MPa abs]", "Chamber B pressures", nm,
-             p->xb, p->yb);
-    k = app_plot_chain_channels(p->col, n, off, 3, c, nm, n);
+             NULL, NULL, p->xb, p->yb);
+    for (int side = 1; side <= 2; ++side) {
+        const int k = app_plot_chain_channels(p->col, n, off, side, c, nm, n);
+        chain_slots(act, na, nm, k, slot);
+        panel_ex(&p->src, NULL, COL_T, 1, c, NULL, k, 1e-6, "t [s]", "pressure [MPa abs]",
+                 side == 1 ? "Chamber A pressures" : "Chamber B pressures", nm, slot, p->xb, p->yb);
+    }
+    const int k = app_plot_chain_channels(p->col, n, off, 3, c, nm, n);
     // The commands in the spools' order (both per function, in the model's
     // order); drawn only when every spool has its command.
     const int kc = app_plot_chain_channels(p->col, n, off, 4, c2, nm2, n);
+    chain_slots(act, na, nm, k, slot);
     panel_ex(&p->src, NULL, COL_T, 1, c, kc == k ? c2 : NULL, k, 100, "t [s]", "opening [%]",
-             "Valve spools (solid) and commands (dashed)", nm, p->xb, p->yb);
-    k = app_plot_chain_channels(p->col, n, off, 5, c, nm, n);
-    panel_ex(&p->src, NULL, COL_T, 1, c, NULL, k, 180 / M_PI, "t [s]", "angle [deg]", "Joint angles", nm, p->xb,
-             p->yb);
+             "Valve spools (solid) and commands (dashed)", nm, slot, p->xb, p->yb);
+    const int kq = app_plot_chain_channels(p->col, n, off, 5, c, nm, n);
+    panel_ex(&p->src, NULL, COL_T, 1, c, NULL, kq, 180 / M_PI, "t [s]", "angle [deg]", "Joint angles", nm, NULL,
+             p->xb, p->yb);
 }
 
 int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol,
@@ -522,8 +539,8 @@ int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_col
     }
     PLFLT* xb = malloc(sizeof(PLFLT) * (size_t)(nrow > 0 ? nrow : 1));
     PLFLT* yb = malloc(sizeof(PLFLT) * (size_t)(nrow > 0 ? nrow : 1));
-    int* cols = malloc(sizeof(int) * 2 * (size_t)(ncol > 0 ? ncol : 1));
-    const char** names = malloc(sizeof(char*) * 2 * (size_t)(ncol > 0 ? ncol : 1));
+    int* cols = malloc(sizeof(int) * 3 * (size_t)(ncol > 0 ? ncol : 1));
+    const char** names = malloc(sizeof(char*) * 3 * (size_t)(ncol > 0 ? ncol : 1));
     int rc = -1;
     if (!xb || !yb || !cols || !names) {
         snprintf(err, errsz, "out of memory");
