@@ -440,6 +440,10 @@ void app_chain_stats_print(const app_chain_stats* s, double every, double t_end,
 /// per-function entries ("peak_pA.lift", ...) added. 0, or -1.
 int app_chain_stats_write_json(const app_chain_stats* s, const run_metrics* met, FILE* f);
 void app_chain_stats_free(app_chain_stats* s);
+/// The summary's metrics block (metrics_print) for a run whose actuators s
+/// names: without the end-stop hits of the first two by position (the
+/// per-actuator line has every one by name). s without actuators: as is.
+void app_chain_metrics_print(const app_chain_stats* s, const run_metrics* met, FILE* f);
 
 /// A run's chain columns, kept row by row (compare: its sim_trace has the
 /// base columns only). Set off (sim_ncol of the run), model_chain (the

@@ -217,3 +217,45 @@ void app_ext_rows_free(app_ext_rows* r) {
     r->ncol = 0;
     r->nrow = r->cap = 0;
 }
+
+void app_chain_metrics_print(const app_chain_stats* s, const run_metrics* met, FILE* f) {
+    if (s->nact == 0) {
+        metrics_print(met, f);
+        return;
+    }
+    // metrics_print's block, less its end-stop hits of the first two
+    // actuators by position ("lift N, jib N": on a chain model the second
+    // may be any actuator), which the per-actuator line has by name; the
+    // slew's stays.
+    char* buf = NULL;
+    size_t len = 0;
+    FILE* m = open_memstream(&buf, &len);
+    if (!m) {
+        metrics_print(met, f);
+        return;
+    }
+    metrics_print(met, m);
+    if (fclose(m) || !buf) {
+        free(buf);
+        metrics_print(met, f);
+        return;
+    }
+    char* a = strstr(buf, "; end-stop hits lift ");
+    char* semi = a ? strchr(a + 1, ';') : NULL;
+    char* nl = a ? strchr(a, '\n') : NULL;
+    char* end = semi && (!nl || semi < nl) ? semi : nl;
+    if (a && end) {
+        char* sl = strstr(a, ", slew ");
+        if (sl && sl < end) {
+            // "; end-stop hits slew N" from "; end-stop hits lift N, jib N, slew N".
+            fwrite(buf, 1, (size_t)(a - buf), f);
+            fprintf(f, "; end-stop hits slew%.*s", (int)(end - (sl + 6)), sl + 6);
+        } else {
+            fwrite(buf, 1, (size_t)(a - buf), f);
+        }
+        fputs(end, f);
+    } else {
+        fputs(buf, f);
+    }
+    free(buf);
+}

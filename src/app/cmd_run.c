@@ -313,7 +313,7 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
         if (every > 1e-3 * (1 + 1e-9)) printf(", rows every %g ms", fmin(every, r->t_end) * 1e3);
     }
     if (!by_act) printf("\n");
-    metrics_print(met, stdout);
+    app_chain_metrics_print(cst, met, stdout);
     printf("  %ld rows -> %s\n", r->rows, out);
 }
 
