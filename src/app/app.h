@@ -365,6 +365,11 @@ int app_plot_chain_channels(const crane_column* col, int ncol, int off, int pane
 /// (the base columns, then the chain's col[0..ncol)). 0, or -1 with a message.
 int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol,
                        const char* title, const char* png, char* err, size_t errsz);
+/// Overlay two chain runs of the same columns (compare): A solid, B dashed,
+/// na and nb rows of stride = SIM_NCOL + ncol each, on app_plot_chain_run's page.
+int app_plot_chain_compare(const double* a, int na, const char* la, const double* b, int nb, const char* lb,
+                           int stride, const crane_column* col, int ncol, const char* title, const char* png,
+                           char* err, size_t errsz);
 /// The run with options o has a slew drive (an ode world with a slewing column).
 bool app_world_has_slew(const sim_opts* o);
 // The energy balance's summary lines (app_energy.c, docs/energy.md).

@@ -169,6 +169,29 @@ static void print_ext_table(const app_ext_rows ext[2], const sim_trace tr[2], do
     *pside = pk[1] > pk[0] ? 1 : 0;
 }
 
+// Both sides have the same chain columns, name for name (one model on two
+// backends or settings, or two designs of one shape).
+static bool same_columns(const app_ext_rows ext[2]) {
+    if (ext[0].ncol == 0 || ext[0].ncol != ext[1].ncol) return false;
+    for (int k = 0; k < ext[0].ncol; ++k)
+        if (strcmp(ext[0].col[k].name, ext[1].col[k].name)) return false;
+    return true;
+}
+
+// A side's rows as the chain plot takes them: SIM_NCOL base columns, then
+// its chain columns. NULL when out of memory.
+static double* wide_rows(const sim_trace* tr, const app_ext_rows* e, int* nrow) {
+    const int n = tr->nrow < e->nrow ? tr->nrow : (int)e->nrow, w = SIM_NCOL + e->ncol;
+    double* v = malloc((size_t)(n > 0 ? n : 1) * (size_t)w * sizeof *v);
+    if (!v) return NULL;
+    for (int i = 0; i < n; ++i) {
+        memcpy(v + (size_t)i * (size_t)w, tr->v + (size_t)i * SIM_NCOL, SIM_NCOL * sizeof *v);
+        memcpy(v + (size_t)i * (size_t)w + SIM_NCOL, e->v + (size_t)i * (size_t)e->ncol, (size_t)e->ncol * sizeof *v);
+    }
+    *nrow = n;
+    return v;
+}
+
 // The designs' metrics side by side, B - A, in the units a reader compares.
 static void print_metrics(const sim_trace tr[2], const sim_result res[2], const sim_opts side[2], char label[2][96],
                           sim_energy* const en[2]) {
@@ -591,8 +614,31 @@ int cmd_compare(int argc, char** argv) {
     if (plot) {
         char err[512], title[320];
         snprintf(title, sizeof title, "%s: %s vs %s", sc.name, label[0], label[1]);
-        if (app_plot_compare(&tr[0], label[0], &tr[1], label[1], title,
-                             app_world_has_slew(&side[0]) && app_world_has_slew(&side[1]), plot, err, sizeof err)) {
+        // Two chain runs of one shape: the chain page by actuator and
+        // function, A solid and B dashed; else the two-link overlay (for two
+        // shapes, said: its first two cylinders are the models' first two).
+        int prc;
+        if (same_columns(ext)) {
+            int na = 0, nb = 0;
+            double* wa = wide_rows(&tr[0], &ext[0], &na);
+            double* wb = wide_rows(&tr[1], &ext[1], &nb);
+            if (wa && wb) {
+                prc = app_plot_chain_compare(wa, na, label[0], wb, nb, label[1], SIM_NCOL + ext[0].ncol, ext[0].col,
+                                             ext[0].ncol, title, plot, err, sizeof err);
+            } else {
+                snprintf(err, sizeof err, "out of memory");
+                prc = -1;
+            }
+            free(wa);
+            free(wb);
+        } else {
+            if (ext[0].ncol || ext[1].ncol)
+                fprintf(stderr, "cranesim compare: note: the sides' models differ in shape: the plot shows their "
+                                "first two cylinders (x1, x2) by position\n");
+            prc = app_plot_compare(&tr[0], label[0], &tr[1], label[1], title,
+                                   app_world_has_slew(&side[0]) && app_world_has_slew(&side[1]), plot, err, sizeof err);
+        }
+        if (prc) {
             fprintf(stderr, "cranesim compare: plot: %s\n", err);
             code = EXIT_RUNTIME;
         } else {

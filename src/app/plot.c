@@ -378,13 +378,17 @@ static void panel_ex(const psrc* a, const psrc* b, int xcol, double xs, const in
     if (g_legend_right) {
         // A chain run: a colour per actuator or function (the same in every
         // panel, in the model's order), its spool solid and its command
-        // dashed; the names in a column right of the panel.
+        // dashed, or (compare) run A solid and run B dashed; the names in a
+        // column right of the panel.
         for (int k = 0; k < nc; ++k) {
             const int sl = slot ? slot[k] : k;
             plcol0(k_colours[sl % NCOLOURS]);
             pllsty(sl < NCOLOURS ? 1 : 3);
             draw_series(a, xcol, xs, cols[k], ys, xb, yb);
-            if (dashed) {
+            if (b) {
+                pllsty(2);
+                draw_series(b, xcol, xs, cols[k], ys, xb, yb);
+            } else if (dashed) {
                 pllsty(2);
                 draw_series(a, xcol, xs, dashed[k], ys, xb, yb);
             }
@@ -477,6 +481,8 @@ int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, con
 
 typedef struct chain_plot {
     psrc src;
+    const psrc* b;  ///< compare: run B's rows (drawn dashed), or NULL
+    const char *la, *lb;
     const crane_column* col;
     int ncol;
     const char* title;
@@ -508,15 +514,17 @@ static void draw_chain(void* user) {
     const char **act = p->names, **nm = p->names + n, **nm2 = p->names + 2 * n;
     const int na = app_plot_chain_channels(p->col, n, off, 0, c, act, n);
     chain_slots(act, na, act, na, slot);
-    panel_ex(&p->src, NULL, COL_T, 1, c, NULL, na, 1e3, "t [s]", "stroke [mm]", "Cylinder strokes", act, slot, p->xb,
+    panel_ex(&p->src, p->b, COL_T, 1, c, NULL, na, 1e3, "t [s]", "stroke [mm]", "Cylinder strokes", act, slot, p->xb,
              p->yb);
     const int tz[] = {COL_TIP_Z};
-    panel_ex(&p->src, NULL, COL_TIP_X, 1, tz, NULL, 1, 1, "reach [m]", "height [m]", "Tip path relative to joint 1",
-             NULL, NULL, p->xb, p->yb);
+    char t4[200];
+    if (p->b) snprintf(t4, sizeof t4, "Tip path (solid: %s, dashed: %s)", p->la, p->lb);
+    else snprintf(t4, sizeof t4, "Tip path relative to joint 1");
+    panel_ex(&p->src, p->b, COL_TIP_X, 1, tz, NULL, 1, 1, "reach [m]", "height [m]", t4, NULL, NULL, p->xb, p->yb);
     for (int side = 1; side <= 2; ++side) {
         const int k = app_plot_chain_channels(p->col, n, off, side, c, nm, n);
         chain_slots(act, na, nm, k, slot);
-        panel_ex(&p->src, NULL, COL_T, 1, c, NULL, k, 1e-6, "t [s]", "pressure [MPa abs]",
+        panel_ex(&p->src, p->b, COL_T, 1, c, NULL, k, 1e-6, "t [s]", "pressure [MPa abs]",
                  side == 1 ? "Chamber A pressures" : "Chamber B pressures", nm, slot, p->xb, p->yb);
     }
     const int k = app_plot_chain_channels(p->col, n, off, 3, c, nm, n);
@@ -524,19 +532,21 @@ static void draw_chain(void* user) {
     // order); drawn only when every spool has its command.
     const int kc = app_plot_chain_channels(p->col, n, off, 4, c2, nm2, n);
     chain_slots(act, na, nm, k, slot);
-    panel_ex(&p->src, NULL, COL_T, 1, c, kc == k ? c2 : NULL, k, 100, "t [s]", "opening [%]",
-             "Valve spools (solid) and commands (dashed)", nm, slot, p->xb, p->yb);
+    panel_ex(&p->src, p->b, COL_T, 1, c, kc == k ? c2 : NULL, k, 100, "t [s]", "opening [%]",
+             p->b ? "Valve spools (solid: A, dashed: B)" : "Valve spools (solid) and commands (dashed)", nm, slot,
+             p->xb, p->yb);
     const int kq = app_plot_chain_channels(p->col, n, off, 5, c, nm, n);
-    panel_ex(&p->src, NULL, COL_T, 1, c, NULL, kq, 180 / M_PI, "t [s]", "angle [deg]", "Joint angles", nm, NULL,
+    panel_ex(&p->src, p->b, COL_T, 1, c, NULL, kq, 180 / M_PI, "t [s]", "angle [deg]", "Joint angles", nm, NULL,
              p->xb, p->yb);
 }
 
-int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol,
-                       const char* title, const char* png, char* err, size_t errsz) {
-    if (stride != SIM_NCOL + ncol) {
-        snprintf(err, errsz, "plot: %d columns a row, expected %d", stride, SIM_NCOL + ncol);
+static int plot_chain(const psrc* a, const char* la, const psrc* b, const char* lb, const crane_column* col,
+                      int ncol, const char* title, const char* png, char* err, size_t errsz) {
+    if (a->stride != SIM_NCOL + ncol || (b && b->stride != a->stride)) {
+        snprintf(err, errsz, "plot: %d columns a row, expected %d", a->stride, SIM_NCOL + ncol);
         return -1;
     }
+    const int nrow = a->nrow > (b ? b->nrow : 0) ? a->nrow : b->nrow;
     PLFLT* xb = malloc(sizeof(PLFLT) * (size_t)(nrow > 0 ? nrow : 1));
     PLFLT* yb = malloc(sizeof(PLFLT) * (size_t)(nrow > 0 ? nrow : 1));
     int* cols = malloc(sizeof(int) * 3 * (size_t)(ncol > 0 ? ncol : 1));
@@ -545,7 +555,7 @@ int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_col
     if (!xb || !yb || !cols || !names) {
         snprintf(err, errsz, "out of memory");
     } else {
-        chain_plot p = {{rows, nrow, stride}, col, ncol, title, xb, yb, cols, names};
+        chain_plot p = {*a, b, la, lb, col, ncol, title, xb, yb, cols, names};
         rc = app_png_render(png, "1400x1400", draw_chain, &p, err, errsz);
     }
     free(xb);
@@ -553,6 +563,19 @@ int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_col
     free(cols);
     free(names);
     return rc;
+}
+
+int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol,
+                       const char* title, const char* png, char* err, size_t errsz) {
+    const psrc a = {rows, nrow, stride};
+    return plot_chain(&a, "", NULL, "", col, ncol, title, png, err, errsz);
+}
+
+int app_plot_chain_compare(const double* a, int na, const char* la, const double* b, int nb, const char* lb,
+                           int stride, const crane_column* col, int ncol, const char* title, const char* png,
+                           char* err, size_t errsz) {
+    const psrc pa = {a, na, stride}, pb = {b, nb, stride};
+    return plot_chain(&pa, la, &pb, lb, col, ncol, title, png, err, errsz);
 }
 
 typedef struct bars_plot {
@@ -609,6 +632,14 @@ int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* 
 int app_plot_energy(const char* const* names, const double* kj, int n, const char* title, const char* png, char* err,
                     size_t errsz) {
     (void)names, (void)kj, (void)n, (void)title, (void)png;
+    snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
+    return -1;
+}
+int app_plot_chain_compare(const double* a, int na, const char* la, const double* b, int nb, const char* lb,
+                           int stride, const crane_column* col, int ncol, const char* title, const char* png,
+                           char* err, size_t errsz) {
+    (void)a, (void)na, (void)la, (void)b, (void)nb, (void)lb, (void)stride, (void)col, (void)ncol, (void)title;
+    (void)png;
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
     return -1;
 }
