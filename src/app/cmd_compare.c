@@ -218,8 +218,10 @@ static void print_metrics(const sim_trace tr[2], const sim_result res[2], const 
 }
 
 // Both runs' rows side by side by index: t (A's), then NAME_A, NAME_B for
-// every column both write. Returns 0, or -1 after one line on stderr.
-static int write_both(const char* path, const sim_trace tr[2], const sim_opts side[2]) {
+// every column both write, then for every chain column both have by name
+// (ext: the sides' chain columns; none for the two-link crane). Returns 0,
+// or -1 after one line on stderr.
+static int write_both(const char* path, const sim_trace tr[2], const sim_opts side[2], const app_ext_rows ext[2]) {
     const int na = sim_ncol(&side[0]), nb = sim_ncol(&side[1]);
     const int ncol = na < nb ? na : nb, n = tr[0].nrow < tr[1].nrow ? tr[0].nrow : tr[1].nrow;
     app_out o = {.f = NULL};
@@ -228,14 +230,28 @@ static int write_both(const char* path, const sim_trace tr[2], const sim_opts si
     if (f) {
         fputs("t", f);
         for (int c = 1; c < ncol; ++c) fprintf(f, ",%s_A,%s_B", sim_col_name[c], sim_col_name[c]);
+        // A's chain columns that B has too, in A's order.
+        int* kb = malloc((size_t)(ext[0].ncol > 0 ? ext[0].ncol : 1) * sizeof *kb);
+        if (!kb) e = ENOMEM;
+        for (int k = 0; kb && k < ext[0].ncol; ++k) {
+            kb[k] = app_ext_rows_find(&ext[1], ext[0].col[k].name);
+            if (kb[k] >= 0) fprintf(f, ",%s_A,%s_B", ext[0].col[k].name, ext[0].col[k].name);
+        }
         fputc('\n', f);
         for (int i = 0; i < n; ++i) {
             const double* a = tr[0].v + (size_t)i * SIM_NCOL;
             const double* b = tr[1].v + (size_t)i * SIM_NCOL;
             fprintf(f, "%.9g", a[COL_T]);
             for (int c = 1; c < ncol; ++c) fprintf(f, ",%.9g,%.9g", a[c], b[c]);
+            for (int k = 0; kb && k < ext[0].ncol; ++k)
+                if (kb[k] >= 0 && i < ext[0].nrow && i < ext[1].nrow)
+                    fprintf(f, ",%.9g,%.9g", ext[0].v[(size_t)i * (size_t)ext[0].ncol + (size_t)k],
+                            ext[1].v[(size_t)i * (size_t)ext[1].ncol + (size_t)kb[k]]);
+                else if (kb[k] >= 0)
+                    fputs(",,", f); // a row a side's chain columns lack: empty fields, the row stays whole
             fputc('\n', f);
         }
+        free(kb);
         if (ferror(f)) e = errno ? errno : EIO;
         e = app_out_close(&o, e, true);
     }
@@ -601,7 +617,7 @@ int cmd_compare(int argc, char** argv) {
         }
     }
     int code = 0;
-    if (out && write_both(out, tr, side)) code = EXIT_RUNTIME;
+    if (out && write_both(out, tr, side, ext)) code = EXIT_RUNTIME;
     else if (out) printf("  rows of both -> %s\n", out);
     if (tol_stroke >= 0 && stroke_rms > tol_stroke) {
         printf("  FAIL: stroke RMS %.4g mm > tolerance %.4g mm\n", stroke_rms, tol_stroke);

@@ -173,8 +173,24 @@ static void test_end_stop(void) {
 // worst stroke RMS the largest of the x_ rows, and --tol-stroke judged on
 // every actuator (ext, the fourth, differs most between the backends).
 static void test_compare(void) {
-    int rc = cli_run("compare --model " MODEL3 " --scenario " SCEN3 " --every 0.01 -q", out, sizeof out);
+    int rc = cli_run("compare --model " MODEL3 " --scenario " SCEN3 " --every 0.01 -q --out outputs_both.csv", out,
+                     sizeof out);
     CHECK(rc == 0, "compare exit %d: %s", rc, out);
+    // --out: every chain column of both sides, NAME_A,NAME_B, after the base ones.
+    {
+        static char hdr[1 << 14];
+        FILE* f = fopen("outputs_both.csv", "r");
+        CHECK(f && fgets(hdr, sizeof hdr, f), "no outputs_both.csv");
+        if (f) fclose(f);
+        for (int a = 0; a < NACT; ++a) {
+            static const char* const pre[] = {"x_", "pA_", "pB_", "F_", "u_", "ucmd_"};
+            for (int k = 0; k < 6; ++k) {
+                char want[96];
+                snprintf(want, sizeof want, ",%s%s_A,%s%s_B", pre[k], k_act[a], pre[k], k_act[a]);
+                CHECK(strstr(hdr, want), "compare --out has no %s", want + 1);
+            }
+        }
+    }
     static const char* const dof[] = {"q_lifting_arm", "q_end_arm", "q_jib2", "q_ext"};
     double worst = 0, ext_rms = NAN, other = 0;
     for (int a = 0; a < NACT; ++a) {
@@ -214,8 +230,8 @@ static void test_compare(void) {
           0.5 * (ext_rms + other), rc, out);
 }
 
-// run --plot on a chain model: its own page (1400 x 1400 px: three rows of
-// panels), the two-link crane's as it was (1400 x 1000).
+// run --plot and compare --plot on a chain model: its own page (1400 x 1400
+// px: three rows of panels), the two-link crane's as it was (1400 x 1000).
 static unsigned be32(const unsigned char* p) {
     return (unsigned)p[0] << 24 | (unsigned)p[1] << 16 | (unsigned)p[2] << 8 | p[3];
 }
@@ -227,8 +243,10 @@ static void test_plot(void) {
         unsigned w, h;
     } k[] = {{"run --model " MODEL3 " --scenario " SCEN3 " --every 0.01 -q --out outputs_p.csv --plot outputs_p.png",
               1400, 1400},
-             {"run --scenario hold -q --out outputs_p.csv --plot outputs_p.png", 1400, 1000}};
-    for (int i = 0; i < 2; ++i) {
+             {"run --scenario hold -q --out outputs_p.csv --plot outputs_p.png", 1400, 1000},
+             {"compare --model " MODEL3 " --scenario " SCEN3 " --every 0.01 -q --plot outputs_p.png", 1400, 1400},
+             {"compare --scenario hold -q --plot outputs_p.png", 1400, 1000}};
+    for (int i = 0; i < 4; ++i) {
         remove("outputs_p.png");
         int rc = cli_run(k[i].args, out, sizeof out);
         CHECK(rc == 0, "%s: exit %d: %s", k[i].args, rc, out);
