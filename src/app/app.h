@@ -355,21 +355,24 @@ int app_plot_run_channels(int panel, bool slew, int cols[APP_PLOT_MAXSERIES], co
 /// run's chain columns col[0..ncol), found at index off of a row: panel 0
 /// strokes (x_<actuator>), 1 A-chamber and 2 B-chamber pressures
 /// (pA_, pB_<actuator>), 3 spools and 4 commands (u_, ucmd_<function>), 5
-/// joint angles (q_<body> of a revolute joint). Fills at most max column
-/// indices and legend names (the actuator's, function's or body's name,
-/// pointing into col); returns how many (pure; no PLplot).
+/// joint angles (q_<body> of a revolute joint); slew: the world's slew
+/// drive too, from the base columns (x3, p3A, p3B, u3, u3_cmd, slew), named
+/// "slew", unless the chain columns have the rack's own. Fills at most max
+/// column indices and legend names (the actuator's, function's or body's
+/// name, pointing into col); returns how many (pure; no PLplot).
 #define APP_PLOT_CHAIN_PANELS 6
-int app_plot_chain_channels(const crane_column* col, int ncol, int off, int panel, int* cols, const char** names,
-                            int max);
+int app_plot_chain_channels(const crane_column* col, int ncol, int off, bool slew, int panel, int* cols,
+                            const char** names, int max);
 /// Plot a chain run to a PNG: nrow rows of stride = SIM_NCOL + ncol columns
-/// (the base columns, then the chain's col[0..ncol)). 0, or -1 with a message.
-int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol,
+/// (the base columns, then the chain's col[0..ncol)); slew: the world has a
+/// slew drive (app_world_has_slew), drawn too. 0, or -1 with a message.
+int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol, bool slew,
                        const char* title, const char* png, char* err, size_t errsz);
 /// Overlay two chain runs of the same columns (compare): A solid, B dashed,
 /// na and nb rows of stride = SIM_NCOL + ncol each, on app_plot_chain_run's page.
 int app_plot_chain_compare(const double* a, int na, const char* la, const double* b, int nb, const char* lb,
-                           int stride, const crane_column* col, int ncol, const char* title, const char* png,
-                           char* err, size_t errsz);
+                           int stride, const crane_column* col, int ncol, bool slew, const char* title,
+                           const char* png, char* err, size_t errsz);
 /// The run with options o has a slew drive (an ode world with a slewing column).
 bool app_world_has_slew(const sim_opts* o);
 // The energy balance's summary lines (app_energy.c, docs/energy.md).

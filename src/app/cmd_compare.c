@@ -640,7 +640,9 @@ int cmd_compare(int argc, char** argv) {
             double* wb = wide_rows(&tr[1], &ext[1], &nb);
             if (wa && wb) {
                 prc = app_plot_chain_compare(wa, na, label[0], wb, nb, label[1], SIM_NCOL + ext[0].ncol, ext[0].col,
-                                             ext[0].ncol, title, plot, err, sizeof err);
+                                             ext[0].ncol,
+                                             app_world_has_slew(&side[0]) && app_world_has_slew(&side[1]), title,
+                                             plot, err, sizeof err);
             } else {
                 snprintf(err, sizeof err, "out of memory");
                 prc = -1;

@@ -580,8 +580,8 @@ int cmd_run(int argc, char** argv) {
         // A chain model: its page by actuator and function; else the
         // two-link crane's plot as it always was.
         const int prc = sink.keep.next
-                            ? app_plot_chain_run(tr.v, tr.nrow, sink.keep.width, sink.keep.col, sink.keep.next, title,
-                                                 plot, err, sizeof err)
+                            ? app_plot_chain_run(tr.v, tr.nrow, sink.keep.width, sink.keep.col, sink.keep.next,
+                                                 app_world_has_slew(&c.sim), title, plot, err, sizeof err)
                             : app_plot_run(&tr, title, app_world_has_slew(&c.sim), plot, err, sizeof err);
         if (prc) {
             fprintf(stderr, "cranesim run: plot: %s\n", err);

@@ -61,8 +61,8 @@ int app_plot_run_channels(int panel, bool slew, int cols[APP_PLOT_MAXSERIES], co
     return k;
 }
 
-int app_plot_chain_channels(const crane_column* col, int ncol, int off, int panel, int* cols, const char** names,
-                            int max) {
+int app_plot_chain_channels(const crane_column* col, int ncol, int off, bool slew, int panel, int* cols,
+                            const char** names, int max) {
     // Each panel's column prefix (and, for the joint angles, the unit: a
     // sliding joint's q_ is the extension's stroke, already in panel 0).
     static const char* const pre[APP_PLOT_CHAIN_PANELS] = {"x_", "pA_", "pB_", "u_", "ucmd_", "q_"};
@@ -72,8 +72,16 @@ int app_plot_chain_channels(const crane_column* col, int ncol, int off, int pane
     for (int k = 0; k < ncol && n < max; ++k) {
         if (strncmp(col[k].name, pre[panel], L)) continue;
         if (panel == 5 && strcmp(col[k].unit, "rad")) continue;
+        if (!strcmp(col[k].name + L, "slew")) slew = false; // the run's chain has the rack's own columns
         cols[n] = off + k;
         names[n++] = col[k].name + L;
+    }
+    // The world's slew drive, in the base columns (the ode sandbox: x3 ..
+    // u3_cmd, and the slew angle), after the chain's.
+    static const int base[APP_PLOT_CHAIN_PANELS] = {COL_X3, COL_P3A, COL_P3B, COL_U3, COL_U3_CMD, COL_SLEW};
+    if (slew && n < max) {
+        cols[n] = base[panel];
+        names[n++] = "slew";
     }
     return n;
 }
@@ -482,6 +490,7 @@ int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, con
 typedef struct chain_plot {
     psrc src;
     const psrc* b;  ///< compare: run B's rows (drawn dashed), or NULL
+    bool slew;      ///< the world's slew drive, in the base columns, drawn too
     const char *la, *lb;
     const crane_column* col;
     int ncol;
@@ -509,10 +518,12 @@ static void chain_slots(const char* const* act, int na, const char* const* nm, i
 static void draw_chain(void* user) {
     const chain_plot* p = user;
     page_begin(p->title, 3, true);
-    const int off = SIM_NCOL, n = p->ncol;
-    int *c = p->cols, *c2 = p->cols + n, *slot = p->cols + 2 * n;
-    const char **act = p->names, **nm = p->names + n, **nm2 = p->names + 2 * n;
-    const int na = app_plot_chain_channels(p->col, n, off, 0, c, act, n);
+    // n: the chain's columns; m: the most series a panel has (one more for
+    // the world's slew drive), the stride of the scratch arrays.
+    const int off = SIM_NCOL, n = p->ncol, m = n + 1;
+    int *c = p->cols, *c2 = p->cols + m, *slot = p->cols + 2 * m;
+    const char **act = p->names, **nm = p->names + m, **nm2 = p->names + 2 * m;
+    const int na = app_plot_chain_channels(p->col, n, off, p->slew, 0, c, act, m);
     chain_slots(act, na, act, na, slot);
     panel_ex(&p->src, p->b, COL_T, 1, c, NULL, na, 1e3, "t [s]", "stroke [mm]", "Cylinder strokes", act, slot, p->xb,
              p->yb);
@@ -522,26 +533,31 @@ static void draw_chain(void* user) {
     else snprintf(t4, sizeof t4, "Tip path relative to joint 1");
     panel_ex(&p->src, p->b, COL_TIP_X, 1, tz, NULL, 1, 1, "reach [m]", "height [m]", t4, NULL, NULL, p->xb, p->yb);
     for (int side = 1; side <= 2; ++side) {
-        const int k = app_plot_chain_channels(p->col, n, off, side, c, nm, n);
+        const int k = app_plot_chain_channels(p->col, n, off, p->slew, side, c, nm, m);
         chain_slots(act, na, nm, k, slot);
         panel_ex(&p->src, p->b, COL_T, 1, c, NULL, k, 1e-6, "t [s]", "pressure [MPa abs]",
                  side == 1 ? "Chamber A pressures" : "Chamber B pressures", nm, slot, p->xb, p->yb);
     }
-    const int k = app_plot_chain_channels(p->col, n, off, 3, c, nm, n);
+    const int k = app_plot_chain_channels(p->col, n, off, p->slew, 3, c, nm, m);
     // The commands in the spools' order (both per function, in the model's
     // order); drawn only when every spool has its command.
-    const int kc = app_plot_chain_channels(p->col, n, off, 4, c2, nm2, n);
+    const int kc = app_plot_chain_channels(p->col, n, off, p->slew, 4, c2, nm2, m);
     chain_slots(act, na, nm, k, slot);
     panel_ex(&p->src, p->b, COL_T, 1, c, kc == k ? c2 : NULL, k, 100, "t [s]", "opening [%]",
              p->b ? "Valve spools (solid: A, dashed: B)" : "Valve spools (solid) and commands (dashed)", nm, slot,
              p->xb, p->yb);
-    const int kq = app_plot_chain_channels(p->col, n, off, 5, c, nm, n);
-    panel_ex(&p->src, p->b, COL_T, 1, c, NULL, kq, 180 / M_PI, "t [s]", "angle [deg]", "Joint angles", nm, NULL,
+    // The joints by their own order, but the slew (a body and an actuator
+    // of one name) in its actuator's colour.
+    const int kq = app_plot_chain_channels(p->col, n, off, p->slew, 5, c, nm, m);
+    chain_slots(act, na, nm, kq, slot);
+    for (int i = 0; i < kq; ++i)
+        if (slot[i] >= na) slot[i] = i;
+    panel_ex(&p->src, p->b, COL_T, 1, c, NULL, kq, 180 / M_PI, "t [s]", "angle [deg]", "Joint angles", nm, slot,
              p->xb, p->yb);
 }
 
 static int plot_chain(const psrc* a, const char* la, const psrc* b, const char* lb, const crane_column* col,
-                      int ncol, const char* title, const char* png, char* err, size_t errsz) {
+                      int ncol, bool slew, const char* title, const char* png, char* err, size_t errsz) {
     if (a->stride != SIM_NCOL + ncol || (b && b->stride != a->stride)) {
         snprintf(err, errsz, "plot: %d columns a row, expected %d", a->stride, SIM_NCOL + ncol);
         return -1;
@@ -549,13 +565,14 @@ static int plot_chain(const psrc* a, const char* la, const psrc* b, const char* 
     const int nrow = a->nrow > (b ? b->nrow : 0) ? a->nrow : b->nrow;
     PLFLT* xb = malloc(sizeof(PLFLT) * (size_t)(nrow > 0 ? nrow : 1));
     PLFLT* yb = malloc(sizeof(PLFLT) * (size_t)(nrow > 0 ? nrow : 1));
-    int* cols = malloc(sizeof(int) * 3 * (size_t)(ncol > 0 ? ncol : 1));
-    const char** names = malloc(sizeof(char*) * 3 * (size_t)(ncol > 0 ? ncol : 1));
+    // Room for the slew's series too (one per panel).
+    int* cols = malloc(sizeof(int) * 3 * (size_t)(ncol + 1));
+    const char** names = malloc(sizeof(char*) * 3 * (size_t)(ncol + 1));
     int rc = -1;
     if (!xb || !yb || !cols || !names) {
         snprintf(err, errsz, "out of memory");
     } else {
-        chain_plot p = {*a, b, la, lb, col, ncol, title, xb, yb, cols, names};
+        chain_plot p = {*a, b, slew, la, lb, col, ncol, title, xb, yb, cols, names};
         rc = app_png_render(png, "1400x1400", draw_chain, &p, err, errsz);
     }
     free(xb);
@@ -565,17 +582,17 @@ static int plot_chain(const psrc* a, const char* la, const psrc* b, const char* 
     return rc;
 }
 
-int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol,
+int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol, bool slew,
                        const char* title, const char* png, char* err, size_t errsz) {
     const psrc a = {rows, nrow, stride};
-    return plot_chain(&a, "", NULL, "", col, ncol, title, png, err, errsz);
+    return plot_chain(&a, "", NULL, "", col, ncol, slew, title, png, err, errsz);
 }
 
 int app_plot_chain_compare(const double* a, int na, const char* la, const double* b, int nb, const char* lb,
-                           int stride, const crane_column* col, int ncol, const char* title, const char* png,
-                           char* err, size_t errsz) {
+                           int stride, const crane_column* col, int ncol, bool slew, const char* title,
+                           const char* png, char* err, size_t errsz) {
     const psrc pa = {a, na, stride}, pb = {b, nb, stride};
-    return plot_chain(&pa, la, &pb, lb, col, ncol, title, png, err, errsz);
+    return plot_chain(&pa, la, &pb, lb, col, ncol, slew, title, png, err, errsz);
 }
 
 typedef struct bars_plot {
@@ -636,16 +653,17 @@ int app_plot_energy(const char* const* names, const double* kj, int n, const cha
     return -1;
 }
 int app_plot_chain_compare(const double* a, int na, const char* la, const double* b, int nb, const char* lb,
-                           int stride, const crane_column* col, int ncol, const char* title, const char* png,
-                           char* err, size_t errsz) {
-    (void)a, (void)na, (void)la, (void)b, (void)nb, (void)lb, (void)stride, (void)col, (void)ncol, (void)title;
+                           int stride, const crane_column* col, int ncol, bool slew, const char* title,
+                           const char* png, char* err, size_t errsz) {
+    (void)a, (void)na, (void)la, (void)b, (void)nb, (void)lb, (void)stride, (void)col, (void)ncol, (void)slew;
+    (void)title;
     (void)png;
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
     return -1;
 }
-int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol,
+int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol, bool slew,
                        const char* title, const char* png, char* err, size_t errsz) {
-    (void)rows, (void)nrow, (void)stride, (void)col, (void)ncol, (void)title, (void)png;
+    (void)rows, (void)nrow, (void)stride, (void)col, (void)ncol, (void)slew, (void)title, (void)png;
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
     return -1;
 }

@@ -76,7 +76,7 @@ static void check_chain_model(const char* path) {
     static const char* const pre[APP_PLOT_CHAIN_PANELS] = {"x_", "pA_", "pB_", "u_", "ucmd_", "q_"};
     const int off = 100; // any base width: the columns follow it
     for (int p = 0; p < APP_PLOT_CHAIN_PANELS; ++p) {
-        const int n = app_plot_chain_channels(cc->col, cc->ncol, off, p, cols, names, MAX);
+        const int n = app_plot_chain_channels(cc->col, cc->ncol, off, false, p, cols, names, MAX);
         int want = p <= 2 ? cc->nact : p <= 4 ? cc->nfn : 0;
         if (p == 5)
             for (int b = 1; b < cc->nbody; ++b) want += !cc->body[b].def.fixed && cc->body[b].def.joint != CHAIN_PRISMATIC;
@@ -96,7 +96,16 @@ static void check_chain_model(const char* path) {
         }
     }
     // max bounds what is filled.
-    CHECK(app_plot_chain_channels(cc->col, cc->ncol, 0, 0, cols, names, 2) == 2, "max not honoured");
+    CHECK(app_plot_chain_channels(cc->col, cc->ncol, 0, false, 0, cols, names, 2) == 2, "max not honoured");
+    // The world's slew drive (the ode sandbox keeps it in the base columns):
+    // one more series per panel, last, named "slew", at its base column.
+    static const int base[APP_PLOT_CHAIN_PANELS] = {COL_X3, COL_P3A, COL_P3B, COL_U3, COL_U3_CMD, COL_SLEW};
+    for (int p = 0; p < APP_PLOT_CHAIN_PANELS; ++p) {
+        const int n0 = app_plot_chain_channels(cc->col, cc->ncol, 100, false, p, cols, names, MAX);
+        const int n1 = app_plot_chain_channels(cc->col, cc->ncol, 100, true, p, cols, names, MAX);
+        CHECK(n1 == n0 + 1 && cols[n0] == base[p] && !strcmp(names[n0], "slew"), "%s panel %d with the slew: %d series",
+              path, p, n1);
+    }
     model_free(m);
 }
 
