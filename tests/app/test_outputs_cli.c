@@ -230,6 +230,42 @@ static void test_compare(void) {
           0.5 * (ext_rms + other), rc, out);
 }
 
+// Two designs whose columns differ in a name (the jib2 actuator renamed
+// knuckle2, nothing else changed): compare matches the columns by name, so
+// the shared ones differ by exactly 0 (the same crane) and the renamed one
+// is listed as only in A and only in B.
+static void test_compare_shapes(void) {
+    static char text[1 << 16];
+    CHECK(cli_read_file(MODEL3, text, sizeof text) > 0, "cannot read %s", MODEL3);
+    const char* from = "{\"name\": \"jib2\", \"cylinder\"";
+    char* p = strstr(text, from);
+    CHECK(p && !strstr(p + 1, from), "the jib2 actuator is not once in %s", MODEL3);
+    if (!p) return;
+    static char edited[1 << 16];
+    snprintf(edited, sizeof edited, "%.*s{\"name\": \"knuckle2\", \"cylinder\"%s", (int)(p - text), text,
+             p + strlen(from));
+    CHECK(cli_write_file("outputs_renamed.json", edited) == 0, "cannot write outputs_renamed.json");
+    int rc = cli_run("compare --model " MODEL3 " --model outputs_renamed.json --scenario " SCEN3 " --every 0.01 -q",
+                     out, sizeof out);
+    CHECK(rc == 0, "compare exit %d: %s", rc, out);
+    static const char* const only[] = {"\n  x_jib2 ", "only in A", "\n  pA_jib2 ", "only in A", "\n  x_knuckle2 ",
+                                       "only in B", "\n  pB_knuckle2 ", "only in B"};
+    for (int i = 0; i < 8; i += 2) {
+        const char* q = strstr(out, only[i]);
+        const char* e = q ? strchr(q + 1, '\n') : NULL;
+        const char* w = q ? strstr(q, only[i + 1]) : NULL;
+        CHECK(q && w && (!e || w < e), "no row%s%s:\n%s", only[i] + 1, only[i + 1], out);
+    }
+    for (int a = 0; a < NACT; ++a) {
+        if (a == 2) continue; // jib2: renamed
+        char want[64];
+        snprintf(want, sizeof want, "\n  x_%s ", k_act[a]);
+        const char* q = strstr(out, want);
+        CHECK(q && strtod(q + strlen(want), NULL) == 0.0, "%s: not 0 between two copies of one crane:\n%s", want + 3,
+              out);
+    }
+}
+
 // run --plot and compare --plot on a chain model: its own page (1400 x 1400
 // px: three rows of panels), the two-link crane's as it was (1400 x 1000).
 static unsigned be32(const unsigned char* p) {
@@ -283,6 +319,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_run_summary);
     RUN_TEST(test_end_stop);
     RUN_TEST(test_compare);
+    RUN_TEST(test_compare_shapes);
     RUN_TEST(test_plot);
     RUN_TEST(test_default_crane);
     TEST_MAIN_END();
