@@ -34,11 +34,13 @@ static void run_help(FILE* f) {
             "                       folder and renamed over FILE when the run ends (also a failed or\n"
             "                       interrupted one, with the rows so far): until then FILE is untouched\n"
             "  --plot FILE.png      also plot strokes, pressures, valve openings (lift, jib, and the\n"
-            "                       slew where the world has one) and tip path, and the energy per\n"
+            "                       slew where the world has one; a chain model: every actuator,\n"
+            "                       function and joint by name) and tip path, and the energy per\n"
             "                       component as a bar chart to FILE_energy.png\n"
             "  --metrics FILE.json  also write the run's metrics (peak pressures, relief time, per-relief\n"
             "                       open time, end-stop hits, energy in and losses, hook sway,\n"
-            "                       collisions with the bodies involved (ode sandbox), ...;\n"
+            "                       collisions with the bodies involved (ode sandbox), per actuator\n"
+            "                       and function of a chain model (peak_pA.NAME, ...), ...;\n"
             "                       docs/sweep.md), replaced as --out is\n"
             "  --energy FILE.csv    per-component hydraulic power [W] at the output period: t, then\n"
             "                       per pump, valve edge (.meter_in, .meter_out), relief, check,\n"
@@ -50,7 +52,8 @@ static void run_help(FILE* f) {
             "                       chart it stops lift down, jib out and slewing towards a weaker\n"
             "                       sector (ode runs; a lagrange run only measures); rcl_util is the\n"
             "                       last CSV column of ode runs (docs/safety.md)\n"
-            "The summary prints the energy balance of the run in kJ (docs/energy.md).\n");
+            "The summary prints the energy balance of the run in kJ (docs/energy.md); on a chain\n"
+            "model its strokes, peak pressures, forces and end-stop hits name every actuator.\n");
     app_common_help(f, true);
     fprintf(f,
             "\nexit codes: 0 ok, 1 runtime failure (a numerical blow-up keeps the rows so far; a failed\n"
