@@ -351,6 +351,28 @@ int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* 
 /// and jib, and with slew the slew's. Returns how many.
 #define APP_PLOT_MAXSERIES 6
 int app_plot_run_channels(int panel, bool slew, int cols[APP_PLOT_MAXSERIES], const char* names[APP_PLOT_MAXSERIES]);
+/// A chain run's plot (app_plot_chain_run): its panels' series by the
+/// run's chain columns col[0..ncol), found at index off of a row: panel 0
+/// strokes (x_<actuator>), 1 A-chamber and 2 B-chamber pressures
+/// (pA_, pB_<actuator>), 3 spools and 4 commands (u_, ucmd_<function>), 5
+/// joint angles (q_<body> of a revolute joint); slew: the world's slew
+/// drive too, from the base columns (x3, p3A, p3B, u3, u3_cmd, slew), named
+/// "slew", unless the chain columns have the rack's own. Fills at most max
+/// column indices and legend names (the actuator's, function's or body's
+/// name, pointing into col); returns how many (pure; no PLplot).
+#define APP_PLOT_CHAIN_PANELS 6
+int app_plot_chain_channels(const crane_column* col, int ncol, int off, bool slew, int panel, int* cols,
+                            const char** names, int max);
+/// Plot a chain run to a PNG: nrow rows of stride = SIM_NCOL + ncol columns
+/// (the base columns, then the chain's col[0..ncol)); slew: the world has a
+/// slew drive (app_world_has_slew), drawn too. 0, or -1 with a message.
+int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol, bool slew,
+                       const char* title, const char* png, char* err, size_t errsz);
+/// Overlay two chain runs of the same columns (compare): A solid, B dashed,
+/// na and nb rows of stride = SIM_NCOL + ncol each, on app_plot_chain_run's page.
+int app_plot_chain_compare(const double* a, int na, const char* la, const double* b, int nb, const char* lb,
+                           int stride, const crane_column* col, int ncol, bool slew, const char* title,
+                           const char* png, char* err, size_t errsz);
 /// The run with options o has a slew drive (an ode world with a slewing column).
 bool app_world_has_slew(const sim_opts* o);
 // The energy balance's summary lines (app_energy.c, docs/energy.md).
@@ -388,5 +410,66 @@ int app_plot_convergence(const char* png, const char* title, const char* ylab, c
 /// have a slew drive, whose channels are drawn too.
 int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb,
                      const char* title, bool slew, const char* png, char* err, size_t errsz);
+
+// A chain model's outputs by actuator and function (app_chain_out.c): read
+// from the rows' chain columns (crane_chain_columns) by name.
+#include "metrics.h"
+struct crane_chain;
+typedef struct app_act_stats {
+    char name[40];
+    int cx, cA, cB, cF;  ///< row columns of x_, pA_, pB_, F_<name>
+    double stroke;       ///< the cylinder's stroke [m]; NaN: not a chain actuator (the slew rack)
+    double xmin, xmax;   ///< [m]
+    double pA, pB, Fabs; ///< peaks [Pa abs, Pa abs, N]
+    int stops;           ///< entries into an end stop (x < 0 or x > stroke), at the rows
+    bool at_stop;
+} app_act_stats;
+typedef struct app_fn_stats {
+    char name[40];
+    int cu;      ///< row column of u_<name>
+    double umax; ///< largest |spool opening| [-]
+} app_fn_stats;
+typedef struct app_chain_stats {
+    bool bound;
+    int nact, nfn;
+    app_act_stats* act;
+    app_fn_stats* fn;
+    long rows;
+} app_chain_stats;
+/// Bind to a run's chain columns, which follow off base columns in its rows;
+/// nothing (nact = nfn = 0) for NULL or the two-link shorthand. 0, or -1
+/// out of memory.
+int app_chain_stats_bind(app_chain_stats* s, const struct crane_chain* cc, int off);
+void app_chain_stats_row(app_chain_stats* s, const double* row);
+/// The summary's lines by actuator (strokes, peak pressures, forces,
+/// end-stop hits); every: the output period [s], t_end the run's end [s].
+void app_chain_stats_print(const app_chain_stats* s, double every, double t_end, FILE* f);
+/// met's JSON document (metrics_write_json) with the per-actuator and
+/// per-function entries ("peak_pA.lift", ...) added. 0, or -1.
+int app_chain_stats_write_json(const app_chain_stats* s, const run_metrics* met, FILE* f);
+void app_chain_stats_free(app_chain_stats* s);
+/// The summary's metrics block (metrics_print) for a run whose actuators s
+/// names: without the end-stop hits of the first two by position (the
+/// per-actuator line has every one by name). s without actuators: as is.
+void app_chain_metrics_print(const app_chain_stats* s, const run_metrics* met, FILE* f);
+
+/// A run's chain columns, kept row by row (compare: its sim_trace has the
+/// base columns only). Set off (sim_ncol of the run), model_chain (the
+/// model's chain) and pass &run_chain to sim_run_energy_chain; rows via
+/// app_ext_rows_cb. Nothing is kept for the two-link shorthand (ncol 0).
+typedef struct app_ext_rows {
+    int off;
+    const struct crane_chain* model_chain;
+    const struct crane_chain* run_chain; ///< set by the run where its columns differ
+    bool bound, oom;
+    int ncol;                  ///< chain columns kept per row
+    struct crane_column* col;  ///< their names and units (a copy)
+    double* v;                 ///< nrow x ncol
+    long nrow, cap;
+} app_ext_rows;
+int app_ext_rows_cb(void* user, const double* row);
+/// The index of column name in r's columns, or -1.
+int app_ext_rows_find(const app_ext_rows* r, const char* name);
+void app_ext_rows_free(app_ext_rows* r);
 
 #endif

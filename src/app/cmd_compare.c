@@ -24,7 +24,8 @@ static void compare_help(FILE* f) {
             "Runs the scenario twice, differing in what the pair options say (the rest is\n"
             "shared), and prints RMS and maximum differences of strokes [mm], chamber\n"
             "pressures [MPa and %% of the higher of the two peaks], joint angles [deg] and tip\n"
-            "position [mm]. Neither side is taken as right: the figures are differences\n"
+            "position [mm] (a chain model: every actuator's stroke and chambers and every\n"
+            "joint, by name). Neither side is taken as right: the figures are differences\n"
             "between the two runs (cvode at its default --rtol 1e-3 is further from the\n"
             "converged peak pressure than krus at 0.1 ms; README.md). Then each side's energy\n"
             "balance [kJ] as run prints it, and B - A term by term (docs/energy.md).\n"
@@ -96,6 +97,102 @@ void app_compare_pressure(const sim_trace* a, const sim_trace* b, double* rms_pa
     *pct = peak > 0 ? 100.0 * worst / peak : 0.0;
 }
 
+// A chain column's difference between the sides (ia in a, ib in b).
+static diff ext_diff(const app_ext_rows* a, int ia, const app_ext_rows* b, int ib, double scale) {
+    const long n = a->nrow < b->nrow ? a->nrow : b->nrow;
+    double s2 = 0, mx = 0;
+    for (long i = 0; i < n; ++i) {
+        const double d = (a->v[(size_t)i * (size_t)a->ncol + (size_t)ia] -
+                          b->v[(size_t)i * (size_t)b->ncol + (size_t)ib]) * scale;
+        s2 += d * d;
+        mx = fmax(mx, fabs(d));
+    }
+    diff r = {n ? sqrt(s2 / (double)n) : 0, mx};
+    return r;
+}
+
+static double ext_peak(const app_ext_rows* r, int k) {
+    double peak = 0;
+    for (long i = 0; i < r->nrow; ++i) peak = fmax(peak, r->v[(size_t)i * (size_t)r->ncol + (size_t)k]);
+    return peak;
+}
+
+// The difference table of two chain runs by name: every actuator's stroke
+// (x_) [mm], then its chamber pressures (pA_, pB_) [MPa], then every degree
+// of freedom (q_) [deg, or mm for a sliding one], then the tip; columns only
+// one side has (two designs of different shape) are listed as such. The
+// worst stroke RMS [mm], the worst pressure RMS [Pa], the higher peak of the
+// pressure columns [Pa] and whose it is (0 A, 1 B) come back.
+static void print_ext_table(const app_ext_rows ext[2], const sim_trace tr[2], double* stroke_rms, double* prms,
+                            double* ppeak, int* pside) {
+    int w = 8;
+    for (int s = 0; s < 2; ++s)
+        for (int k = 0; k < ext[s].ncol; ++k) w = w > (int)strlen(ext[s].col[k].name) ? w : (int)strlen(ext[s].col[k].name);
+    printf("  %-*s %12s %12s\n", w, "column", "RMS diff", "max diff");
+    static const char* const kinds[3][2] = {{"x_", NULL}, {"pA_", "pB_"}, {"q_", NULL}};
+    double pk[2] = {0, 0};
+    *stroke_rms = *prms = 0;
+    for (int g = 0; g < 3; ++g) {
+        for (int k = 0; k < ext[0].ncol; ++k) {
+            const crane_column* c = &ext[0].col[k];
+            const bool in = !strncmp(c->name, kinds[g][0], strlen(kinds[g][0])) ||
+                            (kinds[g][1] && !strncmp(c->name, kinds[g][1], strlen(kinds[g][1])));
+            if (!in) continue;
+            const int kb = app_ext_rows_find(&ext[1], c->name);
+            if (kb < 0) {
+                printf("  %-*s only in A\n", w, c->name);
+                continue;
+            }
+            double scale = 1e3;
+            const char* unit = "mm";
+            if (g == 1) scale = 1e-6, unit = "MPa";
+            else if (g == 2 && !strcmp(c->unit, "rad")) scale = 180 / M_PI, unit = "deg";
+            const diff d = ext_diff(&ext[0], k, &ext[1], kb, scale);
+            printf("  %-*s %9.4g %-3s %9.4g %-3s\n", w, c->name, d.rms, unit, d.max, unit);
+            if (g == 0) *stroke_rms = fmax(*stroke_rms, d.rms);
+            if (g == 1) {
+                *prms = fmax(*prms, d.rms / scale);
+                pk[0] = fmax(pk[0], ext_peak(&ext[0], k));
+                pk[1] = fmax(pk[1], ext_peak(&ext[1], kb));
+            }
+        }
+    }
+    for (int k = 0; k < ext[1].ncol; ++k)
+        if (app_ext_rows_find(&ext[0], ext[1].col[k].name) < 0 &&
+            (!strncmp(ext[1].col[k].name, "x_", 2) || !strncmp(ext[1].col[k].name, "pA_", 3) ||
+             !strncmp(ext[1].col[k].name, "pB_", 3) || !strncmp(ext[1].col[k].name, "q_", 2)))
+            printf("  %-*s only in B\n", w, ext[1].col[k].name);
+    for (int c = COL_TIP_X; c <= COL_TIP_Z; ++c) {
+        const diff d = column_diff(&tr[0], &tr[1], c, 1e3);
+        printf("  %-*s %9.4g %-3s %9.4g %-3s\n", w, sim_col_name[c], d.rms, "mm", d.max, "mm");
+    }
+    *ppeak = fmax(pk[0], pk[1]);
+    *pside = pk[1] > pk[0] ? 1 : 0;
+}
+
+// Both sides have the same chain columns, name for name (one model on two
+// backends or settings, or two designs of one shape).
+static bool same_columns(const app_ext_rows ext[2]) {
+    if (ext[0].ncol == 0 || ext[0].ncol != ext[1].ncol) return false;
+    for (int k = 0; k < ext[0].ncol; ++k)
+        if (strcmp(ext[0].col[k].name, ext[1].col[k].name)) return false;
+    return true;
+}
+
+// A side's rows as the chain plot takes them: SIM_NCOL base columns, then
+// its chain columns. NULL when out of memory.
+static double* wide_rows(const sim_trace* tr, const app_ext_rows* e, int* nrow) {
+    const int n = tr->nrow < e->nrow ? tr->nrow : (int)e->nrow, w = SIM_NCOL + e->ncol;
+    double* v = malloc((size_t)(n > 0 ? n : 1) * (size_t)w * sizeof *v);
+    if (!v) return NULL;
+    for (int i = 0; i < n; ++i) {
+        memcpy(v + (size_t)i * (size_t)w, tr->v + (size_t)i * SIM_NCOL, SIM_NCOL * sizeof *v);
+        memcpy(v + (size_t)i * (size_t)w + SIM_NCOL, e->v + (size_t)i * (size_t)e->ncol, (size_t)e->ncol * sizeof *v);
+    }
+    *nrow = n;
+    return v;
+}
+
 // The designs' metrics side by side, B - A, in the units a reader compares.
 static void print_metrics(const sim_trace tr[2], const sim_result res[2], const sim_opts side[2], char label[2][96],
                           sim_energy* const en[2]) {
@@ -122,8 +219,10 @@ static void print_metrics(const sim_trace tr[2], const sim_result res[2], const 
 }
 
 // Both runs' rows side by side by index: t (A's), then NAME_A, NAME_B for
-// every column both write. Returns 0, or -1 after one line on stderr.
-static int write_both(const char* path, const sim_trace tr[2], const sim_opts side[2]) {
+// every column both write, then for every chain column both have by name
+// (ext: the sides' chain columns; none for the two-link crane). Returns 0,
+// or -1 after one line on stderr.
+static int write_both(const char* path, const sim_trace tr[2], const sim_opts side[2], const app_ext_rows ext[2]) {
     const int na = sim_ncol(&side[0]), nb = sim_ncol(&side[1]);
     const int ncol = na < nb ? na : nb, n = tr[0].nrow < tr[1].nrow ? tr[0].nrow : tr[1].nrow;
     app_out o = {.f = NULL};
@@ -132,14 +231,28 @@ static int write_both(const char* path, const sim_trace tr[2], const sim_opts si
     if (f) {
         fputs("t", f);
         for (int c = 1; c < ncol; ++c) fprintf(f, ",%s_A,%s_B", sim_col_name[c], sim_col_name[c]);
+        // A's chain columns that B has too, in A's order.
+        int* kb = malloc((size_t)(ext[0].ncol > 0 ? ext[0].ncol : 1) * sizeof *kb);
+        if (!kb) e = ENOMEM;
+        for (int k = 0; kb && k < ext[0].ncol; ++k) {
+            kb[k] = app_ext_rows_find(&ext[1], ext[0].col[k].name);
+            if (kb[k] >= 0) fprintf(f, ",%s_A,%s_B", ext[0].col[k].name, ext[0].col[k].name);
+        }
         fputc('\n', f);
         for (int i = 0; i < n; ++i) {
             const double* a = tr[0].v + (size_t)i * SIM_NCOL;
             const double* b = tr[1].v + (size_t)i * SIM_NCOL;
             fprintf(f, "%.9g", a[COL_T]);
             for (int c = 1; c < ncol; ++c) fprintf(f, ",%.9g,%.9g", a[c], b[c]);
+            for (int k = 0; kb && k < ext[0].ncol; ++k)
+                if (kb[k] >= 0 && i < ext[0].nrow && i < ext[1].nrow)
+                    fprintf(f, ",%.9g,%.9g", ext[0].v[(size_t)i * (size_t)ext[0].ncol + (size_t)k],
+                            ext[1].v[(size_t)i * (size_t)ext[1].ncol + (size_t)kb[k]]);
+                else if (kb[k] >= 0)
+                    fputs(",,", f); // a row a side's chain columns lack: empty fields, the row stays whole
             fputc('\n', f);
         }
+        free(kb);
         if (ferror(f)) e = errno ? errno : EIO;
         e = app_out_close(&o, e, true);
     }
@@ -425,13 +538,23 @@ int cmd_compare(int argc, char** argv) {
     app_settle_unused(&side[1]);
     sim_trace tr[2] = {{0}, {0}};
     sim_result res[2];
+    // A chain model's own columns (every actuator, function and DOF by
+    // name), which the traces do not hold.
+    app_ext_rows ext[2] = {{.off = 0}, {.off = 0}};
     // Each side's energy balance, as run keeps it (docs/energy.md); NULL
     // when out of memory (the comparison runs without it).
     sim_energy* en[2] = {sim_energy_create(), sim_energy_create()};
     for (int s = 0; s < 2; ++s) {
         if (!c.quiet && isatty(2)) fprintf(stderr, "run %s:\n", label[s]);
-        sim_run_energy(s && mb ? mb : m, &sc, &side[s], NULL, NULL, &tr[s], c.quiet ? NULL : app_progress, NULL, en[s],
-                       &res[s]);
+        ext[s].off = sim_ncol(&side[s]);
+        ext[s].model_chain = &(s && mb ? mb : m)->chain;
+        sim_run_energy_chain(s && mb ? mb : m, &sc, &side[s], app_ext_rows_cb, &ext[s], &tr[s],
+                             c.quiet ? NULL : app_progress, NULL, en[s], &ext[s].run_chain, &res[s]);
+        ext[s].run_chain = NULL; // it lived until the run returned
+        if (ext[s].oom && !res[s].status) {
+            res[s].status = SIM_FAILED;
+            snprintf(res[s].message, sizeof res[s].message, "out of memory for the chain columns");
+        }
         if (!c.quiet) app_progress_done();
         if (res[s].note[0]) fprintf(stderr, "cranesim compare: %s: note: %s\n", label[s], res[s].note);
         if (res[s].status) {
@@ -442,6 +565,8 @@ int cmd_compare(int argc, char** argv) {
             sim_energy_free(en[1]);
             sim_trace_free(&tr[0]);
             sim_trace_free(&tr[1]);
+            app_ext_rows_free(&ext[0]);
+            app_ext_rows_free(&ext[1]);
             model_free(m);
             model_free(mb);
             return app_exit_code(res[s].status, 0);
@@ -449,27 +574,34 @@ int cmd_compare(int argc, char** argv) {
     }
     printf("cranesim compare: %s, A = %s, B = %s, %d rows\n", sc.name, label[0], label[1],
            tr[0].nrow < tr[1].nrow ? tr[0].nrow : tr[1].nrow);
-    printf("  %-8s %12s %12s\n", "column", "RMS diff", "max diff");
-    struct {
-        int col;
-        double scale;
-        const char* unit;
-    } rows[] = {{COL_X1, 1e3, "mm"},  {COL_X2, 1e3, "mm"},         {COL_P1A, 1e-6, "MPa"},
-                {COL_P1B, 1e-6, "MPa"}, {COL_P2A, 1e-6, "MPa"},    {COL_P2B, 1e-6, "MPa"},
-                {COL_Q1, 180 / M_PI, "deg"}, {COL_Q2, 180 / M_PI, "deg"}, {COL_TIP_X, 1e3, "mm"},
-                {COL_TIP_Z, 1e3, "mm"}};
-    double stroke_rms = 0;
-    for (size_t k = 0; k < sizeof rows / sizeof rows[0]; ++k) {
-        diff d = column_diff(&tr[0], &tr[1], rows[k].col, rows[k].scale);
-        printf("  %-8s %9.4g %-3s %9.4g %-3s\n", sim_col_name[rows[k].col], d.rms, rows[k].unit, d.max,
-               rows[k].unit);
-        if (rows[k].col == COL_X1 || rows[k].col == COL_X2) stroke_rms = fmax(stroke_rms, d.rms);
-    }
-    // No side is the reference: the figure is a difference between two
-    // runs, as a share of the higher peak (README.md, "compare").
-    double prms, ppeak, press_pct;
+    // Two chain runs: by name, every actuator and DOF; else the two-link
+    // crane's table by position, as it always was.
+    const bool by_name = ext[0].ncol > 0 && ext[1].ncol > 0;
+    double stroke_rms = 0, prms, ppeak, press_pct;
     int pside;
-    app_compare_pressure(&tr[0], &tr[1], &prms, &ppeak, &press_pct, &pside);
+    if (by_name) {
+        print_ext_table(ext, tr, &stroke_rms, &prms, &ppeak, &pside);
+        press_pct = ppeak > 0 ? 100.0 * prms / ppeak : 0.0;
+    } else {
+        printf("  %-8s %12s %12s\n", "column", "RMS diff", "max diff");
+        struct {
+            int col;
+            double scale;
+            const char* unit;
+        } rows[] = {{COL_X1, 1e3, "mm"},  {COL_X2, 1e3, "mm"},         {COL_P1A, 1e-6, "MPa"},
+                    {COL_P1B, 1e-6, "MPa"}, {COL_P2A, 1e-6, "MPa"},    {COL_P2B, 1e-6, "MPa"},
+                    {COL_Q1, 180 / M_PI, "deg"}, {COL_Q2, 180 / M_PI, "deg"}, {COL_TIP_X, 1e3, "mm"},
+                    {COL_TIP_Z, 1e3, "mm"}};
+        for (size_t k = 0; k < sizeof rows / sizeof rows[0]; ++k) {
+            diff d = column_diff(&tr[0], &tr[1], rows[k].col, rows[k].scale);
+            printf("  %-8s %9.4g %-3s %9.4g %-3s\n", sim_col_name[rows[k].col], d.rms, rows[k].unit, d.max,
+                   rows[k].unit);
+            if (rows[k].col == COL_X1 || rows[k].col == COL_X2) stroke_rms = fmax(stroke_rms, d.rms);
+        }
+        // No side is the reference: the figure is a difference between two
+        // runs, as a share of the higher peak (README.md, "compare").
+        app_compare_pressure(&tr[0], &tr[1], &prms, &ppeak, &press_pct, &pside);
+    }
     printf("  worst stroke RMS %.4g mm; worst pressure RMS %.4g MPa = %.3g %% of the higher peak %.2f MPa (%s = %s; "
            "no side is taken as the reference)\n",
            stroke_rms, prms * 1e-6, press_pct, ppeak * 1e-6, pside ? "B" : "A", label[pside]);
@@ -486,7 +618,7 @@ int cmd_compare(int argc, char** argv) {
         }
     }
     int code = 0;
-    if (out && write_both(out, tr, side)) code = EXIT_RUNTIME;
+    if (out && write_both(out, tr, side, ext)) code = EXIT_RUNTIME;
     else if (out) printf("  rows of both -> %s\n", out);
     if (tol_stroke >= 0 && stroke_rms > tol_stroke) {
         printf("  FAIL: stroke RMS %.4g mm > tolerance %.4g mm\n", stroke_rms, tol_stroke);
@@ -499,8 +631,33 @@ int cmd_compare(int argc, char** argv) {
     if (plot) {
         char err[512], title[320];
         snprintf(title, sizeof title, "%s: %s vs %s", sc.name, label[0], label[1]);
-        if (app_plot_compare(&tr[0], label[0], &tr[1], label[1], title,
-                             app_world_has_slew(&side[0]) && app_world_has_slew(&side[1]), plot, err, sizeof err)) {
+        // Two chain runs of one shape: the chain page by actuator and
+        // function, A solid and B dashed; else the two-link overlay (for two
+        // shapes, said: its first two cylinders are the models' first two).
+        int prc;
+        if (same_columns(ext)) {
+            int na = 0, nb = 0;
+            double* wa = wide_rows(&tr[0], &ext[0], &na);
+            double* wb = wide_rows(&tr[1], &ext[1], &nb);
+            if (wa && wb) {
+                prc = app_plot_chain_compare(wa, na, label[0], wb, nb, label[1], SIM_NCOL + ext[0].ncol, ext[0].col,
+                                             ext[0].ncol,
+                                             app_world_has_slew(&side[0]) && app_world_has_slew(&side[1]), title,
+                                             plot, err, sizeof err);
+            } else {
+                snprintf(err, sizeof err, "out of memory");
+                prc = -1;
+            }
+            free(wa);
+            free(wb);
+        } else {
+            if (ext[0].ncol || ext[1].ncol)
+                fprintf(stderr, "cranesim compare: note: the sides' models differ in shape: the plot shows their "
+                                "first two cylinders (x1, x2) by position\n");
+            prc = app_plot_compare(&tr[0], label[0], &tr[1], label[1], title,
+                                   app_world_has_slew(&side[0]) && app_world_has_slew(&side[1]), plot, err, sizeof err);
+        }
+        if (prc) {
             fprintf(stderr, "cranesim compare: plot: %s\n", err);
             code = EXIT_RUNTIME;
         } else {
@@ -511,6 +668,8 @@ int cmd_compare(int argc, char** argv) {
     sim_energy_free(en[1]);
     sim_trace_free(&tr[0]);
     sim_trace_free(&tr[1]);
+    app_ext_rows_free(&ext[0]);
+    app_ext_rows_free(&ext[1]);
     model_free(m);
     model_free(mb);
     return code;

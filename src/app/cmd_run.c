@@ -34,11 +34,13 @@ static void run_help(FILE* f) {
             "                       folder and renamed over FILE when the run ends (also a failed or\n"
             "                       interrupted one, with the rows so far): until then FILE is untouched\n"
             "  --plot FILE.png      also plot strokes, pressures, valve openings (lift, jib, and the\n"
-            "                       slew where the world has one) and tip path, and the energy per\n"
+            "                       slew where the world has one; a chain model: every actuator,\n"
+            "                       function and joint by name) and tip path, and the energy per\n"
             "                       component as a bar chart to FILE_energy.png\n"
             "  --metrics FILE.json  also write the run's metrics (peak pressures, relief time, per-relief\n"
             "                       open time, end-stop hits, energy in and losses, hook sway,\n"
-            "                       collisions with the bodies involved (ode sandbox), ...;\n"
+            "                       collisions with the bodies involved (ode sandbox), per actuator\n"
+            "                       and function of a chain model (peak_pA.NAME, ...), ...;\n"
             "                       docs/sweep.md), replaced as --out is\n"
             "  --energy FILE.csv    per-component hydraulic power [W] at the output period: t, then\n"
             "                       per pump, valve edge (.meter_in, .meter_out), relief, check,\n"
@@ -50,7 +52,8 @@ static void run_help(FILE* f) {
             "                       chart it stops lift down, jib out and slewing towards a weaker\n"
             "                       sector (ode runs; a lagrange run only measures); rcl_util is the\n"
             "                       last CSV column of ode runs (docs/safety.md)\n"
-            "The summary prints the energy balance of the run in kJ (docs/energy.md).\n");
+            "The summary prints the energy balance of the run in kJ (docs/energy.md); on a chain\n"
+            "model its strokes, peak pressures, forces and end-stop hits name every actuator.\n");
     app_common_help(f, true);
     fprintf(f,
             "\nexit codes: 0 ok, 1 runtime failure (a numerical blow-up keeps the rows so far; a failed\n"
@@ -67,19 +70,56 @@ static void run_help(FILE* f) {
 // last time), so a one-row pressure spike still reaches the plot. Without
 // --plot nothing is kept (a 600 s sandbox run held 203 MB of rows).
 enum { PLOT_FULL = 100000 };
+// A chain model's rows are kept wider: the SIM_NCOL base columns, then its
+// own (every actuator, function and DOF by name: the plot's page by
+// function, app_plot_chain_run).
 typedef struct plot_keep {
     sim_trace* tr; ///< NULL: no plot
     long stride;   ///< rows per bucket (1: every row)
     long inb;      ///< rows in the current bucket
-    double lo[SIM_NCOL], hi[SIM_NCOL], t0, t1;
+    int width;     ///< values a kept row holds: SIM_NCOL + next (0 until the first row)
+    int next;      ///< the chain's columns kept after the base ones (0: the two-link crane)
+    crane_column* col; ///< their names (a copy: the run's chain lives only until the run returns)
+    double *full, *lo, *hi; ///< width values each
+    double t0, t1;
     bool oom;
 } plot_keep;
+
+// At the first row: the row width, from the chain whose columns the run
+// writes (NULL or the two-link shorthand: the base columns only).
+static void keep_bind(plot_keep* k, const crane_chain* cc) {
+    if (!k->tr || k->width) return;
+    if (cc && !cc->two_link && cc->ncol > 0) {
+        k->col = malloc((size_t)cc->ncol * sizeof *k->col);
+        if (!k->col) {
+            k->oom = true;
+            return;
+        }
+        memcpy(k->col, cc->col, (size_t)cc->ncol * sizeof *k->col);
+        k->next = cc->ncol;
+    }
+    k->width = SIM_NCOL + k->next;
+    k->full = malloc(3 * (size_t)k->width * sizeof(double));
+    if (!k->full) {
+        k->oom = true;
+        return;
+    }
+    k->lo = k->full + k->width;
+    k->hi = k->lo + k->width;
+}
+
+static void keep_free(plot_keep* k) {
+    free(k->col);
+    free(k->full);
+    k->col = NULL;
+    k->full = NULL;
+}
 
 static void keep_push(plot_keep* k, const double* row) {
     sim_trace* tr = k->tr;
     if (tr->nrow == tr->cap) {
         const int cap = tr->cap ? 2 * tr->cap : 4096;
-        double* v = realloc(tr->v, (size_t)cap * SIM_NCOL * sizeof(double));
+        double* v = realloc(tr->v, (size_t)cap * (size_t)k->width * sizeof(double));
         if (!v) {
             k->oom = true;
             return;
@@ -87,7 +127,7 @@ static void keep_push(plot_keep* k, const double* row) {
         tr->v = v;
         tr->cap = cap;
     }
-    memcpy(tr->v + (size_t)tr->nrow * SIM_NCOL, row, SIM_NCOL * sizeof(double));
+    memcpy(tr->v + (size_t)tr->nrow * (size_t)k->width, row, (size_t)k->width * sizeof(double));
     ++tr->nrow;
 }
 
@@ -106,18 +146,20 @@ static void keep_flush(plot_keep* k) {
 
 static void keep_row(plot_keep* k, const double* row, int ncol) {
     if (!k->tr || k->oom) return;
-    double full[SIM_NCOL] = {0};
+    double* full = k->full;
+    memset(full, 0, (size_t)k->width * sizeof(double));
     memcpy(full, row, (size_t)ncol * sizeof(double));
+    if (k->next) memcpy(full + SIM_NCOL, row + ncol, (size_t)k->next * sizeof(double));
     if (k->stride <= 1) {
         keep_push(k, full);
         return;
     }
     if (k->inb == 0) {
-        memcpy(k->lo, full, sizeof full);
-        memcpy(k->hi, full, sizeof full);
+        memcpy(k->lo, full, (size_t)k->width * sizeof(double));
+        memcpy(k->hi, full, (size_t)k->width * sizeof(double));
         k->t0 = full[COL_T];
     } else {
-        for (int c = 0; c < SIM_NCOL; ++c) {
+        for (int c = 0; c < k->width; ++c) {
             k->lo[c] = fmin(k->lo[c], full[c]);
             k->hi[c] = fmax(k->hi[c], full[c]);
         }
@@ -153,6 +195,8 @@ typedef struct csv_sink {
     run_metrics met;
     double t_last; ///< time of the last row written [s]
     rcl* mon;      ///< the limiter's measurement where the rows have no rcl_util (lagrange), or NULL
+    app_chain_stats cst; ///< a chain model's summary and metrics by actuator and function
+    bool cst_oom;
 } csv_sink;
 
 // The CSV is opened at the first row (t = 0, before any step): a run refused
@@ -201,6 +245,11 @@ static int csv_row(void* user, const double* row) {
         }
         s->st.t_prev = row[COL_T];
     }
+    // Bound at the first row to the columns the run writes (its chain's,
+    // which may have the slew rack's besides the model's).
+    if (!s->cst.bound && app_chain_stats_bind(&s->cst, s->chain, s->ncol)) s->cst_oom = true;
+    app_chain_stats_row(&s->cst, row);
+    keep_bind(&s->keep, s->chain);
     keep_row(&s->keep, row, s->ncol);
     metrics_row(&s->met, row);
     return app_signal_caught() != 0;
@@ -216,7 +265,7 @@ static int csv_close(csv_sink* s) {
 }
 
 static void print_summary(const char* scen, const sim_opts* o, const sim_result* r, const row_stats* st,
-                          const run_metrics* met, const char* out) {
+                          const run_metrics* met, const app_chain_stats* cst, const char* out) {
     const double *pmax = st->pmax, *xmin = st->xmin, *xmax = st->xmax;
     const bool adaptive = o->cvode || hyd_method_is_adaptive(o->solver);
     // The backend names the run and its work (engine_describe).
@@ -238,8 +287,12 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     char speed[32];
     printf("  simulated %.3f s in %.3f s wall: %sx real time; %s\n", r->t_end, r->wall,
            app_fmt_speed(speed, sizeof speed, r->wall > 0 ? r->t_end / r->wall : 0.0), work);
-    printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
-           1e3 * xmax[1]);
+    // A chain model: every actuator by name (its strokes, peak pressures,
+    // forces and end-stop hits) instead of the first two by position.
+    const bool by_act = cst->nact > 0;
+    if (!by_act)
+        printf("  strokes: lift %.1f..%.1f mm, jib %.1f..%.1f mm\n", 1e3 * xmin[0], 1e3 * xmax[0], 1e3 * xmin[1],
+               1e3 * xmax[1]);
     char rcl_scripted_off[96]; // a backend whose scripted runs only measure the limiter
     snprintf(rcl_scripted_off, sizeof rcl_scripted_off, "measuring only (%s scripted run)", app_backend(o)->name);
     if (st->rcl_have)
@@ -251,7 +304,9 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
     // coarse rows the true peak can be far higher than any row's); else
     // (CVODE) over the rows, and said so.
     const double every = app_output_period(o);
-    if (r->peak_steps) {
+    if (by_act) {
+        app_chain_stats_print(cst, every, r->t_end, stdout);
+    } else if (r->peak_steps) {
         printf("  peak pressures: p1A %.2f, p1B %.2f, p2A %.2f, p2B %.2f MPa (absolute, over every %s)",
                r->p_peak[0] * 1e-6, r->p_peak[1] * 1e-6, r->p_peak[2] * 1e-6, r->p_peak[3] * 1e-6, d.step_name);
     } else {
@@ -260,8 +315,8 @@ static void print_summary(const char* scen, const sim_opts* o, const sim_result*
         // The rows come every `every`, but never farther apart than the run.
         if (every > 1e-3 * (1 + 1e-9)) printf(", rows every %g ms", fmin(every, r->t_end) * 1e3);
     }
-    printf("\n");
-    metrics_print(met, stdout);
+    if (!by_act) printf("\n");
+    app_chain_metrics_print(cst, met, stdout);
     printf("  %ld rows -> %s\n", r->rows, out);
 }
 
@@ -490,6 +545,10 @@ int cmd_run(int argc, char** argv) {
         fprintf(stderr, "cranesim run: cannot write %s: %s\n", energy_csv, strerror(eerr));
         code = EXIT_RUNTIME;
     }
+    if (sink.cst_oom && code == EXIT_OK_) {
+        fprintf(stderr, "cranesim run: out of memory for the summary by actuator\n");
+        code = EXIT_RUNTIME;
+    }
     if (sink.keep.oom && code == EXIT_OK_) {
         fprintf(stderr, "cranesim run: plot: out of memory for the plotted rows\n");
         code = EXIT_RUNTIME;
@@ -497,7 +556,7 @@ int cmd_run(int argc, char** argv) {
     sim_energy_balance eb;
     sim_energy_result(en, &eb);
     if (code == EXIT_OK_ && !c.quiet) {
-        print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, &sink.met, out);
+        print_summary(sc.name[0] ? sc.name : c.scenario_path, &c.sim, &res, &sink.st, &sink.met, &sink.cst, out);
         if (eb.samples > 1) app_print_energy(en, &eb, NULL);
         if (energy_csv) printf("  energy -> %s\n", energy_csv);
     }
@@ -506,7 +565,7 @@ int cmd_run(int argc, char** argv) {
         app_out mo;
         FILE* f = app_out_open(&mo, metrics_out, "w");
         int e = f ? 0 : errno;
-        if (f && metrics_write_json(&sink.met, f)) e = errno ? errno : EIO;
+        if (f && app_chain_stats_write_json(&sink.cst, &sink.met, f)) e = errno ? errno : EIO;
         if (f) e = app_out_close(&mo, e, true);
         if (e) {
             fprintf(stderr, "cranesim run: cannot write %s: %s\n", metrics_out, strerror(e));
@@ -521,7 +580,13 @@ int cmd_run(int argc, char** argv) {
         engine_describe(&c.sim, &d);
         snprintf(title, sizeof title, "%s: %s, %s", sc.name, d.title,
                  c.sim.cvode ? "cvode" : hyd_method_name(c.sim.solver));
-        if (app_plot_run(&tr, title, app_world_has_slew(&c.sim), plot, err, sizeof err)) {
+        // A chain model: its page by actuator and function; else the
+        // two-link crane's plot as it always was.
+        const int prc = sink.keep.next
+                            ? app_plot_chain_run(tr.v, tr.nrow, sink.keep.width, sink.keep.col, sink.keep.next,
+                                                 app_world_has_slew(&c.sim), title, plot, err, sizeof err)
+                            : app_plot_run(&tr, title, app_world_has_slew(&c.sim), plot, err, sizeof err);
+        if (prc) {
             fprintf(stderr, "cranesim run: plot: %s\n", err);
             if (code == EXIT_OK_) code = EXIT_RUNTIME;
         } else if (!c.quiet) {
@@ -538,6 +603,8 @@ int cmd_run(int argc, char** argv) {
             }
         }
     }
+    app_chain_stats_free(&sink.cst);
+    keep_free(&sink.keep);
     sim_energy_free(en);
     sim_trace_free(&tr);
     if (sink.mon) rcl_free(sink.mon);

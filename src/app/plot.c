@@ -15,6 +15,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 // Write n bytes to path, replacing it only once all are written (app_out);
 // on failure "cannot write FILE: reason" in err, and the previous file is
 // left as it was (a partly written one would pass for a plot).
@@ -55,6 +59,31 @@ int app_plot_run_channels(int panel, bool slew, int cols[APP_PLOT_MAXSERIES], co
     const int k = n[panel][slew ? 1 : 0];
     for (int i = 0; i < k; ++i) cols[i] = c[panel][i], names[i] = nm[panel][i];
     return k;
+}
+
+int app_plot_chain_channels(const crane_column* col, int ncol, int off, bool slew, int panel, int* cols,
+                            const char** names, int max) {
+    // Each panel's column prefix (and, for the joint angles, the unit: a
+    // sliding joint's q_ is the extension's stroke, already in panel 0).
+    static const char* const pre[APP_PLOT_CHAIN_PANELS] = {"x_", "pA_", "pB_", "u_", "ucmd_", "q_"};
+    if (panel < 0 || panel >= APP_PLOT_CHAIN_PANELS) return 0;
+    const size_t L = strlen(pre[panel]);
+    int n = 0;
+    for (int k = 0; k < ncol && n < max; ++k) {
+        if (strncmp(col[k].name, pre[panel], L)) continue;
+        if (panel == 5 && strcmp(col[k].unit, "rad")) continue;
+        if (!strcmp(col[k].name + L, "slew")) slew = false; // the run's chain has the rack's own columns
+        cols[n] = off + k;
+        names[n++] = col[k].name + L;
+    }
+    // The world's slew drive, in the base columns (the ode sandbox: x3 ..
+    // u3_cmd, and the slew angle), after the chain's.
+    static const int base[APP_PLOT_CHAIN_PANELS] = {COL_X3, COL_P3A, COL_P3B, COL_U3, COL_U3_CMD, COL_SLEW};
+    if (slew && n < max) {
+        cols[n] = base[panel];
+        names[n++] = "slew";
+    }
+    return n;
 }
 
 double app_tick_step(double lo, double hi, int max_ticks) {
@@ -230,24 +259,25 @@ int app_png_render(const char* png, const char* geometry, void (*draw)(void* use
     return rc;
 }
 
-typedef struct series {
-    const sim_trace* tr;
-    int col;
-    double scale;
-} series;
+// The rows a panel draws from: a trace (SIM_NCOL columns a row) or a chain
+// run's wider rows (stride columns: the base, then the chain's).
+typedef struct psrc {
+    const double* v;
+    int nrow, stride;
+} psrc;
 
-static void range_of(const sim_trace* tr, int col, double scale, double* lo, double* hi) {
+static void range_of(const psrc* tr, int col, double scale, double* lo, double* hi) {
     for (int i = 0; i < tr->nrow; ++i) {
-        double v = tr->v[(size_t)i * SIM_NCOL + col] * scale;
+        double v = tr->v[(size_t)i * (size_t)tr->stride + (size_t)col] * scale;
         if (v < *lo) *lo = v;
         if (v > *hi) *hi = v;
     }
 }
 
-static void draw_series(const sim_trace* tr, int xcol, double xs, int ycol, double ys, PLFLT* xb, PLFLT* yb) {
+static void draw_series(const psrc* tr, int xcol, double xs, int ycol, double ys, PLFLT* xb, PLFLT* yb) {
     for (int i = 0; i < tr->nrow; ++i) {
-        xb[i] = tr->v[(size_t)i * SIM_NCOL + xcol] * xs;
-        yb[i] = tr->v[(size_t)i * SIM_NCOL + ycol] * ys;
+        xb[i] = tr->v[(size_t)i * (size_t)tr->stride + (size_t)xcol] * xs;
+        yb[i] = tr->v[(size_t)i * (size_t)tr->stride + (size_t)ycol] * ys;
     }
     plline(tr->nrow, xb, yb);
 }
@@ -263,13 +293,17 @@ static void draw_series(const sim_trace* tr, int xcol, double xs, int ycol, doub
 #define PAGE_TITLE_BAND 0.055 // top band of the page for the title [page height]
 
 static int g_cell; // the next panel's cell, row-major
+static int g_rows = 2; // rows of panels on the page (2, or 3 for a chain run's page)
+static bool g_legend_right; // the panels leave room on their right for a legend (chain runs)
 
 // Start a page of 2 x 2 panels under title: as wide as the page allows,
 // smaller type for a title that would not fit at the normal size.
-static void page_begin(const char* title) {
+static void page_begin(const char* title, int rows, bool legend_right) {
     plstar(1, 1);
     pladv(0);
     g_cell = 0;
+    g_rows = rows;
+    g_legend_right = legend_right;
     plvpor(0.0, 1.0, 0.0, 1.0);
     plwind(0.0, 1.0, 0.0, 1.0);
     // The title at 0.8 of PLplot's default size holds about 100 characters
@@ -288,21 +322,36 @@ static void page_begin(const char* title) {
 static void page_panel_viewport(void) {
     const int col = g_cell % 2, row = g_cell / 2;
     ++g_cell;
-    const double h = (1.0 - PAGE_TITLE_BAND) / 2.0;
+    const double h = (1.0 - PAGE_TITLE_BAND) / g_rows;
     const double x0 = 0.5 * col, y1 = 1.0 - PAGE_TITLE_BAND - h * row;
-    plvpor(x0 + 0.085, x0 + 0.48, y1 - h + 0.085, y1 - 0.05);
+    // A chain run's legend (one name per actuator or function, up to a
+    // dozen) goes right of the panel: 0.08 of the page (112 px) holds a
+    // name of about 14 characters.
+    if (g_legend_right) plvpor(x0 + 0.07, x0 + 0.395, y1 - h + 0.06, y1 - 0.035);
+    else plvpor(x0 + 0.085, x0 + 0.48, y1 - h + 0.085, y1 - 0.05);
 }
 
-// One panel: columns cols[0..nc) of up to two traces, the second dashed.
-static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, const int* cols, int nc,
-                  double ys, const char* xlabel, const char* ylabel, const char* title, const char* const* names,
-                  PLFLT* xb, PLFLT* yb) {
+// The colours of a panel's series: distinct on white (PLplot's cmap0
+// without its yellow, wheat and aquamarine); beyond a dozen they repeat with
+// a dotted line.
+static const int k_colours[] = {1, 3, 9, 13, 8, 10, 11, 7, 14, 12, 5, 2};
+#define NCOLOURS ((int)(sizeof k_colours / sizeof k_colours[0]))
+
+// One panel: columns cols[0..nc) of up to two traces, the second dashed;
+// dashed: columns drawn dashed in the same colours as cols (a chain run's
+// commands beside its spools), or NULL; slot: each series' colour slot (a
+// chain run's: the actuator's, so that a name keeps its colour from panel to
+// panel), or NULL for the series' own index.
+static void panel_ex(const psrc* a, const psrc* b, int xcol, double xs, const int* cols, const int* dashed, int nc,
+                     double ys, const char* xlabel, const char* ylabel, const char* title, const char* const* names,
+                     const int* slot, PLFLT* xb, PLFLT* yb) {
     double xlo = 1e300, xhi = -1e300, ylo = 1e300, yhi = -1e300;
-    const sim_trace* trs[2] = {a, b};
+    const psrc* trs[2] = {a, b};
     for (int t = 0; t < 2; ++t) {
         if (!trs[t]) continue;
         range_of(trs[t], xcol, xs, &xlo, &xhi);
         for (int k = 0; k < nc; ++k) range_of(trs[t], cols[k], ys, &ylo, &yhi);
+        for (int k = 0; k < nc && dashed; ++k) range_of(trs[t], dashed[k], ys, &ylo, &yhi);
     }
     if (!(xhi > xlo)) xhi = xlo + 1;
     double pad = 0.05 * (yhi - ylo);
@@ -334,6 +383,33 @@ static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, c
         if ((int)strlen(lb) > wide) wide = (int)strlen(lb);
     }
     plmtex("l", fmax(5.0, 1.5 + 0.75 * wide), 0.5, 0.5, ylabel);
+    if (g_legend_right) {
+        // A chain run: a colour per actuator or function (the same in every
+        // panel, in the model's order), its spool solid and its command
+        // dashed, or (compare) run A solid and run B dashed; the names in a
+        // column right of the panel.
+        for (int k = 0; k < nc; ++k) {
+            const int sl = slot ? slot[k] : k;
+            plcol0(k_colours[sl % NCOLOURS]);
+            pllsty(sl < NCOLOURS ? 1 : 3);
+            draw_series(a, xcol, xs, cols[k], ys, xb, yb);
+            if (b) {
+                pllsty(2);
+                draw_series(b, xcol, xs, cols[k], ys, xb, yb);
+            } else if (dashed) {
+                pllsty(2);
+                draw_series(a, xcol, xs, dashed[k], ys, xb, yb);
+            }
+        }
+        pllsty(1);
+        const double step = 1.0 / (nc > 12 ? nc + 1 : 13); // of the panel's height
+        for (int k = 0; k < nc && names; ++k) {
+            plcol0(k_colours[(slot ? slot[k] : k) % NCOLOURS]);
+            plmtex("rv", 0.8, 1.0 - step * (k + 0.5), 0.0, names[k]);
+        }
+        plcol0(15);
+        return;
+    }
     static const int colours[] = {1, 3, 9, 8, 12, 13};
     for (int t = 0; t < 2; ++t) {
         if (!trs[t]) continue;
@@ -351,6 +427,13 @@ static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, c
     }
 }
 
+static void panel(const sim_trace* a, const sim_trace* b, int xcol, double xs, const int* cols, int nc, double ys,
+                  const char* xlabel, const char* ylabel, const char* title, const char* const* names, PLFLT* xb,
+                  PLFLT* yb) {
+    const psrc pa = {a->v, a->nrow, SIM_NCOL}, pb = {b ? b->v : NULL, b ? b->nrow : 0, SIM_NCOL};
+    panel_ex(&pa, b ? &pb : NULL, xcol, xs, cols, NULL, nc, ys, xlabel, ylabel, title, names, NULL, xb, yb);
+}
+
 typedef struct traces_plot {
     const sim_trace *a, *b;
     const char *la, *lb, *title;
@@ -362,7 +445,7 @@ static void draw_traces(void* user) {
     const traces_plot* p = user;
     const sim_trace *a = p->a, *b = p->b;
     PLFLT *xb = p->xb, *yb = p->yb;
-    page_begin(p->title);
+    page_begin(p->title, 2, false);
     int xs[APP_PLOT_MAXSERIES], ps[APP_PLOT_MAXSERIES], us[APP_PLOT_MAXSERIES];
     const char *xn[APP_PLOT_MAXSERIES], *pn[APP_PLOT_MAXSERIES], *un[APP_PLOT_MAXSERIES];
     const int nx = app_plot_run_channels(0, p->slew, xs, xn), np = app_plot_run_channels(1, p->slew, ps, pn),
@@ -402,6 +485,114 @@ int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* 
 int app_plot_compare(const sim_trace* a, const char* la, const sim_trace* b, const char* lb, const char* title, bool slew,
                      const char* png, char* err, size_t errsz) {
     return plot_traces(a, la, b, lb, title, slew, png, err, errsz);
+}
+
+typedef struct chain_plot {
+    psrc src;
+    const psrc* b;  ///< compare: run B's rows (drawn dashed), or NULL
+    bool slew;      ///< the world's slew drive, in the base columns, drawn too
+    const char *la, *lb;
+    const crane_column* col;
+    int ncol;
+    const char* title;
+    PLFLT *xb, *yb;
+    int* cols;          ///< scratch: 3 x ncol (columns, commands, colour slots)
+    const char** names; ///< scratch: 3 x ncol (actuators, a panel's names, commands)
+} chain_plot;
+
+// A chain run's page: 3 x 2 panels, every actuator's stroke and chamber
+// pressures (A and B chambers in a panel each, so that each holds one line
+// per actuator), every function's spool and command, the joint angles and
+// the tip path; a colour per actuator or function, legend by name.
+// Each legend name's colour slot: its index among the actuators (the
+// strokes' names) when it names one (a function named as its actuator),
+// else after them.
+static void chain_slots(const char* const* act, int na, const char* const* nm, int n, int* slot) {
+    for (int k = 0; k < n; ++k) {
+        slot[k] = na + k;
+        for (int i = 0; i < na; ++i)
+            if (!strcmp(nm[k], act[i])) slot[k] = i;
+    }
+}
+
+static void draw_chain(void* user) {
+    const chain_plot* p = user;
+    page_begin(p->title, 3, true);
+    // n: the chain's columns; m: the most series a panel has (one more for
+    // the world's slew drive), the stride of the scratch arrays.
+    const int off = SIM_NCOL, n = p->ncol, m = n + 1;
+    int *c = p->cols, *c2 = p->cols + m, *slot = p->cols + 2 * m;
+    const char **act = p->names, **nm = p->names + m, **nm2 = p->names + 2 * m;
+    const int na = app_plot_chain_channels(p->col, n, off, p->slew, 0, c, act, m);
+    chain_slots(act, na, act, na, slot);
+    panel_ex(&p->src, p->b, COL_T, 1, c, NULL, na, 1e3, "t [s]", "stroke [mm]", "Cylinder strokes", act, slot, p->xb,
+             p->yb);
+    const int tz[] = {COL_TIP_Z};
+    char t4[200];
+    if (p->b) snprintf(t4, sizeof t4, "Tip path (solid: %s, dashed: %s)", p->la, p->lb);
+    else snprintf(t4, sizeof t4, "Tip path relative to joint 1");
+    panel_ex(&p->src, p->b, COL_TIP_X, 1, tz, NULL, 1, 1, "reach [m]", "height [m]", t4, NULL, NULL, p->xb, p->yb);
+    for (int side = 1; side <= 2; ++side) {
+        const int k = app_plot_chain_channels(p->col, n, off, p->slew, side, c, nm, m);
+        chain_slots(act, na, nm, k, slot);
+        panel_ex(&p->src, p->b, COL_T, 1, c, NULL, k, 1e-6, "t [s]", "pressure [MPa abs]",
+                 side == 1 ? "Chamber A pressures" : "Chamber B pressures", nm, slot, p->xb, p->yb);
+    }
+    const int k = app_plot_chain_channels(p->col, n, off, p->slew, 3, c, nm, m);
+    // The commands in the spools' order (both per function, in the model's
+    // order); drawn only when every spool has its command.
+    const int kc = app_plot_chain_channels(p->col, n, off, p->slew, 4, c2, nm2, m);
+    chain_slots(act, na, nm, k, slot);
+    panel_ex(&p->src, p->b, COL_T, 1, c, kc == k ? c2 : NULL, k, 100, "t [s]", "opening [%]",
+             p->b ? "Valve spools (solid: A, dashed: B)" : "Valve spools (solid) and commands (dashed)", nm, slot,
+             p->xb, p->yb);
+    // The joints by their own order, but the slew (a body and an actuator
+    // of one name) in its actuator's colour.
+    const int kq = app_plot_chain_channels(p->col, n, off, p->slew, 5, c, nm, m);
+    chain_slots(act, na, nm, kq, slot);
+    for (int i = 0; i < kq; ++i)
+        if (slot[i] >= na) slot[i] = i;
+    panel_ex(&p->src, p->b, COL_T, 1, c, NULL, kq, 180 / M_PI, "t [s]", "angle [deg]", "Joint angles", nm, slot,
+             p->xb, p->yb);
+}
+
+static int plot_chain(const psrc* a, const char* la, const psrc* b, const char* lb, const crane_column* col,
+                      int ncol, bool slew, const char* title, const char* png, char* err, size_t errsz) {
+    if (a->stride != SIM_NCOL + ncol || (b && b->stride != a->stride)) {
+        snprintf(err, errsz, "plot: %d columns a row, expected %d", a->stride, SIM_NCOL + ncol);
+        return -1;
+    }
+    const int nrow = a->nrow > (b ? b->nrow : 0) ? a->nrow : b->nrow;
+    PLFLT* xb = malloc(sizeof(PLFLT) * (size_t)(nrow > 0 ? nrow : 1));
+    PLFLT* yb = malloc(sizeof(PLFLT) * (size_t)(nrow > 0 ? nrow : 1));
+    // Room for the slew's series too (one per panel).
+    int* cols = malloc(sizeof(int) * 3 * (size_t)(ncol + 1));
+    const char** names = malloc(sizeof(char*) * 3 * (size_t)(ncol + 1));
+    int rc = -1;
+    if (!xb || !yb || !cols || !names) {
+        snprintf(err, errsz, "out of memory");
+    } else {
+        chain_plot p = {*a, b, slew, la, lb, col, ncol, title, xb, yb, cols, names};
+        rc = app_png_render(png, "1400x1400", draw_chain, &p, err, errsz);
+    }
+    free(xb);
+    free(yb);
+    free(cols);
+    free(names);
+    return rc;
+}
+
+int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol, bool slew,
+                       const char* title, const char* png, char* err, size_t errsz) {
+    const psrc a = {rows, nrow, stride};
+    return plot_chain(&a, "", NULL, "", col, ncol, slew, title, png, err, errsz);
+}
+
+int app_plot_chain_compare(const double* a, int na, const char* la, const double* b, int nb, const char* lb,
+                           int stride, const crane_column* col, int ncol, bool slew, const char* title,
+                           const char* png, char* err, size_t errsz) {
+    const psrc pa = {a, na, stride}, pb = {b, nb, stride};
+    return plot_chain(&pa, la, &pb, lb, col, ncol, slew, title, png, err, errsz);
 }
 
 typedef struct bars_plot {
@@ -458,6 +649,21 @@ int app_plot_run(const sim_trace* tr, const char* title, bool slew, const char* 
 int app_plot_energy(const char* const* names, const double* kj, int n, const char* title, const char* png, char* err,
                     size_t errsz) {
     (void)names, (void)kj, (void)n, (void)title, (void)png;
+    snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
+    return -1;
+}
+int app_plot_chain_compare(const double* a, int na, const char* la, const double* b, int nb, const char* lb,
+                           int stride, const crane_column* col, int ncol, bool slew, const char* title,
+                           const char* png, char* err, size_t errsz) {
+    (void)a, (void)na, (void)la, (void)b, (void)nb, (void)lb, (void)stride, (void)col, (void)ncol, (void)slew;
+    (void)title;
+    (void)png;
+    snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
+    return -1;
+}
+int app_plot_chain_run(const double* rows, int nrow, int stride, const crane_column* col, int ncol, bool slew,
+                       const char* title, const char* png, char* err, size_t errsz) {
+    (void)rows, (void)nrow, (void)stride, (void)col, (void)ncol, (void)slew, (void)title, (void)png;
     snprintf(err, errsz, "cranesim was built without PLplot (install libplplot-dev plplot-driver-cairo)");
     return -1;
 }
