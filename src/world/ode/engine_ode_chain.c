@@ -18,6 +18,24 @@
 // Hand a finished row to the driver's sink; non-zero: stop.
 static int deliver(const engine_sink* k, const double* row) { return k->row && k->row(k->user, row); }
 
+// An output row of either chain run: the run checks on its first ncheck
+// columns, then the sink. 1 when the run ends here: a check failed
+// (res->status SIM_FAILED, the message names the step), or the sink asked
+// to stop (*stop).
+static int emit_row(sim_checks* chk, const double* row, int ncheck, const sim_opts* o, double h, double dt,
+                    const engine_sink* k, sim_result* res, int* stop) {
+    char what[200];
+    if (sim_check_row(chk, row, ncheck, what, sizeof what)) {
+        res->status = SIM_FAILED;
+        char how[96];
+        snprintf(how, sizeof how, "solver %s, h = %g s, ODE step %g s", hyd_method_name(o->solver), h, dt);
+        sim_check_message(res->message, sizeof res->message, what, how, false, row[COL_T], chk->bad_value);
+        return 1;
+    }
+    *stop = deliver(k, row);
+    return 0;
+}
+
 // The kind of the world o names (the validation world when none): the
 // validation world runs in the chain world (the column on the ground, the
 // load at the tip), the sandbox in ode_world with the crane from the chain
@@ -154,17 +172,9 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
         }
         if ((i + 1) % nout && i + 1 != nstep) continue;
         ode_chain_sandbox_row(&r, w, cc, (double)(i + 1) * dt, row); // exact grid times
-        char what[200];
-        if (sim_check_row(&chk, row, SIM_NCOL, what, sizeof what)) {
-            res->status = SIM_FAILED;
-            char how[96];
-            snprintf(how, sizeof how, "solver %s, h = %g s, ODE step %g s", hyd_method_name(o->solver), h, dt);
-            sim_check_message(msg, msz, what, how, false, row[COL_T], chk.bad_value);
-            break;
-        }
+        if (emit_row(&chk, row, SIM_NCOL, o, h, dt, k, res, &stop)) break;
         t_last = row[COL_T];
         ++rows;
-        stop = deliver(k, row);
     }
     res->wall = sim_wall_time() - w0;
     res->stats.steps = (long)floor(ode_world_time(w) / dt + 0.5) * (long)floor(dt / h + 0.5);
@@ -342,17 +352,9 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         }
         if ((i + 1) % nout && i + 1 != nstep) continue;
         ode_chain_make_row(&r, w, (double)(i + 1) * dt, row); // exact grid times
-        char what[200];
-        if (sim_check_row(&chk, row, SIM_NCOL_BASE, what, sizeof what)) {
-            res->status = SIM_FAILED;
-            char how[96];
-            snprintf(how, sizeof how, "solver %s, h = %g s, ODE step %g s", hyd_method_name(o->solver), h, dt);
-            sim_check_message(msg, msz, what, how, false, row[COL_T], chk.bad_value);
-            break;
-        }
+        if (emit_row(&chk, row, SIM_NCOL_BASE, o, h, dt, k, res, &stop)) break;
         t_last = row[COL_T];
         ++rows;
-        stop = deliver(k, row);
     }
     res->wall = sim_wall_time() - w0;
     // The fixed hydraulic sub-steps taken: nsub per ODE step done.
