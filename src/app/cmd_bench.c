@@ -387,6 +387,16 @@ static double soak_command(soak_ramp* r, uint64_t* rng, double t) {
 // toggles as the two-link soak's, every column of every row checked for
 // non-finite values. One JSON line, the two-link soak's fields and the
 // function and column counts.
+// A soak's failure text for its JSON line ("" when it ran through): the
+// engine's error without quotes, backslashes or control characters.
+static void soak_failure(const engine* l, int status, char* msg, size_t n) {
+    msg[0] = 0;
+    if (!status) return;
+    snprintf(msg, n, "%s", engine_error(l));
+    for (char* p = msg; *p; ++p)
+        if (*p == '"' || *p == '\\' || (unsigned char)*p < 0x20) *p = '\'';
+}
+
 static int bench_soak_chain(model* m, const scenario* sc, sim_opts* o, double duration, uint64_t seed) {
     char err[512];
     engine* l = engine_create(m, o, sc->q0, sc->slew0, sim_load_mass(m, sc, o), err, sizeof err);
@@ -446,12 +456,8 @@ static int bench_soak_chain(model* m, const scenario* sc, sim_opts* o, double du
     const double wall = sim_wall_time() - w0;
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    char msg[600] = "";
-    if (status) {
-        snprintf(msg, sizeof msg, "%s", engine_error(l));
-        for (char* p = msg; *p; ++p)
-            if (*p == '"' || *p == '\\' || (unsigned char)*p < 0x20) *p = '\'';
-    }
+    char msg[600];
+    soak_failure(l, status, msg, sizeof msg);
     printf("{\"config\":\"soak\",\"world\":\"%s\",\"backend\":\"%s\",\"functions\":%d,\"seed\":%llu,"
            "\"sim_time_s\":%.3f,\"duration_s\":%g,\"wall_s\":%.3f,\"exit_status\":%d,\"rows\":%ld,"
            "\"columns\":%d,\"nonfinite_values\":%ld,\"peak_pressure_mpa\":%.3f,\"slew_range_deg\":[%.1f,%.1f],"
@@ -534,13 +540,8 @@ static int bench_soak(app_common* c, double duration, uint64_t seed) {
     const double wall = sim_wall_time() - w0;
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    // The failure text without quotes or backslashes (it goes into JSON).
-    char msg[600] = "";
-    if (status) {
-        snprintf(msg, sizeof msg, "%s", engine_error(l));
-        for (char* p = msg; *p; ++p)
-            if (*p == '"' || *p == '\\' || (unsigned char)*p < 0x20) *p = '\'';
-    }
+    char msg[600];
+    soak_failure(l, status, msg, sizeof msg);
     printf("{\"config\":\"soak\",\"world\":\"sandbox\",\"seed\":%llu,\"sim_time_s\":%.3f,\"duration_s\":%g,"
            "\"wall_s\":%.3f,\"exit_status\":%d,\"rows\":%ld,\"nonfinite_values\":%ld,\"peak_pressure_mpa\":%.3f,"
            "\"slew_range_deg\":[%.1f,%.1f],\"hook_toggles\":%d,\"loads_picked\":%d,\"ode_messages\":%ld,"
