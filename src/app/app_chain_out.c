@@ -14,11 +14,8 @@
 
 // The column index (in a row, base columns first) of "<what>_<name>"; -1.
 static int col_of(const crane_chain* cc, int off, const char* what, const char* name) {
-    char want[CRANE_NAME + 16];
-    snprintf(want, sizeof want, "%s_%s", what, name);
-    for (int k = 0; k < cc->ncol; ++k)
-        if (!strcmp(cc->col[k].name, want)) return off + k;
-    return -1;
+    const int k = crane_chain_find_column(cc, what, name);
+    return k < 0 ? -1 : off + k;
 }
 
 void app_chain_stats_free(app_chain_stats* s) {

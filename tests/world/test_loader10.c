@@ -42,14 +42,6 @@ typedef struct trace {
     int finite;
 } trace;
 
-static int column(const crane_chain* cc, const char* what, const char* name) {
-    char want[128];
-    snprintf(want, sizeof want, "%s_%s", what, name);
-    for (int c = 0; c < cc->ncol; ++c)
-        if (!strcmp(cc->col[c].name, want)) return c;
-    return -1;
-}
-
 static int on_row(void* user, const double* row) {
     trace* tr = user;
     if (tr->n == tr->cap) {
@@ -91,9 +83,9 @@ static int run(const model* m, const scenario* sc, sim_opts* o, bool slews, trac
     tr->nact = cc->nact < MAXA ? cc->nact : MAXA;
     for (int k = 0; k < tr->nact; ++k) {
         const char* a = cc->act[k].name;
-        tr->ix[k] = base + column(cc, "x", a);
-        tr->ipA[k] = base + column(cc, "pA", a);
-        tr->ipB[k] = base + column(cc, "pB", a);
+        tr->ix[k] = base + crane_chain_find_column(cc, "x", a);
+        tr->ipA[k] = base + crane_chain_find_column(cc, "pA", a);
+        tr->ipB[k] = base + crane_chain_find_column(cc, "pB", a);
         CHECK(tr->ix[k] >= base && tr->ipA[k] >= base && tr->ipB[k] >= base, "columns of %s", a);
     }
     if (slews && o->mechanics == SIM_ODE) tr->islew = COL_SLEW;
@@ -103,7 +95,7 @@ static int run(const model* m, const scenario* sc, sim_opts* o, bool slews, trac
         c2.slew_free = true;
         c2.slew_rack_columns = true;
         CHECK(crane_chain_columns(&c2) == 0, "columns");
-        const int q = column(&c2, "q", "column");
+        const int q = crane_chain_find_column(&c2, "q", "column");
         CHECK(q >= 0, "no q_column");
         tr->islew = base + q;
         crane_chain_free(&c2);

@@ -59,14 +59,6 @@ typedef struct trace {
     int finite;
 } trace;
 
-static int column(const crane_chain* cc, const char* what, const char* name) {
-    char want[128];
-    snprintf(want, sizeof want, "%s_%s", what, name);
-    for (int c = 0; c < cc->ncol; ++c)
-        if (!strcmp(cc->col[c].name, want)) return c;
-    return -1;
-}
-
 static int on_row(void* user, const double* row) {
     trace* tr = user;
     if (tr->n == tr->cap) {
@@ -110,9 +102,9 @@ static int run(const model* m, const scenario* sc, sim_opts* o, trace* tr, sim_r
     tr->nact = cc->nact < MAXA ? cc->nact : MAXA;
     for (int k = 0; k < tr->nact; ++k) {
         const char* a = cc->act[k].name;
-        tr->ix[k] = tr->base + column(cc, "x", a);
-        tr->ipA[k] = tr->base + column(cc, "pA", a);
-        tr->ipB[k] = tr->base + column(cc, "pB", a);
+        tr->ix[k] = tr->base + crane_chain_find_column(cc, "x", a);
+        tr->ipA[k] = tr->base + crane_chain_find_column(cc, "pA", a);
+        tr->ipB[k] = tr->base + crane_chain_find_column(cc, "pB", a);
         CHECK(tr->ix[k] >= tr->base && tr->ipA[k] >= tr->base && tr->ipB[k] >= tr->base, "columns of %s", a);
     }
     o->no_step_probe = true; // the default step: the probe passes it anyway

@@ -356,9 +356,8 @@ static void test_every_function(void) {
     for (int k = 0; k < cc->nact; ++k) {
         char want[64];
         snprintf(want, sizeof want, "x_%s", cc->act[k].name);
-        int col = -1;
-        for (int c = 0; c < cc->ncol; ++c)
-            if (!strcmp(cc->col[c].name, want)) col = base + c;
+        const int c = crane_chain_find_column(cc, "x", cc->act[k].name);
+        const int col = c < 0 ? -1 : base + c;
         CHECK(col >= 0, "no column %s", want);
         if (col < 0) continue;
         double lo = INFINITY, hi = -INFINITY;

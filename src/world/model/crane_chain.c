@@ -273,3 +273,12 @@ int crane_chain_find_function(const crane_chain* cc, const char* name) {
         if (!strcmp(cc->fn[i].name, name)) return i;
     return -1;
 }
+
+int crane_chain_find_column(const crane_chain* cc, const char* what, const char* name) {
+    const size_t lw = strlen(what);
+    for (int c = 0; c < cc->ncol; ++c) {
+        const char* n = cc->col[c].name;
+        if (!strncmp(n, what, lw) && n[lw] == '_' && !strcmp(n + lw + 1, name)) return c;
+    }
+    return -1;
+}

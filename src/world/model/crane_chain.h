@@ -196,6 +196,9 @@ void crane_chain_free(crane_chain* cc);
 int crane_chain_find_body(const crane_chain* cc, const char* name);
 int crane_chain_find_act(const crane_chain* cc, const char* name);
 int crane_chain_find_function(const crane_chain* cc, const char* name);
+/// Index in cc->col of the chain column "<what>_<name>" (what: "x", "pA",
+/// "ucmd", "q", ...; name: an actuator's, a function's or a body's), or -1.
+int crane_chain_find_column(const crane_chain* cc, const char* what, const char* name);
 
 #ifdef __cplusplus
 }
