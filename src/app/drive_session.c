@@ -12,6 +12,7 @@
 
 #include "channels.h"
 #include "input.h"
+#include "model_controls.h"
 #include "json_util.h"
 #include "panel.h"
 #include "protocol.h"
@@ -122,6 +123,7 @@ struct drive_session {
     char err[400];
     char status[512];
     // Remote mode (drive --connect): the snapshot and row come from the server.
+    double mapbox_off;   // wall time [s] the mapping box hides by itself (DRIVE_MAPPING_S), < 0: M decides
     bool remote;
     bool remote_fed;              // a state has arrived
     double remote_row[SIM_NCOL];  // its row (the server's channels, checked equal to the engine's)
@@ -698,10 +700,54 @@ int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t
             return EXIT_USAGE;
     }
     if (o->mapping_file) {
-        input_mapping map = input_default_mapping();
-        if (input_load_mapping(o->mapping_file, &map, err, errsz)) return EXIT_USAGE;
+        // Read and checked here; its function names against the model's
+        // functions when the session builds the mapping (setup_mapping).
+        model_controls* mc = malloc(sizeof *mc);
+        const int rc = !mc || controls_load_file(o->mapping_file, mc, err, errsz);
+        if (!mc) snprintf(err, errsz, "%s: out of memory", o->mapping_file);
+        free(mc);
+        if (rc) return EXIT_USAGE;
     }
     return 0;
+}
+
+// The operator's mapping for the engine's functions (engine_nfunction, in
+// its order, so command k of input_poll is function k): the default layout
+// (the mapping file's "layout", else the model's, else two-lever), then the
+// model's "controls" section, then the --mapping file over it. 0, or -1 with
+// one line naming the file and field in err.
+static int build_mapping(const drive_session* s, input_mapping* map, char* err, size_t errsz) {
+    const int n = engine_nfunction(s->l);
+    if (n > INPUT_MAX_FN) {
+        snprintf(err, errsz, "%s: %d functions; the drive's input mapping takes at most %d", s->m->file, n,
+                 INPUT_MAX_FN);
+        return -1;
+    }
+    const char* names[INPUT_MAX_FN];
+    for (int k = 0; k < n; ++k) names[k] = engine_function_name(s->l, k);
+    model_controls* fc = NULL;
+    int rc = 0;
+    if (s->o.mapping_file) {
+        fc = malloc(sizeof *fc);
+        rc = !fc || controls_load_file(s->o.mapping_file, fc, err, errsz);
+        if (!fc) snprintf(err, errsz, "%s: out of memory", s->o.mapping_file);
+    }
+    const model_controls* mc = s->m->controls;
+    const char* layout = fc && fc->layout[0] ? fc->layout : mc && mc->layout[0] ? mc->layout : NULL;
+    if (!rc) rc = input_layout_mapping(names, n, layout, map, err, errsz);
+    if (!rc && mc) rc = input_apply_controls(map, mc, s->m->file, "controls", err, errsz);
+    if (!rc && fc) rc = input_apply_controls(map, fc, s->o.mapping_file, "", err, errsz);
+    free(fc);
+    return rc ? -1 : 0;
+}
+
+// The mapping into the input layer and the HUD's box (its text, heading).
+static void show_mapping(drive_session* s, const input_mapping* map) {
+    char text[1536], title[96];
+    input_mapping_text(map, text, sizeof text);
+    snprintf(title, sizeof title, "controls (%s%s) - M hides", map->layout,
+             s->m->controls ? ", the model's" : "");
+    render_set_mapping(s->r, title, text);
 }
 
 // Chosen strip-chart channels: CSV column names, shown in display units
@@ -832,6 +878,16 @@ static void load_model(drive_session* s) {
     }
     model_free(old);
     ++s->st.rebuilds;
+    // The loaded model's functions and controls; a mapping it refuses
+    // (its controls against the --mapping file) keeps the one in use.
+    input_mapping map;
+    char me[400];
+    if (build_mapping(s, &map, me, sizeof me) == 0) {
+        input_set_mapping(s->in, &map);
+        show_mapping(s, &map);
+    } else {
+        fprintf(stderr, "cranesim drive: input mapping kept: %s\n", me);
+    }
     rebind_charts(s);
     setup_panel(s);
     saved(s); // the panel now edits the loaded file's model
@@ -1111,13 +1167,17 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         drive_session_destroy(s);
         return NULL;
     }
-    input_mapping map = input_default_mapping();
-    if (o->mapping_file && input_load_mapping(o->mapping_file, &map, err, errsz)) {
+    input_mapping map;
+    if (build_mapping(s, &map, err, errsz)) {
         drive_session_destroy(s);
         *code = EXIT_USAGE;
         return NULL;
     }
     s->in = input_create(&map);
+    // The box for the first DRIVE_MAPPING_S of the drive (M toggles it).
+    show_mapping(s, &map);
+    render_show_mapping(s->r, true);
+    s->mapbox_off = DRIVE_MAPPING_S;
     snprintf(s->load_path, sizeof s->load_path, "%s", s->m->file);
     // The panel starts hidden (Tab shows it): on llvmpipe it costs ~4 fps at
     // 1280x720 (56 vs 60 fps, cranesim bench --config drive), and the scene
@@ -1403,6 +1463,14 @@ int drive_session_tick(drive_session* s, double wall) {
         if (cmd.pause) s->paused = !s->paused;
         if (cmd.reset) act_reset(s); // ends the session file
     }
+    if (cmd.mapping_box) {
+        render_show_mapping(s->r, !render_mapping_shown(s->r));
+        s->mapbox_off = -1; // the operator decides from now on
+    }
+    if (s->mapbox_off >= 0 && wall >= s->mapbox_off) {
+        render_show_mapping(s->r, false);
+        s->mapbox_off = -1;
+    }
     if (cmd.camera_next) render_set_camera_preset(s->r, (render_get_camera_preset(s->r) + 1) % RENDER_CAM_COUNT);
     if (cmd.camera_preset >= 0) render_set_camera_preset(s->r, (render_cam_preset)cmd.camera_preset);
     if (cmd.screenshot) {
@@ -1487,7 +1555,15 @@ int drive_session_tick(drive_session* s, double wall) {
             if (engine_hook_report(s->l, want, s->status, sizeof s->status) < 0 && want)
                 fprintf(stderr, "cranesim drive: %s\n", s->status);
         }
-        engine_set_commands(s->l, u);
+        if (!s->o.scripted && !(engine_caps(s->l) & ENGINE_CAP_TWO_LINK)) {
+            // A chain engine takes its commands by function: the mapping was
+            // built from engine_nfunction's list, so cmd.u[k] is function k.
+            char fe[200];
+            if (engine_set_function_commands(s->l, cmd.u, cmd.n, fe, sizeof fe))
+                snprintf(s->status, sizeof s->status, "input: %s", fe);
+        } else {
+            engine_set_commands(s->l, u);
+        }
         ++s->st.input_samples;
         // Keep simulated time on wall time. More than 0.1 s behind means the
         // machine cannot keep up: count it and let the clock slip rather than

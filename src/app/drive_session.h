@@ -31,12 +31,15 @@ struct panel;
 /// With panel changes not saved, Esc asks first: a second Esc within this
 /// wall time quits [s].
 #define DRIVE_QUIT_CONFIRM_S 3.0
+/// The HUD's input mapping box shows for this much wall time at the start
+/// of a drive [s], then hides; M shows or hides it any time.
+#define DRIVE_MAPPING_S 8.0
 
 typedef struct drive_opts {
     int width, height;        ///< window or offscreen size [px] (default 1280 x 720)
     bool offscreen;           ///< render into an FBO, no window
     double fps_cap;           ///< render at most this many frames per second (default 65)
-    const char* mapping_file; ///< joystick axis mapping JSON, or NULL for defaults
+    const char* mapping_file; ///< input mapping by function (JSON, docs/render.md), or NULL: the model's / defaults
     const char* record_path;  ///< start recording to this CSV at once, or NULL (F5 toggles)
     bool scripted;            ///< operator input from the scenario instead of devices
     bool hud;                 ///< draw the HUD (default true)

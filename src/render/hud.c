@@ -536,6 +536,7 @@ void render_hud_draw_overlay(render* r, const world_snapshot* s) {
     draw_readouts(r, s);
     draw_rcl_bar(r, s);
     draw_warnings(r, w, nw);
+    render_hud_draw_mapping(r);
     if (r->link[0]) { // the remote link, top right, clear of the warnings at the centre
         const float tw = render_hud_text_width(r->link, 1.0f);
         render_hud_rect(h, (float)h->w - tw - 16, 4, tw + 12, 16, k_panel);

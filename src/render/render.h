@@ -208,6 +208,13 @@ const char* render_get_readout(const render* r, int k, double* value, const char
 /// latency), drawn small at the top right; NULL or "" for none. down, when
 /// not NULL or "", is the first warning line (the link dropped).
 void render_set_link(render* r, const char* text, const char* down);
+/// The input mapping box (hud_mapping.c): a heading and one line per
+/// function as input_mapping_text gives them; shown or hidden.
+void render_set_mapping(render* r, const char* title, const char* text);
+void render_show_mapping(render* r, bool on);
+bool render_mapping_shown(const render* r);
+/// The text the mapping box is drawn from ("" none).
+const char* render_mapping_text(const render* r);
 /// The status line as last set.
 const char* render_get_status(const render* r);
 /// Longest warning line and most lines render_hud_warnings gives.

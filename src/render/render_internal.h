@@ -187,6 +187,8 @@ void render_hud_flush(render_hud* h);
 
 /// Everything the HUD shows for one snapshot (bars, readouts, warnings).
 void render_hud_draw_overlay(render* r, const world_snapshot* s);
+/// The input mapping box, when shown (hud_mapping.c).
+void render_hud_draw_mapping(render* r);
 
 // ---- strip charts (strip_chart.c) ------------------------------------------
 
@@ -235,6 +237,9 @@ struct render {
     char status[128];
     char link[160];    ///< the remote link line (drive --connect), "" none
     char link_down[RENDER_WARN_LEN]; ///< the link is down: this warning, "" while it is up
+    char mapping_title[96];          ///< the input mapping box (hud_mapping.c): its heading
+    char mapping_text[1536];         ///< its lines (input_mapping_text), "" none
+    bool mapping_shown;
     struct {
         char name[64], unit[16];
         double value;

@@ -378,6 +378,30 @@ static int read_shorthand(json_ctx* c, const cJSON* mech, crane_mech* me) {
     return 0;
 }
 
+// The optional "controls" section (model_controls.h): parsed, and every
+// function it names checked against the model's (its chain's, and "slew"
+// where the crane slews: the two-link crane always takes a slew command).
+static int read_controls(model* m, const cJSON* root, const char* file, char* err, size_t errsz) {
+    const cJSON* o = cJSON_GetObjectItemCaseSensitive(root, "controls");
+    if (!o) return 0;
+    model_controls* mc = malloc(sizeof *mc);
+    if (!mc) {
+        snprintf(err, errsz, "%s: out of memory", file);
+        return -1;
+    }
+    m->controls = mc;
+    if (controls_parse(o, file, "controls", mc, err, errsz)) return -1;
+    const char* names[CONTROLS_MAX_FN + 1];
+    int n = 0;
+    bool slew = m->chain.two_link || m->chain.slew.present;
+    for (int i = 0; i < m->chain.nfn && n < CONTROLS_MAX_FN; ++i) {
+        names[n++] = m->chain.fn[i].name;
+        if (!strcmp(m->chain.fn[i].name, "slew")) slew = false;
+    }
+    if (slew) names[n++] = "slew";
+    return controls_check_functions(mc, names, n, file, "controls", err, errsz);
+}
+
 model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     model* m = calloc(1, sizeof *m);
     if (!m) {
@@ -390,7 +414,8 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     json_ctx c = {.file = file, .err = err, .errsz = errsz};
     if (!cJSON_IsObject(root)) json_fail(&c, "", "a model must be a JSON object");
     if (json_wrong_kind(&c, root, "model")) goto fail;
-    static const char* const keys[] = {"name", "description", "mechanics", "hydraulics", "hydraulics_slew", NULL};
+    static const char* const keys[] = {"name",           "description", "mechanics", "hydraulics",
+                                       "hydraulics_slew", "controls",    NULL};
     json_only_keys(&c, root, "", keys);
     json_str(&c, root, "", "name", false, "crane", m->name, sizeof m->name);
 
@@ -453,6 +478,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
     if (chain_form) {
         if (model_chain_bind(&c, m)) goto fail;
         m->chain.slew = slew;
+        if (read_controls(m, root, file, err, errsz)) goto fail;
         return m;
     }
 
@@ -500,6 +526,7 @@ model* model_from_json(cJSON* root, const char* file, char* err, size_t errsz) {
         m->chain.body[0].width = m->chain.body[0].height = 2.0 * slew.column_radius;
     }
     m->chain.slew = slew;
+    if (read_controls(m, root, file, err, errsz)) goto fail;
     return m;
 fail: // err already holds the one-line message
     model_free(m);
@@ -594,6 +621,7 @@ void model_free(model* m) {
     if (!m) return;
     hyd_model_free(m->hyd);
     crane_chain_free(&m->chain);
+    free(m->controls);
     cJSON_Delete(m->json);
     cJSON_Delete(m->world_bursts);
     free(m);

@@ -9,6 +9,7 @@
 #include "crane_chain.h"
 #include "crane_model.h"
 #include "hydraulics.h"
+#include "model_controls.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -34,6 +35,10 @@ typedef struct model {
     /// circuit refuses a model that has them (engine_world_bursts).
     cJSON* world_bursts;
     char world_bursts_src[128]; ///< the scenario file they come from (messages)
+    /// The operator's input mapping by function (the model's "controls"
+    /// section, docs/render.md), NULL when the model has none: drive then
+    /// lays the functions out by its defaults. Owned.
+    model_controls* controls;
 } model;
 
 /// Load a model file and apply "path=value" overrides (see json_set_path) in

@@ -1,0 +1,52 @@
+// hud_mapping.c: the HUD's input mapping box: which stick, button pair and
+// keys drive each function of the crane (input_mapping_text gives the lines,
+// the drive session sets them). Shown for the first seconds of a drive and on
+// M, so an operator of a model with five or eight functions need not guess.
+#include <stdio.h>
+#include <string.h>
+
+#include "render_internal.h"
+
+void render_set_mapping(render* r, const char* title, const char* text) {
+    snprintf(r->mapping_title, sizeof r->mapping_title, "%s", title ? title : "");
+    snprintf(r->mapping_text, sizeof r->mapping_text, "%s", text ? text : "");
+}
+
+void render_show_mapping(render* r, bool on) { r->mapping_shown = on; }
+
+bool render_mapping_shown(const render* r) { return r->mapping_shown; }
+
+const char* render_mapping_text(const render* r) { return r->mapping_text; }
+
+void render_hud_draw_mapping(render* r) {
+    if (!r->mapping_shown || !r->mapping_text[0]) return;
+    static const float bg[4] = {0.05f, 0.06f, 0.08f, 0.72f}, white[4] = {1, 1, 1, 1},
+                       head[4] = {0.55f, 0.85f, 1.0f, 1};
+    render_hud* h = &r->hud;
+    // Measure: the widest line at scale 1 (stb_easy_font, ~12 px per line).
+    char line[160];
+    float tw = render_hud_text_width(r->mapping_title, 1.0f);
+    int nline = 0;
+    for (const char* p = r->mapping_text; *p;) {
+        const char* e = strchr(p, '\n');
+        const size_t len = e ? (size_t)(e - p) : strlen(p);
+        snprintf(line, sizeof line, "%.*s", (int)(len < sizeof line ? len : sizeof line - 1), p);
+        const float w = render_hud_text_width(line, 1.0f);
+        if (w > tw) tw = w;
+        ++nline;
+        p += len + (e ? 1 : 0);
+    }
+    // Top left, under the status lines: clear of the warnings (top centre),
+    // the link line (top right), the load-moment bar and the charts (bottom).
+    const float x = 14, y = 64, lh = 13;
+    render_hud_rect(h, x - 6, y - 6, tw + 12, lh * (float)(nline + 1) + 10, bg);
+    render_hud_text(h, x, y, 1.0f, head, r->mapping_title);
+    float yy = y + lh + 2;
+    for (const char* p = r->mapping_text; *p; yy += lh) {
+        const char* e = strchr(p, '\n');
+        const size_t len = e ? (size_t)(e - p) : strlen(p);
+        snprintf(line, sizeof line, "%.*s", (int)(len < sizeof line ? len : sizeof line - 1), p);
+        render_hud_text(h, x, yy, 1.0f, white, line);
+        p += len + (e ? 1 : 0);
+    }
+}
