@@ -75,6 +75,24 @@ static const SDL_Scancode k_four_lever_keys[INPUT_MAX_FN][2] = {
     {SDL_SCANCODE_HOME, SDL_SCANCODE_END},    {SDL_SCANCODE_INSERT, SDL_SCANCODE_DELETE},
     {SDL_SCANCODE_UP, SDL_SCANCODE_DOWN},     {SDL_SCANCODE_LEFT, SDL_SCANCODE_RIGHT}};
 
+// The sense that feels right for function name on controller axis axis (-1:
+// a + / - pair, which says its sense itself). SDL gives + for a stick down
+// or right: up raises (inverted); on an x axis a function extends to the
+// right, but the slew turns counter-clockwise seen from above (+) to the
+// left, so only the slew is inverted there.
+static bool natural_invert(const char* name, int axis) {
+    switch (axis) {
+    case SDL_CONTROLLER_AXIS_LEFTY:
+    case SDL_CONTROLLER_AXIS_RIGHTY:
+        return true;
+    case SDL_CONTROLLER_AXIS_LEFTX:
+    case SDL_CONTROLLER_AXIS_RIGHTX:
+        return !strcmp(name, "slew");
+    default:
+        return false;
+    }
+}
+
 static void set_common(input_mapping* m) {
     const int cb[INPUT_BUTTON_COUNT] = {SDL_CONTROLLER_BUTTON_A, SDL_CONTROLLER_BUTTON_START,
                                         SDL_CONTROLLER_BUTTON_BACK, SDL_CONTROLLER_BUTTON_Y,
@@ -172,11 +190,7 @@ int input_layout_mapping(const char* const* names, int n, const char* layout, in
             a->key[0] = k_extra_keys[k - 8][0];
             a->key[1] = k_extra_keys[k - 8][1];
         }
-        // On a stick's x axis SDL gives + to the right: a function extends
-        // (or opens) to the right, the slew turns counter-clockwise seen
-        // from above to the left (+), so only the slew is inverted there.
-        if (a->controller_axis == SDL_CONTROLLER_AXIS_LEFTX || a->controller_axis == SDL_CONTROLLER_AXIS_RIGHTX)
-            a->invert = !strcmp(names[i], "slew");
+        a->invert = natural_invert(names[i], a->controller_axis);
     }
     set_common(&t);
     *m = t;
@@ -576,12 +590,15 @@ static double pair_input(const input* in, int code) {
 static double device_axis(const input* in, int a) {
     const input_axis_map* m = &in->map.axis[a];
     double raw = 0;
+    bool pair = false;
     if (in->gc) {
+        pair = m->controller_axis < 0;
         if (m->controller_axis >= 0 && m->controller_axis < SDL_CONTROLLER_AXIS_MAX)
             raw = SDL_GameControllerGetAxis(in->gc, (SDL_GameControllerAxis)m->controller_axis) / 32767.0;
-        else if (m->controller_axis < 0)
+        else if (pair)
             raw = pair_input(in, m->controller_pair[0]) - pair_input(in, m->controller_pair[1]);
     } else if (in->js) {
+        pair = m->joystick_axis < 0;
         if (m->joystick_axis >= 0) {
             if (m->joystick_axis >= SDL_JoystickNumAxes(in->js)) return 0;
             raw = SDL_JoystickGetAxis(in->js, m->joystick_axis) / 32767.0;
@@ -596,7 +613,8 @@ static double device_axis(const input* in, int a) {
         return 0;
     }
     double y = input_shape(raw, m->dead_zone, m->expo) * m->scale;
-    return m->invert ? -y : y;
+    // invert is an axis' sense; a pair says its sense by its order (+ first).
+    return m->invert && !pair ? -y : y;
 }
 
 void input_poll(input* in, double dt, input_command* out) {
