@@ -18,7 +18,13 @@ bool render_mapping_shown(const render* r) { return r->mapping_shown; }
 
 const char* render_mapping_text(const render* r) { return r->mapping_text; }
 
+bool render_mapping_rect(const render* r, int rect[4]) {
+    for (int k = 0; k < 4; ++k) rect[k] = (int)r->mapping_rect[k];
+    return r->mapping_rect[2] > 0;
+}
+
 void render_hud_draw_mapping(render* r) {
+    r->mapping_rect[2] = 0;
     if (!r->mapping_shown || !r->mapping_text[0]) return;
     static const float bg[4] = {0.05f, 0.06f, 0.08f, 0.72f}, white[4] = {1, 1, 1, 1},
                        head[4] = {0.55f, 0.85f, 1.0f, 1};
@@ -36,10 +42,13 @@ void render_hud_draw_mapping(render* r) {
         ++nline;
         p += len + (e ? 1 : 0);
     }
-    // Top left, under the status lines: clear of the warnings (top centre),
-    // the link line (top right), the load-moment bar and the charts (bottom).
-    const float x = 14, y = 64, lh = 13;
-    render_hud_rect(h, x - 6, y - 6, tw + 12, lh * (float)(nline + 1) + 10, bg);
+    // Right, above the load-moment bar (hud.c draws it 150 px over the
+    // bottom, 18 px over its bar): clear of the readouts (top left), the
+    // warnings (top centre), the link line (top right) and the charts.
+    const float lh = 13, bw = tw + 12, bh = lh * (float)(nline + 1) + 10;
+    const float x = (float)h->w - bw - 8, y = (float)h->h - 164 - 18 - 12 - bh + 6;
+    render_hud_rect(h, x - 6, y - 6, bw, bh, bg);
+    r->mapping_rect[0] = x - 6, r->mapping_rect[1] = y - 6, r->mapping_rect[2] = bw, r->mapping_rect[3] = bh;
     render_hud_text(h, x, y, 1.0f, head, r->mapping_title);
     float yy = y + lh + 2;
     for (const char* p = r->mapping_text; *p; yy += lh) {

@@ -215,6 +215,9 @@ void render_show_mapping(render* r, bool on);
 bool render_mapping_shown(const render* r);
 /// The text the mapping box is drawn from ("" none).
 const char* render_mapping_text(const render* r);
+/// Where the last frame drew the mapping box: x, y (top left), w, h [px];
+/// false when it drew none.
+bool render_mapping_rect(const render* r, int rect[4]);
 /// The status line as last set.
 const char* render_get_status(const render* r);
 /// Longest warning line and most lines render_hud_warnings gives.

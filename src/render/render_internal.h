@@ -240,6 +240,7 @@ struct render {
     char mapping_title[96];          ///< the input mapping box (hud_mapping.c): its heading
     char mapping_text[1536];         ///< its lines (input_mapping_text), "" none
     bool mapping_shown;
+    float mapping_rect[4];           ///< where the box was last drawn (x, y, w, h from top left) [px]; w 0: not drawn
     struct {
         char name[64], unit[16];
         double value;

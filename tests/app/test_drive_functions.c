@@ -104,18 +104,18 @@ static void drive_each_function(drive_session* s, double* wall, int nwant) {
     run_for(s, wall, 0.05);
 }
 
-// Pixels of the box's corner of the frame that differ between two frames.
-static long box_pixels_differ(drive_session* s, const unsigned char* a) {
+// Pixels inside rect (x, y, w, h from the top) that differ between frame a
+// and the frame now.
+static long pixels_differ(drive_session* s, const unsigned char* a, const int rect[4]) {
     render* r = drive_session_render_ctx(s);
     int w, h;
     render_size(r, &w, &h);
     unsigned char* b = malloc((size_t)w * h * 4);
     render_read_pixels(r, b, w, h);
     long n = 0;
-    // The box sits top left from y = 58 px down (hud_mapping.c); the read
-    // is bottom-up, so compare the rows from the top of the frame.
-    for (int y = h - 200; y < h - 58; ++y)
-        for (int x = 8; x < 300; ++x) n += memcmp(a + ((size_t)y * w + x) * 4, b + ((size_t)y * w + x) * 4, 3) != 0;
+    for (int y = rect[1]; y < rect[1] + rect[3] && y < h; ++y)
+        for (int x = rect[0]; x < rect[0] + rect[2] && x < w; ++x)
+            n += memcmp(a + ((size_t)y * w + x) * 4, b + ((size_t)y * w + x) * 4, 3) != 0;
     free(b);
     return n;
 }
@@ -149,15 +149,25 @@ static void test_default_crane_mapping_file(void) {
     drive_each_function(s, &wall, 3);
     // The box: shown at the start, gone after DRIVE_MAPPING_S, back on M.
     CHECK(render_mapping_shown(r), "shown at the start (t = %.1f s)", wall);
-    drive_session_render(s);
+    // Drawn: the same state rendered with and without it differs where it sits.
     int w, h;
     render_size(r, &w, &h);
     unsigned char* shown = malloc((size_t)w * h * 4);
+    drive_session_render(s);
+    if (getenv("MAPBOX_PNG")) drive_session_screenshot(s, getenv("MAPBOX_PNG"), err, sizeof err);
     render_read_pixels(r, shown, w, h);
+    int rect[4] = {0, 0, 0, 0};
+    CHECK(render_mapping_rect(r, rect) && rect[0] >= 0 && rect[1] >= 0 && rect[0] + rect[2] <= w &&
+              rect[1] + rect[3] <= h,
+          "drawn inside the frame: %d %d %d %d", rect[0], rect[1], rect[2], rect[3]);
+    render_show_mapping(r, false);
+    drive_session_render(s);
+    CHECK(!render_mapping_rect(r, (int[4]){0}), "hidden: not drawn");
+    const long differ = pixels_differ(s, shown, rect);
+    CHECK(differ > rect[2] * rect[3] / 4, "the box is drawn (%ld px of %d x %d differ)", differ, rect[2], rect[3]);
+    render_show_mapping(r, true);
     run_for(s, &wall, DRIVE_MAPPING_S - wall + 0.1);
     CHECK(!render_mapping_shown(r), "hidden after %.0f s", DRIVE_MAPPING_S);
-    drive_session_render(s);
-    CHECK(box_pixels_differ(s, shown) > 2000, "the box was drawn (%ld px differ)", box_pixels_differ(s, shown));
     push_key(SDL_SCANCODE_M, 1);
     push_key(SDL_SCANCODE_M, 0);
     run_for(s, &wall, 0.05);
