@@ -53,7 +53,7 @@ static void drive_help(FILE* f) {
             "                      chart, at 100 %% stops the motions that carry the load outwards and\n"
             "                      slewing towards a weaker sector (docs/safety.md); with --replay the\n"
             "                      default is the session's setting; with --connect the server's limiter acts\n"
-            "  --mapping FILE      joystick axis mapping (JSON, see docs/render.md)\n"
+            "  --mapping FILE      input mapping by function (JSON, see docs/render.md)\n"
             "  --charts LIST       strip-chart channels, CSV column names (up to 8), e.g.\n"
             "                      p1A,p1B,x1,u1,F1 (default: pressures, strokes, spools), or the\n"
             "                      circuit's channels: NODE.p, VALVE.spool, VALVE.qA/.qB, COMPONENT.q,\n"
