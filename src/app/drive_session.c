@@ -732,11 +732,28 @@ static int build_mapping(const drive_session* s, input_mapping* map, char* err, 
         rc = !fc || controls_load_file(s->o.mapping_file, fc, err, errsz);
         if (!fc) snprintf(err, errsz, "%s: out of memory", s->o.mapping_file);
     }
-    const model_controls* mc = s->m->controls;
+    // The model's section, as far as this engine has its functions: the
+    // loader checked its names against the model's, and a slewing chain's
+    // "slew" has no function in a world without a slew drive (validation).
+    model_controls* mc = NULL;
+    if (!rc && s->m->controls) {
+        mc = malloc(sizeof *mc);
+        if (!mc) {
+            snprintf(err, errsz, "%s: out of memory", s->m->file);
+            rc = -1;
+        } else {
+            *mc = *s->m->controls;
+            int keep = 0;
+            for (int i = 0; i < mc->nfn; ++i)
+                if (engine_find_function(s->l, mc->fn[i].function) >= 0) mc->fn[keep++] = mc->fn[i];
+            mc->nfn = keep;
+        }
+    }
     const char* layout = fc && fc->layout[0] ? fc->layout : mc && mc->layout[0] ? mc->layout : NULL;
     if (!rc) rc = input_layout_mapping(names, n, layout, map, err, errsz);
     if (!rc && mc) rc = input_apply_controls(map, mc, s->m->file, "controls", err, errsz);
     if (!rc && fc) rc = input_apply_controls(map, fc, s->o.mapping_file, "", err, errsz);
+    free(mc);
     free(fc);
     return rc ? -1 : 0;
 }
