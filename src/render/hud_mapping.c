@@ -12,14 +12,21 @@ void render_set_mapping(render* r, const char* title, const char* text) {
     snprintf(r->mapping_text, sizeof r->mapping_text, "%s", text ? text : "");
 }
 
-void render_show_mapping(render* r, bool on) { r->mapping_shown = on; }
+void render_show_mapping(render* r, bool on) {
+    r->mapping_shown = on;
+}
 
-bool render_mapping_shown(const render* r) { return r->mapping_shown; }
+bool render_mapping_shown(const render* r) {
+    return r->mapping_shown;
+}
 
-const char* render_mapping_text(const render* r) { return r->mapping_text; }
+const char* render_mapping_text(const render* r) {
+    return r->mapping_text;
+}
 
 bool render_mapping_rect(const render* r, int rect[4]) {
-    for (int k = 0; k < 4; ++k) rect[k] = (int)r->mapping_rect[k];
+    for (int k = 0; k < 4; ++k)
+        rect[k] = (int)r->mapping_rect[k];
     return r->mapping_rect[2] > 0;
 }
 
@@ -48,7 +55,8 @@ void render_hud_draw_mapping(render* r) {
     const float lh = 13, bw = tw + 12, bh = lh * (float)(nline + 1) + 10;
     const float x = (float)h->w - bw - 8, y = (float)h->h - 164 - 18 - 12 - bh + 6;
     render_hud_rect(h, x - 6, y - 6, bw, bh, bg);
-    r->mapping_rect[0] = x - 6, r->mapping_rect[1] = y - 6, r->mapping_rect[2] = bw, r->mapping_rect[3] = bh;
+    r->mapping_rect[0] = x - 6, r->mapping_rect[1] = y - 6, r->mapping_rect[2] = bw,
+    r->mapping_rect[3] = bh;
     render_hud_text(h, x, y, 1.0f, head, r->mapping_title);
     float yy = y + lh + 2;
     for (const char* p = r->mapping_text; *p; yy += lh) {

@@ -15,7 +15,8 @@
 
 #define MODEL6 CRANESIM_ASSETS "/../tests/world/data/chain_6fn_controls.json"
 
-static drive_session* open_with(const char* model, const char* mapping, char* err, size_t errsz, int* code) {
+static drive_session* open_with(const char* model, const char* mapping, char* err, size_t errsz,
+                                int* code) {
     app_common c = {.sim = sim_default_opts()};
     c.sim.mechanics = SIM_ODE; // the sandbox
     c.model_path = model;
@@ -79,25 +80,30 @@ static void drive_each_function(drive_session* s, double* wall, int nwant) {
     const int n = engine_nfunction(e);
     CHECK(n == nwant && m->naxis == n, "%d functions (mapping %d), want %d", n, m->naxis, nwant);
     for (int k = 0; k < n; ++k)
-        CHECK(!strcmp(m->axis[k].name, engine_function_name(e, k)), "mapping %d is %s, engine's %s", k,
-              m->axis[k].name, engine_function_name(e, k));
+        CHECK(!strcmp(m->axis[k].name, engine_function_name(e, k)), "mapping %d is %s, engine's %s",
+              k, m->axis[k].name, engine_function_name(e, k));
     const int idx = attach_pad();
     CHECK(idx >= 0, "attach: %s", SDL_GetError());
     if (idx < 0) return;
     SDL_Joystick* js = SDL_JoystickOpen(idx);
-    for (int k = 0; k < n; ++k) set_input(js, &m->axis[k], false);
+    for (int k = 0; k < n; ++k)
+        set_input(js, &m->axis[k], false);
     CHECK(run_for(s, wall, 0.1) == 0, "loop: %s", drive_session_error(s));
-    CHECK(input_active_source(drive_session_input(s)) == INPUT_SRC_CONTROLLER, "the pad is a game controller");
-    for (int j = 0; j < n; ++j) CHECK_NEAR(engine_function_command(e, j), 0.0, 0);
+    CHECK(input_active_source(drive_session_input(s)) == INPUT_SRC_CONTROLLER,
+          "the pad is a game controller");
+    for (int j = 0; j < n; ++j)
+        CHECK_NEAR(engine_function_command(e, j), 0.0, 0);
     for (int k = 0; k < n; ++k) {
         set_input(js, &m->axis[k], true);
         CHECK(run_for(s, wall, 0.05) == 0, "loop: %s", drive_session_error(s));
         for (int j = 0; j < n; ++j)
-            CHECK(fabs(engine_function_command(e, j) - (j == k ? 1.0 : 0.0)) < 1e-4, "%s moved: %s = %g",
-                  m->axis[k].name, engine_function_name(e, j), engine_function_command(e, j));
+            CHECK(fabs(engine_function_command(e, j) - (j == k ? 1.0 : 0.0)) < 1e-4,
+                  "%s moved: %s = %g", m->axis[k].name, engine_function_name(e, j),
+                  engine_function_command(e, j));
         set_input(js, &m->axis[k], false);
         CHECK(run_for(s, wall, 0.05) == 0, "loop: %s", drive_session_error(s));
-        for (int j = 0; j < n; ++j) CHECK_NEAR(engine_function_command(e, j), 0.0, 0);
+        for (int j = 0; j < n; ++j)
+            CHECK_NEAR(engine_function_command(e, j), 0.0, 0);
     }
     SDL_JoystickClose(js);
     SDL_JoystickDetachVirtual(idx);
@@ -130,7 +136,8 @@ static void test_default_crane_mapping_file(void) {
     CHECK(f != NULL, "write %s", path);
     if (!f) return;
     fputs("{\"axes\": {\"lift\": {\"controller\": [\"righttrigger\", \"lefttrigger\"]},\n"
-          "          \"jib\": {\"controller\": [\"rightshoulder\", \"leftshoulder\"], \"keys\": [\"I\", \"K\"]}}}\n",
+          "          \"jib\": {\"controller\": [\"rightshoulder\", \"leftshoulder\"], \"keys\": "
+          "[\"I\", \"K\"]}}}\n",
           f);
     fclose(f);
     drive_session* s = open_with(NULL, path, err, sizeof err, NULL);
@@ -142,9 +149,12 @@ static void test_default_crane_mapping_file(void) {
     // The box's text is the mapping the input layer uses, line by line.
     char want[1536];
     input_mapping_text(input_get_mapping(drive_session_input(s)), want, sizeof want);
-    CHECK(!strcmp(render_mapping_text(r), want), "HUD box:\n%s\nmapping:\n%s", render_mapping_text(r), want);
-    CHECK(strstr(render_mapping_text(r), "lift     RT / LT") && strstr(render_mapping_text(r), "jib      RB / LB") &&
-              strstr(render_mapping_text(r), "I / K") && strstr(render_mapping_text(r), "slew     left stick X"),
+    CHECK(!strcmp(render_mapping_text(r), want), "HUD box:\n%s\nmapping:\n%s",
+          render_mapping_text(r), want);
+    CHECK(strstr(render_mapping_text(r), "lift     RT / LT") &&
+              strstr(render_mapping_text(r), "jib      RB / LB") &&
+              strstr(render_mapping_text(r), "I / K") &&
+              strstr(render_mapping_text(r), "slew     left stick X"),
           "the file's mapping:\n%s", render_mapping_text(r));
     drive_each_function(s, &wall, 3);
     // The box: shown at the start, gone after DRIVE_MAPPING_S, back on M.
@@ -164,7 +174,8 @@ static void test_default_crane_mapping_file(void) {
     drive_session_render(s);
     CHECK(!render_mapping_rect(r, (int[4]){0}), "hidden: not drawn");
     const long differ = pixels_differ(s, shown, rect);
-    CHECK(differ > rect[2] * rect[3] / 4, "the box is drawn (%ld px of %d x %d differ)", differ, rect[2], rect[3]);
+    CHECK(differ > rect[2] * rect[3] / 4, "the box is drawn (%ld px of %d x %d differ)", differ,
+          rect[2], rect[3]);
     render_show_mapping(r, true);
     run_for(s, &wall, DRIVE_MAPPING_S - wall + 0.1);
     CHECK(!render_mapping_shown(r), "hidden after %.0f s", DRIVE_MAPPING_S);
@@ -196,7 +207,9 @@ static void test_model_controls_in_the_session(void) {
     text[n] = '\0';
     const char* brace = strchr(text, '{');
     FILE* f = fopen(path, "w");
-    fprintf(f, "{\"controls\": {\"axes\": {\"lift\": {\"controller\": [\"dpup\", \"dpdown\"], \"keys\": [\"Y\", \"N\"]}}},%s",
+    fprintf(f,
+            "{\"controls\": {\"axes\": {\"lift\": {\"controller\": [\"dpup\", \"dpdown\"], "
+            "\"keys\": [\"Y\", \"N\"]}}},%s",
             brace + 1);
     fclose(f);
     drive_session* s = open_with(path, NULL, err, sizeof err, NULL);
@@ -205,7 +218,8 @@ static void test_model_controls_in_the_session(void) {
     double wall = 0;
     run_for(s, &wall, 0.2);
     const char* t = render_mapping_text(drive_session_render_ctx(s));
-    CHECK(strstr(t, "lift     d-pad up / d-pad down |") && strstr(t, "| Y / N\n"), "the model's lift:\n%s", t);
+    CHECK(strstr(t, "lift     d-pad up / d-pad down |") && strstr(t, "| Y / N\n"),
+          "the model's lift:\n%s", t);
     // Y raises through the keyboard path (Up no longer does).
     engine* e = drive_session_engine(s);
     push_key(SDL_SCANCODE_UP, 1);
@@ -245,7 +259,8 @@ static void test_six_functions_in_the_session(void) {
     double wall = 0;
     run_for(s, &wall, 0.2);
     const char* t = render_mapping_text(drive_session_render_ctx(s));
-    CHECK(strstr(t, "ext2     d-pad up / d-pad down | btn 5 / 4 | Y / N\n") != NULL, "the model's ext2:\n%s", t);
+    CHECK(strstr(t, "ext2     d-pad up / d-pad down | btn 5 / 4 | Y / N\n") != NULL,
+          "the model's ext2:\n%s", t);
     drive_each_function(s, &wall, 6);
     drive_session_destroy(s);
 }

@@ -38,17 +38,19 @@ static void test_names_are_sdl_names(void) {
     for (int i = 0; controls_keys[i]; ++i) {
         const SDL_Scancode sc = SDL_GetScancodeFromName(controls_keys[i]);
         CHECK(sc != SDL_SCANCODE_UNKNOWN, "key \"%s\" unknown to SDL", controls_keys[i]);
-        CHECK(!strcmp(SDL_GetScancodeName(sc), controls_keys[i]), "key \"%s\" is \"%s\" in SDL", controls_keys[i],
-              SDL_GetScancodeName(sc));
+        CHECK(!strcmp(SDL_GetScancodeName(sc), controls_keys[i]), "key \"%s\" is \"%s\" in SDL",
+              controls_keys[i], SDL_GetScancodeName(sc));
     }
     for (int i = 0; controls_window_keys[i][0]; ++i)
-        CHECK(SDL_GetScancodeFromName(controls_window_keys[i][0]) != SDL_SCANCODE_UNKNOWN, "window key \"%s\"",
-              controls_window_keys[i][0]);
+        CHECK(SDL_GetScancodeFromName(controls_window_keys[i][0]) != SDL_SCANCODE_UNKNOWN,
+              "window key \"%s\"", controls_window_keys[i][0]);
     for (int i = 0; controls_controller_axes[i]; ++i)
-        CHECK(SDL_GameControllerGetAxisFromString(controls_controller_axes[i]) != SDL_CONTROLLER_AXIS_INVALID,
+        CHECK(SDL_GameControllerGetAxisFromString(controls_controller_axes[i]) !=
+                  SDL_CONTROLLER_AXIS_INVALID,
               "axis \"%s\"", controls_controller_axes[i]);
     for (int i = 0; controls_controller_buttons[i]; ++i)
-        CHECK(SDL_GameControllerGetButtonFromString(controls_controller_buttons[i]) != SDL_CONTROLLER_BUTTON_INVALID,
+        CHECK(SDL_GameControllerGetButtonFromString(controls_controller_buttons[i]) !=
+                  SDL_CONTROLLER_BUTTON_INVALID,
               "button \"%s\"", controls_controller_buttons[i]);
 }
 
@@ -59,16 +61,19 @@ static void test_default_crane_unchanged(void) {
     const input_mapping m = input_default_mapping();
     CHECK(m.naxis == 3, "3 functions, got %d", m.naxis);
     static const char* const names[3] = {"lift", "jib", "slew"};
-    const int ca[3] = {SDL_CONTROLLER_AXIS_LEFTY, SDL_CONTROLLER_AXIS_RIGHTY, SDL_CONTROLLER_AXIS_LEFTX};
+    const int ca[3] = {SDL_CONTROLLER_AXIS_LEFTY, SDL_CONTROLLER_AXIS_RIGHTY,
+                       SDL_CONTROLLER_AXIS_LEFTX};
     const int ja[3] = {1, 3, 0};
-    const int keys[3][4] = {{SDL_SCANCODE_UP, SDL_SCANCODE_DOWN, 0, 0},
-                            {SDL_SCANCODE_W, SDL_SCANCODE_S, 0, 0},
-                            {SDL_SCANCODE_LEFT, SDL_SCANCODE_RIGHT, SDL_SCANCODE_A, SDL_SCANCODE_D}};
+    const int keys[3][4] = {
+        {SDL_SCANCODE_UP, SDL_SCANCODE_DOWN, 0, 0},
+        {SDL_SCANCODE_W, SDL_SCANCODE_S, 0, 0},
+        {SDL_SCANCODE_LEFT, SDL_SCANCODE_RIGHT, SDL_SCANCODE_A, SDL_SCANCODE_D}};
     for (int i = 0; i < 3; ++i) {
         const input_axis_map* a = &m.axis[i];
         CHECK(!strcmp(a->name, names[i]), "function %d is %s", i, a->name);
-        CHECK(a->controller_axis == ca[i] && a->joystick_axis == ja[i] && a->invert, "%s: axis %d, raw %d, inv %d",
-              names[i], a->controller_axis, a->joystick_axis, a->invert);
+        CHECK(a->controller_axis == ca[i] && a->joystick_axis == ja[i] && a->invert,
+              "%s: axis %d, raw %d, inv %d", names[i], a->controller_axis, a->joystick_axis,
+              a->invert);
         CHECK(a->key[0] == keys[i][0] && a->key[1] == keys[i][1] && a->key_alt[0] == keys[i][2] &&
                   a->key_alt[1] == keys[i][3],
               "%s keys", names[i]);
@@ -96,7 +101,8 @@ static bool is_window_key(int sc) {
 static void check_layout(const char* const* names, int n, const char* layout) {
     input_mapping m;
     char err[200] = "";
-    CHECK(input_layout_mapping(names, n, layout, &m, err, sizeof err) == 0, "%d %s: %s", n, layout, err);
+    CHECK(input_layout_mapping(names, n, layout, &m, err, sizeof err) == 0, "%d %s: %s", n, layout,
+          err);
     int used[64], nused = 0, jused[64], njused = 0, keys[64], nkeys = 0;
     for (int i = 0; i < n; ++i) {
         const input_axis_map* a = &m.axis[i];
@@ -106,19 +112,24 @@ static void check_layout(const char* const* names, int n, const char* layout) {
         CHECK(nc > 0, "%s (%d, %s): no controller input", names[i], n, layout);
         for (int k = 0; k < nc; ++k) {
             for (int j = 0; j < nused; ++j)
-                CHECK(used[j] != code[k], "%s (%d, %s): controller input %d twice", names[i], n, layout, code[k]);
+                CHECK(used[j] != code[k], "%s (%d, %s): controller input %d twice", names[i], n,
+                      layout, code[k]);
             // Not one of the buttons hook, pause, reset, screenshot, camera.
             for (int b = 0; b < INPUT_BUTTON_COUNT; ++b)
-                CHECK(code[k] != INPUT_PAIR_BUTTON + m.controller_button[b], "%s: a command button", names[i]);
+                CHECK(code[k] != INPUT_PAIR_BUTTON + m.controller_button[b], "%s: a command button",
+                      names[i]);
             used[nused++] = code[k];
         }
-        const int jn = a->joystick_axis >= 0 ? 1 : (a->joystick_button[0] >= 0) + (a->joystick_button[1] >= 0);
+        const int jn =
+            a->joystick_axis >= 0 ? 1 : (a->joystick_button[0] >= 0) + (a->joystick_button[1] >= 0);
         CHECK(jn > 0, "%s (%d, %s): no joystick input", names[i], n, layout);
-        const int jcode[3] = {a->joystick_axis, a->joystick_button[0] >= 0 ? 1000 + a->joystick_button[0] : -1,
+        const int jcode[3] = {a->joystick_axis,
+                              a->joystick_button[0] >= 0 ? 1000 + a->joystick_button[0] : -1,
                               a->joystick_button[1] >= 0 ? 1000 + a->joystick_button[1] : -1};
         for (int k = 0; k < 3; ++k) {
             if (jcode[k] < 0) continue;
-            for (int j = 0; j < njused; ++j) CHECK(jused[j] != jcode[k], "%s: joystick input twice", names[i]);
+            for (int j = 0; j < njused; ++j)
+                CHECK(jused[j] != jcode[k], "%s: joystick input twice", names[i]);
             for (int b = 0; b < INPUT_BUTTON_COUNT; ++b)
                 CHECK(jcode[k] != 1000 + m.joystick_button[b], "%s: a command button", names[i]);
             jused[njused++] = jcode[k];
@@ -127,9 +138,11 @@ static void check_layout(const char* const* names, int n, const char* layout) {
         CHECK(kk[0] && kk[1], "%s (%d, %s): no key pair", names[i], n, layout);
         for (int k = 0; k < 4; ++k) {
             if (!kk[k]) continue;
-            CHECK(!is_window_key(kk[k]), "%s: key %s is the window's", names[i], SDL_GetScancodeName(kk[k]));
+            CHECK(!is_window_key(kk[k]), "%s: key %s is the window's", names[i],
+                  SDL_GetScancodeName(kk[k]));
             for (int j = 0; j < nkeys; ++j)
-                CHECK(keys[j] != kk[k], "%s (%d, %s): key %s twice", names[i], n, layout, SDL_GetScancodeName(kk[k]));
+                CHECK(keys[j] != kk[k], "%s (%d, %s): key %s twice", names[i], n, layout,
+                      SDL_GetScancodeName(kk[k]));
             keys[nkeys++] = kk[k];
         }
     }
@@ -144,8 +157,8 @@ static void check_layout(const char* const* names, int n, const char* layout) {
             input_poll(in, 10.0, &cmd); // past the keyboard ramp
             for (int j = 0; j < n; ++j)
                 CHECK_NEAR(cmd.u[j], j == i ? (s ? -1.0 : 1.0) : 0.0, 0);
-            CHECK(!cmd.hook_toggle && !cmd.pause && !cmd.reset && !cmd.screenshot && !cmd.quit && !cmd.camera_next &&
-                      cmd.camera_preset < 0 && !cmd.mapping_box,
+            CHECK(!cmd.hook_toggle && !cmd.pause && !cmd.reset && !cmd.screenshot && !cmd.quit &&
+                      !cmd.camera_next && cmd.camera_preset < 0 && !cmd.mapping_box,
                   "%s key %d: an edge", names[i], s);
             push_key((SDL_Scancode)m.axis[i].key[s], false);
             pump(in);
@@ -156,7 +169,8 @@ static void check_layout(const char* const* names, int n, const char* layout) {
 
 static void test_default_layouts(void) {
     // Names by role (lift, jib, slew take today's places) and plain ones.
-    static const char* const roles[8] = {"lift", "jib", "ext", "slew", "jib2", "ext2", "rotator", "grab"};
+    static const char* const roles[8] = {"lift", "jib",  "ext",     "slew",
+                                         "jib2", "ext2", "rotator", "grab"};
     static const char* const plain[8] = {"f1", "f2", "f3", "f4", "f5", "f6", "f7", "f8"};
     for (int n = 4; n <= 8; ++n) {
         check_layout(roles, n, "two-lever");
@@ -172,22 +186,31 @@ static void test_default_layouts(void) {
     CHECK(m.axis[1].controller_axis == SDL_CONTROLLER_AXIS_RIGHTY, "jib");
     CHECK(m.axis[3].controller_axis == SDL_CONTROLLER_AXIS_LEFTX && m.axis[3].invert, "slew");
     CHECK(m.axis[2].controller_axis == SDL_CONTROLLER_AXIS_RIGHTX && !m.axis[2].invert, "ext");
-    CHECK(m.axis[3].key[0] == SDL_SCANCODE_LEFT && m.axis[3].key_alt[0] == SDL_SCANCODE_A, "slew keys");
+    CHECK(m.axis[3].key[0] == SDL_SCANCODE_LEFT && m.axis[3].key_alt[0] == SDL_SCANCODE_A,
+          "slew keys");
     // Four-lever: in the model's order, keys by column (Q/A, W/S, E/D, ...).
     input_layout_mapping(roles, 8, "four-lever", &m, NULL, 0);
-    CHECK(m.axis[0].key[0] == SDL_SCANCODE_Q && m.axis[0].key[1] == SDL_SCANCODE_A, "lever 1: Q / A");
-    CHECK(m.axis[2].key[0] == SDL_SCANCODE_E && m.axis[2].key[1] == SDL_SCANCODE_D, "lever 3: E / D");
-    CHECK(m.axis[3].controller_axis == SDL_CONTROLLER_AXIS_RIGHTX && m.axis[3].invert, "slew on x stays inverted");
+    CHECK(m.axis[0].key[0] == SDL_SCANCODE_Q && m.axis[0].key[1] == SDL_SCANCODE_A,
+          "lever 1: Q / A");
+    CHECK(m.axis[2].key[0] == SDL_SCANCODE_E && m.axis[2].key[1] == SDL_SCANCODE_D,
+          "lever 3: E / D");
+    CHECK(m.axis[3].controller_axis == SDL_CONTROLLER_AXIS_RIGHTX && m.axis[3].invert,
+          "slew on x stays inverted");
     // 9..12: keys only; 13 and a bad layout refused with a reason.
-    static const char* const many[13] = {"a", "b", "c", "d", "e", "f", "g", "h", "i", "j", "k", "l", "m"};
+    static const char* const many[13] = {"a", "b", "c", "d", "e", "f", "g",
+                                         "h", "i", "j", "k", "l", "m"};
     CHECK(input_layout_mapping(many, 12, NULL, &m, NULL, 0) == 0, "12 functions");
-    CHECK(m.axis[11].key[0] && m.axis[11].controller_axis < 0 && m.axis[11].controller_pair[0] < 0, "12th: keys");
+    CHECK(m.axis[11].key[0] && m.axis[11].controller_axis < 0 && m.axis[11].controller_pair[0] < 0,
+          "12th: keys");
     char err[200] = "";
-    CHECK(input_layout_mapping(many, 13, NULL, &m, err, sizeof err) == -1 && strstr(err, "1 to 12"), "13: %s", err);
-    CHECK(input_layout_mapping(many, 4, "three-lever", &m, err, sizeof err) == -1 && strstr(err, "three-lever"),
+    CHECK(input_layout_mapping(many, 13, NULL, &m, err, sizeof err) == -1 && strstr(err, "1 to 12"),
+          "13: %s", err);
+    CHECK(input_layout_mapping(many, 4, "three-lever", &m, err, sizeof err) == -1 &&
+              strstr(err, "three-lever"),
           "layout: %s", err);
     static const char* const twice[2] = {"lift", "lift"};
-    CHECK(input_layout_mapping(twice, 2, NULL, &m, err, sizeof err) == -1 && strstr(err, "twice"), "%s", err);
+    CHECK(input_layout_mapping(twice, 2, NULL, &m, err, sizeof err) == -1 && strstr(err, "twice"),
+          "%s", err);
 }
 
 // The mapping drive builds for chain_6fn_controls.json in the sandbox: the
@@ -198,10 +221,13 @@ static int model6_mapping(input_mapping* m, char* err, size_t errsz) {
     if (!md) return -1;
     const char* names[8];
     int n = 0;
-    for (int i = 0; i < md->chain.nfn; ++i) names[n++] = md->chain.fn[i].name;
+    for (int i = 0; i < md->chain.nfn; ++i)
+        names[n++] = md->chain.fn[i].name;
     names[n++] = "slew";
     int rc = input_layout_mapping(names, n, NULL, m, err, errsz);
-    if (!rc) rc = md->controls ? input_apply_controls(m, md->controls, md->file, "controls", err, errsz) : -1;
+    if (!rc)
+        rc = md->controls ? input_apply_controls(m, md->controls, md->file, "controls", err, errsz)
+                          : -1;
     model_free(md);
     return rc;
 }
@@ -217,7 +243,8 @@ static void test_model_controls(void) {
     const input_axis_map* a = &m.axis[e2];
     // The model's section: the d-pad, raw buttons 5 / 4, keys Y / N; the
     // defaults would give it the shoulder buttons and Insert / Delete.
-    CHECK(a->controller_axis == -1 && a->controller_pair[0] == INPUT_PAIR_BUTTON + SDL_CONTROLLER_BUTTON_DPAD_UP &&
+    CHECK(a->controller_axis == -1 &&
+              a->controller_pair[0] == INPUT_PAIR_BUTTON + SDL_CONTROLLER_BUTTON_DPAD_UP &&
               a->controller_pair[1] == INPUT_PAIR_BUTTON + SDL_CONTROLLER_BUTTON_DPAD_DOWN,
           "ext2 on the d-pad (%d %d)", a->controller_pair[0], a->controller_pair[1]);
     CHECK(a->joystick_button[0] == 5 && a->joystick_button[1] == 4, "raw buttons");
@@ -233,10 +260,12 @@ static void test_model_controls(void) {
     // with what the model gives it.
     char text[1536];
     input_mapping_text(&m, text, sizeof text);
-    static const char* const want[6][3] = {
-        {"lift", "left stick Y", "Up / Down"},  {"jib", "right stick Y", "W / S"},
-        {"jib2", "right stick X", "PageUp / PageDown"}, {"ext", "RT / LT", "Home / End"},
-        {"ext2", "d-pad up / d-pad down", "Y / N"}, {"slew", "left stick X", "Left / Right (A / D)"}};
+    static const char* const want[6][3] = {{"lift", "left stick Y", "Up / Down"},
+                                           {"jib", "right stick Y", "W / S"},
+                                           {"jib2", "right stick X", "PageUp / PageDown"},
+                                           {"ext", "RT / LT", "Home / End"},
+                                           {"ext2", "d-pad up / d-pad down", "Y / N"},
+                                           {"slew", "left stick X", "Left / Right (A / D)"}};
     const char* line = text;
     for (int i = 0; i < 6; ++i) {
         const char* eol = strchr(line, '\n');
@@ -244,9 +273,10 @@ static void test_model_controls(void) {
         if (!eol) break;
         char l[200];
         snprintf(l, sizeof l, "%.*s", (int)(eol - line), line);
-        CHECK(!strncmp(l, want[i][0], strlen(want[i][0])) && l[strlen(want[i][0])] == ' ', "line %d: %s", i, l);
-        CHECK(strstr(l, want[i][1]) && strstr(l, want[i][2]), "line %d: %s (want %s, %s)", i, l, want[i][1],
-              want[i][2]);
+        CHECK(!strncmp(l, want[i][0], strlen(want[i][0])) && l[strlen(want[i][0])] == ' ',
+              "line %d: %s", i, l);
+        CHECK(strstr(l, want[i][1]) && strstr(l, want[i][2]), "line %d: %s (want %s, %s)", i, l,
+              want[i][1], want[i][2]);
         line = eol + 1;
     }
     CHECK(!*line, "six lines only:\n%s", text);
@@ -291,16 +321,24 @@ static model* model6_with(const char* ctl, char* err, size_t errsz) {
 static void test_bad_names_refused(void) {
     // In the model: one line naming the file, the field and the problem.
     static const char* const bad[][2] = {
-        {"{\"axes\": {\"ext2\": {\"controller\": \"stick_of_joy\"}}}", "controls.axes.ext2.controller: unknown"},
-        {"{\"axes\": {\"ext2\": {\"controller\": [\"dpup\", \"bogus\"]}}}", "controls.axes.ext2.controller[1]"},
-        {"{\"axes\": {\"ext2\": {\"keys\": [\"Y\", \"Hyper\"]}}}", "controls.axes.ext2.keys[1]: unknown key"},
-        {"{\"axes\": {\"ext2\": {\"keys\": [\"H\", \"N\"]}}}", "controls.axes.ext2.keys[0]: key \"H\" is the window's (hook)"},
-        {"{\"axes\": {\"ext2\": {\"keys\": \"Y\"}}}", "controls.axes.ext2.keys: must be [plus, minus]"},
-        {"{\"axes\": {\"winch\": {\"keys\": [\"Y\", \"N\"]}}}", "controls.axes.winch: no function 'winch'"},
-        {"{\"axes\": {\"ext2\": {\"dead_zone\": 1}}}", "controls.axes.ext2.dead_zone: must be a number in [0, 0.94]"},
+        {"{\"axes\": {\"ext2\": {\"controller\": \"stick_of_joy\"}}}",
+         "controls.axes.ext2.controller: unknown"},
+        {"{\"axes\": {\"ext2\": {\"controller\": [\"dpup\", \"bogus\"]}}}",
+         "controls.axes.ext2.controller[1]"},
+        {"{\"axes\": {\"ext2\": {\"keys\": [\"Y\", \"Hyper\"]}}}",
+         "controls.axes.ext2.keys[1]: unknown key"},
+        {"{\"axes\": {\"ext2\": {\"keys\": [\"H\", \"N\"]}}}",
+         "controls.axes.ext2.keys[0]: key \"H\" is the window's (hook)"},
+        {"{\"axes\": {\"ext2\": {\"keys\": \"Y\"}}}",
+         "controls.axes.ext2.keys: must be [plus, minus]"},
+        {"{\"axes\": {\"winch\": {\"keys\": [\"Y\", \"N\"]}}}",
+         "controls.axes.winch: no function 'winch'"},
+        {"{\"axes\": {\"ext2\": {\"dead_zone\": 1}}}",
+         "controls.axes.ext2.dead_zone: must be a number in [0, 0.94]"},
         {"{\"layout\": \"three-lever\"}", "controls.layout"},
         {"{\"axis\": {}}", "controls.axis: unknown field"},
-        {"{\"buttons\": {\"hook\": {\"controller\": \"leftx\"}}}", "controls.buttons.hook.controller"},
+        {"{\"buttons\": {\"hook\": {\"controller\": \"leftx\"}}}",
+         "controls.buttons.hook.controller"},
     };
     char err[400];
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
@@ -313,11 +351,13 @@ static void test_bad_names_refused(void) {
     }
     // A good one loads, in any case of the names (SDL's spelling is kept).
     err[0] = '\0';
-    model* m = model6_with("{\"layout\": \"four-lever\", \"axes\": {\"jib2\": {\"controller\": \"RightY\", "
-                           "\"keys\": [\"keypad 8\", \"keypad 2\"]}}}",
-                           err, sizeof err);
+    model* m = model6_with(
+        "{\"layout\": \"four-lever\", \"axes\": {\"jib2\": {\"controller\": \"RightY\", "
+        "\"keys\": [\"keypad 8\", \"keypad 2\"]}}}",
+        err, sizeof err);
     CHECK(m != NULL && m->controls && !strcmp(m->controls->layout, "four-lever") &&
-              !strcmp(m->controls->fn[0].controller[0], "righty") && !strcmp(m->controls->fn[0].key[0], "Keypad 8"),
+              !strcmp(m->controls->fn[0].controller[0], "righty") &&
+              !strcmp(m->controls->fn[0].key[0], "Keypad 8"),
           "good controls: %s", err);
     model_free(m);
 
@@ -332,17 +372,19 @@ static void test_bad_names_refused(void) {
           "clash: %s", err);
     CHECK(memcmp(&before, &dm, sizeof dm) == 0, "untouched on error");
     write_file(path, "{\"axes\": {\"ext\": {\"keys\": [\"Y\", \"N\"]}}}");
-    CHECK(input_load_mapping(path, &dm, err, sizeof err) == -1 && strstr(err, "no function 'ext'") &&
-              strstr(err, "lift, jib, slew"),
+    CHECK(input_load_mapping(path, &dm, err, sizeof err) == -1 &&
+              strstr(err, "no function 'ext'") && strstr(err, "lift, jib, slew"),
           "unknown function: %s", err);
     // The slew on the triggers and the shoulder buttons: a pair each.
-    write_file(path, "{\"axes\": {\"slew\": {\"controller\": [\"lefttrigger\", \"righttrigger\"], "
-                     "\"joystick\": null, \"joystick_buttons\": [4, 5], \"keys\": [\"Z\", \"X\"]}}}");
+    write_file(path,
+               "{\"axes\": {\"slew\": {\"controller\": [\"lefttrigger\", \"righttrigger\"], "
+               "\"joystick\": null, \"joystick_buttons\": [4, 5], \"keys\": [\"Z\", \"X\"]}}}");
     CHECK(input_load_mapping(path, &dm, err, sizeof err) == 0, "%s", err);
     const input_axis_map* sl = &dm.axis[INPUT_SLEW];
     CHECK(sl->controller_axis == -1 && sl->controller_pair[0] == SDL_CONTROLLER_AXIS_TRIGGERLEFT &&
-              sl->controller_pair[1] == SDL_CONTROLLER_AXIS_TRIGGERRIGHT && sl->joystick_axis == -1 &&
-              sl->joystick_button[0] == 4 && sl->key[0] == SDL_SCANCODE_Z && sl->key_alt[0] == 0,
+              sl->controller_pair[1] == SDL_CONTROLLER_AXIS_TRIGGERRIGHT &&
+              sl->joystick_axis == -1 && sl->joystick_button[0] == 4 &&
+              sl->key[0] == SDL_SCANCODE_Z && sl->key_alt[0] == 0,
           "slew remapped");
 }
 
@@ -386,16 +428,19 @@ static void test_six_functions_on_a_virtual_pad(void) {
         return;
     }
     pump(in);
-    CHECK(input_active_source(in) == INPUT_SRC_CONTROLLER, "a game controller (%d)", input_active_source(in));
+    CHECK(input_active_source(in) == INPUT_SRC_CONTROLLER, "a game controller (%d)",
+          input_active_source(in));
     SDL_Joystick* js = SDL_JoystickOpen(idx);
     // At rest (triggers released): nothing moves.
-    for (int k = 0; k < 6; ++k) set_input(js, &m.axis[k], false);
+    for (int k = 0; k < 6; ++k)
+        set_input(js, &m.axis[k], false);
     SDL_JoystickUpdate();
     pump(in);
     input_command cmd;
     input_poll(in, 0.016, &cmd);
     CHECK(cmd.n == 6, "six commands, got %d", cmd.n);
-    for (int j = 0; j < 6; ++j) CHECK_NEAR(cmd.u[j], 0.0, 0);
+    for (int j = 0; j < 6; ++j)
+        CHECK_NEAR(cmd.u[j], 0.0, 0);
     for (int k = 0; k < 6; ++k) {
         set_input(js, &m.axis[k], true);
         SDL_JoystickUpdate();
@@ -407,7 +452,8 @@ static void test_six_functions_on_a_virtual_pad(void) {
         SDL_JoystickUpdate();
         pump(in);
         input_poll(in, 0.016, &cmd);
-        for (int j = 0; j < 6; ++j) CHECK_NEAR(cmd.u[j], 0.0, 0);
+        for (int j = 0; j < 6; ++j)
+            CHECK_NEAR(cmd.u[j], 0.0, 0);
     }
     // The - side of a pair: LT retracts the extension, d-pad down ext2.
     const int ex = input_find_function(&m, "ext"), e2 = input_find_function(&m, "ext2");

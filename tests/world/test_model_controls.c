@@ -20,7 +20,8 @@ static void test_section_parsed(void) {
               !strcmp(f->controller[1], "dpdown"),
           "ext2 on the d-pad");
     CHECK(f && f->has_keys && !strcmp(f->key[0], "Y") && !strcmp(f->key[1], "N"), "keys Y / N");
-    CHECK(f && f->has_joystick_buttons && f->joystick_button[0] == 5 && f->joystick_button[1] == 4, "raw 5 / 4");
+    CHECK(f && f->has_joystick_buttons && f->joystick_button[0] == 5 && f->joystick_button[1] == 4,
+          "raw 5 / 4");
     CHECK(f && !f->has_joystick && !f->has_invert && isnan(f->dead_zone), "the rest not given");
     model_free(m);
     // A model without the section has none.
@@ -33,10 +34,12 @@ static void test_section_parsed(void) {
 // file has): each bad value refused with its field.
 static void test_bad_values_refused(void) {
     static const char* const bad[][2] = {
-        {"controls.axes.ext2.controller[0]=leftstick_y", "controls.axes.ext2.controller[0]: unknown game controller"},
+        {"controls.axes.ext2.controller[0]=leftstick_y",
+         "controls.axes.ext2.controller[0]: unknown game controller"},
         {"controls.axes.ext2.keys[0]=Return", "key \"Return\" is the window's (hook)"},
         {"controls.axes.ext2.keys[1]=Y", "controls.axes.ext2.keys: the same key for + and -"},
-        {"controls.axes.ext2.joystick_buttons[0]=300", "controls.axes.ext2.joystick_buttons: must be a joystick button index 0..255"},
+        {"controls.axes.ext2.joystick_buttons[0]=300",
+         "controls.axes.ext2.joystick_buttons: must be a joystick button index 0..255"},
     };
     char err[400];
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
@@ -45,7 +48,8 @@ static void test_bad_values_refused(void) {
         model* m = model_load(MODEL6, sets, 1, err, sizeof err);
         CHECK(m == NULL, "accepted: %s", bad[i][0]);
         model_free(m);
-        CHECK(strstr(err, "chain_6fn_controls.json") && strstr(err, bad[i][1]) && !strchr(err, '\n'),
+        CHECK(strstr(err, "chain_6fn_controls.json") && strstr(err, bad[i][1]) &&
+                  !strchr(err, '\n'),
               "%s: %s", bad[i][0], err);
     }
 }
@@ -59,7 +63,8 @@ static void test_functions_checked(void) {
     CHECK(controls_parse(o, "f.json", "controls", &c, err, sizeof err) == 0, "%s", err);
     static const char* const names[3] = {"lift", "jib", "slew"};
     CHECK(controls_check_functions(&c, names, 3, "f.json", "controls", err, sizeof err) == -1 &&
-              !strcmp(err, "f.json: controls.axes.winch: no function 'winch' in the model (functions: lift, jib, slew)"),
+              !strcmp(err, "f.json: controls.axes.winch: no function 'winch' in the model "
+                           "(functions: lift, jib, slew)"),
           "%s", err);
     cJSON_Delete(o);
     o = cJSON_Parse("{\"layout\": \"four-lever\", \"keyboard_ramp_s\": 11}");

@@ -13,29 +13,55 @@
 
 const char* const controls_controller_axes[] = {"leftx",       "lefty",        "rightx", "righty",
                                                 "lefttrigger", "righttrigger", NULL};
-const char* const controls_controller_buttons[] = {
-    "a",        "b",       "x",       "y",       "back",    "guide",        "start",
-    "leftstick", "rightstick", "leftshoulder", "rightshoulder", "dpup", "dpdown", "dpleft",
-    "dpright",  "misc1",   "paddle1", "paddle2", "paddle3", "paddle4",      "touchpad", NULL};
+const char* const controls_controller_buttons[] = {"a",
+                                                   "b",
+                                                   "x",
+                                                   "y",
+                                                   "back",
+                                                   "guide",
+                                                   "start",
+                                                   "leftstick",
+                                                   "rightstick",
+                                                   "leftshoulder",
+                                                   "rightshoulder",
+                                                   "dpup",
+                                                   "dpdown",
+                                                   "dpleft",
+                                                   "dpright",
+                                                   "misc1",
+                                                   "paddle1",
+                                                   "paddle2",
+                                                   "paddle3",
+                                                   "paddle4",
+                                                   "touchpad",
+                                                   NULL};
 // Keys a function may have: letters and digits the window does not use,
 // arrows, the navigation block, the keypad and punctuation. SDL's scancode
 // names (SDL_GetScancodeName), so input.c finds each with SDL_GetScancodeFromName.
 const char* const controls_keys[] = {
-    "A", "B", "D", "E", "F", "I", "J", "K", "L", "N", "O", "Q", "S", "T", "U", "V", "W", "X", "Y",
-    "Z", "1", "2", "3", "4", "5", "6", "7", "8", "9", "0", "Up", "Down", "Left", "Right", "Insert", "Home",
-    "PageUp", "Delete", "End", "PageDown", "Keypad 0", "Keypad 1", "Keypad 2", "Keypad 3", "Keypad 4",
-    "Keypad 5", "Keypad 6", "Keypad 7", "Keypad 8", "Keypad 9", "Keypad +", "Keypad -", "Keypad *",
-    "Keypad /", "[", "]", ";", "'", ",", ".", "/", "-", "=", NULL};
+    "A",        "B",        "D",        "E",        "F",        "I",        "J",        "K",
+    "L",        "N",        "O",        "Q",        "S",        "T",        "U",        "V",
+    "W",        "X",        "Y",        "Z",        "1",        "2",        "3",        "4",
+    "5",        "6",        "7",        "8",        "9",        "0",        "Up",       "Down",
+    "Left",     "Right",    "Insert",   "Home",     "PageUp",   "Delete",   "End",      "PageDown",
+    "Keypad 0", "Keypad 1", "Keypad 2", "Keypad 3", "Keypad 4", "Keypad 5", "Keypad 6", "Keypad 7",
+    "Keypad 8", "Keypad 9", "Keypad +", "Keypad -", "Keypad *", "Keypad /", "[",        "]",
+    ";",        "'",        ",",        ".",        "/",        "-",        "=",        NULL};
 // The drive window's own keys (input.c, drive_session.c, render.c): a
 // function on one of them would move a valve each time the operator hooks,
 // pauses or opens the panel.
-const char* const controls_window_keys[][2] = {
-    {"H", "hook"},           {"Return", "hook"},     {"P", "pause"},         {"Space", "pause"},
-    {"R", "reset"},          {"Backspace", "reset"}, {"C", "next camera"},   {"G", "collision view"},
-    {"Tab", "panel"},        {"Escape", "quit"},     {"Left Shift", "fine"}, {"Right Shift", "fine"},
-    {"F1", "camera preset"}, {"F2", "camera preset"}, {"F3", "camera preset"}, {"F4", "camera preset"},
-    {"F5", "record"},        {"M", "mapping box"},  {"F12", "screenshot"},  {NULL, NULL}};
-const char* const controls_button_names[CONTROLS_NBUTTON] = {"hook", "pause", "reset", "screenshot", "camera"};
+const char* const controls_window_keys[][2] = {{"H", "hook"},           {"Return", "hook"},
+                                               {"P", "pause"},          {"Space", "pause"},
+                                               {"R", "reset"},          {"Backspace", "reset"},
+                                               {"C", "next camera"},    {"G", "collision view"},
+                                               {"Tab", "panel"},        {"Escape", "quit"},
+                                               {"Left Shift", "fine"},  {"Right Shift", "fine"},
+                                               {"F1", "camera preset"}, {"F2", "camera preset"},
+                                               {"F3", "camera preset"}, {"F4", "camera preset"},
+                                               {"F5", "record"},        {"M", "mapping box"},
+                                               {"F12", "screenshot"},   {NULL, NULL}};
+const char* const controls_button_names[CONTROLS_NBUTTON] = {"hook", "pause", "reset", "screenshot",
+                                                             "camera"};
 const char* const controls_layouts[] = {"two-lever", "four-lever", NULL};
 
 const char* controls_lookup(const char* const* list, const char* name) {
@@ -53,8 +79,8 @@ typedef struct pctx {
 
 // "where.a.b" or "a.b" at the top of a mapping file.
 static void fail(const pctx* p, const char* field, const char* problem) {
-    snprintf(p->err, p->errsz, "%s: %s%s%s: %s", p->file, p->where, p->where[0] && field[0] ? "." : "", field,
-             problem);
+    snprintf(p->err, p->errsz, "%s: %s%s%s: %s", p->file, p->where,
+             p->where[0] && field[0] ? "." : "", field, problem);
 }
 
 static void list_of(const char* const* list, char* out, size_t n) {
@@ -69,7 +95,8 @@ static void list_of(const char* const* list, char* out, size_t n) {
 static int only_keys(const pctx* p, const cJSON* o, const char* const* allowed, const char* field) {
     for (const cJSON* k = o->child; k; k = k->next) {
         bool ok = false;
-        for (int i = 0; allowed[i] && !ok; ++i) ok = k->string && !strcmp(k->string, allowed[i]);
+        for (int i = 0; allowed[i] && !ok; ++i)
+            ok = k->string && !strcmp(k->string, allowed[i]);
         if (ok) continue;
         char list[200], f[96], msg[300];
         list_of(allowed, list, sizeof list);
@@ -81,8 +108,8 @@ static int only_keys(const pctx* p, const cJSON* o, const char* const* allowed, 
     return 0;
 }
 
-static int get_num(const pctx* p, const cJSON* o, const char* field, const char* key, double lo, double hi,
-                   double* out) {
+static int get_num(const pctx* p, const cJSON* o, const char* field, const char* key, double lo,
+                   double hi, double* out) {
     const cJSON* v = cJSON_GetObjectItemCaseSensitive(o, key);
     if (!v) return 0;
     if (!cJSON_IsNumber(v) || !(v->valuedouble >= lo && v->valuedouble <= hi)) {
@@ -106,7 +133,8 @@ static int get_index(const pctx* p, const cJSON* v, const char* field, const cha
         *out = -1;
         return 0;
     }
-    if (!cJSON_IsNumber(v) || v->valuedouble < 0 || v->valuedouble > 255 || v->valuedouble != floor(v->valuedouble)) {
+    if (!cJSON_IsNumber(v) || v->valuedouble < 0 || v->valuedouble > 255 ||
+        v->valuedouble != floor(v->valuedouble)) {
         char msg[80];
         snprintf(msg, sizeof msg, "must be a joystick %s index 0..255 or null", what);
         fail(p, field, msg);
@@ -117,8 +145,8 @@ static int get_index(const pctx* p, const cJSON* v, const char* field, const cha
 }
 
 // A controller name of one of the lists into out ("" for none).
-static int get_name(const pctx* p, const cJSON* v, const char* field, bool axis_ok, bool button_ok, char* out,
-                    size_t n) {
+static int get_name(const pctx* p, const cJSON* v, const char* field, bool axis_ok, bool button_ok,
+                    char* out, size_t n) {
     if (is_none(v)) {
         out[0] = '\0';
         return 0;
@@ -129,9 +157,13 @@ static int get_name(const pctx* p, const cJSON* v, const char* field, bool axis_
     if (!hit) {
         char msg[200];
         snprintf(msg, sizeof msg, "unknown game controller %s \"%s\" (e.g. %s)",
-                 axis_ok && button_ok ? "axis or button" : axis_ok ? "axis" : "button", s ? s : "?",
+                 axis_ok && button_ok ? "axis or button"
+                 : axis_ok            ? "axis"
+                                      : "button",
+                 s ? s : "?",
                  axis_ok ? "leftx, lefty, rightx, righty, lefttrigger" : "a, b, x, y, start, back");
-        if (axis_ok && button_ok) snprintf(msg + strlen(msg) - 1, sizeof msg - strlen(msg) + 1, "; leftshoulder, dpup)");
+        if (axis_ok && button_ok)
+            snprintf(msg + strlen(msg) - 1, sizeof msg - strlen(msg) + 1, "; leftshoulder, dpup)");
         fail(p, field, msg);
         return -1;
     }
@@ -148,16 +180,18 @@ static int get_key(const pctx* p, const cJSON* v, const char* field, char* out, 
     for (int i = 0; s && controls_window_keys[i][0]; ++i)
         if (!strcasecmp(s, controls_window_keys[i][0])) {
             char msg[160];
-            snprintf(msg, sizeof msg, "key \"%s\" is the window's (%s); choose another", controls_window_keys[i][0],
-                     controls_window_keys[i][1]);
+            snprintf(msg, sizeof msg, "key \"%s\" is the window's (%s); choose another",
+                     controls_window_keys[i][0], controls_window_keys[i][1]);
             fail(p, field, msg);
             return -1;
         }
     const char* hit = controls_lookup(controls_keys, s);
     if (!hit) {
         char msg[200];
-        snprintf(msg, sizeof msg, "unknown key \"%s\" (SDL key names: A..Z, 0..9, Up, Down, Left, Right, PageUp, "
-                                  "Home, Insert, Keypad 8, ...)", s ? s : "?");
+        snprintf(msg, sizeof msg,
+                 "unknown key \"%s\" (SDL key names: A..Z, 0..9, Up, Down, Left, Right, PageUp, "
+                 "Home, Insert, Keypad 8, ...)",
+                 s ? s : "?");
         fail(p, field, msg);
         return -1;
     }
@@ -186,8 +220,9 @@ static int parse_fn(const pctx* p, const cJSON* a, const char* name, controls_fn
         fail(p, field, "must be an object");
         return -1;
     }
-    static const char* const fields[] = {"controller", "joystick", "joystick_buttons", "keys", "invert",
-                                         "dead_zone",  "expo",     "scale",            NULL};
+    static const char* const fields[] = {"controller", "joystick", "joystick_buttons",
+                                         "keys",       "invert",   "dead_zone",
+                                         "expo",       "scale",    NULL};
     if (only_keys(p, a, fields, field)) return -1;
     char sub[96];
     const cJSON* v = cJSON_GetObjectItemCaseSensitive(a, "controller");
@@ -199,13 +234,15 @@ static int parse_fn(const pctx* p, const cJSON* a, const char* name, controls_fn
             for (int k = 0; k < 2; ++k) {
                 char one[104];
                 snprintf(one, sizeof one, "%s[%d]", sub, k);
-                if (get_name(p, cJSON_GetArrayItem(v, k), one, true, true, f->controller[k], sizeof f->controller[k]))
+                if (get_name(p, cJSON_GetArrayItem(v, k), one, true, true, f->controller[k],
+                             sizeof f->controller[k]))
                     return -1;
             }
             f->ncontroller = 2;
             if (!f->controller[0][0] && !f->controller[1][0]) f->ncontroller = 0;
         } else {
-            if (get_name(p, v, sub, true, false, f->controller[0], sizeof f->controller[0])) return -1;
+            if (get_name(p, v, sub, true, false, f->controller[0], sizeof f->controller[0]))
+                return -1;
             f->ncontroller = f->controller[0][0] ? 1 : 0;
         }
     }
@@ -222,7 +259,8 @@ static int parse_fn(const pctx* p, const cJSON* a, const char* name, controls_fn
         if (!is_none(v)) {
             if (get_pair_len(p, v, sub)) return -1;
             for (int k = 0; k < 2; ++k)
-                if (get_index(p, cJSON_GetArrayItem(v, k), sub, "button", &f->joystick_button[k])) return -1;
+                if (get_index(p, cJSON_GetArrayItem(v, k), sub, "button", &f->joystick_button[k]))
+                    return -1;
         }
     }
     v = cJSON_GetObjectItemCaseSensitive(a, "keys");
@@ -234,7 +272,8 @@ static int parse_fn(const pctx* p, const cJSON* a, const char* name, controls_fn
             for (int k = 0; k < 2; ++k) {
                 char one[104];
                 snprintf(one, sizeof one, "%s[%d]", sub, k);
-                if (get_key(p, cJSON_GetArrayItem(v, k), one, f->key[k], sizeof f->key[k])) return -1;
+                if (get_key(p, cJSON_GetArrayItem(v, k), one, f->key[k], sizeof f->key[k]))
+                    return -1;
             }
             if (f->key[0][0] && !strcmp(f->key[0], f->key[1])) {
                 fail(p, sub, "the same key for + and -");
@@ -258,14 +297,15 @@ static int parse_fn(const pctx* p, const cJSON* a, const char* name, controls_fn
     return 0;
 }
 
-int controls_parse(const cJSON* o, const char* file, const char* where, model_controls* out, char* err,
-                   size_t errsz) {
+int controls_parse(const cJSON* o, const char* file, const char* where, model_controls* out,
+                   char* err, size_t errsz) {
     char dummy[8];
     if (!err || !errsz) err = dummy, errsz = sizeof dummy;
     const pctx p = {file, where ? where : "", err, errsz};
     memset(out, 0, sizeof *out);
     out->keyboard_ramp_s = NAN;
-    for (int i = 0; i < CONTROLS_NBUTTON; ++i) out->button_joystick[i] = -1;
+    for (int i = 0; i < CONTROLS_NBUTTON; ++i)
+        out->button_joystick[i] = -1;
     if (!cJSON_IsObject(o)) {
         fail(&p, "", "must be an object");
         return -1;
@@ -274,7 +314,8 @@ int controls_parse(const cJSON* o, const char* file, const char* where, model_co
     if (only_keys(&p, o, top, "")) return -1;
     const cJSON* v = cJSON_GetObjectItemCaseSensitive(o, "layout");
     if (v) {
-        const char* hit = cJSON_IsString(v) ? controls_lookup(controls_layouts, v->valuestring) : NULL;
+        const char* hit =
+            cJSON_IsString(v) ? controls_lookup(controls_layouts, v->valuestring) : NULL;
         if (!hit) {
             fail(&p, "layout", "must be \"two-lever\" or \"four-lever\"");
             return -1;
@@ -301,7 +342,8 @@ int controls_parse(const cJSON* o, const char* file, const char* where, model_co
         if (parse_fn(&p, a, a->string, &out->fn[out->nfn])) return -1;
         ++out->nfn;
     }
-    static const char* const bnames[CONTROLS_NBUTTON + 1] = {"hook", "pause", "reset", "screenshot", "camera", NULL};
+    static const char* const bnames[CONTROLS_NBUTTON + 1] = {"hook",       "pause",  "reset",
+                                                             "screenshot", "camera", NULL};
     if (buttons && only_keys(&p, buttons, bnames, "buttons")) return -1;
     for (int i = 0; buttons && i < CONTROLS_NBUTTON; ++i) {
         const cJSON* b = cJSON_GetObjectItemCaseSensitive(buttons, controls_button_names[i]);
@@ -316,7 +358,8 @@ int controls_parse(const cJSON* o, const char* file, const char* where, model_co
         if (only_keys(&p, b, bf, field)) return -1;
         if ((v = cJSON_GetObjectItemCaseSensitive(b, "controller"))) {
             snprintf(sub, sizeof sub, "%s.controller", field);
-            if (get_name(&p, v, sub, false, true, out->button_controller[i], sizeof out->button_controller[i]))
+            if (get_name(&p, v, sub, false, true, out->button_controller[i],
+                         sizeof out->button_controller[i]))
                 return -1;
             out->has_button_controller[i] = true;
         }
@@ -344,16 +387,20 @@ const controls_fn* controls_find(const model_controls* c, const char* name) {
     return NULL;
 }
 
-int controls_check_functions(const model_controls* c, const char* const* names, int n, const char* file,
-                             const char* where, char* err, size_t errsz) {
+int controls_check_functions(const model_controls* c, const char* const* names, int n,
+                             const char* file, const char* where, char* err, size_t errsz) {
     for (int i = 0; i < c->nfn; ++i) {
         bool ok = false;
-        for (int k = 0; k < n && !ok; ++k) ok = !strcmp(c->fn[i].function, names[k]);
+        for (int k = 0; k < n && !ok; ++k)
+            ok = !strcmp(c->fn[i].function, names[k]);
         if (ok) continue;
         char list[400] = "";
-        for (int k = 0; k < n; ++k) snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? ", " : "", names[k]);
-        snprintf(err, errsz, "%s: %s%saxes.%s: no function '%s' in the model (functions: %s)", file, where ? where : "",
-                 where && where[0] ? "." : "", c->fn[i].function, c->fn[i].function, list);
+        for (int k = 0; k < n; ++k)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", k ? ", " : "",
+                     names[k]);
+        snprintf(err, errsz, "%s: %s%saxes.%s: no function '%s' in the model (functions: %s)", file,
+                 where ? where : "", where && where[0] ? "." : "", c->fn[i].function,
+                 c->fn[i].function, list);
         return -1;
     }
     return 0;

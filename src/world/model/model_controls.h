@@ -58,7 +58,8 @@ extern const char* const controls_keys[];               ///< keys a function may
 /// Keys the drive window uses for itself (hook, pause, panel, ...): never a
 /// function's; each with what it does.
 extern const char* const controls_window_keys[][2];
-extern const char* const controls_button_names[CONTROLS_NBUTTON]; ///< hook, pause, reset, screenshot, camera
+extern const char* const
+    controls_button_names[CONTROLS_NBUTTON]; ///< hook, pause, reset, screenshot, camera
 extern const char* const controls_layouts[]; ///< two-lever, four-lever
 
 /// The canonical spelling of a name of list (case-insensitive match), or NULL.
@@ -69,14 +70,14 @@ const char* controls_lookup(const char* const* list, const char* name);
 /// in a mapping file) name the place in messages. Function names are not
 /// checked against a model here (controls_check_functions does). Returns 0,
 /// or -1 with one line "file: where.field: problem" in err.
-int controls_parse(const cJSON* o, const char* file, const char* where, model_controls* out, char* err,
-                   size_t errsz);
+int controls_parse(const cJSON* o, const char* file, const char* where, model_controls* out,
+                   char* err, size_t errsz);
 /// Read and parse a mapping file. Returns 0, or -1 with one line in err.
 int controls_load_file(const char* path, model_controls* out, char* err, size_t errsz);
 /// Every function named in c must be one of the n names: else -1 with
 /// "file: where.axes.X: no function 'X' in the model (functions: a, b, ...)".
-int controls_check_functions(const model_controls* c, const char* const* names, int n, const char* file,
-                             const char* where, char* err, size_t errsz);
+int controls_check_functions(const model_controls* c, const char* const* names, int n,
+                             const char* file, const char* where, char* err, size_t errsz);
 /// The entry of function name in c, or NULL.
 const controls_fn* controls_find(const model_controls* c, const char* name);
 
