@@ -251,10 +251,12 @@ int input_apply_controls(input_mapping* m, const model_controls* c, const char* 
             for (int k = 0; k < 2 && f->ncontroller == 2; ++k)
                 a->controller_pair[k] = controller_code(f->controller[k], true);
         }
-        if (f->has_joystick) a->joystick_axis = f->joystick;
-        if (f->has_joystick_buttons) {
-            a->joystick_button[0] = f->joystick_button[0];
-            a->joystick_button[1] = f->joystick_button[1];
+        // A raw axis and a raw button pair replace each other, as a
+        // controller axis and a pair do: given one alone, the other goes.
+        if (f->has_joystick || f->has_joystick_buttons) {
+            a->joystick_axis = f->has_joystick ? f->joystick : -1;
+            a->joystick_button[0] = f->has_joystick_buttons ? f->joystick_button[0] : -1;
+            a->joystick_button[1] = f->has_joystick_buttons ? f->joystick_button[1] : -1;
         }
         if (f->has_keys) {
             // A function's keys given are its keys: the default's second pair goes.

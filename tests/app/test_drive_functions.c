@@ -18,7 +18,8 @@
 static drive_session* open_with(const char* model, const char* mapping, char* err, size_t errsz,
                                 int* code) {
     app_common c = {.sim = sim_default_opts()};
-    c.sim.mechanics = SIM_ODE; // the sandbox
+    c.sim.mechanics = SIM_ODE;
+    c.sim.world = "sandbox"; // as cmd_drive names the drive's world
     c.model_path = model;
     drive_opts o = drive_default_opts();
     o.offscreen = true;

@@ -247,7 +247,8 @@ static void test_model_controls(void) {
               a->controller_pair[0] == INPUT_PAIR_BUTTON + SDL_CONTROLLER_BUTTON_DPAD_UP &&
               a->controller_pair[1] == INPUT_PAIR_BUTTON + SDL_CONTROLLER_BUTTON_DPAD_DOWN,
           "ext2 on the d-pad (%d %d)", a->controller_pair[0], a->controller_pair[1]);
-    CHECK(a->joystick_button[0] == 5 && a->joystick_button[1] == 4, "raw buttons");
+    CHECK(a->joystick_button[0] == 5 && a->joystick_button[1] == 4 && a->joystick_axis == -1,
+          "raw buttons instead of the default's raw axis 5 (%d)", a->joystick_axis);
     CHECK(a->key[0] == SDL_SCANCODE_Y && a->key[1] == SDL_SCANCODE_N, "keys Y / N");
     // The rest keep the defaults: jib2 the right stick's x, ext the triggers.
     const input_axis_map* j2 = &m.axis[input_find_function(&m, "jib2")];
