@@ -365,10 +365,11 @@ static void read_linkage(json_ctx* c, const cJSON* o, const char* p, crane_chain
     if (linkage_init(&a->lk, &d, e, sizeof e)) {
         // linkage_init names its own fields ("linkage.x: ..."): its base is
         // the actuator's, its range the knuckle's limits.
-        const char* msg = e;
-        const char* field = "linkage";
-        if (!strncmp(e, "linkage.base: ", 14)) field = "base", msg = e + 14;
-        else if (!strncmp(e, "linkage.", 8)) msg = e + 8;
+        const char* colon = strstr(e, ": ");
+        const char* msg = colon ? colon + 2 : e;
+        char field[64] = "linkage";
+        if (colon && !strncmp(e, "linkage.base: ", 14)) snprintf(field, sizeof field, "base");
+        else if (colon && (size_t)(colon - e) < sizeof field) snprintf(field, sizeof field, "%.*s", (int)(colon - e), e);
         json_path(f, sizeof f, p, field);
         json_fail(c, f, "%s (%s's joint range [%g, %g] rad)", msg, name, kd->q_min, kd->q_max);
         return;
