@@ -1383,6 +1383,12 @@ struct dxBody* ode_chain_body_id(const ode_chain* w, int i, double org[3]) {
     return w->b[i].body;
 }
 
+struct dxBody* ode_chain_link_body(const ode_chain* w, int k, int which, double* len) {
+    if (k < 0 || k >= w->nact || !w->a[k].link) return NULL;
+    if (len) len[0] = which ? w->cc.act[k].lk.d.rocker_len : w->cc.act[k].lk.d.link_len;
+    return which ? w->a[k].rocker : w->a[k].link;
+}
+
 const crane_chain* ode_chain_chain(const ode_chain* w) { return &w->cc; }
 
 void ode_chain_act_pins(const ode_chain* w, int k, double pa[3], double pb[3]) {
