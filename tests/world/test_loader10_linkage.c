@@ -208,6 +208,10 @@ static void test_refusals(void) {
         // q = 1.2 rad the rocker's pin is nearer A than l1 - l2).
         {"mechanics.bodies.knuckle_arm.limits=[-2.6,1.2]", "mechanics.actuators[1].linkage.rocker_len",
          "range [-2.6, 1.2] rad"},
+        // The base moved in line with the common pin's path near the
+        // range's upper end: L turns back there (dL/dq = 0 at -0.2428 rad).
+        {"mechanics.actuators.jib.base.point=[3.0,0,-0.3]", "mechanics.actuators[1].base",
+         "dead centre at q = -0.242827 rad inside the range [-2.6, -0.2] rad"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char err[512] = "";
@@ -222,9 +226,42 @@ static void test_refusals(void) {
     }
 }
 
+// A rod and a linkage on one actuator: the file edited (a --set cannot add
+// a field).
+static void test_rod_and_linkage(void) {
+    FILE* f = fopen(MODEL, "rb");
+    CHECK(f != NULL, "open %s", MODEL);
+    if (!f) return;
+    static char text[1 << 20];
+    const size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = 0;
+    const char* key = "\"linkage\": {\"body\"";
+    char* at = strstr(text, key);
+    CHECK(at != NULL, "no linkage block in %s", MODEL);
+    if (!at) return;
+    const char* path = "linkage_rod_and_linkage.json";
+    FILE* o = fopen(path, "wb");
+    CHECK(o != NULL, "write %s", path);
+    if (!o) return;
+    fwrite(text, 1, (size_t)(at - text), o);
+    fputs("\"rod\": {\"body\": \"knuckle_arm\", \"point\": [0.4, 0, 0]}, ", o);
+    fputs(at, o);
+    fclose(o);
+    char err[512] = "";
+    model* m = model_load(path, NULL, 0, err, sizeof err);
+    printf("  rod and linkage -> %s\n", err);
+    CHECK(m == NULL, "a rod and a linkage accepted");
+    model_free(m);
+    CHECK(strstr(err, "mechanics.actuators[1].rod") && strstr(err, "given with linkage") && !strchr(err, '\n'),
+          "\"%s\"", err);
+    remove(path);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_transmission);
     RUN_TEST(test_ode_loop);
     RUN_TEST(test_refusals);
+    RUN_TEST(test_rod_and_linkage);
     TEST_MAIN_END();
 }

@@ -371,7 +371,9 @@ static void read_linkage(json_ctx* c, const cJSON* o, const char* p, crane_chain
         if (colon && !strncmp(e, "linkage.base: ", 14)) snprintf(field, sizeof field, "base");
         else if (colon && (size_t)(colon - e) < sizeof field) snprintf(field, sizeof field, "%.*s", (int)(colon - e), e);
         json_path(f, sizeof f, p, field);
-        json_fail(c, f, "%s (%s's joint range [%g, %g] rad)", msg, name, kd->q_min, kd->q_max);
+        // The knuckle's range, unless the message gives it already.
+        if (strstr(msg, "range")) json_fail(c, f, "%s (the joint of %s)", msg, name);
+        else json_fail(c, f, "%s (%s's joint range [%g, %g] rad)", msg, name, kd->q_min, kd->q_max);
         return;
     }
     a->kind = CRANE_ACT_LINKAGE;
