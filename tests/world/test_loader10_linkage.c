@@ -14,11 +14,13 @@
 //   cylinder length (from the link body's pin P) against the formula at
 //   ODE's own knuckle angle, at the start and after 1 s of motion under
 //   constant cylinder forces;
-// - bad linkage blocks refused with one line naming the field.
+// - bad linkage blocks refused with one line naming the field;
+// - the sandbox snapshot has the link and the rocker as bodies in place.
 // ODE against the analytic mode on the work cycle through the linkage and
 // the energy balances are test_loader10's.
 #include "check.h"
 #include "crane_chain.h"
+#include "engine.h"
 #include "model.h"
 #include "ode_chain.h"
 
@@ -26,6 +28,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 
 #define MODEL CRANESIM_ASSETS "/models/loader10.json"
 
@@ -258,10 +264,65 @@ static void test_rod_and_linkage(void) {
     remove(path);
 }
 
+// The sandbox's snapshot (what the window draws): the link and the rocker
+// as bodies, the link's centre half its length from the cylinder's rod
+// end (P) and from its pin A, the rocker's half its length from P, after
+// 0.5 s with the jib commanded at 0.8.
+static void test_snapshot(void) {
+    model* m = load();
+    if (!m) return;
+    sim_opts o = sim_default_opts();
+    o.mechanics = SIM_ODE;
+    o.world = CRANESIM_ASSETS "/worlds/sandbox.json";
+    o.no_step_probe = true;
+    const double q0[2] = {130 * M_PI / 180, -75 * M_PI / 180};
+    char err[1024] = "";
+    engine* e = engine_create(m, &o, q0, 0.0, 0.0, err, sizeof err);
+    CHECK(e != NULL, "%s", err);
+    if (!e) {
+        model_free(m);
+        return;
+    }
+    engine_set_commands(e, (const double[3]){0, 0.8, 0});
+    CHECK(engine_advance_to(e, 0.5, NULL, NULL) == 0, "%s", engine_error(e));
+    world_snapshot* s = calloc(1, sizeof *s);
+    CHECK(s && engine_snapshot(e, s), "no snapshot");
+    if (s) {
+        const world_snap_body *link = NULL, *rocker = NULL;
+        const world_snap_cylinder* jib = NULL;
+        for (int i = 0; i < s->nbody; ++i) {
+            if (!strcmp(s->body[i].name, "jib_link")) link = &s->body[i];
+            if (!strcmp(s->body[i].name, "jib_rocker")) rocker = &s->body[i];
+        }
+        for (int i = 0; i < s->ncyl; ++i)
+            if (!strcmp(s->cyl[i].name, "jib")) jib = &s->cyl[i];
+        CHECK(link && rocker && jib, "snapshot: link %p, rocker %p, jib %p", (const void*)link, (const void*)rocker,
+              (const void*)jib);
+        if (link && rocker && jib) {
+            const linkage_def* d = &m->chain.act[crane_chain_find_act(&m->chain, "jib")].lk.d;
+            const double* P = jib->rod_end;
+            const double dl = sqrt(pow(link->pos[0] - P[0], 2) + pow(link->pos[1] - P[1], 2) + pow(link->pos[2] - P[2], 2));
+            const double dr = sqrt(pow(rocker->pos[0] - P[0], 2) + pow(rocker->pos[1] - P[1], 2) +
+                                   pow(rocker->pos[2] - P[2], 2));
+            printf("  snapshot: link centre %.6f m from P (half of %.2f m), rocker's %.6f m (half of %.2f m), jib "
+                   "stroke %.4f m\n",
+                   dl, d->link_len, dr, d->rocker_len, jib->x);
+            CHECK(fabs(dl - 0.5 * d->link_len) < 1e-4 && fabs(dr - 0.5 * d->rocker_len) < 1e-4,
+                  "link %g m, rocker %g m from P", dl, dr);
+            CHECK(link->size[0] == d->link_len && rocker->size[0] == d->rocker_len, "bar lengths %g, %g",
+                  link->size[0], rocker->size[0]);
+        }
+    }
+    free(s);
+    engine_destroy(e);
+    model_free(m);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_transmission);
     RUN_TEST(test_ode_loop);
     RUN_TEST(test_refusals);
     RUN_TEST(test_rod_and_linkage);
+    RUN_TEST(test_snapshot);
     TEST_MAIN_END();
 }
