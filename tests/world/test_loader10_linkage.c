@@ -15,6 +15,8 @@
 //   ODE's own knuckle angle, at the start and after 1 s of motion under
 //   constant cylinder forces;
 // - bad linkage blocks refused with one line naming the field;
+// - the drawing form (the common pin at a knuckle angle) gives back the
+//   lengths and the branch, and a pin at a toggle is refused;
 // - the sandbox snapshot has the link and the rocker as bodies in place.
 // ODE against the analytic mode on the work cycle through the linkage and
 // the energy balances are test_loader10's.
@@ -264,6 +266,73 @@ static void test_rod_and_linkage(void) {
     remove(path);
 }
 
+// The model file with its text `from` replaced by `to` (first occurrence),
+// loaded; NULL with the message in err. The file is written to the test's
+// working folder and removed.
+static model* load_edited(const char* from, const char* to, char* err, size_t errsz) {
+    FILE* f = fopen(MODEL, "rb");
+    if (!f) return NULL;
+    static char text[1 << 20];
+    const size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = 0;
+    char* at = strstr(text, from);
+    CHECK(at != NULL, "no \"%s\" in %s", from, MODEL);
+    if (!at) return NULL;
+    const char* path = "linkage_edited.json";
+    FILE* o = fopen(path, "wb");
+    if (!o) return NULL;
+    fwrite(text, 1, (size_t)(at - text), o);
+    fputs(to, o);
+    fputs(at + strlen(from), o);
+    fclose(o);
+    model* m = model_load(path, NULL, 0, err, errsz);
+    remove(path);
+    return m;
+}
+
+// The drawing form: the common pin's position at a knuckle angle instead
+// of the two lengths and the branch. loader10's P at q = -1.3 rad (from its
+// own loop) gives back its lengths and branch; a P on the line A-C (a
+// toggle) and both forms at once are refused.
+static void test_drawing_form(void) {
+    model* m = load();
+    if (!m) return;
+    const linkage* lk = &m->chain.act[crane_chain_find_act(&m->chain, "jib")].lk;
+    linkage_state st;
+    const double q_ref = -1.3;
+    CHECK(linkage_eval(lk, q_ref, &st) == 0, "eval");
+    const char* lens = "\"link_len\": 0.7, \"rocker_len\": 0.45, \"branch\": -1";
+    char to[256], err[512] = "";
+    snprintf(to, sizeof to, "\"common_pin\": [%.17g, 0, %.17g], \"common_pin_at\": %.17g", st.P[0], st.P[1], q_ref);
+    model* d = load_edited(lens, to, err, sizeof err);
+    CHECK(d != NULL, "drawing form: %s", err);
+    if (d) {
+        const linkage_def* dd = &d->chain.act[crane_chain_find_act(&d->chain, "jib")].lk.d;
+        printf("  drawing form: link %.15f m, rocker %.15f m, branch %d\n", dd->link_len, dd->rocker_len, dd->branch);
+        CHECK(fabs(dd->link_len - 0.7) < 1e-12 && fabs(dd->rocker_len - 0.45) < 1e-12 && dd->branch == -1,
+              "lengths %.17g %.17g, branch %d", dd->link_len, dd->rocker_len, dd->branch);
+        model_free(d);
+    }
+    // On the line A-C: the midpoint of A and C(q_ref).
+    const double mid[2] = {0.5 * (lk->d.link_pin[0] + st.C[0]), 0.5 * (lk->d.link_pin[1] + st.C[1])};
+    snprintf(to, sizeof to, "\"common_pin\": [%.17g, 0, %.17g], \"common_pin_at\": %.17g", mid[0], mid[1], q_ref);
+    d = load_edited(lens, to, err, sizeof err);
+    printf("  toggle -> %s\n", err);
+    CHECK(d == NULL && strstr(err, "mechanics.actuators[1].linkage.common_pin: ") && strstr(err, "a toggle") &&
+              !strchr(err, '\n'),
+          "\"%s\"", err);
+    model_free(d);
+    snprintf(to, sizeof to, "%s, \"common_pin\": [%.17g, 0, %.17g], \"common_pin_at\": -1.3", lens, st.P[0], st.P[1]);
+    d = load_edited(lens, to, err, sizeof err);
+    printf("  both forms -> %s\n", err);
+    CHECK(d == NULL && strstr(err, "mechanics.actuators[1].linkage.link_len: given with common_pin") &&
+              !strchr(err, '\n'),
+          "\"%s\"", err);
+    model_free(d);
+    model_free(m);
+}
+
 // The sandbox's snapshot (what the window draws): the link and the rocker
 // as bodies, the link's centre half its length from the cylinder's rod
 // end (P) and from its pin A, the rocker's half its length from P, after
@@ -323,6 +392,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_ode_loop);
     RUN_TEST(test_refusals);
     RUN_TEST(test_rod_and_linkage);
+    RUN_TEST(test_drawing_form);
     RUN_TEST(test_snapshot);
     TEST_MAIN_END();
 }

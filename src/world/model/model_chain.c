@@ -289,8 +289,8 @@ static void read_linkage(json_ctx* c, const cJSON* o, const char* p, crane_chain
     const cJSON* lo = json_obj(c, o, p, "linkage", true);
     if (c->failed) return;
     json_path(pp, sizeof pp, p, "linkage");
-    static const char* const keys[] = {"body",   "link_pin",  "rocker_pin",  "link_len", "rocker_len",
-                                       "branch", "link_mass", "rocker_mass", NULL};
+    static const char* const keys[] = {"body",      "link_pin",    "rocker_pin", "link_len",      "rocker_len", "branch",
+                                       "link_mass", "rocker_mass", "common_pin", "common_pin_at", NULL};
     json_only_keys(c, lo, pp, keys);
     char name[CHAIN_NAME];
     json_str(c, lo, pp, "body", true, "", name, sizeof name);
@@ -331,11 +331,32 @@ static void read_linkage(json_ctx* c, const cJSON* o, const char* p, crane_chain
     check_reach(c, f, cc, kb, C, "the rocker's pin");
     linkage_def d;
     memset(&d, 0, sizeof d);
-    d.link_len = json_num_r(c, lo, pp, "link_len", true, 0, &R_LINK_LEN);
-    d.rocker_len = json_num_r(c, lo, pp, "rocker_len", true, 0, &R_LINK_LEN);
-    d.branch = json_int(c, lo, pp, "branch", true, 0, -1, 1);
-    json_path(f, sizeof f, pp, "branch");
-    if (!c->failed && d.branch == 0) json_fail(c, f, "0; must be +1 or -1 (the side of link pin -> rocker pin the common pin is on)");
+    // The lengths and the branch, or (as a drawing gives them) the common
+    // pin P in the base's body's frame at the knuckle angle common_pin_at.
+    const bool drawn = cJSON_GetObjectItemCaseSensitive(lo, "common_pin") != NULL;
+    double P[3] = {0, 0, 0}, q_ref = 0;
+    if (drawn) {
+        static const char* const lens[] = {"link_len", "rocker_len", "branch"};
+        for (int i = 0; i < 3 && !c->failed; ++i)
+            if (cJSON_GetObjectItemCaseSensitive(lo, lens[i])) {
+                json_path(f, sizeof f, pp, lens[i]);
+                json_fail(c, f, "given with common_pin; give the lengths and the branch or the common pin, not both");
+            }
+        json_vec_r(c, lo, pp, "common_pin", true, P, 3, &R_POINT);
+        json_path(f, sizeof f, pp, "common_pin");
+        check_reach(c, f, cc, a->body_a, P, "the common pin");
+        q_ref = json_num_r(c, lo, pp, "common_pin_at", true, 0, &R_LIMIT_REV);
+        json_path(f, sizeof f, pp, "common_pin_at");
+        if (!c->failed && !(q_ref >= kd->q_min && q_ref <= kd->q_max))
+            json_fail(c, f, "%g rad, outside %s's joint range [%g, %g] rad", q_ref, name, kd->q_min, kd->q_max);
+    } else {
+        d.link_len = json_num_r(c, lo, pp, "link_len", true, 0, &R_LINK_LEN);
+        d.rocker_len = json_num_r(c, lo, pp, "rocker_len", true, 0, &R_LINK_LEN);
+        d.branch = json_int(c, lo, pp, "branch", true, 0, -1, 1);
+        json_path(f, sizeof f, pp, "branch");
+        if (!c->failed && d.branch == 0)
+            json_fail(c, f, "0; must be +1 or -1 (the side of link pin -> rocker pin the common pin is on)");
+    }
     d.link_mass = json_num_r(c, lo, pp, "link_mass", true, 0, &R_LINK_PART_MASS);
     d.rocker_mass = json_num_r(c, lo, pp, "rocker_mass", true, 0, &R_LINK_PART_MASS);
     if (c->failed) return;
@@ -343,8 +364,11 @@ static void read_linkage(json_ctx* c, const cJSON* o, const char* p, crane_chain
     const struct {
         const char* field;
         double y;
-    } ys[] = {{"base.point[1]", a->pa[1]}, {"linkage.link_pin[1]", A[1]}, {"linkage.rocker_pin[1]", C[1]}};
-    for (int i = 0; i < 3; ++i)
+    } ys[] = {{"base.point[1]", a->pa[1]},
+              {"linkage.link_pin[1]", A[1]},
+              {"linkage.rocker_pin[1]", C[1]},
+              {"linkage.common_pin[1]", P[1]}};
+    for (int i = 0; i < 4; ++i)
         if (ys[i].y != 0.0) {
             snprintf(f, sizeof f, "%s.%s", p, ys[i].field);
             json_fail(c, f, "%g m; a linkage works in the boom plane, y must be 0", ys[i].y);
@@ -362,6 +386,23 @@ static void read_linkage(json_ctx* c, const cJSON* o, const char* p, crane_chain
     d.rocker_pin[0] = C[0], d.rocker_pin[1] = C[2];
     d.q_min = kd->q_min, d.q_max = kd->q_max;
     char e[320];
+    if (drawn) {
+        const double Pr[2] = {P[0], P[2]};
+        json_path(f, sizeof f, pp, "common_pin");
+        if (linkage_def_from_pose(&d, Pr, q_ref, e, sizeof e)) {
+            const char* colon = strstr(e, ": ");
+            json_fail(c, f, "%s", colon ? colon + 2 : e);
+            return;
+        }
+        // The lengths it gives, in the range the lengths form takes.
+        const double l[2] = {d.link_len, d.rocker_len};
+        for (int i = 0; i < 2; ++i)
+            if (!(l[i] >= R_LINK_LEN.lo && l[i] <= R_LINK_LEN.hi)) {
+                json_fail(c, f, "gives a %s of %g m, outside [%g, %g] m", i ? "rocker_len" : "link_len", l[i],
+                          R_LINK_LEN.lo, R_LINK_LEN.hi);
+                return;
+            }
+    }
     if (linkage_init(&a->lk, &d, e, sizeof e)) {
         // linkage_init names its own fields ("linkage.x: ..."): its base is
         // the actuator's, its range the knuckle's limits.
