@@ -76,7 +76,7 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
         engine_row(l, row);
         const double nine[9] = {row[COL_X1], row[COL_X2], row[COL_P1A], row[COL_P1B], row[COL_P2A],
                                 row[COL_P2B], row[COL_U1], row[COL_U2], row[COL_T]};
-        proto_command c = {.seq = 2 * (uint64_t)i + 1, .op = PROTO_OP_VALVES};
+        proto_command c = {.seq = 2 * (uint64_t)i + 1, .op = PROTO_OP_VALVES, .nu = 3};
         for (int k = 0; k < 3; ++k) c.u[k] = fmax(-1, fmin(1, u[k]));
         send_cmd(fd, &c);
         c = (proto_command){.seq = 2 * (uint64_t)i + 2, .op = PROTO_OP_STEP, .frames = 1};
@@ -154,7 +154,7 @@ static uint64_t g_seq = 100;
 // The watcher gets new frames and the controller's next command is echoed, within 3 s.
 static int others_served(void) {
     const unsigned long long w0 = atomic_load(&g_wseq);
-    proto_command c = {.seq = ++g_seq, .op = PROTO_OP_VALVES, .u = {0.2, 0, 0}};
+    proto_command c = {.seq = ++g_seq, .op = PROTO_OP_VALVES, .nu = 3, .u = {0.2, 0, 0}};
     if (g_c < 0 || send_cmd(g_c, &c)) return 0;
     for (int k = 0; k < 300; ++k) {
         if (atomic_load(&g_wseq) > w0 + 2 && atomic_load(&g_cecho) == c.seq) return 1;
@@ -200,7 +200,7 @@ static void hostile(void) {
 
     // 1. a truncated frame: a valves command whose length leaves out 2 bytes of it
     {
-        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES};
+        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 3};
         size_t n = proto_put_command(b + 64, sizeof b - 64, &c);
         memcpy(b, hello, nh);
         b[64] = (uint8_t)(b[64] - 2);
@@ -215,28 +215,33 @@ static void hostile(void) {
         memcpy(b + nh, big, 5);
         CASE("length 2^31", raw(sv.port, b, nh + 5), 3000);
     }
-    // 3. a client of protocol version 1 (the state frame before the tip, roll,
-    // pitch and supply pressure) and one of a version yet to come
-    for (int v = 1; v <= 3; v += 2) {
-        size_t n = proto_put_client_hello(b, sizeof b, (uint32_t)v, PROTO_WATCH);
+    // 3. clients of protocol versions 1 and 2 (written for the two-link
+    // crane: three valve openings, no function list) and one of a version
+    // yet to come: each is told the version this server speaks and what to
+    // update, then closed
+    for (int v = 1; v <= 4; v += v == 2 ? 2 : 1) {
+        size_t n = proto_put_client_hello(b, sizeof b, (uint32_t)v, PROTO_CONTROL);
         int fd = raw(sv.port, b, n);
         proto_msg m;
-        char want[96];
-        snprintf(want, sizeof want, "protocol version %d not supported (this server speaks 2)", v);
+        char want[200];
+        snprintf(want, sizeof want,
+                 "protocol version %d not supported: this server speaks version 3, which lists the functions in its "
+                 "hello and takes one valve opening per function: update the client",
+                 v);
         CHECK(recv_frame(fd, &m, &g_st, 3000) == PROTO_ERROR && m.u.text.code == PROTO_E_VERSION &&
                   strstr(m.u.text.text, want),
               "version %d answered with '%s'", v, want);
-        CASE(v == 1 ? "old version" : "future version", fd, 3000);
+        CASE(v < 3 ? "old version" : "future version", fd, 3000);
     }
     // 4. an unknown op, 5. a NaN valve command (from a client that asked for control: it only watches)
     for (int k = 0; k < 2; ++k) {
         memcpy(b, hello, nh);
-        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .u = {0, 0, 0}};
+        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 3, .u = {0, 0, 0}};
         size_t n = proto_put_command(b + nh, sizeof b - nh, &c);
         if (k == 0) b[nh + 13] = 42;
         else {
             double nan = NAN;
-            memcpy(b + nh + 14, &nan, 8);
+            memcpy(b + nh + 15, &nan, 8); // after the count of openings
         }
         CASE(k == 0 ? "unknown command" : "NaN command", raw(sv.port, b, nh + n), 3000);
     }
@@ -256,7 +261,7 @@ static void hostile(void) {
     // 9. half a frame after the hello, then silence
     {
         memcpy(b, hello, nh);
-        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES};
+        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 3};
         size_t n = proto_put_command(b + nh, sizeof b - nh, &c);
         CASE("frame left half sent", raw(sv.port, b, nh + n / 2), 5000);
     }
@@ -287,7 +292,7 @@ static void hostile(void) {
         int role2 = -1;
         int fd = serve_join(sv.port, PROTO_CONTROL, &role2);
         CHECK(fd >= 0 && role2 == PROTO_WATCH, "a second controller watches (role %d)", role2);
-        proto_command c = {.op = PROTO_OP_VALVES, .u = {1, 1, 1}};
+        proto_command c = {.op = PROTO_OP_VALVES, .nu = 3, .u = {1, 1, 1}};
         size_t n = 0;
         static uint8_t flood[1 << 20];
         while (n + 64 < sizeof flood) {
@@ -346,7 +351,7 @@ static void hostile(void) {
     pthread_join(th, NULL);
     CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
     // Every case left its reason in the log.
-    const char* reasons[] = {"too short", "length 2147483648", "version 1 not supported", "version 3 not supported", "unknown op 42",
+    const char* reasons[] = {"too short", "length 2147483648", "version 1 not supported", "version 2 not supported", "version 4 not supported", "unknown op 42",
                              "opening 1 must be a number", "first frame must be a client hello", "no hello within",
                              "left incomplete", "not reading", "client limit reached", "unexpected state frame",
                              "the server stops"};
@@ -375,7 +380,7 @@ static void dead_man(void) {
     CHECK(next_state(fd, &g_st, 5000) == 0, "the state at t = 0");
     // Jib valve at -0.7 for 0.2 s (15 frames at 75 Hz): the jib stroke moves
     // (from 156 mm; held open it reaches its end stop after about 1 s).
-    proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .u = {0, -0.7, 0}};
+    proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 3, .u = {0, -0.7, 0}};
     send_cmd(fd, &c);
     const double x2_start = g_st.nine[1];
     c = (proto_command){.seq = 2, .op = PROTO_OP_STEP, .frames = 15};
