@@ -1305,7 +1305,7 @@ int cmd_serve(int argc, char** argv) {
     // A limiter asked for by name on a crane that has none is refused (on
     // by default, it is then "unavailable" in the first line).
     if ((rcl_given && c.sim.rcl &&
-         engine_require(m, &c.sim, ENGINE_CAP_LIMITER, "cranesim serve --rcl on", err, sizeof err)) ||
+         engine_require(m, &c.sim, ENGINE_CAP_LIMITER, "--rcl on", err, sizeof err)) ||
         build_engine(&s, NULL, err, sizeof err) || serve_layout(&s, err, sizeof err)) {
         fprintf(stderr, "cranesim serve: %s\n", err);
         rc = EXIT_USAGE;
