@@ -139,6 +139,7 @@ int drive_connect(const char* addr, const scenario* sc, double duration, const c
     bool ever = false;
     dc_functions fns = {.n = 0};
     int fcol[PROTO_MAX_FN]; // the scenario's column for each of the server's functions, -1: none (0)
+    double fmax_cmd[PROTO_MAX_FN] = {0}; // the largest |command| the frames showed per function [-]
     app_signals sig;
     app_signals_catch(&sig);
     while (sim_wall_time() - w0 < duration && !app_signal_caught()) {
@@ -246,6 +247,7 @@ int drive_connect(const char* addr, const scenario* sc, double duration, const c
                     if (last_seq && st->seq > last_seq + 1) lost += (long)(st->seq - last_seq - 1);
                     last_seq = st->seq;
                     last_t = st->nine[8];
+                    for (int k = 0; k < st->nfn && k < fns.n; ++k) fmax_cmd[k] = fmax(fmax_cmd[k], fabs(st->fn[k][0]));
                     if (seq && st->cmd_seq == seq && sent_at > 0) {
                         const double l = sim_wall_time() - sent_at;
                         lat_sum += l, lat_max = fmax(lat_max, l), ++nlat;
@@ -280,6 +282,11 @@ int drive_connect(const char* addr, const scenario* sc, double duration, const c
                "%.2f ms, max %.2f ms (%ld commands); remote t = %.3f s\n",
                frames, lost, drops, drops == 1 ? "" : "s", links, links == 1 ? "" : "s",
                nlat ? 1e3 * lat_sum / nlat : 0.0, 1e3 * lat_max, nlat, last_t);
+    if (ever) { // what reached the crane, by function (the state frames' function records)
+        printf("  functions, the largest |command| the server applied:");
+        for (int k = 0; k < fns.n; ++k) printf("%s %s %.2f", k ? "," : "", fns.name[k], fmax_cmd[k]);
+        printf("\n");
+    }
     free(rx);
     free(st);
     return code;
