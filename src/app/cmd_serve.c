@@ -51,7 +51,9 @@ static void serve_help(FILE* f) {
             "The simulation computer: runs the model headless in real time and streams its state over\n"
             "TCP to clients (a viewer, `cranesim drive --connect`, a valve controller, examples/), which\n"
             "send valve, hook, pause, reset and parameter commands back (docs/protocol.md). One client\n"
-            "controls; the others watch. SIGINT or SIGTERM stop it cleanly (exit 0).\n"
+            "controls; the others watch. SIGINT or SIGTERM stop it cleanly (exit 0). Any crane shape:\n"
+            "the hello lists its functions, the valve commands carry one opening per function\n"
+            "(protocol version 3; a crane chain runs on ode in the sandbox).\n"
             "\n"
             "options:\n"
             "  --listen ADDR:PORT  where to listen (default 127.0.0.1:7575, loopback only; another\n"
@@ -74,7 +76,8 @@ static void serve_help(FILE* f) {
             "                      controller's commands at every frame (docs/safety.md)\n"
             "  --duration T        stop after T simulated seconds (default: run until SIGINT)\n"
             "  --scenario S        the start pose and load (default as drive); its commands are not played\n"
-            "  --mechanics M       ode (default: the sandbox world) or lagrange (analytic 2-DOF)\n"
+            "  --mechanics M       ode (default: the sandbox world) or lagrange (analytic 2-DOF; not for a\n"
+            "                      crane chain)\n"
             "  --world W           ode: world file or name: sandbox (default), validation\n");
     const unsigned all = APP_GIVEN(APP_OPT_COUNT) - 1u;
     app_options_help(f, all & ~(APP_GIVEN(APP_OPT_SCENARIO) | APP_GIVEN(APP_OPT_MECHANICS) | APP_GIVEN(APP_OPT_WORLD) |

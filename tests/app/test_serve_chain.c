@@ -12,7 +12,9 @@
 //    of the same commands on a local engine of the same model, every
 //    function record is that function's command and spool there, every
 //    cylinder record its actuator's stroke and pressures, and the nine
-//    values are the first two functions' (docs/protocol.md).
+//    values are the first two functions' (docs/protocol.md). Then the
+//    controller leaves with every valve open: the next one finds every
+//    function at neutral (dead-man).
 // 4. What stays unsupported is refused in one line, exit 2: a chain
 //    without a picture (--mechanics lagrange), --rcl on (no limiter for a
 //    chain yet).
@@ -230,7 +232,32 @@ static void served_chain(void) {
     CHECK(moved >= 8, "the commands moved %ld cylinders", moved);
     for (int k = 0; k < nfn; ++k)
         CHECK(fcyl[k] >= 0 && fcyl[k] < g_st.ncyl, "function %d has a cylinder record (%d)", k, fcyl[k]);
+    // Dead-man: the controller leaves with every function's valve open; the
+    // next controller finds every function's command at 0 (neutral), and
+    // after 0.2 s every spool closed.
     if (fd >= 0) close(fd);
+    int fd2 = -1, role = -1;
+    for (int k = 0; k < 100 && role != PROTO_CONTROL; ++k) {
+        if (fd2 >= 0) close(fd2);
+        fd2 = serve_join(sv.port, PROTO_CONTROL, &role);
+        if (role != PROTO_CONTROL) usleep(20000);
+    }
+    CHECK(fd2 >= 0 && role == PROTO_CONTROL, "the next client got control");
+    if (fd2 >= 0) {
+        proto_command c = {.seq = 1, .op = PROTO_OP_STEP, .frames = 15};
+        send_cmd(fd2, &c);
+        int open_fn = 0;
+        double worst = 0;
+        CHECK(next_state(fd2, &g_st, 5000) == 0 && next_state(fd2, &g_st, 10000) == 0, "state after 15 frames");
+        for (int k = 0; k < g_st.nfn; ++k) {
+            if (g_st.fn[k][0] != 0) ++open_fn;
+            worst = fmax(worst, fabs(g_st.fn[k][1]));
+        }
+        printf("dead-man: %d of %u function commands not at 0, largest spool %.3g after 0.2 s\n", open_fn, g_st.nfn,
+               worst);
+        CHECK(g_st.nfn == 9 && open_fn == 0 && worst < 0.01, "dead-man: %d commands open, spool %g", open_fn, worst);
+        close(fd2);
+    }
     CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
     cJSON_Delete(j);
     free(row);
