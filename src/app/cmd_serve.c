@@ -231,7 +231,7 @@ static void drop_client(server* s, int idx, uint16_t code, const char* why) {
     if (s->controller == c->id) {
         // Dead-man: a controller that left (or whose link timed out) can no
         // longer stop what it started, so its last openings must not stay
-        // applied. All three spools go to neutral (0) at once.
+        // applied. Every function's spool goes to neutral (0) at once.
         s->controller = 0;
         memset(s->u, 0, sizeof s->u);
         if (s->e) set_commands(s);
@@ -294,7 +294,9 @@ static int build_engine(server* s, struct rcl* lim, char* err, size_t errsz) {
     }
     s->k = 0;
     s->stopped = false;
-    if (s->nfn) set_commands(s); // 0 before serve_layout (the first build): the engine's own neutral
+    // The controller's commands (all 0 at the first build: serve_layout
+    // has not run, so even a chain takes engine_set_commands' neutral).
+    set_commands(s);
     for (int i = 0; i < s->nset; ++i) {
         char e2[320];
         if (apply_set(s, s->sets[i].path, s->sets[i].value, e2, sizeof e2)) logf_(s, "after reset: %s", e2);
@@ -535,7 +537,7 @@ static void fill_state(server* s) {
                 memset(d, 0, 6 * sizeof(double));
             }
             d[6] = row[sc->col[0]], d[7] = row[sc->col[2]], d[8] = row[sc->col[3]];
-            d[9] = st->fn[sc->fn][1], d[10] = st->fn[sc->fn][0];
+            d[9] = sc->fn >= 0 ? st->fn[sc->fn][1] : 0, d[10] = sc->fn >= 0 ? st->fn[sc->fn][0] : 0;
             d[11] = row[sc->col[4]], d[12] = row[sc->col[1]];
         }
         st->cyl_bits[i] = (uint8_t)(y ? (y->relief_open ? PROTO_CYL_RELIEF : 0) | (y->end_stop ? PROTO_CYL_END_STOP : 0)
