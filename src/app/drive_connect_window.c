@@ -548,7 +548,7 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     drive_session_set_remote(s);
     k.sets = (const char* const*)c0->sets;
     k.nset = c0->nset;
-    if (lk_hello(&k, s, &m, err, sizeof err)) { // cannot fail: nbody checked above
+    if (lk_hello(&k, s, &m, err, sizeof err)) { // nbody checked above: a hello without functions
         fprintf(stderr, "cranesim drive: %s\n", err);
         goto done_sc;
     }
