@@ -63,7 +63,7 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
     int fd = serve_join(sv.port, PROTO_CONTROL, &role);
     CHECK(fd >= 0 && role == PROTO_CONTROL, "joined as controller (role %d)", role);
     CHECK(fd >= 0 && next_state(fd, &g_st, 5000) == 0 && g_st.nine[8] == 0, "the state at t = 0 first");
-    long diff = 0, frames = 0, diff2 = 0, tilted = 0;
+    long diff = 0, frames = 0, diff2 = 0, tilted = 0, fn_diff = 0;
     double worst = 0, tilt_err = 0;
     world_snapshot* snap = malloc(sizeof *snap);
     for (int i = 0; i < nframes && fd >= 0; ++i) {
@@ -89,6 +89,15 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
         CHECK(g_st.cmd_seq == c.seq, "frame %d echoes command %llu, got %llu", i, (unsigned long long)c.seq,
               (unsigned long long)g_st.cmd_seq);
         if (memcmp(nine, g_st.nine, sizeof nine)) ++diff;
+        // Version 3: the function records lift, jib, slew: their commands
+        // (after the limiter) and spools are the row's u1_cmd, u2_cmd and
+        // u1, u2 (slew: its cylinder's in the sandbox, the command as given
+        // on the lagrange crane, which does not slew).
+        if (g_st.nfn != 3 || g_st.fn[0][0] != row[COL_U1_CMD] || g_st.fn[1][0] != row[COL_U2_CMD] ||
+            g_st.fn[0][1] != row[COL_U1] || g_st.fn[1][1] != row[COL_U2] ||
+            (o.mechanics == SIM_ODE ? g_st.fn[2][0] != row[COL_U3_CMD] || g_st.fn[2][1] != row[COL_U3]
+                                    : g_st.fn[2][0] != fmax(-1, fmin(1, u[2])) || g_st.fn[2][1] != g_st.fn[2][0]))
+            ++fn_diff;
         for (int k = 0; k < 9; ++k) worst = fmax(worst, fabs(nine[k] - g_st.nine[k]));
         // Version 2: the tip in the world, the truck's roll and pitch and the
         // supply pressure equal the local run's; the tilt from roll and
@@ -112,6 +121,8 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
     printf("%s/%s: %ld frames served, %ld differ from the local run (largest difference %g)\n", mech, scen, frames,
            diff, worst);
     CHECK(frames == nframes && diff == 0, "%s: %ld of %ld frames differ, by up to %g", mech, diff, frames, worst);
+    CHECK(fn_diff == 0, "%s: the function records differ from the row's commands and spools in %ld frames", mech,
+          fn_diff);
     CHECK(g_st.nine[8] == nframes * frame || fabs(g_st.nine[8] - nframes * frame) < 1e-3, "t = %g", g_st.nine[8]);
     if (fd >= 0) close(fd);
     CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");

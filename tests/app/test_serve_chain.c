@@ -18,6 +18,8 @@
 // 4. What stays unsupported is refused in one line, exit 2: a chain
 //    without a picture (--mechanics lagrange), --rcl on (no limiter for a
 //    chain yet).
+// 5. The shipped loader10.json: its functions (ext on two cylinders) and
+//    a frame with a record for each.
 #define _DEFAULT_SOURCE // usleep, in serve_util.h
 #include "check.h"
 #include "crane_chain.h"
@@ -266,6 +268,50 @@ static void served_chain(void) {
     model_free(m);
 }
 
+// 5. The shipped chain model, loader10.json (three functions, the ext
+// function on two telescope cylinders, the model's own slew drive): the
+// hello's functions and actuators, and a frame with a record for each.
+static void served_loader10(void) {
+    const char* args[] = {"--model", CRANESIM_ASSETS "/models/loader10.json", "--lockstep", NULL};
+    served sv = {.pid = 0};
+    CHECK(serve_start(&sv, NULL, args) == 0, "server started on loader10");
+    int fd = tcp_connect(sv.port);
+    uint8_t b[64];
+    size_t n = proto_put_client_hello(b, sizeof b, PROTO_VERSION, PROTO_CONTROL);
+    proto_msg msg;
+    CHECK(fd >= 0 && send_all(fd, b, n) == 0 && recv_frame(fd, &msg, &g_st, 5000) == PROTO_SERVER_HELLO,
+          "hello answered");
+    cJSON* j = cJSON_ParseWithLength(msg.u.shello.json, msg.u.shello.json_len);
+    const cJSON* fa = cJSON_GetObjectItem(j, "functions");
+    char names[256] = "";
+    for (int k = 0; k < cJSON_GetArraySize(fa); ++k) {
+        const cJSON* f = cJSON_GetArrayItem(fa, k);
+        const cJSON* aa = cJSON_GetObjectItem(f, "actuators");
+        size_t L = strlen(names);
+        snprintf(names + L, sizeof names - L, "%s%s(", k ? " " : "", cJSON_GetStringValue(cJSON_GetObjectItem(f, "name")));
+        for (int i = 0; i < cJSON_GetArraySize(aa); ++i) {
+            L = strlen(names);
+            snprintf(names + L, sizeof names - L, "%s%s", i ? "," : "",
+                     cJSON_GetStringValue(cJSON_GetObjectItem(cJSON_GetArrayItem(aa, i), "name")));
+        }
+        L = strlen(names);
+        snprintf(names + L, sizeof names - L, ")");
+    }
+    printf("loader10: functions %s\n", names);
+    CHECK(!strcmp(names, "lift(lift) jib(jib) ext(ext1,ext2) slew(slew)"), "loader10 functions: %s", names);
+    proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 4, .u = {0, 0, 0.8, 0}};
+    send_cmd(fd, &c);
+    c = (proto_command){.seq = 2, .op = PROTO_OP_STEP, .frames = 30};
+    send_cmd(fd, &c);
+    CHECK(next_state(fd, &g_st, 5000) == 0 && next_state(fd, &g_st, 10000) == 0, "state after 30 frames");
+    CHECK(g_st.nfn == 4 && g_st.ncyl == 5 && g_st.fn[2][0] == 0.8 && g_st.fn[2][1] > 0.5 && g_st.fn[0][0] == 0,
+          "loader10 frame: %u functions, %u cylinders, ext command %g spool %g", g_st.nfn, g_st.ncyl, g_st.fn[2][0],
+          g_st.fn[2][1]);
+    cJSON_Delete(j);
+    if (fd >= 0) close(fd);
+    CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
+}
+
 // 4. cranesim serve ARGS: exit 2 and one line on stderr naming want.
 static void refused(const char* args, const char* want) {
     char cmd[1024], out[2048] = "";
@@ -285,6 +331,7 @@ static void refused(const char* args, const char* want) {
 int main(void) {
     signal(SIGPIPE, SIG_IGN);
     served_chain();
+    served_loader10();
     refused("--mechanics lagrange",
             "the serve protocol: chain_8fn_10link.json: the stepped lagrange engine for this crane chain (8 "
             "functions) has no picture for the renderer yet");
