@@ -177,19 +177,19 @@ int cmd_replay(int argc, char** argv) {
         }
         m = fm;
     }
-    // Session files carry the two-link crane's commands and rows (issue 27
-    // sizes them by the model); a chain model's session is refused whole.
-    engine* l = engine_require(m, &s.sim, ENGINE_CAP_TWO_LINK, "session files", err, sizeof err)
-                    ? NULL
-                    : engine_create(m, &s.sim, s.q0, s.slew0, s.m3, err, sizeof err);
+    engine* l = engine_create(m, &s.sim, s.q0, s.slew0, s.m3, err, sizeof err);
     if (!l) {
         fprintf(stderr, "cranesim replay: %s\n", err);
         model_free(m);
         session_free(&s);
         return EXIT_USAGE;
     }
+    const bool changed = model_path || nset;
     const int ncol = engine_ncol(l);
-    if (ncol != s.ncol) {
+    // The recorded design gives the recorded columns; a changed one may have
+    // other functions and so other chain columns: its rows are then compared
+    // as text (none identical) and its metrics over the common base columns.
+    if (ncol != s.ncol && !changed) {
         fprintf(stderr, "cranesim replay: session %s: ncol: the session has %d channels, this engine writes %d\n", path,
                 s.ncol, ncol);
         engine_destroy(l);
@@ -197,39 +197,71 @@ int cmd_replay(int argc, char** argv) {
         session_free(&s);
         return EXIT_USAGE;
     }
-    const int rcol = ncol + (s.window ? 1 : 0); // the window's record adds `segment`
-    app_out o_csv = {.f = NULL};
-    FILE* f = out ? app_out_open(&o_csv, out, "w") : NULL;
-    if (out && !f) {
-        fprintf(stderr, "cranesim replay: cannot write %s: %s\n", out, strerror(errno));
+    // The recorded commands by function name: a function the session
+    // commands must be one of this model's (session_function_map).
+    const int nfn = engine_nfunction(l);
+    const bool two_link = engine_caps(l) & ENGINE_CAP_TWO_LINK;
+    int* fmap = calloc((size_t)nfn + 1, sizeof *fmap);
+    double* uf = calloc((size_t)nfn + 3, sizeof *uf);
+    const int ncommanded = fmap && uf ? session_function_map(&s, l, fmap, err, sizeof err) : -2;
+    if (ncommanded < 0) {
+        if (ncommanded == -2) snprintf(err, sizeof err, "out of memory");
+        fprintf(stderr, "cranesim replay: %s\n", err);
+        free(fmap);
+        free(uf);
         engine_destroy(l);
         model_free(m);
         session_free(&s);
         return EXIT_USAGE;
     }
-    if (f) session_csv_header(&s, f);
+    // The base columns (the backend's, what the metrics and the plot read);
+    // a chain engine's own come after them.
+    const int bcol = ncol < sim_ncol(&s.sim) ? ncol : sim_ncol(&s.sim);
+    const int rcol = ncol + (s.window ? 1 : 0); // the window's record adds `segment`
+    const int scol = s.ncol + (s.window ? 1 : 0); // the recorded rows'
+    const int maxcol = (rcol > scol ? rcol : scol) > SIM_NCOL + 1 ? (rcol > scol ? rcol : scol) : SIM_NCOL + 1;
+    double* row = calloc((size_t)maxcol, sizeof *row);
+    double* rec = calloc((size_t)maxcol, sizeof *rec);
+    app_out o_csv = {.f = NULL};
+    FILE* f = row && rec && out ? app_out_open(&o_csv, out, "w") : NULL;
+    if (!row || !rec || (out && !f)) {
+        if (!row || !rec) fprintf(stderr, "cranesim replay: out of memory\n");
+        else fprintf(stderr, "cranesim replay: cannot write %s: %s\n", out, strerror(errno));
+        free(row);
+        free(rec);
+        free(fmap);
+        free(uf);
+        engine_destroy(l);
+        model_free(m);
+        session_free(&s);
+        return EXIT_USAGE;
+    }
+    if (f) session_csv_header(&s, l, f);
     struct sim_energy* en = app_energy_follow("replay", l); // the replay's energy balance, as run's
     sim_trace tr[2] = {{0}, {0}}; // recorded, replayed
     // The table compares both runs' rows as written (%.9g text), so rows that
     // are identical give a difference of exactly 0; --metrics writes the
     // replay's own values.
     run_metrics met[2], exact;
-    metrics_init(&met[0], ncol);
-    metrics_init(&met[1], ncol);
-    metrics_init(&exact, ncol);
+    metrics_init(&met[0], bcol);
+    metrics_init(&met[1], bcol);
+    metrics_init(&exact, bcol);
     long same = 0, first_diff = -1, nrow = 0;
     int code = 0;
     char* line = NULL;
     size_t linecap = 0;
     FILE* mem = NULL;
-    double row[SIM_NCOL + 1], rec[SIM_NCOL + 1];
     for (long i = 0; i < s.ntick; ++i) {
         const session_tick* t = &s.tick[i];
         // As the drive did: hook events, faults at the sampling time, the
         // commands, then the advance to the same target.
         for (int k = 0; k < t->nhook; ++k) engine_hook(l, t->hook[k]);
         if (faults) engine_apply_faults(l, &sc, t->tm);
-        engine_set_commands(l, t->u);
+        // The commands by function as recorded, through the same path as
+        // the drive's: the two-link crane's with its limiter.
+        session_tick_commands(&s, i, fmap, nfn, uf);
+        if (two_link) engine_set_commands(l, uf);
+        else engine_set_function_commands(l, uf, nfn, NULL, 0);
         const double now = engine_time(l);
         // The window advances only when its target is ahead; the headless
         // drive always asks.
@@ -263,10 +295,10 @@ int cmd_replay(int argc, char** argv) {
         ++nrow;
         metrics_row(&exact, row);
         parse_row(line, row, rcol);
-        trace_push(&tr[1], row, ncol);
+        trace_push(&tr[1], row, bcol);
         metrics_row(&met[1], row);
-        if (recorded && parse_row(recorded, rec, rcol) >= ncol) {
-            trace_push(&tr[0], rec, ncol);
+        if (recorded && parse_row(recorded, rec, scol) >= s.ncol) {
+            trace_push(&tr[0], rec, bcol);
             metrics_row(&met[0], rec);
         }
         if (!quiet) app_progress(NULL, t->target, s.tick[s.ntick - 1].target);
@@ -290,7 +322,19 @@ int cmd_replay(int argc, char** argv) {
     printf("cranesim replay: %s (recorded by the %s drive; %s), %s\n", path, s.window ? "window" : "headless", s.end,
            design);
     printf("  %ld command updates, %ld rows; t = %.6g s\n", s.ntick, nrow, engine_time(l));
-    if (rcl >= 0 && rcl_recorded)
+    // The functions commanded, by name; one this model has and the session
+    // does not command is held at 0 (said, never silent).
+    printf("  commands by function (%d):", s.nfn);
+    for (int j = 0; j < s.nfn; ++j) printf("%s %s", j ? "," : "", s.fn[j]);
+    if (ncommanded < nfn) {
+        printf("; held at 0 (not in the session):");
+        for (int k = 0, c = 0; k < nfn; ++k)
+            if (fmap[k] < 0) printf("%s %s", c++ ? "," : "", engine_function_name(l, k));
+    }
+    printf("\n");
+    if (!(engine_caps(l) & ENGINE_CAP_LIMITER))
+        printf("  rated capacity limiter: none for this crane chain yet (the drive had none either)\n");
+    else if (rcl >= 0 && rcl_recorded)
         printf("  rated capacity limiter %s (--rcl; recorded %s)\n", s.sim.rcl ? "on" : "off",
                rcl_as_recorded ? "on" : "off");
     else if (rcl >= 0)
@@ -343,6 +387,10 @@ int cmd_replay(int argc, char** argv) {
     }
     sim_trace_free(&tr[0]);
     sim_trace_free(&tr[1]);
+    free(row);
+    free(rec);
+    free(fmap);
+    free(uf);
     engine_destroy(l);
     model_free(m);
     session_free(&s);
