@@ -27,6 +27,8 @@ static void replay_help(FILE* f) {
             "\n"
             "options:\n"
             "  --model FILE        replay on this model file instead of the one recorded in the session\n"
+            "                      (the recorded commands go to its functions by name; a function the\n"
+            "                      session commands and the model lacks is refused)\n"
             "  --set PATH=VALUE    change a model value (on the recorded model, or on --model's)\n"
             "  --out FILE.csv      the replay's rows, in the record's format (drive --record)\n"
             "  --metrics FILE.json the replay's metrics (as cranesim run --metrics)\n"
@@ -333,7 +335,8 @@ int cmd_replay(int argc, char** argv) {
     }
     printf("\n");
     if (!(engine_caps(l) & ENGINE_CAP_LIMITER))
-        printf("  rated capacity limiter: none for this crane chain yet (the drive had none either)\n");
+        printf("  rated capacity limiter: none for this crane chain yet (the session records it %s)\n",
+               !rcl_recorded ? "not" : rcl_as_recorded ? "on" : "off");
     else if (rcl >= 0 && rcl_recorded)
         printf("  rated capacity limiter %s (--rcl; recorded %s)\n", s.sim.rcl ? "on" : "off",
                rcl_as_recorded ? "on" : "off");
