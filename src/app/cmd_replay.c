@@ -205,7 +205,8 @@ int cmd_replay(int argc, char** argv) {
     const bool two_link = engine_caps(l) & ENGINE_CAP_TWO_LINK;
     int* fmap = calloc((size_t)nfn + 1, sizeof *fmap);
     double* uf = calloc((size_t)nfn + 3, sizeof *uf);
-    const int ncommanded = fmap && uf ? session_function_map(&s, l, fmap, err, sizeof err) : -2;
+    char dropped[512];
+    const int ncommanded = fmap && uf ? session_function_map(&s, l, fmap, dropped, sizeof dropped, err, sizeof err) : -2;
     if (ncommanded < 0) {
         if (ncommanded == -2) snprintf(err, sizeof err, "out of memory");
         fprintf(stderr, "cranesim replay: %s\n", err);
@@ -333,6 +334,7 @@ int cmd_replay(int argc, char** argv) {
         for (int k = 0, c = 0; k < nfn; ++k)
             if (fmap[k] < 0) printf("%s %s", c++ ? "," : "", engine_function_name(l, k));
     }
+    if (dropped[0]) printf("; left out, not in this model and 0 throughout: %s", dropped);
     printf("\n");
     if (!(engine_caps(l) & ENGINE_CAP_LIMITER))
         printf("  rated capacity limiter: none for this crane chain yet (the session records it %s)\n",

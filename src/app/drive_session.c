@@ -1078,7 +1078,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         s->rp_map = calloc((size_t)nfn + 1, sizeof *s->rp_map);
         s->rp_u = calloc((size_t)nfn + 3, sizeof *s->rp_u);
         if (!s->rp_map || !s->rp_u) snprintf(err, errsz, "out of memory");
-        if (!s->rp_map || !s->rp_u || session_function_map(s->rp, s->l, s->rp_map, err, errsz) < 0) {
+        if (!s->rp_map || !s->rp_u || session_function_map(s->rp, s->l, s->rp_map, NULL, 0, err, errsz) < 0) {
             drive_session_destroy(s);
             *code = EXIT_USAGE;
             return NULL;

@@ -435,7 +435,9 @@ void session_csv_header(const session* s, const engine* l, FILE* f) {
     fputs(s->window ? ",segment\n" : "\n", f);
 }
 
-int session_function_map(const session* s, const engine* l, int* map, char* err, size_t errsz) {
+int session_function_map(const session* s, const engine* l, int* map, char* dropped, size_t dsz, char* err,
+                         size_t errsz) {
+    if (dropped && dsz) dropped[0] = 0;
     const int n = engine_nfunction(l);
     // Version 1 carries the two-link crane's commands, lift, jib, slew, in
     // the two-link engine's order: as they were replayed before names.
@@ -445,6 +447,14 @@ int session_function_map(const session* s, const engine* l, int* map, char* err,
     int found = 0;
     for (int j = 0; j < s->nfn; ++j) {
         const int k = engine_find_function(l, s->fn[j]);
+        bool commanded = k < 0 ? false : true;
+        for (long i = 0; k < 0 && i < s->ntick && !commanded; ++i) commanded = s->tick[i].u[j] != 0.0;
+        if (k < 0 && !commanded) {
+            // Never commanded: leaving it out replays the same operator.
+            const size_t L = dropped ? strlen(dropped) : 0;
+            if (dropped && L + 1 < dsz) snprintf(dropped + L, dsz - L, "%s%s", L ? ", " : "", s->fn[j]);
+            continue;
+        }
         if (k < 0) {
             char list[600];
             int w = 0;

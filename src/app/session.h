@@ -119,11 +119,16 @@ void session_csv_header(const session* s, const struct engine* l, FILE* f);
 /// The session's command of each of engine l's functions, by name: map[k]
 /// (k < engine_nfunction(l)) is the session's function index, or -1 for a
 /// function the session does not command (held at 0). A version 1 session
-/// on a two-link engine maps lift, jib, slew in order. Returns the number
-/// of the engine's functions the session commands, or -1 with one line in
-/// err when the session commands a function l lacks: "session FILE:
-/// functions: 'x' is not a function of this model (its functions: ...)".
-int session_function_map(const session* s, const struct engine* l, int* map, char* err, size_t errsz);
+/// on a two-link engine maps lift, jib, slew in order. A function of the
+/// session that l lacks is left out only when every recorded command of it
+/// is 0 (it carried no operator input: a two-link session's slew outside
+/// the sandbox); its name then goes into dropped (may be NULL), ", "
+/// separated. Returns the number of the engine's functions the session
+/// commands, or -1 with one line in err when the session commands a
+/// function l lacks: "session FILE: functions: 'x' is not a function of
+/// this model (its functions: ...)".
+int session_function_map(const session* s, const struct engine* l, int* map, char* dropped, size_t dsz, char* err,
+                         size_t errsz);
 /// Tick i's commands for the engine's n functions (map from
 /// session_function_map) into u[n].
 void session_tick_commands(const session* s, long i, const int* map, int n, double* u);
