@@ -1527,7 +1527,10 @@ int drive_session_tick(drive_session* s, double wall) {
             const bool keep = !adv && (s->sw.rows == 0 || r[COL_T] > s->sw.t_last);
             if (keep) s->sw.t_last = r[COL_T];
             r[s->ncol] = 0;
-            session_writer_tick(&s->sw, s->t_base + t + 0.5 * dt_wall, target, u, 3, keep ? r : NULL, s->ncol + 1);
+            // The commands as the engine holds them, one per function
+            // (session.h): the sticks' lift, jib, slew on the two-link crane.
+            session_writer_tick_engine(&s->sw, s->l, s->t_base + t + 0.5 * dt_wall, target, keep ? r : NULL,
+                                       s->ncol + 1);
         }
         if (adv) {
             snprintf(s->err, sizeof s->err, "%s", engine_error(s->l));

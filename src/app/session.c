@@ -54,6 +54,13 @@ int session_writer_open(session_writer* w, const char* path, const cJSON* model_
     // The functions every tick commands, in the engine's order: a replay
     // finds each by name (docs/replay.md), on this model or a changed one.
     w->nfn = engine_nfunction(l);
+    w->u = calloc((size_t)w->nfn + 1, sizeof *w->u);
+    if (!w->u) {
+        snprintf(err, errsz, "out of memory");
+        cJSON_Delete(h);
+        cJSON_Delete(sc);
+        return -1;
+    }
     cJSON* fns = cJSON_AddArrayToObject(h, "functions");
     for (int k = 0; k < w->nfn; ++k) cJSON_AddItemToArray(fns, cJSON_CreateString(engine_function_name(l, k)));
     if (sc) cJSON_AddItemToObject(h, "scenario", sc);
@@ -81,12 +88,16 @@ int session_writer_open(session_writer* w, const char* path, const cJSON* model_
     cJSON_Delete(h);
     if (!text) {
         snprintf(err, errsz, "out of memory");
+        free(w->u);
+        w->u = NULL;
         return -1;
     }
     w->f = fopen(path, "w");
     if (!w->f) {
         snprintf(err, errsz, "cannot write %s: %s", path, strerror(errno));
         free(text);
+        free(w->u);
+        w->u = NULL;
         return -1;
     }
     errno = 0;
@@ -124,7 +135,17 @@ void session_writer_tick(session_writer* w, double tm, double target, const doub
     wcheck(w);
 }
 
+void session_writer_tick_engine(session_writer* w, const engine* l, double tm, double target, const double* row,
+                                int ncol) {
+    if (!w->f || w->err || !w->u) return;
+    const int n = engine_nfunction(l) < w->nfn ? engine_nfunction(l) : w->nfn;
+    for (int k = 0; k < n; ++k) w->u[k] = engine_function_command(l, k);
+    session_writer_tick(w, tm, target, w->u, engine_nfunction(l), row, ncol);
+}
+
 int session_writer_close(session_writer* w, const char* why) {
+    free(w->u);
+    w->u = NULL;
     if (!w->f) return w->err;
     errno = 0;
     fprintf(w->f, "e %s\n", why);

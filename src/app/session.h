@@ -81,6 +81,7 @@ typedef struct session_writer {
     double t_last;       ///< the last recorded row's time (window: one row per instant)
     long rows;
     int nfn;             ///< commands per tick (the engine's functions)
+    double* u;           ///< nfn commands read back from the engine (session_writer_tick_engine)
 } session_writer;
 /// Open path and write the header. scenario_path: the scenario whose faults
 /// the drive applies (NULL: none). Returns 0, or -1 with one line in err.
@@ -99,6 +100,12 @@ void session_writer_hook(session_writer* w, int attach);
 /// window's with its `segment` value last).
 void session_writer_tick(session_writer* w, double tm, double target, const double* u, int nu, const double* row,
                          int ncol);
+/// A tick whose commands are those engine l (the one opened with) holds now,
+/// as the operator gave them (engine_function_command): what a driver that
+/// sets them by whatever path (the window's sticks, a chain's functions)
+/// records after setting them.
+void session_writer_tick_engine(session_writer* w, const struct engine* l, double tm, double target,
+                                const double* row, int ncol);
 /// End the file with why; close it. Returns 0, or the errno of the first failure.
 int session_writer_close(session_writer* w, const char* why);
 
