@@ -305,6 +305,32 @@ static void check_by_name(void) {
     }
 }
 
+// A format 2 session with a bad functions list or a tick line whose
+// commands do not match it: one line naming the file and line, exit 2,
+// nothing written.
+static void check_bad_v2(void) {
+    long n = cli_read_file("rp_l10.session", a, sizeof a);
+    const char* fl = "\"functions\":[\"lift\",\"jib\",\"ext\"]";
+    char* f = n > 0 ? strstr(a, fl) : NULL;
+    CHECK(f != NULL, "no functions list in rp_l10.session");
+    if (!f) return;
+    memcpy(f, "\"functions\":[\"lift\",\"lift\",\"ex\"]", strlen(fl));
+    check_refused("a function twice", a, "line 2: header: functions: expected an array of the functions' names, each once");
+    memcpy(f, fl, strlen(fl));
+    // The fourth tick line without its last command.
+    char* t = a;
+    for (int k = 0; k < 4 && t; ++k) t = strstr(t + 1, "\nt ");
+    char* eol = t ? strchr(t + 1, '\n') : NULL;
+    char* last = eol ? eol - 2 : NULL; // " 0" or " 1": the row flag
+    char* cut = last ? last - 1 : NULL;
+    while (cut && cut > t && *cut != ' ') --cut;
+    CHECK(cut && cut > t && last[0] == ' ', "tick line");
+    if (cut && cut > t) {
+        memmove(cut, last, strlen(last) + 1); // drop the last command, keep the row flag
+        check_refused("a command short", a, "expected 't TM TARGET' then 3 commands (lift ...) and ROW 0 or 1");
+    }
+}
+
 // compare on two designs: its CSV of both holds each design's own run rows
 // (as `run` writes them), and the bigger bore's peak is the lower one.
 static void check_compare_designs(void) {
@@ -359,5 +385,6 @@ int main(void) {
     check_old_format("ode");
     check_chain_8fn("chain sandbox", "", 9);
     check_by_name();
+    check_bad_v2();
     TEST_MAIN_END();
 }
