@@ -2,6 +2,7 @@
 // headless, on the recorded design or a changed one, compared with the
 // recorded rows (docs/replay.md).
 #include "app.h"
+#include "app_design_metrics.h"
 #include "engine.h"
 #include "metrics.h"
 #include "session.h"
@@ -249,6 +250,21 @@ int cmd_replay(int argc, char** argv) {
     metrics_init(&met[0], bcol);
     metrics_init(&met[1], bcol);
     metrics_init(&exact, bcol);
+    // A chain's metrics by actuator and function (as run --metrics names
+    // them: app_design_metrics.h), where the engine's rows carry the model's
+    // chain columns right after the base ones (checked by name: else none);
+    // the recorded rows' too when they have the same columns.
+    bool chain_cols = !m->chain.two_link && m->chain.ncol > 0 && ncol == bcol + m->chain.ncol;
+    {
+        int nch;
+        const sim_channel* ch = engine_channels(l, &nch);
+        for (int k = 0; chain_cols && k < m->chain.ncol; ++k)
+            chain_cols = bcol + k < nch && !strcmp(ch[bcol + k].name, m->chain.col[k].name);
+    }
+    if (chain_cols && app_design_metrics_setup(m)) chain_cols = false; // out of memory: the base metrics only
+    const bool chain_rec = chain_cols && s.ncol == ncol;
+    app_design_run cmet[3]; // recorded, replayed (both as written), replayed exactly (--metrics)
+    for (int k = 0; k < 3; ++k) app_design_run_init(&cmet[k], m, bcol);
     long same = 0, first_diff = -1, nrow = 0;
     int code = 0;
     char* line = NULL;
@@ -297,12 +313,15 @@ int cmd_replay(int argc, char** argv) {
         else if (first_diff < 0) first_diff = nrow;
         ++nrow;
         metrics_row(&exact, row);
+        if (chain_cols) app_design_row(&cmet[2], row);
         parse_row(line, row, rcol);
         trace_push(&tr[1], row, bcol);
         metrics_row(&met[1], row);
+        if (chain_cols) app_design_row(&cmet[1], row);
         if (recorded && parse_row(recorded, rec, scol) >= s.ncol) {
             trace_push(&tr[0], rec, bcol);
             metrics_row(&met[0], rec);
+            if (chain_rec) app_design_row(&cmet[0], rec);
         }
         if (!quiet) app_progress(NULL, t->target, s.tick[s.ntick - 1].target);
     }
@@ -355,15 +374,32 @@ int cmd_replay(int argc, char** argv) {
     else
         printf("  rows identical to the recording: %ld of %ld; first difference at row %ld (t = %.6g s)\n", same,
                s.nrow, first_diff + 1, first_diff >= 0 && first_diff < tr[1].nrow ? tr[1].v[(size_t)first_diff * SIM_NCOL + COL_T] : 0.0);
-    printf("  %-27s %14s %14s %14s\n", "metric (over rows)", "recorded", "replay", "difference");
+    // The name column: 27 wide, or the longest chain metric's label.
+    const bool chain_table = chain_rec && cmet[0].cst.rows && cmet[1].cst.rows;
+    int wname = 27;
+    for (int k = 0; chain_table && k < app_design_metric_chain_count(); ++k) {
+        const int id = MET_COUNT + k;
+        const int L = (int)(strlen(app_design_metric_name(id)) + strlen(app_metric_disp_unit(id)) + 3);
+        if (L > wname) wname = L;
+    }
+    printf("  %-*s %14s %14s %14s\n", wname, "metric (over rows)", "recorded", "replay", "difference");
     for (int id = 0; id < MET_COUNT; ++id) {
         if (!met[1].present[id] || !met[0].rows || !met[1].rows) continue;
         const char* unit;
         const double k = shown(id, &unit);
         char name[64];
         snprintf(name, sizeof name, "%s [%s]", metric_name((metric_id)id), unit);
-        printf("  %-27s %14.6g %14.6g %+14.6g\n", name, met[0].value[id] * k, met[1].value[id] * k,
+        printf("  %-*s %14.6g %14.6g %+14.6g\n", wname, name, met[0].value[id] * k, met[1].value[id] * k,
                (met[1].value[id] - met[0].value[id]) * k);
+    }
+    // Then the chain's by actuator and function, in the summary's units.
+    for (int k = 0; chain_table && k < app_design_metric_chain_count(); ++k) {
+        const int id = MET_COUNT + k;
+        const double sc = app_metric_disp_scale(id);
+        const double r0 = app_design_value(&cmet[0], id), r1 = app_design_value(&cmet[1], id);
+        char name[128];
+        snprintf(name, sizeof name, "%s [%s]", app_design_metric_name(id), app_metric_disp_unit(id));
+        printf("  %-*s %14.6g %14.6g %+14.6g\n", wname, name, r0 * sc, r1 * sc, (r1 - r0) * sc);
     }
     app_energy_report(en, "energy of the replay (a session records no balance of the drive):");
     if (out && !we) printf("  %ld rows -> %s\n", nrow, out);
@@ -371,7 +407,9 @@ int cmd_replay(int argc, char** argv) {
         app_out mo = {.f = NULL};
         FILE* mf = app_out_open(&mo, metrics_out, "w");
         int e = mf ? 0 : errno;
-        if (mf && metrics_write_json(&exact, mf)) e = errno ? errno : EIO;
+        // With a chain's entries by actuator and function, as run --metrics writes them.
+        if (mf && (chain_cols ? app_chain_stats_write_json(&cmet[2].cst, &exact, mf) : metrics_write_json(&exact, mf)))
+            e = errno ? errno : EIO;
         e = mf ? app_out_close(&mo, e, true) : e;
         if (e) {
             fprintf(stderr, "cranesim replay: cannot write %s: %s\n", metrics_out, strerror(e));
@@ -392,6 +430,7 @@ int cmd_replay(int argc, char** argv) {
     }
     sim_trace_free(&tr[0]);
     sim_trace_free(&tr[1]);
+    for (int k = 0; k < 3; ++k) app_design_run_free(&cmet[k]);
     free(row);
     free(rec);
     free(fmap);

@@ -217,6 +217,32 @@ static void check_chain_8fn(const char* what, const char* args, int nfn) {
     snprintf(cmd, sizeof cmd, "--model %s --scenario %s/scn_8fn_every_function.json --frame-rate 50 %s", CHAIN_8FN,
              CRANESIM_TESTDATA, args);
     check_bit_for_bit(what, cmd);
+    // The replay's table has the chain's metrics by actuator and function,
+    // recorded and replayed alike (identical rows: difference 0).
+    for (int k = 0; k < 8; ++k) {
+        char lab[96];
+        snprintf(lab, sizeof lab, "  max_spool.%s [-] ", fn[k]);
+        const char* p = strstr(out, lab);
+        double r0 = NAN, r1 = NAN, dd = NAN;
+        CHECK(p && sscanf(p + strlen(lab), "%lg %lg %lg", &r0, &r1, &dd) == 3 && r0 == r1 && dd == 0 && r0 > 0,
+              "%s: replay table row '%s': %.300s", what, lab, p ? p : out);
+    }
+    // Its --metrics has them too: the peaks of the record's columns.
+    int rc = cli_run("replay rp.session --quiet --metrics rp_chain.json", out, sizeof out);
+    static char js[1 << 16];
+    CHECK(rc == 0 && cli_read_file("rp_chain.json", js, sizeof js) > 0, "%s: replay --metrics: %s", what, out);
+    long nr = cli_read_file("rp_rec.csv", a, sizeof a);
+    double pk = 0, um = 0;
+    for (int r = 0; nr > 0 && r < 60; ++r) {
+        pk = fmax(pk, csv_value(a, "pA_fold", r));
+        um = fmax(um, fabs(csv_value(a, "u_jib_ext3", r)));
+    }
+    const char* jp = strstr(js, "\"peak_pA.fold\": {\"value\": ");
+    const char* ju = strstr(js, "\"max_spool.jib_ext3\": {\"value\": ");
+    const double jpk = jp ? strtod(jp + 26, NULL) : NAN, jum = ju ? strtod(ju + 32, NULL) : NAN;
+    CHECK(fabs(jpk - pk) <= 1e-8 * pk && fabs(jum - um) <= 1e-8 && um > 0.5,
+          "%s: --metrics peak_pA.fold %.9g (record %.9g), max_spool.jib_ext3 %.9g (record %.9g)", what, jpk, pk, jum,
+          um);
     // The header (line 2) lists the functions, each once, in the engine's order.
     long n = cli_read_file("rp.session", a, sizeof a);
     char* l2 = n > 0 ? strchr(a, '\n') : NULL;
