@@ -412,5 +412,8 @@ int main(void) {
     check_chain_8fn("chain sandbox", "", 9);
     check_by_name();
     check_bad_v2();
+    // A crane chain with a fault event: the burst at 2 s replayed at the same tick.
+    check_bit_for_bit("chain hose burst", "--mechanics lagrange --model " LOADER10
+                                          " --scenario hose_burst --duration 2.5 --frame-rate 100");
     TEST_MAIN_END();
 }
