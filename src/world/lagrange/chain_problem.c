@@ -53,7 +53,7 @@ unsigned long chain_problem_events(void* user, double t, const double* y) {
     for (int k = 0; k < cc->nact; ++k) {
         const crane_act* a = &cc->act[k];
         double Ld = 0.0;
-        const double L = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, &Ld, NULL, NULL);
+        const double L = crane_act_length(a, s->ch, s->ws, &Ld, NULL, NULL);
         cp->x[a->cyl] = L - a->closed_length;
         cp->v[a->cyl] = Ld;
     }

@@ -235,8 +235,8 @@ static void prepare(chain_sim* s, double t, const double* y, bool jac) {
     hyd_data* d = s->hd;
     for (int k = 0; k < cc->nact; ++k) {
         const crane_act* a = &cc->act[k];
-        s->L[k] = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, &s->Ld[k], s->dL + (size_t)k * nd,
-                                 jac ? s->dLd + (size_t)k * nd : NULL);
+        s->L[k] = crane_act_length(a, s->ch, s->ws, &s->Ld[k], s->dL + (size_t)k * nd,
+                                   jac ? s->dLd + (size_t)k * nd : NULL);
         d->cyl_x[a->cyl] = s->L[k] - a->closed_length;
         d->cyl_v[a->cyl] = s->Ld[k];
     }
@@ -364,7 +364,7 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
             memset(s->H, 0, (size_t)nd * nd * sizeof *s->H);
         } else {
             const crane_act* a = &cc->act[k];
-            chain_cylinder_hessian(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, s->H);
+            crane_act_hessian(a, s->ch, s->ws, s->H);
         }
         for (int i = 0; i < nd; ++i)
             for (int j = 0; j < nd; ++j) {
@@ -444,8 +444,7 @@ int chain_sim_check_pose(chain_sim* s, const double* q0, char* err, size_t errsz
     chain_update(s->ch, s->ws, q0, NULL);
     for (int k = 0; k < s->cc->nact; ++k) {
         const crane_act* a = &s->cc->act[k];
-        const double x = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, NULL, NULL, NULL) -
-                         a->closed_length;
+        const double x = crane_act_length(a, s->ch, s->ws, NULL, NULL, NULL) - a->closed_length;
         // The same tolerance as crane_check_pose: a stroke a rounding
         // outside its range is at its end stop, not beyond it.
         if (!(x >= -1e-9 && x <= a->stroke + 1e-9)) {
@@ -513,7 +512,7 @@ int chain_sim_initial_state(chain_sim* s, const double* q0, double p_low, double
     chain_inverse_dynamics(s->ch, s->ws, NULL, CHAIN_GRAVITY, G);
     for (int k = 0; k < s->cc->nact; ++k) {
         const crane_act* a = &s->cc->act[k];
-        chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, NULL, s->dL + (size_t)k * nd, NULL);
+        crane_act_length(a, s->ch, s->ws, NULL, s->dL + (size_t)k * nd, NULL);
     }
     if (s->rack >= 0) rack_kinematics(s, y, false);
     // The DOFs some actuator moves (a lever arm above 1e-12 of the largest)

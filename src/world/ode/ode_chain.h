@@ -121,6 +121,10 @@ void ode_chain_host_failed(ode_chain* w);
 /// the frame origin (the joint) in that body's coordinates [m] (org may be
 /// NULL): a point p of the frame is org + p in the body.
 struct dxBody* ode_chain_body_id(const ode_chain* w, int i, double org[3]);
+/// Actuator k's linkage bodies (CRANE_ACT_LINKAGE): which 0 the link (A-P),
+/// 1 the rocker (C-P), each a bar along its body x centred on its origin,
+/// its length [m] in len (may be NULL). NULL for a pin pair's actuator.
+struct dxBody* ode_chain_link_body(const ode_chain* w, int k, int which, double* len);
 /// The chain as built (the copy: slew_free set where a slew drive turns the
 /// column; its actuators bound to the circuit).
 const crane_chain* ode_chain_chain(const ode_chain* w);

@@ -505,6 +505,18 @@ int ow_build_chain_crane(ode_world* w, const double base[3], const double R[9], 
         const float* rgba = i == 0 ? RGBA_COLUMN : i == 1 ? RGBA_BOOM1 : RGBA_BOOM2;
         ow_add_vis(w, cb->def.name, role, i == 0 ? WORLD_SHAPE_CYLINDER : WORLD_SHAPE_BOX, sz, rgba, -1, b, pos, NULL);
     }
+    // A linkage's link and rocker: drawn as bars (no collision: they sit
+    // between the booms), named after the actuator.
+    for (int k = 0; k < c->nact; ++k)
+        for (int which = 0; which < 2; ++which) {
+            double len;
+            dBodyID b = ode_chain_link_body(w->chain, k, which, &len);
+            if (!b) continue;
+            char name[40]; // the snapshot's names hold 47 characters
+            snprintf(name, sizeof name, "%.30s_%s", c->act[k].name, which ? "rocker" : "link");
+            const double sz[3] = {len, 0.06, 0.06}, zero[3] = {0, 0, 0};
+            ow_add_vis(w, name, WORLD_ROLE_OTHER, WORLD_SHAPE_BOX, sz, RGBA_BOOM2, -1, b, zero, NULL);
+        }
     // Frames for the sandbox's column and rope (frame 1: the first boom).
     memset(w->frame, 0, sizeof w->frame);
     w->frame[0].body = ode_chain_body_id(w->chain, 0, w->frame[0].org);
