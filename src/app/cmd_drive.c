@@ -242,13 +242,12 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         m = fm;
     }
     double m3 = sim_load_mass(m, &sc, &c->sim);
-    // A crane chain drives headless by function; what is still two-link
-    // shaped is refused before anything starts: session files (issue 27)
-    // and a limiter asked for by name (rcl.h refuses chains; on by default,
+    // A crane chain drives headless by function, and its session records
+    // the commands by function (session.h); a limiter asked for by name is
+    // refused before anything starts (rcl.h refuses chains; on by default,
     // it is then off with a note below).
     engine* l = NULL;
-    if (session_path && engine_require(m, &c->sim, ENGINE_CAP_TWO_LINK, "--session", err, sizeof err)) {
-    } else if (rcl_given && c->sim.rcl &&
+    if (rcl_given && c->sim.rcl &&
                engine_require(m, &c->sim, ENGINE_CAP_LIMITER, "--rcl on", err, sizeof err)) {
     } else {
         l = engine_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
@@ -278,7 +277,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (session_path) {
         char sbuf[512];
         const char* sp = app_scenario_path(c->scenario_path, sbuf, sizeof sbuf);
-        const int so = session_writer_open(&sw, session_path, doc0, m->file, &c->sim, sc.nfault ? sp : NULL, sc.q0,
+        const int so = session_writer_open(&sw, session_path, doc0, m->file, l, &c->sim, sc.nfault ? sp : NULL, sc.q0,
                                            sc.slew0, m3, false, ncol, err, sizeof err);
         cJSON_Delete(doc0);
         if (so) {
@@ -351,7 +350,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         // steps whole ODE steps, so aim at the target, not at +frame).
         const double target = (i + 1) * frame;
         if (engine_advance(l, target - engine_time(l))) {
-            session_writer_tick(&sw, tm, target, u, NULL, ncol);
+            session_writer_tick(&sw, tm, target, two_link ? u : uf, two_link ? 3 : nfn, NULL, ncol);
             if (!c->quiet) app_progress_done();
             if (record) fprintf(stderr, "cranesim drive: %s; record kept in %s\n", engine_error(l), record);
             else fprintf(stderr, "cranesim drive: %s\n", engine_error(l));
@@ -359,7 +358,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
             break;
         }
         engine_row(l, row);
-        session_writer_tick(&sw, tm, target, u, row, ncol);
+        session_writer_tick(&sw, tm, target, two_link ? u : uf, two_link ? 3 : nfn, row, ncol);
         if (limiter && ncol > COL_RCL_UTIL) {
             if (row[COL_RCL_UTIL] >= RCL_WARN) rcl_t90 += frame;
             rcl_max = fmax(rcl_max, row[COL_RCL_UTIL]);

@@ -119,6 +119,8 @@ struct drive_session {
     int sess_err;        // errno of a failed session write (0: none)
     session* rp;         // --replay: the session whose commands drive instead of the devices
     long rp_next;        // its next tick
+    int* rp_map;         // the session's command of each of the engine's functions (session_function_map)
+    double* rp_u;        // one tick's commands by the engine's functions
     char err[400];
     char status[512];
     // Remote mode (drive --connect): the snapshot and row come from the server.
@@ -1070,10 +1072,22 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         *code = EXIT_USAGE;
         return NULL;
     }
+    // The recorded commands by function name (session.h).
+    if (s->rp) {
+        const int nfn = engine_nfunction(s->l);
+        s->rp_map = calloc((size_t)nfn + 1, sizeof *s->rp_map);
+        s->rp_u = calloc((size_t)nfn + 3, sizeof *s->rp_u);
+        if (!s->rp_map || !s->rp_u) snprintf(err, errsz, "out of memory");
+        if (!s->rp_map || !s->rp_u || session_function_map(s->rp, s->l, s->rp_map, NULL, 0, err, errsz) < 0) {
+            drive_session_destroy(s);
+            *code = EXIT_USAGE;
+            return NULL;
+        }
+    }
     // The window's faults are not in the session (its scripted operator
     // applies no bursts: the engine has no burst orifices).
     if (o->session_path && !s->rp &&
-        session_writer_open(&s->sw, o->session_path, s->m->json, s->m->file, &s->c.sim, NULL, s->sc.q0, s->sc.slew0,
+        session_writer_open(&s->sw, o->session_path, s->m->json, s->m->file, s->l, &s->c.sim, NULL, s->sc.q0, s->sc.slew0,
                             sim_load_mass(s->m, &s->sc, &s->c.sim), true, s->ncol, err, errsz)) {
         drive_session_destroy(s);
         *code = EXIT_USAGE;
@@ -1183,6 +1197,8 @@ void drive_session_destroy(drive_session* s) {
     if (s->sw.f) session_writer_close(&s->sw, "the window closed");
     if (s->rp) session_free(s->rp);
     free(s->rp);
+    free(s->rp_map);
+    free(s->rp_u);
     if (s->pn) {
         if (s->r) render_attach_panel(s->r, NULL);
         panel_destroy(s->pn);
@@ -1466,9 +1482,12 @@ int drive_session_tick(drive_session* s, double wall) {
         // bit for bit as recorded; at its end the window closes.
         const double due = wall - s->sim_offset;
         while (s->rp_next < s->rp->ntick && s->rp->tick[s->rp_next].target <= due) {
-            const session_tick* tk = &s->rp->tick[s->rp_next++];
+            const session_tick* tk = &s->rp->tick[s->rp_next];
             for (int k = 0; k < tk->nhook; ++k) engine_hook(s->l, tk->hook[k]);
-            engine_set_commands(s->l, tk->u);
+            const int nfn = engine_nfunction(s->l);
+            session_tick_commands(s->rp, s->rp_next++, s->rp_map, nfn, s->rp_u);
+            if (engine_caps(s->l) & ENGINE_CAP_TWO_LINK) engine_set_commands(s->l, s->rp_u);
+            else engine_set_function_commands(s->l, s->rp_u, nfn, NULL, 0);
             ++s->st.input_samples;
             const double now = engine_time(s->l);
             if (tk->target > now && engine_advance(s->l, tk->target - now)) {
@@ -1508,7 +1527,10 @@ int drive_session_tick(drive_session* s, double wall) {
             const bool keep = !adv && (s->sw.rows == 0 || r[COL_T] > s->sw.t_last);
             if (keep) s->sw.t_last = r[COL_T];
             r[s->ncol] = 0;
-            session_writer_tick(&s->sw, s->t_base + t + 0.5 * dt_wall, target, u, keep ? r : NULL, s->ncol + 1);
+            // The commands as the engine holds them, one per function
+            // (session.h): the sticks' lift, jib, slew on the two-link crane.
+            session_writer_tick_engine(&s->sw, s->l, s->t_base + t + 0.5 * dt_wall, target, keep ? r : NULL,
+                                       s->ncol + 1);
         }
         if (adv) {
             snprintf(s->err, sizeof s->err, "%s", engine_error(s->l));

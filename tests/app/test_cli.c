@@ -478,6 +478,14 @@ static void test_study_usage(void) {
     CHECK(rc == 2 && strstr(out, "--out-dir cli_study_file") && !strstr(out, "reference:") && !strstr(out, "reference run failed"),
           "--out-dir naming a file: exit %d: %s", rc, out);
     remove("cli_study_file");
+    // A crane chain model: its analytic mode has no CVODE reference and the
+    // study measures the two-link columns: refused in one line before the
+    // reference run, and no folder made.
+    rmdir("cli_study_chain");
+    rc = cli_run("study --quick --repeat 1 --duration 0.05 --model loader10 --out-dir cli_study_chain", out, sizeof out);
+    CHECK(rc == 2 && cli_count_lines(out) == 1 && strstr(out, "loader10.json: a chain of 5 bodies and 3 functions") &&
+              !strstr(out, "reference:") && !strstr(out, "reference run failed") && stat("cli_study_chain", &(struct stat){0}) != 0,
+          "chain model: exit %d: %s", rc, out);
     // Only the last folder is made: a missing parent is refused before any
     // run, like an output file's missing folder, and nothing is created.
     remove("cli_study2/made/study.md");
