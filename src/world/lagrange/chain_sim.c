@@ -116,8 +116,9 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     s->L = calloc(2 * na + 2 * na * nd + 1, sizeof(double));
     s->tau = calloc(10 * nd + 3 * nd * nd + (size_t)s->nh + 1, sizeof(double));
     s->acyl = calloc(2 * na + (size_t)s->nfn + 1, sizeof *s->acyl);
+    s->kin_y = calloc(2 * nd + 1, sizeof *s->kin_y);
     if (!s->ws || !s->hd || !s->cmd || !s->iu || !s->ipA || !s->ipB || !s->is_pressure || !s->L || !s->tau || !s->perm ||
-        !s->block || !s->jh || !s->acyl) {
+        !s->block || !s->jh || !s->acyl || !s->kin_y) {
         snprintf(err, errsz, "out of memory");
         chain_sim_free(s);
         return -1;
@@ -199,6 +200,7 @@ void chain_sim_free(chain_sim* s) {
     free(s->L);
     free(s->tau);
     free(s->acyl);
+    free(s->kin_y);
     memset(s, 0, sizeof *s);
 }
 
@@ -242,6 +244,16 @@ static void prepare(chain_sim* s, double t, const double* y, bool jac) {
     }
     if (s->rack >= 0) rack_kinematics(s, y, jac);
     for (int f = 0; f < s->nfn; ++f) d->valve_cmd[s->fvalve[f]] = command(s, f, t);
+    s->kin_valid = true;
+    s->kin_t = t;
+    memcpy(s->kin_y, y + s->iq, 2 * (size_t)nd * sizeof *s->kin_y);
+}
+
+bool chain_sim_inputs_at(const chain_sim* s, double t, const double* y) {
+    // Bitwise: the same doubles give the same kinematics (a -0.0 against
+    // 0.0 merely misses the reuse).
+    return s->kin_valid && memcmp(&s->kin_t, &t, sizeof t) == 0 &&
+           memcmp(s->kin_y, y + s->iq, 2 * (size_t)s->ndof * sizeof *s->kin_y) == 0;
 }
 
 // The ideal forces of the energy tests (chain_sim.ideal_F) into cyl_F.
@@ -508,6 +520,7 @@ int chain_sim_initial_state(chain_sim* s, const double* q0, double p_low, double
     hyd_model_initial_state(hm, s->yh);
     for (int h = 0; h < s->nh; ++h) y[s->hpos[h]] = s->yh[h];
     for (int i = 0; i < nd; ++i) y[iq + i] = q0[i], y[iq + nd + i] = 0.0;
+    s->kin_valid = false; // rack_kinematics below writes hd at q0, not at an evaluation's (t, y)
     chain_update(s->ch, s->ws, q0, NULL);
     double* G = s->id0;
     chain_inverse_dynamics(s->ch, s->ws, NULL, CHAIN_GRAVITY, G);
