@@ -670,6 +670,11 @@ static void test_events_reuse_kinematics(void) {
     double *xa = f + n, *va = xa + nc, *xb = va + nc, *vb = xb + nc, *xc = vb + nc, *vc = xc + nc, *xd = vc + nc,
            *vd = xd + nc;
     CHECK(chain_sim_initial_state(&cs, q0, 0.5e6, y, err, sizeof err) == 0, "%s", err);
+    // The start state writes hd's inputs outside an evaluation: no reuse after it.
+    chain_sim_rhs(&cs, 0.0, y, f);
+    CHECK(chain_sim_inputs_at(&cs, 0.0, y), "f's inputs at the start not recognised");
+    CHECK(chain_sim_initial_state(&cs, q0, 0.5e6, y, err, sizeof err) == 0, "%s", err);
+    CHECK(!chain_sim_inputs_at(&cs, 0.0, y), "inputs reused across chain_sim_initial_state");
     cs.cmd_fn = wave;
     // In motion: 0.3 s of Krus from the start.
     hyd_problem p = chain_sim_problem(&cs, true);
