@@ -576,6 +576,20 @@ static void test_notes_on_unused_options(void) {
           "bench --solver: exit %d: %s", rc, out);
 }
 
+// bench --config loader10: the second crane's cycle on both backends, one
+// JSON line each with its mechanics, its target, and wall and CPU times
+// (issue 27's two targets; docs/performance.md).
+static void test_bench_loader10(void) {
+    static char out[8192];
+    const int rc = cli_run("bench --config loader10 --repeat 1 --duration 0.05", out, sizeof out);
+    const char* a = strstr(out, "\"mechanics\":\"lagrange\"");
+    const char* b = strstr(out, "\"mechanics\":\"ode\"");
+    CHECK(rc == 0 && a && b && strstr(out, "\"world\":\"sandbox\"") && strstr(out, "\"target_rt_factor\":100") &&
+              strstr(out, "\"target_rt_factor\":20") && strstr(out, "\"cpu_s_median\"") &&
+              strstr(out, "\"sim_time_s\":0.05"),
+          "bench --config loader10: exit %d: %s", rc, out);
+}
+
 // The summary says what ran: the ode hydraulic step min(--dt, --dt-ode), the
 // world rather than a lagrange variant, where the peaks come from.
 static void test_run_summary(void) {
@@ -689,6 +703,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_every_multiple_of_step);
     RUN_TEST(test_notes_on_unused_options);
     RUN_TEST(test_run_summary);
+    RUN_TEST(test_bench_loader10);
     RUN_TEST(test_hose_burst_description);
     TEST_MAIN_END();
 }

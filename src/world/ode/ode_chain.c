@@ -21,6 +21,7 @@
 #include "ode_chain.h"
 
 #include "ode_common.h"
+#include "circuit_fast.h"
 #include "circuit_kernel.h"
 #include "energy_acc.h"
 #include "hyd_cylinder.h"
@@ -99,6 +100,7 @@ struct ode_chain {
     // Hydraulics.
     hyd_model* hm;
     hyd_data* hd;
+    hyd_fast* fk; ///< the sub-steps' kernel (circuit_fast.h), or NULL: the component loops
     hyd_solver* hs;
     hyd_problem hp;
     int nh, nsub, npres;
@@ -383,6 +385,24 @@ static int jac(void* user, double t, const double* y, double* J) {
     return 0;
 }
 
+// The sub-steps' f and Jacobian on the fast kernel (circuit_fast.h): the
+// same laws in type-sorted loops, equal to the loops' to rounding. It fills
+// no comp_q or comp_open, so the evaluation the rows and the balance read
+// (after the sub-steps, hyd_step) stays on the loops.
+static int rhs_fast(void* user, double t, const double* y, double* dydt) {
+    ode_chain* w = user;
+    set_inputs(w, t);
+    hyd_fast_eval(w->fk, w->hd, y, dydt);
+    return 0;
+}
+
+static int jac_fast(void* user, double t, const double* y, double* J) {
+    ode_chain* w = user;
+    set_inputs(w, t);
+    hyd_fast_jacobian(w->fk, w->hd, y, NULL, J, w->nh);
+    return 0;
+}
+
 // A node pressure below absolute zero (the solver retries shorter).
 static int outside(void* user, const double* y) {
     const ode_chain* w = user;
@@ -599,6 +619,14 @@ static int hyd_create(ode_chain* w, char* err, size_t errsz) {
     w->hp.user = w;
     w->hp.f = rhs;
     w->hp.jac = jac;
+    if (!w->opt.general_circuit) {
+        // With fallback: a component type the kernel has no loop for runs
+        // its reference loop inside it, so it takes every circuit; NULL
+        // only when out of memory (then the loops, still correct).
+        char why[160];
+        w->fk = hyd_fast_create(w->hm, hyd_fast_types(), 1, why, sizeof why);
+        if (w->fk) w->hp.f = rhs_fast, w->hp.jac = jac_fast;
+    }
     w->hp.outside = outside;
     w->hp.implausible = implausible;
     w->hp.settle = settle;
@@ -1148,6 +1176,7 @@ static void free_world(ode_chain* w) {
     }
     if (w->hs) hyd_solver_destroy(w->hs);
     if (w->hd) hyd_data_free(w->hd);
+    hyd_fast_free(w->fk);
     free(w->y);
     free(w->ydot);
     free(w->pres);

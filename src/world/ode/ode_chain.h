@@ -31,6 +31,7 @@ typedef struct ode_chain_opts {
     double dt_hyd;         ///< hydraulic sub-step [s]; default 1e-4; dt_ode must be a whole multiple
     hyd_method solver;     ///< hydraulic integrator, a fixed-step one; default HYD_KRUS
     int jac_every;         ///< reuse the hydraulic Jacobian for this many sub-steps; default 1 (see docs)
+    int general_circuit;   ///< 1: the sub-steps on the circuit's component loops (hyd_eval), else the fast kernel (circuit_fast.h); default 0
     double tip_mass;       ///< point mass at the chain's tip, merged into its body [kg]; default 0
     const double* q0;      ///< start joint coordinates [rad or m], one per DOF; NULL: all 0
     double slew0;          ///< a fixed column: its slew [rad]; default 0

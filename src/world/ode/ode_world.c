@@ -450,6 +450,7 @@ int ow_build_chain_crane(ode_world* w, const double base[3], const double R[9], 
     co.dt_hyd = w->opt.dt_hyd;
     co.solver = w->opt.solver;
     co.jac_every = w->opt.jac_every > 0 ? w->opt.jac_every : 1;
+    co.general_circuit = w->opt.general_circuit;
     co.q0 = w->chain_q;
     co.slew0 = w->opt.slew0;
     co.stop_limits = w->opt.stop_limits;
