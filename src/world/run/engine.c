@@ -119,8 +119,11 @@ engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2],
         return e;
     }
     if (r) rcl_reset(r);
-    // A stepped engine's world, when o names none, is its drive world.
-    e->rcl = r ? r : engine_rcl_create(m, o, engine_backend_of(o)->drive_world);
+    // A stepped engine's world, when o names none, is its drive world; a
+    // crane chain's engine without a hook runs in no world (the ODE's
+    // validation world: no truck), whatever the backend's drive world.
+    const char* dw = chain && !e->ops->hook ? NULL : engine_backend_of(o)->drive_world;
+    e->rcl = r ? r : engine_rcl_create(m, o, dw);
     // A chain's rows carry its columns after the backend's channels.
     if (e->rcl && chain && rcl_set_chain_row(e->rcl, e->ops->nchannel)) {
         snprintf(err, errsz, "rated capacity limiter: the rows of this engine lack the chain's q, qd or pressure "

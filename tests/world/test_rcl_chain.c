@@ -1,0 +1,308 @@
+// test_rcl_chain.c: the rated capacity limiter and the load chart on a crane
+// chain (issue 27 item 3; docs/safety.md "On a crane chain"), on the second
+// shipped crane, assets/models/loader10.json:
+// - the sign (and size) of each function's outreach per metre of stroke,
+//   which the limiter cuts on, against central differences of the chain's
+//   kinematics (the mechanism library's tip and pin lengths, solved here for
+//   a stroke of the function's cylinders, independent of rcl.c);
+// - an overload with the extensions run out (the limiter off while they
+//   run out, then on): the functions that carry the tip outwards are cut
+//   (spool command 0, strokes stay within 2 mm over 1 s), the reducing ones
+//   pass whole and move, on the analytic mode's and the ODE's stepped engine;
+// - the load the limiter reads from the lift pressure against the load put
+//   at the tip, held still (the chart's check by simulation is in
+//   test_loadchart_chain.c).
+#include "check.h"
+#include "engine.h"
+#include "engine_impl.h"
+#include "lc_chain.h"
+#include "loadchart.h"
+#include "model.h"
+#include "rcl.h"
+#include "sim.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MODEL CRANESIM_ASSETS "/models/loader10.json"
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#define DEG (M_PI / 180)
+
+static model* load(void) {
+    char err[1024];
+    model* m = model_load(MODEL, NULL, 0, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    return m;
+}
+
+// The tip's outreach [m] at boom pose q (the mechanism's own kinematics).
+static double tip_R(chain* ch, chain_ws* w, const crane_chain* cc, const double* q) {
+    chain_update(ch, w, q, NULL);
+    double p[3];
+    chain_world_point(ch, w, cc->tip_body, cc->tip, p, NULL);
+    return p[0] - cc->body[0].def.origin[0];
+}
+
+// Pin length of actuator k at pose q [m].
+static double pin_L(chain* ch, chain_ws* w, const crane_chain* cc, int k, const double* q) {
+    chain_update(ch, w, q, NULL);
+    const crane_act* a = &cc->act[k];
+    return chain_cylinder(ch, w, a->body_a, a->pa, a->body_b, a->pb, NULL, NULL, NULL);
+}
+
+// Solves A x = b (n x n, row-major) by Gaussian elimination with pivoting; 0 or -1.
+static int solve(double* A, double* b, int n) {
+    for (int c = 0; c < n; ++c) {
+        int p = c;
+        for (int i = c + 1; i < n; ++i)
+            if (fabs(A[i * n + c]) > fabs(A[p * n + c])) p = i;
+        if (fabs(A[p * n + c]) < 1e-12) return -1;
+        for (int j = 0; j < n; ++j) {
+            const double t = A[c * n + j];
+            A[c * n + j] = A[p * n + j], A[p * n + j] = t;
+        }
+        const double t = b[c];
+        b[c] = b[p], b[p] = t;
+        for (int i = c + 1; i < n; ++i) {
+            const double f = A[i * n + c] / A[c * n + c];
+            for (int j = c; j < n; ++j) A[i * n + j] -= f * A[c * n + j];
+            b[i] -= f * b[c];
+        }
+    }
+    for (int i = n - 1; i >= 0; --i) {
+        double v = b[i];
+        for (int j = i + 1; j < n; ++j) v -= A[i * n + j] * b[j];
+        b[i] = v / A[i * n + i];
+    }
+    return 0;
+}
+
+// dR/ds of function f at pose q by central differences: the joint motion dq
+// that strokes each of f's cylinders by h and leaves the others' lengths as
+// they are (dL/dq of every cylinder over every boom joint by central
+// differences of the pin lengths), then R(q + dq) - R(q - dq) over 2 h.
+static double fd_gain(chain* ch, chain_ws* w, const crane_chain* cc, const double* q0, int nd, int f) {
+    const int na = cc->nact;
+    const double e = 1e-6, h = 1e-5;
+    double A[64], b[8], qp[8], qm[8];
+    for (int k = 0; k < na; ++k) {
+        for (int j = 0; j < nd; ++j) {
+            memcpy(qp, q0, (size_t)nd * sizeof *q0), memcpy(qm, q0, (size_t)nd * sizeof *q0);
+            qp[j] += e, qm[j] -= e;
+            A[k * nd + j] = (pin_L(ch, w, cc, k, qp) - pin_L(ch, w, cc, k, qm)) / (2 * e);
+        }
+        b[k] = cc->act[k].function == f ? h : 0.0;
+    }
+    if (na != nd || solve(A, b, nd)) return NAN;
+    for (int j = 0; j < nd; ++j) qp[j] = q0[j] + b[j], qm[j] = q0[j] - b[j];
+    return (tip_R(ch, w, cc, qp) - tip_R(ch, w, cc, qm)) / (2 * h);
+}
+
+// The limiter's gain of every function against the central differences, at
+// poses over the joints' ranges: the knuckle hanging down and back, level,
+// raised; the extensions in, half, out.
+static void test_gain_against_central_differences(void) {
+    model* m = load();
+    if (!m) return;
+    const crane_chain* cc = &m->chain;
+    char err[300];
+    rcl r;
+    CHECK(rcl_init(&r, m, NULL, err, sizeof err) == 0, "%s", err);
+    const int base = SIM_NCOL_BASE;
+    CHECK(rcl_set_chain_row(&r, base) == 0, "the chain's columns");
+    chain* ch = crane_chain_mechanism(cc, 0.0, false, 0.0, err, sizeof err);
+    chain_ws* w = ch ? chain_ws_create(ch) : NULL;
+    CHECK(ch && w, "%s", err);
+    const int nd = chain_ndof(ch);
+    CHECK(nd == 4, "loader10 has 4 boom joints, got %d", nd);
+    double* row = calloc((size_t)(base + cc->ncol) + 1, sizeof *row);
+    const double lift[3] = {80 * DEG, 110 * DEG, 150 * DEG}, knuckle[4] = {-120 * DEG, -90 * DEG, -50 * DEG, -28 * DEG},
+                 ext[3] = {0.05, 0.65, 1.25};
+    int n = 0, nout = 0, nin = 0, fext = crane_chain_find_function(cc, "ext");
+    double worst = 0;
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 4; ++b)
+            for (int c = 0; c < 3; ++c) {
+                const double q[4] = {lift[a], knuckle[b], ext[c], ext[c]};
+                // A pose of the crane: every stroke within its range.
+                bool ok = true;
+                for (int k = 0; k < cc->nact; ++k) {
+                    const double x = pin_L(ch, w, cc, k, q) - cc->act[k].closed_length;
+                    ok = ok && x >= 0 && x <= cc->act[k].stroke;
+                }
+                if (!ok) continue;
+                for (int j = 0; j < nd; ++j)
+                    row[base + crane_chain_find_column(cc, "q", cc->body[chain_dof_body(ch, j)].def.name)] = q[j];
+                for (int f = 0; f < cc->nfn; ++f) {
+                    const double g = rcl_function_gain(&r, row, f), fd = fd_gain(ch, w, cc, q, nd, f);
+                    ++n;
+                    if (fabs(fd) < 2e-3) continue; // neutral within the limiter's 1 mm/m band: either is right
+                    CHECK(g * fd > 0, "pose %.0f %.0f deg, ext %.2f m: function %s: limiter %+.4f, central "
+                                      "differences %+.4f m/m",
+                          q[0] / DEG, q[1] / DEG, q[2], cc->fn[f].name, g, fd);
+                    worst = fmax(worst, fabs(g - fd) / fabs(fd));
+                    if (f == fext) nout += fd > 0, nin += fd < 0;
+                }
+            }
+    // Both signs met: with the knuckle pointing out the extension carries the
+    // tip out; folded back past the vertical it brings it in.
+    CHECK(nout > 0 && nin > 0, "the extension's gain of both signs over the poses (%d out, %d in)", nout, nin);
+    CHECK(worst < 1e-4, "largest relative difference %.3g", worst);
+    printf("gain: %d function-poses, largest relative difference to central differences %.2g; extension "
+           "outwards at %d poses, inwards at %d\n",
+           n, worst, nout, nin);
+    free(row);
+    chain_ws_free(w);
+    chain_free(ch);
+    rcl_free(&r);
+    model_free(m);
+}
+
+typedef struct cols {
+    int base, x[8];
+} cols;
+
+// The overload: loader10 at lift 100 deg, knuckle -40 deg (pointing 30 deg
+// down), the extensions half out at the start; a tip load that is 115 % of
+// the chart's capacity where the extensions reach 1.1 m each. The limiter
+// off, the extensions run out to 1.1 m (the load over the chart on the way:
+// nothing stops them); then on.
+static void test_overload_extended(sim_mechanics mech) {
+    const char* bn = mech == SIM_ODE ? "ode" : "lagrange";
+    model* m = load();
+    if (!m) return;
+    const crane_chain* cc = &m->chain;
+    char err[600];
+    sim_opts o = sim_default_opts();
+    o.mechanics = mech;
+    o.no_step_probe = true;
+    o.rcl = true;
+    // The capacity at the pose the test drives to (no world: no truck, the
+    // chart's hydraulic limit and the rating).
+    rcl r0;
+    CHECK(rcl_init(&r0, m, NULL, err, sizeof err) == 0, "%s", err);
+    lc_chain g;
+    CHECK(lc_chain_init(&g, m, "test", err, sizeof err) == 0, "%s", err);
+    const double qt[4] = {100 * DEG, -40 * DEG, 1.1, 1.1};
+    double Rt;
+    lc_chain_eval(&g, qt, &Rt, NULL);
+    const double cap = loadchart_capacity(&r0.chart, Rt, 0.0, NULL), m3 = 1.15 * cap;
+    lc_chain_free(&g);
+    rcl_free(&r0);
+    const double q0[2] = {100 * DEG, -40 * DEG};
+    engine* e = engine_create(m, &o, q0, 0.0, m3, err, sizeof err);
+    CHECK(e != NULL, "%s: %s", bn, err);
+    if (!e) {
+        model_free(m);
+        return;
+    }
+    CHECK(engine_caps(e) & ENGINE_CAP_LIMITER, "%s: the chain engine has the limiter", bn);
+    CHECK(engine_rcl(e) != NULL, "%s: the limiter was made", bn);
+    const int nfn = engine_nfunction(e), ncol = engine_ncol(e), base = ncol - cc->ncol;
+    double* row = calloc((size_t)ncol + 1, sizeof *row);
+    double u[8] = {0};
+    int ix[8];
+    for (int k = 0; k < cc->nact; ++k) ix[k] = base + crane_chain_find_column(cc, "x", cc->act[k].name);
+    const int fl = engine_find_function(e, "lift"), fj = engine_find_function(e, "jib"),
+              fe = engine_find_function(e, "ext");
+    const int ke1 = crane_chain_find_act(cc, "ext1");
+    // Run the extensions out with the limiter off (measuring only).
+    e->o.rcl = false;
+    double t = 0;
+    for (int i = 0; i < 400; ++i) {
+        engine_row(e, row);
+        if (row[ix[ke1]] >= 1.1) break;
+        u[fe] = 0.6;
+        engine_set_function_commands(e, u, nfn, err, sizeof err);
+        t += 0.025;
+        CHECK(engine_advance_to(e, t, NULL, NULL) == 0, "%s: %s", bn, engine_error(e));
+    }
+    u[fe] = 0;
+    engine_set_function_commands(e, u, nfn, err, sizeof err);
+    t += 1.0;
+    CHECK(engine_advance_to(e, t, NULL, NULL) == 0, "%s: %s", bn, engine_error(e));
+    engine_row(e, row);
+    const double x_e1 = row[ix[ke1]];
+    CHECK(x_e1 > 1.05, "%s: ext1 ran out to %.3f m", bn, x_e1);
+    const rcl* r = engine_rcl(e);
+    CHECK(r->util >= 1.0, "%s: overloaded: util %.3f at %.2f m (load %.0f kg, chart %.0f kg)", bn, r->util, r->R, m3,
+          cap);
+    // The measured load against the load at the tip (the lift pressure,
+    // its lever and the booms' gravity: the booms still, the seals' friction
+    // within its band).
+    CHECK_REL(r->m_filt, m3, 0.05);
+    printf("%s: at %.2f m util %.3f, the lift pressure reads %.1f kg for %.1f kg at the tip\n", bn, r->R, r->util,
+           r->m_filt, m3);
+    e->o.rcl = true;
+    // Each function each way from here, 1 s each, increasing ones first.
+    const int fs[3] = {fl, fj, fe};
+    double gain[3];
+    for (int i = 0; i < 3; ++i) gain[i] = rcl_function_gain((rcl*)r, row, fs[i]);
+    CHECK(gain[2] > 0, "%s: the extension carries the tip out here (%.3f m/m)", bn, gain[2]);
+    for (int pass = 0; pass < 2; ++pass)
+        for (int i = 0; i < 3; ++i) {
+            const double dir = (pass == 0) == (gain[i] > 0) ? 1.0 : -1.0; // pass 0: outwards
+            if (gain[i] == 0) continue;
+            double x0[8];
+            engine_row(e, row);
+            for (int k = 0; k < cc->nact; ++k) x0[k] = row[ix[k]];
+            memset(u, 0, sizeof u);
+            u[fs[i]] = dir;
+            double moved = 0;
+            bool cut_ok = true;
+            for (int s = 0; s < 40; ++s) { // a command each frame, as a driver sets it
+                engine_set_function_commands(e, u, nfn, err, sizeof err);
+                if (pass == 0) cut_ok = cut_ok && e->u_lim[fs[i]] == 0.0;
+                else cut_ok = cut_ok && e->u_lim[fs[i]] == dir;
+                t += 0.025;
+                CHECK(engine_advance_to(e, t, NULL, NULL) == 0, "%s: %s", bn, engine_error(e));
+            }
+            engine_row(e, row);
+            for (int k = 0; k < cc->nact; ++k)
+                if (cc->act[k].function == fs[i]) moved = fmax(moved, dir * (row[ix[k]] - x0[k]));
+            memset(u, 0, sizeof u);
+            engine_set_function_commands(e, u, nfn, err, sizeof err);
+            t += 0.5;
+            CHECK(engine_advance_to(e, t, NULL, NULL) == 0, "%s: %s", bn, engine_error(e));
+            if (pass == 0) {
+                CHECK(cut_ok, "%s: %s %+.0f (outwards) cut to 0 at every frame", bn, cc->fn[fs[i]].name, dir);
+                CHECK(fabs(moved) < 2e-3, "%s: %s outwards: stroke moved %.4f m", bn, cc->fn[fs[i]].name, moved);
+            } else {
+                CHECK(cut_ok, "%s: %s %+.0f (inwards) passes whole", bn, cc->fn[fs[i]].name, dir);
+                CHECK(moved > 5e-3, "%s: %s inwards: stroke moved %.4f m", bn, cc->fn[fs[i]].name, moved);
+            }
+            printf("%s: %s %+.0f (%s): stroke %+.4f m, util %.3f\n", bn, cc->fn[fs[i]].name, dir,
+                   pass ? "inwards, passes" : "outwards, cut", moved, engine_rcl(e)->util);
+        }
+    free(row);
+    engine_destroy(e);
+    model_free(m);
+}
+
+// What cannot be read is refused in one line: no rating; a two-link model
+// is not a chain (its limiter is the closed form's).
+static void test_allow_list(void) {
+    char err[600];
+    model* m = load();
+    if (!m) return;
+    m->mech.rated_moment = 0;
+    CHECK(rcl_check_model(m, err, sizeof err) == -1 && strstr(err, "rated_moment"), "no rating refused: %s", err);
+    sim_opts o = sim_default_opts();
+    o.mechanics = SIM_LAGRANGE;
+    CHECK(engine_require(m, &o, ENGINE_CAP_LIMITER, "--rcl on", err, sizeof err) == -1 && strstr(err, "rated_moment"),
+          "engine_require says why: %s", err);
+    model_free(m);
+}
+
+int main(void) {
+    test_gain_against_central_differences();
+    test_allow_list();
+    test_overload_extended(SIM_LAGRANGE);
+    test_overload_extended(SIM_ODE);
+    TEST_MAIN_END();
+}
