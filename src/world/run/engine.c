@@ -296,7 +296,13 @@ int engine_require(const model* m, const sim_opts* o, unsigned caps, const char*
     }
     const unsigned miss = caps & ~engine_caps_for(m, o);
     // The limiter on a crane chain: the chain's shape and rating decide.
-    if (!miss && (caps & ENGINE_CAP_LIMITER) && rcl_check_model(m, err, errsz)) return -1;
+    if (!miss && (caps & ENGINE_CAP_LIMITER)) {
+        char why[400];
+        if (rcl_check_model(m, why, sizeof why)) {
+            snprintf(err, errsz, "%s: %s", what, why);
+            return -1;
+        }
+    }
     if (!miss) return 0;
     // The first missing part, in the order a driver meets them.
     const char* part = (miss & ENGINE_CAP_SNAPSHOT)   ? "picture for the renderer"

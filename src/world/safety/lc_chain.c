@@ -214,6 +214,9 @@ void lc_chain_mass_moment(const lc_chain* g, double* S1, double* M) {
 // finer grid changes is in docs/safety.md.
 #define LCC_STEP_REV (2.5 * M_PI / 180)
 #define LCC_STEP_PRI 0.1
+// Poses beyond which the search is refused (about 3 us a pose and 48 bytes
+// kept per pose: 4e6 is some 12 s and 190 MB).
+#define LCC_MAX_POSES 4000000L
 // Slew angles sampled per sector, bounds included (as loadchart.c's).
 #define LCC_NSLEW 9
 
@@ -298,7 +301,10 @@ void lc_chain_reach(const model* m, double* rmin, double* rmax) {
     lc_chain g;
     char err[300];
     *rmin = *rmax = NAN;
-    if (lc_chain_init(&g, m, "load chart", err, sizeof err)) return;
+    if (lc_chain_init(&g, m, "load chart", err, sizeof err) || lc_chain_grid_size(&g) > LCC_MAX_POSES) {
+        lc_chain_free(&g);
+        return;
+    }
     long n;
     lcc_pose* P = search(&g, 0.0, false, &n);
     double lo = INFINITY, hi = -INFINITY;
@@ -329,6 +335,16 @@ int lc_chain_compute(const model* m, const lc_truck* t, const lc_opts* o, loadch
     lc_chain g;
     if (lc_chain_init(&g, m, "load chart", err, errsz)) return -1;
     const int nd = g.nd;
+    if (lc_chain_grid_size(&g) > LCC_MAX_POSES) {
+        char grid[200] = "";
+        for (int j = 0, w = 0; j < nd && w >= 0 && (size_t)w < sizeof grid; ++j)
+            w += snprintf(grid + w, sizeof grid - (size_t)w, "%s%d", j ? " x " : "", grid_n(&g, j));
+        snprintf(err, errsz, "%s: load chart: the search over every joint of its %d booms would cover %ld poses (%s); "
+                             "at most %ld",
+                 m->file[0] ? m->file : "model", nd, lc_chain_grid_size(&g), grid, LCC_MAX_POSES);
+        lc_chain_free(&g);
+        return -1;
+    }
     const bool truck = t && t->present;
     long np = 0;
     lcc_pose* P = search(&g, o->margin, truck, &np);
