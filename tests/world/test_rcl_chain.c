@@ -114,7 +114,7 @@ static void test_gain_against_central_differences(void) {
     rcl r;
     CHECK(rcl_init(&r, m, NULL, err, sizeof err) == 0, "%s", err);
     const int base = SIM_NCOL_BASE;
-    CHECK(rcl_set_chain_row(&r, base) == 0, "the chain's columns");
+    CHECK(rcl_set_chain_row(&r, NULL, base) == 0, "the chain's columns");
     chain* ch = crane_chain_mechanism(cc, 0.0, false, 0.0, err, sizeof err);
     chain_ws* w = ch ? chain_ws_create(ch) : NULL;
     CHECK(ch && w, "%s", err);

@@ -125,7 +125,7 @@ engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2],
     const char* dw = chain && !e->ops->hook ? NULL : engine_backend_of(o)->drive_world;
     e->rcl = r ? r : engine_rcl_create(m, o, dw);
     // A chain's rows carry its columns after the backend's channels.
-    if (e->rcl && chain && rcl_set_chain_row(e->rcl, e->ops->nchannel)) {
+    if (e->rcl && chain && rcl_set_chain_row(e->rcl, NULL, e->ops->nchannel)) {
         snprintf(err, errsz, "rated capacity limiter: the rows of this engine lack the chain's q, qd or pressure "
                              "columns");
         engine_destroy(e);

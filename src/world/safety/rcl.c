@@ -75,17 +75,17 @@ static void free_chain(rcl* r) {
     r->g = NULL, r->col_q = r->col_qd = NULL, r->q = r->gain = NULL;
 }
 
-int rcl_set_chain_row(rcl* r, int base) {
+int rcl_set_chain_row(rcl* r, const crane_chain* cols, int base) {
     if (!r->chain) return 0;
-    const crane_chain* cc = &r->m->chain;
+    const crane_chain* cc = cols ? cols : &r->m->chain;
     r->row_base = -1;
     for (int j = 0; j < r->g->nd; ++j) {
-        const char* b = cc->body[r->g->dof_body[j]].def.name;
+        const char* b = r->m->chain.body[r->g->dof_body[j]].def.name;
         const int a = crane_chain_find_column(cc, "q", b), v = crane_chain_find_column(cc, "qd", b);
         if (a < 0 || v < 0) return -1;
         r->col_q[j] = base + a, r->col_qd[j] = base + v;
     }
-    const char* lift = cc->act[r->g->lift].name;
+    const char* lift = r->m->chain.act[r->g->lift].name;
     const int pa = crane_chain_find_column(cc, "pA", lift), pb = crane_chain_find_column(cc, "pB", lift);
     if (pa < 0 || pb < 0) return -1;
     r->col_pA = base + pa, r->col_pB = base + pb;

@@ -73,11 +73,12 @@ int rcl_init(rcl* r, const model* m, const world_desc* wd, char* err, size_t err
 /// The allow-list of a crane chain's limiter, without its chart (fast): 0,
 /// or -1 with one line in err (the two-link crane: always 0).
 int rcl_check_model(const model* m, char* err, size_t errsz);
-/// A crane chain's rows carry its columns (crane_chain_columns) from
-/// index base on (the engine's nchannel): where the limiter reads the boom
-/// joints, their rates and the lift cylinder's pressures. 0, or -1 when a
-/// column is missing (the limiter then reads 0).
-int rcl_set_chain_row(rcl* r, int base);
+/// A crane chain's rows carry the columns of chain cols (crane_chain_columns;
+/// NULL: the model's chain; a slewing run's own chain has the slew rack's
+/// besides) from index base on (the engine's nchannel): where the limiter
+/// reads the boom joints, their rates and the lift cylinder's pressures. 0,
+/// or -1 when a column is missing (the limiter then reads 0).
+int rcl_set_chain_row(rcl* r, const crane_chain* cols, int base);
 /// As rcl_init, for the world file of an ode run (NULL: no world, lagrange).
 int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, size_t errsz);
 void rcl_free(rcl* r);
