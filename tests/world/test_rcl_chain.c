@@ -19,7 +19,10 @@
 #include "loadchart.h"
 #include "model.h"
 #include "rcl.h"
+#include "scenario.h"
 #include "sim.h"
+
+#include <cJSON.h>
 
 #include <math.h>
 #include <stdbool.h>
@@ -284,6 +287,73 @@ static void test_overload_extended(sim_mechanics mech) {
     model_free(m);
 }
 
+typedef struct srows {
+    int ix, ncol;
+    double x0, xmax, umax;
+    long n;
+} srows;
+
+static int keep_row(void* user, const double* row) {
+    srows* r = user;
+    if (!r->n++) r->x0 = row[r->ix];
+    r->xmax = fmax(r->xmax, row[r->ix] - r->x0);
+    r->umax = fmax(r->umax, row[COL_RCL_UTIL]);
+    return 0;
+}
+
+// The scripted ODE run (validation world; run --mechanics ode --rcl on):
+// the scenario's extension out at 60 % for 2.5 s with 115 % of the chart's
+// capacity at the tip: with the limiter it never moves and rcl_util reads
+// the overload; without it (measuring nothing) it runs out.
+static void test_scripted_ode_run(void) {
+    model* m = load();
+    if (!m) return;
+    const crane_chain* cc = &m->chain;
+    char err[600];
+    rcl r0;
+    CHECK(rcl_init(&r0, m, NULL, err, sizeof err) == 0, "%s", err);
+    lc_chain g;
+    CHECK(lc_chain_init(&g, m, "test", err, sizeof err) == 0, "%s", err);
+    const double qs[4] = {100 * DEG, -40 * DEG, 0.65, 0.65}; // the start: the extensions mid-range
+    double Rs;
+    lc_chain_eval(&g, qs, &Rs, NULL);
+    lc_chain_free(&g);
+    const double m3 = 1.15 * loadchart_capacity(&r0.chart, Rs, 0.0, NULL);
+    rcl_free(&r0);
+    char text[600];
+    snprintf(text, sizeof text,
+             "{\"name\": \"ext_overload\", \"duration\": 3, \"load_mass\": %.1f, \"initial\": {\"q1_deg\": 100, "
+             "\"q2_deg\": -40}, \"commands\": {\"ext\": [[0, 0], [0.5, 0], [0.6, 0.6], [3, 0.6]]}}",
+             m3);
+    cJSON* j = cJSON_Parse(text);
+    scenario sc;
+    CHECK(j && scenario_from_json(j, "test scenario", &sc, err, sizeof err) == 0, "%s", err);
+    cJSON_Delete(j);
+    for (int on = 1; on >= 0; --on) {
+        sim_opts o = sim_default_opts();
+        o.mechanics = SIM_ODE;
+        o.world = "validation";
+        o.no_step_probe = true;
+        o.rcl = on;
+        int nc;
+        engine_channels_for(&o, &nc);
+        srows rw = {.ix = nc + crane_chain_find_column(cc, "x", "ext1"), .ncol = nc + cc->ncol};
+        engine_sink k = {.row = keep_row, .user = &rw, .rows = true, .t_end = 3.0};
+        sim_result res;
+        memset(&res, 0, sizeof res);
+        CHECK(engine_run(m, &sc, &o, &k, &res) == 0, "%s", res.message);
+        printf("scripted ode, limiter %s, %.0f kg at %.2f m: ext1 runs out %.4f m, rcl_util max %.3f\n",
+               on ? "on" : "off", m3, Rs, rw.xmax, rw.umax);
+        if (on) {
+            CHECK(rw.xmax < 2e-3, "limiter on: the extension stays (%.4f m)", rw.xmax);
+            CHECK(rw.umax >= 1.0 && rw.umax < 1.3, "limiter on: rcl_util %.3f", rw.umax);
+        } else {
+            CHECK(rw.xmax > 0.05, "limiter off: the extension runs out (%.4f m)", rw.xmax);
+        }
+    }
+    model_free(m);
+}
+
 // What cannot be read is refused in one line: no rating; a two-link model
 // is not a chain (its limiter is the closed form's).
 static void test_allow_list(void) {
@@ -304,5 +374,6 @@ int main(void) {
     test_allow_list();
     test_overload_extended(SIM_LAGRANGE);
     test_overload_extended(SIM_ODE);
+    test_scripted_ode_run();
     TEST_MAIN_END();
 }
