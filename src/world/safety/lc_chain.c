@@ -297,6 +297,24 @@ static lcc_pose* search(lc_chain* g, double margin, bool masses, long* np) {
     return P;
 }
 
+// A pose in a point of the chart, for the stability limit's front (below):
+// ordered by point, side of the slew axis, then |R| and sign(R) S1 falling.
+typedef struct lcc_entry {
+    long i;         ///< the point
+    int neg;        ///< R < 0
+    double key, s1; ///< |R| [m], sign(R) S1 [kg m]
+    long p;         ///< the pose (search's index)
+} lcc_entry;
+
+static int entry_cmp(const void* a_, const void* b_) {
+    const lcc_entry *a = a_, *b = b_;
+    if (a->i != b->i) return a->i < b->i ? -1 : 1;
+    if (a->neg != b->neg) return a->neg - b->neg;
+    if (a->key != b->key) return a->key > b->key ? -1 : 1;
+    if (a->s1 != b->s1) return a->s1 > b->s1 ? -1 : 1;
+    return a->p < b->p ? -1 : a->p > b->p;
+}
+
 void lc_chain_reach(const model* m, double* rmin, double* rmax) {
     lc_chain g;
     char err[300];
@@ -409,6 +427,24 @@ int lc_chain_compute(const model* m, const lc_truck* t, const lc_opts* o, loadch
     // takes the weakest pose with |R - R_i| < step, so the chart
     // interpolated between two points is never above a pose between them
     // (the limiter knows the outreach, not the pose the operator chose).
+    // The stability limit of a pose depends on its outreach R and the first
+    // moment S1 of the crane's masses only (stab_lim; their sum M is the same
+    // in every pose), and for R >= 0 it never rises as R or S1 grows (an edge
+    // the tip is beyond lies on the tip's side of the slew axis, so the
+    // tipping lever grows with R and the restoring moment falls with S1;
+    // mirrored for R < 0). So the weakest pose of a point lies on the front
+    // of poses no other pose of the point exceeds in both |R| and sign(R) S1:
+    // only those are rated over the sectors' slew angles (the same minimum
+    // as all of them, a few dozen poses a point instead of thousands).
+    lcc_entry* E = c->truck ? malloc((size_t)np * 2 * sizeof *E + 1) : NULL;
+    if (c->truck && !E) {
+        snprintf(err, errsz, "out of memory for the load chart");
+        free(P), free(hyd_at), free(stab_at), free(cs);
+        loadchart_free(c);
+        lc_chain_free(&g);
+        return -1;
+    }
+    size_t ne = 0;
     for (long p = 0; p < np; ++p) {
         const lcc_pose* P_ = &P[p];
         const long i0 = (long)floor((P_->R - o->lo) / step);
@@ -417,14 +453,30 @@ int lc_chain_compute(const model* m, const lc_truck* t, const lc_opts* o, loadch
             ++c->npose[i];
             // hyd -1: the booms alone overload an actuator here (a chart of 0).
             if (P_->hyd < c->hyd[i]) c->hyd[i] = P_->hyd, c->hyd_cyl[i] = P_->gov, hyd_at[i] = P_->at;
-            for (size_t s = 0; s < ns && c->truck; ++s) {
-                const size_t k = (size_t)i * ns + s;
+            if (E) {
+                const double sg = P_->R >= 0 ? 1.0 : -1.0;
+                E[ne++] = (lcc_entry){.i = i, .neg = P_->R < 0, .key = sg * P_->R, .s1 = sg * P_->S1, .p = p};
+            }
+        }
+    }
+    if (E) {
+        qsort(E, ne, sizeof *E, entry_cmp);
+        double run = -INFINITY;
+        for (size_t e = 0; e < ne; ++e) {
+            if (e == 0 || E[e].i != E[e - 1].i || E[e].neg != E[e - 1].neg) run = -INFINITY;
+            if (!(E[e].s1 > run)) continue; // another pose of the point exceeds it in both
+            run = E[e].s1;
+            const lcc_pose* P_ = &P[E[e].p];
+            const size_t i = (size_t)E[e].i;
+            for (size_t s = 0; s < ns; ++s) {
+                const size_t k = i * ns + s;
                 for (int j = 0; j < LCC_NSLEW; ++j) {
                     const double sl = cs[s * LCC_NSLEW + j], l = stab_lim(t, P_->R, P_->S1, P_->M, sl, o->sf);
                     if (l < c->stab[k]) c->stab[k] = l, c->stab_q[k][2] = sl, stab_at[k] = P_->at;
                 }
             }
         }
+        free(E);
     }
     free(P), free(cs);
     int rc = 0;
