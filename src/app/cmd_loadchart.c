@@ -107,7 +107,7 @@ static void draw_pose(const loadchart* c) {
     plcol0(15);
     plbox("bcgnst", 0, 0, "bcgnstv", 0.5, 0);
     pllab("outreach [m]", "pose in range", "");
-    plmtex("t", 0.8, 0.0, 0.0, "governing pose (sector 0): each joint from its lower (0) to its upper (1) limit");
+    plmtex("t", 0.8, 0.0, 0.0, "the governing pose (sector 0): each joint 0 at its lower limit, 1 at its upper");
     double q[LC_CSV_MAX_DOF], sl;
     for (int d = 0; d < c->nd; ++d) {
         for (int i = 0; i < c->n; ++i) {
@@ -267,7 +267,7 @@ static void draw_chart(void* user) {
     if (c->stab) plptex(0.02, yl, 1, 0, 0, "o: stability governs"), yl -= 0.05;
     plptex(0.02, yl, 1, 0, 0, "chart: min(raw, rating), from its"), yl -= 0.04;
     plptex(0.02, yl, 1, 0, 0, "peak (vertical: minimum outreach)"), yl -= 0.04;
-    plptex(0.02, yl, 1, 0, 0, "outward never rising"), yl -= 0.06;
+    plptex(0.02, yl, 1, 0, 0, "outward never rising"), yl = fmin(yl - 0.06, 0.25);
     // The pose panel's lines: each joint by its body and range.
     for (int d = 0; c->chain && d < c->nd; ++d, yl -= 0.045) {
         const double f = c->dof_prismatic[d] ? 1.0 : 180 / M_PI;
