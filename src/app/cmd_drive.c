@@ -314,9 +314,14 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     double w0 = sim_wall_time(), busy = 0, worst = 0;
     int missed = 0, code = 0, ev = 0, frames_done = 0;
     double rcl_max = 0, rcl_t90 = 0; // the limiter's utilisation [-] and the time at or above 90 % [s]
-    if (!limiter && c->sim.rcl)
-        printf("  rated capacity limiter: none for this crane chain yet (rcl_util not measured; --rcl off silences "
-               "this)\n");
+    if (!limiter && c->sim.rcl) {
+        // Why: the chain's allow-list (rcl_check_model), else its chart failed.
+        char why[400] = "its chart could not be made";
+        rcl_check_model(m, why, sizeof why);
+        printf("  rated capacity limiter: none for this crane chain (%s; rcl_util not measured; --rcl off silences "
+               "this)\n",
+               why);
+    }
     // A row of engine_ncol columns (a chain engine's are more than
     // SIM_NCOL), and the commands by function.
     double* row = calloc((size_t)(ncol > SIM_NCOL ? ncol : SIM_NCOL), sizeof *row);

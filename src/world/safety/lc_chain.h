@@ -10,7 +10,6 @@
 #include <stddef.h>
 
 #include "chain.h"
-#include "loadchart.h"
 #include "model.h"
 
 #ifdef __cplusplus
@@ -71,22 +70,29 @@ void lc_chain_mass_moment(const lc_chain* g, double* S1, double* M);
 
 /// The poses the chart's grid holds (within limits or not).
 long lc_chain_grid_size(const lc_chain* g);
-/// The chain's outreach over every pose of the search (lc_chain_compute's
-/// grid) [m]; NaN both when lc_chain_init refuses the chain.
-void lc_chain_reach(const model* m, double* rmin, double* rmax);
-/// loadchart_compute for a crane chain (docs/safety.md "On a crane chain").
-int lc_chain_compute(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz);
+/// Grid points of boom DOF j in the search (its limits in steps of at most
+/// 2.5 deg or 0.1 m, both ends included).
+int lc_chain_grid_n(const lc_chain* g, int j);
+/// The pose at place `at` of the grid (DOF 0 varying fastest) into q [nd].
+void lc_chain_grid_pose(const lc_chain* g, long at, double* q);
+/// Searches beyond this many grid poses are refused (about 3 us and 48
+/// bytes a pose: some 12 s and 190 MB).
+#define LC_CHAIN_MAX_POSES 4000000L
 
-// loadchart.c's parts the chain's chart shares:
-/// Sizes c for o's points and sectors (t's truck), the sectors' bounds and
-/// the rating; 0, or -1 with err (c freed).
-int lc_chart_alloc(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz);
-/// The printed chart from hyd, stab and rating: env, cap, chart, gov, imin.
-void lc_chart_print(loadchart* c);
-/// Mass moment [kg m] about support edge `edge` (0 front, 1 rear, 2 left,
-/// 3 right) of a mass at horizontal distance rho [m] from the slew axis
-/// along slew angle s [rad]: mass times its distance inside the polygon.
-double lc_edge_moment(const lc_truck* t, int edge, double rho, double s, double mass);
+/// One pose of the search: its outreach, hydraulic limit and governing
+/// actuator, the first moment and sum of the crane's masses.
+typedef struct lcc_pose {
+    double R;   ///< the tip's outreach [m]
+    double hyd; ///< lc_chain_hyd [kg] (-1: the booms alone overload an actuator)
+    double S1;  ///< sum m_b x_b about the slew axis [kg m] (0 unless asked for)
+    double M;   ///< sum m_b [kg] (0 unless asked for)
+    long at;    ///< its place in the grid (lc_chain_grid_pose)
+    int gov;    ///< the actuator that governs hyd
+} lcc_pose;
+/// Every pose of the grid within the joint limits and the strokes, once, in
+/// grid order: *np of them (malloc'd), NULL when out of memory; masses:
+/// fill S1 and M (the stability limit needs them).
+lcc_pose* lc_chain_search(lc_chain* g, double margin, bool masses, long* np);
 
 #ifdef __cplusplus
 }

@@ -1,6 +1,5 @@
 // loadchart.c: rated capacity against outreach (loadchart.h, docs/safety.md).
 #include "loadchart.h"
-#include "lc_chain.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -152,6 +152,23 @@ int loadchart_reliefs(const model* m, int k, double p[2]);
 /// The same for the circuit's cylinder cyl (its index in h).
 int loadchart_cylinder_reliefs(const struct hyd_model* h, int cyl, double p[2]);
 
+// The chart's two files share (loadchart.c, loadchart_chain.c: a crane
+// chain's chart):
+/// A crane chain's outreach over every pose of the chart's search [m]; NaN
+/// both where the chain cannot be searched (loadchart_compute says why).
+void lc_chain_reach(const model* m, double* rmin, double* rmax);
+/// loadchart_compute for a crane chain (docs/safety.md "On a crane chain").
+int lc_chain_compute(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz);
+/// Sizes c for o's points and sectors (t's truck), the sectors' bounds and
+/// the rating; 0, or -1 with err (c freed).
+int lc_chart_alloc(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz);
+/// The printed chart from hyd, stab and rating: env, cap, chart, gov, imin.
+void lc_chart_print(loadchart* c);
+/// Mass moment [kg m] about support edge `edge` (0 front, 1 rear, 2 left,
+/// 3 right) of a mass at horizontal distance rho [m] from the slew axis
+/// along slew angle s [rad]: mass times its distance inside the polygon.
+double lc_edge_moment(const lc_truck* t, int edge, double rho, double s, double mass);
+
 #ifdef __cplusplus
 }
 #endif
