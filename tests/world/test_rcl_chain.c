@@ -196,11 +196,11 @@ static void test_overload_extended(sim_mechanics mech) {
     lc_chain_eval(&g, qt, &Rt, NULL);
     const double cap = loadchart_capacity(&r0.chart, Rt, 0.0, NULL), m3 = 1.15 * cap;
     lc_chain_free(&g);
-    rcl_free(&r0);
     const double q0[2] = {100 * DEG, -40 * DEG};
     engine* e = engine_create(m, &o, q0, 0.0, m3, err, sizeof err);
     CHECK(e != NULL, "%s: %s", bn, err);
     if (!e) {
+        rcl_free(&r0);
         model_free(m);
         return;
     }
@@ -235,6 +235,10 @@ static void test_overload_extended(sim_mechanics mech) {
     const rcl* r = engine_rcl(e);
     CHECK(r->util >= 1.0, "%s: overloaded: util %.3f at %.2f m (load %.0f kg, chart %.0f kg)", bn, r->util, r->R, m3,
           cap);
+    // Against the chart of the engine's world (no truck: the validation
+    // world), not the backend's drive world (the sandbox's truck).
+    CHECK_REL(r->util, r->m_filt / loadchart_capacity(&r0.chart, r->R, 0.0, NULL), 1e-9);
+    rcl_free(&r0);
     // The measured load against the load at the tip (the lift pressure,
     // its lever and the booms' gravity: the booms still, the seals' friction
     // within its band).
