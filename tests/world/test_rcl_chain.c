@@ -293,7 +293,7 @@ static void test_overload_extended(sim_mechanics mech) {
 
 typedef struct srows {
     int ix, ncol;
-    double x0, xmax, umax;
+    double x0, xmax, xmin, umax;
     long n;
 } srows;
 
@@ -301,14 +301,16 @@ static int keep_row(void* user, const double* row) {
     srows* r = user;
     if (!r->n++) r->x0 = row[r->ix];
     r->xmax = fmax(r->xmax, row[r->ix] - r->x0);
+    r->xmin = fmin(r->xmin, row[r->ix] - r->x0);
     r->umax = fmax(r->umax, row[COL_RCL_UTIL]);
     return 0;
 }
 
 // The scripted ODE run (validation world; run --mechanics ode --rcl on):
-// the scenario's extension out at 60 % for 2.5 s with 115 % of the chart's
-// capacity at the tip: with the limiter it never moves and rcl_util reads
-// the overload; without it (measuring nothing) it runs out.
+// the scenario's extension out at 60 % for 1 s, then in at 60 % for 1.4 s,
+// with 115 % of the chart's capacity at the tip: with the limiter it does
+// not move out, comes in, and rcl_util reads the overload; without it
+// (measuring nothing) it runs out.
 static void test_scripted_ode_run(void) {
     model* m = load();
     if (!m) return;
@@ -327,7 +329,7 @@ static void test_scripted_ode_run(void) {
     char text[600];
     snprintf(text, sizeof text,
              "{\"name\": \"ext_overload\", \"duration\": 3, \"load_mass\": %.1f, \"initial\": {\"q1_deg\": 100, "
-             "\"q2_deg\": -40}, \"commands\": {\"ext\": [[0, 0], [0.5, 0], [0.6, 0.6], [3, 0.6]]}}",
+             "\"q2_deg\": -40}, \"commands\": {\"ext\": [[0, 0], [0.5, 0], [0.6, 0.6], [1.5, 0.6], [1.6, -0.6], [3, -0.6]]}}",
              m3);
     cJSON* j = cJSON_Parse(text);
     scenario sc;
@@ -341,15 +343,17 @@ static void test_scripted_ode_run(void) {
         o.rcl = on;
         int nc;
         engine_channels_for(&o, &nc);
-        srows rw = {.ix = nc + crane_chain_find_column(cc, "x", "ext1"), .ncol = nc + cc->ncol};
+        srows rw = {.ix = nc + crane_chain_find_column(cc, "x", "ext1"), .ncol = nc + cc->ncol, .xmin = INFINITY};
         engine_sink k = {.row = keep_row, .user = &rw, .rows = true, .t_end = 3.0};
         sim_result res;
         memset(&res, 0, sizeof res);
         CHECK(engine_run(m, &sc, &o, &k, &res) == 0, "%s", res.message);
-        printf("scripted ode, limiter %s, %.0f kg at %.2f m: ext1 runs out %.4f m, rcl_util max %.3f\n",
-               on ? "on" : "off", m3, Rs, rw.xmax, rw.umax);
+        printf("scripted ode, limiter %s, %.0f kg at %.2f m: ext1 runs out %.4f m, comes in to %.4f m, rcl_util max "
+               "%.3f\n",
+               on ? "on" : "off", m3, Rs, rw.xmax, rw.xmin, rw.umax);
         if (on) {
             CHECK(rw.xmax < 2e-3, "limiter on: the extension stays (%.4f m)", rw.xmax);
+            CHECK(rw.xmin < -0.1, "limiter on: the extension comes in (%.4f m)", rw.xmin);
             CHECK(rw.umax >= 1.0 && rw.umax < 1.3, "limiter on: rcl_util %.3f", rw.umax);
         } else {
             CHECK(rw.xmax > 0.05, "limiter off: the extension runs out (%.4f m)", rw.xmax);

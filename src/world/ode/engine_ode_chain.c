@@ -186,9 +186,10 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
         engine_faults_apply(&ef, hm, sc, tm);
         double slew_u = u3[2];
         if (lim) { // the functions, then the slew, on the state now
-            ode_chain_sandbox_row(&r, w, cc, (double)i * dt, now);
+            // (the row's outputs reuse r.u for the spools: the commands first)
             for (int f = 0; f < r.nf; ++f) ulim[f] = r.u[f];
             ulim[r.nf] = slew_u;
+            ode_chain_sandbox_row(&r, w, cc, (double)i * dt, now);
             rcl_filter_fn(lim, now, r.nf + 1, ulim, ulim + r.nf + 1, r.nf);
             for (int f = 0; f < r.nf; ++f) r.u[f] = ulim[r.nf + 1 + f];
             slew_u = ulim[2 * r.nf + 1];
@@ -392,9 +393,11 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         for (int f = 0; f < r.nf; ++f) r.u[f] = fcol[f] >= 0 ? scenario_command(sc, fcol[f], tm) : 0.0;
         engine_faults_apply(&ef, m->hyd, sc, tm);
         if (lim) { // the functions on the state now
+            // (the row's outputs reuse r.u for the spools: the commands first)
+            memcpy(ulim, r.u, (size_t)r.nf * sizeof *ulim);
             ode_chain_make_row(&r, w, (double)i * dt, now);
-            rcl_filter_fn(lim, now, r.nf, r.u, ulim, -1);
-            memcpy(r.u, ulim, (size_t)r.nf * sizeof *ulim);
+            rcl_filter_fn(lim, now, r.nf, ulim, ulim + r.nf + 1, -1);
+            memcpy(r.u, ulim + r.nf + 1, (size_t)r.nf * sizeof *ulim);
         }
         ode_chain_set_commands(w, r.u);
         if (ode_chain_step(w, dt)) {
