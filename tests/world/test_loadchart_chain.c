@@ -13,7 +13,7 @@
 //   outwards;
 // - the governing pose of every point reaches the point's outreach within
 //   one step and holds the chart's value there (the search's own statics);
-// - a finer grid lowers no point by more than 1 % (the search's resolution).
+// - the governing poses stay within the cylinders' strokes (ext1's cut short).
 // The analytic mode's stepped engine: it starts every joint beyond the
 // first two at the middle of its limits, so those limits are narrowed to
 // the pose (the analytic mode does not enforce joint limits).
@@ -277,7 +277,42 @@ static void test_governing_pose_per_point(void) {
     model_free(m);
 }
 
+// The search takes only poses the cylinders reach: with ext1's stroke cut
+// to 1.0 m (its joint's limits still 0 to 1.3 m) no governing pose has ext1
+// beyond its stroke, by the pin length from the mechanism itself.
+static void test_poses_within_strokes(void) {
+    char err[600];
+    const char* set[] = {"hydraulics.components.ext1_cyl.stroke=1.0"};
+    model* m = model_load(MODEL, set, 1, err, sizeof err);
+    CHECK(m != NULL, "%s", err);
+    if (!m) return;
+    lc_opts o = lc_default_opts();
+    o.lo = 1.0, o.hi = 7.0, o.n = 25;
+    static loadchart c;
+    CHECK(loadchart_compute(m, NULL, &o, &c, err, sizeof err) == 0, "%s", err);
+    const crane_chain* cc = &m->chain;
+    chain* ch = crane_chain_mechanism(cc, 0.0, false, 0.0, err, sizeof err);
+    chain_ws* w = ch ? chain_ws_create(ch) : NULL;
+    const int k = crane_chain_find_act(cc, "ext1");
+    double worst = -INFINITY, near_end = 0;
+    for (int i = 0; ch && w && i < c.n; ++i) {
+        chain_update(ch, w, c.pose + (size_t)i * c.nd, NULL);
+        const crane_act* a = &cc->act[k];
+        const double x = chain_cylinder(ch, w, a->body_a, a->pa, a->body_b, a->pb, NULL, NULL, NULL) - a->closed_length;
+        worst = fmax(worst, x);
+        near_end += x > 0.9;
+    }
+    CHECK(worst <= 1.0 + 1e-4, "a governing pose strokes ext1 to %.4f m (its stroke 1.0 m)", worst);
+    CHECK(near_end > 0, "some governing pose uses ext1's stroke to its end (%.0f)", near_end);
+    printf("ext1's stroke cut to 1.0 m: the governing poses stroke it at most %.4f m\n", worst);
+    chain_ws_free(w);
+    chain_free(ch);
+    loadchart_free(&c);
+    model_free(m);
+}
+
 int main(void) {
+    test_poses_within_strokes();
     test_governing_pose_per_point();
     test_hydraulic_limit_by_simulation();
     test_chart_with_limiter();
