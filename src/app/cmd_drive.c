@@ -294,7 +294,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     const bool loads = sandbox && engine_load_name(l, 0, NULL) != NULL;
     drive_world dw = {.hook = sandbox, .held = -1, .sess = session_path ? &sw : NULL};
     int wr = 0; // errno of the first failed write to the record
-    const bool two_link = engine_caps(l) & ENGINE_CAP_TWO_LINK, limiter = engine_caps(l) & ENGINE_CAP_LIMITER;
+    const bool two_link = engine_caps(l) & ENGINE_CAP_TWO_LINK, limiter = engine_rcl(l) != NULL;
     const int nfn = engine_nfunction(l);
     if (f && two_link) sim_csv_header(f, ncol);
     else if (f) write_header(f, l);
@@ -313,9 +313,14 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     double w0 = sim_wall_time(), busy = 0, worst = 0;
     int missed = 0, code = 0, ev = 0, frames_done = 0;
     double rcl_max = 0, rcl_t90 = 0; // the limiter's utilisation [-] and the time at or above 90 % [s]
-    if (!limiter && c->sim.rcl)
-        printf("  rated capacity limiter: none for this crane chain yet (rcl_util not measured; --rcl off silences "
-               "this)\n");
+    if (!limiter && c->sim.rcl) {
+        // Why: the chain's allow-list (rcl_check_model), else its chart failed.
+        char why[400] = "its chart could not be made";
+        rcl_check_model(m, why, sizeof why);
+        printf("  rated capacity limiter: none for this crane chain (%s; rcl_util not measured; --rcl off silences "
+               "this)\n",
+               why);
+    }
     // A row of engine_ncol columns (a chain engine's are more than
     // SIM_NCOL), and the commands by function.
     double* row = calloc((size_t)(ncol > SIM_NCOL ? ncol : SIM_NCOL), sizeof *row);
@@ -359,9 +364,10 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         }
         engine_row(l, row);
         session_writer_tick(&sw, tm, target, two_link ? u : uf, two_link ? 3 : nfn, row, ncol);
-        if (limiter && ncol > COL_RCL_UTIL) {
-            if (row[COL_RCL_UTIL] >= RCL_WARN) rcl_t90 += frame;
-            rcl_max = fmax(rcl_max, row[COL_RCL_UTIL]);
+        if (limiter) { // the limiter's own reading: a chain's rows may have no rcl_util column
+            const double ut = engine_rcl(l)->util;
+            if (ut >= RCL_WARN) rcl_t90 += frame;
+            rcl_max = fmax(rcl_max, ut);
         }
         // A record that cannot be written stops the run: driving on would
         // only lose more of it.
@@ -424,7 +430,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (sandbox) printf("; truck tilt %.2f deg", row[COL_TRUCK_TILT] * 180 / M_PI);
     if (!sandbox && m3 > 0) printf("; %.0f kg at the tip", m3);
     printf("\n");
-    if (limiter && ncol > COL_RCL_UTIL)
+    if (limiter)
         printf("  rated capacity limiter %s: utilisation max %.0f %%, %.2f s at or above 90 %%\n",
                c->sim.rcl ? "on" : "off (measuring only)", 100 * rcl_max, rcl_t90);
     // As a scripted run's metrics line counts them (the sandbox only).
