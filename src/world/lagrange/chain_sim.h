@@ -35,6 +35,7 @@
 #include <stddef.h>
 
 #include "chain.h"
+#include "chain_stops.h"
 #include "crane_chain.h"
 #include "hydraulics.h"
 #include "hyd_solver.h"
@@ -99,6 +100,7 @@ typedef struct chain_sim {
     double rack_r;          ///< pinion radius [m]
     double rack_stroke;     ///< rack cylinder's full stroke [m]
     double slew_c;          ///< slewing-ring viscous damping [N m s/rad]
+    chain_stops stops;      ///< the joint-limit stops (chain_stops.h), added to tau
 } chain_sim;
 
 /// Set up for chain cc (bound to circuit hm by crane_chain_bind) with a tip
