@@ -123,6 +123,11 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
         chain_sim_free(s);
         return -1;
     }
+    // The joint-limit stops (chain_stops.h), as the ODE world's joints.
+    if (chain_stops_init(&s->stops, s->ch, s->ws, err, errsz)) {
+        chain_sim_free(s);
+        return -1;
+    }
     s->Ld = s->L + na;
     s->dL = s->Ld + na;
     s->dLd = s->dL + na * nd;
@@ -186,6 +191,7 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
 }
 
 void chain_sim_free(chain_sim* s) {
+    chain_stops_free(&s->stops);
     chain_ws_free(s->ws);
     chain_free(s->ch);
     hyd_data_free(s->hd);
@@ -265,9 +271,10 @@ static void ideal_forces(chain_sim* s) {
 }
 
 // tau = sum_k F_k dL_k/dq [N m or N] from the circuit's last forces (the
-// rack's F r on the column among them), and the slewing ring's damping -c
-// theta' [N m] at the rates qd.
-static void joint_forces(chain_sim* s, const double* qd) {
+// rack's F r on the column among them), the slewing ring's damping -c
+// theta' [N m] at the rates qd, and the joint stops at (q, qd)
+// (chain_stops.h; nothing for a joint within its limits).
+static void joint_forces(chain_sim* s, const double* q, const double* qd) {
     const int nd = s->ndof;
     for (int i = 0; i < nd; ++i) s->tau[i] = 0.0;
     for (int k = 0; k < s->nact; ++k) {
@@ -276,6 +283,7 @@ static void joint_forces(chain_sim* s, const double* qd) {
         for (int i = 0; i < nd; ++i) s->tau[i] += F * r[i];
     }
     if (s->rack >= 0) s->tau[0] -= s->slew_c * qd[0];
+    if (s->stops.n) chain_stops_add(&s->stops, nd, q, qd, s->tau, NULL, NULL);
 }
 
 int chain_sim_rhs(void* user, double t, const double* y, double* dydt) {
@@ -290,7 +298,7 @@ int chain_sim_rhs(void* user, double t, const double* y, double* dydt) {
         hyd_eval_mapped(s->hm, s->hd, t, y, dydt, s->hpos);
     }
     const double* qd = y + iq + nd;
-    joint_forces(s, qd);
+    joint_forces(s, y + iq, qd);
     for (int i = 0; i < nd; ++i) dydt[iq + i] = qd[i];
     // M not positive definite (a body of no mass on a DOF): no finite q''.
     if (chain_forward_dynamics(s->ch, s->ws, s->tau, dydt + iq + nd)) return 1;
@@ -356,7 +364,7 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
         }
     }
     const double* qd = y + iq + nd;
-    joint_forces(s, qd);
+    joint_forces(s, y + iq, qd);
     if (chain_forward_dynamics(s->ch, s->ws, s->tau, s->qdd)) return 1;
     double* dtq = s->H + (size_t)nd * nd;  // d tau / dq
     double* dtqd = dtq + (size_t)nd * nd;  // d tau / dq'
@@ -393,6 +401,9 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
             }
     }
     if (s->rack >= 0) dtqd[0] -= s->slew_c; // the ring's damping -c theta'
+    // The joint stops' partials (their force is in tau already; id0 takes
+    // it again as scratch).
+    if (s->stops.n) chain_stops_add(&s->stops, nd, y + iq, qd, s->id0, dtq, dtqd);
     for (int i = 0; i < nd; ++i) J[(size_t)(iq + i) * n + iq + nd + i] = 1.0;
     // The mechanics' rows: d q''/dz = M^-1 (d tau/dz - d ID/dz at fixed q'').
     // The kinematics are perturbed by id_partial and restored after; the
@@ -444,6 +455,15 @@ static int chain_sim_settle(void* user, double t, double* y) {
     return changed;
 }
 
+// hyd_problem.events: a joint stop engaging or pressing past its width
+// (chain_stops_events), so that a reused Jacobian is taken again when the
+// stop stiffens the mechanics.
+static unsigned long chain_sim_events(void* user, double t, const double* y) {
+    chain_sim* s = user;
+    (void)t;
+    return chain_stops_events(&s->stops, y + s->iq);
+}
+
 hyd_problem chain_sim_problem(chain_sim* s, bool blocks) {
     hyd_problem p;
     memset(&p, 0, sizeof p);
@@ -453,6 +473,7 @@ hyd_problem chain_sim_problem(chain_sim* s, bool blocks) {
     p.jac_full = 1;
     p.user = s;
     p.settle = chain_sim_settle;
+    if (s->stops.n) p.events = chain_sim_events;
     if (blocks) {
         p.nblock = s->nblock;
         p.block_size = s->block;

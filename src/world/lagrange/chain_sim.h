@@ -35,6 +35,7 @@
 #include <stddef.h>
 
 #include "chain.h"
+#include "chain_stops.h"
 #include "crane_chain.h"
 #include "hydraulics.h"
 #include "hyd_solver.h"
@@ -105,6 +106,7 @@ typedef struct chain_sim {
     bool kin_valid;
     double kin_t;
     double* kin_y;
+    chain_stops stops;      ///< the joint-limit stops (chain_stops.h), added to tau
 } chain_sim;
 
 /// Set up for chain cc (bound to circuit hm by crane_chain_bind) with a tip
