@@ -195,10 +195,21 @@ static void pressure_color(double frac, float rgba[4]) {
 }
 
 enum { BAR_W = 14, BAR_H = 96, BAR_GAP = 6, BAR_PAD = 4 };
+/// More cylinders than this (a crane chain's) and the HUD is compact: its
+/// readouts table in small text, the pressure bars shorter (BAR_H_MANY), so
+/// a group over every cylinder fits beside the others. The two-link crane
+/// (lift, jib and the slew rack) keeps the full size.
+enum { HUD_FEW_CYL = 4, BAR_H_MANY = 60 };
+
+static bool overlaps(int x, int y, int w, int h, const float b[4]) {
+    return b[2] > 0 && x < b[0] + b[2] && b[0] < x + w && y < b[1] + b[3] && b[1] < y + h;
+}
 
 // keep_out: the warnings' box at the top centre (x, y, w, h [px]; w = 0 for
-// none): a bar group there goes below it, not under it.
-static void draw_pressure_bars(render* r, const world_snapshot* s, const float keep_out[4]) {
+// none): a bar group there goes below it, not under it. readouts: the
+// readouts box (top left), kept clear of the groups in the compact HUD
+// (where the groups are many; w = 0: not kept).
+static void draw_pressure_bars(render* r, const world_snapshot* s, const float keep_out[4], const float readouts[4]) {
     render_hud* h = &r->hud;
     const float empty[4] = {((RENDER_BAR_EMPTY_RGB >> 16) & 255) / 255.0f,
                             ((RENDER_BAR_EMPTY_RGB >> 8) & 255) / 255.0f,
@@ -208,6 +219,8 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
     int placed[WORLD_SNAP_MAX_CYLINDERS][4];
     int nplaced = 0;
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    const bool many = ncyl > HUD_FEW_CYL;
+    const int bar_h = many ? BAR_H_MANY : BAR_H;
     for (int i = 0; i < ncyl; ++i) {
         const world_snap_cylinder* c = &s->cyl[i];
         double mid[3] = {0.5 * (c->base[0] + c->rod_end[0]), 0.5 * (c->base[1] + c->rod_end[1]),
@@ -216,7 +229,7 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
         if (!render_project(r, mid, px)) continue;
         // The group: two bars side by side, raised above the cylinder, with a
         // leader line down to it. Keep it on screen and clear of the others.
-        int gw = 2 * BAR_W + BAR_GAP + 2 * BAR_PAD, gh = BAR_H + 2 * BAR_PAD + 30;
+        int gw = 2 * BAR_W + BAR_GAP + 2 * BAR_PAD, gh = bar_h + 2 * BAR_PAD + 30;
         int gx = (int)px[0] - gw / 2, gy = (int)px[1] - 40 - gh;
         if (gx < 4) gx = 4;
         if (gy < 4) gy = 4;
@@ -230,6 +243,30 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
                 if (gx < placed[k][0] + placed[k][2] + 6 && placed[k][0] < gx + gw + 6 &&
                     gy < placed[k][1] + placed[k][3] && placed[k][1] < gy + gh)
                     gx = placed[k][0] + placed[k][2] + 8;
+        if (many) {
+            // Many groups (a crane chain's cylinders along its booms): one
+            // that overlaps another, the readouts or the warnings, or runs
+            // off the right edge, takes the first free place in rows of
+            // groups from the top, right of the readouts box.
+            bool clash = gx + gw > h->w - 4 || overlaps(gx, gy, gw, gh, readouts) || overlaps(gx, gy, gw, gh, keep_out);
+            for (int k = 0; k < nplaced && !clash; ++k) {
+                const float b[4] = {(float)placed[k][0] - 6, (float)placed[k][1], (float)placed[k][2] + 12,
+                                    (float)placed[k][3]};
+                clash = overlaps(gx, gy, gw, gh, b);
+            }
+            const int x0 = readouts[2] > 0 ? (int)(readouts[0] + readouts[2]) + 8 : 4;
+            for (int row = 0; clash && row < 4; ++row)
+                for (int x = x0; clash && x + gw <= h->w - 4; x += gw + 8) {
+                    const int y = 4 + row * (gh + 8);
+                    clash = overlaps(x, y, gw, gh, readouts) || overlaps(x, y, gw, gh, keep_out);
+                    for (int k = 0; k < nplaced && !clash; ++k) {
+                        const float b[4] = {(float)placed[k][0] - 6, (float)placed[k][1], (float)placed[k][2] + 12,
+                                            (float)placed[k][3]};
+                        clash = overlaps(x, y, gw, gh, b);
+                    }
+                    if (!clash) gx = x, gy = y;
+                }
+        }
         placed[nplaced][0] = gx, placed[nplaced][1] = gy, placed[nplaced][2] = gw,
         placed[nplaced][3] = gh;
         ++nplaced;
@@ -244,6 +281,7 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
         double p[2] = {c->pA, c->pB};
         for (int ch = 0; ch < 2; ++ch) {
             int bx = gx + BAR_PAD + ch * (BAR_W + BAR_GAP), by = gy + 14;
+            const int BAR_H = bar_h; // this frame's height (compact with many cylinders)
             double frac = p[ch] / r->cfg.p_full_scale;
             if (!(frac > 0)) frac = 0; // also catches NaN
             if (frac > 1) frac = 1;
@@ -275,9 +313,20 @@ static void pad_margin_text(const world_snapshot* s, char* buf, size_t n) {
 /// Readouts table, top left. Units in every row header.
 static float draw_readouts(render* r, const world_snapshot* s) {
     render_hud* h = &r->hud;
-    const float sc = 1.5f, lh = 14.0f, col0 = 96.0f, colw = 84.0f;
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    // The cylinder table: text scale, row height and columns [px]. With
+    // many cylinders (a crane chain) it is set in small text, each column as
+    // wide as its longest entry, so ten of them fit half the width.
+    const bool many = ncyl > HUD_FEW_CYL;
+    const float sc = 1.5f, lh = 14.0f, tsc = many ? 1.0f : sc, tlh = many ? 11.0f : lh, col0 = many ? 64.0f : 96.0f;
+    float colw = 84.0f;
+    if (many) {
+        colw = render_hud_text_width("-00000.0", tsc);
+        for (int i = 0; i < ncyl; ++i) colw = fmaxf(colw, render_hud_text_width(s->cyl[i].name, tsc));
+        colw += 8;
+    }
     const int nrows = 14 + r->nreadout + (s->npad ? 1 : 0);
+    const float height = lh * (float)(nrows - 8) + tlh * 8 + (many ? 0.3f * (lh - tlh) : 0.0f);
     float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
     // The status line ("[keys: panel - Enter/Esc gives them back]") is the
     // widest text; the box grows to hold it rather than cut it at its edge.
@@ -290,9 +339,9 @@ static float draw_readouts(render* r, const world_snapshot* s) {
         pad_margin_text(s, line + k, sizeof line - (size_t)k);
         w = fmaxf(w, render_hud_text_width(line, sc) + 12);
     }
-    render_hud_rect(h, x - 6, y - 6, w, lh * (float)nrows + 10, k_panel);
+    render_hud_rect(h, x - 6, y - 6, w, height + 10, k_panel);
     h->readouts_rect[0] = x - 6, h->readouts_rect[1] = y - 6, h->readouts_rect[2] = w,
-    h->readouts_rect[3] = lh * (float)nrows + 10;
+    h->readouts_rect[3] = height + 10;
     char buf[160], rt[32];
     // rt_factor 0 means unknown (world_snapshot.h), e.g. over the first
     // instants, where a ratio of two tiny times means nothing.
@@ -305,13 +354,13 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh * 1.3f;
     for (int i = 0; i < ncyl; ++i)
-        render_hud_text(h, x + col0 + colw * (float)i, y, sc, k_dim,
+        render_hud_text(h, x + col0 + colw * (float)i, y, tsc, k_dim,
                         s->cyl[i].name[0] ? s->cyl[i].name : "cyl");
-    y += lh;
+    y += tlh;
     static const char* rows[] = {"x [mm]", "v [mm/s]",  "pA [MPa]", "pB [MPa]",
                                  "u [%]",  "u_cmd [%]", "F [kN]"};
     for (int row = 0; row < 7; ++row) {
-        render_hud_text(h, x, y, sc, k_dim, rows[row]);
+        render_hud_text(h, x, y, tsc, k_dim, rows[row]);
         for (int i = 0; i < ncyl; ++i) {
             const world_snap_cylinder* c = &s->cyl[i];
             double v[7] = {c->x * 1e3, c->v * 1e3,     c->pA * 1e-6,   c->pB * 1e-6,
@@ -322,9 +371,9 @@ static float draw_readouts(render* r, const world_snapshot* s) {
             // u_cmd in amber where the limiter cut the operator's demand (the
             // warning line gives the demand beside it).
             const float* colr = ((row == 2 || row == 3) && c->relief_open) || (row == 5 && c->rcl_cut) ? k_amber : k_white;
-            render_hud_text(h, x + col0 + colw * (float)i, y, sc, colr, buf);
+            render_hud_text(h, x + col0 + colw * (float)i, y, tsc, colr, buf);
         }
-        y += lh;
+        y += tlh;
     }
     y += 4;
     char f0[32], f1[32], f2[32];
@@ -532,8 +581,17 @@ void render_hud_draw_overlay(render* r, const world_snapshot* s) {
     const int nw = render_hud_warnings(r, s, w, RENDER_WARN_MAX);
     float box[4];
     warnings_box(r, w, nw, box);
-    draw_pressure_bars(r, s, box);
-    draw_readouts(r, s);
+    // The readouts first where the bars must keep clear of them (many
+    // cylinders: compact HUD); else in the order they always had.
+    const int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    if (ncyl > HUD_FEW_CYL) {
+        draw_readouts(r, s);
+        draw_pressure_bars(r, s, box, h->readouts_rect);
+    } else {
+        const float none[4] = {0, 0, 0, 0};
+        draw_pressure_bars(r, s, box, none);
+        draw_readouts(r, s);
+    }
     draw_rcl_bar(r, s);
     draw_warnings(r, w, nw);
     if (r->link[0]) { // the remote link, top right, clear of the warnings at the centre
