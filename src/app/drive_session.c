@@ -627,8 +627,10 @@ static int apply_chain(drive_session* s, drive_param* p, double si) {
     const double old = chain_value(s->m, p->mech, f);
     if (f == CF_LENGTH) {
         p->value = old / p->scale;
-        snprintf(s->status, sizeof s->status, "refused: %s/%s: it places the joints of the bodies on it and the "
-                 "actuators' pins, which the model file gives: edit %s there and load it", p->group, p->label, p->json);
+        char t[512];
+        snprintf(t, sizeof t, "refused: %s/%s: it places the joints of the bodies on it and the actuators' pins, "
+                 "which the model file gives: edit %s there and load it", p->group, p->label, p->json);
+        say(s, t);
         return -1;
     }
     char a[240], e[320];
@@ -658,7 +660,9 @@ static int apply_chain(drive_session* s, drive_param* p, double si) {
     cJSON_Delete(doc);
     if (!nm) {
         p->value = old / p->scale;
-        snprintf(s->status, sizeof s->status, "refused: %s/%s: %s", p->group, p->label, e);
+        char t[512];
+        snprintf(t, sizeof t, "refused: %s/%s: %s", p->group, p->label, e);
+        say(s, t);
         return -1;
     }
     // What the scenario added to the model (its bursts) goes along.
@@ -678,8 +682,10 @@ static int apply_chain(drive_session* s, drive_param* p, double si) {
     model_free(om);
     ++s->st.rebuilds;
     rebind_charts(s);
-    snprintf(s->status, sizeof s->status, "%s/%s = %.4g %s: world rebuilt at t = %.2f s (the joints past the first "
-             "two booms at mid-limits)", p->group, p->label, p->value, p->unit, t_at);
+    char t[512];
+    snprintf(t, sizeof t, "%s/%s = %.4g %s: world rebuilt at t = %.2f s (the joints past the first two booms at "
+             "mid-limits)", p->group, p->label, p->value, p->unit, t_at);
+    say(s, t);
     return 0;
 }
 

@@ -205,6 +205,36 @@ static bool overlaps(int x, int y, int w, int h, const float b[4]) {
     return b[2] > 0 && x < b[0] + b[2] && b[0] < x + w && y < b[1] + b[3] && b[1] < y + h;
 }
 
+// A leader line from (x0, y0) to (x1, y1) [px] with the parts inside any of
+// the n boxes (x, y, w, h; w <= 0: none) left out (Liang-Barsky clipping of
+// the segment against each box in turn, the pieces outside kept).
+static void leader_line(render_hud* h, float x0, float y0, float x1, float y1, const float (*box)[4], int n) {
+    for (int k = 0; k < n; ++k) {
+        const float* b = box[k];
+        if (!(b[2] > 0 && b[3] > 0)) continue;
+        const float dx = x1 - x0, dy = y1 - y0;
+        const float p[4] = {-dx, dx, -dy, dy}, q[4] = {x0 - b[0], b[0] + b[2] - x0, y0 - b[1], b[1] + b[3] - y0};
+        float ta = 0, tb = 1;
+        bool out = false;
+        for (int e = 0; e < 4 && !out; ++e) {
+            if (p[e] == 0) {
+                out = q[e] < 0;
+                continue;
+            }
+            const float t = q[e] / p[e];
+            if (p[e] < 0) ta = fmaxf(ta, t);
+            else tb = fminf(tb, t);
+            out = ta >= tb;
+        }
+        if (out) continue;
+        // The pieces before and after the box, each against the boxes left.
+        if (ta > 0) leader_line(h, x0, y0, x0 + ta * dx, y0 + ta * dy, box + k + 1, n - k - 1);
+        if (tb < 1) leader_line(h, x0 + tb * dx, y0 + tb * dy, x1, y1, box + k + 1, n - k - 1);
+        return;
+    }
+    render_hud_line(h, x0, y0, x1, y1, k_dim);
+}
+
 // keep_out: the warnings' box at the top centre (x, y, w, h [px]; w = 0 for
 // none): a bar group there goes below it, not under it. readouts: the
 // readouts box (top left), kept clear of the groups in the compact HUD
@@ -221,6 +251,14 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
     const bool many = ncyl > HUD_FEW_CYL;
     const int bar_h = many ? BAR_H_MANY : BAR_H;
+    // Many groups: every place first (pass 0), then the groups with their
+    // leader lines clipped out of the other groups and the boxes (pass 1):
+    // the HUD draws its lines over its rectangles, so a line across another
+    // cylinder's bar would read as its pressure. Few: each group with its
+    // line in one pass, as it always was drawn.
+    int gpos[WORLD_SNAP_MAX_CYLINDERS][2], gidx[WORLD_SNAP_MAX_CYLINDERS];
+    bool gok[WORLD_SNAP_MAX_CYLINDERS] = {false};
+    for (int pass = 0; pass < (many ? 2 : 1); ++pass)
     for (int i = 0; i < ncyl; ++i) {
         const world_snap_cylinder* c = &s->cyl[i];
         double mid[3] = {0.5 * (c->base[0] + c->rod_end[0]), 0.5 * (c->base[1] + c->rod_end[1]),
@@ -231,6 +269,20 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
         // leader line down to it. Keep it on screen and clear of the others.
         int gw = 2 * BAR_W + BAR_GAP + 2 * BAR_PAD, gh = bar_h + 2 * BAR_PAD + 30;
         int gx = (int)px[0] - gw / 2, gy = (int)px[1] - 40 - gh;
+        if (pass == 1) {
+            if (!gok[i]) continue;
+            gx = gpos[i][0], gy = gpos[i][1];
+            float avoid[WORLD_SNAP_MAX_CYLINDERS + 2][4];
+            int na = 0;
+            for (int k = 0; k < nplaced; ++k)
+                if (k != gidx[i])
+                    avoid[na][0] = (float)placed[k][0], avoid[na][1] = (float)placed[k][1],
+                    avoid[na][2] = (float)placed[k][2], avoid[na++][3] = (float)placed[k][3];
+            memcpy(avoid[na++], keep_out, sizeof avoid[0]);
+            memcpy(avoid[na++], readouts, sizeof avoid[0]);
+            leader_line(h, (float)gx + gw * 0.5f, (float)(gy + gh), (float)px[0], (float)px[1], avoid, na);
+            goto draw_group;
+        }
         if (gx < 4) gx = 4;
         if (gy < 4) gy = 4;
         if (keep_out[2] > 0 && gx < keep_out[0] + keep_out[2] && keep_out[0] < gx + gw &&
@@ -271,8 +323,13 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
         placed[nplaced][3] = gh;
         ++nplaced;
 
+        if (many) { // the group and its line in pass 1
+            gpos[i][0] = gx, gpos[i][1] = gy, gok[i] = true, gidx[i] = nplaced - 1;
+            continue;
+        }
         render_hud_line(h, (float)gx + gw * 0.5f, (float)(gy + gh), (float)px[0], (float)px[1],
                         k_dim);
+    draw_group:
         render_hud_rect(h, (float)gx, (float)gy, (float)gw, (float)gh, k_panel);
         char buf[64];
         snprintf(buf, sizeof buf, "%s", c->name[0] ? c->name : "cyl");
