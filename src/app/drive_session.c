@@ -1967,7 +1967,8 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     return code;
 }
 
-int drive_bench(const app_common* c, int w, int h, double seconds) {
+int drive_bench(const app_common* c, int w, int h, double seconds, const char* config, double* fps_mean) {
+    if (fps_mean) *fps_mean = 0;
     drive_opts o = drive_default_opts();
     o.width = w;
     o.height = h;
@@ -1978,7 +1979,7 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
     int code;
     drive_session* s = drive_session_create(c, &o, err, sizeof err, &code);
     if (!s) {
-        printf("{\"config\":\"drive\",\"error\":\"%s\"}\n", err);
+        printf("{\"config\":\"%s\",\"error\":\"%s\"}\n", config, err);
         return code;
     }
     // The same 240 Hz ticks as the window loop. Spinning instead would take
@@ -2010,16 +2011,25 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
     for (int i = skip; i < n; ++i) ms[m++] = st->frame_ms[i];
     app_sort(ms, m);
     double p50 = m ? ms[m / 2] : 0, p95 = m ? ms[(int)(0.95 * (m - 1))] : 0;
-    printf("{\"config\":\"drive\",\"width\":%d,\"height\":%d,\"world\":\"%s\",\"wall_s\":%.3f,"
+    // The model file's name, JSON-safe (a quote, backslash or control
+    // character in it would end the string: '_' instead).
+    char mname[256];
+    const char* base = s->m->file[0] ? s->m->file : s->m->name;
+    if (strrchr(base, '/')) base = strrchr(base, '/') + 1;
+    snprintf(mname, sizeof mname, "%s", base);
+    for (char* q = mname; *q; ++q)
+        if (*q == '"' || *q == '\\' || (unsigned char)*q < 0x20) *q = '_';
+    printf("{\"config\":\"%s\",\"model\":\"%s\",\"width\":%d,\"height\":%d,\"world\":\"%s\",\"wall_s\":%.3f,"
            "\"sim_time_s\":%.3f,\"rt_factor\":%.3f,\"frames\":%ld,\"fps_mean\":%.1f,\"fps_median\":%.1f,"
            "\"fps_p5\":%.1f,\"frame_ms_p50\":%.2f,\"frame_ms_p95\":%.2f,\"missed_deadlines\":%ld,"
            "\"command_rate_hz\":%.1f,\"triangles\":%ld,\"bodies\":%d%s}\n",
-           w, h, world, st->wall_time, st->sim_time,
+           config, mname, w, h, world, st->wall_time, st->sim_time,
            st->wall_time > 0 ? st->sim_time / st->wall_time : 0, st->frames,
            st->wall_time > 0 ? st->frames / st->wall_time : 0, p50 > 0 ? 1e3 / p50 : 0, p95 > 0 ? 1e3 / p95 : 0,
            p50, p95, st->missed, st->wall_time > 0 ? st->input_samples / st->wall_time : 0, st->triangles,
            s->snap->nbody, code ? ",\"error\":\"numerical failure\"" : "");
     fflush(stdout);
+    if (fps_mean && !code && st->wall_time > 0) *fps_mean = st->frames / st->wall_time;
     free(ms);
     drive_session_destroy(s);
     return code;

@@ -251,6 +251,61 @@ static void test_panel_by_function_and_body(void) {
     drive_session_destroy(s);
 }
 
+// The chain's bodies as the renderer gets them: the column, a boom per
+// revolute body, an extension per prismatic one, each extension's drawn
+// section inside its parent's; with ext1 set wider and taller than the end
+// arm it slides in (--set), it is drawn at 85 % of the end arm's section
+// and the extensions it carries (given smaller than ext1's model size)
+// inside that.
+static void test_nested_extensions(void) {
+    app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE;
+    c.sim.world = "sandbox";
+    c.model_path = CHAIN8;
+    c.sets[c.nset++] = "mechanics.bodies[3].width=0.3";  // ext1; the end arm is 0.17 x 0.22
+    c.sets[c.nset++] = "mechanics.bodies[3].height=0.25";
+    drive_opts o = drive_default_opts();
+    o.offscreen = true;
+    o.scripted = true;
+    char err[600];
+    drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
+    CHECK(s != NULL, "session: %s", err);
+    if (!s) return;
+    drive_session_render(s);
+    const model* m = drive_session_model(s);
+    const world_snapshot* snap = drive_session_snapshot(s);
+    int nboom = 0, next = 0;
+    for (int i = 1; i < m->chain.nbody; ++i) {
+        const crane_body* cb = &m->chain.body[i];
+        const world_snap_body *b = NULL, *pb = NULL;
+        for (int k = 0; k < snap->nbody; ++k) {
+            if (!strcmp(snap->body[k].name, cb->def.name)) b = &snap->body[k];
+            if (!strcmp(snap->body[k].name, m->chain.body[cb->def.parent].def.name)) pb = &snap->body[k];
+        }
+        CHECK(b && pb, "%s or its parent not drawn", cb->def.name);
+        if (!b || !pb) continue;
+        const bool ext = cb->def.joint == CHAIN_PRISMATIC;
+        nboom += b->role == WORLD_ROLE_BOOM, next += b->role == WORLD_ROLE_EXTENSION;
+        CHECK(b->role == (ext ? WORLD_ROLE_EXTENSION : WORLD_ROLE_BOOM), "%s: role %d", cb->def.name, (int)b->role);
+        CHECK(b->shape == WORLD_SHAPE_BOX && fabs(b->size[0] - cb->length) < 1e-12, "%s: a box of its length",
+              cb->def.name);
+        if (!ext) continue;
+        CHECK(b->size[1] < pb->size[1] && b->size[2] < pb->size[2], "%s: drawn %.3f x %.3f in %s's %.3f x %.3f",
+              cb->def.name, b->size[1], b->size[2], pb->name, pb->size[1], pb->size[2]);
+        if (i == 3) {
+            CHECK(fabs(b->size[1] - 0.85 * pb->size[1]) < 1e-12 && fabs(b->size[2] - 0.85 * pb->size[2]) < 1e-12 &&
+                      cb->width == 0.3 && cb->height == 0.25,
+                  "ext1 drawn %.4f x %.4f in %.4f x %.4f (model %.2f x %.2f)", b->size[1], b->size[2], pb->size[1],
+                  pb->size[2], cb->width, cb->height);
+        } else {
+            CHECK(b->size[1] == cb->width && b->size[2] == cb->height, "%s: drawn %.3f x %.3f, model %.3f x %.3f",
+                  cb->def.name, b->size[1], b->size[2], cb->width, cb->height);
+        }
+    }
+    CHECK(nboom == 3 && next == 6, "%d booms, %d extensions drawn (3 and 6 in the model)", nboom, next);
+    drive_session_destroy(s);
+}
+
 // loader10 in the window: its record has the chain's columns in its header,
 // and the validation world (no picture of a chain there) is refused in one
 // line before a window opens.
@@ -286,6 +341,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_bar_over_every_cylinder);
     RUN_TEST(test_every_function_charted);
     RUN_TEST(test_panel_by_function_and_body);
+    RUN_TEST(test_nested_extensions);
     RUN_TEST(test_record_and_refusal);
     TEST_MAIN_END();
 }

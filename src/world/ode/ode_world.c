@@ -219,13 +219,13 @@ static const float RGBA_EXT[4] = {0.98f, 0.62f, 0.3f, 1};
 
 /// The drawn section (width, height [m]) of a chain body whose model gives
 /// w x h: as given, except for an extension inside a parent drawn pw x ph
-/// (0: none), which is drawn at most 85 % of it, so the nested section shows
-/// inside its boom (a model that gives an extension as wide as its boom, or
-/// wider, would otherwise be drawn through the boom's walls). Collision
-/// keeps the model's size.
+/// (0: none) that is not smaller than it, which is drawn at 85 % of it, so
+/// the nested section shows inside its boom instead of through its walls
+/// (a model that gives an extension as wide as its boom, or wider).
+/// Collision keeps the model's size.
 static void chain_draw_section(double w, double h, double pw, double ph, double* dw, double* dh) {
-    *dw = pw > 0 && w > 0.85 * pw ? 0.85 * pw : w;
-    *dh = ph > 0 && h > 0.85 * ph ? 0.85 * ph : h;
+    *dw = pw > 0 && w >= pw ? 0.85 * pw : w;
+    *dh = ph > 0 && h >= ph ? 0.85 * ph : h;
 }
 
 // Hinge stop angles (relative to the hinge's zero at build time) from the
