@@ -138,6 +138,7 @@ struct drive_session {
     long rp_next;        // its next tick
     char err[400];
     char status[512];
+    char rec_stop[400];  // why the last rebuild ended the recording ("" if it did not)
     // Remote mode (drive --connect): the snapshot and row come from the server.
     bool remote;
     bool remote_fed;              // a state has arrived
@@ -840,12 +841,14 @@ static void rebuild_world(drive_session* s, bool at_start) {
     // A loaded model may have other columns (a crane chain's): the record
     // holds one header, so it stops there.
     const int ncol_old = s->ncol;
+    s->rec_stop[0] = '\0';
     if (size_buffers(s)) {
         snprintf(s->status, sizeof s->status, "out of memory");
     } else if (s->ncol != ncol_old && s->rec) {
         stop_recording(s);
-        snprintf(s->status + strlen(s->status), sizeof s->status - strlen(s->status),
-                 " (the new model has %d columns, the recording %d)", s->ncol, ncol_old);
+        snprintf(s->rec_stop, sizeof s->rec_stop, "%.300s (the new model has %d columns, the recording %d)", s->status,
+                 s->ncol, ncol_old);
+        snprintf(s->status, sizeof s->status, "%s", s->rec_stop);
     }
     // The same circuit, so the same channels in the same order (the charts
     // keep their indices); the list reads the new engine.
@@ -1089,7 +1092,8 @@ static void load_model(drive_session* s) {
     rebind_charts(s);
     setup_panel(s);
     saved(s); // the panel now edits the loaded file's model
-    snprintf(s->status, sizeof s->status, "loaded %s (%s)", nm->file, nm->name);
+    snprintf(s->status, sizeof s->status, "loaded %.200s (%.96s)%s%.200s", nm->file, nm->name, s->rec_stop[0] ? "; " : "",
+             s->rec_stop);
     panel_set_message(s->pn, s->status);
 }
 
@@ -1967,8 +1971,16 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     return code;
 }
 
-int drive_bench(const app_common* c, int w, int h, double seconds, const char* config, double* fps_mean) {
+// Process CPU time, all threads (llvmpipe's rasterisers too) [s].
+static double process_cpu_s(void) {
+    struct timespec t;
+    return clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t) ? 0.0 : (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+int drive_bench(const app_common* c, int w, int h, double seconds, const char* config, double* fps_mean,
+                double* cpu_ms) {
     if (fps_mean) *fps_mean = 0;
+    if (cpu_ms) *cpu_ms = 0;
     drive_opts o = drive_default_opts();
     o.width = w;
     o.height = h;
@@ -1986,6 +1998,9 @@ int drive_bench(const app_common* c, int w, int h, double seconds, const char* c
     // a core from the driver's rasteriser threads on a small machine.
     const double tick = 1.0 / 240.0;
     const uint64_t f = SDL_GetPerformanceFrequency(), t0 = SDL_GetPerformanceCounter();
+    // CPU per frame does not depend on what else the machine runs (the fps
+    // does): the figure to compare runs by on a loaded machine.
+    const double cpu0 = process_cpu_s();
     code = 0;
     for (;;) {
         double wall = (double)(SDL_GetPerformanceCounter() - t0) / (double)f;
@@ -1998,6 +2013,7 @@ int drive_bench(const app_common* c, int w, int h, double seconds, const char* c
         drive_session_idle(s, wall + tick - next);
     }
     const drive_stats* st = drive_session_stats(s);
+    const double cpu_frame = st->frames > 0 ? 1e3 * (process_cpu_s() - cpu0) / (double)st->frames : 0.0;
     // The world the engine was built on (c->sim.world, the sandbox when
     // none is named), and the bodies of its last snapshot, so a reader can
     // tell the worlds apart by what ran, not only by name.
@@ -2022,14 +2038,15 @@ int drive_bench(const app_common* c, int w, int h, double seconds, const char* c
     printf("{\"config\":\"%s\",\"model\":\"%s\",\"width\":%d,\"height\":%d,\"world\":\"%s\",\"wall_s\":%.3f,"
            "\"sim_time_s\":%.3f,\"rt_factor\":%.3f,\"frames\":%ld,\"fps_mean\":%.1f,\"fps_median\":%.1f,"
            "\"fps_p5\":%.1f,\"frame_ms_p50\":%.2f,\"frame_ms_p95\":%.2f,\"missed_deadlines\":%ld,"
-           "\"command_rate_hz\":%.1f,\"triangles\":%ld,\"bodies\":%d%s}\n",
+           "\"command_rate_hz\":%.1f,\"cpu_ms_per_frame\":%.1f,\"triangles\":%ld,\"bodies\":%d%s}\n",
            config, mname, w, h, world, st->wall_time, st->sim_time,
            st->wall_time > 0 ? st->sim_time / st->wall_time : 0, st->frames,
            st->wall_time > 0 ? st->frames / st->wall_time : 0, p50 > 0 ? 1e3 / p50 : 0, p95 > 0 ? 1e3 / p95 : 0,
-           p50, p95, st->missed, st->wall_time > 0 ? st->input_samples / st->wall_time : 0, st->triangles,
+           p50, p95, st->missed, st->wall_time > 0 ? st->input_samples / st->wall_time : 0, cpu_frame, st->triangles,
            s->snap->nbody, code ? ",\"error\":\"numerical failure\"" : "");
     fflush(stdout);
     if (fps_mean && !code && st->wall_time > 0) *fps_mean = st->frames / st->wall_time;
+    if (cpu_ms && !code) *cpu_ms = cpu_frame;
     free(ms);
     drive_session_destroy(s);
     return code;

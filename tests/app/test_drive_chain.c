@@ -306,6 +306,53 @@ static void test_nested_extensions(void) {
     drive_session_destroy(s);
 }
 
+// "load model" from the default crane to loader10 and back, in one window:
+// the engine, its channels, the default charts (by the new cylinders) and
+// the panel follow the model; a recording of the old columns ends there.
+static void test_load_chain_in_panel(void) {
+    const char* rec = "drive_chain_switch.csv";
+    app_common c = {.sim = sim_default_opts()};
+    c.sim.mechanics = SIM_ODE;
+    c.sim.world = "sandbox";
+    drive_opts o = drive_default_opts();
+    o.offscreen = true;
+    o.scripted = true;
+    o.record_path = rec;
+    char err[600];
+    drive_session* s = drive_session_create(&c, &o, err, sizeof err, NULL);
+    CHECK(s != NULL, "session: %s", err);
+    if (!s) return;
+    double wall = 0;
+    run_for(s, &wall, 0.2);
+    render* r = drive_session_render_ctx(s);
+    CHECK(render_chart_count(r) == 12 && !strcmp(render_chart_label(r, 0), "p1A"), "%d charts, first %s",
+          render_chart_count(r), render_chart_label(r, 0));
+    panel* pn = drive_session_panel(s);
+    CHECK(panel_set_text(pn, "model file", LOADER10) && panel_run_action(pn, "load model"), "no model file box");
+    CHECK(run_for(s, &wall, 0.3) == 0, "drive after the load: %s", drive_session_error(s));
+    const model* m = drive_session_model(s);
+    CHECK(!m->chain.two_link && strstr(m->file, "loader10.json"), "model now %s", m->file);
+    CHECK(chan_list_find(drive_session_channels(s), "x_ext2") > 0, "no x_ext2 after the load");
+    const world_snapshot* snap = drive_session_snapshot(s);
+    CHECK(snap->ncyl == 5 && render_chart_count(r) == 20 && !strcmp(render_chart_label(r, 0), "pA lift"),
+          "%d cylinders, %d charts, first %s", snap->ncyl, render_chart_count(r), render_chart_label(r, 0));
+    pn = drive_session_panel(s);
+    CHECK(panel_find(pn, "ext: ext2_cyl (cylinder)/bore") >= 0, "no ext2 bore in the new panel");
+    CHECK(strstr(panel_message(pn), "recording stopped: drive_chain_switch.csv") &&
+              strstr(panel_message(pn), "the new model has"),
+          "panel says: %s", panel_message(pn));
+    long rows = 0;
+    CHECK(drive_session_finish_record(s, &rows, err, sizeof err) == 0 && rows > 0, "record: %s", err);
+    CHECK(panel_set_text(pn, "model file", CRANESIM_ASSETS "/models/hiab031.json") && panel_run_action(pn, "load model"),
+          "no model file box");
+    CHECK(run_for(s, &wall, 0.3) == 0, "drive after loading back: %s", drive_session_error(s));
+    CHECK(drive_session_model(s)->chain.two_link && render_chart_count(r) == 12 &&
+              !strcmp(render_chart_label(r, 0), "p1A"),
+          "back: %d charts, first %s", render_chart_count(r), render_chart_label(r, 0));
+    drive_session_destroy(s);
+    remove(rec);
+}
+
 // loader10 in the window: its record has the chain's columns in its header,
 // and the validation world (no picture of a chain there) is refused in one
 // line before a window opens.
@@ -342,6 +389,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_every_function_charted);
     RUN_TEST(test_panel_by_function_and_body);
     RUN_TEST(test_nested_extensions);
+    RUN_TEST(test_load_chain_in_panel);
     RUN_TEST(test_record_and_refusal);
     TEST_MAIN_END();
 }
