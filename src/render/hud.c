@@ -298,8 +298,9 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
         if (many) {
             // Many groups (a crane chain's cylinders along its booms): one
             // that overlaps another, the readouts or the warnings, or runs
-            // off the right edge, takes the first free place in rows of
-            // groups from the top, right of the readouts box.
+            // off the right edge, takes the first free place right of the
+            // readouts box at its height, else under that box, else in rows
+            // of groups from the top right of the box (clear of the charts).
             bool clash = gx + gw > h->w - 4 || overlaps(gx, gy, gw, gh, readouts) || overlaps(gx, gy, gw, gh, keep_out);
             for (int k = 0; k < nplaced && !clash; ++k) {
                 const float b[4] = {(float)placed[k][0] - 6, (float)placed[k][1], (float)placed[k][2] + 12,
@@ -307,9 +308,13 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
                 clash = overlaps(gx, gy, gw, gh, b);
             }
             const int x0 = readouts[2] > 0 ? (int)(readouts[0] + readouts[2]) + 8 : 4;
-            for (int row = 0; clash && row < 4; ++row)
-                for (int x = x0; clash && x + gw <= h->w - 4; x += gw + 8) {
-                    const int y = 4 + row * (gh + 8);
+            // Nearest first: beside the readouts at its own height, then
+            // under them above the cylinder; then the rows from the top.
+            const int near[2][2] = {{x0, gy}, {gx, readouts[2] > 0 ? (int)(readouts[1] + readouts[3]) + 8 : gy}};
+            for (int row = -2; clash && row < 4; ++row)
+                for (int x = row < 0 ? near[row + 2][0] : x0; clash && x + gw <= h->w - 4; x += gw + 8) {
+                    const int y = row < 0 ? near[row + 2][1] : 4 + row * (gh + 8);
+                    if (y < 4 || y + gh > h->h - 150) break; // not over the strip charts at the bottom
                     clash = overlaps(x, y, gw, gh, readouts) || overlaps(x, y, gw, gh, keep_out);
                     for (int k = 0; k < nplaced && !clash; ++k) {
                         const float b[4] = {(float)placed[k][0] - 6, (float)placed[k][1], (float)placed[k][2] + 12,
