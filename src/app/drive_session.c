@@ -31,7 +31,11 @@ typedef enum param_kind {
     PK_SOLVER, ///< hydraulic integrator, an index into k_solver (a rebuilt world/solver at the current pose)
     PK_STEP,   ///< hydraulic step [s] (rebuilt likewise)
     PK_CHAIN,  ///< a crane chain's body or actuator field (chain_field): the model rebuilt from its document
+    PK_CHART,  ///< a strip-chart slot (mech: 0..DRIVE_CHART_SLOTS-1): an index into the session's chart_opt
 } param_kind;
+
+/// The panel's strip-chart slots, as many as --charts takes.
+#define DRIVE_CHART_SLOTS 8
 
 // The fields of a crane chain the panel shows (a chain model's mechanics;
 // the two-link crane's are the mechanics table's, PK_MECH).
@@ -125,6 +129,9 @@ struct drive_session {
     double readout_scale[8]; // shown = value / scale
     char readout_unit[8][16];
     char readout_name[8][96];
+    char** chart_opt;    // (nchart_opt) the panel's chart choices: "(default)", then every channel's name
+    int nchart_opt;
+    char chart_pick[DRIVE_CHART_SLOTS][96]; // the channel each chart slot shows ("" none)
     int nchart;          // user-chosen strip-chart channels (0: the default set)
     int chart_col[8];    // their channels (index into chans)
     int chart_id[8];     // their render chart ids
@@ -419,6 +426,19 @@ static void build_params(drive_session* s) {
     drive_param* p = add_param(s, PK_SOLVER, "solver", "method", "-", 0, NSOLVER - 1, 0, NSOLVER - 1, method);
     if (p) p->scale = 1, p->unit[0] = 0;
     add_param(s, PK_STEP, "solver", "step", "s", 0.05e-3, 1e-3, 0.05e-3, 1e-3, s->c.sim.h);
+    // The strip charts: a slot per chart, each a choice among the engine's
+    // channels by name (a crane chain's every actuator and function too),
+    // "(default)" for none; all "(default)": the default set.
+    for (int k = 0; k < DRIVE_CHART_SLOTS && s->nchart_opt > 0; ++k) {
+        int pick = 0;
+        for (int j = 1; j < s->nchart_opt && s->chart_pick[k][0] && !pick; ++j)
+            if (!strcmp(s->chart_opt[j], s->chart_pick[k])) pick = j;
+        char label[16];
+        snprintf(label, sizeof label, "chart %d", k + 1);
+        drive_param* q = add_param(s, PK_CHART, "charts", label, "-", 0, s->nchart_opt - 1, 0, s->nchart_opt - 1, pick);
+        if (!q) return;
+        q->scale = 1, q->unit[0] = 0, q->mech = k;
+    }
     // What cannot change in place rebuilds the world (loads back at their
     // start): applied once when the drag or the typing ends, not at every
     // pixel. A link's mass, inertia and centre of mass go to engine_set_link
@@ -613,6 +633,7 @@ static void follow_fluid(drive_session* s, drive_param* p, double si) {
 static void rebuild_world(drive_session* s, bool at_start);
 static void rebind_charts(drive_session* s);
 static void take_snapshot(drive_session* s);
+static void apply_chart_picks(drive_session* s);
 
 // A crane chain's body or actuator field set to si [SI]: the model is built
 // again from its document with the new value (so the chain, its columns and
@@ -694,6 +715,13 @@ static int apply_chain(drive_session* s, drive_param* p, double si) {
 // circuit rejected it (the panel shows the old value again).
 static int apply_param(drive_session* s, int i) {
     drive_param* p = &s->param[i];
+    if (p->kind == PK_CHART) { // the window's own charts, local and remote alike
+        const int k = (int)p->value;
+        snprintf(s->chart_pick[p->mech], sizeof s->chart_pick[0], "%s",
+                 k > 0 && k < s->nchart_opt ? s->chart_opt[k] : "");
+        apply_chart_picks(s);
+        return 0;
+    }
     if (s->remote) {
         remote_param(s, p); // set on the server, not in this drive's model
         return 0;
@@ -752,6 +780,8 @@ static int apply_param(drive_session* s, int i) {
         refresh_mech_params(s);
         break;
     }
+    case PK_CHART: // applied above
+        return 0;
     case PK_CHAIN:
         if (apply_chain(s, p, si)) return -1; // the status line says why
         note_unsaved(s, p);
@@ -993,6 +1023,13 @@ static void act_reset(void* user);
 static void act_save(void* user);
 static void act_pause(void* user);
 
+static void free_chart_opt(drive_session* s) {
+    for (int k = 0; k < s->nchart_opt; ++k) free(s->chart_opt[k]);
+    free(s->chart_opt);
+    s->chart_opt = NULL;
+    s->nchart_opt = 0;
+}
+
 // The panel for the model and engine as they are: generated entries, the
 // model file box and the actions. Replaces the old panel (a loaded model has
 // other components); the window stays shown or hidden as it was.
@@ -1004,16 +1041,28 @@ static int setup_panel(drive_session* s) {
         render_attach_panel(s->r, NULL);
         panel_destroy(s->pn);
     }
+    // The chart choices of the engine's channels (they outlive the panel:
+    // freed only once it is gone).
+    free_chart_opt(s);
+    const int nch = s->chans ? chan_list_count(s->chans) : 0;
+    s->chart_opt = calloc((size_t)nch + 1, sizeof *s->chart_opt);
+    if (s->chart_opt) {
+        s->chart_opt[s->nchart_opt++] = strdup("(default)");
+        for (int k = 1; k < nch; ++k) // not t
+            if ((s->chart_opt[s->nchart_opt] = strdup(chan_list_channel(s->chans, k)->name))) ++s->nchart_opt;
+    }
     s->pn = panel_create();
     if (!s->pn) return -1;
     build_params(s);
     for (int i = 0; i < s->nparam; ++i) {
         drive_param* p = &s->param[i];
         panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0, p->on_release};
-        s->pid[i] = p->kind == PK_SOLVER
-                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
+        s->pid[i] = p->kind == PK_SOLVER ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
+                    : p->kind == PK_CHART
+                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, (const char* const*)s->chart_opt,
+                                           s->nchart_opt)
                         : panel_add_param(s->pn, &d);
-        if (p->kind != PK_SOLVER) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
+        if (p->kind != PK_SOLVER && p->kind != PK_CHART) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
         if (p->inherit[0]) panel_set_note(s->pn, s->pid[i], "fluid's");
     }
     panel_add_text(s->pn, "model file", s->load_path, sizeof s->load_path);
@@ -1034,6 +1083,33 @@ static int setup_panel(drive_session* s) {
 static void default_charts(drive_session* s) {
     if (s->m->chain.two_link) render_charts_default(s->r, s->snap->ncyl);
     else render_charts_default_named(s->r, s->snap);
+}
+
+static int setup_charts(drive_session* s, const char* list, char* err, size_t errsz);
+
+// The charts the panel's slots name, in slot order; none: the default set.
+static void apply_chart_picks(drive_session* s) {
+    char list[DRIVE_CHART_SLOTS * 97] = "", err[400];
+    size_t n = 0;
+    for (int k = 0; k < DRIVE_CHART_SLOTS; ++k)
+        if (s->chart_pick[k][0] && n < sizeof list)
+            n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", n ? "," : "", s->chart_pick[k]);
+    render_charts_reset(s->r);
+    s->nchart = 0;
+    s->chart_circuit = false;
+    for (int i = 0; i < s->nreadout; ++i) // the readouts keep theirs
+        if (s->readout_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
+    if (!list[0] || setup_charts(s, list, err, sizeof err)) {
+        if (list[0]) say(s, err); // a name the channels lost (not from the panel's list)
+        render_charts_reset(s->r);
+        s->nchart = 0;
+        default_charts(s);
+        if (!list[0]) say(s, "charts: the default set");
+        return;
+    }
+    char t[sizeof s->status];
+    snprintf(t, sizeof t, "charts: %.500s", list);
+    say(s, t);
 }
 
 // Charts on channels by name again, in a list that may have changed (a
@@ -1382,6 +1458,17 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     }
     s->in = input_create(&map);
     snprintf(s->load_path, sizeof s->load_path, "%s", s->m->file);
+    // The chart slots of the panel show --charts' channels.
+    for (const char* q = o->charts; q && *q;) {
+        const char* e = strchr(q, ',');
+        const size_t len = e ? (size_t)(e - q) : strlen(q);
+        for (int k = 0; k < DRIVE_CHART_SLOTS; ++k)
+            if (!s->chart_pick[k][0]) {
+                snprintf(s->chart_pick[k], sizeof s->chart_pick[k], "%.*s", (int)len, q);
+                break;
+            }
+        q = e ? e + 1 : q + len;
+    }
     // The panel starts hidden (Tab shows it): on llvmpipe it costs ~4 fps at
     // 1280x720 (56 vs 60 fps, cranesim bench --config drive), and the scene
     // is what an operator watches while driving.
@@ -1458,6 +1545,7 @@ void drive_session_destroy(drive_session* s) {
     free(s->changed);
     free(s->row);
     free(s->ufn);
+    free_chart_opt(s); // after the panel, which pointed at them
     free(s->snap);
     free(s);
 }

@@ -176,6 +176,43 @@ static void test_every_function_charted(void) {
           "%d charts", render_chart_count(r));
     double wall = 0;
     CHECK(run_for(s, &wall, 0.2) == 0, "drive: %s", drive_session_error(s));
+    // The panel's chart slots: every channel of the session by name, the
+    // --charts ones chosen; a slot set to another channel, then every slot
+    // back to "(default)", gives those charts.
+    panel* pn = drive_session_panel(s);
+    const chan_list* ch = drive_session_channels(s);
+    const int slot1 = panel_find(pn, "charts/chart 1"), slot5 = panel_find(pn, "charts/chart 5");
+    CHECK(slot1 >= 0 && slot5 >= 0 && panel_choice_count(pn, slot1) == chan_list_count(ch) &&
+              !strcmp(panel_choice_label(pn, slot1, (int)panel_get(pn, slot1)), "x_jib_ext3") &&
+              panel_get(pn, slot5) == 0,
+          "chart slots: %d options for %d channels", slot1 >= 0 ? panel_choice_count(pn, slot1) : -1,
+          chan_list_count(ch));
+    int want = -1;
+    for (int k = 0; slot1 >= 0 && k < panel_choice_count(pn, slot1); ++k)
+        if (!strcmp(panel_choice_label(pn, slot1, k), "u_jib_ext1")) want = k;
+    // Every function's spool and every actuator's stroke among them.
+    const model* m2 = drive_session_model(s);
+    for (int f = 0; f < m2->chain.nfn + m2->chain.nact; ++f) {
+        char nm[96];
+        if (f < m2->chain.nfn) snprintf(nm, sizeof nm, "u_%s", m2->chain.fn[f].name);
+        else snprintf(nm, sizeof nm, "x_%s", m2->chain.act[f - m2->chain.nfn].name);
+        bool found = false;
+        for (int k = 0; slot1 >= 0 && k < panel_choice_count(pn, slot1) && !found; ++k)
+            found = !strcmp(panel_choice_label(pn, slot1, k), nm);
+        CHECK(found, "%s not among the chart choices", nm);
+    }
+    CHECK(want > 0 && panel_set_id(pn, slot1, want, NULL, 0) == PANEL_OK, "u_jib_ext1 among the chart choices");
+    run_for(s, &wall, 0.05);
+    CHECK(render_chart_count(r) == 4 && !strcmp(render_chart_label(r, 0), "u_jib_ext1"), "%d charts, first %s",
+          render_chart_count(r), render_chart_label(r, 0));
+    for (int k = 1; k <= 8; ++k) {
+        char key[32];
+        snprintf(key, sizeof key, "charts/chart %d", k);
+        panel_set_id(pn, panel_find(pn, key), 0, NULL, 0);
+    }
+    run_for(s, &wall, 0.05);
+    CHECK(render_chart_count(r) == 4 * drive_session_snapshot(s)->ncyl, "%d charts back to the default set",
+          render_chart_count(r));
     drive_session_destroy(s);
 }
 
