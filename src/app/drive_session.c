@@ -13,7 +13,6 @@
 #include "channels.h"
 #include "input.h"
 #include "json_util.h"
-#include "model_chain.h"
 #include "panel.h"
 #include "protocol.h"
 #include "render.h"
@@ -303,9 +302,17 @@ static double chain_value(const model* m, int i, chain_field f) {
     return f == CF_MASS ? b->def.mass : f == CF_LENGTH ? b->length : f == CF_WIDTH ? b->width : b->height;
 }
 
-static void add_chain_param(drive_session* s, const char* group, const char* label, const json_range* r, int i,
+// like: the two-link mechanics table's entry whose range a chain field
+// shares (the loader checks a chain's bodies against the same ranges):
+// "mechanics.links[0].mass", "mechanics.column.height", ...
+static void add_chain_param(drive_session* s, const char* group, const char* label, const char* like, int i,
                             chain_field f, const char* json) {
-    drive_param* p = add_param(s, PK_CHAIN, group, label, r->unit, r->lo, r->hi, r->tlo, r->thi,
+    model_param r = {.unit = "-", .lo = 0, .hi = INFINITY, .tlo = 0, .thi = 1};
+    for (int k = 0; k < model_param_count(); ++k) {
+        model_param mp;
+        if (!model_param_info(k, &mp) && !strcmp(mp.path, like)) r = mp;
+    }
+    drive_param* p = add_param(s, PK_CHAIN, group, label, r.unit, r.lo, r.hi, r.tlo, r.thi,
                                chain_value(s->m, i, f));
     if (!p) return;
     p->mech = i;
@@ -346,7 +353,7 @@ static void chain_functions(drive_session* s, const hyd_model* live, bool* done)
             char group[112], json[96];
             snprintf(group, sizeof group, "%s: %s (actuator)", fn, a->name);
             snprintf(json, sizeof json, "mechanics.actuators[%d].closed_length", k);
-            add_chain_param(s, group, "closed length", &MODEL_R_CLOSED_LENGTH, k, CF_CLOSED, json);
+            add_chain_param(s, group, "closed length", "mechanics.actuators[0].closed_length", k, CF_CLOSED, json);
         }
     }
 }
@@ -359,15 +366,15 @@ static void chain_bodies(drive_session* s) {
         snprintf(group, sizeof group, "%s (%s)", b->def.name,
                  i == 0 ? "column" : b->def.joint == CHAIN_PRISMATIC ? "extension" : "boom");
         snprintf(json, sizeof json, "mechanics.bodies[%d].mass", i);
-        add_chain_param(s, group, "mass", i ? &MODEL_R_LINK_MASS : &MODEL_R_COLUMN_MASS, i, CF_MASS, json);
+        add_chain_param(s, group, "mass", i ? "mechanics.links[0].mass" : "mechanics.column.mass", i, CF_MASS, json);
         snprintf(json, sizeof json, "mechanics.bodies[%d].%s", i, i ? "length" : "height");
-        add_chain_param(s, group, i ? "length" : "height", i ? &MODEL_R_LINK_LENGTH : &MODEL_R_COLUMN_HEIGHT, i,
-                        CF_LENGTH, json);
+        add_chain_param(s, group, i ? "length" : "height",
+                        i ? "mechanics.links[0].length" : "mechanics.column.height", i, CF_LENGTH, json);
         if (i == 0) continue; // the column's section is its radius, drawn and collided as the slew's
         snprintf(json, sizeof json, "mechanics.bodies[%d].width", i);
-        add_chain_param(s, group, "width", &MODEL_R_LINK_SECTION, i, CF_WIDTH, json);
+        add_chain_param(s, group, "width", "mechanics.links[0].width", i, CF_WIDTH, json);
         snprintf(json, sizeof json, "mechanics.bodies[%d].height", i);
-        add_chain_param(s, group, "height", &MODEL_R_LINK_SECTION, i, CF_HEIGHT, json);
+        add_chain_param(s, group, "height", "mechanics.links[0].height", i, CF_HEIGHT, json);
     }
 }
 
