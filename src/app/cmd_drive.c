@@ -707,6 +707,19 @@ int cmd_drive(int argc, char** argv) {
     // A window when there is a display; an offscreen view when only a
     // screenshot is wanted; else the headless loop below.
     if (!headless && (display || shot)) {
+        // A limiter asked for by name that the engine for this model does
+        // not have (a crane chain's, until it has one) is refused, as the
+        // headless drive refuses it; on by default, the window goes without.
+        if (rcl_given && c.sim.rcl) {
+            char me[400];
+            model* rm = model_load(c.model_path, c.sets, c.nset, me, sizeof me);
+            const int miss = rm && engine_require(rm, &c.sim, ENGINE_CAP_LIMITER, "--rcl on", err, sizeof err);
+            model_free(rm);
+            if (miss) {
+                fprintf(stderr, "cranesim drive: %s\n", err);
+                return EXIT_USAGE;
+            }
+        }
         o.offscreen = !display;
         o.scripted = scripted || o.offscreen;
         char nowin[512];
