@@ -38,6 +38,39 @@ SLEW_RANGE_DEG = 400.0 # slew range, rack and pinion
 PINION_R = 0.12        # [m]
 
 
+def linkage_length(bodies, a, q):
+    """The cylinder length [m] of actuator a through its linkage at the
+    knuckle angle q [rad] (the loop in the parent's (x, z); src/world/
+    mechanism/linkage.c solves the same), or None where it cannot close."""
+    k = a["linkage"]
+    b = next(x for x in bodies if x["name"] == k["body"])
+    J, th = (b["origin"][0], b["origin"][2]), b.get("angle0", 0.0) + q
+    c, A, B = k["rocker_pin"], k["link_pin"], a["base"]["point"]
+    C = (J[0] + math.cos(th) * c[0] - math.sin(th) * c[2], J[1] + math.sin(th) * c[0] + math.cos(th) * c[2])
+    dx, dz = C[0] - A[0], C[1] - A[2]
+    D = math.hypot(dx, dz)
+    l1, l2 = k["link_len"], k["rocker_len"]
+    f = (l1 * l1 - l2 * l2 + D * D) / (2 * D)
+    if l1 * l1 - f * f <= 0:
+        return None
+    h = k["branch"] * math.sqrt(l1 * l1 - f * f)
+    P = (A[0] + (f * dx - h * dz) / D, A[2] + (f * dz + h * dx) / D)
+    return math.dist(P, (B[0], B[2]))
+
+
+_direct_length = mcm.local_pin_length
+
+
+def local_pin_length(bodies, a, child, qj):
+    """mcm.local_pin_length, through the linkage for an actuator with one."""
+    if "linkage" in a:
+        return linkage_length(bodies, a, qj)
+    return _direct_length(bodies, a, child, qj)
+
+
+mcm.local_pin_length = local_pin_length
+
+
 def lmin(q):
     """L/min to m^3/s."""
     return round(q / 60000.0, 8)
@@ -51,11 +84,11 @@ def bodies_and_actuators():
         {"name": "lifting_arm", "joint": "revolute", "origin": [0, 0, 1.9], "angle0": -0.5 * math.pi,
          "length": 2.9, "mass": 260.0, "com": [1.45, 0, 0], "width": 0.2, "height": 0.28,
          "limits": [1.23, 2.78]},
-        # Knuckle (outer) arm, the housing of the extensions: -126..-26 deg,
-        # what one direct cylinder covers with a closed length over its stroke
-        # + 0.25 m (docs/model.md; the linkage of item 2 widens it).
+        # Knuckle (outer) arm, the housing of the extensions: -149..-11 deg
+        # through the jib cylinder's four-bar linkage (a direct cylinder
+        # covered -126..-26 deg; docs/model.md).
         {"name": "knuckle_arm", "joint": "revolute", "origin": [2.9, 0, 0], "length": 2.3, "mass": 170.0,
-         "com": [1.1, 0, 0], "width": 0.17, "height": 0.24, "limits": [-2.2, -0.45]},
+         "com": [1.1, 0, 0], "width": 0.17, "height": 0.24, "limits": [-2.6, -0.2]},
         # Two extensions, 1.3 m each, nested: flush-ish with the housing's
         # tip when retracted (offset0 + length = housing length - 0.2 m).
         {"name": "ext1", "joint": "prismatic", "parent": "knuckle_arm", "offset0": 0.3, "length": 2.0,
@@ -68,11 +101,13 @@ def bodies_and_actuators():
         {"name": "lift", "cylinder": "lift_cyl", "valve": "lift_valve",
          "base": {"body": "column", "point": [0.32, 0, 1.2]},
          "rod": {"body": "lifting_arm", "point": [1.85, 0, -0.25]}},
-        # Direct jib cylinder for now (the four-bar linkage comes with
-        # issue 27 item 2).
+        # The jib cylinder through a four-bar linkage (docs/model.md): its rod
+        # pushes the common pin of a link (0.70 m, pinned on the lifting
+        # arm's tip) and a rocker (0.45 m, pinned on the knuckle arm).
         {"name": "jib", "cylinder": "jib_cyl", "valve": "jib_valve",
-         "base": {"body": "lifting_arm", "point": [1.2, 0, 0.15]},
-         "rod": {"body": "knuckle_arm", "point": [0.45, 0, -0.28]}},
+         "base": {"body": "lifting_arm", "point": [0.9, 0, 0.3]},
+         "linkage": {"body": "knuckle_arm", "link_pin": [2.8, 0, 0.27], "rocker_pin": [0.39, 0, 0.07],
+                     "link_len": 0.7, "rocker_len": 0.45, "branch": -1, "link_mass": 17.0, "rocker_mass": 14.0}},
         # One cylinder per stage, inside the booms, both on the ext section.
         {"name": "ext1", "cylinder": "ext1_cyl", "valve": "ext_valve",
          "base": {"body": "knuckle_arm", "point": [0.25, 0, 0.03]},
@@ -193,7 +228,15 @@ def main():
         ls = json.load(f)
     bodies, acts = bodies_and_actuators()
     tip_body, tip = 4, [1.8, 0, 0]
+    # The sizing names the knuckle as a linkage cylinder's "rod" body (its
+    # lengths come from local_pin_length above); the file has no rod there.
+    for a in acts:
+        if "linkage" in a:
+            a["rod"] = {"body": a["linkage"]["body"], "point": [0, 0, 0]}
     sizes = mcm.size_cylinders(bodies, acts, tip_body, tip, SIZING_LOAD)
+    for a in acts:
+        if "linkage" in a:
+            del a["rod"]
     # size_cylinders sized at the hiab031 pump's 20 MPa; re-pick each bore
     # at this crane's cut-off (the same 70 % rule).
     for a in acts:
@@ -211,7 +254,7 @@ def main():
     doc = {
         "name": "loader10: 10 t m knuckle-boom crane, two extensions, load sensing (estimated, docs/model.md)",
         "description": "Second shipped crane (scripts/make_loader10.py): slewing column (rack and pinion, 400 deg), "
-                       "lifting arm, knuckle arm with a direct jib cylinder, two telescopic extensions with a cylinder "
+                       "lifting arm, knuckle arm with the jib cylinder through a four-bar linkage, two telescopic extensions with a cylinder "
                        "each on one valve section; LS pump 40 L/min, 25 MPa cut-off, a post-compensated section each "
                        "for lift, jib, ext and slew, counterbalance valves on lift and jib. Figures and their sources: "
                        "docs/model.md, 'The second crane: loader10'.",

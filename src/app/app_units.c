@@ -4,6 +4,7 @@
 // objective and sweep's plots use these helpers, so a value typed in the
 // summary's unit means what it says and a plot axis reads like the summary.
 #include "app.h"
+#include "app_design_metrics.h"
 #include "metrics.h"
 
 #include <math.h>
@@ -31,9 +32,10 @@ static const dim_def k_dims[] = {
     {"N", "kN", {{"kN", 1e3}, {"N", 1.0}, {"MN", 1e6}, {NULL, 0}}},
 };
 
-// The dimension of a metric, or NULL for a unitless one (count, "-").
+// The dimension of a metric, or NULL for a unitless one (count, "-"); a
+// chain's per actuator too (app_design_metrics.h).
 static const dim_def* dim_of(int met) {
-    const char* u = metric_unit((metric_id)met);
+    const char* u = app_design_metric_unit(met);
     for (size_t k = 0; k < sizeof k_dims / sizeof k_dims[0]; ++k)
         if (!strcmp(k_dims[k].si, u)) return &k_dims[k];
     return NULL;
@@ -54,7 +56,7 @@ static void unit_list(const dim_def* d, char* buf, size_t n) {
 
 const char* app_metric_disp_unit(int met) {
     const dim_def* d = dim_of(met);
-    return d ? d->display : metric_unit((metric_id)met);
+    return d ? d->display : app_design_metric_unit(met);
 }
 
 double app_metric_disp_scale(int met) {
@@ -63,7 +65,7 @@ double app_metric_disp_scale(int met) {
 }
 
 const char* app_metric_label(int met, char* buf, size_t n) {
-    snprintf(buf, n, "%s [%s]", metric_name((metric_id)met), app_metric_disp_unit(met));
+    snprintf(buf, n, "%s [%s]", app_design_metric_name(met), app_metric_disp_unit(met));
     return buf;
 }
 
@@ -73,7 +75,7 @@ int app_metric_unit_scale(int met, const char* unit, double* si, char* err, size
     if (!u) {
         char list[96];
         if (d) unit_list(d, list, sizeof list);
-        snprintf(err, errsz, "%s: unit '%s' is not one of %s", metric_name((metric_id)met), unit,
+        snprintf(err, errsz, "%s: unit '%s' is not one of %s", app_design_metric_name(met), unit,
                  d ? list : "(none: the metric is a plain number)");
         return -1;
     }
@@ -83,7 +85,7 @@ int app_metric_unit_scale(int met, const char* unit, double* si, char* err, size
 
 int app_metric_parse_value(int met, const char* text, double* si, char* err, size_t errsz) {
     const dim_def* d = dim_of(met);
-    const char* name = metric_name((metric_id)met);
+    const char* name = app_design_metric_name(met);
     char* end;
     const double v = strtod(text, &end);
     if (end == text || !isfinite(v)) {
@@ -93,7 +95,7 @@ int app_metric_parse_value(int met, const char* text, double* si, char* err, siz
     while (*end == ' ') ++end; // "24 MPa" as well as "24MPa"
     if (!d) {
         if (*end) {
-            snprintf(err, errsz, "%s is a plain number (%s), got the unit '%s'", name, metric_unit((metric_id)met),
+            snprintf(err, errsz, "%s is a plain number (%s), got the unit '%s'", name, app_design_metric_unit(met),
                      end);
             return -1;
         }

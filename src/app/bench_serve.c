@@ -233,7 +233,7 @@ int bench_serve(const app_common* c, double duration, bool realtime) {
         // A new command once the last one came back (one in flight: its
         // latency is not queued behind the previous ones).
         if (pf[0].revents && echoed == seq && seq < BS_MAXLAT) {
-            proto_command cmd = {.seq = ++seq, .op = PROTO_OP_VALVES,
+            proto_command cmd = {.seq = ++seq, .op = PROTO_OP_VALVES, .nu = 3,
                                  .u = {0.5 * sin(now - w0), 0.5 * cos(now - w0), 0.3 * sin(0.5 * (now - w0))}};
             uint8_t b[128];
             size_t n = proto_put_command(b, sizeof b, &cmd);

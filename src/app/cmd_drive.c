@@ -242,13 +242,12 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         m = fm;
     }
     double m3 = sim_load_mass(m, &sc, &c->sim);
-    // A crane chain drives headless by function; what is still two-link
-    // shaped is refused before anything starts: session files (issue 27)
-    // and a limiter asked for by name (rcl.h refuses chains; on by default,
+    // A crane chain drives headless by function, and its session records
+    // the commands by function (session.h); a limiter asked for by name is
+    // refused before anything starts (rcl.h refuses chains; on by default,
     // it is then off with a note below).
     engine* l = NULL;
-    if (session_path && engine_require(m, &c->sim, ENGINE_CAP_TWO_LINK, "--session", err, sizeof err)) {
-    } else if (rcl_given && c->sim.rcl &&
+    if (rcl_given && c->sim.rcl &&
                engine_require(m, &c->sim, ENGINE_CAP_LIMITER, "--rcl on", err, sizeof err)) {
     } else {
         l = engine_create(m, &c->sim, sc.q0, sc.slew0, m3, err, sizeof err);
@@ -278,7 +277,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (session_path) {
         char sbuf[512];
         const char* sp = app_scenario_path(c->scenario_path, sbuf, sizeof sbuf);
-        const int so = session_writer_open(&sw, session_path, doc0, m->file, &c->sim, sc.nfault ? sp : NULL, sc.q0,
+        const int so = session_writer_open(&sw, session_path, doc0, m->file, l, &c->sim, sc.nfault ? sp : NULL, sc.q0,
                                            sc.slew0, m3, false, ncol, err, sizeof err);
         cJSON_Delete(doc0);
         if (so) {
@@ -295,7 +294,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     const bool loads = sandbox && engine_load_name(l, 0, NULL) != NULL;
     drive_world dw = {.hook = sandbox, .held = -1, .sess = session_path ? &sw : NULL};
     int wr = 0; // errno of the first failed write to the record
-    const bool two_link = engine_caps(l) & ENGINE_CAP_TWO_LINK, limiter = engine_caps(l) & ENGINE_CAP_LIMITER;
+    const bool two_link = engine_caps(l) & ENGINE_CAP_TWO_LINK, limiter = engine_rcl(l) != NULL;
     const int nfn = engine_nfunction(l);
     if (f && two_link) sim_csv_header(f, ncol);
     else if (f) write_header(f, l);
@@ -314,9 +313,14 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     double w0 = sim_wall_time(), busy = 0, worst = 0;
     int missed = 0, code = 0, ev = 0, frames_done = 0;
     double rcl_max = 0, rcl_t90 = 0; // the limiter's utilisation [-] and the time at or above 90 % [s]
-    if (!limiter && c->sim.rcl)
-        printf("  rated capacity limiter: none for this crane chain yet (rcl_util not measured; --rcl off silences "
-               "this)\n");
+    if (!limiter && c->sim.rcl) {
+        // Why: the chain's allow-list (rcl_check_model), else its chart failed.
+        char why[400] = "its chart could not be made";
+        rcl_check_model(m, why, sizeof why);
+        printf("  rated capacity limiter: none for this crane chain (%s; rcl_util not measured; --rcl off silences "
+               "this)\n",
+               why);
+    }
     // A row of engine_ncol columns (a chain engine's are more than
     // SIM_NCOL), and the commands by function.
     double* row = calloc((size_t)(ncol > SIM_NCOL ? ncol : SIM_NCOL), sizeof *row);
@@ -351,7 +355,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
         // steps whole ODE steps, so aim at the target, not at +frame).
         const double target = (i + 1) * frame;
         if (engine_advance(l, target - engine_time(l))) {
-            session_writer_tick(&sw, tm, target, u, NULL, ncol);
+            session_writer_tick(&sw, tm, target, two_link ? u : uf, two_link ? 3 : nfn, NULL, ncol);
             if (!c->quiet) app_progress_done();
             if (record) fprintf(stderr, "cranesim drive: %s; record kept in %s\n", engine_error(l), record);
             else fprintf(stderr, "cranesim drive: %s\n", engine_error(l));
@@ -359,10 +363,11 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
             break;
         }
         engine_row(l, row);
-        session_writer_tick(&sw, tm, target, u, row, ncol);
-        if (limiter && ncol > COL_RCL_UTIL) {
-            if (row[COL_RCL_UTIL] >= RCL_WARN) rcl_t90 += frame;
-            rcl_max = fmax(rcl_max, row[COL_RCL_UTIL]);
+        session_writer_tick(&sw, tm, target, two_link ? u : uf, two_link ? 3 : nfn, row, ncol);
+        if (limiter) { // the limiter's own reading: a chain's rows may have no rcl_util column
+            const double ut = engine_rcl(l)->util;
+            if (ut >= RCL_WARN) rcl_t90 += frame;
+            rcl_max = fmax(rcl_max, ut);
         }
         // A record that cannot be written stops the run: driving on would
         // only lose more of it.
@@ -425,7 +430,7 @@ static int drive_headless(app_common* c, double frame_rate, const char* record, 
     if (sandbox) printf("; truck tilt %.2f deg", row[COL_TRUCK_TILT] * 180 / M_PI);
     if (!sandbox && m3 > 0) printf("; %.0f kg at the tip", m3);
     printf("\n");
-    if (limiter && ncol > COL_RCL_UTIL)
+    if (limiter)
         printf("  rated capacity limiter %s: utilisation max %.0f %%, %.2f s at or above 90 %%\n",
                c->sim.rcl ? "on" : "off (measuring only)", 100 * rcl_max, rcl_t90);
     // As a scripted run's metrics line counts them (the sandbox only).
@@ -702,6 +707,19 @@ int cmd_drive(int argc, char** argv) {
     // A window when there is a display; an offscreen view when only a
     // screenshot is wanted; else the headless loop below.
     if (!headless && (display || shot)) {
+        // A limiter asked for by name that the engine for this model does
+        // not have (a crane chain's, until it has one) is refused, as the
+        // headless drive refuses it; on by default, the window goes without.
+        if (rcl_given && c.sim.rcl) {
+            char me[400];
+            model* rm = model_load(c.model_path, c.sets, c.nset, me, sizeof me);
+            const int miss = rm && engine_require(rm, &c.sim, ENGINE_CAP_LIMITER, "--rcl on", err, sizeof err);
+            model_free(rm);
+            if (miss) {
+                fprintf(stderr, "cranesim drive: %s\n", err);
+                return EXIT_USAGE;
+            }
+        }
         o.offscreen = !display;
         o.scripted = scripted || o.offscreen;
         char nowin[512];

@@ -31,13 +31,19 @@ static void help(FILE* f) {
             "    outward, never rising with outreach; closer in not printed (empty), the capacity column\n"
             "    (what the limiter uses) is the capped envelope there.\n"
             "  Each point names what governs it (lift, jib, stability, rated), at which outreach, and\n"
-            "    the pose (q1, q2, slew in deg) to check it by simulation.\n"
+            "    the pose (q1, q2, slew in deg) to check it by simulation. A crane chain (a model with\n"
+            "    mechanics.bodies): every joint coordinate searched within its limits, extensions\n"
+            "    included; the governing actuator by name and the whole pose (<body>_deg or _m).\n"
             "  --world W     sandbox (default) or validation (no truck: hydraulic limit only), or a file\n"
             "  --outreach    LO:HI:N metres and points (default: the crane's reach from 0.5 m, 50 points)\n"
             "  --out FILE    CSV (default loadchart.csv); --plot FILE: PNG of the charts and the raw limits\n"
             "  --set PATH=V  change a model value (as for run)\n"
             "See docs/safety.md.\n");
 }
+
+// A crane chain's poses in the CSV: angles in deg, slides in m.
+#define LC_CSV_MAX_DOF 64
+static double pose_value(const loadchart* c, int d, double v) { return c->dof_prismatic[d] ? v : v * 180 / M_PI; }
 
 static int parse_range(const char* s, lc_opts* o) {
     char* end;
@@ -90,6 +96,34 @@ static void legend_line(double y, int col, int style, double width, const char* 
     plptex(0.19, y, 1, 0, 0, text);
 }
 
+// A crane chain's governing pose per point (sector 0's; what the CSV's
+// <body>_s0 columns hold), under the chart: each joint coordinate as its
+// place within its limits, 0 at the lower limit and 1 at the upper, so
+// angles and slides share one axis.
+static void draw_pose(const loadchart* c) {
+    static PLFLT x[LOADCHART_MAX_POINTS], y[LOADCHART_MAX_POINTS];
+    plvpor(0.08, 0.68, 0.10, 0.34);
+    plwind(c->R[0], c->R[c->n - 1], -0.05, 1.05);
+    plcol0(15);
+    plbox("bcgnst", 0, 0, "bcgnstv", 0.5, 0);
+    pllab("outreach [m]", "pose in range", "");
+    plmtex("t", 0.8, 0.0, 0.0, "the governing pose (sector 0): each joint 0 at its lower limit, 1 at its upper");
+    double q[LC_CSV_MAX_DOF], sl;
+    for (int d = 0; d < c->nd; ++d) {
+        for (int i = 0; i < c->n; ++i) {
+            loadchart_point_pose_chain(c, i, 0, q, &sl);
+            x[i] = c->R[i];
+            y[i] = (q[d] - c->dof_range[d][0]) / (c->dof_range[d][1] - c->dof_range[d][0]);
+        }
+        plcol0(LC_COL_DARK + d % LC_NCOL);
+        pllsty(1 + (d / LC_NCOL) % 8);
+        plwidth(2);
+        plline(c->n, x, y);
+    }
+    pllsty(1);
+    plwidth(1);
+}
+
 static void draw_chart(void* user) {
     const chart_plot* p = user;
     const loadchart* c = p->c;
@@ -116,7 +150,8 @@ static void draw_chart(void* user) {
     if (!(ymax > 0)) ymax = 1;
     // The plot on the left, its legend in a column of its own on the right
     // (nothing drawn over the curves).
-    plvpor(0.08, 0.68, 0.10, 0.90);
+    // A crane chain: the governing pose under the chart (draw_pose).
+    plvpor(0.08, 0.68, c->chain ? 0.50 : 0.10, 0.90);
     plwind(c->R[0], c->R[c->n - 1], 0, 1.08 * ymax);
     plcol0(15);
     plbox("bcgnst", 0, 0, "bcgnstv", 0, 0);
@@ -193,6 +228,7 @@ static void draw_chart(void* user) {
             plcol0(LC_COL_DARK + s % LC_NCOL);
             plpoin(1, &px, &py, 4);
         }
+    if (c->chain) draw_pose(c);
     // The legend.
     plvpor(0.70, 0.99, 0.10, 0.90);
     plwind(0, 1, 0, 1);
@@ -231,7 +267,14 @@ static void draw_chart(void* user) {
     if (c->stab) plptex(0.02, yl, 1, 0, 0, "o: stability governs"), yl -= 0.05;
     plptex(0.02, yl, 1, 0, 0, "chart: min(raw, rating), from its"), yl -= 0.04;
     plptex(0.02, yl, 1, 0, 0, "peak (vertical: minimum outreach)"), yl -= 0.04;
-    plptex(0.02, yl, 1, 0, 0, "outward never rising");
+    plptex(0.02, yl, 1, 0, 0, "outward never rising"), yl = fmin(yl - 0.06, 0.25);
+    // The pose panel's lines: each joint by its body and range.
+    for (int d = 0; c->chain && d < c->nd; ++d, yl -= 0.045) {
+        const double f = c->dof_prismatic[d] ? 1.0 : 180 / M_PI;
+        snprintf(nm, sizeof nm, "%s %.3g..%.3g %s", c->dof_name[d], c->dof_range[d][0] * f,
+                 c->dof_range[d][1] * f, c->dof_prismatic[d] ? "m" : "deg");
+        legend_line(yl, LC_COL_DARK + d % LC_NCOL, 1 + (d / LC_NCOL) % 8, 2, nm);
+    }
 }
 
 static int plot_chart(const char* png, const loadchart* c, const char* title, char* err, size_t errsz) {
@@ -301,7 +344,7 @@ int cmd_loadchart(int argc, char** argv) {
     if (app_check_distinct("loadchart", (const char* const[]){"--out", "--plot"}, (const char* const[]){out, png}, 2))
         return EXIT_USAGE;
     model* m = model_load(c.model_path, c.sets, c.nset, err, sizeof err);
-    if (!m || model_require_two_link(m, "load chart", err, sizeof err)) {
+    if (!m) {
         fprintf(stderr, "cranesim loadchart: %s\n", err);
         model_free(m);
         return EXIT_USAGE;
@@ -319,7 +362,9 @@ int cmd_loadchart(int argc, char** argv) {
     world_desc_free(&wd);
     double rmin, rmax;
     loadchart_reach(m, &rmin, &rmax);
-    if (!range_given) {
+    if (!(rmin <= rmax)) { // a chain the chart cannot read: loadchart_compute says why
+        lo.lo = 0.5, lo.hi = 1.0;
+    } else if (!range_given) {
         lo.lo = fmax(0.5, rmin), lo.hi = floor(20 * rmax - 1) / 20; // 5 cm steps, inside the reach
     } else if (lo.lo < fmax(0.0, rmin) - 1e-9 || lo.hi > rmax + 1e-9) {
         // The range a user may give: outreaches are >= 0 (a tip behind the
@@ -332,6 +377,12 @@ int cmd_loadchart(int argc, char** argv) {
         return EXIT_USAGE;
     }
     static loadchart ch;
+    if (!m->chain.two_link && m->chain.nbody > LC_CSV_MAX_DOF) {
+        fprintf(stderr, "cranesim loadchart: %s: %d bodies; the chart's output takes at most %d\n", m->file,
+                m->chain.nbody, LC_CSV_MAX_DOF);
+        model_free(m);
+        return EXIT_USAGE;
+    }
     const double w0 = sim_wall_time();
     if (loadchart_compute(m, &t, &lo, &ch, err, sizeof err)) {
         fprintf(stderr, "cranesim loadchart: %s\n", err);
@@ -350,20 +401,33 @@ int cmd_loadchart(int argc, char** argv) {
     // limit per sector, the model's rating; per sector the raw envelope, the
     // printed chart, what governs it, at which outreach, and the pose to
     // check it by simulation (loadchart_point_pose).
-    fprintf(f, "outreach_m,hydraulic_kg,hyd_cylinder,hyd_q1_deg,hyd_q2_deg");
+    // A crane chain's poses: every boom joint coordinate, an angle in deg, a
+    // slide in m, named by its body.
+    fprintf(f, "outreach_m,hydraulic_kg,hyd_cylinder");
+    if (ch.chain)
+        for (int d = 0; d < ch.nd; ++d) fprintf(f, ",hyd_%s_%s", ch.dof_name[d], ch.dof_prismatic[d] ? "m" : "deg");
+    else fprintf(f, ",hyd_q1_deg,hyd_q2_deg");
     for (int s = 0; s < ch.nsec && ch.truck; ++s) {
         fprintf(f, ",stability_s%d_%.0f_%.0fdeg_kg", s, ch.sec_lo[s] * 180 / M_PI, ch.sec_hi[s] * 180 / M_PI);
     }
     fprintf(f, ",rating_kg");
-    for (int s = 0; s < ch.nsec; ++s)
-        fprintf(f,
-                ",envelope_s%d_kg,chart_s%d_kg,capacity_s%d_kg,governs_s%d,gov_outreach_s%d_m,q1_s%d_deg,q2_s%d_deg,"
-                "slew_s%d_deg",
-                s, s, s, s, s, s, s, s);
+    for (int s = 0; s < ch.nsec; ++s) {
+        fprintf(f, ",envelope_s%d_kg,chart_s%d_kg,capacity_s%d_kg,governs_s%d,gov_outreach_s%d_m", s, s, s, s, s);
+        if (ch.chain)
+            for (int d = 0; d < ch.nd; ++d)
+                fprintf(f, ",%s_s%d_%s", ch.dof_name[d], s, ch.dof_prismatic[d] ? "m" : "deg");
+        else fprintf(f, ",q1_s%d_deg,q2_s%d_deg", s, s);
+        fprintf(f, ",slew_s%d_deg", s);
+    }
     fprintf(f, "\n");
     for (int i = 0; i < ch.n; ++i) {
-        fprintf(f, "%.4f,%.1f,%s,%.3f,%.3f", ch.R[i], ch.hyd[i], ch.hyd_cyl[i] ? "jib" : "lift",
-                ch.hyd_q[i][0] * 180 / M_PI, ch.hyd_q[i][1] * 180 / M_PI);
+        if (ch.chain) {
+            fprintf(f, "%.4f,%.1f,%s", ch.R[i], ch.hyd[i], ch.act_name[ch.hyd_cyl[i]]);
+            for (int d = 0; d < ch.nd; ++d) fprintf(f, ",%.4f", pose_value(&ch, d, ch.pose[(size_t)i * ch.nd + d]));
+        } else {
+            fprintf(f, "%.4f,%.1f,%s,%.3f,%.3f", ch.R[i], ch.hyd[i], ch.hyd_cyl[i] ? "jib" : "lift",
+                    ch.hyd_q[i][0] * 180 / M_PI, ch.hyd_q[i][1] * 180 / M_PI);
+        }
         for (int s = 0; s < ch.nsec && ch.truck; ++s) {
             const double v = ch.stab[(size_t)i * ch.nsec + s];
             if (isinf(v)) fprintf(f, ",inf");
@@ -373,15 +437,22 @@ int cmd_loadchart(int argc, char** argv) {
         else fprintf(f, ",%.1f", ch.rating[i]);
         for (int s = 0; s < ch.nsec; ++s) {
             const size_t k = (size_t)i * ch.nsec + s;
-            double q[3];
-            loadchart_point_pose(&ch, i, s, q);
             // Closer than the sector's minimum outreach the chart is not
             // printed (an empty field); the capacity is what the limiter
             // uses there, min(envelope, rating) at that outreach.
             fprintf(f, ",%.1f,", ch.env[k]);
             if (i >= ch.imin[s]) fprintf(f, "%.1f", ch.chart[k]);
-            fprintf(f, ",%.1f,%s,%.4f,%.3f,%.3f,%.3f", ch.cap[k], lc_gov_name(ch.gov[k]), ch.R[ch.gov_at[k]],
-                    q[0] * 180 / M_PI, q[1] * 180 / M_PI, q[2] * 180 / M_PI);
+            fprintf(f, ",%.1f,%s,%.4f", ch.cap[k], loadchart_gov_name(&ch, ch.gov[k]), ch.R[ch.gov_at[k]]);
+            if (ch.chain) {
+                double qc[LC_CSV_MAX_DOF], sl;
+                loadchart_point_pose_chain(&ch, i, s, qc, &sl);
+                for (int d = 0; d < ch.nd; ++d) fprintf(f, ",%.4f", pose_value(&ch, d, qc[d]));
+                fprintf(f, ",%.3f", sl * 180 / M_PI);
+            } else {
+                double q[3];
+                loadchart_point_pose(&ch, i, s, q);
+                fprintf(f, ",%.3f,%.3f,%.3f", q[0] * 180 / M_PI, q[1] * 180 / M_PI, q[2] * 180 / M_PI);
+            }
         }
         fprintf(f, "\n");
     }
@@ -429,8 +500,8 @@ int cmd_loadchart(int argc, char** argv) {
             for (int s = 0; s < ch.nsec; ++s) {
                 const size_t k = (size_t)i * ch.nsec + s;
                 if (i < ch.imin[s]) printf(", sector %d inside the minimum outreach: %.0f kg (%s", s, ch.cap[k],
-                                           lc_gov_name(ch.gov[k]));
-                else printf(", sector %d chart %.0f kg (%s", s, ch.chart[k], lc_gov_name(ch.gov[k]));
+                                           loadchart_gov_name(&ch, ch.gov[k]));
+                else printf(", sector %d chart %.0f kg (%s", s, ch.chart[k], loadchart_gov_name(&ch, ch.gov[k]));
                 if (ch.gov_at[k] != i) printf(" at %.2f m", ch.R[ch.gov_at[k]]);
                 printf(")");
             }

@@ -4,6 +4,7 @@
 // bounds on other metrics. Each evaluation is one headless run of the
 // scenario, its metrics from metrics.c, as `cranesim sweep` computes them.
 #include "app.h"
+#include "app_design_metrics.h"
 #include "energy_acc.h"
 #include "json_util.h"
 #include "metrics.h"
@@ -36,7 +37,10 @@ static void optimize_help(FILE* f) {
             "options:\n"
             "  --param PATH=LO:HI     a model path (the --set syntax, a number) and its bounds (up to %d)\n"
             "  --minimize M           the objective: a metric name, or a --param PATH; 'M[UNIT]'\n"
-            "                         reports a metric in UNIT (default the run summary's unit)\n"
+            "                         reports a metric in UNIT (default the run summary's unit); a\n"
+            "                         crane chain model adds its metrics by actuator and function,\n"
+            "                         named as run --metrics names them ('peak_pA.lift<=6MPa',\n"
+            "                         'stroke_max.ext1<=1200mm', max_spool.ext; docs/sweep.md)\n"
             "  --constraint 'M<=V'    a bound on a metric, V with its unit: 'peak_p1A<=24MPa' (or\n"
             "                         24e6Pa, 240bar), deg/rad, kJ/J, m/mm, s/ms, kN/N; a count takes\n"
             "                         a plain number (also M>=V; up to %d; quoted: < and > are shell\n"
@@ -114,15 +118,12 @@ static const char* short_path(const char* p) {
     return *b == '.' ? b + 1 : b;
 }
 
-static int design_row(void* user, const double* row) {
-    metrics_row(user, row);
-    return app_signal_caught() != 0;
-}
-
-// One run of design v: 0 with the metrics in *met, or the exit code the
-// run would have (1 failed, 2 refused) with its message in err.
-static int run_design(const optimizer* o, const double* v, run_metrics* met, char* err, size_t errsz) {
-    metrics_init(met, o->ncol);
+// One run of design v: 0 with the metrics in *dr (run metrics and, on a
+// crane chain, its by actuator and function: app_design_metrics.h), or the
+// exit code the run would have (1 failed, 2 refused) with its message in err.
+// dr is the caller's to free (app_design_run_free) either way.
+static int run_design(const optimizer* o, const double* v, app_design_run* dr, char* err, size_t errsz) {
+    app_design_run_init(dr, o->base, o->ncol);
     cJSON* doc = cJSON_Duplicate(o->base->json, 1);
     if (!doc) {
         snprintf(err, errsz, "out of memory");
@@ -140,14 +141,20 @@ static int run_design(const optimizer* o, const double* v, run_metrics* met, cha
     if (!m) return EXIT_USAGE;
     sim_energy* en = o->energy ? sim_energy_create() : NULL;
     sim_result res;
-    sim_run_energy(m, &o->sc, &o->c.sim, design_row, met, NULL, NULL, NULL, en, &res);
+    dr->chain = &m->chain; // the run's own (with the slewing run's rack) from its first row
+    sim_run_energy_chain(m, &o->sc, &o->c.sim, app_design_row, dr, NULL, NULL, NULL, en, &dr->chain, &res);
     model_free(m);
-    metrics_finish(met, &res);
-    if (en) metrics_energy(met, en);
+    dr->chain = NULL;
+    metrics_finish(&dr->met, &res);
+    if (en) metrics_energy(&dr->met, en);
     sim_energy_free(en);
     if (res.status != SIM_OK) {
         snprintf(err, errsz, "%s", res.message);
         return res.status == SIM_FAILED ? EXIT_RUNTIME : EXIT_USAGE;
+    }
+    if (dr->oom) {
+        snprintf(err, errsz, "out of memory");
+        return EXIT_RUNTIME;
     }
     return 0;
 }
@@ -167,17 +174,17 @@ static double evaluate(optimizer* o, const double* u, double* cval) {
     double v[OPT_MAXPAR];
     design_of(o, u, v);
     const long e = o->neval;
-    run_metrics met;
+    app_design_run dr;
     char err[1024] = "";
-    const int code = run_design(o, v, &met, err, sizeof err);
+    const int code = run_design(o, v, &dr, err, sizeof err);
     memcpy(o->xs + (size_t)e * (size_t)o->npar, v, (size_t)o->npar * sizeof *v);
     double f = NAN;
     bool feas = code == 0;
     if (code == 0) {
-        f = o->obj_met >= 0 ? met.value[o->obj_met] : v[o->obj_par];
+        f = o->obj_met >= 0 ? app_design_value(&dr, o->obj_met) : v[o->obj_par];
         for (int j = 0; j < o->ncon; ++j) {
             const opt_con* c = &o->con[j];
-            const double x = met.value[c->met];
+            const double x = app_design_value(&dr, c->met);
             // Relative to the bound, so constraints of any unit weigh alike.
             const double scale = c->bound != 0.0 ? fabs(c->bound) : 1.0;
             cval[j] = (c->ge ? c->bound - x : x - c->bound) / scale;
@@ -202,17 +209,18 @@ static double evaluate(optimizer* o, const double* u, double* cval) {
             printf(" ->");
             // In the summary's units (the objective in its report unit).
             if (o->obj_met >= 0)
-                printf(" %s %.6g %s%s", metric_name((metric_id)o->obj_met), f * o->obj_scale, o->obj_unit,
+                printf(" %s %.6g %s%s", app_design_metric_name(o->obj_met), f * o->obj_scale, o->obj_unit,
                        o->ncon ? "," : "");
             for (int j = 0; j < o->ncon; ++j) {
                 const int cm = o->con[j].met;
-                printf(" %s %.6g %s%s", metric_name((metric_id)cm), met.value[cm] * app_metric_disp_scale(cm),
+                printf(" %s %.6g %s%s", app_design_metric_name(cm), app_design_value(&dr, cm) * app_metric_disp_scale(cm),
                        app_metric_disp_unit(cm), j + 1 < o->ncon ? "," : "");
             }
             printf("%s\n", feas ? "" : " (infeasible)");
         }
         fflush(stdout);
     }
+    app_design_run_free(&dr);
     if (code) {
         // A failed design is infeasible: every constraint violated by a
         // margin, and (BOBYQA, no constraints) an objective above anything
@@ -367,14 +375,14 @@ static int parse_constraint(const char* arg, int ncol, opt_con* c) {
     }
     char name[96];
     snprintf(name, sizeof name, "%.*s", (int)(op - arg), arg);
-    const int id = metric_find(name);
+    const int id = app_design_metric_find(name);
     if (id < 0) {
-        char names[1024];
-        metric_names(names, sizeof names);
+        char names[2048];
+        app_design_metric_names(names, sizeof names);
         fprintf(stderr, "cranesim optimize: --constraint: unknown metric '%s' (metrics: %s)\n", name, names);
         return -1;
     }
-    if (!metrics_present((metric_id)id, ncol)) {
+    if (!app_design_metric_present(id, ncol)) {
         fprintf(stderr, "cranesim optimize: --constraint: this run has no %s (the ode world's channels)\n", name);
         return -1;
     }
@@ -471,6 +479,11 @@ int cmd_optimize(int argc, char** argv) {
     rc = app_scenario_world("optimize", &o.c.sim, o.c.given, o.base, &o.sc, true, &switched);
     if (!rc && switched) rc = app_check_sim("optimize", &o.c.sim, o.c.given);
     o.ncol = sim_ncol(&o.c.sim);
+    // A chain model's metrics by actuator and function, by name (app_design_metrics.h).
+    if (!rc && app_design_metrics_setup(o.base)) {
+        fprintf(stderr, "cranesim optimize: out of memory\n");
+        rc = EXIT_RUNTIME;
+    }
     // Every path must name a number in the model: a typo is bad input.
     for (int k = 0; k < o.npar && !rc; ++k) {
         cJSON* doc = cJSON_Duplicate(o.base->json, 1);
@@ -492,7 +505,7 @@ int cmd_optimize(int argc, char** argv) {
             // (A prefix that is no metric leaves it to the path lookup: a
             // model path may end in an index.)
             snprintf(objmet, sizeof objmet, "%.*s", (int)(br - minimize), minimize);
-            o.obj_met = metric_find(objmet);
+            o.obj_met = app_design_metric_find(objmet);
             static char unit[32];
             snprintf(unit, sizeof unit, "%.*s", (int)(L - 1 - (size_t)(br - minimize) - 1), br + 1);
             if (o.obj_met >= 0) objunit_arg = unit;
@@ -510,12 +523,12 @@ int cmd_optimize(int argc, char** argv) {
         }
     }
     if (!rc && !objunit_arg) {
-        o.obj_met = metric_find(minimize);
+        o.obj_met = app_design_metric_find(minimize);
         for (int k = 0; k < o.npar && o.obj_met < 0; ++k)
             if (!strcmp(minimize, o.par[k].path)) o.obj_par = k;
         if (o.obj_met < 0 && o.obj_par < 0) {
-            char names[1024];
-            metric_names(names, sizeof names);
+            char names[2048];
+            app_design_metric_names(names, sizeof names);
             fprintf(stderr, "cranesim optimize: --minimize: '%s' is neither a metric (%s) nor a --param path\n",
                     minimize, names);
             rc = EXIT_USAGE;
@@ -525,7 +538,7 @@ int cmd_optimize(int argc, char** argv) {
         }
     }
     if (!rc && o.obj_met >= 0) {
-        if (!metrics_present((metric_id)o.obj_met, o.ncol)) {
+        if (!app_design_metric_present(o.obj_met, o.ncol)) {
             fprintf(stderr, "cranesim optimize: --minimize: this run has no %s (the ode world's channels)\n", minimize);
             rc = EXIT_USAGE;
         }
@@ -575,7 +588,7 @@ int cmd_optimize(int argc, char** argv) {
 #endif
     app_signals_restore(&sig);
     hyd_set_note_handler(old_note, note_user);
-    const char* objname = o.obj_met >= 0 ? metric_name((metric_id)o.obj_met) : o.par[o.obj_par].path;
+    const char* objname = o.obj_met >= 0 ? app_design_metric_name(o.obj_met) : o.par[o.obj_par].path;
     const char* objunit = o.obj_met >= 0 ? o.obj_unit : "";
     const double objscale = o.obj_met >= 0 ? o.obj_scale : 1.0;
     if (app_signal_caught()) {

@@ -2,6 +2,7 @@
 // headless, on the recorded design or a changed one, compared with the
 // recorded rows (docs/replay.md).
 #include "app.h"
+#include "app_design_metrics.h"
 #include "engine.h"
 #include "metrics.h"
 #include "session.h"
@@ -27,6 +28,8 @@ static void replay_help(FILE* f) {
             "\n"
             "options:\n"
             "  --model FILE        replay on this model file instead of the one recorded in the session\n"
+            "                      (the recorded commands go to its functions by name; a function the\n"
+            "                      session commands and the model lacks is refused)\n"
             "  --set PATH=VALUE    change a model value (on the recorded model, or on --model's)\n"
             "  --out FILE.csv      the replay's rows, in the record's format (drive --record)\n"
             "  --metrics FILE.json the replay's metrics (as cranesim run --metrics)\n"
@@ -177,19 +180,19 @@ int cmd_replay(int argc, char** argv) {
         }
         m = fm;
     }
-    // Session files carry the two-link crane's commands and rows (issue 27
-    // sizes them by the model); a chain model's session is refused whole.
-    engine* l = engine_require(m, &s.sim, ENGINE_CAP_TWO_LINK, "session files", err, sizeof err)
-                    ? NULL
-                    : engine_create(m, &s.sim, s.q0, s.slew0, s.m3, err, sizeof err);
+    engine* l = engine_create(m, &s.sim, s.q0, s.slew0, s.m3, err, sizeof err);
     if (!l) {
         fprintf(stderr, "cranesim replay: %s\n", err);
         model_free(m);
         session_free(&s);
         return EXIT_USAGE;
     }
+    const bool changed = model_path || nset;
     const int ncol = engine_ncol(l);
-    if (ncol != s.ncol) {
+    // The recorded design gives the recorded columns; a changed one may have
+    // other functions and so other chain columns: its rows are then compared
+    // as text (none identical) and its metrics over the common base columns.
+    if (ncol != s.ncol && !changed) {
         fprintf(stderr, "cranesim replay: session %s: ncol: the session has %d channels, this engine writes %d\n", path,
                 s.ncol, ncol);
         engine_destroy(l);
@@ -197,39 +200,87 @@ int cmd_replay(int argc, char** argv) {
         session_free(&s);
         return EXIT_USAGE;
     }
-    const int rcol = ncol + (s.window ? 1 : 0); // the window's record adds `segment`
-    app_out o_csv = {.f = NULL};
-    FILE* f = out ? app_out_open(&o_csv, out, "w") : NULL;
-    if (out && !f) {
-        fprintf(stderr, "cranesim replay: cannot write %s: %s\n", out, strerror(errno));
+    // The recorded commands by function name: a function the session
+    // commands must be one of this model's (session_function_map).
+    const int nfn = engine_nfunction(l);
+    const bool two_link = engine_caps(l) & ENGINE_CAP_TWO_LINK;
+    int* fmap = calloc((size_t)nfn + 1, sizeof *fmap);
+    double* uf = calloc((size_t)nfn + 3, sizeof *uf);
+    char dropped[512];
+    const int ncommanded = fmap && uf ? session_function_map(&s, l, fmap, dropped, sizeof dropped, err, sizeof err) : -2;
+    if (ncommanded < 0) {
+        if (ncommanded == -2) snprintf(err, sizeof err, "out of memory");
+        fprintf(stderr, "cranesim replay: %s\n", err);
+        free(fmap);
+        free(uf);
         engine_destroy(l);
         model_free(m);
         session_free(&s);
         return EXIT_USAGE;
     }
-    if (f) session_csv_header(&s, f);
+    // The base columns (the backend's, what the metrics and the plot read);
+    // a chain engine's own come after them.
+    const int bcol = ncol < sim_ncol(&s.sim) ? ncol : sim_ncol(&s.sim);
+    const int rcol = ncol + (s.window ? 1 : 0); // the window's record adds `segment`
+    const int scol = s.ncol + (s.window ? 1 : 0); // the recorded rows'
+    const int maxcol = (rcol > scol ? rcol : scol) > SIM_NCOL + 1 ? (rcol > scol ? rcol : scol) : SIM_NCOL + 1;
+    double* row = calloc((size_t)maxcol, sizeof *row);
+    double* rec = calloc((size_t)maxcol, sizeof *rec);
+    app_out o_csv = {.f = NULL};
+    FILE* f = row && rec && out ? app_out_open(&o_csv, out, "w") : NULL;
+    if (!row || !rec || (out && !f)) {
+        if (!row || !rec) fprintf(stderr, "cranesim replay: out of memory\n");
+        else fprintf(stderr, "cranesim replay: cannot write %s: %s\n", out, strerror(errno));
+        free(row);
+        free(rec);
+        free(fmap);
+        free(uf);
+        engine_destroy(l);
+        model_free(m);
+        session_free(&s);
+        return EXIT_USAGE;
+    }
+    if (f) session_csv_header(&s, l, f);
     struct sim_energy* en = app_energy_follow("replay", l); // the replay's energy balance, as run's
     sim_trace tr[2] = {{0}, {0}}; // recorded, replayed
     // The table compares both runs' rows as written (%.9g text), so rows that
     // are identical give a difference of exactly 0; --metrics writes the
     // replay's own values.
     run_metrics met[2], exact;
-    metrics_init(&met[0], ncol);
-    metrics_init(&met[1], ncol);
-    metrics_init(&exact, ncol);
+    metrics_init(&met[0], bcol);
+    metrics_init(&met[1], bcol);
+    metrics_init(&exact, bcol);
+    // A chain's metrics by actuator and function (as run --metrics names
+    // them: app_design_metrics.h), where the engine's rows carry the model's
+    // chain columns right after the base ones (checked by name: else none);
+    // the recorded rows' too when they have the same columns.
+    bool chain_cols = !m->chain.two_link && m->chain.ncol > 0 && ncol == bcol + m->chain.ncol;
+    {
+        int nch;
+        const sim_channel* ch = engine_channels(l, &nch);
+        for (int k = 0; chain_cols && k < m->chain.ncol; ++k)
+            chain_cols = bcol + k < nch && !strcmp(ch[bcol + k].name, m->chain.col[k].name);
+    }
+    if (chain_cols && app_design_metrics_setup(m)) chain_cols = false; // out of memory: the base metrics only
+    const bool chain_rec = chain_cols && s.ncol == ncol;
+    app_design_run cmet[3]; // recorded, replayed (both as written), replayed exactly (--metrics)
+    for (int k = 0; k < 3; ++k) app_design_run_init(&cmet[k], m, bcol);
     long same = 0, first_diff = -1, nrow = 0;
     int code = 0;
     char* line = NULL;
     size_t linecap = 0;
     FILE* mem = NULL;
-    double row[SIM_NCOL + 1], rec[SIM_NCOL + 1];
     for (long i = 0; i < s.ntick; ++i) {
         const session_tick* t = &s.tick[i];
         // As the drive did: hook events, faults at the sampling time, the
         // commands, then the advance to the same target.
         for (int k = 0; k < t->nhook; ++k) engine_hook(l, t->hook[k]);
         if (faults) engine_apply_faults(l, &sc, t->tm);
-        engine_set_commands(l, t->u);
+        // The commands by function as recorded, through the same path as
+        // the drive's: the two-link crane's with its limiter.
+        session_tick_commands(&s, i, fmap, nfn, uf);
+        if (two_link) engine_set_commands(l, uf);
+        else engine_set_function_commands(l, uf, nfn, NULL, 0);
         const double now = engine_time(l);
         // The window advances only when its target is ahead; the headless
         // drive always asks.
@@ -262,12 +313,15 @@ int cmd_replay(int argc, char** argv) {
         else if (first_diff < 0) first_diff = nrow;
         ++nrow;
         metrics_row(&exact, row);
+        if (chain_cols) app_design_row(&cmet[2], row);
         parse_row(line, row, rcol);
-        trace_push(&tr[1], row, ncol);
+        trace_push(&tr[1], row, bcol);
         metrics_row(&met[1], row);
-        if (recorded && parse_row(recorded, rec, rcol) >= ncol) {
-            trace_push(&tr[0], rec, ncol);
+        if (chain_cols) app_design_row(&cmet[1], row);
+        if (recorded && parse_row(recorded, rec, scol) >= s.ncol) {
+            trace_push(&tr[0], rec, bcol);
             metrics_row(&met[0], rec);
+            if (chain_rec) app_design_row(&cmet[0], rec);
         }
         if (!quiet) app_progress(NULL, t->target, s.tick[s.ntick - 1].target);
     }
@@ -290,7 +344,21 @@ int cmd_replay(int argc, char** argv) {
     printf("cranesim replay: %s (recorded by the %s drive; %s), %s\n", path, s.window ? "window" : "headless", s.end,
            design);
     printf("  %ld command updates, %ld rows; t = %.6g s\n", s.ntick, nrow, engine_time(l));
-    if (rcl >= 0 && rcl_recorded)
+    // The functions commanded, by name; one this model has and the session
+    // does not command is held at 0 (said, never silent).
+    printf("  commands by function (%d):", s.nfn);
+    for (int j = 0; j < s.nfn; ++j) printf("%s %s", j ? "," : "", s.fn[j]);
+    if (ncommanded < nfn) {
+        printf("; held at 0 (not in the session):");
+        for (int k = 0, c = 0; k < nfn; ++k)
+            if (fmap[k] < 0) printf("%s %s", c++ ? "," : "", engine_function_name(l, k));
+    }
+    if (dropped[0]) printf("; left out, not in this model and 0 throughout: %s", dropped);
+    printf("\n");
+    if (!(engine_caps(l) & ENGINE_CAP_LIMITER))
+        printf("  rated capacity limiter: none for this crane chain yet (the session records it %s)\n",
+               !rcl_recorded ? "not" : rcl_as_recorded ? "on" : "off");
+    else if (rcl >= 0 && rcl_recorded)
         printf("  rated capacity limiter %s (--rcl; recorded %s)\n", s.sim.rcl ? "on" : "off",
                rcl_as_recorded ? "on" : "off");
     else if (rcl >= 0)
@@ -306,15 +374,32 @@ int cmd_replay(int argc, char** argv) {
     else
         printf("  rows identical to the recording: %ld of %ld; first difference at row %ld (t = %.6g s)\n", same,
                s.nrow, first_diff + 1, first_diff >= 0 && first_diff < tr[1].nrow ? tr[1].v[(size_t)first_diff * SIM_NCOL + COL_T] : 0.0);
-    printf("  %-27s %14s %14s %14s\n", "metric (over rows)", "recorded", "replay", "difference");
+    // The name column: 27 wide, or the longest chain metric's label.
+    const bool chain_table = chain_rec && cmet[0].cst.rows && cmet[1].cst.rows;
+    int wname = 27;
+    for (int k = 0; chain_table && k < app_design_metric_chain_count(); ++k) {
+        const int id = MET_COUNT + k;
+        const int L = (int)(strlen(app_design_metric_name(id)) + strlen(app_metric_disp_unit(id)) + 3);
+        if (L > wname) wname = L;
+    }
+    printf("  %-*s %14s %14s %14s\n", wname, "metric (over rows)", "recorded", "replay", "difference");
     for (int id = 0; id < MET_COUNT; ++id) {
         if (!met[1].present[id] || !met[0].rows || !met[1].rows) continue;
         const char* unit;
         const double k = shown(id, &unit);
         char name[64];
         snprintf(name, sizeof name, "%s [%s]", metric_name((metric_id)id), unit);
-        printf("  %-27s %14.6g %14.6g %+14.6g\n", name, met[0].value[id] * k, met[1].value[id] * k,
+        printf("  %-*s %14.6g %14.6g %+14.6g\n", wname, name, met[0].value[id] * k, met[1].value[id] * k,
                (met[1].value[id] - met[0].value[id]) * k);
+    }
+    // Then the chain's by actuator and function, in the summary's units.
+    for (int k = 0; chain_table && k < app_design_metric_chain_count(); ++k) {
+        const int id = MET_COUNT + k;
+        const double sc = app_metric_disp_scale(id);
+        const double r0 = app_design_value(&cmet[0], id), r1 = app_design_value(&cmet[1], id);
+        char name[128];
+        snprintf(name, sizeof name, "%s [%s]", app_design_metric_name(id), app_metric_disp_unit(id));
+        printf("  %-*s %14.6g %14.6g %+14.6g\n", wname, name, r0 * sc, r1 * sc, (r1 - r0) * sc);
     }
     app_energy_report(en, "energy of the replay (a session records no balance of the drive):");
     if (out && !we) printf("  %ld rows -> %s\n", nrow, out);
@@ -322,7 +407,9 @@ int cmd_replay(int argc, char** argv) {
         app_out mo = {.f = NULL};
         FILE* mf = app_out_open(&mo, metrics_out, "w");
         int e = mf ? 0 : errno;
-        if (mf && metrics_write_json(&exact, mf)) e = errno ? errno : EIO;
+        // With a chain's entries by actuator and function, as run --metrics writes them.
+        if (mf && (chain_cols ? app_chain_stats_write_json(&cmet[2].cst, &exact, mf) : metrics_write_json(&exact, mf)))
+            e = errno ? errno : EIO;
         e = mf ? app_out_close(&mo, e, true) : e;
         if (e) {
             fprintf(stderr, "cranesim replay: cannot write %s: %s\n", metrics_out, strerror(e));
@@ -343,6 +430,11 @@ int cmd_replay(int argc, char** argv) {
     }
     sim_trace_free(&tr[0]);
     sim_trace_free(&tr[1]);
+    for (int k = 0; k < 3; ++k) app_design_run_free(&cmet[k]);
+    free(row);
+    free(rec);
+    free(fmap);
+    free(uf);
     engine_destroy(l);
     model_free(m);
     session_free(&s);

@@ -195,6 +195,8 @@ typedef struct csv_sink {
     run_metrics met;
     double t_last; ///< time of the last row written [s]
     rcl* mon;      ///< the limiter's measurement where the rows have no rcl_util (lagrange), or NULL
+    bool mon_bound;  ///< a chain's mon was given its rows' layout (rcl_set_chain_row)
+    bool chain_util; ///< a chain run whose rows carry the limiter's rcl_util (ode, --rcl on, the chain has one)
     app_chain_stats cst; ///< a chain model's summary and metrics by actuator and function
     bool cst_oom;
 } csv_sink;
@@ -232,12 +234,17 @@ static int csv_row(void* user, const double* row) {
     }
     {
         // The limiter's utilisation: the rows' column (ode), else measured
-        // from the row as the limiter measures it (lagrange). A chain model
-        // has no limiter yet (rcl.c is the two-link crane's): its column is
-        // 0, not a measurement.
+        // from the row as the limiter measures it (lagrange). A chain run's
+        // column is the limiter's only where the run had one (chain_util;
+        // else 0, not a measurement); a chain's rows are read from their
+        // chain columns on, bound at the first row (the slewing run's
+        // columns are set up by then).
         double u = NAN;
-        if (s->ncol > COL_RCL_UTIL && !s->chain) u = row[COL_RCL_UTIL];
-        else if (s->mon) u = rcl_utilisation(s->mon, row);
+        if (s->ncol > COL_RCL_UTIL && (!s->chain || s->chain_util)) u = row[COL_RCL_UTIL];
+        else if (s->mon) {
+            if (s->mon->chain && !s->mon_bound) s->mon_bound = true, rcl_set_chain_row(s->mon, s->chain, s->ncol);
+            if (!s->mon->chain || s->mon->row_base >= 0) u = rcl_utilisation(s->mon, row);
+        }
         if (isfinite(u)) {
             if (s->st.rcl_have && u >= RCL_WARN) s->st.rcl_t90 += row[COL_T] - s->st.t_prev;
             s->st.rcl_max = s->st.rcl_have ? fmax(s->st.rcl_max, u) : u;
@@ -454,10 +461,14 @@ int cmd_run(int argc, char** argv) {
     csv_sink sink = {.path = out, .ncol = sim_ncol(&c.sim), .chain = m->chain.ncol > 0 ? &m->chain : NULL,
                      .st = {.xmin = {INFINITY, INFINITY}, .xmax = {-INFINITY, -INFINITY}}};
     static rcl mon;
-    if (sink.ncol <= COL_RCL_UTIL) {
-        char lerr[300];
+    // A crane chain's limiter searches every joint for its chart (about a
+    // second): measured only where the run asks for the limiter.
+    const bool chain_model = !m->chain.two_link;
+    char lerr[400];
+    if (sink.ncol <= COL_RCL_UTIL && (!chain_model || c.sim.rcl)) {
         if (rcl_init(&mon, m, NULL, lerr, sizeof lerr) == 0) sink.mon = &mon;
     }
+    sink.chain_util = chain_model && sink.ncol > COL_RCL_UTIL && c.sim.rcl && !rcl_check_model(m, lerr, sizeof lerr);
     metrics_init(&sink.met, sink.ncol);
     sim_trace tr = {0};
     if (plot) {

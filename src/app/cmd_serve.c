@@ -51,7 +51,9 @@ static void serve_help(FILE* f) {
             "The simulation computer: runs the model headless in real time and streams its state over\n"
             "TCP to clients (a viewer, `cranesim drive --connect`, a valve controller, examples/), which\n"
             "send valve, hook, pause, reset and parameter commands back (docs/protocol.md). One client\n"
-            "controls; the others watch. SIGINT or SIGTERM stop it cleanly (exit 0).\n"
+            "controls; the others watch. SIGINT or SIGTERM stop it cleanly (exit 0). Any crane shape:\n"
+            "the hello lists its functions, the valve commands carry one opening per function\n"
+            "(protocol version 3; a crane chain runs on ode in the sandbox).\n"
             "\n"
             "options:\n"
             "  --listen ADDR:PORT  where to listen (default 127.0.0.1:7575, loopback only; another\n"
@@ -74,7 +76,8 @@ static void serve_help(FILE* f) {
             "                      controller's commands at every frame (docs/safety.md)\n"
             "  --duration T        stop after T simulated seconds (default: run until SIGINT)\n"
             "  --scenario S        the start pose and load (default as drive); its commands are not played\n"
-            "  --mechanics M       ode (default: the sandbox world) or lagrange (analytic 2-DOF)\n"
+            "  --mechanics M       ode (default: the sandbox world) or lagrange (analytic 2-DOF; not for a\n"
+            "                      crane chain)\n"
             "  --world W           ode: world file or name: sandbox (default), validation\n");
     const unsigned all = APP_GIVEN(APP_OPT_COUNT) - 1u;
     app_options_help(f, all & ~(APP_GIVEN(APP_OPT_SCENARIO) | APP_GIVEN(APP_OPT_MECHANICS) | APP_GIVEN(APP_OPT_WORLD) |
@@ -98,6 +101,25 @@ typedef struct client {
     uint64_t frames, lost, cmds;
 } client;
 
+// One cylinder record of the state frame (the hello's "cylinders"): a
+// chain actuator, its values from the row's chain columns and its pins from
+// the world's picture where it draws it; or a cylinder of the picture (the
+// two-link crane's, the sandbox's slew rack), all from the picture.
+typedef struct serve_cyl {
+    char name[WORLD_SNAP_NAME];
+    int fn;     // the function that drives it (index in the hello's "functions"), -1: none
+    int act;    // the chain actuator, -1: a cylinder of the picture
+    int col[5]; // chain actuator: row columns x, v, pA, pB, F
+    double bore, rod, stroke_max, closed_length; // [m]
+} serve_cyl;
+
+// One function of the hello's "functions" (engine_nfunction's order).
+typedef struct serve_fn {
+    char name[WORLD_SNAP_NAME];
+    int ucol[2]; // its spool and command columns (u_<f>, ucmd_<f>) of a chain function, else -1
+    int cyl;     // the first cylinder record it drives, -1: none
+} serve_fn;
+
 typedef struct serve_set {
     char path[PROTO_MAX_PATH + 1];
     double value;
@@ -114,7 +136,15 @@ typedef struct server {
     double frame;     // [s]
     long k;           // frames since the (re)start: the engine advances to (k + 1) * frame
     bool paused, lockstep, stopped;
-    double u[3];
+    // The commands by function (nfn of them, the hello's order). The
+    // two-link crane's are lift, jib, slew (engine_set_commands' u[3]).
+    double u[PROTO_MAX_FN];
+    int nfn;
+    bool chain;     // a crane chain (commands by function, its columns), not the two-link crane
+    serve_fn fn[PROTO_MAX_FN];
+    int ncyl;
+    serve_cyl cyl[PROTO_MAX_CYL];
+    double* row;    // engine_row's, max(engine_ncol, SIM_NCOL) values
     uint64_t cmd_seq, seq;
     serve_set sets[SERVE_MAX_SETS]; // parameters set by clients, applied again after a reset
     int nset;
@@ -147,6 +177,14 @@ static void logf_(const server* s, const char* fmt, ...) {
     vfprintf(stderr, fmt, ap);
     fputc('\n', stderr);
     va_end(ap);
+}
+
+// The controller's commands to the engine: the two-link crane's lift, jib,
+// slew through engine_set_commands (and its limiter) as before version 3,
+// a chain's by function.
+static void set_commands(server* s) {
+    if (!s->chain) engine_set_commands(s->e, s->u);
+    else engine_set_function_commands(s->e, s->u, s->nfn, NULL, 0);
 }
 
 // ---- sending ----
@@ -193,10 +231,10 @@ static void drop_client(server* s, int idx, uint16_t code, const char* why) {
     if (s->controller == c->id) {
         // Dead-man: a controller that left (or whose link timed out) can no
         // longer stop what it started, so its last openings must not stay
-        // applied. All three spools go to neutral (0) at once.
+        // applied. Every function's spool goes to neutral (0) at once.
         s->controller = 0;
         memset(s->u, 0, sizeof s->u);
-        if (s->e) engine_set_commands(s->e, s->u);
+        if (s->e) set_commands(s);
         logf_(s, "no client controls the crane now (valves to neutral)");
     }
     shutdown(c->fd, SHUT_WR);
@@ -242,10 +280,10 @@ static void log_collisions(const server* s, const char* when) {
 // chart depends only on the model and the world, neither of which a SET
 // changes: a SET acts on the engine's circuit), or NULL.
 static int build_engine(server* s, struct rcl* lim, char* err, size_t errsz) {
-    // The protocol carries the two-link crane (u[3], nine[9], its frames,
-    // the snapshot); a crane chain waits for its version (issue 27).
-    if (engine_require(s->m, s->o, ENGINE_CAP_TWO_LINK, "the serve protocol", err, errsz) ||
-        engine_require(s->m, s->o, ENGINE_CAP_SNAPSHOT, "the serve protocol", err, errsz)) {
+    // The frames carry the world's picture (poses, pins, rope, HUD): an
+    // engine without one (a chain outside the sandbox) is refused here, in
+    // one line; any crane shape with one is served by function.
+    if (engine_require(s->m, s->o, ENGINE_CAP_SNAPSHOT, "the serve protocol", err, errsz)) {
         engine_rcl_destroy(lim);
         return -1;
     }
@@ -256,10 +294,111 @@ static int build_engine(server* s, struct rcl* lim, char* err, size_t errsz) {
     }
     s->k = 0;
     s->stopped = false;
-    engine_set_commands(s->e, s->u);
+    // The controller's commands (all 0 at the first build: serve_layout
+    // has not run, so even a chain takes engine_set_commands' neutral).
+    set_commands(s);
     for (int i = 0; i < s->nset; ++i) {
         char e2[320];
         if (apply_set(s, s->sets[i].path, s->sets[i].value, e2, sizeof e2)) logf_(s, "after reset: %s", e2);
+    }
+    return 0;
+}
+
+// The layout of the frames, from the engine just built (the model's: the
+// same after every reset): its functions, its cylinder records (a chain's
+// actuators with their columns, then the picture's other cylinders: the
+// slew rack; the two-link crane's: the picture's, as before), and the row.
+// 0, or -1 with one line in err for a crane the frames cannot carry.
+static int serve_layout(server* s, char* err, size_t errsz) {
+    engine* e = s->e;
+    const crane_chain* cc = &s->m->chain;
+    const char* file = s->m->file[0] ? s->m->file : "model";
+    s->chain = !(engine_caps(e) & ENGINE_CAP_TWO_LINK);
+    const int ncol = engine_ncol(e);
+    if (ncol > PROTO_MAX_ROW) {
+        snprintf(err, errsz, "the serve protocol: %s: its rows have %d columns; a state frame carries at most %d",
+                 file, ncol, PROTO_MAX_ROW);
+        return -1;
+    }
+    s->nfn = engine_nfunction(e);
+    if (s->nfn > PROTO_MAX_FN) {
+        snprintf(err, errsz, "the serve protocol: %s: %d functions; VALVES carries at most %d", file, s->nfn,
+                 PROTO_MAX_FN);
+        return -1;
+    }
+    s->row = calloc((size_t)(ncol > SIM_NCOL ? ncol : SIM_NCOL), sizeof *s->row);
+    if (!s->row) {
+        snprintf(err, errsz, "out of memory");
+        return -1;
+    }
+    engine_snapshot(e, s->snap);
+    const world_snapshot* w = s->snap;
+    s->ncyl = 0;
+    const int base = ncol - cc->ncol; // the chain's columns come after the backend's (engine_channels)
+    if (s->chain) {
+        for (int a = 0; a < cc->nact; ++a) {
+            if (s->ncyl == PROTO_MAX_CYL) break;
+            const crane_act* ca = &cc->act[a];
+            serve_cyl* y = &s->cyl[s->ncyl++];
+            snprintf(y->name, sizeof y->name, "%s", ca->name);
+            y->act = a;
+            y->fn = engine_find_function(e, cc->fn[ca->function].name);
+            static const char* const what[5] = {"x", "v", "pA", "pB", "F"};
+            for (int k = 0; k < 5; ++k) {
+                const int c = crane_chain_find_column(cc, what[k], ca->name);
+                y->col[k] = c < 0 ? -1 : base + c;
+                if (c < 0) {
+                    snprintf(err, errsz, "the serve protocol: %s: actuator %s has no %s_%s column", file, ca->name,
+                             what[k], ca->name);
+                    return -1;
+                }
+            }
+            double AA, AB, st;
+            hyd_model_cylinder_geometry(engine_circuit(e), ca->cyl, &AA, &AB, &st);
+            y->bore = sqrt(4.0 * AA / M_PI);
+            y->rod = sqrt(4.0 * (AA - AB) / M_PI);
+            y->stroke_max = ca->stroke;
+            y->closed_length = ca->closed_length;
+        }
+    }
+    for (int j = 0; j < w->ncyl && j < WORLD_SNAP_MAX_CYLINDERS; ++j) {
+        const world_snap_cylinder* c = &w->cyl[j];
+        if (s->chain && crane_chain_find_act(cc, c->name) >= 0) continue; // a chain actuator: above
+        if (s->ncyl == PROTO_MAX_CYL) {
+            snprintf(err, errsz, "the serve protocol: %s: more than %d cylinders", file, PROTO_MAX_CYL);
+            return -1;
+        }
+        serve_cyl* y = &s->cyl[s->ncyl++];
+        snprintf(y->name, sizeof y->name, "%s", c->name);
+        y->act = -1;
+        // The two-link crane's actuators are named as their functions
+        // (crane_chain_from_mech), the slew rack "slew".
+        const int a = crane_chain_find_act(cc, c->name);
+        y->fn = engine_find_function(e, a >= 0 ? cc->fn[cc->act[a].function].name : c->name);
+        y->bore = c->bore, y->rod = c->rod, y->stroke_max = c->stroke_max, y->closed_length = c->closed_length;
+    }
+    if (s->chain && s->ncyl < cc->nact) {
+        snprintf(err, errsz, "the serve protocol: %s: %d actuators; a state frame carries at most %d cylinders", file,
+                 cc->nact, PROTO_MAX_CYL);
+        return -1;
+    }
+    for (int k = 0; k < s->nfn; ++k) {
+        serve_fn* f = &s->fn[k];
+        snprintf(f->name, sizeof f->name, "%s", engine_function_name(e, k));
+        f->ucol[0] = f->ucol[1] = -1;
+        const int cf = s->chain ? crane_chain_find_function(cc, f->name) : -1;
+        if (cf >= 0) {
+            const int cu = crane_chain_find_column(cc, "u", f->name), cm = crane_chain_find_column(cc, "ucmd", f->name);
+            if (cu < 0 || cm < 0) {
+                snprintf(err, errsz, "the serve protocol: %s: function %s has no u_%s or ucmd_%s column", file,
+                         f->name, f->name, f->name);
+                return -1;
+            }
+            f->ucol[0] = base + cu, f->ucol[1] = base + cm;
+        }
+        f->cyl = -1;
+        for (int i = 0; i < s->ncyl && f->cyl < 0; ++i)
+            if (s->cyl[i].fn == k) f->cyl = i;
     }
     return 0;
 }
@@ -297,7 +436,7 @@ static bool step_frame(server* s) {
     // The controller's commands again at every frame, not only when they
     // change: the limiter (engine_set_commands) cuts them from the state
     // reached, as a local drive's ticks have it.
-    engine_set_commands(s->e, s->u);
+    set_commands(s);
     if (engine_advance(s->e, (s->k + 1) * s->frame - engine_time(s->e))) {
         s->stopped = true;
         logf_(s, "the simulation stopped: %s (RESET starts it again)", engine_error(s->e));
@@ -307,15 +446,40 @@ static bool step_frame(server* s) {
     return true;
 }
 
+// The picture's cylinder called name, or -1.
+static int snap_cyl(const world_snapshot* w, const char* name) {
+    for (int j = 0; j < w->ncyl && j < WORLD_SNAP_MAX_CYLINDERS; ++j)
+        if (!strcmp(w->cyl[j].name, name)) return j;
+    return -1;
+}
+
+static double clamp_opening(double v) { return !(v >= -1) ? -1 : v > 1 ? 1 : v; }
+
+// Every function's command and spool [-] into the state frame: a chain
+// function's from its columns, another's (the two-link crane's, the slew
+// rack) from its cylinder in the picture; a function with neither (the
+// lagrange crane's slew: it does not slew) carries its command as given
+// in both.
+static void fill_functions(server* s, const double* row, const world_snapshot* w) {
+    proto_state* st = s->st;
+    st->nfn = (uint8_t)s->nfn;
+    for (int k = 0; k < s->nfn; ++k) {
+        const serve_fn* f = &s->fn[k];
+        double* v = st->fn[k];
+        const int j = f->ucol[0] < 0 && f->cyl >= 0 ? snap_cyl(w, s->cyl[f->cyl].name) : -1;
+        if (f->ucol[0] >= 0) v[0] = row[f->ucol[1]], v[1] = row[f->ucol[0]];
+        else if (j >= 0) v[0] = w->cyl[j].u_cmd, v[1] = w->cyl[j].u;
+        else v[0] = v[1] = clamp_opening(engine_function_command(s->e, k));
+    }
+}
+
 static void fill_state(server* s) {
     do_reset(s);
     proto_state* st = s->st;
-    double row[SIM_NCOL];
+    double* row = s->row;
     engine_row(s->e, row);
     engine_snapshot(s->e, s->snap);
     const world_snapshot* w = s->snap;
-    const int cols[9] = {COL_X1, COL_X2, COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_U1, COL_U2, COL_T};
-    for (int k = 0; k < 9; ++k) st->nine[k] = row[cols[k]];
     st->seq = ++s->seq;
     st->cmd_seq = s->cmd_seq;
     st->flags = (s->paused ? PROTO_F_PAUSED : 0) | (w->attached ? PROTO_F_ATTACHED : 0) |
@@ -349,21 +513,61 @@ static void fill_state(server* s) {
         memcpy(st->pose[i], w->body[i].pos, 3 * sizeof(double));
         memcpy(st->pose[i] + 3, w->body[i].rot, 9 * sizeof(double));
     }
-    st->ncyl = (uint8_t)(w->ncyl < PROTO_MAX_CYL ? w->ncyl : PROTO_MAX_CYL);
-    for (int i = 0; i < st->ncyl; ++i) {
-        const world_snap_cylinder* y = &w->cyl[i];
+    fill_functions(s, row, w);
+    st->ncyl = (uint8_t)s->ncyl;
+    int rec_of_snap[WORLD_SNAP_MAX_CYLINDERS]; // the record of each cylinder of the picture, -1
+    for (int j = 0; j < WORLD_SNAP_MAX_CYLINDERS; ++j) rec_of_snap[j] = -1;
+    for (int i = 0; i < s->ncyl; ++i) {
+        const serve_cyl* sc = &s->cyl[i];
+        const int j = snap_cyl(w, sc->name);
+        const world_snap_cylinder* y = j >= 0 ? &w->cyl[j] : NULL;
+        if (j >= 0) rec_of_snap[j] = i;
         double* d = st->cyl[i];
-        memcpy(d, y->base, 3 * sizeof(double));
-        memcpy(d + 3, y->rod_end, 3 * sizeof(double));
-        d[6] = y->x, d[7] = y->pA, d[8] = y->pB, d[9] = y->u, d[10] = y->u_cmd, d[11] = y->force, d[12] = y->v;
-        st->cyl_bits[i] = (uint8_t)((y->relief_open ? PROTO_CYL_RELIEF : 0) | (y->end_stop ? PROTO_CYL_END_STOP : 0));
+        if (sc->act < 0 && !y) { // not in this picture (it drew it at the start): nothing known
+            memset(d, 0, PROTO_CYL_VALUES * sizeof(double));
+        } else if (sc->act < 0) { // a cylinder of the picture: all of it from there (the two-link crane as before)
+            memcpy(d, y->base, 3 * sizeof(double));
+            memcpy(d + 3, y->rod_end, 3 * sizeof(double));
+            d[6] = y->x, d[7] = y->pA, d[8] = y->pB, d[9] = y->u, d[10] = y->u_cmd, d[11] = y->force, d[12] = y->v;
+        } else { // a chain actuator: the row's values, the picture's pins where it draws it
+            if (y) {
+                memcpy(d, y->base, 3 * sizeof(double));
+                memcpy(d + 3, y->rod_end, 3 * sizeof(double));
+            } else {
+                memset(d, 0, 6 * sizeof(double));
+            }
+            d[6] = row[sc->col[0]], d[7] = row[sc->col[2]], d[8] = row[sc->col[3]];
+            d[9] = sc->fn >= 0 ? st->fn[sc->fn][1] : 0, d[10] = sc->fn >= 0 ? st->fn[sc->fn][0] : 0;
+            d[11] = row[sc->col[4]], d[12] = row[sc->col[1]];
+        }
+        st->cyl_bits[i] = (uint8_t)(y ? (y->relief_open ? PROTO_CYL_RELIEF : 0) | (y->end_stop ? PROTO_CYL_END_STOP : 0)
+                                      : PROTO_CYL_NO_PINS);
+    }
+    // The paper's nine: the two-link crane's columns as before; a chain's
+    // first two functions (their first actuators' strokes and chamber
+    // pressures, their spools), docs/protocol.md.
+    if (!s->chain) {
+        const int cols[9] = {COL_X1, COL_X2, COL_P1A, COL_P1B, COL_P2A, COL_P2B, COL_U1, COL_U2, COL_T};
+        for (int k = 0; k < 9; ++k) st->nine[k] = row[cols[k]];
+    } else {
+        memset(st->nine, 0, sizeof st->nine);
+        for (int f = 0; f < 2 && f < s->nfn; ++f) {
+            const int c = s->fn[f].cyl;
+            if (c >= 0) {
+                st->nine[f] = st->cyl[c][6];
+                st->nine[2 + 2 * f] = st->cyl[c][7];
+                st->nine[3 + 2 * f] = st->cyl[c][8];
+            }
+            st->nine[6 + f] = st->fn[f][1];
+        }
+        st->nine[8] = row[COL_T];
     }
     st->nrelief = 0;
     for (int i = 0; i < w->nrelief && i < WORLD_SNAP_MAX_RELIEFS && st->nrelief < PROTO_MAX_RELIEFS; ++i) {
         proto_relief* q = &st->relief[st->nrelief];
         const int cyl = w->relief_cyl[i];
         if (!w->relief[i][0]) continue;
-        q->cyl = (int8_t)(cyl >= 0 && cyl < st->ncyl ? cyl : -1);
+        q->cyl = (int8_t)(cyl >= 0 && cyl < WORLD_SNAP_MAX_CYLINDERS ? rec_of_snap[cyl] : -1);
         q->port = (uint8_t)(w->relief_port[i] ? 1 : 0);
         snprintf(q->name, sizeof q->name, "%s", w->relief[i]);
         ++st->nrelief;
@@ -447,15 +651,58 @@ static char* describe(server* s, const char* model_file, const char* model_asset
         cJSON_AddItemToArray(bo, o);
     }
     cJSON* cy = cJSON_AddArrayToObject(j, "cylinders");
-    for (int i = 0; i < w->ncyl && i < PROTO_MAX_CYL; ++i) {
-        const world_snap_cylinder* y = &w->cyl[i];
+    for (int i = 0; i < s->ncyl; ++i) {
+        const serve_cyl* y = &s->cyl[i];
         cJSON* o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "name", y->name);
         cJSON_AddNumberToObject(o, "bore", y->bore);
         cJSON_AddNumberToObject(o, "rod", y->rod);
         cJSON_AddNumberToObject(o, "stroke_max", y->stroke_max);
         cJSON_AddNumberToObject(o, "closed_length", y->closed_length);
+        cJSON_AddNumberToObject(o, "function", y->fn);
         cJSON_AddItemToArray(cy, o);
+    }
+    // The functions, in the order of VALVES' openings and of the state
+    // frame's function records, each with the cylinder records it drives.
+    cJSON* fa = cJSON_AddArrayToObject(j, "functions");
+    for (int k = 0; k < s->nfn; ++k) {
+        cJSON* o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", s->fn[k].name);
+        cJSON_AddStringToObject(o, "unit", "-");
+        cJSON_AddItemToObject(o, "range", cJSON_CreateDoubleArray((const double[2]){-1, 1}, 2));
+        cJSON* ac = cJSON_AddArrayToObject(o, "actuators");
+        for (int i = 0; i < s->ncyl; ++i) {
+            if (s->cyl[i].fn != k) continue;
+            cJSON* a = cJSON_CreateObject();
+            cJSON_AddStringToObject(a, "name", s->cyl[i].name);
+            cJSON_AddNumberToObject(a, "cylinder", i);
+            cJSON* u = cJSON_AddObjectToObject(a, "units");
+            cJSON_AddStringToObject(u, "stroke", "m");
+            cJSON_AddStringToObject(u, "rate", "m/s");
+            cJSON_AddStringToObject(u, "pA", "Pa abs");
+            cJSON_AddStringToObject(u, "pB", "Pa abs");
+            cJSON_AddStringToObject(u, "force", "N");
+            cJSON_AddItemToArray(ac, a);
+        }
+        cJSON_AddItemToArray(fa, o);
+    }
+    // The crane's bodies in chain order (body 0 the column), each with its
+    // joint's coordinate and unit, and its pose in "bodies" (-1: not drawn).
+    const crane_chain* cc = &s->m->chain;
+    cJSON* cb = cJSON_AddArrayToObject(j, "crane_bodies");
+    for (int i = 0; i < cc->nbody; ++i) {
+        const chain_body_def* d = &cc->body[i].def;
+        cJSON* o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", d->name);
+        const bool prismatic = d->joint == CHAIN_PRISMATIC;
+        cJSON_AddStringToObject(o, "joint", prismatic ? "prismatic" : "revolute");
+        cJSON_AddStringToObject(o, "unit", prismatic ? "m" : "rad");
+        cJSON_AddBoolToObject(o, "fixed", d->fixed != 0);
+        int pose = -1;
+        for (int b = 0; b < w->nbody && b < PROTO_MAX_BODIES && pose < 0; ++b)
+            if (!strcmp(w->body[b].name, d->name)) pose = b;
+        cJSON_AddNumberToObject(o, "pose", pose);
+        cJSON_AddItemToArray(cb, o);
     }
     char* txt = cJSON_PrintUnformatted(j);
     cJSON_Delete(j);
@@ -480,8 +727,17 @@ static void handle_command(server* s, client* c, const proto_command* cmd) {
     if (cmd->op == PROTO_OP_HOOK || cmd->op == PROTO_OP_SET || cmd->op == PROTO_OP_STEP) do_reset(s);
     switch (cmd->op) {
     case PROTO_OP_VALVES:
-        memcpy(s->u, cmd->u, sizeof s->u);
-        engine_set_commands(s->e, s->u);
+        if (cmd->nu != s->nfn) {
+            int n = snprintf(err, sizeof err, "valves: %u openings for the %d functions", cmd->nu, s->nfn);
+            for (int k = 0; k < s->nfn && n > 0 && (size_t)n < sizeof err; ++k)
+                n += snprintf(err + n, sizeof err - (size_t)n, "%s%s", k ? ", " : " ", s->fn[k].name);
+            if (n > 0 && (size_t)n < sizeof err)
+                snprintf(err + n, sizeof err - (size_t)n, " (one per function, in the hello's order)");
+            refused = 1;
+            break;
+        }
+        memcpy(s->u, cmd->u, (size_t)s->nfn * sizeof s->u[0]);
+        set_commands(s);
         break;
     case PROTO_OP_HOOK: {
         int got = engine_hook(s->e, cmd->flag);
@@ -558,14 +814,18 @@ static char* g_desc;
 // Returns false when the client was closed.
 static bool handle_frame(server* s, int idx, const proto_msg* msg) {
     client* c = s->c[idx];
-    char why[200];
+    char why[320];
     if (!c->hello) {
         if (msg->type != PROTO_CLIENT_HELLO) {
             drop_client(s, idx, PROTO_E_MALFORMED, "the first frame must be a client hello");
             return false;
         }
         if (msg->u.chello.version != PROTO_VERSION) {
-            snprintf(why, sizeof why, "protocol version %u not supported (this server speaks %u)",
+            // A client of an older version would misread every frame (a
+            // chain's functions, VALVES by function): it gets this line.
+            snprintf(why, sizeof why,
+                     "protocol version %u not supported: this server speaks version %u, which lists the functions "
+                     "in its hello and takes one valve opening per function: update the client (docs/protocol.md)",
                      msg->u.chello.version, PROTO_VERSION);
             drop_client(s, idx, PROTO_E_VERSION, why);
             return false;
@@ -920,7 +1180,7 @@ int cmd_serve(int argc, char** argv) {
     const char* listen_at = "127.0.0.1:7575";
     double rate = 75, timeout = 5;
     int max_clients = 8, queue = 64;
-    bool lockstep = false, realtime = false, log_misses = false;
+    bool lockstep = false, realtime = false, log_misses = false, rcl_given = false;
     double spin_us = 500;
     for (int i = 0; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -954,6 +1214,7 @@ int cmd_serve(int argc, char** argv) {
                 return EXIT_USAGE;
             }
             c.sim.rcl = !strcmp(v, "on");
+            rcl_given = true;
             continue;
         }
         if (!strcmp(argv[i], "--spin")) {
@@ -1046,7 +1307,11 @@ int cmd_serve(int argc, char** argv) {
         rc = EXIT_RUNTIME;
         goto done;
     }
-    if (build_engine(&s, NULL, err, sizeof err)) {
+    // A limiter asked for by name on a crane that has none is refused (on
+    // by default, it is then "unavailable" in the first line).
+    if ((rcl_given && c.sim.rcl &&
+         engine_require(m, &c.sim, ENGINE_CAP_LIMITER, "--rcl on", err, sizeof err)) ||
+        build_engine(&s, NULL, err, sizeof err) || serve_layout(&s, err, sizeof err)) {
         fprintf(stderr, "cranesim serve: %s\n", err);
         rc = EXIT_USAGE;
         goto done;
@@ -1097,6 +1362,7 @@ done:
     free(g_desc);
     g_desc = NULL;
     if (s.e) engine_destroy(s.e);
+    free(s.row);
     free(s.snap);
     free(s.st);
     free(s.frame_buf);

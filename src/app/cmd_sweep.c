@@ -5,6 +5,7 @@
 // design-index order.
 #define _DEFAULT_SOURCE // strsep
 #include "app.h"
+#include "app_design_metrics.h"
 #include "energy_acc.h"
 #include "json_util.h"
 #include "metrics.h"
@@ -31,7 +32,9 @@
 #include <mpi.h>
 #endif
 
-enum { SW_MAXPAR = APP_MAX_PARAM, SW_MAXDESIGN = 10000000 };
+// SW_MAXMET: the run metrics and a chain model's per actuator and function
+// (six per actuator, one per function: far more than any crane has).
+enum { SW_MAXPAR = APP_MAX_PARAM, SW_MAXDESIGN = 10000000, SW_MAXMET = MET_COUNT + 2048 };
 
 static void sweep_help(FILE* f) {
     fprintf(f,
@@ -67,6 +70,12 @@ static void sweep_help(FILE* f) {
     }
     fprintf(f, "\n");
     fprintf(f,
+            "                       a crane chain model (mechanics.bodies) adds its metrics by actuator\n"
+            "                       and function, named as run --metrics names them: stroke_min,\n"
+            "                       stroke_max [m], peak_pA, peak_pB [Pa], peak_force [N], end_stop_hits\n"
+            "                       .ACTUATOR and max_spool.FUNCTION [-] (peak_pA.lift, max_spool.ext);\n"
+            "                       the default table has every one\n");
+    fprintf(f,
             "  --threads T          designs run at once (default: every core; 1 per rank under MPI):\n"
             "                       threads, or on the ode backend T worker processes (ODE is\n"
             "                       process-wide); a worker that dies fails its design (exit 1)\n"
@@ -94,7 +103,7 @@ typedef struct sweep {
     long ndesign;
     long lhs;           ///< > 0: Latin hypercube of this many designs
     double* lhs_v;      ///< npar x ndesign values of the hypercube
-    int met[MET_COUNT]; ///< the metrics tabulated
+    int met[SW_MAXMET]; ///< the metrics tabulated (app_design_metrics.h ids)
     int nmet;
     int ncol;
     bool fail_fast;
@@ -200,12 +209,7 @@ static void sb_printf(sbuf* b, const char* fmt, ...) {
     }
 }
 
-static int design_row(void* user, const double* row) {
-    metrics_row(user, row);
-    return app_signal_caught() != 0;
-}
-
-static char* format_row(const sweep* s, long i, const run_metrics* met, int code, const char* err);
+static char* format_row(const sweep* s, long i, const app_design_run* dr, int code, const char* err);
 
 // Run design i; its CSV row (malloc'd, with the newline), or NULL when a
 // signal cut it short (it is then not a finished design). *failed: exit != 0.
@@ -214,8 +218,8 @@ static char* run_design(const sweep* s, long i, bool* failed) {
     for (int k = 0; k < s->npar; ++k) v[k] = design_value(s, i, k);
     char err[1024] = "";
     int code = 0;
-    run_metrics met;
-    metrics_init(&met, s->ncol);
+    app_design_run dr;
+    app_design_run_init(&dr, s->base, s->ncol);
     cJSON* doc = cJSON_Duplicate(s->base->json, 1);
     if (!doc) {
         snprintf(err, sizeof err, "out of memory");
@@ -238,28 +242,41 @@ static char* run_design(const sweep* s, long i, bool* failed) {
         sim_result res;
         sim_energy* en = s->energy ? sim_energy_create() : NULL;
         if (s->process_wide) pthread_mutex_lock(&g_process_wide_mu);
-        sim_run_energy(m, &s->sc, &s->c.sim, design_row, &met, NULL, NULL, NULL, en, &res);
+        // The design's own chain gives its rows' chain columns (the slewing
+        // run's, with its rack, from the first row): metrics by actuator and
+        // function (app_design_metrics.h).
+        dr.chain = &m->chain;
+        sim_run_energy_chain(m, &s->sc, &s->c.sim, app_design_row, &dr, NULL, NULL, NULL, en, &dr.chain, &res);
         if (s->process_wide) pthread_mutex_unlock(&g_process_wide_mu);
         model_free(m);
+        dr.chain = NULL; // the run's chain lived until the run returned; the stats copied what they need
         if (res.status == SIM_REFUSED && app_signal_caught()) {
             sim_energy_free(en);
+            app_design_run_free(&dr);
             return NULL;
         }
-        metrics_finish(&met, &res);
-        if (en) metrics_energy(&met, en);
+        metrics_finish(&dr.met, &res);
+        if (en) metrics_energy(&dr.met, en);
         sim_energy_free(en);
         if (res.status != SIM_OK) {
             code = res.status == SIM_FAILED ? EXIT_RUNTIME : EXIT_USAGE;
             snprintf(err, sizeof err, "%s", res.message);
         }
     }
+    if (!code && dr.oom) {
+        snprintf(err, sizeof err, "out of memory");
+        code = EXIT_RUNTIME;
+    }
     *failed = code != 0;
-    return format_row(s, i, &met, code, err);
+    char* line = format_row(s, i, &dr, code, err);
+    app_design_run_free(&dr);
+    return line;
 }
 
 // The CSV row of design i (malloc'd, with the newline): its values, the
 // metrics (empty when code != 0 or met is NULL), the exit code and err.
-static char* format_row(const sweep* s, long i, const run_metrics* met, int code, const char* err) {
+static char* format_row(const sweep* s, long i, const app_design_run* dr, int code, const char* err) {
+    const run_metrics* met = dr ? &dr->met : NULL;
     double v[SW_MAXPAR];
     for (int k = 0; k < s->npar; ++k) v[k] = design_value(s, i, k);
     sbuf b = {0};
@@ -271,8 +288,10 @@ static char* format_row(const sweep* s, long i, const run_metrics* met, int code
     for (int k = 0; k < s->nmet; ++k) {
         // A metric the run's world does not have (collisions in the
         // validation world) is empty too, not 0.
-        if (code || !met || (s->met[k] == MET_COLLISIONS && !met->present[MET_COLLISIONS])) sb_printf(&b, ",");
-        else sb_printf(&b, ",%s", app_fmt_double(num, sizeof num, met->value[s->met[k]]));
+        const double v = met ? app_design_value(dr, s->met[k]) : NAN;
+        if (code || !met || (s->met[k] == MET_COLLISIONS && !met->present[MET_COLLISIONS]) || !isfinite(v))
+            sb_printf(&b, ",");
+        else sb_printf(&b, ",%s", app_fmt_double(num, sizeof num, v));
     }
     sb_printf(&b, ",%d,", code);
     if (code) {
@@ -405,14 +424,14 @@ static int parse_metrics(sweep* s, const char* list) {
     snprintf(buf, sizeof buf, "%s", list);
     s->nmet = 0;
     for (char *q = buf, *tok; (tok = strsep(&q, ","));) {
-        const int id = metric_find(tok);
+        const int id = app_design_metric_find(tok);
         if (id < 0) {
-            char names[512];
-            metric_names(names, sizeof names);
+            char names[2048];
+            app_design_metric_names(names, sizeof names);
             fprintf(stderr, "cranesim sweep: --metrics: unknown metric '%s' (metrics: %s)\n", tok, names);
             return -1;
         }
-        if (!metrics_present((metric_id)id, s->ncol)) {
+        if (!app_design_metric_present(id, s->ncol)) {
             fprintf(stderr, "cranesim sweep: --metrics: this run has no %s (the ode world's channels)\n", tok);
             return -1;
         }
@@ -421,7 +440,7 @@ static int parse_metrics(sweep* s, const char* list) {
                 fprintf(stderr, "cranesim sweep: --metrics: '%s' given twice\n", tok);
                 return -1;
             }
-        if (s->nmet == MET_COUNT) return -1;
+        if (s->nmet == SW_MAXMET) return -1;
         s->met[s->nmet++] = id;
     }
     return 0;
@@ -809,7 +828,7 @@ static int sweep_run(sweep* s, int threads, int rank, int nrank, const char* out
         }
         fprintf(o->f, "index");
         for (int k = 0; k < s->npar; ++k) fprintf(o->f, ",%s", s->par[k].path);
-        for (int k = 0; k < s->nmet; ++k) fprintf(o->f, ",%s", metric_name((metric_id)s->met[k]));
+        for (int k = 0; k < s->nmet; ++k) fprintf(o->f, ",%s", app_design_metric_name(s->met[k]));
         fprintf(o->f, ",exit,error\n");
     }
     if (s->process_wide && nrank == 1 && threads > 1) {
@@ -979,7 +998,7 @@ static int sweep_plots(const sweep* s, const sweep_out* o, const char* plot) {
     int nplot = 0;
     char err[512], png[1400], title[400];
     for (int mk = 0; mk < s->nmet && !rc && !(one && nplot); ++mk) {
-        const char* mn = metric_name((metric_id)s->met[mk]);
+        const char* mn = app_design_metric_name(s->met[mk]);
         // The axis and the colours in the run summary's units (MPa, deg, kJ),
         // as a user reads the runs; the CSV stays SI.
         char ylab[96];
@@ -1147,8 +1166,13 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
         }
         cJSON_Delete(doc);
     }
+    // A chain model's metrics by actuator and function, by name.
+    if (!rc && app_design_metrics_setup(s.base)) {
+        fprintf(stderr, "cranesim sweep: out of memory\n");
+        rc = EXIT_RUNTIME;
+    }
     if (!rc && metrics) rc = parse_metrics(&s, metrics) ? EXIT_USAGE : 0;
-    else if (!rc)
+    else if (!rc) {
         for (int id = 0; id < MET_COUNT; ++id)
             // The energy metrics only when asked: the accounting costs a
             // circuit evaluation per step, and the default table stays as it was.
@@ -1156,6 +1180,10 @@ static int sweep_main(int argc, char** argv, int rank, int nrank) {
             if (metrics_present((metric_id)id, s.ncol) && id != MET_ENERGY_IN && id != MET_ENERGY_LOSS &&
                 id != MET_COLLISIONS)
                 s.met[s.nmet++] = id;
+        // Then a chain's by actuator and function: the table shows each one
+        // the model has (a two-link model has none: its table as it was).
+        for (int k = 0; k < app_design_metric_chain_count() && s.nmet < SW_MAXMET; ++k) s.met[s.nmet++] = MET_COUNT + k;
+    }
     for (int k = 0; k < s.nmet; ++k)
         if (s.met[k] == MET_ENERGY_IN || s.met[k] == MET_ENERGY_LOSS) s.energy = true;
     if (!rc && plot && !(strlen(plot) > 4 && !strcmp(plot + strlen(plot) - 4, ".png")) && rank == 0)

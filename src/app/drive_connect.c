@@ -7,8 +7,10 @@
 // reconnect once a second until the drive's time is up.
 #define _GNU_SOURCE
 #include "app.h"
+#include "drive_connect.h"
 #include "protocol.h"
 
+#include <cJSON.h>
 #include <errno.h>
 #include <math.h>
 #include <netdb.h>
@@ -65,6 +67,47 @@ int drive_set_path(const char* set, char* path, size_t np, double* v) {
     return 0;
 }
 
+int dc_hello_functions(const char* json, size_t len, dc_functions* f, char* err, size_t errsz) {
+    memset(f, 0, sizeof *f);
+    cJSON* j = json ? cJSON_ParseWithLength(json, len) : NULL;
+    const cJSON* fa = cJSON_GetObjectItem(j, "functions");
+    const cJSON* ca = cJSON_GetObjectItem(j, "cylinders");
+    int rc = -1;
+    const int n = cJSON_GetArraySize(fa), nc = cJSON_GetArraySize(ca);
+    if (!j) snprintf(err, errsz, "server hello: the description is not JSON");
+    else if (!cJSON_IsArray(fa) || n < 1)
+        snprintf(err, errsz, "server hello: no \"functions\" (a server before protocol version 3?)");
+    else if (n > PROTO_MAX_FN)
+        snprintf(err, errsz, "server hello: %d functions, at most %d", n, PROTO_MAX_FN);
+    else if (nc > PROTO_MAX_CYL)
+        snprintf(err, errsz, "server hello: %d cylinders, at most %d", nc, PROTO_MAX_CYL);
+    else {
+        rc = 0;
+        for (int k = 0; k < n && !rc; ++k) {
+            const cJSON* o = cJSON_GetArrayItem(fa, k);
+            const char* name = cJSON_GetStringValue(cJSON_GetObjectItem(o, "name"));
+            if (!name || !name[0] || strlen(name) >= DC_FN_NAME) {
+                snprintf(err, errsz, "server hello: functions[%d].name missing, empty or longer than %d bytes", k,
+                         DC_FN_NAME - 1);
+                rc = -1;
+                break;
+            }
+            snprintf(f->name[k], DC_FN_NAME, "%s", name);
+            const cJSON* a0 = cJSON_GetArrayItem(cJSON_GetObjectItem(o, "actuators"), 0);
+            const cJSON* ci = cJSON_GetObjectItem(a0, "cylinder");
+            f->cyl[k] = cJSON_IsNumber(ci) && ci->valuedouble >= 0 && ci->valuedouble < nc ? ci->valueint : -1;
+        }
+        for (int i = 0; i < nc && !rc; ++i) {
+            const char* name = cJSON_GetStringValue(cJSON_GetObjectItem(cJSON_GetArrayItem(ca, i), "name"));
+            snprintf(f->cyl_name[i], DC_FN_NAME, "%s", name ? name : "");
+        }
+        f->n = rc ? 0 : n;
+        f->ncyl = rc ? 0 : nc;
+    }
+    cJSON_Delete(j);
+    return rc;
+}
+
 int drive_connect(const char* addr, const scenario* sc, double duration, const char* const* sets, int nset) {
     char host[256], port[16];
     const char* colon = strrchr(addr, ':');
@@ -94,6 +137,9 @@ int drive_connect(const char* addr, const scenario* sc, double duration, const c
     uint64_t seq = 0, last_seq = 0, set_seq[64] = {0}; // set_seq: a SET sent, not answered yet
     int role = -1, code = 0;
     bool ever = false;
+    dc_functions fns = {.n = 0};
+    int fcol[PROTO_MAX_FN]; // the scenario's column for each of the server's functions, -1: none (0)
+    double fmax_cmd[PROTO_MAX_FN] = {0}; // the largest |command| the frames showed per function [-]
     app_signals sig;
     app_signals_catch(&sig);
     while (sim_wall_time() - w0 < duration && !app_signal_caught()) {
@@ -140,10 +186,27 @@ int drive_connect(const char* addr, const scenario* sc, double duration, const c
                 if (rc == 0) break;
                 off += used;
                 if (m.type == PROTO_SERVER_HELLO) {
+                    // The functions, in the order VALVES takes them; the
+                    // scripted operator's column of each name (lift, jib,
+                    // slew, or the scenario's own), 0 where it has none.
+                    if (dc_hello_functions(m.u.shello.json, m.u.shello.json_len, &fns, err, sizeof err)) {
+                        fprintf(stderr, "cranesim drive: --connect %s: %s\n", addr, err);
+                        code = EXIT_RUNTIME;
+                        up = false;
+                        why = err;
+                        break;
+                    }
+                    for (int k = 0; k < fns.n; ++k) fcol[k] = scenario_find_command(sc, fns.name[k]);
                     role = m.u.shello.role;
                     printf("cranesim drive: connected to %s (%s)%s\n", addr,
                            role == PROTO_CONTROL ? "controlling" : "watching: another client controls",
                            ever ? ", reconnected" : "");
+                    if (!ever) {
+                        printf("cranesim drive: the server's %d function%s:", fns.n, fns.n == 1 ? "" : "s");
+                        for (int k = 0; k < fns.n; ++k)
+                            printf("%s %s%s", k ? "," : "", fns.name[k], fcol[k] < 0 ? " (not in the scenario: 0)" : "");
+                        printf("\n");
+                    }
                     fflush(stdout);
                     ever = true;
                     // The drive's --set values go to the server once per
@@ -184,14 +247,16 @@ int drive_connect(const char* addr, const scenario* sc, double duration, const c
                     if (last_seq && st->seq > last_seq + 1) lost += (long)(st->seq - last_seq - 1);
                     last_seq = st->seq;
                     last_t = st->nine[8];
+                    for (int k = 0; k < st->nfn && k < fns.n; ++k) fmax_cmd[k] = fmax(fmax_cmd[k], fabs(st->fn[k][0]));
                     if (seq && st->cmd_seq == seq && sent_at > 0) {
                         const double l = sim_wall_time() - sent_at;
                         lat_sum += l, lat_max = fmax(lat_max, l), ++nlat;
                         sent_at = 0;
                     }
                     if (role == PROTO_CONTROL && sent_at == 0) {
-                        proto_command c = {.seq = ++seq, .op = PROTO_OP_VALVES};
-                        for (int k = 0; k < 3; ++k) c.u[k] = fmax(-1, fmin(1, scenario_command(sc, k, last_t)));
+                        proto_command c = {.seq = ++seq, .op = PROTO_OP_VALVES, .nu = (uint8_t)fns.n};
+                        for (int k = 0; k < fns.n; ++k)
+                            c.u[k] = fcol[k] < 0 ? 0 : fmax(-1, fmin(1, scenario_command(sc, fcol[k], last_t)));
                         uint8_t b[128];
                         const size_t n = proto_put_command(b, sizeof b, &c);
                         sent_at = sim_wall_time();
@@ -204,6 +269,7 @@ int drive_connect(const char* addr, const scenario* sc, double duration, const c
         }
         close(fd);
         sent_at = 0;
+        if (code) break; // a hello this drive cannot work with: said above
         if (!up || (sim_wall_time() - w0 < duration && !app_signal_caught())) {
             ++drops;
             printf("cranesim drive: link to %s lost: %s; reconnecting\n", addr, why);
@@ -216,6 +282,11 @@ int drive_connect(const char* addr, const scenario* sc, double duration, const c
                "%.2f ms, max %.2f ms (%ld commands); remote t = %.3f s\n",
                frames, lost, drops, drops == 1 ? "" : "s", links, links == 1 ? "" : "s",
                nlat ? 1e3 * lat_sum / nlat : 0.0, 1e3 * lat_max, nlat, last_t);
+    if (ever) { // what reached the crane, by function (the state frames' function records)
+        printf("  functions, the largest |command| the server applied:");
+        for (int k = 0; k < fns.n; ++k) printf("%s %s %.2f", k ? "," : "", fns.name[k], fmax_cmd[k]);
+        printf("\n");
+    }
     free(rx);
     free(st);
     return code;

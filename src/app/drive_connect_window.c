@@ -10,6 +10,7 @@
 // (0.25 s to 4 s) until the server is back.
 #define _GNU_SOURCE
 #include "app.h"
+#include "drive_connect.h"
 #include "drive_session.h"
 #include "protocol.h"
 #include "render.h"
@@ -33,6 +34,10 @@ typedef struct rlink {
     uint8_t* rx;
     size_t len;
     proto_state* st;
+    proto_state* view;       // st with its cylinder records in the local picture's order (lk_feed)
+    dc_functions fns;        // the server's functions (its hello), in VALVES' order
+    int fcol[PROTO_MAX_FN];  // the scripted operator's column of each, -1: none (0)
+    int cmap[WORLD_SNAP_MAX_CYLINDERS]; // the local picture's cylinder i: record cmap[i] of the frames, -1 none
     int role;                // granted, -1 before the hello
     bool lockstep, ever;
     double rate;             // frames per simulated second [Hz]
@@ -163,6 +168,35 @@ static int scripted_hook(void* user, int attach) {
     return -1;
 }
 
+// The state to the session: its cylinder records reordered to the local
+// picture's cylinders by name (a chain's frames carry every actuator, the
+// picture draws those it has), the open reliefs' cylinders with them.
+static void lk_feed(rlink* k, drive_session* s) {
+    const proto_state* st = k->st;
+    proto_state* v = k->view;
+    memcpy(v, st, sizeof *v);
+    const int nloc = drive_session_snapshot(s)->ncyl;
+    v->ncyl = 0;
+    for (int i = 0; i < nloc && i < WORLD_SNAP_MAX_CYLINDERS && i < PROTO_MAX_CYL; ++i) {
+        const int r = k->cmap[i];
+        if (r >= 0 && r < st->ncyl) {
+            memcpy(v->cyl[i], st->cyl[r], sizeof v->cyl[i]);
+            v->cyl_bits[i] = st->cyl_bits[r];
+        } else {
+            memset(v->cyl[i], 0, sizeof v->cyl[i]);
+            v->cyl_bits[i] = PROTO_CYL_NO_PINS;
+        }
+        v->ncyl = (uint8_t)(i + 1);
+    }
+    for (int q = 0; q < v->nrelief; ++q) {
+        int loc = -1;
+        for (int i = 0; i < v->ncyl && loc < 0; ++i)
+            if (st->relief[q].cyl >= 0 && k->cmap[i] == st->relief[q].cyl) loc = i;
+        v->relief[q].cyl = (int8_t)loc;
+    }
+    drive_session_feed(s, v, k->rt, k->role == PROTO_CONTROL && k->have_sent ? k->u_sent : NULL);
+}
+
 // A state frame arrived: draw it, count it, and answer it with the operator's commands.
 static void lk_state(rlink* k, drive_session* s) {
     const proto_state* st = k->st;
@@ -184,7 +218,7 @@ static void lk_state(rlink* k, drive_session* s) {
         k->rt = k->lockstep ? 0 : (st->nine[8] - k->rt_t0) / (now - k->rt_w0);
         k->rt_w0 = now, k->rt_t0 = st->nine[8];
     }
-    drive_session_feed(s, st, k->rt, k->role == PROTO_CONTROL && k->have_sent ? k->u_sent : NULL);
+    lk_feed(k, s);
     // A SET not refused by the time the echo passes it was applied.
     for (int i = 0; i < k->npend; ++i)
         if (st->cmd_seq >= k->pend[i].seq) {
@@ -224,22 +258,29 @@ static void lk_state(rlink* k, drive_session* s) {
     if (in.pause == 1)
         lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_PAUSE, .flag = !(st->flags & PROTO_F_PAUSED)});
     if (in.hook >= 0) lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_HOOK, .flag = (uint8_t)in.hook});
-    proto_command c = {.op = PROTO_OP_VALVES};
-    if (k->scripted) {
-        double u[3];
-        scenario_play(k->sc, st->nine[8] + 0.5 / k->rate, &k->ev, u, scripted_hook, k);
-        for (int j = 0; j < 3; ++j) c.u[j] = u[j];
-    } else {
-        memcpy(c.u, in.u, sizeof c.u);
+    // One opening per server function, by name: lift, jib, slew from the
+    // session's sticks (or the script's columns of those names and its
+    // own named ones); a function the input does not give stays at 0.
+    proto_command c = {.op = PROTO_OP_VALVES, .nu = (uint8_t)k->fns.n};
+    double u3[3];
+    if (k->scripted) scenario_play(k->sc, st->nine[8] + 0.5 / k->rate, &k->ev, u3, scripted_hook, k);
+    else memcpy(u3, in.u, sizeof u3);
+    for (int j = 0; j < k->fns.n; ++j) {
+        const int col = k->fcol[j];
+        double v = 0;
+        if (col >= 0 && col < 3) v = u3[col];
+        else if (col >= 0 && k->scripted) v = scenario_command(k->sc, col, st->nine[8] + 0.5 / k->rate);
+        c.u[j] = fmax(-1, fmin(1, isfinite(v) ? v : 0));
     }
-    for (int j = 0; j < 3; ++j) c.u[j] = fmax(-1, fmin(1, isfinite(c.u[j]) ? c.u[j] : 0));
     // One command in flight in real time (its echo times the link); in
     // lockstep every frame is answered with the openings and one step.
     if (k->lockstep || k->sent_at == 0) {
         c.seq = ++k->seq;
         if (k->sent_at == 0) k->sent_at = now;
         lk_send(k, &c);
-        memcpy(k->u_sent, c.u, sizeof k->u_sent); // the demand the server's limiter acts on
+        // The demand the server's limiter acts on, as lift, jib, slew (the
+        // HUD's first three cylinders; the limiter is the two-link crane's).
+        for (int j = 0; j < 3; ++j) k->u_sent[j] = fmax(-1, fmin(1, isfinite(u3[j]) ? u3[j] : 0));
         k->have_sent = true;
     }
     if (k->lockstep) lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_STEP, .frames = 1});
@@ -264,6 +305,15 @@ static int lk_hello(rlink* k, drive_session* s, const proto_msg* m, char* err, s
     k->have_sent = false; // a new link: nothing sent on it yet
     k->lockstep = m->u.shello.lockstep;
     k->rate = m->u.shello.rate;
+    // The functions VALVES carries, and the picture's cylinders by name.
+    if (dc_hello_functions(m->u.shello.json, m->u.shello.json_len, &k->fns, err, errsz)) return -1;
+    for (int f = 0; f < k->fns.n; ++f) k->fcol[f] = k->sc ? scenario_find_command(k->sc, k->fns.name[f]) : -1;
+    const world_snapshot* pic = drive_session_snapshot(s);
+    for (int i = 0; i < WORLD_SNAP_MAX_CYLINDERS; ++i) {
+        k->cmap[i] = -1;
+        for (int r = 0; i < pic->ncyl && r < k->fns.ncyl && k->cmap[i] < 0; ++r)
+            if (!strcmp(k->fns.cyl_name[r], pic->cyl[i].name)) k->cmap[i] = r;
+    }
     cJSON* j = cJSON_ParseWithLength(m->u.shello.json, m->u.shello.json_len);
     const int nb = cJSON_GetArraySize(cJSON_GetObjectItem(j, "bodies"));
     cJSON_Delete(j);
@@ -384,11 +434,12 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     }
     k.rx = malloc(PROTO_MAX_SERVER_FRAME + 8);
     k.st = malloc(sizeof *k.st);
+    k.view = malloc(sizeof *k.view);
     char err[700];
     int code = EXIT_RUNTIME;
     drive_session* s = NULL;
     cJSON* desc = NULL;
-    if (!k.rx || !k.st) {
+    if (!k.rx || !k.st || !k.view) {
         fprintf(stderr, "cranesim drive: out of memory\n");
         goto done;
     }
@@ -497,7 +548,7 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     drive_session_set_remote(s);
     k.sets = (const char* const*)c0->sets;
     k.nset = c0->nset;
-    if (lk_hello(&k, s, &m, err, sizeof err)) { // cannot fail: nbody checked above
+    if (lk_hello(&k, s, &m, err, sizeof err)) { // nbody checked above: a hello without functions
         fprintf(stderr, "cranesim drive: %s\n", err);
         goto done_sc;
     }
@@ -573,6 +624,7 @@ done:
     if (s) drive_session_destroy(s);
     free(k.rx);
     free(k.st);
+    free(k.view);
     free(k.hjson);
     return code;
 }

@@ -30,19 +30,36 @@ typedef enum param_kind {
     PK_LOAD, ///< the tip load, where the engine can set it live [kg]
     PK_SOLVER, ///< hydraulic integrator, an index into k_solver (a rebuilt world/solver at the current pose)
     PK_STEP,   ///< hydraulic step [s] (rebuilt likewise)
+    PK_CHAIN,  ///< a crane chain's body or actuator field (chain_field): the model rebuilt from its document
+    PK_CHART,  ///< a strip-chart slot (mech: 0..DRIVE_CHART_SLOTS-1): an index into the session's chart_opt
 } param_kind;
+
+/// The panel's strip-chart slots, as many as --charts takes.
+#define DRIVE_CHART_SLOTS 8
+
+// The fields of a crane chain the panel shows (a chain model's mechanics;
+// the two-link crane's are the mechanics table's, PK_MECH).
+typedef enum chain_field {
+    CF_MASS,   ///< a body's mass [kg]
+    CF_LENGTH, ///< a body's length (the column's height) [m]: shown, not edited (it places the children)
+    CF_WIDTH,  ///< a boom's section across the boom plane [m]
+    CF_HEIGHT, ///< a boom's section in the boom plane [m]
+    CF_CLOSED, ///< an actuator's closed (pin-to-pin) length [m]
+} chain_field;
 
 // One panel entry, generated from the parameter tables (build_params).
 typedef struct drive_param {
     param_kind kind;
-    char group[64], label[48], unit[16];
+    char group[112], label[48], unit[16]; // group: a crane chain's "function: element (type)"
     double value;      ///< shown value, display units (edited by the panel)
     double scale;      ///< SI value = value * scale
     double min, max;   ///< hard range, display units: a typed value outside it is refused
     double tmin, tmax; ///< typical range, display units: what a drag covers
     char hyd_path[96]; ///< PK_HYD: "lift_cyl.bore", "fluid.bulk_modulus"
     char json[160];    ///< path in the model file, for saving
-    int mech;          ///< PK_MECH, PK_LOAD: entry of the mechanics table (model_param_info)
+    int mech;          ///< PK_MECH, PK_LOAD: entry of the mechanics table (model_param_info); PK_CHAIN:
+                       ///< the body's or actuator's index
+    int field;         ///< PK_CHAIN: its chain_field
     bool on_release;   ///< applied when the edit ends: it rebuilds the world
     bool world_only;   ///< PK_HYD of the world's circuit, not the model's (not saved)
     /// PK_HYD whose 0 means "the fluid's value" (a volume's bulk_modulus) and
@@ -100,6 +117,9 @@ struct drive_session {
     int rec_seg0;        // s->segment when it started: its rows count segments from 0
     char rec_err[320];   // first recording failure ("cannot write FILE: ..."), "" if none
     int ncol;
+    double* row;         // (rowcap) one row of the engine's ncol columns and a segment column
+    int rowcap;
+    double* ufn;         // (engine_nfunction) a crane chain's commands by function (scripted)
     int ev;              // next scripted hook event
     chan_list* chans;    // the engine's channels: its row, then its circuit's (channels.h)
     double* chan_v;      // (chan_list_count) their values at the last charted frame
@@ -109,6 +129,9 @@ struct drive_session {
     double readout_scale[8]; // shown = value / scale
     char readout_unit[8][16];
     char readout_name[8][96];
+    char** chart_opt;    // (nchart_opt) the panel's chart choices: "(default)", then every channel's name
+    int nchart_opt;
+    char chart_pick[DRIVE_CHART_SLOTS][96]; // the channel each chart slot shows ("" none)
     int nchart;          // user-chosen strip-chart channels (0: the default set)
     int chart_col[8];    // their channels (index into chans)
     int chart_id[8];     // their render chart ids
@@ -120,8 +143,11 @@ struct drive_session {
     int sess_err;        // errno of a failed session write (0: none)
     session* rp;         // --replay: the session whose commands drive instead of the devices
     long rp_next;        // its next tick
+    int* rp_map;         // the session's command of each of the engine's functions (session_function_map)
+    double* rp_u;        // one tick's commands by the engine's functions
     char err[400];
     char status[512];
+    char rec_stop[400];  // why the last rebuild ended the recording ("" if it did not)
     // Remote mode (drive --connect): the snapshot and row come from the server.
     double mapbox_off;   // wall time [s] the mapping box hides by itself (DRIVE_MAPPING_S), < 0: M decides
     bool remote;
@@ -218,9 +244,12 @@ static drive_param* add_param(drive_session* s, param_kind k, const char* group,
 // in the model file; one of the world's own circuit (the sandbox's slew
 // valve) lives in the world file: set on the running circuit only (and again
 // after a rebuild), not saved.
-static void add_element(drive_session* s, const hyd_model* live, const char* name, hyd_type t) {
-    char group[64];
-    snprintf(group, sizeof group, "%s (%s)", name, hyd_type_name(t));
+// fn: the crane chain's function the element belongs to (its valve, an
+// actuator's cylinder), which heads its group, or NULL.
+static void add_element(drive_session* s, const hyd_model* live, const char* name, hyd_type t, const char* fn) {
+    char group[112];
+    if (fn) snprintf(group, sizeof group, "%s: %s (%s)", fn, name, hyd_type_name(t));
+    else snprintf(group, sizeof group, "%s (%s)", name, hyd_type_name(t));
     const int is_node = t == HYD_TANK || t == HYD_VOLUME;
     for (int k = 0; k < hyd_param_count(t); ++k) {
         double lo, hi, tlo, thi, v;
@@ -268,17 +297,108 @@ static void mech_group(const crane_mech* me, const model_param* mp, char* out, s
         snprintf(out, n, "%s", mp->group);
 }
 
+// The value of a crane chain's field (PK_CHAIN) in model m [SI].
+static double chain_value(const model* m, int i, chain_field f) {
+    const crane_chain* c = &m->chain;
+    if (f == CF_CLOSED) return i >= 0 && i < c->nact ? c->act[i].closed_length : NAN;
+    if (i < 0 || i >= c->nbody) return NAN;
+    const crane_body* b = &c->body[i];
+    return f == CF_MASS ? b->def.mass : f == CF_LENGTH ? b->length : f == CF_WIDTH ? b->width : b->height;
+}
+
+// like: the two-link mechanics table's entry whose range a chain field
+// shares (the loader checks a chain's bodies against the same ranges):
+// "mechanics.links[0].mass", "mechanics.column.height", ...
+static void add_chain_param(drive_session* s, const char* group, const char* label, const char* like, int i,
+                            chain_field f, const char* json) {
+    model_param r = {.unit = "-", .lo = 0, .hi = INFINITY, .tlo = 0, .thi = 1};
+    for (int k = 0; k < model_param_count(); ++k) {
+        model_param mp;
+        if (!model_param_info(k, &mp) && !strcmp(mp.path, like)) r = mp;
+    }
+    drive_param* p = add_param(s, PK_CHAIN, group, label, r.unit, r.lo, r.hi, r.tlo, r.thi,
+                               chain_value(s->m, i, f));
+    if (!p) return;
+    p->mech = i;
+    p->field = (int)f;
+    // Every edit rebuilds the world (the chain engine has no edits in
+    // place): once, when the drag or the typing ends.
+    p->on_release = true;
+    snprintf(p->json, sizeof p->json, "%s", json);
+}
+
+// A crane chain's entries, grouped by function and body: each function's
+// valve, then per actuator of it its cylinder (bore, rod, stroke) and its
+// closed length; the rest of the circuit as the two-link crane's; the
+// bodies' masses and sizes after the fluid (chain_bodies). done[i]: circuit
+// element i is listed.
+static void chain_functions(drive_session* s, const hyd_model* live, bool* done) {
+    const crane_chain* c = &s->m->chain;
+    const int ne = hyd_model_nelement(live);
+    for (int f = 0; f < c->nfn; ++f) {
+        const char* fn = c->fn[f].name;
+        for (int i = 0; i < ne; ++i) {
+            hyd_type t;
+            const char* name = hyd_model_element(live, i, &t);
+            if (done[i] || strcmp(name, c->fn[f].valve)) continue;
+            add_element(s, live, name, t, fn);
+            done[i] = true;
+        }
+        for (int k = 0; k < c->nact; ++k) {
+            const crane_act* a = &c->act[k];
+            if (a->function != f) continue;
+            for (int i = 0; i < ne; ++i) {
+                hyd_type t;
+                const char* name = hyd_model_element(live, i, &t);
+                if (done[i] || strcmp(name, a->cylinder)) continue;
+                add_element(s, live, name, t, fn);
+                done[i] = true;
+            }
+            char group[112], json[96];
+            snprintf(group, sizeof group, "%s: %s (actuator)", fn, a->name);
+            snprintf(json, sizeof json, "mechanics.actuators[%d].closed_length", k);
+            add_chain_param(s, group, "closed length", "mechanics.actuators[0].closed_length", k, CF_CLOSED, json);
+        }
+    }
+}
+
+static void chain_bodies(drive_session* s) {
+    const crane_chain* c = &s->m->chain;
+    for (int i = 0; i < c->nbody; ++i) {
+        const crane_body* b = &c->body[i];
+        char group[112], json[96];
+        snprintf(group, sizeof group, "%s (%s)", b->def.name,
+                 i == 0 ? "column" : b->def.joint == CHAIN_PRISMATIC ? "extension" : "boom");
+        snprintf(json, sizeof json, "mechanics.bodies[%d].mass", i);
+        add_chain_param(s, group, "mass", i ? "mechanics.links[0].mass" : "mechanics.column.mass", i, CF_MASS, json);
+        snprintf(json, sizeof json, "mechanics.bodies[%d].%s", i, i ? "length" : "height");
+        add_chain_param(s, group, i ? "length" : "height",
+                        i ? "mechanics.links[0].length" : "mechanics.column.height", i, CF_LENGTH, json);
+        if (i == 0) continue; // the column's section is its radius, drawn and collided as the slew's
+        snprintf(json, sizeof json, "mechanics.bodies[%d].width", i);
+        add_chain_param(s, group, "width", "mechanics.links[0].width", i, CF_WIDTH, json);
+        snprintf(json, sizeof json, "mechanics.bodies[%d].height", i);
+        add_chain_param(s, group, "height", "mechanics.links[0].height", i, CF_HEIGHT, json);
+    }
+}
+
 // The panel's list, generated from the tables: every element of the running
-// circuit with its type's parameters, the fluid, the mechanics table and the
-// run's own settings (solver). No component name is known here.
+// circuit with its type's parameters, the fluid, the mechanics table (a
+// crane chain: its functions and bodies) and the run's own settings
+// (solver). No component name is known here.
 static void build_params(drive_session* s) {
     s->nparam = 0;
     const hyd_model* live = engine_circuit(s->l);
+    const bool chain = !s->m->chain.two_link;
+    bool* done = calloc((size_t)hyd_model_nelement(live) + 1, sizeof *done);
+    if (!done) return;
+    if (chain) chain_functions(s, live, done);
     for (int i = 0; i < hyd_model_nelement(live); ++i) {
         hyd_type t;
         const char* name = hyd_model_element(live, i, &t);
-        add_element(s, live, name, t);
+        if (!done[i]) add_element(s, live, name, t, NULL);
     }
+    free(done);
     for (int k = 0; k < hyd_fluid_param_count(); ++k) {
         double lo, hi, tlo, thi, v;
         char hp[96];
@@ -291,7 +411,10 @@ static void build_params(drive_session* s) {
         snprintf(p->json, sizeof p->json, "hydraulics.%s", hp);
     }
     crane_mech* me = &s->m->mech;
-    for (int k = 0; k < model_param_count(); ++k) {
+    if (chain) chain_bodies(s);
+    // A crane chain's mechanics are its bodies' (the table's links and
+    // actuators are the two-link crane's).
+    for (int k = 0; k < model_param_count() && !chain; ++k) {
         model_param mp;
         model_param_info(k, &mp);
         if (!model_param_present(me, k)) continue; // an optional field the model lacks (its rating)
@@ -314,6 +437,19 @@ static void build_params(drive_session* s) {
     drive_param* p = add_param(s, PK_SOLVER, "solver", "method", "-", 0, NSOLVER - 1, 0, NSOLVER - 1, method);
     if (p) p->scale = 1, p->unit[0] = 0;
     add_param(s, PK_STEP, "solver", "step", "s", 0.05e-3, 1e-3, 0.05e-3, 1e-3, s->c.sim.h);
+    // The strip charts: a slot per chart, each a choice among the engine's
+    // channels by name (a crane chain's every actuator and function too),
+    // "(default)" for none; all "(default)": the default set.
+    for (int k = 0; k < DRIVE_CHART_SLOTS && s->nchart_opt > 0; ++k) {
+        int pick = 0;
+        for (int j = 1; j < s->nchart_opt && s->chart_pick[k][0] && !pick; ++j)
+            if (!strcmp(s->chart_opt[j], s->chart_pick[k])) pick = j;
+        char label[16];
+        snprintf(label, sizeof label, "chart %d", k + 1);
+        drive_param* q = add_param(s, PK_CHART, "charts", label, "-", 0, s->nchart_opt - 1, 0, s->nchart_opt - 1, pick);
+        if (!q) return;
+        q->scale = 1, q->unit[0] = 0, q->mech = k;
+    }
     // What cannot change in place rebuilds the world (loads back at their
     // start): applied once when the drag or the typing ends, not at every
     // pixel. A link's mass, inertia and centre of mass go to engine_set_link
@@ -349,6 +485,7 @@ static void sync_json(drive_session* s, const drive_param* p) {
 // The model document's mechanics as the model has them (after an edit that
 // scaled other fields, or a revert).
 static void sync_mech_json(drive_session* s) {
+    if (!s->m->chain.two_link) return; // a chain's fields are edited in its document (apply_chain)
     for (int k = 0; k < model_param_count(); ++k) {
         model_param mp;
         model_param_info(k, &mp);
@@ -362,6 +499,7 @@ static void sync_mech_json(drive_session* s) {
 // Panel values of the mechanics from the model (after an edit moved other
 // fields with it, or a revert).
 static void refresh_mech_params(drive_session* s) {
+    if (!s->m->chain.two_link) return; // no PK_MECH entries
     for (int i = 0; i < s->nparam; ++i) {
         drive_param* p = &s->param[i];
         if (p->kind == PK_MECH) p->value = *model_param_ptr(&s->m->mech, p->mech) / p->scale;
@@ -371,15 +509,38 @@ static void refresh_mech_params(drive_session* s) {
 static engine* make_engine(drive_session* s, const double q0[2], double slew0) {
     char err[400];
     const double m3 = s->rp ? s->rp->m3 : sim_load_mass(s->m, &s->sc, &s->c.sim);
-    // The window draws the snapshot, the HUD and panel are the two-link
-    // crane's (issue 27 sizes them by the model): a crane chain is refused
-    // here, before the window opens (drive --headless runs it).
-    if (engine_require(s->m, &s->c.sim, ENGINE_CAP_SNAPSHOT | ENGINE_CAP_TWO_LINK | ENGINE_CAP_SET_LINK,
-                       "the window (--headless runs a crane chain)", s->err, sizeof s->err))
+    // The window draws the engine's snapshot, with a HUD, charts and panel
+    // sized by it: an engine with a picture (the two-link crane, a crane
+    // chain in the sandbox). Without one (a chain in the validation world or
+    // the lagrange view) it is refused here, before the window opens (drive
+    // --headless runs it). A session file carries the two-link crane's three
+    // commands: replaying one needs that crane.
+    const unsigned need = ENGINE_CAP_SNAPSHOT | (s->rp || s->o.session_path ? ENGINE_CAP_TWO_LINK : 0u);
+    if (engine_require(s->m, &s->c.sim, need, "the window (--headless runs a crane chain)", s->err, sizeof s->err))
         return NULL;
     engine* l = engine_create(s->m, &s->c.sim, q0, slew0, m3, err, sizeof err);
     if (!l) snprintf(s->err, sizeof s->err, "%s", err);
     return l;
+}
+
+// The row buffers for the running engine: its ncol columns (a crane
+// chain's are more than SIM_NCOL) and the record's segment column, and its
+// commands by function. -1: out of memory (the old buffers stay).
+static int size_buffers(drive_session* s) {
+    const int ncol = engine_ncol(s->l), need = (ncol > SIM_NCOL ? ncol : SIM_NCOL) + 1;
+    const int nfn = engine_nfunction(s->l) > 0 ? engine_nfunction(s->l) : 1;
+    if (need > s->rowcap) {
+        double* r = realloc(s->row, (size_t)need * sizeof *r);
+        if (!r) return -1;
+        s->row = r;
+        s->rowcap = need;
+    }
+    double* u = realloc(s->ufn, (size_t)nfn * sizeof *u);
+    if (!u) return -1;
+    s->ufn = u;
+    for (int k = 0; k < nfn; ++k) s->ufn[k] = 0;
+    s->ncol = ncol;
+    return 0;
 }
 
 static void say(drive_session* s, const char* text) {
@@ -423,6 +584,7 @@ static void remote_param(drive_session* s, drive_param* p) {
         return;
     }
     if (p->kind == PK_MECH) p->value = *model_param_ptr(&s->m->mech, p->mech) / p->scale;
+    if (p->kind == PK_CHAIN) p->value = chain_value(s->m, p->mech, (chain_field)p->field) / p->scale;
     if (p->kind == PK_STEP) p->value = s->c.sim.h / p->scale;
     if (p->kind == PK_SOLVER)
         for (int k = 0; k < NSOLVER; ++k)
@@ -479,10 +641,98 @@ static void follow_fluid(drive_session* s, drive_param* p, double si) {
     }
 }
 
+static void rebuild_world(drive_session* s, bool at_start);
+static void rebind_charts(drive_session* s);
+static void take_snapshot(drive_session* s);
+static void apply_chart_picks(drive_session* s);
+
+// A crane chain's body or actuator field set to si [SI]: the model is built
+// again from its document with the new value (so the chain, its columns and
+// its circuit stay one model), and the world rebuilt with it at the current
+// pose (the first two boom angles and the slew; every other joint back at
+// the middle of its limits, as a run starts: engine_create). A body's mass
+// carries its inertia with it (the same distribution). A length is refused:
+// it places the children's joints and the pins on the body, which the file
+// gives separately. -1 with the reason in the status line, the old value
+// shown again, and the running world untouched.
+static int apply_chain(drive_session* s, drive_param* p, double si) {
+    const chain_field f = (chain_field)p->field;
+    const double old = chain_value(s->m, p->mech, f);
+    if (f == CF_LENGTH) {
+        p->value = old / p->scale;
+        char t[512];
+        snprintf(t, sizeof t, "refused: %s/%s: it places the joints of the bodies on it and the actuators' pins, "
+                 "which the model file gives: edit %s there and load it", p->group, p->label, p->json);
+        say(s, t);
+        return -1;
+    }
+    char a[240], e[320];
+    cJSON* doc = cJSON_Duplicate(s->m->json, 1);
+    int rc = doc ? 0 : -1;
+    snprintf(e, sizeof e, "out of memory");
+    if (!rc) {
+        snprintf(a, sizeof a, "%s=%.10g", p->json, si);
+        rc = json_set_path(doc, a, e, sizeof e);
+    }
+    if (!rc && f == CF_MASS && old > 0) {
+        // The file's moment of inertia (a boom's Iyy) scales with the mass.
+        const cJSON* b = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(
+                                                cJSON_GetObjectItemCaseSensitive(doc, "mechanics"), "bodies"),
+                                            p->mech);
+        const cJSON* in = cJSON_GetObjectItemCaseSensitive(b, "inertia");
+        if (cJSON_IsNumber(in)) {
+            snprintf(a, sizeof a, "mechanics.bodies[%d].inertia=%.10g", p->mech, in->valuedouble * si / old);
+            rc = json_set_path(doc, a, e, sizeof e);
+        }
+    }
+    model* nm = NULL;
+    if (!rc) {
+        nm = model_from_json(doc, s->m->file, e, sizeof e); // owns doc from here
+        doc = NULL;
+    }
+    cJSON_Delete(doc);
+    if (!nm) {
+        p->value = old / p->scale;
+        char t[512];
+        snprintf(t, sizeof t, "refused: %s/%s: %s", p->group, p->label, e);
+        say(s, t);
+        return -1;
+    }
+    // What the scenario added to the model (its bursts) goes along.
+    if (s->m->world_bursts) nm->world_bursts = cJSON_Duplicate(s->m->world_bursts, 1);
+    snprintf(nm->world_bursts_src, sizeof nm->world_bursts_src, "%s", s->m->world_bursts_src);
+    model* om = s->m;
+    const int seg = s->segment;
+    const double t_at = s->t_base + engine_time(s->l);
+    s->m = nm;
+    rebuild_world(s, false);
+    if (s->segment == seg) { // rebuild_world said why; the old world runs on
+        s->m = om;
+        model_free(nm);
+        p->value = old / p->scale;
+        return -1;
+    }
+    model_free(om);
+    ++s->st.rebuilds;
+    rebind_charts(s);
+    char t[512];
+    snprintf(t, sizeof t, "%s/%s = %.4g %s: world rebuilt at t = %.2f s (the joints past the first two booms at "
+             "mid-limits)", p->group, p->label, p->value, p->unit, t_at);
+    say(s, t);
+    return 0;
+}
+
 // Apply one accepted panel change to the running simulation; -1 when the
 // circuit rejected it (the panel shows the old value again).
 static int apply_param(drive_session* s, int i) {
     drive_param* p = &s->param[i];
+    if (p->kind == PK_CHART) { // the window's own charts, local and remote alike
+        const int k = (int)p->value;
+        snprintf(s->chart_pick[p->mech], sizeof s->chart_pick[0], "%s",
+                 k > 0 && k < s->nchart_opt ? s->chart_opt[k] : "");
+        apply_chart_picks(s);
+        return 0;
+    }
     if (s->remote) {
         remote_param(s, p); // set on the server, not in this drive's model
         return 0;
@@ -541,6 +791,12 @@ static int apply_param(drive_session* s, int i) {
         refresh_mech_params(s);
         break;
     }
+    case PK_CHART: // applied above
+        return 0;
+    case PK_CHAIN:
+        if (apply_chain(s, p, si)) return -1; // the status line says why
+        note_unsaved(s, p);
+        return 0;
     case PK_LOAD:
         engine_set_load(s->l, si);
         s->c.sim.load_mass = si;
@@ -572,8 +828,10 @@ static int apply_param(drive_session* s, int i) {
     return 0;
 }
 
+static void stop_recording(drive_session* s);
+
 static void rebuild_world(drive_session* s, bool at_start) {
-    double row[SIM_NCOL];
+    double* row = s->row; // the running engine's columns (size_buffers)
     engine_row(s->l, row);
     double q0[2] = {row[COL_Q1], row[COL_Q2]}, slew0 = row[COL_SLEW]; // 0 where the crane does not slew
     if (at_start) {
@@ -621,6 +879,18 @@ static void rebuild_world(drive_session* s, bool at_start) {
     ++s->segment;
     engine_destroy(s->l);
     s->l = l;
+    // A loaded model may have other columns (a crane chain's): the record
+    // holds one header, so it stops there.
+    const int ncol_old = s->ncol;
+    s->rec_stop[0] = '\0';
+    if (size_buffers(s)) {
+        snprintf(s->status, sizeof s->status, "out of memory");
+    } else if (s->ncol != ncol_old && s->rec) {
+        stop_recording(s);
+        snprintf(s->rec_stop, sizeof s->rec_stop, "%.300s (the new model has %d columns, the recording %d)", s->status,
+                 s->ncol, ncol_old);
+        snprintf(s->status, sizeof s->status, "%s", s->rec_stop);
+    }
     // The same circuit, so the same channels in the same order (the charts
     // keep their indices); the list reads the new engine.
     chan_list* cl = chan_list_create(l);
@@ -642,10 +912,13 @@ static void rebuild_world(drive_session* s, bool at_start) {
 // of them: the engine's columns (among the first ncol) and, when cl is not
 // NULL, its circuit's channels ("lift_cyl.A.p"). Without cl a name with a
 // dot is taken as a circuit channel, checked when the session has its
-// circuit. Fills col[] (indices into cl, or columns; -1 for a deferred name)
-// and returns the count, or -1 with a one-line message.
-static int parse_charts(const char* opt, const char* list, int ncol, const chan_list* cl, int col[8], char* err,
-                        size_t errsz) {
+// circuit. Without cl, cc (may be NULL) is the crane chain the model has:
+// its own columns (crane_chain_columns: x_<actuator>, u_<function>, ...) are
+// names too, checked again when the session has its engine. Fills col[]
+// (indices into cl, or columns; -1 for a deferred name) and returns the
+// count, or -1 with a one-line message.
+static int parse_charts(const char* opt, const char* list, int ncol, const chan_list* cl, const crane_chain* cc,
+                        int col[8], char* err, size_t errsz) {
     int n = 0;
     for (const char* p = list;; ++p) {
         const char* e = strchr(p, ',');
@@ -661,14 +934,20 @@ static int parse_charts(const char* opt, const char* list, int ncol, const chan_
             if (k >= ncol && k < chan_list_nrow(cl)) continue; // a world column the engine does not write
             if (strlen(nm) == len && !strncmp(p, nm, len)) c = k;
         }
-        const bool deferred = !cl && memchr(p, '.', len);
+        bool deferred = !cl && memchr(p, '.', len);
+        for (int k = 0; !cl && cc && k < cc->ncol && !deferred; ++k)
+            deferred = strlen(cc->col[k].name) == len && !strncmp(p, cc->col[k].name, len);
         if (c < 0 && !deferred) {
             // A circuit channel is named after the model's nodes and
             // components (docs/render.md), a column is in run --help.
             const bool circ = memchr(p, '.', len) != NULL;
             snprintf(err, errsz, "%s: no %s '%.*s'%s (see %s for the names)", opt, circ ? "circuit channel" : "column",
                      (int)len, p, ncol < SIM_NCOL && !circ ? " in the lagrange view" : "",
-                     circ ? "the model's node and component names, docs/render.md" : "cranesim run --help");
+                     circ ? "the model's node and component names, docs/render.md"
+                     : (cc || (cl && chan_list_nrow(cl) > SIM_NCOL)) ? "cranesim run --help and the crane chain's "
+                                                                       "columns x_<actuator>, pA_<actuator>, "
+                                                                       "u_<function>, ... in docs/render.md"
+                                                                     : "cranesim run --help");
             return -1;
         }
         if (n == 8) {
@@ -689,16 +968,22 @@ int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t
                              "krus, ros2, rk4, ros34pw2 or rodas3");
         return EXIT_USAGE;
     }
-    if (o->charts) {
-        int col[8];
-        if (parse_charts("--charts", o->charts, sim_ncol(&c->sim), NULL, col, err, errsz) < 0)
-            return EXIT_USAGE;
+    // A crane chain's columns are named after its actuators and functions:
+    // the model says which (a model that does not load is said by the load
+    // that follows; here the names are then the base columns).
+    model* m = NULL;
+    if (o->charts || o->readouts) {
+        char me[300];
+        m = model_load(c->model_path, c->sets, c->nset, me, sizeof me);
     }
-    if (o->readouts) {
-        int col[8];
-        if (parse_charts("--readouts", o->readouts, sim_ncol(&c->sim), NULL, col, err, errsz) < 0)
-            return EXIT_USAGE;
-    }
+    const crane_chain* cc = m && !m->chain.two_link ? &m->chain : NULL;
+    int col[8], rc = 0;
+    if (o->charts && parse_charts("--charts", o->charts, sim_ncol(&c->sim), NULL, cc, col, err, errsz) < 0)
+        rc = EXIT_USAGE;
+    if (!rc && o->readouts && parse_charts("--readouts", o->readouts, sim_ncol(&c->sim), NULL, cc, col, err, errsz) < 0)
+        rc = EXIT_USAGE;
+    model_free(m);
+    if (rc) return rc;
     if (o->mapping_file) {
         // Read and checked here; its function names against the model's
         // functions when the session builds the mapping (setup_mapping).
@@ -774,7 +1059,7 @@ static int setup_charts(drive_session* s, const char* list, char* err, size_t er
                                         {0.5f, 0.9f, 0.4f, 1},   {0.8f, 0.5f, 0.95f, 1},  {0.95f, 0.6f, 0.2f, 1},
                                         {0.6f, 0.9f, 0.9f, 1},   {0.9f, 0.9f, 0.9f, 1}};
     int cols[8];
-    const int n = parse_charts("--charts", list, s->ncol, s->chans, cols, err, errsz);
+    const int n = parse_charts("--charts", list, s->ncol, s->chans, NULL, cols, err, errsz);
     if (n < 0) return -1;
     for (int i = 0; i < n; ++i) {
         const int col = cols[i];
@@ -810,6 +1095,13 @@ static void act_reset(void* user);
 static void act_save(void* user);
 static void act_pause(void* user);
 
+static void free_chart_opt(drive_session* s) {
+    for (int k = 0; k < s->nchart_opt; ++k) free(s->chart_opt[k]);
+    free(s->chart_opt);
+    s->chart_opt = NULL;
+    s->nchart_opt = 0;
+}
+
 // The panel for the model and engine as they are: generated entries, the
 // model file box and the actions. Replaces the old panel (a loaded model has
 // other components); the window stays shown or hidden as it was.
@@ -821,16 +1113,28 @@ static int setup_panel(drive_session* s) {
         render_attach_panel(s->r, NULL);
         panel_destroy(s->pn);
     }
+    // The chart choices of the engine's channels (they outlive the panel:
+    // freed only once it is gone).
+    free_chart_opt(s);
+    const int nch = s->chans ? chan_list_count(s->chans) : 0;
+    s->chart_opt = calloc((size_t)nch + 1, sizeof *s->chart_opt);
+    if (s->chart_opt) {
+        s->chart_opt[s->nchart_opt++] = strdup("(default)");
+        for (int k = 1; k < nch; ++k) // not t
+            if ((s->chart_opt[s->nchart_opt] = strdup(chan_list_channel(s->chans, k)->name))) ++s->nchart_opt;
+    }
     s->pn = panel_create();
     if (!s->pn) return -1;
     build_params(s);
     for (int i = 0; i < s->nparam; ++i) {
         drive_param* p = &s->param[i];
         panel_param_def d = {p->label, p->group, p->unit, &p->value, p->min, p->max, 0, p->on_release};
-        s->pid[i] = p->kind == PK_SOLVER
-                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
+        s->pid[i] = p->kind == PK_SOLVER ? panel_add_choice(s->pn, p->label, p->group, &p->value, k_solver_name, NSOLVER)
+                    : p->kind == PK_CHART
+                        ? panel_add_choice(s->pn, p->label, p->group, &p->value, (const char* const*)s->chart_opt,
+                                           s->nchart_opt)
                         : panel_add_param(s->pn, &d);
-        if (p->kind != PK_SOLVER) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
+        if (p->kind != PK_SOLVER && p->kind != PK_CHART) panel_set_slider_range(s->pn, s->pid[i], p->tmin, p->tmax);
         if (p->inherit[0]) panel_set_note(s->pn, s->pid[i], "fluid's");
     }
     panel_add_text(s->pn, "model file", s->load_path, sizeof s->load_path);
@@ -844,9 +1148,51 @@ static int setup_panel(drive_session* s) {
     return 0;
 }
 
+// The charts without --charts: one set of channels per cylinder the world
+// has (the sandbox's slew rack is the third; the validation world and the
+// lagrange view have only the two boom cylinders); a crane chain's every
+// actuator and the slew rack, by name.
+static void default_charts(drive_session* s) {
+    if (s->m->chain.two_link) render_charts_default(s->r, s->snap->ncyl);
+    else render_charts_default_named(s->r, s->snap);
+}
+
+static int setup_charts(drive_session* s, const char* list, char* err, size_t errsz);
+
+// The charts the panel's slots name, in slot order; none: the default set.
+static void apply_chart_picks(drive_session* s) {
+    char list[DRIVE_CHART_SLOTS * 97] = "", err[400];
+    size_t n = 0;
+    for (int k = 0; k < DRIVE_CHART_SLOTS; ++k)
+        if (s->chart_pick[k][0] && n < sizeof list)
+            n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", n ? "," : "", s->chart_pick[k]);
+    render_charts_reset(s->r);
+    s->nchart = 0;
+    s->chart_circuit = false;
+    for (int i = 0; i < s->nreadout; ++i) // the readouts keep theirs
+        if (s->readout_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
+    if (!list[0] || setup_charts(s, list, err, sizeof err)) {
+        if (list[0]) say(s, err); // a name the channels lost (not from the panel's list)
+        render_charts_reset(s->r);
+        s->nchart = 0;
+        default_charts(s);
+        if (!list[0]) say(s, "charts: the default set");
+        return;
+    }
+    char t[sizeof s->status];
+    snprintf(t, sizeof t, "charts: %.500s", list);
+    say(s, t);
+}
+
 // Charts on channels by name again, in a list that may have changed (a
-// loaded model): a channel the new circuit lacks is left empty.
+// loaded model): a channel the new circuit lacks is left empty. The
+// default charts follow the new model's cylinders.
 static void rebind_charts(drive_session* s) {
+    if (!s->nchart) {
+        render_charts_reset(s->r);
+        take_snapshot(s);
+        default_charts(s);
+    }
     s->chart_circuit = false;
     for (int i = 0; i < s->nchart; ++i) {
         s->chart_col[i] = chan_list_find(s->chans, render_chart_label(s->r, s->chart_id[i]));
@@ -869,12 +1215,8 @@ static void rebuild_world(drive_session* s, bool at_start);
 static void load_model(drive_session* s) {
     char e[400];
     model* nm = model_load(s->load_path[0] ? s->load_path : NULL, NULL, 0, e, sizeof e);
-    // The panel edits the two-link fields (the mechanics table) and puts
-    // them back on a failed rebuild: a chain model is refused before that.
-    if (nm && model_require_two_link(nm, "drive panel", e, sizeof e)) {
-        model_free(nm);
-        nm = NULL;
-    }
+    // A crane chain loads as the two-link crane does; the engine for it must
+    // have a picture for the window (make_engine refuses one without).
     if (!nm) {
         snprintf(s->status, sizeof s->status, "load failed (model kept): %s", e);
         panel_set_message(s->pn, s->status);
@@ -908,7 +1250,8 @@ static void load_model(drive_session* s) {
     rebind_charts(s);
     setup_panel(s);
     saved(s); // the panel now edits the loaded file's model
-    snprintf(s->status, sizeof s->status, "loaded %s (%s)", nm->file, nm->name);
+    snprintf(s->status, sizeof s->status, "loaded %.200s (%.96s)%s%.200s", nm->file, nm->name, s->rec_stop[0] ? "; " : "",
+             s->rec_stop);
     panel_set_message(s->pn, s->status);
 }
 
@@ -1023,7 +1366,9 @@ static int start_recording(drive_session* s, const char* path) {
     // The world's columns and `segment`: 0 from the start, one more at each
     // reset or rebuild (a reset starts t at 0 again, a rebuild puts the
     // loads back), so a reader can split the record where the world jumped.
-    for (int c = 0; c < s->ncol; ++c) fprintf(s->rec, "%s,", sim_col_name[c]);
+    // The engine's channels by name (a crane chain's columns after the base
+    // ones), as a scripted run's CSV header.
+    for (int c = 0; c < s->ncol; ++c) fprintf(s->rec, "%s,", chan_list_channel(s->chans, c)->name);
     fputs("segment\n", s->rec);
     if (ferror(s->rec)) {
         record_failed(s, errno);
@@ -1032,7 +1377,8 @@ static int start_recording(drive_session* s, const char* path) {
     return 0;
 }
 
-static void record_row(drive_session* s, const double* row) {
+// row: ncol columns in a buffer of ncol + 1 (s->row): the segment goes last.
+static void record_row(drive_session* s, double* row) {
     // One row per simulated instant: paused (or a tick too short to step)
     // the time stands still, and a row per tick repeated it (196 rows at the
     // same t over a 4 s pause). A reset starts a new segment, whose time may
@@ -1041,10 +1387,8 @@ static void record_row(drive_session* s, const double* row) {
     s->rec_t_last = row[COL_T];
     s->rec_seg_last = s->segment;
     errno = 0;
-    double r[SIM_NCOL + 1];
-    memcpy(r, row, sizeof(double) * (size_t)s->ncol);
-    r[s->ncol] = s->segment - s->rec_seg0;
-    sim_csv_row(s->rec, r, s->ncol + 1);
+    row[s->ncol] = s->segment - s->rec_seg0;
+    sim_csv_row(s->rec, row, s->ncol + 1);
     if (ferror(s->rec)) record_failed(s, errno);
     else ++s->rec_rows;
 }
@@ -1135,7 +1479,11 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         *code = EXIT_USAGE;
         return NULL;
     }
-    s->ncol = engine_ncol(s->l);
+    if (size_buffers(s)) {
+        snprintf(err, errsz, "out of memory");
+        drive_session_destroy(s);
+        return NULL;
+    }
     if (s->rp && s->rp->ncol != s->ncol) {
         snprintf(err, errsz, "session %s: ncol: the session has %d channels, this engine writes %d", s->rp->path,
                  s->rp->ncol, s->ncol);
@@ -1143,10 +1491,22 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
         *code = EXIT_USAGE;
         return NULL;
     }
+    // The recorded commands by function name (session.h).
+    if (s->rp) {
+        const int nfn = engine_nfunction(s->l);
+        s->rp_map = calloc((size_t)nfn + 1, sizeof *s->rp_map);
+        s->rp_u = calloc((size_t)nfn + 3, sizeof *s->rp_u);
+        if (!s->rp_map || !s->rp_u) snprintf(err, errsz, "out of memory");
+        if (!s->rp_map || !s->rp_u || session_function_map(s->rp, s->l, s->rp_map, NULL, 0, err, errsz) < 0) {
+            drive_session_destroy(s);
+            *code = EXIT_USAGE;
+            return NULL;
+        }
+    }
     // The window's faults are not in the session (its scripted operator
     // applies no bursts: the engine has no burst orifices).
     if (o->session_path && !s->rp &&
-        session_writer_open(&s->sw, o->session_path, s->m->json, s->m->file, &s->c.sim, NULL, s->sc.q0, s->sc.slew0,
+        session_writer_open(&s->sw, o->session_path, s->m->json, s->m->file, s->l, &s->c.sim, NULL, s->sc.q0, s->sc.slew0,
                             sim_load_mass(s->m, &s->sc, &s->c.sim), true, s->ncol, err, errsz)) {
         drive_session_destroy(s);
         *code = EXIT_USAGE;
@@ -1196,6 +1556,17 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     render_show_mapping(s->r, true);
     s->mapbox_off = DRIVE_MAPPING_S;
     snprintf(s->load_path, sizeof s->load_path, "%s", s->m->file);
+    // The chart slots of the panel show --charts' channels.
+    for (const char* q = o->charts; q && *q;) {
+        const char* e = strchr(q, ',');
+        const size_t len = e ? (size_t)(e - q) : strlen(q);
+        for (int k = 0; k < DRIVE_CHART_SLOTS; ++k)
+            if (!s->chart_pick[k][0]) {
+                snprintf(s->chart_pick[k], sizeof s->chart_pick[k], "%.*s", (int)len, q);
+                break;
+            }
+        q = e ? e + 1 : q + len;
+    }
     // The panel starts hidden (Tab shows it): on llvmpipe it costs ~4 fps at
     // 1280x720 (56 vs 60 fps, cranesim bench --config drive), and the scene
     // is what an operator watches while driving.
@@ -1212,13 +1583,10 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
             return NULL;
         }
     } else {
-        // One set of channels per cylinder the world has: the sandbox's
-        // slew rack is the third; the validation world and the lagrange
-        // view have only the two boom cylinders.
-        render_charts_default(s->r, s->snap->ncyl);
+        default_charts(s);
     }
     if (o->readouts) {
-        s->nreadout = parse_charts("--readouts", o->readouts, s->ncol, s->chans, s->readout_col, err, errsz);
+        s->nreadout = parse_charts("--readouts", o->readouts, s->ncol, s->chans, NULL, s->readout_col, err, errsz);
         if (s->nreadout < 0) {
             drive_session_destroy(s);
             *code = EXIT_USAGE;
@@ -1260,6 +1628,8 @@ void drive_session_destroy(drive_session* s) {
     if (s->sw.f) session_writer_close(&s->sw, "the window closed");
     if (s->rp) session_free(s->rp);
     free(s->rp);
+    free(s->rp_map);
+    free(s->rp_u);
     if (s->pn) {
         if (s->r) render_attach_panel(s->r, NULL);
         panel_destroy(s->pn);
@@ -1273,6 +1643,9 @@ void drive_session_destroy(drive_session* s) {
     free(s->param);
     free(s->pid);
     free(s->changed);
+    free(s->row);
+    free(s->ufn);
+    free_chart_opt(s); // after the panel, which pointed at them
     free(s->snap);
     free(s);
 }
@@ -1551,9 +1924,12 @@ int drive_session_tick(drive_session* s, double wall) {
         // bit for bit as recorded; at its end the window closes.
         const double due = wall - s->sim_offset;
         while (s->rp_next < s->rp->ntick && s->rp->tick[s->rp_next].target <= due) {
-            const session_tick* tk = &s->rp->tick[s->rp_next++];
+            const session_tick* tk = &s->rp->tick[s->rp_next];
             for (int k = 0; k < tk->nhook; ++k) engine_hook(s->l, tk->hook[k]);
-            engine_set_commands(s->l, tk->u);
+            const int nfn = engine_nfunction(s->l);
+            session_tick_commands(s->rp, s->rp_next++, s->rp_map, nfn, s->rp_u);
+            if (engine_caps(s->l) & ENGINE_CAP_TWO_LINK) engine_set_commands(s->l, s->rp_u);
+            else engine_set_function_commands(s->l, s->rp_u, nfn, NULL, 0);
             ++s->st.input_samples;
             const double now = engine_time(s->l);
             if (tk->target > now && engine_advance(s->l, tk->target - now)) {
@@ -1564,7 +1940,12 @@ int drive_session_tick(drive_session* s, double wall) {
         if (s->rp_next >= s->rp->ntick) quit = true;
     } else {
         double u[3] = {cmd.lift, cmd.jib, cmd.slew};
-        if (s->o.scripted) {
+        // A crane chain's scenario commands every function by name; the
+        // operator's input drives every function by the mapping (input.h).
+        const bool by_function = !(engine_caps(s->l) & ENGINE_CAP_TWO_LINK);
+        if (s->o.scripted && by_function) {
+            engine_play_functions(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, s->ufn, NULL, NULL);
+        } else if (s->o.scripted) {
             engine_play(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, u, s->sw.f ? session_hook : NULL, s);
         } else if (cmd.hook_toggle) {
             const int want = !engine_attached(s->l); // what H asks; a failed attach is said on the console too
@@ -1572,9 +1953,11 @@ int drive_session_tick(drive_session* s, double wall) {
             if (engine_hook_report(s->l, want, s->status, sizeof s->status) < 0 && want)
                 fprintf(stderr, "cranesim drive: %s\n", s->status);
         }
-        if (!s->o.scripted && !(engine_caps(s->l) & ENGINE_CAP_TWO_LINK)) {
-            // A chain engine takes its commands by function: the mapping was
-            // built from engine_nfunction's list, so cmd.u[k] is function k.
+        if (s->o.scripted && by_function) {
+            engine_set_function_commands(s->l, s->ufn, engine_nfunction(s->l), NULL, 0);
+        } else if (by_function) {
+            // The operator's commands by function: the mapping was built from
+            // engine_nfunction's list (build_mapping), so cmd.u[k] is function k.
             char fe[200];
             if (engine_set_function_commands(s->l, cmd.u, cmd.n, fe, sizeof fe))
                 snprintf(s->status, sizeof s->status, "input: %s", fe);
@@ -1601,7 +1984,10 @@ int drive_session_tick(drive_session* s, double wall) {
             const bool keep = !adv && (s->sw.rows == 0 || r[COL_T] > s->sw.t_last);
             if (keep) s->sw.t_last = r[COL_T];
             r[s->ncol] = 0;
-            session_writer_tick(&s->sw, s->t_base + t + 0.5 * dt_wall, target, u, keep ? r : NULL, s->ncol + 1);
+            // The commands as the engine holds them, one per function
+            // (session.h): the sticks' lift, jib, slew on the two-link crane.
+            session_writer_tick_engine(&s->sw, s->l, s->t_base + t + 0.5 * dt_wall, target, keep ? r : NULL,
+                                       s->ncol + 1);
         }
         if (adv) {
             snprintf(s->err, sizeof s->err, "%s", engine_error(s->l));
@@ -1620,7 +2006,7 @@ int drive_session_tick(drive_session* s, double wall) {
     // or input runs meanwhile. Waiting here instead keeps the 240 Hz ticks.
     const bool frame = wall >= s->wall_next_frame && !render_busy(s->r);
     // One CSV row per tick at most, shared by the recording and the charts.
-    double row[SIM_NCOL];
+    double* row = s->row;
     if (s->rec || (frame && (s->nchart || s->nreadout))) session_row(s, row);
     if (frame && (s->nchart || s->nreadout) && !s->remote) {
         memcpy(s->chan_v, row, sizeof *row * (size_t)chan_list_nrow(s->chans));
@@ -1793,7 +2179,16 @@ int drive_window_main(const app_common* c, const drive_opts* o, double duration,
     return code;
 }
 
-int drive_bench(const app_common* c, int w, int h, double seconds) {
+// Process CPU time, all threads (llvmpipe's rasterisers too) [s].
+static double process_cpu_s(void) {
+    struct timespec t;
+    return clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t) ? 0.0 : (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+int drive_bench(const app_common* c, int w, int h, double seconds, const char* config, double* fps_mean,
+                double* cpu_ms) {
+    if (fps_mean) *fps_mean = 0;
+    if (cpu_ms) *cpu_ms = 0;
     drive_opts o = drive_default_opts();
     o.width = w;
     o.height = h;
@@ -1804,13 +2199,16 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
     int code;
     drive_session* s = drive_session_create(c, &o, err, sizeof err, &code);
     if (!s) {
-        printf("{\"config\":\"drive\",\"error\":\"%s\"}\n", err);
+        printf("{\"config\":\"%s\",\"error\":\"%s\"}\n", config, err);
         return code;
     }
     // The same 240 Hz ticks as the window loop. Spinning instead would take
     // a core from the driver's rasteriser threads on a small machine.
     const double tick = 1.0 / 240.0;
     const uint64_t f = SDL_GetPerformanceFrequency(), t0 = SDL_GetPerformanceCounter();
+    // CPU per frame does not depend on what else the machine runs (the fps
+    // does): the figure to compare runs by on a loaded machine.
+    const double cpu0 = process_cpu_s();
     code = 0;
     for (;;) {
         double wall = (double)(SDL_GetPerformanceCounter() - t0) / (double)f;
@@ -1823,6 +2221,7 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
         drive_session_idle(s, wall + tick - next);
     }
     const drive_stats* st = drive_session_stats(s);
+    const double cpu_frame = st->frames > 0 ? 1e3 * (process_cpu_s() - cpu0) / (double)st->frames : 0.0;
     // The world the engine was built on (c->sim.world, the sandbox when
     // none is named), and the bodies of its last snapshot, so a reader can
     // tell the worlds apart by what ran, not only by name.
@@ -1836,16 +2235,26 @@ int drive_bench(const app_common* c, int w, int h, double seconds) {
     for (int i = skip; i < n; ++i) ms[m++] = st->frame_ms[i];
     app_sort(ms, m);
     double p50 = m ? ms[m / 2] : 0, p95 = m ? ms[(int)(0.95 * (m - 1))] : 0;
-    printf("{\"config\":\"drive\",\"width\":%d,\"height\":%d,\"world\":\"%s\",\"wall_s\":%.3f,"
+    // The model file's name, JSON-safe (a quote, backslash or control
+    // character in it would end the string: '_' instead).
+    char mname[256];
+    const char* base = s->m->file[0] ? s->m->file : s->m->name;
+    if (strrchr(base, '/')) base = strrchr(base, '/') + 1;
+    snprintf(mname, sizeof mname, "%s", base);
+    for (char* q = mname; *q; ++q)
+        if (*q == '"' || *q == '\\' || (unsigned char)*q < 0x20) *q = '_';
+    printf("{\"config\":\"%s\",\"model\":\"%s\",\"width\":%d,\"height\":%d,\"world\":\"%s\",\"wall_s\":%.3f,"
            "\"sim_time_s\":%.3f,\"rt_factor\":%.3f,\"frames\":%ld,\"fps_mean\":%.1f,\"fps_median\":%.1f,"
            "\"fps_p5\":%.1f,\"frame_ms_p50\":%.2f,\"frame_ms_p95\":%.2f,\"missed_deadlines\":%ld,"
-           "\"command_rate_hz\":%.1f,\"triangles\":%ld,\"bodies\":%d%s}\n",
-           w, h, world, st->wall_time, st->sim_time,
+           "\"command_rate_hz\":%.1f,\"cpu_ms_per_frame\":%.1f,\"triangles\":%ld,\"bodies\":%d%s}\n",
+           config, mname, w, h, world, st->wall_time, st->sim_time,
            st->wall_time > 0 ? st->sim_time / st->wall_time : 0, st->frames,
            st->wall_time > 0 ? st->frames / st->wall_time : 0, p50 > 0 ? 1e3 / p50 : 0, p95 > 0 ? 1e3 / p95 : 0,
-           p50, p95, st->missed, st->wall_time > 0 ? st->input_samples / st->wall_time : 0, st->triangles,
+           p50, p95, st->missed, st->wall_time > 0 ? st->input_samples / st->wall_time : 0, cpu_frame, st->triangles,
            s->snap->nbody, code ? ",\"error\":\"numerical failure\"" : "");
     fflush(stdout);
+    if (fps_mean && !code && st->wall_time > 0) *fps_mean = st->frames / st->wall_time;
+    if (cpu_ms && !code) *cpu_ms = cpu_frame;
     free(ms);
     drive_session_destroy(s);
     return code;

@@ -188,7 +188,11 @@ int drive_connect_window(const app_common* c, const drive_opts* o, const char* a
 /// Benchmark: the real-time loop offscreen at w x h with the scripted
 /// operator for `seconds` of wall time; prints one JSON line (fps median and
 /// 5th percentile, frame-time p50/p95 [ms], missed deadlines, command rate,
-/// triangles, real-time factor). Returns 0 or an exit code.
-int drive_bench(const app_common* c, int w, int h, double seconds);
+/// triangles, real-time factor, the process CPU time per frame [ms], the
+/// model). config names the line ("drive"); *fps_mean and *cpu_ms (may be
+/// NULL) get its mean frame rate [1/s] and CPU per frame [ms] (0 on failure).
+/// Returns 0 or an exit code.
+int drive_bench(const app_common* c, int w, int h, double seconds, const char* config, double* fps_mean,
+                double* cpu_ms);
 
 #endif

@@ -1,6 +1,7 @@
 // session.c: the session file of a drive (session.h; format in docs/replay.md).
 #include "session.h"
 
+#include "engine.h"
 #include "engine_backend.h"
 #include "json_util.h"
 
@@ -26,7 +27,7 @@ static void wcheck(session_writer* w) {
 }
 
 int session_writer_open(session_writer* w, const char* path, const cJSON* model_doc, const char* model_file,
-                        const sim_opts* o,
+                        const engine* l, const sim_opts* o,
                         const char* scenario_path, const double q0[2], double slew0, double m3, bool window, int ncol,
                         char* err, size_t errsz) {
     memset(w, 0, sizeof *w);
@@ -47,6 +48,21 @@ int session_writer_open(session_writer* w, const char* path, const cJSON* model_
     cJSON_AddStringToObject(h, "model_hash", hash);
     cJSON_AddStringToObject(h, "model_file", model_file);
     cJSON_AddItemToObject(h, "model", cJSON_Duplicate(model_doc, 1));
+    const cJSON* mname = cJSON_GetObjectItemCaseSensitive(model_doc, "name");
+    cJSON_AddStringToObject(h, "model_name", cJSON_IsString(mname) ? mname->valuestring : "");
+    cJSON_AddStringToObject(h, "engine", engine_backend_name(l));
+    // The functions every tick commands, in the engine's order: a replay
+    // finds each by name (docs/replay.md), on this model or a changed one.
+    w->nfn = engine_nfunction(l);
+    w->u = calloc((size_t)w->nfn + 1, sizeof *w->u);
+    if (!w->u) {
+        snprintf(err, errsz, "out of memory");
+        cJSON_Delete(h);
+        cJSON_Delete(sc);
+        return -1;
+    }
+    cJSON* fns = cJSON_AddArrayToObject(h, "functions");
+    for (int k = 0; k < w->nfn; ++k) cJSON_AddItemToArray(fns, cJSON_CreateString(engine_function_name(l, k)));
     if (sc) cJSON_AddItemToObject(h, "scenario", sc);
     cJSON* s = cJSON_AddObjectToObject(h, "sim");
     cJSON_AddNumberToObject(s, "mechanics", o->mechanics);
@@ -72,12 +88,16 @@ int session_writer_open(session_writer* w, const char* path, const cJSON* model_
     cJSON_Delete(h);
     if (!text) {
         snprintf(err, errsz, "out of memory");
+        free(w->u);
+        w->u = NULL;
         return -1;
     }
     w->f = fopen(path, "w");
     if (!w->f) {
         snprintf(err, errsz, "cannot write %s: %s", path, strerror(errno));
         free(text);
+        free(w->u);
+        w->u = NULL;
         return -1;
     }
     errno = 0;
@@ -91,14 +111,20 @@ void session_writer_hook(session_writer* w, int attach) {
     if (w->f && w->nhook < 4) w->hook[w->nhook++] = (signed char)(attach != 0);
 }
 
-void session_writer_tick(session_writer* w, double tm, double target, const double u[3], const double* row,
+void session_writer_tick(session_writer* w, double tm, double target, const double* u, int nu, const double* row,
                          int ncol) {
     if (!w->f || w->err) return;
+    if (nu != w->nfn) { // the header names nfn functions: another count would be read back wrong
+        w->err = EINVAL;
+        return;
+    }
     errno = 0;
     for (int k = 0; k < w->nhook; ++k) fprintf(w->f, "k %d\n", w->hook[k]);
     w->nhook = 0;
     // %.17g: every double reads back to the same bits.
-    fprintf(w->f, "t %.17g %.17g %.17g %.17g %.17g %d\n", tm, target, u[0], u[1], u[2], row ? 1 : 0);
+    fprintf(w->f, "t %.17g %.17g", tm, target);
+    for (int k = 0; k < nu; ++k) fprintf(w->f, " %.17g", u[k]);
+    fprintf(w->f, " %d\n", row ? 1 : 0);
     if (row) {
         // The row as the record writes it (sim_csv_row), so the replay's
         // CSV can be compared byte for byte.
@@ -109,7 +135,17 @@ void session_writer_tick(session_writer* w, double tm, double target, const doub
     wcheck(w);
 }
 
+void session_writer_tick_engine(session_writer* w, const engine* l, double tm, double target, const double* row,
+                                int ncol) {
+    if (!w->f || w->err || !w->u) return;
+    const int n = engine_nfunction(l) < w->nfn ? engine_nfunction(l) : w->nfn;
+    for (int k = 0; k < n; ++k) w->u[k] = engine_function_command(l, k);
+    session_writer_tick(w, tm, target, w->u, engine_nfunction(l), row, ncol);
+}
+
 int session_writer_close(session_writer* w, const char* why) {
+    free(w->u);
+    w->u = NULL;
     if (!w->f) return w->err;
     errno = 0;
     fprintf(w->f, "e %s\n", why);
@@ -174,15 +210,17 @@ int session_load(const char* path, session* s, char* err, size_t errsz) {
         free(line);
         return fail(s, err, errsz, "not a cranesim session file (its first line is not '%s N')", SESSION_MAGIC, 0);
     }
-    if (sscanf(line + strlen(SESSION_MAGIC), "%d", &ver) != 1 || ver != SESSION_VERSION) {
+    if (sscanf(line + strlen(SESSION_MAGIC), "%d", &ver) != 1 || ver < SESSION_VERSION_MIN || ver > SESSION_VERSION) {
         char v[64];
         snprintf(v, sizeof v, "%.40s", line + strlen(SESSION_MAGIC) + 1);
         fclose(f);
         free(line);
         char msg[160];
-        snprintf(msg, sizeof msg, "format version %s, this cranesim reads version %d", v, SESSION_VERSION);
+        snprintf(msg, sizeof msg, "format version %s, this cranesim reads versions %d to %d", v, SESSION_VERSION_MIN,
+                 SESSION_VERSION);
         return fail(s, err, errsz, "%s", msg, 1);
     }
+    s->version = ver;
     ++ln;
     if (!read_line(f, &line, &cap) || !(s->header = cJSON_Parse(line)) || !cJSON_IsObject(s->header)) {
         fclose(f);
@@ -249,6 +287,34 @@ int session_load(const char* path, session* s, char* err, size_t errsz) {
         s->m3 = num(in, "load_mass", &ok);
         s->ncol = (int)num(h, "ncol", &ok);
     }
+    // The functions the ticks command: version 1 has the two-link crane's
+    // three, version 2 names them.
+    static const char* const v1_fn[3] = {"lift", "jib", "slew"};
+    const cJSON* fns = cJSON_GetObjectItemCaseSensitive(h, "functions");
+    if (ok && ver == 1) {
+        s->nfn = 3;
+        s->fn = calloc(3, sizeof *s->fn);
+        if (s->fn) memcpy(s->fn, v1_fn, sizeof v1_fn);
+    } else if (ok) {
+        s->nfn = cJSON_GetArraySize(fns);
+        s->fn = cJSON_IsArray(fns) && s->nfn > 0 ? calloc((size_t)s->nfn, sizeof *s->fn) : NULL;
+        for (int k = 0; s->fn && k < s->nfn; ++k) {
+            const cJSON* n = cJSON_GetArrayItem(fns, k);
+            s->fn[k] = cJSON_IsString(n) && n->valuestring[0] ? n->valuestring : NULL;
+            for (int j = 0; j < k && s->fn[k]; ++j)
+                if (s->fn[j] && !strcmp(s->fn[j], s->fn[k])) s->fn[k] = NULL; // a name twice
+            if (!s->fn[k]) {
+                free(s->fn);
+                s->fn = NULL;
+            }
+        }
+    }
+    if (ok && !s->fn) {
+        fclose(f);
+        free(line);
+        return fail(s, err, errsz, "%s",
+                    "header: functions: expected an array of the functions' names, each once", 2);
+    }
     if (ok && !engine_backend_of(&s->sim)) { // a backend this build does not have: never replayed on another
         fclose(f);
         free(line);
@@ -257,7 +323,9 @@ int session_load(const char* path, session* s, char* err, size_t errsz) {
                  engine_backend_names(known, sizeof known, NULL));
         return fail(s, err, errsz, "%s", msg, 2);
     }
-    if (!ok || s->ncol < 1 || s->ncol > SIM_NCOL || !(s->sim.h > 0)) {
+    // Version 1 rows are the two-link crane's (SIM_NCOL at most); version 2
+    // a chain's, sized by its model (a bound only against a corrupt file).
+    if (!ok || s->ncol < 1 || s->ncol > (ver == 1 ? SIM_NCOL : SESSION_MAX_NCOL) || !(s->sim.h > 0)) {
         fclose(f);
         free(line);
         return fail(s, err, errsz, "%s", "header: sim, initial and ncol are required and must be valid", 2);
@@ -266,6 +334,7 @@ int session_load(const char* path, session* s, char* err, size_t errsz) {
     int nhook = 0;
     signed char hooks[4];
     bool ended = false;
+    char tbad[200];
     while (read_line(f, &line, &cap)) {
         ++ln;
         const char* bad = NULL;
@@ -276,21 +345,42 @@ int session_load(const char* path, session* s, char* err, size_t errsz) {
             else hooks[nhook++] = (signed char)a;
         } else if (line[0] == 't' && line[1] == ' ') {
             session_tick t = {.row_line = -1};
-            int row;
-            if (sscanf(line + 2, "%lg %lg %lg %lg %lg %d", &t.tm, &t.target, &t.u[0], &t.u[1], &t.u[2], &row) != 6)
-                bad = "expected 't TM TARGET U_LIFT U_JIB U_SLEW ROW'";
-            else {
+            int row = 0;
+            if (s->ntick == captick) {
+                captick = captick ? 2 * captick : 1024;
+                session_tick* nt = realloc(s->tick, sizeof *nt * (size_t)captick);
+                double* nu = realloc(s->uv, sizeof *nu * (size_t)captick * (size_t)s->nfn);
+                if (nt) s->tick = nt;
+                if (nu) s->uv = nu;
+                if (!nt || !nu) bad = "out of memory";
+            }
+            // TM TARGET, one command per function, ROW (0 or 1).
+            double* u = bad ? NULL : s->uv + (size_t)s->ntick * (size_t)s->nfn;
+            char* p = line + 2;
+            char* e;
+            int got = 0;
+            for (int k = 0; u && k < s->nfn + 2; ++k, ++got, p = e) {
+                const double v = strtod(p, &e);
+                if (e == p || (*e != ' ' && *e)) break;
+                if (k == 0) t.tm = v;
+                else if (k == 1) t.target = v;
+                else u[k - 2] = v;
+            }
+            if (u && got == s->nfn + 2) {
+                const long r = strtol(p, &e, 10);
+                if (e == p || *e || (r != 0 && r != 1)) got = -1;
+                else row = (int)r;
+            }
+            if (!bad && got != s->nfn + 2) {
+                snprintf(tbad, sizeof tbad, "expected 't TM TARGET' then %d commands (%s%s) and ROW 0 or 1", s->nfn,
+                         s->fn[0], s->nfn > 1 ? " ..." : "");
+                bad = tbad;
+            } else if (!bad) {
                 t.row = row != 0;
                 t.nhook = nhook;
                 memcpy(t.hook, hooks, sizeof hooks);
                 nhook = 0;
-                if (s->ntick == captick) {
-                    captick = captick ? 2 * captick : 1024;
-                    session_tick* nt = realloc(s->tick, sizeof *nt * (size_t)captick);
-                    if (!nt) bad = "out of memory";
-                    else s->tick = nt;
-                }
-                if (!bad) s->tick[s->ntick++] = t;
+                s->tick[s->ntick++] = t;
             }
         } else if (line[0] == 'r' && line[1] == ' ') {
             if (s->ntick == 0 || !s->tick[s->ntick - 1].row || s->tick[s->ntick - 1].row_line >= 0)
@@ -318,6 +408,8 @@ int session_load(const char* path, session* s, char* err, size_t errsz) {
     }
     fclose(f);
     free(line);
+    // Each tick's commands, now that uv no longer moves.
+    for (long i = 0; i < s->ntick; ++i) s->tick[i].u = s->uv + (size_t)i * (size_t)s->nfn;
     // A session of a drive killed outright has no end line: its ticks up to
     // there still replay.
     if (!ended) snprintf(s->end, sizeof s->end, "no end line (the drive was cut short)");
@@ -327,6 +419,10 @@ int session_load(const char* path, session* s, char* err, size_t errsz) {
 void session_free(session* s) {
     cJSON_Delete(s->header);
     free(s->tick);
+    free(s->uv);
+    free(s->fn);
+    s->uv = NULL;
+    s->fn = NULL;
     for (long i = 0; i < s->nrow; ++i) free(s->rows[i]);
     free(s->rows);
     s->header = NULL;
@@ -353,11 +449,51 @@ model* session_model(const session* s, const char* model_path, const char* const
     return model_from_json(root, name, err, errsz);
 }
 
-void session_csv_header(const session* s, FILE* f) {
-    if (!s->window) {
-        sim_csv_header(f, s->ncol);
-        return;
+void session_csv_header(const session* s, const engine* l, FILE* f) {
+    int n;
+    const sim_channel* ch = engine_channels(l, &n);
+    for (int c = 0; c < n; ++c) fprintf(f, "%s%s", c ? "," : "", ch[c].name);
+    fputs(s->window ? ",segment\n" : "\n", f);
+}
+
+int session_function_map(const session* s, const engine* l, int* map, char* dropped, size_t dsz, char* err,
+                         size_t errsz) {
+    if (dropped && dsz) dropped[0] = 0;
+    const int n = engine_nfunction(l);
+    // Version 1 carries the two-link crane's commands, lift, jib, slew, in
+    // the two-link engine's order: as they were replayed before names.
+    const bool v1_two_link = s->version == 1 && (engine_caps(l) & ENGINE_CAP_TWO_LINK) && n == 3;
+    for (int k = 0; k < n; ++k) map[k] = v1_two_link ? k : -1;
+    if (v1_two_link) return n;
+    int found = 0;
+    for (int j = 0; j < s->nfn; ++j) {
+        const int k = engine_find_function(l, s->fn[j]);
+        bool commanded = k < 0 ? false : true;
+        for (long i = 0; k < 0 && i < s->ntick && !commanded; ++i) commanded = s->tick[i].u[j] != 0.0;
+        if (k < 0 && !commanded) {
+            // Never commanded: leaving it out replays the same operator.
+            const size_t L = dropped ? strlen(dropped) : 0;
+            if (dropped && L + 1 < dsz) snprintf(dropped + L, dsz - L, "%s%s", L ? ", " : "", s->fn[j]);
+            continue;
+        }
+        if (k < 0) {
+            char list[600];
+            int w = 0;
+            for (int i = 0; i < n && w >= 0 && (size_t)w < sizeof list; ++i)
+                w += snprintf(list + w, sizeof list - (size_t)w, "%s%s", i ? ", " : "", engine_function_name(l, i));
+            snprintf(err, errsz,
+                     "session %s: functions: '%s' is not a function of this model (its functions: %s); the session "
+                     "commands it, so the replay would not be the recorded operator's",
+                     s->path, s->fn[j], list);
+            return -1;
+        }
+        map[k] = j;
+        ++found;
     }
-    for (int c = 0; c < s->ncol; ++c) fprintf(f, "%s,", sim_col_name[c]);
-    fputs("segment\n", f);
+    return found;
+}
+
+void session_tick_commands(const session* s, long i, const int* map, int n, double* u) {
+    const double* su = s->tick[i].u;
+    for (int k = 0; k < n; ++k) u[k] = map[k] >= 0 ? su[map[k]] : 0.0;
 }

@@ -195,10 +195,51 @@ static void pressure_color(double frac, float rgba[4]) {
 }
 
 enum { BAR_W = 14, BAR_H = 96, BAR_GAP = 6, BAR_PAD = 4 };
+/// More cylinders than this (a crane chain's) and the HUD is compact: its
+/// readouts table in small text, the pressure bars shorter (BAR_H_MANY), so
+/// a group over every cylinder fits beside the others. The two-link crane
+/// (lift, jib and the slew rack) keeps the full size.
+enum { HUD_FEW_CYL = 4, BAR_H_MANY = 60 };
+
+static bool overlaps(int x, int y, int w, int h, const float b[4]) {
+    return b[2] > 0 && x < b[0] + b[2] && b[0] < x + w && y < b[1] + b[3] && b[1] < y + h;
+}
+
+// A leader line from (x0, y0) to (x1, y1) [px] with the parts inside any of
+// the n boxes (x, y, w, h; w <= 0: none) left out (Liang-Barsky clipping of
+// the segment against each box in turn, the pieces outside kept).
+static void leader_line(render_hud* h, float x0, float y0, float x1, float y1, const float (*box)[4], int n) {
+    for (int k = 0; k < n; ++k) {
+        const float* b = box[k];
+        if (!(b[2] > 0 && b[3] > 0)) continue;
+        const float dx = x1 - x0, dy = y1 - y0;
+        const float p[4] = {-dx, dx, -dy, dy}, q[4] = {x0 - b[0], b[0] + b[2] - x0, y0 - b[1], b[1] + b[3] - y0};
+        float ta = 0, tb = 1;
+        bool out = false;
+        for (int e = 0; e < 4 && !out; ++e) {
+            if (p[e] == 0) {
+                out = q[e] < 0;
+                continue;
+            }
+            const float t = q[e] / p[e];
+            if (p[e] < 0) ta = fmaxf(ta, t);
+            else tb = fminf(tb, t);
+            out = ta >= tb;
+        }
+        if (out) continue;
+        // The pieces before and after the box, each against the boxes left.
+        if (ta > 0) leader_line(h, x0, y0, x0 + ta * dx, y0 + ta * dy, box + k + 1, n - k - 1);
+        if (tb < 1) leader_line(h, x0 + tb * dx, y0 + tb * dy, x1, y1, box + k + 1, n - k - 1);
+        return;
+    }
+    render_hud_line(h, x0, y0, x1, y1, k_dim);
+}
 
 // keep_out: the warnings' box at the top centre (x, y, w, h [px]; w = 0 for
-// none): a bar group there goes below it, not under it.
-static void draw_pressure_bars(render* r, const world_snapshot* s, const float keep_out[4]) {
+// none): a bar group there goes below it, not under it. readouts: the
+// readouts box (top left), kept clear of the groups in the compact HUD
+// (where the groups are many; w = 0: not kept).
+static void draw_pressure_bars(render* r, const world_snapshot* s, const float keep_out[4], const float readouts[4]) {
     render_hud* h = &r->hud;
     const float empty[4] = {((RENDER_BAR_EMPTY_RGB >> 16) & 255) / 255.0f,
                             ((RENDER_BAR_EMPTY_RGB >> 8) & 255) / 255.0f,
@@ -208,6 +249,16 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
     int placed[WORLD_SNAP_MAX_CYLINDERS][4];
     int nplaced = 0;
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    const bool many = ncyl > HUD_FEW_CYL;
+    const int bar_h = many ? BAR_H_MANY : BAR_H;
+    // Many groups: every place first (pass 0), then the groups with their
+    // leader lines clipped out of the other groups and the boxes (pass 1):
+    // the HUD draws its lines over its rectangles, so a line across another
+    // cylinder's bar would read as its pressure. Few: each group with its
+    // line in one pass, as it always was drawn.
+    int gpos[WORLD_SNAP_MAX_CYLINDERS][2], gidx[WORLD_SNAP_MAX_CYLINDERS];
+    bool gok[WORLD_SNAP_MAX_CYLINDERS] = {false};
+    for (int pass = 0; pass < (many ? 2 : 1); ++pass)
     for (int i = 0; i < ncyl; ++i) {
         const world_snap_cylinder* c = &s->cyl[i];
         double mid[3] = {0.5 * (c->base[0] + c->rod_end[0]), 0.5 * (c->base[1] + c->rod_end[1]),
@@ -216,8 +267,22 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
         if (!render_project(r, mid, px)) continue;
         // The group: two bars side by side, raised above the cylinder, with a
         // leader line down to it. Keep it on screen and clear of the others.
-        int gw = 2 * BAR_W + BAR_GAP + 2 * BAR_PAD, gh = BAR_H + 2 * BAR_PAD + 30;
+        int gw = 2 * BAR_W + BAR_GAP + 2 * BAR_PAD, gh = bar_h + 2 * BAR_PAD + 30;
         int gx = (int)px[0] - gw / 2, gy = (int)px[1] - 40 - gh;
+        if (pass == 1) {
+            if (!gok[i]) continue;
+            gx = gpos[i][0], gy = gpos[i][1];
+            float avoid[WORLD_SNAP_MAX_CYLINDERS + 2][4];
+            int na = 0;
+            for (int k = 0; k < nplaced; ++k)
+                if (k != gidx[i])
+                    avoid[na][0] = (float)placed[k][0], avoid[na][1] = (float)placed[k][1],
+                    avoid[na][2] = (float)placed[k][2], avoid[na++][3] = (float)placed[k][3];
+            memcpy(avoid[na++], keep_out, sizeof avoid[0]);
+            memcpy(avoid[na++], readouts, sizeof avoid[0]);
+            leader_line(h, (float)gx + gw * 0.5f, (float)(gy + gh), (float)px[0], (float)px[1], avoid, na);
+            goto draw_group;
+        }
         if (gx < 4) gx = 4;
         if (gy < 4) gy = 4;
         if (keep_out[2] > 0 && gx < keep_out[0] + keep_out[2] && keep_out[0] < gx + gw &&
@@ -230,12 +295,46 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
                 if (gx < placed[k][0] + placed[k][2] + 6 && placed[k][0] < gx + gw + 6 &&
                     gy < placed[k][1] + placed[k][3] && placed[k][1] < gy + gh)
                     gx = placed[k][0] + placed[k][2] + 8;
+        if (many) {
+            // Many groups (a crane chain's cylinders along its booms): one
+            // that overlaps another, the readouts or the warnings, or runs
+            // off the right edge, takes the first free place right of the
+            // readouts box at its height, else under that box, else in rows
+            // of groups from the top right of the box (clear of the charts).
+            bool clash = gx + gw > h->w - 4 || overlaps(gx, gy, gw, gh, readouts) || overlaps(gx, gy, gw, gh, keep_out);
+            for (int k = 0; k < nplaced && !clash; ++k) {
+                const float b[4] = {(float)placed[k][0] - 6, (float)placed[k][1], (float)placed[k][2] + 12,
+                                    (float)placed[k][3]};
+                clash = overlaps(gx, gy, gw, gh, b);
+            }
+            const int x0 = readouts[2] > 0 ? (int)(readouts[0] + readouts[2]) + 8 : 4;
+            // Nearest first: beside the readouts at its own height, then
+            // under them above the cylinder; then the rows from the top.
+            const int near[2][2] = {{x0, gy}, {gx, readouts[2] > 0 ? (int)(readouts[1] + readouts[3]) + 8 : gy}};
+            for (int row = -2; clash && row < 4; ++row)
+                for (int x = row < 0 ? near[row + 2][0] : x0; clash && x + gw <= h->w - 4; x += gw + 8) {
+                    const int y = row < 0 ? near[row + 2][1] : 4 + row * (gh + 8);
+                    if (y < 4 || y + gh > h->h - 150) break; // not over the strip charts at the bottom
+                    clash = overlaps(x, y, gw, gh, readouts) || overlaps(x, y, gw, gh, keep_out);
+                    for (int k = 0; k < nplaced && !clash; ++k) {
+                        const float b[4] = {(float)placed[k][0] - 6, (float)placed[k][1], (float)placed[k][2] + 12,
+                                            (float)placed[k][3]};
+                        clash = overlaps(x, y, gw, gh, b);
+                    }
+                    if (!clash) gx = x, gy = y;
+                }
+        }
         placed[nplaced][0] = gx, placed[nplaced][1] = gy, placed[nplaced][2] = gw,
         placed[nplaced][3] = gh;
         ++nplaced;
 
+        if (many) { // the group and its line in pass 1
+            gpos[i][0] = gx, gpos[i][1] = gy, gok[i] = true, gidx[i] = nplaced - 1;
+            continue;
+        }
         render_hud_line(h, (float)gx + gw * 0.5f, (float)(gy + gh), (float)px[0], (float)px[1],
                         k_dim);
+    draw_group:
         render_hud_rect(h, (float)gx, (float)gy, (float)gw, (float)gh, k_panel);
         char buf[64];
         snprintf(buf, sizeof buf, "%s", c->name[0] ? c->name : "cyl");
@@ -244,6 +343,7 @@ static void draw_pressure_bars(render* r, const world_snapshot* s, const float k
         double p[2] = {c->pA, c->pB};
         for (int ch = 0; ch < 2; ++ch) {
             int bx = gx + BAR_PAD + ch * (BAR_W + BAR_GAP), by = gy + 14;
+            const int BAR_H = bar_h; // this frame's height (compact with many cylinders)
             double frac = p[ch] / r->cfg.p_full_scale;
             if (!(frac > 0)) frac = 0; // also catches NaN
             if (frac > 1) frac = 1;
@@ -275,9 +375,20 @@ static void pad_margin_text(const world_snapshot* s, char* buf, size_t n) {
 /// Readouts table, top left. Units in every row header.
 static float draw_readouts(render* r, const world_snapshot* s) {
     render_hud* h = &r->hud;
-    const float sc = 1.5f, lh = 14.0f, col0 = 96.0f, colw = 84.0f;
     int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    // The cylinder table: text scale, row height and columns [px]. With
+    // many cylinders (a crane chain) it is set in small text, each column as
+    // wide as its longest entry, so ten of them fit half the width.
+    const bool many = ncyl > HUD_FEW_CYL;
+    const float sc = 1.5f, lh = 14.0f, tsc = many ? 1.0f : sc, tlh = many ? 11.0f : lh, col0 = many ? 64.0f : 96.0f;
+    float colw = 84.0f;
+    if (many) {
+        colw = render_hud_text_width("-00000.0", tsc);
+        for (int i = 0; i < ncyl; ++i) colw = fmaxf(colw, render_hud_text_width(s->cyl[i].name, tsc));
+        colw += 8;
+    }
     const int nrows = 14 + r->nreadout + (s->npad ? 1 : 0);
+    const float height = lh * (float)(nrows - 8) + tlh * 8 + (many ? 0.3f * (lh - tlh) : 0.0f);
     float x = 10, y = 10, w = col0 + colw * (float)(ncyl > 2 ? ncyl : 2) + 24;
     // The status line ("[keys: panel - Enter/Esc gives them back]") is the
     // widest text; the box grows to hold it rather than cut it at its edge.
@@ -290,9 +401,9 @@ static float draw_readouts(render* r, const world_snapshot* s) {
         pad_margin_text(s, line + k, sizeof line - (size_t)k);
         w = fmaxf(w, render_hud_text_width(line, sc) + 12);
     }
-    render_hud_rect(h, x - 6, y - 6, w, lh * (float)nrows + 10, k_panel);
+    render_hud_rect(h, x - 6, y - 6, w, height + 10, k_panel);
     h->readouts_rect[0] = x - 6, h->readouts_rect[1] = y - 6, h->readouts_rect[2] = w,
-    h->readouts_rect[3] = lh * (float)nrows + 10;
+    h->readouts_rect[3] = height + 10;
     char buf[160], rt[32];
     // rt_factor 0 means unknown (world_snapshot.h), e.g. over the first
     // instants, where a ratio of two tiny times means nothing.
@@ -305,13 +416,13 @@ static float draw_readouts(render* r, const world_snapshot* s) {
     render_hud_text(h, x, y, sc, k_white, buf);
     y += lh * 1.3f;
     for (int i = 0; i < ncyl; ++i)
-        render_hud_text(h, x + col0 + colw * (float)i, y, sc, k_dim,
+        render_hud_text(h, x + col0 + colw * (float)i, y, tsc, k_dim,
                         s->cyl[i].name[0] ? s->cyl[i].name : "cyl");
-    y += lh;
+    y += tlh;
     static const char* rows[] = {"x [mm]", "v [mm/s]",  "pA [MPa]", "pB [MPa]",
                                  "u [%]",  "u_cmd [%]", "F [kN]"};
     for (int row = 0; row < 7; ++row) {
-        render_hud_text(h, x, y, sc, k_dim, rows[row]);
+        render_hud_text(h, x, y, tsc, k_dim, rows[row]);
         for (int i = 0; i < ncyl; ++i) {
             const world_snap_cylinder* c = &s->cyl[i];
             double v[7] = {c->x * 1e3, c->v * 1e3,     c->pA * 1e-6,   c->pB * 1e-6,
@@ -322,9 +433,9 @@ static float draw_readouts(render* r, const world_snapshot* s) {
             // u_cmd in amber where the limiter cut the operator's demand (the
             // warning line gives the demand beside it).
             const float* colr = ((row == 2 || row == 3) && c->relief_open) || (row == 5 && c->rcl_cut) ? k_amber : k_white;
-            render_hud_text(h, x + col0 + colw * (float)i, y, sc, colr, buf);
+            render_hud_text(h, x + col0 + colw * (float)i, y, tsc, colr, buf);
         }
-        y += lh;
+        y += tlh;
     }
     y += 4;
     char f0[32], f1[32], f2[32];
@@ -532,8 +643,17 @@ void render_hud_draw_overlay(render* r, const world_snapshot* s) {
     const int nw = render_hud_warnings(r, s, w, RENDER_WARN_MAX);
     float box[4];
     warnings_box(r, w, nw, box);
-    draw_pressure_bars(r, s, box);
-    draw_readouts(r, s);
+    // The readouts first where the bars must keep clear of them (many
+    // cylinders: compact HUD); else in the order they always had.
+    const int ncyl = s->ncyl < WORLD_SNAP_MAX_CYLINDERS ? s->ncyl : WORLD_SNAP_MAX_CYLINDERS;
+    if (ncyl > HUD_FEW_CYL) {
+        draw_readouts(r, s);
+        draw_pressure_bars(r, s, box, h->readouts_rect);
+    } else {
+        const float none[4] = {0, 0, 0, 0};
+        draw_pressure_bars(r, s, box, none);
+        draw_readouts(r, s);
+    }
     draw_rcl_bar(r, s);
     draw_warnings(r, w, nw);
     render_hud_draw_mapping(r);

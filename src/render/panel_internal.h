@@ -10,7 +10,7 @@ extern "C" {
 #endif
 
 typedef struct panel_param {
-    char label[64], group[64], unit[16];
+    char label[64], group[112], unit[16]; // group: a crane chain's "function: element (type)"
     double* value;
     double min, max, step;
     double smin, smax;          ///< range a drag covers
@@ -50,7 +50,7 @@ struct panel {
     char message[512];
     panel_change_fn on_change;
     void* on_change_user;
-    char last_error[256];
+    char last_error[320]; // room for a group of 112 and a label of 64 with the range
     bool visible;
     bool wants_keyboard;  ///< ImGui had the keyboard at the last frame
     bool focused;         ///< the panel's window had the focus at the end of the last frame

@@ -268,6 +268,12 @@ void render_chart_clear(render* r);
 /// Register the standard channels: pressures of every cylinder chamber
 /// (MPa), strokes (mm) and spool openings (%), grouped in three plots.
 void render_charts_default(render* r, int ncyl);
+/// The standard channels of every cylinder of snapshot s (as many as fit:
+/// four charts each), labelled by the cylinders' names ("pA lift", "x ext1",
+/// "u ext1"): a crane chain's, whose cylinders are more than three.
+void render_charts_default_named(render* r, const world_snapshot* s);
+/// Remove every chart (a loaded model has other cylinders and channels).
+void render_charts_reset(render* r);
 /// Push the standard channels from a snapshot (after render_charts_default).
 void render_charts_sample(render* r, const world_snapshot* snap);
 

@@ -192,7 +192,9 @@ void render_hud_draw_mapping(render* r);
 
 // ---- strip charts (strip_chart.c) ------------------------------------------
 
-#define RENDER_MAX_CHARTS 16
+/// Charts at most: the standard four of every cylinder a crane chain has
+/// (WORLD_SNAP_MAX_CYLINDERS).
+#define RENDER_MAX_CHARTS (4 * WORLD_SNAP_MAX_CYLINDERS)
 #define RENDER_CHART_CAP 1024
 
 typedef struct render_chart {

@@ -58,33 +58,51 @@ static const float k_palette[8][4] = {
     {1.00f, 0.60f, 0.80f, 1}, {0.80f, 0.80f, 0.80f, 1},
 };
 
-void render_charts_default(render* r, int ncyl) {
+// The standard channels of ncyl cylinders, labelled p1A, x1, u1 ... or,
+// with names (the snapshot's cylinders), "pA lift", "x lift", "u lift".
+static void charts_std(render* r, int ncyl, const world_snapshot* named) {
     if (ncyl > WORLD_SNAP_MAX_CYLINDERS) ncyl = WORLD_SNAP_MAX_CYLINDERS;
+    // Four charts a cylinder, as many as fit.
+    if (ncyl > (RENDER_MAX_CHARTS - r->charts.n) / 4) ncyl = (RENDER_MAX_CHARTS - r->charts.n) / 4;
     r->charts.std_first = r->charts.n;
     for (int i = 0; i < ncyl; ++i) {
         char label[32];
+        const char* nm = named && named->cyl[i].name[0] ? named->cyl[i].name : NULL;
         render_chart_def d;
         memset(&d, 0, sizeof d);
         // Pressures: chamber A solid colour, B the next palette entry.
         for (int ch = 0; ch < 2; ++ch) {
-            snprintf(label, sizeof label, "p%d%c", i + 1, ch ? 'B' : 'A');
+            if (nm) snprintf(label, sizeof label, "p%c %s", ch ? 'B' : 'A', nm);
+            else snprintf(label, sizeof label, "p%d%c", i + 1, ch ? 'B' : 'A');
             d.label = label, d.unit = "MPa", d.scale = 1e-6, d.ymin = 0,
             d.ymax = r->cfg.p_full_scale * 1e-6;
             memcpy(d.rgba, k_palette[(2 * i + ch) % 8], sizeof d.rgba);
             d.group = 0;
             render_chart_add(r, &d);
         }
-        snprintf(label, sizeof label, "x%d", i + 1);
+        if (nm) snprintf(label, sizeof label, "x %s", nm);
+        else snprintf(label, sizeof label, "x%d", i + 1);
         d.label = label, d.unit = "mm", d.scale = 1e3, d.ymin = d.ymax = 0; // autoscale
         memcpy(d.rgba, k_palette[(2 * i) % 8], sizeof d.rgba);
         d.group = 1;
         render_chart_add(r, &d);
-        snprintf(label, sizeof label, "u%d", i + 1);
+        if (nm) snprintf(label, sizeof label, "u %s", nm);
+        else snprintf(label, sizeof label, "u%d", i + 1);
         d.label = label, d.unit = "%", d.scale = 100, d.ymin = -100, d.ymax = 100;
         d.group = 2;
         render_chart_add(r, &d);
     }
     r->charts.std_ncyl = ncyl;
+}
+
+void render_charts_default(render* r, int ncyl) { charts_std(r, ncyl, NULL); }
+
+void render_charts_default_named(render* r, const world_snapshot* s) { charts_std(r, s->ncyl, s); }
+
+void render_charts_reset(render* r) {
+    r->charts.n = 0;
+    r->charts.std_ncyl = 0;
+    r->charts.std_first = 0;
 }
 
 void render_charts_sample(render* r, const world_snapshot* s) {

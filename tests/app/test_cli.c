@@ -478,6 +478,14 @@ static void test_study_usage(void) {
     CHECK(rc == 2 && strstr(out, "--out-dir cli_study_file") && !strstr(out, "reference:") && !strstr(out, "reference run failed"),
           "--out-dir naming a file: exit %d: %s", rc, out);
     remove("cli_study_file");
+    // A crane chain model: its analytic mode has no CVODE reference and the
+    // study measures the two-link columns: refused in one line before the
+    // reference run, and no folder made.
+    rmdir("cli_study_chain");
+    rc = cli_run("study --quick --repeat 1 --duration 0.05 --model loader10 --out-dir cli_study_chain", out, sizeof out);
+    CHECK(rc == 2 && cli_count_lines(out) == 1 && strstr(out, "loader10.json: a chain of 5 bodies and 3 functions") &&
+              !strstr(out, "reference:") && !strstr(out, "reference run failed") && stat("cli_study_chain", &(struct stat){0}) != 0,
+          "chain model: exit %d: %s", rc, out);
     // Only the last folder is made: a missing parent is refused before any
     // run, like an output file's missing folder, and nothing is created.
     remove("cli_study2/made/study.md");
@@ -566,6 +574,20 @@ static void test_notes_on_unused_options(void) {
     rc = cli_run("bench --config krus-1ms --repeat 1 --duration 0.01 --solver rodas3", out, sizeof out);
     CHECK(rc == 0 && strstr(out, "note: --solver has no effect") && strstr(out, "\"solver\":\"krus\""),
           "bench --solver: exit %d: %s", rc, out);
+}
+
+// bench --config loader10: the second crane's cycle on both backends, one
+// JSON line each with its mechanics, its target, and wall and CPU times
+// (issue 27's two targets; docs/performance.md).
+static void test_bench_loader10(void) {
+    static char out[8192];
+    const int rc = cli_run("bench --config loader10 --repeat 1 --duration 0.05", out, sizeof out);
+    const char* a = strstr(out, "\"mechanics\":\"lagrange\"");
+    const char* b = strstr(out, "\"mechanics\":\"ode\"");
+    CHECK(rc == 0 && a && b && strstr(out, "\"world\":\"sandbox\"") && strstr(out, "\"target_rt_factor\":100") &&
+              strstr(out, "\"target_rt_factor\":20") && strstr(out, "\"cpu_s_median\"") &&
+              strstr(out, "\"sim_time_s\":0.05"),
+          "bench --config loader10: exit %d: %s", rc, out);
 }
 
 // The summary says what ran: the ode hydraulic step min(--dt, --dt-ode), the
@@ -681,6 +703,7 @@ int main(int argc, char** argv) {
     RUN_TEST(test_every_multiple_of_step);
     RUN_TEST(test_notes_on_unused_options);
     RUN_TEST(test_run_summary);
+    RUN_TEST(test_bench_loader10);
     RUN_TEST(test_hose_burst_description);
     TEST_MAIN_END();
 }

@@ -286,6 +286,19 @@ static void test_bench_drive_world(void) {
     CHECK(rc == 2 && strstr(out, "nosuch") && cli_count_lines(out) == 1, "exit %d: %s", rc, out);
 }
 
+// A crane chain in the window (offscreen for a screenshot): it drives; a
+// limiter asked for by name that its engine lacks is refused in one line,
+// as the headless drive refuses it.
+static void test_chain_window(void) {
+    int rc = drive(NO_DISPLAY, "--model loader10 --scenario loader10_cycle --screenshot chain_window.png "
+                               "--screenshot-at 0.2");
+    CHECK(rc == 0 && strstr(out, "screenshot -> chain_window.png"), "exit %d: %s", rc, out);
+    remove("chain_window.png");
+    rc = drive(NO_DISPLAY, "--model loader10 --rcl on --screenshot never.png");
+    const char* l = strstr(out, "cranesim drive: --rcl on: loader10.json: ");
+    CHECK(rc == 2 && l && cli_count_lines(l) == 1 && strstr(l, "rated capacity limiter"), "exit %d: %s", rc, out);
+}
+
 // --help: the keys come last, after the shared options.
 static void test_help_keys_last(void) {
     int rc = drive("", "--help");
@@ -412,5 +425,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_drive_record_is_the_run);
     RUN_TEST(test_drive_plays_faults);
     RUN_TEST(test_hook_report);
+    RUN_TEST(test_chain_window);
     TEST_MAIN_END();
 }

@@ -109,7 +109,8 @@ static int table_count(drive_session* s) {
         hyd_model_element(hm, i, &t);
         n += hyd_param_count(t);
     }
-    return n + hyd_fluid_param_count() + model_param_count() + 2;
+    // + the solver's two, + the eight strip-chart slots (a choice of channel each)
+    return n + hyd_fluid_param_count() + model_param_count() + 2 + 8;
 }
 
 // Every table entry is in the panel, under "<element> (<type>)".

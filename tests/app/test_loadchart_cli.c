@@ -188,8 +188,75 @@ static void test_chart_plot_lines_visible(void) {
 }
 #endif
 
+// A crane chain (loader10, docs/safety.md "On a crane chain"): the CSV names
+// every joint coordinate of the governing poses by body (deg or m) and the
+// governing actuator by name; the rating by hand (4000 kg, 98 kN m / (g R));
+// each pose within its joint's limits; the chart never rising from its
+// minimum outreach. What the search cannot read is refused in one line.
+#define WDATA CRANESIM_TESTDATA "/../../world/data"
+static void test_chain_csv(void) {
+    const int rc = cli_run("loadchart --model loader10 --world validation --outreach 1:7:7 --out lc_chain.csv --quiet",
+                           out, sizeof out);
+    CHECK(rc == 0, "exit %d: %s", rc, out);
+    static char csv[1 << 16];
+    CHECK(cli_read_file("lc_chain.csv", csv, sizeof csv) > 0, "no CSV");
+    static const char k_head[] =
+        "outreach_m,hydraulic_kg,hyd_cylinder,hyd_lifting_arm_deg,hyd_knuckle_arm_deg,hyd_ext1_m,hyd_ext2_m,rating_kg,"
+        "envelope_s0_kg,chart_s0_kg,capacity_s0_kg,governs_s0,gov_outreach_s0_m,lifting_arm_s0_deg,knuckle_arm_s0_deg,"
+        "ext1_s0_m,ext2_s0_m,slew_s0_deg\n";
+    CHECK(strncmp(csv, k_head, sizeof k_head - 1) == 0, "header: %.400s", csv);
+    CHECK(cli_count_lines(csv) == 8, "%d lines, expected 8", cli_count_lines(csv));
+    // The joints' limits (loader10.json), deg and m.
+    const double lo[4] = {1.23 * 180 / M_PI, -2.2 * 180 / M_PI, 0, 0}, hi[4] = {2.78 * 180 / M_PI, -0.45 * 180 / M_PI, 1.3, 1.3};
+    double prev = INFINITY;
+    char* line = strchr(csv, '\n');
+    int nrow = 0;
+    while (line && line[1]) {
+        char* next = strchr(line + 1, '\n');
+        if (next) *next = '\0';
+        char* f[40];
+        const int n = split(line + 1, f, 40);
+        CHECK(n == 18, "row has %d fields, expected 18", n);
+        if (n == 18) {
+            ++nrow;
+            const double R = atof(f[0]), rating = atof(f[7]);
+            CHECK(fabs(rating - fmin(4000.0, 98e3 / (9.81 * R))) < 0.06, "rating %g at %g m", rating, R);
+            CHECK(!strcmp(f[2], "lift") || !strcmp(f[2], "jib") || !strcmp(f[2], "ext1") || !strcmp(f[2], "ext2"),
+                  "hyd_cylinder %s", f[2]);
+            CHECK(!strcmp(f[11], "rated") || !strcmp(f[11], "lift") || !strcmp(f[11], "jib") ||
+                      !strcmp(f[11], "ext1") || !strcmp(f[11], "ext2"),
+                  "governs %s at %g m", f[11], R);
+            for (int d = 0; d < 4; ++d) {
+                const double v = atof(f[3 + d]), w = atof(f[13 + d]);
+                CHECK(v >= lo[d] - 1e-3 && v <= hi[d] + 1e-3 && w >= lo[d] - 1e-3 && w <= hi[d] + 1e-3,
+                      "pose %d: %g, %g outside [%g, %g] at %g m", d, v, w, lo[d], hi[d], R);
+            }
+            if (f[9][0]) {
+                CHECK(atof(f[9]) <= prev + 1e-9, "the chart rises to %s at %g m", f[9], R);
+                prev = atof(f[9]);
+            }
+        }
+        line = next;
+    }
+    CHECK(nrow == 7 && isfinite(prev), "%d rows, chart printed: %d", nrow, isfinite(prev));
+    remove("lc_chain.csv");
+    static const struct {
+        const char* args;
+        const char* expect;
+    } bad[] = {
+        {"loadchart --model " WDATA "/chain_8fn_10link.json --out lc_bad.csv", "load chart: the search over every joint"},
+        {"loadchart --model " WDATA "/hiab031_chain.json --out lc_bad.csv", "limits: the load chart searches every pose"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        const int r2 = cli_run(bad[i].args, out, sizeof out);
+        CHECK(r2 == 2 && strstr(out, bad[i].expect) && cli_count_lines(out) == 1, "%s: exit %d: %s", bad[i].args, r2,
+              out);
+    }
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_bad_input);
+    RUN_TEST(test_chain_csv);
     RUN_TEST(test_chart_csv);
 #ifdef LC_TEST_PLOT
     RUN_TEST(test_chart_plot_lines_visible);

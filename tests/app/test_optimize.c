@@ -175,9 +175,80 @@ static void test_optimize_bad_input(void) {
     }
 }
 
+#define LOADER10 CRANESIM_TESTDATA "/../../../assets/models/loader10.json"
+
+// The value of metric name in a metrics JSON text, or NAN.
+static double json_metric(const char* text, const char* name) {
+    char key[160];
+    snprintf(key, sizeof key, "\"%s\": {\"value\": ", name);
+    const char* p = strstr(text, key);
+    return p ? strtod(p + strlen(key), NULL) : NAN;
+}
+
+// The hand solution on a crane chain model, by actuator name: loader10 on
+// `hold` (lagrange) holds its load still, so the lift cylinder's force
+// F = pA A_A - pB A_B (pA_lift, pB_lift of one run at its 140 mm bore, rod
+// 84 mm) does not depend on the bore, and the smallest bore whose
+// peak_pA.lift (the chain's metric, by name) stays at V is
+//   b^2 = (4 F / pi - pB d^2) / (V - pB),
+// as for the two-link crane above. The progress lines name the metric and
+// give it in MPa; the written model runs to a peak just under V.
+static void test_optimize_chain_by_name(void) {
+    CHECK(cli_run("run -q --model " LOADER10 " --mechanics lagrange --scenario hold --duration 0.5 --out opt_l10.csv",
+                  out, sizeof out) == 0,
+          "%s", out);
+    static char csv[1 << 20];
+    CHECK(cli_read_file("opt_l10.csv", csv, sizeof csv) > 0, "no CSV");
+    // The columns by name (the chain's follow the base columns).
+    int cA = -1, cB = -1, k = 0;
+    for (const char* p = csv; *p && *p != '\n'; ++k) {
+        const size_t L = strcspn(p, ",\n");
+        if (L == 7 && !strncmp(p, "pA_lift", 7)) cA = k;
+        if (L == 7 && !strncmp(p, "pB_lift", 7)) cB = k;
+        p += L + (p[L] == ',');
+    }
+    const char* r0 = strchr(csv, '\n');
+    CHECK(r0 && cA > 0 && cB > 0, "no pA_lift, pB_lift columns");
+    if (!r0 || cA < 0 || cB < 0) return;
+    const double pA = csv_field(r0 + 1, cA), pB = csv_field(r0 + 1, cB);
+    const double b0 = 0.14, d = 0.084, V = 8e6;
+    const double F = pA * M_PI * b0 * b0 / 4 - pB * M_PI * (b0 * b0 - d * d) / 4;
+    const double b_hand = sqrt((4 * F / M_PI - pB * d * d) / (V - pB));
+    CHECK(F > 5e4 && b_hand > 0.11 && b_hand < 0.135, "F %g N, bore %g m", F, b_hand);
+    unlink("opt_l10_best.json");
+    const int rc = cli_run("optimize --model " LOADER10 " --mechanics lagrange --scenario hold --duration 0.5 --param " BORE
+                           "=0.10:0.16 --minimize " BORE " --constraint 'peak_pA.lift<=8MPa' --out opt_l10_best.json",
+                           out, sizeof out);
+    CHECK(rc == 0, "rc %d: %s", rc, out);
+    const char* pl = strstr(out, "peak_pA.lift ");
+    const double shown = pl ? strtod(pl + strlen("peak_pA.lift "), NULL) : NAN;
+    CHECK(pl && shown > 3 && shown < 20 && !strncmp(strchr(pl + 13, ' '), " MPa", 4), "progress: %.80s",
+          pl ? pl : out);
+    const double b = best_bore(out);
+    CHECK(fabs(b - b_hand) <= 2e-3 * b_hand, "optimum %.6g m, by hand %.6g m", b, b_hand);
+    printf("  loader10: smallest lift bore for peak_pA.lift <= 8 MPa %.6g m, by hand %.6g m\n", b, b_hand);
+    CHECK(cli_run("run -q --model opt_l10_best.json --mechanics lagrange --scenario hold --duration 0.5 --out "
+                  "opt_l10_check.csv --metrics opt_l10_check.json",
+                  out, sizeof out) == 0,
+          "%s", out);
+    static char js[1 << 15];
+    CHECK(cli_read_file("opt_l10_check.json", js, sizeof js) > 0, "no metrics");
+    const double peak = json_metric(js, "peak_pA.lift");
+    CHECK(peak <= V && peak > 0.99 * V, "peak_pA.lift of the best model %.9g Pa", peak);
+    // A name loader10 does not have: one line, exit 2, nothing written.
+    unlink("opt_l10_bad.json");
+    const int rc2 = cli_run("optimize --model " LOADER10 " --mechanics lagrange --scenario hold --param " BORE
+                            "=0.10:0.16 --minimize " BORE " --constraint 'peak_pA.fold<=8MPa' --out opt_l10_bad.json",
+                            out, sizeof out);
+    CHECK(rc2 == 2 && cli_count_lines(out) == 1 && strstr(out, "unknown metric 'peak_pA.fold'") &&
+              access("opt_l10_bad.json", F_OK) != 0,
+          "unknown chain metric: %d %s", rc2, out);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_optimize_finds_hand_bore);
     RUN_TEST(test_optimize_failing_designs_infeasible);
     RUN_TEST(test_optimize_bad_input);
+    RUN_TEST(test_optimize_chain_by_name);
     TEST_MAIN_END();
 }

@@ -63,7 +63,7 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
     int fd = serve_join(sv.port, PROTO_CONTROL, &role);
     CHECK(fd >= 0 && role == PROTO_CONTROL, "joined as controller (role %d)", role);
     CHECK(fd >= 0 && next_state(fd, &g_st, 5000) == 0 && g_st.nine[8] == 0, "the state at t = 0 first");
-    long diff = 0, frames = 0, diff2 = 0, tilted = 0;
+    long diff = 0, frames = 0, diff2 = 0, tilted = 0, fn_diff = 0;
     double worst = 0, tilt_err = 0;
     world_snapshot* snap = malloc(sizeof *snap);
     for (int i = 0; i < nframes && fd >= 0; ++i) {
@@ -76,7 +76,7 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
         engine_row(l, row);
         const double nine[9] = {row[COL_X1], row[COL_X2], row[COL_P1A], row[COL_P1B], row[COL_P2A],
                                 row[COL_P2B], row[COL_U1], row[COL_U2], row[COL_T]};
-        proto_command c = {.seq = 2 * (uint64_t)i + 1, .op = PROTO_OP_VALVES};
+        proto_command c = {.seq = 2 * (uint64_t)i + 1, .op = PROTO_OP_VALVES, .nu = 3};
         for (int k = 0; k < 3; ++k) c.u[k] = fmax(-1, fmin(1, u[k]));
         send_cmd(fd, &c);
         c = (proto_command){.seq = 2 * (uint64_t)i + 2, .op = PROTO_OP_STEP, .frames = 1};
@@ -89,6 +89,15 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
         CHECK(g_st.cmd_seq == c.seq, "frame %d echoes command %llu, got %llu", i, (unsigned long long)c.seq,
               (unsigned long long)g_st.cmd_seq);
         if (memcmp(nine, g_st.nine, sizeof nine)) ++diff;
+        // Version 3: the function records lift, jib, slew: their commands
+        // (after the limiter) and spools are the row's u1_cmd, u2_cmd and
+        // u1, u2 (slew: its cylinder's in the sandbox, the command as given
+        // on the lagrange crane, which does not slew).
+        if (g_st.nfn != 3 || g_st.fn[0][0] != row[COL_U1_CMD] || g_st.fn[1][0] != row[COL_U2_CMD] ||
+            g_st.fn[0][1] != row[COL_U1] || g_st.fn[1][1] != row[COL_U2] ||
+            (o.mechanics == SIM_ODE ? g_st.fn[2][0] != row[COL_U3_CMD] || g_st.fn[2][1] != row[COL_U3]
+                                    : g_st.fn[2][0] != fmax(-1, fmin(1, u[2])) || g_st.fn[2][1] != g_st.fn[2][0]))
+            ++fn_diff;
         for (int k = 0; k < 9; ++k) worst = fmax(worst, fabs(nine[k] - g_st.nine[k]));
         // Version 2: the tip in the world, the truck's roll and pitch and the
         // supply pressure equal the local run's; the tilt from roll and
@@ -112,6 +121,8 @@ static void bit_for_bit(const char* mech, const char* scen, int nframes) {
     printf("%s/%s: %ld frames served, %ld differ from the local run (largest difference %g)\n", mech, scen, frames,
            diff, worst);
     CHECK(frames == nframes && diff == 0, "%s: %ld of %ld frames differ, by up to %g", mech, diff, frames, worst);
+    CHECK(fn_diff == 0, "%s: the function records differ from the row's commands and spools in %ld frames", mech,
+          fn_diff);
     CHECK(g_st.nine[8] == nframes * frame || fabs(g_st.nine[8] - nframes * frame) < 1e-3, "t = %g", g_st.nine[8]);
     if (fd >= 0) close(fd);
     CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
@@ -154,7 +165,7 @@ static uint64_t g_seq = 100;
 // The watcher gets new frames and the controller's next command is echoed, within 3 s.
 static int others_served(void) {
     const unsigned long long w0 = atomic_load(&g_wseq);
-    proto_command c = {.seq = ++g_seq, .op = PROTO_OP_VALVES, .u = {0.2, 0, 0}};
+    proto_command c = {.seq = ++g_seq, .op = PROTO_OP_VALVES, .nu = 3, .u = {0.2, 0, 0}};
     if (g_c < 0 || send_cmd(g_c, &c)) return 0;
     for (int k = 0; k < 300; ++k) {
         if (atomic_load(&g_wseq) > w0 + 2 && atomic_load(&g_cecho) == c.seq) return 1;
@@ -200,7 +211,7 @@ static void hostile(void) {
 
     // 1. a truncated frame: a valves command whose length leaves out 2 bytes of it
     {
-        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES};
+        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 3};
         size_t n = proto_put_command(b + 64, sizeof b - 64, &c);
         memcpy(b, hello, nh);
         b[64] = (uint8_t)(b[64] - 2);
@@ -215,28 +226,33 @@ static void hostile(void) {
         memcpy(b + nh, big, 5);
         CASE("length 2^31", raw(sv.port, b, nh + 5), 3000);
     }
-    // 3. a client of protocol version 1 (the state frame before the tip, roll,
-    // pitch and supply pressure) and one of a version yet to come
-    for (int v = 1; v <= 3; v += 2) {
-        size_t n = proto_put_client_hello(b, sizeof b, (uint32_t)v, PROTO_WATCH);
+    // 3. clients of protocol versions 1 and 2 (written for the two-link
+    // crane: three valve openings, no function list) and one of a version
+    // yet to come: each is told the version this server speaks and what to
+    // update, then closed
+    for (int v = 1; v <= 4; v += v == 2 ? 2 : 1) {
+        size_t n = proto_put_client_hello(b, sizeof b, (uint32_t)v, PROTO_CONTROL);
         int fd = raw(sv.port, b, n);
         proto_msg m;
-        char want[96];
-        snprintf(want, sizeof want, "protocol version %d not supported (this server speaks 2)", v);
+        char want[200];
+        snprintf(want, sizeof want,
+                 "protocol version %d not supported: this server speaks version 3, which lists the functions in its "
+                 "hello and takes one valve opening per function: update the client",
+                 v);
         CHECK(recv_frame(fd, &m, &g_st, 3000) == PROTO_ERROR && m.u.text.code == PROTO_E_VERSION &&
                   strstr(m.u.text.text, want),
               "version %d answered with '%s'", v, want);
-        CASE(v == 1 ? "old version" : "future version", fd, 3000);
+        CASE(v < 3 ? "old version" : "future version", fd, 3000);
     }
     // 4. an unknown op, 5. a NaN valve command (from a client that asked for control: it only watches)
     for (int k = 0; k < 2; ++k) {
         memcpy(b, hello, nh);
-        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .u = {0, 0, 0}};
+        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 3, .u = {0, 0, 0}};
         size_t n = proto_put_command(b + nh, sizeof b - nh, &c);
         if (k == 0) b[nh + 13] = 42;
         else {
             double nan = NAN;
-            memcpy(b + nh + 14, &nan, 8);
+            memcpy(b + nh + 15, &nan, 8); // after the count of openings
         }
         CASE(k == 0 ? "unknown command" : "NaN command", raw(sv.port, b, nh + n), 3000);
     }
@@ -256,7 +272,7 @@ static void hostile(void) {
     // 9. half a frame after the hello, then silence
     {
         memcpy(b, hello, nh);
-        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES};
+        proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 3};
         size_t n = proto_put_command(b + nh, sizeof b - nh, &c);
         CASE("frame left half sent", raw(sv.port, b, nh + n / 2), 5000);
     }
@@ -287,7 +303,7 @@ static void hostile(void) {
         int role2 = -1;
         int fd = serve_join(sv.port, PROTO_CONTROL, &role2);
         CHECK(fd >= 0 && role2 == PROTO_WATCH, "a second controller watches (role %d)", role2);
-        proto_command c = {.op = PROTO_OP_VALVES, .u = {1, 1, 1}};
+        proto_command c = {.op = PROTO_OP_VALVES, .nu = 3, .u = {1, 1, 1}};
         size_t n = 0;
         static uint8_t flood[1 << 20];
         while (n + 64 < sizeof flood) {
@@ -346,7 +362,7 @@ static void hostile(void) {
     pthread_join(th, NULL);
     CHECK(serve_stop(&sv) == 0, "server exits 0 on SIGINT");
     // Every case left its reason in the log.
-    const char* reasons[] = {"too short", "length 2147483648", "version 1 not supported", "version 3 not supported", "unknown op 42",
+    const char* reasons[] = {"too short", "length 2147483648", "version 1 not supported", "version 2 not supported", "version 4 not supported", "unknown op 42",
                              "opening 1 must be a number", "first frame must be a client hello", "no hello within",
                              "left incomplete", "not reading", "client limit reached", "unexpected state frame",
                              "the server stops"};
@@ -375,7 +391,7 @@ static void dead_man(void) {
     CHECK(next_state(fd, &g_st, 5000) == 0, "the state at t = 0");
     // Jib valve at -0.7 for 0.2 s (15 frames at 75 Hz): the jib stroke moves
     // (from 156 mm; held open it reaches its end stop after about 1 s).
-    proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .u = {0, -0.7, 0}};
+    proto_command c = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 3, .u = {0, -0.7, 0}};
     send_cmd(fd, &c);
     const double x2_start = g_st.nine[1];
     c = (proto_command){.seq = 2, .op = PROTO_OP_STEP, .frames = 15};

@@ -65,7 +65,7 @@ static double served_cut(const char* const* extra, bool rcl_on, int nframes, lon
         CHECK(engine_advance(l, (i + 1) * frame - engine_time(l)) == 0, "local step %d", i);
         double row[SIM_NCOL];
         engine_row(l, row);
-        proto_command c = {.seq = 2 * (uint64_t)i + 1, .op = PROTO_OP_VALVES, .u = {0, 1, 0}};
+        proto_command c = {.seq = 2 * (uint64_t)i + 1, .op = PROTO_OP_VALVES, .nu = 3, .u = {0, 1, 0}};
         send_cmd(fd, &c);
         c = (proto_command){.seq = 2 * (uint64_t)i + 2, .op = PROTO_OP_STEP, .frames = 1};
         send_cmd(fd, &c);
@@ -228,7 +228,7 @@ static void before_hello(void) {
     // A valves command cut short (its length leaves out 8 bytes), and a
     // whole reset command, each as the first frame.
     uint8_t b[128];
-    proto_command cmd = {.seq = 1, .op = PROTO_OP_VALVES};
+    proto_command cmd = {.seq = 1, .op = PROTO_OP_VALVES, .nu = 3};
     size_t n = proto_put_command(b, sizeof b, &cmd);
     b[0] = (uint8_t)(b[0] - 8);
     int fd = tcp_connect(sv.port);

@@ -488,6 +488,111 @@ static void test_drive_summary_collisions_match_run(void) {
     CHECK(!strstr(drv, "collisions"), "the lagrange view reports collisions:\n%s", drv);
 }
 
+#define LOADER10 CRANESIM_TESTDATA "/../../../assets/models/loader10.json"
+#define L10_SCN CRANESIM_TESTDATA "/scn_loader10_functions.json"
+
+// Field k of a CSV line as its text (up to the next comma or newline).
+static void csv_text(const char* line, int k, char* buf, size_t n) {
+    const char* p = line;
+    for (int i = 0; i < k && p; ++i) {
+        p = strchr(p, ',');
+        if (p) ++p;
+    }
+    const size_t L = p ? strcspn(p, ",\n") : 0;
+    snprintf(buf, n, "%.*s", (int)(L < n ? L : n - 1), p ? p : "");
+}
+
+// Each row of the sweep file text against `cranesim run --set` of its
+// design (pars: the --param paths, in the file's column order; the runs
+// with run_args): every metric column that the run's --metrics JSON has
+// (the chain's by actuator and function included) must be the same double.
+// Returns the values compared.
+static int check_rows_against_runs(const char* text, const char* const* pars, int npar, const char* run_args) {
+    static char json[1 << 16];
+    const char* nl = strchr(text, '\n');
+    int compared = 0;
+    for (const char* row = nl ? nl + 1 : NULL; row && *row; row = strchr(row, '\n'), row = row ? row + 1 : NULL) {
+        char cmd[2048], v[64];
+        int L = snprintf(cmd, sizeof cmd, "run -q %s --out sweep_l10_run.csv --metrics sweep_l10_run.json", run_args);
+        for (int k = 0; k < npar; ++k) {
+            csv_text(row, 1 + k, v, sizeof v);
+            L += snprintf(cmd + L, sizeof cmd - (size_t)L, " --set %s=%s", pars[k], v);
+        }
+        CHECK(cli_run(cmd, out, sizeof out) == 0, "%s: %s", cmd, out);
+        CHECK(cli_read_file("sweep_l10_run.json", json, sizeof json) > 0, "no metrics json");
+        // Every column after the parameters, up to exit.
+        const int cexit = csv_col(text, "exit");
+        CHECK(cexit > npar + 1 && csv_field(row, cexit) == 0, "row exit: %.120s", row);
+        for (int c = 1 + npar; c < cexit; ++c) {
+            char name[96];
+            csv_text(text, c, name, sizeof name);
+            const double want = json_metric(json, name), got = csv_field(row, c);
+            CHECK(!isnan(want), "%s: not in run's metrics JSON", name);
+            CHECK(got == want, "%s: sweep %.17g, run --set %.17g (%s)", name, got, want, cmd);
+            ++compared;
+        }
+    }
+    return compared;
+}
+
+// A crane chain model (loader10: lift, jib, ext; actuators lift, jib, ext1,
+// ext2): sweep paths name its parts (an actuator, a body, a circuit element),
+// the default table has its metrics by actuator and function, --metrics
+// takes them by name, and every value is that of `cranesim run --set` of the
+// same design (lagrange on threads, ode on worker processes).
+static void test_sweep_chain_by_name(void) {
+    static char a[1 << 16];
+    const char* const pars[] = {"mechanics.actuators.lift.closed_length", "mechanics.bodies.lifting_arm.inertia"};
+    unlink("sweep_l10.csv");
+    CHECK(cli_run("sweep -q --model " LOADER10 " --mechanics lagrange --scenario " L10_SCN
+                  " --param mechanics.actuators.lift.closed_length=1.33:1.35:3"
+                  " --param mechanics.bodies.lifting_arm.inertia=182:184:2 --out sweep_l10.csv",
+                  out, sizeof out) == 0,
+          "%s", out);
+    CHECK(cli_read_file("sweep_l10.csv", a, sizeof a) > 0, "no sweep_l10.csv");
+    // The table shows every function and actuator by name.
+    const char* cols[] = {"max_spool.lift", "max_spool.jib", "max_spool.ext", "peak_pA.lift", "peak_pB.jib",
+                          "peak_force.ext1", "stroke_max.ext2", "end_stop_hits.ext2", "stroke_min.lift"};
+    for (int k = 0; k < 9; ++k) CHECK(csv_col(a, cols[k]) > 2, "no column %s in: %.400s", cols[k], a);
+    // Each function was commanded (scn_loader10_functions: lift 0.8, jib -0.6, ext 0.9 at most).
+    const char* r0 = strchr(a, '\n');
+    CHECK(r0 && fabs(csv_field(r0 + 1, csv_col(a, "max_spool.ext")) - 0.9) < 1e-6 &&
+              fabs(csv_field(r0 + 1, csv_col(a, "max_spool.lift")) - 0.8) < 1e-6 &&
+              fabs(csv_field(r0 + 1, csv_col(a, "max_spool.jib")) - 0.6) < 1e-6,
+          "spool openings by function: %.300s", r0 ? r0 + 1 : "");
+    int n = check_rows_against_runs(a, pars, 2,
+                                    "--model " LOADER10 " --mechanics lagrange --scenario " L10_SCN);
+    CHECK(n >= 6 * 30, "compared %d values", n);
+    printf("  loader10 lagrange: %d sweep values equal to run --set's\n", n);
+    // ode, on worker processes, a circuit element; --metrics by name.
+    const char* const pars2[] = {"hydraulics.components.ext1_cyl.bore"};
+    CHECK(cli_run("sweep -q --threads 2 --model " LOADER10 " --mechanics ode --world validation --scenario " L10_SCN
+                  " --param hydraulics.components.ext1_cyl.bore=0.06:0.07:2"
+                  " --metrics peak_pA.ext1,peak_pB.ext1,stroke_max.ext1,max_spool.ext,peak_p1A --out sweep_l10.csv",
+                  out, sizeof out) == 0,
+          "%s", out);
+    CHECK(cli_read_file("sweep_l10.csv", a, sizeof a) > 0 &&
+              !strncmp(a, "index,hydraulics.components.ext1_cyl.bore,peak_pA.ext1,peak_pB.ext1,stroke_max.ext1,"
+                          "max_spool.ext,peak_p1A,exit,error\n", 100),
+          "ode table: %.300s", a);
+    n = check_rows_against_runs(a, pars2, 1,
+                                "--model " LOADER10 " --mechanics ode --world validation --scenario " L10_SCN);
+    CHECK(n == 10, "compared %d values", n);
+    // The larger ext1 bore holds the same extension with less pressure.
+    const char* r1 = strchr(a, '\n');
+    const char* r2 = r1 ? strchr(r1 + 1, '\n') : NULL;
+    CHECK(r1 && r2 && csv_field(r2 + 1, 2) < csv_field(r1 + 1, 2), "peak_pA.ext1 did not fall with the bore");
+    // A name the model does not have: one line with the names it has, exit 2, no file.
+    unlink("sweep_l10_bad.csv");
+    int rc = cli_run("sweep --model " LOADER10 " --mechanics lagrange --scenario " L10_SCN
+                     " --param hydraulics.components.ext1_cyl.bore=0.06:0.07:2 --metrics peak_pA.fold"
+                     " --out sweep_l10_bad.csv",
+                     out, sizeof out);
+    CHECK(rc == 2 && cli_count_lines(out) == 1 && strstr(out, "unknown metric 'peak_pA.fold'") &&
+              strstr(out, "by function: max_spool.NAME (lift, jib, ext)") && access("sweep_l10_bad.csv", F_OK) != 0,
+          "unknown chain metric: %d %s", rc, out);
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_metrics_match_csv);
     RUN_TEST(test_energy_and_relief_metrics_match_energy_csv);
@@ -498,5 +603,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_sweep_failing_design_is_a_row);
     RUN_TEST(test_sweep_bad_input);
     RUN_TEST(test_sweep_lhs_strata);
+    RUN_TEST(test_sweep_chain_by_name);
     TEST_MAIN_END();
 }

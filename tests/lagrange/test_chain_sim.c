@@ -1,6 +1,7 @@
 // test_chain_sim.c: the general analytic mode (chain_sim.h) against the
 // closed-form two-link crane (lagrange_sim.h), an energy invariant on a
 // five-body chain, and its analytic Jacobian against finite differences.
+#include "chain_problem.h"
 #include "chain_sim.h"
 #include "engine_chain.h"
 #include "engine.h"
@@ -641,7 +642,89 @@ static void test_eight_function_model_file(void) {
     model_free(m);
 }
 
+// The Jacobian events (chain_problem_events) take the strokes and rates that
+// f's kinematics left in hd when f was last evaluated at the same (t, q, q')
+// (chain_sim_inputs_at), else run the kinematics themselves: both ways give
+// the same inputs bit for bit, and a different q, q' or t is never served
+// from the last evaluation. On the slewing 8-function chain in motion.
+static void events_inputs(chain_problem* cp, double t, const double* y, double* x, double* v, int nc) {
+    chain_problem_events(cp, t, y);
+    memcpy(x, cp->x, (size_t)nc * sizeof *x);
+    memcpy(v, cp->v, (size_t)nc * sizeof *v);
+}
+
+static void test_events_reuse_kinematics(void) {
+    crane_chain cc;
+    hyd_model* hm;
+    double qb[8];
+    char err[256];
+    CHECK(crane_chain_synthetic("RRRPRPRP", true, &cc, &hm, qb, err, sizeof err) == 0, "%s", err);
+    if (!hm) return;
+    chain_sim cs;
+    CHECK(chain_sim_init(&cs, &cc, hm, 50.0, 0.0, err, sizeof err) == 0, "%s", err);
+    double q0[9] = {0.3};
+    for (int i = 0; i < 8; ++i) q0[i + 1] = qb[i];
+    const int n = cs.n, nc = hyd_model_ncylinder(hm);
+    double* buf = calloc(3 * (size_t)n + 8 * (size_t)nc, sizeof *buf);
+    double *y = buf, *y2 = y + n, *f = y2 + n;
+    double *xa = f + n, *va = xa + nc, *xb = va + nc, *vb = xb + nc, *xc = vb + nc, *vc = xc + nc, *xd = vc + nc,
+           *vd = xd + nc;
+    CHECK(chain_sim_initial_state(&cs, q0, 0.5e6, y, err, sizeof err) == 0, "%s", err);
+    // The start state writes hd's inputs outside an evaluation: no reuse after it.
+    chain_sim_rhs(&cs, 0.0, y, f);
+    CHECK(chain_sim_inputs_at(&cs, 0.0, y), "f's inputs at the start not recognised");
+    CHECK(chain_sim_initial_state(&cs, q0, 0.5e6, y, err, sizeof err) == 0, "%s", err);
+    CHECK(!chain_sim_inputs_at(&cs, 0.0, y), "inputs reused across chain_sim_initial_state");
+    cs.cmd_fn = wave;
+    // In motion: 0.3 s of Krus from the start.
+    hyd_problem p = chain_sim_problem(&cs, true);
+    hyd_solver_opts so = hyd_default_solver_opts();
+    so.h = 1e-4;
+    hyd_solver* sol = hyd_solver_create(&p, HYD_KRUS, &so);
+    double t = 0;
+    CHECK(sol && hyd_solver_advance(sol, &t, y, 0.3) == HYD_OK, "advance failed at %g", t);
+    hyd_solver_destroy(sol);
+    double vmax = 0.0;
+    for (int i = 0; i < cs.ndof; ++i) vmax = fmax(vmax, fabs(y[cs.iq + cs.ndof + i]));
+    CHECK(vmax > 1e-3, "the chain moves (largest joint rate %g)", vmax);
+    // y2: every q and q' a little off y's.
+    memcpy(y2, y, (size_t)n * sizeof *y);
+    for (int i = 0; i < 2 * cs.ndof; ++i) y2[cs.iq + i] += 1e-3 * (1 + i % 3);
+    chain_problem cp;
+    hyd_problem prob;
+    CHECK(chain_problem_init(&cp, &cs, false, &prob) == 0, "chain_problem_init");
+    // Fresh: the last evaluation elsewhere, so the events run the kinematics.
+    chain_sim_rhs(&cs, t, y2, f);
+    CHECK(!chain_sim_inputs_at(&cs, t, y), "inputs of y2 taken for y");
+    events_inputs(&cp, t, y, xa, va, nc);
+    chain_sim_rhs(&cs, t, y, f);
+    CHECK(!chain_sim_inputs_at(&cs, t, y2), "inputs of y taken for y2");
+    events_inputs(&cp, t, y2, xc, vc, nc);
+    // Reused: f at the same (t, y) just before, as the solver calls them.
+    chain_sim_rhs(&cs, t, y, f);
+    CHECK(chain_sim_inputs_at(&cs, t, y), "f's inputs at (t, y) not recognised");
+    CHECK(!chain_sim_inputs_at(&cs, t + 1e-4, y), "inputs of t taken for another t");
+    events_inputs(&cp, t, y, xb, vb, nc);
+    chain_sim_rhs(&cs, t, y2, f);
+    events_inputs(&cp, t, y2, xd, vd, nc);
+    CHECK(!memcmp(xa, xb, (size_t)nc * sizeof *xa) && !memcmp(va, vb, (size_t)nc * sizeof *va),
+          "strokes or rates at y differ between the reused and the fresh kinematics");
+    CHECK(!memcmp(xc, xd, (size_t)nc * sizeof *xc) && !memcmp(vc, vd, (size_t)nc * sizeof *vc),
+          "strokes or rates at y2 differ between the reused and the fresh kinematics");
+    double dx = 0.0;
+    for (int k = 0; k < cs.nact; ++k) dx = fmax(dx, fabs(xa[cs.acyl[k]] - xc[cs.acyl[k]]));
+    CHECK(dx > 1e-5, "y and y2 give the same strokes (largest difference %g m): the test cannot tell them apart", dx);
+    printf("  %d actuators (slew rack: %s), largest stroke difference y2 - y %.3g mm\n", cs.nact,
+           cs.rack >= 0 ? "yes" : "no", dx * 1e3);
+    chain_problem_free(&cp);
+    free(buf);
+    chain_sim_free(&cs);
+    crane_chain_free(&cc);
+    hyd_model_free(hm);
+}
+
 int main(int argc, char** argv) {
+    RUN_TEST(test_events_reuse_kinematics);
     RUN_TEST(test_eight_function_model_file);
     RUN_TEST(test_chain_model_file);
     RUN_TEST(test_eight_functions_slewing);

@@ -511,6 +511,66 @@ static void test_random_linkages(void) {
           refused_close, refused_dead);
 }
 
+// The linkage as a chain's cylinder (linkage_cylinder, _hessian): a column,
+// a lifting arm (revolute) and the knuckle (revolute, its joint at the
+// crane-like linkage's J); the chain's L, rate, lever arms and their rates
+// against linkage_eval at the knuckle's q (exact: the same formula, the
+// chain only supplies q and qd), 0 in every other DOF; the knuckle locked
+// (not a DOF): L at its q_fixed and no lever anywhere.
+static void test_as_chain_cylinder(void) {
+    linkage_def d = crane_def();
+    linkage lk;
+    char err[256] = "";
+    CHECK(linkage_init(&lk, &d, err, sizeof err) == 0, "%s", err);
+    chain_body_def b[3];
+    for (int i = 0; i < 3; ++i) {
+        chain_body_init(&b[i], i - 1);
+        b[i].mass = 100;
+        b[i].com[0] = 0.5;
+        chain_inertia_box(100, 1, 0.2, 0.2, b[i].inertia);
+    }
+    b[0].fixed = 1;
+    b[1].origin[2] = 2.0;
+    b[1].angle0 = -M_PI / 2;
+    b[2].origin[0] = d.joint[0];
+    for (int locked = 0; locked < 2; ++locked) {
+        b[2].fixed = locked;
+        b[2].q_fixed = -1.1;
+        chain* c = chain_create(b, 3, NULL, err, sizeof err);
+        CHECK(c != NULL, "%s", err);
+        if (!c) return;
+        chain_ws* w = chain_ws_create(c);
+        const int nd = chain_ndof(c), kn = chain_body_dof(c, 2);
+        CHECK(nd == 2 - locked && kn == (locked ? -1 : 1), "dofs %d, knuckle %d", nd, kn);
+        double worst = 0;
+        for (int i = 0; i <= 10; ++i) {
+            const double qk = locked ? -1.1 : d.q_min + (d.q_max - d.q_min) * i / 10.0;
+            const double q[2] = {1.3 + 0.1 * i, qk}, qd[2] = {0.2, -0.45};
+            chain_update(c, w, q, qd);
+            double qdk;
+            CHECK(chain_joint_q(c, w, 2, &qdk) == qk && qdk == (locked ? 0.0 : qd[1]), "chain_joint_q");
+            double Ld, dL[2], dLd[2], H[4];
+            const double L = linkage_cylinder(&lk, c, w, 2, &Ld, dL, dLd);
+            linkage_cylinder_hessian(&lk, c, w, 2, H);
+            linkage_state st;
+            CHECK(linkage_eval(&lk, qk, &st) == 0, "eval at %g", qk);
+            worst = fmax(worst, fabs(L - st.L));
+            CHECK(dL[0] == 0 && dLd[0] == 0 && H[0] == 0, "the lifting arm's lever %g, %g, H %g", dL[0], dLd[0], H[0]);
+            if (locked) {
+                CHECK(Ld == 0, "rate %g with the knuckle locked", Ld);
+            } else {
+                worst = fmax(worst, fabs(Ld - st.dL * qd[1]));
+                worst = fmax(worst, fabs(dL[1] - st.dL) + fabs(dLd[1] - st.d2L * qd[1]));
+                worst = fmax(worst, fabs(H[3] - st.d2L));
+                CHECK(H[1] == 0 && H[2] == 0, "H off-diagonal %g %g", H[1], H[2]);
+            }
+        }
+        CHECK(worst == 0, "%s: %g from linkage_eval", locked ? "locked" : "free", worst);
+        chain_ws_free(w);
+        chain_free(c);
+    }
+}
+
 int main(int argc, char** argv) {
     RUN_TEST(test_hand_three_angles);
     RUN_TEST(test_hand_other_branch);
@@ -522,5 +582,6 @@ int main(int argc, char** argv) {
     RUN_TEST(test_links_terms);
     RUN_TEST(test_from_pose);
     RUN_TEST(test_random_linkages);
+    RUN_TEST(test_as_chain_cylinder);
     TEST_MAIN_END();
 }

@@ -542,9 +542,9 @@ static void test_two_link_consumers_refuse(void) {
               strstr(err, "test path handles the two-link crane (mechanics.links) only"),
           "%s", err);
     // The stepped engines of a chain model are the chain's
-    // (engine_chain_step.c, engine_ode_chain_step.c): no two-link commands,
-    // snapshot or limiter, and a driver that needs one asks first
-    // (engine_require): one line naming the file.
+    // (engine_chain_step.c, engine_ode_chain_step.c): no two-link commands
+    // or snapshot, a limiter by function (rcl_filter_fn), and a driver that
+    // needs one asks first (engine_require): one line naming the file.
     const double q0[2] = {100 * M_PI / 180, -110 * M_PI / 180};
     for (int b = 0; b < 2; ++b) {
         sim_opts o = sim_default_opts();
@@ -552,7 +552,8 @@ static void test_two_link_consumers_refuse(void) {
         o.no_step_probe = true;
         err[0] = 0;
         engine* e = engine_create(m, &o, q0, 0.0, -1, err, sizeof err);
-        CHECK(e != NULL && !(engine_caps(e) & (ENGINE_CAP_TWO_LINK | ENGINE_CAP_SNAPSHOT | ENGINE_CAP_LIMITER)),
+        CHECK(e != NULL && !(engine_caps(e) & (ENGINE_CAP_TWO_LINK | ENGINE_CAP_SNAPSHOT)) &&
+                  (engine_caps(e) & ENGINE_CAP_LIMITER),
               "engine_create (%s): %s", b ? "ode" : "lagrange", err);
         if (e) engine_destroy(e);
         CHECK(engine_require(m, &o, ENGINE_CAP_SNAPSHOT, "drive window", err, sizeof err) == -1 &&
@@ -563,14 +564,32 @@ static void test_two_link_consumers_refuse(void) {
                              sizeof err) == 0,
               "the default crane: %s", err);
     }
+    // The chart and the limiter on a chain (docs/safety.md "On a crane
+    // chain"): what they cannot read is refused in one line. This chain
+    // has no rating (the limiter needs one); the ten-link chain's search
+    // over every joint would be too large.
     lc_truck t = {0};
     lc_opts lo = lc_default_opts();
+    lo.lo = 1.0, lo.hi = 2.0, lo.n = 3;
     static loadchart ch;
-    err[0] = 0;
-    CHECK(loadchart_compute(m, &t, &lo, &ch, err, sizeof err) == -1 && strstr(err, "load chart handles"), "%s", err);
     rcl r;
     err[0] = 0;
-    CHECK(rcl_init(&r, m, NULL, err, sizeof err) == -1 && strstr(err, "rated capacity limiter handles"), "%s", err);
+    CHECK(rcl_init(&r, m, NULL, err, sizeof err) == -1 && strstr(err, "chain_3boom_ext.json: rated capacity limiter: "
+                                                                      "mechanics.rated_moment") == err,
+          "%s", err);
+    model* m8 = load(CHAIN_8FN);
+    if (m8) {
+        err[0] = 0;
+        CHECK(loadchart_compute(m8, &t, &lo, &ch, err, sizeof err) == -1 &&
+                  strstr(err, "chain_8fn_10link.json: load chart: the search over every joint") && !strchr(err, '\n'),
+              "%s", err);
+        m8->mech.rated_moment = 10;
+        err[0] = 0;
+        CHECK(rcl_init(&r, m8, NULL, err, sizeof err) == -1 && strstr(err, "rated capacity limiter: its chart would "
+                                                                          "search"),
+              "%s", err);
+        model_free(m8);
+    }
     // The command line: the valid chain model runs (test_ode_engine_chain),
     // in the sandbox too (test_ode_sandbox_chain), but not from a start that
     // puts its tip in the ground (the default scenario's q1 = 100 deg,
@@ -585,7 +604,7 @@ static void test_two_link_consumers_refuse(void) {
     CHECK(rc == 2 && ref && cli_count_lines(ref) == 1, "cranesim run: exit %d: %s", rc, out);
     snprintf(args, sizeof args, "loadchart --model %s --out %s/never.csv", CHAIN_8FN, out_dir());
     const int rc2 = cli_run(args, out, sizeof out);
-    CHECK(rc2 == 2 && strstr(out, "chain_8fn_10link.json: a chain of 10 bodies and 8 functions; the load chart"),
+    CHECK(rc2 == 2 && strstr(out, "chain_8fn_10link.json: load chart: the search over every joint of its 9 booms"),
           "cranesim loadchart: exit %d: %s", rc2, out);
 out:
     model_free(m);

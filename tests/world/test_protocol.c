@@ -42,10 +42,10 @@ int main(void) {
     size_t n = proto_put_client_hello(buf, sizeof buf, PROTO_VERSION, PROTO_CONTROL);
     CHECK(n == 12, "hello is %zu bytes", n);
     CHECK(buf[0] == 8 && buf[1] == 0 && buf[4] == 1 && buf[5] == 'C' && buf[6] == 'S' && buf[7] == 'I' &&
-              buf[8] == 'M' && buf[9] == 2 && buf[10] == 0 && buf[11] == 1,
+              buf[8] == 'M' && buf[9] == 3 && buf[10] == 0 && buf[11] == 1,
           "hello bytes");
     CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == 1 && m.type == PROTO_CLIENT_HELLO &&
-              m.u.chello.version == 2 && m.u.chello.role == 1,
+              m.u.chello.version == 3 && m.u.chello.role == 1,
           "hello parsed: %s", err);
     // Every partial prefix asks for more.
     for (size_t k = 0; k < n; ++k) CHECK(parse(buf, k, PROTO_MAX_CLIENT_FRAME, &m, err) == 0, "prefix %zu", k);
@@ -90,13 +90,19 @@ int main(void) {
     s_in.nrelief = 2;
     s_in.relief[0] = (proto_relief){.cyl = 1, .port = 1, .name = "jib_relief_B"};
     s_in.relief[1] = (proto_relief){.cyl = -1, .port = 0, .name = "main_relief"};
+    s_in.nfn = 3;
+    for (int k = 0; k < 3; ++k) s_in.fn[k][0] = 0.25 * k, s_in.fn[k][1] = -0.125 * k;
     n = proto_put_state(buf, sizeof buf, &s_in);
     // 5 header + 9*8 + 8 + 8 + 4 + 8 + 24 + 8 + 4, then (version 2) tip 24 + roll, pitch 16 + p_supply 8 +
     // rcl 8 + margin 8 + 1 + 4*8 pads, then 2 + 30*8 + 2 + 17*96 + 1 + 3*(13*8 + 1) + 1 + 2*24, then
-    // 1 + (3 + 12) + (3 + 11) reliefs.
-    const size_t head = 5 + 72 + 8 + 8 + 4 + 8 + 24 + 8 + 4;
-    CHECK(n == head + 24 + 16 + 8 + 8 + 8 + 1 + 32 + 2 + 240 + 2 + 17 * 96 + 1 + 3 * 105 + 1 + 48 + 1 + 15 + 14,
+    // 1 + (3 + 12) + (3 + 11) reliefs, then (version 3) 1 + 3*16 functions.
+    const size_t head = 5 + 72 + 8 + 8 + 4 + 8 + 24 + 8 + 4, fnb = 1 + 3 * 16;
+    CHECK(n == head + 24 + 16 + 8 + 8 + 8 + 1 + 32 + 2 + 240 + 2 + 17 * 96 + 1 + 3 * 105 + 1 + 48 + 1 + 15 + 14 + fnb,
           "state %zu", n);
+    double fn2;
+    memcpy(&fn2, buf + n - 16, 8); // the last function's command, 8 bytes before its spool at the end
+    CHECK(fn2 == 0.5 && buf[n - fnb] == 3, "the function records end the frame: count %u, command %g",
+          buf[n - fnb], fn2);
     double x1, tip_x, p_s;
     memcpy(&x1, buf + 5, 8); // the first value after the header is x1 (a little-endian host)
     CHECK(x1 == s_in.nine[0], "x1 first: %g", x1);
@@ -117,20 +123,100 @@ int main(void) {
               s_out.relief[0].cyl == 1 && s_out.relief[0].port == 1 && !strcmp(s_out.relief[0].name, "jib_relief_B") &&
               s_out.relief[1].cyl == -1 && !strcmp(s_out.relief[1].name, "main_relief"),
           "state round trip (version 2 fields)");
+    CHECK(s_out.nfn == 3 && !memcmp(s_out.fn, s_in.fn, 3 * sizeof s_in.fn[0]), "state round trip (functions)");
     // Version 2 refusals: a relief naming a cylinder the frame does not have,
     // five supports, unknown cylinder status bits.
     {
         uint8_t bad[1 << 16];
         memcpy(bad, buf, n);
-        bad[n - 14] = 9; // relief 1's cylinder byte: cylinder 8 of 3
+        bad[n - fnb - 14] = 9; // relief 1's cylinder byte: cylinder 8 of 3
         CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "relief 1"), "relief: %s", err);
         memcpy(bad, buf, n);
         bad[head + 64] = 5;
         CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "supports"), "pads: %s", err);
         memcpy(bad, buf, n);
         const size_t cyl0 = head + 64 + 1 + 32 + 2 + 240 + 2 + 17 * 96 + 1;
-        bad[cyl0 + 104] = 4;
+        bad[cyl0 + 104] = 8;
         CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "status bits"), "bits: %s", err);
+        bad[cyl0 + 104] = PROTO_CYL_NO_PINS; // version 3's bit 2: the picture does not draw it
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == 1 && s_out.cyl_bits[0] == PROTO_CYL_NO_PINS,
+              "no-pins bit: %s", err);
+    }
+    // Version 3 range checks, each by a byte or a value changed in place:
+    // a function's command past 1, a NaN spool, 17 functions, a cylinder's
+    // spool past 1, a NaN nine value, an infinite pose.
+    {
+        uint8_t bad[1 << 16];
+        const double big = 1.5, nan = NAN, inf = INFINITY;
+        memcpy(bad, buf, n);
+        memcpy(bad + n - 32, &big, 8); // function 1's command
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "function 1: command 1.5"),
+              "fn command: %s", err);
+        memcpy(bad, buf, n);
+        memcpy(bad + n - 8, &nan, 8); // function 2's spool
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "function 2: spool"),
+              "fn spool: %s", err);
+        memcpy(bad, buf, n);
+        bad[n - fnb] = PROTO_MAX_FN + 1;
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "17 functions, at most 16"),
+              "nfn: %s", err);
+        const size_t cyl0 = head + 64 + 1 + 32 + 2 + 240 + 2 + 17 * 96 + 1;
+        memcpy(bad, buf, n);
+        memcpy(bad + cyl0 + 105 + 9 * 8, &big, 8); // cylinder 1's spool u
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "cylinder 1: spool 1.5"),
+              "cyl spool: %s", err);
+        memcpy(bad, buf, n);
+        memcpy(bad + cyl0 + 2 * 105 + 7 * 8, &nan, 8); // cylinder 2's pA
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "cylinder 2: value 8"),
+              "cyl NaN: %s", err);
+        memcpy(bad, buf, n);
+        memcpy(bad + 5 + 8, &nan, 8); // x2
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "nine value 2"), "nine: %s", err);
+        memcpy(bad, buf, n);
+        memcpy(bad + head + 64 + 1 + 32 + 2 + 240 + 2 + 3 * 96 + 4 * 8, &inf, 8); // body 3, rot[1]
+        CHECK(parse(bad, n, PROTO_MAX_SERVER_FRAME, &m, err) == -1 && strstr(err, "body 3: pose value 5"),
+              "pose: %s", err);
+    }
+    // A crane chain of 9 functions and 10 cylinders (the 8-function model
+    // in the sandbox: its functions and the slew) with a 128-column row,
+    // bit for bit; VALVES with 9 openings.
+    {
+        static proto_state a, *bk = &s_out;
+        memset(&a, 0, sizeof a);
+        a.nrow = 128;
+        for (int k = 0; k < 128; ++k) a.row[k] = 1.0 / (k + 1);
+        a.nbody = 12;
+        a.ncyl = 10;
+        for (int i = 0; i < 10; ++i) {
+            for (int k = 0; k < PROTO_CYL_VALUES; ++k) a.cyl[i][k] = (k == 9 || k == 10) ? 0.1 * (i - 5) : i * 100.0 + k;
+            a.cyl_bits[i] = (uint8_t)(i < 3 ? PROTO_CYL_END_STOP : PROTO_CYL_NO_PINS);
+        }
+        a.nfn = 9;
+        for (int k = 0; k < 9; ++k) a.fn[k][0] = (k - 4) / 4.0, a.fn[k][1] = (4 - k) / 8.0;
+        a.nrelief = 1;
+        a.relief[0] = (proto_relief){.cyl = 9, .port = 0, .name = "jib_ext3_relief_A"};
+        static uint8_t big[1 << 16];
+        const size_t nb = proto_put_state(big, sizeof big, &a);
+        CHECK(nb > 0 && parse(big, nb, PROTO_MAX_SERVER_FRAME, &m, err) == 1, "chain state: %s", err);
+        CHECK(bk->nrow == 128 && !memcmp(bk->row, a.row, 128 * 8) && bk->ncyl == 10 &&
+                  !memcmp(bk->cyl, a.cyl, 10 * sizeof a.cyl[0]) && !memcmp(bk->cyl_bits, a.cyl_bits, 10) &&
+                  bk->nfn == 9 && !memcmp(bk->fn, a.fn, 9 * sizeof a.fn[0]) && bk->relief[0].cyl == 9,
+              "chain state round trip");
+        a.ncyl = PROTO_MAX_CYL + 1;
+        CHECK(proto_put_state(big, sizeof big, &a) == 0, "17 cylinders are not encoded");
+        a.ncyl = 10, a.nfn = PROTO_MAX_FN + 1;
+        CHECK(proto_put_state(big, sizeof big, &a) == 0, "17 functions are not encoded");
+        proto_command c9 = {.seq = 11, .op = PROTO_OP_VALVES, .nu = 9};
+        for (int k = 0; k < 9; ++k) c9.u[k] = (k - 4) / 4.0;
+        const size_t nc = proto_put_command(big, sizeof big, &c9);
+        CHECK(nc == 5 + 8 + 1 + 1 + 72, "valves of 9: %zu bytes", nc);
+        CHECK(parse(big, nc, PROTO_MAX_CLIENT_FRAME, &m, err) == 1 && m.u.cmd.nu == 9 &&
+                  !memcmp(m.u.cmd.u, c9.u, 9 * sizeof(double)),
+              "valves of 9 round trip: %s", err);
+        c9.nu = 0;
+        CHECK(proto_put_command(big, sizeof big, &c9) == 0, "valves of 0 are not encoded");
+        c9.nu = PROTO_MAX_FN + 1;
+        CHECK(proto_put_command(big, sizeof big, &c9) == 0, "valves of 17 are not encoded");
     }
     // Roll and pitch from a rotation built from known angles, R = Rz Ry Rx,
     // and the tilt from upright acos(R[2][2]) = acos(cos roll cos pitch).
@@ -156,9 +242,9 @@ int main(void) {
     CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "length"), "%s", err);
 
     // Commands: every op round trips.
-    proto_command c = {.seq = 7, .op = PROTO_OP_VALVES, .u = {0.5, -1, 1}};
+    proto_command c = {.seq = 7, .op = PROTO_OP_VALVES, .nu = 3, .u = {0.5, -1, 1}};
     n = proto_put_command(buf, sizeof buf, &c);
-    CHECK(n == 5 + 8 + 1 + 24, "valves %zu", n);
+    CHECK(n == 5 + 8 + 1 + 1 + 24, "valves %zu", n);
     CHECK(parse(buf, n, PROTO_MAX_CLIENT_FRAME, &m, err) == 1 && m.u.cmd.seq == 7 && m.u.cmd.u[1] == -1, "%s", err);
     c = (proto_command){.seq = 8, .op = PROTO_OP_SET, .path = "lift_cyl.bore", .value = 0.11};
     n = proto_put_command(buf, sizeof buf, &c);
@@ -190,20 +276,40 @@ int main(void) {
     // unknown op
     n = raw_cmd(b, 1, 77, NULL, 0);
     CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "unknown op 77"), "%s", err);
-    // NaN, infinity and 1.5 in valves
+    // NaN, infinity and 1.5 in valves (u8 count, then the openings)
+    uint8_t vp[1 + 17 * 8];
     double u[3] = {0, NAN, 0};
-    n = raw_cmd(b, 2, PROTO_OP_VALVES, u, sizeof u);
+    vp[0] = 3;
+    memcpy(vp + 1, u, sizeof u);
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, vp, 1 + sizeof u);
     CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "opening 2"), "NaN: %s", err);
     u[1] = INFINITY;
-    n = raw_cmd(b, 2, PROTO_OP_VALVES, u, sizeof u);
+    memcpy(vp + 1, u, sizeof u);
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, vp, 1 + sizeof u);
     CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1, "inf");
     u[1] = 0, u[2] = 1.5;
-    n = raw_cmd(b, 2, PROTO_OP_VALVES, u, sizeof u);
+    memcpy(vp + 1, u, sizeof u);
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, vp, 1 + sizeof u);
     CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "[-1, 1]"), "1.5: %s", err);
     // a valves frame two bytes short, with a header that says so
     u[2] = 0;
-    n = raw_cmd(b, 2, PROTO_OP_VALVES, u, sizeof u - 2);
+    memcpy(vp + 1, u, sizeof u);
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, vp, 1 + sizeof u - 2);
     CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "too short"), "short: %s", err);
+    // a count of 0 or 17 (version 3: one opening per function, 1..16)
+    vp[0] = 0;
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, vp, 1);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "0 openings, expected 1..16"), "0: %s",
+          err);
+    vp[0] = 17;
+    memset(vp + 1, 0, 17 * 8);
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, vp, 1 + 17 * 8);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "17 openings"), "17: %s", err);
+    // a version-2 VALVES (three openings, no count): its first byte read as
+    // a count of 0 (the low byte of lift 0.0) is refused, not misread
+    memset(vp, 0, 24);
+    n = raw_cmd(b, 2, PROTO_OP_VALVES, vp, 24);
+    CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1, "a version-2 valves frame is refused");
     // one byte too many
     n = raw_cmd(b, 2, PROTO_OP_RESET, "x", 1);
     CHECK(parse(b, n, PROTO_MAX_CLIENT_FRAME, &m, err) == -1 && strstr(err, "after its fields"), "long: %s", err);

@@ -14,7 +14,10 @@ extern "C" {
 #endif
 
 #define WORLD_SNAP_MAX_BODIES 160
-#define WORLD_SNAP_MAX_CYLINDERS 4
+/// Cylinders drawn: a crane chain's actuators and the sandbox's slew rack
+/// (the 8-function test crane has 9 + 1). The serve protocol carries at most
+/// PROTO_MAX_CYL of them (it serves the two-link crane only).
+#define WORLD_SNAP_MAX_CYLINDERS 16
 #define WORLD_SNAP_MAX_ROPE 32
 #define WORLD_SNAP_NAME 48
 #define WORLD_SNAP_MAX_RELIEFS 8
@@ -41,7 +44,9 @@ typedef enum world_role {
     WORLD_ROLE_BOOM2, ///< end arm (jib)
     WORLD_ROLE_HOOK,
     WORLD_ROLE_LOAD,
-    WORLD_ROLE_OBSTACLE
+    WORLD_ROLE_OBSTACLE,
+    WORLD_ROLE_BOOM,     ///< a boom of a crane chain, on a revolute joint (the two-link crane's are BOOM1, BOOM2)
+    WORLD_ROLE_EXTENSION ///< a telescopic extension of a crane chain, sliding in its parent boom
 } world_role;
 
 typedef struct world_snap_body {

@@ -47,21 +47,34 @@ unsigned long chain_problem_events(void* user, double t, const double* y) {
     chain_sim* s = cp->cs;
     const crane_chain* cc = s->cc;
     const int nd = s->ndof;
-    // The strokes and rates at y (the kinematics alone; f and the Jacobian
-    // take their own at every call, so the workspace left at y is harmless).
-    chain_update(s->ch, s->ws, y + s->iq, y + s->iq + nd);
-    for (int k = 0; k < cc->nact; ++k) {
-        const crane_act* a = &cc->act[k];
-        double Ld = 0.0;
-        const double L = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, &Ld, NULL, NULL);
-        cp->x[a->cyl] = L - a->closed_length;
-        cp->v[a->cyl] = Ld;
-    }
-    // The slew rack (chain_sim.rack, the last actuator when the column
-    // slews with a drive): stroke r theta + s/2, rate r theta' (chain_sim.c).
-    if (s->rack >= 0) {
-        cp->x[s->acyl[s->rack]] = s->rack_r * y[s->iq] + 0.5 * s->rack_stroke;
-        cp->v[s->acyl[s->rack]] = s->rack_r * y[s->iq + nd];
+    // The strokes and rates at y. The solver asks at the (t, y) whose f it
+    // has just evaluated (solver.c: f at the step's start, then the
+    // Jacobian's schedule), so the circuit's inputs that f's kinematics left
+    // in hd are these, bit for bit (chain_sim_inputs_at): taken from there,
+    // the kinematics run once per step instead of twice.
+    if (chain_sim_inputs_at(s, t, y)) {
+        for (int k = 0; k < s->nact; ++k) {
+            const int c = s->acyl[k];
+            cp->x[c] = s->hd->cyl_x[c];
+            cp->v[c] = s->hd->cyl_v[c];
+        }
+    } else {
+        // The kinematics alone; f and the Jacobian take their own at every
+        // call, so the workspace left at y is harmless.
+        chain_update(s->ch, s->ws, y + s->iq, y + s->iq + nd);
+        for (int k = 0; k < cc->nact; ++k) {
+            const crane_act* a = &cc->act[k];
+            double Ld = 0.0;
+            const double L = crane_act_length(a, s->ch, s->ws, &Ld, NULL, NULL);
+            cp->x[a->cyl] = L - a->closed_length;
+            cp->v[a->cyl] = Ld;
+        }
+        // The slew rack (chain_sim.rack, the last actuator when the column
+        // slews with a drive): stroke r theta + s/2, rate r theta' (chain_sim.c).
+        if (s->rack >= 0) {
+            cp->x[s->acyl[s->rack]] = s->rack_r * y[s->iq] + 0.5 * s->rack_stroke;
+            cp->v[s->acyl[s->rack]] = s->rack_r * y[s->iq + nd];
+        }
     }
     // The commands as chain_sim's f takes them (clamped to [-1, 1]).
     for (int f = 0; f < s->nfn; ++f) {

@@ -116,9 +116,15 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
     s->L = calloc(2 * na + 2 * na * nd + 1, sizeof(double));
     s->tau = calloc(10 * nd + 3 * nd * nd + (size_t)s->nh + 1, sizeof(double));
     s->acyl = calloc(2 * na + (size_t)s->nfn + 1, sizeof *s->acyl);
+    s->kin_y = calloc(2 * nd + 1, sizeof *s->kin_y);
     if (!s->ws || !s->hd || !s->cmd || !s->iu || !s->ipA || !s->ipB || !s->is_pressure || !s->L || !s->tau || !s->perm ||
-        !s->block || !s->jh || !s->acyl) {
+        !s->block || !s->jh || !s->acyl || !s->kin_y) {
         snprintf(err, errsz, "out of memory");
+        chain_sim_free(s);
+        return -1;
+    }
+    // The joint-limit stops (chain_stops.h), as the ODE world's joints.
+    if (chain_stops_init(&s->stops, s->ch, s->ws, err, errsz)) {
         chain_sim_free(s);
         return -1;
     }
@@ -185,6 +191,7 @@ int chain_sim_init(chain_sim* s, const crane_chain* cc, const hyd_model* hm, dou
 }
 
 void chain_sim_free(chain_sim* s) {
+    chain_stops_free(&s->stops);
     chain_ws_free(s->ws);
     chain_free(s->ch);
     hyd_data_free(s->hd);
@@ -199,6 +206,7 @@ void chain_sim_free(chain_sim* s) {
     free(s->L);
     free(s->tau);
     free(s->acyl);
+    free(s->kin_y);
     memset(s, 0, sizeof *s);
 }
 
@@ -235,13 +243,23 @@ static void prepare(chain_sim* s, double t, const double* y, bool jac) {
     hyd_data* d = s->hd;
     for (int k = 0; k < cc->nact; ++k) {
         const crane_act* a = &cc->act[k];
-        s->L[k] = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, &s->Ld[k], s->dL + (size_t)k * nd,
-                                 jac ? s->dLd + (size_t)k * nd : NULL);
+        s->L[k] = crane_act_length(a, s->ch, s->ws, &s->Ld[k], s->dL + (size_t)k * nd,
+                                   jac ? s->dLd + (size_t)k * nd : NULL);
         d->cyl_x[a->cyl] = s->L[k] - a->closed_length;
         d->cyl_v[a->cyl] = s->Ld[k];
     }
     if (s->rack >= 0) rack_kinematics(s, y, jac);
     for (int f = 0; f < s->nfn; ++f) d->valve_cmd[s->fvalve[f]] = command(s, f, t);
+    s->kin_valid = true;
+    s->kin_t = t;
+    memcpy(s->kin_y, y + s->iq, 2 * (size_t)nd * sizeof *s->kin_y);
+}
+
+bool chain_sim_inputs_at(const chain_sim* s, double t, const double* y) {
+    // Bitwise: the same doubles give the same kinematics (a -0.0 against
+    // 0.0 merely misses the reuse).
+    return s->kin_valid && memcmp(&s->kin_t, &t, sizeof t) == 0 &&
+           memcmp(s->kin_y, y + s->iq, 2 * (size_t)s->ndof * sizeof *s->kin_y) == 0;
 }
 
 // The ideal forces of the energy tests (chain_sim.ideal_F) into cyl_F.
@@ -253,9 +271,10 @@ static void ideal_forces(chain_sim* s) {
 }
 
 // tau = sum_k F_k dL_k/dq [N m or N] from the circuit's last forces (the
-// rack's F r on the column among them), and the slewing ring's damping -c
-// theta' [N m] at the rates qd.
-static void joint_forces(chain_sim* s, const double* qd) {
+// rack's F r on the column among them), the slewing ring's damping -c
+// theta' [N m] at the rates qd, and the joint stops at (q, qd)
+// (chain_stops.h; nothing for a joint within its limits).
+static void joint_forces(chain_sim* s, const double* q, const double* qd) {
     const int nd = s->ndof;
     for (int i = 0; i < nd; ++i) s->tau[i] = 0.0;
     for (int k = 0; k < s->nact; ++k) {
@@ -264,6 +283,7 @@ static void joint_forces(chain_sim* s, const double* qd) {
         for (int i = 0; i < nd; ++i) s->tau[i] += F * r[i];
     }
     if (s->rack >= 0) s->tau[0] -= s->slew_c * qd[0];
+    if (s->stops.n) chain_stops_add(&s->stops, nd, q, qd, s->tau, NULL, NULL);
 }
 
 int chain_sim_rhs(void* user, double t, const double* y, double* dydt) {
@@ -278,7 +298,7 @@ int chain_sim_rhs(void* user, double t, const double* y, double* dydt) {
         hyd_eval_mapped(s->hm, s->hd, t, y, dydt, s->hpos);
     }
     const double* qd = y + iq + nd;
-    joint_forces(s, qd);
+    joint_forces(s, y + iq, qd);
     for (int i = 0; i < nd; ++i) dydt[iq + i] = qd[i];
     // M not positive definite (a body of no mass on a DOF): no finite q''.
     if (chain_forward_dynamics(s->ch, s->ws, s->tau, dydt + iq + nd)) return 1;
@@ -314,9 +334,17 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
     const int nd = s->ndof, iq = s->iq, n = s->n, nh = s->nh;
     const crane_chain* cc = s->cc;
     hyd_data* d = s->hd;
-    memset(J, 0, (size_t)n * (size_t)n * sizeof *J);
+    // Zero only what is not written in full below: the circuit's rows in
+    // the mechanics' columns (the coupling adds into them) and the
+    // mechanics' rows; the circuit's block is written entry by entry (the
+    // permuted copy; zeroed here for the ideal forces, which have none).
+    // The whole n x n clear was a fifth of the Jacobian's instructions on
+    // loader10 (nh = 47 of n = 57 states).
+    for (int i = 0; i < nh; ++i) memset(J + (size_t)i * n + nh, 0, (size_t)(n - nh) * sizeof *J);
+    memset(J + (size_t)nh * n, 0, (size_t)(n - nh) * (size_t)n * sizeof *J);
     prepare(s, t, y, true);
     if (s->ideal_F) { // constant forces: no partials, the circuit stands still
+        for (int i = 0; i < nh; ++i) memset(J + (size_t)i * n, 0, (size_t)nh * sizeof *J);
         const size_t nc = (size_t)hyd_model_ncylinder(s->hm);
         memset(d->dydx, 0, nc * (size_t)nh * sizeof *d->dydx);
         memset(d->dydv, 0, nc * (size_t)nh * sizeof *d->dydv);
@@ -336,7 +364,7 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
         }
     }
     const double* qd = y + iq + nd;
-    joint_forces(s, qd);
+    joint_forces(s, y + iq, qd);
     if (chain_forward_dynamics(s->ch, s->ws, s->tau, s->qdd)) return 1;
     double* dtq = s->H + (size_t)nd * nd;  // d tau / dq
     double* dtqd = dtq + (size_t)nd * nd;  // d tau / dq'
@@ -364,7 +392,7 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
             memset(s->H, 0, (size_t)nd * nd * sizeof *s->H);
         } else {
             const crane_act* a = &cc->act[k];
-            chain_cylinder_hessian(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, s->H);
+            crane_act_hessian(a, s->ch, s->ws, s->H);
         }
         for (int i = 0; i < nd; ++i)
             for (int j = 0; j < nd; ++j) {
@@ -373,6 +401,9 @@ int chain_sim_jac(void* user, double t, const double* y, double* J) {
             }
     }
     if (s->rack >= 0) dtqd[0] -= s->slew_c; // the ring's damping -c theta'
+    // The joint stops' partials (their force is in tau already; id0 takes
+    // it again as scratch).
+    if (s->stops.n) chain_stops_add(&s->stops, nd, y + iq, qd, s->id0, dtq, dtqd);
     for (int i = 0; i < nd; ++i) J[(size_t)(iq + i) * n + iq + nd + i] = 1.0;
     // The mechanics' rows: d q''/dz = M^-1 (d tau/dz - d ID/dz at fixed q'').
     // The kinematics are perturbed by id_partial and restored after; the
@@ -424,6 +455,15 @@ static int chain_sim_settle(void* user, double t, double* y) {
     return changed;
 }
 
+// hyd_problem.events: a joint stop engaging or pressing past its width
+// (chain_stops_events), so that a reused Jacobian is taken again when the
+// stop stiffens the mechanics.
+static unsigned long chain_sim_events(void* user, double t, const double* y) {
+    chain_sim* s = user;
+    (void)t;
+    return chain_stops_events(&s->stops, y + s->iq);
+}
+
 hyd_problem chain_sim_problem(chain_sim* s, bool blocks) {
     hyd_problem p;
     memset(&p, 0, sizeof p);
@@ -433,6 +473,7 @@ hyd_problem chain_sim_problem(chain_sim* s, bool blocks) {
     p.jac_full = 1;
     p.user = s;
     p.settle = chain_sim_settle;
+    if (s->stops.n) p.events = chain_sim_events;
     if (blocks) {
         p.nblock = s->nblock;
         p.block_size = s->block;
@@ -444,8 +485,7 @@ int chain_sim_check_pose(chain_sim* s, const double* q0, char* err, size_t errsz
     chain_update(s->ch, s->ws, q0, NULL);
     for (int k = 0; k < s->cc->nact; ++k) {
         const crane_act* a = &s->cc->act[k];
-        const double x = chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, NULL, NULL, NULL) -
-                         a->closed_length;
+        const double x = crane_act_length(a, s->ch, s->ws, NULL, NULL, NULL) - a->closed_length;
         // The same tolerance as crane_check_pose: a stroke a rounding
         // outside its range is at its end stop, not beyond it.
         if (!(x >= -1e-9 && x <= a->stroke + 1e-9)) {
@@ -508,12 +548,13 @@ int chain_sim_initial_state(chain_sim* s, const double* q0, double p_low, double
     hyd_model_initial_state(hm, s->yh);
     for (int h = 0; h < s->nh; ++h) y[s->hpos[h]] = s->yh[h];
     for (int i = 0; i < nd; ++i) y[iq + i] = q0[i], y[iq + nd + i] = 0.0;
+    s->kin_valid = false; // rack_kinematics below writes hd at q0, not at an evaluation's (t, y)
     chain_update(s->ch, s->ws, q0, NULL);
     double* G = s->id0;
     chain_inverse_dynamics(s->ch, s->ws, NULL, CHAIN_GRAVITY, G);
     for (int k = 0; k < s->cc->nact; ++k) {
         const crane_act* a = &s->cc->act[k];
-        chain_cylinder(s->ch, s->ws, a->body_a, a->pa, a->body_b, a->pb, NULL, s->dL + (size_t)k * nd, NULL);
+        crane_act_length(a, s->ch, s->ws, NULL, s->dL + (size_t)k * nd, NULL);
     }
     if (s->rack >= 0) rack_kinematics(s, y, false);
     // The DOFs some actuator moves (a lever arm above 1e-12 of the largest)

@@ -35,6 +35,7 @@
 #include <stddef.h>
 
 #include "chain.h"
+#include "chain_stops.h"
 #include "crane_chain.h"
 #include "hydraulics.h"
 #include "hyd_solver.h"
@@ -99,6 +100,13 @@ typedef struct chain_sim {
     double rack_r;          ///< pinion radius [m]
     double rack_stroke;     ///< rack cylinder's full stroke [m]
     double slew_c;          ///< slewing-ring viscous damping [N m s/rad]
+    // Where the circuit's inputs in hd (strokes cyl_x, rates cyl_v) were
+    // last set from the kinematics: the time and q, q' [2 ndof] of that
+    // evaluation (chain_sim_inputs_at).
+    bool kin_valid;
+    double kin_t;
+    double* kin_y;
+    chain_stops stops;      ///< the joint-limit stops (chain_stops.h), added to tau
 } chain_sim;
 
 /// Set up for chain cc (bound to circuit hm by crane_chain_bind) with a tip
@@ -117,6 +125,12 @@ void chain_sim_free(chain_sim* s);
 /// the closed form's for its fixed-step runs; else W is dense.
 hyd_problem chain_sim_problem(chain_sim* s, bool blocks);
 int chain_sim_rhs(void* user, double t, const double* y, double* dydt);
+/// True when hd's strokes and rates (cyl_x, cyl_v) of every actuator are
+/// those of (t, y): the last evaluation (f, the Jacobian or the outputs) set
+/// them at this t and these q, q' bit for bit, so a caller that needs them
+/// at (t, y) (the Jacobian events, chain_problem.c) can take them instead
+/// of running the kinematics again.
+bool chain_sim_inputs_at(const chain_sim* s, double t, const double* y);
 /// The analytic Jacobian (docs/lagrange.md): the circuit block by
 /// hyd_jacobian; the coupling columns from its dydx, dydv with dL/dq and
 /// d(L')/dq; the mechanics rows by M^-1 (chain_solve) of d tau (from dFdy,

@@ -534,6 +534,12 @@ void chain_point_jacobian(const chain* c, const chain_ws* w, int i, const double
     }
 }
 
+double chain_joint_q(const chain* c, const chain_ws* w, int i, double* qd) {
+    const int k = c->dof[i];
+    if (qd) *qd = k >= 0 ? w->qdb[i] : 0.0;
+    return k >= 0 ? w->q[k] : c->def[i].q_fixed;
+}
+
 double chain_cylinder(const chain* c, const chain_ws* w, int a, const double pa[3], int b, const double pb[3],
                       double* Ldot, double* dL_dq, double* dLdot_dq) {
     double xa[3], va[3], xb[3], vb[3];

@@ -119,6 +119,10 @@ void chain_update(const chain* c, chain_ws* w, const double* q, const double* qd
 /// and the body origin p [m]. Either may be NULL.
 void chain_body_pose(const chain* c, const chain_ws* w, int i, double R[9], double p[3]);
 
+/// The joint coordinate of body i as the last chain_update set it [rad or
+/// m] (q_fixed for a locked joint) and its rate (qd may be NULL; 0 when locked).
+double chain_joint_q(const chain* c, const chain_ws* w, int i, double* qd);
+
 /// Base-frame position [m] and velocity [m/s] (either may be NULL) of the
 /// point pb [m] fixed in body i.
 void chain_world_point(const chain* c, const chain_ws* w, int i, const double pb[3], double p[3], double v[3]);

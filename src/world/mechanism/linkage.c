@@ -321,3 +321,27 @@ int linkage_def_from_pose(linkage_def* d, const double P_ref[2], double q_ref, c
     d->branch = side > 0 ? 1 : -1;
     return 0;
 }
+
+double linkage_cylinder(const linkage* lk, const chain* c, const chain_ws* w, int child, double* Ldot,
+                        double* dL_dq, double* dLdot_dq) {
+    const int nd = chain_ndof(c), k = chain_body_dof(c, child);
+    double qd;
+    const double q = chain_joint_q(c, w, child, &qd);
+    linkage_state s;
+    linkage_eval(lk, q, &s); // NaN where the loop cannot close: every output then NaN
+    if (Ldot) *Ldot = s.dL * qd;
+    for (int j = 0; j < nd; ++j) {
+        if (dL_dq) dL_dq[j] = j == k ? s.dL : 0.0;
+        if (dLdot_dq) dLdot_dq[j] = j == k ? s.d2L * qd : 0.0;
+    }
+    return s.L;
+}
+
+void linkage_cylinder_hessian(const linkage* lk, const chain* c, const chain_ws* w, int child, double* H) {
+    const int nd = chain_ndof(c), k = chain_body_dof(c, child);
+    for (int j = 0; j < nd * nd; ++j) H[j] = 0.0;
+    if (k < 0) return;
+    linkage_state s;
+    linkage_eval(lk, chain_joint_q(c, w, child, NULL), &s);
+    H[(size_t)k * (size_t)nd + (size_t)k] = s.d2L;
+}

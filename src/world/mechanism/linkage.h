@@ -122,6 +122,20 @@ typedef struct linkage_links_terms {
 /// 0, or -1 where the loop cannot close (t is then NaN).
 int linkage_links(const linkage* lk, double q, const double g[2], linkage_links_terms* t);
 
+/// The linkage as a cylinder of chain c (chain.h), the chain_cylinder of a
+/// cylinder through the loop: the knuckle is body `child` of c (a revolute
+/// joint; the linkage is described in its parent's frame, its joint and
+/// angle0 the child's), L depends on that joint alone. From the workspace's
+/// last chain_update: returns L [m]; Ldot = L' qd [m/s], dL_dq [ndof]
+/// (L' in the knuckle's DOF, 0 elsewhere), dLdot_dq [ndof] (L'' qd there).
+/// Any output may be NULL. NaN where the loop cannot close.
+double linkage_cylinder(const linkage* lk, const chain* c, const chain_ws* w, int child, double* Ldot,
+                        double* dL_dq, double* dLdot_dq);
+
+/// Its Hessian d2L/dq2 (ndof x ndof, row-major): L'' on the knuckle's
+/// diagonal entry, 0 elsewhere.
+void linkage_cylinder_hessian(const linkage* lk, const chain* c, const chain_ws* w, int child, double* H);
+
 #ifdef __cplusplus
 }
 #endif

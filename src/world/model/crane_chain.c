@@ -240,6 +240,22 @@ void crane_chain_row(const crane_chain* cc, const crane_chain_sample* s, double*
 
 chain* crane_chain_mechanism(const crane_chain* cc, double tip_mass, bool slew_free, double slew, char* err,
                              size_t errsz) {
+    return crane_chain_mechanism_links(cc, tip_mass, slew_free, slew, true, err, errsz);
+}
+
+double crane_act_length(const crane_act* a, const chain* ch, const chain_ws* w, double* Ldot, double* dL_dq,
+                        double* dLdot_dq) {
+    if (a->kind == CRANE_ACT_LINKAGE) return linkage_cylinder(&a->lk, ch, w, a->body_b, Ldot, dL_dq, dLdot_dq);
+    return chain_cylinder(ch, w, a->body_a, a->pa, a->body_b, a->pb, Ldot, dL_dq, dLdot_dq);
+}
+
+void crane_act_hessian(const crane_act* a, const chain* ch, chain_ws* w, double* H) {
+    if (a->kind == CRANE_ACT_LINKAGE) linkage_cylinder_hessian(&a->lk, ch, w, a->body_b, H);
+    else chain_cylinder_hessian(ch, w, a->body_a, a->pa, a->body_b, a->pb, H);
+}
+
+chain* crane_chain_mechanism_links(const crane_chain* cc, double tip_mass, bool slew_free, double slew,
+                                   bool lump_links, char* err, size_t errsz) {
     chain_body_def* defs = malloc((size_t)cc->nbody * sizeof *defs);
     if (!defs) {
         snprintf(err, errsz, "out of memory");
@@ -250,6 +266,11 @@ chain* crane_chain_mechanism(const crane_chain* cc, double tip_mass, bool slew_f
     defs[0].q_fixed = slew;
     if (tip_mass > 0 && cc->tip_body >= 0 && cc->tip_body < cc->nbody)
         chain_body_add_point_mass(&defs[cc->tip_body], tip_mass, cc->tip);
+    // The linkages' links: their masses at their pins (the analytic mode's
+    // one DOF per joint; docs/mechanism.md bounds what that leaves out).
+    for (int k = 0; k < cc->nact && lump_links; ++k)
+        if (cc->act[k].kind == CRANE_ACT_LINKAGE)
+            linkage_lump(&cc->act[k].lk, &defs[cc->act[k].body_a], &defs[cc->act[k].body_b]);
     const double g[3] = {0.0, 0.0, -cc->gravity};
     chain* c = chain_create(defs, cc->nbody, g, err, errsz);
     free(defs);

@@ -21,6 +21,7 @@
 
 #include "chain.h"
 #include "crane_model.h"
+#include "linkage.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -38,7 +39,13 @@ typedef struct crane_body {
 } crane_body;
 
 typedef enum crane_act_kind {
-    CRANE_ACT_CYLINDER = 0 ///< a hydraulic cylinder between two pins (force along the pins)
+    CRANE_ACT_CYLINDER = 0, ///< a hydraulic cylinder between two pins (force along the pins)
+    /// A cylinder whose rod pushes the common pin of a four-bar linkage on a
+    /// knuckle (linkage.h, docs/model.md "A cylinder through a linkage"):
+    /// body_a is the knuckle's parent (the barrel pin pa there is the
+    /// linkage's base B), body_b the knuckle; pb is unused (0) and lk is
+    /// the loop, in body_a's frame.
+    CRANE_ACT_LINKAGE = 1
 } crane_act_kind;
 
 /// One actuator: a circuit's cylinder between a pin on body_a (the barrel)
@@ -54,6 +61,7 @@ typedef struct crane_act {
     int body_b;                ///< rod pin's body
     double pb[3];              ///< rod pin in body_b's frame [m]
     double closed_length;      ///< pin-to-pin length at zero stroke [m]
+    linkage lk;                ///< CRANE_ACT_LINKAGE: the checked loop (the barrel pin to the common pin P is L)
     // Resolved against the circuit by crane_chain_bind:
     int cyl;                   ///< the circuit's cylinder index
     int function;              ///< the function with the same valve
@@ -162,6 +170,22 @@ int crane_chain_bind(crane_chain* cc, const struct hyd_model* h, char* err, size
 /// [rad]). NULL with chain_create's message in err.
 chain* crane_chain_mechanism(const crane_chain* cc, double tip_mass, bool slew_free, double slew, char* err,
                              size_t errsz);
+
+/// As crane_chain_mechanism; lump_links false leaves the masses of the
+/// linkages' links out of the booms (the ODE world makes them bodies),
+/// true (crane_chain_mechanism) lumps them at their pins (linkage_lump).
+chain* crane_chain_mechanism_links(const crane_chain* cc, double tip_mass, bool slew_free, double slew,
+                                   bool lump_links, char* err, size_t errsz);
+
+/// Actuator a's pin length L [m] on mechanism ch at the workspace's last
+/// chain_update, its rate, lever arms dL/dq [ndof] and their rate, as
+/// chain_cylinder (any output may be NULL): a pin pair's from its two pins,
+/// a linkage's from its loop (linkage_cylinder). The one place that knows
+/// the actuator kinds' geometry; every backend asks it.
+double crane_act_length(const crane_act* a, const chain* ch, const chain_ws* w, double* Ldot, double* dL_dq,
+                        double* dLdot_dq);
+/// Its Hessian d2L/dq2 (ndof x ndof), as chain_cylinder_hessian.
+void crane_act_hessian(const crane_act* a, const chain* ch, chain_ws* w, double* H);
 
 /// The degrees of freedom of the chain as the backends integrate it: every
 /// body whose joint is not fixed, the column only when slew_free.

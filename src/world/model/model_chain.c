@@ -272,6 +272,155 @@ static int read_pin(json_ctx* c, const cJSON* o, const char* p, const char* key,
     return c->failed ? -1 : b;
 }
 
+// A linkage's link lengths [m]: a loader crane's links are 0.1..1 m; a few
+// centimetres to 3 m is every sane drawing.
+static const json_range R_LINK_LEN = {0.01, 5, 0.1, 1.5, "m"};
+// The links' masses [kg]: > 0, as the ODE world makes them bodies (a link of
+// a 10 t m crane weighs 5..50 kg).
+static const json_range R_LINK_PART_MASS = {0.01, 1000, 1, 200, "kg"};
+
+// "linkage": the knuckle cylinder's four-bar (linkage.h). The base pin is
+// the actuator's base (B, on the knuckle's parent), the knuckle is "body"
+// (its parent must be the base's body), link_pin A on the base's body,
+// rocker_pin c on the knuckle, both [x, y, z] in their body's frame. The
+// loop is planar in the boom plane y = 0: every y must be 0.
+static void read_linkage(json_ctx* c, const cJSON* o, const char* p, crane_chain* cc, crane_act* a) {
+    char pp[96], f[160];
+    const cJSON* lo = json_obj(c, o, p, "linkage", true);
+    if (c->failed) return;
+    json_path(pp, sizeof pp, p, "linkage");
+    static const char* const keys[] = {"body",      "link_pin",    "rocker_pin", "link_len",      "rocker_len", "branch",
+                                       "link_mass", "rocker_mass", "common_pin", "common_pin_at", NULL};
+    json_only_keys(c, lo, pp, keys);
+    char name[CHAIN_NAME];
+    json_str(c, lo, pp, "body", true, "", name, sizeof name);
+    if (c->failed) return;
+    const int kb = crane_chain_find_body(cc, name);
+    json_path(f, sizeof f, pp, "body");
+    if (kb < 0) {
+        json_fail(c, f, "no body \"%s\" in mechanics.bodies (the knuckle the linkage turns)", name);
+        return;
+    }
+    const chain_body_def* kd = &cc->body[kb].def;
+    if (kb == 0 || kd->parent != a->body_a) {
+        json_fail(c, f,
+                  "\"%s\" is not a child of the base's body \"%s\": the linkage turns the joint between the base's "
+                  "body and its child",
+                  name, cc->body[a->body_a].def.name);
+        return;
+    }
+    if (kd->joint != CHAIN_REVOLUTE) {
+        json_fail(c, f, "\"%s\" slides (prismatic); a linkage turns a revolute joint", name);
+        return;
+    }
+    if (kd->fixed) {
+        json_fail(c, f, "\"%s\"'s joint is fixed; a linkage turns a moving joint", name);
+        return;
+    }
+    if (!(isfinite(kd->q_min) && isfinite(kd->q_max))) {
+        json_fail(c, f, "\"%s\"'s joint has no limits; a linkage needs the joint's range (limits, rad)", name);
+        return;
+    }
+    a->body_b = kb;
+    double A[3], C[3];
+    json_vec_r(c, lo, pp, "link_pin", true, A, 3, &R_POINT);
+    json_path(f, sizeof f, pp, "link_pin");
+    check_reach(c, f, cc, a->body_a, A, "the link's pin");
+    json_vec_r(c, lo, pp, "rocker_pin", true, C, 3, &R_POINT);
+    json_path(f, sizeof f, pp, "rocker_pin");
+    check_reach(c, f, cc, kb, C, "the rocker's pin");
+    linkage_def d;
+    memset(&d, 0, sizeof d);
+    // The lengths and the branch, or (as a drawing gives them) the common
+    // pin P in the base's body's frame at the knuckle angle common_pin_at.
+    const bool drawn = cJSON_GetObjectItemCaseSensitive(lo, "common_pin") != NULL;
+    double P[3] = {0, 0, 0}, q_ref = 0;
+    if (drawn) {
+        static const char* const lens[] = {"link_len", "rocker_len", "branch"};
+        for (int i = 0; i < 3 && !c->failed; ++i)
+            if (cJSON_GetObjectItemCaseSensitive(lo, lens[i])) {
+                json_path(f, sizeof f, pp, lens[i]);
+                json_fail(c, f, "given with common_pin; give the lengths and the branch or the common pin, not both");
+            }
+        json_vec_r(c, lo, pp, "common_pin", true, P, 3, &R_POINT);
+        json_path(f, sizeof f, pp, "common_pin");
+        check_reach(c, f, cc, a->body_a, P, "the common pin");
+        q_ref = json_num_r(c, lo, pp, "common_pin_at", true, 0, &R_LIMIT_REV);
+        json_path(f, sizeof f, pp, "common_pin_at");
+        if (!c->failed && !(q_ref >= kd->q_min && q_ref <= kd->q_max))
+            json_fail(c, f, "%g rad, outside %s's joint range [%g, %g] rad", q_ref, name, kd->q_min, kd->q_max);
+    } else {
+        d.link_len = json_num_r(c, lo, pp, "link_len", true, 0, &R_LINK_LEN);
+        d.rocker_len = json_num_r(c, lo, pp, "rocker_len", true, 0, &R_LINK_LEN);
+        d.branch = json_int(c, lo, pp, "branch", true, 0, -1, 1);
+        json_path(f, sizeof f, pp, "branch");
+        if (!c->failed && d.branch == 0)
+            json_fail(c, f, "0; must be +1 or -1 (the side of link pin -> rocker pin the common pin is on)");
+    }
+    d.link_mass = json_num_r(c, lo, pp, "link_mass", true, 0, &R_LINK_PART_MASS);
+    d.rocker_mass = json_num_r(c, lo, pp, "rocker_mass", true, 0, &R_LINK_PART_MASS);
+    if (c->failed) return;
+    // The plane: y = 0 for the base, both pins and the knuckle's joint.
+    const struct {
+        const char* field;
+        double y;
+    } ys[] = {{"base.point[1]", a->pa[1]},
+              {"linkage.link_pin[1]", A[1]},
+              {"linkage.rocker_pin[1]", C[1]},
+              {"linkage.common_pin[1]", P[1]}};
+    for (int i = 0; i < 4; ++i)
+        if (ys[i].y != 0.0) {
+            snprintf(f, sizeof f, "%s.%s", p, ys[i].field);
+            json_fail(c, f, "%g m; a linkage works in the boom plane, y must be 0", ys[i].y);
+            return;
+        }
+    if (kd->origin[1] != 0.0) {
+        json_fail(c, pp, "the joint of \"%s\" is at y = %g m; a linkage works in the boom plane y = 0", name,
+                  kd->origin[1]);
+        return;
+    }
+    d.joint[0] = kd->origin[0], d.joint[1] = kd->origin[2];
+    d.angle0 = kd->angle0;
+    d.base[0] = a->pa[0], d.base[1] = a->pa[2];
+    d.link_pin[0] = A[0], d.link_pin[1] = A[2];
+    d.rocker_pin[0] = C[0], d.rocker_pin[1] = C[2];
+    d.q_min = kd->q_min, d.q_max = kd->q_max;
+    char e[320];
+    if (drawn) {
+        const double Pr[2] = {P[0], P[2]};
+        json_path(f, sizeof f, pp, "common_pin");
+        if (linkage_def_from_pose(&d, Pr, q_ref, e, sizeof e)) {
+            const char* colon = strstr(e, ": ");
+            json_fail(c, f, "%s", colon ? colon + 2 : e);
+            return;
+        }
+        // The lengths it gives, in the range the lengths form takes.
+        const double l[2] = {d.link_len, d.rocker_len};
+        for (int i = 0; i < 2; ++i)
+            if (!(l[i] >= R_LINK_LEN.lo && l[i] <= R_LINK_LEN.hi)) {
+                json_fail(c, f, "gives a %s of %g m, outside [%g, %g] m", i ? "rocker_len" : "link_len", l[i],
+                          R_LINK_LEN.lo, R_LINK_LEN.hi);
+                return;
+            }
+    }
+    if (linkage_init(&a->lk, &d, e, sizeof e)) {
+        // linkage_init names its own fields ("linkage.x: ..."): its base is
+        // the actuator's, its range the knuckle's limits.
+        const char* colon = strstr(e, ": ");
+        const char* msg = colon ? colon + 2 : e;
+        char field[64] = "linkage";
+        if (colon && !strncmp(e, "linkage.base: ", 14)) snprintf(field, sizeof field, "base");
+        else if (colon && (size_t)(colon - e) < sizeof field) snprintf(field, sizeof field, "%.*s", (int)(colon - e), e);
+        json_path(f, sizeof f, p, field);
+        // The knuckle's range, unless the message gives it already.
+        if (strstr(msg, "range")) json_fail(c, f, "%s (the joint of %s)", msg, name);
+        else json_fail(c, f, "%s (%s's joint range [%g, %g] rad)", msg, name, kd->q_min, kd->q_max);
+        return;
+    }
+    a->kind = CRANE_ACT_LINKAGE;
+    a->pb[0] = a->pb[1] = a->pb[2] = 0.0;
+}
+
 static void read_actuator(json_ctx* c, const cJSON* acts, int k, crane_chain* cc) {
     char p[64], f[128];
     json_path_index(p, sizeof p, "mechanics.actuators", k);
@@ -280,7 +429,7 @@ static void read_actuator(json_ctx* c, const cJSON* acts, int k, crane_chain* cc
         json_fail(c, p, "must be an object");
         return;
     }
-    static const char* const keys[] = {"name", "cylinder", "valve", "base", "rod", "closed_length", NULL};
+    static const char* const keys[] = {"name", "cylinder", "valve", "base", "rod", "linkage", "closed_length", NULL};
     json_only_keys(c, o, p, keys);
     crane_act* a = &cc->act[k];
     a->kind = CRANE_ACT_CYLINDER;
@@ -293,7 +442,14 @@ static void read_actuator(json_ctx* c, const cJSON* acts, int k, crane_chain* cc
     json_str(c, o, p, "cylinder", true, "", a->cylinder, sizeof a->cylinder);
     json_str(c, o, p, "valve", true, "", a->valve, sizeof a->valve);
     a->body_a = read_pin(c, o, p, "base", cc, a->pa, "the barrel pin");
-    a->body_b = read_pin(c, o, p, "rod", cc, a->pb, "the rod pin");
+    // The rod: on a pin of a body, or on the common pin of a linkage (not both).
+    const bool linked = cJSON_GetObjectItemCaseSensitive(o, "linkage") != NULL;
+    if (!c->failed && linked && cJSON_GetObjectItemCaseSensitive(o, "rod")) {
+        json_path(f, sizeof f, p, "rod");
+        json_fail(c, f, "given with linkage; the rod of a cylinder through a linkage pushes the linkage's common pin");
+    }
+    if (linked) read_linkage(c, o, p, cc, a);
+    else a->body_b = read_pin(c, o, p, "rod", cc, a->pb, "the rod pin");
     if (!c->failed && a->body_a == a->body_b) {
         json_path(f, sizeof f, p, "rod.body");
         json_fail(c, f, "\"%s\" is also the base's body: a cylinder between two pins of one body never moves",
@@ -488,6 +644,11 @@ static void child_to_parent(const chain_body_def* d, double q, const double p[3]
 // 0, or -1 when the actuator spans more than one joint (not checked: a
 // multi-joint range is no cheap interval).
 static int pin_range(const crane_chain* cc, const crane_act* a, double* Lmin, double* Lmax) {
+    if (a->kind == CRANE_ACT_LINKAGE) {
+        // Monotonic over the range (linkage_init refuses a dead centre).
+        *Lmin = fmin(a->lk.L_qmin, a->lk.L_qmax), *Lmax = fmax(a->lk.L_qmin, a->lk.L_qmax);
+        return 0;
+    }
     int child;
     const double *pc, *pp; // the pin on the child, the pin on the parent
     if (cc->body[a->body_b].def.parent == a->body_a) child = a->body_b, pc = a->pb, pp = a->pa;

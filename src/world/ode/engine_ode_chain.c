@@ -8,12 +8,33 @@
 #include "ode_chain.h"
 #include "ode_chain_row.h"
 #include "ode_run.h"
+#include "rcl.h"
 #include "world_desc.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+// The rated capacity limiter of a scripted chain run (o->rcl; rcl_filter_fn
+// between the scenario and the world, as engine.c has it for the stepped
+// engines), its rows' chain columns from base on; NULL with the reason in
+// note when the model's chain has none (rcl_check_model), or when o->rcl is
+// off: a chain's limiter searches every joint for its chart (about a
+// second), so a run that does not ask for it does not pay for it.
+static rcl* chain_limiter(const model* m, const sim_opts* o, const char* world, int base, char* note, size_t n) {
+    if (!o->rcl) return NULL;
+    char why[400];
+    if (rcl_check_model(m, why, sizeof why)) {
+        snprintf(note, n, "%.200s: not applied, rcl_util is 0", why);
+        return NULL;
+    }
+    char wbuf[512];
+    rcl* r = rcl_create(m, world ? sim_world_path(world, wbuf, sizeof wbuf) : NULL);
+    if (r && rcl_set_chain_row(r, NULL, base)) rcl_destroy(r), r = NULL;
+    if (!r) snprintf(note, n, "the rated capacity limiter's chart could not be made: not applied, rcl_util is 0");
+    return r;
+}
 
 // Hand a finished row to the driver's sink; non-zero: stop.
 static int deliver(const engine_sink* k, const double* row) { return k->row && k->row(k->user, row); }
@@ -78,16 +99,18 @@ int engine_ode_chain_sandbox_start(ode_world* w, ode_chain_rows* r, const crane_
 // slew at each ODE step's midpoint, its hook events as the two-link
 // sandbox's; rows of the sandbox's base columns (ode_world_row: the first
 // two actuators, the first two boom DOFs, the slew, hook, truck, supports)
-// then the chain's columns. What the two-link run has and this one does not:
-// the rated capacity limiter (rcl.h reads the two-link crane: not applied,
-// rcl_util 0, and the run's note says so where it was on), the tip load (the
-// sandbox's loads hang on the hook).
+// then the chain's columns. The rated capacity limiter where o->rcl asks
+// (chain_limiter; rcl_util 0 without it). What the two-link run has and this
+// one does not: the tip load (the sandbox's loads hang on the hook).
 static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, const engine_sink* k,
                        sim_result* res) {
     char* msg = res->message;
     const size_t msz = sizeof res->message;
     ode_world* w = ode_world_for_run(m, o, "sandbox", sc->q0, sc->slew0, 0.0, msg, msz);
     if (!w) return res->status = SIM_REFUSED;
+    rcl* lim = NULL;
+    double *now = NULL, *ulim = NULL;
+    char lnote[sizeof res->note] = "";
     ode_chain* cw = ode_world_chain(w);
     const crane_chain* cc = &m->chain;
     const crane_chain* hc = ode_chain_chain(cw); // the hosted copy: the column slews
@@ -105,6 +128,16 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
     }
     double* row = buf;
     for (int f = 0; f < r.nf; ++f) fcol[f] = scenario_find_command(sc, hc->fn[f].name);
+    // The limiter reads the model's chain columns after the sandbox's
+    // channels (ode_chain_sandbox_row), and filters the functions then the slew.
+    lim = chain_limiter(m, o, o->world ? o->world : "sandbox", SIM_NCOL, lnote, sizeof lnote);
+    now = lim ? calloc(SIM_NCOL + (size_t)cc->ncol + 1, sizeof *now) : NULL;
+    ulim = lim ? calloc(2 * ((size_t)r.nf + 1), sizeof *ulim) : NULL;
+    if (lim && (!now || !ulim)) {
+        snprintf(msg, msz, "out of memory");
+        res->status = SIM_REFUSED;
+        goto done;
+    }
     const double dt = ode_world_dt(w);
     const double h = o->h < dt ? o->h : dt;
     const double t_end = k->t_end;
@@ -151,8 +184,18 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
         scenario_play(sc, tm, &ev, u3, play_hook, w);
         for (int f = 0; f < r.nf; ++f) r.u[f] = fcol[f] >= 0 ? scenario_command(sc, fcol[f], tm) : 0.0;
         engine_faults_apply(&ef, hm, sc, tm);
+        double slew_u = u3[2];
+        if (lim) { // the functions, then the slew, on the state now
+            // (the row's outputs reuse r.u for the spools: the commands first)
+            for (int f = 0; f < r.nf; ++f) ulim[f] = r.u[f];
+            ulim[r.nf] = slew_u;
+            ode_chain_sandbox_row(&r, w, cc, (double)i * dt, now);
+            rcl_filter_fn(lim, now, r.nf + 1, ulim, ulim + r.nf + 1, r.nf);
+            for (int f = 0; f < r.nf; ++f) r.u[f] = ulim[r.nf + 1 + f];
+            slew_u = ulim[2 * r.nf + 1];
+        }
         ode_chain_set_commands(cw, r.u);
-        ode_chain_set_slew_command(cw, u3[2]);
+        ode_chain_set_slew_command(cw, slew_u);
         if (ode_world_step(w, dt)) {
             res->status = SIM_FAILED;
             snprintf(msg, msz, "numerical blow-up: %s", ode_world_error(w));
@@ -172,6 +215,7 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
         }
         if ((i + 1) % nout && i + 1 != nstep) continue;
         ode_chain_sandbox_row(&r, w, cc, (double)(i + 1) * dt, row); // exact grid times
+        if (lim) row[COL_RCL_UTIL] = rcl_utilisation(lim, row);
         if (emit_row(&chk, row, SIM_NCOL, o, h, dt, k, res, &stop)) break;
         t_last = row[COL_T];
         ++rows;
@@ -189,10 +233,7 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
     if (!res->status) {
         const char* last;
         const long msgs = ode_world_messages(&last) - ode_msgs;
-        if (o->rcl)
-            snprintf(res->note, sizeof res->note,
-                     "the rated capacity limiter follows the two-link crane only: not applied to this chain, rcl_util "
-                     "is 0");
+        if (lnote[0]) snprintf(res->note, sizeof res->note, "%s", lnote);
         if (chk.dip) sim_checks_note(&chk, false, res->note, sizeof res->note);
         else if (msgs > 0)
             snprintf(res->note, sizeof res->note,
@@ -202,6 +243,8 @@ static int run_sandbox(const model* m, const scenario* sc, const sim_opts* o, co
     }
 done:
     ode_world_destroy(w);
+    rcl_destroy(lim);
+    free(now), free(ulim);
     free(buf);
     free(fcol);
     if (!rows_rc) ode_chain_rows_free(&r);
@@ -258,6 +301,9 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
     const crane_chain* cc = &m->chain;
     const int nd = crane_chain_ndof(cc);
     const size_t nf = (size_t)cc->nfn;
+    rcl* lim = NULL;
+    double *now = NULL, *ulim = NULL;
+    char lnote[sizeof res->note] = "";
     // The outputs and the row (ode_chain_row.c, shared with the stepped
     // engine); here the start pose and the row: SIM_NCOL channels, then the
     // chain's columns.
@@ -274,6 +320,16 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
     double* q0 = buf;
     double* row = q0 + nd;
     for (int f = 0; f < r.nf; ++f) fcol[f] = scenario_find_command(sc, cc->fn[f].name);
+    // The limiter (the validation world: no truck) on the rows: the chain's
+    // columns after SIM_NCOL (ode_chain_make_row).
+    lim = chain_limiter(m, o, NULL, SIM_NCOL, lnote, sizeof lnote);
+    now = lim ? calloc((size_t)ode_chain_row_ncol(cc) + 1, sizeof *now) : NULL;
+    ulim = lim ? calloc(2 * ((size_t)r.nf + 1), sizeof *ulim) : NULL;
+    if (lim && (!now || !ulim)) {
+        snprintf(msg, msz, "out of memory");
+        res->status = SIM_REFUSED;
+        goto done;
+    }
     // The analytic general path's start pose, so both start from one state.
     crane_chain_start_pose(cc, sc->q0, sc->slew0, q0);
     ode_chain_opts co = ode_chain_default_opts();
@@ -336,6 +392,13 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         const double tm = ((double)i + 0.5) * dt;
         for (int f = 0; f < r.nf; ++f) r.u[f] = fcol[f] >= 0 ? scenario_command(sc, fcol[f], tm) : 0.0;
         engine_faults_apply(&ef, m->hyd, sc, tm);
+        if (lim) { // the functions on the state now
+            // (the row's outputs reuse r.u for the spools: the commands first)
+            memcpy(ulim, r.u, (size_t)r.nf * sizeof *ulim);
+            ode_chain_make_row(&r, w, (double)i * dt, now);
+            rcl_filter_fn(lim, now, r.nf, ulim, ulim + r.nf + 1, -1);
+            memcpy(r.u, ulim + r.nf + 1, (size_t)r.nf * sizeof *ulim);
+        }
         ode_chain_set_commands(w, r.u);
         if (ode_chain_step(w, dt)) {
             res->status = SIM_FAILED;
@@ -352,6 +415,7 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         }
         if ((i + 1) % nout && i + 1 != nstep) continue;
         ode_chain_make_row(&r, w, (double)(i + 1) * dt, row); // exact grid times
+        if (lim) row[COL_RCL_UTIL] = rcl_utilisation(lim, row);
         if (emit_row(&chk, row, SIM_NCOL_BASE, o, h, dt, k, res, &stop)) break;
         t_last = row[COL_T];
         ++rows;
@@ -367,9 +431,12 @@ int engine_ode_chain_run(const model* m, const scenario* sc, const sim_opts* o, 
         res->status = SIM_REFUSED;
         snprintf(msg, msz, "stopped at t = %.6g s", t_last);
     }
+    if (!res->status && lnote[0]) snprintf(res->note, sizeof res->note, "%s", lnote);
     if (!res->status && chk.dip) sim_checks_note(&chk, false, res->note, sizeof res->note);
 done:
     ode_chain_destroy(w);
+    rcl_destroy(lim);
+    free(now), free(ulim);
     free(buf);
     free(fcol);
     if (!rows_rc) ode_chain_rows_free(&r);

@@ -21,6 +21,7 @@
 #include "ode_chain.h"
 
 #include "ode_common.h"
+#include "circuit_fast.h"
 #include "circuit_kernel.h"
 #include "energy_acc.h"
 #include "hyd_cylinder.h"
@@ -67,6 +68,12 @@ typedef struct oc_act {
     double Fs0, dFs, Fmax;
     double lever;     ///< dL/dq of its joint at the step's start [m/rad or -]
     double Fp;        ///< the force at its pins this step [N] (F without the seal friction when the motor holds it)
+    /// CRANE_ACT_LINKAGE: the link (A-P) and the rocker (C-P) as bodies, the
+    /// loop closed by hinges at A (link-parent), C (rocker-knuckle) and P
+    /// (link-rocker); the rod pushes P, the link's end at (l1/2, 0, 0) in its
+    /// body frame (origin at its centre, x along A->P). 0 for a pin pair.
+    dBodyID link, rocker;
+    double Pl[3];     ///< P in the link's body coordinates [m]
 } oc_act;
 
 struct ode_chain {
@@ -75,6 +82,7 @@ struct ode_chain {
     chain* mech;    ///< the mechanism with the tip mass merged (start poses, gravity load, stroke ends)
     chain_ws* ws;
     int nbody, ndof, nact, nfn;
+    int nlinkage;   ///< actuators through a linkage (two extra bodies each)
     oc_body* b;
     oc_act* a;
     double* tau;    ///< extra joint forces (ndof)
@@ -92,6 +100,7 @@ struct ode_chain {
     // Hydraulics.
     hyd_model* hm;
     hyd_data* hd;
+    hyd_fast* fk; ///< the sub-steps' kernel (circuit_fast.h), or NULL: the component loops
     hyd_solver* hs;
     hyd_problem hp;
     int nh, nsub, npres;
@@ -156,17 +165,38 @@ static void frame_point_vel(const ode_chain* w, int i, const double p[3], double
 
 // Pin length [m] and rate [m/s] of actuator k, and the unit vector from the
 // barrel pin to the rod pin with both pins (any of them may be NULL).
+// The rod pin of actuator k and its velocity: on body_b, or (a linkage) the
+// common pin P on the link's body.
+static void rod_point(const ode_chain* w, int k, double p[3], double v[3]) {
+    const crane_act* c = &w->cc.act[k];
+    const oc_act* a = &w->a[k];
+    if (a->link) {
+        dVector3 r;
+        if (p) {
+            dBodyGetRelPointPos(a->link, a->Pl[0], a->Pl[1], a->Pl[2], r);
+            p[0] = r[0], p[1] = r[1], p[2] = r[2];
+        }
+        if (v) {
+            dBodyGetRelPointVel(a->link, a->Pl[0], a->Pl[1], a->Pl[2], r);
+            v[0] = r[0], v[1] = r[1], v[2] = r[2];
+        }
+        return;
+    }
+    if (p) frame_point(w, c->body_b, c->pb, p);
+    if (v) frame_point_vel(w, c->body_b, c->pb, v);
+}
+
 static double act_geometry(const ode_chain* w, int k, double* rate, double u[3], double pa[3], double pb[3]) {
     const crane_act* c = &w->cc.act[k];
     double a[3], b[3];
     frame_point(w, c->body_a, c->pa, a);
-    frame_point(w, c->body_b, c->pb, b);
+    rod_point(w, k, b, NULL);
     const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double L = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     if (rate) {
         double va[3], vb[3];
         frame_point_vel(w, c->body_a, c->pa, va);
-        frame_point_vel(w, c->body_b, c->pb, vb);
+        rod_point(w, k, NULL, vb);
         *rate = ((vb[0] - va[0]) * d[0] + (vb[1] - va[1]) * d[1] + (vb[2] - va[2]) * d[2]) / L;
     }
     if (u)
@@ -283,7 +313,7 @@ static double stroke_at(ode_chain* w, int k, int dof, double s) {
     memcpy(w->qs, w->qstart, (size_t)w->ndof * sizeof *w->qs);
     w->qs[dof] = s;
     chain_update(w->mech, w->ws, w->qs, NULL);
-    return chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, NULL, NULL) - c->closed_length;
+    return crane_act_length(c, w->mech, w->ws, NULL, NULL, NULL) - c->closed_length;
 }
 
 // The joint coordinate, walking from the start in direction dir, where the
@@ -352,6 +382,24 @@ static int jac(void* user, double t, const double* y, double* J) {
     ode_chain* w = user;
     set_inputs(w, t);
     hyd_jacobian(w->hm, w->hd, t, y, NULL, J, w->nh, 0, 0);
+    return 0;
+}
+
+// The sub-steps' f and Jacobian on the fast kernel (circuit_fast.h): the
+// same laws in type-sorted loops, equal to the loops' to rounding. It fills
+// no comp_q or comp_open, so the evaluation the rows and the balance read
+// (after the sub-steps, hyd_step) stays on the loops.
+static int rhs_fast(void* user, double t, const double* y, double* dydt) {
+    ode_chain* w = user;
+    set_inputs(w, t);
+    hyd_fast_eval(w->fk, w->hd, y, dydt);
+    return 0;
+}
+
+static int jac_fast(void* user, double t, const double* y, double* J) {
+    ode_chain* w = user;
+    set_inputs(w, t);
+    hyd_fast_jacobian(w->fk, w->hd, y, NULL, J, w->nh);
     return 0;
 }
 
@@ -455,7 +503,7 @@ static int holding_forces(ode_chain* w, double* F) {
     chain_inverse_dynamics(w->mech, w->ws, NULL, CHAIN_GRAVITY, G);
     for (int k = 0; k < m; ++k) {
         const crane_act* c = &w->cc.act[k];
-        chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, dL, NULL);
+        crane_act_length(c, w->mech, w->ws, NULL, dL, NULL);
         for (int j = 0; j < n; ++j) A[j * m + k] = dL[j];
     }
     int rc = 0;
@@ -571,6 +619,14 @@ static int hyd_create(ode_chain* w, char* err, size_t errsz) {
     w->hp.user = w;
     w->hp.f = rhs;
     w->hp.jac = jac;
+    if (!w->opt.general_circuit) {
+        // With fallback: a component type the kernel has no loop for runs
+        // its reference loop inside it, so it takes every circuit; NULL
+        // only when out of memory (then the loops, still correct).
+        char why[160];
+        w->fk = hyd_fast_create(w->hm, hyd_fast_types(), 1, why, sizeof why);
+        if (w->fk) w->hp.f = rhs_fast, w->hp.jac = jac_fast;
+    }
     w->hp.outside = outside;
     w->hp.implausible = implausible;
     w->hp.settle = settle;
@@ -612,9 +668,11 @@ static int hyd_init_state(ode_chain* w, char* err, size_t errsz) {
         return -1;
     }
     int bad = 0;
-    if (w->nact && w->opt.hold_tip_mass > 0) {
+    if (w->nact && (w->opt.hold_tip_mass > 0 || w->nlinkage)) {
         // The forces of the pose with the hanging mass at the tip: from a
-        // mechanism with it merged (the world's bodies stay without it).
+        // mechanism with it merged (the world's bodies stay without it);
+        // and the linkages' links lumped at their pins (the world has them
+        // as bodies): their weight is then held, as in the analytic mode.
         char e[320];
         chain* held = crane_chain_mechanism(&w->cc, w->opt.tip_mass + w->opt.hold_tip_mass, w->cc.slew_free,
                                             w->opt.slew0, e, sizeof e);
@@ -739,6 +797,78 @@ static void to_dmatrix(const double R[9], dMatrix3 M) {
     }
 }
 
+// A link of the linkage as a body from a to b (world) [m] of mass m [kg]: a
+// uniform bar, its centre at the middle, its x along a->b, its y the
+// parent's y (rot: the parent's axes, row-major; ang: the bar's angle from
+// the parent's x towards its z [rad]); about its centre m l^2/12 about y
+// and z (linkage_links' uniform link) and m r^2/2 about x for a bar of
+// radius r = 0.05 m (the turn about its own axis, which no joint drives).
+static dBodyID link_body(dWorldID world, const double prot[9], double ang, const double a[3], const double b[3],
+                         double len, double m) {
+    const double ct = cos(ang), st = sin(ang);
+    // R = Rparent Ry with Ry's columns x = (c, 0, s), y, z = (-s, 0, c).
+    const double Ry[9] = {ct, 0, -st, 0, 1, 0, st, 0, ct};
+    double R[9];
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) R[3 * r + c] = prot[3 * r] * Ry[c] + prot[3 * r + 1] * Ry[3 + c] + prot[3 * r + 2] * Ry[6 + c];
+    dMass ms;
+    dMassSetZero(&ms);
+    const double Ib = m * len * len / 12.0, Ia = 0.5 * m * 0.05 * 0.05;
+    dMassSetParameters(&ms, m, 0, 0, 0, Ia, Ib, Ib, 0, 0, 0);
+    dBodyID body = dBodyCreate(world);
+    dBodySetPosition(body, 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]));
+    dMatrix3 M;
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) M[4 * i + j] = R[3 * i + j];
+        M[4 * i + 3] = 0;
+    }
+    dBodySetRotation(body, M);
+    dBodySetMass(body, &ms);
+    return body;
+}
+
+static dJointID loop_hinge(dWorldID world, dBodyID b1, dBodyID b2, const double at[3], const double ax[3]) {
+    dJointID j = dJointCreateHinge(world, 0);
+    dJointAttach(j, b1, b2);
+    dJointSetHingeAnchor(j, at[0], at[1], at[2]);
+    dJointSetHingeAxis(j, ax[0], ax[1], ax[2]);
+    return j;
+}
+
+// Actuator k's linkage as bodies in the start pose (the chain's poses in
+// b[]): the loop solved at the knuckle's start angle (linkage_eval), the
+// link A-P and the rocker C-P as bars, hinged at A to the parent, at C to
+// the knuckle and at P to each other (axes the parent's -y, as the
+// knuckle's). ODE holds the loop closed; the formula only places it.
+static int build_linkage(ode_chain* w, int k, char* err, size_t errsz) {
+    const crane_act* c = &w->cc.act[k];
+    oc_act* a = &w->a[k];
+    const linkage* lk = &c->lk;
+    chain_update(w->mech, w->ws, w->qstart, NULL);
+    const double q = chain_joint_q(w->mech, w->ws, c->body_b, NULL);
+    linkage_state s;
+    if (linkage_eval(lk, q, &s)) {
+        snprintf(err, errsz, "%s: mechanics.actuators[%d] (%s).linkage: the loop does not close at the start angle %g rad",
+                 w->opt.model_file, k, c->name, q);
+        return -1;
+    }
+    const oc_body* pb = &w->b[c->body_a];
+    // A point (x, z) of the parent's plane in the world.
+    double A[3], C[3], P[3];
+    const double* pts[3] = {lk->d.link_pin, s.C, s.P};
+    double* out[3] = {A, C, P};
+    for (int i = 0; i < 3; ++i)
+        for (int r = 0; r < 3; ++r) out[i][r] = pb->p[r] + pb->R[3 * r] * pts[i][0] + pb->R[3 * r + 2] * pts[i][1];
+    a->link = link_body(w->world, pb->R, s.link_angle, A, P, lk->d.link_len, lk->d.link_mass);
+    a->rocker = link_body(w->world, pb->R, s.rocker_angle, C, P, lk->d.rocker_len, lk->d.rocker_mass);
+    a->Pl[0] = 0.5 * lk->d.link_len, a->Pl[1] = a->Pl[2] = 0.0;
+    const double ax[3] = {-pb->R[1], -pb->R[4], -pb->R[7]};
+    loop_hinge(w->world, a->link, pb->body, A, ax);
+    loop_hinge(w->world, a->rocker, w->b[c->body_b].body, C, ax);
+    loop_hinge(w->world, a->link, a->rocker, P, ax);
+    return 0;
+}
+
 typedef struct build_args {
     ode_chain* w;
     char* err;
@@ -854,6 +984,8 @@ static int build(void* arg) {
             }
         }
     }
+    for (int k = 0; k < w->nact; ++k)
+        if (w->cc.act[k].kind == CRANE_ACT_LINKAGE && build_linkage(w, k, ba->err, ba->errsz)) return -1;
     // The cylinders' stroke ends as stops on the joint between their two
     // bodies (the only joint that changes their length), where one is the
     // other's parent; a cylinder across more joints meets its end stop in
@@ -963,7 +1095,8 @@ ode_chain* ode_chain_create(const crane_chain* cc, const ode_chain_opts* o, char
         return NULL;
     }
     char e[320];
-    w->mech = crane_chain_mechanism(&w->cc, opt.tip_mass, w->cc.slew_free, opt.slew0, e, sizeof e);
+    // The booms without the linkages' links: the world makes them bodies.
+    w->mech = crane_chain_mechanism_links(&w->cc, opt.tip_mass, w->cc.slew_free, opt.slew0, false, e, sizeof e);
     if (!w->mech) {
         snprintf(err, errsz, "%s: mechanics.%s", opt.model_file, e);
         free_world(w);
@@ -971,6 +1104,7 @@ ode_chain* ode_chain_create(const crane_chain* cc, const ode_chain_opts* o, char
     }
     w->ws = chain_ws_create(w->mech);
     w->nbody = cc->nbody, w->nact = cc->nact, w->nfn = cc->nfn, w->ndof = chain_ndof(w->mech);
+    for (int k = 0; k < cc->nact; ++k) w->nlinkage += cc->act[k].kind == CRANE_ACT_LINKAGE;
     const size_t nd = (size_t)(w->ndof > 0 ? w->ndof : 1);
     w->b = calloc((size_t)w->nbody, sizeof *w->b);
     w->a = calloc((size_t)(w->nact > 0 ? w->nact : 1), sizeof *w->a);
@@ -1042,6 +1176,7 @@ static void free_world(ode_chain* w) {
     }
     if (w->hs) hyd_solver_destroy(w->hs);
     if (w->hd) hyd_data_free(w->hd);
+    hyd_fast_free(w->fk);
     free(w->y);
     free(w->ydot);
     free(w->pres);
@@ -1071,7 +1206,7 @@ static void apply_forces(ode_chain* w) {
         const crane_act* c = &w->cc.act[k];
         double u[3], pa[3], pb[3];
         act_geometry(w, k, NULL, u, pa, pb);
-        const dBodyID ba = w->b[c->body_a].body, bb = w->b[c->body_b].body;
+        const dBodyID ba = w->b[c->body_a].body, bb = w->a[k].link ? w->a[k].link : w->b[c->body_b].body;
         if (bb) dBodyAddForceAtPos(bb, F * u[0], F * u[1], F * u[2], pb[0], pb[1], pb[2]);
         if (ba) dBodyAddForceAtPos(ba, -F * u[0], -F * u[1], -F * u[2], pa[0], pa[1], pa[2]);
     }
@@ -1142,7 +1277,7 @@ static void apply_seal(ode_chain* w) {
         if (!a->seal) continue;
         oc_body* b = &w->b[a->seal_body];
         const crane_act* c = &w->cc.act[k];
-        chain_cylinder(w->mech, w->ws, c->body_a, c->pa, c->body_b, c->pb, NULL, w->dL, NULL);
+        crane_act_length(c, w->mech, w->ws, NULL, w->dL, NULL);
         const double l = w->dL[b->dof];
         a->lever = l;
         b->C += l * l * a->dFs;
@@ -1234,6 +1369,12 @@ static int post_step(ode_chain* w) {
                      w->cc.body[i].def.name, w->t);
             return -1;
         }
+    for (int k = 0; k < w->nact; ++k)
+        if (w->a[k].link && !(body_finite(w->a[k].link) && body_finite(w->a[k].rocker))) {
+            snprintf(w->err, sizeof w->err, "ode chain world: the linkage of %s became non-finite at t = %.6f s",
+                     w->cc.act[k].name, w->t);
+            return -1;
+        }
     return 0;
 }
 
@@ -1269,6 +1410,12 @@ struct dxBody* ode_chain_body_id(const ode_chain* w, int i, double org[3]) {
     if (i < 0 || i >= w->nbody) return NULL;
     if (org) memcpy(org, w->b[i].org, sizeof w->b[i].org);
     return w->b[i].body;
+}
+
+struct dxBody* ode_chain_link_body(const ode_chain* w, int k, int which, double* len) {
+    if (k < 0 || k >= w->nact || !w->a[k].link) return NULL;
+    if (len) len[0] = which ? w->cc.act[k].lk.d.rocker_len : w->cc.act[k].lk.d.link_len;
+    return which ? w->a[k].rocker : w->a[k].link;
 }
 
 const crane_chain* ode_chain_chain(const ode_chain* w) { return &w->cc; }
@@ -1460,5 +1607,7 @@ double ode_chain_energy(const ode_chain* w) {
     double e = 0.0;
     for (int i = 0; i < w->nbody; ++i)
         if (w->b[i].body) e += body_energy(w->b[i].body, w->g);
+    for (int k = 0; k < w->nact; ++k)
+        if (w->a[k].link) e += body_energy(w->a[k].link, w->g) + body_energy(w->a[k].rocker, w->g);
     return e;
 }

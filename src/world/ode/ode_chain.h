@@ -31,6 +31,7 @@ typedef struct ode_chain_opts {
     double dt_hyd;         ///< hydraulic sub-step [s]; default 1e-4; dt_ode must be a whole multiple
     hyd_method solver;     ///< hydraulic integrator, a fixed-step one; default HYD_KRUS
     int jac_every;         ///< reuse the hydraulic Jacobian for this many sub-steps; default 1 (see docs)
+    int general_circuit;   ///< 1: the sub-steps on the circuit's component loops (hyd_eval), else the fast kernel (circuit_fast.h); default 0
     double tip_mass;       ///< point mass at the chain's tip, merged into its body [kg]; default 0
     const double* q0;      ///< start joint coordinates [rad or m], one per DOF; NULL: all 0
     double slew0;          ///< a fixed column: its slew [rad]; default 0
@@ -121,6 +122,10 @@ void ode_chain_host_failed(ode_chain* w);
 /// the frame origin (the joint) in that body's coordinates [m] (org may be
 /// NULL): a point p of the frame is org + p in the body.
 struct dxBody* ode_chain_body_id(const ode_chain* w, int i, double org[3]);
+/// Actuator k's linkage bodies (CRANE_ACT_LINKAGE): which 0 the link (A-P),
+/// 1 the rocker (C-P), each a bar along its body x centred on its origin,
+/// its length [m] in len (may be NULL). NULL for a pin pair's actuator.
+struct dxBody* ode_chain_link_body(const ode_chain* w, int k, int which, double* len);
 /// The chain as built (the copy: slew_free set where a slew drive turns the
 /// column; its actuators bound to the circuit).
 const crane_chain* ode_chain_chain(const ode_chain* w);

@@ -214,6 +214,19 @@ static const float RGBA_COLUMN[4] = {0.85f, 0.2f, 0.15f, 1};
 static const float RGBA_BOOM1[4] = {0.9f, 0.25f, 0.15f, 1};
 static const float RGBA_BOOM2[4] = {0.95f, 0.35f, 0.2f, 1};
 static const float RGBA_LOAD[4] = {0.3f, 0.45f, 0.75f, 1};
+/// A chain's telescopic extensions: lighter than the booms they slide out of.
+static const float RGBA_EXT[4] = {0.98f, 0.62f, 0.3f, 1};
+
+/// The drawn section (width, height [m]) of a chain body whose model gives
+/// w x h: as given, except for an extension inside a parent drawn pw x ph
+/// (0: none) that is not smaller than it, which is drawn at 85 % of it, so
+/// the nested section shows inside its boom instead of through its walls
+/// (a model that gives an extension as wide as its boom, or wider).
+/// Collision keeps the model's size.
+static void chain_draw_section(double w, double h, double pw, double ph, double* dw, double* dh) {
+    *dw = pw > 0 && w >= pw ? 0.85 * pw : w;
+    *dh = ph > 0 && h >= ph ? 0.85 * ph : h;
+}
 
 // Hinge stop angles (relative to the hinge's zero at build time) from the
 // cylinder's stroke range, so the ODE joint limit takes the end-stop impact
@@ -450,6 +463,7 @@ int ow_build_chain_crane(ode_world* w, const double base[3], const double R[9], 
     co.dt_hyd = w->opt.dt_hyd;
     co.solver = w->opt.solver;
     co.jac_every = w->opt.jac_every > 0 ? w->opt.jac_every : 1;
+    co.general_circuit = w->opt.general_circuit;
     co.q0 = w->chain_q;
     co.slew0 = w->opt.slew0;
     co.stop_limits = w->opt.stop_limits;
@@ -478,7 +492,14 @@ int ow_build_chain_crane(ode_world* w, const double base[3], const double R[9], 
     // named after it: the column over its height along z, a boom or an
     // extension from its joint along x over its length, its section width
     // x height. The two-link meshes fit the two-link crane's sizes only, so
-    // the chain's bodies are drawn as their primitives.
+    // the chain's bodies are drawn as their primitives. An extension is drawn
+    // as a section inside its parent's (chain_draw_section), so it shows
+    // sliding out of the boom instead of overlapping it.
+    double* drawn = calloc((size_t)(2 * c->nbody + 2), sizeof *drawn); // drawn width, height per body [m]
+    if (!drawn) {
+        snprintf(err, errsz, "ode world: out of memory");
+        return -1;
+    }
     for (int i = 0; i < c->nbody; ++i) {
         double org[3];
         dBodyID b = ode_chain_body_id(w->chain, i, org);
@@ -501,10 +522,32 @@ int ow_build_chain_crane(ode_world* w, const double base[3], const double R[9], 
         dGeomSetBody(g, b);
         dGeomSetOffsetPosition(g, pos[0], pos[1], pos[2]);
         ow_geom_name(ow_add_geom(w, g, OW_CAT_CRANE, 0.5), cb->def.name);
-        const world_role role = i == 0 ? WORLD_ROLE_COLUMN : i == 1 ? WORLD_ROLE_BOOM1 : WORLD_ROLE_BOOM2;
-        const float* rgba = i == 0 ? RGBA_COLUMN : i == 1 ? RGBA_BOOM1 : RGBA_BOOM2;
-        ow_add_vis(w, cb->def.name, role, i == 0 ? WORLD_SHAPE_CYLINDER : WORLD_SHAPE_BOX, sz, rgba, -1, b, pos, NULL);
+        const bool ext = i > 0 && cb->def.joint == CHAIN_PRISMATIC;
+        const world_role role = i == 0 ? WORLD_ROLE_COLUMN : ext ? WORLD_ROLE_EXTENSION : WORLD_ROLE_BOOM;
+        const float* rgba = i == 0 ? RGBA_COLUMN : ext ? RGBA_EXT : (i & 1) ? RGBA_BOOM1 : RGBA_BOOM2;
+        double vsz[3] = {sz[0], sz[1], sz[2]};
+        const int par = cb->def.parent;
+        if (i > 0) {
+            const bool nest = ext && par > 0 && par < i;
+            chain_draw_section(cb->width, cb->height, nest ? drawn[2 * par] : 0, nest ? drawn[2 * par + 1] : 0,
+                               &vsz[1], &vsz[2]);
+            drawn[2 * i] = vsz[1], drawn[2 * i + 1] = vsz[2];
+        }
+        ow_add_vis(w, cb->def.name, role, i == 0 ? WORLD_SHAPE_CYLINDER : WORLD_SHAPE_BOX, vsz, rgba, -1, b, pos, NULL);
     }
+    free(drawn);
+    // A linkage's link and rocker: drawn as bars (no collision: they sit
+    // between the booms), named after the actuator.
+    for (int k = 0; k < c->nact; ++k)
+        for (int which = 0; which < 2; ++which) {
+            double len;
+            dBodyID b = ode_chain_link_body(w->chain, k, which, &len);
+            if (!b) continue;
+            char name[40]; // the snapshot's names hold 47 characters
+            snprintf(name, sizeof name, "%.30s_%s", c->act[k].name, which ? "rocker" : "link");
+            const double sz[3] = {len, 0.06, 0.06}, zero[3] = {0, 0, 0};
+            ow_add_vis(w, name, WORLD_ROLE_OTHER, WORLD_SHAPE_BOX, sz, RGBA_BOOM2, -1, b, zero, NULL);
+        }
     // Frames for the sandbox's column and rope (frame 1: the first boom).
     memset(w->frame, 0, sizeof w->frame);
     w->frame[0].body = ode_chain_body_id(w->chain, 0, w->frame[0].org);

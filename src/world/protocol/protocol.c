@@ -89,7 +89,11 @@ size_t proto_put_command(uint8_t* buf, size_t cap, const proto_command* c) {
     put_u64(&w, c->seq);
     put_u8(&w, c->op);
     switch (c->op) {
-    case PROTO_OP_VALVES: put_f64s(&w, c->u, 3); break;
+    case PROTO_OP_VALVES:
+        if (c->nu < 1 || c->nu > PROTO_MAX_FN) return 0;
+        put_u8(&w, c->nu);
+        put_f64s(&w, c->u, c->nu);
+        break;
     case PROTO_OP_HOOK:
     case PROTO_OP_PAUSE: put_u8(&w, c->flag); break;
     case PROTO_OP_RESET: break;
@@ -109,7 +113,8 @@ size_t proto_put_command(uint8_t* buf, size_t cap, const proto_command* c) {
 
 size_t proto_put_state(uint8_t* buf, size_t cap, const proto_state* s) {
     if (s->nrow > PROTO_MAX_ROW || s->nbody > PROTO_MAX_BODIES || s->ncyl > PROTO_MAX_CYL ||
-        s->nrope > PROTO_MAX_ROPE || s->npad > PROTO_MAX_PADS || s->nrelief > PROTO_MAX_RELIEFS)
+        s->nrope > PROTO_MAX_ROPE || s->npad > PROTO_MAX_PADS || s->nrelief > PROTO_MAX_RELIEFS ||
+        s->nfn > PROTO_MAX_FN)
         return 0;
     for (int i = 0; i < s->nrelief; ++i) {
         const size_t k = strnlen(s->relief[i].name, PROTO_RELIEF_NAME + 1);
@@ -155,6 +160,8 @@ size_t proto_put_state(uint8_t* buf, size_t cap, const proto_state* s) {
         put_u8(&w, (uint8_t)k);
         put_bytes(&w, q->name, k);
     }
+    put_u8(&w, s->nfn);
+    for (int i = 0; i < s->nfn; ++i) put_f64s(&w, s->fn[i], PROTO_FN_VALUES);
     return end(&w);
 }
 
@@ -240,9 +247,16 @@ static int parse_command(rd* r, proto_command* c, char* err, size_t errsz) {
     if (r->fail) return 0;
     switch (c->op) {
     case PROTO_OP_VALVES:
-        get_f64s(r, c->u, 3);
+        c->nu = get_u8(r);
         if (r->fail) return 0;
-        for (int k = 0; k < 3; ++k)
+        if (c->nu < 1 || c->nu > PROTO_MAX_FN) {
+            snprintf(err, errsz, "command %llu: valves: %u openings, expected 1..%d (one per function)",
+                     (unsigned long long)c->seq, c->nu, PROTO_MAX_FN);
+            return -1;
+        }
+        get_f64s(r, c->u, c->nu);
+        if (r->fail) return 0;
+        for (int k = 0; k < c->nu; ++k)
             if (!isfinite(c->u[k]) || c->u[k] < -1 || c->u[k] > 1) {
                 snprintf(err, errsz, "command %llu: valves: opening %d must be a number in [-1, 1], got %g",
                          (unsigned long long)c->seq, k + 1, c->u[k]);
@@ -299,8 +313,19 @@ static int parse_command(rd* r, proto_command* c, char* err, size_t errsz) {
     }
 }
 
+// The first of k values that is not a finite number, or -1.
+static int first_nonfinite(const double* d, int k) {
+    for (int i = 0; i < k; ++i)
+        if (!isfinite(d[i])) return i;
+    return -1;
+}
+
 static int parse_state(rd* r, proto_state* s, char* err, size_t errsz) {
     get_f64s(r, s->nine, 9);
+    if (!r->fail && first_nonfinite(s->nine, 9) >= 0) {
+        snprintf(err, errsz, "state: nine value %d is not a finite number", first_nonfinite(s->nine, 9) + 1);
+        return -1;
+    }
     s->seq = get_u64(r);
     s->cmd_seq = get_u64(r);
     s->flags = get_u32(r);
@@ -334,7 +359,14 @@ static int parse_state(rd* r, proto_state* s, char* err, size_t errsz) {
         snprintf(err, errsz, "state: %u bodies, at most %d", s->nbody, PROTO_MAX_BODIES);
         return -1;
     }
-    for (int i = 0; i < s->nbody; ++i) get_f64s(r, s->pose[i], 12);
+    for (int i = 0; i < s->nbody; ++i) {
+        get_f64s(r, s->pose[i], 12);
+        if (!r->fail && first_nonfinite(s->pose[i], 12) >= 0) {
+            snprintf(err, errsz, "state: body %d: pose value %d is not a finite number", i,
+                     first_nonfinite(s->pose[i], 12) + 1);
+            return -1;
+        }
+    }
     s->ncyl = get_u8(r);
     if (r->fail) return 0;
     if (s->ncyl > PROTO_MAX_CYL) {
@@ -344,10 +376,23 @@ static int parse_state(rd* r, proto_state* s, char* err, size_t errsz) {
     for (int i = 0; i < s->ncyl; ++i) {
         get_f64s(r, s->cyl[i], PROTO_CYL_VALUES);
         s->cyl_bits[i] = get_u8(r);
-        if (!r->fail && s->cyl_bits[i] > (PROTO_CYL_RELIEF | PROTO_CYL_END_STOP)) {
-            snprintf(err, errsz, "state: cylinder %d: status bits 0x%02x, only 0x03 defined", i, s->cyl_bits[i]);
+        if (r->fail) return 0;
+        if (s->cyl_bits[i] > (PROTO_CYL_RELIEF | PROTO_CYL_END_STOP | PROTO_CYL_NO_PINS)) {
+            snprintf(err, errsz, "state: cylinder %d: status bits 0x%02x, only 0x07 defined", i, s->cyl_bits[i]);
             return -1;
         }
+        const int bad = first_nonfinite(s->cyl[i], PROTO_CYL_VALUES);
+        if (bad >= 0) {
+            snprintf(err, errsz, "state: cylinder %d: value %d is not a finite number", i, bad + 1);
+            return -1;
+        }
+        // Openings u (spool) and u_cmd (command) [-].
+        for (int k = 9; k <= 10; ++k)
+            if (s->cyl[i][k] < -1 || s->cyl[i][k] > 1) {
+                snprintf(err, errsz, "state: cylinder %d: %s %g outside [-1, 1]", i, k == 9 ? "spool" : "command",
+                         s->cyl[i][k]);
+                return -1;
+            }
     }
     s->nrope = get_u8(r);
     if (r->fail) return 0;
@@ -382,6 +427,22 @@ static int parse_state(rd* r, proto_state* s, char* err, size_t errsz) {
         q->cyl = (int8_t)cyl;
         memcpy(q->name, p, k);
         q->name[k] = 0;
+    }
+    s->nfn = get_u8(r);
+    if (r->fail) return 0;
+    if (s->nfn > PROTO_MAX_FN) {
+        snprintf(err, errsz, "state: %u functions, at most %d", s->nfn, PROTO_MAX_FN);
+        return -1;
+    }
+    for (int i = 0; i < s->nfn; ++i) {
+        get_f64s(r, s->fn[i], PROTO_FN_VALUES);
+        if (r->fail) return 0;
+        for (int k = 0; k < PROTO_FN_VALUES; ++k)
+            if (!(s->fn[i][k] >= -1 && s->fn[i][k] <= 1)) { // NaN fails too
+                snprintf(err, errsz, "state: function %d: %s %g must be a number in [-1, 1]", i,
+                         k ? "spool" : "command", s->fn[i][k]);
+                return -1;
+            }
     }
     return r->fail ? 0 : 1;
 }

@@ -16,18 +16,27 @@ extern "C" {
 
 /// "CSIM" as a little-endian u32: the first field of both hellos.
 #define PROTO_MAGIC 0x4D495343u
-/// 2: the state frame carries the tip, the truck's roll and pitch, the supply
-/// pressure and what the HUD shows (limiter, supports, open reliefs).
-#define PROTO_VERSION 2u
+/// 3: by function, for any crane chain: the hello's JSON lists the functions
+/// (with the actuators each drives), the crane's bodies and the channels;
+/// VALVES carries one opening per function in the hello's order; the state
+/// frame ends with every function's command and spool. (2 added the tip,
+/// the truck's roll and pitch, the supply pressure and the HUD's values.)
+#define PROTO_VERSION 3u
 /// Frame header: u32 length of what follows (type byte + payload), then the type.
 #define PROTO_HEADER 5
 /// The longest frame a client may send (a SET with its path is the longest) [bytes after the length].
 #define PROTO_MAX_CLIENT_FRAME 1024u
 /// The longest frame a server sends (a hello with its JSON description) [bytes after the length].
 #define PROTO_MAX_SERVER_FRAME (1u << 20)
-#define PROTO_MAX_ROW 64
+/// Row columns: 128 for the 8-function, 10-body chain in the sandbox
+/// (tests/world/data/chain_8fn_10link.json), twice that for room.
+#define PROTO_MAX_ROW 256
 #define PROTO_MAX_BODIES 160
-#define PROTO_MAX_CYL 4
+/// Cylinder records: every actuator of the chain and the slew rack.
+#define PROTO_MAX_CYL 16
+/// Functions the operator commands (VALVES openings, the state's function records).
+#define PROTO_MAX_FN 16
+#define PROTO_FN_VALUES 2 ///< f64 per function record: command, spool
 #define PROTO_MAX_ROPE 32
 #define PROTO_MAX_PATH 256
 #define PROTO_MAX_PADS 4
@@ -48,7 +57,7 @@ enum proto_type {
 enum proto_role { PROTO_WATCH = 0, PROTO_CONTROL = 1 };
 
 enum proto_op {
-    PROTO_OP_VALVES = 1, ///< three f64 openings lift, jib, slew in [-1, 1]
+    PROTO_OP_VALVES = 1, ///< u8 n (1..PROTO_MAX_FN), n f64 openings in [-1, 1], one per function in the hello's order
     PROTO_OP_HOOK = 2,   ///< u8: 1 attach the nearest load, 0 release
     PROTO_OP_PAUSE = 3,  ///< u8: 1 pause, 0 run
     PROTO_OP_RESET = 4,  ///< start again from the initial state
@@ -73,7 +82,10 @@ enum {
                                  ///< that ignores them reads the frame as before)
 };
 /// Cylinder status bits (proto_state.cyl_bits).
-enum { PROTO_CYL_RELIEF = 1u << 0, PROTO_CYL_END_STOP = 1u << 1 };
+/// PROTO_CYL_NO_PINS: the world's picture does not draw this cylinder, so
+/// its pins are 0 and its relief and end-stop bits are not known (0); its
+/// stroke, rate, pressures, force and openings are the row's.
+enum { PROTO_CYL_RELIEF = 1u << 0, PROTO_CYL_END_STOP = 1u << 1, PROTO_CYL_NO_PINS = 1u << 2 };
 
 /// An open relief valve: its circuit name and the chamber it guards.
 typedef struct proto_relief {
@@ -99,14 +111,16 @@ typedef struct proto_server_hello {
 typedef struct proto_command {
     uint64_t seq;
     uint8_t op;
-    double u[3];                 ///< VALVES
+    uint8_t nu;                  ///< VALVES: openings, one per function (the hello's "functions")
+    double u[PROTO_MAX_FN];      ///< VALVES [-]
     uint8_t flag;                ///< HOOK, PAUSE
     uint32_t frames;             ///< STEP
     char path[PROTO_MAX_PATH + 1]; ///< SET, NUL-terminated
     double value;                ///< SET
 } proto_command;
 
-/// One state frame. nine: x1, x2 [m], p1A, p1B, p2A, p2B [Pa abs], u1, u2 [-], t [s]: the paper's packet.
+/// One state frame. nine: x1, x2 [m], p1A, p1B, p2A, p2B [Pa abs], u1, u2 [-], t [s]: the paper's packet
+/// (for a crane chain: the first actuator of the first two functions, and their spools).
 typedef struct proto_state {
     double nine[9];
     uint64_t seq;     ///< frame number since the server started (gaps: frames this client lost)
@@ -135,6 +149,8 @@ typedef struct proto_state {
     double rope[PROTO_MAX_ROPE][3];
     uint8_t nrelief;  ///< relief valves passing flow
     proto_relief relief[PROTO_MAX_RELIEFS];
+    uint8_t nfn;      ///< functions, in the hello's "functions" order: command (after the limiter) [-], spool [-]
+    double fn[PROTO_MAX_FN][PROTO_FN_VALUES];
 } proto_state;
 
 /// The truck's roll and pitch [rad] from its body-to-world rotation

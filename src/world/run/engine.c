@@ -109,16 +109,28 @@ engine* engine_create_rcl(const model* m, const sim_opts* o, const double q0[2],
         return NULL;
     }
     // The limiter filters every command a stepped driver sets (drive, the
-    // window's tick, the soak bench, serve): one place for all of them. An
-    // engine without the two-link commands has none (rcl.h refuses chains);
-    // engine_caps says so, and a driver that needs one refuses first.
-    if (!(engine_caps(e) & ENGINE_CAP_LIMITER)) {
+    // window's tick, the soak bench, serve): one place for all of them. A
+    // crane chain's engine makes its limiter only when o->rcl asks for it
+    // (its chart searches every joint of the chain, about a second): the
+    // library's default runs measure nothing there.
+    const bool chain = e->ops->set_function_commands != NULL;
+    if (!(engine_caps(e) & ENGINE_CAP_LIMITER) || (chain && !o->rcl && !r)) {
         rcl_destroy(r);
         return e;
     }
     if (r) rcl_reset(r);
-    // A stepped engine's world, when o names none, is its drive world.
-    e->rcl = r ? r : engine_rcl_create(m, o, engine_backend_of(o)->drive_world);
+    // A stepped engine's world, when o names none, is its drive world; a
+    // crane chain's engine without a hook runs in no world (the ODE's
+    // validation world: no truck), whatever the backend's drive world.
+    const char* dw = chain && !e->ops->hook ? NULL : engine_backend_of(o)->drive_world;
+    e->rcl = r ? r : engine_rcl_create(m, o, dw);
+    // A chain's rows carry its columns after the backend's channels.
+    if (e->rcl && chain && rcl_set_chain_row(e->rcl, NULL, e->ops->nchannel)) {
+        snprintf(err, errsz, "rated capacity limiter: the rows of this engine lack the chain's q, qd or pressure "
+                             "columns");
+        engine_destroy(e);
+        return NULL;
+    }
     return e;
 }
 
@@ -205,7 +217,15 @@ static void apply_function_commands(engine* e, const double* u) {
         return;
     }
     for (int k = 0; k < e->nfn; ++k) e->u_op[k] = e->u_lim[k] = clamp1(u[k]);
-    e->ops->set_function_commands(e, e->u_op);
+    // A crane chain's limiter (rcl_filter_fn): on the row as it stands,
+    // the functions that carry the tip outwards are slowed and stopped.
+    if (e->rcl) {
+        e->ops->row(e, e->rowbuf);
+        if (e->o.rcl)
+            rcl_filter_fn(e->rcl, e->rowbuf, e->nfn, e->u_op, e->u_lim, engine_find_function(e, "slew"));
+        else rcl_utilisation(e->rcl, e->rowbuf); // still measured, for the HUD and the record
+    }
+    e->ops->set_function_commands(e, e->u_lim);
 }
 
 int engine_set_function_commands(engine* e, const double* u, int n, char* err, size_t errsz) {
@@ -253,6 +273,9 @@ unsigned engine_caps(const engine* e) {
     // The limiter and everything shaped lift, jib, slew with SIM_NCOL
     // columns: the engines that take set_commands' three commands.
     if (p->set_commands && !p->set_function_commands) c |= ENGINE_CAP_TWO_LINK | ENGINE_CAP_LIMITER;
+    // A crane chain's engine filters its commands by function (rcl_filter_fn);
+    // which chains it can read, engine_require asks rcl_check_model.
+    if (p->set_function_commands) c |= ENGINE_CAP_LIMITER;
     return c;
 }
 
@@ -272,6 +295,14 @@ int engine_require(const model* m, const sim_opts* o, unsigned caps, const char*
         return -1;
     }
     const unsigned miss = caps & ~engine_caps_for(m, o);
+    // The limiter on a crane chain: the chain's shape and rating decide.
+    if (!miss && (caps & ENGINE_CAP_LIMITER)) {
+        char why[400];
+        if (rcl_check_model(m, why, sizeof why)) {
+            snprintf(err, errsz, "%s: %s", what, why);
+            return -1;
+        }
+    }
     if (!miss) return 0;
     // The first missing part, in the order a driver meets them.
     const char* part = (miss & ENGINE_CAP_SNAPSHOT)   ? "picture for the renderer"
@@ -483,7 +514,15 @@ bool engine_snapshot(engine* e, world_snapshot* s) {
     // Cylinder k (lift, jib, slew) carries command k.
     for (int k = 0; k < s->ncyl && k < WORLD_SNAP_MAX_CYLINDERS; ++k) {
         world_snap_cylinder* c = &s->cyl[k];
-        c->rcl_cut = k < 3 && k < e->nfn && s->rcl_on && e->u_lim[k] != e->u_op[k];
+        // A crane chain's cylinders: the chain's actuators first, each on its function.
+        const crane_chain* cc = e->mdl ? &e->mdl->chain : NULL;
+        const int f = !e->ops->set_function_commands ? k : (cc && k < cc->nact ? cc->act[k].function : -1);
+        c->rcl_cut = f >= 0 && f < e->nfn && (f < 3 || e->ops->set_function_commands) && s->rcl_on &&
+                     e->u_lim[f] != e->u_op[f];
+        if (c->rcl_cut) {
+            c->u_op = e->u_op[f];
+            continue;
+        }
         c->u_op = c->rcl_cut ? e->u_op[k] : c->u_cmd;
     }
     return true;

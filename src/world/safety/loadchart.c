@@ -67,11 +67,10 @@ void lc_truck_from_world(const world_desc* wd, lc_truck* t) {
     t->hook_mass = wd->hook.mass + wd->rope.mass_per_m * wd->rope.length;
 }
 
-int loadchart_reliefs(const model* m, int k, double p[2]) {
-    const hyd_model* hm = m->hyd;
+int loadchart_cylinder_reliefs(const hyd_model* hm, int cyl, double p[2]) {
     for (int c = 0; c < 2; ++c) {
         p[c] = NAN;
-        const int node = hyd_model_comp_node(hm, hyd_model_cylinder_comp(hm, m->cyl[k]), c);
+        const int node = hyd_model_comp_node(hm, hyd_model_cylinder_comp(hm, cyl), c);
         for (int i = 0; i < hyd_model_ncomp(hm); ++i) {
             if (hyd_model_comp_type(hm, i) != HYD_RELIEF || hyd_model_relief_inlet(hm, i) != node) continue;
             char path[160];
@@ -83,6 +82,8 @@ int loadchart_reliefs(const model* m, int k, double p[2]) {
     }
     return 0;
 }
+
+int loadchart_reliefs(const model* m, int k, double p[2]) { return loadchart_cylinder_reliefs(m->hyd, m->cyl[k], p); }
 
 // Joint range of actuator k: the joint angles at zero and full stroke [rad].
 static void joint_range(const model* m, int k, double* lo, double* hi) {
@@ -123,7 +124,7 @@ double loadchart_hyd_pose(const model* m, double q1, double q2, double margin, i
 // Mass moment [kg m] about a support edge: mass times its distance inside
 // the polygon (negative outside), for a mass at horizontal distance rho [m]
 // from the slew axis along slew angle s.
-static double edge_moment(const lc_truck* t, int edge, double rho, double s, double mass) {
+double lc_edge_moment(const lc_truck* t, int edge, double rho, double s, double mass) {
     const double x = t->column_x + rho * cos(s), y = rho * sin(s);
     double d;
     switch (edge) {
@@ -141,17 +142,17 @@ double loadchart_stab_pose(const model* m, const lc_truck* t, double q1, double 
     const double r1 = e1 * sin(q1), r2 = L1 * sin(q1) + e2 * sin(q1 + q2), rt = L1 * sin(q1) + L2 * sin(q1 + q2);
     double best = INFINITY;
     for (int edge = 0; edge < 4; ++edge) {
-        const double dl = edge_moment(t, edge, rt, slew, 1.0); // m: tip's distance inside
+        const double dl = lc_edge_moment(t, edge, rt, slew, 1.0); // m: tip's distance inside
         if (dl >= 0) continue;                                  // a load there cannot tip over this edge
         // Truck and crane only: the hook and rope hang at the tip with the
         // payload, so they are part of the tipping mass m (and of its
         // factor), subtracted once from the chart (loadchart_compute).
         // Counting them here too, as a negative restoring moment, had the
         // chart 40.7 / 1.25 = 32.6 kg low at every outreach.
-        const double restoring = edge_moment(t, edge, -t->column_x, 0.0, t->mass) // truck COM at the chassis centre
-                                 + edge_moment(t, edge, 0.0, slew, me->column_mass)
-                                 + edge_moment(t, edge, r1, slew, me->link[0].mass)
-                                 + edge_moment(t, edge, r2, slew, me->link[1].mass);
+        const double restoring = lc_edge_moment(t, edge, -t->column_x, 0.0, t->mass) // truck COM at the chassis centre
+                                 + lc_edge_moment(t, edge, 0.0, slew, me->column_mass)
+                                 + lc_edge_moment(t, edge, r1, slew, me->link[0].mass)
+                                 + lc_edge_moment(t, edge, r2, slew, me->link[1].mass);
         // sf * m (-dl) <= restoring
         const double lim = restoring > 0 ? restoring / (sf * -dl) : 0.0;
         best = fmin(best, lim);
@@ -160,6 +161,10 @@ double loadchart_stab_pose(const model* m, const lc_truck* t, double q1, double 
 }
 
 void loadchart_reach(const model* m, double* rmin, double* rmax) {
+    if (!m->chain.two_link) {
+        lc_chain_reach(m, rmin, rmax);
+        return;
+    }
     double q1lo, q1hi, q2lo, q2hi, x, z;
     joint_range(m, 0, &q1lo, &q1hi);
     joint_range(m, 1, &q2lo, &q2hi);
@@ -210,24 +215,7 @@ static int poses_at(const model* m, double R, double (*pose)[2], int cap) {
     return np;
 }
 
-int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz) {
-    memset(c, 0, sizeof *c);
-    if (model_require_two_link(m, "load chart", err, errsz)) return -1;
-    if (lc_check_opts(o, err, errsz)) return -1;
-    for (int k = 0; k < 2; ++k) {
-        double pr[2];
-        if (loadchart_reliefs(m, k, pr)) {
-            snprintf(err, errsz, "%s: no port relief on a chamber of cylinder '%s': no hydraulic limit",
-                     m->file[0] ? m->file : "model", hyd_model_comp_name(m->hyd, hyd_model_cylinder_comp(m->hyd, m->cyl[k])));
-            return -1;
-        }
-    }
-    loadchart_reach(m, &c->reach_min, &c->reach_max);
-    if (o->lo < c->reach_min - 1e-9 || o->hi > c->reach_max + 1e-9) {
-        snprintf(err, errsz, "--outreach: %g:%g m is outside the crane's reach [%.3f, %.3f] m", o->lo, o->hi,
-                 c->reach_min, c->reach_max);
-        return -1;
-    }
+int lc_chart_alloc(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz) {
     c->n = o->n;
     c->truck = t && t->present;
     c->nsec = c->truck ? o->sectors : 1;
@@ -258,6 +246,73 @@ int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadc
         loadchart_free(c);
         return -1;
     }
+    return 0;
+}
+
+void lc_chart_print(loadchart* c) {
+    // The printed chart, per sector. First min(raw envelope, rating) at each
+    // point, what the crane may lift there. The chart starts at the
+    // sector's minimum working outreach, where that value is largest (the
+    // first such point: a plateau at the rated load starts where the crane
+    // first holds it), and from there outward it is the running minimum
+    // (held down by every closer outreach of the chart): a chart that rises
+    // with outreach invites the operator to reach out to lift more (the
+    // limiter rates outreach, not the way the booms got there), and the
+    // running minimum is the largest non-increasing curve under the capped
+    // envelope. Closer in than the peak the value falls towards the column
+    // (on the shipped crane the folded jib: 1183 kg at 0.5 m); a running
+    // minimum from there would hold the whole chart down to it (out to
+    // 2.45 m), so those points are not printed (NAN) and the limiter takes
+    // min(envelope, rating) at the point itself (cap). The raw envelope is
+    // kept beside it.
+    for (int s = 0; s < c->nsec; ++s) {
+        int i0 = 0;
+        for (int i = 0; i < c->n; ++i) {
+            const size_t k = (size_t)i * c->nsec + s;
+            const double st = c->stab ? c->stab[k] : INFINITY;
+            const int gh = c->chain ? LC_GOV_ACT + c->hyd_cyl[i] : (c->hyd_cyl[i] ? LC_GOV_JIB : LC_GOV_LIFT);
+            int g = st < c->hyd[i] ? LC_GOV_STAB : gh;
+            c->env[k] = fmin(c->hyd[i], st);
+            double v = c->env[k];
+            if (c->rating[i] < v) v = c->rating[i], g = LC_GOV_RATED;
+            c->cap[k] = v, c->gov[k] = g, c->gov_at[k] = i;
+            if (v > c->cap[(size_t)i0 * c->nsec + s]) i0 = i;
+        }
+        c->imin[s] = i0;
+        for (int i = 0; i < c->n; ++i) {
+            const size_t k = (size_t)i * c->nsec + s;
+            if (i < i0) {
+                c->chart[k] = NAN;
+                continue;
+            }
+            if (i > i0 && c->cap[k - c->nsec] < c->cap[k]) {
+                c->cap[k] = c->cap[k - c->nsec];
+                c->gov[k] = c->gov[k - c->nsec], c->gov_at[k] = c->gov_at[k - c->nsec];
+            }
+            c->chart[k] = c->cap[k];
+        }
+    }
+}
+
+int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz) {
+    memset(c, 0, sizeof *c);
+    if (lc_check_opts(o, err, errsz)) return -1;
+    if (!m->chain.two_link) return lc_chain_compute(m, t, o, c, err, errsz);
+    for (int k = 0; k < 2; ++k) {
+        double pr[2];
+        if (loadchart_reliefs(m, k, pr)) {
+            snprintf(err, errsz, "%s: no port relief on a chamber of cylinder '%s': no hydraulic limit",
+                     m->file[0] ? m->file : "model", hyd_model_comp_name(m->hyd, hyd_model_cylinder_comp(m->hyd, m->cyl[k])));
+            return -1;
+        }
+    }
+    loadchart_reach(m, &c->reach_min, &c->reach_max);
+    if (o->lo < c->reach_min - 1e-9 || o->hi > c->reach_max + 1e-9) {
+        snprintf(err, errsz, "--outreach: %g:%g m is outside the crane's reach [%.3f, %.3f] m", o->lo, o->hi,
+                 c->reach_min, c->reach_max);
+        return -1;
+    }
+    if (lc_chart_alloc(m, t, o, c, err, errsz)) return -1;
     static double pose[LC_NQ1 * 10 + 40][2];
     for (int i = 0; i < c->n; ++i) {
         const double R = o->lo + (o->hi - o->lo) * i / (c->n - 1);
@@ -297,47 +352,7 @@ int loadchart_compute(const model* m, const lc_truck* t, const lc_opts* o, loadc
         }
         c->rating[i] = loadchart_rating(c, R);
     }
-    // The printed chart, per sector. First min(raw envelope, rating) at each
-    // point, what the crane may lift there. The chart starts at the
-    // sector's minimum working outreach, where that value is largest (the
-    // first such point: a plateau at the rated load starts where the crane
-    // first holds it), and from there outward it is the running minimum
-    // (held down by every closer outreach of the chart): a chart that rises
-    // with outreach invites the operator to reach out to lift more (the
-    // limiter rates outreach, not the way the booms got there), and the
-    // running minimum is the largest non-increasing curve under the capped
-    // envelope. Closer in than the peak the value falls towards the column
-    // (on the shipped crane the folded jib: 1183 kg at 0.5 m); a running
-    // minimum from there would hold the whole chart down to it (out to
-    // 2.45 m), so those points are not printed (NAN) and the limiter takes
-    // min(envelope, rating) at the point itself (cap). The raw envelope is
-    // kept beside it.
-    for (int s = 0; s < c->nsec; ++s) {
-        int i0 = 0;
-        for (int i = 0; i < c->n; ++i) {
-            const size_t k = (size_t)i * c->nsec + s;
-            const double st = c->stab ? c->stab[k] : INFINITY;
-            int g = st < c->hyd[i] ? LC_GOV_STAB : (c->hyd_cyl[i] ? LC_GOV_JIB : LC_GOV_LIFT);
-            c->env[k] = fmin(c->hyd[i], st);
-            double v = c->env[k];
-            if (c->rating[i] < v) v = c->rating[i], g = LC_GOV_RATED;
-            c->cap[k] = v, c->gov[k] = g, c->gov_at[k] = i;
-            if (v > c->cap[(size_t)i0 * c->nsec + s]) i0 = i;
-        }
-        c->imin[s] = i0;
-        for (int i = 0; i < c->n; ++i) {
-            const size_t k = (size_t)i * c->nsec + s;
-            if (i < i0) {
-                c->chart[k] = NAN;
-                continue;
-            }
-            if (i > i0 && c->cap[k - c->nsec] < c->cap[k]) {
-                c->cap[k] = c->cap[k - c->nsec];
-                c->gov[k] = c->gov[k - c->nsec], c->gov_at[k] = c->gov_at[k - c->nsec];
-            }
-            c->chart[k] = c->cap[k];
-        }
-    }
+    lc_chart_print(c);
     return 0;
 }
 
@@ -368,13 +383,33 @@ const char* lc_gov_name(int gov) {
     case LC_GOV_JIB: return "jib";
     case LC_GOV_STAB: return "stability";
     case LC_GOV_RATED: return "rated";
-    default: return "?";
+    default: return gov >= LC_GOV_ACT ? "actuator" : "?";
     }
 }
 
 void loadchart_free(loadchart* c) {
     free(c->stab), free(c->stab_q), free(c->env), free(c->chart), free(c->cap), free(c->gov), free(c->gov_at);
     c->stab = NULL, c->stab_q = NULL, c->env = c->chart = c->cap = NULL, c->gov = c->gov_at = NULL;
+    free(c->dof_name), free(c->act_name), free(c->dof_prismatic), free(c->dof_range), free(c->pose), free(c->stab_pose), free(c->npose);
+    c->dof_name = c->act_name = NULL, c->dof_prismatic = NULL, c->dof_range = NULL, c->pose = c->stab_pose = NULL, c->npose = NULL;
+}
+
+const char* loadchart_gov_name(const loadchart* c, int gov) {
+    if (c->chain && gov >= LC_GOV_ACT && gov < LC_GOV_ACT + c->nact) return c->act_name[gov - LC_GOV_ACT];
+    return lc_gov_name(gov);
+}
+
+void loadchart_point_pose_chain(const loadchart* c, int i, int s, double* q, double* slew) {
+    const size_t k = (size_t)i * c->nsec + s;
+    const int j = c->gov_at[k];
+    const size_t kj = (size_t)j * c->nsec + s;
+    // As loadchart_point_pose: the stability limit's pose where it governs
+    // (or where the rating does over a stability limit below the hydraulic
+    // one), else the hydraulic limit's at the sector's middle.
+    const bool stab = c->gov[k] == LC_GOV_STAB || (c->gov[k] == LC_GOV_RATED && c->stab && c->stab[kj] < c->hyd[j]);
+    const double* p = stab ? c->stab_pose + kj * (size_t)c->nd : c->pose + (size_t)j * (size_t)c->nd;
+    for (int d = 0; d < c->nd; ++d) q[d] = p[d];
+    *slew = stab ? c->stab_q[kj][2] : 0.5 * (c->sec_lo[s] + c->sec_hi[s]);
 }
 
 int loadchart_sector(const loadchart* c, double slew) {

@@ -49,8 +49,10 @@ typedef enum lc_gov {
     LC_GOV_JIB,      ///< hydraulic limit, the jib cylinder
     LC_GOV_STAB,     ///< stability limit of the sector
     LC_GOV_RATED,    ///< the model's rated capacity (rated_load, rated_moment)
+    LC_GOV_ACT,      ///< a crane chain's hydraulic limit: LC_GOV_ACT + k for its actuator k
 } lc_gov;
-/// "lift", "jib", "stability", "rated".
+/// "lift", "jib", "stability", "rated" ("actuator" for a chain's LC_GOV_ACT + k:
+/// loadchart_gov_name names it).
 const char* lc_gov_name(int gov);
 
 typedef struct loadchart {
@@ -80,6 +82,20 @@ typedef struct loadchart {
     double hook_mass;                 ///< subtracted from the tip load (payload under the hook) [kg]
     double rated_moment, rated_load;  ///< the model's rating [N m], [kg]; 0: none
     double gravity;                   ///< the model's g [m/s^2], for the rated moment
+    // A crane chain (model.chain not the two-link shorthand; docs/safety.md
+    // "On a crane chain"): hyd_cyl is the actuator index, hyd_q and stab_q's
+    // first two the first two boom DOFs, and the whole poses are here.
+    bool chain;
+    int nd;                           ///< boom DOFs (every joint coordinate, extensions included)
+    int nact;                         ///< actuators
+    char (*dof_name)[48];             ///< [nd] the body of each DOF
+    char (*act_name)[48];             ///< [nact]
+    bool* dof_prismatic;              ///< [nd] the DOF is a slide [m] (else an angle [rad])
+    double (*dof_range)[2];           ///< [nd] its joint limits [rad or m]
+    double* pose;                     ///< n x nd the weakest pose of the hydraulic limit
+    double* stab_pose;                ///< n x nsec x nd the weakest pose of the stability limit (slew: stab_q[.][2])
+    int* npose;                       ///< [n] the poses of the search within one step of R[i]
+    long nsearch;                     ///< poses searched (within the joint limits and strokes)
 } loadchart;
 
 /// Compute the chart. Returns 0, or -1 with one line in err (an outreach
@@ -121,12 +137,37 @@ double loadchart_envelope(const loadchart* c, double R, double slew);
 /// depend on the slew); stability: the weakest pose and slew angle; rated:
 /// the weakest pose of the raw envelope there.
 void loadchart_point_pose(const loadchart* c, int i, int s, double q[3]);
+/// What governs, by name: lc_gov_name, a chain's actuator by its name.
+const char* loadchart_gov_name(const loadchart* c, int gov);
+/// A crane chain's governing pose of point i, sector s: q[nd] every boom
+/// joint coordinate [rad or m], *slew [rad]; as loadchart_point_pose picks it.
+void loadchart_point_pose_chain(const loadchart* c, int i, int s, double* q, double* slew);
+
 /// The model's rated capacity [kg] at R [m] (payload: the hook subtracted);
 /// INFINITY when the model gives no rating.
 double loadchart_rating(const loadchart* c, double R);
 
 /// Port relief cracking setting [Pa] of each chamber (A, B) of actuator k.
 int loadchart_reliefs(const model* m, int k, double p[2]);
+/// The same for the circuit's cylinder cyl (its index in h).
+int loadchart_cylinder_reliefs(const struct hyd_model* h, int cyl, double p[2]);
+
+// The chart's two files share (loadchart.c, loadchart_chain.c: a crane
+// chain's chart):
+/// A crane chain's outreach over every pose of the chart's search [m]; NaN
+/// both where the chain cannot be searched (loadchart_compute says why).
+void lc_chain_reach(const model* m, double* rmin, double* rmax);
+/// loadchart_compute for a crane chain (docs/safety.md "On a crane chain").
+int lc_chain_compute(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz);
+/// Sizes c for o's points and sectors (t's truck), the sectors' bounds and
+/// the rating; 0, or -1 with err (c freed).
+int lc_chart_alloc(const model* m, const lc_truck* t, const lc_opts* o, loadchart* c, char* err, size_t errsz);
+/// The printed chart from hyd, stab and rating: env, cap, chart, gov, imin.
+void lc_chart_print(loadchart* c);
+/// Mass moment [kg m] about support edge `edge` (0 front, 1 rear, 2 left,
+/// 3 right) of a mass at horizontal distance rho [m] from the slew axis
+/// along slew angle s [rad]: mass times its distance inside the polygon.
+double lc_edge_moment(const lc_truck* t, int edge, double rho, double s, double mass);
 
 #ifdef __cplusplus
 }

@@ -30,6 +30,7 @@ extern "C" {
 /// pressure-based limiter cannot tell from load.
 #define RCL_STOP_BAND 0.01
 
+struct lc_chain;
 typedef struct rcl {
     const model* m;
     loadchart chart;
@@ -51,12 +52,33 @@ typedef struct rcl {
                        ///< its pressures were not used, the load estimate held
     bool warn;         ///< util >= RCL_WARN
     bool stopped;      ///< the last filter cut a command
+    // A crane chain (docs/safety.md "On a crane chain"): its statics
+    // (lc_chain.h) and where its columns are in the rows (rcl_set_chain_row).
+    bool chain;
+    struct lc_chain* g;
+    int row_base;      ///< the chain's first column in a row (-1: not set: utilisation 0)
+    int* col_q;        ///< [nd] q_<body> of each boom DOF (row index)
+    int* col_qd;       ///< [nd] qd_<body>
+    int col_pA, col_pB;///< the lift actuator's pA_, pB_
+    double* q;         ///< [nd] scratch
+    double* gain;      ///< [chain functions] outreach per metre of the function's stroke at the last row [m/m]
 } rcl;
 
 /// Build the limiter for model m on world wd (NULL or validation: the
 /// hydraulic limit only), with the default chart options over the crane's
-/// whole reach. Returns 0, or -1 with one line in err.
+/// whole reach. Returns 0, or -1 with one line in err. A crane chain: the
+/// chain's chart (loadchart.h) and statics, refused in one line where
+/// rcl_check_model refuses it; its rows' layout comes from rcl_set_chain_row.
 int rcl_init(rcl* r, const model* m, const world_desc* wd, char* err, size_t errsz);
+/// The allow-list of a crane chain's limiter, without its chart (fast): 0,
+/// or -1 with one line in err (the two-link crane: always 0).
+int rcl_check_model(const model* m, char* err, size_t errsz);
+/// A crane chain's rows carry the columns of chain cols (crane_chain_columns;
+/// NULL: the model's chain; a slewing run's own chain has the slew rack's
+/// besides) from index base on (the engine's nchannel): where the limiter
+/// reads the boom joints, their rates and the lift cylinder's pressures. 0,
+/// or -1 when a column is missing (the limiter then reads 0).
+int rcl_set_chain_row(rcl* r, const crane_chain* cols, int base);
 /// As rcl_init, for the world file of an ode run (NULL: no world, lagrange).
 int rcl_init_world(rcl* r, const model* m, const char* world_path, char* err, size_t errsz);
 void rcl_free(rcl* r);
@@ -91,6 +113,17 @@ double rcl_utilisation(rcl* r, const double* row);
 /// [-1, 1]; positive extends the lift and jib cylinders and increases the
 /// slew angle) into u_out, from the state in row. Returns the utilisation.
 double rcl_filter(rcl* r, const double* row, const double u_in[3], double u_out[3]);
+
+/// A crane chain's command filter: n commands u_in by function (the
+/// chain's functions in order, then possibly more: islew, if >= 0, is the
+/// slew's) into u_out. A function whose stroke carries the tip outwards at
+/// this pose (its cylinders' dR/ds summed, from the chain's Jacobian and
+/// lever arms) is slowed and stopped as rcl_filter's; the slew as there;
+/// anything else passes. Returns the utilisation.
+double rcl_filter_fn(rcl* r, const double* row, int n, const double* u_in, double* u_out, int islew);
+/// The outreach gained per metre of stroke of chain function f at the
+/// row's pose [m/m] (0 below 1 mm per metre): what rcl_filter_fn cuts on.
+double rcl_function_gain(rcl* r, const double* row, int f);
 
 #ifdef __cplusplus
 }
