@@ -99,7 +99,7 @@ static void drive_each_function(drive_session* s, double* wall, int nwant) {
         CHECK(run_for(s, wall, 0.05) == 0, "loop: %s", drive_session_error(s));
         for (int j = 0; j < n; ++j)
             CHECK(fabs(engine_function_command(e, j) - (j == k ? 1.0 : 0.0)) < 1e-4,
-                  "%s moved: %s = %g", m->axis[k].name, engine_function_name(e, j),
+                  "%s on: %s = %g", m->axis[k].name, engine_function_name(e, j),
                   engine_function_command(e, j));
         set_input(js, &m->axis[k], false);
         CHECK(run_for(s, wall, 0.05) == 0, "loop: %s", drive_session_error(s));
