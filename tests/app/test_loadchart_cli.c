@@ -7,7 +7,10 @@
 #include "check.h"
 #include "cli_util.h"
 
+#include <cJSON.h>
 #include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -194,6 +197,43 @@ static void test_chart_plot_lines_visible(void) {
 // each pose within its joint's limits; the chart never rising from its
 // minimum outreach. What the search cannot read is refused in one line.
 #define WDATA CRANESIM_TESTDATA "/../../world/data"
+
+// lo, hi: the limits of the CSV's four pose columns (lifting_arm,
+// knuckle_arm deg; ext1, ext2 m) from the model file's bodies, by name and
+// joint kind. false (a failed check) when the file does not give them.
+static bool chain_limits(const char* path, double lo[4], double hi[4]) {
+    static char text[1 << 16];
+    FILE* fp = fopen(path, "rb");
+    CHECK(fp != NULL, "cannot open %s", path);
+    if (!fp) return false;
+    const size_t n = fread(text, 1, sizeof text - 1, fp);
+    fclose(fp);
+    text[n] = '\0';
+    cJSON* root = cJSON_Parse(text);
+    CHECK(root != NULL, "%s: not JSON", path);
+    const cJSON* bodies =
+        cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(root, "mechanics"), "bodies");
+    static const char* const names[4] = {"lifting_arm", "knuckle_arm", "ext1", "ext2"};
+    int found = 0;
+    const cJSON* b;
+    cJSON_ArrayForEach(b, bodies) {
+        const cJSON* name = cJSON_GetObjectItemCaseSensitive(b, "name");
+        const cJSON* lim = cJSON_GetObjectItemCaseSensitive(b, "limits");
+        const cJSON* joint = cJSON_GetObjectItemCaseSensitive(b, "joint");
+        for (int d = 0; d < 4; ++d)
+            if (cJSON_IsString(name) && !strcmp(name->valuestring, names[d]) && cJSON_GetArraySize(lim) == 2) {
+                // Revolute limits in rad, the CSV's angles in deg; prismatic in m both.
+                const double k =
+                    cJSON_IsString(joint) && !strcmp(joint->valuestring, "prismatic") ? 1.0 : 180 / M_PI;
+                lo[d] = cJSON_GetArrayItem(lim, 0)->valuedouble * k;
+                hi[d] = cJSON_GetArrayItem(lim, 1)->valuedouble * k;
+                found |= 1 << d;
+            }
+    }
+    cJSON_Delete(root);
+    CHECK(found == 15, "%s: limits of lifting_arm, knuckle_arm, ext1, ext2 (found mask %d)", path, found);
+    return found == 15;
+}
 static void test_chain_csv(void) {
     const int rc = cli_run("loadchart --model loader10 --world validation --outreach 1:7:7 --out lc_chain.csv --quiet",
                            out, sizeof out);
@@ -206,8 +246,11 @@ static void test_chain_csv(void) {
         "ext1_s0_m,ext2_s0_m,slew_s0_deg\n";
     CHECK(strncmp(csv, k_head, sizeof k_head - 1) == 0, "header: %.400s", csv);
     CHECK(cli_count_lines(csv) == 8, "%d lines, expected 8", cli_count_lines(csv));
-    // The joints' limits (loader10.json), deg and m.
-    const double lo[4] = {1.23 * 180 / M_PI, -2.2 * 180 / M_PI, 0, 0}, hi[4] = {2.78 * 180 / M_PI, -0.45 * 180 / M_PI, 1.3, 1.3};
+    // The joints' limits as the model file gives them (mechanics.bodies[].limits,
+    // rad or m), in the CSV's units (deg or m): the model changes (the jib's
+    // linkage moved the knuckle's range) and the test follows it.
+    double lo[4], hi[4];
+    if (!chain_limits(CRANESIM_ASSETS "/models/loader10.json", lo, hi)) return;
     double prev = INFINITY;
     char* line = strchr(csv, '\n');
     int nrow = 0;

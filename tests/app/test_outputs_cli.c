@@ -150,14 +150,17 @@ static void test_run_summary(void) {
 // An end stop: hits counted per actuator, as entries (x < 0 or x > stroke).
 // The 3-boom crane with the ext function held fully out for 2.8 s runs ext
 // (from mid-stroke, 0.5 m to go at about 0.5 m/s) into its stop once, and no
-// other actuator into its.
+// other actuator into its. The model's ext cylinder (stroke 1.01 m) reaches
+// the ext joint's limit (1.0 m, at x = 1.005 m) first, where the joint's stop
+// holds it as ODE's does; with the stroke set to 1.0 m the cylinder's own end
+// comes first.
 static void test_end_stop(void) {
     static const char scen[] =
         "{\"name\": \"ext_to_stop\", \"duration\": 3.0, \"initial\": {\"q1_deg\": 100, \"q2_deg\": -110},\n"
         " \"commands\": {\"ext\": [[0, 0], [0.2, 1.0], [3.0, 1.0]]}}\n";
     CHECK(cli_write_file("outputs_stop.json", scen) == 0, "cannot write the scenario");
     int rc = cli_run("run --model " MODEL3 " --scenario outputs_stop.json --out outputs_stop.csv"
-                     " --metrics outputs_stop_m.json -q",
+                     " --set hydraulics.components.ext_cyl.stroke=1.0 --metrics outputs_stop_m.json -q",
                      out, sizeof out);
     CHECK(rc == 0, "run exit %d: %s", rc, out);
     colstat x;

@@ -5,7 +5,8 @@
 //   relief settings themselves) in the pose the chart names for it, every
 //   joint coordinate and stroke: 90 % of it holds (no chamber at its relief,
 //   the booms still within 1 mm of stroke), 110 % puts the governing
-//   cylinder's load side at its relief and the booms give way;
+//   function's load side at its relief (either extension stage: they share
+//   one valve section) and the booms give way;
 // - the printed chart (margin 10 %, the rating) at the same outreaches with
 //   the limiter on: at the charted load the limiter reads it (utilisation
 //   1 within 3 %) and lets the motions that bring the tip in through; 10 %
@@ -65,6 +66,7 @@ typedef struct hold {
     double dx;    ///< largest stroke change of any actuator over the run [m]
     double p_rel; ///< largest chamber pressure over its relief setting [-]
     int k_rel;    ///< that actuator
+    double peak[8]; ///< each actuator's largest chamber pressure over its relief [-]
 } hold;
 
 // 2 s with no command: the strokes' largest change and the chambers' peak
@@ -95,6 +97,7 @@ static int run_hold(engine* e, const model* m, hold* h, char* err, size_t n) {
             for (int c = 0; c < 2; ++c) {
                 const double p = row[base + crane_chain_find_column(cc, c ? "pB" : "pA", a)] / rel[k][c];
                 if (p > h->p_rel) h->p_rel = p, h->k_rel = k;
+                if (p > h->peak[k]) h->peak[k] = p;
             }
         }
     }
@@ -146,9 +149,28 @@ static void test_hydraulic_limit_by_simulation(void) {
                    c.R[i], gov, q[0] * 180 / M_PI, q[1] * 180 / M_PI, q[2], q[3], m3, over ? "+10 %" : "-10 %", h.dx,
                    h.p_rel, mm->chain.act[h.k_rel].name);
             if (over) {
-                CHECK(h.p_rel >= 0.99 && h.k_rel == c.hyd_cyl[i], "%.2f m, +10 %%: the governing %s at its relief "
-                                                                  "(peak %.3f on %s)",
-                      c.R[i], gov, h.p_rel, mm->chain.act[h.k_rel].name);
+                // The governing *function* at its relief: one of its
+                // cylinders, not necessarily the one the chart names. The
+                // chart holds each stage on its own joint; in the circuit
+                // loader10's two extension stages hang on one valve section
+                // (their chambers on the same lines: both peak at the same
+                // fraction of the relief to 3 digits, printed below), so the
+                // relief caps both at once, and which stage breaks away from
+                // its seal friction and reads the highest peak is decided by
+                // rounding (it changed with the fast circuit kernel's
+                // rounding). A function other than the governing one at its
+                // relief, or the function below it, still fails.
+                const crane_chain* mc = &mm->chain;
+                const int gf = mc->act[c.hyd_cyl[i]].function;
+                double pf = 0;
+                for (int k = 0; k < mc->nact; ++k)
+                    if (mc->act[k].function == gf) pf = fmax(pf, h.peak[k]);
+                CHECK(pf >= 0.99 && mc->act[h.k_rel].function == gf,
+                      "%.2f m, +10 %%: the governing %s's function %s at its relief (its cylinders' peak %.3f; "
+                      "the peak %.3f on %s)",
+                      c.R[i], gov, mc->fn[gf].name, pf, h.p_rel, mc->act[h.k_rel].name);
+                for (int k = 0; k < mc->nact; ++k)
+                    if (mc->act[k].function == gf) printf("  %s: peak %.3f of its relief\n", mc->act[k].name, h.peak[k]);
                 // The seals' breakaway force (4.5 kN, 8 % of an extension
                 // cylinder's force at its relief) holds most of the 10 %:
                 // the booms creep, three times as far as under the chart.

@@ -51,11 +51,13 @@ static double tip_R(chain* ch, chain_ws* w, const crane_chain* cc, const double*
     return p[0] - cc->body[0].def.origin[0];
 }
 
-// Pin length of actuator k at pose q [m].
+// Pin length of actuator k at pose q [m], through crane_act_length: a
+// linkage's (loader10's jib) is its barrel pin to the loop's common pin, which
+// a pin pair (chain_cylinder with pb) does not give (pb is unused, 0, for a
+// linkage: that is the knuckle's joint, which does not move with the knuckle).
 static double pin_L(chain* ch, chain_ws* w, const crane_chain* cc, int k, const double* q) {
     chain_update(ch, w, q, NULL);
-    const crane_act* a = &cc->act[k];
-    return chain_cylinder(ch, w, a->body_a, a->pa, a->body_b, a->pb, NULL, NULL, NULL);
+    return crane_act_length(&cc->act[k], ch, w, NULL, NULL, NULL);
 }
 
 // Solves A x = b (n x n, row-major) by Gaussian elimination with pivoting; 0 or -1.
@@ -124,21 +126,33 @@ static void test_gain_against_central_differences(void) {
     const int nd = chain_ndof(ch);
     CHECK(nd == 4, "loader10 has 4 boom joints, got %d", nd);
     double* row = calloc((size_t)(base + cc->ncol) + 1, sizeof *row);
-    const double lift[3] = {80 * DEG, 110 * DEG, 150 * DEG}, knuckle[4] = {-120 * DEG, -90 * DEG, -50 * DEG, -28 * DEG},
-                 ext[3] = {0.05, 0.65, 1.25};
-    int n = 0, nout = 0, nin = 0, fext = crane_chain_find_function(cc, "ext");
+    // The poses at fractions of each joint's limits as the model gives them
+    // (a linkage's loop closes only within its knuckle's range): the lift
+    // low, middle, high; the knuckle folded back past the vertical to
+    // pointing out; the extensions in, half, out.
+    double lim[4][2];
+    for (int j = 0; j < nd; ++j) {
+        const chain_body_def* d = &cc->body[chain_dof_body(ch, j)].def;
+        CHECK(isfinite(d->q_min) && isfinite(d->q_max) && d->q_min < d->q_max, "DOF %d (%s) has limits", j,
+              d->name);
+        lim[j][0] = d->q_min, lim[j][1] = d->q_max;
+    }
+    const double flift[3] = {0.1, 0.45, 0.9}, fknuckle[4] = {0.1, 0.35, 0.65, 0.9}, fext_[3] = {0.04, 0.5, 0.96};
+#define AT(j, f) (lim[j][0] + (f) * (lim[j][1] - lim[j][0]))
+    int n = 0, nout = 0, nin = 0, nposes = 0, fext = crane_chain_find_function(cc, "ext");
     double worst = 0;
     for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 4; ++b)
             for (int c = 0; c < 3; ++c) {
-                const double q[4] = {lift[a], knuckle[b], ext[c], ext[c]};
+                const double q[4] = {AT(0, flift[a]), AT(1, fknuckle[b]), AT(2, fext_[c]), AT(3, fext_[c])};
                 // A pose of the crane: every stroke within its range.
                 bool ok = true;
                 for (int k = 0; k < cc->nact; ++k) {
                     const double x = pin_L(ch, w, cc, k, q) - cc->act[k].closed_length;
-                    ok = ok && x >= 0 && x <= cc->act[k].stroke;
+                    ok = ok && isfinite(x) && x >= 0 && x <= cc->act[k].stroke;
                 }
                 if (!ok) continue;
+                ++nposes;
                 for (int j = 0; j < nd; ++j)
                     row[base + crane_chain_find_column(cc, "q", cc->body[chain_dof_body(ch, j)].def.name)] = q[j];
                 for (int f = 0; f < cc->nfn; ++f) {
@@ -154,11 +168,15 @@ static void test_gain_against_central_differences(void) {
             }
     // Both signs met: with the knuckle pointing out the extension carries the
     // tip out; folded back past the vertical it brings it in.
+#undef AT
     CHECK(nout > 0 && nin > 0, "the extension's gain of both signs over the poses (%d out, %d in)", nout, nin);
+    // Most of the 36 poses are the crane's (strokes within range): a check
+    // that skipped them all would not be one.
+    CHECK(nposes >= 18, "%d of 36 sampled poses within every stroke", nposes);
     CHECK(worst < 1e-4, "largest relative difference %.3g", worst);
-    printf("gain: %d function-poses, largest relative difference to central differences %.2g; extension "
+    printf("gain: %d poses, %d function-poses, largest relative difference to central differences %.2g; extension "
            "outwards at %d poses, inwards at %d\n",
-           n, worst, nout, nin);
+           nposes, n, worst, nout, nin);
     free(row);
     chain_ws_free(w);
     chain_free(ch);

@@ -211,7 +211,7 @@ void lc_chain_mass_moment(const lc_chain* g, double* S1, double* M) {
 // The search's grid over every boom joint, ends included (the weakest
 // poses sit at the ends of a stroke: docs/safety.md): an angle in steps of
 // at most 2.5 deg, a slide in steps of at most 0.1 m. loader10 (lift 89
-// deg, knuckle 100 deg, two 1.3 m extensions): 37 x 41 x 14 x 14 = 297k
+// deg, knuckle 138 deg, two 1.3 m extensions): 37 x 57 x 14 x 14 = 413k
 // poses, about 1 s (the limiter makes its chart once per engine). What a
 // finer grid changes is in docs/safety.md.
 #define LCC_STEP_REV (2.5 * M_PI / 180)
