@@ -513,9 +513,9 @@ static engine* make_engine(drive_session* s, const double q0[2], double slew0) {
     // sized by it: an engine with a picture (the two-link crane, a crane
     // chain in the sandbox). Without one (a chain in the validation world or
     // the lagrange view) it is refused here, before the window opens (drive
-    // --headless runs it). A session file carries the two-link crane's three
-    // commands: replaying one needs that crane.
-    const unsigned need = ENGINE_CAP_SNAPSHOT | (s->rp || s->o.session_path ? ENGINE_CAP_TWO_LINK : 0u);
+    // --headless runs it). Session files carry one command per function
+    // (session.h, format 2), so recording and replaying need no more.
+    const unsigned need = ENGINE_CAP_SNAPSHOT;
     if (engine_require(s->m, &s->c.sim, need, "the window (--headless runs a crane chain)", s->err, sizeof s->err))
         return NULL;
     engine* l = engine_create(s->m, &s->c.sim, q0, slew0, m3, err, sizeof err);
@@ -1944,7 +1944,8 @@ int drive_session_tick(drive_session* s, double wall) {
         // operator's input drives every function by the mapping (input.h).
         const bool by_function = !(engine_caps(s->l) & ENGINE_CAP_TWO_LINK);
         if (s->o.scripted && by_function) {
-            engine_play_functions(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, s->ufn, NULL, NULL);
+            engine_play_functions(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, s->ufn,
+                                  s->sw.f ? session_hook : NULL, s);
         } else if (s->o.scripted) {
             engine_play(s->l, &s->sc, s->t_base + t + 0.5 * dt_wall, &s->ev, u, s->sw.f ? session_hook : NULL, s);
         } else if (cmd.hook_toggle) {
@@ -1979,7 +1980,7 @@ int drive_session_tick(drive_session* s, double wall) {
         if (s->sw.f) {
             // The tick, and the row the record keeps after it (one per
             // simulated instant, as record_row; `segment` 0).
-            double r[SIM_NCOL + 1];
+            double* r = s->row; // ncol + 1 columns (size_buffers): a chain's row is longer than SIM_NCOL
             session_row(s, r);
             const bool keep = !adv && (s->sw.rows == 0 || r[COL_T] > s->sw.t_last);
             if (keep) s->sw.t_last = r[COL_T];

@@ -1,7 +1,9 @@
 // test_replay_window.c: a session recorded by the drive window (offscreen GL,
 // an SDL virtual joystick, the keyboard, a virtual clock) replays bit for bit:
 // `cranesim replay` writes the window's record byte for byte, and
-// `drive --replay` in the window records it again byte for byte.
+// `drive --replay` in the window records it again byte for byte. The same for
+// a crane chain of six functions (chain_6fn_controls.json) driven by function
+// on the pad (its session carries one command per function).
 #include "app.h"
 #include "check.h"
 #include "drive_session.h"
@@ -42,8 +44,13 @@ static void push_key(SDL_Scancode sc, int down) {
     SDL_PushEvent(&ev);
 }
 
+#define MODEL6 CRANESIM_ASSETS "/../tests/world/data/chain_6fn_controls.json"
+
+static const char* g_model; // NULL: the default crane
+
 static drive_session* open_window(const char* record, const char* session_path, const char* replay) {
     app_common c = {.sim = sim_default_opts()};
+    c.model_path = g_model;
     c.sim.mechanics = SIM_ODE; // the sandbox: truck, slew, hook, loads
     c.sim.world = "sandbox";
     c.scenario_path = CRANESIM_ASSETS "/scenarios/sandbox_pick_place.json"; // the start pose
@@ -96,6 +103,49 @@ static void record_in_the_window(void) {
     drive_session_destroy(s); // closes the session file
 }
 
+// The chain: the pad's sticks and d-pad (the six-function model's controls:
+// lift, jib, slew, ext, ext2 among them) moved in turn, so the session's
+// commands vary on several functions, then the hook key.
+static void record_chain_in_the_window(void) {
+    drive_session* s = open_window("rw_rec.csv", "rw.session", NULL);
+    if (!s) return;
+    double wall = 0;
+    SDL_VirtualJoystickDesc d;
+    memset(&d, 0, sizeof d);
+    d.version = SDL_VIRTUAL_JOYSTICK_DESC_VERSION;
+    d.type = SDL_JOYSTICK_TYPE_GAMECONTROLLER;
+    d.naxes = 6;
+    d.nbuttons = 15;
+    d.name = "cranesim replay stick";
+    int idx = SDL_JoystickAttachVirtualEx(&d);
+    CHECK(idx >= 0, "attach virtual joystick: %s", SDL_GetError());
+    SDL_Joystick* js = SDL_JoystickOpen(idx);
+    run_for(s, &wall, 0.2);
+    static const int axes[] = {SDL_CONTROLLER_AXIS_LEFTY, SDL_CONTROLLER_AXIS_RIGHTY, SDL_CONTROLLER_AXIS_LEFTX,
+                               SDL_CONTROLLER_AXIS_RIGHTX, SDL_CONTROLLER_AXIS_TRIGGERRIGHT};
+    for (size_t k = 0; k < sizeof axes / sizeof axes[0]; ++k) {
+        SDL_JoystickSetVirtualAxis(js, axes[k], k & 1 ? 24000 : -28000);
+        CHECK(run_for(s, &wall, 0.3) == 0, "loop: %s", drive_session_error(s));
+        SDL_JoystickSetVirtualAxis(js, axes[k], 0);
+    }
+    SDL_JoystickSetVirtualButton(js, SDL_CONTROLLER_BUTTON_DPAD_UP, 1);
+    CHECK(run_for(s, &wall, 0.3) == 0, "loop: %s", drive_session_error(s));
+    SDL_JoystickSetVirtualButton(js, SDL_CONTROLLER_BUTTON_DPAD_UP, 0);
+    SDL_JoystickClose(js);
+    SDL_JoystickDetachVirtual(idx);
+    push_key(SDL_SCANCODE_H, 1);
+    run_for(s, &wall, 0.05);
+    push_key(SDL_SCANCODE_H, 0);
+    CHECK(run_for(s, &wall, 0.3) == 0, "loop: %s", drive_session_error(s));
+    long rows = 0;
+    char err[400];
+    CHECK(drive_session_finish_record(s, &rows, err, sizeof err) == 0 && rows > 100, "record: %ld rows %s", rows, err);
+    drive_session_destroy(s);
+    // The session names the six functions and its ticks move more than one.
+    long n = read_file("rw.session", a, sizeof a);
+    CHECK(n > 0 && strstr(a, "\"functions\":[") && strstr(a, "\"ext2\""), "session header: %.300s", a);
+}
+
 static void replay_headless(void) {
     unlink("rw_rep.csv");
     char* argv[] = {"rw.session", "--quiet", "--out", "rw_rep.csv", NULL};
@@ -138,6 +188,10 @@ int main(void) {
     setenv("SDL_AUDIODRIVER", "dummy", 0);
     app_name_params();
     record_in_the_window();
+    replay_headless();
+    replay_in_the_window();
+    g_model = MODEL6;
+    record_chain_in_the_window();
     replay_headless();
     replay_in_the_window();
     TEST_MAIN_END();
