@@ -55,6 +55,7 @@ typedef struct rlink {
     bool scripted;
     double u_sent[PROTO_MAX_FN]; // the openings last sent, per function (the operator's demand, for the HUD)
     bool same_model;         // the local model is the server's file: its "controls" map the sticks
+    bool bad_mapping;        // the last hello's functions refused the input mapping (bad input: exit 2)
     bool have_sent;
     char* hjson;             // the first hello's description (a copy)
     struct { uint64_t seq; char path[128]; double v; } pend[16]; // SETs sent, no answer yet
@@ -330,7 +331,8 @@ static int lk_hello(rlink* k, drive_session* s, const proto_msg* m, char* err, s
     {
         const char* names[PROTO_MAX_FN];
         for (int f = 0; f < k->fns.n; ++f) names[f] = k->fns.name[f];
-        if (drive_session_remote_functions(s, names, k->fns.n, k->same_model, err, errsz)) return -1;
+        k->bad_mapping = drive_session_remote_functions(s, names, k->fns.n, k->same_model, err, errsz) != 0;
+        if (k->bad_mapping) return -1;
     }
     const world_snapshot* pic = drive_session_snapshot(s);
     for (int i = 0; i < WORLD_SNAP_MAX_CYLINDERS; ++i) {
@@ -578,8 +580,9 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     drive_session_set_remote(s);
     k.sets = (const char* const*)c0->sets;
     k.nset = c0->nset;
-    if (lk_hello(&k, s, &m, err, sizeof err)) { // nbody checked above: a hello without functions
+    if (lk_hello(&k, s, &m, err, sizeof err)) { // nbody checked above: a hello without functions, a bad --mapping
         fprintf(stderr, "cranesim drive: %s\n", err);
+        if (k.bad_mapping) code = EXIT_USAGE;
         goto done_sc;
     }
     cJSON_Delete(desc);
