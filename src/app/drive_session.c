@@ -2077,7 +2077,9 @@ int drive_session_tick(drive_session* s, double wall) {
         memcpy(s->chan_v, row, sizeof *row * (size_t)chan_list_nrow(s->chans));
         if (s->chart_circuit) chan_list_values(s->chans, s->l, s->chan_v, true);
     }
-    if (s->rec) record_row(s, row);
+    // A remote view records the server's states only: before the first one
+    // its row is all zeros (no crane has 0 Pa in a chamber at t = 0).
+    if (s->rec && (!s->remote || s->remote_fed)) record_row(s, row);
     if (frame) {
         char status[640];
         // Who drives: the scenario, a named device, or the keyboard alone.
