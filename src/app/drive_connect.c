@@ -98,8 +98,11 @@ int dc_hello_functions(const char* json, size_t len, dc_functions* f, char* err,
             f->cyl[k] = cJSON_IsNumber(ci) && ci->valuedouble >= 0 && ci->valuedouble < nc ? ci->valueint : -1;
         }
         for (int i = 0; i < nc && !rc; ++i) {
-            const char* name = cJSON_GetStringValue(cJSON_GetObjectItem(cJSON_GetArrayItem(ca, i), "name"));
+            const cJSON* co = cJSON_GetArrayItem(ca, i);
+            const char* name = cJSON_GetStringValue(cJSON_GetObjectItem(co, "name"));
             snprintf(f->cyl_name[i], DC_FN_NAME, "%s", name ? name : "");
+            const cJSON* fi = cJSON_GetObjectItem(co, "function");
+            f->cyl_fn[i] = cJSON_IsNumber(fi) && fi->valuedouble >= 0 && fi->valuedouble < n ? fi->valueint : -1;
         }
         f->n = rc ? 0 : n;
         f->ncyl = rc ? 0 : nc;

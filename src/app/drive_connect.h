@@ -17,6 +17,7 @@ typedef struct dc_functions {
     int cyl[PROTO_MAX_FN];                // the first cylinder record each drives, -1 none
     int ncyl;                             // the hello's cylinder records
     char cyl_name[PROTO_MAX_CYL][DC_FN_NAME];
+    int cyl_fn[PROTO_MAX_CYL];            // the function each cylinder record belongs to, -1 none
 } dc_functions;
 
 /// The hello's "functions" (and "cylinders") into f. 0, or -1 with one line

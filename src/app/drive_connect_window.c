@@ -53,7 +53,9 @@ typedef struct rlink {
     int ev;                  // the scripted operator's next hook event
     const scenario* sc;
     bool scripted;
-    double u_sent[3];        // the valve commands last sent (the operator's demand, for the HUD)
+    double u_sent[PROTO_MAX_FN]; // the openings last sent, per function (the operator's demand, for the HUD)
+    bool same_model;         // the local model is the server's file: its "controls" map the sticks
+    bool bad_mapping;        // the last hello's functions refused the input mapping (bad input: exit 2)
     bool have_sent;
     char* hjson;             // the first hello's description (a copy)
     struct { uint64_t seq; char path[128]; double v; } pend[16]; // SETs sent, no answer yet
@@ -194,7 +196,15 @@ static void lk_feed(rlink* k, drive_session* s) {
             if (st->relief[q].cyl >= 0 && k->cmap[i] == st->relief[q].cyl) loc = i;
         v->relief[q].cyl = (int8_t)loc;
     }
-    drive_session_feed(s, v, k->rt, k->role == PROTO_CONTROL && k->have_sent ? k->u_sent : NULL);
+    // The demand of each picture cylinder: the opening last sent to the
+    // function its record belongs to (NaN: none).
+    double demand[WORLD_SNAP_MAX_CYLINDERS];
+    for (int i = 0; i < WORLD_SNAP_MAX_CYLINDERS; ++i) {
+        const int r = i < v->ncyl ? k->cmap[i] : -1;
+        const int f = r >= 0 && r < k->fns.ncyl ? k->fns.cyl_fn[r] : -1;
+        demand[i] = f >= 0 && f < k->fns.n ? k->u_sent[f] : NAN;
+    }
+    drive_session_feed(s, v, k->rt, k->role == PROTO_CONTROL && k->have_sent ? demand : NULL);
 }
 
 // A state frame arrived: draw it, count it, and answer it with the operator's commands.
@@ -258,18 +268,26 @@ static void lk_state(rlink* k, drive_session* s) {
     if (in.pause == 1)
         lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_PAUSE, .flag = !(st->flags & PROTO_F_PAUSED)});
     if (in.hook >= 0) lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_HOOK, .flag = (uint8_t)in.hook});
-    // One opening per server function, by name: lift, jib, slew from the
-    // session's sticks (or the script's columns of those names and its
-    // own named ones); a function the input does not give stays at 0.
+    // One opening per server function, by name: the operator's command of
+    // that function (the session's mapping is built from the hello's list:
+    // drive_session_remote_functions), or the script's column of that name;
+    // a function neither gives stays at 0.
     proto_command c = {.op = PROTO_OP_VALVES, .nu = (uint8_t)k->fns.n};
     double u3[3];
     if (k->scripted) scenario_play(k->sc, st->nine[8] + 0.5 / k->rate, &k->ev, u3, scripted_hook, k);
-    else memcpy(u3, in.u, sizeof u3);
     for (int j = 0; j < k->fns.n; ++j) {
-        const int col = k->fcol[j];
         double v = 0;
-        if (col >= 0 && col < 3) v = u3[col];
-        else if (col >= 0 && k->scripted) v = scenario_command(k->sc, col, st->nine[8] + 0.5 / k->rate);
+        if (k->scripted) {
+            const int col = k->fcol[j];
+            if (col >= 0 && col < 3) v = u3[col];
+            else if (col >= 0) v = scenario_command(k->sc, col, st->nine[8] + 0.5 / k->rate);
+        } else {
+            for (int i = 0; i < in.n; ++i)
+                if (!strcmp(in.name[i], k->fns.name[j])) {
+                    v = in.u[i];
+                    break;
+                }
+        }
         c.u[j] = fmax(-1, fmin(1, isfinite(v) ? v : 0));
     }
     // One command in flight in real time (its echo times the link); in
@@ -278,9 +296,9 @@ static void lk_state(rlink* k, drive_session* s) {
         c.seq = ++k->seq;
         if (k->sent_at == 0) k->sent_at = now;
         lk_send(k, &c);
-        // The demand the server's limiter acts on, as lift, jib, slew (the
-        // HUD's first three cylinders; the limiter is the two-link crane's).
-        for (int j = 0; j < 3; ++j) k->u_sent[j] = fmax(-1, fmin(1, isfinite(u3[j]) ? u3[j] : 0));
+        // The demand the server's limiter acts on, per function (the HUD
+        // shows it beside a command the limiter cut: lk_feed).
+        memcpy(k->u_sent, c.u, (size_t)k->fns.n * sizeof c.u[0]);
         k->have_sent = true;
     }
     if (k->lockstep) lk_send(k, &(proto_command){.seq = ++k->seq, .op = PROTO_OP_STEP, .frames = 1});
@@ -308,6 +326,14 @@ static int lk_hello(rlink* k, drive_session* s, const proto_msg* m, char* err, s
     // The functions VALVES carries, and the picture's cylinders by name.
     if (dc_hello_functions(m->u.shello.json, m->u.shello.json_len, &k->fns, err, errsz)) return -1;
     for (int f = 0; f < k->fns.n; ++f) k->fcol[f] = k->sc ? scenario_find_command(k->sc, k->fns.name[f]) : -1;
+    // The sticks and keys map to the server's functions by name (a chain's
+    // ext, ext2, rotator... as well as lift, jib, slew).
+    {
+        const char* names[PROTO_MAX_FN];
+        for (int f = 0; f < k->fns.n; ++f) names[f] = k->fns.name[f];
+        k->bad_mapping = drive_session_remote_functions(s, names, k->fns.n, k->same_model, err, errsz) != 0;
+        if (k->bad_mapping) return -1;
+    }
     const world_snapshot* pic = drive_session_snapshot(s);
     for (int i = 0; i < WORLD_SNAP_MAX_CYLINDERS; ++i) {
         k->cmap[i] = -1;
@@ -489,14 +515,20 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     const char* asset = cJSON_GetStringValue(cJSON_GetObjectItem(desc, "model_asset"));
     char asset_buf[1024];
     snprintf(asset_buf, sizeof asset_buf, "%s/%s", model_assets_dir(), asset ? asset : "");
+    // k.same_model: the local model is the server's file, so its "controls"
+    // section maps the sticks to the server's functions as a local drive would.
+    k.same_model = true;
     if (file_exists(model_file)) c.model_path = model_file;
     else if (asset && asset[0] && file_exists(asset_buf)) { // the same file in this install's assets
         snprintf(model_buf, sizeof model_buf, "%s", asset_buf);
         c.model_path = model_buf;
     } else if (!strcmp(model_file, base) || !strcmp(model_file, dflt)) c.model_path = NULL; // the shipped model, by name
-    else if (model_file && model_file[0])
-        printf("cranesim drive: the server's model %s is not here: drawing %s\n", model_file,
-               c.model_path ? c.model_path : "the default model");
+    else {
+        k.same_model = false;
+        if (model_file && model_file[0])
+            printf("cranesim drive: the server's model %s is not here: drawing %s\n", model_file,
+                   c.model_path ? c.model_path : "the default model");
+    }
     if (be->world) {
         if (file_exists(world_file)) c.sim.world = world_file;
         else {
@@ -548,8 +580,9 @@ int drive_connect_window(const app_common* c0, const drive_opts* o, const char* 
     drive_session_set_remote(s);
     k.sets = (const char* const*)c0->sets;
     k.nset = c0->nset;
-    if (lk_hello(&k, s, &m, err, sizeof err)) { // nbody checked above: a hello without functions
+    if (lk_hello(&k, s, &m, err, sizeof err)) { // nbody checked above: a hello without functions, a bad --mapping
         fprintf(stderr, "cranesim drive: %s\n", err);
+        if (k.bad_mapping) code = EXIT_USAGE;
         goto done_sc;
     }
     cJSON_Delete(desc);

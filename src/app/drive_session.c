@@ -135,6 +135,8 @@ struct drive_session {
     int nchart;          // user-chosen strip-chart channels (0: the default set)
     int chart_col[8];    // their channels (index into chans)
     int chart_id[8];     // their render chart ids
+    long chart_n[8];     // samples each has received (chart_push)
+    double chart_last[8]; // and the last one, SI
     int missed_window;   // missed ticks in the current second
     double missed_t0;
     drive_stats st;
@@ -152,8 +154,9 @@ struct drive_session {
     double mapbox_off;   // wall time [s] the mapping box hides by itself (DRIVE_MAPPING_S), < 0: M decides
     bool remote;
     bool remote_fed;              // a state has arrived
-    double remote_row[SIM_NCOL];  // its row (the server's channels, checked equal to the engine's)
+    double remote_row[PROTO_MAX_ROW]; // its row (the server's channels, checked equal to the engine's)
     int remote_nrow;
+    bool remote_mapped;           // the mapping is the server's functions' (drive_session_remote_functions)
     drive_remote_input rin;       // the operator's input of the last tick
     struct { char path[128]; double v; } rset[16]; // panel edits for the server (SET), oldest first
     int nrset;
@@ -996,20 +999,18 @@ int drive_opts_check(const app_common* c, const drive_opts* o, char* err, size_t
     return 0;
 }
 
-// The operator's mapping for the engine's functions (engine_nfunction, in
-// its order, so command k of input_poll is function k): the default layout
-// (the mapping file's "layout", else the model's, else two-lever), then the
-// model's "controls" section, then the --mapping file over it. 0, or -1 with
-// one line naming the file and field in err.
-static int build_mapping(const drive_session* s, input_mapping* map, char* err, size_t errsz) {
-    const int n = engine_nfunction(s->l);
+// The operator's mapping for the functions names[n] (in that order, so
+// command k of input_poll is function k): the default layout (the mapping
+// file's "layout", else the model's, else two-lever), then the model's
+// "controls" section (controls, or NULL) as far as names has its functions,
+// then the --mapping file over it. 0, or -1 with one line naming the file and
+// field in err. what names the crane for the "too many functions" message.
+static int build_mapping_for(const drive_session* s, const char* const* names, int n, const model_controls* controls,
+                             const char* what, input_mapping* map, char* err, size_t errsz) {
     if (n > INPUT_MAX_FN) {
-        snprintf(err, errsz, "%s: %d functions; the drive's input mapping takes at most %d", s->m->file, n,
-                 INPUT_MAX_FN);
+        snprintf(err, errsz, "%s: %d functions; the drive's input mapping takes at most %d", what, n, INPUT_MAX_FN);
         return -1;
     }
-    const char* names[INPUT_MAX_FN];
-    for (int k = 0; k < n; ++k) names[k] = engine_function_name(s->l, k);
     model_controls* fc = NULL;
     int rc = 0;
     if (s->o.mapping_file) {
@@ -1017,20 +1018,24 @@ static int build_mapping(const drive_session* s, input_mapping* map, char* err, 
         rc = !fc || controls_load_file(s->o.mapping_file, fc, err, errsz);
         if (!fc) snprintf(err, errsz, "%s: out of memory", s->o.mapping_file);
     }
-    // The model's section, as far as this engine has its functions: the
-    // loader checked its names against the model's, and a slewing chain's
-    // "slew" has no function in a world without a slew drive (validation).
+    // The model's section, as far as names has its functions: the loader
+    // checked its names against the model's, and a slewing chain's "slew" has
+    // no function in a world without a slew drive (validation).
     model_controls* mc = NULL;
-    if (!rc && s->m->controls) {
+    if (!rc && controls) {
         mc = malloc(sizeof *mc);
         if (!mc) {
             snprintf(err, errsz, "%s: out of memory", s->m->file);
             rc = -1;
         } else {
-            *mc = *s->m->controls;
+            *mc = *controls;
             int keep = 0;
             for (int i = 0; i < mc->nfn; ++i)
-                if (engine_find_function(s->l, mc->fn[i].function) >= 0) mc->fn[keep++] = mc->fn[i];
+                for (int k = 0; k < n; ++k)
+                    if (!strcmp(names[k], mc->fn[i].function)) {
+                        mc->fn[keep++] = mc->fn[i];
+                        break;
+                    }
             mc->nfn = keep;
         }
     }
@@ -1043,12 +1048,21 @@ static int build_mapping(const drive_session* s, input_mapping* map, char* err, 
     return rc ? -1 : 0;
 }
 
+// The mapping for the engine's functions (engine_nfunction, in its order)
+// and the model's "controls".
+static int build_mapping(const drive_session* s, input_mapping* map, char* err, size_t errsz) {
+    const int n = engine_nfunction(s->l);
+    const char* names[INPUT_MAX_FN];
+    for (int k = 0; k < n && k < INPUT_MAX_FN; ++k) names[k] = engine_function_name(s->l, k);
+    return build_mapping_for(s, names, n, s->m->controls, s->m->file, map, err, errsz);
+}
+
 // The mapping into the input layer and the HUD's box (its text, heading).
-static void show_mapping(drive_session* s, const input_mapping* map) {
+// model_controls: the model's "controls" section is in it.
+static void show_mapping(drive_session* s, const input_mapping* map, bool model_controls) {
     char text[1536], title[96];
     input_mapping_text(map, text, sizeof text);
-    snprintf(title, sizeof title, "controls (%s%s) - M hides", map->layout,
-             s->m->controls ? ", the model's" : "");
+    snprintf(title, sizeof title, "controls (%s%s) - M hides", map->layout, model_controls ? ", the model's" : "");
     render_set_mapping(s->r, title, text);
 }
 
@@ -1168,6 +1182,7 @@ static void apply_chart_picks(drive_session* s) {
             n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", n ? "," : "", s->chart_pick[k]);
     render_charts_reset(s->r);
     s->nchart = 0;
+    memset(s->chart_n, 0, sizeof s->chart_n); // the slots' channels change
     s->chart_circuit = false;
     for (int i = 0; i < s->nreadout; ++i) // the readouts keep theirs
         if (s->readout_col[i] >= chan_list_nrow(s->chans)) s->chart_circuit = true;
@@ -1243,7 +1258,7 @@ static void load_model(drive_session* s) {
     char me[400];
     if (build_mapping(s, &map, me, sizeof me) == 0) {
         input_set_mapping(s->in, &map);
-        show_mapping(s, &map);
+        show_mapping(s, &map, s->m->controls != NULL);
     } else {
         fprintf(stderr, "cranesim drive: input mapping kept: %s\n", me);
     }
@@ -1404,7 +1419,10 @@ int drive_session_finish_record(drive_session* s, long* rows, char* err, size_t 
 // The world's row, on the session's clock.
 static void session_row(drive_session* s, double* row) {
     if (s->remote) {
-        memcpy(row, s->remote_row, sizeof s->remote_row);
+        // The local engine's ncol columns (the record's header, the buffer's
+        // size: size_buffers), from the server's row of the same channels; a
+        // column past the protocol's PROTO_MAX_ROW is not sent (NaN).
+        for (int k = 0; k < s->ncol; ++k) row[k] = k < PROTO_MAX_ROW ? s->remote_row[k] : NAN;
         return;
     }
     engine_row(s->l, row);
@@ -1552,7 +1570,7 @@ drive_session* drive_session_create(const app_common* c, const drive_opts* o, ch
     }
     s->in = input_create(&map);
     // The box for the first DRIVE_MAPPING_S of the drive (M toggles it).
-    show_mapping(s, &map);
+    show_mapping(s, &map, s->m->controls != NULL);
     render_show_mapping(s->r, true);
     s->mapbox_off = DRIVE_MAPPING_S;
     snprintf(s->load_path, sizeof s->load_path, "%s", s->m->file);
@@ -1661,6 +1679,19 @@ static void render_snapshot(drive_session* s) {
     ++s->st.frames;
 }
 
+// One sample t [s], v (SI) into the session's chart i, counted.
+static void chart_push(drive_session* s, int i, double t, double v) {
+    render_chart_push(s->r, s->chart_id[i], t, v);
+    ++s->chart_n[i];
+    s->chart_last[i] = v;
+}
+
+long drive_session_chart_samples(const drive_session* s, int i, double* last) {
+    if (i < 0 || i >= s->nchart) return -1;
+    if (last) *last = s->chart_last[i];
+    return s->chart_n[i];
+}
+
 void drive_session_set_remote(drive_session* s) {
     s->remote = true; // the panel stays: its circuit edits go to the server (remote_param)
     // The state frames carry the row's channels, not the circuit's: say so
@@ -1734,7 +1765,9 @@ void drive_session_feed(drive_session* s, const proto_state* st, double rt_facto
     w->stab_margin = st->stab_margin;
     w->ncoll = 0;
     memset(s->remote_row, 0, sizeof s->remote_row);
-    s->remote_nrow = st->nrow < SIM_NCOL ? st->nrow : SIM_NCOL;
+    // A chain's row is longer than SIM_NCOL: every channel the frame carries
+    // (up to PROTO_MAX_ROW) reaches the charts, readouts and the record.
+    s->remote_nrow = st->nrow < PROTO_MAX_ROW ? st->nrow : PROTO_MAX_ROW;
     memcpy(s->remote_row, st->row, (size_t)s->remote_nrow * sizeof(double));
     s->remote_fed = true;
     s->st.sim_time = w->t;
@@ -1745,7 +1778,7 @@ void drive_session_feed(drive_session* s, const proto_state* st, double rt_facto
     if (s->nchart) {
         for (int i = 0; i < s->nchart; ++i)
             if (s->chart_col[i] >= 0 && s->chart_col[i] < s->remote_nrow)
-                render_chart_push(s->r, s->chart_id[i], w->t, s->remote_row[s->chart_col[i]]);
+                chart_push(s, i, w->t, s->remote_row[s->chart_col[i]]);
     } else {
         render_charts_sample(s->r, w);
     }
@@ -1754,6 +1787,30 @@ void drive_session_feed(drive_session* s, const proto_state* st, double rt_facto
             const int k = s->readout_col[i];
             s->chan_v[k >= 0 ? k : 0] = k >= 0 && k < s->remote_nrow ? s->remote_row[k] : NAN;
         }
+}
+
+// drive_remote_input holds every function a mapping can drive, by its name.
+_Static_assert(INPUT_MAX_FN <= (int)(sizeof((drive_remote_input*)0)->u / sizeof(double)), "drive_remote_input.u");
+_Static_assert(sizeof((drive_remote_input*)0)->name[0] >= sizeof((input_axis_map*)0)->name, "drive_remote_input.name");
+
+int drive_session_remote_functions(drive_session* s, const char* const* names, int n, bool model_controls,
+                                   char* err, size_t errsz) {
+    const input_mapping* cur = input_get_mapping(s->in);
+    bool same = s->remote_mapped && cur->naxis == n;
+    for (int k = 0; same && k < n; ++k) same = !strcmp(cur->axis[k].name, names[k]);
+    if (same) return 0; // a reconnection: held keys and ramps go on
+    input_mapping map;
+    char e[400];
+    if (build_mapping_for(s, names, n, model_controls ? s->m->controls : NULL, "the server's crane", &map, e,
+                          sizeof e)) {
+        snprintf(err, errsz, "input mapping for the server's functions: %s", e);
+        return -1;
+    }
+    input_set_mapping(s->in, &map);
+    show_mapping(s, &map, model_controls && s->m->controls);
+    s->remote_mapped = true;
+    s->rin.n = 0; // no command until the next tick reads the new mapping
+    return 0;
 }
 
 void drive_session_remote_input(drive_session* s, drive_remote_input* in) {
@@ -1910,7 +1967,14 @@ int drive_session_tick(drive_session* s, double wall) {
     if (s->remote) {
         // The sticks (or the script, which drive_connect plays at the remote
         // time) go to the server; nothing steps here.
-        s->rin.u[0] = cmd.lift, s->rin.u[1] = cmd.jib, s->rin.u[2] = cmd.slew;
+        // One command per function of the mapping (the server's functions
+        // once its hello came: drive_session_remote_functions), by name.
+        const input_mapping* im = input_get_mapping(s->in);
+        s->rin.n = cmd.n < im->naxis ? cmd.n : im->naxis;
+        for (int k = 0; k < s->rin.n; ++k) {
+            s->rin.u[k] = cmd.u[k];
+            snprintf(s->rin.name[k], sizeof s->rin.name[k], "%s", im->axis[k].name);
+        }
         if (cmd.hook_toggle) s->rin.hook = !s->snap->attached;
         ++s->st.input_samples;
     } else if (s->paused) {
@@ -2013,7 +2077,9 @@ int drive_session_tick(drive_session* s, double wall) {
         memcpy(s->chan_v, row, sizeof *row * (size_t)chan_list_nrow(s->chans));
         if (s->chart_circuit) chan_list_values(s->chans, s->l, s->chan_v, true);
     }
-    if (s->rec) record_row(s, row);
+    // A remote view records the server's states only: before the first one
+    // its row is all zeros (no crane has 0 Pa in a chamber at t = 0).
+    if (s->rec && (!s->remote || s->remote_fed)) record_row(s, row);
     if (frame) {
         char status[640];
         // Who drives: the scenario, a named device, or the keyboard alone.
@@ -2050,7 +2116,7 @@ int drive_session_tick(drive_session* s, double wall) {
             // drive_session_feed sampled the charts with every state
         } else if (s->nchart) {
             for (int i = 0; i < s->nchart; ++i)
-                if (s->chart_col[i] >= 0) render_chart_push(s->r, s->chart_id[i], row[COL_T], s->chan_v[s->chart_col[i]]);
+                if (s->chart_col[i] >= 0) chart_push(s, i, row[COL_T], s->chan_v[s->chart_col[i]]);
         } else
             render_charts_sample(s->r, s->snap);
         render_snapshot(s);

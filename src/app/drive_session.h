@@ -126,7 +126,12 @@ struct chan_list;
 /// The channels the session can chart (--charts names): the engine's
 /// columns, then its circuit's (channels.h).
 const struct chan_list* drive_session_channels(const drive_session* s);
-/// The row (CSV columns) at the current simulated time.
+/// The samples the i-th --charts channel has received since the charts were
+/// last chosen (a remote view: one per state frame that carries its
+/// channel), the last one (SI) into *last (may be NULL); -1: no such chart.
+long drive_session_chart_samples(const drive_session* s, int i, double* last);
+/// The row (CSV columns) at the current simulated time: the engine's ncol
+/// columns (remote mode: the server's values of them).
 void drive_session_row(drive_session* s, double* row);
 
 struct proto_state;
@@ -149,17 +154,31 @@ void drive_session_set_answer(drive_session* s, const char* text);
 /// One state frame (protocol.h): poses, cylinders, rope and HUD values into
 /// the snapshot the next frame draws, and one sample for the charts.
 /// rt_factor: the remote simulated time over wall time, 0 unknown.
-/// demand: the valve commands this drive last sent as the server's
-/// controller (the operator's demand the HUD shows beside a command the
-/// server's limiter cut), or NULL (watching: not known here).
+/// demand: per cylinder of the picture, the opening this drive last sent
+/// to its function as the server's controller (the operator's demand the HUD
+/// shows beside a command the server's limiter cut; NaN: none), or NULL
+/// (watching: not known here).
 void drive_session_feed(drive_session* s, const struct proto_state* st, double rt_factor, const double* demand);
-/// The operator's input of the last tick, remote mode: stick positions
-/// u[3] in [-1, 1] and the requests (each -1: none): hook (0 release, 1
-/// attach), pause (toggle: 1), reset (1).
+/// The operator's input of the last tick, remote mode: n commands in [-1,
+/// 1], command k for the function name[k] (the mapping's: the server's
+/// functions once drive_session_remote_functions took them), and the
+/// requests (each -1: none): hook (0 release, 1 attach), pause (toggle: 1),
+/// reset (1).
 typedef struct drive_remote_input {
-    double u[3];
+    int n;
+    double u[16];       // INPUT_MAX_FN (input.h) at most
+    char name[16][32];  // the function of each (input_axis_map.name)
     int hook, pause, reset;
 } drive_remote_input;
+/// Remote mode: map the operator's sticks and keys to the server's functions
+/// names[n] (its hello, VALVES' order) by name: the default layout, the
+/// model's "controls" when model_controls (the local model is the server's
+/// file), then --mapping. A list equal to the one mapped keeps the mapping
+/// (a reconnection to the same server). 0, or -1 with one line in err (more
+/// functions than the mapping takes, a mapping file naming a function the
+/// server does not have); the mapping in use is kept then.
+int drive_session_remote_functions(drive_session* s, const char* const* names, int n, bool model_controls,
+                                   char* err, size_t errsz);
 void drive_session_remote_input(drive_session* s, drive_remote_input* in);
 /// The link's HUD line and, when the link is down, its warning (NULL: up).
 void drive_session_set_link(drive_session* s, const char* text, const char* down);
