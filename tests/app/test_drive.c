@@ -6,6 +6,7 @@
 #include "input.h"
 #include "panel.h"
 #include "render.h"
+#include "drive_test_util.h"
 
 #include <SDL2/SDL.h>
 #include <errno.h>
@@ -251,29 +252,10 @@ static void test_record_write_failure(void) {
 }
 
 // Run the loop for `seconds` of virtual wall time at 240 ticks per second.
-static int run_for(drive_session* s, double* wall, double seconds) {
-    int rc = 0;
-    for (double end = *wall + seconds; *wall < end && rc == 0;) {
-        *wall += 1.0 / 240.0;
-        rc = drive_session_tick(s, *wall);
-    }
-    return rc;
-}
-
 static double lift_stroke(drive_session* s) {
     double row[SIM_NCOL];
     drive_session_row(s, row);
     return row[COL_X1];
-}
-
-static void push_key(SDL_Scancode sc, int down) {
-    SDL_Event ev;
-    memset(&ev, 0, sizeof ev);
-    ev.type = down ? SDL_KEYDOWN : SDL_KEYUP;
-    ev.key.state = down ? SDL_PRESSED : SDL_RELEASED;
-    ev.key.keysym.scancode = sc;
-    ev.key.keysym.sym = SDL_GetKeyFromScancode(sc);
-    SDL_PushEvent(&ev);
 }
 
 // Count bar pixels that are not the empty-bar colour.
@@ -361,14 +343,7 @@ static void test_joystick_and_keyboard_drive_the_lift(void) {
     int bar0 = bar_fill(s, 0, 0);
     double x0 = lift_stroke(s);
 
-    SDL_VirtualJoystickDesc d;
-    memset(&d, 0, sizeof d);
-    d.version = SDL_VIRTUAL_JOYSTICK_DESC_VERSION;
-    d.type = SDL_JOYSTICK_TYPE_GAMECONTROLLER;
-    d.naxes = 6;
-    d.nbuttons = 15;
-    d.name = "cranesim test stick";
-    int idx = SDL_JoystickAttachVirtualEx(&d);
+    int idx = attach_pad("cranesim test stick");
     CHECK(idx >= 0, "attach virtual joystick: %s", SDL_GetError());
     SDL_Joystick* js = SDL_JoystickOpen(idx);
     run_for(s, &wall, 0.2); // hot-plug event reaches the input layer

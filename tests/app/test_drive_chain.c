@@ -9,6 +9,7 @@
 #include "drive_session.h"
 #include "panel.h"
 #include "render.h"
+#include "drive_test_util.h"
 
 #include <SDL2/SDL.h>
 #include <math.h>
@@ -41,15 +42,6 @@ static drive_session* open_ok(const char* model, const char* charts, const char*
     drive_session* s = open_chain(model, NULL, charts, record, err, sizeof err);
     CHECK(s != NULL, "session on %s: %s", model, err);
     return s;
-}
-
-static int run_for(drive_session* s, double* wall, double seconds) {
-    int rc = 0;
-    for (double end = *wall + seconds; *wall < end && rc == 0;) {
-        *wall += 1.0 / 240.0;
-        rc = drive_session_tick(s, *wall);
-    }
-    return rc;
 }
 
 static bool disjoint(const int a[4], const int b[4]) {
@@ -389,16 +381,6 @@ static void test_load_chain_in_panel(void) {
           "back: %d charts, first %s", render_chart_count(r), render_chart_label(r, 0));
     drive_session_destroy(s);
     remove(rec);
-}
-
-static void push_key(SDL_Scancode sc, int down) {
-    SDL_Event ev;
-    memset(&ev, 0, sizeof ev);
-    ev.type = down ? SDL_KEYDOWN : SDL_KEYUP;
-    ev.key.state = down ? SDL_PRESSED : SDL_RELEASED;
-    ev.key.keysym.scancode = sc;
-    ev.key.keysym.sym = SDL_GetKeyFromScancode(sc);
-    SDL_PushEvent(&ev);
 }
 
 // The value of channel name in the session's row now.

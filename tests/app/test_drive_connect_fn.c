@@ -20,6 +20,7 @@
 #include "drive_connect.h"
 #include "drive_session.h"
 #include "serve_util.h"
+#include "drive_test_util.h"
 
 #include <SDL2/SDL.h>
 #include <math.h>
@@ -88,14 +89,7 @@ static void window_sends_every_function(void) {
     served sv = {0};
     CHECK(serve_start(&sv, "test_drive_connect_fn_serve.log", args) == 0, "server started on the 6-function chain");
     if (!sv.port) return;
-    SDL_VirtualJoystickDesc d;
-    memset(&d, 0, sizeof d);
-    d.version = SDL_VIRTUAL_JOYSTICK_DESC_VERSION;
-    d.type = (Uint16)SDL_JOYSTICK_TYPE_GAMECONTROLLER;
-    d.naxes = SDL_CONTROLLER_AXIS_MAX;
-    d.nbuttons = SDL_CONTROLLER_BUTTON_MAX;
-    d.name = "cranesim connect pad";
-    const int idx = SDL_JoystickAttachVirtualEx(&d);
+    const int idx = attach_pad("cranesim connect pad");
     CHECK(idx >= 0, "attach: %s", SDL_GetError());
     SDL_Joystick* js = idx >= 0 ? SDL_JoystickOpen(idx) : NULL;
     // The triggers' rest is the axis' bottom on SDL's virtual controller.

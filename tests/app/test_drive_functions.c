@@ -7,6 +7,7 @@
 #include "drive_session.h"
 #include "input.h"
 #include "render.h"
+#include "drive_test_util.h"
 
 #include <SDL2/SDL.h>
 #include <math.h>
@@ -27,36 +28,6 @@ static drive_session* open_with(const char* model, const char* mapping, char* er
     o.height = 540;
     o.mapping_file = mapping;
     return drive_session_create(&c, &o, err, errsz, code);
-}
-
-static int run_for(drive_session* s, double* wall, double seconds) {
-    int rc = 0;
-    for (double end = *wall + seconds; *wall < end && rc == 0;) {
-        *wall += 1.0 / 240.0;
-        rc = drive_session_tick(s, *wall);
-    }
-    return rc;
-}
-
-static void push_key(SDL_Scancode sc, int down) {
-    SDL_Event ev;
-    memset(&ev, 0, sizeof ev);
-    ev.type = down ? SDL_KEYDOWN : SDL_KEYUP;
-    ev.key.state = down ? SDL_PRESSED : SDL_RELEASED;
-    ev.key.keysym.scancode = sc;
-    ev.key.keysym.sym = SDL_GetKeyFromScancode(sc);
-    SDL_PushEvent(&ev);
-}
-
-static int attach_pad(void) {
-    SDL_VirtualJoystickDesc d;
-    memset(&d, 0, sizeof d);
-    d.version = SDL_VIRTUAL_JOYSTICK_DESC_VERSION;
-    d.type = (Uint16)SDL_JOYSTICK_TYPE_GAMECONTROLLER;
-    d.naxes = SDL_CONTROLLER_AXIS_MAX;
-    d.nbuttons = SDL_CONTROLLER_BUTTON_MAX;
-    d.name = "cranesim function pad";
-    return SDL_JoystickAttachVirtualEx(&d);
 }
 
 // One function's controller input at full + deflection (on) or at rest.
@@ -83,7 +54,7 @@ static void drive_each_function(drive_session* s, double* wall, int nwant) {
     for (int k = 0; k < n; ++k)
         CHECK(!strcmp(m->axis[k].name, engine_function_name(e, k)), "mapping %d is %s, engine's %s",
               k, m->axis[k].name, engine_function_name(e, k));
-    const int idx = attach_pad();
+    const int idx = attach_pad("cranesim function pad");
     CHECK(idx >= 0, "attach: %s", SDL_GetError());
     if (idx < 0) return;
     SDL_Joystick* js = SDL_JoystickOpen(idx);

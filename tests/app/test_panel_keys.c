@@ -9,6 +9,7 @@
 #include "drive_session.h"
 #include "panel.h"
 #include "render.h"
+#include "drive_test_util.h"
 
 #include <SDL2/SDL.h>
 #include <math.h>
@@ -45,16 +46,6 @@ static int ticks(drive_session* s, double* wall, int n) {
     int rc = 0;
     for (int i = 0; i < n && rc == 0; ++i) rc = tick_and_draw(s, wall);
     return rc;
-}
-
-static void push_key(SDL_Scancode sc, int down) {
-    SDL_Event ev;
-    memset(&ev, 0, sizeof ev);
-    ev.type = down ? SDL_KEYDOWN : SDL_KEYUP;
-    ev.key.state = down ? SDL_PRESSED : SDL_RELEASED;
-    ev.key.keysym.scancode = sc;
-    ev.key.keysym.sym = SDL_GetKeyFromScancode(sc);
-    SDL_PushEvent(&ev);
 }
 
 // A key pressed on one tick and released on the next: the result of both.

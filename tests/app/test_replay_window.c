@@ -8,6 +8,7 @@
 #include "check.h"
 #include "drive_session.h"
 #include "render.h"
+#include "drive_test_util.h"
 
 #include <SDL2/SDL.h>
 #include <stdlib.h>
@@ -23,25 +24,6 @@ static long read_file(const char* path, char* buf, size_t n) {
     buf[got] = 0;
     fclose(f);
     return (long)got;
-}
-
-static int run_for(drive_session* s, double* wall, double seconds) {
-    int rc = 0;
-    for (double end = *wall + seconds; *wall < end && rc == 0;) {
-        *wall += 1.0 / 240.0;
-        rc = drive_session_tick(s, *wall);
-    }
-    return rc;
-}
-
-static void push_key(SDL_Scancode sc, int down) {
-    SDL_Event ev;
-    memset(&ev, 0, sizeof ev);
-    ev.type = down ? SDL_KEYDOWN : SDL_KEYUP;
-    ev.key.state = down ? SDL_PRESSED : SDL_RELEASED;
-    ev.key.keysym.scancode = sc;
-    ev.key.keysym.sym = SDL_GetKeyFromScancode(sc);
-    SDL_PushEvent(&ev);
 }
 
 #define MODEL6 CRANESIM_ASSETS "/../tests/world/data/chain_6fn_controls.json"
@@ -71,14 +53,7 @@ static void record_in_the_window(void) {
     drive_session* s = open_window("rw_rec.csv", "rw.session", NULL);
     if (!s) return;
     double wall = 0;
-    SDL_VirtualJoystickDesc d;
-    memset(&d, 0, sizeof d);
-    d.version = SDL_VIRTUAL_JOYSTICK_DESC_VERSION;
-    d.type = SDL_JOYSTICK_TYPE_GAMECONTROLLER;
-    d.naxes = 6;
-    d.nbuttons = 15;
-    d.name = "cranesim replay stick";
-    int idx = SDL_JoystickAttachVirtualEx(&d);
+    int idx = attach_pad("cranesim replay stick");
     CHECK(idx >= 0, "attach virtual joystick: %s", SDL_GetError());
     SDL_Joystick* js = SDL_JoystickOpen(idx);
     run_for(s, &wall, 0.2);
@@ -110,14 +85,7 @@ static void record_chain_in_the_window(void) {
     drive_session* s = open_window("rw_rec.csv", "rw.session", NULL);
     if (!s) return;
     double wall = 0;
-    SDL_VirtualJoystickDesc d;
-    memset(&d, 0, sizeof d);
-    d.version = SDL_VIRTUAL_JOYSTICK_DESC_VERSION;
-    d.type = SDL_JOYSTICK_TYPE_GAMECONTROLLER;
-    d.naxes = 6;
-    d.nbuttons = 15;
-    d.name = "cranesim replay stick";
-    int idx = SDL_JoystickAttachVirtualEx(&d);
+    int idx = attach_pad("cranesim replay stick");
     CHECK(idx >= 0, "attach virtual joystick: %s", SDL_GetError());
     SDL_Joystick* js = SDL_JoystickOpen(idx);
     run_for(s, &wall, 0.2);
