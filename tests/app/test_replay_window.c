@@ -49,6 +49,19 @@ static drive_session* open_window(const char* record, const char* session_path, 
     return s;
 }
 
+// The hook key pressed and released, `after` s more of driving, then the
+// record and the session closed (both recordings end this way).
+static void hook_and_finish(drive_session* s, double* wall, double after) {
+    push_key(SDL_SCANCODE_H, 1);
+    run_for(s, wall, 0.05);
+    push_key(SDL_SCANCODE_H, 0);
+    CHECK(run_for(s, wall, after) == 0, "loop: %s", drive_session_error(s));
+    long rows = 0;
+    char err[400];
+    CHECK(drive_session_finish_record(s, &rows, err, sizeof err) == 0 && rows > 100, "record: %ld rows %s", rows, err);
+    drive_session_destroy(s); // closes the session file
+}
+
 static void record_in_the_window(void) {
     drive_session* s = open_window("rw_rec.csv", "rw.session", NULL);
     if (!s) return;
@@ -68,14 +81,7 @@ static void record_in_the_window(void) {
     push_key(SDL_SCANCODE_W, 1);
     run_for(s, &wall, 0.5);
     push_key(SDL_SCANCODE_W, 0);
-    push_key(SDL_SCANCODE_H, 1);
-    run_for(s, &wall, 0.05);
-    push_key(SDL_SCANCODE_H, 0);
-    CHECK(run_for(s, &wall, 0.4) == 0, "loop: %s", drive_session_error(s));
-    long rows = 0;
-    char err[400];
-    CHECK(drive_session_finish_record(s, &rows, err, sizeof err) == 0 && rows > 100, "record: %ld rows %s", rows, err);
-    drive_session_destroy(s); // closes the session file
+    hook_and_finish(s, &wall, 0.4);
 }
 
 // The chain: the pad's sticks and d-pad (the six-function model's controls:
@@ -101,15 +107,8 @@ static void record_chain_in_the_window(void) {
     SDL_JoystickSetVirtualButton(js, SDL_CONTROLLER_BUTTON_DPAD_UP, 0);
     SDL_JoystickClose(js);
     SDL_JoystickDetachVirtual(idx);
-    push_key(SDL_SCANCODE_H, 1);
-    run_for(s, &wall, 0.05);
-    push_key(SDL_SCANCODE_H, 0);
-    CHECK(run_for(s, &wall, 0.3) == 0, "loop: %s", drive_session_error(s));
-    long rows = 0;
-    char err[400];
-    CHECK(drive_session_finish_record(s, &rows, err, sizeof err) == 0 && rows > 100, "record: %ld rows %s", rows, err);
-    drive_session_destroy(s);
-    // The session names the six functions and its ticks move more than one.
+    hook_and_finish(s, &wall, 0.3);
+    // The session names the functions (ext2 among them).
     long n = read_file("rw.session", a, sizeof a);
     CHECK(n > 0 && strstr(a, "\"functions\":[") && strstr(a, "\"ext2\""), "session header: %.300s", a);
 }
